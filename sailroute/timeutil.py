@@ -1,0 +1,71 @@
+"""Time handling: timezone-aware at the edges, POSIX seconds (UTC) inside.
+
+Internally every time is a ``float`` number of seconds since
+1970-01-01T00:00:00Z ("epoch seconds"), so wind sampling and routing can use
+plain float64 arrays.  Timestamps read from files must carry an offset or ``Z``;
+naive timestamps are rejected with an :class:`~sailroute.errors.InputError`.
+"""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+
+from sailroute.errors import InputError
+
+
+def parse_time(text: str | datetime, where: str = "time") -> datetime:
+    """Parse an ISO 8601 timestamp that carries a UTC offset.
+
+    Parameters
+    ----------
+    text : str or datetime
+        E.g. ``"2018-04-24T12:10:00+02:00"`` or ``"2018-04-24T10:10:00Z"``.
+    where : str
+        Where the value came from (file, key or line) for error messages.
+
+    Returns
+    -------
+    datetime
+        Timezone-aware, converted to UTC.
+
+    Raises
+    ------
+    InputError
+        If the text is not ISO 8601 or has no offset.
+    """
+    if isinstance(text, datetime):
+        dt = text
+    else:
+        s = str(text).strip()
+        if s.endswith(("Z", "z")):
+            s = s[:-1] + "+00:00"
+        try:
+            dt = datetime.fromisoformat(s)
+        except ValueError:
+            raise InputError(
+                f"{where}: cannot read {text!r} as an ISO 8601 time; "
+                "expected e.g. '2018-04-24T12:10:00+02:00'"
+            ) from None
+    if dt.tzinfo is None or dt.utcoffset() is None:
+        raise InputError(
+            f"{where}: time {text!r} has no UTC offset; add one, e.g. "
+            f"'{dt.isoformat()}+00:00' or '{dt.isoformat()}Z'"
+        )
+    return dt.astimezone(UTC)
+
+
+def to_epoch(dt: datetime) -> float:
+    """Epoch seconds [s] of an aware datetime."""
+    if dt.tzinfo is None:
+        raise InputError(f"time {dt.isoformat()} has no UTC offset")
+    return dt.timestamp()
+
+
+def from_epoch(t: float) -> datetime:
+    """Aware UTC datetime of epoch seconds ``t`` [s]."""
+    return datetime.fromtimestamp(float(t), tz=UTC)
+
+
+def iso(t: float) -> str:
+    """ISO 8601 UTC string (``...Z``, millisecond precision) of epoch seconds ``t``."""
+    return from_epoch(t).isoformat(timespec="milliseconds").replace("+00:00", "Z")

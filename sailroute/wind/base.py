@@ -1,0 +1,161 @@
+"""The one contract every wind source implements: :class:`WindField`.
+
+A wind field maps arrays of ``(t, x, y)`` to arrays ``(u, v)``:
+
+* ``t`` epoch seconds [s] (UTC), ``x``/``y`` metres east/north in the course's
+  :class:`~sailroute.geo.LocalFrame`;
+* ``u``/``v`` eastward/northward air velocity [m s⁻¹] (direction the air moves
+  TO; use :func:`sailroute.units.wind_speed_direction` for speed and FROM-direction);
+* inputs broadcast against each other (numpy rules); outputs have the
+  broadcast shape and dtype float64;
+* sampling outside :attr:`WindField.coverage` raises
+  :class:`~sailroute.errors.OutOfCoverageError` naming both ranges, unless the
+  field was built with ``clamp=True`` (then points are clamped to the edges).
+
+``tests/wind/test_field_contract.py`` runs the same checks on every implementation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sailroute.errors import OutOfCoverageError
+from sailroute.timeutil import iso
+
+
+@dataclass(frozen=True)
+class Coverage:
+    """Where and when a wind field is defined.
+
+    Attributes
+    ----------
+    t0, t1 : float
+        Time span [epoch s]; ``-inf``/``inf`` for time-independent fields.
+    xmin, xmax, ymin, ymax : float
+        Bounding box in the local frame [m]; infinite for uniform fields.
+    """
+
+    t0: float
+    t1: float
+    xmin: float
+    xmax: float
+    ymin: float
+    ymax: float
+
+    @classmethod
+    def everywhere(cls) -> Coverage:
+        """Unbounded coverage (uniform, time-independent wind)."""
+        inf = float("inf")
+        return cls(-inf, inf, -inf, inf, -inf, inf)
+
+    def describe(self) -> str:
+        """Human-readable description used in error messages."""
+        return f"time {_fmt_t(self.t0)} .. {_fmt_t(self.t1)}, " + (
+            f"x {self.xmin:.0f} .. {self.xmax:.0f} m, y {self.ymin:.0f} .. {self.ymax:.0f} m"
+        )
+
+    def contains(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
+        """Boolean mask of points inside the coverage (edges included)."""
+        t = np.asarray(t, dtype=float)
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        return (
+            (t >= self.t0)
+            & (t <= self.t1)
+            & (x >= self.xmin)
+            & (x <= self.xmax)
+            & (y >= self.ymin)
+            & (y <= self.ymax)
+        )
+
+
+def _fmt_t(t: float) -> str:
+    return str(t) if not np.isfinite(t) else iso(t)
+
+
+@runtime_checkable
+class WindField(Protocol):
+    """Protocol of all wind sources (see module docstring for the contract)."""
+
+    @property
+    def coverage(self) -> Coverage:
+        """Time span and bounding box where :meth:`sample` is defined."""
+        ...
+
+    def sample(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Wind ``(u, v)`` [m s⁻¹] at epoch times ``t`` [s] and local positions ``x, y`` [m]."""
+        ...
+
+
+def prepare_points(
+    coverage: Coverage,
+    t: ArrayLike,
+    x: ArrayLike,
+    y: ArrayLike,
+    *,
+    clamp: bool,
+    name: str = "wind field",
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Broadcast sample points and enforce coverage.
+
+    Parameters
+    ----------
+    coverage : Coverage
+        The field's coverage.
+    t, x, y : array_like
+        Requested points [epoch s, m, m].
+    clamp : bool
+        If True, clip points to the coverage instead of raising.
+    name : str
+        Field name for the error message.
+
+    Returns
+    -------
+    t, x, y : ndarray
+        Broadcast float64 arrays (clamped if requested).
+
+    Raises
+    ------
+    OutOfCoverageError
+        If any point lies outside and ``clamp`` is False.  The message gives the
+        requested range, the covered range and how to opt in to clamping.
+    """
+    t, x, y = np.broadcast_arrays(
+        np.asarray(t, dtype=float), np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    )
+    c = coverage
+    if clamp:
+        return (
+            np.clip(t, c.t0, c.t1),
+            np.clip(x, c.xmin, c.xmax),
+            np.clip(y, c.ymin, c.ymax),
+        )
+    if t.size and not (
+        t.min() >= c.t0
+        and t.max() <= c.t1
+        and x.min() >= c.xmin
+        and x.max() <= c.xmax
+        and y.min() >= c.ymin
+        and y.max() <= c.ymax
+    ):
+        bad = ~c.contains(t, x, y)
+        if np.isnan(t).any() or np.isnan(x).any() or np.isnan(y).any():
+            raise OutOfCoverageError(f"{name}: sample points contain NaN")
+        requested = Coverage(
+            float(t.min()), float(t.max()), float(x.min()), float(x.max()),
+            float(y.min()), float(y.max()),
+        )
+        raise OutOfCoverageError(
+            f"{name}: {int(bad.sum())} of {bad.size} sample points lie outside the data.\n"
+            f"  requested: {requested.describe()}\n"
+            f"  covered:   {c.describe()}\n"
+            "  Use wind data that covers the course and race time, or opt in to "
+            "clamping at the edges (`clamp: true` in the wind spec)."
+        )
+    return t, x, y
