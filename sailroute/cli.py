@@ -66,6 +66,102 @@ def run_guarded(fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
 # Each command parses options and delegates to the package API.  Keep logic out.
 
 
+@app.command("vpp")
+def vpp_command(
+    boat: Annotated[
+        str | None,
+        typer.Argument(help="Boat YAML (class, crew_mass_kg, parameter overrides); "
+                       "default: the shipped ILCA 7."),
+    ] = None,
+    crew_mass: Annotated[
+        float | None, typer.Option("--crew-mass", help="Sailor mass in kg (overrides the file).")
+    ] = None,
+    tws: Annotated[
+        str | None,
+        typer.Option("--tws", help="Comma-separated TWS list in --unit, e.g. '4,6,8,10'."),
+    ] = None,
+    twa_step: Annotated[float, typer.Option("--twa-step", help="TWA row step in degrees.")] = 5.0,
+    out: Annotated[str, typer.Option("--out", help="Output folder.")] = "vpp-out",
+    unit: Annotated[str, typer.Option("--unit", help="Speed unit: kn or m/s.")] = "kn",
+) -> None:
+    """Run the Laser/ILCA VPP: print the polar and best VMG, write .pol/.csv/.json/.png."""
+    from sailroute.boat.vpp_outputs import run_vpp_command
+
+    res = run_guarded(
+        run_vpp_command, boat, crew_mass_kg=crew_mass, tws=tws, twa_step_deg=twa_step,
+        out_dir=out, unit=unit,
+    )
+    typer.echo(res.report)
+    typer.echo("")
+    for kind, path in res.files.items():
+        typer.echo(f"wrote {kind}: {path}")
+
+
+@app.command("strategy")
+def strategy_command(
+    tws_kn: Annotated[float, typer.Option("--tws-kn", help="Wind speed, kn.")] = 10.0,
+    polar: Annotated[
+        str, typer.Option("--polar", help="builtin:ilca7 | builtin:ilca6 | builtin:ilca4 | PATH.")
+    ] = "builtin:ilca7",
+    length_m: Annotated[float, typer.Option("--length-m", help="Beat length, m.")] = 1600.0,
+    half_width_m: Annotated[
+        float, typer.Option("--half-width-m", help="Course half-width, m.")
+    ] = 800.0,
+    sigma_deg: Annotated[
+        float, typer.Option("--sigma-deg", help="Standard deviation of the wind direction, deg.")
+    ] = 10.0,
+    timescale_min: Annotated[
+        float, typer.Option("--timescale-min", help="Time scale (e-folding) of the shifts, min.")
+    ] = 10.0,
+    drift_deg_per_min: Annotated[
+        float,
+        typer.Option("--drift-deg-per-min", help="Persistent shift for the deadline "
+                     "objective, deg/min (+ veers)."),
+    ] = 0.0,
+    fit_from: Annotated[
+        str | None,
+        typer.Option("--fit-from", help="Station CSV: fit sigma and time scale from it."),
+    ] = None,
+    fit_station: Annotated[
+        str | None, typer.Option("--fit-station", help="Station id in --fit-from.")
+    ] = None,
+    fit_timezone: Annotated[
+        str | None,
+        typer.Option("--fit-timezone", help="UTC offset for naive times in --fit-from, "
+                     "e.g. +01:00."),
+    ] = None,
+    tack_penalty_s: Annotated[
+        float, typer.Option("--tack-penalty-s", help="Time lost per tack, s.")
+    ] = 5.0,
+    objective: Annotated[
+        str,
+        typer.Option("--objective", help="expected | deadline=SECONDS[,SECONDS...]"),
+    ] = "expected",
+    runs: Annotated[int, typer.Option("--runs", help="Monte Carlo runs per policy.")] = 4000,
+    seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 1,
+    start_tack: Annotated[
+        str, typer.Option("--start-tack", help="starboard | port.")
+    ] = "starboard",
+    out: Annotated[str, typer.Option("--out", help="Output folder.")] = "strategy-out",
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="JSON summary only.")] = False,
+) -> None:
+    """Tack strategy on an upwind leg under wind shifts: expected-time or deadline policies."""
+    from sailroute.strategy.api import run_strategy_command
+
+    res = run_guarded(
+        run_strategy_command,
+        polar_spec=polar, tws_kn=tws_kn, sigma_deg=sigma_deg, timescale_min=timescale_min,
+        drift_deg_per_min=drift_deg_per_min, fit_from=fit_from, fit_station=fit_station,
+        fit_timezone=fit_timezone, objective=objective, out_dir=out, plots=not no_plots,
+        progress=lambda msg: typer.echo(msg, err=True),
+        length_m=length_m, half_width_m=half_width_m, tack_penalty_s=tack_penalty_s,
+        runs=runs, seed=seed, start_tack=start_tack,
+    )
+    typer.echo(res.report)
+    for path in res.files:
+        typer.echo(f"wrote {path}")
+
+
 def main() -> None:
     """Console-script entry point."""
     try:

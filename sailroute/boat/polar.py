@@ -1,18 +1,61 @@
 """Boat performance polar: boat speed as a function of TWS and TWA.
 
 Conventions: TWS [m s⁻¹], TWA [°] (sign ignored, folded into ``[0, 180]``),
-boat speed [m s⁻¹].  See ``docs/nomenclature.md``.
+boat speed [m s⁻¹].  See ``docs/nomenclature.md`` and ``docs/design/boat.md``.
+
+Two interpolation methods are offered:
+
+``"pchip"`` (default, for routing)
+    A C¹ shape-preserving surface: monotone piecewise-cubic Hermite (PCHIP,
+    Fritsch-Carlson) along TWA in every TWS column, then PCHIP along TWS in
+    every row of the result.  PCHIP never overshoots the table (no spurious
+    maxima between nodes).  The surface is sampled once on a dense regular
+    grid (0.5° x ≈0.05 m s⁻¹) and lookups are bilinear on that grid with index
+    arithmetic, so a lookup costs a few array operations.
+``"linear"``
+    Plain bilinear interpolation on the table nodes, identical to OpenCPN's
+    ``Polar::Speed`` and libweatherrouting's ``get_speed`` inside the table.
+
+Edge semantics (both methods, documented in ``docs/design/boat.md``):
+
+* TWS below the lowest column tapers to 0 at TWS = 0 (a zero column is added
+  at TWS 0 when the table lacks one); TWS above the highest column is clamped
+  to that column; negative TWS counts as 0.
+* TWA below the first row tapers to 0 at TWA = 0 and TWA above the last row
+  tapers to 0 at TWA = 180 (zero rows are added where the table lacks them):
+  a table that omits angles says the boat does not sail there.
+* There is no hard no-go cut: inside the no-go zone the table's (low) speeds
+  are used.  Upwind, sailing closer than :meth:`Polar.vmg_upwind`'s angle is
+  never optimal, which is how the no-go zone shows up in routing.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError
-from sailroute.units import wrap180
+
+INTERPOLATIONS: Final = ("pchip", "linear")
+"""Valid values of :attr:`Polar.interpolation`."""
+
+DENSE_TWA_STEP_DEG: Final = 0.5
+"""TWA spacing of the dense lookup table of the ``"pchip"`` method [°]."""
+DENSE_TWS_STEP_MS: Final = 0.05
+"""Largest TWS spacing of the dense lookup table [m s⁻¹]."""
+_MAX_DENSE_TWS: Final = 2000
+
+_VMG_SEARCH_STEP_DEG: Final = 0.5
+_GOLDEN_ITERATIONS: Final = 64
+_INV_PHI: Final = (np.sqrt(5.0) - 1.0) / 2.0
+
+
+def fold_twa(twa_deg: ArrayLike) -> NDArray[np.float64]:
+    """Fold any signed angle [°] to ``|wrap180(twa)|`` in ``[0, 180]``."""
+    return 180.0 - np.abs(np.mod(np.asarray(twa_deg, dtype=float), 360.0) - 180.0)
 
 
 @dataclass(frozen=True, eq=False)
@@ -29,27 +72,27 @@ class Polar:
         Boat speed [m s⁻¹] at each (TWA, TWS) node.
     name : str
         Label (boat name or source file).
+    interpolation : {"pchip", "linear"}
+        ``"pchip"``: smooth monotone C¹ surface (default, for routing);
+        ``"linear"``: plain bilinear on the nodes (peer-tool compatible).
 
     Notes
     -----
-    Interpolation is bilinear in (TWA, TWS).  Outside the table:
-
-    * TWS below the lowest column tapers linearly to 0 at TWS = 0 (a boat does
-      not sail in no wind); above the highest column the last column is used
-      (clamp);
-    * TWA below the first row tapers linearly to 0 at TWA = 0 (head to wind);
-      above the last row the last row is used.
+    Outside the table: TWS below the lowest column tapers to 0 at TWS 0, above
+    the highest column it is clamped; TWA below the first row tapers to 0 at
+    TWA 0 and above the last row to 0 at TWA 180.  See the module docstring.
     """
 
     twa_deg: NDArray[np.float64]
     tws_ms: NDArray[np.float64]
     speed_ms: NDArray[np.float64]
     name: str = ""
+    interpolation: str = "pchip"
 
     def __post_init__(self) -> None:
-        twa = np.asarray(self.twa_deg, dtype=float)
-        tws = np.asarray(self.tws_ms, dtype=float)
-        spd = np.asarray(self.speed_ms, dtype=float)
+        twa = np.array(self.twa_deg, dtype=float)
+        tws = np.array(self.tws_ms, dtype=float)
+        spd = np.array(self.speed_ms, dtype=float)
         where = f"polar {self.name!r}" if self.name else "polar"
         if twa.ndim != 1 or tws.ndim != 1 or spd.shape != (twa.size, tws.size):
             raise InputError(
@@ -58,28 +101,85 @@ class Polar:
             )
         if twa.size < 2 or tws.size < 1:
             raise InputError(f"{where}: need at least 2 TWA rows and 1 TWS column")
-        if np.any(np.diff(twa) <= 0) or twa[0] < 0 or twa[-1] > 180:
+        if not np.all(np.isfinite(twa)) or np.any(np.diff(twa) <= 0) or twa[0] < 0 or twa[-1] > 180:
             raise InputError(f"{where}: TWA values must increase strictly within [0, 180]")
-        if np.any(np.diff(tws) <= 0) or tws[0] < 0:
+        if not np.all(np.isfinite(tws)) or np.any(np.diff(tws) <= 0) or tws[0] < 0:
             raise InputError(f"{where}: TWS values must increase strictly and be >= 0")
         if not np.all(np.isfinite(spd)) or np.any(spd < 0):
             raise InputError(f"{where}: boat speeds must be finite and >= 0")
+        if self.interpolation not in INTERPOLATIONS:
+            raise InputError(
+                f"{where}: interpolation must be one of {', '.join(map(repr, INTERPOLATIONS))}; "
+                f"got {self.interpolation!r}"
+            )
+        for arr in (twa, tws, spd):
+            arr.setflags(write=False)
         object.__setattr__(self, "twa_deg", twa)
         object.__setattr__(self, "tws_ms", tws)
         object.__setattr__(self, "speed_ms", spd)
 
+    # --- construction helpers -------------------------------------------------
+
+    def with_interpolation(self, interpolation: str) -> Polar:
+        """Same table with another interpolation method (a new :class:`Polar`)."""
+        return replace(self, interpolation=interpolation)
+
+    def with_name(self, name: str) -> Polar:
+        """Same table under another name (a new :class:`Polar`)."""
+        return replace(self, name=name)
+
+    # --- lookups ----------------------------------------------------------------
+
     def speed(self, tws_ms: ArrayLike, twa_deg: ArrayLike) -> NDArray[np.float64]:
-        """Boat speed [m s⁻¹] at TWS [m s⁻¹] and TWA [°] (any sign, broadcast)."""
+        """Boat speed [m s⁻¹] at TWS [m s⁻¹] and TWA [°].
+
+        Parameters
+        ----------
+        tws_ms : array_like
+            True wind speed [m s⁻¹]; negative values count as calm.
+        twa_deg : array_like
+            True wind angle [°], any sign and range (folded to ``[0, 180]``).
+            Broadcast against ``tws_ms``.
+
+        Returns
+        -------
+        ndarray
+            Boat speed [m s⁻¹], the broadcast shape of the inputs.  NaN inputs
+            give NaN.
+        """
+        if self.interpolation == "linear":
+            return self._speed_linear(tws_ms, twa_deg)
+        inv_twa, inv_tws, tws_max, n_twa, n_tws, cells = self._dense()
+        a = np.abs(np.asarray(twa_deg, dtype=float))
+        if np.any(a > 360.0):  # NaN-safe: NaN > 360 is False
+            a = np.mod(a, 360.0)
+        a = np.minimum(a, 360.0 - a) * inv_twa
+        w = np.clip(np.asarray(tws_ms, dtype=float), 0.0, tws_max) * inv_tws
+        with np.errstate(invalid="ignore"):
+            i = np.minimum(a.astype(np.intp), n_twa - 2)
+            j = np.minimum(w.astype(np.intp), n_tws - 2)
+        i = np.maximum(i, 0)
+        j = np.maximum(j, 0)
+        fa = a - i
+        fw = w - j
+        c = np.take(cells, i * (n_tws - 1) + j, axis=0)
+        lo = c[..., 0] + fw * (c[..., 1] - c[..., 0])
+        hi = c[..., 2] + fw * (c[..., 3] - c[..., 2])
+        return lo + fa * (hi - lo)
+
+    def _speed_linear(self, tws_ms: ArrayLike, twa_deg: ArrayLike) -> NDArray[np.float64]:
         tws = np.asarray(tws_ms, dtype=float)
-        a = np.abs(wrap180(twa_deg))
-        # extended axes with zero at TWA 0 and TWS 0 where the table does not start there
+        a = fold_twa(twa_deg)
         twa_ax, tws_ax, tab = self._extended()
-        i = np.clip(np.searchsorted(twa_ax, a, side="right") - 1, 0, twa_ax.size - 2)
-        fa = np.clip((a - twa_ax[i]) / (twa_ax[i + 1] - twa_ax[i]), 0.0, 1.0)
-        if tws_ax.size == 1:
-            return (1 - fa) * tab[i, 0] + fa * tab[i + 1, 0]
-        j = np.clip(np.searchsorted(tws_ax, tws, side="right") - 1, 0, tws_ax.size - 2)
-        fw = np.clip((tws - tws_ax[j]) / (tws_ax[j + 1] - tws_ax[j]), 0.0, 1.0)
+        with np.errstate(invalid="ignore"):
+            i = np.clip(np.searchsorted(twa_ax, a, side="right") - 1, 0, twa_ax.size - 2)
+            fa = np.clip((a - twa_ax[i]) / (twa_ax[i + 1] - twa_ax[i]), 0.0, 1.0)
+            if tws_ax.size == 1:
+                return (1 - fa) * tab[i, 0] + fa * tab[i + 1, 0] + 0.0 * tws
+            j = np.clip(np.searchsorted(tws_ax, tws, side="right") - 1, 0, tws_ax.size - 2)
+            fw = np.clip((tws - tws_ax[j]) / (tws_ax[j + 1] - tws_ax[j]), 0.0, 1.0)
+        fa = np.where(np.isnan(a), np.nan, fa)
+        fw = np.where(np.isnan(tws), np.nan, fw)
         return (
             (1 - fa) * (1 - fw) * tab[i, j]
             + fa * (1 - fw) * tab[i + 1, j]
@@ -88,6 +188,7 @@ class Polar:
         )
 
     def _extended(self) -> tuple[NDArray, NDArray, NDArray]:
+        """Table with the taper rows/column added (zero at TWA 0, TWA 180, TWS 0)."""
         cache = self.__dict__.get("_ext")
         if cache is not None:
             return cache
@@ -95,6 +196,9 @@ class Polar:
         if twa[0] > 0:
             twa = np.concatenate([[0.0], twa])
             tab = np.vstack([np.zeros((1, tab.shape[1])), tab])
+        if twa[-1] < 180:
+            twa = np.concatenate([twa, [180.0]])
+            tab = np.vstack([tab, np.zeros((1, tab.shape[1]))])
         if tws[0] > 0:
             tws = np.concatenate([[0.0], tws])
             tab = np.hstack([np.zeros((tab.shape[0], 1)), tab])
@@ -102,10 +206,119 @@ class Polar:
         object.__setattr__(self, "_ext", ext)
         return ext
 
+    def _dense(self) -> tuple[float, float, float, int, int, NDArray]:
+        """Dense regular PCHIP table (built once, cached)."""
+        cache = self.__dict__.get("_dense_cache")
+        if cache is not None:
+            return cache
+        from scipy.interpolate import PchipInterpolator
+
+        twa, tws, tab = self._extended()
+        n_twa = round(180.0 / DENSE_TWA_STEP_DEG) + 1
+        twa_d = np.linspace(0.0, 180.0, n_twa)
+        by_twa = PchipInterpolator(twa, tab, axis=0)(twa_d)
+        tws_max = float(tws[-1])
+        if tws.size == 1 or tws_max <= 0:
+            n_tws = 2
+            tws_max = max(tws_max, 1.0)
+            dense = np.repeat(by_twa[:, :1], 2, axis=1)
+        else:
+            n_tws = min(int(np.ceil(tws_max / DENSE_TWS_STEP_MS)), _MAX_DENSE_TWS) + 1
+            tws_d = np.linspace(0.0, tws_max, n_tws)
+            dense = PchipInterpolator(tws, by_twa, axis=1)(tws_d)
+        dense = np.where(dense > 1e-12, dense, 0.0)  # exact zeros at the taper rows
+        # corner values of every cell, contiguous: one gather per lookup
+        cells = np.stack(
+            [dense[:-1, :-1], dense[:-1, 1:], dense[1:, :-1], dense[1:, 1:]], axis=-1
+        ).reshape(-1, 4)
+        cells.setflags(write=False)
+        cache = (
+            (n_twa - 1) / 180.0,
+            (n_tws - 1) / tws_max,
+            tws_max,
+            n_twa,
+            n_tws,
+            cells,
+        )
+        object.__setattr__(self, "_dense_cache", cache)
+        return cache
+
+    # --- VMG --------------------------------------------------------------------
+
+    def vmg_upwind(self, tws_ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Best upwind VMG angle and VMG at each TWS.
+
+        Parameters
+        ----------
+        tws_ms : array_like
+            True wind speed [m s⁻¹].
+
+        Returns
+        -------
+        twa_deg, vmg_ms : ndarray
+            The TWA in ``[0, 90]`` [°] that maximises ``speed(tws, twa) cos(twa)``
+            and that maximum [m s⁻¹], same shape as ``tws_ms``.  The optimum
+            is continuous (not a table node): a 0.5° search brackets it and a
+            golden-section search refines it to ~1e-10°, so
+            ``vmg == speed(tws, twa) * cos(twa)`` exactly.  Where the polar
+            gives no positive VMG (calm) the angle is 0 and the VMG 0.
+        """
+        return self._vmg(tws_ms, upwind=True)
+
+    def vmg_downwind(self, tws_ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Best downwind VMG angle in ``[90, 180]`` [°] and VMG [m s⁻¹] (positive).
+
+        Same method as :meth:`vmg_upwind`, maximising ``-speed cos(twa)``.
+        Where the polar gives no positive VMG (calm) the angle is 180 and the
+        VMG 0.
+        """
+        return self._vmg(tws_ms, upwind=False)
+
+    def _vmg(self, tws_ms: ArrayLike, upwind: bool) -> tuple[NDArray, NDArray]:
+        tws_in = np.asarray(tws_ms, dtype=float)
+        tws = tws_in.reshape(-1)
+        sign = 1.0 if upwind else -1.0
+        lo_lim, hi_lim = (0.0, 90.0) if upwind else (90.0, 180.0)
+        grid = np.linspace(lo_lim, hi_lim, round(90.0 / _VMG_SEARCH_STEP_DEG) + 1)
+        cosg = np.cos(np.radians(grid))
+        vmg_grid = self.speed(tws[:, None], grid[None, :]) * (sign * cosg)[None, :]
+        k = np.argmax(vmg_grid, axis=1)
+        lo = grid[np.maximum(k - 1, 0)]
+        hi = grid[np.minimum(k + 1, grid.size - 1)]
+
+        def f(x: NDArray) -> NDArray:
+            return self.speed(tws, x) * (sign * np.cos(np.radians(x)))
+
+        c = hi - _INV_PHI * (hi - lo)
+        d = lo + _INV_PHI * (hi - lo)
+        fc, fd = f(c), f(d)
+        for _ in range(_GOLDEN_ITERATIONS):
+            left = fc >= fd  # keep [lo, d]
+            hi = np.where(left, d, hi)
+            lo = np.where(left, lo, c)
+            new = np.where(left, hi - _INV_PHI * (hi - lo), lo + _INV_PHI * (hi - lo))
+            fnew = f(new)
+            c, d, fc, fd = (
+                np.where(left, new, d),
+                np.where(left, c, new),
+                np.where(left, fnew, fd),
+                np.where(left, fc, fnew),
+            )
+        ang = 0.5 * (lo + hi)
+        val = f(ang)
+        best_grid = vmg_grid[np.arange(tws.size), k]
+        use_grid = best_grid > val
+        ang = np.where(use_grid, grid[k], ang)
+        val = np.where(use_grid, best_grid, val)
+        calm = ~(val > 0)
+        ang = np.where(calm, lo_lim if upwind else hi_lim, ang)
+        val = np.where(calm, 0.0, val)
+        return ang.reshape(tws_in.shape), val.reshape(tws_in.shape)
+
     def best_vmg(
         self, tws_ms: ArrayLike, upwind: bool = True, step_deg: float = 0.05
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Optimal VMG angle and VMG at each TWS, by dense search.
+        """Optimal VMG angle and VMG at each TWS (kept for compatibility).
 
         Parameters
         ----------
@@ -114,17 +327,20 @@ class Polar:
         upwind : bool
             Upwind (maximise ``bsp cos twa``) or downwind (maximise ``-bsp cos twa``).
         step_deg : float
-            Search resolution [°].
+            Ignored; the optimum is continuous (see :meth:`vmg_upwind`).
 
         Returns
         -------
         twa_deg, vmg_ms : ndarray
             Best angle [°] and the VMG [m s⁻¹] (positive) at that angle.
         """
-        tws = np.atleast_1d(np.asarray(tws_ms, dtype=float))
-        angles = np.arange(0.0, 180.0 + step_deg / 2, step_deg)
-        sp = self.speed(tws[:, None], angles[None, :])
-        vmg = sp * np.cos(np.radians(angles))[None, :] * (1.0 if upwind else -1.0)
-        k = np.argmax(vmg, axis=1)
-        shape = np.shape(tws_ms)
-        return angles[k].reshape(shape), vmg[np.arange(tws.size), k].reshape(shape)
+        del step_deg
+        return self._vmg(tws_ms, upwind=upwind)
+
+    def max_speed(self, tws_ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """TWA [°] of the highest boat speed and that speed [m s⁻¹], on a 0.5° grid."""
+        tws = np.asarray(tws_ms, dtype=float)
+        grid = np.linspace(0.0, 180.0, 361)
+        sp = self.speed(tws.reshape(-1)[:, None], grid[None, :])
+        k = np.argmax(sp, axis=1)
+        return grid[k].reshape(tws.shape), sp[np.arange(k.size), k].reshape(tws.shape)

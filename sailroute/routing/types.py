@@ -82,7 +82,8 @@ class RoutingSettings:
     router : {"isochrone", "griddp", "spline"}
         Which router to use.
     dt_s : float
-        Isochrone time step [s].
+        Isochrone time step [s] (default 10 s: with mid-step wind sampling, halving
+        it down to 1.25 s moved a 1809 m beat by < 2e-5; see docs/design/routing.md).
     heading_step_deg : float
         Heading resolution [°].
     tack_penalty_s, gybe_penalty_s : float
@@ -91,15 +92,71 @@ class RoutingSettings:
         Tack at the start of a leg; None lets the router choose freely.
     clamp_wind : bool
         Unused by routers (wind fields carry their own clamp flag); kept for reports.
+    zone_m : float
+        Length of a mark's rounding segment [m] (see ``routing/geometry.py``):
+        the leg ends when the boat crosses it, so it is how close a rounding
+        must pass.  Default 13 m, about three Laser hull lengths.
+    start_line_spacing_m : float
+        Spacing of the candidate start points along a start line [m].
+    max_leg_time_s : float
+        A leg not finished after this much race time [s] fails with
+        :class:`~sailroute.errors.RoutingError`.
+    min_dt_s : float
+        Isochrone: smallest time step of the refinement near the target [s]
+        (steps shrink from ``dt_s`` once the target is a few steps away).
+    prune_sector_deg : float
+        Isochrone: width of the pruning sectors, in bearing seen from the
+        target [°]; one point per sector and tack side survives each step.
+    max_front_points : int
+        Isochrone: cap on the points kept per step (sectors widen to respect it).
+    heading_fan : {"hull", "full"}
+        Isochrone: ``"hull"`` tries grid TWAs between the upwind and downwind
+        VMG angles only (the rest of the polar is never optimal without a
+        tack penalty; the exact VMG angles and the direct bearing to the
+        target are always tried); ``"full"`` tries the whole circle.
+    dp_rows : int
+        Grid DP / multi-spline: rows of nodes including the start and target
+        rows (Dębski: 10-16).
+    dp_cols : int
+        Grid DP: nodes per row, C (Dębski: up to 128).
+    dp_refinements : int
+        Grid DP: mesh refinements after the first pass (each centred on the
+        best route so far, band scaled by ``dp_shrink``).
+    dp_half_width_m : float or None
+        Grid DP / multi-spline: half-width of the node rows [m]; None derives it
+        from the one-tack laylines (see ``docs/design/griddp.md``).
+    dp_shrink : float
+        Grid DP: band scale factor per refinement (0.5 halves the node spacing).
+    dp_samples : int
+        Grid DP: pieces per segment along which the wind is sampled.
+    spline_cols, spline_slopes, spline_refinements : int
+        Multi-spline: nodes per row, tangent slopes per node (n_ts) and
+        refinements (ranges shrink by 1/3 each).
     """
 
     router: RouterName = "isochrone"
-    dt_s: float = 5.0
+    dt_s: float = 10.0
     heading_step_deg: float = 2.0
     tack_penalty_s: float = 5.0
     gybe_penalty_s: float = 3.0
     initial_side: Side | None = None
     extra: dict[str, float] = field(default_factory=dict)
+    zone_m: float = 13.0
+    start_line_spacing_m: float = 5.0
+    max_leg_time_s: float = 10800.0
+    min_dt_s: float = 1.0
+    prune_sector_deg: float = 1.0
+    max_front_points: int = 2000
+    heading_fan: str = "hull"
+    dp_rows: int = 13
+    dp_cols: int = 64
+    dp_refinements: int = 2
+    dp_half_width_m: float | None = None
+    dp_shrink: float = 0.5
+    dp_samples: int = 4
+    spline_cols: int = 25
+    spline_slopes: int = 7
+    spline_refinements: int = 3
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,5 +1,39 @@
-"""Wind sources, all behind the :class:`~sailroute.wind.base.WindField` protocol."""
+"""Wind sources, all behind the :class:`~sailroute.wind.base.WindField` protocol.
 
+* :class:`UniformWind` — constant or time-table wind, the same everywhere;
+* :class:`AnalyticWind` — a formula ``f(t, x, y)``;
+* :func:`open_wrf` -> :class:`GridWind` — WRF ``wrfout`` NetCDF;
+* :func:`read_stations` -> :class:`StationData` -> :class:`StationWind` — measured wind;
+* :class:`BlendedWind` — a model field corrected by stations;
+* :func:`wind_from_spec` — any of these from a course-file wind spec.
+
+Design notes: ``docs/design/wind.md``.
+"""
+
+from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import Coverage, WindField, prepare_points
+from sailroute.wind.blended import BlendedWind
+from sailroute.wind.build import check_covers, wind_from_spec
+from sailroute.wind.grid import GridWind
+from sailroute.wind.ndbc import read_ndbc
+from sailroute.wind.stations import StationData, StationWind, read_stations, resample_stations
+from sailroute.wind.uniform import UniformWind
+from sailroute.wind.wrf import open_wrf
 
-__all__ = ["Coverage", "WindField", "prepare_points"]
+__all__ = [
+    "AnalyticWind",
+    "BlendedWind",
+    "Coverage",
+    "GridWind",
+    "StationData",
+    "StationWind",
+    "UniformWind",
+    "WindField",
+    "check_covers",
+    "open_wrf",
+    "prepare_points",
+    "read_ndbc",
+    "read_stations",
+    "resample_stations",
+    "wind_from_spec",
+]

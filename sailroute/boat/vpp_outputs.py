@@ -1,0 +1,247 @@
+"""Inputs and outputs of ``sailroute vpp``: boat YAML, text report, files, polar plot.
+
+The CLI command only parses options and calls :func:`run_vpp_command`; every
+piece is a plain function here so that it can be tested and reused.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import asdict, dataclass, replace
+from itertools import pairwise
+from pathlib import Path
+from typing import Any, Final
+
+import numpy as np
+
+from sailroute.boat.build import vpp_polar
+from sailroute.boat.io import write_pol, write_polar_csv, write_polar_json
+from sailroute.boat.laser import CLASSES, ILCA7, LaserParams, params_from_mapping
+from sailroute.boat.polar import Polar
+from sailroute.errors import InputError
+from sailroute.units import speed_factor
+
+DEFAULT_TWS: Final = {
+    "kn": (4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 20.0, 24.0),
+    "m/s": (2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 10.0, 12.0),
+}
+"""Default TWS columns of ``sailroute vpp`` per display unit."""
+UNITS: Final = ("kn", "m/s")
+
+
+@dataclass(frozen=True)
+class VppRun:
+    """Result of :func:`run_vpp_command`.
+
+    Attributes
+    ----------
+    params : LaserParams
+        Boat used.
+    polar : Polar
+        Computed polar (TWS [m s⁻¹], TWA [°]).
+    report : str
+        Text table and VMG summary (in the display unit).
+    files : dict of str to Path
+        ``pol``, ``csv``, ``json``, ``png`` outputs.
+    """
+
+    params: LaserParams
+    polar: Polar
+    report: str
+    files: dict[str, Path]
+
+
+def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
+    """Read a boat YAML (see ``docs/vpp.md``) and return its parameters and a file stem.
+
+    Raises
+    ------
+    InputError
+        Missing file, YAML syntax error (with line), unknown key or bad value
+        (with the key), all in one message.
+    """
+    import yaml
+
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(f"{p}: boat file not found") from None
+    except OSError as exc:
+        raise InputError(f"{p}: cannot read boat file ({exc})") from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = f":{mark.line + 1}" if mark is not None else ""
+        raise InputError(f"{p}{line}: not valid YAML ({getattr(exc, 'problem', exc)})") from None
+    if doc is None:
+        doc = {}
+    if not isinstance(doc, dict):
+        raise InputError(
+            f"{p}: a boat file is a mapping like 'class: ilca7' and 'crew_mass_kg: 80'; "
+            f"got {type(doc).__name__}"
+        )
+    return params_from_mapping(doc, where=str(p)), _slug(p.stem)
+
+
+def parse_speed_list(text: str, unit: str, *, option: str = "--tws") -> tuple[float, ...]:
+    """Parse ``"4,6,8"`` (in ``unit``) into increasing speeds [m s⁻¹]."""
+    f = speed_factor(unit)
+    vals = []
+    for k, cell in enumerate(c for c in re.split(r"[,\s]+", text.strip()) if c):
+        try:
+            v = float(cell)
+        except ValueError:
+            raise InputError(f"{option}: item {k + 1} ({cell!r}) is not a number") from None
+        if not v > 0 or not np.isfinite(v):
+            raise InputError(f"{option}: item {k + 1} ({cell!r}) must be a positive speed")
+        vals.append(v * f)
+    if not vals:
+        raise InputError(f"{option}: give at least one wind speed, e.g. '4,6,8'")
+    if any(b <= a for a, b in pairwise(vals)):
+        raise InputError(f"{option}: wind speeds must increase; got {text!r}")
+    return tuple(vals)
+
+
+def twa_grid(step_deg: float) -> tuple[float, ...]:
+    """TWA rows 0..180 [°] every ``step_deg`` (180 always included)."""
+    if not 0.1 <= step_deg <= 90:
+        raise InputError(f"--twa-step: expected a step between 0.1 and 90 degrees; got {step_deg}")
+    grid = np.arange(0.0, 180.0, step_deg)
+    return tuple(float(a) for a in np.append(grid, 180.0))
+
+
+def polar_report(polar: Polar, unit: str = "kn") -> str:
+    """Text table (rows TWA, columns TWS) and best VMG per TWS, in ``unit``.
+
+    Speeds are printed with 2 decimals; the same numbers come from
+    ``polar.speed(tws, twa)`` at the table's nodes.
+    """
+    f = speed_factor(unit)
+    tws = polar.tws_ms
+    label = f"TWA\\TWS [{unit}]"
+    w = 7
+    lines = [f"{polar.name}: boat speed [{unit}] (TWS at the sail's centre of effort)"]
+    lines.append(f"{label:>14}" + "".join(f"{v / f:>{w}.1f}" for v in tws))
+    for a, row in zip(polar.twa_deg, polar.speed_ms, strict=True):
+        lines.append(f"{a:>14.1f}" + "".join(f"{v / f:>{w}.2f}" for v in row))
+    up_a, up_v = polar.vmg_upwind(tws)
+    dn_a, dn_v = polar.vmg_downwind(tws)
+    lines.append("")
+    lines.append(f"{'beat TWA [deg]':>14}" + "".join(f"{a:>{w}.1f}" for a in up_a))
+    lines.append(f"{'beat VMG':>14}" + "".join(f"{v / f:>{w}.2f}" for v in up_v))
+    lines.append(f"{'run TWA [deg]':>14}" + "".join(f"{a:>{w}.1f}" for a in dn_a))
+    lines.append(f"{'run VMG':>14}" + "".join(f"{v / f:>{w}.2f}" for v in dn_v))
+    return "\n".join(lines)
+
+
+def plot_polar(polar: Polar, path: str | Path, unit: str = "kn") -> Path:
+    """Polar plot (one curve per TWS, VMG points marked) as a PNG.
+
+    Uses matplotlib's object-oriented API (no pyplot, no global state).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    f = speed_factor(unit)
+    fig = Figure(figsize=(7, 7))
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(projection="polar")
+    ax.set_theta_zero_location("N")
+    ax.set_theta_direction(-1)
+    ax.set_thetamin(0)
+    ax.set_thetamax(180)
+    a = np.linspace(0.0, 180.0, 361)
+    up_a = polar.vmg_upwind(polar.tws_ms)[0]
+    dn_a = polar.vmg_downwind(polar.tws_ms)[0]
+    for j, tws in enumerate(polar.tws_ms):
+        (line,) = ax.plot(np.radians(a), polar.speed(tws, a) / f, lw=1.2,
+                          label=f"{tws / f:g} {unit}")
+        for ang in (up_a[j], dn_a[j]):
+            ax.plot(np.radians(ang), polar.speed(tws, ang) / f, "o", ms=3, color=line.get_color())
+    ax.set_title(f"{polar.name}: boat speed [{unit}] vs TWA (dots: best VMG)")
+    ax.legend(loc="lower left", fontsize=7, title="TWS", title_fontsize=7)
+    out = Path(path)
+    fig.savefig(out, dpi=110)
+    return out
+
+
+def write_outputs(
+    polar: Polar, params: LaserParams, out_dir: str | Path, stem: str, unit: str = "kn"
+) -> dict[str, Path]:
+    """Write ``<stem>.pol``, ``.csv``, ``.json`` (with the parameters) and ``.png``."""
+    d = Path(out_dir)
+    try:
+        d.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"--out: cannot create folder {str(d)!r} ({exc})") from None
+    extra: dict[str, Any] = {
+        "tws_reference": "true wind at the sail's centre-of-effort height",
+        "vpp_params": _jsonable(asdict(params)),
+    }
+    return {
+        "pol": write_pol(polar, d / f"{stem}.pol", unit=unit),
+        "csv": write_polar_csv(polar, d / f"{stem}.csv", unit=unit),
+        "json": write_polar_json(polar, d / f"{stem}.json", unit=unit, extra=extra),
+        "png": plot_polar(polar, d / f"{stem}.png", unit=unit),
+    }
+
+
+def run_vpp_command(
+    boat_file: str | Path | None,
+    *,
+    crew_mass_kg: float | None = None,
+    tws: str | None = None,
+    twa_step_deg: float = 5.0,
+    out_dir: str | Path = "vpp-out",
+    unit: str = "kn",
+) -> VppRun:
+    """Everything ``sailroute vpp`` does, minus printing.
+
+    Parameters
+    ----------
+    boat_file : path or None
+        Boat YAML; ``None`` uses the shipped ILCA 7 parameters.
+    crew_mass_kg : float, optional
+        Overrides the file's (or the class's) sailor mass [kg].
+    tws : str, optional
+        Comma-separated TWS list in ``unit``; default :data:`DEFAULT_TWS`.
+    twa_step_deg : float
+        TWA row spacing [°].
+    out_dir : path
+        Output folder (created).
+    unit : {"kn", "m/s"}
+        Unit of the printed table and the written files.
+    """
+    if unit not in UNITS:
+        raise InputError(f"--unit: expected one of 'kn', 'm/s'; got {unit!r}")
+    if boat_file is None:
+        params, stem = ILCA7, "ilca7"
+    else:
+        params, stem = load_boat_file(boat_file)
+    if crew_mass_kg is not None:
+        if not 20.0 <= crew_mass_kg <= 200.0:
+            raise InputError(
+                f"--crew-mass: expected a sailor mass in 20-200 kg; got {crew_mass_kg}"
+            )
+        params = replace(params, crew_mass_kg=float(crew_mass_kg))
+    tws_ms = parse_speed_list(tws, unit) if tws else tuple(v * speed_factor(unit)
+                                                              for v in DEFAULT_TWS[unit])
+    polar = vpp_polar(params, tws_ms, twa_grid(twa_step_deg))
+    files = write_outputs(polar, params, out_dir, stem, unit)
+    return VppRun(params=params, polar=polar, report=polar_report(polar, unit), files=files)
+
+
+def _slug(text: str) -> str:
+    s = re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")
+    return s or "boat"
+
+
+def _jsonable(d: dict[str, Any]) -> dict[str, Any]:
+    return {k: list(v) if isinstance(v, tuple) else v for k, v in d.items()}
+
+
+def class_names() -> tuple[str, ...]:
+    """Valid ``class`` values of a boat file."""
+    return tuple(sorted(CLASSES))

@@ -1,0 +1,270 @@
+"""The race course: marks, lines, gates, legs, boat, routing settings and wind scenarios.
+
+A :class:`Course` is what :func:`sailroute.course.load.load_course` returns.  Every
+position is stored in the course's :class:`~sailroute.geo.LocalFrame` (metres east
+``x`` and north ``y`` of the origin) and in latitude/longitude, so that routers work
+in metres and reports can write geographic coordinates.
+
+Wind and boat specifications are kept as the raw YAML mappings; they are turned into
+a :class:`~sailroute.wind.base.WindField` and a :class:`~sailroute.boat.polar.Polar`
+by the factories in ``sailroute.wind.build`` and ``sailroute.boat.build`` when a
+plan is run (see :func:`sailroute.course.load.validate_specs`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, Literal
+
+import numpy as np
+
+from sailroute.geo import LocalFrame
+from sailroute.routing.types import RoutingSettings, Side
+from sailroute.timeutil import to_epoch
+
+LegKind = Literal["mark", "gate", "line"]
+"""What ends a leg: round a mark, pass through a gate, or cross a line."""
+
+
+@dataclass(frozen=True)
+class Mark:
+    """A buoy (or committee boat) at a fixed position.
+
+    Attributes
+    ----------
+    name : str
+        Name used in ``lines``, ``gates`` and ``legs`` (e.g. ``"1"``, ``"4p"``).
+    x, y : float
+        Position in the course frame [m east, m north of the origin].
+    lat, lon : float
+        The same position in degrees (WGS-84).
+    """
+
+    name: str
+    x: float
+    y: float
+    lat: float
+    lon: float
+
+    @property
+    def xy(self) -> tuple[float, float]:
+        """Position ``(x, y)`` [m]."""
+        return (self.x, self.y)
+
+
+@dataclass(frozen=True)
+class Line:
+    """A start or finish line between two marks.
+
+    Attributes
+    ----------
+    name : str
+        Line name (``"start"``, ``"finish"``, ...).
+    a, b : Mark
+        The two ends, in the order written in the course file.
+    """
+
+    name: str
+    a: Mark
+    b: Mark
+
+    @property
+    def length_m(self) -> float:
+        """Distance between the two ends [m]."""
+        return float(np.hypot(self.b.x - self.a.x, self.b.y - self.a.y))
+
+    @property
+    def midpoint(self) -> tuple[float, float]:
+        """Midpoint ``(x, y)`` [m]."""
+        return (0.5 * (self.a.x + self.b.x), 0.5 * (self.a.y + self.b.y))
+
+    def fraction_of(self, xy: tuple[float, float]) -> float:
+        """Position of the projection of ``xy`` on the line, 0 at ``a`` and 1 at ``b``."""
+        dx, dy = self.b.x - self.a.x, self.b.y - self.a.y
+        den = dx * dx + dy * dy
+        if den == 0.0:
+            return 0.0
+        return float(((xy[0] - self.a.x) * dx + (xy[1] - self.a.y) * dy) / den)
+
+
+@dataclass(frozen=True)
+class Gate(Line):
+    """A gate: two marks that boats pass between, then round either one.
+
+    Same attributes as :class:`Line`.
+    """
+
+
+@dataclass(frozen=True)
+class LegSpec:
+    """One leg of the course as written in the course file.
+
+    Attributes
+    ----------
+    index : int
+        Position in the course, 0-based.
+    from_name : str
+        Where the leg starts: the first leg's ``from`` (a line or mark); for later
+        legs the previous leg's ``to``.
+    to_name : str
+        The mark, gate or line that ends the leg.
+    kind : {"mark", "gate", "line"}
+        What ``to_name`` is.
+    rounding : {"port", "starboard"} or None
+        Side the mark is left on (marks only; None for gates and lines).
+    """
+
+    index: int
+    from_name: str
+    to_name: str
+    kind: LegKind
+    rounding: Side | None = None
+
+    @property
+    def label(self) -> str:
+        """``"from -> to"`` for tables."""
+        return f"{self.from_name} -> {self.to_name}"
+
+
+def _frozen(d: Mapping[str, Any] | None) -> Mapping[str, Any]:
+    return MappingProxyType(dict(d or {}))
+
+
+@dataclass(frozen=True, eq=False)
+class ScenarioSpec:
+    """A named wind scenario.
+
+    Attributes
+    ----------
+    name : str
+        Scenario name (the key under ``scenarios``).
+    wind : mapping
+        The raw wind spec (``{type: uniform|wrf|stations|blended, ...}``), passed to
+        ``sailroute.wind.build.wind_from_spec`` unchanged.
+    references : mapping of str to tuple of float
+        Leg times [s] to compare this scenario with, in addition to the course-wide
+        ``references`` (e.g. the thesis's own model output for the same wind).
+    description : str
+        Free text for reports.
+    where : str
+        Key path of the wind spec for error messages
+        (e.g. ``"courses/hyeres-r1.yaml: scenarios.wrf10.wind"``).
+    """
+
+    name: str
+    wind: Mapping[str, Any]
+    references: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
+    description: str = ""
+    where: str = ""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "wind", _frozen(self.wind))
+        object.__setattr__(self, "references", _frozen(self.references))
+
+
+@dataclass(frozen=True, eq=False)
+class Course:
+    """A validated race course.
+
+    Attributes
+    ----------
+    name : str
+        Course name.
+    start_time : datetime
+        Start signal, timezone-aware, in UTC.
+    frame : LocalFrame
+        The local metric frame all ``x, y`` refer to.
+    marks : mapping of str to Mark
+        All marks by name, in file order.
+    lines : mapping of str to Line
+        Start/finish lines by name.
+    gates : mapping of str to Gate
+        Gates by name.
+    legs : tuple of LegSpec
+        The legs in sailing order.
+    boat_spec : mapping
+        Raw ``boat`` section (``{builtin: ilca7}``, ``{polar: path}`` or ``{vpp: {...}}``).
+    routing : RoutingSettings
+        Router and its settings from the ``routing`` section.
+    scenarios : mapping of str to ScenarioSpec
+        Wind scenarios by name, in file order.
+    references : mapping of str to tuple of float
+        Course-wide reference leg times [s] (e.g. the race winner's), one per leg.
+    source : Path or None
+        The course file (relative ``path`` values in specs resolve against its folder).
+    description : str
+        Free text.
+    template : mapping or None
+        The raw ``template`` section if the layout was generated from one.
+    time_limit_s : float
+        Wind data must cover ``[start_time, start_time + time_limit_s]`` [s]; routes
+        that take longer run out of wind data (``time_limit_min`` in the file).
+    boat_where : str
+        ``"file:line"`` of the ``boat`` section, for the boat factory's messages.
+    """
+
+    name: str
+    start_time: datetime
+    frame: LocalFrame
+    marks: Mapping[str, Mark]
+    lines: Mapping[str, Line]
+    gates: Mapping[str, Gate]
+    legs: tuple[LegSpec, ...]
+    boat_spec: Mapping[str, Any] = field(default_factory=dict)
+    routing: RoutingSettings = field(default_factory=RoutingSettings)
+    scenarios: Mapping[str, ScenarioSpec] = field(default_factory=dict)
+    references: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
+    source: Path | None = None
+    description: str = ""
+    template: Mapping[str, Any] | None = None
+    time_limit_s: float = 5400.0
+    boat_where: str = ""
+
+    def __post_init__(self) -> None:
+        for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        object.__setattr__(self, "legs", tuple(self.legs))
+
+    @property
+    def start_epoch(self) -> float:
+        """Start time [epoch s]."""
+        return to_epoch(self.start_time)
+
+    @property
+    def base_dir(self) -> Path:
+        """Folder that relative paths in the course file are resolved against."""
+        return self.source.parent if self.source is not None else Path.cwd()
+
+    @property
+    def n_legs(self) -> int:
+        """Number of legs."""
+        return len(self.legs)
+
+    def where(self, key_path: str) -> str:
+        """Error-message prefix ``"<file>: <key_path>"`` for specs of this course."""
+        src = str(self.source) if self.source is not None else "<course>"
+        return f"{src}: {key_path}"
+
+    def references_for(self, scenario: str | None = None) -> dict[str, tuple[float, ...]]:
+        """Course-wide references plus those of ``scenario`` (scenario wins on a clash)."""
+        out = dict(self.references)
+        if scenario is not None and scenario in self.scenarios:
+            out.update(self.scenarios[scenario].references)
+        return out
+
+    def feature(self, name: str) -> Mark | Line | Gate:
+        """The mark, line or gate called ``name``.
+
+        Raises
+        ------
+        KeyError
+            If there is none (a validated course only refers to existing names).
+        """
+        for table in (self.marks, self.gates, self.lines):
+            if name in table:
+                return table[name]
+        raise KeyError(name)

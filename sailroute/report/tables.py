@@ -1,0 +1,171 @@
+"""Plain-text tables for the terminal: pure functions that return strings (no printing).
+
+Percent errors are ``(model − reference) / reference`` (positive: model slower).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from sailroute.report.plan import Comparison, Plan, PlannedLeg, percent_error
+from sailroute.timeutil import iso
+
+
+def format_duration(seconds: float) -> str:
+    """``m:ss.s`` (or ``h:mm:ss.s`` from one hour) for a duration [s]."""
+    if not math.isfinite(seconds):
+        return "-"
+    sign = "-" if seconds < 0 else ""
+    s = abs(seconds)
+    tenths = round(s * 10)
+    h, rem = divmod(tenths, 36000)
+    m, rem = divmod(rem, 600)
+    sec = rem / 10
+    if h:
+        return f"{sign}{h}:{m:02d}:{sec:04.1f}"
+    return f"{sign}{m}:{sec:04.1f}"
+
+
+def render_table(
+    headers: Sequence[str], rows: Sequence[Sequence[str]], *, align: str | None = None,
+    footer: Sequence[Sequence[str]] = (),
+) -> str:
+    """Align columns of text.
+
+    Parameters
+    ----------
+    headers : sequence of str
+        Column titles.
+    rows : sequence of sequence of str
+        Cells, one row per item.
+    align : str, optional
+        One character per column, ``"l"`` or ``"r"``; default: first column left,
+        the others right.
+    footer : sequence of sequence of str
+        Rows printed below a rule (totals).
+
+    Returns
+    -------
+    str
+        The table, lines joined with ``\\n``, no trailing newline.
+    """
+    ncol = len(headers)
+    align = align or "l" + "r" * (ncol - 1)
+    allrows = [list(headers), *[list(r) for r in rows], *[list(r) for r in footer]]
+    widths = [max(len(r[i]) for r in allrows) for i in range(ncol)]
+
+    def fmt(r: Sequence[str]) -> str:
+        cells = [
+            c.ljust(w) if a == "l" else c.rjust(w) for c, w, a in zip(r, widths, align, strict=True)
+        ]
+        return "  ".join(cells).rstrip()
+
+    rule = "  ".join("-" * w for w in widths)
+    out = [fmt(headers), rule, *[fmt(r) for r in rows]]
+    if footer:
+        out.append(rule)
+        out += [fmt(r) for r in footer]
+    return "\n".join(out)
+
+
+def start_point_text(leg: PlannedLeg) -> str:
+    """Where on the line/gate the leg started, e.g. ``"37% start1->start2"``; ``-`` for a point."""
+    if leg.start_line_fraction is None:
+        return "-"
+    course_feature = leg.spec.from_name
+    return f"{100.0 * leg.start_line_fraction:.0f}% along {course_feature}"
+
+
+def _pct(model: float, ref: float) -> str:
+    return f"{percent_error(model, ref):+.1f}%"
+
+
+def plan_table(plan: Plan) -> str:
+    """Leg-by-leg table of a plan with a total row and, per reference, time and error.
+
+    Columns: leg, from -> to, wind mode, time (m:ss.s and seconds), tacks, gybes,
+    distance [m], start point on the line/gate the leg started from, then for each
+    reference its leg time and ``(model − ref)/ref``.
+    """
+    refs = list(plan.references.items())
+    headers = ["leg", "from -> to", "mode", "time", "time s", "tacks", "gybes", "dist m",
+               "start point"]
+    for name, _ in refs:
+        headers += [name, "err"]
+    rows = []
+    for k, leg in enumerate(plan.legs):
+        r = leg.result
+        row = [
+            str(leg.spec.index + 1), leg.spec.label, leg.mode or "-", format_duration(r.time_s),
+            f"{r.time_s:.1f}", str(r.n_tacks), str(r.n_gybes), f"{r.distance_m:.0f}",
+            start_point_text(leg),
+        ]
+        for _, times in refs:
+            row += [format_duration(times[k]), _pct(r.time_s, times[k])]
+        rows.append(row)
+    total = [
+        "", "total", "", format_duration(plan.total_time_s), f"{plan.total_time_s:.1f}",
+        str(sum(leg.result.n_tacks for leg in plan.legs)),
+        str(sum(leg.result.n_gybes for leg in plan.legs)),
+        f"{sum(leg.result.distance_m for leg in plan.legs):.0f}", "",
+    ]
+    for _, times in refs:
+        total += [format_duration(sum(times)), _pct(plan.total_time_s, sum(times))]
+    title = (
+        f"{plan.course.name} | scenario {plan.scenario} | router {plan.router or '-'} | "
+        f"start {iso(plan.t_start)}"
+    )
+    align = "rllrrrrrl" + "rr" * len(refs)
+    return title + "\n" + render_table(headers, rows, align=align, footer=[total])
+
+
+def comparison_table(cmp: Comparison) -> str:
+    """Legs × scenarios table of leg times, then one error table per reference.
+
+    The first block lists each scenario's leg times and the references' times.
+    Then, for every shared reference, ``model − ref`` [s] and ``(model − ref)/ref``
+    [%] per scenario.  Scenario-specific references get one line each.
+    """
+    n = len(cmp.leg_labels)
+    ref_names = list(cmp.references)
+    headers = ["leg", *cmp.scenarios, *ref_names]
+    rows = []
+    for k in range(n):
+        rows.append(
+            [f"{k + 1} {cmp.leg_labels[k]}"]
+            + [format_duration(cmp.times[s, k]) for s in range(len(cmp.scenarios))]
+            + [format_duration(cmp.references[r][k]) for r in ref_names]
+        )
+    footer = [
+        ["total"]
+        + [format_duration(t) for t in cmp.totals]
+        + [format_duration(float(cmp.references[r].sum())) for r in ref_names]
+    ]
+    blocks = [f"{cmp.course_name}: leg times", render_table(headers, rows, footer=footer)]
+    for r in ref_names:
+        d = cmp.delta_s(r)
+        pc = cmp.percent(r)
+        rows = [
+            [f"{k + 1} {cmp.leg_labels[k]}"]
+            + [f"{d[s, k]:+.1f} s {pc[s, k]:+.1f}%" for s in range(len(cmp.scenarios))]
+            for k in range(n)
+        ]
+        tot = cmp.totals - cmp.references[r].sum()
+        tp = cmp.total_percent(r)
+        footer = [["total"] + [f"{tot[s]:+.1f} s {tp[s]:+.1f}%" for s in range(len(cmp.scenarios))]]
+        blocks += ["", f"error vs {r}: model - {r}, (model - {r})/{r}",
+                   render_table(["leg", *cmp.scenarios], rows, footer=footer)]
+    if cmp.scenario_references:
+        lines = []
+        for s, refs in cmp.scenario_references.items():
+            i = cmp.scenarios.index(s)
+            for r, vals in refs.items():
+                legs = " ".join(
+                    f"{percent_error(cmp.times[i, k], vals[k]):+.1f}%" for k in range(n)
+                )
+                lines.append([s, r, legs, _pct(float(cmp.totals[i]), float(vals.sum()))])
+        blocks += ["", "error vs scenario-specific references, (model - ref)/ref",
+                   render_table(["scenario", "reference", "legs", "total"], lines,
+                                align="lllr")]
+    return "\n".join(blocks)

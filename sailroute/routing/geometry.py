@@ -1,0 +1,310 @@
+"""Leg starts and targets as geometry: crossing segments, rounding segments, line sampling.
+
+Every target is reduced to one **directed segment** ``a``-``b`` with a unit
+``normal``: the leg ends at the first instant the boat's track crosses the
+segment while moving along ``normal`` (``d · normal > 0`` for a step ``d``).
+Routers test each time step's straight move against it
+(:func:`segment_crossing`) and interpolate the arrival time inside the step.
+
+=========  ==================================================================
+target     crossing segment
+=========  ==================================================================
+line       the line ``a``-``b``, crossed from the side of the leg start (the
+           course side, RRS "finish") to the other side.
+gate       the segment between the two marks, crossed from the side of the
+           leg start.
+mark       a **rounding segment**: from the mark, perpendicular to the leg
+           bearing θ (start → mark), ``zone_m`` long, on the side where the
+           boat passes; crossed in the direction of θ.  Leaving the mark to
+           port (mark on the boat's left) means passing on its right as seen
+           along θ, so the segment points to the right of θ,
+           ``(cos θ, −sin θ)``; starboard mirrors it.  A mark without a
+           rounding side gets a segment of ``2 zone_m`` centred on the mark
+           (pass within ``zone_m`` on either side).  Passing on the wrong side
+           crosses nothing and does not end the leg.
+=========  ==================================================================
+
+All functions are pure; the array kernels take the array module ``xp``
+(NumPy by default, CuPy works) and never divide by zero.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from types import ModuleType
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sailroute.errors import InputError
+from sailroute.routing.types import Start, Target
+
+XY = tuple[float, float]
+
+DEFAULT_ZONE_M = 13.0
+"""Default rounding-segment length [m]: about three Laser hull lengths (3 × 4.23 m)."""
+
+AIM_MARGIN_M = 1.0
+"""Routers aim at the target segment no closer than this to its ends [m] (a mark is
+passed at 1 m, not touched)."""
+
+
+@dataclass(frozen=True)
+class TargetGeometry:
+    """A target reduced to a directed crossing segment.
+
+    Attributes
+    ----------
+    a, b : tuple of float
+        Segment ends ``(x, y)`` [m].  For a mark, ``a`` is the mark.
+    normal : tuple of float
+        Unit vector perpendicular to the segment: the leg ends when the boat
+        crosses the segment moving along it.
+    kind : {"mark", "gate", "line"}
+        The target kind it was built from.
+    name : str
+        Label for messages.
+    """
+
+    a: XY
+    b: XY
+    normal: XY
+    kind: str
+    name: str = ""
+
+    @property
+    def centre(self) -> XY:
+        """Midpoint of the segment [m]."""
+        return ((self.a[0] + self.b[0]) / 2.0, (self.a[1] + self.b[1]) / 2.0)
+
+    @property
+    def length_m(self) -> float:
+        """Segment length [m]."""
+        return math.hypot(self.b[0] - self.a[0], self.b[1] - self.a[1])
+
+
+def start_centre(start: Start) -> XY:
+    """Start point, or the midpoint of a start line [m]."""
+    if start.b is None:
+        return (float(start.a[0]), float(start.a[1]))
+    return ((start.a[0] + start.b[0]) / 2.0, (start.a[1] + start.b[1]) / 2.0)
+
+
+def leg_label(start: Start, target: Target) -> str:
+    """``"start -> 1"``-style label used in messages."""
+    return f"{start.name or 'start'} -> {target.name or target.kind}"
+
+
+def leg_bearing_deg(start: Start, target: Target) -> float:
+    """Compass bearing [°] from the start (centre) to the target (centre).
+
+    Raises
+    ------
+    InputError
+        If the two coincide (the leg has no direction).
+    """
+    sx, sy = start_centre(start)
+    tx, ty = target.centre
+    dx, dy = tx - sx, ty - sy
+    if math.hypot(dx, dy) < 1e-6:
+        raise InputError(
+            f"leg {leg_label(start, target)}: the start and the target are at the same "
+            f"point ({sx:.1f}, {sy:.1f}) m; a leg needs two different places"
+        )
+    return math.degrees(math.atan2(dx, dy)) % 360.0
+
+
+def rounding_segment(
+    mark: XY, bearing_deg: float, rounding: str | None, zone_m: float = DEFAULT_ZONE_M
+) -> tuple[XY, XY]:
+    """Rounding segment of a mark approached along ``bearing_deg``.
+
+    Parameters
+    ----------
+    mark : tuple of float
+        Mark position [m].
+    bearing_deg : float
+        Approach (leg) bearing θ [°].
+    rounding : {"port", "starboard"} or None
+        Side on which the mark is left.  ``None``: either side.
+    zone_m : float
+        Segment length [m].
+
+    Returns
+    -------
+    a, b : tuple of float
+        Segment ends [m]; ``a`` is the mark (or, for ``None``, the end at
+        ``mark − zone_m r`` where ``r`` points to the right of θ).
+    """
+    th = math.radians(bearing_deg)
+    rx, ry = math.cos(th), -math.sin(th)  # unit vector to the right of the approach
+    mx, my = float(mark[0]), float(mark[1])
+    if rounding == "port":
+        return (mx, my), (mx + zone_m * rx, my + zone_m * ry)
+    if rounding == "starboard":
+        return (mx, my), (mx - zone_m * rx, my - zone_m * ry)
+    if rounding is None:
+        return (mx - zone_m * rx, my - zone_m * ry), (mx + zone_m * rx, my + zone_m * ry)
+    raise InputError(f"mark rounding {rounding!r}: expected 'port', 'starboard' or None")
+
+
+def target_geometry(
+    target: Target, start: Start, zone_m: float = DEFAULT_ZONE_M
+) -> TargetGeometry:
+    """The directed crossing segment of ``target`` for a leg from ``start``.
+
+    Parameters
+    ----------
+    target : Target
+        Mark (with rounding side), gate or line.
+    start : Start
+        Leg start (point or line); its centre fixes the leg bearing and the
+        course side.
+    zone_m : float
+        Rounding-segment length for marks [m].
+
+    Returns
+    -------
+    TargetGeometry
+
+    Raises
+    ------
+    InputError
+        For a zero-length gate/line, a non-positive ``zone_m``, a start lying on
+        the line through a gate/line, or a start at the mark.
+    """
+    label = leg_label(start, target)
+    if target.kind == "mark":
+        if not zone_m > 0:
+            raise InputError(f"leg {label}: zone_m must be > 0 m, got {zone_m!r}")
+        th = leg_bearing_deg(start, target)
+        a, b = rounding_segment(target.a, th, target.rounding, zone_m)
+        n = (math.sin(math.radians(th)), math.cos(math.radians(th)))
+        return TargetGeometry(a, b, n, "mark", target.name)
+    if target.kind not in ("gate", "line") or target.b is None:
+        raise InputError(
+            f"leg {label}: target kind {target.kind!r} needs two ends (gate or line) "
+            "or must be 'mark'"
+        )
+    a = (float(target.a[0]), float(target.a[1]))
+    b = (float(target.b[0]), float(target.b[1]))
+    ex, ey = b[0] - a[0], b[1] - a[1]
+    length = math.hypot(ex, ey)
+    if length < 1e-6:
+        raise InputError(f"leg {label}: the {target.kind} ends coincide; give two different ends")
+    nx, ny = ey / length, -ex / length
+    sx, sy = start_centre(start)
+    side = (sx - a[0]) * nx + (sy - a[1]) * ny
+    if abs(side) < 1e-6:
+        raise InputError(
+            f"leg {label}: the leg start ({sx:.1f}, {sy:.1f}) m lies on the line through the "
+            f"{target.kind}, so the side it must be crossed from is undefined; move the start "
+            "off that line"
+        )
+    if side > 0:
+        nx, ny = -nx, -ny
+    return TargetGeometry(a, b, (nx, ny), target.kind, target.name)
+
+
+def segment_crossing(
+    px: NDArray, py: NDArray, qx: NDArray, qy: NDArray, geom: TargetGeometry,
+    *, xp: ModuleType = np,
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Which straight moves ``P → Q`` cross the target segment forwards, and where.
+
+    Parameters
+    ----------
+    px, py, qx, qy : ndarray
+        Move starts and ends [m] (broadcast).
+    geom : TargetGeometry
+        The directed target segment.
+    xp : module
+        Array module.
+
+    Returns
+    -------
+    hit : ndarray of bool
+        The move crosses the segment (ends included) moving along ``normal``.
+    s : ndarray
+        Fraction of the move at the crossing, in ``[0, 1]`` (0 where not hit).
+    r : ndarray
+        Fraction along ``a → b`` of the crossing point, in ``[0, 1]`` (0 where not hit).
+
+    Notes
+    -----
+    Solves ``P + s d = A + r e`` with ``d = Q − P``, ``e = B − A``:
+    ``s = (w × e)/(d × e)``, ``r = (w × d)/(d × e)``, ``w = A − P``.  The range
+    tests use the numerators times ``sign(d × e)``, so nothing is divided by 0.
+    """
+    ax, ay = geom.a
+    ex, ey = geom.b[0] - ax, geom.b[1] - ay
+    nx, ny = geom.normal
+    dx = qx - px
+    dy = qy - py
+    wx = ax - px
+    wy = ay - py
+    den = dx * ey - dy * ex
+    sgn = xp.where(den < 0, -1.0, 1.0)
+    ns = (wx * ey - wy * ex) * sgn
+    nr = (wx * dy - wy * dx) * sgn
+    ad = den * sgn
+    hit = (dx * nx + dy * ny > 0) & (ad > 0) & (ns >= 0) & (ns <= ad) & (nr >= 0) & (nr <= ad)
+    safe = xp.where(hit, ad, 1.0)
+    s = xp.where(hit, ns / safe, 0.0)
+    r = xp.where(hit, nr / safe, 0.0)
+    return hit, s, r
+
+
+def aim_points(
+    px: NDArray, py: NDArray, geom: TargetGeometry, margin_m: float = AIM_MARGIN_M,
+    *, xp: ModuleType = np,
+) -> tuple[NDArray, NDArray]:
+    """Nearest point of the target segment, kept ``margin_m`` from its ends [m].
+
+    Routers steer the "direct" candidate heading at this point: the projection
+    of ``P`` onto the segment, clipped to ``[m, L − m]`` from ``a`` with
+    ``m = min(margin_m, L/2)``.
+    """
+    ax, ay = geom.a
+    length = geom.length_m
+    ux, uy = (geom.b[0] - ax) / length, (geom.b[1] - ay) / length
+    m = min(margin_m, 0.5 * length)
+    r = xp.clip((px - ax) * ux + (py - ay) * uy, m, length - m)
+    return ax + r * ux, ay + r * uy
+
+
+def sample_line(
+    a: XY, b: XY, spacing_m: float, max_points: int = 401
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Evenly spaced points on the segment ``a``-``b``, both ends included.
+
+    Parameters
+    ----------
+    a, b : tuple of float
+        Ends [m].
+    spacing_m : float
+        Largest spacing [m] (> 0).
+    max_points : int
+        Upper bound on the number of points (the spacing grows if needed).
+
+    Returns
+    -------
+    x, y : ndarray
+        Point coordinates [m], from ``a`` to ``b``.
+    """
+    if not spacing_m > 0:
+        raise InputError(f"line spacing must be > 0 m, got {spacing_m!r}")
+    length = math.hypot(b[0] - a[0], b[1] - a[1])
+    n = int(min(max(2, math.ceil(length / spacing_m - 1e-9) + 1), max(2, max_points)))
+    f = np.linspace(0.0, 1.0, n)
+    return a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])
+
+
+def start_points(
+    start: Start, spacing_m: float = 5.0, max_points: int = 401
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Initial positions of a leg: the start point, or points along the start line [m]."""
+    if start.b is None:
+        return np.array([float(start.a[0])]), np.array([float(start.a[1])])
+    return sample_line(start.a, start.b, spacing_m, max_points)

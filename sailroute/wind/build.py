@@ -1,0 +1,420 @@
+"""Build a :class:`~sailroute.wind.base.WindField` from a wind spec (a YAML mapping).
+
+The course loader calls :func:`wind_from_spec` once per scenario.  Spec keys are
+documented in ``docs/design/wind.md`` ("Wind spec keys").  Every problem in a
+spec is collected and reported in one :class:`~sailroute.errors.InputError`,
+each line prefixed with its key path.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+from sailroute.errors import InputError, OutOfCoverageError
+from sailroute.geo import LocalFrame
+from sailroute.timeutil import parse_time, to_epoch
+from sailroute.units import KNOT, SPEED_UNITS
+from sailroute.wind._spec import SpecChecker
+from sailroute.wind.base import Coverage, WindField
+from sailroute.wind.blended import BlendedWind
+from sailroute.wind.height import DEFAULT_EXPONENT, DEFAULT_EXPONENT_RANGE, DEFAULT_ROUGHNESS_M
+from sailroute.wind.stations import (
+    CANONICAL_COLUMNS,
+    DEFAULT_MISSING,
+    StationData,
+    StationWind,
+    parse_offset,
+    read_stations,
+)
+from sailroute.wind.uniform import UniformWind
+from sailroute.wind.wrf import open_wrf
+
+BBox = tuple[float, float, float, float]
+"""Local-frame box ``(xmin, xmax, ymin, ymax)`` [m] (same order as :class:`Coverage`)."""
+
+
+def wind_from_spec(
+    spec: Mapping[str, Any],
+    *,
+    frame: LocalFrame,
+    base_dir: Path,
+    where: str,
+    crop_bbox: BBox | None = None,
+    time_window: tuple[float, float] | None = None,
+) -> WindField:
+    """Build a wind field from a spec mapping.
+
+    Parameters
+    ----------
+    spec : mapping
+        The wind spec, e.g. ``{"type": "uniform", "tws_kn": 10, "twd_deg": 108}``;
+        ``type`` is one of ``uniform``, ``wrf``, ``stations``, ``blended``.
+    frame : LocalFrame
+        The course's local frame; gridded and station data are mapped into it.
+    base_dir : Path
+        Directory that relative ``path`` values are resolved against (the course file's).
+    where : str
+        Prefix for error messages, e.g. ``"courses/x.yaml: scenarios.wrf10[0]"``.
+    crop_bbox : tuple of float, optional
+        Course bounding box ``(xmin, xmax, ymin, ymax)`` [m] in ``frame`` (marks, no
+        margin).  WRF data are cropped to it plus ``margin_m``; a source that does
+        not cover it raises :class:`~sailroute.errors.OutOfCoverageError` now
+        (unless the spec sets ``clamp: true``).
+    time_window : tuple of float, optional
+        Race time window ``(t0, t1)`` [epoch s].  WRF slices outside it are not
+        read; a source that does not cover it raises now (unless ``clamp``).
+
+    Returns
+    -------
+    WindField
+
+    Raises
+    ------
+    InputError
+        Unknown type, unknown/missing/invalid keys (all listed at once), unreadable files.
+    WindDataError
+        Malformed data files.
+    OutOfCoverageError
+        The data do not cover ``crop_bbox``/``time_window`` and ``clamp`` is false.
+    """
+    chk = SpecChecker(where)
+    if not isinstance(spec, Mapping):
+        raise InputError(f"{where}: expected a wind spec mapping (type: ...), got {spec!r}")
+    kind = chk.choice(spec, "type", list(_BUILDERS))
+    if kind is None:
+        chk.raise_if_any()
+    if crop_bbox is not None and not (
+        crop_bbox[0] <= crop_bbox[1] and crop_bbox[2] <= crop_bbox[3]
+    ):
+        raise InputError(f"{where}: crop_bbox must be (xmin, xmax, ymin, ymax) in metres, got "
+                         f"{tuple(crop_bbox)}")
+    if time_window is not None and not time_window[0] <= time_window[1]:
+        raise InputError(f"{where}: time_window must be (t0, t1) with t0 <= t1, got "
+                         f"{tuple(time_window)}")
+    ctx = _Context(frame, Path(base_dir), crop_bbox, time_window)
+    field = _BUILDERS[kind](spec, chk, ctx)
+    if not spec.get("clamp", False):
+        check_covers(field, crop_bbox, time_window, name=f"{where}: {kind} wind")
+    return field
+
+
+def check_covers(
+    field: WindField,
+    bbox: BBox | None,
+    time_window: tuple[float, float] | None,
+    *,
+    name: str = "wind field",
+) -> None:
+    """Raise :class:`OutOfCoverageError` unless ``field`` covers ``bbox`` and ``time_window``.
+
+    Parameters
+    ----------
+    field : WindField
+        The field to check.
+    bbox : tuple of float or None
+        ``(xmin, xmax, ymin, ymax)`` [m] that must lie inside the field's box.
+    time_window : tuple of float or None
+        ``(t0, t1)`` [epoch s] that must lie inside the field's time span.
+    name : str
+        Label for the message.
+    """
+    c = field.coverage
+    t0, t1 = time_window if time_window is not None else (c.t0, c.t1)
+    x0, x1, y0, y1 = bbox if bbox is not None else (c.xmin, c.xmax, c.ymin, c.ymax)
+    if t0 >= c.t0 and t1 <= c.t1 and x0 >= c.xmin and x1 <= c.xmax and y0 >= c.ymin and (
+        y1 <= c.ymax
+    ):
+        return
+    need = Coverage(t0, t1, x0, x1, y0, y1)
+    raise OutOfCoverageError(
+        f"{name} does not cover the course and race time.\n"
+        f"  needed:  {need.describe()}\n"
+        f"  covered: {c.describe()}\n"
+        "  Use wind data that covers the course (the thesis's main failure was extrapolating "
+        "outside the data), or opt in to clamping at the edges with `clamp: true`."
+    )
+
+
+class _Context:
+    def __init__(
+        self,
+        frame: LocalFrame,
+        base_dir: Path,
+        crop_bbox: BBox | None,
+        time_window: tuple[float, float] | None,
+    ) -> None:
+        self.frame = frame
+        self.base_dir = base_dir
+        self.crop_bbox = crop_bbox
+        self.time_window = time_window
+
+
+# ---------------------------------------------------------------------------- uniform
+_UNIFORM_KEYS = ("type", "tws_kn", "tws_ms", "twd_deg", "table", "interpolation", "clamp")
+
+
+def _speed(chk: SpecChecker, spec: Mapping[str, Any], required: bool) -> float | None:
+    has_kn, has_ms = "tws_kn" in spec, "tws_ms" in spec
+    if has_kn and has_ms:
+        chk.add("tws_kn", "give either tws_kn or tws_ms, not both")
+        return None
+    if has_kn:
+        v = chk.number(spec, "tws_kn", nonnegative=True)
+        return None if v is None else v * KNOT
+    if has_ms:
+        return chk.number(spec, "tws_ms", nonnegative=True)
+    if required:
+        chk.add("tws_kn", "missing required key; give the wind speed as tws_kn or tws_ms")
+    return None
+
+
+def _build_uniform(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+    chk.check_keys(spec, _UNIFORM_KEYS)
+    clamp = chk.boolean(spec, "clamp", False)
+    interpolation = chk.choice(spec, "interpolation", ["linear", "previous"], "linear")
+    table = spec.get("table")
+    if table is None:
+        tws = _speed(chk, spec, required=True)
+        twd = chk.number(spec, "twd_deg")
+        chk.raise_if_any()
+        return UniformWind(tws, twd, clamp=clamp)
+    for key in ("tws_kn", "tws_ms", "twd_deg"):
+        if key in spec:
+            chk.add(key, "not allowed together with `table`; put speeds and directions in the rows")
+    if not isinstance(table, list) or not table:
+        chk.add("table", f"expected a non-empty list of rows {{time, tws_kn, twd_deg}}, "
+                f"got {table!r}")
+        chk.raise_if_any()
+    times: list[float] = []
+    speeds: list[float] = []
+    dirs: list[float] = []
+    tchk = chk.child("table")
+    for k, row in enumerate(table):
+        rchk = tchk.child(k)
+        if not isinstance(row, Mapping):
+            rchk.add("time", f"expected a mapping {{time, tws_kn, twd_deg}}, got {row!r}")
+            continue
+        rchk.check_keys(row, ("time", "tws_kn", "tws_ms", "twd_deg"), ("time",))
+        t = None
+        if "time" in row:
+            try:
+                t = to_epoch(parse_time(row["time"], where=rchk.path("time")))
+            except InputError as exc:
+                rchk.problems.append(str(exc))
+        s = _speed(rchk, row, required=True)
+        d = rchk.number(row, "twd_deg")
+        if t is not None and s is not None and d is not None:
+            times.append(t)
+            speeds.append(s)
+            dirs.append(d)
+    if not chk.problems:
+        for k in range(1, len(times)):
+            if times[k] <= times[k - 1]:
+                tchk.child(k).add("time", "table times must increase strictly from row to row")
+    chk.raise_if_any()
+    return UniformWind(speeds, dirs, times=times, interpolation=interpolation, clamp=clamp)
+
+
+# ---------------------------------------------------------------------------- wrf
+_WRF_KEYS = ("type", "path", "height_m", "time_step_min", "interpolation", "levels", "shear",
+             "fallback_exponent", "exponent_range", "roughness_m", "margin_m", "clamp")
+
+
+def _path(chk: SpecChecker, spec: Mapping[str, Any], ctx: _Context) -> Path | None:
+    p = chk.string(spec, "path")
+    if p is None:
+        return None
+    full = (ctx.base_dir / p).resolve() if not Path(p).is_absolute() else Path(p)
+    if not full.is_file():
+        chk.add("path", f"file not found: {full} (paths are relative to {ctx.base_dir})")
+        return None
+    return full
+
+
+def _wrf_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> dict[str, Any]:
+    """Validate a ``type: wrf`` spec into keyword arguments of :func:`open_wrf`."""
+    chk.check_keys(spec, _WRF_KEYS, ("path",))
+    opts: dict[str, Any] = {
+        "path": _path(chk, spec, ctx),
+        "height_m": chk.number(spec, "height_m", None, positive=True),
+        "time_step_min": chk.number(spec, "time_step_min", None, positive=True),
+        "interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
+        "levels": chk.choice(spec, "levels", ["auto", "u10", "model"], "auto"),
+        "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
+        "fallback_exponent": chk.number(spec, "fallback_exponent", DEFAULT_EXPONENT, lo=-1.0,
+                                        hi=1.0),
+        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, positive=True),
+        "margin_m": chk.number(spec, "margin_m", None, nonnegative=True),
+        "clamp": chk.boolean(spec, "clamp", False),
+        "exponent_range": DEFAULT_EXPONENT_RANGE,
+    }
+    if "exponent_range" in spec:
+        er = spec["exponent_range"]
+        if (not isinstance(er, list | tuple) or len(er) != 2
+                or not all(isinstance(a, int | float) and not isinstance(a, bool) for a in er)
+                or not er[0] < er[1]):
+            chk.add("exponent_range", f"expected [min, max] with min < max, e.g. [0.0, 0.6]; "
+                    f"got {er!r}")
+        else:
+            opts["exponent_range"] = (float(er[0]), float(er[1]))
+    if opts["levels"] == "model" and "height_m" not in spec:
+        chk.add("levels", "'model' levels are only used for a height correction; set height_m "
+                "(e.g. 2.68 for a Laser's centre of effort) or use levels: auto")
+    return opts
+
+
+def _open_wrf_checked(opts: dict[str, Any], where: str, ctx: _Context) -> WindField:
+    try:
+        return open_wrf(opts.pop("path"), ctx.frame, bbox=ctx.crop_bbox,
+                        time_window=ctx.time_window, **opts)
+    except InputError as exc:
+        raise type(exc)(f"{where}: {exc}") from None
+
+
+def _build_wrf(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+    opts = _wrf_options(spec, chk, ctx)
+    chk.raise_if_any()
+    return _open_wrf_checked(opts, chk.where, ctx)
+
+
+# ---------------------------------------------------------------------------- stations
+_READ_KEYS = ("path", "speed_unit", "columns", "timezone", "resample_s", "station", "position",
+              "measurement_height_m", "missing")
+_STATION_FIELD_KEYS = ("method", "power", "radius_m", "max_gap_s", "height_m", "shear",
+                       "exponent", "roughness_m", "clamp")
+
+
+def _read_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> dict[str, Any]:
+    """Validate the station-file keys into keyword arguments of :func:`read_stations`."""
+    opts: dict[str, Any] = {"path": _path(chk, spec, ctx)}
+    unit = chk.string(spec, "speed_unit", None)
+    if unit is not None and unit.strip().lower() not in SPEED_UNITS:
+        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph', got {unit!r}")
+        unit = None
+    opts["speed_unit"] = unit
+    cols = chk.mapping(spec, "columns", None)
+    if cols is not None:
+        for k, v in cols.items():
+            if k not in CANONICAL_COLUMNS:
+                chk.child("columns").add(str(k), "unknown canonical column; expected one of "
+                                         + ", ".join(CANONICAL_COLUMNS))
+            elif not isinstance(v, str):
+                chk.child("columns").add(str(k), f"expected a column name, got {v!r}")
+    opts["columns"] = cols
+    tz = chk.string(spec, "timezone", None)
+    if tz is not None:
+        try:
+            parse_offset(tz)
+        except InputError as exc:
+            chk.add("timezone", str(exc).split(": ", 1)[-1])
+            tz = None
+    opts["timezone"] = tz
+    opts["resample_s"] = chk.number(spec, "resample_s", None, positive=True)
+    st = spec.get("station")
+    if st is not None and not isinstance(st, str | int):
+        chk.add("station", f"expected a station id, got {st!r}")
+    opts["station"] = None if st is None else str(st)
+    pos = chk.mapping(spec, "position", None)
+    if pos is not None:
+        pchk = chk.child("position")
+        pchk.check_keys(pos, ("lat", "lon"), ("lat", "lon"))
+        la = pchk.number(pos, "lat", lo=-90.0, hi=90.0) if "lat" in pos else None
+        lo = pchk.number(pos, "lon", lo=-180.0, hi=360.0) if "lon" in pos else None
+        opts["position"] = None if la is None or lo is None else (la, lo)
+    opts["height_m"] = chk.number(spec, "measurement_height_m", None, positive=True)
+    miss = spec.get("missing")
+    if miss is not None:
+        if not isinstance(miss, list) or not all(isinstance(m, str | int | float) for m in miss):
+            chk.add("missing", f"expected a list of markers such as ['', 'MM', '999'], "
+                    f"got {miss!r}")
+        else:
+            opts["missing"] = tuple(DEFAULT_MISSING) + tuple(str(m) for m in miss)
+    return opts
+
+
+def _read_checked(opts: dict[str, Any], where: str) -> StationData:
+    try:
+        return read_stations(opts.pop("path"), **opts)
+    except InputError as exc:
+        raise type(exc)(f"{where}: {exc}") from None
+
+
+def _build_stations(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+    chk.check_keys(spec, ("type", *_READ_KEYS, *_STATION_FIELD_KEYS), ("path",))
+    ropts = _read_options(spec, chk, ctx)
+    fopts = {
+        "method": chk.choice(spec, "method", ["idw", "rbf"], "idw"),
+        "power": chk.number(spec, "power", 2.0, positive=True),
+        "radius_m": chk.number(spec, "radius_m", 2000.0, nonnegative=True),
+        "max_gap_s": chk.number(spec, "max_gap_s", 1800.0, positive=True),
+        "height_m": chk.number(spec, "height_m", None, positive=True),
+        "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
+        "exponent": chk.number(spec, "exponent", DEFAULT_EXPONENT, lo=-1.0, hi=1.0),
+        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, positive=True),
+        "clamp": chk.boolean(spec, "clamp", False),
+    }
+    chk.raise_if_any()
+    data = _read_checked(ropts, chk.where)
+    try:
+        return StationWind(data, ctx.frame, name=f"station wind {data.source}", **fopts)
+    except InputError as exc:
+        raise type(exc)(f"{chk.where}: {exc}") from None
+
+
+# ---------------------------------------------------------------------------- blended
+_BLEND_KEYS = ("type", "wrf", "stations", "length_scale_m", "time_scale_s", "min_speed_ms",
+               "ratio_range", "max_offset_deg", "clamp")
+
+
+def _build_blended(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+    chk.check_keys(spec, _BLEND_KEYS, ("wrf", "stations"))
+    wspec = chk.mapping(spec, "wrf")
+    sspec = chk.mapping(spec, "stations")
+    wopts: dict[str, Any] = {}
+    ropts: dict[str, Any] = {}
+    if wspec is not None:
+        wchk = chk.child("wrf")
+        if wspec.get("type", "wrf") != "wrf":
+            wchk.add("type", f"expected 'wrf' (or leave it out), got {wspec.get('type')!r}")
+        wopts = _wrf_options({k: v for k, v in wspec.items() if k != "type"} | {"type": "wrf"},
+                             wchk, ctx)
+    if sspec is not None:
+        schk = chk.child("stations")
+        schk.check_keys(sspec, ("type", *_READ_KEYS), ("path",))
+        ropts = _read_options(sspec, schk, ctx)
+    bopts: dict[str, Any] = {
+        "length_scale_m": chk.number(spec, "length_scale_m", 2000.0, positive=True),
+        "time_scale_s": chk.number(spec, "time_scale_s", 600.0, nonnegative=True),
+        "min_speed_ms": chk.number(spec, "min_speed_ms", 1.0, nonnegative=True),
+        "max_offset_deg": chk.number(spec, "max_offset_deg", 60.0, lo=0.0, hi=180.0),
+        "clamp": chk.boolean(spec, "clamp", False),
+    }
+    if "ratio_range" in spec:
+        rr = spec["ratio_range"]
+        if (not isinstance(rr, list | tuple) or len(rr) != 2
+                or not all(isinstance(a, int | float) and not isinstance(a, bool) for a in rr)
+                or not 0 < rr[0] <= 1 <= rr[1]):
+            chk.add("ratio_range", f"expected [min, max] with 0 < min <= 1 <= max, e.g. "
+                    f"[0.5, 2.0]; got {rr!r}")
+        else:
+            bopts["ratio_range"] = (float(rr[0]), float(rr[1]))
+    chk.raise_if_any()
+    base = _open_wrf_checked(dict(wopts), f"{chk.where}.wrf", ctx)
+    data = _read_checked(ropts, f"{chk.where}.stations")
+    try:
+        return BlendedWind(base, data, ctx.frame, height_m=wopts.get("height_m"),
+                           exponent=wopts.get("fallback_exponent", DEFAULT_EXPONENT),
+                           name=f"blended wind ({Path(str(wopts['path'])).name} + "
+                           f"{Path(data.source).name})", **bopts)
+    except InputError as exc:
+        raise type(exc)(f"{chk.where}: {exc}") from None
+
+
+_BUILDERS: dict[str, Callable[[Mapping[str, Any], SpecChecker, _Context], WindField]] = {
+    "uniform": _build_uniform,
+    "wrf": _build_wrf,
+    "stations": _build_stations,
+    "blended": _build_blended,
+}

@@ -1,0 +1,303 @@
+"""Wind on a (curvilinear) structured grid in time: the field behind WRF sources.
+
+Sampling is done in *index space*.  A WRF grid is regular in its own map
+projection, not in the course's local frame, so a least-squares polynomial
+``(x, y) -> (i, j)`` of the lowest degree (1 = affine, up to 5) that reproduces
+every cell centre to within ``map_tolerance_cells`` (default 0.01 cells = 1 % of
+DX) is fitted once.  A sample point's fractional indices then give bilinear
+(or nearest-cell) weights, and times are interpolated linearly between slices,
+or frozen per block of ``time_step_s`` (thesis's 60/30/10-min scenarios).
+
+Everything is vectorised; u and v travel together as one complex array so each
+corner costs one gather.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sailroute.errors import InputError, WindDataError
+from sailroute.wind.base import Coverage, prepare_points
+
+MAX_MAP_DEGREE = 5
+
+
+@dataclass(frozen=True)
+class IndexMap:
+    """Polynomial map from local ``(x, y)`` [m] to fractional grid indices ``(i, j)``.
+
+    Attributes
+    ----------
+    degree : int
+        Total polynomial degree.
+    x0, y0, scale : float
+        Normalisation: the polynomial is evaluated at ``((x - x0)/scale, (y - y0)/scale)``.
+    ci, cj : ndarray
+        Coefficients of the monomials ``X^p Y^q`` (``p + q <= degree``, ``p``-major order).
+    residual_cells : float
+        Largest misfit at the cell centres it was fitted on [cells].
+    """
+
+    degree: int
+    x0: float
+    y0: float
+    scale: float
+    ci: NDArray[np.float64]
+    cj: NDArray[np.float64]
+    residual_cells: float
+
+    def __call__(self, x: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
+        """Fractional indices ``(i, j)`` of local points ``(x, y)`` [m]."""
+        X = (x - self.x0) * (1.0 / self.scale)
+        Y = (y - self.y0) * (1.0 / self.scale)
+        if self.degree == 1:
+            ci, cj = self.ci, self.cj  # monomials: 1, Y, X
+            return ci[0] + ci[1] * Y + ci[2] * X, cj[0] + cj[1] * Y + cj[2] * X
+        fi = np.zeros_like(X)
+        fj = np.zeros_like(X)
+        k = 0
+        xp = np.ones_like(X)
+        for p in range(self.degree + 1):
+            term = xp
+            for q in range(self.degree + 1 - p):
+                if q:
+                    term = term * Y
+                fi += self.ci[k] * term
+                fj += self.cj[k] * term
+                k += 1
+            if p < self.degree:
+                xp = xp * X
+        return fi, fj
+
+
+def _monomials(X: NDArray, Y: NDArray, degree: int) -> NDArray:
+    cols = []
+    for p in range(degree + 1):
+        for q in range(degree + 1 - p):
+            cols.append(X**p * Y**q)
+    return np.stack(cols, axis=-1)
+
+
+def fit_index_map(
+    x: NDArray, y: NDArray, *, tolerance_cells: float = 0.01, name: str = "grid"
+) -> IndexMap:
+    """Fit the lowest-degree polynomial ``(x, y) -> (i, j)`` within ``tolerance_cells``.
+
+    Parameters
+    ----------
+    x, y : ndarray, shape (ny, nx)
+        Local coordinates of the cell centres [m]; ``i`` runs along axis 1, ``j`` along axis 0.
+    tolerance_cells : float
+        Largest accepted misfit at any cell centre [cells].
+    name : str
+        Label for the error message.
+
+    Returns
+    -------
+    IndexMap
+
+    Raises
+    ------
+    WindDataError
+        If even degree 5 misfits by more than the tolerance (a huge or folded grid).
+    """
+    ny, nx = x.shape
+    jj, ii = np.mgrid[0:ny, 0:nx]
+    x0, y0 = float(np.mean(x)), float(np.mean(y))
+    scale = float(max(np.ptp(x), np.ptp(y), 1.0))
+    X = ((x - x0) / scale).ravel()
+    Y = ((y - y0) / scale).ravel()
+    best = None
+    for degree in range(1, MAX_MAP_DEGREE + 1):
+        nterms = (degree + 1) * (degree + 2) // 2
+        if nterms > X.size:
+            break
+        A = _monomials(X, Y, degree)
+        ci, *_ = np.linalg.lstsq(A, ii.ravel().astype(float), rcond=None)
+        cj, *_ = np.linalg.lstsq(A, jj.ravel().astype(float), rcond=None)
+        res = float(max(np.max(np.abs(A @ ci - ii.ravel())), np.max(np.abs(A @ cj - jj.ravel()))))
+        best = IndexMap(degree, x0, y0, scale, ci, cj, res)
+        if res <= tolerance_cells:
+            return best
+    raise WindDataError(
+        f"{name}: the grid cannot be mapped to the local frame to within {tolerance_cells:g} "
+        f"cells (best misfit {best.residual_cells if best else float('nan'):.3g} cells); "
+        "crop the data to the course area (a smaller `margin_m`) or check XLAT/XLONG"
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class GridWind:
+    """Wind on a structured grid of cell centres, at a series of times.
+
+    Parameters
+    ----------
+    times : array_like, shape (nt,)
+        Epoch seconds [s] of the slices, strictly increasing.
+    x, y : array_like, shape (ny, nx)
+        Local coordinates of the cell centres [m] (a smooth, non-folded grid
+        whose axis 1 runs roughly east and axis 0 roughly north).
+    u, v : array_like, shape (nt, ny, nx)
+        Local-frame wind components [m s⁻¹].
+    interpolation : {"linear", "nearest"}
+        In space: bilinear in grid-index space, or the nearest cell centre.
+    time_step_s : float, optional
+        Freeze the wind per block of this length [s]: a time ``t`` uses the field
+        at ``floor(t / time_step_s) * time_step_s`` (UTC-aligned block start,
+        clipped to the data), held constant through the block.  ``None``: linear
+        in time between slices.
+    clamp : bool
+        Clamp points to the coverage instead of raising
+        :class:`~sailroute.errors.OutOfCoverageError`.
+    name : str
+        Label used in messages.
+    info : mapping
+        Provenance and diagnostics (file, levels, map residual, ...).
+    map_tolerance_cells : float
+        Accepted misfit of the local-frame index map [cells].
+
+    Notes
+    -----
+    Coverage is the time span of the slices and the largest axis-aligned box
+    inside the grid's footprint (the cell centres on the outer ring bound it).
+    """
+
+    times: ArrayLike
+    x: ArrayLike
+    y: ArrayLike
+    u: ArrayLike
+    v: ArrayLike
+    interpolation: str = "linear"
+    time_step_s: float | None = None
+    clamp: bool = False
+    name: str = "gridded wind"
+    info: Mapping[str, Any] = field(default_factory=dict)
+    map_tolerance_cells: float = 0.01
+    _t: NDArray = field(init=False, repr=False)
+    _uv: NDArray = field(init=False, repr=False)
+    _map: IndexMap = field(init=False, repr=False)
+    _cov: Coverage = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        t = np.asarray(self.times, dtype=float).ravel()
+        x = np.asarray(self.x, dtype=float)
+        y = np.asarray(self.y, dtype=float)
+        u = np.asarray(self.u, dtype=float)
+        v = np.asarray(self.v, dtype=float)
+        if x.ndim != 2 or x.shape != y.shape or min(x.shape) < 2:
+            raise InputError(
+                f"{self.name}: x and y must be 2-D arrays of the same shape with at least "
+                f"2 x 2 cells, got {x.shape} and {y.shape}"
+            )
+        if u.shape != (t.size, *x.shape) or v.shape != u.shape:
+            raise InputError(
+                f"{self.name}: u and v must have shape (times, ny, nx) = "
+                f"{(t.size, *x.shape)}, got {u.shape} and {v.shape}"
+            )
+        if t.size == 0 or np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
+            raise InputError(f"{self.name}: times must be finite and strictly increasing")
+        for label, a in (("x", x), ("y", y), ("u", u), ("v", v)):
+            if not np.all(np.isfinite(a)):
+                raise InputError(f"{self.name}: {label} contains NaN or infinite values")
+        if self.interpolation not in ("linear", "nearest"):
+            raise InputError(
+                f"{self.name}: interpolation {self.interpolation!r}; "
+                "expected 'linear' or 'nearest'"
+            )
+        if self.time_step_s is not None and not (self.time_step_s > 0):
+            raise InputError(
+                f"{self.name}: time_step_s must be a positive number of seconds or None, "
+                f"got {self.time_step_s!r}"
+            )
+        # The outer ring bounds the footprint; axis 1 must run east, axis 0 north.
+        xmin, xmax = float(np.max(x[:, 0])), float(np.min(x[:, -1]))
+        ymin, ymax = float(np.max(y[0, :])), float(np.min(y[-1, :]))
+        if not (xmin < xmax and ymin < ymax):
+            raise WindDataError(
+                f"{self.name}: the grid's first axis must run south to north and its second "
+                "west to east in the local frame (a grid rotated by more than ~45 degrees or "
+                "mirrored is not supported)"
+            )
+        imap = fit_index_map(x, y, tolerance_cells=self.map_tolerance_cells, name=self.name)
+        uv = np.ascontiguousarray((u + 1j * v).reshape(t.size, -1))
+        object.__setattr__(self, "_t", t)
+        object.__setattr__(self, "_uv", uv)
+        object.__setattr__(self, "_map", imap)
+        object.__setattr__(self, "_cov", Coverage(float(t[0]), float(t[-1]), xmin, xmax, ymin,
+                                                   ymax))
+
+    @property
+    def coverage(self) -> Coverage:
+        """Time span of the slices and the box inside the grid footprint."""
+        return self._cov
+
+    @property
+    def shape(self) -> tuple[int, int, int]:
+        """``(nt, ny, nx)``."""
+        ny, nx = np.shape(self.x)
+        return (self._t.size, ny, nx)
+
+    @property
+    def index_map(self) -> IndexMap:
+        """The fitted local-frame -> grid-index map."""
+        return self._map
+
+    def grid_indices(self, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
+        """Fractional grid indices ``(i, j)`` (column, row) of local points [m]."""
+        return self._map(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+
+    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
+        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast)."""
+        t, x, y = prepare_points(self._cov, t, x, y, clamp=self.clamp, name=self.name)
+        shape = t.shape
+        t, x, y = t.ravel(), x.ravel(), y.ravel()
+        nt, ny, nx = self.shape
+        tt = self._t
+        if self.time_step_s is not None:
+            t = np.clip(np.floor(t / self.time_step_s) * self.time_step_s, tt[0], tt[-1])
+        fi, fj = self._map(x, y)
+        np.clip(fi, 0.0, nx - 1.0, out=fi)
+        np.clip(fj, 0.0, ny - 1.0, out=fj)
+        uv = self._uv
+        if nt == 1:
+            k = np.zeros(t.shape, dtype=np.intp)
+            wt = None
+        else:
+            k = np.searchsorted(tt, t, side="right") - 1
+            np.clip(k, 0, nt - 2, out=k)
+            wt = (t - tt[k]) / (tt[k + 1] - tt[k])
+            np.clip(wt, 0.0, 1.0, out=wt)
+        ncell = ny * nx
+        flat = uv.ravel()
+        if self.interpolation == "nearest":
+            cell = np.rint(fj).astype(np.intp) * nx + np.rint(fi).astype(np.intp)
+            base = k * ncell + cell
+            out = flat.take(base)
+            if wt is not None:
+                out = out + wt * (flat.take(base + ncell) - out)
+        else:
+            i0 = np.minimum(fi.astype(np.intp), nx - 2)
+            j0 = np.minimum(fj.astype(np.intp), ny - 2)
+            wx = fi - i0
+            wy = fj - j0
+            base = k * ncell + j0 * nx + i0
+            out = _bilinear(flat, base, nx, wx, wy)
+            if wt is not None:
+                out = out + wt * (_bilinear(flat, base + ncell, nx, wx, wy) - out)
+        return out.real.reshape(shape).copy(), out.imag.reshape(shape).copy()
+
+
+def _bilinear(flat: NDArray, base: NDArray, nx: int, wx: NDArray, wy: NDArray) -> NDArray:
+    """Bilinear blend of the 4 cells whose lower-left corner is ``base`` (flat index)."""
+    a = flat.take(base)
+    b = flat.take(base + 1)
+    c = flat.take(base + nx)
+    d = flat.take(base + nx + 1)
+    lo = a + wx * (b - a)
+    hi = c + wx * (d - c)
+    return lo + wy * (hi - lo)

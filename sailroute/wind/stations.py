@@ -1,0 +1,780 @@
+"""Measured wind from stations (fixed anemometers, buoys, coach boats): read, resample, field.
+
+* :func:`read_stations` reads a CSV with the canonical columns ``time`` (ISO 8601
+  with offset), ``station``, ``lat``, ``lon``, ``speed``, ``direction`` (from,
+  °T) and optional ``height_m``, ``gust``; other headers are mapped through
+  :data:`COLUMN_ALIASES` or an explicit ``columns`` mapping.  Missing-value
+  markers are counted and their rows dropped.
+* :func:`resample_stations` averages 1-20 Hz logs into fixed intervals: scalar
+  mean speed, vector-mean direction.
+* :class:`StationWind` interpolates the stations in space (inverse distance or
+  scipy RBF) and linearly in time, inside the stations' box plus ``radius_m``.
+
+A station whose position changes (a coach boat) is one moving station; its
+position is interpolated in time like its wind.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from datetime import UTC, datetime, timedelta, timezone
+from pathlib import Path
+from typing import Any, Final
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sailroute.errors import InputError, WindDataError, format_problems
+from sailroute.geo import LocalFrame
+from sailroute.timeutil import iso
+from sailroute.units import speed_factor, wind_components, wind_speed_direction
+from sailroute.wind.base import Coverage, prepare_points
+from sailroute.wind.height import (
+    DEFAULT_EXPONENT,
+    DEFAULT_ROUGHNESS_M,
+    log_law_factor,
+    power_law_factor,
+)
+from sailroute.wind.rotation import earth_to_local
+
+CANONICAL_COLUMNS: Final = ("time", "station", "lat", "lon", "speed", "direction", "height_m",
+                            "gust")
+"""Column names of the canonical station CSV schema."""
+
+REQUIRED_COLUMNS: Final = ("time", "speed", "direction")
+"""Always required (``lat``/``lon`` unless ``position`` is given; ``station`` defaults)."""
+
+COLUMN_ALIASES: Final[dict[str, tuple[str, ...]]] = {
+    "time": ("time", "time_utc", "datetime", "datetime_utc", "datetime_local", "timestamp",
+             "date_time", "utc", "time_iso", "t"),
+    "station": ("station", "station_id", "stationid", "id", "name", "sensor"),
+    "lat": ("lat", "latitude", "lat_deg"),
+    "lon": ("lon", "lng", "long", "longitude", "lon_deg"),
+    "speed": ("speed", "tws", "tws_kn", "tws_kt", "tws_ms", "tws_m_s", "wspd", "wspd_m_s",
+              "wspd_kn", "wind_speed", "wind_speed_kn", "wind_speed_ms", "wind_speed_m_s",
+              "windspeed", "ws", "speed_kn", "speed_ms", "speed_m_s", "speed_kmh", "speed_mph"),
+    "direction": ("direction", "twd", "twd_deg", "wdir", "wdir_deg", "wdir_deg_true",
+                  "wind_direction", "wind_dir", "winddir", "wd", "direction_deg", "dir"),
+    "height_m": ("height_m", "height", "z", "z_m", "anemometer_height_m", "sensor_height_m"),
+    "gust": ("gust", "gust_m_s", "gust_ms", "gust_kn", "gst", "wind_gust", "gust_speed"),
+}
+"""Built-in header aliases (case-insensitive) for each canonical column."""
+
+DEFAULT_MISSING: Final = ("", "NA", "N/A", "NaN", "nan", "NAN", "null", "NULL", "None", "MM",
+                          "-", "--")
+"""Cell values read as missing by default (add e.g. ``"999"`` for NDBC codes)."""
+
+_UNIT_SUFFIXES: Final = (("_m_s", "m/s"), ("_ms", "m/s"), ("_mps", "m/s"), ("_kn", "kn"),
+                         ("_kt", "kn"), ("_kts", "kn"), ("_knots", "kn"), ("_kmh", "km/h"),
+                         ("_kph", "km/h"), ("_mph", "mph"))
+
+
+# ------------------------------------------------------------------------------ data
+@dataclass(frozen=True)
+class StationData:
+    """Station records, one per (station, time), SI units, sorted by station then time.
+
+    Attributes
+    ----------
+    station : ndarray of str
+        Station id of each record.
+    t : ndarray
+        Epoch seconds [s] (UTC).
+    lat, lon : ndarray
+        Position [°] (varies in time for a moving station).
+    speed_ms : ndarray
+        Wind speed [m s⁻¹].
+    direction_deg : ndarray
+        Direction the wind comes from [°], in ``[0, 360)``.
+    height_m : ndarray
+        Measurement height above the water [m]; NaN when unknown.
+    gust_ms : ndarray
+        Gust [m s⁻¹]; NaN when absent.
+    source : str
+        File the records came from.
+    n_raw : int
+        Data rows in the file (before dropping and resampling).
+    n_missing : int
+        Rows dropped because a needed value was a missing marker or NaN.
+    missing_by_column : mapping of str to int
+        Missing cells per canonical column (also counting optional columns).
+    """
+
+    station: NDArray[np.str_]
+    t: NDArray[np.float64]
+    lat: NDArray[np.float64]
+    lon: NDArray[np.float64]
+    speed_ms: NDArray[np.float64]
+    direction_deg: NDArray[np.float64]
+    height_m: NDArray[np.float64]
+    gust_ms: NDArray[np.float64]
+    source: str = ""
+    n_raw: int = 0
+    n_missing: int = 0
+    missing_by_column: Mapping[str, int] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def stations(self) -> tuple[str, ...]:
+        """Station ids in order of first appearance."""
+        _, first = np.unique(self.station, return_index=True)
+        return tuple(str(s) for s in self.station[np.sort(first)])
+
+    def select(self, station: str) -> StationData:
+        """Records of one station."""
+        m = self.station == station
+        return replace(self, **{k: getattr(self, k)[m] for k in _ARRAY_FIELDS})
+
+    @property
+    def u(self) -> NDArray[np.float64]:
+        """Eastward wind component [m s⁻¹] (true east)."""
+        return wind_components(self.speed_ms, self.direction_deg)[0]
+
+    @property
+    def v(self) -> NDArray[np.float64]:
+        """Northward wind component [m s⁻¹] (true north)."""
+        return wind_components(self.speed_ms, self.direction_deg)[1]
+
+
+_ARRAY_FIELDS: Final = ("station", "t", "lat", "lon", "speed_ms", "direction_deg", "height_m",
+                        "gust_ms")
+
+
+# ------------------------------------------------------------------------------ reading
+def unit_from_header(column: str) -> str | None:
+    """Speed unit implied by a header suffix (``tws_kn`` -> ``"kn"``), or None."""
+    c = column.strip().lower()
+    for suffix, unit in _UNIT_SUFFIXES:
+        if c.endswith(suffix):
+            return unit
+    return None
+
+
+def parse_offset(text: str, where: str = "timezone") -> timezone:
+    """Parse a fixed UTC offset such as ``"+01:00"``, ``"-0530"``, ``"Z"`` or ``"UTC"``."""
+    s = text.strip()
+    if s.upper() in ("Z", "UTC", "GMT", "+00:00", "00:00"):
+        return UTC
+    m = re.fullmatch(r"([+-])(\d{1,2}):?(\d{2})?", s)
+    if not m:
+        raise InputError(
+            f"{where}: {text!r} is not a UTC offset; expected e.g. '+01:00', '-05:00' or 'Z' "
+            "(named zones are not accepted: give the offset that applied on the day)"
+        )
+    sign = 1 if m.group(1) == "+" else -1
+    delta = timedelta(hours=int(m.group(2)), minutes=int(m.group(3) or 0))
+    if delta > timedelta(hours=14):
+        raise InputError(f"{where}: offset {text!r} is larger than 14 hours")
+    return timezone(sign * delta)
+
+
+def map_columns(
+    header: Sequence[str], columns: Mapping[str, str] | None = None, *, where: str = "CSV"
+) -> dict[str, int]:
+    """Map canonical column names to indices of ``header``.
+
+    Parameters
+    ----------
+    header : sequence of str
+        The file's header fields.
+    columns : mapping, optional
+        Explicit ``canonical -> file column`` mapping; takes precedence over aliases.
+    where : str
+        File name for messages.
+
+    Returns
+    -------
+    dict
+        ``canonical name -> column index`` for every canonical column found.
+
+    Raises
+    ------
+    InputError
+        Unknown canonical names, explicit columns not in the header, or ambiguous
+        aliases (two headers for one canonical column).
+    """
+    norm = [h.strip().lower() for h in header]
+    out: dict[str, int] = {}
+    problems: list[str] = []
+    for canon, col in (columns or {}).items():
+        if canon not in CANONICAL_COLUMNS:
+            problems.append(f"columns.{canon}: unknown canonical column; expected one of "
+                            + ", ".join(CANONICAL_COLUMNS))
+            continue
+        if not isinstance(col, str) or col.strip().lower() not in norm:
+            problems.append(f"columns.{canon}: column {col!r} is not in the header "
+                            f"({', '.join(h.strip() for h in header)})")
+            continue
+        out[canon] = norm.index(col.strip().lower())
+    for canon, aliases in COLUMN_ALIASES.items():
+        if canon in out:
+            continue
+        hits = [k for k, h in enumerate(norm) if h in aliases and k not in out.values()]
+        if len(hits) > 1:
+            problems.append(
+                f"columns: {', '.join(header[k].strip() for k in hits)} could all be the "
+                f"{canon!r} column; choose one with `columns: {{{canon}: <name>}}`"
+            )
+        elif hits:
+            out[canon] = hits[0]
+    if problems:
+        raise InputError(format_problems(f"{where}: cannot map the CSV columns", problems))
+    return out
+
+
+def read_stations(
+    path: str | Path,
+    *,
+    columns: Mapping[str, str] | None = None,
+    speed_unit: str | None = None,
+    timezone: str | None = None,
+    missing: Sequence[str] = DEFAULT_MISSING,
+    station: str | None = None,
+    position: tuple[float, float] | None = None,
+    height_m: float | None = None,
+    resample_s: float | None = None,
+    min_fill: float = 0.5,
+) -> StationData:
+    """Read a station wind CSV.
+
+    Parameters
+    ----------
+    path : str or Path
+        CSV file (``,``, ``;`` or tab separated; lines starting with ``#`` are skipped).
+    columns : mapping, optional
+        ``canonical -> file column`` for headers that the built-in aliases do not know.
+    speed_unit : str, optional
+        Unit of ``speed`` and ``gust``: ``m/s``, ``kn``, ``km/h`` or ``mph``.  When
+        omitted, the speed header's suffix decides (``tws_kn`` -> kn,
+        ``wspd_m_s`` -> m/s); a plain ``speed`` header then is an error, because a
+        wrong guess would silently scale every speed.
+    timezone : str, optional
+        UTC offset (``"+01:00"``) applied to timestamps that carry none.  Without it
+        a naive timestamp is an error naming the line.
+    missing : sequence of str
+        Cell values that mean "no data" (compared after stripping blanks).
+    station : str, optional
+        Station id when the file has no ``station`` column (default: the file stem).
+    position : (float, float), optional
+        ``(lat, lon)`` [°] of a fixed station when the file has no ``lat``/``lon``.
+    height_m : float, optional
+        Measurement height [m] when the file has no ``height_m`` column.
+    resample_s : float, optional
+        Average into bins of this many seconds (see :func:`resample_stations`).
+    min_fill : float
+        With ``resample_s``: drop bins holding less than this fraction of the
+        samples a full bin would hold.
+
+    Returns
+    -------
+    StationData
+
+    Raises
+    ------
+    InputError / WindDataError
+        Empty file, unknown or ambiguous columns, undeclared unit, unreadable
+        numbers or times (naming line and column), naive times without
+        ``timezone``, values out of range, times that do not increase per station.
+    """
+    p = Path(path)
+    name = str(p)
+    if not p.is_file():
+        raise InputError(f"{name}: station file not found; check the `path`")
+    text = p.read_text(encoding="utf-8-sig", errors="replace")
+    lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
+             if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise WindDataError(
+            f"{name}: the file is empty; expected a header row (e.g. "
+            "time,station,lat,lon,speed,direction) followed by data rows"
+        )
+    delim = max((",", ";", "\t"), key=lines[0][1].count)
+    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
+    header, body = rows[0], rows[1:]
+    linenos = [k for k, _ in lines[1:]]
+    cmap = map_columns(header, columns, where=name)
+    need = list(REQUIRED_COLUMNS) + ([] if position is not None else ["lat", "lon"])
+    absent = [c for c in need if c not in cmap]
+    if absent:
+        raise InputError(
+            f"{name}: no column for {', '.join(absent)}; header is "
+            f"{', '.join(h.strip() for h in header)}. Rename the columns to the canonical "
+            "names (time, station, lat, lon, speed, direction) or map them with `columns: "
+            "{canonical: file_column}`" + (" or give `position: {lat, lon}` for a fixed "
+                                           "station" if "lat" in absent else "")
+        )
+    if not body:
+        raise WindDataError(f"{name}: the file has a header but no data rows")
+    unit = _speed_unit(header[cmap["speed"]], speed_unit, name)
+    gust_unit = unit
+    if "gust" in cmap and speed_unit is None and unit_from_header(header[cmap["gust"]]):
+        gust_unit = unit_from_header(header[cmap["gust"]]) or unit
+    tz = parse_offset(timezone, f"{name}: timezone") if timezone is not None else None
+    miss = {m.strip() for m in missing}
+
+    ncol = len(header)
+    n = len(body)
+    cols: dict[str, list[str]] = {c: [] for c in cmap}
+    for r, lineno in zip(body, linenos, strict=True):
+        if len(r) != ncol:
+            raise WindDataError(
+                f"{name}, line {lineno}: {len(r)} fields but the header has {ncol}; check "
+                f"the separator ({delim!r}) and quoting"
+            )
+        for c, k in cmap.items():
+            cols[c].append(r[k].strip())
+
+    missing_by: dict[str, int] = {}
+    values: dict[str, NDArray] = {}
+    for c in ("lat", "lon", "speed", "direction", "height_m", "gust"):
+        if c in cols:
+            values[c], missing_by[c] = _numbers(cols[c], c, header[cmap[c]], linenos, miss, name)
+    t, missing_by["time"] = _times(cols["time"], linenos, miss, tz, name, header[cmap["time"]])
+    if "station" in cols:
+        st = np.array(cols["station"], dtype=object)
+        st_missing = np.isin(st, list(miss))
+        missing_by["station"] = int(st_missing.sum())
+    else:
+        st = np.full(n, station if station is not None else p.stem, dtype=object)
+        st_missing = np.zeros(n, dtype=bool)
+    if position is not None and "lat" not in values:
+        values["lat"] = np.full(n, float(position[0]))
+        values["lon"] = np.full(n, float(position[1]))
+
+    lat, lon = values["lat"], values["lon"]
+    spd = values["speed"] * speed_factor(unit)
+    dirn = values["direction"]
+    h = values["height_m"] if "height_m" in values else np.full(
+        n, np.nan if height_m is None else float(height_m))
+    gust = values["gust"] * speed_factor(gust_unit) if "gust" in values else np.full(n, np.nan)
+
+    _check_range(name, linenos, header[cmap["speed"]], spd, 0.0, np.inf, "speeds must be >= 0")
+    _check_range(name, linenos, header[cmap["direction"]], dirn, 0.0, 360.0,
+                 "directions must lie in [0, 360] degrees (wind FROM, true)")
+    if "lat" in cmap:
+        _check_range(name, linenos, header[cmap["lat"]], lat, -90.0, 90.0, "latitude in [-90, 90]")
+        _check_range(name, linenos, header[cmap["lon"]], lon, -180.0, 360.0,
+                     "longitude in [-180, 360]")
+
+    bad = np.isnan(t) | np.isnan(lat) | np.isnan(lon) | np.isnan(spd) | np.isnan(dirn) | st_missing
+    keep = ~bad
+    if not keep.any():
+        raise WindDataError(
+            f"{name}: every one of the {n} rows has a missing value in a needed column "
+            f"(missing per column: {_fmt_counts(missing_by)}); check the `missing` markers "
+            "and the column mapping"
+        )
+    ids = np.array([str(s) for s in st[keep]])
+    data = StationData(
+        station=ids, t=t[keep], lat=lat[keep], lon=lon[keep], speed_ms=spd[keep],
+        direction_deg=np.mod(dirn[keep], 360.0), height_m=h[keep], gust_ms=gust[keep],
+        source=name, n_raw=n, n_missing=int(bad.sum()),
+        missing_by_column={k: v for k, v in missing_by.items() if v},
+    )
+    data = _sorted_checked(data, np.asarray(linenos)[keep], name,
+                           allow_repeats=resample_s is not None)
+    if resample_s is not None:
+        data = resample_stations(data, resample_s, min_fill=min_fill)
+    return data
+
+
+def _speed_unit(column: str, declared: str | None, name: str) -> str:
+    implied = unit_from_header(column)
+    if declared is None:
+        if implied is None:
+            raise InputError(
+                f"{name}: the unit of column {column!r} is not known; declare it with "
+                "`speed_unit:` (one of 'm/s', 'kn', 'km/h', 'mph') or name the column with a "
+                "unit suffix such as speed_kn / speed_m_s"
+            )
+        return implied
+    try:
+        f_decl = speed_factor(declared)
+    except InputError as exc:
+        raise InputError(f"{name}: speed_unit: {exc}") from None
+    if implied is not None and not np.isclose(f_decl, speed_factor(implied)):
+        raise InputError(
+            f"{name}: speed_unit {declared!r} contradicts the column name {column!r} "
+            f"(which says {implied!r}); fix one of them"
+        )
+    return declared
+
+
+def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss: set[str],
+             name: str) -> tuple[NDArray, int]:
+    out = np.empty(len(cells))
+    n_miss = 0
+    for k, c in enumerate(cells):
+        if c in miss:
+            out[k] = np.nan
+            n_miss += 1
+            continue
+        try:
+            out[k] = float(c)
+        except ValueError:
+            raise WindDataError(
+                f"{name}, line {linenos[k]}, column {column!r}: cannot read {c!r} as a number "
+                f"({canon}); if it marks missing data, add it to `missing`"
+            ) from None
+        if np.isnan(out[k]):
+            n_miss += 1
+    return out, n_miss
+
+
+def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | None, name: str,
+           column: str) -> tuple[NDArray, int]:
+    out = np.empty(len(cells))
+    n_miss = 0
+    for k, c in enumerate(cells):
+        if c in miss:
+            out[k] = np.nan
+            n_miss += 1
+            continue
+        s = c[:-1] + "+00:00" if c.endswith(("Z", "z")) else c
+        try:
+            dt = datetime.fromisoformat(s)
+        except ValueError:
+            raise WindDataError(
+                f"{name}, line {linenos[k]}, column {column!r}: cannot read {c!r} as an ISO "
+                "8601 time; expected e.g. 2018-02-15T10:34:58+01:00"
+            ) from None
+        if dt.tzinfo is None:
+            if tz is None:
+                raise InputError(
+                    f"{name}, line {linenos[k]}, column {column!r}: time {c!r} has no UTC "
+                    f"offset; add it to the file (e.g. {c}+01:00 or {c}Z) or declare the "
+                    "logger's offset with `timezone: '+01:00'`"
+                )
+            dt = dt.replace(tzinfo=tz)
+        out[k] = dt.timestamp()
+    return out, n_miss
+
+
+def _check_range(name: str, linenos: list[int], column: str, a: NDArray, lo: float, hi: float,
+                 what: str) -> None:
+    bad = np.nonzero((a < lo) | (a > hi))[0]
+    if bad.size:
+        k = int(bad[0])
+        raise WindDataError(
+            f"{name}, line {linenos[k]}, column {column!r}: value {a[k]:g} is out of range "
+            f"({what}); {bad.size} row(s) affected"
+        )
+
+
+def _fmt_counts(d: Mapping[str, int]) -> str:
+    return ", ".join(f"{k} {v}" for k, v in d.items() if v) or "none"
+
+
+def _sorted_checked(data: StationData, linenos: NDArray, name: str, *,
+                    allow_repeats: bool = False) -> StationData:
+    """Group by station (first appearance) and check times increase within each station.
+
+    Repeated timestamps (1 Hz loggers with a 1 s clock jitter) are accepted only
+    when the data will be resampled into bins anyway.
+    """
+    order_ids = {s: k for k, s in enumerate(data.stations)}
+    key = np.array([order_ids[s] for s in data.station])
+    order = np.argsort(key, kind="stable")
+    data = replace(data, **{k: getattr(data, k)[order] for k in _ARRAY_FIELDS})
+    linenos = linenos[order]
+    key = key[order]
+    same = key[1:] == key[:-1]
+    dt = np.diff(data.t)
+    bad = np.nonzero(same & ((dt < 0) if allow_repeats else (dt <= 0)))[0]
+    if bad.size:
+        k = int(bad[0])
+        repeat = data.t[k + 1] == data.t[k]
+        kind = "repeats the time of" if repeat else "goes back in time from"
+        fix = ("Remove the duplicated rows, or average them away with `resample_s` (e.g. 10)."
+               if repeat else "Sort the file by time.")
+        raise WindDataError(
+            f"{name}, line {linenos[k + 1]}: time {iso(data.t[k + 1])} of station "
+            f"{str(data.station[k + 1])!r} {kind} line {linenos[k]} ({iso(data.t[k])}); times "
+            f"must increase within each station. {fix}"
+        )
+    return data
+
+
+# ------------------------------------------------------------------------------ resample
+def resample_stations(data: StationData, interval_s: float, *, min_fill: float = 0.5
+                      ) -> StationData:
+    """Average records into fixed intervals per station.
+
+    Bins are aligned to multiples of ``interval_s`` since the epoch (UTC clock),
+    and each output record is stamped at its bin's centre.  Speed is the scalar
+    mean of the speeds (what an anemometer's mean speed reports); direction is
+    that of the mean wind vector (``u``, ``v`` averaged), so a wind swinging
+    across north averages to north, not south.  Position and height are means,
+    gust is the bin's maximum.  Bins with fewer than ``min_fill`` times the
+    samples of a full bin (at the station's median sampling interval) are
+    dropped, so a 2-sample bin at the end of a log does not stand for a full minute.
+
+    Parameters
+    ----------
+    data : StationData
+        Raw records.
+    interval_s : float
+        Bin length [s], > 0.
+    min_fill : float
+        Minimum filled fraction of a bin, in [0, 1].
+
+    Returns
+    -------
+    StationData
+        Resampled records (``n_raw``/``n_missing`` carried over).
+    """
+    if not (interval_s > 0):
+        raise InputError(f"resample_s must be a positive number of seconds, got {interval_s!r}")
+    if len(data) == 0:
+        return data
+    ids = data.stations
+    lookup = {s: k for k, s in enumerate(ids)}
+    sidx = np.array([lookup[s] for s in data.station], dtype=np.int64)
+    b = np.floor(data.t / interval_s).astype(np.int64)
+    key = sidx.astype(np.int64) * (1 << 40) + (b - b.min())
+    uniq, first, inv, counts = np.unique(key, return_index=True, return_inverse=True,
+                                         return_counts=True)
+    u, v = data.u, data.v
+
+    def mean(a: NDArray) -> NDArray:
+        return np.bincount(inv, weights=a, minlength=uniq.size) / counts
+
+    expected = np.empty(uniq.size)
+    for k in range(len(ids)):
+        m = sidx == k
+        dt = np.median(np.diff(data.t[m])) if m.sum() > 1 else interval_s
+        expected[sidx[first] == k] = max(interval_s / max(dt, 1e-9), 1.0)
+    keep = counts >= min_fill * expected
+    um, vm = mean(u), mean(v)
+    _, dirn = wind_speed_direction(um, vm)
+    gust = np.full(uniq.size, -np.inf)
+    np.maximum.at(gust, inv, np.where(np.isnan(data.gust_ms), -np.inf, data.gust_ms))
+    gust[~np.isfinite(gust)] = np.nan
+    out = StationData(
+        station=data.station[first], t=(b[first] + 0.5) * interval_s, lat=mean(data.lat),
+        lon=mean(data.lon), speed_ms=mean(data.speed_ms), direction_deg=dirn,
+        height_m=mean(data.height_m), gust_ms=gust, source=data.source, n_raw=data.n_raw,
+        n_missing=data.n_missing, missing_by_column=data.missing_by_column,
+    )
+    return replace(out, **{k: getattr(out, k)[keep] for k in _ARRAY_FIELDS})
+
+
+# ------------------------------------------------------------------------------ field
+@dataclass(frozen=True, eq=False)
+class StationWind:
+    """Wind field interpolated from station records.
+
+    Parameters
+    ----------
+    data : StationData
+        The records (resample high-rate logs first).
+    frame : LocalFrame
+        The course's local frame.
+    method : {"idw", "rbf"}
+        Spatial interpolation: inverse-distance weighting (``power``), or a scipy
+        :class:`~scipy.interpolate.RBFInterpolator` (``rbf_kernel``; fixed
+        stations only).  Both reproduce a station's value at its position and a
+        constant wind exactly.
+    power : float
+        IDW exponent (2: weights ``1/d²``).
+    radius_m : float
+        Coverage = the stations' bounding box (every recorded position) expanded
+        by this [m].  Far from the stations an interpolant is an extrapolation,
+        which was the thesis's main failure, so the box is kept tight.
+    max_gap_s : float
+        A station whose records are further apart than this inside the common
+        time span is an error (no silent bridging of outages) [s].
+    height_m : float, optional
+        Target height [m]; records are scaled from their ``height_m`` with the
+        power law (``exponent``) or log law (``shear="log"``).  ``None``: as measured.
+    shear : {"power", "log"}
+    exponent : float
+        Power-law exponent for the height correction [-].
+    roughness_m : float
+        Log-law roughness length [m].
+    rbf_kernel : str
+        Kernel for ``method="rbf"`` (see scipy).
+    clamp : bool
+        Clamp points to the coverage instead of raising.
+    name : str
+        Label for messages.
+
+    Notes
+    -----
+    Coverage in time is the span during which *every* station reports (the
+    intersection), so no station drops out mid-race.  Between records each
+    station's ``(u, v)`` (and position) is interpolated linearly in time.
+    """
+
+    data: StationData
+    frame: LocalFrame
+    method: str = "idw"
+    power: float = 2.0
+    radius_m: float = 2000.0
+    max_gap_s: float = 1800.0
+    height_m: float | None = None
+    shear: str = "power"
+    exponent: float = DEFAULT_EXPONENT
+    roughness_m: float = DEFAULT_ROUGHNESS_M
+    rbf_kernel: str = "thin_plate_spline"
+    clamp: bool = False
+    name: str = "station wind"
+    _series: tuple = field(init=False, repr=False)
+    _cov: Coverage = field(init=False, repr=False)
+    _moving: bool = field(init=False, repr=False)
+    _rbf: Any = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        d = self.data
+        if len(d) == 0:
+            raise WindDataError(f"{self.name}: no station records")
+        if self.method not in ("idw", "rbf"):
+            raise InputError(f"{self.name}: method {self.method!r}; expected 'idw' or 'rbf'")
+        if self.shear not in ("power", "log"):
+            raise InputError(f"{self.name}: shear {self.shear!r}; expected 'power' or 'log'")
+        if not (self.radius_m >= 0) or not (self.power > 0) or not (self.max_gap_s > 0):
+            raise InputError(f"{self.name}: radius_m must be >= 0, power and max_gap_s > 0")
+        x, y = self.frame.to_xy(d.lat, d.lon)
+        ue, ve = d.u, d.v
+        if self.height_m is not None:
+            if np.any(np.isnan(d.height_m)):
+                raise InputError(
+                    f"{self.name}: a target height_m is set but the measurement height of "
+                    f"{d.source or 'the stations'} is unknown; add a height_m column or give "
+                    "the stations' height (`measurement_height_m`)"
+                )
+            f = (power_law_factor(d.height_m, self.height_m, self.exponent)
+                 if self.shear == "power" else
+                 log_law_factor(d.height_m, self.height_m, self.roughness_m))
+            ue, ve = ue * f, ve * f
+        ul, vl = earth_to_local(ue, ve, self.frame.grid_north_deg(d.lat, d.lon))
+        series = []
+        moving = False
+        for s in d.stations:
+            m = d.station == s
+            ts = d.t[m]
+            moving |= bool(np.ptp(x[m]) > 1e-6 or np.ptp(y[m]) > 1e-6)
+            series.append((s, ts, x[m], y[m], ul[m], vl[m]))
+        t0 = max(float(s[1][0]) for s in series)
+        t1 = min(float(s[1][-1]) for s in series)
+        if t0 > t1:
+            spans = "; ".join(f"{s[0]}: {iso(s[1][0])} .. {iso(s[1][-1])}" for s in series)
+            raise WindDataError(
+                f"{self.name}: the stations never report at the same time ({spans}); "
+                "use stations with overlapping records"
+            )
+        for s, ts, *_ in series:
+            inside = ts[(ts >= t0) & (ts <= t1)]
+            edges = np.concatenate([[t0], inside, [t1]])
+            gaps = np.diff(edges)
+            if gaps.size and gaps.max() > self.max_gap_s:
+                k = int(np.argmax(gaps))
+                raise WindDataError(
+                    f"{self.name}: station {s!r} has no record from {iso(edges[k])} to "
+                    f"{iso(edges[k + 1])} ({gaps[k] / 60:.0f} min > max_gap_s "
+                    f"{self.max_gap_s / 60:.0f} min); the wind there would be a guess. "
+                    "Restrict the race window, drop that station, or raise max_gap_s."
+                )
+        rbf = None
+        if self.method == "rbf":
+            if moving:
+                raise InputError(f"{self.name}: method 'rbf' needs fixed stations; a station "
+                                 "moves (coach boat?) -- use method 'idw'")
+            from scipy.interpolate import RBFInterpolator
+
+            pts = np.array([[s[2][0], s[3][0]] for s in series])
+            # A degree-1 polynomial needs 3 non-collinear stations; with fewer, use the
+            # linear kernel with a constant term (still exact at the stations).
+            kernel, deg = (self.rbf_kernel, None) if len(series) >= 3 else ("linear", 0)
+            try:
+                rbf = RBFInterpolator(pts, np.eye(len(series)), kernel=kernel, degree=deg)
+            except (ValueError, np.linalg.LinAlgError) as exc:
+                raise InputError(f"{self.name}: RBF interpolation failed for these stations "
+                                 f"({exc}); use method 'idw'") from None
+        cov = Coverage(t0, t1, float(x.min()) - self.radius_m, float(x.max()) + self.radius_m,
+                       float(y.min()) - self.radius_m, float(y.max()) + self.radius_m)
+        object.__setattr__(self, "_series", tuple(series))
+        object.__setattr__(self, "_cov", cov)
+        object.__setattr__(self, "_moving", moving)
+        object.__setattr__(self, "_rbf", rbf)
+
+    @property
+    def coverage(self) -> Coverage:
+        """Common time span of the stations; their box plus ``radius_m``."""
+        return self._cov
+
+    def station_values(self, t: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+        """Per-station ``(x, y, u, v)`` interpolated at times ``t``, each shape ``(n, S)``."""
+        cols: list[list[NDArray]] = [[], [], [], []]
+        for _, ts, xs, ys, us, vs in self._series:
+            for c, a, moves in zip(cols, (xs, ys, us, vs), (self._moving, self._moving, True,
+                                                            True), strict=True):
+                if not moves or a.size == 1:
+                    c.append(np.full(t.shape, a[0]))
+                else:
+                    c.append(np.interp(t, ts, a))
+        return tuple(np.stack(c, axis=-1) for c in cols)  # type: ignore[return-value]
+
+    @property
+    def station_ids(self) -> tuple[str, ...]:
+        """Station ids in the order of the weight columns."""
+        return tuple(s[0] for s in self._series)
+
+    def weights(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> NDArray:
+        """Normalised spatial weights ``(n, S)`` of the stations at points ``(t, x, y)``.
+
+        Points are flattened; no coverage check (used by :class:`BlendedWind`-style
+        diagnostics).
+        """
+        t, x, y = (a.ravel() for a in np.broadcast_arrays(
+            np.asarray(t, float), np.asarray(x, float), np.asarray(y, float)))
+        if self._rbf is not None:
+            return self._rbf(np.column_stack([x, y]))
+        sx, sy, _, _ = self.station_values(t)
+        return idw_weights(x, y, sx, sy, self.power)
+
+    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
+        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast)."""
+        t, x, y = prepare_points(self._cov, t, x, y, clamp=self.clamp, name=self.name)
+        shape = t.shape
+        t, x, y = t.ravel(), x.ravel(), y.ravel()
+        sx, sy, su, sv = self.station_values(t)
+        if self._rbf is not None:
+            w = self._rbf(np.column_stack([x, y]))
+        elif len(self._series) == 1:
+            w = np.ones((t.size, 1))
+        else:
+            w = idw_weights(x, y, sx, sy, self.power)
+        u = np.einsum("ns,ns->n", w, su)
+        v = np.einsum("ns,ns->n", w, sv)
+        return u.reshape(shape), v.reshape(shape)
+
+
+def idw_weights(x: NDArray, y: NDArray, sx: NDArray, sy: NDArray, power: float = 2.0
+                ) -> NDArray[np.float64]:
+    """Inverse-distance weights ``(n, S)`` normalised to sum 1 per point.
+
+    Parameters
+    ----------
+    x, y : ndarray (n,)
+        Points [m].
+    sx, sy : ndarray (n, S) or (1, S)
+        Station positions [m].
+    power : float
+        Exponent ``p`` in ``w = 1 / d^p``.
+
+    Returns
+    -------
+    ndarray (n, S)
+        A point on a station gets weight 1 for it (to within 1e-12).
+    """
+    d2 = (x[:, None] - sx) ** 2 + (y[:, None] - sy) ** 2
+    d2 = np.maximum(d2, 1e-24)
+    w = d2 ** (-0.5 * power) if power != 2.0 else 1.0 / d2
+    return w / w.sum(axis=1, keepdims=True)

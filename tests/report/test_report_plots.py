@@ -1,0 +1,72 @@
+"""Route and comparison charts: the expected artists exist (no pixel comparison)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sailroute.report.plan import compare
+from sailroute.report.plots import WIND_GRID, plot_comparison, plot_plan, plot_route
+from sailroute.units import wind_components
+from sailroute.wind.analytic import AnalyticWind
+
+
+def by_gid(fig, prefix):
+    return [a for a in fig.findobj() if (a.get_gid() or "").startswith(prefix)]
+
+
+def test_plot_route_artists(plan, wind, tmp_path):
+    fig = plot_route(plan.course, plan.results, wind)
+    legs = by_gid(fig, "leg:")
+    assert sorted(a.get_gid() for a in legs) == ["leg:1", "leg:2", "leg:3"]
+    for a, pl in zip(sorted(legs, key=lambda a: a.get_gid()), plan.legs, strict=True):
+        assert len(a.get_segments()) == len(pl.result.track) - 1
+        # coloured by boat speed in knots
+        np.testing.assert_allclose(a.get_array(), pl.result.track.bsp_ms[:-1] / 0.514444,
+                                   rtol=1e-5)
+    (tacks,) = by_gid(fig, "tacks")
+    (gybes,) = by_gid(fig, "gybes")
+    assert len(tacks.get_xdata()) == 1 and len(gybes.get_xdata()) == 1
+    m = plan.legs[0].result.manoeuvres[0]
+    assert (tacks.get_xdata()[0], tacks.get_ydata()[0]) == (m.x, m.y)
+    (marks,) = by_gid(fig, "marks")
+    assert len(marks.get_xdata()) == len(plan.course.marks)
+    assert len(by_gid(fig, "line:")) == 2 and len(by_gid(fig, "gate:")) == 1
+    (q,) = by_gid(fig, "wind")
+    assert q.N == WIND_GRID * WIND_GRID
+    assert by_gid(fig, "wind-field") == []  # uniform wind: arrows only
+    ax = fig.axes[0]
+    assert ax.get_aspect() == 1.0
+    assert any("boat speed" in a.get_ylabel() for a in fig.axes)
+    path = tmp_path / "r.png"
+    fig.savefig(path, dpi=40)
+    assert path.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_plot_route_varying_wind_has_background(plan):
+    wind = AnalyticWind(lambda t, x, y: wind_components(5.0 + 0.002 * y, 0.0 * x))
+    fig = plot_plan(plan, wind)
+    assert len(by_gid(fig, "wind-field")) == 1
+    assert fig.axes[0].get_aspect() == 1.0  # the background image keeps the map's equal aspect
+    assert "north" in fig.axes[0].get_title()
+
+
+def test_plot_route_without_wind(plan):
+    fig = plot_route(plan.course, plan.results)
+    assert by_gid(fig, "wind") == []
+    assert len(by_gid(fig, "leg:")) == 3
+
+
+@pytest.mark.parametrize("with_map", [True, False])
+def test_plot_comparison(plan, with_map):
+    other = plan.__class__(plan.course, "copy", plan.legs, plan.references, plan.router)
+    cmp = compare([plan, other])
+    fig = plot_comparison(cmp, [plan, other] if with_map else [])
+    assert len(by_gid(fig, "bars:north")) == 3 and len(by_gid(fig, "bars:copy")) == 3
+    heights = [p.get_height() for p in by_gid(fig, "bars:north")]
+    np.testing.assert_allclose(heights, [leg.time_s for leg in plan.legs])
+    (ref,) = by_gid(fig, "reference:winner")
+    np.testing.assert_allclose(ref.get_ydata(), [700.0, 300.0, 100.0])
+    routes = by_gid(fig, "route:")
+    assert len(routes) == (2 if with_map else 0)
+    assert len(fig.axes) == (2 if with_map else 1)
