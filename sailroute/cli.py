@@ -66,6 +66,87 @@ def run_guarded(fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
 # Each command parses options and delegates to the package API.  Keep logic out.
 
 
+_ROUTER_HELP = "Router: isochrone | griddp | spline (default: the course's routing.router)."
+_BACKEND_HELP = "Array backend: numpy | cupy | auto (cupy needs an NVIDIA GPU)."
+
+
+def _progress(n_legs: int, quiet: bool) -> Any:
+    from sailroute.report.progress import Progress
+
+    return Progress(n_legs, enabled=not quiet)
+
+
+def _echo_result(res: Any) -> None:
+    typer.echo(res.report)
+    typer.echo("")
+    for kind, path in res.files.items():
+        typer.echo(f"wrote {kind}: {path}")
+
+
+@app.command("plan")
+def plan_command(
+    course: Annotated[str, typer.Argument(help="Course file (YAML, see docs/course-format.md).")],
+    scenario: Annotated[
+        str | None,
+        typer.Option("--scenario", "-s", help="Wind scenario name (default: the first)."),
+    ] = None,
+    router: Annotated[str | None, typer.Option("--router", "-r", help=_ROUTER_HELP)] = None,
+    out: Annotated[
+        str | None,
+        typer.Option("--out", "-o", help="Output folder (default: out/<course>/<scenario>)."),
+    ] = None,
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="Skip route.png.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
+    backend: Annotated[str, typer.Option("--backend", help=_BACKEND_HELP)] = "numpy",
+) -> None:
+    """Route a course leg by leg: leg times, start points, tacks; writes JSON/CSV/GPX/PNG."""
+    from sailroute.plan import run_plan_command
+
+    def run() -> Any:
+        from sailroute.course.load import load_course
+
+        progress = _progress(load_course(course).n_legs, quiet)
+        return run_plan_command(course, scenario=scenario, router=router, out_dir=out,
+                                plots=not no_plots, backend=backend, progress=progress)
+
+    _echo_result(run_guarded(run))
+
+
+@app.command("compare-scenarios")
+def compare_command(
+    course: Annotated[str, typer.Argument(help="Course file (YAML, see docs/course-format.md).")],
+    scenario: Annotated[
+        list[str] | None,
+        typer.Option("--scenario", "-s", help="Scenario to include (repeat; default: all)."),
+    ] = None,
+    router: Annotated[str | None, typer.Option("--router", "-r", help=_ROUTER_HELP)] = None,
+    out: Annotated[
+        str | None,
+        typer.Option("--out", "-o", help="Output folder (default: out/<course>/comparison)."),
+    ] = None,
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="Skip comparison.png.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
+    backend: Annotated[str, typer.Option("--backend", help=_BACKEND_HELP)] = "numpy",
+    scheduler: Annotated[
+        str | None,
+        typer.Option("--scheduler", help="serial (default) | processes (local Dask cluster) | "
+                     "tcp://HOST:PORT (existing Dask scheduler); results are identical."),
+    ] = None,
+) -> None:
+    """Route a course in every wind scenario; legs x scenarios table with reference errors."""
+    from sailroute.plan import run_compare_command
+
+    def run() -> Any:
+        from sailroute.course.load import load_course
+
+        progress = _progress(load_course(course).n_legs, quiet)
+        return run_compare_command(course, scenarios=scenario, router=router, out_dir=out,
+                                   plots=not no_plots, backend=backend, progress=progress,
+                                   scheduler=scheduler)
+
+    _echo_result(run_guarded(run))
+
+
 @app.command("vpp")
 def vpp_command(
     boat: Annotated[

@@ -1017,18 +1017,19 @@ def validate_specs(course: Course, scenarios: Iterable[str] | None = None) -> No
     InputError
         One error listing every boat/wind spec problem (each with its key path).
     """
-    problems: list[str] = []
+    errors: list[InputError] = []
     try:
         build_boat(course)
     except InputError as exc:
-        problems += _flatten(str(exc))
+        errors.append(exc)
     for name in course.scenarios if scenarios is None else scenarios:
         try:
             build_wind(course, name)
         except InputError as exc:
-            problems += _flatten(str(exc))
-    if len(problems) == 1:
-        raise InputError(problems[0])
+            errors.append(exc)
+    if len(errors) == 1:  # keep its type (e.g. OutOfCoverageError) and message
+        raise errors[0]
+    problems = [p for exc in errors for p in _flatten(str(exc))]
     if problems:
         raise InputError(format_problems(
             f"{course.source or '<course>'}: {len(problems)} problems in boat/wind specs",

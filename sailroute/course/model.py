@@ -13,6 +13,7 @@ plan is run (see :func:`sailroute.course.load.validate_specs`).
 
 from __future__ import annotations
 
+import copyreg
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from datetime import datetime
@@ -132,6 +133,14 @@ class LegSpec:
 
 def _frozen(d: Mapping[str, Any] | None) -> Mapping[str, Any]:
     return MappingProxyType(dict(d or {}))
+
+
+def _reduce_proxy(m: MappingProxyType) -> tuple[Any, tuple[dict[str, Any]]]:
+    """Pickle a read-only mapping as a copy of its dict (for process/Dask workers)."""
+    return _frozen, (dict(m),)
+
+
+copyreg.pickle(MappingProxyType, _reduce_proxy)
 
 
 @dataclass(frozen=True, eq=False)

@@ -50,8 +50,14 @@ class Progress:
         self._t_leg = 0.0
         self._t_last = -1e9
         self._width = 0
+        self.prefix = ""
+
+    def set_prefix(self, text: str) -> None:
+        """Put ``text`` (e.g. ``"wrf10: "``) before every line, for multi-scenario runs."""
+        self.prefix = text
 
     def _write(self, text: str, *, end: str) -> None:
+        text = self.prefix + text
         if self.live and end == "":
             pad = max(self._width - len(text), 0)
             self.stream.write("\r" + text + " " * pad)

@@ -20,6 +20,7 @@ import importlib
 from collections.abc import Callable
 from typing import Any
 
+from sailroute.backend import get_xp
 from sailroute.errors import InputError, RoutingError
 from sailroute.routing.geometry import leg_label
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
@@ -77,6 +78,7 @@ def route_leg(
     settings: RoutingSettings,
     *,
     progress: Callable[[float], None] | None = None,
+    backend: str = "numpy",
 ) -> LegResult:
     """Fastest route of one leg with the router chosen in ``settings.router``.
 
@@ -96,6 +98,9 @@ def route_leg(
         Router choice and numerical settings.
     progress : callable, optional
         Receives the estimated fraction done, in [0, 1].
+    backend : {"numpy", "cupy", "auto"}
+        Array backend of the router's data-parallel kernels
+        (:func:`sailroute.backend.get_xp`); results agree within float tolerance.
 
     Returns
     -------
@@ -104,7 +109,7 @@ def route_leg(
     Raises
     ------
     InputError
-        Unknown router or invalid settings/geometry.
+        Unknown router or backend, or invalid settings/geometry.
     RoutingError
         The router is not installed, or the leg cannot be routed (the message
         names the leg, why, and what to try).
@@ -112,8 +117,9 @@ def route_leg(
         The wind field does not cover the leg (propagated).
     """
     func = get_router(settings.router)
+    xp = get_xp(backend)
     try:
-        return func(start, target, t0, wind, boat, settings, progress=progress)
+        return func(start, target, t0, wind, boat, settings, progress=progress, xp=xp)
     except RoutingError as exc:
         label = leg_label(start, target)
         if f"leg {label}" in str(exc):

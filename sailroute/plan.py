@@ -1,0 +1,291 @@
+"""Orchestration: route a whole course in one wind scenario, or in several.
+
+This is the only place where the layers meet: a loaded
+:class:`~sailroute.course.model.Course` gives the boat and the scenario's wind
+(``course/load.py``), each leg is routed with
+:func:`~sailroute.routing.api.route_leg` starting where and when the previous leg
+ended, and the results become a :class:`~sailroute.report.plan.Plan`.  Nothing
+here reads files except through those factories, and nothing prints: progress
+goes to an optional :class:`~sailroute.report.progress.Progress`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from sailroute.backend import get_xp
+from sailroute.course.geometry import leg_endpoints
+from sailroute.course.load import build_boat, build_wind, load_course, validate_specs
+from sailroute.course.model import Course
+from sailroute.report.plan import Comparison, Plan, compare, make_plan
+from sailroute.report.progress import Progress
+from sailroute.routing.api import get_router, route_leg
+from sailroute.routing.types import LegResult, RoutingSettings
+from sailroute.wind.base import WindField
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedCourse:
+    """A :class:`Plan` with the wind field it was routed in (for plots).
+
+    Attributes
+    ----------
+    plan : Plan
+        The routed course.
+    wind : WindField
+        The scenario's wind field.
+    """
+
+    plan: Plan
+    wind: WindField
+
+
+def settings_for(course: Course, router: str | None = None) -> RoutingSettings:
+    """The course's routing settings, with the router replaced if ``router`` is given."""
+    return course.routing if router is None else dataclasses.replace(course.routing, router=router)
+
+
+def default_scenario(course: Course) -> str:
+    """The first scenario of the course file (the one ``plan`` routes by default)."""
+    return next(iter(course.scenarios))
+
+
+def route_course(
+    course: Course,
+    wind: WindField,
+    boat: object,
+    settings: RoutingSettings,
+    *,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+) -> list[LegResult]:
+    """Route every leg in order, each starting where and when the previous one ended.
+
+    Parameters
+    ----------
+    course : Course
+        The course (its first leg may start anywhere on a line; the router picks
+        the best point).
+    wind : WindField
+        Wind field covering the course and the race time.
+    boat : Polar
+        Boat performance.
+    settings : RoutingSettings
+        Router choice and numerical settings.
+    backend : {"numpy", "cupy", "auto"}
+        Array backend of the router kernels.
+    progress : Progress, optional
+        Receives per-leg start/update/end calls.
+
+    Returns
+    -------
+    list of LegResult
+        One per leg; ``results[i].t_start == results[i - 1].t_end``.
+    """
+    results: list[LegResult] = []
+    t0, end_xy = course.start_epoch, None
+    for i, spec in enumerate(course.legs):
+        start, target = leg_endpoints(course, i, end_xy)
+        if progress is not None:
+            progress.start_leg(i, spec.label)
+        res = route_leg(start, target, t0, wind, boat, settings, backend=backend,
+                        progress=progress.update if progress is not None else None)
+        if progress is not None:
+            progress.end_leg(res.time_s, f"{res.n_tacks} tacks, {res.n_gybes} gybes")
+        results.append(res)
+        t0, end_xy = res.t_end, res.end_xy
+    return results
+
+
+def plan_course(
+    course: Course,
+    scenario: str | None = None,
+    *,
+    router: str | None = None,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+) -> PlannedCourse:
+    """Route ``course`` in one of its wind scenarios.
+
+    Parameters
+    ----------
+    course : Course
+        A loaded course (:func:`sailroute.course.load.load_course`).
+    scenario : str, optional
+        Scenario name; default the first one in the file.
+    router : {"isochrone", "griddp", "spline"}, optional
+        Overrides the course's ``routing.router``.
+    backend : {"numpy", "cupy", "auto"}
+        Array backend of the router kernels.
+    progress : Progress, optional
+        Progress display.
+
+    Returns
+    -------
+    PlannedCourse
+
+    Raises
+    ------
+    InputError
+        Unknown scenario or router, bad boat or wind spec (all problems listed).
+    OutOfCoverageError
+        The wind data do not cover the course area or the race time.
+    RoutingError
+        A leg cannot be routed (the message names it).
+    """
+    name = default_scenario(course) if scenario is None else scenario
+    settings = settings_for(course, router)
+    get_router(settings.router)  # fail on a bad router or backend name before any work
+    get_xp(backend)
+    validate_specs(course, [name])
+    wind, boat = build_wind(course, name), build_boat(course)
+    results = route_course(course, wind, boat, settings, backend=backend, progress=progress)
+    return PlannedCourse(make_plan(course, name, results, wind, router=settings.router), wind)
+
+
+def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:
+    """One scenario of :func:`compare_scenarios` (top level, so Dask can pickle it)."""
+    course, name, router, backend = task
+    return plan_course(course, name, router=router, backend=backend).plan
+
+
+def compare_scenarios(
+    course: Course,
+    scenarios: Sequence[str] | None = None,
+    *,
+    router: str | None = None,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+    scheduler: str | None = None,
+) -> tuple[Comparison, list[Plan]]:
+    """Route ``course`` in several scenarios and put the leg times side by side.
+
+    Parameters
+    ----------
+    course : Course
+        A loaded course.
+    scenarios : sequence of str, optional
+        Scenario names, in the order to report them; default all, in file order.
+    router, backend : str, optional
+        As in :func:`plan_course`.
+    progress : Progress, optional
+        Per-leg progress (serial runs only; a distributed run reports nothing
+        until all scenarios are back).
+    scheduler : str, optional
+        None or ``"serial"``: route the scenarios one after the other here;
+        ``"processes"``: a local Dask cluster; ``"tcp://HOST:PORT"``: an existing
+        Dask scheduler (see ``docs/scale-out.md``).  The results are identical.
+
+    Returns
+    -------
+    comparison : Comparison
+        Leg times (scenarios × legs) with the references.
+    plans : list of Plan
+        One per scenario, in the same order.
+    """
+    names = list(course.scenarios) if not scenarios else list(dict.fromkeys(scenarios))
+    validate_specs(course, names)  # every problem of every scenario in one error, up front
+    if scheduler in (None, "serial"):
+        plans = []
+        for n in names:
+            if progress is not None:
+                progress.set_prefix(f"{n}: ")
+            plans.append(plan_course(course, n, router=router, backend=backend,
+                                     progress=progress).plan)
+    else:
+        from sailroute.parallel import map_tasks
+
+        plans = map_tasks(_plan_task, [(course, n, router, backend) for n in names],
+                          scheduler=scheduler)
+    return compare(plans), plans
+
+
+@dataclass(frozen=True, eq=False)
+class CommandResult:
+    """What ``sailroute plan`` / ``compare-scenarios`` print and wrote.
+
+    Attributes
+    ----------
+    report : str
+        The terminal table.
+    files : mapping of str to Path
+        Kind (``plan``, ``track``, ``gpx``, ``png``, ``comparison_json``, ...) -> path.
+    plans : tuple of Plan
+        The routed plans (one for ``plan``).
+    """
+
+    report: str
+    files: Mapping[str, Path]
+    plans: tuple[Plan, ...]
+
+
+def default_out_dir(course: Course, what: str) -> Path:
+    """``out/<course file stem>/<what>``: where results go without ``--out``."""
+    stem = Path(course.source).stem if course.source else "course"
+    return Path("out") / stem / what
+
+
+def run_plan_command(
+    course_path: str | Path,
+    *,
+    scenario: str | None = None,
+    router: str | None = None,
+    out_dir: str | Path | None = None,
+    plots: bool = True,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+) -> CommandResult:
+    """Everything ``sailroute plan`` does, minus printing.
+
+    Writes ``plan.json``, ``track.csv``, ``route.gpx`` and ``route.png`` (unless
+    ``plots`` is False) into ``out_dir`` (default ``out/<course>/<scenario>``).
+    """
+    from sailroute.report.files import write_plan_outputs
+    from sailroute.report.tables import plan_table
+
+    course = load_course(course_path)
+    run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
+    out = Path(out_dir) if out_dir is not None else default_out_dir(course, run.plan.scenario)
+    files = write_plan_outputs(out, run.plan, wind=run.wind, plot=plots)
+    return CommandResult(plan_table(run.plan), files, (run.plan,))
+
+
+def run_compare_command(
+    course_path: str | Path,
+    *,
+    scenarios: Sequence[str] | None = None,
+    router: str | None = None,
+    out_dir: str | Path | None = None,
+    plots: bool = True,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+    scheduler: str | None = None,
+) -> CommandResult:
+    """Everything ``sailroute compare-scenarios`` does, minus printing.
+
+    Writes ``comparison.json``, ``comparison.csv`` and ``comparison.png`` (unless
+    ``plots`` is False) into ``out_dir`` (default ``out/<course>/comparison``), and
+    each scenario's ``plan.json``, ``track.csv`` and ``route.gpx`` into
+    ``out_dir/<scenario>/``.
+    """
+    from sailroute.report.files import write_comparison, write_plan_outputs
+    from sailroute.report.tables import comparison_table
+
+    course = load_course(course_path)
+    cmp, plans = compare_scenarios(course, scenarios, router=router, backend=backend,
+                                   progress=progress, scheduler=scheduler)
+    out = Path(out_dir) if out_dir is not None else default_out_dir(course, "comparison")
+    js, cs = write_comparison(out, cmp)
+    files: dict[str, Path] = {"comparison_json": js, "comparison_csv": cs}
+    if plots:
+        from sailroute.report.plots import plot_comparison
+
+        plot_comparison(cmp, plans).savefig(out / "comparison.png", dpi=150)
+        files["comparison_png"] = out / "comparison.png"
+    for p in plans:
+        for kind, path in write_plan_outputs(out / p.scenario, p, plot=False).items():
+            files[f"{p.scenario}/{kind}"] = path
+    return CommandResult(comparison_table(cmp), files, tuple(plans))
