@@ -9,7 +9,9 @@ router         function                                         module
 =============  ===============================================  ==========================
 
 All routers share the signature
-``(start, target, t0, wind, polar, settings, *, progress=None) -> LegResult`` and
+``(start, target, t0, wind, polar, settings, *, progress=None) -> LegResult`` (routers
+with a GPU path also take ``xp=``, an array module, which :func:`route_leg` passes only for
+a non-NumPy ``backend``) and
 report through :func:`~sailroute.routing.track.make_leg_result`, so their results
 compare directly.  The grid-DP and spline routers are imported only when asked for.
 """
@@ -19,6 +21,8 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable
 from typing import Any
+
+import numpy as np
 
 from sailroute.backend import get_xp
 from sailroute.errors import InputError, RoutingError
@@ -118,8 +122,9 @@ def route_leg(
     """
     func = get_router(settings.router)
     xp = get_xp(backend)
+    extra = {} if xp is np else {"xp": xp}  # NumPy is every router's default
     try:
-        return func(start, target, t0, wind, boat, settings, progress=progress, xp=xp)
+        return func(start, target, t0, wind, boat, settings, progress=progress, **extra)
     except RoutingError as exc:
         label = leg_label(start, target)
         if f"leg {label}" in str(exc):
