@@ -95,6 +95,16 @@ def _at(p: XY, *terms: tuple[float, XY]) -> XY:
     return (x, y)
 
 
+def _pair(
+    into: dict[str, tuple[str, str]], layout: CourseLayout, name: str, ends: tuple[str, str],
+    centre: XY, length_m: float, axis: XY,
+) -> None:
+    """Put marks ``ends`` at ``centre ± length_m / 2 · axis`` and register them as ``name``."""
+    layout.marks[ends[0]] = _at(centre, (length_m / 2, axis))
+    layout.marks[ends[1]] = _at(centre, (-length_m / 2, axis))
+    into[name] = ends
+
+
 def _check_positive(**values: float) -> None:
     bad = [f"{k} must be > 0, got {v!r}" for k, v in values.items() if not v > 0]
     if bad:
@@ -115,13 +125,10 @@ def _leeward_end(
     m1 = _at(centre, (leg_length_m / 2, up))
     g4 = _at(centre, (-leg_length_m / 2, up))
     layout.marks["1"] = m1
-    layout.marks["4s"] = _at(g4, (gate_width_m / 2, left))
-    layout.marks["4p"] = _at(g4, (-gate_width_m / 2, left))
-    layout.gates["4"] = ("4s", "4p")
+    _pair(layout.gates, layout, "4", ("4s", "4p"), g4, gate_width_m, left)
     st = _at(g4, (-start_offset_m, up))
-    layout.marks["start_pin"] = _at(st, (start_line_length_m / 2, left))
-    layout.marks["start_boat"] = _at(st, (-start_line_length_m / 2, left))
-    layout.lines["start"] = ("start_pin", "start_boat")
+    _pair(layout.lines, layout, "start", ("start_pin", "start_boat"), st, start_line_length_m,
+          left)
 
 
 def windward_leeward(
@@ -187,9 +194,8 @@ def windward_leeward(
         fc = _at(centre_xy, (-leg_length_m / 2 - start_offset_m, up))
     else:
         fc = _at(centre_xy, (leg_length_m / 2 + finish_offset_m, up))
-    layout.marks["finish_pin"] = _at(fc, (finish_line_length_m / 2, left))
-    layout.marks["finish_boat"] = _at(fc, (-finish_line_length_m / 2, left))
-    layout.lines["finish"] = ("finish_pin", "finish_boat")
+    _pair(layout.lines, layout, "finish", ("finish_pin", "finish_boat"), fc,
+          finish_line_length_m, left)
     legs = [LayoutLeg("1", "port")]
     n_gate_to_1 = laps - 1 if finish == "leeward" else laps - 2
     for _ in range(n_gate_to_1):
@@ -279,13 +285,10 @@ def trapezoid(
             f"(run 2->3 would be {drop:.0f} m); use a smaller reach_length_m or reach_angle_deg"
         )
     g3 = _at(m2, (-drop, up))
-    layout.marks["3s"] = _at(g3, (gate_width_m / 2, left))
-    layout.marks["3p"] = _at(g3, (-gate_width_m / 2, left))
-    layout.gates["3"] = ("3s", "3p")
+    _pair(layout.gates, layout, "3", ("3s", "3p"), g3, gate_width_m, left)
     fc = _at(g3, (-finish_reach_m, left))
-    layout.marks["finish_pin"] = _at(fc, (finish_line_length_m / 2, up))
-    layout.marks["finish_boat"] = _at(fc, (-finish_line_length_m / 2, up))
-    layout.lines["finish"] = ("finish_pin", "finish_boat")
+    _pair(layout.lines, layout, "finish", ("finish_pin", "finish_boat"), fc,
+          finish_line_length_m, up)
     legs = [LayoutLeg("1", "port")]
     if loop == "inner":
         for _ in range(laps - 1):
