@@ -25,6 +25,8 @@ Sources (``docs/vpp.md`` has the full discussion):
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
 from typing import Any, Final
 
@@ -32,6 +34,8 @@ from sailroute.errors import InputError, format_problems
 
 HULL_MODELS: Final = ("dsyhs", "thesis")
 STABILITY_MODELS: Final = ("hiking", "heel")
+CREW_MASS_RANGE_KG: Final = (20.0, 200.0)
+"""Accepted sailor mass of a hiking dinghy [kg] (``stability="hiking"``)."""
 
 
 @dataclass(frozen=True)
@@ -279,7 +283,9 @@ def param_names() -> tuple[str, ...]:
     return tuple(f.name for f in fields(LaserParams))
 
 
-def params_from_mapping(spec: Any, *, where: str, key: str = "") -> LaserParams:
+def params_from_mapping(
+    spec: Any, *, where: str, key: str = "", lines: Mapping[str, int] | None = None
+) -> LaserParams:
     """Build parameters from a mapping ``{class: ilca7, crew_mass_kg: 75, ...}``.
 
     Parameters
@@ -292,24 +298,26 @@ def params_from_mapping(spec: Any, *, where: str, key: str = "") -> LaserParams:
     key : str
         Key path of ``spec`` inside the file (e.g. ``"boat.vpp"``), prefixed
         to each problem.
+    lines : mapping of str to int, optional
+        1-based line of each key of ``spec`` in the file; a problem about a key
+        with a known line is reported as ``where:LINE: key: ...``.
 
     Raises
     ------
     InputError
-        Listing every problem (unknown key, bad class, wrong type, bad value)
-        with its key path.
+        Listing every problem (unknown key, with a "did you mean" where one is
+        close; bad class; wrong type; bad value) with its key path.
     """
     prefix = f"{key}." if key else ""
     if not isinstance(spec, dict):
         raise InputError(f"{where}: {key or 'boat'}: expected a mapping of parameters; "
                          f"got {type(spec).__name__}")
-    problems: list[str] = []
+    problems: list[tuple[str, str]] = []  # (top-level key, message without the file)
     cls = spec.get("class", "ilca7")
     base = ILCA7
     if not isinstance(cls, str) or cls.lower() not in CLASSES:
-        problems.append(
-            f"{prefix}class: expected one of {', '.join(map(repr, sorted(CLASSES)))}; got {cls!r}"
-        )
+        problems.append(("class", f"{prefix}class: expected one of "
+                         f"{', '.join(map(repr, sorted(CLASSES)))}; got {cls!r}"))
     else:
         base = CLASSES[cls.lower()]
     types = {f.name: f.type for f in fields(LaserParams)}
@@ -319,35 +327,38 @@ def params_from_mapping(spec: Any, *, where: str, key: str = "") -> LaserParams:
         if k in _RESERVED:
             continue
         if k not in types:
-            problems.append(
-                f"{prefix}{k}: unknown key; expected 'class' or a parameter such as "
-                "'crew_mass_kg' (see docs/vpp.md for the full list)"
-            )
+            # "weight" is what sailors say for mass (crew_weight -> crew_mass_kg)
+            word = str(k).lower().replace("weight", "mass")
+            close = difflib.get_close_matches(word, [*_RESERVED, *types], n=1, cutoff=0.6)
+            hint = f"did you mean {close[0]!r}? " if close else ""
+            problems.append((str(k), (
+                f"{prefix}{k}: unknown key; {hint}expected 'class' or a parameter such as "
+                "'crew_mass_kg' (see docs/vpp.md for the full list)")))
             continue
         default = defaults[k]
         if isinstance(default, str):
             if not isinstance(v, str):
-                problems.append(f"{prefix}{k}: expected a string; got {v!r}")
+                problems.append((k, f"{prefix}{k}: expected a string; got {v!r}"))
                 continue
         elif isinstance(default, tuple):
             if not isinstance(v, list | tuple) or not all(
                 isinstance(x, int | float) and not isinstance(x, bool) for x in v
             ):
-                problems.append(f"{prefix}{k}: expected a list of numbers; got {v!r}")
+                problems.append((k, f"{prefix}{k}: expected a list of numbers; got {v!r}"))
                 continue
             v = tuple(float(x) for x in v)
         else:
             if isinstance(v, bool) or not isinstance(v, int | float):
-                problems.append(f"{prefix}{k}: expected a number; got {v!r}")
+                problems.append((k, f"{prefix}{k}: expected a number; got {v!r}"))
                 continue
             v = float(v)
         overrides[k] = v
     if problems:
-        _raise(where, problems)
+        _raise_keyed(where, problems, lines)
     params = replace(base, **overrides)
-    problems = [f"{prefix}{p}" for p in validate(params)]
+    problems = [(p.split(":", 1)[0], f"{prefix}{p}") for p in validate(params)]
     if problems:
-        _raise(where, problems)
+        _raise_keyed(where, problems, lines)
     return params
 
 
@@ -406,17 +417,36 @@ def validate(p: LaserParams) -> list[str]:
         out.append("kite_ce_height_m: must be > 0 when kite_area_m2 > 0")
     if p.headsail_table not in ("jib", "kite"):
         out.append(f"headsail_table: expected 'jib' or 'kite'; got {p.headsail_table!r}")
+    lo, hi = CREW_MASS_RANGE_KG
+    if p.stability == "hiking" and p.crew_mass_kg > 0 and not lo <= p.crew_mass_kg <= hi:
+        out.append(f"crew_mass_kg: expected a sailor mass in {lo:g}-{hi:g} kg for a hiking "
+                   f"dinghy; got {p.crew_mass_kg!r}")
+    if p.stability == "heel" and not (max(p.gz_m, default=0.0) > 0 or p.crew_arm_m > 0):
+        out.append("gz_m: stability 'heel' needs a righting-arm curve with a positive value "
+                   "(or crew_arm_m > 0); with none the boat cannot carry sail. Give gz_m "
+                   "(and gz_heel_deg) or use stability: hiking")
     return out
 
 
-def _raise(where: str, problems: list[str]) -> None:
-    if len(problems) == 1:
-        raise InputError(f"{where}: {problems[0]}")
-    raise InputError(format_problems(f"{where}: {len(problems)} problems", problems))
+def _raise_keyed(
+    where: str, problems: list[tuple[str, str]], lines: Mapping[str, int] | None
+) -> None:
+    """Raise one InputError; with ``lines``, each problem is located as ``where:LINE:``."""
+    if lines is None:
+        texts = [m for _, m in problems]
+        if len(texts) == 1:
+            raise InputError(f"{where}: {texts[0]}")
+        raise InputError(format_problems(f"{where}: {len(texts)} problems", texts))
+    located = [f"{where}:{lines[k]}: {m}" if k in lines else f"{where}: {m}"
+               for k, m in problems]
+    if len(located) == 1:
+        raise InputError(located[0])
+    raise InputError(format_problems(f"{where}: {len(located)} problems", located))
 
 
 __all__ = [
     "CLASSES",
+    "CREW_MASS_RANGE_KG",
     "ILCA4",
     "ILCA6",
     "ILCA7",

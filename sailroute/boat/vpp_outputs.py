@@ -16,7 +16,13 @@ import numpy as np
 
 from sailroute.boat.build import vpp_polar
 from sailroute.boat.io import write_pol, write_polar_csv, write_polar_json
-from sailroute.boat.laser import CLASSES, ILCA7, LaserParams, params_from_mapping
+from sailroute.boat.laser import (
+    CLASSES,
+    CREW_MASS_RANGE_KG,
+    ILCA7,
+    LaserParams,
+    params_from_mapping,
+)
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 from sailroute.units import speed_factor
@@ -54,27 +60,47 @@ class VppRun:
 def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
     """Read a boat YAML (see ``docs/vpp.md``) and return its parameters and a file stem.
 
+    The YAML is read like a course file (YAML 1.2 scalars: ``1e6`` is a number,
+    ``no`` is text), and a key given twice is an error rather than silently the
+    last value.
+
     Raises
     ------
     InputError
-        Missing file, YAML syntax error (with line), unknown key or bad value
-        (with the key), all in one message.
+        Missing file, folder, not UTF-8, YAML syntax error (with line and
+        column), duplicate key, unknown key or bad value (with the key and its
+        line), all in one message.
     """
     import yaml
 
+    from sailroute.course.load import CourseLoader  # same scalar rules as course files
+
     p = Path(path)
+    if p.is_dir():
+        raise InputError(f"{p}: is a folder; expected a boat file (.yaml)")
     try:
         text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise InputError(f"{p}: boat file not found") from None
+        raise InputError(
+            f"{p}: boat file not found; check the path, or leave BOAT.yaml out to use the "
+            "shipped ILCA 7 parameters"
+        ) from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{p}: not a UTF-8 text file ({exc.reason}); save it as UTF-8") from None
     except OSError as exc:
-        raise InputError(f"{p}: cannot read boat file ({exc})") from None
+        raise InputError(f"{p}: cannot read boat file ({exc.strerror or exc})") from None
     try:
-        doc = yaml.safe_load(text)
+        node = yaml.compose(text, Loader=CourseLoader)
+        doc = yaml.load(text, Loader=CourseLoader)  # CourseLoader is a SafeLoader
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        at = f"{p}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(p)
+        raise InputError(
+            f"{at}: not valid YAML ({exc.problem or exc.context or 'syntax error'}); a boat "
+            "file is lines of 'key: value', e.g. 'class: ilca7' and 'crew_mass_kg: 80'"
+        ) from None
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = f":{mark.line + 1}" if mark is not None else ""
-        raise InputError(f"{p}{line}: not valid YAML ({getattr(exc, 'problem', exc)})") from None
+        raise InputError(f"{p}: not valid YAML ({exc})") from None
     if doc is None:
         doc = {}
     if not isinstance(doc, dict):
@@ -82,25 +108,39 @@ def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
             f"{p}: a boat file is a mapping like 'class: ilca7' and 'crew_mass_kg: 80'; "
             f"got {type(doc).__name__}"
         )
-    return params_from_mapping(doc, where=str(p)), _slug(p.stem)
+    lines: dict[str, int] = {}
+    if isinstance(node, yaml.MappingNode):
+        for k, _ in node.value:
+            key, line = str(k.value), k.start_mark.line + 1
+            if key in lines:
+                raise InputError(
+                    f"{p}:{line}: {key}: the key appears twice (lines {lines[key]} and "
+                    f"{line}); keep one"
+                )
+            lines[key] = line
+    return params_from_mapping(doc, where=str(p), lines=lines), _slug(p.stem)
 
 
 def parse_speed_list(text: str, unit: str, *, option: str = "--tws") -> tuple[float, ...]:
     """Parse ``"4,6,8"`` (in ``unit``) into increasing speeds [m s⁻¹]."""
     f = speed_factor(unit)
     vals = []
+    example = f"give comma-separated wind speeds in {unit}, e.g. '4,6,8'"
     for k, cell in enumerate(c for c in re.split(r"[,\s]+", text.strip()) if c):
         try:
             v = float(cell)
         except ValueError:
-            raise InputError(f"{option}: item {k + 1} ({cell!r}) is not a number") from None
+            raise InputError(
+                f"{option}: item {k + 1} ({cell!r}) is not a number; {example}") from None
         if not v > 0 or not np.isfinite(v):
-            raise InputError(f"{option}: item {k + 1} ({cell!r}) must be a positive speed")
+            raise InputError(
+                f"{option}: item {k + 1} ({cell!r}) must be a positive, finite speed; {example}")
         vals.append(v * f)
     if not vals:
-        raise InputError(f"{option}: give at least one wind speed, e.g. '4,6,8'")
+        raise InputError(f"{option}: no wind speed given; {example}")
     if any(b <= a for a, b in pairwise(vals)):
-        raise InputError(f"{option}: wind speeds must increase; got {text!r}")
+        raise InputError(
+            f"{option}: wind speeds must increase from item to item; got {text!r}, e.g. '4,6,8'")
     return tuple(vals)
 
 
@@ -221,13 +261,14 @@ def run_vpp_command(
     else:
         params, stem = load_boat_file(boat_file)
     if crew_mass_kg is not None:
-        if not 20.0 <= crew_mass_kg <= 200.0:
+        lo, hi = CREW_MASS_RANGE_KG
+        if not lo <= crew_mass_kg <= hi:
             raise InputError(
-                f"--crew-mass: expected a sailor mass in 20-200 kg; got {crew_mass_kg}"
+                f"--crew-mass: expected a sailor mass in {lo:g}-{hi:g} kg; got {crew_mass_kg}"
             )
         params = replace(params, crew_mass_kg=float(crew_mass_kg))
-    tws_ms = parse_speed_list(tws, unit) if tws else tuple(v * speed_factor(unit)
-                                                              for v in DEFAULT_TWS[unit])
+    tws_ms = (parse_speed_list(tws, unit) if tws is not None
+              else tuple(v * speed_factor(unit) for v in DEFAULT_TWS[unit]))
     polar = vpp_polar(params, tws_ms, twa_grid(twa_step_deg))
     files = write_outputs(polar, params, out_dir, stem, unit)
     return VppRun(params=params, polar=polar, report=polar_report(polar, unit), files=files)

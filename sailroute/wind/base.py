@@ -10,7 +10,9 @@ A wind field maps arrays of ``(t, x, y)`` to arrays ``(u, v)``:
   broadcast shape and dtype float64;
 * sampling outside :attr:`WindField.coverage` raises
   :class:`~sailroute.errors.OutOfCoverageError` naming both ranges, unless the
-  field was built with ``clamp=True`` (then points are clamped to the edges).
+  field was built with ``clamp=True`` (then points are clamped to the edges);
+* NaN in ``t``, ``x`` or ``y`` raises :class:`~sailroute.errors.OutOfCoverageError`
+  in both modes (never NaN winds out).
 
 ``tests/wind/test_field_contract.py`` runs the same checks on every implementation.
 """
@@ -124,32 +126,41 @@ def prepare_points(
     ------
     OutOfCoverageError
         If any point lies outside and ``clamp`` is False.  The message gives the
-        requested range, the covered range and how to opt in to clamping.
+        requested range, the covered range and how to opt in to clamping.  NaN
+        points raise in both modes: a NaN has no nearest edge to be clamped to,
+        and passing it on would give NaN winds (or an invalid grid index).
     """
     t, x, y = np.broadcast_arrays(
         np.asarray(t, dtype=float), np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     )
     c = coverage
+    if not t.size:
+        return t, x, y
+    tmin, xmin, ymin = t.min(), x.min(), y.min()  # NaN-propagating: one pass each
+    if np.isnan(tmin) or np.isnan(xmin) or np.isnan(ymin):
+        n_bad = int((np.isnan(t) | np.isnan(x) | np.isnan(y)).sum())
+        raise OutOfCoverageError(
+            f"{name}: {n_bad} of {t.size} sample points contain NaN (time or position); "
+            "the caller must pass finite epoch seconds and local metres"
+        )
     if clamp:
         return (
             np.clip(t, c.t0, c.t1),
             np.clip(x, c.xmin, c.xmax),
             np.clip(y, c.ymin, c.ymax),
         )
-    if t.size and not (
-        t.min() >= c.t0
-        and t.max() <= c.t1
-        and x.min() >= c.xmin
-        and x.max() <= c.xmax
-        and y.min() >= c.ymin
-        and y.max() <= c.ymax
+    tmax, xmax, ymax = t.max(), x.max(), y.max()
+    if not (
+        tmin >= c.t0
+        and tmax <= c.t1
+        and xmin >= c.xmin
+        and xmax <= c.xmax
+        and ymin >= c.ymin
+        and ymax <= c.ymax
     ):
         bad = ~c.contains(t, x, y)
-        if np.isnan(t).any() or np.isnan(x).any() or np.isnan(y).any():
-            raise OutOfCoverageError(f"{name}: sample points contain NaN")
         requested = Coverage(
-            float(t.min()), float(t.max()), float(x.min()), float(x.max()),
-            float(y.min()), float(y.max()),
+            float(tmin), float(tmax), float(xmin), float(xmax), float(ymin), float(ymax)
         )
         raise OutOfCoverageError(
             f"{name}: {int(bad.sum())} of {bad.size} sample points lie outside the data.\n"

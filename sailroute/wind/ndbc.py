@@ -92,6 +92,13 @@ def read_ndbc(
                 except ValueError:
                     raise WindDataError(f"{name}, line {lineno}, column {c}: cannot read "
                                         f"{cell!r} as a number") from None
+                hi, want = ((360.0, "0..360 degrees") if key == "direction"
+                            else (np.inf, "a finite speed >= 0 m/s"))
+                if not 0.0 <= arr[k] <= hi or np.isinf(arr[k]):
+                    raise WindDataError(
+                        f"{name}, line {lineno}, column {c}: value {cell!r} is out of range "
+                        f"(expected {want}; NDBC codes missing values as MM, 99.0 or 999)"
+                    )
     order = np.argsort(t, kind="stable")
     linenos = np.array([r[0] for r in rows])[order]
     t, spd, dirn, gust = t[order], spd[order], dirn[order], gust[order]

@@ -48,19 +48,21 @@ CANONICAL_COLUMNS: Final = ("time", "station", "lat", "lon", "speed", "direction
 REQUIRED_COLUMNS: Final = ("time", "speed", "direction")
 """Always required (``lat``/``lon`` unless ``position`` is given; ``station`` defaults)."""
 
+_SPEED_SUFFIXES: Final = ("_kn", "_kt", "_kts", "_ms", "_m_s", "_mps", "_kmh", "_kph", "_mph")
+
 COLUMN_ALIASES: Final[dict[str, tuple[str, ...]]] = {
     "time": ("time", "time_utc", "datetime", "datetime_utc", "datetime_local", "timestamp",
              "date_time", "utc", "time_iso", "t"),
     "station": ("station", "station_id", "stationid", "id", "name", "sensor"),
     "lat": ("lat", "latitude", "lat_deg"),
     "lon": ("lon", "lng", "long", "longitude", "lon_deg"),
-    "speed": ("speed", "tws", "tws_kn", "tws_kt", "tws_ms", "tws_m_s", "wspd", "wspd_m_s",
-              "wspd_kn", "wind_speed", "wind_speed_kn", "wind_speed_ms", "wind_speed_m_s",
-              "windspeed", "ws", "speed_kn", "speed_ms", "speed_m_s", "speed_kmh", "speed_mph"),
+    "speed": ("speed", "tws", "wspd", "wind_speed", "windspeed", "ws",
+              *(f"{base}{suffix}" for base in ("speed", "tws", "wspd", "wind_speed")
+                for suffix in _SPEED_SUFFIXES)),
     "direction": ("direction", "twd", "twd_deg", "wdir", "wdir_deg", "wdir_deg_true",
                   "wind_direction", "wind_dir", "winddir", "wd", "direction_deg", "dir"),
     "height_m": ("height_m", "height", "z", "z_m", "anemometer_height_m", "sensor_height_m"),
-    "gust": ("gust", "gust_m_s", "gust_ms", "gust_kn", "gst", "wind_gust", "gust_speed"),
+    "gust": ("gust", "gst", "wind_gust", "gust_speed", *(f"gust{x}" for x in _SPEED_SUFFIXES)),
 }
 """Built-in header aliases (case-insensitive) for each canonical column."""
 
@@ -422,6 +424,11 @@ def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss
                 f"{name}, line {linenos[k]}, column {column!r}: cannot read {c!r} as a number "
                 f"({canon}); if it marks missing data, add it to `missing`"
             ) from None
+        if np.isinf(out[k]):
+            raise WindDataError(
+                f"{name}, line {linenos[k]}, column {column!r}: {c!r} is not a finite number "
+                f"({canon}); replace it with a value or a missing marker"
+            )
         if np.isnan(out[k]):
             n_miss += 1
     return out, n_miss

@@ -7,6 +7,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from sailroute.boat.build import vpp_polar
@@ -77,13 +78,55 @@ def test_vpp_bad_input_exits_2_and_names_the_key(tmp_path: Path) -> None:
     boat.write_text("class: ilca7\ncrew_weight: 80\n")
     res = runner.invoke(app, ["vpp", str(boat), "--out", str(tmp_path)])
     assert res.exit_code == 2
-    assert "b.yaml: crew_weight: unknown key" in res.output
+    assert "b.yaml:2: crew_weight: unknown key; did you mean 'crew_mass_kg'?" in res.output
     boat.write_text("class: [ilca7\n")
     res = runner.invoke(app, ["vpp", str(boat), "--out", str(tmp_path)])
-    assert res.exit_code == 2 and "b.yaml:2: not valid YAML" in res.output
+    assert res.exit_code == 2 and "b.yaml:2:1: not valid YAML" in res.output
     res = runner.invoke(app, ["vpp", "--tws", "4,x", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "--tws: item 2 ('x') is not a number" in res.output
     res = runner.invoke(app, ["vpp", "--unit", "km/h", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "--unit: expected one of 'kn', 'm/s'" in res.output
     res = runner.invoke(app, ["vpp", str(tmp_path / "none.yaml"), "--out", str(tmp_path)])
     assert res.exit_code == 2 and "boat file not found" in res.output
+
+
+@pytest.mark.parametrize(
+    ("content", "args", "message"),
+    [
+        (None, ["--tws", ""], "--tws: no wind speed given; give comma-separated wind speeds"),
+        (None, ["--tws", "8,4"], "--tws: wind speeds must increase"),
+        (None, ["--tws", "4,-6"], "--tws: item 2 ('-6') must be a positive, finite speed"),
+        (None, ["--crew-mass", "-70"], "--crew-mass: expected a sailor mass in 20-200 kg"),
+        (None, ["--twa-step", "0"], "--twa-step: expected a step between 0.1 and 90 degrees"),
+        (b"crew_mass_kg: -70\n", [], "b.yaml:1: crew_mass_kg: must be a positive finite number"),
+        (b"crew_mass_kg: 5\n", [], "b.yaml:1: crew_mass_kg: expected a sailor mass in 20-200 kg"),
+        (b"class: ilca7\nname: \xff\n", [], "b.yaml: not a UTF-8 text file"),
+        (b"crew_mass_kg: 80\nclass: ilca6\ncrew_mass_kg: 90\n", [],
+         "b.yaml:3: crew_mass_kg: the key appears twice (lines 1 and 3)"),
+        (b"- ilca7\n", [], "b.yaml: a boat file is a mapping like 'class: ilca7'"),
+        (b"stability: heel\n", [], "b.yaml: gz_m: stability 'heel' needs a righting-arm curve"),
+        (b"sail_area_m2: 1e6\nbeam_m: wide\n", [], "b.yaml:2: beam_m: expected a number"),
+    ],
+)
+def test_vpp_bad_input_table(tmp_path: Path, content: bytes | None, args: list[str],
+                             message: str) -> None:
+    """Every bad input: exit code 2, one message naming the file/line/key or option."""
+    cmd = ["vpp", "--out", str(tmp_path / "out")]
+    if content is not None:
+        boat = tmp_path / "b.yaml"
+        boat.write_bytes(content)
+        cmd.insert(1, str(boat))
+    res = runner.invoke(app, [*cmd, *args])
+    assert res.exit_code == 2, (res.output, res.exception)
+    assert message in res.output
+    assert "Traceback" not in res.output
+    assert "1e6" not in res.output  # YAML 1.2 scalars: 1e6 is a number, as in course files
+    assert not (tmp_path / "out").exists()  # nothing written on bad input
+
+
+def test_vpp_missing_file_and_folder(tmp_path: Path) -> None:
+    res = runner.invoke(app, ["vpp", str(tmp_path / "none.yaml"), "--out", str(tmp_path)])
+    assert res.exit_code == 2
+    assert "none.yaml: boat file not found; check the path, or leave BOAT.yaml out" in res.output
+    res = runner.invoke(app, ["vpp", str(tmp_path), "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "is a folder; expected a boat file" in res.output

@@ -287,3 +287,34 @@ def test_opencpn_speed_and_vmg_known_answers() -> None:
     q = p.with_interpolation("pchip")
     assert float(q.vmg_upwind(10 * KNOT)[0]) == pytest.approx(44.998, abs=1.0)
     assert float(q.vmg_downwind(10 * KNOT)[0]) == pytest.approx(152.498, abs=1.5)
+
+
+@requires_shared
+def test_opencpn_true_wind_speed_inverse_lookup() -> None:
+    # test/Polar_tests.cpp: TrueWindSpeed(stw=5, twa=90, maxTWS=80) = 4.428 kn, the lowest TWS
+    # at which the (bilinear) polar gives 5 kn at 90 deg.  Between the 4 and 6 kn columns
+    # (4.7 and 6.1 kn at 90 deg) that is 4 + 2 (5 - 4.7) / 1.4 = 4.4286 kn.
+    p = read_polar(OCPN / "Hallberg-Rassy_40_test.pol", interpolation="linear")
+    tws = brentq(lambda w: float(p.speed(w * KNOT, 90.0)) / KNOT - 5.0, 0.01, 10.0, xtol=1e-12)
+    assert tws == pytest.approx(4.428, abs=1e-3)
+    assert tws == pytest.approx(4.0 + 2.0 * 0.3 / 1.4, abs=1e-9)
+
+
+@requires_shared
+def test_libweatherrouting_routage_known_answer() -> None:
+    # tests/polar_test.py: get_routage_speed(2.2 kn, 170 deg) = 1.24069 kn and
+    # get_twa_routage = 140 deg.  The library finds the downwind VMG optimum on a 1-deg grid
+    # from 90 deg (a candidate must beat the best so far by 1e-3 kn) and, for a target beyond
+    # it, counts VMG / |cos(target)|.  The same rule on our bilinear speeds gives both numbers.
+    p = read_polar(LWR / "bavaria38.pol", interpolation="linear")
+    tws = 2.2 * KNOT
+    best, best_a = -1.0, None
+    for a in np.arange(90.0, 180.0, 1.0):
+        vmg = -float(p.speed(tws, a)) / KNOT * math.cos(math.radians(a))
+        if vmg - best > 1e-3:
+            best, best_a = vmg, a
+    assert best_a == 140.0
+    assert best / abs(math.cos(math.radians(170.0))) == pytest.approx(1.24069, abs=1e-5)
+    # our continuous optimum lies between table rows, with at least that VMG
+    ang, vmg = p.vmg_downwind(tws)
+    assert 140.0 < float(ang) < 142.0 and float(vmg) / KNOT >= best

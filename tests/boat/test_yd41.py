@@ -8,7 +8,7 @@ lack LCB/LCF, waterplane area and crew data (assumed below) and WinVPP's model d
 detail (reefing, heel-dependent resistance, kite handling).
 
 Measured (all 224 points, TWS 3-10 m/s): RMS error 5.9 %, mean -1.3 %, max 21 % (10 m/s,
-kite at 126 deg); per TWS RMS 8.5 / 4.7 / 3.7 / 3.5 / 3.7 / 4.7 / 9.5 % for 3..10 m/s.
+TWA 89 deg, +21 %: no reefing); per TWS RMS 8.5 / 4.7 / 3.7 / 3.5 / 3.7 / 4.7 / 9.5 % for 3..10 m/s.
 Best beat: 3 m/s 41.3 deg / 3.99 kn (WinVPP 44.6 / 4.10); 10 m/s 32.5 deg / 6.78 kn (39.4 /
 6.02): no reefing and no heel-dependent resistance make it point too high in strong wind.
 """
@@ -125,4 +125,4 @@ def test_yd41_polar_all_winds() -> None:
     rms = float(np.sqrt(np.mean(errs**2)))
     assert rms < 0.07  # measured 5.9 %
     assert abs(float(np.mean(errs))) < 0.03  # measured -1.3 %
-    assert float(np.max(np.abs(errs))) < 0.25  # measured 21 % (10 m/s, kite at 126 deg)
+    assert float(np.max(np.abs(errs))) < 0.25  # measured 21 % (10 m/s, TWA 89 deg)

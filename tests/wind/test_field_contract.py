@@ -16,7 +16,8 @@ from conftest import T0
 from sailroute.errors import OutOfCoverageError
 from sailroute.geo import LocalFrame
 from sailroute.units import wind_components
-from sailroute.wind.base import WindField
+from sailroute.wind.analytic import AnalyticWind
+from sailroute.wind.base import Coverage, WindField
 from sailroute.wind.blended import BlendedWind
 from sailroute.wind.rotation import rotate_clockwise
 from sailroute.wind.stations import StationData, StationWind
@@ -71,6 +72,9 @@ def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
         return UniformWind(TWS, TWD, clamp=clamp)
     if kind == "uniform-table":
         return UniformWind([TWS, TWS], [TWD, TWD], times=[T0, T0 + 1800.0], clamp=clamp)
+    if kind == "analytic":
+        cover = Coverage(T0, T0 + 1800.0, -2000.0, 2000.0, -1500.0, 1500.0)
+        return AnalyticWind(lambda t, x, y: (U0, V0), cover, clamp=clamp)
     path = tiny_wrf("contract.nc", wind10=local_constant_wind(frame),
                     wind_at=local_constant_profile(frame))
     if kind == "wrf-linear":
@@ -90,10 +94,11 @@ def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
     raise AssertionError(kind)
 
 
-KINDS = ["uniform", "uniform-table", "wrf-linear", "wrf-nearest", "wrf-frozen-10min",
-         "wrf-2.68m", "stations-idw", "stations-rbf", "blended"]
+KINDS = ["uniform", "uniform-table", "analytic", "wrf-linear", "wrf-nearest",
+         "wrf-frozen-10min", "wrf-2.68m", "stations-idw", "stations-rbf", "blended"]
 # Exact for the analytic sources; float32 storage in WRF files limits those to ~1e-6 m/s.
-TOL = {"uniform": 1e-12, "uniform-table": 1e-12, "stations-idw": 1e-12, "stations-rbf": 1e-9}
+TOL = {"uniform": 1e-12, "uniform-table": 1e-12, "analytic": 1e-12, "stations-idw": 1e-12,
+       "stations-rbf": 1e-9}
 
 
 @pytest.fixture(params=KINDS)
@@ -174,8 +179,12 @@ def test_outside_raises_and_clamp_holds_edge(field_and_tol) -> None:
         assert "requested" in str(e.value) and "covered" in str(e.value)
         u, v = fc.sample(*p)
         np.testing.assert_allclose([u, v], [U0, V0], atol=tol)
-    with pytest.raises(OutOfCoverageError, match="NaN"):
-        f.sample(np.nan, x[1], y[1])
+    # NaN is never "clamped" to an edge: both modes refuse it (no NaN winds out)
+    for g in (f, fc):
+        with pytest.raises(OutOfCoverageError, match="1 of 3 sample points contain NaN"):
+            g.sample(t[1], np.array([x[1], np.nan, x[1]]), y[1])
+        with pytest.raises(OutOfCoverageError, match="NaN"):
+            g.sample(np.nan, x[1], y[1])
     if not probes:  # unbounded (constant uniform wind): anything goes
         u, _ = f.sample(1e12, 1e9, -1e9)
         assert float(u) == pytest.approx(U0, abs=tol)

@@ -291,3 +291,52 @@ def test_moving_station_coverage_follows_track() -> None:
         d.lat[k], d.lon[k]), abs=1e-6)
     with pytest.raises(InputError, match="'rbf' needs fixed stations"):
         StationWind(d, frame, method="rbf")
+
+
+# --------------------------------------------------------------------------- additions
+@pytest.mark.parametrize(("header", "declared", "factor"), [
+    ("speed_kmh", None, 1000.0 / 3600.0), ("wind_speed_mph", None, 1609.344 / 3600.0),
+    ("speed", "km/h", 1000.0 / 3600.0), ("speed", "mph", 1609.344 / 3600.0),
+    ("speed", "m/s", 1.0), ("tws_kn", None, 1852.0 / 3600.0)])
+def test_all_four_speed_units(station_csv, header: str, declared, factor: float) -> None:
+    p = station_csv(rows((0, "A", 43.0, 6.0, 18, 90), (1, "A", 43.0, 6.0, 36, 95)),
+                    header=("time", "station", "lat", "lon", header, "direction"))
+    d = read_stations(p, speed_unit=declared)
+    np.testing.assert_allclose(d.speed_ms, np.array([18.0, 36.0]) * factor, rtol=1e-15)
+
+
+@pytest.mark.parametrize("hz", [1, 10, 20])
+def test_resampling_high_rate_logs(hz: int) -> None:
+    # 3 minutes at hz: a wind veering steadily from 350 to 10 deg (across north) at 5 m/s,
+    # starting 20 s into a UTC minute (1_000_020 s is a minute boundary): bins of 40, 60, 60
+    # and 20 s; the last holds a third of a full bin's samples and is dropped (min_fill 0.5).
+    n = 180 * hz
+    t = 1_000_040.0 + np.arange(n) / hz
+    direction = (350.0 + 20.0 * np.arange(n) / n) % 360.0
+    r = resample_stations(_data(t, np.full(n, 5.0), direction), 60.0)
+    assert len(r) == 3
+    np.testing.assert_allclose(r.speed_ms, 5.0, rtol=1e-12)
+    starts = np.floor(t / 60.0) * 60.0
+    for k, b in enumerate(np.unique(starts)[:3]):
+        m = starts == b
+        u, v = wind_components(5.0, direction[m])
+        assert r.direction_deg[k] == pytest.approx(wind_speed_direction(u.mean(), v.mean())[1],
+                                                   abs=1e-9)
+        assert r.t[k] == b + 30.0
+    assert r.direction_deg[1] > 355.0 or r.direction_deg[1] < 5.0  # across north, not south
+
+
+def test_non_finite_numbers_are_refused(station_csv) -> None:
+    p = station_csv(rows((0, "A", 43, 6, 10, 90), (1, "A", 43, 6, "inf", 90)), name="inf.csv")
+    with pytest.raises(WindDataError, match=r"line 3, column 'speed': 'inf' is not a finite"):
+        read_stations(p, speed_unit="kn")
+
+
+def test_ndbc_out_of_range_value_is_named(tmp_path) -> None:
+    lines = NDBC_TXT.read_text().splitlines()
+    f = lines[2].split()
+    f[5] = "412"  # WDIR
+    bad = tmp_path / "bad.cwind.txt"
+    bad.write_text("\n".join([*lines[:2], " ".join(f), *lines[3:]]) + "\n")
+    with pytest.raises(WindDataError, match=r"line 3, column WDIR: value '412' is out of range"):
+        read_ndbc(bad, position=GRAYS_REEF)
