@@ -71,53 +71,22 @@ def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
         column), duplicate key, unknown key or bad value (with the key and its
         line), all in one message.
     """
-    import yaml
-
-    from sailroute.course.load import CourseLoader  # same scalar rules as course files
+    from sailroute.yamlfile import read_yaml
 
     p = Path(path)
-    if p.is_dir():
-        raise InputError(f"{p}: is a folder; expected a boat file (.yaml)")
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(
-            f"{p}: boat file not found; check the path, or leave BOAT.yaml out to use the "
-            "shipped ILCA 7 parameters"
-        ) from None
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{p}: not a UTF-8 text file ({exc.reason}); save it as UTF-8") from None
-    except OSError as exc:
-        raise InputError(f"{p}: cannot read boat file ({exc.strerror or exc})") from None
-    try:
-        node = yaml.compose(text, Loader=CourseLoader)
-        doc = yaml.load(text, Loader=CourseLoader)  # CourseLoader is a SafeLoader
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        at = f"{p}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(p)
-        raise InputError(
-            f"{at}: not valid YAML ({exc.problem or exc.context or 'syntax error'}); a boat "
-            "file is lines of 'key: value', e.g. 'class: ilca7' and 'crew_mass_kg: 80'"
-        ) from None
-    except yaml.YAMLError as exc:
-        raise InputError(f"{p}: not valid YAML ({exc})") from None
-    if doc is None:
-        doc = {}
+    ydoc = read_yaml(p, what="boat file", hint="check the path, or leave BOAT.yaml out to "
+                     "use the shipped ILCA 7 parameters")
+    doc = {} if ydoc.data is None else ydoc.data
     if not isinstance(doc, dict):
         raise InputError(
             f"{p}: a boat file is a mapping like 'class: ilca7' and 'crew_mass_kg: 80'; "
             f"got {type(doc).__name__}"
         )
-    lines: dict[str, int] = {}
-    if isinstance(node, yaml.MappingNode):
-        for k, _ in node.value:
-            key, line = str(k.value), k.start_mark.line + 1
-            if key in lines:
-                raise InputError(
-                    f"{p}:{line}: {key}: the key appears twice (lines {lines[key]} and "
-                    f"{line}); keep one"
-                )
-            lines[key] = line
+    if ydoc.duplicates:
+        d = ydoc.duplicates[0]
+        raise InputError(f"{p}:{d.line}: {d.path}: the key appears twice (lines "
+                         f"{d.first_line} and {d.line}); keep one")
+    lines = {k: v for k, v in ydoc.lines.items() if "." not in k and "[" not in k}
     return params_from_mapping(doc, where=str(p), lines=lines), _slug(p.stem)
 
 

@@ -16,7 +16,6 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import math
-import re
 import typing
 from collections.abc import Callable, Iterable, Mapping
 from datetime import date, datetime
@@ -24,7 +23,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from sailroute.course.model import Course, Gate, LegSpec, Line, Mark, ScenarioSpec
 from sailroute.course.templates import TEMPLATES, CourseLayout
@@ -32,6 +30,7 @@ from sailroute.errors import InputError, format_problems
 from sailroute.geo import LocalFrame
 from sailroute.routing.types import RouterName, RoutingSettings
 from sailroute.timeutil import parse_time
+from sailroute.yamlfile import YamlLoader, join_path, read_yaml
 
 TOP_KEYS = (
     "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
@@ -88,10 +87,7 @@ class _Problems:
         raise InputError(format_problems(title, self.items))
 
 
-def _join(path: str, key: str | int) -> str:
-    if isinstance(key, int):
-        return f"{path}[{key}]"
-    return f"{path}.{key}" if path else str(key)
+_join = join_path
 
 
 def _quoted(choices: Iterable[Any]) -> str:
@@ -113,97 +109,15 @@ def _show(value: Any) -> str:
 
 
 # ----------------------------------------------------------------------------- YAML
-class CourseLoader(yaml.SafeLoader):
-    """PyYAML's safe loader with YAML 1.2 core-schema scalars.
-
-    YAML 1.1 (PyYAML's default) reads ``4_2`` as the integer 42, ``12:10`` as 730
-    (base 60), ``010`` as 8 and ``no``/``off`` as false, which silently renames marks
-    such as the thesis's ``4_2``.  Here only decimal numbers are numbers and only
-    ``true``/``false`` are booleans; everything else is text.
-    """
-
-
-_DROP = {"tag:yaml.org,2002:int", "tag:yaml.org,2002:float", "tag:yaml.org,2002:bool"}
-CourseLoader.yaml_implicit_resolvers = {
-    k: [r for r in v if r[0] not in _DROP]
-    for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()
-}
-CourseLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:bool", re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$"), list("tTfF")
-)
-CourseLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:int", re.compile(r"^[-+]?[0-9]+$"), list("-+0123456789")
-)
-CourseLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
-               r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
-    list("-+0123456789."),
-)
-CourseLoader.add_constructor(
-    "tag:yaml.org,2002:int", lambda loader, node: int(loader.construct_scalar(node), 10)
-)
-
-
-def _key_lines(node: yaml.Node, path: str, out: dict[str, int], dup: list[str]) -> None:
-    """Record the 1-based line of every key path; report duplicate keys."""
-    if isinstance(node, yaml.MappingNode):
-        seen: dict[str, int] = {}
-        for k, v in node.value:
-            key = str(k.value)
-            line = k.start_mark.line + 1
-            if key in seen:
-                dup.append(
-                    f"{_join(path, key) or key}: the key {key!r} appears twice in the same "
-                    f"mapping (lines {seen[key]} and {line}); keep one"
-                )
-            seen[key] = line
-            p = _join(path, key)
-            out[p] = line
-            _key_lines(v, p, out, dup)
-    elif isinstance(node, yaml.SequenceNode):
-        for i, item in enumerate(node.value):
-            p = _join(path, i)
-            out[p] = item.start_mark.line + 1
-            _key_lines(item, p, out, dup)
+CourseLoader = YamlLoader
+"""The YAML loader of course files (YAML 1.2 scalars; see :mod:`sailroute.yamlfile`)."""
 
 
 def _read_yaml(path: Path) -> tuple[Any, dict[str, int], list[str]]:
-    if not path.exists():
-        raise InputError(f"{path}: course file not found")
-    if path.is_dir():
-        raise InputError(f"{path}: is a folder; expected a course file (.yaml)")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except UnicodeDecodeError as exc:
-        raise InputError(
-            f"{path}: not a UTF-8 text file ({exc.reason}); save it as UTF-8"
-        ) from None
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read the course file ({exc.strerror})") from None
-    try:
-        node = yaml.compose(text, Loader=CourseLoader)
-        data = yaml.load(text, Loader=CourseLoader)  # CourseLoader is a SafeLoader
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(path)
-        what = exc.problem or "invalid YAML"
-        cm = exc.context_mark
-        if exc.context and cm is not None and (mark is None or cm.line != mark.line):
-            what += f" ({exc.context} at line {cm.line + 1}, column {cm.column + 1})"
-        elif exc.context:
-            what += f" ({exc.context})"
-        raise InputError(
-            f"{where}: YAML syntax error: {what}; check indentation, colons, quotes and "
-            "brackets on this line and the ones before"
-        ) from None
-    except yaml.YAMLError as exc:
-        raise InputError(f"{path}: YAML syntax error: {exc}") from None
-    lines: dict[str, int] = {}
-    dup: list[str] = []
-    if node is not None:
-        _key_lines(node, "", lines, dup)
-    return data, lines, dup
+    doc = read_yaml(path, what="course file")
+    dup = [f"{d.path}: the key {d.key!r} appears twice in the same mapping "
+           f"(lines {d.first_line} and {d.line}); keep one" for d in doc.duplicates]
+    return doc.data, doc.lines, dup
 
 
 # ----------------------------------------------------------------------------- checkers

@@ -81,7 +81,7 @@ def test_vpp_bad_input_exits_2_and_names_the_key(tmp_path: Path) -> None:
     assert "b.yaml:2: crew_weight: unknown key; did you mean 'crew_mass_kg'?" in res.output
     boat.write_text("class: [ilca7\n")
     res = runner.invoke(app, ["vpp", str(boat), "--out", str(tmp_path)])
-    assert res.exit_code == 2 and "b.yaml:2:1: not valid YAML" in res.output
+    assert res.exit_code == 2 and "b.yaml:2:1: YAML syntax error" in res.output
     res = runner.invoke(app, ["vpp", "--tws", "4,x", "--out", str(tmp_path)])
     assert res.exit_code == 2 and "--tws: item 2 ('x') is not a number" in res.output
     res = runner.invoke(app, ["vpp", "--unit", "km/h", "--out", str(tmp_path)])
