@@ -4,6 +4,8 @@ Usage::
 
     python benchmarks/bench_strategy.py            # SDP, Monte Carlo, deadline solves
     python benchmarks/bench_strategy.py --paper    # + seed 004 Figs 3 and 4(a) reproduction
+    python benchmarks/bench_strategy.py --scheduler processes --workers 2
+                                                   # + Monte Carlo on Dask vs serial
 
 Prints seconds (best of ``--repeat`` for the SDP) and the numbers the paper reports next to
 ours.  BLAS threads are pinned to one before numpy is imported.
@@ -24,14 +26,17 @@ import numpy as np  # noqa: E402
 
 from sailroute.boat.build import builtin_polar  # noqa: E402
 from sailroute.boat.polar import Polar  # noqa: E402
+from sailroute.parallel import open_runner  # noqa: E402
 from sailroute.strategy.deadline import (  # noqa: E402
     DeadlineGrid,
+    DeadlinePolicy,
+    RiskNeutralPolicy,
     simulate_deadline,
     solve_deadline,
     solve_risk_neutral,
 )
 from sailroute.strategy.montecarlo import simulate  # noqa: E402
-from sailroute.strategy.sdp import BeatGrid, solve_expected_time  # noqa: E402
+from sailroute.strategy.sdp import BeatGrid, ExpectedTimePolicy, solve_expected_time  # noqa: E402
 from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift  # noqa: E402
 from sailroute.units import KNOT  # noqa: E402
 
@@ -41,7 +46,7 @@ SO40_KN = [0.0, 0.6, 1.2, 1.8, 2.1, 2.5, 4.1, 4.6, 5.0, 5.4, 5.8, 6.2, 6.4, 6.5,
            6.2, 5.7, 5.2, 4.7, 4.2, 3.9, 3.6]
 
 
-def bench_sdp(repeat: int, runs: int) -> None:
+def bench_sdp(repeat: int, runs: int) -> ExpectedTimePolicy:
     polar = builtin_polar("ilca7")
     grid = BeatGrid()
     model = OUShift(10.0, 600.0)
@@ -59,9 +64,10 @@ def bench_sdp(repeat: int, runs: int) -> None:
     s = sim.summary()
     print(f"Monte Carlo {runs} runs: {dt:.2f} s; mean {s['mean_s']:.1f} ± {s['se_mean_s']:.1f} s, "
           f"tacks {s['tacks']['mean']:.2f}")
+    return pol
 
 
-def bench_deadline_physical() -> None:
+def bench_deadline_physical() -> tuple[RiskNeutralPolicy, DeadlinePolicy]:
     polar = builtin_polar("ilca7")
     model = DriftDiffusionShift(0.0, 0.4275)
     for interp in ("linear", "cubic"):
@@ -75,6 +81,41 @@ def bench_deadline_physical() -> None:
     t0 = time.perf_counter()
     simulate_deadline(rn, 4000, 1, (1600.0, 0.0, 1), ra=ra, deadline_s=800.0)
     print(f"deadline Monte Carlo, 4000 runs (Δt = 1 s): {time.perf_counter() - t0:.2f} s")
+    return rn, ra
+
+
+def bench_scale_out(
+    pol: ExpectedTimePolicy,
+    rn: RiskNeutralPolicy,
+    ra: DeadlinePolicy,
+    runs: int,
+    scheduler: str,
+    n_workers: int | None,
+    repeat: int,
+) -> None:
+    """Monte Carlo serial vs on ``scheduler`` (cluster start timed separately)."""
+    start = (1600.0, 0.0, 1)
+    t0 = time.perf_counter()
+    with open_runner(scheduler, n_workers) as runner:
+        print(f"Dask: {runner.description}, ready in {time.perf_counter() - t0:.2f} s")
+        for n in (runs, 5 * runs):
+            cases = (
+                ("expected-time MC", lambda sch, n=n: simulate(pol, n, 1, scheduler=sch)),
+                ("deadline MC", lambda sch, n=n: simulate_deadline(
+                    rn, n, 1, start, ra=ra, deadline_s=800.0, scheduler=sch)),
+            )
+            for name, run in cases:
+                t_serial, t_dist = math.inf, math.inf
+                for _ in range(repeat):
+                    t0 = time.perf_counter()
+                    a = run(None)
+                    t_serial = min(t_serial, time.perf_counter() - t0)
+                    t0 = time.perf_counter()
+                    b = run(runner)
+                    t_dist = min(t_dist, time.perf_counter() - t0)
+                same = np.array_equal(a.leg_time_s, b.leg_time_s)
+                print(f"  {name}, {n} runs: serial {t_serial:.2f} s, Dask {t_dist:.2f} s "
+                      f"(best of {repeat}), identical leg times: {same}")
 
 
 def _so40() -> Polar:
@@ -123,9 +164,14 @@ def main() -> None:
     ap.add_argument("--paper-grid", default="200,256,0.2",
                     help="n_r,n_theta,ds for --paper (default 200,256,0.2)")
     ap.add_argument("--paper-interp", default="linear", choices=("linear", "cubic"))
+    ap.add_argument("--scheduler", default=None,
+                    help="also time the Monte Carlo on Dask: processes | tcp://HOST:PORT")
+    ap.add_argument("--workers", type=int, default=None, help="workers for --scheduler processes")
     args = ap.parse_args()
-    bench_sdp(args.repeat, args.runs)
-    bench_deadline_physical()
+    pol = bench_sdp(args.repeat, args.runs)
+    rn, ra = bench_deadline_physical()
+    if args.scheduler:
+        bench_scale_out(pol, rn, ra, args.runs, args.scheduler, args.workers, args.repeat)
     if args.paper:
         n_r, n_t, ds = args.paper_grid.split(",")
         bench_paper(int(n_r), int(n_t), float(ds), args.runs, args.paper_interp)

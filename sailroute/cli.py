@@ -223,8 +223,26 @@ def strategy_command(
     start_tack: Annotated[
         str, typer.Option("--start-tack", help="starboard | port.")
     ] = "starboard",
+    shift: Annotated[
+        str,
+        typer.Option("--shift", help="Wind-shift model of the expected-time policy: ou "
+                     "(mean-reverting) | drift-diffusion."),
+    ] = "ou",
+    diffusion_deg_per_sqrt_min: Annotated[
+        float | None,
+        typer.Option("--diffusion-deg-per-sqrt-min", help="Diffusion of the direction for "
+                     "--shift drift-diffusion, deg/sqrt(min) (default: fitted or from sigma)."),
+    ] = None,
     out: Annotated[str, typer.Option("--out", help="Output folder.")] = "strategy-out",
     no_plots: Annotated[bool, typer.Option("--no-plots", help="JSON summary only.")] = False,
+    scheduler: Annotated[
+        str | None,
+        typer.Option("--scheduler", help="Monte Carlo on: serial (default) | processes (local "
+                     "Dask cluster) | tcp://HOST:PORT; results are identical."),
+    ] = None,
+    workers: Annotated[
+        int | None, typer.Option("--workers", help="Worker processes for --scheduler processes.")
+    ] = None,
 ) -> None:
     """Tack strategy on an upwind leg under wind shifts: expected-time or deadline policies."""
     from sailroute.strategy.api import run_strategy_command
@@ -236,7 +254,8 @@ def strategy_command(
         fit_timezone=fit_timezone, objective=objective, out_dir=out, plots=not no_plots,
         progress=lambda msg: typer.echo(msg, err=True),
         length_m=length_m, half_width_m=half_width_m, tack_penalty_s=tack_penalty_s,
-        runs=runs, seed=seed, start_tack=start_tack,
+        runs=runs, seed=seed, start_tack=start_tack, scheduler=scheduler, n_workers=workers,
+        shift=shift, diffusion_deg_per_sqrt_min=diffusion_deg_per_sqrt_min,
     )
     typer.echo(res.report)
     for path in res.files:

@@ -18,6 +18,7 @@ import numpy as np
 
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.parallel import TaskRunner, check_scheduler, open_runner
 from sailroute.strategy.deadline import (
     DeadlineGrid,
     DeadlinePolicy,
@@ -189,6 +190,8 @@ def run_strategy(
     settings: StrategySettings | None = None,
     progress: Progress | None = None,
     fit: dict[str, Any] | None = None,
+    scheduler: str | TaskRunner | None = None,
+    n_workers: int | None = None,
 ) -> StrategyResult:
     """Solve and simulate the expected-time policy, and the deadline policies if asked.
 
@@ -203,18 +206,40 @@ def run_strategy(
         Receives one-line progress messages.
     fit : dict, optional
         Description of a parameter fit, copied into the summary.
+    scheduler : str, TaskRunner or None
+        Where the Monte Carlo chunks run (:func:`sailroute.parallel.map_tasks`):
+        ``None``/``"serial"`` (default), ``"processes"`` (local Dask cluster),
+        or a Dask scheduler address.  The solves always run here; the results
+        (and ``summary``) are identical for every scheduler.
+    n_workers : int, optional
+        Worker processes for ``scheduler="processes"`` (default: one per core).
     """
     st = StrategySettings() if settings is None else settings
-    say = progress or (lambda _msg: None)
     if st.runs < 1:
         raise InputError(f"runs = {st.runs}: need at least one Monte Carlo run")
+    # connect first: a wrong address fails before minutes of solving, and one cluster
+    # serves all the simulations of the study
+    with open_runner(scheduler, n_workers) as runner:
+        return _run_study(polar, model, st, progress, fit, runner)
+
+
+def _run_study(
+    polar: Polar,
+    model: ShiftModel,
+    st: StrategySettings,
+    progress: Progress | None,
+    fit: dict[str, Any] | None,
+    runner: TaskRunner,
+) -> StrategyResult:
+    say = progress or (lambda _msg: None)
     grid = st.beat_grid()
     say(f"solving the expected-time SDP ({grid.n_x} x {grid.n_rows} x 2 x {grid.theta_deg.size})")
     policy = solve_expected_time(
         polar, st.tws_ms, model, grid, st.tack_penalty_s, st.clock, st.chain_method  # type: ignore[arg-type]
     )
-    say(f"  solved in {policy.solve_time_s:.2f} s; simulating {st.runs} runs")
-    sim = simulate(policy, st.runs, st.seed, tack0=st.start_tack)
+    where = "" if runner.client is None else f" on {runner.description}"
+    say(f"  solved in {policy.solve_time_s:.2f} s; simulating {st.runs} runs{where}")
+    sim = simulate(policy, st.runs, st.seed, tack0=st.start_tack, scheduler=runner)
     vmg_angle, vmg = polar.vmg_upwind(st.tws_ms)
     vmg_angle, vmg = float(vmg_angle), float(vmg)
     q_heading, q_vmg = quantised_vmg(grid, polar, st.tws_ms)
@@ -256,13 +281,18 @@ def run_strategy(
     }
     study = None
     if st.deadlines_s:
-        study = _run_deadline(polar, model, st, nominal, say)
+        study = _run_deadline(polar, model, st, nominal, say, runner)
         summary["deadline"] = _deadline_summary(study, st)
     return StrategyResult(st, polar, model, policy, sim, study, summary)
 
 
 def _run_deadline(
-    polar: Polar, model: ShiftModel, st: StrategySettings, nominal: float, say: Progress
+    polar: Polar,
+    model: ShiftModel,
+    st: StrategySettings,
+    nominal: float,
+    say: Progress,
+    runner: TaskRunner,
 ) -> DeadlineStudy:
     f_max = float(polar.max_speed(st.tws_ms)[1])
     grid = deadline_grid_for(st, f_max, nominal)
@@ -277,10 +307,13 @@ def _run_deadline(
     say(f"  solved in {rn.solve_time_s:.1f} s ({rn.iterations} sweeps); simulating")
     start = (st.length_m, 0.0, st.start_tack)
     t_max = 3.0 * grid.s_max_s
-    sim_rn = simulate_deadline(rn, st.runs, st.seed, start, t_max_s=t_max, n_tracks=100)
+    sim_rn = simulate_deadline(
+        rn, st.runs, st.seed, start, t_max_s=t_max, n_tracks=100, scheduler=runner
+    )
     sims = {
         float(d): simulate_deadline(
-            rn, st.runs, st.seed, start, ra=ra, deadline_s=float(d), t_max_s=t_max, n_tracks=100
+            rn, st.runs, st.seed, start, ra=ra, deadline_s=float(d), t_max_s=t_max,
+            n_tracks=100, scheduler=runner,
         )
         for d in st.deadlines_s
     }
@@ -434,6 +467,10 @@ def run_strategy_command(
     plots: bool = True,
     progress: Progress | None = None,
     start_tack: str = "starboard",
+    scheduler: str | None = None,
+    n_workers: int | None = None,
+    shift: str = "ou",
+    diffusion_deg_per_sqrt_min: float | None = None,
     **settings: Any,
 ) -> CommandResult:
     """The ``sailroute strategy`` command as a function (the CLI only parses and prints).
@@ -447,9 +484,12 @@ def run_strategy_command(
     sigma_deg, timescale_min : float
         OU shift: stationary sd [°] and time scale [min] (ignored with ``fit_from``).
     drift_deg_per_min : float
-        Persistent shift for the deadline problem [° min⁻¹] (positive veers).
+        Persistent shift [° min⁻¹] (positive veers): the drift of
+        ``shift="drift-diffusion"``, and of the deadline problem's Brownian
+        wind when ``shift="ou"``.
     fit_from, fit_station, fit_timezone : str, optional
-        Station CSV to fit ``sigma`` and the time scale from (e-fold method).
+        Station CSV to fit the shift model from (OU: sigma and the e-fold time
+        scale; drift-diffusion: drift and diffusion).
     objective : str
         ``expected`` or ``deadline=SECONDS[,SECONDS]``.
     out_dir : str or Path
@@ -460,13 +500,28 @@ def run_strategy_command(
         Progress messages.
     start_tack : {"starboard", "port"}
         Tack at the start.
+    scheduler : str, optional
+        ``--scheduler``: ``serial`` (default), ``processes`` (local Dask
+        cluster), or a Dask scheduler address ``tcp://HOST:PORT``; only the
+        Monte Carlo is distributed and the numbers do not change
+        (``docs/scale-out.md``).
+    n_workers : int, optional
+        Worker processes for ``processes`` (default: one per core).
+    shift : {"ou", "drift-diffusion"}
+        Wind-shift model of the study: oscillating (Ornstein–Uhlenbeck, from
+        ``sigma_deg`` and ``timescale_min``) or persistent (Brownian with
+        drift, from ``drift_deg_per_min`` and ``diffusion_deg_per_sqrt_min``).
+    diffusion_deg_per_sqrt_min : float, optional
+        Diffusion of ``shift="drift-diffusion"`` [° min⁻½]: the sd of the
+        change of direction after one minute (``Var = s² t``).
     **settings
         Further :class:`StrategySettings` fields (``length_m``, ``runs``, ...).
     """
     from sailroute.strategy.fit import fit_station_file
-    from sailroute.strategy.shiftmodel import OUShift
 
     deadlines = parse_objective(objective)
+    scheduler = check_scheduler(scheduler)
+    kind = parse_shift(shift)
     tack = {"starboard": 1, "port": -1}.get(str(start_tack).strip().lower())
     if tack is None:
         raise InputError(f"--start-tack {start_tack!r}: expected 'starboard' or 'port'")
@@ -476,12 +531,11 @@ def run_strategy_command(
     fit = None
     if fit_from is not None:
         ou, dd = fit_station_file(fit_from, station=fit_station, timezone=fit_timezone)
-        model: ShiftModel = ou.model()
+        model: ShiftModel = ou.model() if kind == "ou" else dd.model()
         fit = fit_summary(ou, dd, str(fit_from))
     else:
-        if not timescale_min > 0:
-            raise InputError(f"--timescale-min {timescale_min}: must be > 0")
-        model = OUShift(sigma_deg, timescale_min * 60.0)
+        model = shift_model(kind, sigma_deg, timescale_min, drift_deg_per_min,
+                            diffusion_deg_per_sqrt_min)
     try:
         st = StrategySettings(
             tws_ms=tws_kn * KNOT,
@@ -492,9 +546,63 @@ def run_strategy_command(
         )
     except TypeError as exc:  # pragma: no cover - programming error in a caller
         raise InputError(f"strategy settings: {exc}") from None
-    result = run_strategy(polar, model, st, progress=progress, fit=fit)
+    result = run_strategy(
+        polar, model, st, progress=progress, fit=fit, scheduler=scheduler, n_workers=n_workers
+    )
     files = write_outputs(result, out_dir, plots=plots)
     return CommandResult(format_report(result), files, result)
+
+
+SHIFT_KINDS = ("ou", "drift-diffusion")
+"""Wind-shift models the ``strategy`` command can use."""
+
+
+def parse_shift(text: str) -> str:
+    """``"ou"`` or ``"drift-diffusion"`` (case and ``_`` insensitive), else an InputError."""
+    kind = str(text).strip().lower().replace("_", "-")
+    if kind not in SHIFT_KINDS:
+        raise InputError(
+            f"--shift {text!r}: expected 'ou' (oscillating shifts) or 'drift-diffusion' "
+            "(persistent shift)"
+        )
+    return kind
+
+
+def shift_model(
+    kind: str,
+    sigma_deg: float,
+    timescale_min: float,
+    drift_deg_per_min: float,
+    diffusion_deg_per_sqrt_min: float | None,
+) -> ShiftModel:
+    """The shift model given directly on the command line (minutes converted to seconds).
+
+    Parameters
+    ----------
+    kind : {"ou", "drift-diffusion"}
+    sigma_deg, timescale_min : float
+        OU: stationary sd [°] and e-folding time [min].
+    drift_deg_per_min, diffusion_deg_per_sqrt_min : float
+        Drift-diffusion: drift [° min⁻¹] (positive veers) and diffusion [° min⁻½].
+    """
+    from sailroute.strategy.shiftmodel import OUShift
+
+    if kind == "ou":
+        if not timescale_min > 0:
+            raise InputError(f"--timescale-min {timescale_min}: must be > 0")
+        return OUShift(sigma_deg, timescale_min * 60.0)
+    if diffusion_deg_per_sqrt_min is None:
+        raise InputError(
+            "--shift drift-diffusion needs --diffusion-deg-per-sqrt-min (the sd of the change "
+            "of direction after one minute, e.g. 3), or --fit-from a station file"
+        )
+    if not (math.isfinite(diffusion_deg_per_sqrt_min) and diffusion_deg_per_sqrt_min >= 0):
+        raise InputError(
+            f"--diffusion-deg-per-sqrt-min {diffusion_deg_per_sqrt_min}: must be finite and >= 0"
+        )
+    return DriftDiffusionShift(
+        drift_deg_per_min / 60.0, diffusion_deg_per_sqrt_min / math.sqrt(60.0)
+    )
 
 
 def fit_summary(ou: Any, dd: Any, source: str) -> dict[str, Any]:
@@ -513,12 +621,20 @@ def format_report(result: StrategyResult) -> str:
         f"at TWA {b['vmg_twa_deg']:.1f}°",
         f"shift model: {result.model.describe()}",
     ]
-    if s.get("fit"):
+    if s.get("fit") and result.model.kind == "ou":
         ou = s["fit"]["ou"]
         lines.append(
             f"fitted from {s['fit']['source']}: sigma {ou['sigma_deg']:.1f} ± "
             f"{ou['sigma_se_deg']:.1f}°, time scale {ou['timescale_s'] / 60:.1f} ± "
             f"{ou['timescale_se_s'] / 60:.1f} min"
+        )
+    elif s.get("fit"):
+        dd = s["fit"]["drift_diffusion"]
+        lines.append(
+            f"fitted from {s['fit']['source']}: drift {60 * dd['drift_deg_per_s']:.2f} ± "
+            f"{60 * dd['drift_se_deg_per_s']:.2f}°/min, diffusion "
+            f"{math.sqrt(60) * dd['sigma_deg_per_sqrt_s']:.2f} ± "
+            f"{math.sqrt(60) * dd['sigma_se_deg_per_sqrt_s']:.2f}°/√min"
         )
     diag = s["chain"]["diagnostics_at_stage_time"]
     sd_err = diag["stationary_sd_deg"] / diag["target_sd_deg"] - 1.0

@@ -49,6 +49,7 @@ from numpy.typing import NDArray
 
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.parallel import TaskRunner, map_tasks
 from sailroute.strategy.montecarlo import CHUNK_SIZE, chunk_rng
 from sailroute.strategy.shiftmodel import DriftDiffusionShift
 
@@ -778,6 +779,7 @@ def simulate_deadline(
     t_max_s: float | None = None,
     n_tracks: int = 0,
     give_up_below: float = 0.0,
+    scheduler: str | TaskRunner | None = None,
 ) -> DeadlineSimulation:
     """Seeded Monte Carlo of the risk-aware policy ``α^ŝ`` (with ``ra`` and ``deadline_s``)
     or of the risk-neutral policy ``μ*`` (without).
@@ -803,17 +805,24 @@ def simulate_deadline(
         Runs still sailing then count as failures; default ``3 s_max``.
     n_tracks : int
         Keep the tracks of this many runs (from the first chunk only).
+    give_up_below : float
+        Fall back to ``μ*`` once ``w`` at the nearest node is at or below this.
+    scheduler : str, TaskRunner or None
+        Where the chunks of :data:`~sailroute.strategy.montecarlo.CHUNK_SIZE`
+        runs go (:func:`sailroute.parallel.map_tasks`); the result does not
+        depend on it.
     """
     if n_runs < 1:
         raise InputError(f"number of Monte Carlo runs {n_runs} must be >= 1")
     if (ra is None) != (deadline_s is None):
         raise InputError("give both a deadline policy and a deadline, or neither")
     n_chunks = -(-int(n_runs) // CHUNK_SIZE)
-    parts = [
-        simulate_deadline_chunk(rn, k, seed, start, ra, deadline_s, dt_s, t_max_s,
-                                n_tracks if k == 0 else 0, CHUNK_SIZE, give_up_below)
-        for k in range(n_chunks)
-    ]
+    parts = map_tasks(
+        _deadline_chunk_task,
+        range(n_chunks),
+        shared=(rn, seed, start, ra, deadline_s, dt_s, t_max_s, n_tracks, give_up_below),
+        scheduler=scheduler,
+    )
     sl = slice(0, n_runs)
     return DeadlineSimulation(
         leg_time_s=np.concatenate([p.leg_time_s for p in parts])[sl],
@@ -822,4 +831,23 @@ def simulate_deadline(
         deadline_s=parts[0].deadline_s,
         tracks_xy_m=parts[0].tracks_xy_m,
         seed=int(seed),
+    )
+
+
+def _deadline_chunk_task(
+    chunk_index: int,
+    rn: RiskNeutralPolicy,
+    seed: int,
+    start: tuple[float, float, int],
+    ra: DeadlinePolicy | None,
+    deadline_s: float | None,
+    dt_s: float | None,
+    t_max_s: float | None,
+    n_tracks: int,
+    give_up_below: float,
+) -> DeadlineSimulation:
+    """One chunk of :func:`simulate_deadline` (top level, so Dask can pickle it)."""
+    return simulate_deadline_chunk(
+        rn, chunk_index, seed, start, ra, deadline_s, dt_s, t_max_s,
+        n_tracks if chunk_index == 0 else 0, CHUNK_SIZE, give_up_below,
     )

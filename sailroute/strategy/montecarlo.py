@@ -3,7 +3,8 @@
 Runs are simulated in chunks of a fixed size; chunk ``k`` draws from
 ``Generator(PCG64(SeedSequence(seed, spawn_key=(k,))))``, which is the same
 stream as ``SeedSequence(seed).spawn(k + 1)[k]``.  Results therefore do not
-depend on how the chunks are scheduled (serially here, or over Dask later):
+depend on how the chunks are scheduled (serially, or over Dask with
+``scheduler=``, see :mod:`sailroute.parallel`) nor on the number of workers:
 :func:`simulate` is exactly the concatenation of :func:`simulate_chunk` for
 chunks ``0, 1, ...``, truncated to ``n_runs``; a smaller ``n_runs`` gives a
 prefix of a larger one.
@@ -24,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.errors import InputError
+from sailroute.parallel import TaskRunner, map_tasks
 from sailroute.strategy.sdp import TACKS, ExpectedTimePolicy
 
 CHUNK_SIZE = 1000
@@ -221,21 +223,46 @@ def simulate(
     tack0: int = 1,
     theta0_deg: float = 0.0,
     transitions: NDArray[np.float64] | None = None,
+    scheduler: str | TaskRunner | None = None,
 ) -> SimulationResult:
     """Simulate ``n_runs`` runs: chunks ``0, 1, ...`` of :data:`CHUNK_SIZE`, concatenated.
 
-    See :func:`simulate_chunk` for the parameters.
+    See :func:`simulate_chunk` for the other parameters.
+
+    Parameters
+    ----------
+    scheduler : str, TaskRunner or None
+        Where the chunks run (:func:`sailroute.parallel.map_tasks`): ``None``
+        or ``"serial"`` (default), ``"processes"``, a Dask scheduler address,
+        or an open runner.  The result is the same, bit for bit.
     """
     if n_runs < 1:
         raise InputError(f"number of Monte Carlo runs {n_runs} must be >= 1")
     if tack0 not in TACKS:
         raise InputError(f"start tack must be +1 (starboard) or -1 (port), got {tack0}")
     n_chunks = -(-int(n_runs) // CHUNK_SIZE)
-    parts = [
-        simulate_chunk(policy, k, seed, CHUNK_SIZE, x0_m, tack0, theta0_deg, transitions)
-        for k in range(n_chunks)
-    ]
+    parts = map_tasks(
+        _chunk_task,
+        range(n_chunks),
+        shared=(policy, seed, x0_m, tack0, theta0_deg, transitions),
+        scheduler=scheduler,
+    )
     return concatenate(parts, n_runs)
+
+
+def _chunk_task(
+    chunk_index: int,
+    policy: ExpectedTimePolicy,
+    seed: int,
+    x0_m: float,
+    tack0: int,
+    theta0_deg: float,
+    transitions: NDArray[np.float64] | None,
+) -> SimulationResult:
+    """One chunk of :func:`simulate` (a top-level function, so Dask can pickle it)."""
+    return simulate_chunk(
+        policy, chunk_index, seed, CHUNK_SIZE, x0_m, tack0, theta0_deg, transitions
+    )
 
 
 def concatenate(parts: list[SimulationResult], n_runs: int | None = None) -> SimulationResult:

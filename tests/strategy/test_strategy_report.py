@@ -16,17 +16,20 @@ from sailroute.strategy import report
 from sailroute.strategy.api import (
     StrategySettings,
     parse_objective,
+    parse_shift,
     run_strategy,
+    run_strategy_command,
     write_outputs,
 )
 from sailroute.strategy.montecarlo import simulate
 from sailroute.strategy.sdp import BeatGrid, solve_expected_time
-from sailroute.strategy.shiftmodel import OUShift
+from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
 from sailroute.units import KNOT
-from tests.conftest import SHARED_REAL, requires_shared
+from tests.conftest import SHARED_REAL, TESTS_DATA, requires_shared
 
 ILCA7 = builtin_polar("ilca7")
 COACH = SHARED_REAL / "wind" / "anemomind-coach-trieste" / "coach_wind_1hz.csv"
+COACH_EXCERPT = TESTS_DATA / "wind" / "coach_wind_1hz_excerpt.csv"
 SMALL = dict(length_m=400.0, half_width_m=200.0, lateral_m=4.0, row_m=10.0, runs=300)
 
 
@@ -110,6 +113,33 @@ def test_run_strategy_with_deadline_writes_everything(tmp_path) -> None:
     assert saved["seed"] == 1 and saved["runs"] == 300
 
 
+def test_drift_diffusion_shift_given_directly_in_minutes(tmp_path) -> None:
+    # 0.6 °/min drift and 3 °/√min diffusion are 0.01 °/s and 3/√60 °/√s; the study's
+    # SDP runs on that model (the chain diagnostics have no stationary target for it)
+    res = run_strategy_command(
+        shift="Drift_Diffusion", drift_deg_per_min=0.6, diffusion_deg_per_sqrt_min=3.0,
+        out_dir=tmp_path, plots=False, length_m=200.0, half_width_m=100.0, runs=50,
+    ).result
+    assert res.model == DriftDiffusionShift(0.01, 3.0 / math.sqrt(60.0))
+    assert res.policy.model == res.model
+    assert res.summary["shift_model"]["kind"] == "drift-diffusion"
+    assert math.isnan(res.summary["chain"]["diagnostics_at_stage_time"]["target_sd_deg"])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"shift": "brownian"}, "--shift 'brownian': expected 'ou'"),
+        ({"shift": "drift-diffusion"}, "needs --diffusion-deg-per-sqrt-min"),
+        ({"shift": "drift-diffusion", "diffusion_deg_per_sqrt_min": -1.0}, "finite and >= 0"),
+    ],
+)
+def test_shift_model_errors_teach(kwargs, message, tmp_path) -> None:
+    with pytest.raises(InputError, match=message):
+        run_strategy_command(out_dir=tmp_path, plots=False, runs=10, **kwargs)
+    assert parse_shift(" OU ") == "ou"
+
+
 def test_deadline_objective_needs_a_tack_penalty() -> None:
     st = StrategySettings(deadlines_s=(190.0,), tack_penalty_s=0.0, **SMALL)
     with pytest.raises(InputError, match="tack penalty"):
@@ -166,3 +196,16 @@ def test_cli_fits_the_shift_from_a_station_file(tmp_path) -> None:
     assert s["shift_model"]["sigma_deg"] == pytest.approx(s["fit"]["ou"]["sigma_deg"])
     assert s["shift_model"]["timescale_s"] == pytest.approx(s["fit"]["ou"]["timescale_s"])
     assert "fitted from" in res.stdout
+
+
+def test_drift_diffusion_fitted_from_a_station_file(tmp_path) -> None:
+    # the committed 15 min excerpt of the coach-boat log: the fitted Brownian model, not the
+    # OU one, drives the study
+    res = run_strategy_command(
+        shift="drift-diffusion", fit_from=str(COACH_EXCERPT), fit_timezone="+01:00",
+        out_dir=tmp_path, plots=False, length_m=200.0, half_width_m=100.0, runs=50,
+    )
+    dd = res.result.summary["fit"]["drift_diffusion"]
+    assert res.result.model == DriftDiffusionShift(dd["drift_deg_per_s"],
+                                                   dd["sigma_deg_per_sqrt_s"])
+    assert "diffusion" in res.report and "°/√min" in res.report

@@ -51,8 +51,10 @@ def test_zero_volatility_ilca_equals_one_tack_closed_form_within_quantisation() 
     # σ = 0: the wind stays at θ = 0.  On the lattice the best heading is the quantised
     # ψ_n = atan(n δx/δy) with the best VMG, and the leg takes L / VMG(ψ_n) + λ exactly
     # (brief O3).  Its gap to the continuous one-tack answer L / VMG* + λ (O2) is the heading
-    # quantisation error, computed exactly here and asserted, not tolerated.
-    grid = BeatGrid()
+    # quantisation error, computed exactly here and asserted, not tolerated.  COARSE
+    # (8 m x 20 m) has the same best heading atan(0.8) as seed 003's 2 m x 10 m lattice
+    # at a twentieth of the cost (the full lattice is solved in the speed test below).
+    grid = COARSE
     pol = solve_expected_time(ILCA7, TWS, OUShift(0.0, 600.0), grid, 5.0)
     sim = simulate(pol, 20, seed=3)
     psi_q, vmg_q = quantised_vmg(grid, ILCA7, TWS)
@@ -66,6 +68,38 @@ def test_zero_volatility_ilca_equals_one_tack_closed_form_within_quantisation() 
     assert sim.leg_time_s[0] - continuous == pytest.approx(quantisation, rel=1e-9)
     assert 0.0 < quantisation < 0.005 * continuous  # ψ_4 = 38.66° vs 41.6°: 0.26 %
     assert psi_q == pytest.approx(np.degrees(np.arctan(0.8)))
+
+
+@pytest.mark.parametrize(
+    "models",
+    [
+        [OUShift(s, 600.0) for s in (2.0, 0.5, 0.1)],  # sigma -> 0
+        [OUShift(10.0, l_t) for l_t in (3.6e3, 3.6e4, 3.6e6)],  # time scale -> inf
+    ],
+    ids=["sigma", "timescale"],
+)
+def test_vanishing_volatility_converges_to_the_one_tack_closed_form(models) -> None:
+    # Issue 6 / brief O10: as the shifts vanish (sigma -> 0 or l_t -> inf, not just at
+    # sigma = 0), the policy's expected time tends to L / VMG(ψ_q) + λ (O3), the value
+    # table to the steady-wind one, and every simulated run to exactly one tack.
+    grid = BeatGrid(length_m=800.0, half_width_m=400.0, lateral_m=8.0, row_m=20.0)
+    _, vmg_q = quantised_vmg(grid, ILCA7, TWS)
+    closed = grid.length_m / vmg_q + 5.0
+    steady = solve_expected_time(ILCA7, TWS, OUShift(0.0, 600.0), grid, 5.0)
+    assert steady.expected_time() == pytest.approx(closed, rel=1e-12)
+    gaps, one_tack, table_gaps = [], [], []
+    for model in models:
+        pol = solve_expected_time(ILCA7, TWS, model, grid, 5.0)
+        sim = simulate(pol, 1000, seed=1)
+        gaps.append(abs(pol.expected_time() - closed))
+        one_tack.append(np.mean(sim.n_tacks == 1))
+        v, v0 = pol.value_s[0, :, 9, :], steady.value_s[0, :, 9, :]  # row 0, mean wind
+        table_gaps.append(np.max(np.abs(v - v0)[np.isfinite(v0)]))
+    assert gaps[0] > gaps[1] > gaps[2]
+    assert gaps[-1] < 2e-3  # seconds, on a 412 s leg
+    assert table_gaps[0] > table_gaps[-1] and table_gaps[-1] < 5e-3
+    assert one_tack[0] < 1.0 and one_tack[-1] == 1.0
+    np.testing.assert_allclose(sim.leg_time_s, closed, rtol=1e-12)
 
 
 def test_monte_carlo_mean_equals_dp_value() -> None:
