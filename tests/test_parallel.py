@@ -184,3 +184,22 @@ def test_partial_chunks_and_seeds_do_not_depend_on_the_scheduler(cluster, serial
             assert dist.leg_time_s.shape == (n_runs,)
             assert np.array_equal(serial.leg_time_s, dist.leg_time_s)
             assert np.array_equal(serial.n_tacks, dist.n_tacks)
+
+
+def test_compare_scenarios_on_a_cluster_equals_serial(cluster) -> None:
+    """Each scenario is one task; leg times and whole tracks come back bit-identical."""
+    from pathlib import Path
+
+    from sailroute.course.load import load_course
+    from sailroute.plan import compare_scenarios
+
+    course = load_course(Path(__file__).resolve().parents[1] / "courses"
+                         / "windward-leeward-template.yaml")
+    serial_cmp, serial_plans = compare_scenarios(course)
+    dist_cmp, dist_plans = compare_scenarios(course, scheduler=cluster.scheduler_address)
+    assert dist_cmp.scenarios == serial_cmp.scenarios == ("steady-12kn", "veered-10deg")
+    np.testing.assert_array_equal(dist_cmp.times, serial_cmp.times)
+    for a, b in zip(serial_plans, dist_plans, strict=True):
+        for ra, rb in zip(a.results, b.results, strict=True):
+            np.testing.assert_array_equal(ra.track.x, rb.track.x)
+            np.testing.assert_array_equal(ra.track.t, rb.track.t)
