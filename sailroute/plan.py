@@ -17,12 +17,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sailroute.backend import get_xp
-from sailroute.course.geometry import leg_endpoints
+from sailroute.course.geometry import leg_endpoints, target_of
 from sailroute.course.load import build_boat, build_wind, load_course, validate_specs
 from sailroute.course.model import Course
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
 from sailroute.routing.api import get_router, route_leg
+from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import LegResult, RoutingSettings
 from sailroute.wind.base import WindField
 
@@ -83,12 +84,18 @@ def route_course(
     Returns
     -------
     list of LegResult
-        One per leg; ``results[i].t_start == results[i - 1].t_end``.
+        One per leg; ``results[i].t_start == results[i - 1].t_end`` and
+        ``results[i].start_xy == results[i - 1].end_xy``.  A leg to a mark ends once
+        the mark is rounded on its side, and the next leg may not cross back.
     """
     results: list[LegResult] = []
     t0, end_xy = course.start_epoch, None
     for i, spec in enumerate(course.legs):
         start, target = leg_endpoints(course, i, end_xy)
+        # a mark is rounded on its side: the leg ends past the rounding (towards the next
+        # target) and the next leg may not cross back (routing/geometry.py, chain_leg)
+        following = target_of(course, i + 1) if i + 1 < course.n_legs else None
+        start, target = chain_leg(start, target, results[-1] if results else None, following)
         if progress is not None:
             progress.start_leg(i, spec.label)
         res = route_leg(start, target, t0, wind, boat, settings, backend=backend,

@@ -1,6 +1,7 @@
 """Leg routers (isochrones, grid DP, multi-spline) and their shared types."""
 
 from sailroute.routing.types import (
+    Barrier,
     LegResult,
     Manoeuvre,
     RoutingSettings,
@@ -9,4 +10,4 @@ from sailroute.routing.types import (
     Track,
 )
 
-__all__ = ["LegResult", "Manoeuvre", "RoutingSettings", "Start", "Target", "Track"]
+__all__ = ["Barrier", "LegResult", "Manoeuvre", "RoutingSettings", "Start", "Target", "Track"]

@@ -11,6 +11,8 @@
 * :func:`sample_chains`: wind along chains of straight pieces (segments split
   into pieces, or spline chords), sampled at the time the boat is there.
 * :func:`default_half_width`: the grid half-width from the laylines.
+* :class:`PathLimits`: the rounding constraints on straight pieces (arrive
+  across the target segment along its normal; respect the leg's barriers).
 
 See ``docs/design/griddp.md``.
 """
@@ -30,11 +32,13 @@ from sailroute.errors import InputError
 from sailroute.routing.geometry import (
     AIM_MARGIN_M,
     TargetGeometry,
+    barrier_blocks,
+    leg_barriers,
     leg_label,
     start_centre,
     target_geometry,
 )
-from sailroute.routing.types import Start, Target
+from sailroute.routing.types import Barrier, Start, Target
 from sailroute.units import wind_speed_direction, wrap180
 from sailroute.wind.base import WindField
 
@@ -147,14 +151,46 @@ class Row:
         return np.zeros(1)
 
 
+@dataclass(frozen=True)
+class PathLimits:
+    """Rounding constraints on the straight pieces of a grid route.
+
+    Attributes
+    ----------
+    normal : tuple of float
+        Crossing direction of the target segment: the last piece must move
+        along it (``d · normal > 0``), as the isochrone router's crossing test
+        requires.
+    barriers : tuple of (Barrier, float)
+        The leg's barriers with their mark clearances [m]
+        (:func:`~sailroute.routing.geometry.leg_barriers`): the target's entry
+        barrier and the previous leg's rounding ray (``Start.barrier``).
+    """
+
+    normal: tuple[float, float]
+    barriers: tuple[tuple[Barrier, float], ...] = ()
+
+    def allowed(self, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, last: bool
+                ) -> NDArray:
+        """Straight moves ``(x0, y0) → (x1, y1)`` (broadcast) that respect the limits;
+        ``last``: the moves end on the target segment."""
+        ok = np.ones(np.broadcast_shapes(np.shape(x0), np.shape(x1)), dtype=bool)
+        if last:
+            ok &= (x1 - x0) * self.normal[0] + (y1 - y0) * self.normal[1] > 0
+        for bar, clear in self.barriers:
+            ok &= ~barrier_blocks(x0, y0, x1, y1, bar, clear)
+        return ok
+
+
 @dataclass(frozen=True, eq=False)
 class LegGrid:
-    """Frame, rows and target geometry of one leg."""
+    """Frame, rows, target geometry and path limits of one leg."""
 
     frame: LegFrame
     rows: tuple[Row, ...]
     geom: TargetGeometry
     label: str
+    limits: PathLimits
 
 
 def make_grid(start: Start, target: Target, n_rows: int, zone_m: float) -> LegGrid:
@@ -164,6 +200,7 @@ def make_grid(start: Start, target: Target, n_rows: int, zone_m: float) -> LegGr
     (:func:`~sailroute.routing.geometry.target_geometry`): the gate or finish
     line, or a mark's rounding segment on the correct side, its nodes kept
     :data:`~sailroute.routing.geometry.AIM_MARGIN_M` from the segment ends.
+    ``LegGrid.limits`` holds the crossing direction and the leg's barriers.
     """
     label = leg_label(start, target)
     geom = target_geometry(target, start, zone_m)
@@ -179,7 +216,8 @@ def make_grid(start: Start, target: Target, n_rows: int, zone_m: float) -> LegGr
     m = min(AIM_MARGIN_M, 0.5 * seg_len) / seg_len
     last = Row("line", a=geom.a, b=geom.b, lo=m, hi=1.0 - m)
     free = tuple(Row("free", along=length * r / (n_rows - 1)) for r in range(1, n_rows - 1))
-    return LegGrid(frame, (first, *free, last), geom, label)
+    limits = PathLimits(geom.normal, leg_barriers(start, target))
+    return LegGrid(frame, (first, *free, last), geom, label, limits)
 
 
 # --------------------------------------------------------------------------------------

@@ -48,12 +48,14 @@ from sailroute.errors import InputError, RoutingError
 from sailroute.routing._dp_grid import (
     BoatModel,
     LegGrid,
+    PathLimits,
     default_half_width,
     make_grid,
     node_inside,
     penalty_of,
     sample_chains,
 )
+from sailroute.routing.geometry import target_barrier
 from sailroute.routing.track import build_track, make_leg_result
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
 from sailroute.wind.base import WindField
@@ -251,15 +253,18 @@ def solve_griddp(
             if progress is not None:
                 progress((k + frac) / n_pass)
 
+        lim = grid.limits
         if model.dynamic is not None:
-            path, dp_time, evals = _dp_dynamic(model.dynamic, wind, xy, t0, opts, xp, rowprog)
+            path, dp_time, evals = _dp_dynamic(model.dynamic, wind, xy, t0, opts, lim, xp,
+                                               rowprog)
         else:
-            path, dp_time, evals = _dp_polar(model, wind, xy, t0, opts, settings, xp, rowprog)
+            path, dp_time, evals = _dp_polar(model, wind, xy, t0, opts, settings, lim, xp,
+                                             rowprog)
         if path is None:
             raise _no_route(grid, half * opts.shrink ** k, k)
         ev = evaluate_path(model, wind, np.array([xy[r][0][c] for r, c in enumerate(path)]),
                            np.array([xy[r][1][c] for r, c in enumerate(path)]), t0,
-                           opts.samples, settings)
+                           opts.samples, settings, limits=lim)
         if best is None or ev.time_s < best.time_s:
             best = ev
             best_params = [float(params[r][c]) for r, c in enumerate(path)]
@@ -279,7 +284,8 @@ def solve_griddp(
                         bsp_ms=best.bsp, side=best.side)
     if progress is not None:
         progress(1.0)
-    return GridDPSolution(make_leg_result(track, "griddp"), tuple(passes), half,
+    result = make_leg_result(track, "griddp", target_barrier(target, start, settings.zone_m))
+    return GridDPSolution(result, tuple(passes), half,
                           np.stack([best.node_x, best.node_y], axis=1))
 
 
@@ -291,9 +297,11 @@ def _rows_or_raise(s: RoutingSettings) -> int:
 def _no_route(grid: LegGrid, band: float, k: int) -> RoutingError:
     return RoutingError(
         f"leg {grid.label}: the grid DP found no feasible path (pass {k + 1}, node band "
-        f"±{band:.0f} m).  Every path either leaves the wind data, meets calm, or needs a "
-        "heading the boat cannot sail.  Check that the wind covers the course area and "
-        "race time, or widen the grid (dp_half_width_m) / add rows (dp_rows)."
+        f"±{band:.0f} m).  Every path either leaves the wind data, meets calm, needs a "
+        "heading the boat cannot sail, or would pass a rounded mark on the wrong side.  "
+        "Check that the wind covers the course area and race time, or widen the grid "
+        "(dp_half_width_m) / add rows (dp_rows); a leg that must first finish a rounding "
+        "of more than 180° needs the isochrone router."
     )
 
 
@@ -310,9 +318,12 @@ def _chains(x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, n: int
     return px, py
 
 
-def _inside_pairs(wind: WindField, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray
-                  ) -> NDArray:
-    return node_inside(wind, x0, y0)[:, None] & node_inside(wind, x1, y1)[None, :]
+def _inside_pairs(wind: WindField, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray,
+                  lim: PathLimits, last: bool) -> NDArray:
+    """Segments (every node of a row to every node of the next) that may be sailed:
+    both ends inside the wind coverage, and the rounding limits respected."""
+    ok = node_inside(wind, x0, y0)[:, None] & node_inside(wind, x1, y1)[None, :]
+    return ok & lim.allowed(x0[:, None], y0[:, None], x1[None, :], y1[None, :], last)
 
 
 # --------------------------------------------------------------------------------------
@@ -320,8 +331,8 @@ def _inside_pairs(wind: WindField, x0: NDArray, y0: NDArray, x1: NDArray, y1: ND
 
 
 def _dp_polar(model: BoatModel, wind: WindField, xy: list, t0: float, opts: GridDPOptions,
-              s: RoutingSettings, xp: ModuleType, progress: Callable[[float], None]
-              ) -> tuple[list[int] | None, float, int]:
+              s: RoutingSettings, lim: PathLimits, xp: ModuleType,
+              progress: Callable[[float], None]) -> tuple[list[int] | None, float, int]:
     n_rows = len(xy)
     c0 = xy[0][0].size
     T = np.full((c0, 2), np.inf)
@@ -345,7 +356,8 @@ def _dp_polar(model: BoatModel, wind: WindField, xy: list, t0: float, opts: Grid
         with np.errstate(divide="ignore", invalid="ignore"):
             tp = np.where(cw.length > 0, cw.length / spd, 0.0)
         tp = np.where(np.isnan(tp), np.inf, tp)
-        ok = np.all(cw.valid, axis=-1) & _inside_pairs(wind, x0, y0, x1, y1)[:, None, :]
+        ok = np.all(cw.valid, axis=-1) & _inside_pairs(
+            wind, x0, y0, x1, y1, lim, r == n_rows - 2)[:, None, :]
         side = cw.side
         ch = side[..., 1:] != side[..., :-1]
         pen_int = np.sum(ch * penalty_of(cw.beta[..., 1:], cw.beta[..., :-1],
@@ -392,7 +404,7 @@ def _dp_polar(model: BoatModel, wind: WindField, xy: list, t0: float, opts: Grid
 
 
 def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: GridDPOptions,
-                xp: ModuleType, progress: Callable[[float], None]
+                lim: PathLimits, xp: ModuleType, progress: Callable[[float], None]
                 ) -> tuple[list[int] | None, float, int]:
     model = BoatModel(dynamic=boat)
     tab = boat.table()
@@ -402,7 +414,7 @@ def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: G
     (x0, y0), (x1, y1) = xy[0], xy[1]
     px, py = _chains(x0, y0, x1, y1, n)
     cw = sample_chains(wind, px, py, np.full(x0.size, t0)[:, None], model)
-    ok = np.all(cw.valid, axis=-1) & _inside_pairs(wind, x0, y0, x1, y1)
+    ok = np.all(cw.valid, axis=-1) & _inside_pairs(wind, x0, y0, x1, y1, lim, n_rows == 2)
     t, v_end = chain_time(boat, *(xp.asarray(a) for a in (cw.beta, cw.tws, cw.length)),
                           xp.ones(cw.beta.shape), xp.zeros(cw.beta.shape[:-1]), xp)
     T = xp.where(xp.asarray(ok), t0 + t, xp.inf)
@@ -419,7 +431,8 @@ def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: G
         reach = np.isfinite(t_est)
         px, py = _chains(x0, y0, x1, y1, n)
         cw = sample_chains(wind, px, py, np.where(reach, t_est, t0)[:, None], model)
-        ok = np.all(cw.valid, axis=-1) & _inside_pairs(wind, x0, y0, x1, y1) & reach[:, None]
+        ok = (np.all(cw.valid, axis=-1) & reach[:, None]
+              & _inside_pairs(wind, x0, y0, x1, y1, lim, r == n_rows - 2))
         beta, tws, length = (xp.asarray(a) for a in (cw.beta, cw.tws, cw.length))
         b1, vt1, l1 = beta[..., 0], tws[..., 0], length[..., 0]
         ws1 = tab.steady(b1, xp)
@@ -591,13 +604,15 @@ class _PathEval:
 
 
 def evaluate_path(model: BoatModel, wind: WindField, xs: NDArray, ys: NDArray, t0: float,
-                  samples: int, settings: RoutingSettings) -> _PathEval:
+                  samples: int, settings: RoutingSettings, *,
+                  limits: PathLimits | None = None) -> _PathEval:
     """Sail a polyline exactly as the DP costs it, segment by segment in time order.
 
     Returns the leg time and the track vertices: the nodes, the piece
     boundaries, and for the polar model a repeated vertex where a tack or gybe
     penalty stops the boat.  ``side`` is the side of the piece leaving each
-    vertex (the last vertex repeats the last piece's).
+    vertex (the last vertex repeats the last piece's).  A path that breaks
+    ``limits`` (the leg's :class:`PathLimits`) takes infinitely long.
     """
     n = samples
     f = np.linspace(0.0, 1.0, n + 1)
@@ -607,6 +622,11 @@ def evaluate_path(model: BoatModel, wind: WindField, xs: NDArray, ys: NDArray, t
     cur_beta = math.nan
     v = 0.0
     prev_dir: tuple[float, float] | None = None
+    if limits is not None:
+        last = np.arange(xs.size - 1) == xs.size - 2
+        if not np.all(limits.allowed(xs[:-1], ys[:-1], xs[1:], ys[1:], False)
+                      & (limits.allowed(xs[:-1], ys[:-1], xs[1:], ys[1:], True) | ~last)):
+            return _PathEval(math.inf, *(np.zeros(0),) * 3, None, np.zeros(0, np.int8), xs, ys)
     for r in range(xs.size - 1):
         px = xs[r] + (xs[r + 1] - xs[r]) * f
         py = ys[r] + (ys[r + 1] - ys[r]) * f

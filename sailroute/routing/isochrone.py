@@ -18,7 +18,9 @@ of length ``dt`` (10 s by default, shorter near the target):
    ``dt`` is; the penalty is priced with the first heading sailed after it;
 5. every move near the target is tested against its crossing segment
    (:func:`~sailroute.routing.geometry.segment_crossing`); the earliest crossing,
-   interpolated inside the step, ends the leg;
+   interpolated inside the step, ends the leg; moves that would pass a rounded mark on
+   the wrong side (the leg's barriers: the target's entry barrier and
+   ``Start.barrier``, :func:`~sailroute.routing.geometry.leg_barriers`) are dropped;
 6. pruning: candidates are binned by their bearing seen from the target (sectors of
    ``prune_sector_deg``, symmetric about the leg axis) and side, and per bin the one
    with the least estimated time to go survives (VMG-hull time in the wind averaged
@@ -46,16 +48,20 @@ from sailroute.boat.polar import Polar
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
 from sailroute.routing.geometry import (
     AIM_MARGIN_M,
+    BARRIER_LENGTH_M,
     TargetGeometry,
     aim_points,
+    barrier_blocks,
+    leg_barriers,
     leg_label,
     segment_crossing,
     start_centre,
     start_points,
+    target_barrier,
     target_geometry,
 )
 from sailroute.routing.track import build_track, make_leg_result
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target, Track
+from sailroute.routing.types import Barrier, LegResult, RoutingSettings, Start, Target, Track
 from sailroute.wind.base import WindField
 
 TABLE_TWS_STEP_MS = 0.05
@@ -267,6 +273,13 @@ class _LegFrame:
     def vec_to_leg(self, vx: Any, vy: Any) -> tuple[Any, Any]:
         return vx * self.fy - vy * self.fx, vx * self.fx + vy * self.fy
 
+    def barrier(self, b: Barrier) -> Barrier:
+        """The barrier in the leg frame."""
+        mark = tuple(float(v) for v in self.to_leg(b.mark[0], b.mark[1]))
+        ray = tuple(float(v) for v in self.vec_to_leg(b.ray[0], b.ray[1]))
+        n = tuple(float(v) for v in self.vec_to_leg(b.normal[0], b.normal[1]))
+        return Barrier(mark, ray, n, b.name)  # type: ignore[arg-type]
+
     def geometry(self, g: TargetGeometry) -> TargetGeometry:
         a = tuple(float(v) for v in self.to_leg(g.a[0], g.a[1]))
         b = tuple(float(v) for v in self.to_leg(g.b[0], g.b[1]))
@@ -325,6 +338,7 @@ class _Context:
     max_points: int
     fan_hull: bool
     box: tuple[float, float, float, float] | None  # world coverage box to stay in, or None
+    barriers: tuple[tuple[Barrier, float], ...] = ()  # (leg frame, mark clearance [m])
 
 
 def _host(a: Any) -> NDArray:
@@ -412,10 +426,12 @@ def route_isochrone(
     """
     label = leg_label(start, target)
     _check_settings(settings, label, t0)
+    _check_polar(polar, label)
     geom = target_geometry(target, start, settings.zone_m)
     tab = polar_tables(polar, settings.heading_step_deg)
     frame = _LegFrame.for_leg(geom.centre, start_centre(start))
-    ctx = _context(label, float(t0), frame, geom, wind, settings)
+    ctx = _context(label, float(t0), frame, geom, wind, settings,
+                   leg_barriers(start, target))
     if ctx.box is not None:
         _check_target_covered(geom, ctx.box, wind, label)
     dev = _device_tables(tab, xp)
@@ -435,10 +451,11 @@ def route_isochrone(
     while True:
         out = _step(layers[-1], wind, polar, dev, ctx, settings, tau_hint, xp)
         if isinstance(out, _Arrival):
-            track = _backtrack(layers, out, frame, wind, polar)
+            track = _backtrack(layers, out, frame, wind, polar, (wx0, wy0))
             if progress is not None:
                 progress(1.0)
-            return make_leg_result(track, "isochrone")
+            return make_leg_result(track, "isochrone",
+                                   target_barrier(target, start, settings.zone_m))
         layer, moved, tau_min, dist_min = out
         if moved:
             calm_since = None
@@ -489,6 +506,20 @@ def _check_settings(s: RoutingSettings, label: str, t0: float) -> None:
         )
 
 
+def _check_polar(polar: Any, label: str) -> None:
+    """Refuse a boat without a polar interface (e.g. the dynamic boat model)."""
+    if callable(getattr(polar, "speed", None)):
+        return
+    hint = ""
+    if callable(getattr(polar, "steady_polar", None)):
+        hint = (" For the dynamic boat model use router 'griddp' or 'spline', or route "
+                "its steady polar (boat.steady_polar(tws_ms)) with the isochrone router.")
+    raise InputError(
+        f"leg {label}: the isochrone router needs a Polar (with .speed(tws, twa)), got "
+        f"{type(polar).__name__}.{hint}"
+    )
+
+
 def _check_target_covered(
     geom: TargetGeometry, box: tuple[float, float, float, float], wind: WindField, label: str
 ) -> None:
@@ -505,7 +536,7 @@ def _check_target_covered(
 
 def _context(
     label: str, t0: float, frame: _LegFrame, geom: TargetGeometry, wind: WindField,
-    s: RoutingSettings,
+    s: RoutingSettings, barriers: tuple[tuple[Barrier, float], ...] = (),
 ) -> _Context:
     cov = wind.coverage
     bounded = any(math.isfinite(v) for v in (cov.xmin, cov.xmax, cov.ymin, cov.ymax))
@@ -519,6 +550,7 @@ def _context(
         n_bins=math.ceil(2.0 * math.pi / math.radians(s.prune_sector_deg)) + 3,
         max_points=int(s.max_front_points),
         fan_hull=s.heading_fan == "hull", box=box,
+        barriers=tuple((frame.barrier(b), c) for b, c in barriers),
     )
 
 
@@ -594,6 +626,7 @@ class _Prep:
     debt: Any
     pend_pen: Any
     near: Any  # bool: within one step of the target segment
+    bar_near: list  # per barrier of ctx: bool, within one step of it (None: no point is)
     any_pending: bool
 
 
@@ -939,6 +972,12 @@ def _prepare(
     pen_dn = xp.where(unknown | (base >= 90.0), ctx.gybe_s, mixed)
     reach = xp.maximum(xp.maximum(dev.vmax[j], dev.vmax[j + 1]), xp.max(v_extra, axis=1))
     near = _segment_distance(X, Y, ctx.geom, xp) <= reach * dt * 1.0001 + 1e-6
+    bar_near = []  # per barrier: the points within one step of its ray (None: none)
+    for b, clear in ctx.barriers:
+        ray = TargetGeometry(b.mark, (b.mark[0] + BARRIER_LENGTH_M * b.ray[0],
+                                      b.mark[1] + BARRIER_LENGTH_M * b.ray[1]), b.normal, "ray")
+        close = _segment_distance(X, Y, ray, xp) <= reach * dt * 1.0001 + clear + 1e-3
+        bar_near.append(close if bool(xp.any(close)) else None)
 
     pre = _Prep(
         t=f.t, dt=dt, n=n, h=hi - lo + 3, lo=lo, hi=hi, X=X, Y=Y, sw=sw, cw=cw, j=j, fw=fw,
@@ -946,7 +985,7 @@ def _prepare(
         sin_d1=sin_d[1], tau0=tau[0], gx0=gx[0], gy0=gy[0], tau1=tau[1], gx1=gx[1],
         gy1=gy[1], s0=s0, free=free,
         pending=pending, base=base, pen_up=pen_up, pen_dn=pen_dn, debt=f.debt,
-        pend_pen=f.pend_pen, near=near, any_pending=bool(xp.any(pending)),
+        pend_pen=f.pend_pen, near=near, bar_near=bar_near, any_pending=bool(xp.any(pending)),
     )
     return pre, tau_min, dist_min
 
@@ -1053,6 +1092,18 @@ def _expand(
     ok0 = s0 * pre.sin_d0[sl] >= 0
     ok1 = s0 * pre.sin_d1[sl] <= 0
 
+    # moves that pass a rounded mark on the wrong side (rows near a barrier only)
+    blocked = None
+    for (bar, clear), close in zip(ctx.barriers, pre.bar_near, strict=True):
+        nb = None if close is None else xp.flatnonzero(close[sl])
+        if nb is None or nb.shape[0] == 0:
+            continue
+        if blocked is None:
+            blocked = [xp.zeros(qx0.shape, dtype=bool), xp.zeros(qx1.shape, dtype=bool)]
+        px_b, py_b = X[nb][:, None], Y[nb][:, None]
+        for m, qx_b, qy_b in zip(blocked, (qx0, qx1), (qy0, qy1), strict=True):
+            m[nb] |= barrier_blocks(px_b, py_b, qx_b[nb], qy_b[nb], bar, clear, xp=xp)
+
     # arrival: earliest forward crossing of the target segment (rows within reach only)
     arrival = None
     near = xp.flatnonzero(pre.near[sl])
@@ -1066,6 +1117,8 @@ def _expand(
             py = Y[near][:, None]
             hit, sfrac, _ = segment_crossing(px, py, qx_b[near], qy_b[near], ctx.geom, xp=xp)
             hit[:, -1] &= ok_b[near]
+            if blocked is not None:
+                hit &= ~blocked[blk][near]
             if blk == 1 and any_pend:
                 hit &= ~pending[near, None]
             if ctx.box is not None:
@@ -1100,6 +1153,9 @@ def _expand(
     score1[:, -1] = xp.where(ok1, score1[:, -1], np.inf)
     if any_pend:
         score1[pending] = np.inf
+    if blocked is not None:
+        score0 = xp.where(blocked[0], np.inf, score0)
+        score1 = xp.where(blocked[1], np.inf, score1)
     if ctx.box is not None:
         score0 = xp.where(_in_box(qx0, qy0, ctx.frame, ctx.box), score0, np.inf)
         score1 = xp.where(_in_box(qx1, qy1, ctx.frame, ctx.box), score1, np.inf)
@@ -1159,9 +1215,15 @@ def _heading_deg(ux: float, uy: float) -> float:
 
 
 def _backtrack(
-    layers: list[_Layer], arr: _Arrival, frame: _LegFrame, wind: WindField, polar: Polar
+    layers: list[_Layer], arr: _Arrival, frame: _LegFrame, wind: WindField, polar: Polar,
+    world_start: tuple[NDArray, NDArray],
 ) -> Track:
-    """Polyline of the chosen route: step starts, penalty stops, exact arrival (world frame)."""
+    """Polyline of the chosen route: step starts, penalty stops, exact arrival (world frame).
+
+    The vertices at the start point get its world coordinates ``world_start[k][root]``
+    exactly (not through the leg frame and back), so a leg starts bit-for-bit where
+    the previous one ended.
+    """
     # moves, newest first: (t_start, t_end, index in its source layer, heading, bsp, delay, side)
     moves = [(arr.t_start, arr.t, arr.parent, arr.heading, arr.bsp, arr.delay, arr.side)]
     idx = arr.parent
@@ -1195,6 +1257,9 @@ def _backtrack(
 
     a = np.array(rows)
     wx, wy = frame.to_world(a[:, 1], a[:, 2])
+    at_start = (a[:, 1] == float(layers[0].x[idx])) & (a[:, 2] == float(layers[0].y[idx]))
+    wx[at_start] = float(world_start[0][idx])
+    wy[at_start] = float(world_start[1][idx])
     heading = np.mod(a[:, 3] + frame.offset_deg, 360.0)
     if np.isnan(heading[0]):
         u, v = wind.sample(a[0, 0], wx[0], wy[0])

@@ -42,6 +42,7 @@ from sailroute.errors import InputError, RoutingError
 from sailroute.routing._dp_grid import (
     BoatModel,
     LegFrame,
+    PathLimits,
     Row,
     default_half_width,
     make_grid,
@@ -49,6 +50,7 @@ from sailroute.routing._dp_grid import (
     sample_chains,
     sample_wind,
 )
+from sailroute.routing.geometry import target_barrier
 from sailroute.routing.track import build_track, make_leg_result
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
 from sailroute.wind.base import WindField
@@ -466,7 +468,7 @@ def solve_spline(
     _check(settings, grid.label)
     model = BoatModel.of(boat, grid.label)
     half = settings.dp_half_width_m or default_half_width(grid.frame, wind, t0, model)
-    cost = _route_cost(grid.frame, wind, model, t0, settings)
+    cost = _route_cost(grid.frame, wind, model, t0, settings, grid.limits, len(grid.rows))
     fit = fit_multispline(cost, grid.frame, grid.rows, n_cols=settings.spline_cols,
                           n_slopes=settings.spline_slopes, n_refine=settings.spline_refinements,
                           half_width=half, xp=xp, progress=progress)
@@ -483,11 +485,11 @@ def solve_spline(
             f"max_leg_time_s = {settings.max_leg_time_s:.0f} s; check the wind (calm?) or "
             "raise max_leg_time_s"
         )
-    t, x, y, side, bsp = _sail_curve(grid.frame, wind, model, t0, settings, fit)
+    t, x, y, side, bsp = _sail_curve(grid.frame, wind, model, t0, settings, fit, grid.limits)
     track = build_track(t, x, y, wind, model.polar, bsp_ms=bsp, side=side)
     if progress is not None:
         progress(1.0)
-    return make_leg_result(track, "spline"), fit
+    return make_leg_result(track, "spline", target_barrier(target, start, settings.zone_m)), fit
 
 
 def _check(s: RoutingSettings, label: str) -> None:
@@ -531,7 +533,8 @@ def _tangent_side(frame: LegFrame, wind: WindField, t: NDArray, px: NDArray, py:
 
 def _sail_edges(frame: LegFrame, wind: WindField, model: BoatModel, t_dep: NDArray,
                 x: NDArray, y: NDArray, m0: NDArray, m1: NDArray,
-                settings: RoutingSettings) -> _EdgeSail:
+                settings: RoutingSettings, limits: PathLimits | None = None,
+                last: bool = False) -> _EdgeSail:
     """Sail chord chains ``(x, y)`` of shape ``(..., CHORDS + 1)`` from ``t_dep``.
 
     The tack side at a node is that of the curve's tangent there (the same for
@@ -539,12 +542,18 @@ def _sail_edges(frame: LegFrame, wind: WindField, model: BoatModel, t_dep: NDArr
     once: between the start node and the first chord, between chords, or
     between the last chord and the end node.  The dynamic model starts each
     edge at the steady speed of the start node's tangent (no seconds penalty;
-    turns between chords follow the model's turn rule).
+    turns between chords follow the model's turn rule).  Chains that break
+    ``limits`` (``last``: the edge ends on the target segment) take infinitely long.
     """
     px, py = frame.point(x, y)
     cw = sample_chains(wind, px, py, t_dep, model)
     hx, hy, tws0, twa0, side0 = _tangent_side(frame, wind, t_dep, px[..., 0], py[..., 0], m0)
     ok = np.all(cw.valid, axis=-1)
+    if limits is not None:
+        x0, y0, x1, y1 = px[..., :-1], py[..., :-1], px[..., 1:], py[..., 1:]
+        ok = ok & np.all(limits.allowed(x0, y0, x1, y1, False), axis=-1)
+        if last:
+            ok = ok & limits.allowed(x0[..., -1], y0[..., -1], x1[..., -1], y1[..., -1], True)
     lead = cw.side.shape[:-1]
     if model.dynamic is not None:
         boat = model.dynamic
@@ -578,7 +587,7 @@ def _sail_edges(frame: LegFrame, wind: WindField, model: BoatModel, t_dep: NDArr
 
 
 def _route_cost(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
-                settings: RoutingSettings) -> EdgeCost:
+                settings: RoutingSettings, limits: PathLimits, n_rows: int) -> EdgeCost:
     t = np.linspace(0.0, 1.0, CHORDS + 1)
 
     def cost(r: int, e: Edges) -> NDArray:
@@ -586,13 +595,14 @@ def _route_cost(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
         t_dep = np.broadcast_to(t0 + e.acc, e.shape)
         m0 = np.broadcast_to(e.m0, e.shape)
         m1 = np.broadcast_to(e.m1, e.shape)
-        return _sail_edges(frame, wind, model, t_dep, x, y, m0, m1, settings).time
+        return _sail_edges(frame, wind, model, t_dep, x, y, m0, m1, settings, limits,
+                           r == n_rows - 2).time
 
     return cost
 
 
 def _sail_curve(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
-                settings: RoutingSettings, fit: SplineFit
+                settings: RoutingSettings, fit: SplineFit, limits: PathLimits | None = None
                 ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray | None]:
     """Sail the best curve edge by edge: track vertices at the chord ends."""
     tt = np.linspace(0.0, 1.0, CHORDS + 1)
@@ -603,7 +613,8 @@ def _sail_curve(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
         X = fit.along[r] + tt * dx
         Y = hermite_y(fit.across[r], fit.slopes[r], fit.across[r + 1], fit.slopes[r + 1], dx, tt)
         es = _sail_edges(frame, wind, model, np.array([t]), X[None], Y[None],
-                         np.array([fit.slopes[r]]), np.array([fit.slopes[r + 1]]), settings)
+                         np.array([fit.slopes[r]]), np.array([fit.slopes[r + 1]]), settings,
+                         limits, r == fit.along.size - 2)
         px, py = frame.point(X, Y)
         for j in range(CHORDS):
             if es.pen[0, j] > 0:

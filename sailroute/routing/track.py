@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat.polar import Polar
-from sailroute.routing.types import LegResult, Manoeuvre, Track
+from sailroute.routing.types import Barrier, LegResult, Manoeuvre, Track
 from sailroute.units import bearing_deg, signed_twa, wind_speed_direction
 from sailroute.wind.base import WindField
 
@@ -111,8 +111,12 @@ def find_manoeuvres(track: Track) -> tuple[Manoeuvre, ...]:
     return tuple(out)
 
 
-def make_leg_result(track: Track, router: str) -> LegResult:
-    """Assemble the :class:`LegResult` of a finished track (first/last rows = start/arrival)."""
+def make_leg_result(track: Track, router: str, barrier: Barrier | None = None) -> LegResult:
+    """Assemble the :class:`LegResult` of a finished track (first/last rows = start/arrival).
+
+    ``barrier`` is the rounding ray the leg ended on, handed on to the next leg
+    (:func:`~sailroute.routing.geometry.target_barrier`).
+    """
     man = find_manoeuvres(track)
     return LegResult(
         t_start=float(track.t[0]),
@@ -125,4 +129,5 @@ def make_leg_result(track: Track, router: str) -> LegResult:
         manoeuvres=man,
         track=track,
         router=router,
+        barrier=barrier,
     )

@@ -18,6 +18,34 @@ RouterName = Literal["isochrone", "griddp", "spline"]
 
 
 @dataclass(frozen=True)
+class Barrier:
+    """A half-line from a rounded mark that the next leg may not cross backwards.
+
+    A leg to a mark with a rounding side ends on the mark's rounding segment,
+    crossed along ``normal``; the next leg starts there.  Crossing the ray
+    ``mark + s ray`` (``s >= 0``) against ``normal`` would unwind the rounding
+    (the boat would pass the mark on the wrong side), so routers forbid it, and
+    they keep moves a small clearance away from the mark itself.
+
+    Attributes
+    ----------
+    mark : tuple of float
+        The mark ``(x, y)`` [m].
+    ray : tuple of float
+        Unit vector from the mark along the rounding segment.
+    normal : tuple of float
+        Unit vector of the direction in which the rounding segment was crossed.
+    name : str
+        The mark's label, for messages.
+    """
+
+    mark: tuple[float, float]
+    ray: tuple[float, float]
+    normal: tuple[float, float]
+    name: str = ""
+
+
+@dataclass(frozen=True)
 class Start:
     """Where a leg starts: a point, or anywhere on a line segment.
 
@@ -29,11 +57,16 @@ class Start:
         Second end of the line [m]; ``None`` for a point start.
     name : str
         Label for reports (e.g. ``"start"``, ``"1"``).
+    barrier : Barrier or None
+        The rounding ray of the mark the previous leg ended at
+        (``LegResult.barrier``): this leg may not cross it backwards, so the
+        mark stays on the side it is rounded on.  None: no constraint.
     """
 
     a: tuple[float, float]
     b: tuple[float, float] | None = None
     name: str = ""
+    barrier: Barrier | None = None
 
     @property
     def is_line(self) -> bool:
@@ -57,6 +90,12 @@ class Target:
         Side on which the mark is left (marks only).
     name : str
         Label for reports.
+    exit_xy : tuple of float or None
+        Where the course goes after a mark with a rounding side: the next leg's
+        target centre ``(x, y)`` [m].  The leg then ends once the mark is rounded
+        (the rounding segment lies on the outside of the turn, see
+        ``routing/geometry.py``); None: the mark is passed, as for a course that
+        goes straight on.
     """
 
     kind: TargetKind
@@ -64,6 +103,7 @@ class Target:
     b: tuple[float, float] | None = None
     rounding: Side | None = None
     name: str = ""
+    exit_xy: tuple[float, float] | None = None
 
     @property
     def centre(self) -> tuple[float, float]:
@@ -230,6 +270,10 @@ class LegResult:
         The route, first row at ``t_start``, last at ``t_end``.
     router : str
         Router that produced it.
+    barrier : Barrier or None
+        For a leg that ended at a mark with a rounding side: the rounding ray
+        the next leg must not cross back (give it to the next leg's
+        :class:`Start`, e.g. with :func:`~sailroute.routing.geometry.chain_leg`).
     """
 
     t_start: float
@@ -242,6 +286,7 @@ class LegResult:
     manoeuvres: tuple[Manoeuvre, ...]
     track: Track
     router: str
+    barrier: Barrier | None = None
 
     @property
     def time_s(self) -> float:
