@@ -77,6 +77,36 @@ def test_constant_wind_matches_closed_forms(hyeres, hyeres_constant):
     assert r.time_s == pytest.approx(math.hypot(dx, dy) / float(boat.speed(tws, twa)), rel=1e-3)
 
 
+@pytest.mark.parametrize(("course_file", "router"), [
+    ("windward-leeward-template.yaml", "isochrone"),
+    ("hyeres-r1.yaml", "isochrone"),
+    ("trapezoid-outer-template.yaml", "griddp"),
+])
+def test_every_mark_is_rounded_on_its_side(course_file, router):
+    """The track of the two legs meeting at a mark winds round it like the taut string.
+
+    Winding angle of the joined track around the mark, against the string pulled from
+    the arrival leg's start round the mark on its side to the next leg's end (see
+    tests/routing/test_rounding.py; equal to 1e-6 deg exactly when the mark is on the
+    required side).  Routed legs chained by ``plan_course``, where the bug lived.
+    """
+    from tests.routing.test_rounding import string_winding_deg, winding_deg
+
+    course = load_course(COURSES / course_file)
+    legs = plan_course(course, router=router).plan.legs
+    checked = 0
+    for a, b in itertools.pairwise(legs):
+        if a.spec.rounding is None:
+            continue
+        mark = course.feature(a.spec.to_name).xy
+        x = np.concatenate([a.result.track.x, b.result.track.x])
+        y = np.concatenate([a.result.track.y, b.result.track.y])
+        expected = string_winding_deg((x[0], y[0]), (x[-1], y[-1]), mark, a.spec.rounding)
+        assert winding_deg(x, y, mark) == pytest.approx(expected, abs=1e-6), a.spec.label
+        checked += 1
+    assert checked >= 2
+
+
 def test_later_legs_see_later_wind():
     """A wind that turns at a known time: the leg sailed after it is a beat, not a reach."""
     course = course_from_mapping({
