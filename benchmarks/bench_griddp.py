@@ -32,6 +32,7 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from sailroute.backend import get_xp  # noqa: E402
 from sailroute.boat.dynamic import DynamicBoat, build_table  # noqa: E402
 from sailroute.routing.griddp import solve_griddp  # noqa: E402
 from sailroute.routing.multispline import fit_function, solve_spline  # noqa: E402
@@ -44,7 +45,7 @@ A = Start((0.0, 0.0))
 POINT_ZONE_M = 0.01  # the papers' B is a point: a 1 cm rounding segment
 
 
-def _grid_rows(cols: list[int], quick: bool) -> None:
+def _grid_rows(cols: list[int], quick: bool, xp=np) -> None:
     boat = DynamicBoat()
     polar = boat.steady_polar(np.arange(0.0, 61.0, 2.0), twa_step=1.0)
     paper_wind = UniformWind(12.0, 5.0)
@@ -63,7 +64,7 @@ def _grid_rows(cols: list[int], quick: bool) -> None:
                                         tack_penalty_s=0.0, gybe_penalty_s=0.0,
                                         zone_m=POINT_ZONE_M)
                     tic = time.perf_counter()
-                    sol = solve_griddp(A, tgt, 0.0, wind, b, s)
+                    sol = solve_griddp(A, tgt, 0.0, wind, b, s, xp=xp)
                     wall = time.perf_counter() - tic
                     ev = sum(p.segment_evals for p in sol.passes)
                     print(f"{name:<22}{model_name:<9}{c:>5}{ref + 1:>7}{wall:>9.2f}{ev:>13,d}"
@@ -138,12 +139,14 @@ def _kernel_accuracy() -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="skip C = 128")
+    ap.add_argument("--backend", default="numpy",
+                    help="numpy | cupy | auto: array backend of the grid-DP rows table")
     args = ap.parse_args()
     print(f"# sailroute grid-DP benchmark — {platform.processor() or platform.machine()}, "
           f"Python {platform.python_version()}, numpy {np.__version__}, 1 thread")
     DynamicBoat().table()  # build the lookup table outside the timings
     cols = [32, 64] + ([] if args.quick else [128])
-    _grid_rows(cols, args.quick)
+    _grid_rows(cols, args.quick, get_xp(args.backend))
     _paper_convergence(args.quick)
     _splines()
     _kernel_accuracy()

@@ -36,6 +36,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from sailroute.backend import get_xp, xp_name  # noqa: E402
 from sailroute.boat.polar import Polar  # noqa: E402
 from sailroute.routing import isochrone  # noqa: E402
 from sailroute.routing.types import RoutingSettings, Start, Target  # noqa: E402
@@ -99,7 +100,8 @@ def beat(wind, t0: float) -> tuple[Start, Target]:
         "mark", (LEG_M * math.sin(th), LEG_M * math.cos(th)), rounding="port", name="1")
 
 
-def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repeat: int):
+def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repeat: int,
+             xp=np):
     start, target = beat(wind, t0)
     sizes: list[int] = []
     orig = isochrone._step
@@ -110,14 +112,14 @@ def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repe
 
     isochrone._step = counting
     try:
-        res = isochrone.route_isochrone(start, target, t0, wind, polar, st)  # warm-up
+        res = isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)  # warm-up
         steps, mean_n, max_n = len(sizes), float(np.mean(sizes)), max(sizes)
     finally:
         isochrone._step = orig
     walls, cpus = [], []
     for _ in range(repeat):
         w0, c0 = time.perf_counter(), time.process_time()
-        isochrone.route_isochrone(start, target, t0, wind, polar, st)
+        isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)
         walls.append(time.perf_counter() - w0)
         cpus.append(time.process_time() - c0)
     tab = isochrone.polar_tables(polar, st.heading_step_deg)
@@ -143,7 +145,9 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=None, help="dt_s (default: RoutingSettings)")
     ap.add_argument("--heading-step", type=float, default=None)
     ap.add_argument("--sector", type=float, default=None)
+    ap.add_argument("--backend", default="numpy", help="numpy | cupy | auto (array backend)")
     args = ap.parse_args()
+    xp = get_xp(args.backend)
     kw = {k: v for k, v in (("dt_s", args.dt), ("heading_step_deg", args.heading_step),
                             ("prune_sector_deg", args.sector)) if v is not None}
     st = RoutingSettings(**kw)
@@ -151,20 +155,20 @@ def main() -> None:
     print(f"isochrone router, one thread, numpy {np.__version__}; polar {polar.name!r}; "
           f"dt {st.dt_s:g} s, heading step {st.heading_step_deg:g} deg, sectors "
           f"{st.prune_sector_deg:g} deg, tack {st.tack_penalty_s:g} s, gybe "
-          f"{st.gybe_penalty_s:g} s")
+          f"{st.gybe_penalty_s:g} s; backend {xp_name(xp)}")
     t0 = 1524567600.0  # 2018-04-24T11:00Z, inside the synthetic WRF file
     run_case("uniform 8.5 kn from 0 deg, 1809 m beat", UniformWind(8.5 * KNOT, 0.0), t0,
-             polar, st, args.repeat)
+             polar, st, args.repeat, xp)
     wrf = wrf_field()
     if wrf is not None:
         c = wrf.coverage
         t_w = c.t0 + 0.25 * (c.t1 - c.t0)
         run_case(f"WRF {wrf.name} (grid {wrf.shape}), 1809 m beat", wrf, t_w, polar, st,
-                 args.repeat)
+                 args.repeat, xp)
     else:
         print("WRF reader not available: WRF case skipped")
     run_case("gridded analytic field (17 x 17 cells, 10-min slices), 1809 m beat",
-             gridded_field(t0), t0 + 600.0, polar, st, args.repeat)
+             gridded_field(t0), t0 + 600.0, polar, st, args.repeat, xp)
 
 
 if __name__ == "__main__":
