@@ -27,17 +27,20 @@ import numpy as np  # noqa: E402
 from sailroute.boat.build import builtin_polar  # noqa: E402
 from sailroute.boat.polar import Polar  # noqa: E402
 from sailroute.parallel import open_runner  # noqa: E402
-from sailroute.strategy.deadline import (  # noqa: E402
+from sailroute.strategy import (  # noqa: E402
+    BeatGrid,
     DeadlineGrid,
     DeadlinePolicy,
+    DriftDiffusionShift,
+    ExpectedTimePolicy,
+    OUShift,
     RiskNeutralPolicy,
+    simulate,
     simulate_deadline,
     solve_deadline,
+    solve_expected_time,
     solve_risk_neutral,
 )
-from sailroute.strategy.montecarlo import simulate  # noqa: E402
-from sailroute.strategy.sdp import BeatGrid, ExpectedTimePolicy, solve_expected_time  # noqa: E402
-from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift  # noqa: E402
 from sailroute.units import KNOT  # noqa: E402
 
 SO40_TWA = [0, 5, 10, 15, 20, 25, 32, 36, 40, 45, 52, 60, 70, 80, 90, 100, 110, 120, 130, 140,

@@ -249,26 +249,29 @@ class LaserParams:
         return self.crew_mass_kg * self.gravity * self.hiking_arm_m
 
 
+def _smaller_rig(
+    base: LaserParams, name: str, sail_area_m2: float, crew_mass_kg: float
+) -> LaserParams:
+    """``base`` with a smaller mainsail [m²] and another sailor [kg].
+
+    The foot height stays and the sail height scales with √area (shorter lower
+    mast) [A]; the CE stays at 40 % of the sail height, so its height above the
+    foot scales with √area too.
+    """
+    foot = base.sail_foot_height_m
+    ce = foot + (base.ce_height_m - foot) * (sail_area_m2 / base.sail_area_m2) ** 0.5
+    return replace(base, name=name, sail_area_m2=sail_area_m2, ce_height_m=ce,
+                   crew_mass_kg=crew_mass_kg)
+
+
 ILCA7: Final = LaserParams()
 """ILCA 7 (standard rig, 7.06 m²), 80 kg sailor."""
 
-ILCA6: Final = replace(
-    ILCA7,
-    name="ILCA 6",
-    sail_area_m2=5.76,
-    ce_height_m=0.60 + 0.4 * (2.68 - 0.60) / 0.4 * (5.76 / 7.06) ** 0.5,
-    crew_mass_kg=68.0,
-)
+ILCA6: Final = _smaller_rig(ILCA7, "ILCA 6", sail_area_m2=5.76, crew_mass_kg=68.0)
 """ILCA 6 (radial, 5.76 m² [T]); the sail height scales with √area
 (shorter lower mast, same foot height) [A]; 68 kg sailor [A]."""
 
-ILCA4: Final = replace(
-    ILCA7,
-    name="ILCA 4",
-    sail_area_m2=4.70,
-    ce_height_m=0.60 + 0.4 * (2.68 - 0.60) / 0.4 * (4.70 / 7.06) ** 0.5,
-    crew_mass_kg=58.0,
-)
+ILCA4: Final = _smaller_rig(ILCA7, "ILCA 4", sail_area_m2=4.70, crew_mass_kg=58.0)
 """ILCA 4 (4.7 rig, 4.70 m² [ILCA]); sail height scaled with √area [A];
 58 kg sailor [A]."""
 

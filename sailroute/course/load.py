@@ -17,7 +17,7 @@ import dataclasses
 import difflib
 import math
 import typing
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from datetime import date, datetime
 from pathlib import Path
 from typing import Any
@@ -153,6 +153,17 @@ class _Checker:
         self.p.add(path, f"expected {what}; got {_show(value)}")
         return False
 
+    def absent(self, path: str, default: Any, expected: str) -> Any:
+        """Value of a key that is not there: ``default``, or ``None`` and a problem if required.
+
+        ``default`` is ``_MISSING`` for a required key; ``expected`` says what the key
+        should hold (``"a number"``, ``"text"``, ...).
+        """
+        if default is _MISSING:
+            self.p.add(path, f"missing required key; expected {expected}")
+            return None
+        return default
+
     def number(
         self,
         d: Mapping[str, Any],
@@ -167,10 +178,7 @@ class _Checker:
     ) -> Any:
         p = _join(path, key)
         if key not in d or d[key] is None:
-            if default is _MISSING:
-                self.p.add(p, f"missing required key; expected {what or 'a number'}")
-                return None
-            return default
+            return self.absent(p, default, what or "a number")
         v = d[key]
         if what is None:
             if lo is not None and hi is not None:
@@ -205,10 +213,7 @@ class _Checker:
         choices = list(choices)
         p = _join(path, key)
         if key not in d:
-            if default is _MISSING:
-                self.p.add(p, f"missing required key; expected one of {_quoted(choices)}")
-                return None
-            return default
+            return self.absent(p, default, f"one of {_quoted(choices)}")
         v = d[key]
         if v not in choices:
             hint = _suggest(str(v), [str(c) for c in choices]) if isinstance(v, str) else ""
@@ -220,10 +225,7 @@ class _Checker:
     def string(self, d: Mapping[str, Any], key: str, path: str, default: Any = _MISSING) -> Any:
         p = _join(path, key)
         if key not in d:
-            if default is _MISSING:
-                self.p.add(p, "missing required key; expected text")
-                return None
-            return default
+            return self.absent(p, default, "text")
         v = d[key]
         if not isinstance(v, str) or not v.strip():
             self.p.add(p, f"expected non-empty text; got {_show(v)}")
@@ -247,6 +249,17 @@ class _Checker:
             self.p.add(path, f"expected {what} (text or a whole number); got {_show(value)}")
             return None
         return str(value)
+
+    def named_items(
+        self, raw: Mapping[Any, Any], path: str, what: str
+    ) -> Iterator[tuple[str, Any]]:
+        """``(name, value)`` of each entry of the mapping ``raw`` at ``path`` whose key
+        is a valid name (:meth:`name`, ``what`` for its message); bad keys are recorded
+        and skipped."""
+        for key, value in raw.items():
+            name = self.name(key, _join(path, str(key)), what)
+            if name is not None:
+                yield name, value
 
 
 # ----------------------------------------------------------------------------- sections
@@ -327,10 +340,7 @@ def _marks(c: _Checker, raw: Any) -> dict[str, tuple[str, tuple[float, float]]]:
         return out
     if not raw:
         c.p.add("marks", "expected at least two marks; got none")
-    for key, value in raw.items():
-        name = c.name(key, _join("marks", str(key)), "a mark name")
-        if name is None:
-            continue
+    for name, value in c.named_items(raw, "marks", "a mark name"):
         c.declared.add(name)
         pos = _position(c, value, _join("marks", name), f"the position of mark {name!r}")
         if pos is not None:
@@ -346,10 +356,7 @@ def _pairs(
     what = "line" if section == "lines" else "gate"
     if not c.mapping(raw, section, f"a mapping of {what} name to [mark, mark]"):
         return out
-    for key, value in raw.items():
-        name = c.name(key, _join(section, str(key)), f"a {what} name")
-        if name is None:
-            continue
+    for name, value in c.named_items(raw, section, f"a {what} name"):
         path = _join(section, name)
         if name not in taken:
             c.declared.add(name)
@@ -580,10 +587,7 @@ def _references(
         return out
     if not c.mapping(raw, path, "a mapping of reference name to a list of leg times [s]"):
         return out
-    for key, value in raw.items():
-        name = c.name(key, _join(path, str(key)), "a reference name")
-        if name is None:
-            continue
+    for name, value in c.named_items(raw, path, "a reference name"):
         times = _leg_times(c, value, _join(path, name), n_legs)
         if times is not None:
             out[name] = times
@@ -614,10 +618,7 @@ def _scenarios(c: _Checker, raw: Any, n_legs: int | None) -> dict[str, ScenarioS
         return out
     if not raw:
         c.p.add("scenarios", "expected at least one scenario; got none")
-    for key, value in raw.items():
-        name = c.name(key, _join("scenarios", str(key)), "a scenario name")
-        if name is None:
-            continue
+    for name, value in c.named_items(raw, "scenarios", "a scenario name"):
         path = _join("scenarios", name)
         if not c.mapping(value, path, "a wind spec {type: ...} or {wind: {type: ...}, "
                          "references: ..., description: ...}"):

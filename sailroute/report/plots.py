@@ -45,6 +45,16 @@ def _extent(course: Course, legs: Sequence[LegResult], pad: float = 0.08) -> tup
     return x0 - pad * span, x1 + pad * span, y0 - pad * span, y1 + pad * span
 
 
+def _map_frame(ax: Axes, extent: Sequence[float]) -> None:
+    """Plan view of ``extent`` = ``(x0, x1, y0, y1)`` [m]: equal aspect, axis labels, grid."""
+    ax.set_xlim(extent[0], extent[1])
+    ax.set_ylim(extent[2], extent[3])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x, east [m]")
+    ax.set_ylabel("y, north [m]")
+    ax.grid(True, lw=0.3, alpha=0.5)
+
+
 def _label_directions(course: Course) -> dict[str, tuple[float, float]]:
     """Unit offset direction of each mark's label: away from its line/gate partner, or
     away from the course centroid for single marks."""
@@ -170,12 +180,7 @@ def plot_route(
             linestyle="none", zorder=7, gid="tacks", label=f"tacks ({len(tacks)})")
     ax.plot([p[0] for p in gybes], [p[1] for p in gybes], "s", color="royalblue", ms=5,
             linestyle="none", zorder=7, gid="gybes", label=f"gybes ({len(gybes)})")
-    ax.set_xlim(extent[0], extent[1])
-    ax.set_ylim(extent[2], extent[3])
-    ax.set_aspect("equal")
-    ax.set_xlabel("x, east [m]")
-    ax.set_ylabel("y, north [m]")
-    ax.grid(True, lw=0.3, alpha=0.5)
+    _map_frame(ax, extent)
     ax.legend(loc="best", fontsize=8, title=wind_label, title_fontsize=8)
     ax.set_title(title or course.name, fontsize=10)
     return fig
@@ -239,13 +244,7 @@ def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:
             ys = np.concatenate([r.track.y for r in p.results])
             mx.plot(xs, ys, "-", color=colours[i % len(colours)], lw=1.6, gid=f"route:{p.scenario}",
                     label=p.scenario)
-        ext = _extent(course, [r for p in plans for r in p.results])
-        mx.set_xlim(ext[0], ext[1])
-        mx.set_ylim(ext[2], ext[3])
-        mx.set_aspect("equal")
-        mx.set_xlabel("x, east [m]")
-        mx.set_ylabel("y, north [m]")
-        mx.grid(True, lw=0.3, alpha=0.5)
+        _map_frame(mx, _extent(course, [r for p in plans for r in p.results]))
         mx.legend(fontsize=8)
         mx.set_title("routes", fontsize=10)
     return fig

@@ -369,8 +369,7 @@ class DeadlinePolicy:
 
     def node(self, r_m: float, theta_rad: float, tack: int) -> int:
         """Flat index of the node nearest to ``(r, θ)`` on ``tack`` (+1/-1)."""
-        return int(_nearest_nodes(self.grid, np.array([r_m]), np.array([theta_rad]),
-                                  np.array([0 if tack == 1 else 1]))[0])
+        return _nearest_node(self.grid, r_m, theta_rad, tack)
 
     def success_curve(self, r_m: float, theta_rad: float, tack: int = 1) -> NDArray[np.float64]:
         """``w`` at the nearest node for every budget slice: ``P(T <= s_k)`` under ``α^{s_k}``."""
@@ -412,9 +411,7 @@ class RiskNeutralPolicy:
 
     def expected_time(self, r_m: float, theta_rad: float, tack: int = 1) -> float:
         """``v`` at the nearest node [s]."""
-        k = _nearest_nodes(self.grid, np.array([r_m]), np.array([theta_rad]),
-                           np.array([0 if tack == 1 else 1]))[0]
-        return float(self.value_s[k])
+        return float(self.value_s[_nearest_node(self.grid, r_m, theta_rad, tack)])
 
 
 def _nearest_nodes(
@@ -426,6 +423,12 @@ def _nearest_nodes(
     i = np.clip(np.where(r > grid.target_radius_m, np.maximum(i, first), i), 0, grid.n_r)
     j = np.mod(np.rint(theta / grid.dtheta).astype(np.int64), grid.n_theta)
     return _flat(grid, q.astype(np.int64), i, j)
+
+
+def _nearest_node(grid: DeadlineGrid, r_m: float, theta_rad: float, tack: int) -> int:
+    """Flat index of the node nearest to one point ``(r [m], θ [rad])`` on ``tack`` (+1/-1)."""
+    return int(_nearest_nodes(grid, np.array([r_m]), np.array([theta_rad]),
+                              np.array([0 if tack == 1 else 1]))[0])
 
 
 def _active_nodes(grid: DeadlineGrid) -> tuple[NDArray[np.int64], NDArray[np.bool_]]:

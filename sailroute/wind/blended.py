@@ -26,9 +26,9 @@ from sailroute.errors import InputError, WindDataError
 from sailroute.geo import LocalFrame
 from sailroute.units import wrap180
 from sailroute.wind.base import WindField, prepare_points
-from sailroute.wind.height import DEFAULT_EXPONENT, power_law_factor
-from sailroute.wind.rotation import earth_to_local, rotate_clockwise
-from sailroute.wind.stations import StationData
+from sailroute.wind.height import DEFAULT_EXPONENT
+from sailroute.wind.rotation import rotate_clockwise
+from sailroute.wind.stations import StationData, local_records
 
 
 @dataclass(frozen=True)
@@ -147,17 +147,8 @@ class BlendedWind:
             raise InputError(f"{self.name}: ratio_range must satisfy 0 < min <= 1 <= max, "
                              f"got {self.ratio_range}")
         d = self.stations
-        x, y = self.frame.to_xy(d.lat, d.lon)
-        ue, ve = d.u, d.v
-        if self.height_m is not None:
-            if np.any(np.isnan(d.height_m)):
-                raise InputError(
-                    f"{self.name}: height_m is set but the stations' measurement height is "
-                    "unknown; add a height_m column or `measurement_height_m` to the stations"
-                )
-            f = power_law_factor(d.height_m, self.height_m, self.exponent)
-            ue, ve = ue * f, ve * f
-        uo, vo = earth_to_local(ue, ve, self.frame.grid_north_deg(d.lat, d.lon))
+        x, y, uo, vo = local_records(d, self.frame, self.height_m, self.name,
+                                     exponent=self.exponent)
         inside = self.base.coverage.contains(d.t, x, y)
         if not inside.any():
             raise WindDataError(

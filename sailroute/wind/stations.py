@@ -19,7 +19,7 @@ from __future__ import annotations
 import csv
 import io
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime, timedelta, timezone
 from pathlib import Path
@@ -408,41 +408,40 @@ def _speed_unit(column: str, declared: str | None, name: str) -> str:
     return declared
 
 
+def _parse_cells(cells: list[str], miss: set[str], parse: Callable[[int, str], float]
+                 ) -> tuple[NDArray, int]:
+    """Parse a column cell by cell: ``parse(k, cell)``, or NaN for a missing marker.
+
+    Returns the values and how many are missing (markers, and cells read as NaN).
+    """
+    out = np.array([np.nan if c in miss else parse(k, c) for k, c in enumerate(cells)],
+                   dtype=float)
+    return out, int(np.count_nonzero(np.isnan(out)))
+
+
 def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss: set[str],
              name: str) -> tuple[NDArray, int]:
-    out = np.empty(len(cells))
-    n_miss = 0
-    for k, c in enumerate(cells):
-        if c in miss:
-            out[k] = np.nan
-            n_miss += 1
-            continue
+    def number(k: int, c: str) -> float:
         try:
-            out[k] = float(c)
+            v = float(c)
         except ValueError:
             raise WindDataError(
                 f"{name}, line {linenos[k]}, column {column!r}: cannot read {c!r} as a number "
                 f"({canon}); if it marks missing data, add it to `missing`"
             ) from None
-        if np.isinf(out[k]):
+        if np.isinf(v):
             raise WindDataError(
                 f"{name}, line {linenos[k]}, column {column!r}: {c!r} is not a finite number "
                 f"({canon}); replace it with a value or a missing marker"
             )
-        if np.isnan(out[k]):
-            n_miss += 1
-    return out, n_miss
+        return v
+
+    return _parse_cells(cells, miss, number)
 
 
 def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | None, name: str,
            column: str) -> tuple[NDArray, int]:
-    out = np.empty(len(cells))
-    n_miss = 0
-    for k, c in enumerate(cells):
-        if c in miss:
-            out[k] = np.nan
-            n_miss += 1
-            continue
+    def epoch(k: int, c: str) -> float:
         s = c[:-1] + "+00:00" if c.endswith(("Z", "z")) else c
         try:
             dt = datetime.fromisoformat(s)
@@ -459,8 +458,9 @@ def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | 
                     "logger's offset with `timezone: '+01:00'`"
                 )
             dt = dt.replace(tzinfo=tz)
-        out[k] = dt.timestamp()
-    return out, n_miss
+        return dt.timestamp()
+
+    return _parse_cells(cells, miss, epoch)
 
 
 def _check_range(name: str, linenos: list[int], column: str, a: NDArray, lo: float, hi: float,
@@ -572,6 +572,65 @@ def resample_stations(data: StationData, interval_s: float, *, min_fill: float =
     return replace(out, **{k: getattr(out, k)[keep] for k in _ARRAY_FIELDS})
 
 
+def local_records(
+    data: StationData,
+    frame: LocalFrame,
+    height_m: float | None,
+    name: str,
+    *,
+    shear: str = "power",
+    exponent: float = DEFAULT_EXPONENT,
+    roughness_m: float = DEFAULT_ROUGHNESS_M,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Positions and winds of the records in the local frame, at a target height.
+
+    Parameters
+    ----------
+    data : StationData
+        Station records.
+    frame : LocalFrame
+        The local frame.
+    height_m : float or None
+        Target height [m]; each record is scaled from its ``height_m`` with the
+        power law (``exponent``) or the log law (``shear="log"``, ``roughness_m``).
+        ``None``: as measured.
+    name : str
+        Label for messages.
+    shear : {"power", "log"}
+        Height-correction law.
+    exponent : float
+        Power-law exponent [-].
+    roughness_m : float
+        Log-law roughness length [m].
+
+    Returns
+    -------
+    x, y : ndarray
+        Record positions [m].
+    u, v : ndarray
+        Record winds, local-frame components [m s⁻¹].
+
+    Raises
+    ------
+    InputError
+        ``height_m`` is set but a record's measurement height is unknown.
+    """
+    x, y = frame.to_xy(data.lat, data.lon)
+    ue, ve = data.u, data.v
+    if height_m is not None:
+        if np.any(np.isnan(data.height_m)):
+            raise InputError(
+                f"{name}: a target height_m is set but the measurement height is unknown "
+                f"for {data.source or 'the stations'}; add a height_m column or give the "
+                "stations' height (`measurement_height_m`)"
+            )
+        f = (power_law_factor(data.height_m, height_m, exponent) if shear == "power" else
+             log_law_factor(data.height_m, height_m, roughness_m))
+        ue, ve = ue * f, ve * f
+    u, v = earth_to_local(ue, ve, frame.grid_north_deg(data.lat, data.lon))
+    return x, y, u, v
+
+
 # ------------------------------------------------------------------------------ field
 @dataclass(frozen=True, eq=False)
 class StationWind:
@@ -647,20 +706,8 @@ class StationWind:
             raise InputError(f"{self.name}: shear {self.shear!r}; expected 'power' or 'log'")
         if not (self.radius_m >= 0) or not (self.power > 0) or not (self.max_gap_s > 0):
             raise InputError(f"{self.name}: radius_m must be >= 0, power and max_gap_s > 0")
-        x, y = self.frame.to_xy(d.lat, d.lon)
-        ue, ve = d.u, d.v
-        if self.height_m is not None:
-            if np.any(np.isnan(d.height_m)):
-                raise InputError(
-                    f"{self.name}: a target height_m is set but the measurement height of "
-                    f"{d.source or 'the stations'} is unknown; add a height_m column or give "
-                    "the stations' height (`measurement_height_m`)"
-                )
-            f = (power_law_factor(d.height_m, self.height_m, self.exponent)
-                 if self.shear == "power" else
-                 log_law_factor(d.height_m, self.height_m, self.roughness_m))
-            ue, ve = ue * f, ve * f
-        ul, vl = earth_to_local(ue, ve, self.frame.grid_north_deg(d.lat, d.lon))
+        x, y, ul, vl = local_records(d, self.frame, self.height_m, self.name, shear=self.shear,
+                                     exponent=self.exponent, roughness_m=self.roughness_m)
         series = []
         moving = False
         for s in d.stations:

@@ -1,8 +1,8 @@
 """Isochrone router: analytic leg times, manoeuvre counts, symmetries, targets, errors.
 
-The boat is a synthetic, smooth Laser-like polar built here (independent of the boat
-package's data files).  Reference values are closed forms: a reach takes
-``L / S(tws, twa)``; a beat in uniform wind takes ``L cos(alpha) / VMG*`` plus one tack
+The boat is a synthetic, smooth Laser-like polar (``tests/routing/polars.py``,
+independent of the boat package's data files).  Reference values are closed forms: a
+reach takes ``L / S(tws, twa)``; a beat in uniform wind takes ``L cos(alpha) / VMG*`` plus one tack
 penalty (alpha = angle between the leg and the wind), a run ``L / VMG*_down`` plus one
 gybe.  ``VMG*`` comes from the polar's own optimiser, so the router is checked against
 the polar, not against its own output.
@@ -26,7 +26,6 @@ import pytest
 
 from sailroute.boat import builtin_polar
 from sailroute.boat.dynamic import DynamicBoat
-from sailroute.boat.polar import Polar
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
 from sailroute.routing.isochrone import polar_tables, route_isochrone
 from sailroute.routing.types import RoutingSettings, Start, Target
@@ -34,21 +33,11 @@ from sailroute.units import wind_components
 from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import Coverage
 from sailroute.wind.uniform import UniformWind
+from tests.routing.polars import laser_like_polar
 
 TWS = 4.37  # 8.5 kn, the thesis's validation wind [m s⁻¹]
 T0 = 1_524_567_600.0  # 2018-04-24T11:00Z
 ROUNDOFF = 1e-9  # relative float64 round-off over ~100-300 steps
-
-
-def laser_like_polar() -> Polar:
-    """Smooth Laser-like table: speed = f(TWS) g(TWA), no-go below ~30°, best VMG
-    near 43° upwind and near 150° downwind (running dead downwind is clearly slower,
-    so a run is sailed with gybes)."""
-    twa = np.array([0, 30, 40, 45, 50, 60, 75, 90, 105, 120, 135, 150, 165, 180.0])
-    g = np.array([0, 0.45, 0.68, 0.74, 0.79, 0.85, 0.92, 0.97, 1.0, 0.97, 0.9, 0.82, 0.66,
-                  0.55])
-    tws = np.array([1, 2, 3, 4, 5, 6, 7, 8, 10, 12.0])
-    return Polar(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))), name="laser-like")
 
 
 POLAR = laser_like_polar()

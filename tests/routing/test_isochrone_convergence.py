@@ -3,8 +3,8 @@
 A 1809 m beat (the thesis's validation beat) in a smooth wind that varies in space
 (8° geographic shift across the course, ±10-15 % pressure bands) and in time (6°
 oscillation with a 15 min period), with the synthetic Laser-like polar of
-``test_isochrone.py``.  There is no closed form, so the checks are on the sequence of
-leg times as the time step ``dt``, the heading step and the pruning sector are halved.
+``tests/routing/polars.py``.  There is no closed form, so the checks are on the sequence
+of leg times as the time step ``dt``, the heading step and the pruning sector are halved.
 
 Measured (2026, this code; numbers in seconds, leg time ~1262 s):
 
@@ -31,23 +31,14 @@ import math
 import numpy as np
 import pytest
 
-from sailroute.boat.polar import Polar
 from sailroute.routing.isochrone import route_isochrone
 from sailroute.routing.types import RoutingSettings, Start, Target
 from sailroute.units import wind_components
 from sailroute.wind.analytic import AnalyticWind
+from tests.routing.polars import laser_like_polar
 
 L = 1809.0
 TWS = 4.37
-
-
-def laser_like_polar() -> Polar:
-    """The synthetic polar of ``test_isochrone.py`` (repeated to keep files independent)."""
-    twa = np.array([0, 30, 40, 45, 50, 60, 75, 90, 105, 120, 135, 150, 165, 180.0])
-    g = np.array([0, 0.45, 0.68, 0.74, 0.79, 0.85, 0.92, 0.97, 1.0, 0.97, 0.9, 0.82, 0.66,
-                  0.55])
-    tws = np.array([1, 2, 3, 4, 5, 6, 7, 8, 10, 12.0])
-    return Polar(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))), name="laser-like")
 
 
 POLAR = laser_like_polar()

@@ -17,7 +17,7 @@ float round-off (asserted to 1e-6°).  A route that passes the mark on the wrong
 or turns back without going round it, is off by 360° (the naive chaining below shows
 that the check fails without the rounding constraints).
 
-Winds are uniform, the polar is the synthetic Laser-like one of ``test_isochrone.py``.
+Winds are uniform, the polar is the synthetic Laser-like one of ``polars.py``.
 """
 
 from __future__ import annotations
@@ -28,7 +28,6 @@ import types
 import numpy as np
 import pytest
 
-from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 from sailroute.routing.geometry import (
     BARRIER_SLACK_M,
@@ -45,16 +44,7 @@ from sailroute.routing.isochrone import route_isochrone
 from sailroute.routing.multispline import route_spline
 from sailroute.routing.types import Barrier, RoutingSettings, Start, Target
 from sailroute.wind.uniform import UniformWind
-
-
-def laser_like_polar() -> Polar:
-    """The synthetic polar of ``test_isochrone.py`` (repeated to keep files independent)."""
-    twa = np.array([0, 30, 40, 45, 50, 60, 75, 90, 105, 120, 135, 150, 165, 180.0])
-    g = np.array([0, 0.45, 0.68, 0.74, 0.79, 0.85, 0.92, 0.97, 1.0, 0.97, 0.9, 0.82, 0.66,
-                  0.55])
-    tws = np.array([1, 2, 3, 4, 5, 6, 7, 8, 10, 12.0])
-    return Polar(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))), name="laser-like")
-
+from tests.routing.polars import laser_like_polar
 
 POLAR = laser_like_polar()
 TWS = 4.37  # 8.5 kn [m s⁻¹]
