@@ -244,6 +244,7 @@ def test_progress_is_reported_up_to_one() -> None:
     assert all(b >= a for a, b in itertools.pairwise(seen))
 
 
+@pytest.mark.timing
 @pytest.mark.slow
 def test_c128_dynamic_finishes_in_seconds() -> None:
     # the paper needed 874 s (serial C) and 21 s (GPU) for C = 128; one pass here

@@ -528,6 +528,7 @@ def test_generic_array_module_path_gives_the_same_route(case):
 WRF_FILE = Path(__file__).resolve().parents[2] / "data" / "hyeres-2018-04-24-synthetic-wrfout.nc"
 
 
+@pytest.mark.timing
 @pytest.mark.slow
 def test_wrf_beat_routes_well_under_a_second():
     # the speed target: a 1.8 km beat at default resolution in a WRF field, one
