@@ -105,9 +105,10 @@ def plan_command(
     def run() -> Any:
         from sailroute.course.load import load_course
 
-        progress = _progress(load_course(course).n_legs, quiet)
-        return run_plan_command(course, scenario=scenario, router=router, out_dir=out,
-                                plots=not no_plots, backend=backend, progress=progress)
+        loaded = load_course(course)
+        return run_plan_command(loaded, scenario=scenario, router=router, out_dir=out,
+                                plots=not no_plots, backend=backend,
+                                progress=_progress(loaded.n_legs, quiet))
 
     _echo_result(run_guarded(run))
 
@@ -139,10 +140,10 @@ def compare_command(
     def run() -> Any:
         from sailroute.course.load import load_course
 
-        progress = _progress(load_course(course).n_legs, quiet)
-        return run_compare_command(course, scenarios=scenario, router=router, out_dir=out,
-                                   plots=not no_plots, backend=backend, progress=progress,
-                                   scheduler=scheduler)
+        loaded = load_course(course)
+        return run_compare_command(loaded, scenarios=scenario, router=router, out_dir=out,
+                                   plots=not no_plots, backend=backend,
+                                   progress=_progress(loaded.n_legs, quiet), scheduler=scheduler)
 
     _echo_result(run_guarded(run))
 

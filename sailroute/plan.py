@@ -18,7 +18,7 @@ from pathlib import Path
 
 from sailroute.backend import get_xp
 from sailroute.course.geometry import leg_endpoints, target_of
-from sailroute.course.load import build_boat, build_wind, load_course, validate_specs
+from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
@@ -44,9 +44,21 @@ class PlannedCourse:
     wind: WindField
 
 
-def settings_for(course: Course, router: str | None = None) -> RoutingSettings:
-    """The course's routing settings, with the router replaced if ``router`` is given."""
-    return course.routing if router is None else dataclasses.replace(course.routing, router=router)
+def settings_for(
+    course: Course, router: str | None = None, backend: str = "numpy"
+) -> RoutingSettings:
+    """The course's routing settings, with the router replaced if ``router`` is given.
+
+    Raises
+    ------
+    InputError
+        Unknown router or backend name (checked here, before any work is done).
+    """
+    settings = course.routing if router is None else dataclasses.replace(course.routing,
+                                                                         router=router)
+    get_router(settings.router)
+    get_xp(backend)
+    return settings
 
 
 def default_scenario(course: Course) -> str:
@@ -89,13 +101,14 @@ def route_course(
         the mark is rounded on its side, and the next leg may not cross back.
     """
     results: list[LegResult] = []
-    t0, end_xy = course.start_epoch, None
     for i, spec in enumerate(course.legs):
-        start, target = leg_endpoints(course, i, end_xy)
-        # a mark is rounded on its side: the leg ends past the rounding (towards the next
-        # target) and the next leg may not cross back (routing/geometry.py, chain_leg)
+        previous = results[-1] if results else None
+        # chain_leg starts the leg at the previous arrival; a mark is rounded on its side:
+        # the leg ends past the rounding (towards the next target) and the next leg may not
+        # cross back (routing/geometry.py)
         following = target_of(course, i + 1) if i + 1 < course.n_legs else None
-        start, target = chain_leg(start, target, results[-1] if results else None, following)
+        start, target = chain_leg(*leg_endpoints(course, i), previous, following)
+        t0 = previous.t_end if previous is not None else course.start_epoch
         if progress is not None:
             progress.start_leg(i, spec.label)
         res = route_leg(start, target, t0, wind, boat, settings, backend=backend,
@@ -103,7 +116,6 @@ def route_course(
         if progress is not None:
             progress.end_leg(res.time_s, f"{res.n_tacks} tacks, {res.n_gybes} gybes")
         results.append(res)
-        t0, end_xy = res.t_end, res.end_xy
     return results
 
 
@@ -144,11 +156,16 @@ def plan_course(
         A leg cannot be routed (the message names it).
     """
     name = default_scenario(course) if scenario is None else scenario
-    settings = settings_for(course, router)
-    get_router(settings.router)  # fail on a bad router or backend name before any work
-    get_xp(backend)
-    validate_specs(course, [name])
-    wind, boat = build_wind(course, name), build_boat(course)
+    settings = settings_for(course, router, backend)
+    boat, winds = build_specs(course, [name])
+    return _routed(course, name, winds[name], boat, settings, backend, progress)
+
+
+def _routed(
+    course: Course, name: str, wind: WindField, boat: object, settings: RoutingSettings,
+    backend: str, progress: Progress | None,
+) -> PlannedCourse:
+    """Route the course in one built scenario and assemble its :class:`Plan`."""
     results = route_course(course, wind, boat, settings, backend=backend, progress=progress)
     return PlannedCourse(make_plan(course, name, results, wind, router=settings.router), wind)
 
@@ -194,17 +211,19 @@ def compare_scenarios(
         One per scenario, in the same order.
     """
     names = list(course.scenarios) if not scenarios else list(dict.fromkeys(scenarios))
-    validate_specs(course, names)  # every problem of every scenario in one error, up front
+    settings = settings_for(course, router, backend)
+    # every problem of every scenario in one error, up front
+    boat, winds = build_specs(course, names)
     if scheduler in (None, "serial"):
         plans = []
         for n in names:
             if progress is not None:
                 progress.set_prefix(f"{n}: ")
-            plans.append(plan_course(course, n, router=router, backend=backend,
-                                     progress=progress).plan)
+            plans.append(_routed(course, n, winds[n], boat, settings, backend, progress).plan)
     else:
         from sailroute.parallel import map_tasks
 
+        # workers build their own scenario (a wind field is not worth shipping)
         plans = map_tasks(_plan_task, [(course, n, router, backend) for n in names],
                           scheduler=scheduler)
     return compare(plans), plans
@@ -229,6 +248,11 @@ class CommandResult:
     plans: tuple[Plan, ...]
 
 
+def _loaded(course: Course | str | Path) -> Course:
+    """``course`` itself, or the course loaded from that path."""
+    return course if isinstance(course, Course) else load_course(course)
+
+
 def default_out_dir(course: Course, what: str) -> Path:
     """``out/<course file stem>/<what>``: where results go without ``--out``."""
     stem = Path(course.source).stem if course.source else "course"
@@ -236,7 +260,7 @@ def default_out_dir(course: Course, what: str) -> Path:
 
 
 def run_plan_command(
-    course_path: str | Path,
+    course: Course | str | Path,
     *,
     scenario: str | None = None,
     router: str | None = None,
@@ -253,7 +277,7 @@ def run_plan_command(
     from sailroute.report.files import write_plan_outputs
     from sailroute.report.tables import plan_table
 
-    course = load_course(course_path)
+    course = _loaded(course)
     run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, run.plan.scenario)
     files = write_plan_outputs(out, run.plan, wind=run.wind, plot=plots)
@@ -261,7 +285,7 @@ def run_plan_command(
 
 
 def run_compare_command(
-    course_path: str | Path,
+    course: Course | str | Path,
     *,
     scenarios: Sequence[str] | None = None,
     router: str | None = None,
@@ -281,7 +305,7 @@ def run_compare_command(
     from sailroute.report.files import write_comparison, write_plan_outputs
     from sailroute.report.tables import comparison_table
 
-    course = load_course(course_path)
+    course = _loaded(course)
     cmp, plans = compare_scenarios(course, scenarios, router=router, backend=backend,
                                    progress=progress, scheduler=scheduler)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, "comparison")

@@ -917,29 +917,40 @@ def build_wind(course: Course, scenario: str) -> Any:
     )
 
 
-def validate_specs(course: Course, scenarios: Iterable[str] | None = None) -> None:
-    """Build the boat and every scenario's wind once, reporting all problems together.
+def build_specs(
+    course: Course, scenarios: Iterable[str] | None = None
+) -> tuple[Any, dict[str, Any]]:
+    """Build the boat and each scenario's wind once, reporting all problems together.
 
     Parameters
     ----------
     course : Course
         A loaded course.
     scenarios : iterable of str, optional
-        Scenario names to check (default: all).
+        Scenario names to build (default: all).
+
+    Returns
+    -------
+    boat : Polar
+        As :func:`build_boat`.
+    winds : dict of str to WindField
+        Scenario name -> wind field, as :func:`build_wind`.
 
     Raises
     ------
     InputError
-        One error listing every boat/wind spec problem (each with its key path).
+        One error listing every boat/wind spec problem (each with its key path); a
+        single problem keeps its own type (e.g. ``OutOfCoverageError``).
     """
     errors: list[InputError] = []
+    boat, winds = None, {}
     try:
-        build_boat(course)
+        boat = build_boat(course)
     except InputError as exc:
         errors.append(exc)
     for name in course.scenarios if scenarios is None else scenarios:
         try:
-            build_wind(course, name)
+            winds[name] = build_wind(course, name)
         except InputError as exc:
             errors.append(exc)
     if len(errors) == 1:  # keep its type (e.g. OutOfCoverageError) and message
@@ -950,6 +961,12 @@ def validate_specs(course: Course, scenarios: Iterable[str] | None = None) -> No
             f"{course.source or '<course>'}: {len(problems)} problems in boat/wind specs",
             problems,
         ))
+    return boat, winds
+
+
+def validate_specs(course: Course, scenarios: Iterable[str] | None = None) -> None:
+    """:func:`build_specs`, keeping only its errors (check a course without routing it)."""
+    build_specs(course, scenarios)
 
 
 def _flatten(message: str) -> list[str]:
