@@ -30,7 +30,8 @@ from sailroute.errors import InputError, format_problems
 from sailroute.geo import LocalFrame
 from sailroute.routing.types import RouterName, RoutingSettings
 from sailroute.timeutil import parse_time
-from sailroute.yamlfile import YamlLoader, join_path, read_yaml
+from sailroute.yamlfile import join_path as _join
+from sailroute.yamlfile import read_yaml
 
 TOP_KEYS = (
     "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
@@ -87,7 +88,6 @@ class _Problems:
         raise InputError(format_problems(title, self.items))
 
 
-_join = join_path
 
 
 def _quoted(choices: Iterable[Any]) -> str:
@@ -109,10 +109,6 @@ def _show(value: Any) -> str:
 
 
 # ----------------------------------------------------------------------------- YAML
-CourseLoader = YamlLoader
-"""The YAML loader of course files (YAML 1.2 scalars; see :mod:`sailroute.yamlfile`)."""
-
-
 def _read_yaml(path: Path) -> tuple[Any, dict[str, int], list[str]]:
     doc = read_yaml(path, what="course file")
     dup = [f"{d.path}: the key {d.key!r} appears twice in the same mapping "
