@@ -20,6 +20,7 @@ from sailroute.backend import get_xp
 from sailroute.course.geometry import leg_endpoints, target_of
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
+from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
 from sailroute.routing.api import get_router, route_leg
@@ -212,20 +213,19 @@ def compare_scenarios(
     """
     names = list(course.scenarios) if not scenarios else list(dict.fromkeys(scenarios))
     settings = settings_for(course, router, backend)
+    where = check_scheduler(scheduler)  # a bad name fails before any work
     # every problem of every scenario in one error, up front
     boat, winds = build_specs(course, names)
-    if scheduler in (None, "serial"):
+    if where == SERIAL:
         plans = []
         for n in names:
             if progress is not None:
                 progress.set_prefix(f"{n}: ")
             plans.append(_routed(course, n, winds[n], boat, settings, backend, progress).plan)
     else:
-        from sailroute.parallel import map_tasks
-
         # workers build their own scenario (a wind field is not worth shipping)
         plans = map_tasks(_plan_task, [(course, n, router, backend) for n in names],
-                          scheduler=scheduler)
+                          scheduler=where)
     return compare(plans), plans
 
 

@@ -168,3 +168,15 @@ def test_wind_not_covering_the_race_is_an_error(tmp_path):
     assert "needed:  time 2018-02-15T14:45:00.000Z" in msg
     assert "covered: time 2018-02-15T09:35:30.000Z" in msg
     assert not (tmp_path / "out").exists()  # nothing written on failure
+
+
+def test_compare_checks_the_scheduler_name_before_building_any_wind(tmp_path):
+    text = (COURSES / "trieste-coach-wl.yaml").read_text()
+    text = text.replace("10:45:00+01:00", "15:45:00+01:00")  # wind no longer covers it
+    text = text.replace("../data/", str(ROOT / "data") + "/")
+    path = tmp_path / "late.yaml"
+    path.write_text(text)
+    with pytest.raises(InputError, match="scheduler 'tcp:/bad': expected 'serial'"):
+        compare_scenarios(load_course(path), scheduler="tcp:/bad")
+    with pytest.raises(OutOfCoverageError):  # a valid name gets as far as the wind
+        compare_scenarios(load_course(path), scheduler=" Serial ")
