@@ -599,39 +599,21 @@ def _route_course(course: Any, wind: WindField, boat: Any, st: RoutingSettings
     """Route every leg in order, chained in time and place; ``(timing, result)`` per leg.
 
     Uses :func:`sailroute.plan.route_course` (the ``plan`` command's leg chaining,
-    rounding rules included), timed per leg through its progress hooks; without it,
-    chains :func:`~sailroute.routing.api.route_leg` calls here.
+    rounding rules included), timed per leg through its progress hooks.
     """
-    try:
-        from sailroute.plan import route_course
-    except ImportError:
-        route_course = None
-    if route_course is not None:
-        clock = _LegClock()
-        results = route_course(course, wind, boat, st, progress=clock)
-        return list(zip(clock.times, results, strict=True))
-    from sailroute.course.geometry import leg_endpoints
+    from sailroute.plan import route_course
 
-    out: list[tuple[Timing, LegResult]] = []
-    t0, end_xy = course.start_epoch, None
-    for i in range(course.n_legs):
-        start, target = leg_endpoints(course, i, end_xy)
-        w0, c0 = time.perf_counter(), time.process_time()
-        res = route_leg(start, target, t0, wind, boat, st)
-        out.append((Timing(time.perf_counter() - w0, time.process_time() - c0), res))
-        t0, end_xy = res.t_end, res.end_xy
-    return out
+    clock = _LegClock()
+    results = route_course(course, wind, boat, st, progress=clock)
+    return list(zip(clock.times, results, strict=True))
 
 
 def _plan_course_wall(course: Any, scenario: str, repeat: int) -> str:
-    """Best wall time of :func:`sailroute.plan.plan_course` (or why it is missing)."""
-    try:
-        from sailroute.plan import plan_course
-    except ImportError as exc:
-        return f"not available ({exc})"
+    """Best wall time of :func:`sailroute.plan.plan_course`, with its route time."""
+    from sailroute.plan import plan_course
+
     tm, out = best_of(lambda: plan_course(course, scenario), repeat)
-    plan = getattr(out, "plan", out)
-    return f"{tm} wall (cpu), route {plan.total_time_s:.1f} s"
+    return f"{tm} wall (cpu), route {out.plan.total_time_s:.1f} s"
 
 
 def section_course(args: argparse.Namespace) -> None:
