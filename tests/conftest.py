@@ -3,17 +3,24 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+COURSES = ROOT / "courses"
 TESTS_DATA = ROOT / "tests" / "data"
+WIND_DATA = TESTS_DATA / "wind"
 SHARED_REAL = ROOT.parent / "shared" / "data" / "real"
 
-requires_shared = pytest.mark.skipif(
-    not SHARED_REAL.is_dir(), reason="../shared/data/real not present"
-)
+F = TypeVar("F")
+
+
+def requires_shared(test: F) -> F:
+    """Mark a test ``shared`` (reads ../shared/data/real) and skip it when that is absent."""
+    skip = pytest.mark.skipif(not SHARED_REAL.is_dir(), reason="../shared/data/real not present")
+    return pytest.mark.shared(skip(test))
 
 
 def pytest_report_header(config: pytest.Config) -> list[str]:

@@ -23,9 +23,8 @@ from typer.testing import CliRunner
 
 from sailroute.cli import app
 from sailroute.course.load import load_course
+from tests.conftest import COURSES, ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
-COURSES = ROOT / "courses"
 runner = CliRunner()
 GPX = "{http://www.topografix.com/GPX/1/1}"
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 import itertools
 import math
 import pickle
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,9 +21,7 @@ from sailroute.course.load import build_boat, course_from_mapping, load_course
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.plan import compare_scenarios, plan_course, run_plan_command
 from sailroute.units import wrap180
-
-ROOT = Path(__file__).resolve().parents[1]
-COURSES = ROOT / "courses"
+from tests.conftest import COURSES, ROOT
 
 
 @pytest.fixture(scope="module")

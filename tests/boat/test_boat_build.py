@@ -20,8 +20,7 @@ from sailroute.boat.io import write_pol
 from sailroute.boat.laser import CLASSES
 from sailroute.errors import InputError
 from sailroute.units import KNOT
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.conftest import ROOT
 
 
 def check_shipped(name: str) -> None:

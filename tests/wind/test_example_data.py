@@ -9,11 +9,11 @@ from datetime import UTC, datetime
 import netCDF4
 import numpy as np
 import pytest
-from wind_testpaths import ROOT
 
 from sailroute.geo import LocalFrame
 from sailroute.units import wind_speed_direction
 from sailroute.wind.wrf import open_wrf
+from tests.conftest import ROOT
 
 DATA = ROOT / "data"
 WRF = DATA / "hyeres-2018-04-24-synthetic-wrfout.nc"

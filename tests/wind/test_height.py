@@ -7,7 +7,6 @@ import math
 import netCDF4
 import numpy as np
 import pytest
-from wind_testpaths import WIND_DATA
 
 from sailroute.errors import InputError
 from sailroute.wind.height import (
@@ -19,6 +18,7 @@ from sailroute.wind.height import (
     power_law,
     power_law_exponent,
 )
+from tests.conftest import WIND_DATA
 
 
 def test_power_law_thesis_example() -> None:

@@ -7,7 +7,6 @@ import math
 import netCDF4
 import numpy as np
 import pytest
-from wind_testpaths import WIND_DATA
 
 from sailroute.errors import WindDataError
 from sailroute.geo import LocalFrame
@@ -20,6 +19,7 @@ from sailroute.wind.rotation import (
     rotate_clockwise,
     rotation_from_cone,
 )
+from tests.conftest import WIND_DATA
 
 SALEM = WIND_DATA / "salem_lambert_crop.nc"
 

@@ -8,7 +8,6 @@ from datetime import datetime
 
 import numpy as np
 import pytest
-from wind_testpaths import WIND_DATA
 
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
@@ -21,6 +20,7 @@ from sailroute.wind.stations import (
     read_stations,
     resample_stations,
 )
+from tests.conftest import WIND_DATA
 
 COACH = WIND_DATA / "coach_wind_1hz_excerpt.csv"
 NDBC_CSV = WIND_DATA / "ndbc_41008_excerpt.csv"

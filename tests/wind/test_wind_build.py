@@ -7,7 +7,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import T0
-from wind_testpaths import ROOT, WIND_DATA
 
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
@@ -17,6 +16,7 @@ from sailroute.wind.build import wind_from_spec
 from sailroute.wind.grid import GridWind
 from sailroute.wind.stations import StationWind
 from sailroute.wind.uniform import UniformWind
+from tests.conftest import ROOT, WIND_DATA
 
 WHERE = "courses/x.yaml: scenarios.wrf10[0]"
 

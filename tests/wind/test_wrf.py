@@ -11,7 +11,6 @@ import netCDF4
 import numpy as np
 import pytest
 from conftest import T0, constant_wind, power_profile
-from wind_testpaths import SHARED_REAL, WIND_DATA, requires_shared
 
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
@@ -26,6 +25,7 @@ from sailroute.wind.wrf import (
     read_wrf,
     read_wrf_header,
 )
+from tests.conftest import SHARED_REAL, WIND_DATA, requires_shared
 
 CI = WIND_DATA / "wrfpython_ci_crop.nc"
 CI_REF = WIND_DATA / "wrfpython_ci_result_crop.nc"
@@ -104,8 +104,7 @@ def test_salem_model_level_height_correction_is_sane() -> None:
     ["ligurian_sea_2014-10-07T12-00-00_area_strong_wind_conv.nc",
      "ligurian_sea_2014-10-07T12-00-00_area_domain.nc"],
 )
-@requires_shared[0]
-@requires_shared[1]
+@requires_shared
 def test_ligurian_file_is_rejected_naming_missing_variables(name: str) -> None:
     """Post-processed WRF (lon/lat/u10/v10, no Times): not wrfout, rejected cleanly.
 
