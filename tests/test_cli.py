@@ -176,3 +176,13 @@ def test_installed_console_script_runs_the_readme_example(tmp_path):
                          text=True)
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
     assert bad.stderr.startswith("error: missing.yaml: course file not found")
+
+
+def test_out_that_is_a_file_exits_2_with_a_message(tmp_path):
+    taken = tmp_path / "taken"
+    taken.write_text("not a folder")
+    res = invoke("plan", str(COURSES / "windward-leeward-template.yaml"), "--no-plots", "-q",
+                 "--out", str(taken))
+    assert res.exit_code == 2
+    assert f"--out: cannot create the output folder {str(taken)!r} (a file of that name " \
+           "exists); choose another folder with --out" in res.output

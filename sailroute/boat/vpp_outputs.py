@@ -25,6 +25,7 @@ from sailroute.boat.laser import (
 )
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.outdir import make_out_dir
 from sailroute.units import speed_factor
 
 DEFAULT_TWS: Final = {
@@ -180,11 +181,7 @@ def write_outputs(
     polar: Polar, params: LaserParams, out_dir: str | Path, stem: str, unit: str = "kn"
 ) -> dict[str, Path]:
     """Write ``<stem>.pol``, ``.csv``, ``.json`` (with the parameters) and ``.png``."""
-    d = Path(out_dir)
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"--out: cannot create folder {str(d)!r} ({exc})") from None
+    d = make_out_dir(out_dir)
     extra: dict[str, Any] = {
         "tws_reference": "true wind at the sail's centre-of-effort height",
         "vpp_params": _jsonable(asdict(params)),

@@ -25,6 +25,7 @@ import numpy as np
 
 from sailroute import __version__
 from sailroute.course.model import Course
+from sailroute.outdir import make_out_dir
 from sailroute.report.plan import Comparison, Plan, percent_error
 from sailroute.timeutil import iso
 from sailroute.units import KNOT
@@ -280,8 +281,7 @@ def write_comparison(out_dir: str | Path, cmp: Comparison) -> tuple[Path, Path]:
     ``label``, ``scenario``, ``time_s``, then ``<ref>_s`` and ``<ref>_error_pct``
     for every shared reference.
     """
-    d = Path(out_dir)
-    d.mkdir(parents=True, exist_ok=True)
+    d = make_out_dir(out_dir)
     jp = d / "comparison.json"
     jp.write_text(json.dumps(comparison_to_dict(cmp), indent=2, ensure_ascii=False) + "\n",
                   encoding="utf-8")
@@ -333,8 +333,7 @@ def write_plan_outputs(
     mapping of str to Path
         ``{"plan": ..., "track": ..., "gpx": ..., "png": ...}``.
     """
-    d = Path(out_dir)
-    d.mkdir(parents=True, exist_ok=True)
+    d = make_out_dir(out_dir)
     out = {
         "plan": write_plan_json(d / "plan.json", plan),
         "track": write_track_csv(d / "track.csv", plan),

@@ -18,6 +18,7 @@ import numpy as np
 
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.outdir import make_out_dir
 from sailroute.parallel import TaskRunner, check_scheduler, open_runner
 from sailroute.strategy.deadline import (
     DeadlineGrid,
@@ -366,11 +367,7 @@ def write_outputs(result: StrategyResult, out_dir: str | Path, plots: bool = Tru
     """
     from sailroute.strategy import report
 
-    out = Path(out_dir)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"{out}: cannot create the output directory ({exc})") from None
+    out = make_out_dir(out_dir)
     written = [report.write_json(result.summary, out / "summary.json")]
     if not plots:
         return written
