@@ -635,18 +635,18 @@ def _scenarios(c: _Checker, raw: Any, n_legs: int | None) -> dict[str, ScenarioS
 
 
 # ----------------------------------------------------------------------------- template
-_NUM = "number"
+_DIR = "direction"  # a compass direction, [0, 360] deg (nomenclature)
 _POS = "positive"
 _NONNEG = "nonnegative"
 _TEMPLATE_KEYS: dict[str, dict[str, Any]] = {
     "windward-leeward": {
-        "twd_deg": _NUM, "leg_length_m": _POS, "laps": "int", "gate_width_m": _POS,
+        "twd_deg": _DIR, "leg_length_m": _POS, "laps": "int", "gate_width_m": _POS,
         "start_line_length_m": _POS, "start_offset_m": _NONNEG,
         "finish": ("leeward", "windward"), "finish_line_length_m": _POS,
         "finish_offset_m": _NONNEG,
     },
     "trapezoid": {
-        "twd_deg": _NUM, "leg_length_m": _POS, "laps": "int", "loop": ("inner", "outer"),
+        "twd_deg": _DIR, "leg_length_m": _POS, "laps": "int", "loop": ("inner", "outer"),
         "reach_angle_deg": _POS, "reach_length_m": _POS, "gate_width_m": _POS,
         "start_line_length_m": _POS, "start_offset_m": _NONNEG, "finish_line_length_m": _POS,
         "finish_reach_m": _POS,
@@ -672,8 +672,8 @@ def _template(
     for key, rule in spec.items():
         if key not in raw:
             continue
-        if rule == _NUM:
-            v = c.number(raw, key, "template")
+        if rule == _DIR:
+            v = c.number(raw, key, "template", lo=0.0, hi=360.0)
         elif rule == _POS:
             v = c.number(raw, key, "template", lo=0.0, lo_open=True)
         elif rule == _NONNEG:

@@ -177,7 +177,7 @@ def _build_uniform(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> 
     table = spec.get("table")
     if table is None:
         tws = _speed(chk, spec, required=True)
-        twd = chk.number(spec, "twd_deg")
+        twd = chk.number(spec, "twd_deg", lo=0.0, hi=360.0)
         chk.raise_if_any()
         return UniformWind(tws, twd, clamp=clamp)
     for key in ("tws_kn", "tws_ms", "twd_deg"):
@@ -204,7 +204,7 @@ def _build_uniform(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> 
             except InputError as exc:
                 rchk.problems.append(str(exc))
         s = _speed(rchk, row, required=True)
-        d = rchk.number(row, "twd_deg")
+        d = rchk.number(row, "twd_deg", lo=0.0, hi=360.0)
         if t is not None and s is not None and d is not None:
             times.append(t)
             speeds.append(s)

@@ -314,6 +314,15 @@ def test_template_problems(tmp_path):
     assert "template.leg_length_m: expected a number > 0; got -5" in msg
     assert "template.loop: expected one of 'inner', 'outer'; got 'middle'" in msg
     assert "template.centre: positions in {x, y} metres need `origin: {lat, lon}`" in msg
+    text = head + textwrap.dedent("""\
+        template:
+          type: windward-leeward
+          centre: {lat: 45.0, lon: 13.0}
+          twd_deg: 2700
+          leg_length_m: 800
+        """) + tail  # a typo for 270 must not become a 180 deg course axis
+    assert "template.twd_deg: expected a number in [0, 360]; got 2700" in problems(
+        write(tmp_path, text))
 
 
 def test_template_course_loads(tmp_path):

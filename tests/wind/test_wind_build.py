@@ -52,6 +52,18 @@ def test_every_problem_listed_with_its_key_path() -> None:
         build({"type": "grib"})
 
 
+def test_wind_direction_outside_the_compass_is_an_error() -> None:
+    # directions are [0, 360] (docs/nomenclature.md); 2700 for 270 is a typo, not 180
+    with pytest.raises(InputError, match=r"wrf10\[0\].twd_deg: expected a number in \[0, 360\]"):
+        build({"type": "uniform", "tws_kn": 10, "twd_deg": 2700})
+    with pytest.raises(InputError, match=r"table\[1\].twd_deg: expected a number in \[0, 360\]"):
+        build({"type": "uniform", "table": [
+            {"time": "2018-04-24T12:00:00+02:00", "tws_ms": 5.0, "twd_deg": 100},
+            {"time": "2018-04-24T12:30:00+02:00", "tws_ms": 5.0, "twd_deg": -10}]})
+    f = build({"type": "uniform", "tws_kn": 10, "twd_deg": 360})  # north, both ways
+    assert float(wind_speed_direction(*f.sample(0.0, 0.0, 0.0))[1]) % 360.0 == pytest.approx(0.0)
+
+
 def test_the_briefs_example_message(tiny_wrf, tmp_path) -> None:
     path = tiny_wrf()
     with pytest.raises(InputError) as e:
