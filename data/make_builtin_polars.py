@@ -2,7 +2,8 @@
 
 Usage::
 
-    python data/make_builtin_polars.py            # writes ilca4.pol, ilca6.pol, ilca7.pol
+    python data/make_builtin_polars.py            # writes ilca{4,6,7}.pol (race) and
+                                                  # ilca{4,6,7}-steady.pol (steady VPP)
     python data/make_builtin_polars.py --check    # exit 1 if a shipped file is stale
 
 The grid is :data:`sailroute.boat.build.BUILTIN_TWS_KN` (1-28 kn at the sail's
@@ -20,7 +21,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from sailroute.boat.build import BUILTIN_DECIMALS, vpp_polar
+from sailroute.boat.build import BUILTIN_DECIMALS, builtin_kind, builtin_names, vpp_polar
 from sailroute.boat.io import write_pol
 from sailroute.boat.laser import CLASSES
 
@@ -28,8 +29,9 @@ DATA = Path(__file__).resolve().parents[1] / "sailroute" / "boat" / "data"
 
 
 def render(name: str) -> str:
-    """Text of the shipped ``.pol`` file for class ``name``."""
-    polar = vpp_polar(CLASSES[name])
+    """Text of the shipped ``.pol`` file of the built-in boat ``name``."""
+    cls, kinetics = builtin_kind(name)
+    polar = vpp_polar(CLASSES[cls], kinetics=kinetics)
     with tempfile.TemporaryDirectory() as tmp:
         path = write_pol(polar, Path(tmp) / f"{name}.pol", unit="kn", decimals=BUILTIN_DECIMALS)
         return path.read_text(encoding="utf-8")
@@ -41,7 +43,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--check", action="store_true", help="only compare, do not write")
     args = ap.parse_args(argv)
     stale = []
-    for name in sorted(CLASSES):
+    for name in builtin_names():
         text = render(name)
         target = DATA / f"{name}.pol"
         if args.check:

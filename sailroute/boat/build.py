@@ -2,12 +2,17 @@
 
 A course file's ``boat`` value takes one of three forms::
 
-    boat: {builtin: ilca7}                       # shipped VPP polar (default boat)
+    boat: {builtin: ilca7}                       # shipped race polar (default boat)
+    boat: {builtin: ilca7-steady}                # shipped steady VPP polar
     boat: {polar: polars/mine.pol, speed_unit: kn, wind_unit: kn}
-    boat: {vpp: {class: ilca7, crew_mass_kg: 75}}  # run the VPP at load time
+    boat: {vpp: {class: ilca7, crew_mass_kg: 75}, kinetics: race}  # VPP at load time
 
-``polar`` paths are relative to the course file's folder.  Optional key in
-every form: ``interpolation`` (``pchip``, the default, or ``linear``).
+The built-in ``ilca7``, ``ilca6`` and ``ilca4`` are race polars (the steady VPP
+plus wave riding and pumping, :mod:`sailroute.boat.kinetics`); ``<class>-steady``
+are the steady VPP alone.  ``kinetics`` (``race``, the default, or ``steady``)
+picks the same for the ``vpp`` form.  ``polar`` paths are relative to the course
+file's folder.  Optional key in every form: ``interpolation`` (``pchip``, the
+default, or ``linear``).
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ from typing import Any, Final
 import numpy as np
 
 from sailroute.boat.io import read_polar
+from sailroute.boat.kinetics import RACE, STEADY, Kinetics, race_polar
 from sailroute.boat.laser import CLASSES, LaserParams, params_from_mapping
 from sailroute.boat.polar import INTERPOLATIONS, Polar
 from sailroute.errors import InputError, format_problems
@@ -39,22 +45,37 @@ _COMMON: Final = ("interpolation",)
 _ALLOWED: Final = {
     "builtin": {"builtin", *_COMMON},
     "polar": {"polar", "speed_unit", "wind_unit", "format", *_COMMON},
-    "vpp": {"vpp", *_COMMON},
+    "vpp": {"vpp", "kinetics", *_COMMON},
 }
+STEADY_SUFFIX: Final = "-steady"
+"""Suffix of the built-in names of the steady VPP polars (``ilca7-steady``)."""
+KINETICS: Final = ("race", "steady")
+"""Values of the ``kinetics`` key of a ``vpp`` boat."""
 
 
 def builtin_names() -> tuple[str, ...]:
-    """Names of the shipped polars (``ilca4``, ``ilca6``, ``ilca7``)."""
-    return tuple(sorted(CLASSES))
+    """Names of the shipped polars: ``ilca4``, ``ilca6``, ``ilca7`` (race) and the
+    same with ``-steady`` (steady VPP)."""
+    return tuple(sorted([*CLASSES, *(c + STEADY_SUFFIX for c in CLASSES)]))
+
+
+def builtin_kind(name: str) -> tuple[str, Kinetics]:
+    """Class and race model of a built-in name: ``"ilca7-steady"`` -> ``("ilca7", STEADY)``."""
+    if name.endswith(STEADY_SUFFIX):
+        return name[: -len(STEADY_SUFFIX)], STEADY
+    return name, RACE
 
 
 def builtin_polar(name: str = "ilca7", interpolation: str = "pchip") -> Polar:
-    """Shipped VPP polar of an ILCA class (cached).
+    """Shipped polar of an ILCA class (cached).
 
     Parameters
     ----------
-    name : {"ilca7", "ilca6", "ilca4"}
-        Class; ``ilca7`` (standard rig, 80 kg sailor) is the default boat.
+    name : str
+        ``ilca7`` (standard rig, 80 kg sailor: the default boat), ``ilca6`` or
+        ``ilca4``: race polars (steady VPP plus wave riding and pumping, see
+        :mod:`sailroute.boat.kinetics`); ``ilca7-steady``, ``ilca6-steady``,
+        ``ilca4-steady``: the steady VPP alone.
     interpolation : {"pchip", "linear"}
         Interpolation method.
 
@@ -70,7 +91,7 @@ def builtin_polar(name: str = "ilca7", interpolation: str = "pchip") -> Polar:
         Unknown name.
     """
     key = name.lower() if isinstance(name, str) else name
-    if key not in CLASSES:
+    if key not in builtin_names():
         raise InputError(
             f"unknown built-in boat {name!r}; expected one of "
             + ", ".join(map(repr, builtin_names()))
@@ -83,7 +104,8 @@ def _builtin(key: str, interpolation: str) -> Polar:
     ref = resources.files("sailroute.boat").joinpath("data", f"{key}.pol")
     with resources.as_file(ref) as path:
         polar = read_polar(path, speed_unit="kn", wind_unit="kn", interpolation=interpolation)
-    return polar.with_name(CLASSES[key].name)
+    cls, kinetics = builtin_kind(key)
+    return polar.with_name(CLASSES[cls].name + (" steady" if kinetics == STEADY else ""))
 
 
 @lru_cache(maxsize=32)
@@ -92,6 +114,7 @@ def vpp_polar(
     tws_ms: tuple[float, ...] | None = None,
     twa_deg: tuple[float, ...] | None = None,
     interpolation: str = "pchip",
+    kinetics: Kinetics = STEADY,
 ) -> Polar:
     """Run the VPP on a grid (default: the built-in grid) and return its polar (cached).
 
@@ -105,14 +128,15 @@ def vpp_polar(
         TWA rows [°]; default :data:`BUILTIN_TWA_DEG`.
     interpolation : {"pchip", "linear"}
         Interpolation method.
+    kinetics : Kinetics
+        :data:`~sailroute.boat.kinetics.STEADY` (default: the steady VPP) or a race
+        model such as :data:`~sailroute.boat.kinetics.RACE`.
     """
-    from sailroute.boat.vpp import solve_polar
-
     tws = np.asarray(tws_ms if tws_ms is not None else BUILTIN_TWS_KN, dtype=float)
     if tws_ms is None:
         tws = tws * KNOT
     twa = np.asarray(twa_deg if twa_deg is not None else BUILTIN_TWA_DEG, dtype=float)
-    return solve_polar(params, tws, twa, interpolation=interpolation)
+    return race_polar(params, tws, twa, kinetics, interpolation=interpolation)
 
 
 def boat_from_spec(
@@ -172,7 +196,7 @@ def boat_from_spec(
         )
     if form == "builtin":
         name = spec["builtin"]
-        if not isinstance(name, str) or name.lower() not in CLASSES:
+        if not isinstance(name, str) or name.lower() not in builtin_names():
             problems.append(
                 f"{key}.builtin: expected one of {', '.join(map(repr, builtin_names()))}; "
                 f"got {name!r}"
@@ -209,6 +233,10 @@ def boat_from_spec(
             interpolation=interpolation,
         )
     # vpp
+    kinetics = spec.get("kinetics", "race")
+    if kinetics not in KINETICS:
+        problems.append(f"{key}.kinetics: expected one of {', '.join(map(repr, KINETICS))}; "
+                        f"got {kinetics!r}")
     vspec = spec["vpp"]
     if vspec is None:
         vspec = {}
@@ -223,7 +251,8 @@ def boat_from_spec(
             lines[0][len(where) + 2:]]
         problems.extend(extra)
     _raise(where, problems)
-    return vpp_polar(params, interpolation=interpolation)
+    return vpp_polar(params, interpolation=interpolation,
+                     kinetics=RACE if kinetics == "race" else STEADY)
 
 
 def _raise(where: str, problems: list[str]) -> None:

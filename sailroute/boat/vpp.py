@@ -34,6 +34,7 @@ documented with their equations in ``docs/vpp.md``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import cache, lru_cache
 from importlib import resources
@@ -57,6 +58,9 @@ _ROOT_TOL: Final = 1e-10
 _G_TOL: Final = 1e-9
 _MAX_ROOT_ITER: Final = 60
 _V_MIN: Final = 0.02
+
+Thrust = Callable[[NDArray, NDArray, NDArray], NDArray]
+"""Extra forward force [N] as a function of (TWS [m s⁻¹], TWA [°], V [m s⁻¹])."""
 
 # --- coefficient tables ------------------------------------------------------------
 
@@ -601,7 +605,9 @@ def _surplus_at(p: LaserParams, tws: NDArray, twa: NDArray, v: NDArray) -> tuple
     return s, x, t, over, heel, ctx
 
 
-def solve_point(params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike) -> PointSolution:
+def solve_point(
+    params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike, thrust: Thrust | None = None
+) -> PointSolution:
     """Steady-state speed and sail setting at each (TWS, TWA).
 
     Parameters
@@ -612,6 +618,10 @@ def solve_point(params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike) -> P
         True wind speed at the centre-of-effort height [m s⁻¹], ``>= 0``.
     twa_deg : array_like
         True wind angle [°], any sign (folded to 0-180); broadcast with ``tws_ms``.
+    thrust : callable, optional
+        Extra forward force [N] ``thrust(tws_ms, twa_deg, v_ms)`` added to the surge
+        balance (the race model's kinetics, :mod:`sailroute.boat.kinetics`); the
+        force fields of the result stay those of the sail and hull alone.
 
     Returns
     -------
@@ -628,7 +638,7 @@ def solve_point(params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike) -> P
         raise InputError("VPP parameters: " + "; ".join(problems))
     if params.kite_area_m2 > 0:
         # two sail sets: main + jib and main + kite; keep the faster at each point
-        upwind = _solve_point(replace(params, kite_area_m2=0.0), tws_ms, twa_deg)
+        upwind = _solve_point(replace(params, kite_area_m2=0.0), tws_ms, twa_deg, thrust)
         kite = _solve_point(
             replace(
                 params,
@@ -639,15 +649,18 @@ def solve_point(params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike) -> P
             ),
             tws_ms,
             twa_deg,
+            thrust,
         )
         use = kite.speed_ms > upwind.speed_ms
         return PointSolution(
             **{k: np.where(use, getattr(kite, k), getattr(upwind, k)) for k in upwind.__dict__}
         )
-    return _solve_point(params, tws_ms, twa_deg)
+    return _solve_point(params, tws_ms, twa_deg, thrust)
 
 
-def _solve_point(params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike) -> PointSolution:
+def _solve_point(
+    params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike, thrust: Thrust | None = None
+) -> PointSolution:
     tws_b, twa_b = np.broadcast_arrays(
         np.asarray(tws_ms, dtype=float), np.asarray(twa_deg, dtype=float)
     )
@@ -661,7 +674,7 @@ def _solve_point(params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike) -> 
     active = (tws > 0) & (twa > 0)
     idx = np.flatnonzero(active)
     if idx.size:
-        speed[idx] = _solve_speed(params, tws[idx], twa[idx])
+        speed[idx] = _solve_speed(params, tws[idx], twa[idx], thrust)
     # final state at the solution
     moving = speed > 0
     v = np.where(moving, speed, _V_MIN)
@@ -688,23 +701,26 @@ def _solve_point(params: LaserParams, tws_ms: ArrayLike, twa_deg: ArrayLike) -> 
     return PointSolution(**{k: np.reshape(getattr(res, k), shape) for k in res.__dict__})
 
 
-def _solve_speed(p: LaserParams, tws: NDArray, twa: NDArray) -> NDArray:
-    """Largest root of g(V) for each point (0 if g < 0 everywhere)."""
+def _solve_speed(
+    p: LaserParams, tws: NDArray, twa: NDArray, thrust: Thrust | None = None
+) -> NDArray:
+    """Largest root of g(V) (+ ``thrust(tws, twa, V)`` if given) per point (0 if none)."""
+
+    def surplus(t: NDArray, a: NDArray, v: NDArray) -> NDArray:
+        s = _surplus_at(p, t, a, v)[0]
+        return s if thrust is None else s + thrust(t, a, v)
+
     n = tws.size
     vmax = 1.5 * tws + 1.0
     for _ in range(4):  # make sure g(vmax) < 0
-        g_top = _surplus_at(p, tws, twa, vmax)[0]
+        g_top = surplus(tws, twa, vmax)
         if not np.any(g_top >= 0):
             break
         vmax = np.where(g_top >= 0, 2.0 * vmax, vmax)
     frac = (np.arange(1, _N_SCAN + 1) / _N_SCAN) ** 1.5
     grid = _V_MIN + (vmax[:, None] - _V_MIN) * frac[None, :]  # (n, K), increasing
-    g = _surplus_at(
-        p,
-        np.repeat(tws, _N_SCAN),
-        np.repeat(twa, _N_SCAN),
-        grid.ravel(),
-    )[0].reshape(n, _N_SCAN)
+    g = surplus(np.repeat(tws, _N_SCAN), np.repeat(twa, _N_SCAN), grid.ravel()).reshape(
+        n, _N_SCAN)
     pos = g >= 0
     has = pos.any(axis=1)
     # last grid point with g >= 0; the root lies between it and the next point
@@ -726,8 +742,8 @@ def _solve_speed(p: LaserParams, tws: NDArray, twa: NDArray) -> NDArray:
         a = grid[miss, np.maximum(k - 1, 0)]
         b = grid[miss, np.minimum(k + 1, _N_SCAN - 1)]
         tm, am = tws[miss], twa[miss]
-        peak = _golden_max(lambda v: _surplus_at(p, tm, am, v)[0], a, b, _N_GOLDEN_FLAT)
-        g_peak = _surplus_at(p, tm, am, peak)[0]
+        peak = _golden_max(lambda v: surplus(tm, am, v), a, b, _N_GOLDEN_FLAT)
+        g_peak = surplus(tm, am, peak)
         found = g_peak >= 0
         has[miss[found]] = True
         last[miss[found]] = k[found]
@@ -751,7 +767,7 @@ def _solve_speed(p: LaserParams, tws: NDArray, twa: NDArray) -> NDArray:
         aa, bb, ga_, gb_ = a[act], b[act], ga[act], gb[act]
         c = np.where(ga_ != gb_, (aa * gb_ - bb * ga_) / (gb_ - ga_), 0.5 * (aa + bb))
         c = np.clip(c, np.minimum(aa, bb), np.maximum(aa, bb))
-        gc = _surplus_at(p, ts[act], ta[act], c)[0]
+        gc = surplus(ts[act], ta[act], c)
         pos_c = gc >= 0
         # Illinois: halve the retained end's value when the same end is kept twice
         a[act] = np.where(pos_c, c, aa)
@@ -776,6 +792,7 @@ def solve_polar(
     *,
     name: str | None = None,
     interpolation: str = "pchip",
+    thrust: Thrust | None = None,
 ) -> Polar:
     """Polar of the boat on a (TWA, TWS) grid.
 
@@ -791,6 +808,8 @@ def solve_polar(
         Polar name (default ``params.name``).
     interpolation : {"pchip", "linear"}
         Interpolation method of the result.
+    thrust : callable, optional
+        Extra forward force [N], see :func:`solve_point`.
 
     Returns
     -------
@@ -799,5 +818,5 @@ def solve_polar(
     """
     tws = np.asarray(tws_ms, dtype=float)
     twa = np.asarray(twa_deg, dtype=float)
-    sol = solve_point(params, tws[None, :], twa[:, None])
+    sol = solve_point(params, tws[None, :], twa[:, None], thrust)
     return Polar(twa, tws, sol.speed_ms, name=name or params.name, interpolation=interpolation)

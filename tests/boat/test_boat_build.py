@@ -12,11 +12,13 @@ from sailroute.boat.build import (
     BUILTIN_TWA_DEG,
     BUILTIN_TWS_KN,
     boat_from_spec,
+    builtin_kind,
     builtin_names,
     builtin_polar,
     vpp_polar,
 )
 from sailroute.boat.io import write_pol
+from sailroute.boat.kinetics import RACE, STEADY, Kinetics
 from sailroute.boat.laser import CLASSES
 from sailroute.errors import InputError
 from sailroute.units import KNOT
@@ -25,7 +27,8 @@ from tests.conftest import ROOT
 
 def check_shipped(name: str) -> None:
     shipped = builtin_polar(name)
-    fresh = vpp_polar(CLASSES[name])
+    cls, kinetics = builtin_kind(name)
+    fresh = vpp_polar(CLASSES[cls], kinetics=kinetics)
     np.testing.assert_array_equal(shipped.twa_deg, BUILTIN_TWA_DEG)
     np.testing.assert_allclose(shipped.tws_ms / KNOT, BUILTIN_TWS_KN, rtol=1e-15)
     # the file holds knots rounded to BUILTIN_DECIMALS: equal to half a unit of the last digit
@@ -33,29 +36,35 @@ def check_shipped(name: str) -> None:
     np.testing.assert_allclose(shipped.speed_ms, fresh.speed_ms, rtol=0, atol=tol)
 
 
-def test_shipped_ilca7_equals_a_fresh_vpp_run() -> None:
-    check_shipped("ilca7")
+@pytest.mark.parametrize("name", ["ilca7", "ilca7-steady"])
+def test_shipped_ilca7_equals_a_fresh_vpp_run(name: str) -> None:
+    check_shipped(name)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["ilca6", "ilca4"])
+@pytest.mark.parametrize("name", ["ilca6", "ilca4", "ilca6-steady", "ilca4-steady"])
 def test_shipped_other_classes_equal_fresh_vpp_runs(name: str) -> None:
     check_shipped(name)
 
 
-def test_shipped_file_text_is_what_the_script_writes(tmp_path: Path) -> None:
-    # byte-level: the regeneration script's writer reproduces the shipped ilca7.pol
-    text = write_pol(vpp_polar(CLASSES["ilca7"]), tmp_path / "x.pol", unit="kn",
-                     decimals=BUILTIN_DECIMALS).read_text()
-    assert text == (ROOT / "sailroute" / "boat" / "data" / "ilca7.pol").read_text()
+@pytest.mark.parametrize(("name", "kinetics"), [("ilca7", RACE), ("ilca7-steady", STEADY)])
+def test_shipped_file_text_is_what_the_script_writes(
+    tmp_path: Path, name: str, kinetics: Kinetics
+) -> None:
+    # byte-level: the regeneration script's writer reproduces the shipped files
+    text = write_pol(vpp_polar(CLASSES["ilca7"], kinetics=kinetics), tmp_path / "x.pol",
+                     unit="kn", decimals=BUILTIN_DECIMALS).read_text()
+    assert text == (ROOT / "sailroute" / "boat" / "data" / f"{name}.pol").read_text()
 
 
 def test_builtin_polar_is_cached_and_named() -> None:
-    assert builtin_names() == ("ilca4", "ilca6", "ilca7")
+    assert builtin_names() == ("ilca4", "ilca4-steady", "ilca6", "ilca6-steady", "ilca7",
+                               "ilca7-steady")
     a = builtin_polar()
     assert a is builtin_polar("ilca7")
     assert a.name == "ILCA 7" and a.interpolation == "pchip"
     assert builtin_polar("ILCA6").name == "ILCA 6"
+    assert builtin_polar("ilca7-steady").name == "ILCA 7 steady"
     assert builtin_polar("ilca7", "linear").interpolation == "linear"
     with pytest.raises(InputError, match="unknown built-in boat 'ilca8'; expected one of"):
         builtin_polar("ilca8")
@@ -87,7 +96,8 @@ def test_spec_builtin_polar_and_vpp(tmp_path: Path) -> None:
     ("spec", "message"),
     [
         ({"builtin": "ilca8"},
-         "courses/x.yaml: boat.builtin: expected one of 'ilca4', 'ilca6', 'ilca7'; got 'ilca8'"),
+         "courses/x.yaml: boat.builtin: expected one of 'ilca4', 'ilca4-steady', 'ilca6', "
+         "'ilca6-steady', 'ilca7', 'ilca7-steady'; got 'ilca8'"),
         ({"builtin": "ilca7", "polar": "a.pol"},
          "courses/x.yaml: boat: give exactly one of 'builtin', 'polar' or 'vpp'; "
          "got builtin, polar"),

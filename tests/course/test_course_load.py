@@ -374,7 +374,7 @@ def test_validate_specs_reports_boat_and_wind_problems_together(tmp_path):
         validate_specs(c)
     msg = str(ei.value)
     assert msg.startswith(f"{path}: ")
-    assert f"{path}:21: boat.builtin: expected one of 'ilca4', 'ilca6', 'ilca7'" in msg
+    assert f"{path}:21: boat.builtin: expected one of 'ilca4', 'ilca4-steady', 'ilca6'" in msg
     assert f"{path}:20: scenarios.bad.twd_degs: unknown key" in msg
     with pytest.raises(InputError, match=r"boat\.builtin"):
         validate_specs(c, ["north"])  # the boat is always checked

@@ -233,12 +233,12 @@ def test_dead_downwind_leg_is_L_over_vmg_plus_one_gybe():
 
 
 def test_ilca7_runs_dead_downwind_without_gybing():
-    # the shipped ILCA 7 polar at 5.61 m/s (the thesis's race wind): its best downwind
-    # VMG is at TWA 180°, so a run is one board, no gybe.  Bounds: the best straight
+    # the shipped steady ILCA 7 polar at 5.61 m/s (the thesis's race wind): its best
+    # downwind VMG is at TWA 180°, so a run is one board, no gybe.  Bounds: the best straight
     # line to any point of the rounding segment (= L / S(180), crossing at the mark)
     # and the straight line aimed 1 m inside it (0.01 m scan); measured 2e-3 s (5e-6)
     # above the latter (a few steps on the 180° grid heading, then the aim), so 1e-5.
-    ilca = builtin_polar("ilca7")
+    ilca = builtin_polar("ilca7-steady")
     tws, L = 5.61, 1000.0
     assert float(ilca.vmg_downwind(tws)[0]) == 180.0
     r = route_isochrone(Start((0.0, 0.0)), north_mark(-L, "port"), T0, UniformWind(tws, 0.0),
