@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/race_polar_validation.py [--boat ilca7] [--boat ilca7-steady]
+    python benchmarks/race_polar_validation.py [--boat ilca7] [--boat ilca7-steady] [--sensitivity]
 
 For each race it routes the course with the built-in boat in the race's reported
 wind (uniform) and compares with the observed leg times:
@@ -57,7 +57,20 @@ def snipe_observed(race: str) -> tuple[float, float]:
     return sum(runs) / len(runs), sum(beats) / len(beats)
 
 
-def snipe_course(race: str, boat: str) -> Course:
+VARIANTS = {
+    "race (defaults)": {},
+    "pump_efficiency 0.5": {"pump_efficiency": 0.5},
+    "pump_efficiency 0.87": {"pump_efficiency": 0.87},
+    "sea_age_h 2": {"sea_age_h": 2.0},
+    "sea_age_h 4": {"sea_age_h": 4.0},
+    "fetch_m 10 km": {"fetch_m": 10_000.0},
+    "upwind_efficiency 0.925 (P90)": {"upwind_efficiency": 0.925},
+    "upwind_efficiency 1 (none)": {"upwind_efficiency": 1.0},
+}
+"""Race-model variants for ``--sensitivity``: one parameter moved across its plausible range."""
+
+
+def snipe_course(race: str, boat: str | dict) -> Course:
     tws, lat, lon, _ = SNIPE[race]
     return course_from_mapping({
         "name": f"Snipe Valencia 2025 {race} (ILCA stand-in)",
@@ -68,16 +81,43 @@ def snipe_course(race: str, boat: str) -> Course:
                  {"to": "S1", "rounding": "port"},
                  {"to": "B1", "rounding": "port"},
                  {"to": "S1", "rounding": "port"}],
-        "boat": {"builtin": boat},
+        "boat": {"builtin": boat} if isinstance(boat, str) else boat,
         "routing": {"router": "isochrone", "tack_penalty_s": 5.0, "gybe_penalty_s": 5.0},
         "scenarios": {"reported": {"wind": {"type": "uniform", "tws_kn": tws, "twd_deg": 110}}},
     }, source=f"<snipe {race}>")
 
 
+def ratios(boat: dict) -> tuple[float, float, float, float]:
+    """Hyères total error vs the winner and the dn/up ratio errors (Hyères, P01, P02)."""
+    hy = dataclasses.replace(load_course("courses/hyeres-r1.yaml"), boat_spec=boat)
+    t = [leg.time_s for leg in plan_course(hy, "constant").plan.legs]
+    ref = hy.references["winner"]
+    out = [sum(t) / sum(ref) - 1,
+           (t[1] + t[3]) / (t[0] + t[2]) / ((ref[1] + ref[3]) / (ref[0] + ref[2])) - 1]
+    for race in SNIPE:
+        legs = [leg.time_s for leg in plan_course(snipe_course(race, boat)).plan.legs]
+        run_o, beat_o = snipe_observed(race)
+        out.append((legs[1] + legs[3]) / 2 / legs[2] / (run_o / beat_o) - 1)
+    return tuple(out)
+
+
+def sensitivity() -> None:
+    """Print the acceptance numbers for each race-model variant."""
+    print("| variant | Hyères total vs winner | Hyères dn/up | Snipe P01 dn/up | "
+          "Snipe P02 dn/up |")
+    print("|---|---|---|---|---|")
+    for name, kin in VARIANTS.items():
+        r = ratios({"vpp": {"class": "ilca7"}, "kinetics": kin or "race"})
+        print(f"| {name} | " + " | ".join(f"{x:+.1%}" for x in r) + " |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--boat", action="append", default=None)
-    boats = ap.parse_args().boat or ["ilca7", "ilca7-steady"]
+    ap.add_argument("--sensitivity", action="store_true",
+                    help="also move each race-model parameter across its range")
+    args = ap.parse_args()
+    boats = args.boat or ["ilca7", "ilca7-steady"]
     print("| boat | race | wind | model dn/up | observed dn/up | ratio error | model total | "
           "observed total | total error |")
     print("|---|---|---|---|---|---|---|---|---|")
@@ -100,6 +140,9 @@ def main() -> None:
                   f"{run_o / beat_o:.3f} | {run_m / beat_m / (run_o / beat_o) - 1:+.1%} | "
                   f"run {run_m:.0f} s, beat {beat_m:.0f} s | run {run_o:.0f} s, beat {beat_o:.0f} s"
                   f" | run {run_m / run_o - 1:+.1%}, beat {beat_m / beat_o - 1:+.1%} |")
+    if args.sensitivity:
+        print()
+        sensitivity()
 
 
 if __name__ == "__main__":

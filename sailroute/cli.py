@@ -165,13 +165,17 @@ def vpp_command(
     twa_step: Annotated[float, typer.Option("--twa-step", help="TWA row step in degrees.")] = 5.0,
     out: Annotated[str, typer.Option("--out", help="Output folder.")] = "vpp-out",
     unit: Annotated[str, typer.Option("--unit", help="Speed unit: kn or m/s.")] = "kn",
+    kinetics: Annotated[
+        str, typer.Option("--kinetics", help="steady: the VPP alone; race: with wave riding "
+                          "and pumping, as the built-in ilca7 (docs/vpp.md).")
+    ] = "steady",
 ) -> None:
     """Run the Laser/ILCA VPP: print the polar and best VMG, write .pol/.csv/.json/.png."""
     from sailroute.boat.vpp_outputs import run_vpp_command
 
     res = run_guarded(
         run_vpp_command, boat, crew_mass_kg=crew_mass, tws=tws, twa_step_deg=twa_step,
-        out_dir=out, unit=unit,
+        out_dir=out, unit=unit, kinetics=kinetics,
     )
     typer.echo(res.report)
     typer.echo("")
@@ -183,7 +187,8 @@ def vpp_command(
 def strategy_command(
     tws_kn: Annotated[float, typer.Option("--tws-kn", help="Wind speed, kn.")] = 10.0,
     polar: Annotated[
-        str, typer.Option("--polar", help="builtin:ilca7 | builtin:ilca6 | builtin:ilca4 | PATH.")
+        str, typer.Option("--polar", help="builtin:ilca7 | builtin:ilca6 | builtin:ilca4 "
+                          "(race polars; add -steady for the steady VPP) | PATH.")
     ] = "builtin:ilca7",
     length_m: Annotated[float, typer.Option("--length-m", help="Beat length, m.")] = 1600.0,
     half_width_m: Annotated[

@@ -9,8 +9,9 @@ A course file's ``boat`` value takes one of three forms::
 
 The built-in ``ilca7``, ``ilca6`` and ``ilca4`` are race polars (the steady VPP
 plus wave riding and pumping, :mod:`sailroute.boat.kinetics`); ``<class>-steady``
-are the steady VPP alone.  ``kinetics`` (``race``, the default, or ``steady``)
-picks the same for the ``vpp`` form.  ``polar`` paths are relative to the course
+are the steady VPP alone.  ``kinetics`` (``race``, the default, ``steady``, or a
+mapping of race-model parameters such as ``{sea_age_h: 6}``) picks the same for
+the ``vpp`` form.  ``polar`` paths are relative to the course
 file's folder.  Optional key in every form: ``interpolation`` (``pchip``, the
 default, or ``linear``).
 """
@@ -26,7 +27,7 @@ from typing import Any, Final
 import numpy as np
 
 from sailroute.boat.io import read_polar
-from sailroute.boat.kinetics import RACE, STEADY, Kinetics, race_polar
+from sailroute.boat.kinetics import RACE, STEADY, Kinetics, kinetics_from_spec, race_polar
 from sailroute.boat.laser import CLASSES, LaserParams, params_from_mapping
 from sailroute.boat.polar import INTERPOLATIONS, Polar
 from sailroute.errors import InputError, format_problems
@@ -49,8 +50,7 @@ _ALLOWED: Final = {
 }
 STEADY_SUFFIX: Final = "-steady"
 """Suffix of the built-in names of the steady VPP polars (``ilca7-steady``)."""
-KINETICS: Final = ("race", "steady")
-"""Values of the ``kinetics`` key of a ``vpp`` boat."""
+
 
 
 def builtin_names() -> tuple[str, ...]:
@@ -233,10 +233,8 @@ def boat_from_spec(
             interpolation=interpolation,
         )
     # vpp
-    kinetics = spec.get("kinetics", "race")
-    if kinetics not in KINETICS:
-        problems.append(f"{key}.kinetics: expected one of {', '.join(map(repr, KINETICS))}; "
-                        f"got {kinetics!r}")
+    kinetics, kproblems = kinetics_from_spec(spec.get("kinetics", "race"), f"{key}.kinetics")
+    problems.extend(kproblems)
     vspec = spec["vpp"]
     if vspec is None:
         vspec = {}
@@ -251,8 +249,7 @@ def boat_from_spec(
             lines[0][len(where) + 2:]]
         problems.extend(extra)
     _raise(where, problems)
-    return vpp_polar(params, interpolation=interpolation,
-                     kinetics=RACE if kinetics == "race" else STEADY)
+    return vpp_polar(params, interpolation=interpolation, kinetics=kinetics)
 
 
 def _raise(where: str, problems: list[str]) -> None:

@@ -45,7 +45,7 @@ none was fitted to a race.  :data:`RACE` is the default set.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields, replace
 from typing import Final
 
@@ -147,6 +147,60 @@ RACE: Final = Kinetics()
 STEADY: Final = Kinetics(fetch_m=0.0, sea_age_h=0.0, pump_power_w_per_kg=0.0,
                          upwind_efficiency=1.0)
 """No waves, no pumping: the race model reduces to the steady VPP."""
+
+
+def kinetics_from_spec(value: object, key: str = "kinetics") -> tuple[Kinetics, list[str]]:
+    """The race model a course file's ``kinetics`` value names, and its problems.
+
+    Parameters
+    ----------
+    value : {"race", "steady"} or mapping
+        ``race`` (:data:`RACE`), ``steady`` (:data:`STEADY`) or a mapping of
+        :class:`Kinetics` fields overriding :data:`RACE`, e.g. ``{sea_age_h: 6,
+        fetch_m: 8000}``.
+    key : str
+        Key path for messages.
+
+    Returns
+    -------
+    kinetics : Kinetics
+        :data:`RACE` where there are problems.
+    problems : list of str
+        ``"<key>.<field>: ..."`` messages (empty when valid).
+    """
+    if value == "race":
+        return RACE, []
+    if value == "steady":
+        return STEADY, []
+    if not isinstance(value, Mapping):
+        return RACE, [f"{key}: expected 'race', 'steady' or a mapping of race-model "
+                      f"parameters; got {value!r}"]
+    names = [f.name for f in fields(Kinetics)]
+    pairs = {f.name for f in fields(Kinetics) if isinstance(getattr(RACE, f.name), tuple)}
+    problems, given = [], {}
+    for k, v in value.items():
+        if k not in names:
+            problems.append(f"{key}.{k}: unknown key; allowed: " + ", ".join(map(repr, names)))
+        elif k in pairs:
+            if (not isinstance(v, list | tuple) or len(v) != 2
+                    or not all(_is_number(x) for x in v)):
+                problems.append(f"{key}.{k}: expected two numbers [from, to]; got {v!r}")
+            else:
+                given[k] = (float(v[0]), float(v[1]))
+        elif not _is_number(v):
+            problems.append(f"{key}.{k}: expected a number; got {v!r}")
+        else:
+            given[k] = float(v)
+    if problems:
+        return RACE, problems
+    try:
+        return replace(RACE, **given), []
+    except InputError as exc:
+        return RACE, [f"{key}: {str(exc).removeprefix('race kinetics: ')}"]
+
+
+def _is_number(x: object) -> bool:
+    return isinstance(x, int | float) and not isinstance(x, bool)
 
 
 def wind_sea(

@@ -16,6 +16,7 @@ import numpy as np
 
 from sailroute.boat.build import vpp_polar
 from sailroute.boat.io import write_pol, write_polar_csv, write_polar_json
+from sailroute.boat.kinetics import STEADY, Kinetics, kinetics_from_spec
 from sailroute.boat.laser import (
     CLASSES,
     CREW_MASS_RANGE_KG,
@@ -178,13 +179,15 @@ def plot_polar(polar: Polar, path: str | Path, unit: str = "kn") -> Path:
 
 
 def write_outputs(
-    polar: Polar, params: LaserParams, out_dir: str | Path, stem: str, unit: str = "kn"
+    polar: Polar, params: LaserParams, out_dir: str | Path, stem: str, unit: str = "kn",
+    kinetics: Kinetics = STEADY,
 ) -> dict[str, Path]:
     """Write ``<stem>.pol``, ``.csv``, ``.json`` (with the parameters) and ``.png``."""
     d = make_out_dir(out_dir)
     extra: dict[str, Any] = {
         "tws_reference": "true wind at the sail's centre-of-effort height",
         "vpp_params": _jsonable(asdict(params)),
+        "kinetics": "steady" if kinetics == STEADY else _jsonable(asdict(kinetics)),
     }
     return {
         "pol": write_pol(polar, d / f"{stem}.pol", unit=unit),
@@ -202,6 +205,7 @@ def run_vpp_command(
     twa_step_deg: float = 5.0,
     out_dir: str | Path = "vpp-out",
     unit: str = "kn",
+    kinetics: str = "steady",
 ) -> VppRun:
     """Everything ``sailroute vpp`` does, minus printing.
 
@@ -219,9 +223,14 @@ def run_vpp_command(
         Output folder (created).
     unit : {"kn", "m/s"}
         Unit of the printed table and the written files.
+    kinetics : {"steady", "race"}
+        ``steady``: the VPP alone; ``race``: with wave riding and pumping (the
+        model of the built-in ``ilca7``, :mod:`sailroute.boat.kinetics`).
     """
     if unit not in UNITS:
         raise InputError(f"--unit: expected one of 'kn', 'm/s'; got {unit!r}")
+    if kinetics not in ("steady", "race"):
+        raise InputError(f"--kinetics: expected one of 'steady', 'race'; got {kinetics!r}")
     if boat_file is None:
         params, stem = ILCA7, "ilca7"
     else:
@@ -235,8 +244,9 @@ def run_vpp_command(
         params = replace(params, crew_mass_kg=float(crew_mass_kg))
     tws_ms = (parse_speed_list(tws, unit) if tws is not None
               else tuple(v * speed_factor(unit) for v in DEFAULT_TWS[unit]))
-    polar = vpp_polar(params, tws_ms, twa_grid(twa_step_deg))
-    files = write_outputs(polar, params, out_dir, stem, unit)
+    kin = kinetics_from_spec(kinetics)[0]
+    polar = vpp_polar(params, tws_ms, twa_grid(twa_step_deg), kinetics=kin)
+    files = write_outputs(polar, params, out_dir, stem, unit, kin)
     return VppRun(params=params, polar=polar, report=polar_report(polar, unit), files=files)
 
 

@@ -186,3 +186,68 @@ def test_snipe_valencia_downwind_upwind_ratio_with_the_ilca_stand_in(race: str) 
     model = _dn_up(legs, [1, 3], [2])
     # measured +1.8 % (P01) and +8.7 % (P02); the steady VPP gave +48 % on both
     assert abs(model / (run_obs / beat_obs) - 1) < 0.15
+
+
+# --- the course's `kinetics` key and `sailroute vpp --kinetics` ----------------------------
+
+
+def test_vpp_boat_kinetics_key_race_steady_and_overrides(tmp_path) -> None:
+    from sailroute.boat.build import boat_from_spec, vpp_polar
+
+    def boat(kinetics: object) -> object:
+        spec = {"vpp": {"class": "ilca7"}}
+        if kinetics is not None:
+            spec["kinetics"] = kinetics
+        return boat_from_spec(spec, base_dir=tmp_path, where="c.yaml")
+
+    w = 5.61
+    race = vpp_polar(ILCA7, kinetics=RACE).speed_ms
+    np.testing.assert_array_equal(boat(None).speed_ms, race)  # race by default
+    np.testing.assert_array_equal(boat("race").speed_ms, race)
+    np.testing.assert_array_equal(boat("steady").speed_ms, vpp_polar(ILCA7).speed_ms)
+    # no waves (sea_age_h 0): a slower run, the same beat; an older sea (6 h) has higher but
+    # less steep waves (JONSWAP: H/L ∝ F^-1/6), so in this model a slightly slower run
+    calm, older, base = boat({"sea_age_h": 0}), boat({"sea_age_h": 6}), boat("race")
+    assert float(calm.speed(w, 180.0)) < float(older.speed(w, 180.0)) < float(
+        base.speed(w, 180.0))
+    assert float(calm.speed(w, 45.0)) == float(older.speed(w, 45.0)) == float(
+        base.speed(w, 45.0))
+
+
+@pytest.mark.parametrize(("value", "message"), [
+    ("fast", "c.yaml: boat.kinetics: expected 'race', 'steady' or a mapping"),
+    ({"sea_age": 3}, "boat.kinetics.sea_age: unknown key; allowed: 'fetch_m', 'sea_age_h'"),
+    ({"fetch_m": "far"}, "boat.kinetics.fetch_m: expected a number; got 'far'"),
+    ({"pump_twa_deg": [60]}, "boat.kinetics.pump_twa_deg: expected two numbers"),
+    ({"pump_efficiency": 2}, "boat.kinetics: pump_efficiency is a share, at most 1"),
+    ({"fetch_m": True}, "boat.kinetics.fetch_m: expected a number; got True"),
+])
+def test_vpp_boat_kinetics_key_errors(tmp_path, value: object, message: str) -> None:
+    from sailroute.boat.build import boat_from_spec
+
+    with pytest.raises(InputError) as exc:
+        boat_from_spec({"vpp": {"class": "ilca7"}, "kinetics": value}, base_dir=tmp_path,
+                       where="c.yaml")
+    assert message in str(exc.value)
+
+
+def test_cli_vpp_kinetics_race_writes_the_race_polar(tmp_path) -> None:
+    import json
+
+    from typer.testing import CliRunner
+
+    from sailroute.boat.build import vpp_polar
+    from sailroute.cli import app
+
+    res = CliRunner().invoke(app, ["vpp", "--kinetics", "race", "--tws", "2,6", "--unit", "m/s",
+                                   "--twa-step", "30", "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    doc = json.loads((tmp_path / "ilca7.json").read_text())
+    assert doc["kinetics"]["pump_efficiency"] == RACE.pump_efficiency
+    api = vpp_polar(ILCA7, (2.0, 6.0), tuple(range(0, 181, 30)), kinetics=RACE)
+    from sailroute.boat.io import read_polar
+
+    back = read_polar(tmp_path / "ilca7.csv")
+    np.testing.assert_allclose(back.speed_ms, api.speed_ms, atol=1e-4)
+    bad = CliRunner().invoke(app, ["vpp", "--kinetics", "fast", "--out", str(tmp_path / "x")])
+    assert bad.exit_code == 2 and "--kinetics: expected one of 'steady', 'race'" in bad.output
