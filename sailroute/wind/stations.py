@@ -71,6 +71,7 @@ DEFAULT_MISSING: Final = ("", "NA", "N/A", "NaN", "nan", "NAN", "null", "NULL", 
 """Cell values read as missing by default (add e.g. ``"999"`` for NDBC codes)."""
 
 _UNIT_SUFFIXES: Final = (("_m_s", "m/s"), ("_ms", "m/s"), ("_mps", "m/s"), ("_kn", "kn"),
+                         ("_km_h", "km/h"),
                          ("_kt", "kn"), ("_kts", "kn"), ("_knots", "kn"), ("_kmh", "km/h"),
                          ("_kph", "km/h"), ("_mph", "mph"))
 
@@ -177,7 +178,8 @@ def parse_offset(text: str, where: str = "timezone") -> timezone:
 
 
 def map_columns(
-    header: Sequence[str], columns: Mapping[str, str] | None = None, *, where: str = "CSV"
+    header: Sequence[str], columns: Mapping[str, str] | None = None, *, where: str = "CSV",
+    aliases: Mapping[str, Sequence[str]] = COLUMN_ALIASES,
 ) -> dict[str, int]:
     """Map canonical column names to indices of ``header``.
 
@@ -189,6 +191,9 @@ def map_columns(
         Explicit ``canonical -> file column`` mapping; takes precedence over aliases.
     where : str
         File name for messages.
+    aliases : mapping of str to sequence of str
+        Canonical name -> accepted lower-case headers (default: the station schema,
+        :data:`COLUMN_ALIASES`; the track reader passes its own).
 
     Returns
     -------
@@ -205,19 +210,19 @@ def map_columns(
     out: dict[str, int] = {}
     problems: list[str] = []
     for canon, col in (columns or {}).items():
-        if canon not in CANONICAL_COLUMNS:
+        if canon not in aliases:
             problems.append(f"columns.{canon}: unknown canonical column; expected one of "
-                            + ", ".join(CANONICAL_COLUMNS))
+                            + ", ".join(aliases))
             continue
         if not isinstance(col, str) or col.strip().lower() not in norm:
             problems.append(f"columns.{canon}: column {col!r} is not in the header "
                             f"({', '.join(h.strip() for h in header)})")
             continue
         out[canon] = norm.index(col.strip().lower())
-    for canon, aliases in COLUMN_ALIASES.items():
+    for canon, names in aliases.items():
         if canon in out:
             continue
-        hits = [k for k, h in enumerate(norm) if h in aliases and k not in out.values()]
+        hits = [k for k, h in enumerate(norm) if h in names and k not in out.values()]
         if len(hits) > 1:
             problems.append(
                 f"columns: {', '.join(header[k].strip() for k in hits)} could all be the "

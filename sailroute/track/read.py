@@ -1,0 +1,432 @@
+"""Read sailed tracks: GPX 1.0/1.1 and CSV logs (GPS watches, phones, instrument systems).
+
+:func:`read_track` is the one entry point; the format is chosen from the file's
+content (``<`` starts XML, otherwise CSV).
+
+GPX
+    Every ``<trkpt>`` of every ``<trk>`` and ``<trkseg>``, in any namespace (GPX 1.0
+    or 1.1); each needs ``lat``, ``lon`` and a ``<time>``.  Extensions (Garmin heart
+    rate, temperature) are ignored.
+CSV
+    ``,``, ``;`` or tab separated; lines starting with ``#`` are skipped.  Columns
+    are found from their headers (:data:`TRACK_ALIASES`, case-insensitive, after
+    removing a unit suffix such as ``_kn``, ``_km_h``, ``_deg``, ``_unk`` and a
+    trailing ``_1``) or named with ``columns={"time": ..., "lat": ..., "sog": ...}``.
+
+**Speed units.**  A speed column whose header carries a unit (``sog_kn``,
+``BOAT_SPEED_km_h_1``, ``speed_kmh``) is read in that unit; unsuffixed speed
+columns (``sog``, ``tws``) take ``speed_unit``, and without it the read fails
+asking for one: a wrong guess would scale every speed silently (the rule of the
+station reader, ``sailroute.wind.stations``).  A ``speed_unit`` that contradicts a
+header suffix is an error.
+
+**Times.**  ISO 8601 with an offset or ``Z``; ``YYYY-MM-DD HH:MM:SS:mmm`` (phone
+loggers) is read as ``.mmm``.  Naive times need ``time_zone`` (an offset such as
+``"-07:00"``, ``"UTC"``, or an IANA name such as ``"Europe/Madrid"``), unless the
+time column's header says UTC (``time_utc``, ``datetime_utc``).  Plain numbers are
+epoch seconds (or milliseconds when above 1e11).
+
+**Cleaning** (reported in ``Track.notes``): rows without a time or position are
+dropped, points are sorted by time, repeated timestamps keep their first point,
+and gaps longer than ``max(30 s, 10 × the median interval)`` are noted.  A track
+with fewer than two points left is an error.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+import re
+import xml.etree.ElementTree as ET
+from collections.abc import Mapping
+from datetime import UTC, datetime, tzinfo
+from pathlib import Path
+from typing import Final
+from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sailroute.errors import InputError
+from sailroute.timeutil import iso
+from sailroute.track.model import Track
+from sailroute.units import speed_factor
+from sailroute.wind.stations import DEFAULT_MISSING, map_columns, parse_offset, unit_from_header
+
+TRACK_ALIASES: Final[dict[str, tuple[str, ...]]] = {
+    "time": ("time", "datetime", "timestamp", "date_time", "time_utc", "datetime_utc", "utc",
+             "gps_time", "time_iso"),
+    "lat": ("lat", "latitude", "latitude_gps", "lat_gps", "gps_lat"),
+    "lon": ("lon", "lng", "long", "longitude", "longitude_gps", "lon_gps", "gps_lon"),
+    "sog": ("sog", "gps_sog", "speed", "speed_over_ground", "gps_speed"),
+    "cog": ("cog", "gps_cog", "course", "course_over_ground", "loc_orientation"),
+    "hdg": ("hdg", "heading", "heading_true", "hdg_true"),
+    "bsp": ("bsp", "boat_speed", "boatspeed", "stw", "speed_through_water"),
+    "tws": ("tws", "tws_sgp", "true_wind_speed"),
+    "twa": ("twa", "twa_sgp", "true_wind_angle"),
+    "twd": ("twd", "twd_sgp", "true_wind_direction"),
+    "aws": ("aws", "aws_sgp", "apparent_wind_speed"),
+    "awa": ("awa", "awa_sgp", "apparent_wind_angle"),
+}
+"""Canonical track column -> accepted header stems (lower case, unit suffix removed)."""
+
+SPEED_COLUMNS: Final = ("sog", "bsp", "tws", "aws")
+ANGLE_COLUMNS: Final = ("cog", "hdg", "twa", "twd", "awa")
+_SIGNED: Final = ("twa", "awa")
+
+_STRIP: Final = re.compile(r"(_\d+)?$")
+_UNIT_PART: Final = re.compile(
+    r"_(km_h|kmh|kph|kn|kt|kts|knots|m_s|ms|mps|mph|deg|degrees|unk)$")
+_PHONE_MS: Final = re.compile(r"^(.*\d{2}:\d{2}:\d{2}):(\d{1,3})$")
+
+GAP_MIN_S: Final = 30.0
+"""A jump in time longer than ``max(GAP_MIN_S, 10 × median interval)`` is reported [s]."""
+
+
+def header_stem(column: str) -> str:
+    """Lower-case header without a trailing ``_<digits>`` and unit suffix.
+
+    ``"TWS_SGP_km_h_1"`` -> ``"tws_sgp"``, ``"LATITUDE_GPS_unk"`` -> ``"latitude_gps"``.
+    """
+    c = _STRIP.sub("", column.strip().lower())
+    return _UNIT_PART.sub("", c)
+
+
+def header_unit(column: str) -> str | None:
+    """Speed unit of a header suffix (``BOAT_SPEED_km_h_1`` -> ``"km/h"``), or None."""
+    return unit_from_header(_STRIP.sub("", column.strip().lower()))
+
+
+def read_track(
+    path: str | Path,
+    *,
+    columns: Mapping[str, str] | None = None,
+    speed_unit: str | None = None,
+    time_zone: str | None = None,
+    name: str | None = None,
+) -> Track:
+    """Read a GPX or CSV track.
+
+    Parameters
+    ----------
+    path : str or Path
+        GPX (1.0/1.1) or CSV file.
+    columns : mapping, optional
+        CSV only: ``canonical -> file column`` for headers the aliases do not know
+        (canonical names: ``time``, ``lat``, ``lon``, ``sog``, ``cog``, ``hdg``,
+        ``bsp``, ``tws``, ``twa``, ``twd``, ``aws``, ``awa``).
+    speed_unit : str, optional
+        Unit of unsuffixed speed columns: ``m/s``, ``kn``, ``km/h`` or ``mph``.
+    time_zone : str, optional
+        Zone of naive timestamps: a UTC offset (``"+02:00"``, ``"UTC"``) or an IANA
+        name (``"America/Los_Angeles"``).
+    name : str, optional
+        Track name (default: the GPX track name, else the file stem).
+
+    Returns
+    -------
+    Track
+        Cleaned track (see the module notes).
+
+    Raises
+    ------
+    InputError
+        Missing or empty file, XML errors (line and column), points without time,
+        unknown/ambiguous/missing columns, undeclared speed unit, unreadable values
+        (naming line and column), naive times without ``time_zone``, positions out of
+        range, fewer than two usable points.
+    """
+    p = Path(path)
+    src = str(p)
+    if not p.is_file():
+        raise InputError(f"{src}: track file not found; check the path")
+    text = p.read_text(encoding="utf-8-sig", errors="replace")
+    if not text.strip():
+        raise InputError(f"{src}: the track file is empty; expected GPX or CSV with "
+                         "time, lat, lon")
+    tz = _zone(time_zone, src) if time_zone is not None else None
+    if text.lstrip().startswith("<"):
+        if columns:
+            raise InputError(f"{src}: `columns` applies to CSV tracks only; this is GPX")
+        t, lat, lon, lines, gpx_name, channels = _read_gpx(text, src, tz)
+        default_name = gpx_name or p.stem
+    else:
+        t, lat, lon, lines, channels = _read_csv(text, src, columns, speed_unit, tz)
+        default_name = p.stem
+    return clean_track(t, lat, lon, lines, channels, src,
+                       name if name is not None else default_name)
+
+
+# ------------------------------------------------------------------------------ times
+def _zone(text: str, src: str) -> tzinfo:
+    try:
+        return parse_offset(text, f"{src}: time_zone")
+    except InputError:
+        pass
+    try:
+        return ZoneInfo(text.strip())
+    except (ZoneInfoNotFoundError, ValueError):
+        raise InputError(
+            f"{src}: time_zone {text!r} is neither a UTC offset ('+02:00', 'UTC') nor a "
+            "known IANA zone name ('Europe/Madrid'); give one of those"
+        ) from None
+
+
+def parse_epoch(cell: str, tz: tzinfo | None, where: str, utc_column: bool = False) -> float:
+    """Epoch seconds of one timestamp cell (see the module notes for the formats)."""
+    s = cell.strip()
+    try:
+        v = float(s)
+    except ValueError:
+        pass
+    else:
+        if not math.isfinite(v):
+            raise InputError(f"{where}: {cell!r} is not a time")
+        return v / 1000.0 if abs(v) > 1e11 else v
+    m = _PHONE_MS.match(s)
+    if m:
+        s = f"{m.group(1)}.{m.group(2).ljust(3, '0')}"
+    if s.endswith(("Z", "z")):
+        s = s[:-1] + "+00:00"
+    try:
+        dt = datetime.fromisoformat(s)
+    except ValueError:
+        raise InputError(
+            f"{where}: cannot read {cell!r} as a time; expected ISO 8601 with an offset "
+            "(2025-06-21T11:18:29Z), or epoch seconds"
+        ) from None
+    if dt.tzinfo is None:
+        if tz is None and not utc_column:
+            raise InputError(
+                f"{where}: time {cell!r} has no UTC offset; give the logger's zone with "
+                "time_zone (--time-zone), e.g. 'UTC', '+02:00' or 'Europe/Madrid'"
+            )
+        dt = dt.replace(tzinfo=tz if tz is not None else UTC)
+    return dt.timestamp()
+
+
+# ------------------------------------------------------------------------------ GPX
+def _local(tag: str) -> str:
+    return tag.rsplit("}", 1)[-1]
+
+
+def _read_gpx(text: str, src: str, tz: tzinfo | None
+              ) -> tuple[NDArray, NDArray, NDArray, NDArray, str, dict[str, NDArray]]:
+    parser = ET.XMLPullParser(events=("start", "end"))
+    t: list[float] = []
+    lat: list[float] = []
+    lon: list[float] = []
+    lines: list[int] = []
+    names: list[str] = []
+    root_seen = False
+    stack: list[str] = []
+    pt: dict[str, str] | None = None
+    pt_line = 0
+    try:
+        for lineno, line in enumerate(text.splitlines(keepends=True), start=1):
+            parser.feed(line)
+            for event, el in parser.read_events():
+                tag = _local(el.tag)  # type: ignore[union-attr]
+                if event == "start":
+                    if not root_seen:
+                        root_seen = True
+                        if tag != "gpx":
+                            raise InputError(f"{src}: line {lineno}: root element <{tag}>; "
+                                             "expected <gpx> (a GPX 1.0/1.1 file)")
+                    stack.append(tag)
+                    if tag == "trkpt":
+                        pt = {"lat": el.get("lat", ""), "lon": el.get("lon", "")}  # type: ignore[union-attr]
+                        pt_line = lineno
+                    continue
+                stack.pop()
+                if tag == "time" and pt is not None and stack and stack[-1] == "trkpt":
+                    pt["time"] = (el.text or "").strip()  # type: ignore[union-attr]
+                elif tag == "name" and stack and stack[-1] == "trk":
+                    names.append((el.text or "").strip())  # type: ignore[union-attr]
+                elif tag == "trkpt" and pt is not None:
+                    where = f"{src}: line {pt_line}"
+                    if "time" not in pt or not pt["time"]:
+                        raise InputError(f"{where}: <trkpt> has no <time>; a track for "
+                                         "analysis needs a time on every point")
+                    try:
+                        la, lo = float(pt["lat"]), float(pt["lon"])
+                    except ValueError:
+                        raise InputError(
+                            f"{where}: <trkpt lat={pt['lat']!r} lon={pt['lon']!r}>: expected "
+                            "decimal degrees") from None
+                    t.append(parse_epoch(pt["time"], tz, where, utc_column=False))
+                    lat.append(la)
+                    lon.append(lo)
+                    lines.append(pt_line)
+                    pt = None
+                if len(stack) > 2:
+                    el.clear()  # type: ignore[union-attr]
+        parser.close()
+    except ET.ParseError as exc:
+        line, col = exc.position
+        raise InputError(f"{src}:{line}:{col}: not well-formed XML ({exc}); is the file a "
+                         "complete GPX export?") from None
+    if not root_seen:
+        raise InputError(f"{src}: no XML element found; expected a GPX file")
+    if not t:
+        raise InputError(f"{src}: the GPX file has no track points (<trk><trkseg><trkpt>); "
+                         "export the activity as a track with times")
+    return (np.array(t), np.array(lat), np.array(lon), np.array(lines),
+            names[0] if names else "", {})
+
+
+# ------------------------------------------------------------------------------ CSV
+def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit: str | None,
+              tz: tzinfo | None
+              ) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray]]:
+    lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
+             if ln.strip() and not ln.lstrip().startswith("#")]
+    delim = max((",", ";", "\t"), key=lines[0][1].count)
+    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
+    header, body = rows[0], rows[1:]
+    linenos = [k for k, _ in lines[1:]]
+    stems = [header_stem(h) for h in header]
+    explicit: dict[str, str] = {}
+    low = [h.strip().lower() for h in header]
+    for canon, col in (columns or {}).items():
+        if isinstance(col, str) and col.strip().lower() in low:
+            explicit[canon] = stems[low.index(col.strip().lower())]
+        else:
+            explicit[canon] = col  # map_columns reports it
+    cmap = map_columns(stems, explicit, where=src, aliases=TRACK_ALIASES)
+    absent = [c for c in ("time", "lat", "lon") if c not in cmap]
+    if absent:
+        raise InputError(
+            f"{src}: no column for {', '.join(absent)}; header is "
+            f"{', '.join(h.strip() for h in header)}. Name the columns time, lat, lon (see "
+            "docs/usage.md, 'sailroute analyze') or map them with --column CANON=NAME"
+        )
+    if not body:
+        raise InputError(f"{src}: the file has a header but no data rows")
+    units = {c: _speed_unit(header[cmap[c]], speed_unit, src) for c in SPEED_COLUMNS
+             if c in cmap}
+    ncol = len(header)
+    for r, lineno in zip(body, linenos, strict=True):
+        if len(r) != ncol:
+            raise InputError(f"{src}, line {lineno}: {len(r)} fields but the header has {ncol}; "
+                             f"check the separator ({delim!r}) and quoting")
+    miss = set(DEFAULT_MISSING)
+    tcol = header[cmap["time"]]
+    utc_col = "utc" in tcol.strip().lower()
+    t = np.array([np.nan if r[cmap["time"]].strip() in miss else
+                  parse_epoch(r[cmap["time"]], tz, f"{src}, line {ln}, column {tcol!r}", utc_col)
+                  for r, ln in zip(body, linenos, strict=True)])
+    vals = {c: _numbers(body, linenos, cmap[c], header[cmap[c]], miss, src)
+            for c in cmap if c != "time"}
+    lat, lon = vals.pop("lat"), vals.pop("lon")
+    channels: dict[str, NDArray] = {}
+    for c, v in vals.items():
+        if c in SPEED_COLUMNS:
+            channels[f"{c}_ms"] = v * speed_factor(units[c])
+        elif c in _SIGNED:
+            channels[f"{c}_deg"] = 180.0 - np.mod(180.0 - v, 360.0)
+        else:
+            channels[f"{c}_deg"] = np.mod(v, 360.0)
+    return t, lat, lon, np.array(linenos), channels
+
+
+def _speed_unit(column: str, declared: str | None, src: str) -> str:
+    implied = header_unit(column)
+    if declared is None:
+        if implied is None:
+            raise InputError(
+                f"{src}: the unit of speed column {column!r} is not known; declare it with "
+                "speed_unit (--speed-unit: 'kn', 'm/s', 'km/h' or 'mph') or name the column "
+                "with a unit suffix such as sog_kn"
+            )
+        return implied
+    try:
+        f = speed_factor(declared)
+    except InputError as exc:
+        raise InputError(f"{src}: speed_unit: {exc}") from None
+    if implied is not None and not np.isclose(f, speed_factor(implied)):
+        raise InputError(f"{src}: speed_unit {declared!r} contradicts column {column!r} "
+                         f"(which says {implied!r}); fix one of them")
+    return declared if implied is None else implied
+
+
+def _numbers(body: list[list[str]], linenos: list[int], k: int, column: str, miss: set[str],
+             src: str) -> NDArray:
+    out = np.empty(len(body))
+    for i, r in enumerate(body):
+        c = r[k].strip()
+        if c in miss:
+            out[i] = np.nan
+            continue
+        try:
+            out[i] = float(c)
+        except ValueError:
+            raise InputError(f"{src}, line {linenos[i]}, column {column!r}: cannot read {c!r} "
+                             "as a number") from None
+    return out
+
+
+# ------------------------------------------------------------------------------ cleaning
+def clean_track(t: NDArray, lat: NDArray, lon: NDArray, lines: NDArray,
+                channels: Mapping[str, NDArray], src: str, name: str) -> Track:
+    """Drop unusable rows, sort, remove repeated times, note gaps; build the :class:`Track`.
+
+    Parameters
+    ----------
+    t, lat, lon : ndarray
+        Raw times [epoch s] and positions [°] (NaN = missing).
+    lines : ndarray of int
+        File line of each point (for messages).
+    channels : mapping
+        Measured channels, same length.
+    src, name : str
+        File and track name.
+
+    Returns
+    -------
+    Track
+
+    Raises
+    ------
+    InputError
+        A latitude/longitude out of range (naming the line), or fewer than two
+        usable points.
+    """
+    notes: list[str] = []
+    n0 = t.size
+    for a, lo, hi, what in ((lat, -90.0, 90.0, "latitude"), (lon, -180.0, 360.0, "longitude")):
+        bad = np.nonzero((a < lo) | (a > hi))[0]
+        if bad.size:
+            k = int(bad[0])
+            raise InputError(f"{src}, line {int(lines[k])}: {what} {a[k]:g} is out of range "
+                             f"[{lo:g}, {hi:g}] ({bad.size} point(s))")
+    ok = np.isfinite(t) & np.isfinite(lat) & np.isfinite(lon) & ~((lat == 0) & (lon == 0))
+    if (~ok).any():
+        notes.append(f"dropped {int((~ok).sum())} row(s) without a time or position")
+    idx = np.nonzero(ok)[0]
+    back = int(np.count_nonzero(np.diff(t[idx]) < 0))
+    order = idx[np.argsort(t[idx], kind="stable")]
+    if back:
+        notes.append(f"sorted {back} out-of-order point(s)")
+    ts = t[order]
+    keep = np.concatenate([[True], np.diff(ts) > 0]) if ts.size else np.zeros(0, bool)
+    if (~keep).any():
+        notes.append(f"dropped {int((~keep).sum())} duplicate timestamp(s)")
+    order = order[keep]
+    if order.size < 2:
+        raise InputError(
+            f"{src}: only {order.size} usable point(s) of {n0} (a point needs a time, lat and "
+            "lon); a track needs at least two"
+        )
+    ts = t[order]
+    dt = np.diff(ts)
+    limit = max(GAP_MIN_S, 10.0 * float(np.median(dt)))
+    gaps = np.nonzero(dt > limit)[0]
+    for k in gaps[:5]:
+        notes.append(f"gap of {dt[k]:.0f} s at {iso(ts[k])[:-5]}Z")
+    if gaps.size > 5:
+        notes.append(f"... and {gaps.size - 5} more gap(s) longer than {limit:.0f} s")
+    lon_w = np.mod(lon[order] + 180.0, 360.0) - 180.0
+    return Track(ts, lat[order].astype(float), lon_w, name, src,
+                 {k: np.asarray(v, float)[order] for k, v in channels.items()}, tuple(notes))
