@@ -12,6 +12,7 @@ import sys
 from collections.abc import Callable
 from typing import Annotated, Any, TypeVar
 
+import click
 import typer
 
 from sailroute import __version__
@@ -60,6 +61,15 @@ def run_guarded(fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
     except KeyboardInterrupt:
         typer.echo("interrupted", err=True)
         raise typer.Exit(code=130) from None
+    except (typer.Exit, typer.Abort, click.exceptions.ClickException):
+        raise
+    except Exception as exc:  # anything else is a bug: one short paragraph, exit 1
+        if _STATE["debug"]:
+            raise
+        typer.echo(f"internal error: {type(exc).__name__}: {exc}\nThis is a bug in sailroute; "
+                   "rerun with --debug (sailroute --debug COMMAND ...) for the traceback and "
+                   "please report it.", err=True)
+        raise typer.Exit(code=1) from None
 
 
 # --- commands -------------------------------------------------------------------
@@ -217,6 +227,11 @@ def strategy_command(
         typer.Option("--fit-timezone", help="UTC offset for naive times in --fit-from, "
                      "e.g. +01:00."),
     ] = None,
+    fit_speed_unit: Annotated[
+        str | None,
+        typer.Option("--fit-speed-unit", help="Unit of the speed column of --fit-from when "
+                     "its header does not say: kn | m/s | km/h | mph."),
+    ] = None,
     tack_penalty_s: Annotated[
         float, typer.Option("--tack-penalty-s", help="Time lost per tack, s.")
     ] = 5.0,
@@ -257,7 +272,8 @@ def strategy_command(
         run_strategy_command,
         polar_spec=polar, tws_kn=tws_kn, sigma_deg=sigma_deg, timescale_min=timescale_min,
         drift_deg_per_min=drift_deg_per_min, fit_from=fit_from, fit_station=fit_station,
-        fit_timezone=fit_timezone, objective=objective, out_dir=out, plots=not no_plots,
+        fit_timezone=fit_timezone, fit_speed_unit=fit_speed_unit, objective=objective,
+        out_dir=out, plots=not no_plots,
         progress=lambda msg: typer.echo(msg, err=True),
         length_m=length_m, half_width_m=half_width_m, tack_penalty_s=tack_penalty_s,
         runs=runs, seed=seed, start_tack=start_tack, scheduler=scheduler, n_workers=workers,

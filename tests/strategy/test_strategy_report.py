@@ -25,7 +25,7 @@ from sailroute.strategy.montecarlo import simulate
 from sailroute.strategy.sdp import BeatGrid, solve_expected_time
 from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
 from sailroute.units import KNOT
-from tests.conftest import SHARED_REAL, TESTS_DATA, requires_shared
+from tests.conftest import ROOT, SHARED_REAL, TESTS_DATA, requires_shared
 
 ILCA7 = builtin_polar("ilca7")
 COACH = SHARED_REAL / "wind" / "anemomind-coach-trieste" / "coach_wind_1hz.csv"
@@ -167,6 +167,8 @@ def test_cli_strategy_expected(tmp_path) -> None:
         (["--polar", "builtin:optimist"], "unknown built-in boat"),
         (["--length-m", "405"], "whole"),
         (["--fit-from", "nowhere.csv"], "not found"),
+        (["--seed", "-1"], "--seed -1: expected an integer >= 0"),
+        (["--fit-from", str(ROOT / "data" / "trieste-coach-2018-02-15.csv")], "speed_unit"),
     ],
 )
 def test_cli_strategy_errors_exit_2_without_traceback(args, message, tmp_path) -> None:
@@ -209,3 +211,15 @@ def test_drift_diffusion_fitted_from_a_station_file(tmp_path) -> None:
     assert res.result.model == DriftDiffusionShift(dd["drift_deg_per_s"],
                                                    dd["sigma_deg_per_sqrt_s"])
     assert "diffusion" in res.report and "°/√min" in res.report
+
+
+def test_cli_fits_the_shipped_coach_log_given_its_speed_unit(tmp_path) -> None:
+    # the shipped log's speed column is in knots with no unit in its header: the CLI can now
+    # say so (it failed with "declare it with speed_unit:" and had no option to)
+    res = CliRunner().invoke(app, [
+        "strategy", "--length-m", "200", "--half-width-m", "100", "--runs", "50",
+        "--fit-from", str(ROOT / "data" / "trieste-coach-2018-02-15.csv"),
+        "--fit-speed-unit", "kn", "--out", str(tmp_path), "--no-plots"])
+    assert res.exit_code == 0, res.output
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["fit"]["ou"]["sigma_deg"] == pytest.approx(28.4, abs=0.05)  # docs/strategy.md
