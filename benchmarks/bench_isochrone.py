@@ -7,7 +7,7 @@ Cases (Laser/ILCA 7 polar from ``sailroute/boat/data/ilca7.pol`` when present, e
 synthetic Laser-like table):
 
 * uniform wind, 8.5 kn from 0°, start (0, 0), windward mark 1809 m north (the
-  thesis's validation beat, seed-002 §5.7);
+  thesis's validation beat, the thesis's §5.7);
 * the synthetic Hyères wrfout in ``data/`` (bilinear + linear in time, height-corrected
   to 2.68 m), the mark 1809 m upwind of the start in the local wind at the start time;
 * a gridded analytic field (500 m cells, 10-min slices, shifts and pressure bands)

@@ -3,7 +3,7 @@
 Usage::
 
     python benchmarks/bench_strategy.py            # SDP, Monte Carlo, deadline solves
-    python benchmarks/bench_strategy.py --paper    # + seed 004 Figs 3 and 4(a) reproduction
+    python benchmarks/bench_strategy.py --paper    # + Wang et al. (2024) Figs 3, 4(a)
     python benchmarks/bench_strategy.py --scheduler processes --workers 2
                                                    # + Monte Carlo on Dask vs serial
 
@@ -163,7 +163,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--runs", type=int, default=4000)
-    ap.add_argument("--paper", action="store_true", help="reproduce seed 004 Figs 3 and 4(a)")
+    ap.add_argument("--paper", action="store_true",
+                    help="reproduce Wang et al. (2024) Figs 3 and 4(a)")
     ap.add_argument("--paper-grid", default="200,256,0.2",
                     help="n_r,n_theta,ds for --paper (default 200,256,0.2)")
     ap.add_argument("--paper-interp", default="linear", choices=("linear", "cubic"))

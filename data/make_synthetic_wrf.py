@@ -3,7 +3,7 @@
 No real WRF run of 24 April 2018 is available, so this script writes a file in genuine
 wrfout layout (it goes through sailroute's real WRF reader) with a wind designed after
 the thesis's description of the WRF field for race R1 (Laser, World Cup Series,
-Hyères, start 12:10 CEST = 10:10Z; brief §3.8):
+Hyères, start 12:10 CEST = 10:10Z; the thesis's reported WRF values, its Ch. 5):
 
 * direction about 148 deg (from SE) at the start, backing 3 deg per hour, with a
   +-2 deg oscillation of 90 min period and a spatial gradient (+0.3 deg/km to the east,

@@ -1,6 +1,6 @@
 """Dębski's dynamic segment model: a boat that accelerates along straight segments.
 
-The model (``seeds-000-001-grid-dp.md`` §1) moves a boat along a straight
+The model (Dębski 2016) moves a boat along a straight
 segment with the 1-D equation of motion
 
 .. math::
@@ -148,7 +148,7 @@ class DynamicBoat:
     The defaults are the paper's ``c1 = 0.03, c2 = 0.005, k = 0.7, Um = 0.98,
     Lm = 0.5`` (the mass cancels).  At TWS 12 m s⁻¹ the steady state gives the
     best upwind VMG 1.424 m s⁻¹ at TWA 41.65° (boat speed 1.906 m s⁻¹) and
-    3.157 m s⁻¹ dead downwind (``seeds-003-004.md`` §3).
+    3.157 m s⁻¹ dead downwind (Wang et al. 2024).
     """
 
     c1: float = 0.03

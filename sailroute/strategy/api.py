@@ -2,7 +2,7 @@
 
 :func:`run_strategy` solves the expected-time SDP for an upwind leg, simulates
 it, and -- when deadlines are given -- solves the risk-aware (deadline) and
-risk-neutral problems of seed 004 for the same leg and simulates both.
+risk-neutral problems of Wang et al. (2024) for the same leg and simulates both.
 :func:`write_outputs` writes ``summary.json`` and the figures.
 """
 
@@ -60,8 +60,8 @@ class StrategySettings:
     length_m, half_width_m : float
         Beat length and course half-width [m].
     tack_penalty_s : float
-        Time lost per tack [s]: added time in the SDP (seed 003), time standing
-        still while the wind moves in the deadline problem (seed 004).
+        Time lost per tack [s]: added time in the SDP (Shepherd et al.), time standing
+        still while the wind moves in the deadline problem (Wang et al. (2024)).
     runs, seed : int
         Monte Carlo runs per policy and seed.
     row_m, lateral_m, shift_step_deg, shift_max_deg, max_heading_deg : float
@@ -329,7 +329,7 @@ def _deadline_summary(study: DeadlineStudy, st: StrategySettings) -> dict[str, A
     out: dict[str, Any] = {
         "model": study.model.describe(),
         "note": (
-            "target-relative problem of seed 004: Brownian wind direction, no course "
+            "target-relative problem of Wang et al. (2024): Brownian wind direction, no course "
             "boundary, the boat stands still for the tack penalty"
         ),
         "grid": asdict(g),
@@ -459,6 +459,7 @@ def run_strategy_command(
     fit_from: str | None = None,
     fit_station: str | None = None,
     fit_timezone: str | None = None,
+    fit_speed_unit: str | None = None,
     objective: str = "expected",
     out_dir: str | Path = "strategy-out",
     plots: bool = True,
@@ -487,6 +488,9 @@ def run_strategy_command(
     fit_from, fit_station, fit_timezone : str, optional
         Station CSV to fit the shift model from (OU: sigma and the e-fold time
         scale; drift-diffusion: drift and diffusion).
+    fit_speed_unit : str, optional
+        Unit of the station file's speed column when its header does not say
+        (``kn``, ``m/s``, ``km/h``, ``mph``).
     objective : str
         ``expected`` or ``deadline=SECONDS[,SECONDS]``.
     out_dir : str or Path
@@ -524,10 +528,15 @@ def run_strategy_command(
         raise InputError(f"--start-tack {start_tack!r}: expected 'starboard' or 'port'")
     if not (math.isfinite(tws_kn) and tws_kn > 0):
         raise InputError(f"--tws-kn {tws_kn}: must be > 0")
+    seed = settings.get("seed", 0)
+    if not isinstance(seed, int) or seed < 0:
+        raise InputError(f"--seed {seed}: expected an integer >= 0 (NumPy's generators take "
+                         "no negative seeds)")
     polar = load_polar(polar_spec)
     fit = None
     if fit_from is not None:
-        ou, dd = fit_station_file(fit_from, station=fit_station, timezone=fit_timezone)
+        ou, dd = fit_station_file(fit_from, station=fit_station, timezone=fit_timezone,
+                                  speed_unit=fit_speed_unit)
         model: ShiftModel = ou.model() if kind == "ou" else dd.model()
         fit = fit_summary(ou, dd, str(fit_from))
     else:

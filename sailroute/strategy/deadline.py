@@ -1,25 +1,25 @@
 """Risk-aware tack strategy: maximise the probability of reaching a mark by a deadline.
 
-Seed 004 (Wang, Patnaik, Somalwar, Wu & Vladimirsky), in physical units.  The
+Wang, Patnaik, Somalwar, Wu & Vladimirsky (2024), in physical units.  The
 mark is a disc of radius ``R_D`` at the origin; the wind is uniform with a
 fixed speed and a direction that follows a Brownian motion with drift
 (:class:`~sailroute.strategy.shiftmodel.DriftDiffusionShift`).  The state is
 target-relative: distance ``r`` [m], angle ``θ`` [rad] of the upwind
 direction measured counter-clockwise from the boat→mark line, and the tack
-``q`` (index 0 = starboard, seed 004's ``q = 1``; index 1 = port).  Steering
+``q`` (index 0 = starboard, Wang et al.'s (2024) ``q = 1``; index 1 = port).  Steering
 angle ``u ∈ [0, π]`` off the wind; speed ``f(u)`` from the polar; on
 starboard the heading is ``u`` counter-clockwise of the wind (the wind is on
-the starboard side), on port ``u`` clockwise.  Seed 004 eq. (4)::
+the starboard side), on port ``u`` clockwise.  Wang et al. (2024) eq. (4)::
 
     dr = -f(u) cos(θ + s_q u) dt,    dθ = [f(u)/r sin(θ + s_q u) + a] dt + σ dB,
 
-``s_q = +1`` on starboard, ``-1`` on port.  Seed 004's ``φ`` (and so ``θ``) is
+``s_q = +1`` on starboard, ``-1`` on port.  Wang et al.'s (2024) ``φ`` (and so ``θ``) is
 counter-clockwise, while compass directions are clockwise: a veer
 (``drift_deg_per_s > 0``) is ``a < 0`` here.  A tack switch freezes the boat for
 ``C`` seconds (the tack penalty) while the wind keeps moving.
 
 :func:`solve_deadline` marches the budget ``s`` from 0 to ``s_max`` with the
-semi-Lagrangian scheme of seed 004 (all deadlines at once): steering update
+semi-Lagrangian scheme of Wang et al. (2024) (all deadlines at once): steering update
 with a two-node Gauss–Hermite rule (feet ``θ ± σ√τ``, bilinear interpolation,
 periodic in ``θ``), switch update with the three-node rule (weights 1/6, 2/3,
 1/6 at ``θ + aC + {-1, 0, 1} σ √(3C)``, linear interpolation), ``w = 1`` inside
@@ -29,7 +29,7 @@ an integer.  Each update is a sparse linear operator built once (the feet do
 not depend on ``s``), so a budget slice costs one sparse mat-vec.
 
 :func:`solve_risk_neutral` computes the risk-neutral counterpart (minimum
-expected time, seed 004 eq. 5) by value iteration with the same operators,
+expected time, Wang et al. (2024) eq. 5) by value iteration with the same operators,
 sweeping rings outward in ``r`` (Gauss–Seidel).  :func:`simulate_deadline`
 runs seeded Monte Carlo (Euler–Maruyama in Cartesian coordinates) of a
 deadline policy with the deadline upgrade and the fallback to the risk-neutral
@@ -68,7 +68,7 @@ RN_OUTSIDE_S = 1.0e6
 RN_UNREACHED_S = 1.0e9
 """Initial risk-neutral value [s] outside the mark."""
 INTERPOLATIONS = ("linear", "cubic")
-"""Interpolation of the steering feet: bilinear (seed 004 "bilinear"), or bicubic Lagrange."""
+"""Interpolation of the steering feet: bilinear (Wang et al. 2024), or bicubic Lagrange."""
 
 
 @dataclass(frozen=True)
@@ -91,7 +91,7 @@ class DeadlineGrid:
     s_max_s : float
         Largest budget (deadline) solved for [s].
     n_controls : int
-        Steering angles ``u_n = nπ/(n_controls - 1)`` (seed 004: 49, 3.75°).
+        Steering angles ``u_n = nπ/(n_controls - 1)`` (Wang et al. (2024): 49, 3.75°).
     interpolation : {"linear", "cubic"}
         Interpolation at the steering feet: bilinear, or bicubic Lagrange
         (4 x 4 points, 4x the memory and time, much less numerical diffusion).
@@ -174,7 +174,7 @@ def _flat(grid: DeadlineGrid, q: NDArray, i: NDArray, j: NDArray) -> NDArray[np.
 
 
 def _model_rates(model: DriftDiffusionShift) -> tuple[float, float]:
-    """Seed-004 drift ``a`` [rad s⁻¹] (counter-clockwise) and ``σ`` [rad s⁻½]."""
+    """Wang et al. (2024) drift ``a`` [rad s⁻¹] (counter-clockwise) and ``σ`` [rad s⁻½]."""
     if not isinstance(model, DriftDiffusionShift):
         raise InputError(
             "the deadline solver needs a drift-diffusion (Brownian) shift model; convert an OU "
@@ -532,7 +532,7 @@ def solve_risk_neutral(
     tau_s: float | None = None,
     progress: Callable[[int, float], None] | None = None,
 ) -> RiskNeutralPolicy:
-    """Minimum expected time by value iteration (seed 004 eq. 5, risk-neutral).
+    """Minimum expected time by value iteration (Wang et al. (2024) eq. 5, risk-neutral).
 
     ``v = min( min_u [τ + ½ Σ± v(foot±)],  C + 𝒢[v(r, ·, q̃)] )``, ``v = 0`` in
     the mark, ``v = RN_OUTSIDE_S`` beyond ``r_max``.  Rings are updated in

@@ -1,6 +1,6 @@
 """Expected-time tack strategy on an upwind leg: stochastic dynamic programming.
 
-Seed 003 (Shepherd, Haydon & Vermillion) with the defects of its text fixed
+Shepherd, Haydon & Vermillion with the defects of its text fixed
 (``docs/design/strategy.md``).  The leg is a lattice of rows ``y = 0, δy, ...,
 L`` along the course axis and lateral positions ``x = -x_max, ..., x_max``
 (``δx`` apart).  State: (row, ``x``, tack ``k``, shift bin ``θ``).  A decision
@@ -19,7 +19,7 @@ leaves open); reaching any other lateral position there is infeasible.
 Wind clock (``clock="time"``, the default): the chain advances by the sailing
 time of the chosen segment -- each candidate segment has its own exact
 transition row ``M(Δt_seg)[θ, :]``; the tack penalty is a pure additive time
-(the wind does not move during it).  ``clock="stage"`` reproduces seed 003's
+(the wind does not move during it).  ``clock="stage"`` reproduces Shepherd et al.'s
 per-row clock with one matrix over a nominal stage time ``δy / VMG*``.
 """
 
@@ -62,7 +62,7 @@ def _whole(value: float, step: float, what: str) -> int:
 
 @dataclass(frozen=True)
 class BeatGrid:
-    """Lattice of an upwind leg (defaults: seed 003's resolution).
+    """Lattice of an upwind leg (defaults: Shepherd et al.'s resolution).
 
     Parameters
     ----------
@@ -193,7 +193,7 @@ def quantised_vmg(grid: BeatGrid, polar: Polar, tws_ms: float) -> tuple[float, f
     heading_deg, vmg_ms : float
         Best quantised heading offset [°] and its VMG [m s⁻¹].  A one-tack
         route on the lattice (layline inside the course) takes exactly
-        ``L / vmg + λ`` (seed brief, oracle O3).
+        ``L / vmg + λ`` (the steady-wind one-tack limit).
     """
     n = np.arange(1, grid.d_max + 1)
     psi = np.degrees(np.arctan2(n * grid.lateral_m, grid.row_m))
@@ -339,11 +339,11 @@ def solve_expected_time(
     model : OUShift or DriftDiffusionShift
         Wind-shift process (shift relative to the course axis).
     grid : BeatGrid, optional
-        Lattice; default seed 003's (1600 m x ±800 m, 10 m x 2 m, 5° bins).
+        Lattice; default Shepherd et al.'s (1600 m x ±800 m, 10 m x 2 m, 5° bins).
     tack_penalty_s : float
         Time added per tack ``λ`` [s], ``>= 0``.
     clock : {"time", "stage"}
-        Wind clock: per-segment sailing time (default) or seed 003's per row.
+        Wind clock: per-segment sailing time (default) or Shepherd et al.'s per row.
     chain_method : {"generator", "integrate"}
         Shift discretisation (:mod:`sailroute.strategy.shiftmodel`).
 

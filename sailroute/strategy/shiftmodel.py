@@ -9,15 +9,15 @@ Two continuous-time models are offered:
 
 * :class:`OUShift` -- an oscillating, mean-reverting shift (Ornstein–Uhlenbeck):
   ``dθ = -(θ - m)/l dt + σ sqrt(2/l) dW``, stationary sd ``σ``, autocorrelation
-  ``exp(-|τ|/l)`` (seed 003's AR(1) wind in continuous time);
+  ``exp(-|τ|/l)`` (Shepherd et al.'s AR(1) wind in continuous time);
 * :class:`DriftDiffusionShift` -- a persistent/trending shift (Brownian motion
-  with drift): ``dθ = a dt + s dW`` (seed 004).
+  with drift): ``dθ = a dt + s dW`` (Wang et al. (2024)).
 
 Both have exact Gaussian transition laws over any time step ``Δt``
 (:meth:`transition_moments`).  For the stochastic DP the shift is discretised to
 a Markov chain on bins of width ``δθ`` (:func:`transition_matrix`) either by
 integrating the exact transition density over each bin (``method="integrate"``,
-seed 003's eq. 13 with the corrected bin limits and the tails lumped into the
+Shepherd et al.'s eq. 13 with the corrected bin limits and the tails lumped into the
 edge bins) or from a birth–death generator ``Q`` that matches the drift and the
 diffusion of the process locally, ``M(Δt) = expm(Q Δt)`` (``method="generator"``,
 time-consistent: ``M(t1) M(t2) = M(t1 + t2)``).  :func:`chain_diagnostics`
@@ -115,7 +115,7 @@ class OUShift:
 
 @dataclass(frozen=True)
 class DriftDiffusionShift:
-    """Persistent wind shift: Brownian motion with constant drift (seed 004).
+    """Persistent wind shift: Brownian motion with constant drift (Wang et al. (2024)).
 
     Parameters
     ----------
@@ -201,7 +201,7 @@ def _bin_step(bins_deg: NDArray[np.float64]) -> float:
 def _integrate_rows(
     model: ShiftModel, bins: NDArray, i_from: NDArray, dt_s: NDArray
 ) -> NDArray[np.float64]:
-    """Bin-integrated exact transition law (seed 003 eq. 13, corrected)."""
+    """Bin-integrated exact transition law (Shepherd et al. eq. 13, corrected)."""
     h = _bin_step(bins)
     mean, sd = model.transition_moments(bins[i_from], dt_s)
     # bin j collects θ' in [θ_j - δθ/2, θ_j + δθ/2); the edge bins take the tails

@@ -53,7 +53,7 @@ class AnalyticWind:
 def debski_test_wind(
     v0: float = -20.0, length_m: float = 500.0, half_width_m: float = 400.0
 ) -> AnalyticWind:
-    """Spatially varying test wind of Dębski (2016b), ``seeds-000-001-grid-dp.md`` §2.
+    """Spatially varying test wind of Dębski (2016b).
 
     ``v_t(x, y) = v0 [(cos(x/L) + y/H) x̂ + (x/L - sin(y/L)) ŷ]`` with the paper's
     ``v0 = -20, L = 500, H = 400``; the leg runs from A = (0, 0) to B = (L, 0).
