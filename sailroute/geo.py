@@ -16,6 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from pyproj import Transformer
 
 from sailroute.errors import InputError
+from sailroute.units import wrap360
 
 
 @lru_cache(maxsize=32)
@@ -24,6 +25,12 @@ def _transformers(lat0: float, lon0: float) -> tuple[Transformer, Transformer]:
     fwd = Transformer.from_crs("EPSG:4326", proj, always_xy=True)
     inv = Transformer.from_crs(proj, "EPSG:4326", always_xy=True)
     return fwd, inv
+
+
+def wrap_lon(lon_deg: ArrayLike) -> NDArray[np.float64] | float:
+    """Longitude [°] wrapped to ``[-180, 180)`` (GPX's range); 288.67 -> -71.33."""
+    w = wrap360(np.asarray(lon_deg, dtype=float) + 180.0) - 180.0
+    return float(w) if w.ndim == 0 else w
 
 
 @dataclass(frozen=True)
@@ -56,7 +63,7 @@ class LocalFrame:
         """Inverse of :meth:`to_xy`: local ``(x, y)`` [m] to ``(lat, lon)`` [°]."""
         _, inv = _transformers(float(self.lat0), float(self.lon0))
         lon, lat = inv.transform(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        return np.asarray(lat, dtype=float), np.asarray(lon, dtype=float)
+        return np.asarray(lat, dtype=float), np.asarray(wrap_lon(lon), dtype=float)
 
     def grid_north_deg(self, lat: ArrayLike, lon: ArrayLike) -> NDArray[np.float64]:
         """Angle [°] from local +y to true north at the given points (meridian convergence).

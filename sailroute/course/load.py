@@ -27,9 +27,10 @@ import numpy as np
 from sailroute.course.model import Course, Gate, LegSpec, Line, Mark, ScenarioSpec
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError, format_problems
-from sailroute.geo import LocalFrame
+from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.routing.types import RouterName, RoutingSettings
 from sailroute.timeutil import parse_time
+from sailroute.units import KNOT
 from sailroute.yamlfile import join_path as _join
 from sailroute.yamlfile import read_yaml
 
@@ -283,7 +284,8 @@ def _latlon(c: _Checker, d: Mapping[str, Any], path: str) -> tuple[float, float]
     lat = c.number(d, "lat", path, lo=-90.0, hi=90.0, what="a latitude in [-90, 90] degrees")
     lon = c.number(d, "lon", path, lo=-180.0, hi=360.0,
                    what="a longitude in [-180, 360] degrees")
-    return None if lat is None or lon is None else (lat, lon)
+    # 0..360 longitudes are accepted and wrapped to [-180, 180), as GPX and plan.json use
+    return None if lat is None or lon is None else (lat, wrap_lon(lon))
 
 
 def _position(
@@ -654,8 +656,18 @@ _TEMPLATE_KEYS: dict[str, dict[str, Any]] = {
 }
 
 
+_FASTEST_MS = 70.0 * KNOT
+"""No sailing boat races faster than 70 kn [m s⁻¹]: bounds what a time limit can hold."""
+
+
+def _max_laps(leg_length_m: float, time_limit_min: float | None) -> int:
+    """Most laps (two legs of ``leg_length_m`` each) a boat at 70 kn sails in the time limit."""
+    limit_s = 60.0 * (time_limit_min or DEFAULT_TIME_LIMIT_MIN)
+    return max(1, int(limit_s * _FASTEST_MS / (2.0 * leg_length_m)))
+
+
 def _template(
-    c: _Checker, raw: Any
+    c: _Checker, raw: Any, time_limit_min: float | None = None
 ) -> tuple[CourseLayout | None, tuple[str, tuple[float, float]] | None]:
     """Validate ``template`` and build its layout around ``centre`` (in a provisional frame)."""
     if not c.mapping(raw, "template", "{type: windward-leeward|trapezoid, twd_deg, "
@@ -690,6 +702,12 @@ def _template(
         return None, centre
     twd, length = kw.pop("twd_deg"), kw.pop("leg_length_m")
     laps = kw.pop("laps", 2)
+    most = _max_laps(length, time_limit_min)
+    if laps > most:
+        c.p.add("template.laps", f"{laps} laps of 2 × {length:g} m cannot be sailed within "
+                f"time_limit_min {time_limit_min or DEFAULT_TIME_LIMIT_MIN:g} even at 70 kn; "
+                f"expected an integer in [1, {most}] (or raise time_limit_min)")
+        return None, centre
     try:
         layout = TEMPLATES[kind]((0.0, 0.0), twd, length, laps, **kw)
     except InputError as exc:
@@ -775,7 +793,7 @@ def course_from_mapping(
         if clash:
             probs.add(clash[0], "a course with `template` gets its marks, lines, gates and "
                       f"legs from the template; remove {', '.join(clash)} or the template")
-        layout, centre = _template(c, template)
+        layout, centre = _template(c, template, time_limit)
         if layout is not None:
             layout_raw = _layout_mapping(layout)
             positions = {k: ("xy", xy) for k, xy in layout.marks.items()}

@@ -389,3 +389,35 @@ def test_legs_may_be_bare_names(tmp_path):
     c = load_course(write(tmp_path, text))
     assert [(leg.to_name, leg.rounding) for leg in c.legs] == [
         ("top", "port"), ("gate", None), ("top", "port"), ("start", None)]
+
+
+@pytest.mark.parametrize(("laps", "limit", "expected"), [
+    # 90 min at 70 kn (36.0 m/s) covers 194 km: at most 121 laps of 2 x 800 m
+    ("10000000", None, "template.laps: 10000000 laps of 2 × 800 m cannot be sailed within "
+     "time_limit_min 90 even at 70 kn; expected an integer in [1, 121]"),
+    ("1e30", None, "template.laps:"),
+    ("50", "10", "expected an integer in [1, 13] (or raise time_limit_min)"),
+])
+def test_template_laps_bounded_by_the_time_limit(tmp_path, laps, limit, expected):
+    # laps: 10000000 took 5.4 GB in 60 s and 1e30 never finished; both now fail at once
+    import time
+
+    text = textwrap.dedent(f"""\
+        name: t
+        start_time: "2024-05-01T12:00:00Z"
+        template:
+          type: windward-leeward
+          centre: {{lat: 45.0, lon: 13.0}}
+          twd_deg: 90
+          leg_length_m: 800
+          laps: {laps}
+        scenarios:
+          s: {{type: uniform, tws_kn: 10, twd_deg: 90}}
+        """) + (f"time_limit_min: {limit}\n" if limit else "")
+    t0 = time.perf_counter()
+    msg = problems(write(tmp_path, text))
+    assert expected in msg
+    assert time.perf_counter() - t0 < 5.0
+    ok = text.replace(f"laps: {laps}", "laps: 13") if limit else None
+    if ok:
+        assert load_course(write(tmp_path, ok, "ok.yaml")).n_legs == 26
