@@ -257,10 +257,11 @@ def wave_thrust(
     allowed = _oscar(tws, kin)
     share = allowed * _ramp(np.abs(twa), 90.0, 120.0) + (1.0 - allowed) * share
     slope = np.divide(2.0 * hs, lp, out=np.zeros_like(hs), where=lp > 0)
-    # the hull feels the slope averaged over its waterline length: sinc(π L_wl / L_p)
+    # the hull feels the slope averaged over its waterline length: sinc(π L_wl / L_p); a hull
+    # longer than the waves spans crest and trough and cannot ride one (0 past the first zero)
     x = np.divide(np.pi * params.lwl_m * np.maximum(cos_phi, 0.0), lp, out=np.zeros_like(lp),
                   where=lp > 0)
-    hull = np.sinc(x / np.pi)
+    hull = np.where(x < np.pi, np.sinc(x / np.pi), 0.0)
     mass = params.hull_mass_kg + params.crew_mass_kg
     return mass * G * slope * hull * share * np.maximum(cos_phi, 0.0)
 

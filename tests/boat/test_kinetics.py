@@ -134,6 +134,16 @@ def test_race_polar_is_steady_times_efficiency_on_a_beat_and_faster_downwind() -
     assert np.all(extra[:, 1] > 1.5 * extra[:, 0])  # [m/s]: 0.48 at 3 m/s, 0.85 at 5.61
 
 
+def test_builtin_race_polar_never_below_steady_off_the_wind() -> None:
+    # at every node with TWA >= 90 (no beat factor there) the extra force can only help; the
+    # hull-length filter once made short light-air waves push backwards (sinc < 0)
+    race, steady = builtin_polar("ilca7"), builtin_polar("ilca7-steady")
+    off = race.twa_deg >= 90.0
+    assert np.all(race.speed_ms[off] >= steady.speed_ms[off] - 1e-4)  # file rounding
+    assert np.all(wave_thrust(ILCA7, RACE, np.linspace(0.1, 3.0, 30)[:, None],
+                              np.linspace(90, 180, 19)[None, :], 1.0) >= 0.0)
+
+
 def test_builtin_race_polar_vmg_ratio_and_steady_name() -> None:
     # the run is much faster than the beat in the race polar, about equal in the steady one
     race, steady = builtin_polar("ilca7"), builtin_polar("ilca7-steady")
