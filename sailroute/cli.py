@@ -284,6 +284,75 @@ def strategy_command(
         typer.echo(f"wrote {path}")
 
 
+polar_app = typer.Typer(no_args_is_help=True, help="Boat polars: fit one from logged data.")
+app.add_typer(polar_app, name="polar")
+
+
+@polar_app.command("fit")
+def polar_fit_command(
+    log: Annotated[str, typer.Argument(help="Instrument log (CSV with tws, twa, bsp or sog) "
+                                       "or GPS track (GPX/CSV, with --course).")],
+    course: Annotated[
+        str | None,
+        typer.Option("--course", help="Course file whose scenario wind gives TWS/TWA at the "
+                     "track points (GPS track input)."),
+    ] = None,
+    scenario: Annotated[
+        str | None, typer.Option("--scenario", "-s", help="Scenario of --course (default: "
+                                 "the first).")
+    ] = None,
+    columns: Annotated[
+        str | None,
+        typer.Option("--columns", help="Log columns the reader does not recognise, e.g. "
+                     "'time=Time,bsp=BSP,tws=TWS,twa=TWA'."),
+    ] = None,
+    speed_unit: Annotated[
+        str | None,
+        typer.Option("--speed-unit", help="Unit of the log's unsuffixed speed columns: "
+                     "kn | m/s | km/h | mph."),
+    ] = None,
+    time_zone: Annotated[
+        str | None,
+        typer.Option("--time-zone", help="Zone of naive log times: UTC, +02:00, "
+                     "Europe/Tallinn."),
+    ] = None,
+    percentile: Annotated[
+        float, typer.Option("--percentile", help="Envelope percentile per cell.")
+    ] = 90.0,
+    min_count: Annotated[
+        int, typer.Option("--min-count", help="Samples a cell needs to count as covered.")
+    ] = 5,
+    tws_bins: Annotated[
+        str | None,
+        typer.Option("--tws-bins", help="Comma-separated TWS columns in --unit (default: "
+                     "every 2 kn / 1 m/s over the data)."),
+    ] = None,
+    twa_step: Annotated[float, typer.Option("--twa-step", help="TWA row step in degrees.")
+                        ] = 10.0,
+    out: Annotated[str, typer.Option("--out", help="Output folder.")] = "polar-fit-out",
+    unit: Annotated[str, typer.Option("--unit", help="Speed unit: kn or m/s.")] = "kn",
+    reference: Annotated[
+        str | None,
+        typer.Option("--reference", help="Polar to compare with: RMS and per-angle errors."),
+    ] = None,
+    reference_unit: Annotated[
+        str | None,
+        typer.Option("--reference-unit", help="Speed unit of --reference (default: the "
+                     "reader's, knots for .pol/CSV)."),
+    ] = None,
+) -> None:
+    """Fit a polar to a logged race: filtered percentile envelope; writes .pol/.csv/.json/.png."""
+    from sailroute.boat.fit_outputs import run_fit_command
+
+    res = run_guarded(
+        run_fit_command, log, course=course, scenario=scenario, columns=columns,
+        speed_unit=speed_unit, time_zone=time_zone, percentile=percentile,
+        min_count=min_count, tws_bins=tws_bins, twa_step_deg=twa_step, out_dir=out,
+        unit=unit, reference=reference, reference_unit=reference_unit,
+    )
+    _echo_result(res)
+
+
 def main() -> None:
     """Console-script entry point."""
     try:

@@ -42,7 +42,7 @@ BUILTIN_DECIMALS: Final = 4
 """Decimals of the shipped ``.pol`` files (knots): 5e-5 kn resolution."""
 
 _FORMS: Final = ("builtin", "polar", "vpp")
-_COMMON: Final = ("interpolation",)
+_COMMON: Final = ("interpolation", "efficiency")
 _ALLOWED: Final = {
     "builtin": {"builtin", *_COMMON},
     "polar": {"polar", "speed_unit", "wind_unit", "format", *_COMMON},
@@ -149,7 +149,8 @@ def boat_from_spec(
     spec : mapping
         One of ``{builtin: NAME}``, ``{polar: PATH, speed_unit?, wind_unit?,
         format?}`` or ``{vpp: {class: ..., crew_mass_kg: ..., <parameter>: ...}}``,
-        each with an optional ``interpolation``.
+        each with an optional ``interpolation`` and ``efficiency`` (speed factors by
+        point of sail, :func:`sailroute.boat.efficiency.scale_polar`).
     base_dir : Path
         Folder that relative ``polar`` paths are resolved against (the course
         file's folder).
@@ -174,6 +175,13 @@ def boat_from_spec(
             f"{where}: {key}: expected a mapping such as {{builtin: ilca7}}, {{polar: FILE}} or "
             f"{{vpp: {{class: ilca7}}}}; got {type(spec).__name__} {spec!r}"
         )
+    if "efficiency" in spec:
+        from sailroute.boat.efficiency import efficiency_from_spec, scale_polar
+
+        factors = efficiency_from_spec(spec["efficiency"], where=where, key=f"{key}.efficiency")
+        rest = {k: v for k, v in spec.items() if k != "efficiency"}
+        return scale_polar(boat_from_spec(rest, base_dir=base_dir, where=where, key=key),
+                           **factors)
     forms = [f for f in _FORMS if f in spec]
     if len(forms) != 1:
         found = f"got {', '.join(forms)}" if forms else f"got keys {sorted(map(str, spec))}"

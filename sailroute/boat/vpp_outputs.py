@@ -155,10 +155,23 @@ def plot_polar(polar: Polar, path: str | Path, unit: str = "kn") -> Path:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    f = speed_factor(unit)
     fig = Figure(figsize=(7, 7))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(projection="polar")
+    draw_polar(ax, polar, unit)
+    ax.set_title(f"{polar.name}: boat speed [{unit}] vs TWA (dots: best VMG)")
+    out = Path(path)
+    fig.savefig(out, dpi=110)
+    return out
+
+
+def draw_polar(ax: Any, polar: Polar, unit: str = "kn", colors: list[Any] | None = None) -> None:
+    """Draw one curve per TWS column and the best-VMG points on a polar ``ax``.
+
+    ``ax`` is a matplotlib polar axes (set to 0-180°, north up, clockwise);
+    ``colors`` gives one colour per TWS column (default: matplotlib's cycle).
+    """
+    f = speed_factor(unit)
     ax.set_theta_zero_location("N")
     ax.set_theta_direction(-1)
     ax.set_thetamin(0)
@@ -167,15 +180,12 @@ def plot_polar(polar: Polar, path: str | Path, unit: str = "kn") -> Path:
     up_a = polar.vmg_upwind(polar.tws_ms)[0]
     dn_a = polar.vmg_downwind(polar.tws_ms)[0]
     for j, tws in enumerate(polar.tws_ms):
+        kw = {} if colors is None else {"color": colors[j]}
         (line,) = ax.plot(np.radians(a), polar.speed(tws, a) / f, lw=1.2,
-                          label=f"{tws / f:g} {unit}")
+                          label=f"{tws / f:g} {unit}", **kw)
         for ang in (up_a[j], dn_a[j]):
             ax.plot(np.radians(ang), polar.speed(tws, ang) / f, "o", ms=3, color=line.get_color())
-    ax.set_title(f"{polar.name}: boat speed [{unit}] vs TWA (dots: best VMG)")
     ax.legend(loc="lower left", fontsize=7, title="TWS", title_fontsize=7)
-    out = Path(path)
-    fig.savefig(out, dpi=110)
-    return out
 
 
 def write_outputs(
