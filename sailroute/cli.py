@@ -353,6 +353,65 @@ def polar_fit_command(
     _echo_result(res)
 
 
+@app.command("analyze")
+def analyze_command(
+    course: Annotated[str, typer.Argument(help="Course file the boats sailed (YAML).")],
+    tracks: Annotated[
+        list[str], typer.Argument(help="Track file(s): GPX or CSV; several = a fleet.")
+    ],
+    scenario: Annotated[
+        str | None,
+        typer.Option("--scenario", "-s", help="Wind scenario name (default: the first)."),
+    ] = None,
+    out: Annotated[
+        str | None,
+        typer.Option("--out", "-o", help="Output folder (default: out/<course>/analysis-<track>)."),
+    ] = None,
+    leg_times: Annotated[
+        str | None,
+        typer.Option("--leg-times", help="Override detection: n_legs+1 comma-separated ISO "
+                     "times with offset (start crossing, each leg's end); '-' = detect."),
+    ] = None,
+    speed_unit: Annotated[
+        str | None,
+        typer.Option("--speed-unit", help="Unit of unsuffixed CSV speed columns: kn | m/s | "
+                     "km/h | mph."),
+    ] = None,
+    time_zone: Annotated[
+        str | None,
+        typer.Option("--time-zone", help="Zone of naive track times: '+02:00', 'UTC' or an "
+                     "IANA name."),
+    ] = None,
+    column: Annotated[
+        list[str] | None,
+        typer.Option("--column", help="CSV column mapping CANON=NAME, e.g. time=when (repeat)."),
+    ] = None,
+    router: Annotated[str | None, typer.Option("--router", "-r", help=_ROUTER_HELP)] = None,
+    no_plots: Annotated[bool, typer.Option("--no-plots", help="Skip legs.png, loss.png.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
+) -> None:
+    """Race analysis: a sailed track against the optimal route, leg by leg (time lost where)."""
+    from sailroute.analyze import run_analyze_command
+
+    def run() -> Any:
+        from sailroute.course.load import load_course
+        from sailroute.errors import InputError
+
+        columns = {}
+        for item in column or []:
+            canon, sep, name = item.partition("=")
+            if not sep or not canon.strip() or not name.strip():
+                raise InputError(f"--column {item!r}: expected CANON=NAME, e.g. time=when")
+            columns[canon.strip()] = name.strip()
+        loaded = load_course(course)
+        return run_analyze_command(
+            loaded, tracks, scenario=scenario, router=router, out_dir=out, leg_times=leg_times,
+            columns=columns or None, speed_unit=speed_unit, time_zone=time_zone,
+            plots=not no_plots, progress=_progress(loaded.n_legs, quiet))
+
+    _echo_result(run_guarded(run))
+
+
 def main() -> None:
     """Console-script entry point."""
     try:

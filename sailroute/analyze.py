@@ -1,0 +1,572 @@
+"""Race analysis orchestration: a sailed track against the optimal route, leg by leg.
+
+``analyze_track`` is where the layers meet (as :mod:`sailroute.plan` for routing):
+the track (``sailroute.track``) is projected into the course frame, split into legs
+(:mod:`sailroute.analysis.segment`), its tacks and gybes found
+(:mod:`sailroute.analysis.manoeuvres`), and each leg is routed from the boat's own
+leg start point and time to the same target in the scenario's wind
+(:func:`sailroute.routing.api.route_leg`), then compared
+(:mod:`sailroute.analysis.loss`).  Nothing here prints or writes;
+``run_analyze_command`` adds reading, file output and the terminal table.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sailroute.analysis.loss import (
+    LossSplit,
+    axis_progress,
+    lateral_offset,
+    manoeuvre_mask,
+    progress_loss,
+    side_label,
+    split_loss,
+    time_mean,
+)
+from sailroute.analysis.manoeuvres import SailedManoeuvre, find_sailed_manoeuvres
+from sailroute.analysis.segment import (
+    DETECT_M,
+    Segmentation,
+    leg_target,
+    segment_track,
+)
+from sailroute.course.geometry import feature_centre, leg_wind_mode
+from sailroute.course.load import build_specs, load_course
+from sailroute.course.model import Course
+from sailroute.errors import InputError
+from sailroute.plan import default_scenario, settings_for
+from sailroute.report.progress import Progress
+from sailroute.routing.api import route_leg
+from sailroute.routing.geometry import target_barrier
+from sailroute.routing.types import LegResult, RoutingSettings, Start
+from sailroute.timeutil import iso
+from sailroute.track.kinematics import track_xy, velocity
+from sailroute.track.model import Track
+from sailroute.track.read import read_track
+from sailroute.units import bearing_deg, signed_twa, wind_speed_direction
+from sailroute.wind.base import WindField
+
+NEAR_COURSE_M = 3000.0
+"""During the race the track must come this close to a mark [m], or it is another place."""
+SMOOTH_S = 3.0
+"""Window of the velocity smoothing used for COG, TWA and the manoeuvre detection [s]."""
+
+
+@dataclass(frozen=True, eq=False)
+class PointTable:
+    """Per-point quantities of the analysed part of a track (start crossing to finish).
+
+    All arrays have the same length.  ``leg`` is 1-based; a boundary time appears
+    twice (end of one leg, start of the next), as in ``track.csv`` of ``plan``.
+
+    Attributes
+    ----------
+    leg : ndarray of int
+    t : ndarray
+        [epoch s].
+    x, y : ndarray
+        [m], course frame.
+    lat, lon : ndarray
+        [°].
+    sog_ms, cog_deg : ndarray
+        Speed [m s⁻¹] and course [°] over ground (smoothed over ``SMOOTH_S``).
+    tws_ms, twd_deg, twa_deg : ndarray
+        Scenario wind at the point and TWA from COG [m s⁻¹, °, ° signed].
+    polar_ms, polar_pct : ndarray
+        Polar speed [m s⁻¹] and ``100 · SOG / polar`` [%] (NaN where the polar is
+        below ``POLAR_MIN_MS``).
+    vmg_ms : ndarray
+        Velocity made good [m s⁻¹]: against the wind on upwind legs, with it on
+        downwind legs, towards the target centre on reaches.
+    loss_s : ndarray
+        Cumulative time lost against the optimal legs [s].
+    """
+
+    leg: NDArray[np.int64]
+    t: NDArray[np.float64]
+    x: NDArray[np.float64]
+    y: NDArray[np.float64]
+    lat: NDArray[np.float64]
+    lon: NDArray[np.float64]
+    sog_ms: NDArray[np.float64]
+    cog_deg: NDArray[np.float64]
+    tws_ms: NDArray[np.float64]
+    twd_deg: NDArray[np.float64]
+    twa_deg: NDArray[np.float64]
+    polar_ms: NDArray[np.float64]
+    polar_pct: NDArray[np.float64]
+    vmg_ms: NDArray[np.float64]
+    loss_s: NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class LegAnalysis:
+    """One leg, sailed against optimal.
+
+    Attributes
+    ----------
+    index : int
+        0-based leg index.
+    label : str
+        ``"from -> to"``.
+    mode : str
+        Wind mode at the leg start (upwind / reach / downwind).
+    t_start, t_end : float
+        Sailed leg start and end [epoch s].
+    start_xy, end_xy : tuple of float
+        Where the boat started and ended the leg [m].
+    detected : bool
+        True when the end was found from the geometry (False: given).
+    sailed_time_s, optimal_time_s, loss_s : float
+        [s]; ``loss_s = sailed − optimal``.
+    sailed_distance_m, optimal_distance_m : float
+        [m].
+    sailed_tacks, sailed_gybes, optimal_tacks, optimal_gybes : int
+    manoeuvres : tuple of SailedManoeuvre
+        Sailed tacks/gybes in this leg.
+    mean_vmg_ms, mean_sog_ms, mean_polar_pct : float
+        Time-weighted means over the leg (polar % outside manoeuvre windows).
+    split : LossSplit
+        ``loss_s`` split into manoeuvres, speed and route (``analysis/loss.py``).
+    side_sailed, side_optimal : str
+        ``left`` / ``middle`` / ``right`` of the leg axis, looking from the leg start
+        to the target; ``lateral_*_m`` the time-mean offsets [m] (+ right).
+    optimal : LegResult
+        The optimal route of the leg.
+    """
+
+    index: int
+    label: str
+    mode: str
+    t_start: float
+    t_end: float
+    start_xy: tuple[float, float]
+    end_xy: tuple[float, float]
+    detected: bool
+    sailed_time_s: float
+    optimal_time_s: float
+    loss_s: float
+    sailed_distance_m: float
+    optimal_distance_m: float
+    sailed_tacks: int
+    sailed_gybes: int
+    optimal_tacks: int
+    optimal_gybes: int
+    manoeuvres: tuple[SailedManoeuvre, ...]
+    mean_vmg_ms: float
+    mean_sog_ms: float
+    mean_polar_pct: float
+    split: LossSplit
+    side_sailed: str
+    side_optimal: str
+    lateral_sailed_m: float
+    lateral_optimal_m: float
+    optimal: LegResult
+
+
+@dataclass(frozen=True, eq=False)
+class TrackAnalysis:
+    """A whole track analysed.
+
+    Attributes
+    ----------
+    course : Course
+    track : Track
+    scenario, router : str
+    segmentation : Segmentation
+        Start report and leg boundaries.
+    legs : tuple of LegAnalysis
+    points : PointTable
+    wind : WindField
+        The scenario's wind (for plots).
+    """
+
+    course: Course
+    track: Track
+    scenario: str
+    router: str
+    segmentation: Segmentation
+    legs: tuple[LegAnalysis, ...]
+    points: PointTable
+    wind: WindField
+
+    @property
+    def sailed_time_s(self) -> float:
+        """Start crossing to finish [s]."""
+        return sum(leg.sailed_time_s for leg in self.legs)
+
+    @property
+    def optimal_time_s(self) -> float:
+        """Sum of the optimal leg times [s]."""
+        return sum(leg.optimal_time_s for leg in self.legs)
+
+    @property
+    def loss_s(self) -> float:
+        """Sum of the leg losses [s]."""
+        return sum(leg.loss_s for leg in self.legs)
+
+
+def check_same_race(course: Course, track: Track, x: NDArray, y: NDArray) -> None:
+    """Refuse a track from another day or place than the course and its wind.
+
+    Raises
+    ------
+    InputError
+        No track point inside the race window ``[start_time, start_time +
+        time_limit]``, or none of them within :data:`NEAR_COURSE_M` of a mark.
+    """
+    t0 = course.start_epoch
+    t1 = t0 + course.time_limit_s
+    inside = (track.t_s >= t0) & (track.t_s <= t1)
+    if not inside.any():
+        raise InputError(
+            f"{track.source}: the track runs {iso(track.t_start)} .. {iso(track.t_end)} but "
+            f"the race ({course.source}) runs {iso(t0)} .. {iso(t1)} (start_time + "
+            "time_limit_min): another day or time zone? Check the track's times (time_zone "
+            "for naive times) and the course's start_time"
+        )
+    mx = np.array([m.x for m in course.marks.values()])
+    my = np.array([m.y for m in course.marks.values()])
+    d = np.hypot(x[inside, None] - mx[None, :], y[inside, None] - my[None, :]).min()
+    if d > NEAR_COURSE_M:
+        raise InputError(
+            f"{track.source}: during the race the track never comes within "
+            f"{NEAR_COURSE_M / 1000:.0f} km of a mark of {course.source} (closest "
+            f"{d / 1000:.1f} km): a track from another place? Check the files"
+        )
+
+
+def _smoothed_velocity(t: NDArray, x: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
+    vx, vy = velocity(t, x, y)
+    if t.size < 3:
+        return vx, vy
+    cx = np.concatenate([[0.0], np.cumsum(vx)])
+    cy = np.concatenate([[0.0], np.cumsum(vy)])
+    lo = np.searchsorted(t, t - 0.5 * SMOOTH_S, side="left")
+    hi = np.searchsorted(t, t + 0.5 * SMOOTH_S, side="right")
+    n = np.maximum(hi - lo, 1)
+    return (cx[hi] - cx[lo]) / n, (cy[hi] - cy[lo]) / n
+
+
+def _wind_at(wind: WindField, t: NDArray, x: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
+    u, v = wind.sample(t, x, y)
+    return wind_speed_direction(u, v)
+
+
+def analyze_track(
+    course: Course,
+    track: Track,
+    scenario: str | None = None,
+    *,
+    leg_times: Sequence[float | None] | None = None,
+    router: str | None = None,
+    detect_m: float = DETECT_M,
+    built: tuple[Any, WindField] | None = None,
+    progress: Progress | None = None,
+) -> TrackAnalysis:
+    """Analyse a sailed track against the optimal route of each leg.
+
+    Parameters
+    ----------
+    course : Course
+        The course sailed (marks, legs, start time = the gun, boat, wind scenarios).
+    track : Track
+        The boat's track (:func:`sailroute.track.read.read_track`).
+    scenario : str, optional
+        Wind scenario (default: the course's first).
+    leg_times : sequence of float or None, optional
+        ``n_legs + 1`` boundary times [epoch s] overriding the detection (None
+        entries are detected).
+    router : str, optional
+        Overrides the course's router.
+    detect_m : float
+        Rounding-ray length for mark detection [m].
+    built : (boat, wind), optional
+        Already built boat and wind (a fleet shares them).
+    progress : Progress, optional
+        Per-leg progress of the optimal routing.
+
+    Returns
+    -------
+    TrackAnalysis
+
+    Raises
+    ------
+    InputError
+        Track from another day/place, a leg that is never completed or a mark
+        rounded on the wrong side, bad leg times, bad scenario/specs.
+    OutOfCoverageError
+        The scenario's wind does not cover the track.
+    RoutingError
+        An optimal leg cannot be routed.
+    """
+    name = default_scenario(course) if scenario is None else scenario
+    settings: RoutingSettings = settings_for(course, router)
+    if built is None:
+        boat, winds = build_specs(course, [name])
+        wind = winds[name]
+    else:
+        boat, wind = built
+    where = f"{track.source or track.name}"
+    x, y = track_xy(track, course.frame)
+    check_same_race(course, track, x, y)
+    t = track.t_s
+    seg = segment_track(course, t, x, y, leg_times=leg_times, detect_m=detect_m, where=where)
+    svx, svy = _smoothed_velocity(t, x, y)
+    bounds = seg.bounds
+    t_a, t_b = bounds[0].t, bounds[-1].t
+    race = (t >= t_a) & (t <= t_b)
+    # manoeuvres over the race part, with TWA from the smoothed COG
+    tr, xr, yr = t[race], x[race], y[race]
+    _, twd_r = _wind_at(wind, tr, xr, yr)
+    mans, _ = find_sailed_manoeuvres(tr, twd_r, bearing_deg(svx[race], svy[race]),
+                                     np.hypot(svx[race], svy[race]))
+
+    legs: list[LegAnalysis] = []
+    cols: dict[str, list[NDArray]] = {k: [] for k in (
+        "leg", "t", "x", "y", "sog", "cog", "tws", "twd", "twa", "polar", "vmg", "loss")}
+    loss_before = 0.0
+    for i, spec in enumerate(course.legs):
+        a, b = bounds[i], bounds[i + 1]
+        inner = (t > a.t) & (t < b.t)
+        tl = np.concatenate([[a.t], t[inner], [b.t]])
+        xl = np.concatenate([[a.x], x[inner], [b.x]])
+        yl = np.concatenate([[a.y], y[inner], [b.y]])
+        vx = np.interp(tl, t, svx)
+        vy = np.interp(tl, t, svy)
+        sog = np.hypot(vx, vy)
+        cog = bearing_deg(vx, vy)
+        tws, twd = _wind_at(wind, tl, xl, yl)
+        twa = signed_twa(twd, cog)
+        polar = np.asarray(boat.speed(tws, np.abs(twa)), float)
+        ratio = np.where(polar >= 0.3, sog / np.where(polar > 0, polar, 1.0), np.nan)
+        target = leg_target(course, i)
+        centre = target.centre if target.kind != "mark" else feature_centre(
+            course.feature(spec.to_name))
+        mode = leg_wind_mode(wind, a.t, (a.x, a.y), centre)
+        if mode == "upwind":
+            vmg = sog * np.cos(np.radians(twa))
+        elif mode == "downwind":
+            vmg = -sog * np.cos(np.radians(twa))
+        else:
+            ux, uy = centre[0] - xl, centre[1] - yl
+            vmg = (vx * ux + vy * uy) / np.maximum(np.hypot(ux, uy), 1e-9)
+        # optimal route from the same point and time
+        barrier = None
+        if i > 0:
+            prev_start = (bounds[i - 1].x, bounds[i - 1].y)
+            barrier = target_barrier(leg_target(course, i - 1),
+                                     Start(prev_start, None, course.legs[i - 1].from_name),
+                                     settings.zone_m)
+        start = Start((a.x, a.y), None, spec.from_name, barrier)
+        if progress is not None:
+            progress.start_leg(i, spec.label)
+        opt = route_leg(start, target, a.t, wind, boat, settings,
+                        progress=progress.update if progress is not None else None)
+        if progress is not None:
+            progress.end_leg(opt.time_s, f"{opt.n_tacks} tacks, {opt.n_gybes} gybes")
+        sailed = b.t - a.t
+        loss = sailed - opt.time_s
+        prog = axis_progress(xl, yl, (a.x, a.y), centre)
+        prog_o = axis_progress(opt.track.x, opt.track.y, (a.x, a.y), centre)
+        cum = loss_before + progress_loss(tl - a.t, prog, opt.track.t - opt.t_start, prog_o)
+        cum[-1] = loss_before + loss
+        leg_mans = tuple(m for m in mans if a.t <= m.t < b.t)
+        lm_t = np.array([m.t for m in leg_mans])
+        penalty = opt.n_tacks * settings.tack_penalty_s + opt.n_gybes * settings.gybe_penalty_s
+        split = split_loss(tl, prog, ratio, lm_t, loss, penalty)
+        lat_s = time_mean(tl, lateral_offset(xl, yl, (a.x, a.y), centre))
+        lat_o = time_mean(opt.track.t, lateral_offset(opt.track.x, opt.track.y, (a.x, a.y),
+                                                      centre))
+        length = float(np.hypot(centre[0] - a.x, centre[1] - a.y))
+        straight = ~manoeuvre_mask(tl, lm_t)
+        legs.append(LegAnalysis(
+            index=i, label=spec.label, mode=mode, t_start=a.t, t_end=b.t,
+            start_xy=(a.x, a.y), end_xy=(b.x, b.y), detected=b.detected,
+            sailed_time_s=sailed, optimal_time_s=opt.time_s, loss_s=loss,
+            sailed_distance_m=float(np.sum(np.hypot(np.diff(xl), np.diff(yl)))),
+            optimal_distance_m=opt.distance_m,
+            sailed_tacks=sum(m.kind == "tack" for m in leg_mans),
+            sailed_gybes=sum(m.kind == "gybe" for m in leg_mans),
+            optimal_tacks=opt.n_tacks, optimal_gybes=opt.n_gybes, manoeuvres=leg_mans,
+            mean_vmg_ms=time_mean(tl, vmg), mean_sog_ms=time_mean(tl, sog),
+            mean_polar_pct=100.0 * time_mean(tl, np.clip(ratio, 0, 2), straight),
+            split=split, side_sailed=side_label(lat_s, length),
+            side_optimal=side_label(lat_o, length), lateral_sailed_m=lat_s,
+            lateral_optimal_m=lat_o, optimal=opt,
+        ))
+        loss_before += loss
+        for k, v in (("leg", np.full(tl.size, i + 1)), ("t", tl), ("x", xl), ("y", yl),
+                     ("sog", sog), ("cog", cog), ("tws", tws), ("twd", twd), ("twa", twa),
+                     ("polar", polar), ("vmg", vmg), ("loss", cum)):
+            cols[k].append(v)
+    c = {k: np.concatenate(v) for k, v in cols.items()}
+    lat, lon = course.frame.to_latlon(c["x"], c["y"])
+    pct = np.where(c["polar"] >= 0.3, 100.0 * c["sog"] / np.maximum(c["polar"], 1e-9), np.nan)
+    points = PointTable(c["leg"].astype(np.int64), c["t"], c["x"], c["y"], lat, lon, c["sog"],
+                        c["cog"], c["tws"], c["twd"], c["twa"], c["polar"], pct, c["vmg"],
+                        c["loss"])
+    return TrackAnalysis(course, track, name, settings.router, seg, tuple(legs), points, wind)
+
+
+def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
+    """Rank boats per leg by sailed leg time and by elapsed time at the leg's end.
+
+    Returns
+    -------
+    list of dict
+        One row per (leg, boat): ``leg`` (1-based), ``label``, ``boat``,
+        ``leg_time_s``, ``leg_rank``, ``elapsed_s`` (from the gun), ``position``,
+        ``loss_s``.
+    """
+    rows: list[dict[str, Any]] = []
+    if not analyses:
+        return rows
+    n = min(len(a.legs) for a in analyses)
+    for i in range(n):
+        times = [a.legs[i].sailed_time_s for a in analyses]
+        elapsed = [a.legs[i].t_end - a.segmentation.start.gun_t for a in analyses]
+        leg_rank = np.argsort(np.argsort(times, kind="stable"), kind="stable") + 1
+        pos = np.argsort(np.argsort(elapsed, kind="stable"), kind="stable") + 1
+        for k, a in enumerate(analyses):
+            rows.append({"leg": i + 1, "label": a.legs[i].label, "boat": a.track.name,
+                         "leg_time_s": times[k], "leg_rank": int(leg_rank[k]),
+                         "elapsed_s": elapsed[k], "position": int(pos[k]),
+                         "loss_s": a.legs[i].loss_s})
+    return rows
+
+
+def parse_leg_times(text: str | None, n_legs: int) -> list[float | None] | None:
+    """``--leg-times``: ``n_legs + 1`` comma-separated ISO times with offset, ``-`` to detect.
+
+    Raises
+    ------
+    InputError
+        Wrong count or a time without offset.
+    """
+    if text is None:
+        return None
+    from sailroute.timeutil import parse_time, to_epoch
+
+    parts = [p.strip() for p in text.split(",")]
+    if len(parts) != n_legs + 1:
+        raise InputError(
+            f"--leg-times: got {len(parts)} times for {n_legs} legs; give {n_legs + 1} "
+            "comma-separated ISO times with offset (start crossing, then each leg's end), "
+            "'-' for one to detect"
+        )
+    return [None if p in ("-", "") else to_epoch(parse_time(p, "--leg-times")) for p in parts]
+
+
+@dataclass(frozen=True, eq=False)
+class AnalyzeResult:
+    """What ``sailroute analyze`` prints and wrote.
+
+    Attributes
+    ----------
+    report : str
+        The terminal tables.
+    files : mapping of str to Path
+    analyses : tuple of TrackAnalysis
+    """
+
+    report: str
+    files: Mapping[str, Path]
+    analyses: tuple[TrackAnalysis, ...]
+
+
+def run_analyze_command(
+    course: Course | str | Path,
+    tracks: Sequence[str | Path],
+    *,
+    scenario: str | None = None,
+    router: str | None = None,
+    out_dir: str | Path | None = None,
+    leg_times: str | None = None,
+    columns: Mapping[str, str] | None = None,
+    speed_unit: str | None = None,
+    time_zone: str | None = None,
+    detect_m: float = DETECT_M,
+    plots: bool = True,
+    progress: Progress | None = None,
+) -> AnalyzeResult:
+    """Everything ``sailroute analyze`` does, minus printing.
+
+    Every track is read and analysed before anything is written, so a bad input
+    leaves no files.  One track: ``analysis.json``, ``analysis.csv``,
+    ``points.csv``, ``legs.png``, ``loss.png`` in ``out_dir`` (default
+    ``out/<course>/analysis-<track stem>``).  Several: the same per boat in
+    ``out_dir/<track stem>/`` plus ``fleet.csv`` and ``fleet.json`` (default
+    ``out/<course>/analysis-fleet``).
+    """
+    from sailroute.outdir import make_out_dir
+    from sailroute.plan import _loaded
+    from sailroute.report.analysis import analysis_table, fleet_table, write_analysis, write_fleet
+
+    course = _loaded(course)
+    if not tracks:
+        raise InputError("analyze: give at least one track file")
+    if leg_times is not None and len(tracks) > 1:
+        raise InputError("--leg-times applies to one track; analyse the boats one by one")
+    name = default_scenario(course) if scenario is None else scenario
+    times = parse_leg_times(leg_times, course.n_legs)
+    read = [read_track(p, columns=columns, speed_unit=speed_unit, time_zone=time_zone,
+                       name=s) for p, s in zip(tracks, _unique_stems(tracks), strict=True)]
+    settings_for(course, router)
+    boat, winds = build_specs(course, [name])
+    analyses = []
+    for tr in read:
+        if progress is not None:
+            progress.set_prefix(f"{tr.name}: ")
+        analyses.append(analyze_track(course, tr, name, leg_times=times, router=router,
+                                      detect_m=detect_m, built=(boat, winds[name]),
+                                      progress=progress))
+    stem = Path(course.source).stem if course.source else "course"
+    files: dict[str, Path] = {}
+    if len(analyses) == 1:
+        default = Path("out") / stem / f"analysis-{Path(tracks[0]).stem}"
+        out = make_out_dir(Path(out_dir) if out_dir is not None else default)
+        files.update(write_analysis(out, analyses[0], plots=plots))
+        return AnalyzeResult(analysis_table(analyses[0]), files, tuple(analyses))
+    out = make_out_dir(Path(out_dir) if out_dir is not None
+                       else Path("out") / stem / "analysis-fleet")
+    stems = _unique_stems(tracks)
+    for s, a in zip(stems, analyses, strict=True):
+        for kind, p in write_analysis(out / s, a, plots=plots).items():
+            files[f"{s}/{kind}"] = p
+    rows = fleet_ranking(analyses)
+    files.update(write_fleet(out, analyses, rows))
+    report = "\n\n".join([*(analysis_table(a) for a in analyses), fleet_table(rows)])
+    return AnalyzeResult(report, files, tuple(analyses))
+
+
+def _unique_stems(paths: Sequence[str | Path]) -> list[str]:
+    out: list[str] = []
+    for p in paths:
+        s = Path(p).stem
+        k = 2
+        base = s
+        while s in out:
+            s = f"{base}-{k}"
+            k += 1
+        out.append(s)
+    return out
+
+
+def load_and_analyze(course_path: str | Path, track_path: str | Path, scenario: str | None = None,
+                     **read_kw: Any) -> TrackAnalysis:
+    """Convenience: load a course, read a track, analyse (the Python API in one call)."""
+    course = load_course(course_path)
+    return analyze_track(course, read_track(track_path, **read_kw), scenario)
+
+
+__all__ = ["AnalyzeResult", "LegAnalysis", "PointTable", "TrackAnalysis", "analyze_track",
+           "check_same_race", "fleet_ranking", "load_and_analyze",
+           "parse_leg_times", "run_analyze_command"]

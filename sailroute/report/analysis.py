@@ -1,0 +1,284 @@
+"""Outputs of ``sailroute analyze``: JSON, CSVs, terminal tables and charts.
+
+Schemas in ``docs/output-format.md`` (``analysis.json`` ``schema_version`` 1).
+Charts use matplotlib's object-oriented API (no ``pyplot``), imported only when
+plotting.  Artists carry a ``gid``: ``sailed:<leg>``, ``optimal:<leg>`` on the leg
+maps, ``loss`` on the loss chart.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from sailroute import __version__
+from sailroute.report.files import _num, _point
+from sailroute.timeutil import iso
+from sailroute.units import KNOT
+
+if TYPE_CHECKING:  # pragma: no cover
+    from matplotlib.figure import Figure
+
+    from sailroute.analyze import TrackAnalysis
+
+SCHEMA_VERSION = 1
+
+LEG_COLUMNS = (
+    "leg", "from", "to", "mode", "start_time", "end_time", "detected", "sailed_time_s",
+    "optimal_time_s", "loss_s", "loss_manoeuvres_s", "loss_speed_s", "loss_route_s",
+    "sailed_distance_m", "optimal_distance_m", "sailed_tacks", "optimal_tacks", "sailed_gybes",
+    "optimal_gybes", "mean_vmg_ms", "mean_sog_ms", "mean_polar_pct", "side_sailed",
+    "side_optimal", "lateral_sailed_m", "lateral_optimal_m",
+)
+"""Columns of ``analysis.csv``."""
+
+POINT_COLUMNS = (
+    "leg", "time", "x_m", "y_m", "lat", "lon", "sog_ms", "sog_kn", "cog_deg", "tws_ms",
+    "twd_deg", "twa_deg", "polar_ms", "polar_pct", "vmg_ms", "loss_s",
+)
+"""Columns of ``points.csv``."""
+
+
+def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
+    """The ``analysis.json`` document (see ``docs/output-format.md``)."""
+    c = a.course
+    st = a.segmentation.start
+    legs = []
+    for leg in a.legs:
+        spec = c.legs[leg.index]
+        legs.append({
+            "index": leg.index + 1, "from": spec.from_name, "to": spec.to_name,
+            "target_kind": spec.kind, "rounding": spec.rounding, "mode": leg.mode,
+            "start_time": iso(leg.t_start), "end_time": iso(leg.t_end),
+            "end_detected": leg.detected,
+            "start_point": _point(c, leg.start_xy), "end_point": _point(c, leg.end_xy),
+            "sailed_time_s": _num(leg.sailed_time_s), "optimal_time_s": _num(leg.optimal_time_s),
+            "loss_s": _num(leg.loss_s),
+            "loss_split_s": {"manoeuvres": _num(leg.split.manoeuvres),
+                             "speed": _num(leg.split.speed), "route": _num(leg.split.route)},
+            "sailed_distance_m": _num(leg.sailed_distance_m, 1),
+            "optimal_distance_m": _num(leg.optimal_distance_m, 1),
+            "sailed_tacks": leg.sailed_tacks, "sailed_gybes": leg.sailed_gybes,
+            "optimal_tacks": leg.optimal_tacks, "optimal_gybes": leg.optimal_gybes,
+            "manoeuvres": [{"kind": m.kind, "time": iso(m.t)} for m in leg.manoeuvres],
+            "mean_vmg_ms": _num(leg.mean_vmg_ms), "mean_sog_ms": _num(leg.mean_sog_ms),
+            "mean_polar_pct": _num(leg.mean_polar_pct, 1),
+            "side": {"sailed": leg.side_sailed, "optimal": leg.side_optimal,
+                     "lateral_sailed_m": _num(leg.lateral_sailed_m, 1),
+                     "lateral_optimal_m": _num(leg.lateral_optimal_m, 1)},
+        })
+    return {
+        "schema_version": SCHEMA_VERSION,
+        "sailroute_version": __version__,
+        "course": c.name,
+        "source": str(c.source) if c.source else None,
+        "track": {"name": a.track.name, "source": a.track.source, "points": len(a.track),
+                  "first_time": iso(a.track.t_start), "last_time": iso(a.track.t_end),
+                  "notes": list(a.track.notes)},
+        "scenario": a.scenario,
+        "router": a.router,
+        "origin": {"lat": c.frame.lat0, "lon": c.frame.lon0},
+        "start": {"gun_time": iso(st.gun_t), "start_time": iso(st.crossing.t),
+                  "detected": st.crossing.detected, "late_s": _num(st.late_s),
+                  "distance_at_gun_m": _num(st.distance_at_gun_m, 1),
+                  "side_at_gun": st.side_at_gun, "line_fraction": _num(st.line_fraction),
+                  "point": _point(c, (st.crossing.x, st.crossing.y))},
+        "finish_time": iso(a.segmentation.ends[-1].t),
+        "sailed_time_s": _num(a.sailed_time_s),
+        "optimal_time_s": _num(a.optimal_time_s),
+        "loss_s": _num(a.loss_s),
+        "loss_split_s": {k: _num(sum(getattr(leg.split, k) for leg in a.legs))
+                         for k in ("manoeuvres", "speed", "route")},
+        "legs": legs,
+    }
+
+
+def _fmt(v: Any) -> Any:
+    if isinstance(v, float):
+        return "" if not math.isfinite(v) else f"{v:.3f}"
+    return v
+
+
+def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
+                   ) -> dict[str, Path]:
+    """Write ``analysis.json``, ``analysis.csv``, ``points.csv`` and (with ``plots``)
+    ``legs.png`` and ``loss.png`` into ``out_dir`` (created)."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    files: dict[str, Path] = {}
+    jp = out / "analysis.json"
+    jp.write_text(json.dumps(analysis_to_dict(a), indent=2, ensure_ascii=False) + "\n",
+                  encoding="utf-8")
+    files["analysis_json"] = jp
+    cp = out / "analysis.csv"
+    with cp.open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(LEG_COLUMNS)
+        for leg in a.legs:
+            spec = a.course.legs[leg.index]
+            w.writerow([_fmt(v) for v in (
+                leg.index + 1, spec.from_name, spec.to_name, leg.mode, iso(leg.t_start),
+                iso(leg.t_end), leg.detected, leg.sailed_time_s, leg.optimal_time_s,
+                leg.loss_s, leg.split.manoeuvres, leg.split.speed, leg.split.route,
+                leg.sailed_distance_m, leg.optimal_distance_m, leg.sailed_tacks,
+                leg.optimal_tacks, leg.sailed_gybes, leg.optimal_gybes, leg.mean_vmg_ms,
+                leg.mean_sog_ms, leg.mean_polar_pct, leg.side_sailed, leg.side_optimal,
+                leg.lateral_sailed_m, leg.lateral_optimal_m)])
+    files["analysis_csv"] = cp
+    pp = out / "points.csv"
+    p = a.points
+    with pp.open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(POINT_COLUMNS)
+        for k in range(p.t.size):
+            w.writerow([int(p.leg[k]), iso(p.t[k]), f"{p.x[k]:.2f}", f"{p.y[k]:.2f}",
+                        f"{p.lat[k]:.8f}", f"{p.lon[k]:.8f}",
+                        *(_fmt(float(v)) for v in (
+                            p.sog_ms[k], p.sog_ms[k] / KNOT, p.cog_deg[k], p.tws_ms[k],
+                            p.twd_deg[k], p.twa_deg[k], p.polar_ms[k], p.polar_pct[k],
+                            p.vmg_ms[k], p.loss_s[k]))])
+    files["points_csv"] = pp
+    if plots:
+        plot_legs(a).savefig(out / "legs.png", dpi=120)
+        files["legs_png"] = out / "legs.png"
+        plot_loss(a).savefig(out / "loss.png", dpi=120)
+        files["loss_png"] = out / "loss.png"
+    return files
+
+
+def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
+                rows: Sequence[Mapping[str, Any]]) -> dict[str, Path]:
+    """Write ``fleet.csv`` (one row per leg and boat) and ``fleet.json``."""
+    out = Path(out_dir)
+    cp = out / "fleet.csv"
+    cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s")
+    with cp.open("w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        for r in rows:
+            w.writerow([_fmt(r[c]) for c in cols])
+    jp = out / "fleet.json"
+    doc = {"schema_version": SCHEMA_VERSION, "sailroute_version": __version__,
+           "course": analyses[0].course.name if analyses else None,
+           "boats": [a.track.name for a in analyses],
+           "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()}
+                    for r in rows]}
+    jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
+    return {"fleet_csv": cp, "fleet_json": jp}
+
+
+def _mss(s: float) -> str:
+    sign = "-" if s < 0 else ""
+    tenths = round(abs(s) * 10)
+    return f"{sign}{tenths // 600}:{(tenths % 600) / 10:04.1f}"
+
+
+def analysis_table(a: TrackAnalysis) -> str:
+    """Terminal report: start, then one row per leg and a total."""
+    st = a.segmentation.start
+    head = (f"{a.track.name} on {a.course.name} ({a.scenario}, {a.router})\n"
+            f"start: {'detected' if st.crossing.detected else 'given'} "
+            f"{iso(st.crossing.t)}, {st.late_s:+.1f} s after the gun, "
+            f"{st.distance_at_gun_m:.0f} m from the line at the gun "
+            f"({st.side_at_gun} side), {100 * st.line_fraction:.0f}% along it")
+    cols = f"{'leg':<14}{'mode':<9}{'sailed':>9}{'optimal':>9}{'lost':>8}{'man':>7}" \
+           f"{'speed':>7}{'route':>7}{'dist m':>13}{'tk/gb':>11}{'polar%':>7}{'side s/o':>15}"
+    rows = [head, "", cols]
+    for leg in a.legs:
+        rows.append(
+            f"{leg.label:<14}{leg.mode:<9}{_mss(leg.sailed_time_s):>9}"
+            f"{_mss(leg.optimal_time_s):>9}{leg.loss_s:>+8.1f}{leg.split.manoeuvres:>+7.1f}"
+            f"{leg.split.speed:>+7.1f}{leg.split.route:>+7.1f}"
+            f"{leg.sailed_distance_m:>6.0f}/{leg.optimal_distance_m:<6.0f}"
+            f"{leg.sailed_tacks:>3}/{leg.sailed_gybes}:{leg.optimal_tacks}/{leg.optimal_gybes:<3}"
+            f"{leg.mean_polar_pct:>7.0f}{leg.side_sailed:>8}/{leg.side_optimal:<6}")
+    tot = [sum(getattr(leg.split, k) for leg in a.legs) for k in ("manoeuvres", "speed",
+                                                                   "route")]
+    rows.append(f"{'total':<14}{'':<9}{_mss(a.sailed_time_s):>9}{_mss(a.optimal_time_s):>9}"
+                f"{a.loss_s:>+8.1f}{tot[0]:>+7.1f}{tot[1]:>+7.1f}{tot[2]:>+7.1f}")
+    rows.append("(lost = sailed - optimal from the same point and time, split into "
+                "manoeuvres + speed + route; tk/gb sailed:optimal)")
+    if a.track.notes:
+        rows.append("track: " + "; ".join(a.track.notes))
+    return "\n".join(rows)
+
+
+def fleet_table(rows: Sequence[Mapping[str, Any]]) -> str:
+    """Boats ranked per leg: leg time (rank) and elapsed time (position)."""
+    out = ["fleet: leg time (rank) | elapsed from the gun (position) | lost vs optimal"]
+    leg = None
+    for r in sorted(rows, key=lambda r: (r["leg"], r["leg_rank"])):
+        if r["leg"] != leg:
+            leg = r["leg"]
+            out.append(f"leg {leg} ({r['label']})")
+        out.append(f"  {r['leg_rank']}. {r['boat']:<28}{_mss(r['leg_time_s']):>9}  "
+                   f"pos {r['position']} {_mss(r['elapsed_s']):>9}  {r['loss_s']:+.1f} s")
+    return "\n".join(out)
+
+
+def plot_legs(a: TrackAnalysis) -> Figure:
+    """One map per leg: the sailed track (solid, coloured by leg) and the optimal route
+    (dashed) from the same start, with the course and the sailed manoeuvres."""
+    from matplotlib.figure import Figure
+
+    from sailroute.report.plots import draw_course
+
+    n = len(a.legs)
+    ncol = min(n, 3)
+    nrow = math.ceil(n / ncol)
+    fig = Figure(figsize=(4.6 * ncol, 4.4 * nrow), layout="constrained")
+    p = a.points
+    for i, leg in enumerate(a.legs):
+        ax = fig.add_subplot(nrow, ncol, i + 1)
+        draw_course(ax, a.course)
+        m = p.leg == i + 1
+        ax.plot(p.x[m], p.y[m], "-", color="tab:blue", lw=1.4, gid=f"sailed:{i + 1}",
+                label=f"sailed {_mss(leg.sailed_time_s)}")
+        o = leg.optimal.track
+        ax.plot(o.x, o.y, "--", color="tab:red", lw=1.4, gid=f"optimal:{i + 1}",
+                label=f"optimal {_mss(leg.optimal_time_s)}")
+        if leg.manoeuvres:
+            idx = [int(np.argmin(np.abs(p.t[m] - mm.t))) for mm in leg.manoeuvres]
+            ax.plot(p.x[m][idx], p.y[m][idx], "^", color="black", ms=4, linestyle="none",
+                    label="sailed tacks/gybes")
+        xs = np.concatenate([p.x[m], o.x])
+        ys = np.concatenate([p.y[m], o.y])
+        pad = 0.1 * max(np.ptp(xs), np.ptp(ys), 50.0)
+        ax.set_xlim(xs.min() - pad, xs.max() + pad)
+        ax.set_ylim(ys.min() - pad, ys.max() + pad)
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_title(f"leg {i + 1}: {leg.label} ({leg.mode}), lost {leg.loss_s:+.0f} s",
+                     fontsize=9)
+        ax.set_xlabel("x [m]", fontsize=8)
+        ax.set_ylabel("y [m]", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.legend(fontsize=7, loc="best")
+    fig.suptitle(f"{a.track.name}: sailed vs optimal ({a.scenario})", fontsize=10)
+    return fig
+
+
+def plot_loss(a: TrackAnalysis) -> Figure:
+    """Cumulative time lost against the optimal legs over race time, legs shaded."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(8, 3.8), layout="constrained")
+    ax = fig.add_subplot(1, 1, 1)
+    p = a.points
+    t0 = a.segmentation.start.crossing.t
+    ax.plot((p.t - t0) / 60.0, p.loss_s, "-", color="tab:red", lw=1.4, gid="loss")
+    for i, leg in enumerate(a.legs):
+        ax.axvspan((leg.t_start - t0) / 60, (leg.t_end - t0) / 60, alpha=0.08 if i % 2 else 0.0,
+                   color="grey")
+        ax.annotate(f"{i + 1}", ((0.5 * (leg.t_start + leg.t_end) - t0) / 60, 0.98),
+                    xycoords=("data", "axes fraction"), ha="center", va="top", fontsize=8)
+    ax.axhline(0, color="black", lw=0.6)
+    ax.set_xlabel("minutes since the start crossing")
+    ax.set_ylabel("time lost vs optimal [s]")
+    ax.set_title(f"{a.track.name}: cumulative loss (total {a.loss_s:+.0f} s)", fontsize=10)
+    return fig
