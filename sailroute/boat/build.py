@@ -13,7 +13,9 @@ are the steady VPP alone.  ``kinetics`` (``race``, the default, ``steady``, or a
 mapping of race-model parameters such as ``{sea_age_h: 6}``) picks the same for
 the ``vpp`` form.  ``polar`` paths are relative to the course
 file's folder.  Optional key in every form: ``interpolation`` (``pchip``, the
-default, or ``linear``).
+default, or ``linear``).  ``allow_extrapolation`` (default false) lets a course
+route in wind above the polar's highest TWS column, with a warning instead of an
+error (:mod:`sailroute.boat.sanity`).
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ BUILTIN_DECIMALS: Final = 4
 """Decimals of the shipped ``.pol`` files (knots): 5e-5 kn resolution."""
 
 _FORMS: Final = ("builtin", "polar", "vpp")
-_COMMON: Final = ("interpolation", "efficiency")
+_COMMON: Final = ("interpolation", "efficiency", "allow_extrapolation")
 _ALLOWED: Final = {
     "builtin": {"builtin", *_COMMON},
     "polar": {"polar", "speed_unit", "wind_unit", "format", *_COMMON},
@@ -202,6 +204,9 @@ def boat_from_spec(
             f"{key}.interpolation: expected one of {', '.join(map(repr, INTERPOLATIONS))}; "
             f"got {interpolation!r}"
         )
+    allow = spec.get("allow_extrapolation", False)
+    if not isinstance(allow, bool):
+        problems.append(f"{key}.allow_extrapolation: expected true or false; got {allow!r}")
     if form == "builtin":
         name = spec["builtin"]
         if not isinstance(name, str) or name.lower() not in builtin_names():

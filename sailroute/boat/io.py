@@ -10,8 +10,9 @@ Formats
     semicolons, tabs, commas or runs of spaces (detected from the header line);
     CRLF line endings are accepted.  **Units default to knots** for both TWS
     and boat speed (the de-facto convention of OpenCPN, qtVlm and
-    libweatherrouting); pass ``speed_unit``/``wind_unit`` otherwise.
-    Empty cells are filled (see :func:`fill_empty_cells`).
+    libweatherrouting); pass ``speed_unit``/``wind_unit`` otherwise, or name
+    the unit in the label cell (``TWA\\TWS (km/h)``, ``twa/tws_ms``) or the
+    file name (see below).  Empty cells are filled (see :func:`fill_empty_cells`).
 ``csv`` long format
     A header naming a TWS, a TWA and a speed column (``tws``, ``twa``,
     ``speed``/``bsp``/``boat_speed``/``stw``, in any order), each optionally with
@@ -21,6 +22,20 @@ Formats
     sailroute's own format (written by :func:`write_polar_json`, units stated
     in the file) or an ORC certificate JSON (``jieter/orc-data``; knots), see
     :func:`read_orc_json`.
+
+Units named by the file
+    The last ``.``/``_``/``-``-separated word of the file's stem may name the
+    unit of the whole file: ``kn``, ``kt``, ``kts``, ``knot``, ``knots``, ``ms``,
+    ``mps``, ``kmh``, ``kph``, ``mph`` (e.g. ``f50.kph.csv``, ``polar_kmh.pol``;
+    see :func:`unit_from_name`).  The file is then read in that unit; a
+    ``speed_unit``/``wind_unit``, a label cell or a column suffix that says
+    otherwise is an error.
+
+Sanity (see ``docs/usage.md``, "Polar sanity"): boat speeds above
+:data:`~sailroute.boat.polar.MAX_BOAT_SPEED_KN`, TWS columns above
+:data:`~sailroute.boat.polar.MAX_TWS_KN`, TWA/TWS nodes closer than
+:data:`~sailroute.boat.polar.MIN_AXIS_STEP` (counting TWA 0/180 and TWS 0) and a
+table without any positive speed are refused.
 
 Every error names the file, the line and the cell.
 """
@@ -38,9 +53,17 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import NDArray
 
-from sailroute.boat.polar import Polar
+from sailroute.boat.polar import (
+    MAX_BOAT_SPEED_KN,
+    MAX_BOAT_SPEED_MS,
+    MAX_TWS_KN,
+    MAX_TWS_MS,
+    MIN_AXIS_STEP,
+    Polar,
+    axis_spacing_problem,
+)
 from sailroute.errors import InputError
-from sailroute.units import speed_factor
+from sailroute.units import KNOT, speed_factor
 
 FORMATS: Final = ("pol", "csv", "json")
 """Values of the ``format`` argument of :func:`read_polar`."""
@@ -61,6 +84,10 @@ _UNIT_SUFFIX: Final = {
     "mph": "mph",
 }
 JSON_FORMAT_TAG: Final = "sailroute-polar"
+_NAME_UNITS: Final = {
+    "kn": "kn", "kt": "kn", "kts": "kn", "knot": "kn", "knots": "kn",
+    "ms": "m/s", "mps": "m/s", "kmh": "km/h", "kph": "km/h", "mph": "mph",
+}
 
 
 # --- public entry points --------------------------------------------------------
@@ -290,7 +317,6 @@ def parse_pol(
 ) -> Polar:
     """Parse the text of a wide polar table (see the module docstring)."""
     src = str(source)
-    fs, fw = _units(src, speed_unit, wind_unit, "kn")
     lines = text.splitlines()
     # header: first non-comment, non-empty line whose first cell is a label;
     # one free-text description line before it is allowed (OpenCPN)
@@ -322,6 +348,9 @@ def parse_pol(
     lineno = header_idx + 1
     if len(head) < 2:
         raise InputError(f"{src}:{lineno}: header has no wind speeds after {head[0]!r}")
+    s_unit, w_unit = _file_units(src, speed_unit, wind_unit, [
+        (f"the label cell {head[0].strip()!r} (line {lineno})", _header_unit(head[0]))])
+    header_line = lineno
     tws = [_number(c, src, lineno, k + 2, "wind speed") for k, c in enumerate(head[1:])]
     for k in range(1, len(tws)):
         if tws[k] <= tws[k - 1]:
@@ -381,9 +410,14 @@ def parse_pol(
     if len(twa) < 2:
         raise InputError(f"{src}: the table needs at least 2 TWA rows; found {len(twa)}")
     tws_arr = np.asarray(tws, dtype=float)
-    tab = fill_empty_cells(np.asarray(twa), tws_arr, np.asarray(rows, dtype=float))
-    return Polar(np.asarray(twa), tws_arr * fw, tab * fs, name=Path(src).stem,
-                 interpolation=interpolation)
+    raw = np.asarray(rows, dtype=float)
+    _check_table(src, np.asarray(twa), tws_arr, raw, s_unit, w_unit,
+                 at_twa=lambda i: f"{src}:{row_lines[i]}: cell 1",
+                 at_tws=lambda j: f"{src}:{header_line}: cell {j + 2}",
+                 at_cell=lambda i, j: f"{src}:{row_lines[i]}: cell {j + 2}")
+    tab = fill_empty_cells(np.asarray(twa), tws_arr, raw)
+    return Polar(np.asarray(twa), tws_arr * speed_factor(w_unit), tab * speed_factor(s_unit),
+                 name=Path(src).stem, interpolation=interpolation)
 
 
 def fill_empty_cells(
@@ -469,11 +503,18 @@ def parse_long_csv(
     if cols["twa"][1] not in (None, "deg"):
         raise InputError(f"{src}:{start + 1}: TWA must be in degrees; got column "
                          f"{header[cols['twa'][0]]!r}")
-    s_unit = _merge_unit(src, start + 1, "speed", cols["speed"][1], speed_unit)
-    w_unit = _merge_unit(src, start + 1, "wind", cols["tws"][1], wind_unit or
-                         (speed_unit if cols["tws"][1] is None and cols["speed"][1] is None
-                          else None))
-    fs, fw = speed_factor(s_unit), speed_factor(w_unit)
+    named = unit_from_name(src)
+    given_w = wind_unit or (speed_unit if cols["tws"][1] is None and cols["speed"][1] is None
+                            else None)
+    if named is not None:  # the file name covers both columns
+        name_claim = (f"the file name {Path(src).name!r}", named)
+        for what, role, given, opt in (("boat speed", "speed", speed_unit, "speed_unit"),
+                                       ("wind speed", "tws", given_w, "wind_unit")):
+            _agree(src, what, [(f"column {header[cols[role][0]]!r}", cols[role][1]),
+                               (f"{opt}={given!r}", given), name_claim])
+    s_unit = _merge_unit(src, start + 1, "speed", cols["speed"][1], speed_unit,
+                         default=named or "kn")
+    w_unit = _merge_unit(src, start + 1, "wind", cols["tws"][1], given_w, default=named or "kn")
     values: dict[tuple[float, float], tuple[float, int]] = {}
     for k in range(start + 1, len(rows)):
         r = rows[k]
@@ -501,10 +542,21 @@ def parse_long_csv(
     if twa_ax.size < 2:
         raise InputError(f"{src}: need at least 2 distinct TWA values; found {twa_ax.size}")
     tab = np.full((twa_ax.size, tws_ax.size), np.nan)
-    for (w, a), (v, _) in values.items():
-        tab[np.searchsorted(twa_ax, a), np.searchsorted(tws_ax, w)] = v
+    line_of = np.zeros(tab.shape, dtype=int)
+    for (w, a), (v, ln) in values.items():
+        ij = np.searchsorted(twa_ax, a), np.searchsorted(tws_ax, w)
+        tab[ij], line_of[ij] = v, ln
+
+    def first_line(axis: int, value: float) -> int:  # (only on error)
+        return min(ln for key, (_, ln) in values.items() if key[axis] == value)
+
+    _check_table(src, twa_ax, tws_ax, tab, s_unit, w_unit,
+                 at_twa=lambda i: f"{src}:{first_line(1, twa_ax[i])}: cell {cols['twa'][0] + 1}",
+                 at_tws=lambda j: f"{src}:{first_line(0, tws_ax[j])}: cell {cols['tws'][0] + 1}",
+                 at_cell=lambda i, j: f"{src}:{line_of[i, j]}: cell {cols['speed'][0] + 1}")
     tab = fill_empty_cells(twa_ax, tws_ax, tab)
-    return Polar(twa_ax, tws_ax * fw, tab * fs, name=Path(src).stem, interpolation=interpolation)
+    return Polar(twa_ax, tws_ax * speed_factor(w_unit), tab * speed_factor(s_unit),
+                 name=Path(src).stem, interpolation=interpolation)
 
 
 # --- JSON -----------------------------------------------------------------------------
@@ -532,6 +584,9 @@ def _read_json_text(
         raise InputError(f"{p}: " + "; ".join(problems))
     file_speed = str(doc["speed_unit"])
     file_wind = str(doc.get("wind_unit", file_speed))
+    name_claim = (f"the file name {p.name!r}", unit_from_name(p))
+    _agree(str(p), "boat speed", [(f"its speed_unit {file_speed!r}", file_speed), name_claim])
+    _agree(str(p), "wind speed", [(f"its wind_unit {file_wind!r}", file_wind), name_claim])
     s_unit = _merge_unit(str(p), None, "speed", file_speed, speed_unit)
     w_unit = _merge_unit(str(p), None, "wind", file_wind, wind_unit)
     try:
@@ -540,6 +595,10 @@ def _read_json_text(
         tab = np.asarray(doc["speed"], dtype=float)
     except (TypeError, ValueError) as exc:
         raise InputError(f"{p}: twa_deg, tws and speed must be numbers ({exc})") from None
+    if _well_formed(twa, tws, tab):
+        _check_table(str(p), twa, tws, tab, s_unit, w_unit,
+                     at_twa=lambda i: f"{p}: twa_deg[{i}]", at_tws=lambda j: f"{p}: tws[{j}]",
+                     at_cell=lambda i, j: f"{p}: speed[{i}][{j}]")
     try:
         return Polar(twa, tws * speed_factor(w_unit), tab * speed_factor(s_unit),
                      name=str(doc.get("name") or p.stem), interpolation=interpolation)
@@ -548,25 +607,46 @@ def _read_json_text(
 
 
 def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -> Polar:
+    named = unit_from_name(p)
+    if named not in (None, "kn"):
+        raise InputError(f"{p}: the file name says {named}, but ORC certificate polars are in "
+                         "knots; rename the file")
+    what = ("not an ORC certificate polar: need vpp.angles, vpp.speeds, one speed list per "
+            "angle and beat/run angle and VMG lists")
     try:
         vpp = doc["vpp"]
         angles = [float(a) for a in vpp["angles"]]
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"{p}: {what} ({type(exc).__name__}: {exc})") from None
+    _orc_check(p, "vpp.angles", np.asarray(angles), 0.0, 180.0, "an angle in [0, 180] deg")
+    try:
         tws = np.asarray([float(v) for v in vpp["speeds"]])
-        tab = np.asarray([[float(v) for v in vpp[_orc_key(vpp, a)]] for a in angles])
+        keys = [_orc_key(vpp, a) for a in angles]
+        tab = np.asarray([[float(v) for v in vpp[k]] for k in keys])
         optima = {k: np.asarray(vpp[k], dtype=float)
                   for k in ("beat_angle", "beat_vmg", "run_angle", "run_vmg")}
     except (KeyError, TypeError, ValueError) as exc:
-        raise InputError(
-            f"{p}: not an ORC certificate polar: need vpp.angles, vpp.speeds, one speed list "
-            f"per angle and beat/run angle and VMG lists ({type(exc).__name__}: {exc})"
-        ) from None
+        raise InputError(f"{p}: {what} ({type(exc).__name__}: {exc})") from None
     if tab.shape != (len(angles), tws.size) or any(v.shape != tws.shape for v in optima.values()):
         raise InputError(f"{p}: ORC vpp block: every list must have one value per wind speed "
                          f"({tws.size})")
+    _orc_check(p, "vpp.speeds", tws, 0.0, math.inf, "a wind speed >= 0 kn")
+    for i, k in enumerate(keys):
+        _orc_check(p, f"vpp[{k!r}]", tab[i], 0.0, math.inf, "a boat speed >= 0 kn")
+    _orc_check(p, "vpp.beat_angle", optima["beat_angle"], 0.0, 90.0, "an angle in (0, 90) deg",
+               open_ends=True)
+    _orc_check(p, "vpp.run_angle", optima["run_angle"], 90.0, 180.0, "an angle in (90, 180] deg",
+               open_ends=(True, False))
+    for k in ("beat_vmg", "run_vmg"):
+        _orc_check(p, f"vpp.{k}", optima[k], 0.0, math.inf, "a VMG >= 0 kn")
+    if _well_formed(np.asarray(angles), tws, tab):
+        _check_table(str(p), np.asarray(angles), tws, tab, "kn", "kn",
+                     at_twa=lambda i: f"{p}: vpp.angles[{i}]",
+                     at_tws=lambda j: f"{p}: vpp.speeds[{j}]",
+                     at_cell=lambda i, j: f"{p}: vpp[{keys[i]!r}][{j}]")
     name = str(doc.get("boat", {}).get("type") or doc.get("name") or p.stem)
     if not include_optima:
-        return Polar(np.asarray(angles), tws * speed_factor("kn"), tab * speed_factor("kn"),
-                     name=name, interpolation=interpolation)
+        return _orc_polar(p, np.asarray(angles), tws, tab, name, interpolation)
     cols: list[tuple[NDArray, NDArray]] = []
     for j in range(tws.size):
         a_b, a_r = optima["beat_angle"][j], optima["run_angle"][j]
@@ -575,14 +655,46 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
         pts[round(a_r, 1)] = optima["run_vmg"][j] / abs(math.cos(math.radians(a_r)))
         keys = sorted(pts)
         cols.append((np.asarray(keys), np.asarray([pts[k] for k in keys])))
+    for k, a_key, v_key in (("beat", "beat_angle", "beat_vmg"), ("run", "run_angle", "run_vmg")):
+        v = optima[v_key] / np.abs(np.cos(np.radians(optima[a_key])))
+        if np.any(v > MAX_BOAT_SPEED_KN):
+            j = int(np.argmax(v))
+            raise InputError(
+                f"{p}: vpp.{v_key}[{j}] / cos(vpp.{a_key}[{j}]) gives a {k} boat speed of "
+                f"{v[j]:.4g} kn, above {MAX_BOAT_SPEED_KN:g} kn (faster than any sailing craft); "
+                "check the VMG and angle"
+            )
     rows = np.asarray(sorted({a for c in cols for a in c[0]}))
     out = np.empty((rows.size, tws.size))
     for j, (a, v) in enumerate(cols):
         aa = np.concatenate([[0.0], a, [180.0]]) if a[-1] < 180 else np.concatenate([[0.0], a])
         vv = np.concatenate([[0.0], v, [0.0]]) if a[-1] < 180 else np.concatenate([[0.0], v])
         out[:, j] = np.interp(rows, aa, vv)
-    return Polar(rows, tws * speed_factor("kn"), out * speed_factor("kn"), name=name,
-                 interpolation=interpolation)
+    return _orc_polar(p, rows, tws, out, name, interpolation)
+
+
+def _orc_polar(p: Path, twa: NDArray, tws_kn: NDArray, tab_kn: NDArray, name: str,
+               interpolation: str) -> Polar:
+    try:
+        return Polar(twa, tws_kn * speed_factor("kn"), tab_kn * speed_factor("kn"), name=name,
+                     interpolation=interpolation)
+    except InputError as exc:
+        raise InputError(f"{p}: {exc}") from None
+
+
+def _orc_check(p: Path, key: str, values: NDArray, lo: float, hi: float, expected: str,
+               open_ends: bool | tuple[bool, bool] = False) -> None:
+    """Every value of ``values`` finite and in ``[lo, hi]`` (open ends if asked), else an error."""
+    lo_open, hi_open = (open_ends, open_ends) if isinstance(open_ends, bool) else open_ends
+    v = np.asarray(values, dtype=float)
+    with np.errstate(invalid="ignore"):
+        bad = ~np.isfinite(v) | (v <= lo if lo_open else v < lo) | (v >= hi if hi_open else v > hi)
+    if np.any(bad):
+        k = int(np.flatnonzero(bad)[0])
+        raise InputError(
+            f"{p}: {key}[{k}]: expected {expected}; got {float(v[k])!r}"
+            + (" (JSON 1e400, Infinity or NaN)" if not math.isfinite(v[k]) else "")
+        )
 
 
 def _orc_key(vpp: dict[str, Any], angle: float) -> str:
@@ -590,6 +702,174 @@ def _orc_key(vpp: dict[str, Any], angle: float) -> str:
         if key in vpp:
             return key
     raise KeyError(f"no speed list for angle {angle:g}")
+
+
+# --- units and sanity ------------------------------------------------------------------
+
+
+def unit_from_name(path: str | Path) -> str | None:
+    """Speed unit that a polar file's name states, or None.
+
+    Only the last word of the stem counts (words split at ``.``, ``_``, ``-`` and
+    spaces), and only unambiguous unit words: ``kn``, ``kt``, ``kts``, ``knot``,
+    ``knots``, ``ms``, ``mps``, ``kmh``, ``kph``, ``mph``.
+
+    Parameters
+    ----------
+    path : str or Path
+        File name or path.
+
+    Returns
+    -------
+    str or None
+        ``"kn"``, ``"m/s"``, ``"km/h"`` or ``"mph"``; None when the name says nothing.
+
+    Examples
+    --------
+    >>> unit_from_name("2502_m8_APW_HSB2_HSRW.kph.csv")
+    'km/h'
+    >>> unit_from_name("j24-polars-knots.csv")
+    'kn'
+    >>> unit_from_name("msd_polar.pol") is None
+    True
+    """
+    words = [w for w in re.split(r"[._\s-]+", Path(str(path)).stem.lower()) if w]
+    return _NAME_UNITS.get(words[-1]) if words else None
+
+
+_HEADER_UNIT: Final = re.compile(
+    r"(?:twa|tws)(?:\s*(?:\\+|/)\s*(?:twa|tws))?(?:[\s_]*[(\[]?\s*([a-z/]+)\s*[)\]]?)?"
+)
+
+
+def _header_unit(label: str) -> str | None:
+    """Unit named in a wide table's label cell (``TWA\\TWS (km/h)``, ``twa/tws_ms``)."""
+    m = _HEADER_UNIT.fullmatch(label.strip().lower())
+    if m is None or m.group(1) is None:
+        return None
+    return _UNIT_SUFFIX.get(m.group(1))
+
+
+def _agree(src: str, what: str, claims: list[tuple[str, str | None]],
+           default: str = "kn") -> str:
+    """The one unit that every claim names (``default`` if none does), else an error.
+
+    ``claims`` are ``(who, unit)`` pairs, e.g. ``("speed_unit='kn'", "kn")`` or
+    ``("the file name 'x.kph.csv'", "km/h")``; None units are skipped.
+    """
+    known: list[tuple[str, str, float]] = []
+    for who, unit in claims:
+        if unit is None:
+            continue
+        try:
+            known.append((who, unit, speed_factor(unit)))
+        except InputError as exc:
+            raise InputError(f"{src}: {exc}") from None
+    for who, unit, f in known[1:]:
+        if f != known[0][2]:
+            raise InputError(
+                f"{src}: {known[0][0]} says the {what} unit is {known[0][1]!r} but {who} says "
+                f"{unit!r}; make them agree (fix or drop the option, or rename the file)"
+            )
+    return known[0][1] if known else default
+
+
+def _in_kn(value_ms: float, unit: str) -> str:
+    """`` (12.3 kn)`` after a value given in ``unit``, unless that is knots already."""
+    return "" if speed_factor(unit) == KNOT else f" ({value_ms / KNOT:.1f} kn)"
+
+
+def _unit_hint(unit: str, option: str) -> str:
+    """How to fix a value that is too large for the unit it was read in."""
+    smaller = [u for u in ("kn", "mph", "km/h") if speed_factor(u) < speed_factor(unit)]
+    if not smaller:
+        return f"it is read in {unit} already; check the file's values"
+    return (f"a unit mistake? It is read in {unit}; if the file is in {' or '.join(smaller)}, "
+            f"say so with {option}: {smaller[-1]} in the course's boat: block (or end the file "
+            "name with .kph, .kmh, .mph, ...)")
+
+
+def _check_table(
+    src: str,
+    twa: NDArray[np.float64],
+    tws: NDArray[np.float64],
+    tab: NDArray[np.float64],
+    s_unit: str,
+    w_unit: str,
+    *,
+    at_twa: Any,
+    at_tws: Any,
+    at_cell: Any,
+) -> None:
+    """Refuse absurd or degenerate tables, naming the cell (file units).
+
+    Parameters
+    ----------
+    src : str
+        File label.
+    twa, tws, tab : ndarray
+        TWA rows [°], TWS columns and boat speeds (NaN = empty cell) in the file's
+        units ``w_unit`` and ``s_unit``.
+    at_twa, at_tws, at_cell : callable
+        ``at_twa(i)``, ``at_tws(j)``, ``at_cell(i, j)``: where that value is in the
+        file, e.g. ``"x.pol:3: cell 2"``.
+
+    Raises
+    ------
+    InputError
+        TWS above :data:`MAX_TWS_KN`, boat speed above :data:`MAX_BOAT_SPEED_KN`,
+        nodes closer than ``MIN_AXIS_STEP`` or no positive speed at all.
+    """
+    fs, fw = speed_factor(s_unit), speed_factor(w_unit)
+    for j, w in enumerate(tws):
+        if w * fw > MAX_TWS_MS:
+            raise InputError(
+                f"{at_tws(j)}: wind speed {w:g} {w_unit}{_in_kn(w * fw, w_unit)} is above "
+                f"{MAX_TWS_KN:g} kn, stronger than any wind a polar is made for; "
+                + _unit_hint(w_unit, "wind_unit")
+            )
+    for axis, values, factor, at in (("TWS", tws, fw, at_tws), ("TWA", twa, 1.0, at_twa)):
+        v = np.asarray(values, dtype=float) * factor
+        problem = axis_spacing_problem(v, axis)
+        if problem:
+            raise InputError(f"{at(_close_index(v, axis))}: {problem}")
+    with np.errstate(invalid="ignore"):
+        fast = np.argwhere(tab * fs > MAX_BOAT_SPEED_MS)
+    if fast.size:
+        i, j = (int(k) for k in fast[0])
+        v = float(tab[i, j])
+        raise InputError(
+            f"{at_cell(i, j)}: boat speed {v:g} {s_unit}{_in_kn(v * fs, s_unit)} at TWA "
+            f"{twa[i]:g}, TWS {tws[j]:g} {w_unit} is above {MAX_BOAT_SPEED_KN:g} kn, faster "
+            "than any sailing craft has gone (record 65.45 kn); "
+            + _unit_hint(s_unit, "speed_unit")
+        )
+    if not np.nanmax(tab, initial=0.0) > 0:
+        raise InputError(
+            f"{src}: this polar has no speed: every boat speed in the table is 0, so the boat "
+            f"cannot sail in any wind; fill in the boat speeds ({s_unit}) for each TWA row "
+            "and TWS column, or pick the right file"
+        )
+
+
+def _well_formed(twa: NDArray, tws: NDArray, tab: NDArray) -> bool:
+    """Axes 1-D, finite and increasing, table finite and of matching shape (else the
+    :class:`Polar` constructor reports the problem)."""
+    return bool(
+        twa.ndim == 1 and tws.ndim == 1 and tab.shape == (twa.size, tws.size)
+        and twa.size >= 2 and tws.size >= 1
+        and np.all(np.isfinite(twa)) and np.all(np.isfinite(tws)) and np.all(np.isfinite(tab))
+        and np.all(np.diff(twa) > 0) and np.all(np.diff(tws) > 0)
+    )
+
+
+def _close_index(v: NDArray[np.float64], axis: str) -> int:
+    """Index of the first node closer than ``MIN_AXIS_STEP`` to its neighbour or edge."""
+    for k in range(v.size):
+        prev = v[k - 1] if k else 0.0
+        if (k or v[0] > 0) and v[k] - prev < MIN_AXIS_STEP:
+            return k
+    return v.size - 1  # only the TWA 180 edge is left
 
 
 # --- helpers --------------------------------------------------------------------------
@@ -670,18 +950,25 @@ def _suffix(unit: str) -> str:
             speed_factor("mph"): "mph"}[f]
 
 
-def _units(src: str, speed_unit: str | None, wind_unit: str | None,
-           default: str) -> tuple[float, float]:
-    s = speed_unit or default
-    w = wind_unit or speed_unit or default
-    try:
-        return speed_factor(s), speed_factor(w)
-    except InputError as exc:
-        raise InputError(f"{src}: {exc}") from None
+def _file_units(src: str, speed_unit: str | None, wind_unit: str | None,
+                claims: list[tuple[str, str | None]]) -> tuple[str, str]:
+    """Speed and wind unit of a wide table: the options, what the file says, else knots.
+
+    ``claims`` are the file's own statements (e.g. its label cell); the file name
+    (:func:`unit_from_name`) is added.  A file-wide statement covers both the
+    boat speeds and the TWS; any disagreement is an error.
+    """
+    named = unit_from_name(src)
+    claims = [*claims, (f"the file name {Path(src).name!r}", named)]
+    s_unit = _agree(src, "boat speed", [(f"speed_unit={speed_unit!r}", speed_unit), *claims])
+    given_w = (f"wind_unit={wind_unit!r}", wind_unit) if wind_unit else (
+        f"speed_unit={speed_unit!r}", speed_unit)
+    w_unit = _agree(src, "wind speed", [given_w, *claims])
+    return s_unit, w_unit
 
 
 def _merge_unit(src: str, lineno: int | None, what: str, declared: str | None,
-                given: str | None) -> str:
+                given: str | None, default: str = "kn") -> str:
     where = f"{src}:{lineno}" if lineno else src
     try:
         if declared and given and speed_factor(declared) != speed_factor(given):
@@ -689,7 +976,7 @@ def _merge_unit(src: str, lineno: int | None, what: str, declared: str | None,
                 f"{where}: the file declares {what} unit {declared!r} but {given!r} was passed; "
                 "drop the option or fix the file"
             )
-        unit = declared or given or "kn"
+        unit = declared or given or default
         speed_factor(unit)
     except InputError as exc:
         if str(exc).startswith(where):

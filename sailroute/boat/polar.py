@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError
+from sailroute.units import KNOT
 
 INTERPOLATIONS: Final = ("pchip", "linear")
 """Valid values of :attr:`Polar.interpolation`."""
@@ -47,6 +48,22 @@ DENSE_TWA_STEP_DEG: Final = 0.5
 DENSE_TWS_STEP_MS: Final = 0.05
 """Largest TWS spacing of the dense lookup table [m s⁻¹]."""
 _MAX_DENSE_TWS: Final = 2000
+
+MAX_BOAT_SPEED_KN: Final = 70.0
+"""Highest boat speed a polar may hold [kn] (36.0 m s⁻¹): above the outright sailing
+speed record (65.45 kn, Vestas Sailrocket 2, 2012), so no real boat is refused, while
+a km/h table of a fast boat read as knots (an F50's 85 km/h as "85 kn") is."""
+MAX_BOAT_SPEED_MS: Final = MAX_BOAT_SPEED_KN * KNOT
+""":data:`MAX_BOAT_SPEED_KN` in m s⁻¹."""
+MAX_TWS_KN: Final = 80.0
+"""Highest TWS column a polar may hold [kn] (41.2 m s⁻¹): well above hurricane force
+(64 kn), where no polar is measured or computed."""
+MAX_TWS_MS: Final = MAX_TWS_KN * KNOT
+""":data:`MAX_TWS_KN` in m s⁻¹."""
+MIN_AXIS_STEP: Final = 1e-6
+"""Smallest spacing of adjacent TWA rows [°] and TWS columns [m s⁻¹], counting the
+taper rows at TWA 0 and 180 and the column at TWS 0 that the polar adds: closer nodes
+(e.g. TWA 1e-320) make the PCHIP slopes infinite."""
 
 _VMG_SEARCH_STEP_DEG: Final = 0.5
 _GOLDEN_ITERATIONS: Final = 64
@@ -58,6 +75,43 @@ def fold_twa(twa_deg: ArrayLike) -> NDArray[np.float64]:
     return 180.0 - np.abs(np.mod(np.asarray(twa_deg, dtype=float), 360.0) - 180.0)
 
 
+def axis_spacing_problem(values: ArrayLike, axis: str) -> str | None:
+    """Why a TWA or TWS axis has nodes too close together, or None if it is fine.
+
+    Parameters
+    ----------
+    values : array_like
+        Strictly increasing TWA [°] (``axis="TWA"``) or TWS [m s⁻¹] (``"TWS"``).
+    axis : {"TWA", "TWS"}
+        Which axis: TWA counts the taper rows the polar adds at 0 and 180 [°], TWS
+        the column it adds at 0 [m s⁻¹].
+
+    Returns
+    -------
+    str or None
+        ``"TWA 0 and 1e-320 are closer than 1e-06 deg ..."`` when two adjacent
+        nodes differ by less than :data:`MIN_AXIS_STEP`, else None.
+    """
+    v = np.asarray(values, dtype=float)
+    unit = "deg" if axis == "TWA" else "m/s"
+    ext = v
+    if v.size and v[0] > 0:
+        ext = np.concatenate([[0.0], ext])
+    if axis == "TWA" and v.size and v[-1] < 180:
+        ext = np.concatenate([ext, [180.0]])
+    close = np.flatnonzero(np.diff(ext) < MIN_AXIS_STEP)
+    if not close.size:
+        return None
+    a, b = float(ext[close[0]]), float(ext[close[0] + 1])
+    edges = "TWA 0 and 180 count: the polar adds zero-speed rows there" if axis == "TWA" \
+        else "TWS 0 counts: the polar adds a zero-speed column there"
+    return (
+        f"{axis} {a!r} and {b!r} {unit} are closer than {MIN_AXIS_STEP:g} {unit} ({edges}); "
+        f"adjacent {axis} values must differ by at least {MIN_AXIS_STEP:g} {unit}: merge "
+        "them or round the value"
+    )
+
+
 @dataclass(frozen=True, eq=False)
 class Polar:
     """Polar table with vectorised interpolation.
@@ -65,11 +119,16 @@ class Polar:
     Parameters
     ----------
     twa_deg : ndarray, shape (m,)
-        Strictly increasing true wind angles [°] within ``[0, 180]``.
+        Strictly increasing true wind angles [°] within ``[0, 180]``, at least
+        :data:`MIN_AXIS_STEP` apart (and from 0 and 180).
     tws_ms : ndarray, shape (n,)
-        Strictly increasing true wind speeds [m s⁻¹], ``>= 0``.
+        Strictly increasing true wind speeds [m s⁻¹], ``>= 0``, at least
+        :data:`MIN_AXIS_STEP` apart (and from 0).
     speed_ms : ndarray, shape (m, n)
-        Boat speed [m s⁻¹] at each (TWA, TWS) node.
+        Boat speed [m s⁻¹] at each (TWA, TWS) node, ``>= 0``.  Neither an all-zero
+        table nor speeds above :data:`MAX_BOAT_SPEED_MS` (or TWS above
+        :data:`MAX_TWS_MS`) are refused here: analytic test boats use them; the
+        file readers (:mod:`sailroute.boat.io`) refuse all three.
     name : str
         Label (boat name or source file).
     interpolation : {"pchip", "linear"}
@@ -107,6 +166,9 @@ class Polar:
             raise InputError(f"{where}: TWS values must increase strictly and be >= 0")
         if not np.all(np.isfinite(spd)) or np.any(spd < 0):
             raise InputError(f"{where}: boat speeds must be finite and >= 0")
+        for problem in (axis_spacing_problem(twa, "TWA"), axis_spacing_problem(tws, "TWS")):
+            if problem:
+                raise InputError(f"{where}: {problem}")
         if self.interpolation not in INTERPOLATIONS:
             raise InputError(
                 f"{where}: interpolation must be one of {', '.join(map(repr, INTERPOLATIONS))}; "

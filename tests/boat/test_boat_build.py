@@ -103,7 +103,8 @@ def test_spec_builtin_polar_and_vpp(tmp_path: Path) -> None:
          "got builtin, polar"),
         ({"name": "x"}, "give exactly one of 'builtin', 'polar' or 'vpp'; got keys \\['name'\\]"),
         ({"builtin": "ilca7", "crew": 70},
-         "boat.crew: unknown key for a 'builtin' boat; allowed: 'builtin', 'interpolation'"),
+         "boat.crew: unknown key for a 'builtin' boat; allowed: 'allow_extrapolation', "
+         "'builtin', 'efficiency', 'interpolation'"),
         ({"polar": "missing.pol"}, "boat.polar: file '.*missing.pol' not found"),
         ({"polar": "a.pol", "speed_unit": "furlong"},
          "boat.speed_unit: expected one of 'kn', 'm/s', 'km/h', 'mph'; got 'furlong'"),
