@@ -12,7 +12,11 @@ at low speed and around head-to-wind, so the side (sign of TWA) is:
 
 Each remaining change of side is a manoeuvre at the first point on the new side: a
 **tack** if the mean |TWA| over ``hold_s`` either side is below 90°, else a **gybe**
-(``docs/nomenclature.md``).
+(``docs/nomenclature.md``) — provided the boat really turned: the mean course over
+``2 hold_s`` after the change differs by at least ``min_turn_deg`` from the mean course
+over ``2 hold_s`` before it.  Without that rule a run sailed dead downwind (or a beat
+head to wind) in a wind a few degrees off the scenario's counted a gybe (tack) at every
+wobble of the course across the wind axis.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from sailroute.units import bearing_deg, signed_twa
+from sailroute.units import bearing_deg, signed_twa, wrap180
 
 HOLD_S = 5.0
 """A new side must be held this long to count as a manoeuvre [s]."""
@@ -31,6 +35,9 @@ SMOOTH_S = 3.0
 """Window of the vector-mean COG smoothing [s]."""
 MIN_SPEED_MS = 0.5
 """Below this speed over ground the side is carried forward [m s⁻¹]."""
+MIN_TURN_DEG = 30.0
+"""A change of side counts as a manoeuvre only if the course turned this much [°]
+(a Laser's gybe in a run turns ≥ 30°; a wobble across dead downwind does not)."""
 
 
 @dataclass(frozen=True)
@@ -93,8 +100,15 @@ def sides(t: NDArray, twa_deg: NDArray, sog_ms: NDArray, *, hold_s: float = HOLD
     return s
 
 
+def _mean_course(cog_deg: NDArray, sel: NDArray) -> float:
+    """Vector-mean course [°] of the selected points."""
+    r = np.radians(cog_deg[sel])
+    return float(np.degrees(np.arctan2(np.sin(r).sum(), np.cos(r).sum())))
+
+
 def find_sailed_manoeuvres(t: NDArray, twd_deg: NDArray, cog_deg: NDArray, sog_ms: NDArray,
-                           *, hold_s: float = HOLD_S, min_speed_ms: float = MIN_SPEED_MS
+                           *, hold_s: float = HOLD_S, min_speed_ms: float = MIN_SPEED_MS,
+                           min_turn_deg: float = MIN_TURN_DEG
                            ) -> tuple[tuple[SailedManoeuvre, ...], NDArray[np.float64]]:
     """Tacks and gybes of a track.
 
@@ -108,7 +122,7 @@ def find_sailed_manoeuvres(t: NDArray, twd_deg: NDArray, cog_deg: NDArray, sog_m
         (Smoothed) course over ground [°].
     sog_ms : ndarray
         Speed over ground [m s⁻¹].
-    hold_s, min_speed_ms : float
+    hold_s, min_speed_ms, min_turn_deg : float
         See the module notes.
 
     Returns
@@ -119,8 +133,15 @@ def find_sailed_manoeuvres(t: NDArray, twd_deg: NDArray, cog_deg: NDArray, sog_m
     """
     twa = signed_twa(twd_deg, cog_deg)
     s = sides(t, twa, sog_ms, hold_s=hold_s, min_speed_ms=min_speed_ms)
+    cog = np.asarray(cog_deg, float)
     out = []
     for i in np.flatnonzero(s[1:] != s[:-1]) + 1:
+        before = (t >= t[i] - 2.0 * hold_s) & (t < t[i])
+        after = (t > t[i]) & (t <= t[i] + 2.0 * hold_s)
+        if before.any() and after.any():
+            turn = abs(float(wrap180(_mean_course(cog, after) - _mean_course(cog, before))))
+            if turn < min_turn_deg:
+                continue
         near = np.abs(t - t[i]) <= hold_s
         kind: Literal["tack", "gybe"] = "tack" if np.mean(np.abs(twa[near])) < 90.0 else "gybe"
         out.append(SailedManoeuvre(kind, float(t[i]), int(i)))
