@@ -3,6 +3,8 @@
 * :class:`UniformWind` — constant or time-table wind, the same everywhere;
 * :class:`AnalyticWind` — a formula ``f(t, x, y)``;
 * :func:`open_wrf` -> :class:`GridWind` — WRF ``wrfout`` NetCDF;
+* :func:`open_netcdf` / :func:`open_grib` -> :class:`GridWind` — wind on latitude/longitude
+  (CF NetCDF, xarray datasets, GRIB via the ``grib`` extra);
 * :func:`read_stations` -> :class:`StationData` -> :class:`StationWind` — measured wind;
 * :class:`BlendedWind` — a model field corrected by stations;
 * :func:`wind_from_spec` — any of these from a course-file wind spec.
@@ -14,6 +16,7 @@ from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import Coverage, WindField, prepare_points
 from sailroute.wind.blended import BlendedWind
 from sailroute.wind.build import check_covers, wind_from_spec
+from sailroute.wind.cf import open_grib, open_netcdf
 from sailroute.wind.grid import GridWind
 from sailroute.wind.ndbc import read_ndbc
 from sailroute.wind.stations import StationData, StationWind, read_stations, resample_stations
@@ -30,6 +33,8 @@ __all__ = [
     "UniformWind",
     "WindField",
     "check_covers",
+    "open_grib",
+    "open_netcdf",
     "open_wrf",
     "prepare_points",
     "read_ndbc",

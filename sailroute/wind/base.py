@@ -19,14 +19,17 @@ A wind field maps arrays of ``(t, x, y)`` to arrays ``(u, v)``:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Protocol, runtime_checkable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import OutOfCoverageError
 from sailroute.timeutil import iso
+
+if TYPE_CHECKING:
+    from sailroute.geo import LocalFrame
 
 
 @dataclass(frozen=True)
@@ -39,6 +42,12 @@ class Coverage:
         Time span [epoch s]; ``-inf``/``inf`` for time-independent fields.
     xmin, xmax, ymin, ymax : float
         Bounding box in the local frame [m]; infinite for uniform fields.
+    frame : LocalFrame, optional
+        The local frame, when known: :meth:`describe` then adds the box in
+        latitude/longitude (what a user can check against a chart or the file).
+    source_span : (float, float), optional
+        Time span of the whole source [epoch s] when the field holds only part of
+        it (a file cropped to the race window); :meth:`describe` names it.
     """
 
     t0: float
@@ -47,6 +56,8 @@ class Coverage:
     xmax: float
     ymin: float
     ymax: float
+    frame: LocalFrame | None = field(default=None, compare=False, repr=False)
+    source_span: tuple[float, float] | None = field(default=None, compare=False, repr=False)
 
     @classmethod
     def everywhere(cls) -> Coverage:
@@ -55,10 +66,37 @@ class Coverage:
         return cls(-inf, inf, -inf, inf, -inf, inf)
 
     def describe(self) -> str:
-        """Human-readable description used in error messages."""
-        return f"time {_fmt_t(self.t0)} .. {_fmt_t(self.t1)}, " + (
+        """Human-readable description used in error messages.
+
+        Times in UTC, the box in local metres and, when :attr:`frame` is known, in
+        degrees; the source's full time span when it differs from the field's.
+        """
+        text = f"time {_fmt_t(self.t0)} .. {_fmt_t(self.t1)}, " + (
             f"x {self.xmin:.0f} .. {self.xmax:.0f} m, y {self.ymin:.0f} .. {self.ymax:.0f} m"
         )
+        ll = self.latlon_box()
+        if ll is not None:
+            text += (f" (lat {_fmt_lat(ll[0])} .. {_fmt_lat(ll[1])}, "
+                     f"lon {_fmt_lon(ll[2])} .. {_fmt_lon(ll[3])})")
+        if self.source_span is not None and (self.source_span[0] != self.t0
+                                             or self.source_span[1] != self.t1):
+            text += (f"; the source holds {_fmt_t(self.source_span[0])} .. "
+                     f"{_fmt_t(self.source_span[1])}")
+        return text
+
+    def latlon_box(self) -> tuple[float, float, float, float] | None:
+        """``(lat_min, lat_max, lon_min, lon_max)`` [°] of the box, or None.
+
+        None without a :attr:`frame` or for an unbounded box.  Computed from the
+        box's corners and edge midpoints, so good to a few metres for course-sized boxes.
+        """
+        if self.frame is None or not all(np.isfinite(
+                (self.xmin, self.xmax, self.ymin, self.ymax))):
+            return None
+        xs = np.array([self.xmin, 0.5 * (self.xmin + self.xmax), self.xmax])
+        ys = np.array([self.ymin, 0.5 * (self.ymin + self.ymax), self.ymax])
+        lat, lon = self.frame.to_latlon(*np.meshgrid(xs, ys))
+        return (float(lat.min()), float(lat.max()), float(lon.min()), float(lon.max()))
 
     def contains(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
         """Boolean mask of points inside the coverage (edges included)."""
@@ -77,6 +115,14 @@ class Coverage:
 
 def _fmt_t(t: float) -> str:
     return str(t) if not np.isfinite(t) else iso(t)
+
+
+def _fmt_lat(lat: float) -> str:
+    return f"{abs(lat):.4f}°{'N' if lat >= 0 else 'S'}"
+
+
+def _fmt_lon(lon: float) -> str:
+    return f"{abs(lon):.4f}°{'E' if lon >= 0 else 'W'}"
 
 
 @runtime_checkable
@@ -160,7 +206,8 @@ def prepare_points(
     ):
         bad = ~c.contains(t, x, y)
         requested = Coverage(
-            float(tmin), float(tmax), float(xmin), float(xmax), float(ymin), float(ymax)
+            float(tmin), float(tmax), float(xmin), float(xmax), float(ymin), float(ymax),
+            frame=c.frame,
         )
         raise OutOfCoverageError(
             f"{name}: {int(bad.sum())} of {bad.size} sample points lie outside the data.\n"

@@ -20,13 +20,16 @@ from sailroute.wind._spec import SpecChecker
 from sailroute.wind.base import Coverage, WindField
 from sailroute.wind.blended import BlendedWind
 from sailroute.wind.height import DEFAULT_EXPONENT, DEFAULT_EXPONENT_RANGE, DEFAULT_ROUGHNESS_M
+from sailroute.wind.ndbc import is_ndbc_text, read_ndbc
 from sailroute.wind.stations import (
     CANONICAL_COLUMNS,
     DEFAULT_MISSING,
+    TIME_PARTS,
     StationData,
     StationWind,
     parse_offset,
     read_stations,
+    resample_stations,
 )
 from sailroute.wind.uniform import UniformWind
 from sailroute.wind.wrf import open_wrf
@@ -50,7 +53,8 @@ def wind_from_spec(
     ----------
     spec : mapping
         The wind spec, e.g. ``{"type": "uniform", "tws_kn": 10, "twd_deg": 108}``;
-        ``type`` is one of ``uniform``, ``wrf``, ``stations``, ``blended``.
+        ``type`` is one of ``uniform``, ``wrf``, ``netcdf`` (CF lat/lon, or wrfout
+        detected), ``grib``, ``stations``, ``blended``.
     frame : LocalFrame
         The course's local frame; gridded and station data are mapped into it.
     base_dir : Path
@@ -96,7 +100,7 @@ def wind_from_spec(
     ctx = _Context(frame, Path(base_dir), crop_bbox, time_window)
     field = _BUILDERS[kind](spec, chk, ctx)
     if not spec.get("clamp", False):
-        check_covers(field, crop_bbox, time_window, name=f"{where}: {kind} wind")
+        check_covers(field, crop_bbox, time_window, name=f"{where}: {kind} wind", frame=frame)
     return field
 
 
@@ -106,6 +110,7 @@ def check_covers(
     time_window: tuple[float, float] | None,
     *,
     name: str = "wind field",
+    frame: LocalFrame | None = None,
 ) -> None:
     """Raise :class:`OutOfCoverageError` unless ``field`` covers ``bbox`` and ``time_window``.
 
@@ -119,6 +124,9 @@ def check_covers(
         ``(t0, t1)`` [epoch s] that must lie inside the field's time span.
     name : str
         Label for the message.
+    frame : LocalFrame, optional
+        Adds latitude/longitude to the message (the field's own frame is used
+        when its coverage has one).
     """
     c = field.coverage
     t0, t1 = time_window if time_window is not None else (c.t0, c.t1)
@@ -127,14 +135,51 @@ def check_covers(
         y1 <= c.ymax
     ):
         return
-    need = Coverage(t0, t1, x0, x1, y0, y1)
+    frame = frame if frame is not None else c.frame
+    need = Coverage(t0, t1, x0, x1, y0, y1, frame=frame)
+    if c.frame is None and frame is not None:
+        c = Coverage(c.t0, c.t1, c.xmin, c.xmax, c.ymin, c.ymax, frame=frame,
+                     source_span=c.source_span)
+    span = c.source_span or (c.t0, c.t1)
+    single = span[0] == span[1] and not (t0 >= c.t0 and t1 <= c.t1)
     raise OutOfCoverageError(
         f"{name} does not cover the course and race time.\n"
         f"  needed:  {need.describe()}\n"
         f"  covered: {c.describe()}\n"
-        "  Use wind data that covers the course (the thesis's main failure was extrapolating "
+        + ("  The source holds a single time: to use it as a steady wind for the whole race, "
+           "set `steady: true`.\n" if single else "")
+        + "  Use wind data that covers the course (the thesis's main failure was extrapolating "
         "outside the data), or opt in to clamping at the edges with `clamp: true`."
     )
+
+
+def wind_notes(field: WindField) -> list[str]:
+    """One-line summaries of how a wind source was read, for the progress display.
+
+    Gridded fields: the slices read, the cells and how many hold no wind (NaN);
+    station fields: the rows read and how many were dropped for missing values.
+    Other fields: none.
+    """
+    name = getattr(field, "name", type(field).__name__)
+    info = getattr(field, "info", None)
+    data = getattr(field, "data", None)
+    if isinstance(info, Mapping) and "times" in info:
+        text = f"{name}: {info['times']}"
+        if "cells" in info:
+            text += f", {info['cells']} cells"
+            if info.get("nan_cells"):
+                text += f" ({info['nan_cells']} without wind: land or masked)"
+        if info.get("height_m") is not None:
+            text += f", wind at {info['height_m']:g} m"
+        return [text]
+    if isinstance(data, StationData):
+        text = f"{name}: {data.n_raw} rows read"
+        if data.n_missing:
+            per = ", ".join(f"{k} {v}" for k, v in data.missing_by_column.items()
+                            if k not in ("gust", "height_m"))  # optional: no row dropped
+            text += f", {data.n_missing} dropped for missing values ({per})"
+        return [text + f", {len(data)} records used"]
+    return []
 
 
 class _Context:
@@ -279,16 +324,108 @@ def _build_wrf(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> Wind
     return _open_wrf_checked(opts, chk.where, ctx)
 
 
+# ---------------------------------------------------------------------------- netcdf / grib
+_GRID_KEYS = ("type", "path", "variables", "time", "data_height_m", "speed_unit", "height_m",
+              "shear", "exponent", "roughness_m", "time_step_min", "interpolation", "steady",
+              "margin_m", "clamp")
+_CF_ONLY = ("variables", "time", "data_height_m", "speed_unit", "steady")
+
+
+def _grid_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context,
+                  extra: tuple[str, ...] = ()) -> dict[str, Any]:
+    """Validate a ``type: netcdf`` / ``type: grib`` spec into :func:`open_netcdf` keywords."""
+    chk.check_keys(spec, (*_GRID_KEYS, *extra))  # a missing path is reported by _path
+    opts: dict[str, Any] = {
+        "path": _path(chk, spec, ctx),
+        "height_m": chk.number(spec, "height_m", None, positive=True),
+        "data_height_m": chk.number(spec, "data_height_m", None, positive=True),
+        "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
+        "exponent": chk.number(spec, "exponent", DEFAULT_EXPONENT, lo=-1.0, hi=1.0),
+        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, positive=True),
+        "time_step_min": chk.number(spec, "time_step_min", None, positive=True),
+        "interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
+        "steady": chk.boolean(spec, "steady", False),
+        "margin_m": chk.number(spec, "margin_m", None, nonnegative=True),
+        "clamp": chk.boolean(spec, "clamp", False),
+        "speed_unit": None,
+        "variables": None,
+        "time": None,
+    }
+    unit = chk.string(spec, "speed_unit", None)
+    if unit is not None and unit.strip().lower() not in SPEED_UNITS:
+        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph', got {unit!r}")
+    else:
+        opts["speed_unit"] = unit
+    var = chk.mapping(spec, "variables", None)
+    if var is not None:
+        from sailroute.wind.cf import DATA_KEYS
+
+        vchk = chk.child("variables")
+        vchk.check_keys(var, DATA_KEYS)
+        for k, v in var.items():
+            if k in DATA_KEYS and (not isinstance(v, str) or not v.strip()):
+                vchk.add(str(k), f"expected a variable name, got {v!r}")
+        if not ({"u", "v"} <= set(var) or {"speed", "direction"} <= set(var)
+                or not set(var) & {"u", "v", "speed", "direction"}):
+            chk.add("variables", "give both u and v, or both speed and direction, e.g. "
+                    "{u: u10, v: v10}")
+        opts["variables"] = dict(var)
+    if "time" in spec:
+        try:
+            opts["time"] = to_epoch(parse_time(spec["time"], where=chk.path("time")))
+        except InputError as exc:
+            chk.problems.append(str(exc))
+    return opts
+
+
+def _build_netcdf(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+    from sailroute.wind.cf import is_wrfout, open_netcdf
+
+    opts = _grid_options(spec, chk, ctx)
+    chk.raise_if_any()
+    path = opts.pop("path")
+    try:
+        if is_wrfout(path):
+            used = [k for k in _CF_ONLY if k in spec]
+            if used:
+                raise InputError(f"{path.name} is a WRF wrfout file; {', '.join(used)} only "
+                                 "apply to latitude/longitude files (use the `type: wrf` keys)")
+            for k in _CF_ONLY:
+                opts.pop(k)
+            opts["fallback_exponent"] = opts.pop("exponent")
+            return open_wrf(path, ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window,
+                            **opts)
+        return open_netcdf(path, ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window,
+                           **opts)
+    except InputError as exc:
+        raise type(exc)(f"{chk.where}: {exc}") from None
+
+
+def _build_grib(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+    from sailroute.wind.cf import open_grib
+
+    opts = _grid_options(spec, chk, ctx, extra=("filter",))
+    filt = chk.mapping(spec, "filter", None)
+    chk.raise_if_any()
+    path = opts.pop("path")
+    try:
+        return open_grib(path, ctx.frame, filter_by_keys=filt, bbox=ctx.crop_bbox,
+                         time_window=ctx.time_window, **opts)
+    except InputError as exc:
+        raise type(exc)(f"{chk.where}: {exc}") from None
+
+
 # ---------------------------------------------------------------------------- stations
-_READ_KEYS = ("path", "speed_unit", "columns", "timezone", "resample_s", "station", "position",
-              "measurement_height_m", "missing")
+_READ_KEYS = ("path", "format", "speed_unit", "columns", "timezone", "resample_s", "station",
+              "position", "measurement_height_m", "missing")
 _STATION_FIELD_KEYS = ("method", "power", "radius_m", "max_gap_s", "height_m", "shear",
                        "exponent", "roughness_m", "clamp")
 
 
 def _read_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> dict[str, Any]:
     """Validate the station-file keys into keyword arguments of :func:`read_stations`."""
-    opts: dict[str, Any] = {"path": _path(chk, spec, ctx)}
+    opts: dict[str, Any] = {"path": _path(chk, spec, ctx),
+                            "format": chk.choice(spec, "format", ["auto", "csv", "ndbc"], "auto")}
     unit = chk.string(spec, "speed_unit", None)
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
         chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph', got {unit!r}")
@@ -297,9 +434,9 @@ def _read_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> d
     cols = chk.mapping(spec, "columns", None)
     if cols is not None:
         for k, v in cols.items():
-            if k not in CANONICAL_COLUMNS:
+            if k not in CANONICAL_COLUMNS and k not in TIME_PARTS:
                 chk.child("columns").add(str(k), "unknown canonical column; expected one of "
-                                         + ", ".join(CANONICAL_COLUMNS))
+                                         + ", ".join((*CANONICAL_COLUMNS, *TIME_PARTS)))
             elif not isinstance(v, str):
                 chk.child("columns").add(str(k), f"expected a column name, got {v!r}")
     opts["columns"] = cols
@@ -335,10 +472,31 @@ def _read_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> d
 
 
 def _read_checked(opts: dict[str, Any], where: str) -> StationData:
+    opts = dict(opts)
+    path, fmt = opts.pop("path"), opts.pop("format", "auto")
     try:
-        return read_stations(opts.pop("path"), **opts)
+        if fmt == "ndbc" or (fmt == "auto" and is_ndbc_text(path)):
+            return _read_ndbc_checked(path, opts, where)
+        return read_stations(path, **opts)
     except InputError as exc:
         raise type(exc)(f"{where}: {exc}") from None
+
+
+def _read_ndbc_checked(path: Path, opts: dict[str, Any], where: str) -> StationData:
+    """NDBC realtime text: only position, station, height and resample_s apply."""
+    if opts.get("position") is None:
+        raise InputError(f"{path.name} is NDBC text, which does not carry the buoy's position; "
+                         "add `position: {lat: ..., lon: ...}` (from the station's NDBC page, "
+                         "e.g. 41008: {lat: 31.400, lon: -80.866})")
+    bad = [k for k in ("columns", "speed_unit", "timezone") if opts.get(k) is not None]
+    if bad:
+        raise InputError(f"{', '.join(bad)}: not used for NDBC text (its columns, m/s and UTC "
+                         "are fixed by the format); remove them")
+    data = read_ndbc(path, position=opts["position"], station=opts.get("station"),
+                     height_m=opts.get("height_m"))
+    if opts.get("resample_s") is not None:
+        data = resample_stations(data, opts["resample_s"])
+    return data
 
 
 def _build_stations(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
@@ -358,7 +516,8 @@ def _build_stations(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) ->
     chk.raise_if_any()
     data = _read_checked(ropts, chk.where)
     try:
-        return StationWind(data, ctx.frame, name=f"station wind {data.source}", **fopts)
+        return StationWind(data, ctx.frame, name=f"station wind {data.source}",
+                           time_window=ctx.time_window, **fopts)
     except InputError as exc:
         raise type(exc)(f"{chk.where}: {exc}") from None
 
@@ -415,6 +574,8 @@ def _build_blended(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> 
 _BUILDERS: dict[str, Callable[[Mapping[str, Any], SpecChecker, _Context], WindField]] = {
     "uniform": _build_uniform,
     "wrf": _build_wrf,
+    "netcdf": _build_netcdf,
+    "grib": _build_grib,
     "stations": _build_stations,
     "blended": _build_blended,
 }

@@ -16,13 +16,17 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sailroute.errors import InputError, WindDataError
+from sailroute.errors import InputError, OutOfCoverageError, WindDataError
+from sailroute.timeutil import iso
 from sailroute.wind.base import Coverage, prepare_points
+
+if TYPE_CHECKING:
+    from sailroute.geo import LocalFrame
 
 MAX_MAP_DEGREE = 5
 
@@ -160,6 +164,20 @@ class GridWind:
         Provenance and diagnostics (file, levels, map residual, ...).
     map_tolerance_cells : float
         Accepted misfit of the local-frame index map [cells].
+    frame : LocalFrame, optional
+        The local frame ``x``/``y`` are in.  Lets messages give positions in
+        latitude/longitude and :meth:`to_xarray` write true east/north winds.
+    source_span : (float, float), optional
+        Time span of the whole file [epoch s] when only some slices were read;
+        named in coverage messages.
+    allow_nan : bool
+        Accept NaN winds (land or masked cells of a sea-only product).  Sampling
+        where the interpolation touches such a cell raises
+        :class:`~sailroute.errors.OutOfCoverageError` naming the place; without
+        this flag NaN winds are refused when the field is built.
+    steady : bool
+        Only for a single time slice: hold it at all times (time coverage
+        unbounded) instead of covering just that instant.
 
     Notes
     -----
@@ -178,7 +196,12 @@ class GridWind:
     name: str = "gridded wind"
     info: Mapping[str, Any] = field(default_factory=dict)
     map_tolerance_cells: float = 0.01
+    frame: LocalFrame | None = None
+    source_span: tuple[float, float] | None = None
+    allow_nan: bool = False
+    steady: bool = False
     _t: NDArray = field(init=False, repr=False)
+    _has_nan: bool = field(init=False, repr=False)
     _uv: NDArray = field(init=False, repr=False)
     _map: IndexMap = field(init=False, repr=False)
     _cov: Coverage = field(init=False, repr=False)
@@ -202,8 +225,15 @@ class GridWind:
         if t.size == 0 or np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
             raise InputError(f"{self.name}: times must be finite and strictly increasing")
         for label, a in (("x", x), ("y", y), ("u", u), ("v", v)):
-            if not np.all(np.isfinite(a)):
-                raise InputError(f"{self.name}: {label} contains NaN or infinite values")
+            ok = np.isfinite(a) | (np.isnan(a) if self.allow_nan and label in "uv" else False)
+            if not np.all(ok):
+                hint = "" if label in "xy" else (
+                    "; pass allow_nan=True to keep NaN (land) cells as holes that routing "
+                    "must not cross")
+                raise InputError(f"{self.name}: {label} contains NaN or infinite values{hint}")
+        if self.steady and t.size != 1:
+            raise InputError(f"{self.name}: steady=True holds a single time slice at all "
+                             f"times, but there are {t.size} slices")
         if self.interpolation not in ("linear", "nearest"):
             raise InputError(
                 f"{self.name}: interpolation {self.interpolation!r}; "
@@ -228,8 +258,11 @@ class GridWind:
         object.__setattr__(self, "_t", t)
         object.__setattr__(self, "_uv", uv)
         object.__setattr__(self, "_map", imap)
-        object.__setattr__(self, "_cov", Coverage(float(t[0]), float(t[-1]), xmin, xmax, ymin,
-                                                   ymax))
+        t0, t1 = (-np.inf, np.inf) if self.steady else (float(t[0]), float(t[-1]))
+        object.__setattr__(self, "_cov", Coverage(t0, t1, xmin, xmax, ymin, ymax,
+                                                   frame=self.frame,
+                                                   source_span=self.source_span))
+        object.__setattr__(self, "_has_nan", bool(np.isnan(uv).any()))
 
     @property
     def coverage(self) -> Coverage:
@@ -252,7 +285,23 @@ class GridWind:
         return self._map(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
-        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast)."""
+        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast).
+
+        Raises
+        ------
+        OutOfCoverageError
+            Outside the coverage (unless ``clamp``), NaN points, or points whose
+            interpolation touches a NaN (land) cell of an ``allow_nan`` field.
+        """
+        return self._sample(t, x, y, refuse_nan=True)
+
+    def sample_with_holes(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+                          ) -> tuple[NDArray, NDArray]:
+        """As :meth:`sample`, but NaN where the data hold no wind (for statistics over an area)."""
+        return self._sample(t, x, y, refuse_nan=False)
+
+    def _sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike, *, refuse_nan: bool
+                ) -> tuple[NDArray, NDArray]:
         t, x, y = prepare_points(self._cov, t, x, y, clamp=self.clamp, name=self.name)
         shape = t.shape
         t, x, y = t.ravel(), x.ravel(), y.ravel()
@@ -289,7 +338,79 @@ class GridWind:
             out = _bilinear(flat, base, nx, wx, wy)
             if wt is not None:
                 out = out + wt * (_bilinear(flat, base + ncell, nx, wx, wy) - out)
+        if self._has_nan and refuse_nan:
+            self._refuse_nan(out, t, x, y)
         return out.real.reshape(shape).copy(), out.imag.reshape(shape).copy()
+
+    def _refuse_nan(self, out: NDArray, t: NDArray, x: NDArray, y: NDArray) -> None:
+        bad = np.isnan(out)
+        if not bad.any():
+            return
+        k = int(np.argmax(bad))
+        where = f"x {x[k]:.0f} m, y {y[k]:.0f} m"
+        if self.frame is not None:
+            la, lo = self.frame.to_latlon(x[k], y[k])
+            where = f"lat {float(la):.5f}, lon {float(lo):.5f} ({where})"
+        raise OutOfCoverageError(
+            f"{self.name}: the data hold no wind (NaN: land or masked cells) at "
+            f"{int(bad.sum())} of {bad.size} sample points, first at {where}, "
+            f"{iso(float(t[k]))}. The route would cross cells without wind data; move the "
+            "course (or its bounding box) away from the masked area, or use data that are "
+            "complete there."
+        )
+
+    def to_xarray(self) -> Any:
+        """The field as an :class:`xarray.Dataset` (needs the ``xarray`` extra).
+
+        Returns
+        -------
+        xarray.Dataset
+            Dimensions ``(time, j, i)`` (rows south to north, columns west to east).
+            Data variables ``u``, ``v``: local-frame components [m s⁻¹]; with a
+            :attr:`frame` also ``eastward_wind``/``northward_wind`` (true east/north,
+            CF standard names) and ``lat``/``lon`` coordinates, so the dataset is CF
+            and :func:`sailroute.wind.cf.open_netcdf` reads it back.  Coordinates
+            ``time`` (UTC, ``datetime64[ns]``), ``x``/``y`` [m].  Attributes: the
+            field's name, frame origin, interpolation and ``time_step_s``.
+        """
+        from sailroute.wind._xr import require_xarray
+
+        xr = require_xarray("GridWind.to_xarray()")
+        nt, ny, nx = self.shape
+        uv = self._uv.reshape(nt, ny, nx)
+        x = np.asarray(self.x, dtype=float)
+        y = np.asarray(self.y, dtype=float)
+        dims = ("time", "j", "i")
+        ms = {"units": "m s-1"}
+        data: dict[str, Any] = {
+            "u": (dims, uv.real.copy(), {**ms, "long_name": "wind towards +x (local frame)"}),
+            "v": (dims, uv.imag.copy(), {**ms, "long_name": "wind towards +y (local frame)"}),
+        }
+        coords: dict[str, Any] = {
+            "time": ("time", (self._t * 1e9).astype("int64").astype("datetime64[ns]")),
+            "x": (("j", "i"), x, {"units": "m", "long_name": "metres east of the origin"}),
+            "y": (("j", "i"), y, {"units": "m", "long_name": "metres north of the origin"}),
+        }
+        attrs: dict[str, Any] = {"title": self.name, "interpolation": self.interpolation,
+                                 "source": "sailroute GridWind"}
+        if self.time_step_s is not None:
+            attrs["time_step_s"] = float(self.time_step_s)
+        if self.frame is not None:
+            from sailroute.wind.rotation import rotate_clockwise
+
+            lat, lon = self.frame.to_latlon(x, y)
+            gn = self.frame.grid_north_deg(lat, lon)
+            ue, ve = rotate_clockwise(uv.real, uv.imag, -gn)
+            coords["lat"] = (("j", "i"), lat, {"standard_name": "latitude",
+                                               "units": "degrees_north"})
+            coords["lon"] = (("j", "i"), lon, {"standard_name": "longitude",
+                                               "units": "degrees_east"})
+            data["eastward_wind"] = (dims, ue, {**ms, "standard_name": "eastward_wind"})
+            data["northward_wind"] = (dims, ve, {**ms, "standard_name": "northward_wind"})
+            attrs["frame_lat0"] = float(self.frame.lat0)
+            attrs["frame_lon0"] = float(self.frame.lon0)
+            attrs["Conventions"] = "CF-1.8"
+        return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 def _bilinear(flat: NDArray, base: NDArray, nx: int, wx: NDArray, wy: NDArray) -> NDArray:

@@ -19,6 +19,17 @@ from sailroute.wind.stations import StationData, _sorted_checked
 _MISSING = {"MM", "999", "99.0", "9999", "999.0", "99", "9999.0"}
 
 
+def is_ndbc_text(path: str | Path) -> bool:
+    """True when the file starts with NDBC's ``#YY  MM DD hh mm`` header line."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            first = f.readline()
+    except OSError:
+        return False
+    return first.startswith(("#YY", "#yy")) and len(first.split()) >= 6 and (
+        "WDIR" in first.split() or "WSPD" in first.split())
+
+
 def read_ndbc(
     path: str | Path,
     *,

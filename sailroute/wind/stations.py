@@ -235,8 +235,72 @@ def map_columns(
     return out
 
 
+TIME_PARTS: Final = ("year", "month", "day", "hour", "minute", "second")
+"""Split date/time columns that can stand in for ``time`` (``columns`` may map them)."""
+
+_PART_ALIASES: Final[dict[str, tuple[str, ...]]] = {
+    "year": ("year", "yyyy", "yy", "#yy", "yr", "#yr"),
+    "month": ("month", "mo", "mon", "mth"),
+    "day": ("day", "dd", "dy"),
+    "hour": ("hour", "hh", "hr"),
+    "minute": ("minute", "min", "mn", "mi"),
+    "second": ("second", "sec", "ss"),
+}
+_PART_CASED: Final = {"MM": "month", "mm": "minute"}  # NDBC: '#YY MM DD hh mm'
+
+
+def time_part_columns(header: Sequence[str], columns: Mapping[str, str] | None = None, *,
+                      where: str = "CSV") -> dict[str, int]:
+    """Indices of split date/time columns (year, month, day, hour[, minute, second]).
+
+    ``MM`` (upper case) is the month and ``mm`` the minute, as in NDBC's
+    ``#YY MM DD hh mm``; other names are matched case-insensitively.  Returns an
+    empty dict unless at least year, month, day and hour are found.
+
+    Raises
+    ------
+    InputError
+        A mapped column is not in the header, or ``mm`` could be month or minute.
+    """
+    stripped = [h.strip() for h in header]
+    norm = [h.lower() for h in stripped]
+    out: dict[str, int] = {}
+    for part, col in (columns or {}).items():
+        if part in TIME_PARTS:
+            if col.strip().lower() not in norm:
+                raise InputError(f"{where}: columns.{part}: column {col!r} is not in the header "
+                                 f"({', '.join(stripped)})")
+            out[part] = norm.index(col.strip().lower())
+    for k, h in enumerate(stripped):
+        part = _PART_CASED.get(h)
+        if part is None:
+            part = next((q for q, names in _PART_ALIASES.items() if h.lower() in names), None)
+        if part is not None and part not in out and k not in out.values():
+            out[part] = k
+    if "minute" in out and "month" not in out and stripped[out["minute"]] == "mm":
+        raise InputError(f"{where}: column 'mm' could be the month or the minute; say which "
+                         "with `columns: {month: mm}` or `columns: {minute: mm}` (NDBC writes "
+                         "the month as MM and the minute as mm)")
+    return out if all(q in out for q in TIME_PARTS[:4]) else {}
+
+
+def _table_text(source: Any) -> tuple[str, str]:
+    """``(text, name)`` of a station table: a CSV file, or a pandas DataFrame as CSV."""
+    if type(source).__name__ == "DataFrame" and hasattr(source, "to_csv"):
+        df = source
+        import pandas as pd
+
+        if isinstance(df.index, pd.DatetimeIndex):
+            df = df.reset_index(names=df.index.name or "time")
+        return df.to_csv(index=False), "DataFrame"
+    p = Path(source)
+    if not p.is_file():
+        raise InputError(f"{p}: station file not found; check the `path`")
+    return p.read_text(encoding="utf-8-sig", errors="replace"), str(p)
+
+
 def read_stations(
-    path: str | Path,
+    path: str | Path | Any,
     *,
     columns: Mapping[str, str] | None = None,
     speed_unit: str | None = None,
@@ -252,10 +316,15 @@ def read_stations(
 
     Parameters
     ----------
-    path : str or Path
-        CSV file (``,``, ``;`` or tab separated; lines starting with ``#`` are skipped).
+    path : str, Path or pandas.DataFrame
+        CSV file (``,``, ``;``, tab or blank separated; lines starting with ``#``
+        are skipped), or a DataFrame with the same columns (a ``DatetimeIndex``
+        counts as the ``time`` column; line numbers in messages then count the
+        header as line 1).
     columns : mapping, optional
-        ``canonical -> file column`` for headers that the built-in aliases do not know.
+        ``canonical -> file column`` for headers that the built-in aliases do not
+        know; also ``year``, ``month``, ``day``, ``hour``, ``minute``, ``second``
+        for split date/time columns.
     speed_unit : str, optional
         Unit of ``speed`` and ``gust``: ``m/s``, ``kn``, ``km/h`` or ``mph``.  When
         omitted, the speed header's suffix decides (``tws_kn`` -> kn,
@@ -263,7 +332,9 @@ def read_stations(
         wrong guess would silently scale every speed.
     timezone : str, optional
         UTC offset (``"+01:00"``) applied to timestamps that carry none.  Without it
-        a naive timestamp is an error naming the line.
+        a naive timestamp is an error naming the line.  Without a ``time`` column
+        the time is built from year/month/day/hour[/minute/second] columns
+        (``#YY MM DD hh mm`` as NDBC writes them: UTC), which carry no offset either.
     missing : sequence of str
         Cell values that mean "no data" (compared after stripping blanks).
     station : str, optional
@@ -289,25 +360,35 @@ def read_stations(
         numbers or times (naming line and column), naive times without
         ``timezone``, values out of range, times that do not increase per station.
     """
-    p = Path(path)
-    name = str(p)
-    if not p.is_file():
-        raise InputError(f"{name}: station file not found; check the `path`")
-    text = p.read_text(encoding="utf-8-sig", errors="replace")
-    lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
+    text, name = _table_text(path)
+    p = Path(name)
+    all_lines = text.splitlines()
+    lines = [(k + 1, ln) for k, ln in enumerate(all_lines)
              if ln.strip() and not ln.lstrip().startswith("#")]
+    if all_lines and all_lines[0].startswith(("#YY", "#yy", "#YYYY")):  # NDBC-style header
+        lines = [(1, all_lines[0].lstrip("#")), *lines]
     if not lines:
         raise WindDataError(
             f"{name}: the file is empty; expected a header row (e.g. "
             "time,station,lat,lon,speed,direction) followed by data rows"
         )
     delim = max((",", ";", "\t"), key=lines[0][1].count)
-    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
+    if not lines[0][1].count(delim) and len(lines[0][1].split()) > 1:
+        delim = " "  # blank separated (NDBC-like text)
+        rows = [ln.split() for _, ln in lines]
+    else:
+        rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
     header, body = rows[0], rows[1:]
     linenos = [k for k, _ in lines[1:]]
-    cmap = map_columns(header, columns, where=name)
+    canon_cols = {k: v for k, v in (columns or {}).items() if k not in TIME_PARTS}
+    cmap = map_columns(header, canon_cols, where=name)
+    parts: dict[str, int] = {}
+    if "time" not in cmap:
+        parts = time_part_columns(header, columns, where=name)
+        if parts and timezone is None and header[parts["year"]].strip().upper() in ("YY", "#YY"):
+            timezone = "Z"  # NDBC's #YY MM DD hh mm columns are UTC
     need = list(REQUIRED_COLUMNS) + ([] if position is not None else ["lat", "lon"])
-    absent = [c for c in need if c not in cmap]
+    absent = [c for c in need if c not in cmap and not (c == "time" and parts)]
     if absent:
         raise InputError(
             f"{name}: no column for {', '.join(absent)}; header is "
@@ -315,6 +396,8 @@ def read_stations(
             "names (time, station, lat, lon, speed, direction) or map them with `columns: "
             "{canonical: file_column}`" + (" or give `position: {lat, lon}` for a fixed "
                                            "station" if "lat" in absent else "")
+            + (". The time may also come from year, month, day, hour[, minute, second] "
+               "columns" if "time" in absent else "")
         )
     if not body:
         raise WindDataError(f"{name}: the file has a header but no data rows")
@@ -327,14 +410,15 @@ def read_stations(
 
     ncol = len(header)
     n = len(body)
-    cols: dict[str, list[str]] = {c: [] for c in cmap}
+    every = {**cmap, **{f"_{q}": k for q, k in parts.items()}}
+    cols: dict[str, list[str]] = {c: [] for c in every}
     for r, lineno in zip(body, linenos, strict=True):
         if len(r) != ncol:
             raise WindDataError(
                 f"{name}, line {lineno}: {len(r)} fields but the header has {ncol}; check "
                 f"the separator ({delim!r}) and quoting"
             )
-        for c, k in cmap.items():
+        for c, k in every.items():
             cols[c].append(r[k].strip())
 
     missing_by: dict[str, int] = {}
@@ -342,7 +426,13 @@ def read_stations(
     for c in ("lat", "lon", "speed", "direction", "height_m", "gust"):
         if c in cols:
             values[c], missing_by[c] = _numbers(cols[c], c, header[cmap[c]], linenos, miss, name)
-    t, missing_by["time"] = _times(cols["time"], linenos, miss, tz, name, header[cmap["time"]])
+    if parts:
+        t, missing_by["time"] = _part_times({q: cols[f"_{q}"] for q in parts},
+                                            {q: header[k].strip() for q, k in parts.items()},
+                                            linenos, miss, tz, name)
+    else:
+        t, missing_by["time"] = _times(cols["time"], linenos, miss, tz, name,
+                                       header[cmap["time"]])
     if "station" in cols:
         st = np.array(cols["station"], dtype=object)
         st_missing = np.isin(st, list(miss))
@@ -466,6 +556,37 @@ def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | 
         return dt.timestamp()
 
     return _parse_cells(cells, miss, epoch)
+
+
+def _part_times(cells: Mapping[str, list[str]], headers: Mapping[str, str], linenos: list[int],
+                miss: set[str], tz: timezone | None, name: str) -> tuple[NDArray, int]:
+    """Epoch seconds from split year/month/day/hour[/minute/second] columns."""
+    if tz is None:
+        cols = "/".join(headers.values())
+        raise InputError(
+            f"{name}: times from the columns {cols} carry no UTC offset; declare it with "
+            "`timezone: 'Z'` (UTC, as NDBC and most loggers write) or e.g. `timezone: '+01:00'`"
+        )
+    n = len(next(iter(cells.values())))
+    out = np.full(n, np.nan)
+    for k in range(n):
+        vals = {q: c[k] for q, c in cells.items()}
+        if any(v in miss for v in vals.values()):
+            continue
+        try:
+            num = {q: int(float(v)) for q, v in vals.items()}
+            year = num["year"]
+            if year < 100:  # two-digit years (old NDBC files): 50..99 -> 19xx
+                year += 1900 if year >= 50 else 2000
+            out[k] = datetime(year, num["month"], num["day"], num["hour"], num.get("minute", 0),
+                              num.get("second", 0), tzinfo=tz).timestamp()
+        except ValueError:
+            shown = " ".join(f"{headers[q]}={v}" for q, v in vals.items())
+            raise WindDataError(
+                f"{name}, line {linenos[k]}: cannot read the date/time columns ({shown}) as a "
+                "date; expected whole numbers (year, month 1-12, day, hour 0-23, ...)"
+            ) from None
+    return out, int(np.count_nonzero(np.isnan(out)))
 
 
 def _check_range(name: str, linenos: list[int], column: str, a: NDArray, lo: float, hi: float,
@@ -675,6 +796,11 @@ class StationWind:
         Clamp points to the coverage instead of raising.
     name : str
         Label for messages.
+    time_window : (float, float), optional
+        The race window [epoch s].  Gaps longer than ``max_gap_s`` are then an
+        error only inside it: a month-long record with an outage a week before
+        the race is usable, and the coverage is the gap-free stretch around the
+        window.  ``None``: every gap inside the stations' common span counts.
 
     Notes
     -----
@@ -696,6 +822,7 @@ class StationWind:
     rbf_kernel: str = "thin_plate_spline"
     clamp: bool = False
     name: str = "station wind"
+    time_window: tuple[float, float] | None = None
     _series: tuple = field(init=False, repr=False)
     _cov: Coverage = field(init=False, repr=False)
     _moving: bool = field(init=False, repr=False)
@@ -720,23 +847,36 @@ class StationWind:
             ts = d.t[m]
             moving |= bool(np.ptp(x[m]) > 1e-6 or np.ptp(y[m]) > 1e-6)
             series.append((s, ts, x[m], y[m], ul[m], vl[m]))
-        t0 = max(float(s[1][0]) for s in series)
-        t1 = min(float(s[1][-1]) for s in series)
+        spans = [_gap_free_span(ts, self.time_window, self.max_gap_s) if
+                 self.time_window is not None else (float(ts[0]), float(ts[-1]))
+                 for _, ts, *_ in series]
+        t0 = max(a for a, _ in spans)
+        t1 = min(b for _, b in spans)
         if t0 > t1:
-            spans = "; ".join(f"{s[0]}: {iso(s[1][0])} .. {iso(s[1][-1])}" for s in series)
+            spans_txt = "; ".join(f"{s[0]}: {iso(a)} .. {iso(b)}"
+                                  for s, (a, b) in zip(series, spans, strict=True))
             raise WindDataError(
-                f"{self.name}: the stations never report at the same time ({spans}); "
+                f"{self.name}: the stations never report at the same time ({spans_txt}); "
                 "use stations with overlapping records"
             )
+        lo, hi = (t0, t1) if self.time_window is None else (
+            max(t0, self.time_window[0]), min(t1, self.time_window[1]))
         for s, ts, *_ in series:
-            inside = ts[(ts >= t0) & (ts <= t1)]
-            edges = np.concatenate([[t0], inside, [t1]])
+            if lo > hi:
+                break
+            if self.time_window is None:
+                edges = np.concatenate([[lo], ts[(ts >= lo) & (ts <= hi)], [hi]])
+            else:  # the records around the window too: a gap is bridged from record to record
+                k0 = max(int(np.searchsorted(ts, lo, side="right")) - 1, 0)
+                k1 = int(np.searchsorted(ts, hi, side="left")) + 1
+                edges = ts[k0:k1]
             gaps = np.diff(edges)
             if gaps.size and gaps.max() > self.max_gap_s:
                 k = int(np.argmax(gaps))
+                where = "" if self.time_window is None else " inside the race window"
                 raise WindDataError(
                     f"{self.name}: station {s!r} has no record from {iso(edges[k])} to "
-                    f"{iso(edges[k + 1])} ({gaps[k] / 60:.0f} min > max_gap_s "
+                    f"{iso(edges[k + 1])}{where} ({gaps[k] / 60:.0f} min > max_gap_s "
                     f"{self.max_gap_s / 60:.0f} min); the wind there would be a guess. "
                     "Restrict the race window, drop that station, or raise max_gap_s."
                 )
@@ -757,7 +897,8 @@ class StationWind:
                 raise InputError(f"{self.name}: RBF interpolation failed for these stations "
                                  f"({exc}); use method 'idw'") from None
         cov = Coverage(t0, t1, float(x.min()) - self.radius_m, float(x.max()) + self.radius_m,
-                       float(y.min()) - self.radius_m, float(y.max()) + self.radius_m)
+                       float(y.min()) - self.radius_m, float(y.max()) + self.radius_m,
+                       frame=self.frame, source_span=(float(d.t.min()), float(d.t.max())))
         object.__setattr__(self, "_series", tuple(series))
         object.__setattr__(self, "_cov", cov)
         object.__setattr__(self, "_moving", moving)
@@ -813,6 +954,25 @@ class StationWind:
         u = np.einsum("ns,ns->n", w, su)
         v = np.einsum("ns,ns->n", w, sv)
         return u.reshape(shape), v.reshape(shape)
+
+
+def _gap_free_span(ts: NDArray, window: tuple[float, float], max_gap_s: float
+                   ) -> tuple[float, float]:
+    """The stretch of records around ``window`` without a gap longer than ``max_gap_s``.
+
+    Gaps that overlap the window itself are left in (the caller reports them);
+    a window outside the records gives the whole record (the coverage check
+    then reports it).
+    """
+    cut = np.nonzero(np.diff(ts) > max_gap_s)[0]
+    starts = np.concatenate([[0], cut + 1])
+    ends = np.concatenate([cut, [ts.size - 1]])
+    w0, w1 = window
+    first = int(np.searchsorted(ts[ends], w0, side="left"))  # first stretch ending >= w0
+    last = int(np.searchsorted(ts[starts], w1, side="right")) - 1  # last starting <= w1
+    if first >= starts.size or last < 0 or first > last:
+        return float(ts[0]), float(ts[-1])
+    return float(ts[starts[first]]), float(ts[ends[last]])
 
 
 def idw_weights(x: NDArray, y: NDArray, sx: NDArray, sy: NDArray, power: float = 2.0

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso
+from sailroute.wind._xr import XarrayAsNetCDF, is_xarray_dataset
 from sailroute.wind.base import Coverage
 from sailroute.wind.grid import GridWind
 from sailroute.wind.height import (
@@ -98,9 +99,11 @@ class WrfHeader:
         return (self.times.size, *self.lat.shape)
 
 
-def _open(path: str | Path):
+def _open(path: str | Path | Any):
     import netCDF4
 
+    if is_xarray_dataset(path):
+        return XarrayAsNetCDF(path)
     p = Path(path)
     if not p.is_file():
         raise InputError(f"{p}: WRF file not found; check the `path` (relative to the course "
@@ -115,6 +118,11 @@ def _open(path: str | Path):
         ) from None
     ds.set_auto_mask(True)
     return ds
+
+
+def source_name(path: Any) -> str:
+    """File name of a path, or ``"xarray.Dataset"`` for a dataset (for messages)."""
+    return "xarray.Dataset" if is_xarray_dataset(path) else str(path)
 
 
 def parse_wrf_times(chars: NDArray, *, path: str = "WRF file") -> NDArray[np.float64]:
@@ -173,8 +181,8 @@ def read_wrf_header(path: str | Path) -> WrfHeader:
 
     Parameters
     ----------
-    path : str or Path
-        The NetCDF file.
+    path : str, Path or xarray.Dataset
+        The NetCDF file, or the same data opened with xarray.
 
     Returns
     -------
@@ -186,7 +194,7 @@ def read_wrf_header(path: str | Path) -> WrfHeader:
         Not NetCDF, not a wrfout file (names the missing variables and what was
         found), unreadable times, NaN coordinates.
     """
-    name = str(path)
+    name = source_name(path)
     with _open(path) as ds:
         names = frozenset(ds.variables)
         missing = [v for v in REQUIRED_VARIABLES if v not in names]
@@ -195,7 +203,8 @@ def read_wrf_header(path: str | Path) -> WrfHeader:
             raise WindDataError(
                 f"{name}: not a WRF wrfout file: missing variable(s) {', '.join(missing)} "
                 f"(found: {found or 'none'}); expected {', '.join(REQUIRED_VARIABLES)} as "
-                "written by WRF. Convert the data to wrfout layout or use another wind source."
+                "written by WRF. For winds on latitude/longitude (regridded WRF, ERA5, ICON, "
+                "CF NetCDF) use `type: netcdf` (Python: sailroute.wind.open_netcdf)."
             )
         times = parse_wrf_times(ds.variables["Times"][:], path=name)
         lat = _coords(ds, "XLAT", name)
@@ -283,13 +292,18 @@ def crop_window(
         xmin, xmax, ymin, ymax = bbox
         inside = (x >= xmin - m) & (x <= xmax + m) & (y >= ymin - m) & (y <= ymax + m)
         if not inside.any():
-            cov = Coverage(float(header.times[0]), float(header.times[-1]), float(x.min()),
-                           float(x.max()), float(y.min()), float(y.max()))
+            course = Coverage(0.0, 0.0, xmin, xmax, ymin, ymax, frame=frame).latlon_box()
+            assert course is not None
+            lon = np.asarray(header.lon, dtype=float)
             raise OutOfCoverageError(
-                f"{header.path}: the WRF domain does not contain the course.\n"
-                f"  course box: x {xmin:.0f} .. {xmax:.0f} m, y {ymin:.0f} .. {ymax:.0f} m "
-                f"(plus margin {m:.0f} m)\n"
-                f"  WRF grid:   {cov.describe()}\n"
+                f"{header.path}: the grid does not contain the course.\n"
+                f"  course box: lat {course[0]:.4f} .. {course[1]:.4f}, lon {course[2]:.4f} .. "
+                f"{course[3]:.4f} (x {xmin:.0f} .. {xmax:.0f} m, y {ymin:.0f} .. {ymax:.0f} m, "
+                f"plus margin {m:.0f} m)\n"
+                f"  grid:       lat {float(np.min(header.lat)):.4f} .. "
+                f"{float(np.max(header.lat)):.4f}, lon {float(lon.min()):.4f} .. "
+                f"{float(lon.max()):.4f}; time {iso(header.times[0])} .. "
+                f"{iso(header.times[-1])}\n"
                 "  Check the course origin/marks and that the file is for this venue."
             )
         rows = np.nonzero(inside.any(axis=1))[0]
@@ -693,8 +707,8 @@ def open_wrf(
 
     Parameters
     ----------
-    path : str or Path
-        The wrfout NetCDF file.
+    path : str, Path or xarray.Dataset
+        The wrfout NetCDF file (or the same data opened with xarray).
     frame : LocalFrame
         The course's local frame.
     bbox : tuple of float, optional
@@ -731,9 +745,10 @@ def open_wrf(
     dec = decode_wrf(raw, frame, height_m=height_m, levels=levels if want_model else "u10",
                      shear=shear, fallback_exponent=fallback_exponent,
                      exponent_range=exponent_range, roughness_m=roughness_m)
-    label = f"WRF wind {Path(path).name}"
+    label = f"WRF wind {Path(header.path).name}"
     field = GridWind(dec.times, dec.x, dec.y, dec.u, dec.v, interpolation=interpolation,
-                     time_step_s=step_s, clamp=clamp, name=label, info={})
+                     time_step_s=step_s, clamp=clamp, name=label, info={}, frame=frame,
+                     source_span=(float(header.times[0]), float(header.times[-1])))
     info = {
         "path": header.path,
         "levels": dec.levels,

@@ -19,6 +19,7 @@ from sailroute.units import wind_components
 from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import Coverage, WindField
 from sailroute.wind.blended import BlendedWind
+from sailroute.wind.cf import open_netcdf
 from sailroute.wind.rotation import rotate_clockwise
 from sailroute.wind.stations import StationData, StationWind
 from sailroute.wind.uniform import UniformWind
@@ -85,6 +86,8 @@ def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
         return open_wrf(path, frame, time_step_min=10, clamp=clamp)
     if kind == "wrf-2.68m":  # scaled from the model levels: constant speed again
         return open_wrf(path, frame, height_m=10.0, levels="model", clamp=clamp)
+    if kind == "netcdf-cf":
+        return open_netcdf(cf_constant(tiny_wrf, frame), frame, clamp=clamp)
     if kind == "stations-idw":
         return StationWind(stations_constant(frame), frame, clamp=clamp)
     if kind == "stations-rbf":
@@ -94,8 +97,36 @@ def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
     raise AssertionError(kind)
 
 
+def cf_constant(tiny_wrf, frame: LocalFrame):
+    """A CF lat/lon file (descending latitudes) holding the local constant wind."""
+    import netCDF4
+
+    path = tiny_wrf("contract.nc").with_name("contract_cf.nc")
+    lat = np.linspace(45.03, 44.97, 7)
+    lon = np.linspace(9.96, 10.04, 9)
+    LAT, LON = np.meshgrid(lat, lon, indexing="ij")
+    ue, ve = local_constant_wind(frame)(T0, LAT, LON)
+    with netCDF4.Dataset(path, "w") as ds:
+        for name, n in (("time", 4), ("latitude", lat.size), ("longitude", lon.size)):
+            ds.createDimension(name, n)
+        tv = ds.createVariable("time", "f8", ("time",))
+        tv.units = "minutes since 2018-04-24 08:00:00"
+        tv[:] = [0.0, 10.0, 20.0, 30.0]
+        for name, vals, units in (("latitude", lat, "degrees_north"),
+                                  ("longitude", lon, "degrees_east")):
+            v = ds.createVariable(name, "f8", (name,))
+            v.units = units
+            v[:] = vals
+        for name, std, vals in (("u10", "eastward_wind", ue), ("v10", "northward_wind", ve)):
+            v = ds.createVariable(name, "f4", ("time", "latitude", "longitude"))
+            v.standard_name, v.units = std, "m s-1"
+            v[:] = np.broadcast_to(vals, (4, *vals.shape))
+    return path
+
+
 KINDS = ["uniform", "uniform-table", "analytic", "wrf-linear", "wrf-nearest",
-         "wrf-frozen-10min", "wrf-2.68m", "stations-idw", "stations-rbf", "blended"]
+         "wrf-frozen-10min", "wrf-2.68m", "netcdf-cf", "stations-idw", "stations-rbf",
+         "blended"]
 # Exact for the analytic sources; float32 storage in WRF files limits those to ~1e-6 m/s.
 TOL = {"uniform": 1e-12, "uniform-table": 1e-12, "analytic": 1e-12, "stations-idw": 1e-12,
        "stations-rbf": 1e-9}

@@ -1,0 +1,117 @@
+"""Optional xarray support: the lazy import, and an xarray Dataset seen as a netCDF4 Dataset.
+
+The NetCDF readers (:mod:`sailroute.wind.wrf`, :mod:`sailroute.wind.cf`) are written
+against the small part of the ``netCDF4.Dataset`` interface they use: ``variables``
+(``dimensions``, ``shape``, ``ndim``, attributes, orthogonal ``[...]`` indexing),
+``dimensions``, ``ncattrs()``/``getncattr()`` and the context manager.
+:class:`XarrayAsNetCDF` offers the same for an in-memory :class:`xarray.Dataset`, so
+one reader serves files and datasets.  xarray itself is an optional extra
+(``pip install 'sailroute[xarray]'``): imported only here, and only when asked for.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+import numpy as np
+
+from sailroute.errors import InputError
+
+
+def require_xarray(what: str) -> Any:
+    """Import xarray, or raise an :class:`InputError` that says how to install it.
+
+    Parameters
+    ----------
+    what : str
+        The feature that needs it (for the message).
+    """
+    try:
+        import xarray
+    except ImportError:
+        raise InputError(
+            f"{what} needs the optional package xarray, which is not installed; install it "
+            "with `pip install 'sailroute[xarray]'` (or `pip install xarray`)"
+        ) from None
+    return xarray
+
+
+def is_xarray_dataset(obj: Any) -> bool:
+    """True for an :class:`xarray.Dataset`, without importing xarray when it is not loaded."""
+    import sys
+
+    xr = sys.modules.get("xarray")
+    return xr is not None and isinstance(obj, xr.Dataset)
+
+
+class _Var:
+    """One xarray variable behind the netCDF4.Variable interface."""
+
+    def __init__(self, name: str, var: Any) -> None:
+        self._name = name
+        self._var = var
+        self.dimensions: tuple[str, ...] = tuple(str(d) for d in var.dims)
+        self.shape: tuple[int, ...] = tuple(int(n) for n in var.shape)
+        self.ndim = len(self.shape)
+        self.dtype = var.dtype
+        attrs = dict(var.attrs)
+        # decoded CF times keep their units in .encoding; expose them like netCDF4 would
+        for key in ("units", "calendar"):
+            if key not in attrs and key in getattr(var, "encoding", {}):
+                attrs[key] = var.encoding[key]
+        self._attrs = attrs
+
+    def ncattrs(self) -> list[str]:
+        return list(self._attrs)
+
+    def getncattr(self, key: str) -> Any:
+        return self._attrs[key]
+
+    def __getattr__(self, key: str) -> Any:
+        attrs = self.__dict__.get("_attrs", {})
+        if key in attrs:
+            return attrs[key]
+        raise AttributeError(key)
+
+    def __getitem__(self, index: Any) -> np.ndarray:
+        a = self._var[index] if index != () else self._var
+        return np.asarray(a.values)
+
+
+class XarrayAsNetCDF:
+    """An :class:`xarray.Dataset` with the netCDF4.Dataset interface the readers use.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        The dataset (coordinates count as variables, as in a file).
+    label : str
+        Name used in messages in place of a file name.
+    """
+
+    def __init__(self, ds: Any, label: str = "xarray.Dataset") -> None:
+        self._ds = ds
+        self.label = label
+        self.variables: Mapping[str, _Var] = {str(k): _Var(str(k), v)
+                                              for k, v in ds.variables.items()}
+        self.dimensions: Mapping[str, int] = {str(k): int(n) for k, n in ds.sizes.items()}
+        self._attrs = dict(ds.attrs)
+
+    def ncattrs(self) -> list[str]:
+        return list(self._attrs)
+
+    def getncattr(self, key: str) -> Any:
+        return self._attrs[key]
+
+    def set_auto_mask(self, flag: bool) -> None:
+        """No-op: xarray has already decoded fill values to NaN."""
+
+    def __enter__(self) -> XarrayAsNetCDF:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.variables)
