@@ -561,7 +561,8 @@ def read_cf_header(
                 raise WindDataError(
                     f"{label}: the wind variables have an extra dimension {d!r} of size {n} "
                     "(levels or ensemble members); select one first (e.g. with xarray "
-                    "`ds.isel({d!r}: 0)`) and pass the dataset")
+                    f"`ds.isel({{{d!r}: 0}})`) and pass the dataset, or save it with "
+                    "`.to_netcdf(PATH)`")
             fixed[d] = 0
         if str(_attr(va, "GRIB_uvRelativeToGrid", 0)) == "1":
             raise WindDataError(

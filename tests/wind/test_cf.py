@@ -277,7 +277,8 @@ def test_errors_teach(tmp_path) -> None:
     assert open_netcdf(p, FRAME, bbox=BOX, height_m=2.68, data_height_m=10.0).info[
         "height_source"] == "argument"
     p = write_cf(tmp_path / "ens.nc", extra_dim=3)
-    with pytest.raises(WindDataError, match=r"extra dimension 'member' of size 3"):
+    with pytest.raises(WindDataError, match=r"extra dimension 'member' of size 3 .*"
+                                            r"`ds.isel\(\{'member': 0\}\)`"):
         read_cf_header(p)
     p = write_cf(tmp_path / "k.nc", units="furlongs per fortnight")
     with pytest.raises(WindDataError, match=r"units 'furlongs per fortnight'; expected a speed"):
