@@ -17,9 +17,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from sailroute.backend import get_xp
-from sailroute.course.geometry import leg_endpoints, target_of
+from sailroute.boat.polar import Polar
+from sailroute.boat.sanity import check_wind_range, peak_wind, require_speed
+from sailroute.course.geometry import course_bbox, leg_endpoints, race_time_window, target_of
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
+from sailroute.errors import InputError, format_problems
 from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
@@ -27,6 +30,7 @@ from sailroute.routing.api import get_router, route_leg
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import LegResult, RoutingSettings
 from sailroute.wind.base import WindField
+from sailroute.wind.build import wind_notes
 
 
 @dataclass(frozen=True, eq=False)
@@ -39,10 +43,14 @@ class PlannedCourse:
         The routed course.
     wind : WindField
         The scenario's wind field.
+    notes : tuple of str
+        Warnings about the run (e.g. wind above the polar's range, allowed by
+        ``boat.allow_extrapolation``); also sent to the progress display.
     """
 
     plan: Plan
     wind: WindField
+    notes: tuple[str, ...] = ()
 
 
 def settings_for(
@@ -60,6 +68,69 @@ def settings_for(
     get_router(settings.router)
     get_xp(backend)
     return settings
+
+
+def check_boat_and_winds(
+    course: Course, boat: Polar, winds: Mapping[str, WindField]
+) -> dict[str, str]:
+    """Polar sanity for every built scenario, before any routing (``docs/usage.md``).
+
+    The boat must have some speed, and each scenario's wind over the course area
+    (marks plus a margin, 25 x 25 points) every 5 min over the race window must stay
+    within the polar's TWS columns (:mod:`sailroute.boat.sanity`), unless the
+    course's ``boat`` block says ``allow_extrapolation: true``.
+
+    Parameters
+    ----------
+    course : Course
+        The course (area, race time window, ``boat.allow_extrapolation``).
+    boat : Polar
+        The built boat.
+    winds : mapping of str to WindField
+        Scenario name -> built wind.
+
+    Returns
+    -------
+    dict of str to str
+        Scenario name -> warning, for scenarios whose wind exceeds the polar
+        where extrapolation is allowed.
+
+    Raises
+    ------
+    InputError
+        The boat has no speed, or the wind exceeds the polar in some scenarios
+        (all of them listed) and extrapolation is not allowed.
+    """
+    boat_where = course.boat_where or (str(course.source) if course.source else "<course>")
+    require_speed(boat, f"{boat_where}: boat")
+    allow = course.boat_spec.get("allow_extrapolation", False) is True
+    bbox, window = course_bbox(course), race_time_window(course)
+    notes: dict[str, str] = {}
+    problems: list[str] = []
+    for name, wind in winds.items():
+        sc = course.scenarios[name]
+        where = sc.where or course.where(f"scenarios.{name}")
+        try:
+            note = check_wind_range(boat, peak_wind(wind, bbox, window),
+                                    allow_extrapolation=allow, where=where)
+        except InputError as exc:
+            problems.append(str(exc))
+            continue
+        if note is not None:
+            notes[name] = note
+    if len(problems) == 1:
+        raise InputError(problems[0])
+    if problems:
+        raise InputError(format_problems(
+            f"{course.source or '<course>'}: the wind exceeds the polar in {len(problems)} "
+            "scenarios", problems))
+    return notes
+
+
+def _warn(progress: Progress | None, notes: Mapping[str, str]) -> None:
+    if progress is not None:
+        for note in notes.values():
+            progress.warn(note)
 
 
 def default_scenario(course: Course) -> str:
@@ -150,7 +221,8 @@ def plan_course(
     Raises
     ------
     InputError
-        Unknown scenario or router, bad boat or wind spec (all problems listed).
+        Unknown scenario or router, bad boat or wind spec (all problems listed),
+        wind above the polar's highest TWS (:func:`check_boat_and_winds`).
     OutOfCoverageError
         The wind data do not cover the course area or the race time.
     RoutingError
@@ -159,7 +231,10 @@ def plan_course(
     name = default_scenario(course) if scenario is None else scenario
     settings = settings_for(course, router, backend)
     boat, winds = build_specs(course, [name])
-    return _routed(course, name, winds[name], boat, settings, backend, progress)
+    notes = check_boat_and_winds(course, boat, winds)
+    _warn(progress, notes)
+    run = _routed(course, name, winds[name], boat, settings, backend, progress)
+    return dataclasses.replace(run, notes=tuple(notes.values()))
 
 
 def _routed(
@@ -167,6 +242,9 @@ def _routed(
     backend: str, progress: Progress | None,
 ) -> PlannedCourse:
     """Route the course in one built scenario and assemble its :class:`Plan`."""
+    if progress is not None:
+        for line in wind_notes(wind):
+            progress.note(line)
     results = route_course(course, wind, boat, settings, backend=backend, progress=progress)
     return PlannedCourse(make_plan(course, name, results, wind, router=settings.router), wind)
 
@@ -216,6 +294,7 @@ def compare_scenarios(
     where = check_scheduler(scheduler)  # a bad name fails before any work
     # every problem of every scenario in one error, up front
     boat, winds = build_specs(course, names)
+    _warn(progress, check_boat_and_winds(course, boat, winds))
     if where == SERIAL:
         plans = []
         for n in names:

@@ -106,8 +106,13 @@ def peak_wind(
     n_t = min(max(n_times, int(np.ceil((t1 - t0) / TIME_STEP_S)) + 1), MAX_TIMES)
     ts = span(t0, t1, c.t0, c.t1, n_t, 0.0)
     t, x, y = np.meshgrid(ts, xs, ys, indexing="ij")
-    u, v = wind.sample(t, x, y)
+    # gridded data with land (NaN) cells near the course: the peak is over the sea; the
+    # routers themselves refuse to cross a hole (GridWind.sample)
+    sample = getattr(wind, "sample_with_holes", wind.sample)
+    u, v = sample(t, x, y)
     tws, _ = wind_speed_direction(u, v)
+    if not np.isfinite(tws).any():
+        return WindPeak(0.0, float(t.flat[0]), float(x.flat[0]), float(y.flat[0]))
     k = int(np.nanargmax(tws))
     return WindPeak(float(tws.flat[k]), float(t.flat[k]), float(x.flat[k]), float(y.flat[k]))
 

@@ -69,6 +69,24 @@ class Progress:
             self.stream.write(text + end)
         self.stream.flush()
 
+    def warn(self, text: str) -> None:
+        """Print ``warning: <text>`` on its own line, even when disabled (``--quiet``).
+
+        Warnings change what a result means (e.g. wind above the polar's range),
+        so quiet mode does not hide them.
+        """
+        saved, self.prefix = self.prefix, ""
+        try:
+            self._write(f"warning: {text}", end="\n")
+        finally:
+            self.prefix = saved
+
+    def note(self, text: str) -> None:
+        """Write one line of information (e.g. how the wind data were read)."""
+        if not self.enabled:
+            return
+        self._write(text, end="\n")
+
     def start_leg(self, index: int, label: str) -> None:
         """Announce leg ``index`` (0-based) with a label like ``"start -> 1"``."""
         if not self.enabled:

@@ -36,7 +36,7 @@ def test_wrap_lon_range() -> None:
 
 def test_local_frame_latlon_stays_in_gpx_range() -> None:
     frame = LocalFrame(41.48, 288.67)  # an east-positive origin
-    lat, lon = frame.to_latlon(np.array([0.0, 500.0]), np.array([0.0, 0.0]))
+    _, lon = frame.to_latlon(np.array([0.0, 500.0]), np.array([0.0, 0.0]))
     assert np.all((lon >= -180) & (lon < 180))
     assert lon[0] == pytest.approx(-71.33, abs=1e-9)
 

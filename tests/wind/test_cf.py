@@ -224,6 +224,29 @@ def test_routing_into_nan_cells_raises(tmp_path) -> None:
                                                 name="1"), T0, f, boat, RoutingSettings())
 
 
+def test_plan_near_land_cells_routes_and_checks_the_polar_over_the_sea(tmp_path) -> None:
+    # land in the north-east corner of the course area's margin: the polar-range check
+    # samples the area with holes (it once stopped here with the NaN error), the legs
+    # stay on the sea and route
+    from sailroute.course.load import course_from_mapping
+    from sailroute.plan import plan_course
+
+    lats = np.arange(43.3, 42.69, -0.05)
+    lons = np.arange(6.6, 7.41, 0.05)
+    LAT, LON = np.meshgrid(lats, lons, indexing="ij")
+    land = np.broadcast_to((LAT > 43.012) & (LON > 7.015), (3, *LAT.shape))
+    write_cf(tmp_path / "coast.nc", land=land)
+    course = course_from_mapping({
+        "name": "coast", "start_time": "2014-10-07T12:00:00Z", "time_limit_min": 60,
+        "origin": {"lat": 43.0, "lon": 7.0},
+        "marks": {"a": {"x": -300.0, "y": -1800.0}, "b": {"x": -300.0, "y": -200.0}},
+        "legs": [{"from": "a", "to": "b"}],
+        "scenarios": {"cf": {"wind": {"type": "netcdf", "path": "coast.nc"}}},
+    }, source=tmp_path / "coast.yaml")
+    run = plan_course(course)
+    assert run.plan.total_time_s > 0 and run.notes == ()
+
+
 # --------------------------------------------------------------------------- time, coverage
 def test_single_time_needs_steady_and_coverage_message_names_lat_lon(tmp_path) -> None:
     p = write_cf(tmp_path / "one.nc", times=(0.0,))
