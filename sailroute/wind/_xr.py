@@ -115,3 +115,54 @@ class XarrayAsNetCDF:
 
     def __iter__(self) -> Iterator[str]:
         return iter(self.variables)
+
+
+SOURCE_ATTR = "sailroute_source"
+"""Dataset attribute naming the file an in-memory dataset came from (set for GRIB)."""
+
+_GRIB_SUFFIXES = (".grib", ".grb", ".grib2", ".grb2")
+
+
+def open_dataset(source: Any, kind: str, expected: str) -> tuple[Any, str]:
+    """A netCDF4-like dataset and its label, for a path or an xarray Dataset.
+
+    Parameters
+    ----------
+    source : str, Path or xarray.Dataset
+        The file, or a dataset already in memory.
+    kind : str
+        What the file is, for messages (``"NetCDF"``, ``"WRF"``).
+    expected : str
+        What a readable file holds, for messages (``"a WRF wrfout NetCDF file"``).
+
+    Raises
+    ------
+    InputError
+        The file does not exist.
+    WindDataError
+        It is empty or not NetCDF (a GRIB file is pointed to ``type: grib``).
+    """
+    from pathlib import Path
+
+    from sailroute.errors import WindDataError
+
+    if is_xarray_dataset(source):
+        label = str(source.attrs.get(SOURCE_ATTR, "xarray.Dataset"))
+        return XarrayAsNetCDF(source, label=label), label
+    import netCDF4
+
+    p = Path(source)
+    if not p.is_file():
+        raise InputError(f"{p}: {kind} file not found; check the `path` (relative to the "
+                         "course file's folder)")
+    if p.stat().st_size == 0:
+        raise WindDataError(f"{p}: the file is empty (0 bytes); expected {expected}")
+    try:
+        ds = netCDF4.Dataset(str(p), "r")
+    except OSError as exc:
+        hint = (" GRIB files are read with `type: grib`." if p.suffix.lower() in _GRIB_SUFFIXES
+                else "")
+        raise WindDataError(f"{p}: cannot be read as NetCDF ({exc}); expected {expected}."
+                            f"{hint}") from None
+    ds.set_auto_mask(True)
+    return ds, str(p)

@@ -49,7 +49,11 @@ from sailroute.errors import InputError, WindDataError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso, parse_time
 from sailroute.units import speed_factor, wind_components
-from sailroute.wind._xr import XarrayAsNetCDF, is_xarray_dataset, require_xarray
+from sailroute.wind._xr import (
+    SOURCE_ATTR,
+    open_dataset,
+    require_xarray,
+)
 from sailroute.wind.grid import GridWind
 from sailroute.wind.height import (
     DEFAULT_EXPONENT,
@@ -90,36 +94,14 @@ _SPEED_UNIT_ALIASES = {"m s-1": "m/s", "m s**-1": "m/s", "m.s-1": "m/s", "ms-1":
                        "m s^-1": "m/s", "m sec-1": "m/s", "meter second-1": "m/s",
                        "meters/second": "m/s", "metre second-1": "m/s", "m s{-1}": "m/s",
                        "knot": "kn", "km h-1": "km/h", "km/hr": "km/h"}
-SOURCE_ATTR = "sailroute_source"
-"""Dataset attribute naming the file an in-memory dataset came from (set for GRIB)."""
-
 DATA_KEYS = ("u", "v", "speed", "direction", "lat", "lon", "time")
 """Keys of the ``variables`` mapping."""
 
 
 # ----------------------------------------------------------------------------- open
-def _open_source(source: Any, kind: str = "NetCDF") -> tuple[Any, str]:
+def _open_source(source: Any) -> tuple[Any, str]:
     """A netCDF4-like dataset and its label, for a path or an xarray Dataset."""
-    if is_xarray_dataset(source):
-        label = str(source.attrs.get(SOURCE_ATTR, "xarray.Dataset"))
-        return XarrayAsNetCDF(source, label=label), label
-    import netCDF4
-
-    p = Path(source)
-    if not p.is_file():
-        raise InputError(f"{p}: {kind} file not found; check the `path` (relative to the "
-                         "course file's folder)")
-    if p.stat().st_size == 0:
-        raise WindDataError(f"{p}: the file is empty (0 bytes); expected a {kind} file")
-    try:
-        ds = netCDF4.Dataset(str(p), "r")
-    except OSError as exc:
-        hint = (" GRIB files are read with `type: grib`." if p.suffix.lower() in
-                (".grib", ".grb", ".grib2", ".grb2") else "")
-        raise WindDataError(f"{p}: cannot be read as NetCDF ({exc}); expected a NetCDF file "
-                            f"with wind on latitude/longitude.{hint}") from None
-    ds.set_auto_mask(True)
-    return ds, str(p)
+    return open_dataset(source, "NetCDF", "a NetCDF file with wind on latitude/longitude")
 
 
 def is_wrfout(source: Any) -> bool:

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso
-from sailroute.wind._xr import XarrayAsNetCDF, is_xarray_dataset
+from sailroute.wind._xr import is_xarray_dataset, open_dataset
 from sailroute.wind.base import Coverage
 from sailroute.wind.grid import GridWind
 from sailroute.wind.height import (
@@ -99,25 +99,8 @@ class WrfHeader:
         return (self.times.size, *self.lat.shape)
 
 
-def _open(path: str | Path | Any):
-    import netCDF4
-
-    if is_xarray_dataset(path):
-        return XarrayAsNetCDF(path)
-    p = Path(path)
-    if not p.is_file():
-        raise InputError(f"{p}: WRF file not found; check the `path` (relative to the course "
-                         "file's folder)")
-    if p.stat().st_size == 0:
-        raise WindDataError(f"{p}: the file is empty (0 bytes); expected a WRF wrfout NetCDF file")
-    try:
-        ds = netCDF4.Dataset(str(p), "r")
-    except OSError as exc:
-        raise WindDataError(
-            f"{p}: cannot be read as NetCDF ({exc}); expected a WRF wrfout NetCDF file"
-        ) from None
-    ds.set_auto_mask(True)
-    return ds
+def _open(path: str | Path | Any) -> Any:
+    return open_dataset(path, "WRF", "a WRF wrfout NetCDF file")[0]
 
 
 def source_name(path: Any) -> str:
