@@ -52,7 +52,13 @@ from sailroute.errors import InputError
 from sailroute.timeutil import iso
 from sailroute.track.model import Track
 from sailroute.units import speed_factor
-from sailroute.wind.stations import DEFAULT_MISSING, map_columns, parse_offset, unit_from_header
+from sailroute.wind.stations import (
+    DEFAULT_MISSING,
+    column_speed_unit,
+    map_columns,
+    parse_offset,
+    unit_from_header,
+)
 
 TRACK_ALIASES: Final[dict[str, tuple[str, ...]]] = {
     "time": ("time", "datetime", "timestamp", "date_time", "time_utc", "datetime_utc", "utc",
@@ -304,7 +310,8 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
         )
     if not body:
         raise InputError(f"{src}: the file has a header but no data rows")
-    units = {c: _speed_unit(header[cmap[c]], speed_unit, src) for c in SPEED_COLUMNS
+    units = {c: column_speed_unit(header[cmap[c]], speed_unit, src,
+                                  header_unit(header[cmap[c]])) for c in SPEED_COLUMNS
              if c in cmap}
     ncol = len(header)
     for r, lineno in zip(body, linenos, strict=True):
@@ -329,26 +336,6 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
         else:
             channels[f"{c}_deg"] = np.mod(v, 360.0)
     return t, lat, lon, np.array(linenos), channels
-
-
-def _speed_unit(column: str, declared: str | None, src: str) -> str:
-    implied = header_unit(column)
-    if declared is None:
-        if implied is None:
-            raise InputError(
-                f"{src}: the unit of speed column {column!r} is not known; declare it with "
-                "speed_unit (--speed-unit: 'kn', 'm/s', 'km/h' or 'mph') or name the column "
-                "with a unit suffix such as sog_kn"
-            )
-        return implied
-    try:
-        f = speed_factor(declared)
-    except InputError as exc:
-        raise InputError(f"{src}: speed_unit: {exc}") from None
-    if implied is not None and not np.isclose(f, speed_factor(implied)):
-        raise InputError(f"{src}: speed_unit {declared!r} contradicts column {column!r} "
-                         f"(which says {implied!r}); fix one of them")
-    return declared if implied is None else implied
 
 
 def _numbers(body: list[list[str]], linenos: list[int], k: int, column: str, miss: set[str],

@@ -401,7 +401,8 @@ def read_stations(
         )
     if not body:
         raise WindDataError(f"{name}: the file has a header but no data rows")
-    unit = _speed_unit(header[cmap["speed"]], speed_unit, name)
+    column = header[cmap["speed"]]
+    unit = column_speed_unit(column, speed_unit, name, unit_from_header(column))
     gust_unit = unit
     if "gust" in cmap and speed_unit is None and unit_from_header(header[cmap["gust"]]):
         gust_unit = unit_from_header(header[cmap["gust"]]) or unit
@@ -481,23 +482,43 @@ def read_stations(
     return data
 
 
-def _speed_unit(column: str, declared: str | None, name: str) -> str:
-    implied = unit_from_header(column)
+def column_speed_unit(
+    column: str, declared: str | None, where: str, implied: str | None = None
+) -> str:
+    """Unit of a speed column: the declared ``speed_unit`` or the header's unit suffix.
+
+    Parameters
+    ----------
+    column : str
+        Header of the column, for messages.
+    declared : str, optional
+        ``speed_unit`` given by the course file or ``--speed-unit``.
+    where : str
+        File name, for messages.
+    implied : str, optional
+        Unit the header names (``unit_from_header(column)`` or the caller's own
+        reading of it); ``None``: none.
+
+    Raises
+    ------
+    InputError
+        Neither says, the declared unit is unknown, or the two disagree.
+    """
     if declared is None:
         if implied is None:
             raise InputError(
-                f"{name}: the unit of column {column!r} is not known; declare it with "
-                "`speed_unit:` (one of 'm/s', 'kn', 'km/h', 'mph') or name the column with a "
-                "unit suffix such as speed_kn / speed_m_s"
+                f"{where}: the unit of column {column!r} is not known; declare it with "
+                "`speed_unit:` (--speed-unit on the command line; one of 'm/s', 'kn', 'km/h', "
+                "'mph') or name the column with a unit suffix such as speed_kn / speed_m_s"
             )
         return implied
     try:
         f_decl = speed_factor(declared)
     except InputError as exc:
-        raise InputError(f"{name}: speed_unit: {exc}") from None
+        raise InputError(f"{where}: speed_unit: {exc}") from None
     if implied is not None and not np.isclose(f_decl, speed_factor(implied)):
         raise InputError(
-            f"{name}: speed_unit {declared!r} contradicts the column name {column!r} "
+            f"{where}: speed_unit {declared!r} contradicts the column name {column!r} "
             f"(which says {implied!r}); fix one of them"
         )
     return declared

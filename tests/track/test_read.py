@@ -104,7 +104,7 @@ def test_csv_units_time_zones_and_channels(tmp_path: Path) -> None:
 def test_csv_unsuffixed_speed_needs_a_unit(tmp_path: Path) -> None:
     p = _write(tmp_path, "d.csv", "time,lat,lng,sog\n2023-09-27 14:31:56+00:00,59.4,24.8,5\n"
                "2023-09-27 14:31:57+00:00,59.4,24.8001,6\n")
-    with pytest.raises(InputError, match=r"unit of speed column 'sog'.*speed_unit"):
+    with pytest.raises(InputError, match=r"unit of column 'sog' is not known.*speed_unit"):
         read_track(p)
     assert read_track(p, speed_unit="kn").channels["sog_ms"][1] == pytest.approx(6 * KNOT)
     with pytest.raises(InputError, match="unknown speed unit"):
