@@ -65,6 +65,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat.polar import Polar, fold_twa
 from sailroute.errors import InputError
+from sailroute.numerics import pchip
 from sailroute.units import wrap180
 
 RULES: Final = ("non_finite", "low_wind", "manoeuvre", "acceleration", "outside_bins",
@@ -437,8 +438,6 @@ def _monotone_in_tws(raw: NDArray, counts: NDArray, se: NDArray) -> NDArray:
 
 def _fill(tab: NDArray, tws: NDArray, twa: NDArray) -> NDArray:
     """Fill NaN cells (rules in the module docstring, step 5)."""
-    from scipy.interpolate import PchipInterpolator
-
     out = tab.copy()
     for i in range(out.shape[0]):  # linear along TWS between covered cells
         ok = np.flatnonzero(np.isfinite(tab[i]))
@@ -464,7 +463,7 @@ def _fill(tab: NDArray, tws: NDArray, twa: NDArray) -> NDArray:
         ok = np.flatnonzero(np.isfinite(out[:, j]))
         if ok.size >= 2:
             inner = np.arange(ok[0], ok[-1] + 1)
-            out[inner, j] = PchipInterpolator(twa[ok], out[ok, j])(twa[inner])
+            out[inner, j] = pchip(twa[ok], out[ok, j], twa[inner])
     for i in range(out.shape[0]):  # last resort: nearest value of the row
         ok = np.flatnonzero(np.isfinite(out[i]))
         miss = np.flatnonzero(np.isnan(out[i]))

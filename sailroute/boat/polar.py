@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError
+from sailroute.numerics import pchip
 from sailroute.units import KNOT
 
 INTERPOLATIONS: Final = ("pchip", "linear")
@@ -273,12 +274,10 @@ class Polar:
         cache = self.__dict__.get("_dense_cache")
         if cache is not None:
             return cache
-        from scipy.interpolate import PchipInterpolator
-
         twa, tws, tab = self._extended()
         n_twa = round(180.0 / DENSE_TWA_STEP_DEG) + 1
         twa_d = np.linspace(0.0, 180.0, n_twa)
-        by_twa = PchipInterpolator(twa, tab, axis=0)(twa_d)
+        by_twa = pchip(twa, tab, twa_d, axis=0)
         tws_max = float(tws[-1])
         if tws.size == 1 or tws_max <= 0:
             n_tws = 2
@@ -287,7 +286,7 @@ class Polar:
         else:
             n_tws = min(int(np.ceil(tws_max / DENSE_TWS_STEP_MS)), _MAX_DENSE_TWS) + 1
             tws_d = np.linspace(0.0, tws_max, n_tws)
-            dense = PchipInterpolator(tws, by_twa, axis=1)(tws_d)
+            dense = pchip(tws, by_twa, tws_d, axis=1)
         dense = np.where(dense > 1e-12, dense, 0.0)  # exact zeros at the taper rows
         # corner values of every cell, contiguous: one gather per lookup
         cells = np.stack(
