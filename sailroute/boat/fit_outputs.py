@@ -360,7 +360,8 @@ def plot_fit(fit: PolarFit, path: str | Path, unit: str = "kn",
             ax.plot(np.radians(a), reference.speed(tws, a) / f, ls="--", lw=0.8,
                     color=cmap[j])
     ax.set_title(f"{p.name}: {fit.percentile:g}th percentile fit [{unit}]"
-                 + (" (dashed: reference)" if reference is not None else ""), fontsize=9)
+                 + (" (dashed: reference)" if reference is not None else ""), fontsize=9,
+                 pad=16)  # clear of the 0° label of the polar axes
     ax2 = fig.add_subplot(1, 2, 2)
     im = ax2.imshow(np.where(fit.counts > 0, fit.counts, np.nan), origin="lower",
                     aspect="auto", cmap="viridis")
@@ -376,7 +377,7 @@ def plot_fit(fit: PolarFit, path: str | Path, unit: str = "kn",
     fig.colorbar(im, ax=ax2, shrink=0.8)
     fig.tight_layout()
     out = Path(path)
-    fig.savefig(out, dpi=100)
+    fig.savefig(out, dpi=100, bbox_inches="tight")  # keeps the polar title in
     return out
 
 
