@@ -1,4 +1,4 @@
-"""A real track without marks (the Tallinn 2023 keelboat instrument log) analyses.
+"""Real tracks without marks (Tallinn 2023 keelboat, J/24 Lake Washington 2015) analyse.
 
 Neither data set gives mark positions, so the course is laid on the track itself: the start
 at its first point, the windward and leeward marks at its most upwind and most downwind
@@ -77,4 +77,33 @@ def test_tallinn_instrument_log_analyses(tmp_path: Path) -> None:
     c = course_on_track(tr, tr.t_s[0], tr.t_s[-1], d,
                         f"{{type: uniform, tws_ms: {s:.2f}, twd_deg: {d:.0f}}}",
                         tmp_path / "tallinn.yaml")
+    _check(analyze_track(c, tr))
+
+
+@requires_shared
+def test_j24_phone_track_with_the_bridge_station_analyses(tmp_path: Path) -> None:
+    # J/24 Lake Washington 2015 (phone GPS, test-only data) in the SR-520 bridge station's
+    # wind; marks laid on the track between 0.5 h and 2.5 h after its start (a window where
+    # the invented windward mark is really rounded; ending at 3.5 h it is not: the boat is
+    # still beating at the window's end, and the analysis rightly says "never rounds 'W'")
+    import csv
+
+    with open(SHARED_REAL / "wind" / "lake-washington-sr520" / "tuesday-july-28-2015.csv") as f:
+        rows = list(csv.DictReader(f))
+    station = tmp_path / "sr520.csv"
+    with open(station, "w") as f:
+        f.write("time,lat,lon,speed_mph,direction\n")
+        for r in rows:
+            h = float(r["hod"])
+            hh, mm = int(h), round((h - int(h)) * 60)
+            if mm == 60:
+                hh, mm = hh + 1, 0
+            f.write(f"2015-07-28T{hh:02d}:{mm:02d}:00-07:00,47.641,-122.262,{r['speed']},"
+                    f"{r['direction']}\n")
+    tr = read_track(SHARED_REAL / "races" / "j24-lake-washington-2015" /
+                    "Sensor_record_20150728_211517_AndroSensor.csv", time_zone="-07:00")
+    t0 = tr.t_s[0] + 0.5 * 3600
+    c = course_on_track(tr, t0, t0 + 2.0 * 3600, 300.0,
+                        f"{{type: stations, path: {station}, radius_m: 8000}}",
+                        tmp_path / "j24.yaml")
     _check(analyze_track(c, tr))
