@@ -134,8 +134,18 @@ def _warn(progress: Progress | None, notes: Mapping[str, str]) -> None:
 
 
 def default_scenario(course: Course) -> str:
-    """The first scenario of the course file (the one ``plan`` routes by default)."""
-    return next(iter(course.scenarios))
+    """The first scenario of the course file (the one ``plan`` routes by default; an
+    ensemble's own name if the first one is an ensemble)."""
+    return course.scenario_names[0]
+
+
+def scenario_members(course: Course, names: Sequence[str]) -> list[str]:
+    """``names`` with each ensemble replaced by its members (order kept, no repeats)."""
+    ens = course.ensembles
+    out: list[str] = []
+    for n in names:
+        out.extend(ens.get(n, (n,)))
+    return list(dict.fromkeys(out))
 
 
 def route_course(
@@ -229,6 +239,12 @@ def plan_course(
         A leg cannot be routed (the message names it).
     """
     name = default_scenario(course) if scenario is None else scenario
+    if name in course.ensembles:
+        raise InputError(
+            f"{course.where('scenarios.' + name)}: {name!r} is an ensemble of "
+            f"{len(course.ensembles[name])} members; route them all with "
+            "`sailroute plan --scenario NAME` (run_plan_command) or compare_scenarios, or "
+            f"one member by its name ({course.ensembles[name][0]!r}, ...)")
     settings = settings_for(course, router, backend)
     boat, winds = build_specs(course, [name])
     notes = check_boat_and_winds(course, boat, winds)
@@ -289,7 +305,7 @@ def compare_scenarios(
     plans : list of Plan
         One per scenario, in the same order.
     """
-    names = list(course.scenarios) if not scenarios else list(dict.fromkeys(scenarios))
+    names = list(course.scenarios) if not scenarios else scenario_members(course, scenarios)
     settings = settings_for(course, router, backend)
     where = check_scheduler(scheduler)  # a bad name fails before any work
     # every problem of every scenario in one error, up front
@@ -351,16 +367,42 @@ def run_plan_command(
     """Everything ``sailroute plan`` does, minus printing.
 
     Writes ``plan.json``, ``track.csv``, ``route.gpx`` and ``route.png`` (unless
-    ``plots`` is False) into ``out_dir`` (default ``out/<course>/<scenario>``).
+    ``plots`` is False) into ``out_dir`` (default ``out/<course>/<scenario>``).  For an
+    ensemble scenario it routes every member and writes ``ensemble.json`` and
+    ``ensemble.csv`` (the spread of leg times, the side of the course) plus each
+    member's plan files in ``out_dir/<member>/``.
     """
     from sailroute.report.files import write_plan_outputs
     from sailroute.report.tables import plan_table
 
     course = _loaded(course)
+    name = default_scenario(course) if scenario is None else scenario
+    if name in course.ensembles:
+        return _run_ensemble(course, name, router=router, out_dir=out_dir, backend=backend,
+                             progress=progress)
     run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, run.plan.scenario)
     files = write_plan_outputs(out, run.plan, wind=run.wind, plot=plots)
     return CommandResult(plan_table(run.plan), files, (run.plan,))
+
+
+def _run_ensemble(
+    course: Course, name: str, *, router: str | None, out_dir: str | Path | None,
+    backend: str, progress: Progress | None,
+) -> CommandResult:
+    """``sailroute plan`` on an ensemble scenario: every member, then the spread."""
+    from sailroute.report.ensemble import ensemble_table, summarize_ensemble, write_ensemble
+    from sailroute.report.files import write_plan_outputs
+
+    _, plans = compare_scenarios(course, [name], router=router, backend=backend,
+                                 progress=progress)
+    summary = summarize_ensemble(name, plans)
+    out = Path(out_dir) if out_dir is not None else default_out_dir(course, name)
+    files: dict[str, Path] = dict(write_ensemble(out, summary))
+    for p in plans:
+        for kind, path in write_plan_outputs(out / p.scenario, p, plot=False).items():
+            files[f"{p.scenario}/{kind}"] = path
+    return CommandResult(ensemble_table(summary), files, tuple(plans))
 
 
 def run_compare_command(
@@ -379,8 +421,10 @@ def run_compare_command(
     Writes ``comparison.json``, ``comparison.csv`` and ``comparison.png`` (unless
     ``plots`` is False) into ``out_dir`` (default ``out/<course>/comparison``), and
     each scenario's ``plan.json``, ``track.csv`` and ``route.gpx`` into
-    ``out_dir/<scenario>/``.
+    ``out_dir/<scenario>/``; for each ensemble whose members were all routed, its
+    spread in ``out_dir/<ensemble>/ensemble.json`` and ``ensemble.csv``.
     """
+    from sailroute.report.ensemble import ensemble_table, summarize_ensemble, write_ensemble
     from sailroute.report.files import write_comparison, write_plan_outputs
     from sailroute.report.tables import comparison_table
 
@@ -398,4 +442,12 @@ def run_compare_command(
     for p in plans:
         for kind, path in write_plan_outputs(out / p.scenario, p, plot=False).items():
             files[f"{p.scenario}/{kind}"] = path
-    return CommandResult(comparison_table(cmp), files, tuple(plans))
+    report = [comparison_table(cmp)]
+    by_name = {p.scenario: p for p in plans}
+    for ens, members in course.ensembles.items():
+        if all(m in by_name for m in members):
+            summary = summarize_ensemble(ens, [by_name[m] for m in members])
+            for kind, path in write_ensemble(out / ens, summary).items():
+                files[f"{ens}/{kind}"] = path
+            report.append(ensemble_table(summary))
+    return CommandResult("\n\n".join(report), files, tuple(plans))

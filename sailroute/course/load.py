@@ -621,19 +621,81 @@ def _scenarios(c: _Checker, raw: Any, n_legs: int | None) -> dict[str, ScenarioS
         if not c.mapping(value, path, "a wind spec {type: ...} or {wind: {type: ...}, "
                          "references: ..., description: ...}"):
             continue
-        if "type" in value or not any(k in value for k in ("wind", "references", "description")):
+        keys = ("wind", "members", "references", "description")
+        if "type" in value or not any(k in value for k in keys):
             # shorthand: the scenario is the wind spec itself
             wind, wpath, refs, desc = value, path, {}, ""
         else:
-            c.keys(value, path, ("wind", "references", "description"), ("wind",))
-            if "wind" not in value:
+            c.keys(value, path, keys)
+            if ("wind" in value) == ("members" in value):
+                c.p.add(path, "give exactly one of `wind: {type: ...}` (one wind) or "
+                        "`members: [...]` (an ensemble of winds)")
                 continue
-            wind, wpath = value["wind"], _join(path, "wind")
             refs = _references(c, value.get("references"), _join(path, "references"), n_legs)
             desc = c.string(value, "description", path, "") or ""
+            if "members" in value:
+                mpath = _join(path, "members")
+                for k, (spec, where) in enumerate(_members(c, value["members"], mpath), 1):
+                    out[f"{name}#{k}"] = ScenarioSpec(f"{name}#{k}", dict(spec), refs, desc,
+                                                      c.p.prefix(where), ensemble=str(name))
+                continue
+            wind, wpath = value["wind"], _join(path, "wind")
         if _wind_spec(c, wind, wpath):
             out[name] = ScenarioSpec(name, dict(wind), refs, desc, c.p.prefix(wpath))
     return out
+
+
+def _members(c: _Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], str]]:
+    """The member wind specs of an ensemble scenario, each with its key path.
+
+    ``members`` is a list of wind specs, or ``{dim: NAME, wind: {type: netcdf, ...}}``:
+    one member per index of the NetCDF dimension ``NAME`` (the spec's ``select`` picks it).
+    """
+    if isinstance(raw, list):
+        if len(raw) < 2:
+            c.p.add(path, f"an ensemble needs at least 2 members; got {len(raw)}")
+            return []
+        items = [(spec, f"{path}[{k}]") for k, spec in enumerate(raw)]
+        return [(s, w) for s, w in items if _wind_spec(c, s, w)]
+    if not c.mapping(raw, path, "a list of wind specs, or {dim: NAME, wind: {type: netcdf, "
+                     "path: FILE}} (one member per index of that dimension)"):
+        return []
+    c.keys(raw, path, ("dim", "wind"), ("dim", "wind"))
+    dim, wpath = raw.get("dim"), _join(path, "wind")
+    wind = raw.get("wind")
+    if not isinstance(dim, str) or not _wind_spec(c, wind, wpath):
+        if "dim" in raw and not isinstance(dim, str):
+            c.p.add(_join(path, "dim"), f"expected a dimension name; got {_show(dim)}")
+        return []
+    if wind.get("type") != "netcdf" or not isinstance(wind.get("path"), str):
+        c.p.add(wpath, "members along a dimension need `type: netcdf` with a `path`")
+        return []
+    n = _dimension_size(c, Path(c.p.file).parent / wind["path"], dim, wpath)
+    if n is None:
+        return []
+    return [({**wind, "select": {**dict(wind.get("select") or {}), dim: k}}, wpath)
+            for k in range(n)]
+
+
+def _dimension_size(c: _Checker, file: Path, dim: str, path: str) -> int | None:
+    """Size of dimension ``dim`` in a NetCDF file (a problem at ``path`` if it has none)."""
+    import netCDF4
+
+    if not file.is_file():
+        c.p.add(_join(path, "path"), f"file {str(file)!r} not found (paths are relative to "
+                "the course file's folder)")
+        return None
+    try:
+        with netCDF4.Dataset(str(file), "r") as ds:
+            dims = {k: len(v) for k, v in ds.dimensions.items()}
+    except OSError as exc:
+        c.p.add(_join(path, "path"), f"{file.name} cannot be read as NetCDF ({exc})")
+        return None
+    if dim not in dims:
+        c.p.add(path, f"{file.name} has no dimension {dim!r}; it has "
+                + ", ".join(f"{k} ({v})" for k, v in dims.items()))
+        return None
+    return dims[dim]
 
 
 # ----------------------------------------------------------------------------- template

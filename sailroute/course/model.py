@@ -162,6 +162,9 @@ class ScenarioSpec:
     where : str
         Key path of the wind spec for error messages
         (e.g. ``"courses/hyeres-r1.yaml: scenarios.wrf10.wind"``).
+    ensemble : str
+        For a member of an ensemble scenario (``members:``), the ensemble's name; the
+        member itself is called ``"<ensemble>#<k>"`` (k from 1).  Empty otherwise.
     """
 
     name: str
@@ -169,6 +172,7 @@ class ScenarioSpec:
     references: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
     description: str = ""
     where: str = ""
+    ensemble: str = ""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "wind", _frozen(self.wind))
@@ -252,6 +256,21 @@ class Course:
     def n_legs(self) -> int:
         """Number of legs."""
         return len(self.legs)
+
+    @property
+    def ensembles(self) -> dict[str, tuple[str, ...]]:
+        """Ensemble scenario name -> its member scenario names, in file order."""
+        out: dict[str, list[str]] = {}
+        for name, sc in self.scenarios.items():
+            if sc.ensemble:
+                out.setdefault(sc.ensemble, []).append(name)
+        return {k: tuple(v) for k, v in out.items()}
+
+    @property
+    def scenario_names(self) -> tuple[str, ...]:
+        """The scenarios as the file names them: an ensemble once, by its own name."""
+        names = (sc.ensemble or name for name, sc in self.scenarios.items())
+        return tuple(dict.fromkeys(names))
 
     def where(self, key_path: str) -> str:
         """Error-message prefix ``"<file>: <key_path>"`` for specs of this course."""

@@ -327,8 +327,8 @@ def _build_wrf(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> Wind
 # ---------------------------------------------------------------------------- netcdf / grib
 _GRID_KEYS = ("type", "path", "variables", "time", "data_height_m", "speed_unit", "height_m",
               "shear", "exponent", "roughness_m", "time_step_min", "interpolation", "steady",
-              "margin_m", "clamp")
-_CF_ONLY = ("variables", "time", "data_height_m", "speed_unit", "steady")
+              "margin_m", "clamp", "select")
+_CF_ONLY = ("variables", "time", "data_height_m", "speed_unit", "steady", "select")
 
 
 def _grid_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context,
@@ -350,7 +350,17 @@ def _grid_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context,
         "speed_unit": None,
         "variables": None,
         "time": None,
+        "select": None,
     }
+    sel = chk.mapping(spec, "select", None)
+    if sel is not None:
+        bad = {k: v for k, v in sel.items()
+               if not isinstance(v, int) or isinstance(v, bool) or v < 0}
+        if bad:
+            chk.add("select", "expected a mapping of dimension name to an index >= 0, e.g. "
+                    f"{{number: 3}}; got {dict(sel)!r}")
+        else:
+            opts["select"] = {str(k): int(v) for k, v in sel.items()}
     unit = chk.string(spec, "speed_unit", None)
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
         chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph', got {unit!r}")

@@ -482,6 +482,7 @@ def read_cf_header(
     time: str | float | None = None,
     data_height_m: float | None = None,
     speed_unit: str | None = None,
+    select: Mapping[str, int] | None = None,
 ) -> CFHeader:
     """Find the winds, coordinates, times and data height of a lat/lon wind source.
 
@@ -498,6 +499,9 @@ def read_cf_header(
         Height of the winds [m] when the source does not say.
     speed_unit : str, optional
         Speed unit overriding the ``units`` attribute.
+    select : mapping of str to int, optional
+        Index to take along each extra dimension (an ensemble member or a level),
+        e.g. ``{"number": 3}``; extra dimensions of size 1 need none.
 
     Returns
     -------
@@ -536,15 +540,30 @@ def read_cf_header(
                 f"{label}: times must increase strictly, but time[{k}] = {iso(times[k])} and "
                 f"time[{k + 1}] = {iso(times[k + 1])}; remove duplicated or out-of-order slices")
         fixed: dict[str, int] = {}
+        chosen = dict(select or {})
+        unknown = sorted(set(chosen) - set(dims))
+        if unknown:
+            raise InputError(f"{label}: select names {', '.join(map(repr, unknown))}, which "
+                             f"the wind variables do not have (dimensions: {', '.join(dims)})")
         for d, n in zip(dims, va.shape, strict=True):
             if d in (row_dim, col_dim, time_dim):
+                if d in chosen:
+                    raise InputError(f"{label}: select {d!r}: that is a time or grid "
+                                     "dimension; select only members or levels")
+                continue
+            if d in chosen:
+                k = chosen[d]
+                if not 0 <= k < n:
+                    raise InputError(f"{label}: select {d}: {k} is out of range; that "
+                                     f"dimension has indices 0 .. {n - 1}")
+                fixed[d] = int(k)
                 continue
             if n != 1:
                 raise WindDataError(
                     f"{label}: the wind variables have an extra dimension {d!r} of size {n} "
-                    "(levels or ensemble members); select one first (e.g. with xarray "
-                    f"`ds.isel({{{d!r}: 0}})`) and pass the dataset, or save it with "
-                    "`.to_netcdf(PATH)`")
+                    "(levels or ensemble members); pick one with `select: {"
+                    f"{d}: 0}}` in the wind spec (an ensemble scenario's `members: {{dim: "
+                    f"{d}, ...}}` takes them all), or with xarray `ds.isel({{{d!r}: 0}})`")
             fixed[d] = 0
         if str(_attr(va, "GRIB_uvRelativeToGrid", 0)) == "1":
             raise WindDataError(
@@ -611,6 +630,7 @@ def open_netcdf(
     steady: bool = False,
     clamp: bool = False,
     label: str | None = None,
+    select: Mapping[str, int] | None = None,
 ) -> GridWind:
     """Open gridded lat/lon wind (CF NetCDF file or xarray Dataset) as a wind field.
 
@@ -628,7 +648,7 @@ def open_netcdf(
         Crop margin [m].
     time_window : tuple of float, optional
         ``(t0, t1)`` [epoch s]; only the slices bracketing it are read.
-    variables, time, data_height_m, speed_unit
+    variables, time, data_height_m, speed_unit, select
         See :func:`read_cf_header`.
     height_m : float, optional
         Height the wind is wanted at [m] (Laser centre of effort: 2.68); the data
@@ -669,7 +689,7 @@ def open_netcdf(
     if shear not in ("power", "log"):
         raise InputError(f"shear {shear!r}; expected 'power' or 'log'")
     hdr = read_cf_header(source, variables=variables, time=time, data_height_m=data_height_m,
-                         speed_unit=speed_unit)
+                         speed_unit=speed_unit, select=select)
     name = hdr.label
     if height_m is not None and hdr.data_height_m is None:
         raise InputError(
@@ -699,7 +719,8 @@ def open_netcdf(
                 elif d == hdr.col_dim:
                     index.append(_index(c_sorted))
                 else:
-                    index.append(slice(0, 1))
+                    k = hdr.fixed.get(d, 0)
+                    index.append(slice(k, k + 1))
             a = var[tuple(index)]
             a = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan)
             order = [hdr.dims.index(d) for d in (hdr.time_dim, hdr.row_dim, hdr.col_dim)
