@@ -41,6 +41,7 @@ SR_NS = "urn:x-sailroute:gpx:1"
 TRACK_COLUMNS = (
     "leg", "from", "to", "time", "t_race_s", "t_leg_s", "x_m", "y_m", "lat", "lon",
     "heading_deg", "tws_ms", "tws_kn", "twd_deg", "twa_deg", "bsp_ms", "bsp_kn", "tack", "event",
+    "sog_ms", "sog_kn", "cog_deg",
 )
 """Columns of ``track.csv`` (see ``docs/output-format.md``)."""
 
@@ -86,6 +87,7 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
             "tacks": int(r.n_tacks),
             "gybes": int(r.n_gybes),
             "distance_m": _num(r.distance_m, 2),
+            **_speeds(r),
             "start_time": iso(r.t_start),
             "end_time": iso(r.t_end),
             "start_point": _point(c, r.start_xy),
@@ -116,6 +118,7 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
         "total_tacks": int(sum(pl.result.n_tacks for pl in plan.legs)),
         "total_gybes": int(sum(pl.result.n_gybes for pl in plan.legs)),
         "origin": {"lat": c.frame.lat0, "lon": c.frame.lon0},
+        "current": _current_of(plan),
         "legs": legs,
         "references": {
             name: {"total_time_s": _num(sum(times)),
@@ -124,6 +127,23 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
             for name, times in plan.references.items()
         },
     }
+
+
+def _speeds(r: Any) -> dict[str, float | None]:
+    """Mean speeds of a leg [kn]: over the ground (distance / time) and through the
+    water (boat speed, time-weighted over the track's segments)."""
+    tr = r.track
+    dt = np.diff(tr.t)
+    stw = float(np.sum(tr.bsp_ms[:-1] * dt) / r.time_s) if r.time_s > 0 else float("nan")
+    sog = r.distance_m / r.time_s if r.time_s > 0 else float("nan")
+    return {"mean_sog_kn": _num(sog / KNOT), "mean_stw_kn": _num(stw / KNOT)}
+
+
+def _current_of(plan: Plan) -> dict[str, Any] | None:
+    """The scenario's surface-current spec as given (None: still water)."""
+    sc = plan.course.scenarios.get(plan.scenario)
+    cur = getattr(sc, "current", None)
+    return None if cur is None else json.loads(json.dumps(dict(cur), default=str))
 
 
 def write_plan_json(path: str | Path, plan: Plan) -> Path:
@@ -157,6 +177,7 @@ def write_track_csv(path: str | Path, plan: Plan) -> Path:
             tr = pl.result.track
             lat, lon = plan.course.frame.to_latlon(tr.x, tr.y)
             events = _events(tr.t, pl.result.manoeuvres)
+            sog, cog = tr.ground_speed_ms, tr.ground_course_deg
             for i in range(len(tr)):
                 w.writerow([
                     pl.spec.index + 1, pl.spec.from_name, pl.spec.to_name, iso(tr.t[i]),
@@ -166,6 +187,7 @@ def write_track_csv(path: str | Path, plan: Plan) -> Path:
                     f"{tr.tws_ms[i] / KNOT:.3f}", f"{tr.twd_deg[i]:.2f}",
                     f"{tr.twa_deg[i]:.2f}", f"{tr.bsp_ms[i]:.3f}", f"{tr.bsp_ms[i] / KNOT:.3f}",
                     "starboard" if tr.side[i] > 0 else "port", events[i],
+                    f"{sog[i]:.3f}", f"{sog[i] / KNOT:.3f}", f"{cog[i]:.2f}",
                 ])
     return p
 

@@ -73,6 +73,21 @@ def get_router(name: str) -> Callable[..., LegResult]:
     return func
 
 
+def check_current_router(router: str) -> None:
+    """Refuse a surface current for a router that cannot route one.
+
+    Raises
+    ------
+    InputError
+        For any router but ``isochrone``.
+    """
+    if router != "isochrone":
+        raise InputError(
+            f"routing.router: {router!r}: a current is supported by the isochrone router "
+            "only; set routing.router: isochrone (or remove the scenario's `current:`)"
+        )
+
+
 def route_leg(
     start: Start,
     target: Target,
@@ -83,6 +98,7 @@ def route_leg(
     *,
     progress: Callable[[float], None] | None = None,
     backend: str = "numpy",
+    current: Any = None,
 ) -> LegResult:
     """Fastest route of one leg with the router chosen in ``settings.router``.
 
@@ -105,6 +121,8 @@ def route_leg(
     backend : {"numpy", "cupy", "auto"}
         Array backend of the router's data-parallel kernels
         (:func:`sailroute.backend.get_xp`); results agree within float tolerance.
+    current : CurrentField, optional
+        Surface current (:mod:`sailroute.current`); only the isochrone router takes one.
 
     Returns
     -------
@@ -123,6 +141,9 @@ def route_leg(
     func = get_router(settings.router)
     xp = get_xp(backend)
     extra = {} if xp is np else {"xp": xp}  # NumPy is every router's default
+    if current is not None:
+        check_current_router(settings.router)
+        extra["current"] = current
     try:
         return func(start, target, t0, wind, boat, settings, progress=progress, **extra)
     except RoutingError as exc:

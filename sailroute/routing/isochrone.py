@@ -34,6 +34,7 @@ method, the defaults and the measured accuracy and speed.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import weakref
 from collections.abc import Callable
@@ -45,6 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.boat.polar import Polar
+from sailroute.current import CurrentField, RelativeWind, current_rate_set
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
 from sailroute.routing.geometry import (
     AIM_MARGIN_M,
@@ -339,6 +341,7 @@ class _Context:
     fan_hull: bool
     box: tuple[float, float, float, float] | None  # world coverage box to stay in, or None
     barriers: tuple[tuple[Barrier, float], ...] = ()  # (leg frame, mark clearance [m])
+    current: CurrentField | None = None  # surface current (None: still water)
 
 
 def _host(a: Any) -> NDArray:
@@ -379,6 +382,7 @@ def route_isochrone(
     *,
     progress: Callable[[float], None] | None = None,
     xp: ModuleType = np,
+    current: CurrentField | None = None,
 ) -> LegResult:
     """Fastest route of one leg by isochrones.
 
@@ -405,6 +409,12 @@ def route_isochrone(
     xp : module
         Array module of the kernel (NumPy; the kernel uses CuPy-compatible
         operations, the wind and polar are sampled on the host).
+    current : CurrentField, optional
+        Surface current (water velocity over the ground, towards).  The polar is then
+        entered with the wind relative to the water (:class:`~sailroute.current.RelativeWind`),
+        each move goes over the ground by (velocity through the water + current) and
+        the track carries SOG/COG; a boat stopped by a penalty drifts with the water.
+        None (default): still water, the unchanged code path.
 
     Returns
     -------
@@ -425,13 +435,15 @@ def route_isochrone(
         its time span (propagated from the wind field).
     """
     label = leg_label(start, target)
+    if current is not None:
+        wind = RelativeWind(wind, current)
     _check_settings(settings, label, t0)
     _check_polar(polar, label)
     geom = target_geometry(target, start, settings.zone_m)
     tab = polar_tables(polar, settings.heading_step_deg)
     frame = _LegFrame.for_leg(geom.centre, start_centre(start))
     ctx = _context(label, float(t0), frame, geom, wind, settings,
-                   leg_barriers(start, target))
+                   leg_barriers(start, target), current)
     if ctx.box is not None:
         _check_target_covered(geom, ctx.box, wind, label)
     dev = _device_tables(tab, xp)
@@ -451,7 +463,7 @@ def route_isochrone(
     while True:
         out = _step(layers[-1], wind, polar, dev, ctx, settings, tau_hint, xp)
         if isinstance(out, _Arrival):
-            track = _backtrack(layers, out, frame, wind, polar, (wx0, wy0))
+            track = _backtrack(layers, out, frame, wind, polar, (wx0, wy0), current)
             if progress is not None:
                 progress(1.0)
             return make_leg_result(track, "isochrone",
@@ -537,6 +549,7 @@ def _check_target_covered(
 def _context(
     label: str, t0: float, frame: _LegFrame, geom: TargetGeometry, wind: WindField,
     s: RoutingSettings, barriers: tuple[tuple[Barrier, float], ...] = (),
+    current: CurrentField | None = None,
 ) -> _Context:
     cov = wind.coverage
     bounded = any(math.isfinite(v) for v in (cov.xmin, cov.xmax, cov.ymin, cov.ymax))
@@ -550,7 +563,7 @@ def _context(
         n_bins=math.ceil(2.0 * math.pi / math.radians(s.prune_sector_deg)) + 3,
         max_points=int(s.max_front_points),
         fan_hull=s.heading_fan == "hull", box=box,
-        barriers=tuple((frame.barrier(b), c) for b, c in barriers),
+        barriers=tuple((frame.barrier(b), c) for b, c in barriers), current=current,
     )
 
 
@@ -628,6 +641,8 @@ class _Prep:
     near: Any  # bool: within one step of the target segment
     bar_near: list  # per barrier of ctx: bool, within one step of it (None: no point is)
     any_pending: bool
+    cx: Any = None  # current of the move (leg frame) [m s⁻¹]; None: still water
+    cy: Any = None
 
 
 def _step(
@@ -721,8 +736,11 @@ def _survivors(
     delay = xp.minimum(debt, dt)
     move = dt - delay
     in_man = xp.where(switch, ~free, pending) & ~(move > 0)
+    nx_, ny_ = pre.X[row] + move * vx, pre.Y[row] + move * vy
+    if pre.cx is not None:  # drift with the water for the whole step
+        nx_, ny_ = nx_ + dt * pre.cx[row], ny_ + dt * pre.cy[row]
     layer = _Layer(
-        t=pre.t + dt, x=pre.X[row] + move * vx, y=pre.Y[row] + move * vy,
+        t=pre.t + dt, x=nx_, y=ny_,
         side=xp.where(switch, -s0, s0), debt=debt - delay, abs_twa=twa,
         pend_old=xp.where(in_man, pre.base[row], np.nan), pend_pen=xp.where(in_man, pen, 0.0),
         parent=row, heading=xp.mod(xp.degrees(xp.arctan2(vx, vy)), 360.0), bsp=bsp,
@@ -828,6 +846,7 @@ def _support(j: Any, fw: Any, beta_deg: Any, dev: _DeviceTables, xp: ModuleType
 def _fastest_aim(
     X: Any, Y: Any, ex: Any, ey: Any, dist: Any, s0: Any, sw: Any, cw: Any, j: Any,
     fw: Any, g: TargetGeometry, dev: _DeviceTables, xp: ModuleType,
+    cur: tuple[Any, Any] | None = None,
 ) -> tuple[Any, Any, Any]:
     """Aim points on the target segment that the local wind reaches soonest, per side.
 
@@ -838,7 +857,9 @@ def _fastest_aim(
     ``Q*``; the aim point is ``Q*`` kept ``AIM_MARGIN_M`` inside the segment.  Where no
     heading approaches the line, the projection of ``P`` (``ex, ey, dist`` passed in)
     is kept.  This makes the direct candidate the exact best heading to a line or gate
-    in uniform wind.
+    in uniform wind.  In a current ``cur`` (leg frame) the same heading is fastest (the
+    current adds the same normal speed to every heading) but its track over the ground,
+    ``S·d + C``, meets the line elsewhere.
 
     Returns the unit vectors ``(ex, ey)`` to the aim points and their distances, each of
     shape (2, n): row 0 for side ``s0``, row 1 for side ``-s0``.
@@ -859,6 +880,11 @@ def _fastest_aim(
     ahead = (ax0 - X) * nx + (ay0 - Y) * ny  # distance to the segment's line along n
     dn = dx * nx + dy * ny
     ok = (best > 0) & (dn > 1e-9) & (ahead > 0)
+    if cur is not None:  # ground track: speed S = best / dn along d, plus the current
+        spd = best / xp.where(ok, dn, 1.0)
+        dx, dy = spd * dx + cur[0], spd * dy + cur[1]
+        dn = dx * nx + dy * ny
+        ok = ok & (dn > 1e-9)
     t = xp.where(ok, ahead / xp.where(ok, dn, 1.0), 0.0)
     length = g.length_m
     ux, uy = (g.b[0] - ax0) / length, (g.b[1] - ay0) / length
@@ -870,6 +896,73 @@ def _fastest_aim(
     use = ok & (d2 > 0)
     inv = 1.0 / xp.where(use, d2, 1.0)
     return xp.where(use, vx * inv, ex), xp.where(use, vy * inv, ey), xp.where(use, d2, dist)
+
+
+_CRAB_ITERATIONS = 8
+"""Fixed-point iterations of the crab angle of the direct column in a current."""
+_TTG_ITERATIONS = 4
+"""Newton iterations of the time to go in a current."""
+
+
+def _crab(
+    ex: Any, ey: Any, cx: Any, cy: Any, tws: Any, sw: Any, cw: Any, polar: Polar,
+    xp: ModuleType,
+) -> tuple[Any, Any, Any, Any]:
+    """The direct column in a current: the heading through the water whose velocity
+    over the ground, ``S(TWA(h))·w(h) + C``, points along the unit vectors ``(ex, ey)``.
+
+    Fixed-point iteration on the crab angle ``phi`` (from ``e`` towards the
+    perpendicular ``p``): ``sin(phi) = -C·p / S(phi)``.  Where no heading can hold the
+    line (``|C·p| >= S``, or no speed) the still-water direction ``e`` is kept.
+
+    Returns ``cos``/signed ``sin`` of the heading against the upwind unit vector
+    ``(sw, cw)``, its ``|TWA|`` [°] and boat speed [m s⁻¹], as the still-water columns.
+    """
+    px, py = ey, -ex
+    cp = cx * px + cy * py
+    wx, wy = ex, ey
+    tws_h = _host(tws)
+    for _ in range(_CRAB_ITERATIONS):
+        a_d = xp.degrees(xp.arccos(xp.clip(cw * wy + sw * wx, -1.0, 1.0)))
+        spd = xp.asarray(polar.speed(tws_h, _host(a_d)), dtype=float)
+        q = -cp / xp.where(spd > 0, spd, 1.0)
+        q = xp.where((spd > 0) & (xp.abs(q) < 1.0), q, 0.0)
+        r = xp.sqrt(1.0 - q * q)
+        wx, wy = r * ex + q * px, r * ey + q * py
+    cos_d = xp.clip(cw * wy + sw * wx, -1.0, 1.0)
+    a_d = xp.degrees(xp.arccos(cos_d))
+    v_d = xp.asarray(polar.speed(tws_h, _host(a_d)), dtype=float)
+    return cos_d, sw * wy - cw * wx, a_d, v_d
+
+
+def _time_to_go_current(
+    tau: Any, gx: Any, gy: Any, avg: tuple, ex: Any, ey: Any, dist: Any, cx: Any, cy: Any,
+    sides: Any, free: Any, ctx: _Context, dev: _DeviceTables, xp: ModuleType,
+) -> tuple[Any, Any, Any]:
+    """Time to go in a current ``C`` (averaged along the way, leg frame) and its gradient.
+
+    In the water the target drifts by ``-C`` per second, so the time to go solves
+    ``tau = T(D - C tau)`` with ``T`` the still-water :func:`_time_to_go` and ``D``
+    the way over the ground (Newton iterations from the still-water ``tau``; a plain
+    fixed-point step where ``1 + G·C`` is small).  The gradient is
+    ``G / (1 + G·C)`` (implicit differentiation).
+    """
+    dx, dy = dist * ex, dist * ey
+    for _ in range(_TTG_ITERATIONS):
+        ok = tau < _BIG_S
+        tt = xp.where(ok, tau, 0.0)
+        wx, wy = dx - cx * tt, dy - cy * tt
+        dw = xp.sqrt(wx * wx + wy * wy)
+        pos = dw > 0
+        inv = 1.0 / xp.where(pos, dw, 1.0)
+        t_w, gx, gy = _time_to_go(*avg, xp.where(pos, wx * inv, ex), xp.where(pos, wy * inv, ey),
+                                  dw, sides, free, ctx.tack_s, ctx.gybe_s, dev, xp)
+        der = 1.0 + gx * cx + gy * cy
+        newton = der > 0.25
+        tau = xp.where(ok, tt - (tt - t_w) / xp.where(newton, der, 1.0), t_w)
+        tau = xp.where(t_w >= _BIG_S, _BIG_S, xp.maximum(tau, 0.0))
+    scale = 1.0 / xp.maximum(1.0 + gx * cx + gy * cy, 0.25)
+    return tau, gx * scale, gy * scale
 
 
 def _prepare(
@@ -918,11 +1011,18 @@ def _prepare(
     py = xp.concatenate([Y + half * xp.cos(hr), (Y + fk[:, None] * (ay - Y)).reshape(-1)])
     pt = xp.concatenate([xp.full(n, t_mid), (t_mid + fk[:, None] * horizon).reshape(-1)])
     wx, wy = fr.to_world(px, py)
-    u, v = wind.sample(
-        _host(xp.clip(pt, cov.t0, cov.t1)), _host(xp.clip(wx, cov.xmin, cov.xmax)),
-        _host(xp.clip(wy, cov.ymin, cov.ymax)))
+    pts = (_host(xp.clip(pt, cov.t0, cov.t1)), _host(xp.clip(wx, cov.xmin, cov.xmax)),
+           _host(xp.clip(wy, cov.ymin, cov.ymax)))
+    u, v = wind.sample(*pts)
     u = xp.asarray(u, dtype=float).reshape(PATH_SAMPLES + 1, n)
     v = xp.asarray(v, dtype=float).reshape(PATH_SAMPLES + 1, n)
+    cur = None  # current (leg frame): of the move, and averaged along the way
+    if ctx.current is not None:
+        cu, cv = ctx.current.sample(*pts)
+        cu, cv = fr.vec_to_leg(xp.asarray(cu, dtype=float).reshape(PATH_SAMPLES + 1, n),
+                               xp.asarray(cv, dtype=float).reshape(PATH_SAMPLES + 1, n))
+        if bool(xp.any(cu != 0.0)) or bool(xp.any(cv != 0.0)):  # slack water: still water
+            cur = (cu[0], cv[0], xp.mean(cu, axis=0), xp.mean(cv, axis=0))
 
     # the move's wind: speed, direction, VMG angles
     tws, sw, cw, j, fw, a_up, a_dn = _wind_state(u[0], v[0], dev, fr, xp)
@@ -941,13 +1041,17 @@ def _prepare(
     # aim, per side, at the point of the target segment reached fastest in this wind
     s0 = xp.where(f.side < 0, -1.0, 1.0)
     free = f.side == 0
-    aex, aey, adist = _fastest_aim(X, Y, ex, ey, dist, s0, sw, cw, j, fw, ctx.geom, dev, xp)
+    aex, aey, adist = _fastest_aim(X, Y, ex, ey, dist, s0, sw, cw, j, fw, ctx.geom, dev, xp,
+                                   None if cur is None else cur[:2])
 
     # the exact columns: VMG up, VMG down, direct to the aim (side s0), direct (side -s0)
-    cos_d = xp.clip(cw * aey + sw * aex, -1.0, 1.0)  # (2, n)
-    sin_d = sw * aey - cw * aex
-    a_d = xp.degrees(xp.arccos(cos_d))
-    v_d = xp.asarray(polar.speed(_host(tws), _host(a_d)), dtype=float)
+    if cur is None:
+        cos_d = xp.clip(cw * aey + sw * aex, -1.0, 1.0)  # (2, n)
+        sin_d = sw * aey - cw * aex
+        a_d = xp.degrees(xp.arccos(cos_d))
+        v_d = xp.asarray(polar.speed(_host(tws), _host(a_d)), dtype=float)
+    else:  # the heading through the water whose track over the ground goes to the aim
+        cos_d, sin_d, a_d, v_d = _crab(aex, aey, cur[0], cur[1], tws, sw, cw, polar, xp)
     angles = xp.concatenate([a_up[:, None], a_dn[:, None], a_d.T], axis=1)
     v_extra = xp.concatenate([v_vmg, v_d.T], axis=1)
     rad = xp.radians(angles[:, :2])
@@ -958,7 +1062,12 @@ def _prepare(
     avg = _wind_state(xp.mean(u, axis=0), xp.mean(v, axis=0), dev, fr, xp)
     tau, gx, gy = _time_to_go(*avg, aex, aey, adist, xp.stack([s0, -s0]), free, ctx.tack_s,
                               ctx.gybe_s, dev, xp)
+    if cur is not None:
+        tau, gx, gy = _time_to_go_current(tau, gx, gy, avg, aex, aey, adist, cur[2], cur[3],
+                                          xp.stack([s0, -s0]), free, ctx, dev, xp)
     tau_min = float(xp.min(f.debt + tau[0]))
+    if cur is not None:  # the drift of the step is common to all candidates of a point
+        tau = tau - dt * (gx * cur[0] + gy * cur[1])
     dist_min = float(xp.min(adist))
 
     # manoeuvre state
@@ -971,6 +1080,8 @@ def _prepare(
     pen_up = xp.where(unknown | (base < 90.0), ctx.tack_s, mixed)
     pen_dn = xp.where(unknown | (base >= 90.0), ctx.gybe_s, mixed)
     reach = xp.maximum(xp.maximum(dev.vmax[j], dev.vmax[j + 1]), xp.max(v_extra, axis=1))
+    if cur is not None:
+        reach = reach + xp.sqrt(cur[0] * cur[0] + cur[1] * cur[1])
     near = _segment_distance(X, Y, ctx.geom, xp) <= reach * dt * 1.0001 + 1e-6
     bar_near = []  # per barrier: the points within one step of its ray (None: none)
     for b, clear in ctx.barriers:
@@ -986,6 +1097,7 @@ def _prepare(
         gy1=gy[1], s0=s0, free=free,
         pending=pending, base=base, pen_up=pen_up, pen_dn=pen_dn, debt=f.debt,
         pend_pen=f.pend_pen, near=near, bar_near=bar_near, any_pending=bool(xp.any(pending)),
+        cx=None if cur is None else cur[0], cy=None if cur is None else cur[1],
     )
     return pre, tau_min, dist_min
 
@@ -1087,6 +1199,9 @@ def _expand(
         qy0[prow] = Y[prow, None] + move_p * vy0[prow]
     qx1 = X[:, None] + move1 * vx1
     qy1 = Y[:, None] + move1 * vy1
+    if pre.cx is not None:  # drift with the water for the whole step, stopped or not
+        drx, dry = dt * pre.cx[sl, None], dt * pre.cy[sl, None]
+        qx0, qy0, qx1, qy1 = qx0 + drx, qy0 + dry, qx1 + drx, qy1 + dry
 
     # the direct columns exist on their own side only
     ok0 = s0 * pre.sin_d0[sl] >= 0
@@ -1115,6 +1230,9 @@ def _expand(
                 (qx1, qy1, delay1[near], move1[near], ok1))):
             px = X[near][:, None]
             py = Y[near][:, None]
+            if pre.cx is not None:  # the move starts after the drift of the penalty stop
+                px = px + dl_n * pre.cx[sl][near, None]
+                py = py + dl_n * pre.cy[sl][near, None]
             hit, sfrac, _ = segment_crossing(px, py, qx_b[near], qy_b[near], ctx.geom, xp=xp)
             hit[:, -1] &= ok_b[near]
             if blocked is not None:
@@ -1133,12 +1251,14 @@ def _expand(
             best_t = float(t_arr[rr, c])
             p = int(near[rr])
             ds = float(sfrac[rr, c])
-            x0, y0 = float(X[p]), float(Y[p])
+            x0, y0 = float(px[rr, 0]), float(py[rr, 0])
             q_x, q_y = float(qx_b[p, c]), float(qy_b[p, c])
+            hd = (_heading_deg(q_x - x0, q_y - y0) if pre.cx is None  # through the water:
+                  else _heading_deg(float(vel[blk][0][p, c]), float(vel[blk][1][p, c])))
             arrival = _Arrival(
                 parent=r0 + p, t_start=pre.t, t=pre.t + best_t,
                 x=x0 + ds * (q_x - x0), y=y0 + ds * (q_y - y0),
-                heading=_heading_deg(q_x - x0, q_y - y0), bsp=float(blocks[blk][0][p, c]),
+                heading=hd, bsp=float(blocks[blk][0][p, c]),
                 delay=float(dl_n[rr, c]), side=int(s0[p]) * (1 - 2 * blk),
             )
     if not want_winners or arrival is not None:
@@ -1216,13 +1336,14 @@ def _heading_deg(ux: float, uy: float) -> float:
 
 def _backtrack(
     layers: list[_Layer], arr: _Arrival, frame: _LegFrame, wind: WindField, polar: Polar,
-    world_start: tuple[NDArray, NDArray],
+    world_start: tuple[NDArray, NDArray], current: CurrentField | None = None,
 ) -> Track:
     """Polyline of the chosen route: step starts, penalty stops, exact arrival (world frame).
 
     The vertices at the start point get its world coordinates ``world_start[k][root]``
     exactly (not through the leg frame and back), so a leg starts bit-for-bit where
-    the previous one ended.
+    the previous one ended.  In a ``current`` the headings and speeds are through the
+    water and the track gets SOG/COG (velocity through the water plus the current).
     """
     # moves, newest first: (t_start, t_end, index in its source layer, heading, bsp, delay, side)
     moves = [(arr.t_start, arr.t, arr.parent, arr.heading, arr.bsp, arr.delay, arr.side)]
@@ -1265,10 +1386,16 @@ def _backtrack(
         u, v = wind.sample(a[0, 0], wx[0], wy[0])
         twd = math.degrees(math.atan2(-float(u), -float(v)))
         heading[0] = (2.0 * twd - heading[1]) % 360.0
-    return build_track(
+    track = build_track(
         a[:, 0], wx, wy, wind, polar, heading_deg=heading, bsp_ms=a[:, 4],
         side=a[:, 5].astype(np.int8),
     )
+    if current is None:
+        return track
+    cu, cv = current.sample(track.t, track.x, track.y)
+    hr = np.radians(track.heading_deg)
+    sog, cog = current_rate_set(track.bsp_ms * np.sin(hr) + cu, track.bsp_ms * np.cos(hr) + cv)
+    return dataclasses.replace(track, sog_ms=sog, cog_deg=cog)
 
 
 def _timeout_error(

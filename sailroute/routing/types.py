@@ -219,6 +219,11 @@ class Track:
         Boat speed through the water [m s⁻¹].
     side : ndarray of int
         +1 starboard tack, -1 port tack.
+    sog_ms, cog_deg : ndarray or None
+        Speed [m s⁻¹] and course [° compass] over the ground, where a surface current
+        was routed (``heading_deg``/``bsp_ms`` are then through the water and
+        ``tws``/``twd``/``twa`` relative to the water); None in still water, where they
+        equal ``bsp_ms``/``heading_deg`` (:attr:`ground_speed_ms`, :attr:`ground_course_deg`).
     """
 
     t: NDArray[np.float64]
@@ -230,9 +235,21 @@ class Track:
     twa_deg: NDArray[np.float64]
     bsp_ms: NDArray[np.float64]
     side: NDArray[np.int8]
+    sog_ms: NDArray[np.float64] | None = None
+    cog_deg: NDArray[np.float64] | None = None
 
     def __len__(self) -> int:
         return int(self.t.size)
+
+    @property
+    def ground_speed_ms(self) -> NDArray[np.float64]:
+        """Speed over the ground [m s⁻¹] (boat speed in still water)."""
+        return self.bsp_ms if self.sog_ms is None else self.sog_ms
+
+    @property
+    def ground_course_deg(self) -> NDArray[np.float64]:
+        """Course over the ground [°] (the heading in still water)."""
+        return self.heading_deg if self.cog_deg is None else self.cog_deg
 
     @property
     def distance_m(self) -> float:
