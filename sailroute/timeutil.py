@@ -33,6 +33,11 @@ def parse_time(text: str | datetime, where: str = "time") -> datetime:
     InputError
         If the text is not ISO 8601 or has no offset.
     """
+    return _aware(text, where).astimezone(UTC)
+
+
+def _aware(text: str | datetime, where: str) -> datetime:
+    """The time as written, with its own UTC offset (checks as :func:`parse_time`)."""
     if isinstance(text, datetime):
         dt = text
     else:
@@ -51,7 +56,19 @@ def parse_time(text: str | datetime, where: str = "time") -> datetime:
             f"{where}: time {text!r} has no UTC offset; add one, e.g. "
             f"'{dt.isoformat()}+00:00' or '{dt.isoformat()}Z'"
         )
-    return dt.astimezone(UTC)
+    return dt
+
+
+def utc_offset_s(text: str | datetime, where: str = "time") -> float:
+    """The UTC offset [s] an ISO 8601 time is written with (``+02:00`` -> 7200).
+
+    Raises
+    ------
+    InputError
+        As :func:`parse_time`.
+    """
+    off = _aware(text, where).utcoffset()
+    return off.total_seconds() if off is not None else 0.0
 
 
 def to_epoch(dt: datetime) -> float:

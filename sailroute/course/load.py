@@ -29,7 +29,7 @@ from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError, format_problems
 from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.routing.types import RouterName, RoutingSettings
-from sailroute.timeutil import parse_time
+from sailroute.timeutil import parse_time, utc_offset_s
 from sailroute.units import KNOT
 from sailroute.yamlfile import join_path as _join
 from sailroute.yamlfile import read_yaml
@@ -922,6 +922,7 @@ def course_from_mapping(
         template=dict(template) if template is not None else None,
         time_limit_s=float(time_limit) * 60.0,
         boat_where=probs.prefix("boat").removesuffix(": boat"),
+        utc_offset_s=utc_offset_s(data["start_time"]),
     )
 
 

@@ -218,6 +218,9 @@ class Course:
         that take longer run out of wind data (``time_limit_min`` in the file).
     boat_where : str
         ``"file:line"`` of the ``boat`` section, for the boat factory's messages.
+    utc_offset_s : float
+        The course's local time offset from UTC [s], taken from the offset
+        ``start_time`` is written with (``+02:00`` -> 7200); for reports.
     """
 
     name: str
@@ -236,6 +239,7 @@ class Course:
     template: Mapping[str, Any] | None = None
     time_limit_s: float = 5400.0
     boat_where: str = ""
+    utc_offset_s: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):

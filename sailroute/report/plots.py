@@ -8,7 +8,17 @@ Artists carry a ``gid`` so tests and callers can find them: ``leg:<n>`` (one
 ``LineCollection`` per leg, coloured by boat speed), ``tacks``/``gybes`` (marker
 lines, one point per manoeuvre), ``marks``, ``line:<name>``, ``gate:<name>``,
 ``wind`` (quiver), ``wind-field`` (speed background, only for non-uniform wind),
+``legno:<n>`` (the leg number, on the track), ``wind-leg:<n>`` (the wind where and when
+the boat passes the leg's number; drawn only when the wind differs between legs),
 ``route:<scenario>`` and ``bars:<scenario>`` in comparison charts.
+
+Map conventions (``route.png``): x/y metres of the course's local frame with latitude
+and longitude on the top and right axes; the boat-speed colour scale spans the 2nd-98th
+percentile of the moving speeds (penalty stops do not pull it to 0) and at least 2 kn (a
+few hundredths of a knot of noise do not look like a change); a leg sailed again over
+the same water as an earlier one (the same marks, e.g. the second run of a
+windward-leeward) is drawn shifted sideways by a few pixels so both stay visible; times
+are the course's local time with its UTC offset.
 """
 
 from __future__ import annotations
@@ -17,6 +27,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
@@ -92,7 +103,7 @@ def draw_course(ax: Axes, course: Course) -> None:
 
 
 def _draw_wind(ax: Axes, fig: Figure, wind: WindField, t: float,
-               extent: tuple[float, ...]) -> str | None:
+               extent: tuple[float, ...], utc_offset_s: float = 0.0) -> str | None:
     """Quiver (and speed background if the field varies) at time ``t``; returns a label."""
     x0, x1, y0, y1 = extent
     c = wind.coverage
@@ -107,17 +118,115 @@ def _draw_wind(ax: Axes, fig: Figure, wind: WindField, t: float,
         return None
     spd, twd = wind_speed_direction(u, v)
     if float(np.ptp(spd)) > 1e-6 or float(np.ptp(np.cos(np.radians(twd)))) > 1e-6:
+        lo, hi = speed_limits(np.ravel(spd) / KNOT)  # >= 2 kn wide: noise stays pale
         mesh = ax.imshow(spd / KNOT, extent=(gx0, gx1, gy0, gy1), origin="lower",
                          cmap="Blues", alpha=0.35, interpolation="bilinear", zorder=0,
-                         aspect="auto")
+                         aspect="auto", vmin=lo, vmax=hi)
         mesh.set_gid("wind-field")
         fig.colorbar(mesh, ax=ax, orientation="horizontal", fraction=0.04, pad=0.08,
                      label="wind speed [kn]")
     q = ax.quiver(gx, gy, u, v, color="0.35", alpha=0.7, zorder=1, angles="xy", pivot="middle")
     q.set_gid("wind")
     mean_dir = circular_mean_deg(twd, weights=spd) if float(spd.sum()) > 0 else 0.0
-    return (f"wind at {iso(t)[11:16]} UTC: {float(spd.mean()) / KNOT:.1f} kn "
-            f"from {mean_dir:.0f}°")
+    return (f"grey arrows: wind at {local_time(t, utc_offset_s)}, "
+            f"{float(spd.mean()) / KNOT:.1f} kn from {mean_dir:.0f}°")
+
+
+SPEED_SPAN_KN = 2.0
+"""Smallest span of the boat-speed colour scale [kn]."""
+OFFSET_PT = 4.0
+"""Sideways shift of a leg that repeats an earlier one [points]."""
+
+
+def speed_limits(bsp_kn: NDArray) -> tuple[float, float]:
+    """Colour-scale limits [kn]: 2nd-98th percentile of moving speeds, >= SPEED_SPAN_KN wide."""
+    moving = bsp_kn[bsp_kn > 0.05]
+    if moving.size == 0:
+        return 0.0, SPEED_SPAN_KN
+    lo, hi = (float(v) for v in np.percentile(moving, [2.0, 98.0]))
+    if hi - lo < SPEED_SPAN_KN:
+        lo = max(0.5 * (lo + hi - SPEED_SPAN_KN), 0.0)
+        hi = lo + SPEED_SPAN_KN
+    return lo, hi
+
+
+def repeat_index(legs: Sequence[LegResult], tol_m: float = 30.0) -> list[int]:
+    """For each leg, how many earlier legs started and ended at the same places (within
+    ``tol_m``): 0 for a first passage, 1 for the second over the same water, ..."""
+    out = []
+    for k, r in enumerate(legs):
+        same = sum(1 for q in legs[:k]
+                   if np.hypot(*np.subtract(q.start_xy, r.start_xy)) < tol_m
+                   and np.hypot(*np.subtract(q.end_xy, r.end_xy)) < tol_m)
+        out.append(same)
+    return out
+
+
+def local_time(t: float, utc_offset_s: float) -> str:
+    """``HH:MM`` in the course's local time and its offset, e.g. ``12:10 (UTC+02:00)``."""
+    sign = "+" if utc_offset_s >= 0 else "-"
+    h, m = divmod(round(abs(utc_offset_s) / 60.0), 60)
+    return f"{iso(t + utc_offset_s)[11:16]} (UTC{sign}{h:02d}:{m:02d})"
+
+
+def _latlon_axes(ax: Axes, course: Course) -> None:
+    """Latitude (right) and longitude (top) on secondary axes of the local x/y map."""
+    frame = course.frame
+    lat0, lon0 = frame.lat0, frame.lon0
+    m_lat = 111_132.0  # metres per degree of latitude (WGS-84, mid-latitudes; ±0.5 %)
+    m_lon = m_lat * float(np.cos(np.radians(lat0)))
+    top = ax.secondary_xaxis("top", functions=(lambda x: lon0 + x / m_lon,
+                                               lambda lon: (lon - lon0) * m_lon))
+    right = ax.secondary_yaxis("right", functions=(lambda y: lat0 + y / m_lat,
+                                                   lambda lat: (lat - lat0) * m_lat))
+    top.set_xlabel("longitude [°E]", fontsize=8)
+    right.set_ylabel("latitude [°N]", fontsize=8)
+    for a in (top, right):
+        a.tick_params(labelsize=7)
+    top.xaxis.set_major_formatter("{x:.3f}")
+    right.yaxis.set_major_formatter("{x:.3f}")
+
+
+def label_point(r: LegResult, k: int) -> int:
+    """Track index where leg ``k``'s number goes: spread along the legs (golden-ratio
+    steps between 30 % and 70 % of the track), so that legs over the same water, or
+    crossing at their middles, do not put their numbers on top of each other."""
+    frac = 0.3 + 0.4 * ((k * 0.6180339887) % 1.0)
+    return min(int(frac * r.track.t.size), r.track.t.size - 1)
+
+
+def _leg_wind(ax: Axes, wind: WindField, legs: Sequence[LegResult],
+              extent: tuple[float, ...]) -> str | None:
+    """One arrow per leg where its number is (at that point's time); nothing when the wind
+    is the same on every leg.  Returns the legend text ("1: 6.3 kn 149°, ...") or None."""
+    size = 0.06 * max(extent[1] - extent[0], extent[3] - extent[2])
+    samples = []
+    for k, r in enumerate(legs):
+        i = label_point(r, k)
+        t, x, y = float(r.track.t[i]), float(r.track.x[i]), float(r.track.y[i])
+        try:
+            u, v = wind.sample(t, x, y)
+        except OutOfCoverageError:
+            continue
+        samples.append((k, x, y, float(u), float(v)))
+    if not samples:
+        return None
+    uv = np.array([(u, v) for *_, u, v in samples])
+    if float(np.ptp(uv[:, 0])) < 0.02 and float(np.ptp(uv[:, 1])) < 0.02:
+        return None  # the same wind on every leg: the background arrows say it all
+    parts = []
+    for k, x, y, u, v in samples:
+        spd, twd = (float(a) for a in wind_speed_direction(u, v))
+        if spd <= 0:
+            continue
+        ux, uy = u / spd, v / spd
+        ax.annotate("", xy=(x + 0.5 * size * ux, y + 0.5 * size * uy),
+                    xytext=(x - 0.5 * size * ux, y - 0.5 * size * uy),
+                    arrowprops={"arrowstyle": "-|>", "color": "steelblue", "lw": 1.6},
+                    zorder=8, gid=f"wind-leg:{k + 1}")
+        parts.append(f"{k + 1}: {spd / KNOT:.1f} kn {twd:.0f}°")
+    rows = [", ".join(parts[i:i + 3]) for i in range(0, len(parts), 3)]
+    return "blue arrows, wind at each leg's number:\n" + "\n".join(rows)
 
 
 def plot_route(
@@ -127,6 +236,7 @@ def plot_route(
     t: float | None = None,
     *,
     title: str | None = None,
+    utc_offset_s: float = 0.0,
 ) -> Figure:
     """Map of a routed course.
 
@@ -143,6 +253,8 @@ def plot_route(
         Time of the wind drawing [epoch s]; default the first leg's start.
     title : str, optional
         Axes title.
+    utc_offset_s : float
+        The course's local offset from UTC [s], for the times shown.
 
     Returns
     -------
@@ -151,6 +263,7 @@ def plot_route(
     from matplotlib.collections import LineCollection
     from matplotlib.colors import Normalize
     from matplotlib.figure import Figure
+    from matplotlib.transforms import offset_copy
 
     extent = _extent(course, legs)
     aspect = (extent[3] - extent[2]) / (extent[1] - extent[0])
@@ -159,19 +272,35 @@ def plot_route(
     ax = fig.add_subplot()
     if t is None:
         t = legs[0].t_start if legs else course.start_epoch
-    wind_label = _draw_wind(ax, fig, wind, t, extent) if wind is not None else None
+    wind_label = (_draw_wind(ax, fig, wind, t, extent, utc_offset_s)
+                  if wind is not None else None)
     draw_course(ax, course)
     bsp_all = np.concatenate([r.track.bsp_ms for r in legs]) / KNOT if legs else np.zeros(1)
-    norm = Normalize(vmin=float(bsp_all.min()), vmax=max(float(bsp_all.max()),
-                                                          float(bsp_all.min()) + 1e-3))
+    norm = Normalize(*speed_limits(bsp_all))
     lc = None
+    repeats = repeat_index(legs)
     for k, r in enumerate(legs):
         pts = np.column_stack([r.track.x, r.track.y])
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
         lc = LineCollection(segs, cmap="viridis", norm=norm, linewidths=2.2, zorder=3)
         lc.set_array(r.track.bsp_ms[:-1] / KNOT)
         lc.set_gid(f"leg:{k + 1}")
+        if repeats[k]:  # the same water as an earlier leg: shift it sideways on screen
+            dx, dy = np.subtract(r.end_xy, r.start_xy)
+            n = float(np.hypot(dx, dy)) or 1.0
+            off = OFFSET_PT * repeats[k]
+            lc.set_transform(offset_copy(ax.transData, fig=fig, x=off * dy / n,
+                                         y=-off * dx / n, units="points"))
         ax.add_collection(lc)
+        i = label_point(r, k)
+        ax.annotate(str(k + 1), (float(r.track.x[i]), float(r.track.y[i])),
+                    xytext=(0, 0), textcoords="offset points", fontsize=7, ha="center",
+                    va="center", zorder=9, gid=f"legno:{k + 1}",
+                    bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.3",
+                          "lw": 0.6})
+    legs_wind = _leg_wind(ax, wind, legs, extent) if wind is not None else None
+    if legs_wind:
+        wind_label = f"{wind_label}\n{legs_wind}" if wind_label else legs_wind
     if lc is not None:
         fig.colorbar(lc, ax=ax, label="boat speed [kn]", shrink=0.8)
     tacks = [(m.x, m.y) for r in legs for m in r.manoeuvres if m.kind == "tack"]
@@ -181,6 +310,7 @@ def plot_route(
     ax.plot([p[0] for p in gybes], [p[1] for p in gybes], "s", color="royalblue", ms=5,
             linestyle="none", zorder=7, gid="gybes", label=f"gybes ({len(gybes)})")
     _map_frame(ax, extent)
+    _latlon_axes(ax, course)
     ax.legend(loc="best", fontsize=8, title=wind_label, title_fontsize=8)
     ax.set_title(title or course.name, fontsize=10)
     return fig
@@ -190,9 +320,11 @@ def plot_plan(plan: Plan, wind: WindField | None = None) -> Figure:
     """:func:`plot_route` of a :class:`Plan` with a title giving scenario and total time."""
     from sailroute.report.tables import format_duration
 
+    off = plan.course.utc_offset_s
     title = (f"{plan.course.name} - {plan.scenario}: {format_duration(plan.total_time_s)} "
-             f"({plan.total_time_s:.0f} s), start {iso(plan.t_start)[:16]}Z")
-    return plot_route(plan.course, plan.results, wind, plan.t_start, title=title)
+             f"({plan.total_time_s:.0f} s), start {local_time(plan.t_start, off)}")
+    return plot_route(plan.course, plan.results, wind, plan.t_start, title=title,
+                      utc_offset_s=off)
 
 
 def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:

@@ -70,3 +70,58 @@ def test_plot_comparison(plan, with_map):
     routes = by_gid(fig, "route:")
     assert len(routes) == (2 if with_map else 0)
     assert len(fig.axes) == (2 if with_map else 1)
+
+
+# --- route.png conventions (issue 13 item 2) ------------------------------------------------
+from sailroute.report.plots import OFFSET_PT, local_time, repeat_index, speed_limits  # noqa: E402
+
+
+def test_speed_scale_ignores_stops_and_is_at_least_2_kn_wide():
+    bsp = np.r_[np.zeros(50), np.full(200, 6.28), np.full(10, 6.3)]  # stops + 0.02 kn noise
+    lo, hi = speed_limits(bsp)
+    assert lo > 5.0 and hi - lo == pytest.approx(2.0)
+    assert lo <= 6.28 <= hi
+    wide = np.linspace(3.0, 9.0, 101)
+    lo, hi = speed_limits(wide)
+    assert lo == pytest.approx(np.percentile(wide, 2)) and hi == pytest.approx(
+        np.percentile(wide, 98))
+
+
+def test_local_time_names_the_offset(plan):
+    assert plan.course.utc_offset_s == 7200.0  # "2024-05-01T12:00:00+02:00"
+    assert local_time(plan.t_start, plan.course.utc_offset_s) == "12:00 (UTC+02:00)"
+    assert local_time(0.0, -4.5 * 3600) == "19:30 (UTC-04:30)"
+    fig = plot_plan(plan)
+    assert "start 12:00 (UTC+02:00)" in fig.axes[0].get_title()
+
+
+def test_leg_numbers_lat_lon_axes_and_repeated_legs_offset(plan, wind):
+    fig = plot_route(plan.course, plan.results, wind)
+    nums = by_gid(fig, "legno:")
+    assert sorted(a.get_text() for a in nums) == ["1", "2", "3"]
+    labels = " ".join(a.get_xlabel() + a.get_ylabel() for a in fig.axes[0].child_axes)
+    assert "longitude" in labels and "latitude" in labels
+    # uniform wind: no per-leg wind arrows
+    assert by_gid(fig, "wind-leg:") == []
+    # the same leg twice: the second copy is drawn OFFSET_PT points to the side
+    legs = [*plan.results, plan.results[1]]
+    assert repeat_index(legs) == [0, 0, 0, 1]
+    fig2 = plot_route(plan.course, legs)
+    ax = fig2.axes[0]
+    first, again = (next(a for a in by_gid(fig2, "leg:") if a.get_gid() == g)
+                    for g in ("leg:2", "leg:4"))
+    fig2.canvas.draw()
+    p1 = first.get_transform().transform(first.get_segments()[0][0])
+    p2 = again.get_transform().transform(again.get_segments()[0][0])
+    shift_pt = float(np.hypot(*(p2 - p1))) * 72.0 / fig2.dpi
+    assert shift_pt == pytest.approx(OFFSET_PT, rel=1e-6)
+    assert first.get_transform() == ax.transData
+
+
+def test_varying_wind_draws_one_arrow_per_leg(plan):
+    wind = AnalyticWind(lambda t, x, y: wind_components(5.0 + 0.002 * y, 0.0 * x))
+    fig = plot_plan(plan, wind)
+    assert sorted(a.get_gid() for a in by_gid(fig, "wind-leg:")) == [
+        "wind-leg:1", "wind-leg:2", "wind-leg:3"]
+    title = fig.axes[0].get_legend().get_title().get_text()
+    assert "wind at each leg's number" in title and "1: " in title
