@@ -20,13 +20,13 @@ from sailroute.backend import get_xp
 from sailroute.boat.polar import Polar
 from sailroute.boat.sanity import check_wind_range, peak_wind, require_speed
 from sailroute.course.geometry import course_bbox, leg_endpoints, race_time_window, target_of
-from sailroute.course.load import build_specs, load_course
+from sailroute.course.load import build_current, build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError, format_problems
 from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
-from sailroute.routing.api import get_router, route_leg
+from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import LegResult, RoutingSettings
 from sailroute.wind.base import WindField
@@ -156,6 +156,7 @@ def route_course(
     *,
     backend: str = "numpy",
     progress: Progress | None = None,
+    current: object | None = None,
 ) -> list[LegResult]:
     """Route every leg in order, each starting where and when the previous one ended.
 
@@ -174,6 +175,8 @@ def route_course(
         Array backend of the router kernels.
     progress : Progress, optional
         Receives per-leg start/update/end calls.
+    current : CurrentField, optional
+        Surface current (isochrone router only); None: still water.
 
     Returns
     -------
@@ -194,7 +197,8 @@ def route_course(
         if progress is not None:
             progress.start_leg(i, spec.label)
         res = route_leg(start, target, t0, wind, boat, settings, backend=backend,
-                        progress=progress.update if progress is not None else None)
+                        progress=progress.update if progress is not None else None,
+                        **({} if current is None else {"current": current}))
         if progress is not None:
             progress.end_leg(res.time_s, f"{res.n_tacks} tacks, {res.n_gybes} gybes")
         results.append(res)
@@ -261,7 +265,11 @@ def _routed(
     if progress is not None:
         for line in wind_notes(wind):
             progress.note(line)
-    results = route_course(course, wind, boat, settings, backend=backend, progress=progress)
+    current = build_current(course, name)
+    if current is not None:
+        check_current_router(settings.router)
+    results = route_course(course, wind, boat, settings, backend=backend, progress=progress,
+                           current=current)
     return PlannedCourse(make_plan(course, name, results, wind, router=settings.router), wind)
 
 

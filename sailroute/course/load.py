@@ -621,7 +621,8 @@ def _scenarios(c: _Checker, raw: Any, n_legs: int | None) -> dict[str, ScenarioS
         if not c.mapping(value, path, "a wind spec {type: ...} or {wind: {type: ...}, "
                          "references: ..., description: ...}"):
             continue
-        keys = ("wind", "members", "references", "description")
+        keys = ("wind", "members", "references", "description", "current")
+        cur, cwhere = None, ""  # surface current spec (sailroute.current), key path
         if "type" in value or not any(k in value for k in keys):
             # shorthand: the scenario is the wind spec itself
             wind, wpath, refs, desc = value, path, {}, ""
@@ -633,15 +634,21 @@ def _scenarios(c: _Checker, raw: Any, n_legs: int | None) -> dict[str, ScenarioS
                 continue
             refs = _references(c, value.get("references"), _join(path, "references"), n_legs)
             desc = c.string(value, "description", path, "") or ""
+            if value.get("current") is not None and c.mapping(
+                    value["current"], _join(path, "current"),
+                    "a current spec {type: uniform|diamonds|netcdf, ...}"):
+                cur, cwhere = dict(value["current"]), c.p.prefix(_join(path, "current"))
             if "members" in value:
                 mpath = _join(path, "members")
                 for k, (spec, where) in enumerate(_members(c, value["members"], mpath), 1):
                     out[f"{name}#{k}"] = ScenarioSpec(f"{name}#{k}", dict(spec), refs, desc,
-                                                      c.p.prefix(where), ensemble=str(name))
+                                                      c.p.prefix(where), ensemble=str(name),
+                                                      current=cur, current_where=cwhere)
                 continue
             wind, wpath = value["wind"], _join(path, "wind")
         if _wind_spec(c, wind, wpath):
-            out[name] = ScenarioSpec(name, dict(wind), refs, desc, c.p.prefix(wpath))
+            out[name] = ScenarioSpec(name, dict(wind), refs, desc, c.p.prefix(wpath),
+                                     current=cur, current_where=cwhere)
     return out
 
 
@@ -994,6 +1001,25 @@ def build_wind(course: Course, scenario: str) -> Any:
     )
 
 
+def build_current(course: Course, scenario: str) -> Any:
+    """Build the surface current of one scenario (:mod:`sailroute.current`), or None.
+
+    Like :func:`build_wind`: relative paths resolve against the course file's folder
+    and the current must cover the course box and the race time window.
+    """
+    from sailroute.course.geometry import course_bbox, race_time_window
+    from sailroute.current import current_from_spec
+
+    sc = course.scenarios.get(scenario)
+    if sc is None or sc.current is None:  # (an unknown name is build_wind's error)
+        return None
+    return current_from_spec(
+        dict(sc.current), frame=course.frame, base_dir=course.base_dir,
+        where=sc.current_where or course.where(f"scenarios.{scenario}.current"),
+        crop_bbox=course_bbox(course), time_window=race_time_window(course),
+    )
+
+
 def build_specs(
     course: Course, scenarios: Iterable[str] | None = None
 ) -> tuple[Any, dict[str, Any]]:
@@ -1028,6 +1054,10 @@ def build_specs(
     for name in course.scenarios if scenarios is None else scenarios:
         try:
             winds[name] = build_wind(course, name)
+        except InputError as exc:
+            errors.append(exc)
+        try:  # validated here with the winds; plan.py builds it again to route
+            build_current(course, name)
         except InputError as exc:
             errors.append(exc)
     if len(errors) == 1:  # keep its type (e.g. OutOfCoverageError) and message

@@ -165,6 +165,11 @@ class ScenarioSpec:
     ensemble : str
         For a member of an ensemble scenario (``members:``), the ensemble's name; the
         member itself is called ``"<ensemble>#<k>"`` (k from 1).  Empty otherwise.
+    current : mapping or None
+        The raw surface-current spec (``scenarios.<name>.current``, built by
+        ``sailroute.current.current_from_spec``); None: still water.
+    current_where : str
+        Key path of the current spec for error messages.
     """
 
     name: str
@@ -173,10 +178,14 @@ class ScenarioSpec:
     description: str = ""
     where: str = ""
     ensemble: str = ""
+    current: Mapping[str, Any] | None = None
+    current_where: str = ""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "wind", _frozen(self.wind))
         object.__setattr__(self, "references", _frozen(self.references))
+        if self.current is not None:
+            object.__setattr__(self, "current", _frozen(self.current))
 
 
 @dataclass(frozen=True, eq=False)
