@@ -192,3 +192,39 @@ def test_other_routers_refuse_a_current(router):
         route_leg(Start((0.0, 0.0)), mark(500.0), T0, UniformWind(TWS, 90.0), POLAR,
                   replace(SET, router=router), current=UniformCurrent(0.5, 0.0))
 
+
+
+def test_gridded_netcdf_current_equals_the_uniform_one_it_holds(tmp_path):
+    # a CMEMS-style file (uo/vo, CF standard names, m/s) holding 0.6 m/s towards 200° on
+    # a lat/lon grid: bilinear in a uniform field is that field, so the route equals the
+    # UniformCurrent route (the grid's rotation into the local frame is < 0.01° here)
+    import netCDF4
+
+    frame = LocalFrame(43.0, 7.0)
+    lats, lons = np.arange(42.95, 43.06, 0.01), np.arange(6.95, 7.06, 0.01)
+    cu, cv = 0.6 * math.sin(math.radians(200.0)), 0.6 * math.cos(math.radians(200.0))
+    path = tmp_path / "cur.nc"
+    with netCDF4.Dataset(str(path), "w") as ds:
+        ds.createDimension("time", 2)
+        ds.createDimension("latitude", lats.size)
+        ds.createDimension("longitude", lons.size)
+        t = ds.createVariable("time", "f8", ("time",))
+        t.units, t[:] = "seconds since 1970-01-01 00:00:00", [T0 - 3600.0, T0 + 7200.0]
+        la = ds.createVariable("latitude", "f8", ("latitude",))
+        la.standard_name, la.units, la[:] = "latitude", "degrees_north", lats
+        lo = ds.createVariable("longitude", "f8", ("longitude",))
+        lo.standard_name, lo.units, lo[:] = "longitude", "degrees_east", lons
+        for name, std, val in (("uo", "eastward_sea_water_velocity", cu),
+                               ("vo", "northward_sea_water_velocity", cv)):
+            v = ds.createVariable(name, "f4", ("time", "latitude", "longitude"))
+            v.standard_name, v.units = std, "m s-1"
+            v[:] = np.full((2, lats.size, lons.size), val, dtype=np.float32)
+    grid = current_from_spec({"type": "netcdf", "path": "cur.nc"}, frame=frame,
+                             base_dir=tmp_path, where="c.yaml: scenarios.s.current")
+    u, v = grid.sample(T0, 100.0, 200.0)
+    assert math.hypot(float(u), float(v)) == pytest.approx(0.6, rel=1e-6)
+    wind = UniformWind(TWS, 90.0)
+    a = route_isochrone(Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET, current=grid)
+    b = route_isochrone(Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET,
+                        current=UniformCurrent(0.6, 200.0))
+    assert a.time_s == pytest.approx(b.time_s, rel=1e-4)
