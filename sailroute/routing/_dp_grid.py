@@ -20,6 +20,7 @@ See ``docs/design/griddp.md``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -336,7 +337,8 @@ def _pieces_wind(wind: WindField, t: NDArray, mx: NDArray, my: NDArray, ux: NDAr
 
 
 def sample_chains(wind: WindField, px: NDArray, py: NDArray, t_dep: NDArray,
-                  model: BoatModel) -> ChainWind:
+                  model: BoatModel,
+                  speed: Callable[[NDArray, NDArray], NDArray] | None = None) -> ChainWind:
     """Wind along chains of pieces at the time the boat sails each piece.
 
     Parameters
@@ -349,6 +351,10 @@ def sample_chains(wind: WindField, px: NDArray, py: NDArray, t_dep: NDArray,
         Departure time at the first vertex [epoch s].
     model : BoatModel
         Gives the steady speeds used to time the pieces.
+    speed : callable, optional
+        ``speed(tws, beta) -> [m s⁻¹]`` used instead of ``model.steady_speed``
+        to time the pieces (a cheaper approximation is enough: it only sets
+        the times at which the wind is sampled again).
 
     Returns
     -------
@@ -374,7 +380,7 @@ def sample_chains(wind: WindField, px: NDArray, py: NDArray, t_dep: NDArray,
     t1, mx, my, ux, uy, length = (np.broadcast_to(a, shape)
                                   for a in (t1, mx, my, ux, uy, length))
     tws, beta, _, _ = _pieces_wind(wind, t1, mx, my, ux, uy)
-    spd = model.steady_speed(tws, beta)
+    spd = (model.steady_speed if speed is None else speed)(tws, beta)
     with np.errstate(divide="ignore", invalid="ignore"):
         tau = np.where(length > 0, length / spd, 0.0)
     tau = np.where(np.isfinite(tau), tau, 0.0)

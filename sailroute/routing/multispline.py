@@ -41,6 +41,7 @@ from sailroute.boat.polar import Polar
 from sailroute.errors import InputError, RoutingError
 from sailroute.routing._dp_grid import (
     BoatModel,
+    ChainWind,
     LegFrame,
     PathLimits,
     Row,
@@ -90,6 +91,10 @@ class Edges:
         End node.
     acc : ndarray, shape (C0, S0, 1, 1)
         Accumulated cost of the start states (elapsed time for routing).
+    carry : ndarray, shape (C0, S0, 1, 1), or None
+        State carried along the best path into the start states (the boat
+        speed for routing with ``spline_carry_speed``); None on the first row
+        or when the edge cost carries nothing.
     """
 
     x0: NDArray
@@ -99,6 +104,7 @@ class Edges:
     y1: NDArray
     m1: NDArray
     acc: NDArray
+    carry: NDArray | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -116,8 +122,13 @@ class Edges:
         return x, y
 
 
-EdgeCost = Callable[[int, Edges], NDArray]
-"""``edge_cost(r, edges) -> cost`` of shape ``edges.shape`` (``inf``: forbidden)."""
+EdgeCost = Callable[[int, Edges], "NDArray | tuple[NDArray, NDArray]"]
+"""``edge_cost(r, edges) -> cost`` of shape ``edges.shape`` (``inf``: forbidden).
+
+It may instead return ``(cost, carry)``: ``carry`` (broadcast to ``edges.shape``)
+is the state at the end of each edge; the DP keeps it for the best predecessor of
+every state and passes it back as ``Edges.carry`` on the next row.
+"""
 
 
 @dataclass(frozen=True)
@@ -206,6 +217,7 @@ def multispline_pass(
     xy = [frame.coords(*row.points(frame, p)) for row, p in zip(rows, params, strict=True)]
     n_rows = len(rows)
     A = np.zeros((xy[0][0].size, slopes[0].size))
+    carry: NDArray | None = None
     bps = []
     edges = 0
     for r in range(n_rows - 1):
@@ -213,14 +225,20 @@ def multispline_pass(
         e = Edges(xa[:, None, None, None], ya[:, None, None, None],
                   slopes[r][None, :, None, None], xb[None, None, :, None],
                   yb[None, None, :, None], slopes[r + 1][None, None, None, :],
-                  A[:, :, None, None])
-        cost = np.broadcast_to(np.asarray(edge_cost(r, e), float), e.shape)
+                  A[:, :, None, None], None if carry is None else carry[:, :, None, None])
+        out = edge_cost(r, e)
+        cost, c_out = out if isinstance(out, tuple) else (out, None)
+        cost = np.broadcast_to(np.asarray(cost, float), e.shape)
         edges += int(np.prod(e.shape))
         c0, s0, c1, s1 = e.shape
         tot = xp.asarray((A[:, :, None, None] + cost).reshape(c0 * s0, c1 * s1))
         arg = xp.argmin(tot, axis=0)
         A = to_numpy(xp.take_along_axis(tot, arg[None], axis=0)[0]).reshape(c1, s1)
-        bps.append(to_numpy(arg).reshape(c1, s1))
+        arg_np = to_numpy(arg)
+        bps.append(arg_np.reshape(c1, s1))
+        if c_out is not None:
+            flat = np.broadcast_to(np.asarray(c_out, float), e.shape).reshape(c0 * s0, c1 * s1)
+            carry = flat[arg_np, np.arange(c1 * s1)].reshape(c1, s1)
         if progress is not None:
             progress((r + 1) / (n_rows - 1))
     flat = int(np.argmin(A))
@@ -371,14 +389,44 @@ def fitting_target(theta: ArrayLike) -> NDArray[np.float64]:
 
 
 def l2_edge_cost(target: Callable[[NDArray], NDArray], n_gauss: int = 8) -> EdgeCost:
-    """Edge cost ``∫ (Y(X) − target(X))² dX`` by Gauss-Legendre quadrature (fixed-X rows)."""
+    """Edge cost ``∫ (Y(X) − target(X))² dX`` by Gauss-Legendre quadrature (fixed-X rows).
+
+    When every edge of a row spans the same ``X`` interval (rows at fixed
+    ``X``, as in :func:`fit_function`) the cost separates: with
+    ``Y = P(y0, m0) + Q(y1, m1)`` at the quadrature nodes,
+    ``Σ w (P + Q − target)² = Σ w (P − target)² + Σ w Q² + 2 Σ w (P − target) Q``,
+    so the row's ``(C0 S0) × (C1 S1)`` costs are two vectors and one matrix
+    product instead of a quadrature per edge (equal to rounding: about 1e-16
+    of the terms, 1e-10 relative to a converged edge's cost).
+    """
     g, w = np.polynomial.legendre.leggauss(n_gauss)
     t = 0.5 * (g + 1.0)
+    t2, t3 = t * t, t * t * t
+    h00, h10, h01, h11 = 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, 3 * t2 - 2 * t3, t3 - t2
 
     def cost(r: int, e: Edges) -> NDArray:
+        x0, x1 = np.asarray(e.x0, float), np.asarray(e.x1, float)
+        if x0.size and np.all(x0 == x0.flat[0]) and np.all(x1 == x1.flat[0]):
+            c0, s0, c1, s1 = e.shape
+            xa = float(x0.flat[0])
+            dx = float(x1.flat[0]) - xa
+            ref = target(xa + t * dx)
+            y0 = np.broadcast_to(e.y0, (c0, 1, 1, 1)).reshape(c0, 1, 1)
+            m0 = np.broadcast_to(e.m0, (1, s0, 1, 1)).reshape(1, s0, 1)
+            y1 = np.broadcast_to(e.y1, (1, 1, c1, 1)).reshape(c1, 1, 1)
+            m1 = np.broadcast_to(e.m1, (1, 1, 1, s1)).reshape(1, s1, 1)
+            p = (h00 * y0 + h10 * dx * m0 - ref).reshape(c0 * s0, -1)
+            q = (h01 * y1 + h11 * dx * m1).reshape(c1 * s1, -1)
+            tot = (p * w) @ q.T
+            tot *= 2.0
+            tot += ((p * p) @ w)[:, None]
+            tot += ((q * q) @ w)[None, :]
+            np.maximum(tot, 0.0, out=tot)
+            tot *= 0.5 * dx
+            return tot.reshape(c0, s0, c1, s1)
         x, y = e.points(t)
-        dx = np.broadcast_to(e.x1 - e.x0, e.shape)
-        return 0.5 * dx * np.sum(w * (y - target(x)) ** 2, axis=-1)
+        dxs = np.broadcast_to(e.x1 - e.x0, e.shape)
+        return 0.5 * dxs * np.sum(w * (y - target(x)) ** 2, axis=-1)
 
     return cost
 
@@ -499,6 +547,10 @@ def _check(s: RoutingSettings, label: str) -> None:
         v = getattr(s, name)
         if not (isinstance(v, int | np.integer) and lo <= v <= 1000):
             problems.append(f"{name} must be an integer >= {lo}, got {v!r}")
+    for name in ("spline_carry_speed", "spline_start_from_rest"):
+        v = getattr(s, name)
+        if not isinstance(v, bool | np.bool_):
+            problems.append(f"{name} must be true or false, got {v!r}")
     hw = s.dp_half_width_m
     if hw is not None and not (isinstance(hw, int | float) and math.isfinite(hw) and hw > 0):
         problems.append(f"dp_half_width_m must be > 0 m or None (automatic), got {hw!r}")
@@ -515,6 +567,7 @@ class _EdgeSail:
     pen_end: NDArray  # (...,) penalty at the end node [s]
     side: NDArray  # (..., CHORDS)
     v_in: NDArray | None  # (..., CHORDS) dynamic: speed entering each chord
+    v_end: NDArray | None = None  # (...,) dynamic: speed at the end node [m/s]
 
 
 def _tangent_side(frame: LegFrame, wind: WindField, t: NDArray, px: NDArray, py: NDArray,
@@ -531,40 +584,54 @@ def _tangent_side(frame: LegFrame, wind: WindField, t: NDArray, px: NDArray, py:
     return hx, hy, tws, twa, np.where(twa >= 0, 1, -1)
 
 
-def _sail_edges(frame: LegFrame, wind: WindField, model: BoatModel, t_dep: NDArray,
-                x: NDArray, y: NDArray, m0: NDArray, m1: NDArray,
-                settings: RoutingSettings, limits: PathLimits | None = None,
-                last: bool = False) -> _EdgeSail:
-    """Sail chord chains ``(x, y)`` of shape ``(..., CHORDS + 1)`` from ``t_dep``.
-
-    The tack side at a node is that of the curve's tangent there (the same for
-    the edges on both sides, the route being C¹), so a side change is charged
-    once: between the start node and the first chord, between chords, or
-    between the last chord and the end node.  The dynamic model starts each
-    edge at the steady speed of the start node's tangent (no seconds penalty;
-    turns between chords follow the model's turn rule).  Chains that break
-    ``limits`` (``last``: the edge ends on the target segment) take infinitely long.
-    """
-    px, py = frame.point(x, y)
-    cw = sample_chains(wind, px, py, t_dep, model)
-    hx, hy, tws0, twa0, side0 = _tangent_side(frame, wind, t_dep, px[..., 0], py[..., 0], m0)
+def _chain_limits(cw: ChainWind, px: NDArray, py: NDArray, limits: PathLimits | None,
+                  last: bool) -> NDArray:
+    """Chains inside the wind data that respect ``limits`` (``last``: ending on the target)."""
     ok = np.all(cw.valid, axis=-1)
     if limits is not None:
         x0, y0, x1, y1 = px[..., :-1], py[..., :-1], px[..., 1:], py[..., 1:]
         ok = ok & np.all(limits.allowed(x0, y0, x1, y1, False), axis=-1)
         if last:
             ok = ok & limits.allowed(x0[..., -1], y0[..., -1], x1[..., -1], y1[..., -1], True)
+    return ok
+
+
+def _turn_cosines(cw: ChainWind, hx: NDArray, hy: NDArray) -> NDArray:
+    """Cosine of the turn into each chord; the first from the start tangent ``(hx, hy)``."""
+    cos_t = np.ones(cw.beta.shape)
+    cos_t[..., 0] = hx * cw.ux[..., 0] + hy * cw.uy[..., 0]
+    cos_t[..., 1:] = cw.ux[..., 1:] * cw.ux[..., :-1] + cw.uy[..., 1:] * cw.uy[..., :-1]
+    return cos_t
+
+
+def _sail_edges(frame: LegFrame, wind: WindField, model: BoatModel, t_dep: NDArray,
+                x: NDArray, y: NDArray, m0: NDArray, m1: NDArray,
+                settings: RoutingSettings, limits: PathLimits | None = None,
+                last: bool = False, v_in: NDArray | None = None) -> _EdgeSail:
+    """Sail chord chains ``(x, y)`` of shape ``(..., CHORDS + 1)`` from ``t_dep``.
+
+    The tack side at a node is that of the curve's tangent there (the same for
+    the edges on both sides, the route being C¹), so a side change is charged
+    once: between the start node and the first chord, between chords, or
+    between the last chord and the end node.  The dynamic model enters each
+    edge at ``v_in`` [m s⁻¹] (default: the steady speed of the start node's
+    tangent; no seconds penalty; turns between chords follow the model's turn
+    rule).  Chains that break ``limits`` (``last``: the edge ends on the target
+    segment) take infinitely long.
+    """
+    px, py = frame.point(x, y)
+    cw = sample_chains(wind, px, py, t_dep, model)
+    hx, hy, tws0, twa0, side0 = _tangent_side(frame, wind, t_dep, px[..., 0], py[..., 0], m0)
+    ok = _chain_limits(cw, px, py, limits, last)
     lead = cw.side.shape[:-1]
     if model.dynamic is not None:
         boat = model.dynamic
-        v_start = tws0 * boat.table().steady(np.abs(twa0))
-        cos_t = np.ones(cw.beta.shape)
-        cos_t[..., 0] = hx * cw.ux[..., 0] + hy * cw.uy[..., 0]
-        cos_t[..., 1:] = cw.ux[..., 1:] * cw.ux[..., :-1] + cw.uy[..., 1:] * cw.uy[..., :-1]
-        total, _, tp, v_in = chain_time(boat, cw.beta, cw.tws, cw.length, cos_t,
-                                        np.broadcast_to(v_start, lead), pieces=True)
+        v_start = tws0 * boat.table().steady(np.abs(twa0)) if v_in is None else v_in
+        cos_t = _turn_cosines(cw, hx, hy)
+        total, v_end, tp, v_pc = chain_time(boat, cw.beta, cw.tws, cw.length, cos_t,
+                                            np.broadcast_to(v_start, lead), pieces=True)
         total = np.where(ok, total, np.inf)
-        return _EdgeSail(total, tp, np.zeros(tp.shape), np.zeros(lead), cw.side, v_in)
+        return _EdgeSail(total, tp, np.zeros(tp.shape), np.zeros(lead), cw.side, v_pc, v_end)
     spd = model.steady_speed(cw.tws, cw.beta)
     with np.errstate(divide="ignore", invalid="ignore"):
         tp = np.where(cw.length > 0, cw.length / spd, 0.0)
@@ -583,20 +650,183 @@ def _sail_edges(frame: LegFrame, wind: WindField, model: BoatModel, t_dep: NDArr
                        penalty_of(np.abs(twa1), cw.beta[..., -1], settings.tack_penalty_s,
                                   settings.gybe_penalty_s), 0.0)
     total = np.where(ok, run + pen_end, np.inf)
-    return _EdgeSail(total, tp, pen, pen_end, cw.side, None)
+    return _EdgeSail(total, tp, pen, pen_end, cw.side, None, None)
+
+
+# --------------------------------------------------------------------------------------
+# the dynamic model's row cost: bound, then sail only the edges that can win
+
+PRUNE_REL = 1e-3
+"""Relative safety margin of the edge-time lower bound used to skip edges."""
+PRUNE_ABS_S = 1e-2
+"""Absolute safety margin [s] of that bound."""
+PRUNE_PROBE = 2
+"""Candidates per end state sailed first, to give every state an upper bound."""
+
+
+def _predictor_speed(boat: DynamicBoat) -> Callable[[NDArray, NDArray], NDArray]:
+    """Steady speed [m s⁻¹] linear in the table's angles (no Newton polish).
+
+    Used only to time the chords for the wind's second sample (relative error
+    below 1e-6; none at all in time-independent wind).
+    """
+    tab = boat.table()
+    ws = tab.w_ss
+
+    def speed(tws: NDArray, beta: NDArray) -> NDArray:
+        jf = np.clip((beta - tab.beta_lo) / tab.dbeta, 0.0, ws.size - 1.0 - 1e-9)
+        j0 = jf.astype(np.intp)
+        f = jf - j0
+        return np.where(beta < tab.beta_min, 0.0, tws * ((1.0 - f) * ws[j0] + f * ws[j0 + 1]))
+
+    return speed
+
+
+def _speed_cap(boat: DynamicBoat) -> NDArray[np.float64]:
+    """Per table interval, an upper bound of the scaled steady speed ``w_ss`` on it."""
+    ws = boat.table().w_ss
+    return np.maximum(ws[:-1], ws[1:]) * (1.0 + 1e-4)
+
+
+def edge_time_bound(boat: DynamicBoat, cw: ChainWind, v_in: NDArray,
+                    cap: NDArray | None = None) -> NDArray:
+    """Lower bound [s] of the time to sail chord chains entered at ``v_in`` [m s⁻¹].
+
+    Driving, the boat approaches the steady speed ``w_ss v_t`` from either side;
+    coasting (no-drive zone) or turning it slows down.  So it enters chord ``j``
+    no faster than ``V_j = max(v_in, max_{i<j} w_ss,i v_t,i)`` and sails it no
+    faster than ``max(V_j, w_ss,j v_t,j)``; where it drives, the chord takes
+    at least its steady time plus the (negative) transient loss
+    ``Λ(β_j, V_j / v_t,j)`` of a boat entering at ``V_j``, since a transient
+    entered faster than steady saves at most its whole loss; and where it
+    coasts (``β < c2/c1``) the drag alone gives ``dv/ds ≤ −k v``, so a chord of
+    length ``ℓ`` takes at least ``(e^{kℓ} − 1) / (k V_j)``.  The bound per chord
+    is the largest of these; shape ``cw.beta.shape[:-1]``.
+    """
+    tab = boat.table()
+    cap = _speed_cap(boat) if cap is None else cap
+    jf = np.clip((cw.beta - tab.beta_lo) / tab.dbeta, 0.0, cap.size - 1.0)
+    vss = cap[jf.astype(np.intp)] * cw.tws  # upper bound of the steady speed [m/s]
+    v_enter = np.empty_like(vss)
+    v_enter[..., 0] = v_in
+    if vss.shape[-1] > 1:
+        v_enter[..., 1:] = np.maximum(np.maximum.accumulate(vss[..., :-1], axis=-1),
+                                      np.asarray(v_in, float)[..., None])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(cw.length > 0, cw.length / np.maximum(v_enter, vss), 0.0)
+        drive = (cw.beta >= tab.beta_lo) & (cw.length > 0) & (cw.tws > 0)
+        fast = drive & (v_enter > vss)
+        steady = np.where(drive, cw.length / vss, 0.0)
+        t_drive = steady
+        if np.any(fast):
+            i = np.nonzero(fast)
+            u = cw.tws[i]
+            w0 = v_enter[i] / u
+            ok = w0 <= tab.w_max
+            b = cw.beta[i]
+            jb = np.clip((b - tab.beta_lo) / tab.dbeta, 0.0, tab.w_ss.size - 1.0 - 1e-9)
+            j0 = jb.astype(np.intp)
+            ws = (1.0 - (jb - j0)) * tab.w_ss[j0] + (jb - j0) * tab.w_ss[j0 + 1]
+            lam = np.where(ok, tab.loss_at(b, w0, ws), -np.inf)
+            t_drive = steady.copy()
+            t_drive[i] = steady[i] + np.minimum(lam, 0.0) / u
+        t = np.where(drive, np.maximum(t, t_drive), t)
+        # coasting through the no-drive zone: dv/ds <= -k v, so v <= V e^{-k s}
+        coast = (cw.beta < tab.beta_min) & (cw.length > 0)
+        if np.any(coast):
+            i = np.nonzero(coast)
+            t[i] = np.maximum(t[i], np.expm1(boat.k * cw.length[i]) / (boat.k * v_enter[i]))
+    return np.sum(t, axis=-1)
+
+
+def _dynamic_row(frame: LegFrame, wind: WindField, model: BoatModel, e: Edges,
+                 px: NDArray, py: NDArray, t_start: NDArray, v_start: NDArray | None,
+                 limits: PathLimits | None, last: bool, cap: NDArray
+                 ) -> tuple[NDArray, NDArray]:
+    """Edge times [s] and end speeds [m s⁻¹] of one row of the dynamic model.
+
+    ``px, py``: chord vertices, shape ``(N, CHORDS + 1)`` with ``N = M0 M1`` edges
+    ordered (start state, end state); ``t_start``, ``v_start``: departure time and
+    entry speed per start state (``v_start`` None: steady speed of the tangent).
+    Edges are sailed only where ``acc + bound`` does not exceed an upper bound of
+    their end state's best arrival (from :data:`PRUNE_PROBE` sailed candidates),
+    so the row's minima, and the DP, are those of sailing every edge; the other
+    edges get ``inf``.
+    """
+    boat = model.dynamic
+    assert boat is not None
+    c0, s0, c1, s1 = e.shape
+    m0n, m1n = c0 * s0, c1 * s1
+    n = m0n * m1n
+    t_dep = np.repeat(t_start.reshape(-1), m1n)
+    cw = sample_chains(wind, px, py, t_dep, model, _predictor_speed(boat))
+    ok = _chain_limits(cw, px, py, limits, last)
+    sx, sy = frame.point(np.broadcast_to(e.x0[:, :, 0, 0], (c0, s0)),
+                         np.broadcast_to(e.y0[:, :, 0, 0], (c0, s0)))
+    hx, hy, tws0, twa0, _ = _tangent_side(frame, wind, t_start, sx, sy,
+                                          np.broadcast_to(e.m0[:, :, 0, 0], (c0, s0)))
+    if v_start is None:
+        v_start = tws0 * boat.table().steady(np.abs(twa0))
+    v_e = np.repeat(np.broadcast_to(v_start, (c0, s0)).reshape(-1), m1n)
+    cos_t = _turn_cosines(cw, np.repeat(hx.reshape(-1), m1n), np.repeat(hy.reshape(-1), m1n))
+    acc = np.repeat(np.broadcast_to(e.acc[:, :, 0, 0], (c0, s0)).reshape(-1), m1n)
+    bound = edge_time_bound(boat, cw, v_e, cap)
+    lo = np.where(ok, acc + (bound * (1.0 - PRUNE_REL) - PRUNE_ABS_S), np.inf)
+    cost = np.full(n, np.inf)
+    v_end = np.zeros(n)
+
+    def sail(idx: NDArray) -> None:
+        if idx.size:
+            t, v = chain_time(boat, cw.beta[idx], cw.tws[idx], cw.length[idx], cos_t[idx],
+                              v_e[idx])
+            cost[idx] = t
+            v_end[idx] = v
+
+    end = np.arange(n) % m1n
+    k = min(PRUNE_PROBE, m0n)
+    lo2 = lo.reshape(m0n, m1n)
+    probe = np.argpartition(lo2, k - 1, axis=0)[:k] if k < m0n else np.arange(m0n)[:, None]
+    first = np.unique((probe * m1n + np.arange(m1n)).reshape(-1))
+    first = first[ok[first]]
+    sail(first)
+    ub = np.full(m1n, np.inf)
+    np.minimum.at(ub, end[first], acc[first] + cost[first])
+    todo = ok & (lo <= ub[end])
+    todo[first] = False
+    sail(np.flatnonzero(todo))
+    return cost.reshape(e.shape), v_end.reshape(e.shape)
 
 
 def _route_cost(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
                 settings: RoutingSettings, limits: PathLimits, n_rows: int) -> EdgeCost:
     t = np.linspace(0.0, 1.0, CHORDS + 1)
+    boat = model.dynamic
+    carry = bool(settings.spline_carry_speed) and boat is not None
+    rest = bool(settings.spline_start_from_rest) and boat is not None
+    cap = _speed_cap(boat) if boat is not None else None
 
-    def cost(r: int, e: Edges) -> NDArray:
+    def cost(r: int, e: Edges) -> NDArray | tuple[NDArray, NDArray]:
         x, y = e.points(t)
-        t_dep = np.broadcast_to(t0 + e.acc, e.shape)
-        m0 = np.broadcast_to(e.m0, e.shape)
-        m1 = np.broadcast_to(e.m1, e.shape)
-        return _sail_edges(frame, wind, model, t_dep, x, y, m0, m1, settings, limits,
-                           r == n_rows - 2).time
+        last = r == n_rows - 2
+        if boat is None:
+            t_dep = np.broadcast_to(t0 + e.acc, e.shape)
+            m0 = np.broadcast_to(e.m0, e.shape)
+            m1 = np.broadcast_to(e.m1, e.shape)
+            return _sail_edges(frame, wind, model, t_dep, x, y, m0, m1, settings, limits,
+                               last).time
+        assert cap is not None
+        px, py = frame.point(x.reshape(-1, CHORDS + 1), y.reshape(-1, CHORDS + 1))
+        c0, s0 = e.shape[:2]
+        t_start = np.broadcast_to(t0 + e.acc[:, :, 0, 0], (c0, s0))
+        if r == 0 and rest:
+            v_start = np.zeros((c0, s0))
+        elif carry and e.carry is not None:
+            v_start = np.broadcast_to(e.carry[:, :, 0, 0], (c0, s0))
+        else:
+            v_start = None
+        times, v_end = _dynamic_row(frame, wind, model, e, px, py, t_start, v_start, limits,
+                                    last, cap)
+        return (times, v_end) if carry else times
 
     return cost
 
@@ -607,14 +837,22 @@ def _sail_curve(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
     """Sail the best curve edge by edge: track vertices at the chord ends."""
     tt = np.linspace(0.0, 1.0, CHORDS + 1)
     t = t0
+    dyn = model.dynamic is not None
+    carry = bool(settings.spline_carry_speed) and dyn
+    rest = bool(settings.spline_start_from_rest) and dyn
+    v_prev: float | None = None
     out_t, out_x, out_y, out_s, out_v = [], [], [], [], []
     for r in range(fit.along.size - 1):
         dx = fit.along[r + 1] - fit.along[r]
         X = fit.along[r] + tt * dx
         Y = hermite_y(fit.across[r], fit.slopes[r], fit.across[r + 1], fit.slopes[r + 1], dx, tt)
+        v_in = (np.zeros(1) if r == 0 and rest
+                else np.array([v_prev]) if carry and v_prev is not None else None)
         es = _sail_edges(frame, wind, model, np.array([t]), X[None], Y[None],
                          np.array([fit.slopes[r]]), np.array([fit.slopes[r + 1]]), settings,
-                         limits, r == fit.along.size - 2)
+                         limits, r == fit.along.size - 2, v_in)
+        if es.v_end is not None:
+            v_prev = float(es.v_end[0])
         px, py = frame.point(X, Y)
         for j in range(CHORDS):
             if es.pen[0, j] > 0:

@@ -172,6 +172,13 @@ class RoutingSettings:
     spline_cols, spline_slopes, spline_refinements : int
         Multi-spline: nodes per row, tangent slopes per node (n_ts) and
         refinements (ranges shrink by 1/3 each).
+    spline_carry_speed : bool
+        Multi-spline, dynamic boat: enter each edge at the end speed of the best
+        previous edge (the DP carries it, as Dębski's) instead of the steady
+        speed of the node's tangent.  No effect with a polar.
+    spline_start_from_rest : bool
+        Multi-spline, dynamic boat: the first edge starts from rest instead of
+        at the steady speed (a flying start).  No effect with a polar.
     """
 
     router: RouterName = "isochrone"
@@ -197,6 +204,8 @@ class RoutingSettings:
     spline_cols: int = 25
     spline_slopes: int = 7
     spline_refinements: int = 3
+    spline_carry_speed: bool = False
+    spline_start_from_rest: bool = False
 
 
 @dataclass(frozen=True, eq=False)
