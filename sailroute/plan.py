@@ -221,8 +221,9 @@ def plan_course(
         A loaded course (:func:`sailroute.course.load.load_course`).
     scenario : str, optional
         Scenario name; default the first one in the file.
-    router : {"isochrone", "griddp", "spline"}, optional
-        Overrides the course's ``routing.router``.
+    router : str, optional
+        ``"isochrone"``, ``"griddp"`` or ``"spline"``; overrides the course's
+        ``routing.router``.
     backend : {"numpy", "cupy", "auto"}
         Array backend of the router kernels.
     progress : Progress, optional
@@ -296,8 +297,11 @@ def compare_scenarios(
         A loaded course.
     scenarios : sequence of str, optional
         Scenario names, in the order to report them; default all, in file order.
-    router, backend : str, optional
-        As in :func:`plan_course`.
+    router : str, optional
+        ``"isochrone"``, ``"griddp"`` or ``"spline"``; overrides the course's
+        ``routing.router``.
+    backend : {"numpy", "cupy", "auto"}
+        Array backend of the router kernels.
     progress : Progress, optional
         Per-leg progress (serial runs only; a distributed run reports nothing
         until all scenarios are back).

@@ -113,10 +113,10 @@ def read_polar(
     wind_unit : str, optional
         Unit of the TWS values.  Default: ``speed_unit`` if that is given,
         else as for ``speed_unit``.
-    format : {"pol", "csv", "json"}, optional
-        Force a format; by default it is chosen from the suffix (``.json`` ->
-        json; ``.csv`` -> long CSV unless the header is a ``TWA/TWS`` table;
-        anything else -> pol).
+    format : str, optional
+        Force a format: ``"pol"``, ``"csv"`` or ``"json"``; by default it is
+        chosen from the suffix (``.json`` -> json; ``.csv`` -> long CSV unless the
+        header is a ``TWA/TWS`` table; anything else -> pol).
     interpolation : {"pchip", "linear"}
         Interpolation method of the returned polar.
 

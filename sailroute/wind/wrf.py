@@ -701,9 +701,20 @@ def open_wrf(
         Crop margin [m].
     time_window : tuple of float, optional
         ``(t0, t1)`` [epoch s]; only the slices bracketing it are read.
-    height_m, levels, shear, fallback_exponent, exponent_range, roughness_m
-        Height correction, see :func:`decode_wrf`.  With ``levels="auto"`` the
-        model levels are used when ``height_m`` is set and the file has them.
+    height_m : float, optional
+        Height the wind is wanted at [m] (Laser centre of effort: 2.68); ``None``:
+        the 10 m wind, uncorrected.  Height correction: :func:`decode_wrf`.
+    levels : {"auto", "u10", "model"}
+        ``auto``: the model levels when ``height_m`` is set and the file has them,
+        else ``U10/V10`` (see :func:`decode_wrf`).
+    shear : {"power", "log"}
+        Profile law of the height correction.
+    fallback_exponent : float
+        Power-law exponent where no fit is used or usable [-] (default 1/7).
+    exponent_range : (float, float)
+        Accepted fitted exponents [-] (default 0 .. 0.6).
+    roughness_m : float
+        Log-law roughness length [m].
     time_step_min : float, optional
         Freeze the wind per block of this many minutes (thesis: 60, 30, 10).
     interpolation : {"linear", "nearest"}
