@@ -254,6 +254,16 @@ def strategy_command(
         typer.Option("--diffusion-deg-per-sqrt-min", help="Diffusion of the direction for "
                      "--shift drift-diffusion, deg/sqrt(min) (default: fitted or from sigma)."),
     ] = None,
+    deadline_interpolation: Annotated[
+        str,
+        typer.Option("--deadline-interpolation", help="Deadline solver interpolation: linear "
+                     "(bilinear, reproduces Wang et al. 2024) | cubic."),
+    ] = "linear",
+    deadline_refine: Annotated[
+        str,
+        typer.Option("--deadline-refine", help="Deadline solver steering: none (49 angles) | "
+                     "golden (golden-section refinement per node)."),
+    ] = "none",
     out: Annotated[str, typer.Option("--out", help="Output folder.")] = "strategy-out",
     no_plots: Annotated[bool, typer.Option("--no-plots", help="JSON summary only.")] = False,
     scheduler: Annotated[
@@ -278,6 +288,7 @@ def strategy_command(
         length_m=length_m, half_width_m=half_width_m, tack_penalty_s=tack_penalty_s,
         runs=runs, seed=seed, start_tack=start_tack, scheduler=scheduler, n_workers=workers,
         shift=shift, diffusion_deg_per_sqrt_min=diffusion_deg_per_sqrt_min,
+        interpolation=deadline_interpolation, refine_controls=deadline_refine,
     )
     typer.echo(res.report)
     for path in res.files:

@@ -69,6 +69,10 @@ RN_UNREACHED_S = 1.0e9
 """Initial risk-neutral value [s] outside the mark."""
 INTERPOLATIONS = ("linear", "cubic")
 """Interpolation of the steering feet: bilinear (Wang et al. 2024), or bicubic Lagrange."""
+REFINEMENTS = ("none", "golden")
+"""Steering-angle refinement after the direct search over the fixed controls."""
+BLOCK_NODES = 8192
+"""Nodes per sparse mat-vec block (the block's values stay in cache for the max)."""
 
 
 @dataclass(frozen=True)
@@ -93,8 +97,15 @@ class DeadlineGrid:
     n_controls : int
         Steering angles ``u_n = nπ/(n_controls - 1)`` (Wang et al. (2024): 49, 3.75°).
     interpolation : {"linear", "cubic"}
-        Interpolation at the steering feet: bilinear, or bicubic Lagrange
-        (4 x 4 points, 4x the memory and time, much less numerical diffusion).
+        Interpolation at the steering feet: bilinear (default; reproduces Wang et al.
+        (2024)'s probabilities, ``docs/strategy.md``), or bicubic Lagrange (4 x 4 points,
+        4x the memory and time, less numerical diffusion but non-monotone weights that
+        bias the risk-aware policies on coarse grids).
+    refine_controls : {"none", "golden"}
+        ``"golden"``: after the direct search over the ``n_controls`` angles, a
+        golden-section search between the best angle's neighbours (tolerance 1e-3 rad,
+        polar speed linear in between), per node, as Wang et al. (2024); the refined
+        angle is stored as an int8 offset (``DeadlinePolicy.steer_offset``).
     """
 
     r_max_m: float
@@ -105,6 +116,7 @@ class DeadlineGrid:
     s_max_s: float
     n_controls: int = 49
     interpolation: str = "linear"
+    refine_controls: str = "none"
 
     def __post_init__(self) -> None:
         if not (self.r_max_m > 0 and math.isfinite(self.r_max_m)):
@@ -121,6 +133,11 @@ class DeadlineGrid:
             raise InputError(
                 f"deadline grid: interpolation {self.interpolation!r}; expected one of "
                 + ", ".join(INTERPOLATIONS)
+            )
+        if self.refine_controls not in REFINEMENTS:
+            raise InputError(
+                f"deadline grid: refine_controls {self.refine_controls!r}; expected one of "
+                + ", ".join(REFINEMENTS)
             )
 
     @property
@@ -199,12 +216,6 @@ def brownian_equivalent(sigma_deg: float, timescale_s: float, horizon_s: float) 
     return math.sqrt(var / horizon_s)
 
 
-def _index_dtype(nnz: int) -> type:
-    """int32 indices (as the column indices) unless the matrix is too large: scipy would
-    otherwise upcast and copy the column indices."""
-    return np.int32 if nnz < 2**31 - 1 else np.int64
-
-
 def _stencil(frac: NDArray, cubic: bool) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Offsets and weights of linear (2-point) or cubic Lagrange (4-point) interpolation."""
     t = frac[..., None]
@@ -222,113 +233,270 @@ def _stencil(frac: NDArray, cubic: bool) -> tuple[NDArray[np.int64], NDArray[np.
     return np.array([-1, 0, 1, 2]), w
 
 
+def _node_coords(
+    grid: DeadlineGrid, nodes: NDArray[np.int64]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """Tack index, ring and angle index of flat nodes."""
+    per_tack = (grid.n_r + 1) * grid.n_theta
+    return nodes // per_tack, (nodes % per_tack) // grid.n_theta, nodes % grid.n_theta
+
+
+def _feet_stencil(
+    grid: DeadlineGrid,
+    q: NDArray[np.int64],
+    i: NDArray[np.int64],
+    j: NDArray[np.int64],
+    u: float | NDArray,
+    speed: float | NDArray,
+    a: float,
+    sigma: float,
+    tau: float,
+    outer: str,
+    cubic: bool,
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Columns and weights ``(*shape, 2 k²)`` of the two Gauss–Hermite feet of steering ``u``.
+
+    ``q, i, j`` (tack, ring, angle index) broadcast with ``u`` [rad] and ``speed``
+    [m s⁻¹] to ``shape``: e.g. one control for all nodes, one per node, or nodes
+    ``(m, 1)`` by controls ``(n_u,)``.  Entries ``0 .. k² - 1`` are the ``+σ√τ`` foot.
+    Column ``n_nodes`` is the ghost inside the mark (value 1), ``n_nodes + 1`` the one
+    beyond ``r_max`` (value 0, with ``outer="fail"``); a ghost foot has weight ½ on it.
+    ``cubic``: 4-point Lagrange weights in ``r`` and ``θ`` (linear in ``r`` next to the
+    grid's ends).
+    """
+    nr, nt = grid.n_r, grid.n_theta
+    r = i * grid.dr
+    th = j * grid.dtheta
+    sgn = np.where(q == 0, 1.0, -1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv_r = np.where(r > 0, 1.0 / r, 0.0)
+    k = 4 if cubic else 2
+    ang = th + sgn * u
+    rf = r - tau * speed * np.cos(ang)
+    dth = tau * (speed * inv_r * np.sin(ang) + a)
+    shape = np.broadcast_shapes(np.shape(q), np.shape(u), np.shape(speed))
+    rf = np.broadcast_to(rf, shape)
+    dth = np.broadcast_to(dth, shape)
+    th = np.broadcast_to(th, shape)
+    inside = rf <= grid.target_radius_m
+    if outer == "fail":
+        beyond = rf > grid.r_max_m
+    else:
+        beyond = np.zeros(shape, dtype=bool)
+        rf = np.minimum(rf, grid.r_max_m)
+    fr = np.clip(rf / grid.dr, 0.0, nr)
+    i0 = np.minimum(np.floor(fr).astype(np.int64), nr - 1)
+    off_r, w_r = _stencil(fr - i0, cubic)
+    if cubic:
+        # next to r = 0 or r_max fall back to linear weights on the inner two points
+        edge = (i0 < 1) | (i0 > nr - 2)
+        _, w_lin = _stencil(fr - i0, False)
+        pad = np.zeros((*shape, 1))
+        w_r = np.where(edge[..., None], np.concatenate([pad, w_lin, pad], axis=-1), w_r)
+    rows_r = np.clip(i0[..., None] + off_r, 0, nr)  # (*shape, k)
+    ghost = inside | beyond
+    base = (np.broadcast_to(q, shape)[..., None] * (nr + 1) + rows_r) * nt  # (*shape, k)
+    cols = np.empty((*shape, 2, k * k), dtype=np.int64)
+    wts = np.empty((*shape, 2, k * k))
+    for f, pm in enumerate((1.0, -1.0)):
+        ft = (th + dth + pm * sigma * math.sqrt(tau)) / grid.dtheta
+        j0f = np.floor(ft)
+        off_t, w_t = _stencil(ft - j0f, cubic)
+        cols_t = np.mod(j0f.astype(np.int64)[..., None] + off_t, nt)  # (*shape, k)
+        cols[..., f, :] = (base[..., :, None] + cols_t[..., None, :]).reshape(*shape, k * k)
+        wts[..., f, :] = 0.5 * (w_r[..., :, None] * w_t[..., None, :]).reshape(*shape, k * k)
+    cols[ghost] = np.where(inside[ghost], grid.n_nodes, grid.n_nodes + 1)[:, None, None]
+    wts[ghost] = 0.0
+    wts[ghost, :, 0] = 0.5
+    return cols.reshape(*shape, 2 * k * k), wts.reshape(*shape, 2 * k * k)
+
+
+@dataclass(frozen=True, eq=False)
+class _RowOperator:
+    """A sparse operator with ``rows_per_node`` rows of ``per_row`` entries for every node.
+
+    Row ``p * rows_per_node + n`` belongs to node ``p`` (node-major: the controls of one
+    node are adjacent, so the max over controls is a contiguous reduction).  Stored as the
+    CSR ``data`` and ``indices`` arrays; :meth:`apply` multiplies the rows of a range of
+    nodes, so a budget slice only pays for the nodes that can change.
+    """
+
+    data: NDArray
+    indices: NDArray[np.int32]
+    rows_per_node: int
+    n_cols: int
+    block_nodes: int
+    indptr: NDArray[np.int32]
+
+    @classmethod
+    def build(cls, cols: NDArray, vals: NDArray, n_cols: int,
+              block_nodes: int = BLOCK_NODES) -> _RowOperator:
+        """From ``cols`` and ``vals`` of shape ``(n_nodes, rows_per_node, per_row)``."""
+        _, rows_per_node, per_row = cols.shape
+        if n_cols >= 2**31 or per_row * rows_per_node * block_nodes >= 2**31:
+            raise InputError("deadline grid too large for 32-bit sparse indices")
+        return cls(
+            data=vals.reshape(-1),
+            indices=cols.reshape(-1),
+            rows_per_node=rows_per_node,
+            n_cols=n_cols,
+            block_nodes=block_nodes,
+            indptr=np.arange(0, per_row * rows_per_node * block_nodes + 1, per_row,
+                             dtype=np.int32),
+        )
+
+    @property
+    def per_row(self) -> int:
+        """Entries per row."""
+        return int(self.indptr[1])
+
+    def apply(self, x: NDArray, node_lo: int, node_hi: int) -> NDArray:
+        """Rows of nodes ``node_lo .. node_hi - 1`` (at most ``block_nodes``) times ``x``,
+        shape ``(nodes, rows_per_node)``."""
+        n_rows = (node_hi - node_lo) * self.rows_per_node
+        a = node_lo * self.rows_per_node * self.per_row
+        b = a + n_rows * self.per_row
+        # An empty matrix given the block's arrays as views: the constructor would copy
+        # views of a much larger array (scipy's prune), i.e. the whole block each time.
+        mat = sp.csr_matrix((n_rows, self.n_cols), dtype=self.data.dtype)
+        mat.indptr = self.indptr[: n_rows + 1]
+        mat.indices = self.indices[a:b]
+        mat.data = self.data[a:b]
+        return (mat @ x).reshape(node_hi - node_lo, self.rows_per_node)
+
+    @property
+    def nbytes(self) -> int:
+        """Memory of the stored entries [bytes]."""
+        return int(self.data.nbytes + self.indices.nbytes)
+
+
 def _steer_operator(
     grid: DeadlineGrid,
-    nodes: NDArray[np.int64],
     speeds: NDArray[np.float64],
     a: float,
     sigma: float,
     tau: float,
     outer: str,
     interpolation: str = "linear",
-) -> sp.csr_matrix:
-    """Sparse operator: row ``n*m + p`` = half-sum of the two feet of node ``p``, control ``n``.
-
-    Columns index the flattened slice plus two ghosts: ``n_nodes`` (inside the
-    mark) and ``n_nodes + 1`` (beyond ``r_max``; only with ``outer="fail"``).
-    ``interpolation="cubic"`` uses 4-point Lagrange weights in ``r`` and ``θ``
-    (linear in ``r`` next to the grid's ends).
-    """
+    dtype: type = np.float32,
+) -> _RowOperator:
+    """Steering operator of every node: row ``p n_u + n`` = half-sum of the two feet of
+    node ``p`` under control ``n`` (:func:`_feet_stencil`; columns: the flat slice plus
+    the two ghosts)."""
     if interpolation not in INTERPOLATIONS:
         raise InputError(
             f"interpolation {interpolation!r}: expected one of {', '.join(INTERPOLATIONS)}"
         )
     cubic = interpolation == "cubic"
-    nr, nt = grid.n_r, grid.n_theta
-    per_tack = (nr + 1) * nt
-    q = nodes // per_tack
-    i = (nodes % per_tack) // nt
-    j = nodes % nt
-    r = i * grid.dr
-    th = j * grid.dtheta
-    sgn = np.where(q == 0, 1.0, -1.0)
     u = grid.controls_rad
-    m = nodes.size
-    n_u = u.size
-    k = 4 if cubic else 2
-    per_row = 2 * k * k
-    ghost_in, ghost_out = grid.n_nodes, grid.n_nodes + 1
-    indices = np.empty((n_u, m, 2, k * k), dtype=np.int32)
-    data = np.empty((n_u, m, 2, k * k), dtype=np.float32)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv_r = np.where(r > 0, 1.0 / r, 0.0)
-    for n in range(n_u):
-        ang = th + sgn * u[n]
-        rf = r - tau * speeds[n] * np.cos(ang)
-        dth = tau * (speeds[n] * inv_r * np.sin(ang) + a)
-        inside = rf <= grid.target_radius_m
-        if outer == "fail":
-            beyond = rf > grid.r_max_m
-        else:
-            beyond = np.zeros(m, dtype=bool)
-            rf = np.minimum(rf, grid.r_max_m)
-        fr = np.clip(rf / grid.dr, 0.0, nr)
-        i0 = np.minimum(np.floor(fr).astype(np.int64), nr - 1)
-        off_r, w_r = _stencil(fr - i0, cubic)
-        if cubic:
-            # next to r = 0 or r_max fall back to linear weights on the inner two points
-            edge = (i0 < 1) | (i0 > nr - 2)
-            _, w_lin = _stencil(fr - i0, False)
-            w_r = np.where(edge[:, None], np.concatenate(
-                [np.zeros((m, 1)), w_lin, np.zeros((m, 1))], axis=-1), w_r)
-        rows_r = np.clip(i0[:, None] + off_r[None, :], 0, nr)  # (m, k)
-        ghost = inside | beyond
-        for f, pm in enumerate((1.0, -1.0)):
-            ft = (th + dth + pm * sigma * math.sqrt(tau)) / grid.dtheta
-            j0f = np.floor(ft)
-            off_t, w_t = _stencil(ft - j0f, cubic)
-            cols_t = np.mod(j0f.astype(np.int64)[:, None] + off_t[None, :], nt)  # (m, k)
-            base = (q[:, None] * (nr + 1) + rows_r) * nt  # (m, k)
-            cols = (base[:, :, None] + cols_t[:, None, :]).reshape(m, k * k)
-            w = 0.5 * (w_r[:, :, None] * w_t[:, None, :]).reshape(m, k * k)
-            cols[ghost] = np.where(inside[ghost], ghost_in, ghost_out)[:, None]
-            w[ghost] = 0.0
-            w[ghost, 0] = 0.5
-            indices[n, :, f] = cols
-            data[n, :, f] = w
-    indptr = np.arange(0, per_row * n_u * m + 1, per_row, dtype=_index_dtype(per_row * n_u * m))
-    return sp.csr_matrix(
-        (data.reshape(-1), indices.reshape(-1), indptr), shape=(n_u * m, grid.n_nodes + 2)
-    )
+    kk = 16 if cubic else 4
+    cols = np.empty((grid.n_nodes, u.size, 2 * kk), dtype=np.int32)
+    vals = np.empty((grid.n_nodes, u.size, 2 * kk), dtype=dtype)
+    step = max(1, BLOCK_NODES // 4)
+    for n0 in range(0, grid.n_nodes, step):
+        n1 = min(n0 + step, grid.n_nodes)
+        q, i, j = _node_coords(grid, np.arange(n0, n1)[:, None])
+        cols[n0:n1], vals[n0:n1] = _feet_stencil(grid, q, i, j, u, speeds, a, sigma, tau,
+                                                 outer, cubic)
+    return _RowOperator.build(cols, vals, grid.n_nodes + 2)
 
 
 def _switch_operator(
-    grid: DeadlineGrid, nodes: NDArray[np.int64], a: float, sigma: float, penalty_s: float
-) -> sp.csr_matrix:
-    """Sparse operator: three-node Gauss–Hermite average over the other tack's θ after ``C``."""
+    grid: DeadlineGrid, a: float, sigma: float, penalty_s: float, dtype: type = np.float32
+) -> _RowOperator:
+    """Switch operator of every node: three-node Gauss–Hermite average over the other
+    tack's ``θ`` after ``C`` (linear interpolation)."""
     nr, nt = grid.n_r, grid.n_theta
-    per_tack = (nr + 1) * nt
-    q = nodes // per_tack
-    i = (nodes % per_tack) // nt
-    j = nodes % nt
-    m = nodes.size
+    q, i, j = _node_coords(grid, np.arange(grid.n_nodes))
+    m = q.size
     base = ((1 - q) * (nr + 1) + i) * nt
     spread = sigma * math.sqrt(3.0 * penalty_s)
-    cols = np.empty((m, 3, 2), dtype=np.int32)
-    vals = np.empty((m, 3, 2), dtype=np.float32)
+    cols = np.empty((m, 1, 3, 2), dtype=np.int32)
+    vals = np.empty((m, 1, 3, 2), dtype=dtype)
     for k, (off, wgt) in enumerate(zip(GH3_OFFSETS, GH3_WEIGHTS, strict=True)):
         ft = (j * grid.dtheta + a * penalty_s + off * spread) / grid.dtheta
         j0f = np.floor(ft)
         wt = ft - j0f
         j0 = np.mod(j0f.astype(np.int64), nt)
-        cols[:, k, 0] = base + j0
-        cols[:, k, 1] = base + np.mod(j0 + 1, nt)
-        vals[:, k, 0] = wgt * (1 - wt)
-        vals[:, k, 1] = wgt * wt
-    indptr = np.arange(0, 6 * m + 1, 6, dtype=_index_dtype(6 * m))
-    return sp.csr_matrix(
-        (vals.reshape(-1), cols.reshape(-1), indptr), shape=(m, grid.n_nodes + 2)
-    )
+        cols[:, 0, k, 0] = base + j0
+        cols[:, 0, k, 1] = base + np.mod(j0 + 1, nt)
+        vals[:, 0, k, 0] = wgt * (1 - wt)
+        vals[:, 0, k, 1] = wgt * wt
+    return _RowOperator.build(cols.reshape(m, 1, 6), vals.reshape(m, 1, 6), grid.n_nodes + 2)
+
+
+OFFSET_STEPS = 127
+"""``steer_offset`` units: ``Δu / 127`` (0.03° for 49 controls)."""
+FINE_SPEED_STEPS = 1440
+"""Intervals of the speed table used between the controls (0.125°)."""
+GOLDEN_TOL_RAD = 1e-3
+"""Golden-section tolerance on the steering angle (Wang et al. 2024's code) [rad]."""
+
+
+def _fine_speed_table(polar: Polar, tws_ms: float) -> tuple[NDArray, NDArray]:
+    u = np.linspace(0.0, math.pi, FINE_SPEED_STEPS + 1)
+    return u, np.asarray(polar.speed(tws_ms, np.degrees(u)), dtype=float)
+
+
+class _SteerRefiner:
+    """Golden-section search of the steering angle between the neighbours of the best
+    coarse control, per node, vectorised (Wang et al. 2024's second stage).
+
+    The speed between controls is read from a 0.125° table of the polar (linear in
+    between); the feet are computed on the fly with the solver's interpolation.  The
+    refined angle is kept as ``u_best + offset Δu / 127`` (int8 offset), and used only
+    where it beats the best coarse control.
+    """
+
+    def __init__(self, grid: DeadlineGrid, polar: Polar, tws_ms: float, a: float,
+                 sigma: float, tau: float) -> None:
+        self.grid, self.a, self.sigma, self.tau = grid, a, sigma, tau
+        self.cubic = grid.interpolation == "cubic"
+        self.u_tab, self.f_tab = _fine_speed_table(polar, tws_ms)
+        self.du = math.pi / (grid.n_controls - 1)
+        self.n_iter = max(1, math.ceil(math.log(2 * self.du / GOLDEN_TOL_RAD)
+                                       / math.log((1 + math.sqrt(5)) / 2)))
+
+    def _value(self, x: NDArray, q: NDArray, i: NDArray, j: NDArray, u: NDArray) -> NDArray:
+        f = np.interp(u, self.u_tab, self.f_tab)
+        cols, wts = _feet_stencil(self.grid, q, i, j, u, f, self.a, self.sigma, self.tau,
+                                  "fail", self.cubic)
+        return np.einsum("mk,mk->m", wts, x[cols])
+
+    def refine(self, x: NDArray, n0: int, n1: int, best: NDArray, wk: NDArray
+               ) -> tuple[NDArray, NDArray]:
+        """Values and int8 offsets after refining nodes ``n0 .. n1 - 1`` (``x``: previous
+        slice with ghosts; ``best``, ``wk``: the best coarse control and its value)."""
+        offset = np.zeros(n1 - n0, dtype=np.int8)
+        todo = np.flatnonzero((wk > ZERO_CLIP) & (wk < SURE))
+        if todo.size == 0:
+            return wk, offset
+        q, i, j = _node_coords(self.grid, n0 + todo)
+        ub = best[todo] * self.du
+        lo = np.maximum(ub - self.du, 0.0)
+        hi = np.minimum(ub + self.du, math.pi)
+        g = (math.sqrt(5) - 1) / 2
+        c = hi - g * (hi - lo)
+        d = lo + g * (hi - lo)
+        fc = self._value(x, q, i, j, c)
+        fd = self._value(x, q, i, j, d)
+        for _ in range(self.n_iter):
+            left = fc >= fd  # the maximum lies in [lo, d], else in [c, hi]
+            hi = np.where(left, d, hi)
+            lo = np.where(left, lo, c)
+            c, d = np.where(left, hi - g * (hi - lo), d), np.where(left, c, lo + g * (hi - lo))
+            f_new = self._value(x, q, i, j, np.where(left, c, d))
+            fc, fd = np.where(left, f_new, fd), np.where(left, fc, f_new)
+        u_star = 0.5 * (lo + hi)
+        off = np.clip(np.rint((u_star - ub) / self.du * OFFSET_STEPS), -OFFSET_STEPS,
+                      OFFSET_STEPS)
+        u_q = np.clip(ub + off * self.du / OFFSET_STEPS, 0.0, math.pi)
+        v_q = self._value(x, q, i, j, u_q).astype(wk.dtype)
+        better = v_q > wk[todo]
+        wk = wk.copy()
+        wk[todo[better]] = v_q[better]
+        offset[todo[better]] = off[better].astype(np.int8)
+        return wk, offset
 
 
 def _controls_speed(grid: DeadlineGrid, polar: Polar, tws_ms: float) -> NDArray[np.float64]:
@@ -356,6 +524,11 @@ class DeadlinePolicy:
     switch : ndarray of bool, shape (n_s + 1, n_nodes)
         True where switching tack is optimal.
     solve_time_s : float
+    steer_offset : ndarray of int8, shape (n_s + 1, n_nodes), or None
+        With ``grid.refine_controls``: the refined angle is
+        ``u[steer] + steer_offset Δu / 127`` (:meth:`steering_rad`).
+    fine_speeds : (ndarray, ndarray) or None
+        Angles [rad] and polar speeds [m s⁻¹] (0.125° table) for refined angles.
     """
 
     grid: DeadlineGrid
@@ -366,6 +539,18 @@ class DeadlinePolicy:
     steer: NDArray[np.int8]
     switch: NDArray[np.bool_]
     solve_time_s: float
+    steer_offset: NDArray[np.int8] | None = None
+    fine_speeds: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    def steering(self, k: NDArray, node: NDArray) -> tuple[NDArray, NDArray]:
+        """Steering angle [rad] and boat speed [m s⁻¹] of slice(s) ``k`` at ``node``."""
+        idx = self.steer[k, node].astype(np.int64)
+        if self.steer_offset is None or self.fine_speeds is None:
+            return self.grid.controls_rad[idx], self.speeds_ms[idx]
+        du = math.pi / (self.grid.n_controls - 1)
+        u = np.clip(self.grid.controls_rad[idx]
+                    + self.steer_offset[k, node] * (du / OFFSET_STEPS), 0.0, math.pi)
+        return u, np.interp(u, *self.fine_speeds)
 
     def node(self, r_m: float, theta_rad: float, tack: int) -> int:
         """Flat index of the node nearest to ``(r, θ)`` on ``tack`` (+1/-1)."""
@@ -437,6 +622,19 @@ def _active_nodes(grid: DeadlineGrid) -> tuple[NDArray[np.int64], NDArray[np.boo
     return np.flatnonzero(~inside), inside
 
 
+def _rings_all_sure(w_prev: NDArray, grid: DeadlineGrid, lo: int, hi: int) -> int:
+    """First ring ``>= lo`` (and ``< hi``) where some node of either tack is not sure."""
+    per_tack = (grid.n_r + 1) * grid.n_theta
+    nt = grid.n_theta
+    while lo < hi:
+        if (w_prev[lo * nt:(lo + 1) * nt] < SURE).any() or (
+            w_prev[per_tack + lo * nt:per_tack + (lo + 1) * nt] < SURE
+        ).any():
+            return lo
+        lo += 1
+    return lo
+
+
 def solve_deadline(
     polar: Polar,
     tws_ms: float,
@@ -444,6 +642,7 @@ def solve_deadline(
     grid: DeadlineGrid,
     tack_penalty_s: float,
     progress: Callable[[int, int], None] | None = None,
+    dtype: str = "float32",
 ) -> DeadlinePolicy:
     """March ``w`` over the budget slices ``s = 0, Δs, ..., s_max`` (module docstring).
 
@@ -461,52 +660,91 @@ def solve_deadline(
         budget steps.
     progress : callable, optional
         Called as ``progress(k, n_s)`` after each slice (for a CLI progress line).
+    dtype : {"float32", "float64"}
+        Precision of the operators and of ``w``.  ``float32`` (default) halves the
+        memory and the memory traffic; it changes ``w`` by at most a few 1e-6 on the
+        paper's set-up (``benchmarks/bench_deadline.py``).
 
     Returns
     -------
     DeadlinePolicy
-        Memory: ``6 (n_s + 1) n_nodes`` bytes for ``w``, ``steer`` and ``switch``.
+        Memory: ``(4 + 2) (n_s + 1) n_nodes`` bytes for ``w``, ``steer`` and ``switch``
+        (``w`` in ``dtype``), plus ``steer_offset`` with ``grid.refine_controls``.
+
+    Notes
+    -----
+    A slice only updates the rings that can change: those that the boat can reach from
+    within the budget at top speed (farther rings stay 0) and that are not yet sure
+    everywhere (``w >= 1 - 1e-6`` keeps its value and action); with the node-major
+    operators each block of nodes is one sparse mat-vec and a contiguous max over the
+    controls.
     """
     t0 = time.perf_counter()
+    if dtype not in ("float32", "float64"):
+        raise InputError(f"dtype {dtype!r}: expected 'float32' or 'float64'")
+    ftype = np.dtype(dtype).type
     kc = grid.penalty_steps(tack_penalty_s)
     a, sigma = _model_rates(model)
     f = _controls_speed(grid, polar, tws_ms)
     f_max = float(np.max(f))
-    active, inside = _active_nodes(grid)
-    steer_op = _steer_operator(
-        grid, active, f, a, sigma, grid.ds_s, "fail", grid.interpolation
+    steer_op = _steer_operator(grid, f, a, sigma, grid.ds_s, "fail", grid.interpolation, ftype)
+    switch_op = _switch_operator(grid, a, sigma, tack_penalty_s, ftype)
+    refine = (
+        _SteerRefiner(grid, polar, tws_ms, a, sigma, grid.ds_s)
+        if grid.refine_controls != "none" else None
     )
-    switch_op = _switch_operator(grid, active, a, sigma, tack_penalty_s)
-    n_s, n_nodes, m, n_u = grid.n_s, grid.n_nodes, active.size, f.size
-    w = np.zeros((n_s + 1, n_nodes + 2), dtype=np.float32)
-    w[:, :n_nodes][:, inside] = 1.0
+    n_s, n_nodes, nt = grid.n_s, grid.n_nodes, grid.n_theta
+    per_tack = (grid.n_r + 1) * nt
+    n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))  # rings inside the mark
+    w = np.zeros((n_s + 1, n_nodes + 2), dtype=ftype)
+    for q in (0, 1):
+        w[:, q * per_tack:q * per_tack + n_in * nt] = 1.0
     w[:, n_nodes] = 1.0  # ghost: a foot inside the mark
     steer = np.zeros((n_s + 1, n_nodes), dtype=np.int8)
     switch = np.zeros((n_s + 1, n_nodes), dtype=np.bool_)
-    r_active = np.tile(np.repeat(grid.r_m, grid.n_theta), 2)[active]
-    reach_time = (r_active - grid.target_radius_m) / f_max
+    offset = np.zeros((n_s + 1, n_nodes), dtype=np.int8) if refine is not None else None
+    reach_time = (grid.r_m - grid.target_radius_m) / f_max  # per ring
+    lo = n_in
     for k in range(1, n_s + 1):
-        vals = (steer_op @ w[k - 1]).reshape(n_u, m)
-        best = np.argmax(vals, axis=0)
-        wk = vals[best, np.arange(m)]
-        if k >= kc:
-            ws = switch_op @ w[k - kc]
-            sw = ws > wk + SWITCH_EPS
-            wk = np.where(sw, ws, wk)
-        else:
-            sw = np.zeros(m, dtype=bool)
-        late = reach_time > k * grid.ds_s
-        wk = np.where(late | (wk < ZERO_CLIP), 0.0, np.minimum(wk, 1.0))
-        # More budget never hurts: following the policy of budget s - Δs succeeds by s at
-        # least as often.  Where that beats this slice (possible with the non-monotone cubic
-        # weights), or where success was already sure (deadline upgrade: any action keeping
-        # w = 1 ties, the one of the least sure budget is the tightest), keep the previous
-        # slice's value and action.
-        prev = w[k - 1, active]
-        keep = (prev >= SURE) | (prev > wk)
-        w[k, active] = np.where(keep, prev, wk)
-        steer[k, active] = np.where(keep, steer[k - 1, active], best)
-        switch[k, active] = np.where(keep, switch[k - 1, active], sw & ~late)
+        prev = w[k - 1]
+        # rings reachable at top speed within the budget; rings beyond stay 0
+        hi = int(np.searchsorted(reach_time, k * grid.ds_s, side="right"))
+        lo = _rings_all_sure(prev, grid, lo, hi)
+        for q in (0, 1):
+            base = q * per_tack
+            keep_to = base + lo * nt
+            w[k, base:keep_to] = prev[base:keep_to]
+            steer[k, base:keep_to] = steer[k - 1, base:keep_to]
+            switch[k, base:keep_to] = switch[k - 1, base:keep_to]
+            if offset is not None:
+                offset[k, base:keep_to] = offset[k - 1, base:keep_to]
+            for n0 in range(keep_to, base + hi * nt, BLOCK_NODES):
+                n1 = min(n0 + BLOCK_NODES, base + hi * nt)
+                vals = steer_op.apply(prev, n0, n1)
+                best = np.argmax(vals, axis=1)
+                wk = np.take_along_axis(vals, best[:, None], axis=1)[:, 0]
+                off = None
+                if refine is not None:
+                    wk, off = refine.refine(prev, n0, n1, best, wk)
+                if k >= kc:
+                    ws = switch_op.apply(w[k - kc], n0, n1)[:, 0]
+                    sw = ws > wk + SWITCH_EPS
+                    wk = np.where(sw, ws, wk)
+                else:
+                    sw = np.zeros(n1 - n0, dtype=bool)
+                wk = np.where(wk < ZERO_CLIP, 0.0, np.minimum(wk, 1.0))
+                # More budget never hurts: following the policy of budget s - Δs succeeds
+                # by s at least as often.  Where that beats this slice (possible with the
+                # non-monotone cubic weights), or where success was already sure (deadline
+                # upgrade: any action keeping w = 1 ties, the one of the least sure budget
+                # is the tightest), keep the previous slice's value and action.
+                p = prev[n0:n1]
+                keep = (p >= SURE) | (p > wk)
+                w[k, n0:n1] = np.where(keep, p, wk)
+                steer[k, n0:n1] = np.where(keep, steer[k - 1, n0:n1], best)
+                switch[k, n0:n1] = np.where(keep, switch[k - 1, n0:n1], sw)
+                if offset is not None and off is not None:
+                    offset[k, n0:n1] = np.where(keep, offset[k - 1, n0:n1], off)
         if progress is not None:
             progress(k, n_s)
     return DeadlinePolicy(
@@ -518,6 +756,8 @@ def solve_deadline(
         steer=steer,
         switch=switch,
         solve_time_s=time.perf_counter() - t0,
+        steer_offset=offset,
+        fine_speeds=(refine.u_tab, refine.f_tab) if refine is not None else None,
     )
 
 
@@ -531,6 +771,7 @@ def solve_risk_neutral(
     max_sweeps: int = 2000,
     tau_s: float | None = None,
     progress: Callable[[int, float], None] | None = None,
+    ring_iterations: int = 64,
 ) -> RiskNeutralPolicy:
     """Minimum expected time by value iteration (Wang et al. (2024) eq. 5, risk-neutral).
 
@@ -546,7 +787,12 @@ def solve_risk_neutral(
     ``E[T]`` 44.14 instead of 43.90).
     Interpolation is always bilinear here (whatever ``grid.interpolation``
     says): value iteration needs the monotone scheme (non-negative weights) to
-    converge, and ``v`` is smooth.
+    converge, and ``v`` is smooth.  Each ring is repeated (up to
+    ``ring_iterations`` times) until it changes by less than ``tol_s``: a ring's nodes
+    feed each other through ``θ`` and the switch, and one update moves information
+    only a few cells around the ring, so plain sweeps need hundreds of passes (Wang et
+    al.'s Fig. 3 set-up at 201 x 256: 204 sweeps, 18 s; with ring iterations: 2 sweeps,
+    2.3 s, and a better converged value).
 
     Raises
     ------
@@ -556,21 +802,20 @@ def solve_risk_neutral(
     t0 = time.perf_counter()
     a, sigma = _model_rates(model)
     f = _controls_speed(grid, polar, tws_ms)
-    active, inside = _active_nodes(grid)
-    n_nodes, n_u = grid.n_nodes, f.size
+    _, inside = _active_nodes(grid)
+    n_nodes = grid.n_nodes
     tau = grid.ds_s if tau_s is None else float(tau_s)
     if not tau > 0:
         raise InputError(f"risk-neutral time step {tau_s} s must be > 0")
-    per_tack = (grid.n_r + 1) * grid.n_theta
-    ring = (active % per_tack) // grid.n_theta
-    rings = [active[ring == i] for i in np.unique(ring)]
-    ops = [
-        (
-            nodes,
-            _steer_operator(grid, nodes, f, a, sigma, tau, "fail", "linear"),
-            _switch_operator(grid, nodes, a, sigma, tack_penalty_s),
-        )
-        for nodes in rings
+    nt = grid.n_theta
+    per_tack = (grid.n_r + 1) * nt
+    n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))
+    s_op = _steer_operator(grid, f, a, sigma, tau, "fail", "linear")
+    c_op = _switch_operator(grid, a, sigma, tack_penalty_s)
+    blocks = [
+        [(q * per_tack + i * nt + b0, q * per_tack + i * nt + min(b0 + BLOCK_NODES, nt))
+         for q in (0, 1) for b0 in range(0, nt, BLOCK_NODES)]
+        for i in range(n_in, grid.n_r + 1)
     ]
     # start from a plausible upper estimate (beat to the mark at the worst VMG, two switches)
     # rather than "unreached": far fewer sweeps, the fixed point is the same
@@ -595,18 +840,30 @@ def solve_risk_neutral(
             )
         sweeps += 1
         residual = 0.0
-        for nodes, s_op, c_op in ops:
-            mloc = nodes.size
-            vals = tau + (s_op @ v).reshape(n_u, mloc)
-            best = np.argmin(vals, axis=0)
-            vs = vals[best, np.arange(mloc)]
-            vc = tack_penalty_s + c_op @ v
-            sw = vc < vs - SWITCH_EPS
-            new = np.minimum(np.where(sw, vc, vs), RN_UNREACHED_S)
-            residual = max(residual, float(np.max(np.abs(new - v[nodes]))))
-            v[nodes] = new
-            steer[nodes] = best
-            switch[nodes] = sw
+        for ring in blocks:
+            # both tacks of a ring from the old values, then written (Gauss–Seidel by ring);
+            # the ring is repeated while it changes (its nodes feed each other through θ
+            # and the switch), which carries information around the ring in one sweep
+            for it in range(ring_iterations):
+                change = 0.0
+                updates = []
+                for n0, n1 in ring:
+                    vals = tau + s_op.apply(v, n0, n1)
+                    best = np.argmin(vals, axis=1)
+                    vs = np.take_along_axis(vals, best[:, None], axis=1)[:, 0]
+                    vc = tack_penalty_s + c_op.apply(v, n0, n1)[:, 0]
+                    sw = vc < vs - SWITCH_EPS
+                    new = np.minimum(np.where(sw, vc, vs), RN_UNREACHED_S)
+                    change = max(change, float(np.max(np.abs(new - v[n0:n1]))))
+                    updates.append((n0, n1, new, best, sw))
+                for n0, n1, new, best, sw in updates:
+                    v[n0:n1] = new
+                    steer[n0:n1] = best
+                    switch[n0:n1] = sw
+                if it == 0:
+                    residual = max(residual, change)
+                if change <= tol_s:
+                    break
         if progress is not None:
             progress(sweeps, residual)
     return RiskNeutralPolicy(
@@ -717,6 +974,7 @@ def simulate_deadline_chunk(
         theta = np.mod(phi - np.arctan2(x, -y), 2 * math.pi)
         node = _nearest_nodes(g, r, theta, q)
         act_steer = rn.steer[node].astype(np.int64)
+        act_u, act_f = u[act_steer], f[act_steer]
         act_switch = rn.switch[node].copy()
         if use_ra:
             assert ra is not None
@@ -727,7 +985,9 @@ def simulate_deadline_chunk(
             newly = risk_aware & (~ok | hopeless) & ~done
             fell_back |= newly
             risk_aware &= ~newly
-            act_steer = np.where(risk_aware, ra.steer[kk, node], act_steer)
+            ra_u, ra_f = ra.steering(kk, node)
+            act_u = np.where(risk_aware, ra_u, act_u)
+            act_f = np.where(risk_aware, ra_f, act_f)
             act_switch = np.where(risk_aware, ra.switch[kk, node], act_switch)
         # never two switches in a row (a coarse grid can make the lookups ping-pong)
         act_switch &= ~last_switch & ~done
@@ -735,8 +995,8 @@ def simulate_deadline_chunk(
         # switch: stand still for C while the wind moves
         phi_sw = phi + a * c + sigma * math.sqrt(c) * z
         # steer: Euler–Maruyama step
-        heading = phi + np.where(q == 0, 1.0, -1.0) * u[act_steer]
-        sp_ = f[act_steer]
+        heading = phi + np.where(q == 0, 1.0, -1.0) * act_u
+        sp_ = act_f
         xn = x - sp_ * np.sin(heading) * dt
         yn = y + sp_ * np.cos(heading) * dt
         phin = phi + a * dt + sigma * math.sqrt(dt) * z

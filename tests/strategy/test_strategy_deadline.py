@@ -244,3 +244,114 @@ def test_seed_004_fig3_numbers_on_a_finer_grid() -> None:
     assert np.mean(sim_rn.leg_time_s) == pytest.approx(54.46, abs=0.5)
     assert np.mean(sim_rn.leg_time_s <= 56) == pytest.approx(0.525, abs=0.03)
     assert np.mean(sim_ra.leg_time_s <= 56) == pytest.approx(0.589, abs=0.03)
+
+
+def _reference_solve(g: DeadlineGrid, m: DriftDiffusionShift) -> np.ndarray:
+    """Every node in every slice (no reach or sure window): the scheme as written."""
+    from sailroute.strategy.deadline import (
+        SURE,
+        SWITCH_EPS,
+        ZERO_CLIP,
+        _model_rates,
+        _steer_operator,
+        _switch_operator,
+    )
+
+    a, sigma = _model_rates(m)
+    f = SO40.speed(1.0, np.degrees(g.controls_rad))
+    kc = g.penalty_steps(C)
+    s_op = _steer_operator(g, f, a, sigma, g.ds_s, "fail", g.interpolation)
+    c_op = _switch_operator(g, a, sigma, C)
+    r = np.tile(np.repeat(g.r_m, g.n_theta), 2)
+    out = r > g.target_radius_m
+    w = np.zeros((g.n_s + 1, g.n_nodes + 2), dtype=np.float32)
+    w[:, : g.n_nodes][:, ~out] = 1.0
+    w[:, g.n_nodes] = 1.0
+    reach = (r - g.target_radius_m) / float(np.max(f))
+    for k in range(1, g.n_s + 1):
+        wk = np.max(s_op.apply(w[k - 1], 0, g.n_nodes), axis=1)
+        if k >= kc:
+            ws = c_op.apply(w[k - kc], 0, g.n_nodes)[:, 0]
+            wk = np.where(ws > wk + SWITCH_EPS, ws, wk)
+        wk = np.where((reach > k * g.ds_s) | (wk < ZERO_CLIP), 0.0, np.minimum(wk, 1.0))
+        prev = w[k - 1, : g.n_nodes]
+        new = np.where((prev >= SURE) | (prev > wk), prev, wk)
+        w[k, : g.n_nodes] = np.where(out, new, 1.0)
+    return w[:, : g.n_nodes]
+
+
+@pytest.mark.parametrize("interpolation", ["linear", "cubic"])
+def test_windowed_solve_equals_updating_every_node(interpolation: str) -> None:
+    # the solver skips rings out of reach at top speed and rings already sure; the
+    # result must be bit-identical to updating every node of every slice
+    g = DeadlineGrid(1.0, 24, 32, 0.1, 0.4, 30.0, interpolation=interpolation)
+    m = model(0.05, SIGMA)
+    ra = solve_deadline(SO40, 1.0, m, g, C)
+    np.testing.assert_array_equal(ra.w, _reference_solve(g, m))
+    assert (ra.w[-1] >= 1 - 1e-6).sum() > (ra.w[-1] > 0.5).sum() / 4  # sure rings exist
+
+
+def test_bilinear_is_the_default() -> None:
+    from sailroute.strategy.api import StrategySettings, deadline_grid_for
+
+    assert DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 10.0).interpolation == "linear"
+    assert DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 10.0).refine_controls == "none"
+    st = StrategySettings(deadlines_s=(800.0,))
+    g = deadline_grid_for(st, 2.0, 800.0)
+    assert (g.interpolation, g.refine_controls) == ("linear", "none")
+    g = deadline_grid_for(StrategySettings(deadlines_s=(800.0,), interpolation="cubic",
+                                           refine_controls="golden"), 2.0, 800.0)
+    assert (g.interpolation, g.refine_controls) == ("cubic", "golden")
+    with pytest.raises(InputError, match="refine_controls"):
+        DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 10.0, refine_controls="brent")
+
+
+def test_float64_agrees_with_float32() -> None:
+    g = DeadlineGrid(2.0, 40, 48, 0.1, 0.4, 30.0)
+    m = model(0.05, SIGMA)
+    w32 = solve_deadline(SO40, 1.0, m, g, C).w
+    w64 = solve_deadline(SO40, 1.0, m, g, C, dtype="float64").w
+    assert w64.dtype == np.float64 and w32.dtype == np.float32
+    assert np.max(np.abs(w64 - w32)) < 1e-4
+    with pytest.raises(InputError, match="dtype"):
+        solve_deadline(SO40, 1.0, m, g, C, dtype="float16")
+
+
+@pytest.fixture(scope="module")
+def golden():
+    g = DeadlineGrid(2.0, 40, 48, 0.1, 0.4, 46.0)
+    gg = DeadlineGrid(2.0, 40, 48, 0.1, 0.4, 46.0, refine_controls="golden")
+    m = model(0.05, SIGMA)
+    return solve_deadline(SO40, 1.0, m, g, C), solve_deadline(SO40, 1.0, m, gg, C), m
+
+
+def test_golden_refinement_never_lowers_w(golden) -> None:
+    # the scheme is monotone (bilinear weights >= 0): a larger control set can only raise
+    # w, slice by slice
+    coarse, fine, _ = golden
+    assert coarse.steer_offset is None and fine.steer_offset is not None
+    assert np.all(fine.w >= coarse.w - 1e-6)
+    assert np.mean(fine.w) > np.mean(coarse.w)
+    assert np.any(fine.steer_offset != 0)
+    assert np.all(np.abs(fine.steer_offset.astype(int)) <= 127)
+
+
+def test_golden_refined_angles_lie_between_the_neighbours(golden) -> None:
+    _, fine, _ = golden
+    g = fine.grid
+    k = np.arange(g.n_s + 1)[:, None]
+    node = np.arange(g.n_nodes)[None, :]
+    u, f = fine.steering(k, node)
+    du = math.pi / (g.n_controls - 1)
+    assert np.all(np.abs(u - g.controls_rad[fine.steer]) <= du + 1e-12)
+    assert np.all((u >= 0) & (u <= math.pi))
+    # the speed is the polar's between the controls
+    np.testing.assert_allclose(f, SO40.speed(1.0, np.degrees(u)), atol=1e-6)
+
+
+def test_golden_policy_simulates(golden) -> None:
+    _, fine, m = golden
+    rn = solve_risk_neutral(SO40, 1.0, m, fine.grid, C, tol_s=1e-2)
+    sim = simulate_deadline(rn, 400, 3, (1.80, 2.67, 1), ra=fine, deadline_s=42.0)
+    assert np.all(np.isfinite(sim.leg_time_s))
+    assert np.mean(sim.n_switches == 0) > 0.5  # the bet on the shift, as the coarse policy
