@@ -105,11 +105,13 @@ def plan_command(
         str | None,
         typer.Option("--out", "-o", help="Output folder (default: out/<course>/<scenario>)."),
     ] = None,
-    no_plots: Annotated[bool, typer.Option("--no-plots", help="Skip route.png.")] = False,
+    no_plots: Annotated[
+        bool, typer.Option("--no-plots", help="Skip route.png and report.html.")
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
     backend: Annotated[str, typer.Option("--backend", help=_BACKEND_HELP)] = "numpy",
 ) -> None:
-    """Route a course leg by leg: leg times, start points, tacks; writes JSON/CSV/GPX/PNG."""
+    """Route a course leg by leg: leg times, start points, tacks; writes JSON/CSV/GPX/PNG/HTML."""
     from sailroute.plan import run_plan_command
 
     def run() -> Any:
@@ -135,7 +137,9 @@ def compare_command(
         str | None,
         typer.Option("--out", "-o", help="Output folder (default: out/<course>/comparison)."),
     ] = None,
-    no_plots: Annotated[bool, typer.Option("--no-plots", help="Skip comparison.png.")] = False,
+    no_plots: Annotated[
+        bool, typer.Option("--no-plots", help="Skip comparison.png and report.html.")
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
     backend: Annotated[str, typer.Option("--backend", help=_BACKEND_HELP)] = "numpy",
     scheduler: Annotated[
@@ -398,7 +402,9 @@ def analyze_command(
         typer.Option("--column", help="CSV column mapping CANON=NAME, e.g. time=when (repeat)."),
     ] = None,
     router: Annotated[str | None, typer.Option("--router", "-r", help=_ROUTER_HELP)] = None,
-    no_plots: Annotated[bool, typer.Option("--no-plots", help="Skip legs.png, loss.png.")] = False,
+    no_plots: Annotated[
+        bool, typer.Option("--no-plots", help="Skip legs.png, loss.png and report.html.")
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
 ) -> None:
     """Race analysis: a sailed track against the optimal route, leg by leg (time lost where)."""

@@ -317,6 +317,21 @@ def compare_scenarios(
     plans : list of Plan
         One per scenario, in the same order.
     """
+    cmp, plans, _ = _compare_scenarios(course, scenarios, router=router, backend=backend,
+                                       progress=progress, scheduler=scheduler)
+    return cmp, plans
+
+
+def _compare_scenarios(
+    course: Course,
+    scenarios: Sequence[str] | None = None,
+    *,
+    router: str | None = None,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+    scheduler: str | None = None,
+) -> tuple[Comparison, list[Plan], dict[str, WindField]]:
+    """:func:`compare_scenarios`, plus the scenarios' built winds (for ``report.html``)."""
     names = list(course.scenarios) if not scenarios else scenario_members(course, scenarios)
     settings = settings_for(course, router, backend)
     where = check_scheduler(scheduler)  # a bad name fails before any work
@@ -333,7 +348,7 @@ def compare_scenarios(
         # workers build their own scenario (a wind field is not worth shipping)
         plans = map_tasks(_plan_task, [(course, n, router, backend) for n in names],
                           scheduler=where)
-    return compare(plans), plans
+    return compare(plans), plans, winds
 
 
 @dataclass(frozen=True, eq=False)
@@ -378,10 +393,11 @@ def run_plan_command(
 ) -> CommandResult:
     """Everything ``sailroute plan`` does, minus printing.
 
-    Writes ``plan.json``, ``track.csv``, ``route.gpx`` and ``route.png`` (unless
-    ``plots`` is False) into ``out_dir`` (default ``out/<course>/<scenario>``).  For an
-    ensemble scenario it routes every member and writes ``ensemble.json`` and
-    ``ensemble.csv`` (the spread of leg times, the side of the course) plus each
+    Writes ``plan.json``, ``track.csv``, ``route.gpx``, ``route.png`` and ``report.html``
+    (the last two unless ``plots`` is False) into ``out_dir`` (default
+    ``out/<course>/<scenario>``).  For an ensemble scenario it routes every member and
+    writes ``ensemble.json`` and ``ensemble.csv`` (the spread of leg times, the side of the
+    course), ``report.html`` with every member's route (unless ``plots`` is False) plus each
     member's plan files in ``out_dir/<member>/``.
     """
     from sailroute.report.files import write_plan_outputs
@@ -391,26 +407,34 @@ def run_plan_command(
     name = default_scenario(course) if scenario is None else scenario
     if name in course.ensembles:
         return _run_ensemble(course, name, router=router, out_dir=out_dir, backend=backend,
-                             progress=progress)
+                             progress=progress, plots=plots)
     run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, run.plan.scenario)
-    files = write_plan_outputs(out, run.plan, wind=run.wind, plot=plots)
+    files = dict(write_plan_outputs(out, run.plan, wind=run.wind, plot=plots))
+    if plots:
+        from sailroute.report.html import plan_report, write_report
+
+        files["html"] = write_report(out / "report.html", plan_report(run.plan, run.wind))
     return CommandResult(plan_table(run.plan), files, (run.plan,))
 
 
 def _run_ensemble(
     course: Course, name: str, *, router: str | None, out_dir: str | Path | None,
-    backend: str, progress: Progress | None,
+    backend: str, progress: Progress | None, plots: bool = True,
 ) -> CommandResult:
     """``sailroute plan`` on an ensemble scenario: every member, then the spread."""
     from sailroute.report.ensemble import ensemble_table, summarize_ensemble, write_ensemble
     from sailroute.report.files import write_plan_outputs
 
-    _, plans = compare_scenarios(course, [name], router=router, backend=backend,
-                                 progress=progress)
+    cmp, plans, winds = _compare_scenarios(course, [name], router=router, backend=backend,
+                                           progress=progress)
     summary = summarize_ensemble(name, plans)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, name)
     files: dict[str, Path] = dict(write_ensemble(out, summary))
+    if plots:
+        from sailroute.report.html import comparison_report, write_report
+
+        files["html"] = write_report(out / "report.html", comparison_report(cmp, plans, winds))
     for p in plans:
         for kind, path in write_plan_outputs(out / p.scenario, p, plot=False).items():
             files[f"{p.scenario}/{kind}"] = path
@@ -430,8 +454,9 @@ def run_compare_command(
 ) -> CommandResult:
     """Everything ``sailroute compare-scenarios`` does, minus printing.
 
-    Writes ``comparison.json``, ``comparison.csv`` and ``comparison.png`` (unless
-    ``plots`` is False) into ``out_dir`` (default ``out/<course>/comparison``), and
+    Writes ``comparison.json``, ``comparison.csv``, ``comparison.png`` and ``report.html``
+    (the last two unless ``plots`` is False) into ``out_dir`` (default
+    ``out/<course>/comparison``), and
     each scenario's ``plan.json``, ``track.csv`` and ``route.gpx`` into
     ``out_dir/<scenario>/``; for each ensemble whose members were all routed, its
     spread in ``out_dir/<ensemble>/ensemble.json`` and ``ensemble.csv``.
@@ -441,16 +466,18 @@ def run_compare_command(
     from sailroute.report.tables import comparison_table
 
     course = _loaded(course)
-    cmp, plans = compare_scenarios(course, scenarios, router=router, backend=backend,
-                                   progress=progress, scheduler=scheduler)
+    cmp, plans, winds = _compare_scenarios(course, scenarios, router=router, backend=backend,
+                                           progress=progress, scheduler=scheduler)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, "comparison")
     js, cs = write_comparison(out, cmp)
     files: dict[str, Path] = {"comparison_json": js, "comparison_csv": cs}
     if plots:
+        from sailroute.report.html import comparison_report, write_report
         from sailroute.report.plots import plot_comparison
 
         plot_comparison(cmp, plans).savefig(out / "comparison.png", dpi=150)
         files["comparison_png"] = out / "comparison.png"
+        files["html"] = write_report(out / "report.html", comparison_report(cmp, plans, winds))
     for p in plans:
         for kind, path in write_plan_outputs(out / p.scenario, p, plot=False).items():
             files[f"{p.scenario}/{kind}"] = path

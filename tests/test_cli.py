@@ -65,6 +65,35 @@ def check_plan_files(out: Path, course_file: Path) -> dict:
     return doc
 
 
+def check_report_html(path: Path, doc: dict, course) -> None:
+    """report.html agrees with plan.json and track.csv: offline page, the route's points and
+    times, the marks, the leg table."""
+    from sailroute.report.html import clock, read_figure
+    from sailroute.report.tables import format_duration
+
+    page = path.read_text(encoding="utf-8")
+    assert "<script src" not in page and len(page) > 3_000_000  # plotly.js inlined
+    fig = read_figure(page)
+    (route,) = [t for t in fig["data"] if t["name"] == f"route: {doc['scenario']}"]
+    with (path.parent / "track.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert len(route["x"]) == len(rows)
+    assert route["y"] == pytest.approx([float(r["lat"]) for r in rows], abs=1e-6)
+    assert route["x"] == pytest.approx([float(r["lon"]) for r in rows], abs=1e-6)
+    assert [c[0] for c in route["customdata"]] == [int(r["leg"]) for r in rows]
+    assert [c[3] for c in route["customdata"]] == [r["time"][11:19] for r in rows]  # UTC
+    (marks,) = [t for t in fig["data"] if t["name"] == "marks"]
+    for name, lon, lat in zip(marks["text"], marks["x"], marks["y"], strict=True):
+        assert (lat, lon) == pytest.approx((course.marks[name].lat, course.marks[name].lon),
+                                           abs=1e-6)
+    off = course.utc_offset_s
+    for leg in doc["legs"]:  # leg table: local start and arrival, the leg time
+        assert (f"<tr><td>{leg['index']}</td><td class=\"l\">{leg['from']} → {leg['to']}</td>"
+                f"<td class=\"l\">{leg['mode']}</td><td>{clock(iso(leg['start_time']), off)}"
+                f"</td><td>{clock(iso(leg['end_time']), off)}</td>"
+                f"<td>{format_duration(leg['time_s'])}</td>") in page
+
+
 def test_plan_hyeres_constant_writes_consistent_files(tmp_path):
     out = tmp_path / "plan"
     res = invoke("plan", str(COURSES / "hyeres-r1.yaml"), "--out", str(out))
@@ -78,6 +107,8 @@ def test_plan_hyeres_constant_writes_consistent_files(tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     # the terminal table: one row per leg and the total, which equals plan.json
     assert "total" in res.output and f"{doc['total_time_s']:.1f}" in res.output
+    check_report_html(out / "report.html", doc, load_course(COURSES / "hyeres-r1.yaml"))
+    assert f"wrote html: {out / 'report.html'}" in res.output
     assert "leg 5/5 4p -> finish" in res.output  # progress lines (stderr, mixed in here)
 
 
@@ -95,6 +126,7 @@ def test_plan_other_shipped_courses(tmp_path, course, scenario, n_legs):
     doc = check_plan_files(tmp_path, COURSES / course)
     assert len(doc["legs"]) == n_legs
     assert not (tmp_path / "route.png").exists()
+    assert not (tmp_path / "report.html").exists()  # --no-plots: no plot output at all
     assert "routing..." not in res.output
 
 
@@ -126,6 +158,15 @@ def test_compare_scenarios_table_files_and_per_scenario_plans(tmp_path):
     with (tmp_path / "comparison.csv").open() as f:
         assert len(list(csv.DictReader(f))) == 2 * 6 + 2  # legs x scenarios + totals
     assert (tmp_path / "comparison.png").read_bytes()[:4] == b"\x89PNG"
+    from sailroute.report.html import read_figure
+
+    fig = read_figure((tmp_path / "report.html").read_text(encoding="utf-8"))
+    routes = [t for t in fig["data"] if t.get("legendgroup", "").startswith("route")
+              and t["mode"] == "lines"]
+    assert [t["name"] for t in routes] == doc["scenarios"]
+    for t, name in zip(routes, doc["scenarios"], strict=True):
+        with (tmp_path / name / "track.csv").open() as f:
+            assert len(t["x"]) == sum(1 for _ in csv.DictReader(f))
 
 
 def test_compare_reference_errors_follow_the_stated_convention(tmp_path):

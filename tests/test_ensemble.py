@@ -89,6 +89,11 @@ def test_cli_plan_on_an_ensemble_writes_the_spread(tmp_path) -> None:
     assert doc["total_s"]["min"] == pytest.approx(min(totals))
     assert doc["total_s"]["median"] == pytest.approx(float(np.median(totals)))
     assert (tmp_path / "o" / "spread#3" / "plan.json").is_file()
+    from sailroute.report.html import read_figure
+
+    fig = read_figure((tmp_path / "o" / "report.html").read_text(encoding="utf-8"))
+    assert [t["name"] for t in fig["data"] if t.get("legendgroup", "").startswith("route")
+            and t["mode"] == "lines"] == doc["members"]
     cmp = CliRunner().invoke(app, ["compare-scenarios", str(course), "-q", "--no-plots",
                                    "--out", str(tmp_path / "c")])
     assert cmp.exit_code == 0, cmp.output

@@ -3,7 +3,8 @@
 ``make_plan`` assembles the routers' results into a :class:`Plan`;
 ``plan_table``/``write_plan_outputs`` render it; ``compare`` puts several
 scenarios side by side.  Charts (``sailroute.report.plots``) import matplotlib
-lazily.
+lazily; the interactive ``report.html`` (``sailroute.report.html``) reads plotly's
+JavaScript bundle only when a page is written.
 """
 
 from sailroute.report.files import write_comparison, write_plan_outputs

@@ -108,7 +108,7 @@ def _fmt(v: Any) -> Any:
 def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
                    ) -> dict[str, Path]:
     """Write ``analysis.json``, ``analysis.csv``, ``points.csv`` and (with ``plots``)
-    ``legs.png`` and ``loss.png`` into ``out_dir`` (created)."""
+    ``legs.png``, ``loss.png`` and ``report.html`` into ``out_dir`` (created)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files: dict[str, Path] = {}
@@ -149,6 +149,9 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
         files["legs_png"] = out / "legs.png"
         plot_loss(a).savefig(out / "loss.png", dpi=120)
         files["loss_png"] = out / "loss.png"
+        from sailroute.report.html import analysis_report, write_report
+
+        files["html"] = write_report(out / "report.html", analysis_report(a))
     return files
 
 

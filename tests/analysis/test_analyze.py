@@ -180,7 +180,7 @@ def test_shipped_example_runs_and_writes_every_file(tmp_path: Path) -> None:
                               [ROOT / "data" / "snipe-valencia-2025-06-21-ESP30782-P01.gpx"],
                               out_dir=out)
     assert set(res.files) == {"analysis_json", "analysis_csv", "points_csv", "legs_png",
-                              "loss_png"}
+                              "loss_png", "html"}
     doc = json.loads((out / "analysis.json").read_text())
     assert doc["schema_version"] == 1 and len(doc["legs"]) == 4
     ends = [leg["end_time"][11:19] for leg in doc["legs"]]
@@ -188,6 +188,17 @@ def test_shipped_example_runs_and_writes_every_file(tmp_path: Path) -> None:
     rows = (out / "points.csv").read_text().splitlines()
     assert rows[0].startswith("leg,time,x_m,y_m,lat,lon,sog_ms")
     assert len(rows) > 1400
+    # report.html: the sailed track point by point, the optimal legs in 4 pieces
+    from sailroute.report.html import read_figure
+
+    fig = read_figure((out / "report.html").read_text(encoding="utf-8"))
+    (sailed,) = [t for t in fig["data"] if t["name"].startswith("sailed: ")
+                 and t["mode"] == "lines"]
+    assert len(sailed["x"]) == len(rows) - 1
+    assert [c[3] for c in sailed["customdata"][:3]] == [r.split(",")[1][11:19]
+                                                        for r in rows[1:4]]
+    (optimal,) = [t for t in fig["data"] if t["name"].startswith("optimal")]
+    assert optimal["x"].count(None) == 3 and optimal["line"]["dash"] == "dash"
     leg1 = doc["legs"][0]
     split = leg1["loss_split_s"]
     assert split["manoeuvres"] + split["speed"] + split["route"] == \
