@@ -499,14 +499,16 @@ def run_analyze_command(
 ) -> AnalyzeResult:
     """Everything ``sailroute analyze`` does, minus printing.
 
-    Every track is read and analysed before anything is written, so a bad input
-    leaves no files.  One track: ``analysis.json``, ``analysis.csv``,
+    ``out_dir`` is checked first; every track is read and analysed before anything is
+    written, and the files are written as a set
+    (:func:`sailroute.outdir.write_output_set`), so a bad input or an interrupted run
+    leaves the folder as it was.  One track: ``analysis.json``, ``analysis.csv``,
     ``points.csv``, ``legs.png``, ``loss.png`` in ``out_dir`` (default
     ``out/<course>/analysis-<track stem>``).  Several: the same per boat in
     ``out_dir/<track stem>/`` plus ``fleet.csv`` and ``fleet.json`` (default
     ``out/<course>/analysis-fleet``).
     """
-    from sailroute.outdir import make_out_dir
+    from sailroute.outdir import check_out_dir, write_output_set
     from sailroute.plan import _loaded
     from sailroute.report.analysis import analysis_table, fleet_table, write_analysis, write_fleet
 
@@ -517,6 +519,10 @@ def run_analyze_command(
         raise InputError("--leg-times applies to one track; analyse the boats one by one")
     name = default_scenario(course) if scenario is None else scenario
     times = parse_leg_times(leg_times, course.n_legs)
+    stem = Path(course.source).stem if course.source else "course"
+    default = (Path("out") / stem / (f"analysis-{Path(tracks[0]).stem}" if len(tracks) == 1
+                                     else "analysis-fleet"))
+    out = check_out_dir(Path(out_dir) if out_dir is not None else default)
     read = [read_track(p, columns=columns, speed_unit=speed_unit, time_zone=time_zone,
                        name=s) for p, s in zip(tracks, _unique_stems(tracks), strict=True)]
     settings_for(course, router)
@@ -528,23 +534,22 @@ def run_analyze_command(
         analyses.append(analyze_track(course, tr, name, leg_times=times, router=router,
                                       detect_m=detect_m, built=(boat, winds[name]),
                                       progress=progress))
-    stem = Path(course.source).stem if course.source else "course"
-    files: dict[str, Path] = {}
     if len(analyses) == 1:
-        default = Path("out") / stem / f"analysis-{Path(tracks[0]).stem}"
-        out = make_out_dir(Path(out_dir) if out_dir is not None else default)
-        files.update(write_analysis(out, analyses[0], plots=plots))
+        files = write_output_set(out, lambda d: write_analysis(d, analyses[0], plots=plots))
         return AnalyzeResult(analysis_table(analyses[0]), files, tuple(analyses))
-    out = make_out_dir(Path(out_dir) if out_dir is not None
-                       else Path("out") / stem / "analysis-fleet")
     stems = _unique_stems(tracks)
-    for s, a in zip(stems, analyses, strict=True):
-        for kind, p in write_analysis(out / s, a, plots=plots).items():
-            files[f"{s}/{kind}"] = p
     rows = fleet_ranking(analyses)
-    files.update(write_fleet(out, analyses, rows))
+
+    def write(d: Path) -> dict[str, Path]:
+        files: dict[str, Path] = {}
+        for s, a in zip(stems, analyses, strict=True):
+            for kind, p in write_analysis(d / s, a, plots=plots).items():
+                files[f"{s}/{kind}"] = p
+        files.update(write_fleet(d, analyses, rows))
+        return files
+
     report = "\n\n".join([*(analysis_table(a) for a in analyses), fleet_table(rows)])
-    return AnalyzeResult(report, files, tuple(analyses))
+    return AnalyzeResult(report, write_output_set(out, write), tuple(analyses))
 
 
 def _unique_stems(paths: Sequence[str | Path]) -> list[str]:

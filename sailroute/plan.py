@@ -23,6 +23,7 @@ from sailroute.course.geometry import course_bbox, leg_endpoints, race_time_wind
 from sailroute.course.load import build_current, build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError, format_problems
+from sailroute.outdir import check_out_dir, write_output_set
 from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
@@ -395,9 +396,11 @@ def run_plan_command(
 
     Writes ``plan.json``, ``track.csv``, ``route.gpx``, ``route.png`` and ``report.html``
     (the last two unless ``plots`` is False) into ``out_dir`` (default
-    ``out/<course>/<scenario>``).  For an ensemble scenario it routes every member and
-    writes ``ensemble.json`` and ``ensemble.csv`` (the spread of leg times, the side of the
-    course), ``report.html`` with every member's route (unless ``plots`` is False) plus each
+    ``out/<course>/<scenario>``; checked before routing, written as a set:
+    :func:`sailroute.outdir.write_output_set`).  For an ensemble scenario it routes every
+    member and writes ``ensemble.json`` and ``ensemble.csv`` (the spread of leg times, the
+    side of the course), ``report.html`` with every member's route (unless ``plots`` is
+    False) plus each
     member's plan files in ``out_dir/<member>/``.
     """
     from sailroute.report.files import write_plan_outputs
@@ -405,16 +408,21 @@ def run_plan_command(
 
     course = _loaded(course)
     name = default_scenario(course) if scenario is None else scenario
+    out = check_out_dir(Path(out_dir) if out_dir is not None else default_out_dir(course, name))
     if name in course.ensembles:
-        return _run_ensemble(course, name, router=router, out_dir=out_dir, backend=backend,
+        return _run_ensemble(course, name, router=router, out_dir=out, backend=backend,
                              progress=progress, plots=plots)
     run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
-    out = Path(out_dir) if out_dir is not None else default_out_dir(course, run.plan.scenario)
-    files = dict(write_plan_outputs(out, run.plan, wind=run.wind, plot=plots))
-    if plots:
-        from sailroute.report.html import plan_report, write_report
 
-        files["html"] = write_report(out / "report.html", plan_report(run.plan, run.wind))
+    def write(d: Path) -> dict[str, Path]:
+        files = dict(write_plan_outputs(d, run.plan, wind=run.wind, plot=plots))
+        if plots:
+            from sailroute.report.html import plan_report, write_report
+
+            files["html"] = write_report(d / "report.html", plan_report(run.plan, run.wind))
+        return files
+
+    files = write_output_set(out, write)
     return CommandResult(plan_table(run.plan), files, (run.plan,))
 
 
@@ -430,15 +438,20 @@ def _run_ensemble(
                                            progress=progress)
     summary = summarize_ensemble(name, plans)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, name)
-    files: dict[str, Path] = dict(write_ensemble(out, summary))
-    if plots:
-        from sailroute.report.html import comparison_report, write_report
 
-        files["html"] = write_report(out / "report.html", comparison_report(cmp, plans, winds))
-    for p in plans:
-        for kind, path in write_plan_outputs(out / p.scenario, p, plot=False).items():
-            files[f"{p.scenario}/{kind}"] = path
-    return CommandResult(ensemble_table(summary), files, tuple(plans))
+    def write(d: Path) -> dict[str, Path]:
+        files: dict[str, Path] = dict(write_ensemble(d, summary))
+        if plots:
+            from sailroute.report.html import comparison_report, write_report
+
+            files["html"] = write_report(d / "report.html",
+                                         comparison_report(cmp, plans, winds))
+        for p in plans:
+            for kind, path in write_plan_outputs(d / p.scenario, p, plot=False).items():
+                files[f"{p.scenario}/{kind}"] = path
+        return files
+
+    return CommandResult(ensemble_table(summary), write_output_set(out, write), tuple(plans))
 
 
 def run_compare_command(
@@ -466,27 +479,33 @@ def run_compare_command(
     from sailroute.report.tables import comparison_table
 
     course = _loaded(course)
+    out = check_out_dir(Path(out_dir) if out_dir is not None
+                        else default_out_dir(course, "comparison"))
     cmp, plans, winds = _compare_scenarios(course, scenarios, router=router, backend=backend,
                                            progress=progress, scheduler=scheduler)
-    out = Path(out_dir) if out_dir is not None else default_out_dir(course, "comparison")
-    js, cs = write_comparison(out, cmp)
-    files: dict[str, Path] = {"comparison_json": js, "comparison_csv": cs}
-    if plots:
-        from sailroute.report.html import comparison_report, write_report
-        from sailroute.report.plots import plot_comparison
-
-        plot_comparison(cmp, plans).savefig(out / "comparison.png", dpi=150)
-        files["comparison_png"] = out / "comparison.png"
-        files["html"] = write_report(out / "report.html", comparison_report(cmp, plans, winds))
-    for p in plans:
-        for kind, path in write_plan_outputs(out / p.scenario, p, plot=False).items():
-            files[f"{p.scenario}/{kind}"] = path
     report = [comparison_table(cmp)]
     by_name = {p.scenario: p for p in plans}
-    for ens, members in course.ensembles.items():
-        if all(m in by_name for m in members):
-            summary = summarize_ensemble(ens, [by_name[m] for m in members])
-            for kind, path in write_ensemble(out / ens, summary).items():
-                files[f"{ens}/{kind}"] = path
-            report.append(ensemble_table(summary))
-    return CommandResult("\n\n".join(report), files, tuple(plans))
+    summaries = [summarize_ensemble(ens, [by_name[m] for m in members])
+                 for ens, members in course.ensembles.items()
+                 if all(m in by_name for m in members)]
+    report += [ensemble_table(summary) for summary in summaries]
+
+    def write(d: Path) -> dict[str, Path]:
+        js, cs = write_comparison(d, cmp)
+        files: dict[str, Path] = {"comparison_json": js, "comparison_csv": cs}
+        if plots:
+            from sailroute.report.html import comparison_report, write_report
+            from sailroute.report.plots import plot_comparison
+
+            plot_comparison(cmp, plans).savefig(d / "comparison.png", dpi=150)
+            files["comparison_png"] = d / "comparison.png"
+            files["html"] = write_report(d / "report.html", comparison_report(cmp, plans, winds))
+        for p in plans:
+            for kind, path in write_plan_outputs(d / p.scenario, p, plot=False).items():
+                files[f"{p.scenario}/{kind}"] = path
+        for summary in summaries:
+            for kind, path in write_ensemble(d / summary.name, summary).items():
+                files[f"{summary.name}/{kind}"] = path
+        return files
+
+    return CommandResult("\n\n".join(report), write_output_set(out, write), tuple(plans))

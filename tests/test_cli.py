@@ -186,7 +186,8 @@ def test_compare_reference_errors_follow_the_stated_convention(tmp_path):
     (["plan", str(COURSES / "windward-leeward-template.yaml"), "-s", "steady"],
      "did you mean 'steady-12kn'? scenarios are: steady-12kn, veered-10deg"),
     (["plan", str(COURSES / "windward-leeward-template.yaml"), "-r", "fast"],
-     "unknown router 'fast'; expected one of 'isochrone', 'griddp', 'spline'"),
+     "Invalid value for '--router' / '-r': 'fast' is not one of 'isochrone', 'griddp', "
+     "'spline'"),
     (["compare-scenarios", str(COURSES / "windward-leeward-template.yaml"), "-s", "calm"],
      "no scenario 'calm'"),
     (["plan", str(ROOT / "tests" / "data" / "course" / "many-problems.yaml")],

@@ -27,7 +27,7 @@ from sailroute.boat.io import write_pol, write_polar_csv, write_polar_json
 from sailroute.boat.polar import Polar
 from sailroute.boat.vpp_outputs import UNITS, _slug, draw_polar, parse_speed_list, polar_report
 from sailroute.errors import InputError
-from sailroute.outdir import make_out_dir
+from sailroute.outdir import check_out_dir, write_output_set
 from sailroute.track.model import Track
 from sailroute.units import speed_factor, wind_speed_direction, wrap180
 
@@ -487,7 +487,8 @@ def run_fit_command(
     twa_step_deg : float
         TWA node spacing [°] (0 to 180).
     out_dir : path
-        Output folder (checked before the work).
+        Output folder (checked before the work; written as a set, see
+        :mod:`sailroute.outdir`).
     unit : {"kn", "m/s"}
         Unit of the printed table and the written files.
     reference : path, optional
@@ -508,7 +509,7 @@ def run_fit_command(
     if scenario is not None and course is None:
         raise InputError("--scenario needs --course: the scenario's wind comes from a course "
                          "file")
-    d = make_out_dir(out_dir)
+    check_out_dir(out_dir)
     ref = None
     if reference is not None:
         ref = read_polar(reference, speed_unit=reference_unit, wind_unit=reference_unit)
@@ -526,5 +527,6 @@ def run_fit_command(
                     min_count=min_count, filters=filters, name=stem)
     errors = compare_polars(fit, ref) if ref is not None else None
     report = fit_report(fit, samples, unit, errors, ref.name if ref is not None else "")
-    files = write_fit_outputs(fit, samples, d, stem, unit, ref, errors)
+    files = write_output_set(
+        out_dir, lambda d: write_fit_outputs(fit, samples, d, stem, unit, ref, errors))
     return FitRun(fit=fit, samples=samples, report=report, files=files, errors=errors)

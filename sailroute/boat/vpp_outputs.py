@@ -26,7 +26,7 @@ from sailroute.boat.laser import (
 )
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
-from sailroute.outdir import make_out_dir
+from sailroute.outdir import check_out_dir, make_out_dir, write_output_set
 from sailroute.units import speed_factor
 
 DEFAULT_TWS: Final = {
@@ -230,7 +230,7 @@ def run_vpp_command(
     twa_step_deg : float
         TWA row spacing [°].
     out_dir : path
-        Output folder (created).
+        Output folder (checked first; written as a set, see :mod:`sailroute.outdir`).
     unit : {"kn", "m/s"}
         Unit of the printed table and the written files.
     kinetics : {"steady", "race"}
@@ -241,6 +241,7 @@ def run_vpp_command(
         raise InputError(f"--unit: expected one of 'kn', 'm/s'; got {unit!r}")
     if kinetics not in ("steady", "race"):
         raise InputError(f"--kinetics: expected one of 'steady', 'race'; got {kinetics!r}")
+    check_out_dir(out_dir)
     if boat_file is None:
         params, stem = ILCA7, "ilca7"
     else:
@@ -256,7 +257,7 @@ def run_vpp_command(
               else tuple(v * speed_factor(unit) for v in DEFAULT_TWS[unit]))
     kin = kinetics_from_spec(kinetics)[0]
     polar = vpp_polar(params, tws_ms, twa_grid(twa_step_deg), kinetics=kin)
-    files = write_outputs(polar, params, out_dir, stem, unit, kin)
+    files = write_output_set(out_dir, lambda d: write_outputs(polar, params, d, stem, unit, kin))
     return VppRun(params=params, polar=polar, report=polar_report(polar, unit), files=files)
 
 

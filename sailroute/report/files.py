@@ -6,6 +6,9 @@
   start/end points (``rte``) and the timed track (``trk``, one segment per leg);
 * ``comparison.json`` / ``comparison.csv``: legs × scenarios with errors.
 
+:func:`file_label` names a written file for the "wrote ..." lines of the CLI.  The
+commands write their files as a set through :func:`sailroute.outdir.write_output_set`.
+
 Schemas, with units, are documented in ``docs/output-format.md``; bump
 :data:`SCHEMA_VERSION` on any incompatible change.  Times are ISO 8601 UTC with a
 ``Z`` suffix; positions are local ``x, y`` [m] and WGS-84 ``lat, lon`` [°].
@@ -325,6 +328,66 @@ def write_comparison(out_dir: str | Path, cmp: Comparison) -> tuple[Path, Path]:
                 row += [f"{cmp.references[r].sum():.3f}", f"{cmp.total_percent(r)[i]:.3f}"]
             w.writerow(row)
     return jp, cp
+
+
+FILE_LABELS: dict[str, str] = {
+    "plan": "plan (JSON)",
+    "track": "track (CSV)",
+    "gpx": "route (GPX)",
+    "png": "route map (PNG)",
+    "comparison_json": "comparison (JSON)",
+    "comparison_csv": "comparison (CSV)",
+    "comparison_png": "comparison chart (PNG)",
+    "ensemble_json": "ensemble spread (JSON)",
+    "ensemble_csv": "ensemble spread (CSV)",
+    "analysis_json": "analysis (JSON)",
+    "analysis_csv": "analysis per leg (CSV)",
+    "points_csv": "analysis per track point (CSV)",
+    "legs_png": "leg maps (PNG)",
+    "loss_png": "time lost chart (PNG)",
+    "fleet_json": "fleet ranking (JSON)",
+    "fleet_csv": "fleet ranking (CSV)",
+}
+"""Human names of the output kinds (the keys of the commands' ``files`` mappings)."""
+
+POLAR_FILE_LABELS: dict[str, str] = {
+    "pol": "polar (.pol table)", "csv": "polar (CSV)", "json": "polar (JSON)",
+    "png": "polar plot (PNG)",
+}
+"""Names of the files of ``sailroute vpp`` and ``sailroute polar fit``."""
+
+_STEM_LABELS = {
+    "summary": "summary", "policy_map": "policy map", "spaghetti": "simulated tracks",
+    "leg_times": "leg-time distributions", "deadline_policy": "deadline policy map",
+    "deadline_tracks": "deadline tracks",
+}
+
+
+def file_label(kind: str | None, path: str | Path,
+               labels: Mapping[str, str] = FILE_LABELS) -> str:
+    """A human name for an output file, e.g. ``"plan (JSON)"`` or ``"wrf10: track (CSV)"``.
+
+    Parameters
+    ----------
+    kind : str or None
+        Key in a command's ``files`` mapping (``plan``, ``wrf10/track``, ...); None
+        names the file by its stem (``policy_map.png`` -> ``"policy map (PNG)"``).
+    path : str or Path
+        The file.
+    labels : mapping of str to str
+        Kind -> name (default :data:`FILE_LABELS`; :data:`POLAR_FILE_LABELS` for the
+        polar commands).
+    """
+    p = Path(path)
+    prefix = ""
+    if kind is not None and "/" in kind:
+        prefix, kind = kind.rsplit("/", 1)
+        prefix += ": "
+    if kind in labels:
+        return prefix + labels[kind]
+    stem = p.stem
+    name = _STEM_LABELS.get(stem, stem.replace("_", " "))
+    return f"{prefix}{name} ({p.suffix.lstrip('.').upper() or 'file'})"
 
 
 def write_plan_outputs(

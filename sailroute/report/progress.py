@@ -1,16 +1,20 @@
-"""A tiny progress reporter for the CLI (stderr, plain text, no dependency).
+"""Progress reporters for the CLI (stderr).
 
-The library never prints; the CLI creates a :class:`Progress` and passes it (or
-its :meth:`Progress.update` method) to the routing loop.  On a terminal, updates
-overwrite one line with ``\\r``; otherwise (pipes, CI logs) only the start and end
-of each leg are written, one line each.
+The library never prints; the CLI creates one with :func:`make_progress` and passes
+it (or its :meth:`Progress.update` method) to the routing loop.  On a terminal it is
+a :class:`RichProgress`: a rich progress bar for the leg being routed, and one line
+per finished leg above it.  Otherwise (pipes, CI logs, tests) it is a plain
+:class:`Progress`: only the start and end of each leg, one line each.  Both print
+the same lines for finished legs, notes and warnings, and are context managers
+(leaving the block removes the bar and restores the cursor).
 """
 
 from __future__ import annotations
 
 import sys
 import time
-from typing import TextIO
+from types import TracebackType
+from typing import Any, TextIO
 
 
 class Progress:
@@ -51,6 +55,16 @@ class Progress:
         self._t_last = -1e9
         self._width = 0
         self.prefix = ""
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
+                 tb: TracebackType | None) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """End the display (nothing to do for plain text)."""
 
     def set_prefix(self, text: str) -> None:
         """Put ``text`` (e.g. ``"wrf10: "``) before every line, for multi-scenario runs."""
@@ -129,3 +143,108 @@ class Progress:
             f"(computed in {wall:.1f} s)",
             end="\n",
         )
+
+
+class RichProgress(Progress):
+    """Progress on a terminal: a rich bar for the current leg (fraction, note, elapsed
+    time) and the plain :class:`Progress` lines for finished legs, notes and warnings.
+
+    Parameters
+    ----------
+    n_legs : int
+        Number of legs.
+    stream : text stream, optional
+        Where to draw (default ``sys.stderr``).
+    enabled : bool
+        False: no bar and no lines, warnings only (``--quiet``).
+    min_interval_s : float
+        Minimum wall time between two redraws [s].
+    force_terminal : bool, optional
+        Draw as on a terminal even if ``stream`` is not one (tests).
+    """
+
+    def __init__(
+        self,
+        n_legs: int,
+        stream: TextIO | None = None,
+        *,
+        enabled: bool = True,
+        min_interval_s: float = 0.1,
+        force_terminal: bool | None = None,
+    ) -> None:
+        super().__init__(n_legs, stream, enabled=enabled, min_interval_s=min_interval_s,
+                         live=True)
+        from rich.console import Console
+        from rich.progress import BarColumn, TaskProgressColumn, TextColumn, TimeElapsedColumn
+        from rich.progress import Progress as Bar
+
+        self.console = Console(file=self.stream, force_terminal=force_terminal,
+                               highlight=False)
+        self._bar = Bar(TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(),
+                        TimeElapsedColumn(), TextColumn("{task.fields[note]}"),
+                        console=self.console, transient=True, auto_refresh=False)
+        self._task: Any = None
+        self._running = False
+
+    def _write(self, text: str, *, end: str) -> None:
+        style = "yellow" if text.startswith("warning: ") else None
+        self.console.print(self.prefix + text, end=end, style=style, markup=False,
+                           highlight=False, soft_wrap=True)
+
+    def start_leg(self, index: int, label: str) -> None:
+        """Start the bar of leg ``index`` (0-based)."""
+        if not self.enabled:
+            return
+        self._leg, self._label = index, label
+        self._t_leg = time.perf_counter()
+        self._t_last = -1e9
+        desc = f"{self.prefix}leg {index + 1}/{self.n_legs} {label}"
+        if self._task is None:
+            self._task = self._bar.add_task(desc, total=1.0, note="")
+        else:
+            self._bar.reset(self._task, total=1.0, description=desc, note="")
+        if not self._running:
+            self._bar.start()
+            self._running = True
+        self._bar.refresh()
+
+    def update(self, fraction: float | None = None, note: str = "") -> None:
+        """Move the bar to ``fraction`` in [0, 1] (None: keep) and show ``note``."""
+        if not self.enabled or self._task is None:
+            return
+        now = time.perf_counter()
+        if now - self._t_last < self.min_interval_s:
+            return
+        self._t_last = now
+        kw: dict[str, Any] = {"note": note}
+        if fraction is not None:
+            kw["completed"] = min(max(float(fraction), 0.0), 1.0)
+        self._bar.update(self._task, **kw)
+        self._bar.refresh()
+
+    __call__ = update
+
+    def end_leg(self, leg_time_s: float, summary: str = "") -> None:
+        """Print the finished leg's line above the bar."""
+        if not self.enabled:
+            return
+        if self._task is not None:
+            self._bar.update(self._task, completed=1.0, note="")
+        super().end_leg(leg_time_s, summary)
+
+    def close(self) -> None:
+        """Remove the bar and show the cursor again."""
+        if self._running:
+            self._bar.stop()
+            self._running = False
+
+
+def make_progress(n_legs: int, *, enabled: bool = True, stream: TextIO | None = None
+                  ) -> Progress:
+    """A :class:`RichProgress` if ``stream`` (default stderr) is a terminal, else a
+    plain :class:`Progress`; ``enabled=False`` (``--quiet``) prints warnings only."""
+    s = stream if stream is not None else sys.stderr
+    isatty = getattr(s, "isatty", None)
+    if enabled and isatty is not None and isatty():
+        return RichProgress(n_legs, s, enabled=enabled)
+    return Progress(n_legs, s, enabled=enabled)

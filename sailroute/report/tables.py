@@ -1,12 +1,18 @@
-"""Plain-text tables for the terminal: pure functions that return strings (no printing).
+"""Tables for the terminal: pure functions that return strings (no printing).
 
 Percent errors are ``(model − reference) / reference`` (positive: model slower).
+The tables are plain text, or, inside ``with rich_tables(console):`` (the CLI when
+stdout is a terminal), drawn by rich for that console (a string with its styles).
 """
 
 from __future__ import annotations
 
+import io
 import math
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Any
 
 from sailroute.report.plan import Comparison, Plan, PlannedLeg, percent_error
 from sailroute.timeutil import iso
@@ -25,6 +31,44 @@ def format_duration(seconds: float) -> str:
     if h:
         return f"{sign}{h}:{m:02d}:{sec:04.1f}"
     return f"{sign}{m}:{sec:04.1f}"
+
+
+_RICH_CONSOLE: ContextVar[Any] = ContextVar("sailroute_rich_tables", default=None)
+
+
+@contextmanager
+def rich_tables(console: Any) -> Iterator[None]:
+    """Within the block, :func:`render_table` draws with rich for ``console`` (a
+    ``rich.console.Console``; None: plain text)."""
+    token = _RICH_CONSOLE.set(console)
+    try:
+        yield
+    finally:
+        _RICH_CONSOLE.reset(token)
+
+
+def _rich_table(console: Any, headers: Sequence[str], rows: Sequence[Sequence[str]],
+                align: str, footer: Sequence[Sequence[str]]) -> str:
+    from rich.box import Box
+    from rich.console import Console
+    from rich.table import Table
+
+    rules = Box("    \n    \n ── \n    \n ── \n ── \n    \n    \n")  # under head, above total
+    t = Table(box=rules, show_edge=False, header_style="bold", pad_edge=False,
+              padding=(0, 1, 0, 0))
+    for h, a in zip(headers, align, strict=True):
+        t.add_column(h, justify="left" if a == "l" else "right")
+    for r in rows:
+        t.add_row(*r)
+    if footer:
+        t.add_section()
+        for r in footer:
+            t.add_row(*r, style="bold")
+    # drawn at its natural width, never squeezed to the terminal's: numbers stay whole
+    wide = Console(file=io.StringIO(), width=100_000, color_system=console.color_system,
+                   force_terminal=console.is_terminal, no_color=console.no_color)
+    wide.print(t)
+    return "\n".join(line.rstrip() for line in wide.file.getvalue().rstrip("\n").split("\n"))
 
 
 def render_table(
@@ -52,6 +96,9 @@ def render_table(
     """
     ncol = len(headers)
     align = align or "l" + "r" * (ncol - 1)
+    console = _RICH_CONSOLE.get()
+    if console is not None:
+        return _rich_table(console, headers, rows, align, footer)
     allrows = [list(headers), *[list(r) for r in rows], *[list(r) for r in footer]]
     widths = [max(len(r[i]) for r in allrows) for i in range(ncol)]
 

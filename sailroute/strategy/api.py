@@ -18,7 +18,7 @@ import numpy as np
 
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
-from sailroute.outdir import make_out_dir
+from sailroute.outdir import check_out_dir, make_out_dir, write_output_set
 from sailroute.parallel import TaskRunner, check_scheduler, open_runner
 from sailroute.strategy.deadline import (
     DeadlineGrid,
@@ -502,7 +502,7 @@ def run_strategy_command(
     objective : str
         ``expected`` or ``deadline=SECONDS[,SECONDS]``.
     out_dir : str or Path
-        Output folder.
+        Output folder (checked first; written as a set, see :mod:`sailroute.outdir`).
     plots : bool
         Write the PNG figures.
     progress : callable, optional
@@ -529,6 +529,7 @@ def run_strategy_command(
     from sailroute.strategy.fit import fit_station_file
 
     deadlines = parse_objective(objective)
+    check_out_dir(out_dir)
     scheduler = check_scheduler(scheduler)
     kind = parse_shift(shift)
     tack = {"starboard": 1, "port": -1}.get(str(start_tack).strip().lower())
@@ -563,7 +564,7 @@ def run_strategy_command(
     result = run_strategy(
         polar, model, st, progress=progress, fit=fit, scheduler=scheduler, n_workers=n_workers
     )
-    files = write_outputs(result, out_dir, plots=plots)
+    files = write_output_set(out_dir, lambda d: write_outputs(result, d, plots=plots))
     return CommandResult(format_report(result), files, result)
 
 
@@ -624,6 +625,20 @@ def fit_summary(ou: Any, dd: Any, source: str) -> dict[str, Any]:
     return {"source": source, "ou": ou.describe(), "drift_diffusion": dd.describe()}
 
 
+def shift_model_text(model: ShiftModel) -> str:
+    """The shift model in words with sensible precision (degrees and minutes), e.g.
+    ``"oscillating (OU): sd 10.0°, time scale 10.0 min"``."""
+    d = model.describe()
+    if d["kind"] == "ou":
+        tl = float(d["timescale_s"])
+        text = (f"oscillating (OU): sd {float(d['sigma_deg']):.1f}°, time scale "
+                + ("infinite (frozen wind)" if math.isinf(tl) else f"{tl / 60:.1f} min"))
+        mean = float(d["mean_deg"])
+        return text + (f", mean {mean:+.1f}°" if mean else "")
+    return (f"persistent (drift-diffusion): drift {60 * float(d['drift_deg_per_s']):+.2f}°/min, "
+            f"diffusion {math.sqrt(60) * float(d['sigma_deg_per_sqrt_s']):.2f}°/√min")
+
+
 def format_report(result: StrategyResult) -> str:
     """Short human-readable summary of a study."""
     s = result.summary
@@ -633,7 +648,7 @@ def format_report(result: StrategyResult) -> str:
     lines = [
         f"boat {b['polar']} at {b['tws_kn']:.1f} kn: upwind VMG {b['vmg_upwind_ms']:.3f} m/s "
         f"at TWA {b['vmg_twa_deg']:.1f}°",
-        f"shift model: {result.model.describe()}",
+        f"shift model: {shift_model_text(result.model)}",
     ]
     if s.get("fit") and result.model.kind == "ou":
         ou = s["fit"]["ou"]

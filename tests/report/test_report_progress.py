@@ -46,3 +46,51 @@ def test_throttled_and_disabled():
     d.update(0.5)
     d.end_leg(1.0)
     assert q.getvalue() == ""
+
+
+class _Tty(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_rich_bar_on_a_terminal_plain_lines_elsewhere():
+    from sailroute.report.progress import RichProgress, make_progress
+
+    assert type(make_progress(2, stream=io.StringIO())) is Progress
+    assert type(make_progress(2, stream=_Tty(), enabled=False)) is Progress  # -q: no bar
+    s = _Tty()
+    p = make_progress(2, stream=s)
+    assert isinstance(p, RichProgress)
+    p.min_interval_s = 0.0
+    with p:
+        p.start_leg(0, "start -> 1")
+        p.update(0.5, "front 120 points")
+        p.warn("wind above the polar")
+        p.end_leg(984.04, "1 tack")
+    out = s.getvalue()
+    assert 0 <= out.index("\x1b[?25l") < out.rindex("\x1b[?25h")  # cursor hidden, then back
+    assert " 50%" in out and "front 120 points" in out and "━" in out  # the bar
+    # the finished leg and the warning are ordinary lines, as in the plain display
+    assert "leg 1/2 start -> 1: 984.0 s, 1 tack (computed in " in out
+    assert "warning: wind above the polar" in out
+
+
+def test_rich_tables_keep_every_cell_whole_on_a_narrow_terminal():
+    import re
+
+    from rich.console import Console
+
+    from sailroute.report.tables import render_table, rich_tables
+
+    headers, rows = ["leg", "from -> to", "time"], [["1", "start -> windward", "15:46.2"]]
+    footer = [["", "total", "49:42.7"]]
+    plain = render_table(headers, rows, footer=footer)
+    assert plain.splitlines()[2] == "1    start -> windward  15:46.2"
+    with rich_tables(Console(file=io.StringIO(), force_terminal=True, width=20)):
+        drawn = render_table(headers, rows, footer=footer)
+    text = re.sub(r"\x1b\[[0-9;]*m", "", drawn)
+    assert "\x1b[1m" in drawn  # styled (bold header and total)
+    # a 20-column terminal: still one line per row, nothing cut ("…") or wrapped
+    assert text.splitlines()[2] == "1    start -> windward  15:46.2"
+    assert "…" not in text and text.splitlines()[4].split() == ["total", "49:42.7"]
+    assert render_table(headers, rows, footer=footer) == plain  # plain again outside
