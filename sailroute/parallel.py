@@ -27,8 +27,11 @@ and ``shared``.  ``shared`` arguments are sent to every worker once
 
 from __future__ import annotations
 
+import logging
 import os
 import re
+import signal
+import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -173,20 +176,52 @@ def open_runner(
         )
     distributed = _import_distributed(name)
     if name == PROCESSES:
-        with distributed.LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address=":0",
-        ) as cluster, distributed.Client(cluster) as client:
-            yield TaskRunner(client, f"{PROCESSES} ({n} workers on 127.0.0.1)")
+        import dask
+
+        # the workers inherit the ignored SIGINT (Ctrl-C is the parent's to handle) and
+        # this logging config (a cancelled run must not print each cancelled task)
+        with _sigint_ignored(), dask.config.set(
+            {"logging": {"distributed.worker": "error", "distributed.nanny": "error"}}
+        ):
+            cluster = distributed.LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=":0",
+            )
+        try:
+            with cluster, distributed.Client(cluster) as client:
+                yield TaskRunner(client, f"{PROCESSES} ({n} workers on 127.0.0.1)")
+        except KeyboardInterrupt:
+            # the cluster is torn down mid-task: Dask logs every cancelled future
+            for name_ in ("distributed", "asyncio"):
+                logging.getLogger(name_).setLevel(logging.CRITICAL)
+            raise
         return
     client = _connect(distributed, name, timeout_s)
     try:
         yield TaskRunner(client, name)
     finally:
         client.close()
+
+
+@contextmanager
+def _sigint_ignored() -> Iterator[None]:
+    """Ignore SIGINT in this process for the block (main thread only; else a no-op).
+
+    Processes started inside the block inherit the ignored SIGINT, and Python keeps it
+    ignored at start-up, so a Ctrl-C at the terminal (sent to the whole process group)
+    reaches only the parent, which stops the run and the cluster as the serial run stops.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)
 
 
 def _connect(distributed: Any, address: str, timeout_s: float) -> Any:

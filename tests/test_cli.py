@@ -108,7 +108,7 @@ def test_plan_hyeres_constant_writes_consistent_files(tmp_path):
     # the terminal table: one row per leg and the total, which equals plan.json
     assert "total" in res.output and f"{doc['total_time_s']:.1f}" in res.output
     check_report_html(out / "report.html", doc, load_course(COURSES / "hyeres-r1.yaml"))
-    assert f"wrote html: {out / 'report.html'}" in res.output
+    assert f"wrote interactive report (HTML): {out / 'report.html'}" in res.output
     assert "leg 5/5 4p -> finish" in res.output  # progress lines (stderr, mixed in here)
 
 

@@ -116,6 +116,27 @@ def test_processes_scheduler_equals_serial() -> None:
     assert got == SQUARES
 
 
+def _sigint_handler(_item: int) -> str:
+    import signal
+
+    return repr(signal.getsignal(signal.SIGINT))
+
+
+def test_ctrl_c_reaches_only_the_parent_of_a_local_cluster() -> None:
+    # A terminal's Ctrl-C goes to the whole process group: the local workers must ignore
+    # it (they printed five Dask tracebacks), the parent keeps its own handler and stops
+    # the run as the serial run does
+    import signal
+
+    pytest.importorskip("distributed")
+    before = signal.getsignal(signal.SIGINT)
+    with open_runner("processes", n_workers=1) as runner:
+        assert signal.getsignal(signal.SIGINT) is before
+        got = runner.map(_sigint_handler, [0])
+    assert got == [repr(signal.SIG_IGN)]
+    assert signal.getsignal(signal.SIGINT) is before
+
+
 def test_explicit_address_equals_serial_and_runner_is_reusable(cluster) -> None:
     assert map_tasks(pow, ITEMS, shared=(3,), scheduler=cluster.scheduler_address) == [
         v**3 for v in ITEMS

@@ -347,6 +347,7 @@ FILE_LABELS: dict[str, str] = {
     "loss_png": "time lost chart (PNG)",
     "fleet_json": "fleet ranking (JSON)",
     "fleet_csv": "fleet ranking (CSV)",
+    "html": "interactive report (HTML)",
 }
 """Human names of the output kinds (the keys of the commands' ``files`` mappings)."""
 
