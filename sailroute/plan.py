@@ -25,6 +25,7 @@ from sailroute.course.model import Course
 from sailroute.errors import InputError, format_problems
 from sailroute.outdir import check_out_dir, write_output_set
 from sailroute.parallel import SERIAL, check_scheduler, map_tasks
+from sailroute.report import png_worker
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
@@ -412,17 +413,19 @@ def run_plan_command(
     if name in course.ensembles:
         return _run_ensemble(course, name, router=router, out_dir=out, backend=backend,
                              progress=progress, plots=plots)
-    run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
+    with png_worker.start(plots) as png:  # loads matplotlib on another core meanwhile
+        run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
 
-    def write(d: Path) -> dict[str, Path]:
-        files = dict(write_plan_outputs(d, run.plan, wind=run.wind, plot=plots))
-        if plots:
-            from sailroute.report.html import plan_report, write_report
+        def write(d: Path) -> dict[str, Path]:
+            files = dict(write_plan_outputs(d, run.plan, wind=run.wind, plot=False))
+            if plots:
+                from sailroute.report.html import plan_report, write_report
 
-            files["html"] = write_report(d / "report.html", plan_report(run.plan, run.wind))
-        return files
+                files["png"] = png.draw(run.plan, run.wind, d / "route.png", png_worker.DPI)
+                files["html"] = write_report(d / "report.html", plan_report(run.plan, run.wind))
+            return files
 
-    files = write_output_set(out, write)
+        files = write_output_set(out, write)
     return CommandResult(plan_table(run.plan), files, (run.plan,))
 
 
