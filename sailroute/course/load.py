@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from sailroute.course.model import Course, Gate, LegSpec, Line, Mark, ScenarioSpec
+from sailroute.course.model import Course, Gate, LegKind, LegSpec, Line, Mark, ScenarioSpec
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError, format_problems
 from sailroute.geo import LocalFrame, wrap_lon
@@ -285,7 +285,7 @@ def _latlon(c: _Checker, d: Mapping[str, Any], path: str) -> tuple[float, float]
     lon = c.number(d, "lon", path, lo=-180.0, hi=360.0,
                    what="a longitude in [-180, 360] degrees")
     # 0..360 longitudes are accepted and wrapped to [-180, 180), as GPX and plan.json use
-    return None if lat is None or lon is None else (lat, wrap_lon(lon))
+    return None if lat is None or lon is None else (lat, float(wrap_lon(lon)))
 
 
 def _position(
@@ -366,9 +366,10 @@ def _pairs(
             c.p.add(path, f"expected a list of two mark names, e.g. [{what}_a, {what}_b]; "
                     f"got {_show(value)}")
             continue
-        ends = [c.name(v, _join(path, i), "a mark name") for i, v in enumerate(value)]
-        if None in ends:
+        e0, e1 = (c.name(v, _join(path, i), "a mark name") for i, v in enumerate(value))
+        if e0 is None or e1 is None:
             continue
+        ends = (e0, e1)
         ok = True
         for i, m in enumerate(ends):
             if m not in marks:
@@ -416,8 +417,8 @@ def _legs(
     if not raw:
         c.p.add("legs", "expected at least one leg; got an empty list")
         return out
-    features = {**{m: "mark" for m in marks}, **{g: "gate" for g in gates},
-                **{n: "line" for n in lines}}
+    features: dict[str, LegKind] = {**{m: "mark" for m in marks}, **{g: "gate" for g in gates},
+                                    **{n: "line" for n in lines}}
     centres = {**gates, **lines}
     prev: str | None = None
     for i, item in enumerate(raw):
@@ -477,7 +478,7 @@ def _legs(
                     c.p.add(path, f"the leg {frm!r} -> {to!r} is {d:.2f} m long; "
                             f"expected at least {MIN_SEPARATION_M:g} m")
         if to is not None and kind is not None and frm is not None:
-            out.append(LegSpec(i, frm, to, kind, rounding))  # type: ignore[arg-type]
+            out.append(LegSpec(i, frm, to, kind, rounding))
         prev = to
     return out
 

@@ -212,7 +212,8 @@ def make_grid(start: Start, target: Target, n_rows: int, zone_m: float) -> LegGr
     if start.b is None:
         first = Row("point", a=(float(start.a[0]), float(start.a[1])))
     else:
-        first = Row("line", a=tuple(map(float, start.a)), b=tuple(map(float, start.b)))
+        first = Row("line", a=(float(start.a[0]), float(start.a[1])),
+                    b=(float(start.b[0]), float(start.b[1])))
     seg_len = math.hypot(geom.b[0] - geom.a[0], geom.b[1] - geom.a[1])
     m = min(AIM_MARGIN_M, 0.5 * seg_len) / seg_len
     last = Row("line", a=geom.a, b=geom.b, lo=m, hi=1.0 - m)

@@ -42,6 +42,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -146,12 +147,12 @@ class DeadlineGrid:
     @property
     def r_m(self) -> NDArray[np.float64]:
         """Radial nodes [m]."""
-        return self.dr * np.arange(self.n_r + 1)
+        return self.dr * np.arange(self.n_r + 1, dtype=np.float64)
 
     @property
     def theta_rad(self) -> NDArray[np.float64]:
         """Angular nodes [rad]."""
-        return self.dtheta * np.arange(self.n_theta)
+        return self.dtheta * np.arange(self.n_theta, dtype=np.float64)
 
     @property
     def controls_rad(self) -> NDArray[np.float64]:
@@ -199,10 +200,10 @@ def brownian_equivalent(sigma_deg: float, timescale_s: float, horizon_s: float) 
     return math.sqrt(var / horizon_s)
 
 
-def _index_dtype(nnz: int) -> type:
+def _index_dtype(nnz: int) -> np.dtype[np.signedinteger[Any]]:
     """int32 indices (as the column indices) unless the matrix is too large: scipy would
     otherwise upcast and copy the column indices."""
-    return np.int32 if nnz < 2**31 - 1 else np.int64
+    return np.dtype(np.int32 if nnz < 2**31 - 1 else np.int64)
 
 
 def _stencil(frac: NDArray, cubic: bool) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
@@ -378,7 +379,7 @@ class DeadlinePolicy:
     @property
     def s_s(self) -> NDArray[np.float64]:
         """Budget of each slice [s]."""
-        return self.grid.ds_s * np.arange(self.grid.n_s + 1)
+        return self.grid.ds_s * np.arange(self.grid.n_s + 1, dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False)
