@@ -34,11 +34,6 @@ def _cupy_or_none() -> ModuleType | None:
     return cupy
 
 
-def gpu_available() -> bool:
-    """True if CuPy imports and sees at least one CUDA device."""
-    return _cupy_or_none() is not None
-
-
 def get_xp(name: str = "numpy") -> ModuleType:
     """Resolve a backend name to an array module.
 

@@ -257,14 +257,7 @@ class BoatModel:
         if self.dynamic is not None:
             return self.dynamic.best_vmg(True, 0.05)[0], self.dynamic.best_vmg(False, 0.05)[0]
         assert self.polar is not None
-        p = self.polar
-        if hasattr(p, "vmg_upwind"):
-            up = float(p.vmg_upwind(tws)[0])
-            down = float(p.vmg_downwind(tws)[0])
-        else:  # pragma: no cover - older Polar
-            up = float(p.best_vmg(tws, True)[0])
-            down = float(p.best_vmg(tws, False)[0])
-        return up, down
+        return float(self.polar.vmg_upwind(tws)[0]), float(self.polar.vmg_downwind(tws)[0])
 
 
 # --------------------------------------------------------------------------------------

@@ -132,11 +132,7 @@ _TABLE_CACHE: weakref.WeakKeyDictionary[Any, dict[int, PolarTables]] = (
 
 
 def _vmg_angles(polar: Polar, tws: NDArray, upwind: bool) -> tuple[NDArray, NDArray]:
-    fn = getattr(polar, "vmg_upwind" if upwind else "vmg_downwind", None)
-    if callable(fn):
-        a, v = fn(tws)
-    else:
-        a, v = polar.best_vmg(tws, upwind=upwind)
+    a, v = polar.vmg_upwind(tws) if upwind else polar.vmg_downwind(tws)
     return np.asarray(a, dtype=float), np.asarray(v, dtype=float)
 
 
