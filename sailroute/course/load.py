@@ -315,7 +315,11 @@ def _position(
 def _frame(
     c: _Checker, data: Mapping[str, Any], latlons: list[tuple[float, float]], needs: list[str]
 ) -> LocalFrame | None:
-    """The local frame: ``origin`` if given, else the mean of the lat/lon positions."""
+    """The local frame: ``origin`` if given, else the mean of the lat/lon positions.
+
+    Marks on both sides of the antimeridian (longitudes more than 180° apart) are
+    averaged across it (179.9995 and -179.9985 give 180.0005), not around the globe.
+    """
     if "origin" in data:
         if not c.mapping(data["origin"], "origin", "{lat, lon} of the local frame's origin"):
             return None
@@ -328,7 +332,10 @@ def _frame(
         return None
     if latlons:
         a = np.array(latlons)
-        return LocalFrame(float(a[:, 0].mean()), float(a[:, 1].mean()))
+        lon = a[:, 1]  # in [-180, 180)
+        if lon.max() - lon.min() > 180.0:  # across the antimeridian: average east of it
+            lon = np.where(lon < 0.0, lon + 360.0, lon)
+        return LocalFrame(float(a[:, 0].mean()), float(lon.mean()))
     return None
 
 
