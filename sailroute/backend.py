@@ -23,7 +23,7 @@ BACKENDS = ("numpy", "cupy", "auto")
 @lru_cache(maxsize=1)
 def _cupy_or_none() -> ModuleType | None:
     try:
-        import cupy  # type: ignore[import-not-found]
+        import cupy
     except Exception:  # ImportError, or CUDA libraries missing
         return None
     try:
