@@ -763,12 +763,9 @@ def section_profile(args: argparse.Namespace) -> None:
 def _first_leg(course: Any) -> tuple[Start, Target]:
     """Leg 1 of ``course`` as ``sailroute plan`` routes it (rounding exit towards leg 2)."""
     from sailroute.course.geometry import leg_endpoints, target_of
+    from sailroute.routing.geometry import chain_leg
 
     start, target = leg_endpoints(course, 0)
-    try:
-        from sailroute.routing.geometry import chain_leg
-    except ImportError:  # older tree: a leg ends at its mark
-        return start, target
     following = target_of(course, 1) if course.n_legs > 1 else None
     return chain_leg(start, target, None, following)
 

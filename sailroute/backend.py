@@ -23,7 +23,7 @@ BACKENDS = ("numpy", "cupy", "auto")
 @lru_cache(maxsize=1)
 def _cupy_or_none() -> ModuleType | None:
     try:
-        import cupy  # type: ignore[import-not-found]
+        import cupy
     except Exception:  # ImportError, or CUDA libraries missing
         return None
     try:
@@ -32,11 +32,6 @@ def _cupy_or_none() -> ModuleType | None:
     except Exception:
         return None
     return cupy
-
-
-def gpu_available() -> bool:
-    """True if CuPy imports and sees at least one CUDA device."""
-    return _cupy_or_none() is not None
 
 
 def get_xp(name: str = "numpy") -> ModuleType:

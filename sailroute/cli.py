@@ -58,7 +58,8 @@ def _tidy(params: list[Any]) -> list[Any]:
         if isinstance(p, TyperArgument):
             if p.metavar is None:
                 p.metavar = (p.name or "").upper()
-            p.display_type_rich = _no_type  # an instance attribute hides the type column
+            # an instance attribute hides the type column
+            p.display_type_rich = _no_type  # type: ignore[method-assign]
         elif isinstance(p, TyperOption):
             if p.is_flag or p.count:
                 p.metavar = ""

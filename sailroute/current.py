@@ -330,6 +330,7 @@ def current_from_spec(
             chk.add("speed_kn", "missing required key; give the rate as speed_kn or speed_ms")
         set_deg = chk.number(spec, "set_deg", lo=0.0, hi=360.0) if "set_deg" in spec else None
         chk.raise_if_any("current spec")
+        assert set_deg is not None  # required key: reported above when missing
         field_ = UniformCurrent(rate, set_deg)
     elif kind == "diamonds":
         chk.check_keys(spec, _DIAMOND_KEYS, ("high_water", "table"))
@@ -365,6 +366,7 @@ def current_from_spec(
                     rows.append((float(row[0]), float(row[1]), float(row[2]) * scale))
         chk.raise_if_any("current spec")
         h, s, r = (list(c) for c in zip(*rows, strict=True))
+        assert hw is not None  # required key: reported above when missing or unreadable
         field_ = DiamondCurrent(hw, h, s, r, clamp=clamp)
     else:
         chk.check_keys(spec, _NETCDF_KEYS, ("path",))
@@ -388,6 +390,7 @@ def current_from_spec(
                 "steady": chk.boolean(spec, "steady", False),
                 "clamp": chk.boolean(spec, "clamp", False)}
         chk.raise_if_any("current spec")
+        assert path is not None  # required key: reported above when missing
         try:
             field_ = open_netcdf_current(path, frame, variables=var, speed_unit=unit,
                                          select=sel, bbox=crop_bbox, time_window=time_window,

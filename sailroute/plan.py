@@ -15,6 +15,7 @@ import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 from sailroute.backend import get_xp
 from sailroute.boat.polar import Polar
@@ -30,7 +31,7 @@ from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.geometry import chain_leg
-from sailroute.routing.types import LegResult, RoutingSettings
+from sailroute.routing.types import LegResult, RouterName, RoutingSettings
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
 
@@ -65,8 +66,8 @@ def settings_for(
     InputError
         Unknown router or backend name (checked here, before any work is done).
     """
-    settings = course.routing if router is None else dataclasses.replace(course.routing,
-                                                                         router=router)
+    settings = course.routing if router is None else dataclasses.replace(
+        course.routing, router=cast(RouterName, router))  # the name is checked just below
     get_router(settings.router)
     get_xp(backend)
     return settings

@@ -44,9 +44,14 @@ YamlLoader.add_implicit_resolver(
                r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
     list("-+0123456789."),
 )
-YamlLoader.add_constructor(
-    "tag:yaml.org,2002:int", lambda loader, node: int(loader.construct_scalar(node), 10)
-)
+
+
+def _construct_int(loader: YamlLoader, node: yaml.ScalarNode) -> int:
+    """Decimal integer (the resolver above lets only ``[-+]?[0-9]+`` through)."""
+    return int(loader.construct_scalar(node), 10)
+
+
+YamlLoader.add_constructor("tag:yaml.org,2002:int", _construct_int)
 
 
 def join_path(path: str, key: str | int) -> str:

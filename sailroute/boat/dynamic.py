@@ -519,10 +519,11 @@ def build_table(
 ) -> SegmentTable:
     """Tabulate ``w_ss(β)``, ``Λ(β, w0)`` and the transient length for one set of constants.
 
-    ``Λ`` is integrated with the trapezoidal rule on ``nfine`` points per branch
-    and column (the integrand is smooth, error ~1e-6 relative) and subsampled to
-    ``nq`` points.  Takes about a second; cached per constants by
-    :meth:`DynamicBoat.table`.
+    ``Λ`` is integrated with the cumulative Simpson rule on ``nfine`` points per
+    branch and column (the integrand is smooth: against 4097 points the largest
+    difference is 2e-7 of the largest ``Λ`` for the default constants) and
+    subsampled to ``nq`` points; the transient lengths use the trapezoidal rule.
+    Takes well under a second; cached per constants by :meth:`DynamicBoat.table`.
     """
     if (nfine - 1) % (nq - 1):
         raise ValueError("nfine - 1 must be a multiple of nq - 1")
@@ -539,7 +540,8 @@ def build_table(
     frac = np.linspace(0.0, 1.0, nfine)
     step = (nfine - 1) // (nq - 1)
 
-    def branch(w: NDArray) -> tuple[NDArray, NDArray]:
+    def branch(w: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+        """Λ, its integrand h, the convergence length and the distance to 5 % of w_ss."""
         # w: (nb, nfine) ordered away from the fixed point (w[:, 0] == w_ss)
         g = drive(w, beta[:, None], c1, c2, k)
         dw = w - wss[:, None]
@@ -691,7 +693,7 @@ def chain_time(
                                          cos_turn[idx], v_start[idx], xp)
         total[idx] = t_ex
         v[idx] = v_ex
-        if pieces:
+        if t_pieces is not None:  # pieces
             t_pieces[idx] = tp_ex
     if pieces:
         return total, v, t_pieces, xp.stack(v_list, axis=-1)
@@ -799,11 +801,11 @@ def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, ome
                     - drive(np.maximum(yv[1], 0.0), bv, c1, c2, k)) * 1e6
         lim = np.minimum(_A_RATE * wp / np.maximum(np.abs(k1[1]), 1e-300),
                          _B_RELAX * wp / np.maximum(gw, 1e-300))
-        h = np.clip(lim, h_all[act], 40.0 * h_all[act])
-        k2 = f(yv + 0.5 * h * k1, bv)
-        k3 = f(yv + 0.5 * h * k2, bv)
-        k4 = f(yv + h * k3, bv)
-        yn = yv + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        hs = np.clip(lim, h_all[act], 40.0 * h_all[act])  # this step's h per item
+        k2 = f(yv + 0.5 * hs * k1, bv)
+        k3 = f(yv + 0.5 * hs * k2, bv)
+        k4 = f(yv + hs * k3, bv)
+        yn = yv + hs / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
         # stopped for good: (nearly) at rest and decelerating (a no-drive coast
         # that has run out; at w < 1e-3 it would crawl for ages before stopping)
         stopped = (yn[1] <= _W_STUCK) & (drive(np.maximum(yn[1], 0.0), bv, c1, c2, k) <= 0.0)
@@ -812,7 +814,7 @@ def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, ome
         if cross.any():
             i = act[cross]
             f1 = f(yn[:, cross], bv[cross])
-            hh = h[cross]
+            hh = hs[cross]
             th = _hermite_crossing(yv[0, cross], yn[0, cross], k1[0, cross], f1[0], hh, ell[i])
             out_tau[i] = _hermite(yv[2, cross], yn[2, cross], k1[2, cross], f1[2], hh, th)
             out_w[i] = _hermite(yv[1, cross], yn[1, cross], k1[1, cross], f1[1], hh, th)

@@ -484,8 +484,8 @@ def _finish(raw: NDArray, counts: NDArray, covered: NDArray, tws_n: NDArray, twa
     """Monotone rule, trim empty rows/columns, fill, build the polar."""
     se = _quantile_se(v, g, counts.size, counts, q)
     mono = _monotone_in_tws(raw, counts, se)
-    rows = covered.any(axis=1)
-    cols = covered.any(axis=0)
+    rows = np.asarray(covered.any(axis=1))  # (arrays: numpy's stubs say "bool or array")
+    cols = np.asarray(covered.any(axis=0))
     if rows.sum() < 2:
         # a polar needs 2 TWA rows: keep the nearest empty neighbour too (filled)
         i = int(np.flatnonzero(rows)[0])

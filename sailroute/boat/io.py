@@ -410,12 +410,12 @@ def parse_pol(
     if len(twa) < 2:
         raise InputError(f"{src}: the table needs at least 2 TWA rows; found {len(twa)}")
     tws_arr = np.asarray(tws, dtype=float)
-    raw = np.asarray(rows, dtype=float)
-    _check_table(src, np.asarray(twa), tws_arr, raw, s_unit, w_unit,
+    raw_tab = np.asarray(rows, dtype=float)
+    _check_table(src, np.asarray(twa), tws_arr, raw_tab, s_unit, w_unit,
                  at_twa=lambda i: f"{src}:{row_lines[i]}: cell 1",
                  at_tws=lambda j: f"{src}:{header_line}: cell {j + 2}",
                  at_cell=lambda i, j: f"{src}:{row_lines[i]}: cell {j + 2}")
-    tab = fill_empty_cells(np.asarray(twa), tws_arr, raw)
+    tab = fill_empty_cells(np.asarray(twa), tws_arr, raw_tab)
     return Polar(np.asarray(twa), tws_arr * speed_factor(w_unit), tab * speed_factor(s_unit),
                  name=Path(src).stem, interpolation=interpolation)
 
@@ -551,8 +551,10 @@ def parse_long_csv(
         return min(ln for key, (_, ln) in values.items() if key[axis] == value)
 
     _check_table(src, twa_ax, tws_ax, tab, s_unit, w_unit,
-                 at_twa=lambda i: f"{src}:{first_line(1, twa_ax[i])}: cell {cols['twa'][0] + 1}",
-                 at_tws=lambda j: f"{src}:{first_line(0, tws_ax[j])}: cell {cols['tws'][0] + 1}",
+                 at_twa=lambda i: f"{src}:{first_line(1, float(twa_ax[i]))}: "
+                                  f"cell {cols['twa'][0] + 1}",
+                 at_tws=lambda j: f"{src}:{first_line(0, float(tws_ax[j]))}: "
+                                  f"cell {cols['tws'][0] + 1}",
                  at_cell=lambda i, j: f"{src}:{line_of[i, j]}: cell {cols['speed'][0] + 1}")
     tab = fill_empty_cells(twa_ax, tws_ax, tab)
     return Polar(twa_ax, tws_ax * speed_factor(w_unit), tab * speed_factor(s_unit),
@@ -653,8 +655,8 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
         pts = {round(a, 1): v for a, v in zip(angles, tab[:, j], strict=True)}
         pts[round(a_b, 1)] = optima["beat_vmg"][j] / math.cos(math.radians(a_b))
         pts[round(a_r, 1)] = optima["run_vmg"][j] / abs(math.cos(math.radians(a_r)))
-        keys = sorted(pts)
-        cols.append((np.asarray(keys), np.asarray([pts[k] for k in keys])))
+        nodes = sorted(pts)
+        cols.append((np.asarray(nodes), np.asarray([pts[k] for k in nodes])))
     for k, a_key, v_key in (("beat", "beat_angle", "beat_vmg"), ("run", "run_angle", "run_vmg")):
         v = optima[v_key] / np.abs(np.cos(np.radians(optima[a_key])))
         if np.any(v > MAX_BOAT_SPEED_KN):
@@ -837,9 +839,9 @@ def _check_table(
         fast = np.argwhere(tab * fs > MAX_BOAT_SPEED_MS)
     if fast.size:
         i, j = (int(k) for k in fast[0])
-        v = float(tab[i, j])
+        cell = float(tab[i, j])
         raise InputError(
-            f"{at_cell(i, j)}: boat speed {v:g} {s_unit}{_in_kn(v * fs, s_unit)} at TWA "
+            f"{at_cell(i, j)}: boat speed {cell:g} {s_unit}{_in_kn(cell * fs, s_unit)} at TWA "
             f"{twa[i]:g}, TWS {tws[j]:g} {w_unit} is above {MAX_BOAT_SPEED_KN:g} kn, faster "
             "than any sailing craft has gone (record 65.45 kn); "
             + _unit_hint(s_unit, "speed_unit")

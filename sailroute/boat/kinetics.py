@@ -47,7 +47,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, fields, replace
-from typing import Final
+from typing import Any, Final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -177,7 +177,8 @@ def kinetics_from_spec(value: object, key: str = "kinetics") -> tuple[Kinetics, 
                       f"parameters; got {value!r}"]
     names = [f.name for f in fields(Kinetics)]
     pairs = {f.name for f in fields(Kinetics) if isinstance(getattr(RACE, f.name), tuple)}
-    problems, given = [], {}
+    problems: list[str] = []
+    given: dict[str, Any] = {}  # field name -> float or (from, to)
     for k, v in value.items():
         if k not in names:
             problems.append(f"{key}.{k}: unknown key; allowed: " + ", ".join(map(repr, names)))

@@ -376,28 +376,6 @@ class Polar:
         val = np.where(calm, 0.0, val)
         return ang.reshape(tws_in.shape), val.reshape(tws_in.shape)
 
-    def best_vmg(
-        self, tws_ms: ArrayLike, upwind: bool = True, step_deg: float = 0.05
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Optimal VMG angle and VMG at each TWS (kept for compatibility).
-
-        Parameters
-        ----------
-        tws_ms : array_like
-            True wind speed [m s⁻¹].
-        upwind : bool
-            Upwind (maximise ``bsp cos twa``) or downwind (maximise ``-bsp cos twa``).
-        step_deg : float
-            Ignored; the optimum is continuous (see :meth:`vmg_upwind`).
-
-        Returns
-        -------
-        twa_deg, vmg_ms : ndarray
-            Best angle [°] and the VMG [m s⁻¹] (positive) at that angle.
-        """
-        del step_deg
-        return self._vmg(tws_ms, upwind=upwind)
-
     def max_speed(self, tws_ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """TWA [°] of the highest boat speed and that speed [m s⁻¹], on a 0.5° grid."""
         tws = np.asarray(tws_ms, dtype=float)

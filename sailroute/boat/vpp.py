@@ -21,7 +21,8 @@ Algorithm (all vectorised over points, deterministic, no failure modes):
 1. ``g(V) = max_{f,t feasible} [X - R]`` at fixed V has closed-form forces, so
    the inner problem is a golden-section search over f (t = 0) and, where the
    moment limit binds, a golden-section search over t with f on the moment
-   limit found by bisection.
+   limit found by safeguarded Newton iterations (a bisection step wherever the
+   Newton step leaves the bracket).
 2. ``g`` is scanned on a speed grid; the speed is the largest root, refined by
    the Illinois (regula-falsi) method to 1e-10 m s⁻¹.  No root means no
    steady sailing (speed 0: the no-go zone).
@@ -494,7 +495,7 @@ class _Ctx:
         return fx, fy, surplus, moment
 
 
-def _golden_max(f, lo: NDArray, hi: NDArray, n: int) -> NDArray:
+def _golden_max(f: Callable[[NDArray], NDArray], lo: NDArray, hi: NDArray, n: int) -> NDArray:
     """Vectorised golden-section search for the maximiser of ``f`` on ``[lo, hi]``."""
     c = hi - _GOLDEN * (hi - lo)
     d = lo + _GOLDEN * (hi - lo)
@@ -585,8 +586,10 @@ def _heel_for(p: LaserParams, moment: NDArray) -> NDArray:
     return np.interp(moment, rm, grid)
 
 
-def _surplus_at(p: LaserParams, tws: NDArray, twa: NDArray, v: NDArray) -> tuple[NDArray, ...]:
-    """g(V): best surplus at speed V, with the controls and heel behind it."""
+def _surplus_at(
+    p: LaserParams, tws: NDArray, twa: NDArray, v: NDArray
+) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray, _Ctx]:
+    """g(V): best surplus at speed V, with the controls, overpowered flag, heel and state."""
     if p.stability == "hiking":
         ctx = _Ctx(p, tws, twa, v, 0.0)
         s, x, t, over = _best_controls(p, ctx, p.max_righting_moment_nm)
@@ -722,7 +725,7 @@ def _solve_speed(
     g = surplus(np.repeat(tws, _N_SCAN), np.repeat(twa, _N_SCAN), grid.ravel()).reshape(
         n, _N_SCAN)
     pos = g >= 0
-    has = pos.any(axis=1)
+    has = np.asarray(pos.any(axis=1))  # (an array: numpy's stubs say "bool or array")
     # last grid point with g >= 0; the root lies between it and the next point
     last = _N_SCAN - 1 - np.argmax(pos[:, ::-1], axis=1)
     lo_v = grid[np.arange(n), last]

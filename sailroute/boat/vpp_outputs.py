@@ -18,7 +18,6 @@ from sailroute.boat.build import vpp_polar
 from sailroute.boat.io import write_pol, write_polar_csv, write_polar_json
 from sailroute.boat.kinetics import STEADY, Kinetics, kinetics_from_spec
 from sailroute.boat.laser import (
-    CLASSES,
     CREW_MASS_RANGE_KG,
     ILCA7,
     LaserParams,
@@ -268,8 +267,3 @@ def _slug(text: str) -> str:
 
 def _jsonable(d: dict[str, Any]) -> dict[str, Any]:
     return {k: list(v) if isinstance(v, tuple) else v for k, v in d.items()}
-
-
-def class_names() -> tuple[str, ...]:
-    """Valid ``class`` values of a boat file."""
-    return tuple(sorted(CLASSES))

@@ -57,7 +57,7 @@ def target_of(course: Course, i: int) -> Target:
     feat = course.feature(leg.to_name)
     if isinstance(feat, Mark):
         return Target("mark", feat.xy, None, leg.rounding, name=leg.to_name)
-    kind = "gate" if isinstance(feat, Gate) else "line"
+    kind: Literal["gate", "line"] = "gate" if isinstance(feat, Gate) else "line"
     return Target(kind, feat.a.xy, feat.b.xy, None, name=leg.to_name)
 
 

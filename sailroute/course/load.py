@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from sailroute.course.model import Course, Gate, LegSpec, Line, Mark, ScenarioSpec
+from sailroute.course.model import Course, Gate, LegKind, LegSpec, Line, Mark, ScenarioSpec
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError, format_problems
 from sailroute.geo import LocalFrame, wrap_lon
@@ -285,7 +285,7 @@ def _latlon(c: _Checker, d: Mapping[str, Any], path: str) -> tuple[float, float]
     lon = c.number(d, "lon", path, lo=-180.0, hi=360.0,
                    what="a longitude in [-180, 360] degrees")
     # 0..360 longitudes are accepted and wrapped to [-180, 180), as GPX and plan.json use
-    return None if lat is None or lon is None else (lat, wrap_lon(lon))
+    return None if lat is None or lon is None else (lat, float(wrap_lon(lon)))
 
 
 def _position(
@@ -315,7 +315,11 @@ def _position(
 def _frame(
     c: _Checker, data: Mapping[str, Any], latlons: list[tuple[float, float]], needs: list[str]
 ) -> LocalFrame | None:
-    """The local frame: ``origin`` if given, else the mean of the lat/lon positions."""
+    """The local frame: ``origin`` if given, else the mean of the lat/lon positions.
+
+    Marks on both sides of the antimeridian (longitudes more than 180° apart) are
+    averaged across it (179.9995 and -179.9985 give 180.0005), not around the globe.
+    """
     if "origin" in data:
         if not c.mapping(data["origin"], "origin", "{lat, lon} of the local frame's origin"):
             return None
@@ -328,7 +332,10 @@ def _frame(
         return None
     if latlons:
         a = np.array(latlons)
-        return LocalFrame(float(a[:, 0].mean()), float(a[:, 1].mean()))
+        lon = a[:, 1]  # in [-180, 180)
+        if lon.max() - lon.min() > 180.0:  # across the antimeridian: average east of it
+            lon = np.where(lon < 0.0, lon + 360.0, lon)
+        return LocalFrame(float(a[:, 0].mean()), float(lon.mean()))
     return None
 
 
@@ -366,9 +373,10 @@ def _pairs(
             c.p.add(path, f"expected a list of two mark names, e.g. [{what}_a, {what}_b]; "
                     f"got {_show(value)}")
             continue
-        ends = [c.name(v, _join(path, i), "a mark name") for i, v in enumerate(value)]
-        if None in ends:
+        e0, e1 = (c.name(v, _join(path, i), "a mark name") for i, v in enumerate(value))
+        if e0 is None or e1 is None:
             continue
+        ends = (e0, e1)
         ok = True
         for i, m in enumerate(ends):
             if m not in marks:
@@ -416,8 +424,8 @@ def _legs(
     if not raw:
         c.p.add("legs", "expected at least one leg; got an empty list")
         return out
-    features = {**{m: "mark" for m in marks}, **{g: "gate" for g in gates},
-                **{n: "line" for n in lines}}
+    features: dict[str, LegKind] = {**{m: "mark" for m in marks}, **{g: "gate" for g in gates},
+                                    **{n: "line" for n in lines}}
     centres = {**gates, **lines}
     prev: str | None = None
     for i, item in enumerate(raw):
@@ -477,7 +485,7 @@ def _legs(
                     c.p.add(path, f"the leg {frm!r} -> {to!r} is {d:.2f} m long; "
                             f"expected at least {MIN_SEPARATION_M:g} m")
         if to is not None and kind is not None and frm is not None:
-            out.append(LegSpec(i, frm, to, kind, rounding))  # type: ignore[arg-type]
+            out.append(LegSpec(i, frm, to, kind, rounding))
         prev = to
     return out
 

@@ -41,6 +41,7 @@ Sequences (``laps`` = number of beats, as in the course codes ``L2``, ``I2``, ``
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -302,5 +303,6 @@ def trapezoid(
     return CourseLayout(layout.marks, layout.lines, layout.gates, "start", tuple(legs))
 
 
-TEMPLATES = {"windward-leeward": windward_leeward, "trapezoid": trapezoid}
+TEMPLATES: dict[str, Callable[..., CourseLayout]] = {
+    "windward-leeward": windward_leeward, "trapezoid": trapezoid}
 """Template name (the ``template.type`` key) → builder."""

@@ -115,7 +115,7 @@ def ensemble_table(summary: EnsembleSummary) -> str:
     sp, sh = summary.spread(), summary.side_shares()
     head = (f"ensemble {summary.name}: {len(summary.members)} members; leg times over the "
             "members (min / P10 / median / P90 / max) and the side of the course routes took")
-    rows = [("leg", *STATS, "left", "middle", "right")]
+    rows: list[tuple[str, ...]] = [("leg", *STATS, "left", "middle", "right")]
     for k, label in enumerate(summary.leg_labels):
         rows.append((f"{k + 1} {label}", *(_mmss(v) for v in sp[k]),
                      *(f"{100 * v:.0f}%" for v in sh[k])))

@@ -56,7 +56,8 @@ def _num(x: float, nd: int = 3) -> float | None:
 
 def _point(course: Course, xy: tuple[float, float]) -> dict[str, float | None]:
     lat, lon = course.frame.to_latlon(xy[0], xy[1])
-    return {"x": _num(xy[0]), "y": _num(xy[1]), "lat": _num(lat, 7), "lon": _num(lon, 7)}
+    return {"x": _num(xy[0]), "y": _num(xy[1]), "lat": _num(float(lat), 7),
+            "lon": _num(float(lon), 7)}
 
 
 def plan_to_dict(plan: Plan) -> dict[str, Any]:
@@ -384,7 +385,7 @@ def file_label(kind: str | None, path: str | Path,
     if kind is not None and "/" in kind:
         prefix, kind = kind.rsplit("/", 1)
         prefix += ": "
-    if kind in labels:
+    if kind is not None and kind in labels:
         return prefix + labels[kind]
     stem = p.stem
     name = _STEM_LABELS.get(stem, stem.replace("_", " "))

@@ -175,10 +175,10 @@ def _latlon_axes(ax: Axes, course: Course) -> None:
     lat0, lon0 = frame.lat0, frame.lon0
     m_lat = 111_132.0  # metres per degree of latitude (WGS-84, mid-latitudes; ±0.5 %)
     m_lon = m_lat * float(np.cos(np.radians(lat0)))
-    top = ax.secondary_xaxis("top", functions=(lambda x: lon0 + x / m_lon,
-                                               lambda lon: (lon - lon0) * m_lon))
-    right = ax.secondary_yaxis("right", functions=(lambda y: lat0 + y / m_lat,
-                                                   lambda lat: (lat - lat0) * m_lat))
+    top = ax.secondary_xaxis("top", functions=(lambda x: lon0 + np.asarray(x) / m_lon,
+                                               lambda lon: (np.asarray(lon) - lon0) * m_lon))
+    right = ax.secondary_yaxis("right", functions=(lambda y: lat0 + np.asarray(y) / m_lat,
+                                                   lambda lat: (np.asarray(lat) - lat0) * m_lat))
     top.set_xlabel("longitude [°E]", fontsize=8)
     right.set_ylabel("latitude [°N]", fontsize=8)
     for a in (top, right):
@@ -205,10 +205,10 @@ def _leg_wind(ax: Axes, wind: WindField, legs: Sequence[LegResult],
         i = label_point(r, k)
         t, x, y = float(r.track.t[i]), float(r.track.x[i]), float(r.track.y[i])
         try:
-            u, v = wind.sample(t, x, y)
+            su, sv = wind.sample(t, x, y)
         except OutOfCoverageError:
             continue
-        samples.append((k, x, y, float(u), float(v)))
+        samples.append((k, x, y, float(su), float(sv)))
     if not samples:
         return None
     uv = np.array([(u, v) for *_, u, v in samples])
@@ -288,7 +288,9 @@ def plot_route(
     for k, r in enumerate(legs):
         pts = np.column_stack([r.track.x, r.track.y])
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
-        lc = LineCollection(segs, cmap="viridis", norm=norm, linewidths=2.2, zorder=3)
+        # an (n, 2, 2) array is the segment list matplotlib documents; its stubs want a Sequence
+        lc = LineCollection(segs, cmap="viridis", norm=norm, linewidths=2.2,  # type: ignore[arg-type]
+                            zorder=3)
         lc.set_array(r.track.bsp_ms[:-1] / KNOT)
         lc.set_gid(f"leg:{k + 1}")
         if repeats[k]:  # the same water as an earlier leg: shift it sideways on screen

@@ -65,10 +65,11 @@ def _rich_table(console: Any, headers: Sequence[str], rows: Sequence[Sequence[st
         for r in footer:
             t.add_row(*r, style="bold")
     # drawn at its natural width, never squeezed to the terminal's: numbers stay whole
-    wide = Console(file=io.StringIO(), width=100_000, color_system=console.color_system,
+    buf = io.StringIO()
+    wide = Console(file=buf, width=100_000, color_system=console.color_system,
                    force_terminal=console.is_terminal, no_color=console.no_color)
     wide.print(t)
-    return "\n".join(line.rstrip() for line in wide.file.getvalue().rstrip("\n").split("\n"))
+    return "\n".join(line.rstrip() for line in buf.getvalue().rstrip("\n").split("\n"))
 
 
 def render_table(

@@ -212,7 +212,8 @@ def make_grid(start: Start, target: Target, n_rows: int, zone_m: float) -> LegGr
     if start.b is None:
         first = Row("point", a=(float(start.a[0]), float(start.a[1])))
     else:
-        first = Row("line", a=tuple(map(float, start.a)), b=tuple(map(float, start.b)))
+        first = Row("line", a=(float(start.a[0]), float(start.a[1])),
+                    b=(float(start.b[0]), float(start.b[1])))
     seg_len = math.hypot(geom.b[0] - geom.a[0], geom.b[1] - geom.a[1])
     m = min(AIM_MARGIN_M, 0.5 * seg_len) / seg_len
     last = Row("line", a=geom.a, b=geom.b, lo=m, hi=1.0 - m)
@@ -256,14 +257,7 @@ class BoatModel:
         if self.dynamic is not None:
             return self.dynamic.best_vmg(True, 0.05)[0], self.dynamic.best_vmg(False, 0.05)[0]
         assert self.polar is not None
-        p = self.polar
-        if hasattr(p, "vmg_upwind"):
-            up = float(p.vmg_upwind(tws)[0])
-            down = float(p.vmg_downwind(tws)[0])
-        else:  # pragma: no cover - older Polar
-            up = float(p.best_vmg(tws, True)[0])
-            down = float(p.best_vmg(tws, False)[0])
-        return up, down
+        return float(self.polar.vmg_upwind(tws)[0]), float(self.polar.vmg_downwind(tws)[0])
 
 
 # --------------------------------------------------------------------------------------

@@ -415,7 +415,7 @@ def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: G
     px, py = _chains(x0, y0, x1, y1, n)
     cw = sample_chains(wind, px, py, np.full(x0.size, t0)[:, None], model)
     ok = np.all(cw.valid, axis=-1) & _inside_pairs(wind, x0, y0, x1, y1, lim, n_rows == 2)
-    t, v_end = chain_time(boat, *(xp.asarray(a) for a in (cw.beta, cw.tws, cw.length)),
+    t, v_end = chain_time(boat, xp.asarray(cw.beta), xp.asarray(cw.tws), xp.asarray(cw.length),
                           xp.ones(cw.beta.shape), xp.zeros(cw.beta.shape[:-1]), xp)
     T = xp.where(xp.asarray(ok), t0 + t, xp.inf)
     V = v_end

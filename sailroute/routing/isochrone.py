@@ -132,11 +132,7 @@ _TABLE_CACHE: weakref.WeakKeyDictionary[Any, dict[int, PolarTables]] = (
 
 
 def _vmg_angles(polar: Polar, tws: NDArray, upwind: bool) -> tuple[NDArray, NDArray]:
-    fn = getattr(polar, "vmg_upwind" if upwind else "vmg_downwind", None)
-    if callable(fn):
-        a, v = fn(tws)
-    else:
-        a, v = polar.best_vmg(tws, upwind=upwind)
+    a, v = polar.vmg_upwind(tws) if upwind else polar.vmg_downwind(tws)
     return np.asarray(a, dtype=float), np.asarray(v, dtype=float)
 
 
@@ -277,16 +273,21 @@ class _LegFrame:
 
     def barrier(self, b: Barrier) -> Barrier:
         """The barrier in the leg frame."""
-        mark = tuple(float(v) for v in self.to_leg(b.mark[0], b.mark[1]))
-        ray = tuple(float(v) for v in self.vec_to_leg(b.ray[0], b.ray[1]))
-        n = tuple(float(v) for v in self.vec_to_leg(b.normal[0], b.normal[1]))
-        return Barrier(mark, ray, n, b.name)  # type: ignore[arg-type]
+        mark = _floats(self.to_leg(b.mark[0], b.mark[1]))
+        ray = _floats(self.vec_to_leg(b.ray[0], b.ray[1]))
+        n = _floats(self.vec_to_leg(b.normal[0], b.normal[1]))
+        return Barrier(mark, ray, n, b.name)
 
     def geometry(self, g: TargetGeometry) -> TargetGeometry:
-        a = tuple(float(v) for v in self.to_leg(g.a[0], g.a[1]))
-        b = tuple(float(v) for v in self.to_leg(g.b[0], g.b[1]))
-        n = tuple(float(v) for v in self.vec_to_leg(g.normal[0], g.normal[1]))
-        return TargetGeometry(a, b, n, g.kind, g.name)  # type: ignore[arg-type]
+        a = _floats(self.to_leg(g.a[0], g.a[1]))
+        b = _floats(self.to_leg(g.b[0], g.b[1]))
+        n = _floats(self.vec_to_leg(g.normal[0], g.normal[1]))
+        return TargetGeometry(a, b, n, g.kind, g.name)
+
+
+def _floats(p: tuple[Any, Any]) -> tuple[float, float]:
+    """A point or vector as two Python floats."""
+    return float(p[0]), float(p[1])
 
 
 # --------------------------------------------------------------------------------------
@@ -936,8 +937,9 @@ def _crab(
 
 
 def _time_to_go_current(
-    tau: Any, gx: Any, gy: Any, avg: tuple, ex: Any, ey: Any, dist: Any, cx: Any, cy: Any,
-    sides: Any, free: Any, ctx: _Context, dev: _DeviceTables, xp: ModuleType,
+    tau: Any, gx: Any, gy: Any, avg: tuple[Any, Any, Any, Any, Any, Any, Any], ex: Any, ey: Any,
+    dist: Any, cx: Any, cy: Any, sides: Any, free: Any, ctx: _Context, dev: _DeviceTables,
+    xp: ModuleType,
 ) -> tuple[Any, Any, Any]:
     """Time to go in a current ``C`` (averaged along the way, leg frame) and its gradient.
 

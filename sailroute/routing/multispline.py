@@ -241,11 +241,11 @@ def multispline_pass(
             carry = flat[arg_np, np.arange(c1 * s1)].reshape(c1, s1)
         if progress is not None:
             progress((r + 1) / (n_rows - 1))
-    flat = int(np.argmin(A))
-    best = float(A.reshape(-1)[flat])
+    i_best = int(np.argmin(A))
+    best = float(A.reshape(-1)[i_best])
     if not math.isfinite(best):
         return None, math.inf, edges
-    c, s = divmod(flat, A.shape[1])
+    c, s = divmod(i_best, A.shape[1])
     path = [(c, s)]
     for r in range(n_rows - 2, -1, -1):
         c, s = divmod(int(bps[r][c, s]), slopes[r].size)

@@ -7,6 +7,8 @@ that all routers report the same quantities computed the same way.
 
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -106,7 +108,7 @@ def find_manoeuvres(track: Track) -> tuple[Manoeuvre, ...]:
     out = []
     for i in change:
         mean_abs = 0.5 * (abs(track.twa_deg[i - 1]) + abs(track.twa_deg[i]))
-        kind = "tack" if mean_abs < 90.0 else "gybe"
+        kind: Literal["tack", "gybe"] = "tack" if mean_abs < 90.0 else "gybe"
         out.append(Manoeuvre(kind, float(track.t[i]), float(track.x[i]), float(track.y[i])))
     return tuple(out)
 

@@ -34,11 +34,13 @@ from sailroute.strategy.deadline import (
 from sailroute.strategy.montecarlo import SimulationResult, simulate, time_summary
 from sailroute.strategy.sdp import (
     BeatGrid,
+    Clock,
     ExpectedTimePolicy,
     quantised_vmg,
     solve_expected_time,
 )
 from sailroute.strategy.shiftmodel import (
+    ChainMethod,
     DriftDiffusionShift,
     ShiftModel,
     chain_diagnostics,
@@ -66,8 +68,10 @@ class StrategySettings:
         Monte Carlo runs per policy and seed.
     row_m, lateral_m, shift_step_deg, shift_max_deg, max_heading_deg : float
         SDP lattice (:class:`~sailroute.strategy.sdp.BeatGrid`).
-    clock, chain_method : str
-        SDP wind clock and shift discretisation.
+    clock : {"time", "stage"}
+        SDP wind clock.
+    chain_method : {"generator", "integrate"}
+        SDP shift discretisation.
     start_tack : int
         +1 starboard, -1 port.
     deadlines_s : tuple of float
@@ -105,8 +109,8 @@ class StrategySettings:
     shift_step_deg: float = 5.0
     shift_max_deg: float = 45.0
     max_heading_deg: float = 80.0
-    clock: str = "time"
-    chain_method: str = "generator"
+    clock: Clock = "time"
+    chain_method: ChainMethod = "generator"
     start_tack: int = 1
     deadlines_s: tuple[float, ...] = ()
     drift_deg_per_s: float = 0.0
@@ -244,16 +248,16 @@ def _run_study(
     grid = st.beat_grid()
     say(f"solving the expected-time SDP ({grid.n_x} x {grid.n_rows} x 2 x {grid.theta_deg.size})")
     policy = solve_expected_time(
-        polar, st.tws_ms, model, grid, st.tack_penalty_s, st.clock, st.chain_method  # type: ignore[arg-type]
+        polar, st.tws_ms, model, grid, st.tack_penalty_s, st.clock, st.chain_method
     )
     where = "" if runner.client is None else f" on {runner.description}"
     say(f"  solved in {policy.solve_time_s:.2f} s; simulating {st.runs} runs{where}")
     sim = simulate(policy, st.runs, st.seed, tack0=st.start_tack, scheduler=runner)
-    vmg_angle, vmg = polar.vmg_upwind(st.tws_ms)
-    vmg_angle, vmg = float(vmg_angle), float(vmg)
+    vmg_angle_arr, vmg_arr = polar.vmg_upwind(st.tws_ms)
+    vmg_angle, vmg = float(vmg_angle_arr), float(vmg_arr)
     q_heading, q_vmg = quantised_vmg(grid, polar, st.tws_ms)
     nominal = st.length_m / vmg
-    m_stage = transition_matrix(model, grid.theta_deg, policy.stage_dt_s, st.chain_method)  # type: ignore[arg-type]
+    m_stage = transition_matrix(model, grid.theta_deg, policy.stage_dt_s, st.chain_method)
     diag = chain_diagnostics(m_stage, grid.theta_deg, model, policy.stage_dt_s)
     summary: dict[str, Any] = {
         "boat": {

@@ -42,6 +42,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -163,12 +164,12 @@ class DeadlineGrid:
     @property
     def r_m(self) -> NDArray[np.float64]:
         """Radial nodes [m]."""
-        return self.dr * np.arange(self.n_r + 1)
+        return self.dr * np.arange(self.n_r + 1, dtype=np.float64)
 
     @property
     def theta_rad(self) -> NDArray[np.float64]:
         """Angular nodes [rad]."""
-        return self.dtheta * np.arange(self.n_theta)
+        return self.dtheta * np.arange(self.n_theta, dtype=np.float64)
 
     @property
     def controls_rad(self) -> NDArray[np.float64]:
@@ -391,7 +392,7 @@ def _steer_operator(
     u = grid.controls_rad
     kk = 16 if cubic else 4
     cols = np.empty((grid.n_nodes, u.size, 2 * kk), dtype=np.int32)
-    vals = np.empty((grid.n_nodes, u.size, 2 * kk), dtype=dtype)
+    vals: NDArray[Any] = np.empty((grid.n_nodes, u.size, 2 * kk), dtype=dtype)
     step = max(1, BLOCK_NODES // 4)
     for n0 in range(0, grid.n_nodes, step):
         n1 = min(n0 + step, grid.n_nodes)
@@ -412,7 +413,7 @@ def _switch_operator(
     base = ((1 - q) * (nr + 1) + i) * nt
     spread = sigma * math.sqrt(3.0 * penalty_s)
     cols = np.empty((m, 1, 3, 2), dtype=np.int32)
-    vals = np.empty((m, 1, 3, 2), dtype=dtype)
+    vals: NDArray[Any] = np.empty((m, 1, 3, 2), dtype=dtype)
     for k, (off, wgt) in enumerate(zip(GH3_OFFSETS, GH3_WEIGHTS, strict=True)):
         ft = (j * grid.dtheta + a * penalty_s + off * spread) / grid.dtheta
         j0f = np.floor(ft)
@@ -563,7 +564,7 @@ class DeadlinePolicy:
     @property
     def s_s(self) -> NDArray[np.float64]:
         """Budget of each slice [s]."""
-        return self.grid.ds_s * np.arange(self.grid.n_s + 1)
+        return self.grid.ds_s * np.arange(self.grid.n_s + 1, dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False)

@@ -112,8 +112,9 @@ def time_summary(
     out: dict[str, object] = {"n_runs": int(n), "n_failed": int(n - fin.size)}
     if fin.size:
         out["mean_s"] = float(np.mean(fin))
-        out["sd_s"] = float(np.std(fin, ddof=1)) if fin.size > 1 else 0.0
-        out["se_mean_s"] = float(out["sd_s"]) / math.sqrt(fin.size)  # type: ignore[arg-type]
+        sd = float(np.std(fin, ddof=1)) if fin.size > 1 else 0.0
+        out["sd_s"] = sd
+        out["se_mean_s"] = sd / math.sqrt(fin.size)
         # failures sort last; percentiles that fall on them are inf (without inf - inf warnings)
         top = float(np.max(fin))
         pct = np.percentile(np.where(np.isfinite(t), t, 2.0 * abs(top) + 1.0), TIME_PERCENTILES)

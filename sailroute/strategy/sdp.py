@@ -286,8 +286,8 @@ class ExpectedTimePolicy:
 
 def nominal_stage_time(grid: BeatGrid, polar: Polar, tws_ms: float) -> float:
     """Time [s] to make one row ``δy`` good at the polar's best upwind VMG."""
-    _, vmg = polar.best_vmg(tws_ms, upwind=True)
-    vmg = float(vmg)
+    _, vmg_ms = polar.vmg_upwind(tws_ms)
+    vmg = float(vmg_ms)
     if vmg <= 0:
         raise InputError(f"polar {polar.name!r} makes no VMG upwind at TWS {tws_ms} m/s")
     return grid.row_m / vmg

@@ -39,10 +39,10 @@ import io
 import math
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from datetime import UTC, datetime, tzinfo
 from pathlib import Path
-from typing import Final
+from typing import Final, cast
 from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 
 import numpy as np
@@ -219,7 +219,7 @@ def _local(tag: str) -> str:
 
 def _read_gpx(text: str, src: str, tz: tzinfo | None
               ) -> tuple[NDArray, NDArray, NDArray, NDArray, str, dict[str, NDArray]]:
-    parser = ET.XMLPullParser(events=("start", "end"))
+    parser: ET.XMLPullParser[ET.Element] = ET.XMLPullParser(events=("start", "end"))
     t: list[float] = []
     lat: list[float] = []
     lon: list[float] = []
@@ -232,8 +232,10 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
     try:
         for lineno, line in enumerate(text.splitlines(keepends=True), start=1):
             parser.feed(line)
-            for event, el in parser.read_events():
-                tag = _local(el.tag)  # type: ignore[union-attr]
+            # "start"/"end" events are (event, element) pairs
+            events = cast("Iterator[tuple[str, ET.Element]]", parser.read_events())
+            for event, el in events:
+                tag = _local(el.tag)
                 if event == "start":
                     if not root_seen:
                         root_seen = True
@@ -242,14 +244,14 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
                                              "expected <gpx> (a GPX 1.0/1.1 file)")
                     stack.append(tag)
                     if tag == "trkpt":
-                        pt = {"lat": el.get("lat", ""), "lon": el.get("lon", "")}  # type: ignore[union-attr]
+                        pt = {"lat": el.get("lat", ""), "lon": el.get("lon", "")}
                         pt_line = lineno
                     continue
                 stack.pop()
                 if tag == "time" and pt is not None and stack and stack[-1] == "trkpt":
-                    pt["time"] = (el.text or "").strip()  # type: ignore[union-attr]
+                    pt["time"] = (el.text or "").strip()
                 elif tag == "name" and stack and stack[-1] == "trk":
-                    names.append((el.text or "").strip())  # type: ignore[union-attr]
+                    names.append((el.text or "").strip())
                 elif tag == "trkpt" and pt is not None:
                     where = f"{src}: line {pt_line}"
                     if "time" not in pt or not pt["time"]:
@@ -267,11 +269,11 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
                     lines.append(pt_line)
                     pt = None
                 if len(stack) > 2:
-                    el.clear()  # type: ignore[union-attr]
+                    el.clear()
         parser.close()
     except ET.ParseError as exc:
-        line, col = exc.position
-        raise InputError(f"{src}:{line}:{col}: not well-formed XML ({exc}); is the file a "
+        err_line, err_col = exc.position
+        raise InputError(f"{src}:{err_line}:{err_col}: not well-formed XML ({exc}); is the file a "
                          "complete GPX export?") from None
     if not root_seen:
         raise InputError(f"{src}: no XML element found; expected a GPX file")
@@ -310,9 +312,9 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
         )
     if not body:
         raise InputError(f"{src}: the file has a header but no data rows")
-    units = {c: column_speed_unit(header[cmap[c]], speed_unit, src,
-                                  header_unit(header[cmap[c]])) for c in SPEED_COLUMNS
-             if c in cmap}
+    units: dict[str, str] = {c: column_speed_unit(header[cmap[c]], speed_unit, src,
+                                                  header_unit(header[cmap[c]]))
+                             for c in SPEED_COLUMNS if c in cmap}
     ncol = len(header)
     for r, lineno in zip(body, linenos, strict=True):
         if len(r) != ncol:

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from sailroute.errors import InputError, WindDataError
 from sailroute.geo import LocalFrame
 from sailroute.units import wrap180
-from sailroute.wind.base import WindField, prepare_points
+from sailroute.wind.base import Coverage, WindField, prepare_points
 from sailroute.wind.height import DEFAULT_EXPONENT
 from sailroute.wind.rotation import rotate_clockwise
 from sailroute.wind.stations import StationData, local_records
@@ -180,7 +180,7 @@ class BlendedWind:
         object.__setattr__(self, "_corr", tuple(corr))
 
     @property
-    def coverage(self):
+    def coverage(self) -> Coverage:
         """The base field's coverage."""
         return self.base.coverage
 

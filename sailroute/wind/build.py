@@ -224,6 +224,7 @@ def _build_uniform(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> 
         tws = _speed(chk, spec, required=True)
         twd = chk.number(spec, "twd_deg", lo=0.0, hi=360.0)
         chk.raise_if_any()
+        assert tws is not None  # required: reported above when missing or invalid
         return UniformWind(tws, twd, clamp=clamp)
     for key in ("tws_kn", "tws_ms", "twd_deg"):
         if key in spec:

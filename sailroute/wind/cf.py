@@ -576,6 +576,7 @@ def read_cf_header(
             if du not in DIRECTION_UNITS:
                 raise WindDataError(f"{label}: direction variable {names[1]} has units {du!r}; "
                                     "expected degrees (clockwise from true north)")
+        h: float | None
         if data_height_m is not None:
             h, hsrc = float(data_height_m), "argument"
         else:
@@ -749,9 +750,11 @@ def open_netcdf(
                             "(NaN: land or masked); check the course position and the file")
     z_out = hdr.data_height_m
     if height_m is not None:
+        z_in = hdr.data_height_m
+        assert z_in is not None  # a height correction without the data's height is refused above
         z_out = float(height_m)
-        f = (power_law_factor(hdr.data_height_m, z_out, exponent) if shear == "power"
-             else log_law_factor(hdr.data_height_m, z_out, roughness_m))
+        f = (power_law_factor(z_in, z_out, exponent) if shear == "power"
+             else log_law_factor(z_in, z_out, roughness_m))
         ue, ve = ue * f, ve * f
     lat_w = lat_o[w.j0:w.j1, w.i0:w.i1]
     lon_w = lon_o[w.j0:w.j1, w.i0:w.i1]

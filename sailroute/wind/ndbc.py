@@ -65,9 +65,9 @@ def read_ndbc(
         raise WindDataError(
             f"{name}: expected an NDBC header line starting with '#YY  MM DD hh mm'")
     names = lines[0].lstrip("#").split()
-    for col in ("YY", "MM", "DD", "hh", "mm", "WDIR", "WSPD"):
-        if col not in names:
-            raise WindDataError(f"{name}: NDBC header lacks column {col!r} (found {names})")
+    for need in ("YY", "MM", "DD", "hh", "mm", "WDIR", "WSPD"):
+        if need not in names:
+            raise WindDataError(f"{name}: NDBC header lacks column {need!r} (found {names})")
     col = {n: k for k, n in enumerate(names)}
     rows = [(k + 1, ln.split()) for k, ln in enumerate(lines) if ln.strip()
             and not ln.startswith("#")]

@@ -23,7 +23,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime, timedelta, timezone
 from pathlib import Path
-from typing import Any, Final
+from typing import Any, Final, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -272,11 +272,11 @@ def time_part_columns(header: Sequence[str], columns: Mapping[str, str] | None =
                                  f"({', '.join(stripped)})")
             out[part] = norm.index(col.strip().lower())
     for k, h in enumerate(stripped):
-        part = _PART_CASED.get(h)
-        if part is None:
-            part = next((q for q, names in _PART_ALIASES.items() if h.lower() in names), None)
-        if part is not None and part not in out and k not in out.values():
-            out[part] = k
+        found = _PART_CASED.get(h)
+        if found is None:
+            found = next((q for q, names in _PART_ALIASES.items() if h.lower() in names), None)
+        if found is not None and found not in out and k not in out.values():
+            out[found] = k
     if "minute" in out and "month" not in out and stripped[out["minute"]] == "mm":
         raise InputError(f"{where}: column 'mm' could be the month or the minute; say which "
                          "with `columns: {month: mm}` or `columns: {minute: mm}` (NDBC writes "
@@ -711,8 +711,8 @@ def resample_stations(data: StationData, interval_s: float, *, min_fill: float =
     np.maximum.at(gust, inv, np.where(np.isnan(data.gust_ms), -np.inf, data.gust_ms))
     gust[~np.isfinite(gust)] = np.nan
     out = StationData(
-        station=data.station[first], t=(b[first] + 0.5) * interval_s, lat=mean(data.lat),
-        lon=mean(data.lon), speed_ms=mean(data.speed_ms), direction_deg=dirn,
+        station=data.station[first], t=(b[first] + 0.5).astype(np.float64) * interval_s,
+        lat=mean(data.lat), lon=mean(data.lon), speed_ms=mean(data.speed_ms), direction_deg=dirn,
         height_m=mean(data.height_m), gust_ms=gust, source=data.source, n_raw=data.n_raw,
         n_missing=data.n_missing, missing_by_column=data.missing_by_column,
     )
@@ -779,6 +779,11 @@ def local_records(
 
 
 # ------------------------------------------------------------------------------ field
+RbfKernel = Literal["thin_plate_spline", "linear", "cubic", "quintic", "multiquadric",
+                    "inverse_multiquadric", "inverse_quadratic", "gaussian"]
+"""Kernel names of :class:`scipy.interpolate.RBFInterpolator`."""
+
+
 @dataclass(frozen=True, eq=False)
 class StationWind:
     """Wind field interpolated from station records.
@@ -812,7 +817,7 @@ class StationWind:
     roughness_m : float
         Log-law roughness length [m].
     rbf_kernel : str
-        Kernel for ``method="rbf"`` (see scipy).
+        Kernel for ``method="rbf"`` (see scipy; :data:`RbfKernel`).
     clamp : bool
         Clamp points to the coverage instead of raising.
     name : str
@@ -840,7 +845,7 @@ class StationWind:
     shear: str = "power"
     exponent: float = DEFAULT_EXPONENT
     roughness_m: float = DEFAULT_ROUGHNESS_M
-    rbf_kernel: str = "thin_plate_spline"
+    rbf_kernel: RbfKernel = "thin_plate_spline"
     clamp: bool = False
     name: str = "station wind"
     time_window: tuple[float, float] | None = None
@@ -911,7 +916,8 @@ class StationWind:
             pts = np.array([[s[2][0], s[3][0]] for s in series])
             # A degree-1 polynomial needs 3 non-collinear stations; with fewer, use the
             # linear kernel with a constant term (still exact at the stations).
-            kernel, deg = (self.rbf_kernel, None) if len(series) >= 3 else ("linear", 0)
+            kernel: RbfKernel = self.rbf_kernel if len(series) >= 3 else "linear"
+            deg = None if len(series) >= 3 else 0
             try:
                 rbf = RBFInterpolator(pts, np.eye(len(series)), kernel=kernel, degree=deg)
             except (ValueError, np.linalg.LinAlgError) as exc:
@@ -940,7 +946,8 @@ class StationWind:
                     c.append(np.full(t.shape, a[0]))
                 else:
                     c.append(np.interp(t, ts, a))
-        return tuple(np.stack(c, axis=-1) for c in cols)  # type: ignore[return-value]
+        x, y, u, v = (np.stack(c, axis=-1) for c in cols)
+        return x, y, u, v
 
     @property
     def station_ids(self) -> tuple[str, ...]:

@@ -447,7 +447,7 @@ def _read(ds: Any, vname: str, name: str, shape: tuple[int, ...], index: tuple[s
         )
     if speed:
         _check_units(var, vname, name)
-    a = np.ma.filled(np.ma.asarray(var[index], dtype=float), np.nan)
+    a: NDArray[np.float64] = np.ma.filled(np.ma.asarray(var[index], dtype=float), np.nan)
     _check_finite(a, vname, name, index)
     return a
 
@@ -642,6 +642,8 @@ def _from_model_levels(
     min_speed: float,
 ) -> tuple[NDArray, NDArray, NDArray | None, float]:
     name = raw.header.path
+    if raw.u is None or raw.v is None or raw.ph is None or raw.phb is None or raw.hgt is None:
+        raise InputError("levels 'model' needs the model-level arrays: read_wrf(model_levels=True)")
     um = destagger(raw.u, axis=-1)  # (nt, 2, ny, nx)
     vm = destagger(raw.v, axis=-2)
     z = mass_level_heights(raw.ph, raw.phb, raw.hgt)  # (nt, 2, ny, nx)

@@ -191,8 +191,6 @@ def test_vmg_shapes_and_calm() -> None:
     assert v[1, 1] == 0.0 and a[1, 1] == 0.0  # calm: documented convention
     a, v = p.vmg_downwind(0.0)
     assert float(a) == 180.0 and float(v) == 0.0
-    # best_vmg (older API) is the same continuous optimum
-    np.testing.assert_array_equal(p.best_vmg(3.0, upwind=False)[0], p.vmg_downwind(3.0)[0])
 
 
 def debski_speed(tws: float, twa_deg: float) -> float:

@@ -91,7 +91,7 @@ def laylines_time(wind, current, target, pen):
     """One tack, both boards at the VMG angles through the water: a g1 + pen C + b g2 =
     target (the boat drifts during the penalty), t = a + pen + b."""
     tws, twd = water_wind(wind, current)
-    a_up, vmg = (float(v) for v in POLAR.best_vmg(tws, upwind=True))
+    a_up, vmg = (float(v) for v in POLAR.vmg_upwind(tws))
     s = vmg / math.cos(math.radians(a_up))
     c = np.array([float(a) for a in current.sample(T0, 0.0, 0.0)])
     g = [s * np.array([math.sin(math.radians(twd + k * a_up)),

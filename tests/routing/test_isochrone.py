@@ -41,8 +41,8 @@ ROUNDOFF = 1e-9  # relative float64 round-off over ~100-300 steps
 
 
 POLAR = laser_like_polar()
-A_UP, VMG_UP = (float(v) for v in POLAR.best_vmg(TWS, upwind=True))
-A_DN, VMG_DN = (float(v) for v in POLAR.best_vmg(TWS, upwind=False))
+A_UP, VMG_UP = (float(v) for v in POLAR.vmg_upwind(TWS))
+A_DN, VMG_DN = (float(v) for v in POLAR.vmg_downwind(TWS))
 SET = RoutingSettings()
 
 

@@ -49,7 +49,7 @@ from tests.routing.polars import laser_like_polar
 POLAR = laser_like_polar()
 TWS = 4.37  # 8.5 kn [m s⁻¹]
 T0 = 1_524_567_600.0
-VMG_UP = float(POLAR.best_vmg(TWS, upwind=True)[1])
+VMG_UP = float(POLAR.vmg_upwind(TWS)[1])
 
 ROUTERS = {"isochrone": route_isochrone, "griddp": route_griddp, "spline": route_spline}
 L = 600.0
