@@ -7,6 +7,8 @@ Usage::
     python benchmarks/bench_deadline.py --grid 401,512 --interp cubic --figs 4b
     python benchmarks/bench_deadline.py --grid 801,1024 --solve-only --s-max 5
                                                    # time a few budget slices only
+    python benchmarks/bench_deadline.py --grid 401,512 --figs 4b --solve-only \
+        --engine numpy,numba,numpy,numba           # NumPy vs the numba kernels, one run
 
 ``--grid NR1,NT`` gives the nodes in ``r`` (``n_r + 1``) and the intervals in ``θ``; the
 budget step is the largest ``Δs = C/n`` with ``f_max Δs <= Δr`` (the CLI's rule), the
@@ -124,12 +126,12 @@ def run_fig(name: str, args: argparse.Namespace) -> dict:
     polar = so40()
     print(f"Fig {name}: grid {g.n_r + 1} x {g.n_theta} x 2, Δs {g.ds_s:g} ({g.n_s} slices), "
           f"{g.interpolation}, refine {g.refine_controls}; {uptime()}", flush=True)
-    ra = solve_deadline(polar, 1.0, m, g, C, dtype=args.dtype)
+    ra = solve_deadline(polar, 1.0, m, g, C, dtype=args.dtype, engine=args.engine)
     out: dict = {"fig": name, "grid": [g.n_r + 1, g.n_theta], "ds": g.ds_s, "n_s": g.n_s,
                  "interpolation": g.interpolation, "refine": g.refine_controls,
-                 "dtype": args.dtype, "solve_s": ra.solve_time_s,
+                 "dtype": args.dtype, "engine": args.engine, "solve_s": ra.solve_time_s,
                  "rss_gb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6}
-    print(f"  risk-aware solve {ra.solve_time_s:.1f} s "
+    print(f"  risk-aware solve ({args.engine}) {ra.solve_time_s:.1f} s "
           f"({1e3 * ra.solve_time_s / g.n_s:.1f} ms/slice), peak RSS {out['rss_gb']:.1f} GB",
           flush=True)
     if args.solve_only:
@@ -202,6 +204,9 @@ def main() -> None:
     ap.add_argument("--ds-cells", type=float, default=1.0,
                     help="budget step in radial cells at top speed (paper: 1)")
     ap.add_argument("--dtype", default="float32", choices=("float32", "float64"))
+    ap.add_argument("--engine", default="auto",
+                    help="risk-aware solver kernels, auto, numpy or numba (the extra "
+                    "sailroute[fast]); a comma list runs every figure with each in turn")
     ap.add_argument("--figs", default="3,4a,4b")
     ap.add_argument("--runs", type=int, default=20000)
     ap.add_argument("--seed", type=int, default=1)
@@ -214,7 +219,11 @@ def main() -> None:
     args = ap.parse_args()
     print(uptime())
     run = check_dtype if args.check_dtype else run_fig
-    results = [run(f.strip(), args) for f in args.figs.split(",")]
+    results = []
+    for f in args.figs.split(","):
+        for engine in args.engine.split(","):
+            results.append(run(f.strip(), argparse.Namespace(**{**vars(args),
+                                                                "engine": engine.strip()})))
     print(uptime())
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:

@@ -51,6 +51,7 @@ from numpy.typing import NDArray
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 from sailroute.parallel import TaskRunner, map_tasks
+from sailroute.strategy import _deadline_jit as _jit
 from sailroute.strategy.montecarlo import CHUNK_SIZE, chunk_rng
 from sailroute.strategy.shiftmodel import DriftDiffusionShift
 
@@ -402,6 +403,44 @@ def _steer_operator(
     return _RowOperator.build(cols, vals, grid.n_nodes + 2)
 
 
+@dataclass(frozen=True, eq=False)
+class _CompiledSteer:
+    """The steering operator in the form the numba slice kernel reads
+    (:mod:`sailroute.strategy._deadline_jit`): bilinear rows in the padded form, or the
+    CSR rows of a :class:`_RowOperator` (bicubic)."""
+
+    bilinear: bool
+    cols: NDArray[np.uint32]
+    vals: NDArray
+    n_u: int
+    per_row: int
+    """Entries per CSR row; bilinear: the padded ring length ``n_θ + 1``."""
+    xpad: NDArray
+    """Scratch for the padded slice (bilinear)."""
+
+    @classmethod
+    def build(cls, grid: DeadlineGrid, speeds: NDArray[np.float64], a: float, sigma: float,
+              tau: float, dtype: type) -> _CompiledSteer:
+        """The steering operator of :func:`_steer_operator` (``outer="fail"``)."""
+        u = grid.controls_rad
+        if grid.interpolation == "cubic":
+            op = _steer_operator(grid, speeds, a, sigma, tau, "fail", "cubic", dtype)
+            return cls(False, op.indices.view(np.uint32), op.data, u.size, op.per_row,
+                       np.zeros(1, dtype=dtype))
+        # the same arithmetic as _feet_stencil, one pass (the angle tables from NumPy)
+        q = np.arange(2)[:, None, None]
+        ang = grid.theta_rad[None, :, None] + np.where(q == 0, 1.0, -1.0) * u
+        cols = np.empty((grid.n_nodes, u.size, 2), dtype=np.uint32)
+        vals: NDArray[Any] = np.empty((grid.n_nodes, u.size, 8), dtype=dtype)
+        _jit.steer_stencil_bilinear(
+            np.cos(ang), np.sin(ang), np.asarray(speeds, dtype=np.float64), grid.n_r,
+            grid.n_theta, grid.dr, grid.dtheta, grid.target_radius_m, grid.r_max_m, tau, a,
+            1.0 * sigma * math.sqrt(tau), cols, vals)
+        n_pad = _jit.padded_offset(grid.n_theta) + 2 * (grid.n_r + 1) * (grid.n_theta + 1)
+        return cls(True, cols.reshape(-1), vals.reshape(-1), u.size, grid.n_theta + 1,
+                   np.zeros(n_pad, dtype=dtype))
+
+
 def _switch_operator(
     grid: DeadlineGrid, a: float, sigma: float, penalty_s: float, dtype: type = np.float32
 ) -> _RowOperator:
@@ -636,6 +675,18 @@ def _rings_all_sure(w_prev: NDArray, grid: DeadlineGrid, lo: int, hi: int) -> in
     return lo
 
 
+ENGINES = ("auto", "numpy", "numba")
+
+
+def _use_compiled(engine: str) -> bool:
+    """Whether ``engine`` selects the numba kernels (raises if it cannot)."""
+    if engine not in ENGINES:
+        raise InputError(f"engine {engine!r}: expected one of {', '.join(ENGINES)}")
+    if engine == "numba" and not _jit.AVAILABLE:
+        raise InputError("engine 'numba' needs numba: pip install 'sailroute[fast]'")
+    return engine == "numba" or (engine == "auto" and _jit.AVAILABLE)
+
+
 def solve_deadline(
     polar: Polar,
     tws_ms: float,
@@ -644,6 +695,7 @@ def solve_deadline(
     tack_penalty_s: float,
     progress: Callable[[int, int], None] | None = None,
     dtype: str = "float32",
+    engine: str = "auto",
 ) -> DeadlinePolicy:
     """March ``w`` over the budget slices ``s = 0, Δs, ..., s_max`` (module docstring).
 
@@ -665,6 +717,11 @@ def solve_deadline(
         Precision of the operators and of ``w``.  ``float32`` (default) halves the
         memory and the memory traffic; it changes ``w`` by at most a few 1e-6 on the
         paper's set-up (``benchmarks/bench_deadline.py``).
+    engine : {"auto", "numpy", "numba"}
+        ``"numba"``: the compiled kernels of :mod:`sailroute.strategy._deadline_jit`
+        (the optional extra ``sailroute[fast]``) build the bilinear operator and march
+        the slices without golden refinement; the policy is the same bit for bit as
+        with ``"numpy"``.  ``"auto"`` (default): numba where it is installed.
 
     Returns
     -------
@@ -684,16 +741,20 @@ def solve_deadline(
     if dtype not in ("float32", "float64"):
         raise InputError(f"dtype {dtype!r}: expected 'float32' or 'float64'")
     ftype = np.dtype(dtype).type
+    compiled = _use_compiled(engine)
     kc = grid.penalty_steps(tack_penalty_s)
     a, sigma = _model_rates(model)
     f = _controls_speed(grid, polar, tws_ms)
     f_max = float(np.max(f))
-    steer_op = _steer_operator(grid, f, a, sigma, grid.ds_s, "fail", grid.interpolation, ftype)
-    switch_op = _switch_operator(grid, a, sigma, tack_penalty_s, ftype)
     refine = (
         _SteerRefiner(grid, polar, tws_ms, a, sigma, grid.ds_s)
         if grid.refine_controls != "none" else None
     )
+    kernel = (_CompiledSteer.build(grid, f, a, sigma, grid.ds_s, ftype)
+              if compiled and refine is None else None)
+    steer_op = (None if kernel is not None else
+                _steer_operator(grid, f, a, sigma, grid.ds_s, "fail", grid.interpolation, ftype))
+    switch_op = _switch_operator(grid, a, sigma, tack_penalty_s, ftype)
     n_s, n_nodes, nt = grid.n_s, grid.n_nodes, grid.n_theta
     per_tack = (grid.n_r + 1) * nt
     n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))  # rings inside the mark
@@ -705,6 +766,7 @@ def solve_deadline(
     switch = np.zeros((n_s + 1, n_nodes), dtype=np.bool_)
     offset = np.zeros((n_s + 1, n_nodes), dtype=np.int8) if refine is not None else None
     reach_time = (grid.r_m - grid.target_radius_m) / f_max  # per ring
+    consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
     lo = n_in
     for k in range(1, n_s + 1):
         prev = w[k - 1]
@@ -719,6 +781,16 @@ def solve_deadline(
             switch[k, base:keep_to] = switch[k - 1, base:keep_to]
             if offset is not None:
                 offset[k, base:keep_to] = offset[k - 1, base:keep_to]
+            if kernel is not None:
+                if q == 0 and kernel.bilinear:
+                    _jit.pad_slice(prev, nt, kernel.xpad)
+                _jit.slice_update(
+                    kernel.bilinear, kernel.cols, kernel.vals, kernel.n_u, kernel.per_row,
+                    prev, kernel.xpad, switch_op.data, switch_op.indices.view(np.uint32),
+                    w[max(k - kc, 0)], k >= kc, keep_to, base + hi * nt, *consts,
+                    steer[k - 1], switch[k - 1], w[k], steer[k], switch[k])
+                continue
+            assert steer_op is not None
             for n0 in range(keep_to, base + hi * nt, BLOCK_NODES):
                 n1 = min(n0 + BLOCK_NODES, base + hi * nt)
                 vals = steer_op.apply(prev, n0, n1)

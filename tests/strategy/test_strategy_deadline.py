@@ -1,4 +1,4 @@
-"""Risk-aware (deadline) and risk-neutral target-relative solvers of seed 004.
+"""Risk-aware (deadline) and risk-neutral target-relative solvers (Wang et al. 2024).
 
 Default tests run the paper's nondimensional set-up on a coarse grid (100 x 128 nodes per
 tack, Δs = 0.4 instead of 1600 x 1600, 0.025) and assert qualitative facts and closed forms;
@@ -26,7 +26,7 @@ from sailroute.strategy.deadline import (
 )
 from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
 
-# Sun Odyssey 40, TWS 8 kn column (seed brief §2.2), scaled to f_max = 0.05
+# Sun Odyssey 40, TWS 8 kn column (Wang et al. 2024, Table 1), scaled to f_max = 0.05
 SO40_TWA = np.array([0, 5, 10, 15, 20, 25, 32, 36, 40, 45, 52, 60, 70, 80, 90, 100, 110, 120,
                      130, 140, 150, 160, 170, 180], dtype=float)
 SO40_KN = np.array([0.0, 0.6, 1.2, 1.8, 2.1, 2.5, 4.1, 4.6, 5.0, 5.4, 5.8, 6.2, 6.4, 6.5, 6.5,
@@ -38,7 +38,7 @@ SIGMA = 0.05  # rad per sqrt(time unit)
 
 
 def model(a: float, sigma: float) -> DriftDiffusionShift:
-    # seed 004's a is counter-clockwise; sailroute's drift is a compass veer: opposite sign
+    # Wang et al.'s a is counter-clockwise; sailroute's drift is a compass veer: opposite sign
     return DriftDiffusionShift(-math.degrees(a), math.degrees(sigma))
 
 
@@ -46,8 +46,8 @@ def grid(s_max: float) -> DeadlineGrid:
     return DeadlineGrid(2.0, 100, 128, 0.1, 0.4, s_max)
 
 
-def test_seed_004_polar_vmg_known_answers() -> None:
-    # brief §2.2 / O1 (continuous, linear interpolation): 41.73°, 0.029498 up; 148.93°,
+def test_wang_2024_polar_vmg_known_answers() -> None:
+    # Wang et al. (2024) (continuous, linear interpolation): 41.73°, 0.029498 up; 148.93°,
     # 0.031320 down; on the 49 controls: 41.25°, 0.029495 up; 150.00°, 0.031310 down
     ang, vmg = SO40.vmg_upwind(1.0)
     assert float(ang) == pytest.approx(41.73, abs=0.005)
@@ -65,7 +65,7 @@ def test_seed_004_polar_vmg_known_answers() -> None:
 
 
 def test_three_node_gauss_hermite_is_exact_to_degree_five() -> None:
-    # O7: nodes m + {-1, 0, 1} sqrt(3 v), weights 1/6, 2/3, 1/6; Gaussian moments of N(m, v)
+    # nodes m + {-1, 0, 1} sqrt(3 v), weights 1/6, 2/3, 1/6; Gaussian moments of N(m, v)
     m, v = 0.3, 0.02
     nodes = m + np.array(GH3_OFFSETS) * math.sqrt(3 * v)
     w = np.array(GH3_WEIGHTS)
@@ -87,7 +87,7 @@ def test_brownian_equivalent_matches_ou_change_over_horizon() -> None:
 
 @pytest.fixture(scope="module")
 def fig4a():
-    """Seed 004 Fig. 4(a): a = 0.05, σ = 0.05, C = 2, start (1.80, 2.67, starboard), ŝ = 42."""
+    """Wang et al. (2024) Fig. 4(a): a = σ = 0.05, C = 2, start (1.80, 2.67, starboard), ŝ = 42."""
     g = grid(46.0)
     m = model(0.05, SIGMA)
     ra = solve_deadline(SO40, 1.0, m, g, C)
@@ -102,7 +102,7 @@ def test_w_is_a_probability_non_decreasing_in_budget(fig4a) -> None:
     ra = fig4a[0]
     g = ra.grid
     assert np.all(ra.w >= 0.0) and np.all(ra.w <= 1.0)
-    assert np.all(np.diff(ra.w, axis=0) >= -1e-6)  # O8: more time never hurts
+    assert np.all(np.diff(ra.w, axis=0) >= -1e-6)  # more time never hurts
     r = np.tile(np.repeat(g.r_m, g.n_theta), 2)
     assert np.all(ra.w[:, r <= g.target_radius_m] == 1.0)  # inside the mark
     f_max = float(np.max(ra.speeds_ms))
@@ -134,7 +134,7 @@ def test_risk_aware_beats_risk_neutral_at_its_deadline(fig4a) -> None:
 
 
 def test_risk_neutral_has_the_lower_mean(fig4a) -> None:
-    # O8: E[T_μ*] <= E[T_α] (paper 43.83 vs 44.30), within MC error
+    # E[T_μ*] <= E[T_α] (paper 43.83 vs 44.30), within MC error
     _, _, _, sim_rn, sim_ra = fig4a
     se = math.hypot(np.std(sim_rn.leg_time_s), np.std(sim_ra.leg_time_s)) / math.sqrt(2000)
     assert np.mean(sim_rn.leg_time_s) <= np.mean(sim_ra.leg_time_s) + 3 * se
@@ -144,7 +144,7 @@ def test_risk_neutral_has_the_lower_mean(fig4a) -> None:
 
 
 def test_ecdf_of_any_policy_stays_below_w(fig4a) -> None:
-    # O8: F_π(s) <= w(s).  On a coarse grid w is the true curve smeared by numerical
+    # F_π(s) <= w(s).  On a coarse grid w is the true curve smeared by numerical
     # diffusion: too high left of the median arrival time, too low right of it (at s = 44
     # here w = 0.52 while μ* already achieves 0.60).  The bound is checked on the left tail,
     # where deadlines are interesting, with 3 MC standard errors plus 0.03.
@@ -179,7 +179,7 @@ def test_deadline_monte_carlo_is_chunk_independent(fig4a) -> None:
 
 @pytest.fixture(scope="module")
 def steady():
-    """σ = 0, a = 0 from the Fig. 3 start: the deterministic problem (brief O5/B4)."""
+    """σ = 0, a = 0 from the Fig. 3 start: the deterministic problem (closed form)."""
     g = grid(60.0)
     m = model(0.0, 0.0)
     rn = solve_risk_neutral(SO40, 1.0, m, g, C, tol_s=1e-2)
@@ -187,8 +187,8 @@ def steady():
 
 
 def test_zero_volatility_matches_deterministic_two_leg_answer(steady) -> None:
-    # O5: T_det = 1.5352 / 0.029498 + C = 54.04 from (1.93, 0.56, starboard): starboard
-    # 6.56, one switch, port 45.49 (closed form in the seed brief).  The Monte Carlo of the
+    # T_det = 1.5352 / 0.029498 + C = 54.04 from (1.93, 0.56, starboard): starboard
+    # 6.56, one switch, port 45.49 (one switch at the lay line).  The Monte Carlo of the
     # risk-neutral policy is deterministic and must be within 0.3 (0.6 %: headings of
     # 3.75° steps, Δr = 0.02, Euler steps); w(s) smeared by numerical diffusion crosses 1/2
     # within 1.0 of T_det.
@@ -230,7 +230,7 @@ def test_cubic_interpolation_runs_and_stays_a_probability() -> None:
 
 
 @pytest.mark.slow
-def test_seed_004_fig3_numbers_on_a_finer_grid() -> None:
+def test_wang_2024_fig3_numbers_on_a_finer_grid() -> None:
     # Paper (1601 x 1601, Δs = 0.025, bicubic ENO, 1e5 runs): E[T] μ* 54.46;
     # P(T <= 56) 52.5 % (μ*) -> 58.9 % (α^56).  Here 200 x 256, Δs = 0.2, bilinear,
     # 4000 runs: allow 0.5 in the mean and 3 percentage points (+ MC error ~0.8 pp).
@@ -355,3 +355,32 @@ def test_golden_policy_simulates(golden) -> None:
     sim = simulate_deadline(rn, 400, 3, (1.80, 2.67, 1), ra=fine, deadline_s=42.0)
     assert np.all(np.isfinite(sim.leg_time_s))
     assert np.mean(sim.n_switches == 0) > 0.5  # the bet on the shift, as the coarse policy
+
+
+@pytest.mark.parametrize(("interpolation", "fig"), [("linear", (0.05, 46.0)),
+                                                    ("cubic", (0.0, 20.0))])
+def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig) -> None:
+    # the numba kernels do the NumPy arithmetic in the same order: the same w and actions
+    pytest.importorskip("numba")
+    a, s_max = fig
+    g = DeadlineGrid(2.0, 40, 48, 0.1, 0.4, s_max, interpolation=interpolation)
+    m = model(a, SIGMA)
+    ref = solve_deadline(SO40, 1.0, m, g, C, engine="numpy")
+    jit = solve_deadline(SO40, 1.0, m, g, C, engine="numba")
+    assert ref.w.max() > 0.5  # a solve with something to compare
+    assert np.array_equal(jit.w, ref.w)
+    assert np.array_equal(jit.steer, ref.steer)
+    assert np.array_equal(jit.switch, ref.switch)
+
+
+def test_engine_errors(monkeypatch) -> None:
+    from sailroute.strategy import _deadline_jit
+
+    g = DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 2.0)
+    with pytest.raises(InputError, match="engine 'cuda': expected one of auto, numpy, numba"):
+        solve_deadline(SO40, 1.0, model(0.0, SIGMA), g, C, engine="cuda")
+    monkeypatch.setattr(_deadline_jit, "AVAILABLE", False)
+    with pytest.raises(InputError, match=r"pip install 'sailroute\[fast\]'"):
+        solve_deadline(SO40, 1.0, model(0.0, SIGMA), g, C, engine="numba")
+    # auto falls back to NumPy
+    assert solve_deadline(SO40, 1.0, model(0.0, SIGMA), g, C).w.shape == (g.n_s + 1, g.n_nodes)
