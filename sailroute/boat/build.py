@@ -258,8 +258,8 @@ def boat_from_spec(
         if not problems:
             raise
         lines = str(exc).split("\n")
-        extra = [ln.strip()[2:] for ln in lines[1:]] if len(lines) > 1 else [
-            lines[0][len(where) + 2:]]
+        extra = [ln.strip()[2:].removeprefix(f"{where}: ") for ln in lines[1:]] if len(
+            lines) > 1 else [lines[0].removeprefix(f"{where}: ")]
         problems.extend(extra)
     _raise(where, problems)
     return vpp_polar(params, interpolation=interpolation, kinetics=kinetics)
