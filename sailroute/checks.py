@@ -294,9 +294,6 @@ class Checker:
         """A finite number (int or float, not a boolean) in ``[lo, hi]`` (``(lo, hi]``
         with ``lo_open``); a null value counts as absent.  ``what`` overrides the
         generated ``"a number in [lo, hi]"`` / ``"a number > lo"`` in messages."""
-        if key not in d or d[key] is None:
-            return self.absent(key, default, what or "a number")
-        v = d[key]
         if what is None:
             if lo is not None and hi is not None:
                 what = f"a number in {'(' if lo_open else '['}{lo:g}, {hi:g}]"
@@ -306,6 +303,9 @@ class Checker:
                 what = f"a number <= {hi:g}"
             else:
                 what = "a number"
+        if key not in d or d[key] is None:
+            return self.absent(key, default, what)
+        v = d[key]
         if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(float(v)):
             self.add(key, f"expected {what}; got {show(v)}")
             return None
@@ -334,8 +334,7 @@ class Checker:
             return self.absent(key, default, f"one of {quoted(choices)}")
         v = d[key]
         if v not in choices:
-            hint = suggest(v, [c for c in choices if c is not None]) if isinstance(
-                v, str) else ""
+            hint = suggest(v, choices) if isinstance(v, str) else ""
             self.add(key, f"expected one of {quoted(choices)}; got {show(v)}"
                      + (f" ({hint.strip()})" if hint else ""))
             return None
