@@ -138,7 +138,7 @@ def _start_time(c: Checker, data: Mapping[str, Any]) -> datetime | None:
 def _latlon(c: Checker, d: Mapping[str, Any], path: str) -> tuple[float, float] | None:
     lat = c.at(path).number(d, "lat", lo=-90.0, hi=90.0, what="a latitude in [-90, 90] degrees")
     lon = c.at(path).number(d, "lon", lo=-180.0, hi=360.0,
-                   what="a longitude in [-180, 360] degrees")
+                            what="a longitude in [-180, 360] degrees")
     # 0..360 longitudes are accepted and wrapped to [-180, 180), as GPX and plan.json use
     return None if lat is None or lon is None else (lat, float(wrap_lon(lon)))
 
@@ -354,14 +354,15 @@ def _routing(c: Checker, raw: Any) -> RoutingSettings:
     c.at("routing").keys(raw, list(fields))
     defaults = RoutingSettings()
     kw: dict[str, Any] = {}
+    r = c.at("routing")
     special: dict[str, Callable[[], Any]] = {
-        "router": lambda: c.at("routing").choice(raw, "router", typing.get_args(RouterName)),
-        "dt_s": lambda: c.at("routing").number(raw, "dt_s", lo=0.0, lo_open=True),
-        "heading_step_deg": lambda: c.at("routing").number(raw, "heading_step_deg", lo=0.0,
-                                             hi=45.0, lo_open=True),
-        "tack_penalty_s": lambda: c.at("routing").number(raw, "tack_penalty_s", lo=0.0),
-        "gybe_penalty_s": lambda: c.at("routing").number(raw, "gybe_penalty_s", lo=0.0),
-        "initial_side": lambda: c.at("routing").choice(raw, "initial_side", (*SIDES, None)),
+        "router": lambda: r.choice(raw, "router", typing.get_args(RouterName)),
+        "dt_s": lambda: r.number(raw, "dt_s", lo=0.0, lo_open=True),
+        "heading_step_deg": lambda: r.number(raw, "heading_step_deg", lo=0.0, hi=45.0,
+                                             lo_open=True),
+        "tack_penalty_s": lambda: r.number(raw, "tack_penalty_s", lo=0.0),
+        "gybe_penalty_s": lambda: r.number(raw, "gybe_penalty_s", lo=0.0),
+        "initial_side": lambda: r.choice(raw, "initial_side", (*SIDES, None)),
     }
     for key in raw:
         if key not in fields:
@@ -484,7 +485,7 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
     for name, value in c.at("scenarios").named_items(raw, "a scenario name"):
         path = join_path("scenarios", name)
         if not c.at(path).is_mapping(value, "a wind spec {type: ...} or {wind: {type: ...}, "
-                         "references: ..., description: ...}"):
+                                     "references: ..., description: ...}"):
             continue
         keys = ("wind", "members", "references", "description", "current")
         cur, cwhere = None, ""  # surface current spec (sailroute.current), key path
@@ -499,10 +500,10 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
                 continue
             refs = _references(c, value.get("references"), join_path(path, "references"), n_legs)
             desc = c.at(path).string(value, "description", "") or ""
-            if value.get("current") is not None and c.at(join_path(path, "current")).is_mapping(
-                    value["current"],
-                    "a current spec {type: uniform|diamonds|netcdf, ...}"):
-                cur, cwhere = dict(value["current"]), c.p.prefix(join_path(path, "current"))
+            cchk = c.at(join_path(path, "current"))
+            if value.get("current") is not None and cchk.is_mapping(
+                    value["current"], "a current spec {type: uniform|diamonds|netcdf, ...}"):
+                cur, cwhere = dict(value["current"]), cchk.where()
             if "members" in value:
                 mpath = join_path(path, "members")
                 for k, (spec, where) in enumerate(_members(c, value["members"], mpath), 1):
@@ -537,8 +538,8 @@ def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], s
             return []
         items = [(spec, f"{path}[{k}]") for k, spec in enumerate(raw)]
         return [(s, w) for s, w in items if _wind_spec(c, s, w)]
-    if not c.at(path).is_mapping(raw, "a list of wind specs, or {dim: NAME, wind: {type: netcdf, "
-                     "path: FILE}} (one member per index of that dimension)"):
+    if not c.at(path).is_mapping(raw, "a list of wind specs, or {dim: NAME, wind: {type: "
+                                 "netcdf, path: FILE}} (one member per index of that dimension)"):
         return []
     c.at(path).keys(raw, ("dim", "wind"), ("dim", "wind"))
     dim, wpath = raw.get("dim"), join_path(path, "wind")
@@ -612,14 +613,15 @@ def _template(
     c: Checker, raw: Any, time_limit_min: float | None = None
 ) -> tuple[CourseLayout | None, Position | None]:
     """Validate ``template`` and build its layout around ``centre`` (in a provisional frame)."""
-    if not c.at("template").is_mapping(raw, "{type: windward-leeward|trapezoid, twd_deg, "
-                     "leg_length_m, centre, ...}"):
+    t = c.at("template")
+    if not t.is_mapping(raw, "{type: windward-leeward|trapezoid, twd_deg, leg_length_m, "
+                        "centre, ...}"):
         return None, None
-    kind = c.at("template").choice(raw, "type", list(_TEMPLATE_KEYS))
+    kind = t.choice(raw, "type", list(_TEMPLATE_KEYS))
     if kind is None:
         return None, None
     spec = _TEMPLATE_KEYS[kind]
-    c.at("template").keys(raw, ("type", "centre", *spec), ("twd_deg", "leg_length_m", "centre"))
+    t.keys(raw, ("type", "centre", *spec), ("twd_deg", "leg_length_m", "centre"))
     centre = _position(c, raw["centre"], "template.centre", "the course centre") if (
         "centre" in raw) else None
     kw: dict[str, Any] = {}
@@ -627,15 +629,15 @@ def _template(
         if key not in raw:
             continue
         if rule == _DIR:
-            v = c.at("template").number(raw, key, lo=0.0, hi=360.0)
+            v = t.number(raw, key, lo=0.0, hi=360.0)
         elif rule == _POS:
-            v = c.at("template").number(raw, key, lo=0.0, lo_open=True)
+            v = t.number(raw, key, lo=0.0, lo_open=True)
         elif rule == _NONNEG:
-            v = c.at("template").number(raw, key, lo=0.0)
+            v = t.number(raw, key, lo=0.0)
         elif rule == "int":
-            v = c.at("template").integer(raw, key, None, lo=1)
+            v = t.integer(raw, key, None, lo=1)
         else:
-            v = c.at("template").choice(raw, key, rule)
+            v = t.choice(raw, key, rule)
         if v is not None:
             kw[key] = v
     if centre is None or any(k not in kw for k in ("twd_deg", "leg_length_m")) or any(
