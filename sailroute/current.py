@@ -279,6 +279,7 @@ def current_from_spec(
     where: str,
     crop_bbox: tuple[float, float, float, float] | None = None,
     time_window: tuple[float, float] | None = None,
+    lines: Mapping[str, int] | None = None,
 ) -> CurrentField:
     """Build a current field from a scenario's ``current:`` mapping.
 
@@ -297,6 +298,9 @@ def current_from_spec(
     crop_bbox, time_window : optional
         Course box [m] and race window [epoch s] that the current must cover
         (unless ``clamp: true``), as for a wind spec.
+    lines : mapping of str to int, optional
+        1-based line of each key path of the file (the course's line map): each
+        problem is reported at its own key's line.
 
     Raises
     ------
@@ -305,49 +309,50 @@ def current_from_spec(
     OutOfCoverageError
         The current does not cover the course or the race time.
     """
+    from sailroute.checks import Checker, Problems, show
     from sailroute.timeutil import parse_time, to_epoch
     from sailroute.units import KNOT, SPEED_UNITS
-    from sailroute.wind._spec import SpecChecker
     from sailroute.wind.build import check_covers
 
-    chk = SpecChecker(where)
+    probs = Problems.below(where, lines, what="current spec")
+    chk = Checker(probs, probs.root)
     if not isinstance(spec, Mapping):
         raise InputError(f"{where}: expected a current spec mapping, e.g. {{type: uniform, "
-                         f"speed_kn: 1.5, set_deg: 90}}; got {spec!r}")
+                         f"speed_kn: 1.5, set_deg: 90}}; got {show(spec)}")
     kind = chk.choice(spec, "type", CURRENT_TYPES)
-    chk.raise_if_any("current spec")
+    chk.p.raise_if_any()
     field_: CurrentField
     if kind == "uniform":
-        chk.check_keys(spec, _UNIFORM_KEYS, ("set_deg",))
+        chk.keys(spec, _UNIFORM_KEYS, ("set_deg",))
         if "speed_kn" in spec and "speed_ms" in spec:
             chk.add("speed_kn", "give either speed_kn or speed_ms, not both")
         elif "speed_ms" in spec:
-            rate = chk.number(spec, "speed_ms", nonnegative=True)
+            rate = chk.number(spec, "speed_ms", lo=0.0)
         elif "speed_kn" in spec:
-            rate = chk.number(spec, "speed_kn", nonnegative=True)
+            rate = chk.number(spec, "speed_kn", lo=0.0)
             rate = None if rate is None else rate * KNOT
         else:
             chk.add("speed_kn", "missing required key; give the rate as speed_kn or speed_ms")
         set_deg = chk.number(spec, "set_deg", lo=0.0, hi=360.0) if "set_deg" in spec else None
-        chk.raise_if_any("current spec")
+        chk.p.raise_if_any()
         assert set_deg is not None  # required key: reported above when missing
         field_ = UniformCurrent(rate, set_deg)
     elif kind == "diamonds":
-        chk.check_keys(spec, _DIAMOND_KEYS, ("high_water", "table"))
+        chk.keys(spec, _DIAMOND_KEYS, ("high_water", "table"))
         unit = chk.choice(spec, "rate_unit", ["kn", "m/s"], "kn")
         scale = KNOT if unit == "kn" else 1.0
         clamp = chk.boolean(spec, "clamp", False)
         hw = None
         if "high_water" in spec:
             try:
-                hw = to_epoch(parse_time(spec["high_water"], where=chk.path("high_water")))
+                hw = to_epoch(parse_time(spec["high_water"], where=chk.where("high_water")))
             except InputError as exc:
-                chk.problems.append(str(exc))
+                chk.p.extend([str(exc)])
         rows: list[tuple[float, float, float]] = []
         table = spec.get("table")
         if "table" in spec and (not isinstance(table, list) or not table):
             chk.add("table", "expected a non-empty list of rows [hour, set_deg, rate_kn], "
-                    f"e.g. [[-6, 250, 0.4], [0, 70, 1.2]]; got {table!r}")
+                    f"e.g. [[-6, 250, 0.4], [0, 70, 1.2]]; got {show(table)}")
         elif isinstance(table, list):
             tchk = chk.child("table")
             for k, row in enumerate(table):
@@ -356,20 +361,20 @@ def current_from_spec(
                     for a in row))
                 if not ok:
                     tchk.add(k, f"expected [hour, set_deg, rate_{'kn' if scale != 1 else 'ms'}]"
-                             f" (three numbers), got {row!r}")
+                             f" (three numbers); got {row!r}")
                 elif not (0.0 <= row[1] <= 360.0 and row[2] >= 0):
-                    tchk.add(k, f"expected a set in [0, 360] and a rate >= 0, got {row!r}")
+                    tchk.add(k, f"expected a set in [0, 360] and a rate >= 0; got {row!r}")
                 elif rows and row[0] <= rows[-1][0]:
                     tchk.add(k, f"the hours must increase strictly from row to row "
                              f"({row[0]:g} after {rows[-1][0]:g})")
                 else:
                     rows.append((float(row[0]), float(row[1]), float(row[2]) * scale))
-        chk.raise_if_any("current spec")
+        chk.p.raise_if_any()
         h, s, r = (list(c) for c in zip(*rows, strict=True))
         assert hw is not None  # required key: reported above when missing or unreadable
         field_ = DiamondCurrent(hw, h, s, r, clamp=clamp)
     else:
-        chk.check_keys(spec, _NETCDF_KEYS, ("path",))
+        chk.keys(spec, _NETCDF_KEYS, ("path",))
         p = chk.string(spec, "path")
         path = None
         if p is not None:
@@ -383,13 +388,13 @@ def current_from_spec(
                     f"got {dict(var)!r}")
         unit = chk.string(spec, "speed_unit", None)
         if unit is not None and unit.strip().lower() not in SPEED_UNITS:
-            chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph', got {unit!r}")
+            chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
         sel = chk.mapping(spec, "select", None)
         opts = {"interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"],
                                             "linear"),
                 "steady": chk.boolean(spec, "steady", False),
                 "clamp": chk.boolean(spec, "clamp", False)}
-        chk.raise_if_any("current spec")
+        chk.p.raise_if_any()
         assert path is not None  # required key: reported above when missing
         try:
             field_ = open_netcdf_current(path, frame, variables=var, speed_unit=unit,

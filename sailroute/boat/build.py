@@ -142,7 +142,8 @@ def vpp_polar(
 
 
 def boat_from_spec(
-    spec: Mapping[str, Any], *, base_dir: Path, where: str, key: str = "boat"
+    spec: Mapping[str, Any], *, base_dir: Path, where: str, key: str = "boat",
+    lines: Mapping[str, int] | None = None,
 ) -> Polar:
     """Build the boat's polar from a course file's ``boat`` mapping.
 
@@ -160,6 +161,9 @@ def boat_from_spec(
         File label for messages, e.g. ``"courses/x.yaml"``.
     key : str
         Key path of ``spec`` in the file, prefixed to problems (``"boat"``).
+    lines : mapping of str to int, optional
+        1-based line of each key path of the file (the course's line map): the
+        ``vpp`` parameters' problems are reported at their own lines.
 
     Returns
     -------
@@ -182,8 +186,8 @@ def boat_from_spec(
 
         factors = efficiency_from_spec(spec["efficiency"], where=where, key=f"{key}.efficiency")
         rest = {k: v for k, v in spec.items() if k != "efficiency"}
-        return scale_polar(boat_from_spec(rest, base_dir=base_dir, where=where, key=key),
-                           **factors)
+        return scale_polar(boat_from_spec(rest, base_dir=base_dir, where=where, key=key,
+                                          lines=lines), **factors)
     forms = [f for f in _FORMS if f in spec]
     if len(forms) != 1:
         found = f"got {', '.join(forms)}" if forms else f"got keys {sorted(map(str, spec))}"
@@ -252,14 +256,17 @@ def boat_from_spec(
     if vspec is None:
         vspec = {}
     try:
+        vkey = f"{key}.vpp"
+        vlines = {k.removeprefix(vkey + "."): n for k, n in (lines or {}).items()
+                  if k.startswith(vkey + ".")}
         params = params_from_mapping(dict(vspec) if isinstance(vspec, Mapping) else vspec,
-                                     where=where, key=f"{key}.vpp")
+                                     where=where, key=vkey, lines=vlines)
     except InputError as exc:
         if not problems:
             raise
-        lines = str(exc).split("\n")
-        extra = [ln.strip()[2:] for ln in lines[1:]] if len(lines) > 1 else [
-            lines[0][len(where) + 2:]]
+        text = str(exc).split("\n")
+        extra = [ln.strip()[2:].removeprefix(f"{where}: ") for ln in text[1:]] if len(
+            text) > 1 else [text[0].removeprefix(f"{where}: ")]
         problems.extend(extra)
     _raise(where, problems)
     return vpp_polar(params, interpolation=interpolation, kinetics=kinetics)

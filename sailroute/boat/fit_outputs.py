@@ -204,6 +204,7 @@ def samples_from_course_wind(track: Track, course_path: str | Path,
         dict(sc.wind), frame=frame, base_dir=course.base_dir,
         where=sc.where or course.where(f"scenarios.{name}"),
         crop_bbox=(float(x.min()), float(x.max()), float(y.min()), float(y.max())),
+        lines=course.key_lines,
     )
     notes: list[str] = []
     t = np.asarray(track.t_s, float)

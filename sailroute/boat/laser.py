@@ -25,12 +25,12 @@ Sources (``docs/vpp.md`` has the full discussion):
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
 from typing import Any, Final
 
-from sailroute.errors import InputError, format_problems
+from sailroute.checks import Checker, Problems, join_path, quoted, show, split_where, suggest
+from sailroute.errors import InputError
 
 HULL_MODELS: Final = ("dsyhs", "thesis")
 STABILITY_MODELS: Final = ("hiking", "heel")
@@ -297,7 +297,8 @@ def params_from_mapping(
         ``class`` (``ilca4``, ``ilca6``, ``ilca7``; default ``ilca7``) and any
         :class:`LaserParams` field as an override.
     where : str
-        File label for messages (e.g. ``"boats/me.yaml"``).
+        File label for messages (e.g. ``"boats/me.yaml"``), or ``"file:LINE"`` of
+        the block (the line of problems whose own line is not in ``lines``).
     key : str
         Key path of ``spec`` inside the file (e.g. ``"boat.vpp"``), prefixed
         to each problem.
@@ -309,59 +310,58 @@ def params_from_mapping(
     ------
     InputError
         Listing every problem (unknown key, with a "did you mean" where one is
-        close; bad class; wrong type; bad value) with its key path.
+        close; bad class; wrong type; bad value) with its key path, in the wording
+        of :mod:`sailroute.checks`.
     """
-    prefix = f"{key}." if key else ""
+    file, line, _ = split_where(where)
+    known = {join_path(key, str(k)): v for k, v in (lines or {}).items()}
+    if line is not None:  # ``where`` is "file:LINE" of the block: the fallback line
+        known.setdefault("", line)
+    probs = Problems(file, known, what="boat spec" if key else "boat file")
+    c = Checker(probs, key)
     if not isinstance(spec, dict):
         raise InputError(f"{where}: {key or 'boat'}: expected a mapping of parameters; "
-                         f"got {type(spec).__name__}")
-    problems: list[tuple[str, str]] = []  # (top-level key, message without the file)
+                         f"got {show(spec)}")
     cls = spec.get("class", "ilca7")
     base = ILCA7
     if not isinstance(cls, str) or cls.lower() not in CLASSES:
-        problems.append(("class", f"{prefix}class: expected one of "
-                         f"{', '.join(map(repr, sorted(CLASSES)))}; got {cls!r}"))
+        hint = suggest(cls.lower(), CLASSES).strip() if isinstance(cls, str) else ""
+        c.add("class", f"expected one of {quoted(sorted(CLASSES))}; got {show(cls)}"
+              + (f" ({hint})" if hint else ""))
     else:
         base = CLASSES[cls.lower()]
-    types = {f.name: f.type for f in fields(LaserParams)}
-    defaults = {f.name: getattr(base, f.name) for f in fields(LaserParams)}
+    names = [f.name for f in fields(LaserParams)]
     overrides: dict[str, Any] = {}
     for k, v in spec.items():
         if k in _RESERVED:
             continue
-        if k not in types:
+        if k not in names:
             # "weight" is what sailors say for mass (crew_weight -> crew_mass_kg)
             word = str(k).lower().replace("weight", "mass")
-            close = difflib.get_close_matches(word, [*_RESERVED, *types], n=1, cutoff=0.6)
-            hint = f"did you mean {close[0]!r}? " if close else ""
-            problems.append((str(k), (
-                f"{prefix}{k}: unknown key; {hint}expected 'class' or a parameter such as "
-                "'crew_mass_kg' (see docs/vpp.md for the full list)")))
+            c.add(str(k), f"unknown key; {suggest(word, [*_RESERVED, *names])}expected "
+                  "'class' or a parameter such as 'crew_mass_kg' (see docs/vpp.md for the "
+                  "full list)")
             continue
-        default = defaults[k]
+        default = getattr(base, k)
         if isinstance(default, str):
-            if not isinstance(v, str):
-                problems.append((k, f"{prefix}{k}: expected a string; got {v!r}"))
-                continue
+            v = c.string(spec, k)
         elif isinstance(default, tuple):
             if not isinstance(v, list | tuple) or not all(
                 isinstance(x, int | float) and not isinstance(x, bool) for x in v
             ):
-                problems.append((k, f"{prefix}{k}: expected a list of numbers; got {v!r}"))
+                c.add(k, f"expected a list of numbers; got {v!r}")
                 continue
             v = tuple(float(x) for x in v)
         else:
-            if isinstance(v, bool) or not isinstance(v, int | float):
-                problems.append((k, f"{prefix}{k}: expected a number; got {v!r}"))
-                continue
-            v = float(v)
-        overrides[k] = v
-    if problems:
-        _raise_keyed(where, problems, lines)
+            v = c.number(spec, k)
+        if v is not None:
+            overrides[k] = v
+    probs.raise_if_any()
     params = replace(base, **overrides)
-    problems = [(p.split(":", 1)[0], f"{prefix}{p}") for p in validate(params)]
-    if problems:
-        _raise_keyed(where, problems, lines)
+    for problem in validate(params):
+        name, message = problem.split(": ", 1)
+        c.add(name, message)
+    probs.raise_if_any()
     return params
 
 
@@ -378,7 +378,7 @@ def validate(p: LaserParams) -> list[str]:
     for name in positive:
         v = getattr(p, name)
         if not v > 0 or v != v or v == float("inf"):
-            out.append(f"{name}: must be a positive finite number; got {v!r}")
+            out.append(f"{name}: expected a finite number > 0; got {v!r}")
     nonneg = (
         "wetted_area_m2", "form_factor", "rudder_area_m2", "appendage_form_factor",
         "effective_draft_m", "clr_depth_m", "sail_foot_height_m", "effective_span_m",
@@ -390,15 +390,15 @@ def validate(p: LaserParams) -> list[str]:
     for name in nonneg:
         v = getattr(p, name)
         if not v >= 0 or v == float("inf"):
-            out.append(f"{name}: must be a finite number >= 0; got {v!r}")
+            out.append(f"{name}: expected a finite number >= 0; got {v!r}")
     if not 0 <= p.flat_min < 1:
-        out.append(f"flat_min: must be in [0, 1); got {p.flat_min!r}")
+        out.append(f"flat_min: expected a number in [0, 1); got {p.flat_min!r}")
     if not 0 <= p.ease_flat <= 1:
-        out.append(f"ease_flat: must be in [0, 1]; got {p.ease_flat!r}")
+        out.append(f"ease_flat: expected a number in [0, 1]; got {p.ease_flat!r}")
     if not 0 <= p.twist_max <= 1:
-        out.append(f"twist_max: must be in [0, 1]; got {p.twist_max!r}")
+        out.append(f"twist_max: expected a number in [0, 1]; got {p.twist_max!r}")
     if not 0 <= p.windage_shielding < 1:
-        out.append(f"windage_shielding: must be in [0, 1); got {p.windage_shielding!r}")
+        out.append(f"windage_shielding: expected a number in [0, 1); got {p.windage_shielding!r}")
     if p.ce_height_m <= p.sail_foot_height_m:
         out.append(
             f"ce_height_m: must be above sail_foot_height_m ({p.sail_foot_height_m}); "
@@ -429,22 +429,6 @@ def validate(p: LaserParams) -> list[str]:
                    "(or crew_arm_m > 0); with none the boat cannot carry sail. Give gz_m "
                    "(and gz_heel_deg) or use stability: hiking")
     return out
-
-
-def _raise_keyed(
-    where: str, problems: list[tuple[str, str]], lines: Mapping[str, int] | None
-) -> None:
-    """Raise one InputError; with ``lines``, each problem is located as ``where:LINE:``."""
-    if lines is None:
-        texts = [m for _, m in problems]
-        if len(texts) == 1:
-            raise InputError(f"{where}: {texts[0]}")
-        raise InputError(format_problems(f"{where}: {len(texts)} problems", texts))
-    located = [f"{where}:{lines[k]}: {m}" if k in lines else f"{where}: {m}"
-               for k, m in problems]
-    if len(located) == 1:
-        raise InputError(located[0])
-    raise InputError(format_problems(f"{where}: {len(located)} problems", located))
 
 
 __all__ = [

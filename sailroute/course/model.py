@@ -230,6 +230,10 @@ class Course:
     utc_offset_s : float
         The course's local time offset from UTC [s], taken from the offset
         ``start_time`` is written with (``+02:00`` -> 7200); for reports.
+    key_lines : mapping of str to int
+        1-based line of each key path of the course file (``"scenarios.a.wind.tws_kn"``),
+        so that the wind, current and boat factories report problems at their lines;
+        empty for a course built from a mapping.
     """
 
     name: str
@@ -249,6 +253,7 @@ class Course:
     time_limit_s: float = 5400.0
     boat_where: str = ""
     utc_offset_s: float = 0.0
+    key_lines: Mapping[str, int] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):

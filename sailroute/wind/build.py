@@ -12,11 +12,11 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+from sailroute.checks import Checker, Problems, show
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import parse_time, to_epoch
 from sailroute.units import KNOT, SPEED_UNITS
-from sailroute.wind._spec import SpecChecker
 from sailroute.wind.base import Coverage, WindField
 from sailroute.wind.blended import BlendedWind
 from sailroute.wind.height import DEFAULT_EXPONENT, DEFAULT_EXPONENT_RANGE, DEFAULT_ROUGHNESS_M
@@ -46,6 +46,7 @@ def wind_from_spec(
     where: str,
     crop_bbox: BBox | None = None,
     time_window: tuple[float, float] | None = None,
+    lines: Mapping[str, int] | None = None,
 ) -> WindField:
     """Build a wind field from a spec mapping.
 
@@ -69,6 +70,10 @@ def wind_from_spec(
     time_window : tuple of float, optional
         Race time window ``(t0, t1)`` [epoch s].  WRF slices outside it are not
         read; a source that does not cover it raises now (unless ``clamp``).
+    lines : mapping of str to int, optional
+        1-based line of each key path of the file ``where`` names (the course
+        file's line map, :attr:`~sailroute.course.model.Course.key_lines`): each
+        problem is then reported at its own key's line.
 
     Returns
     -------
@@ -83,19 +88,20 @@ def wind_from_spec(
     OutOfCoverageError
         The data do not cover ``crop_bbox``/``time_window`` and ``clamp`` is false.
     """
-    chk = SpecChecker(where)
+    probs = Problems.below(where, lines, what="wind spec")
+    chk = Checker(probs, probs.root)
     if not isinstance(spec, Mapping):
-        raise InputError(f"{where}: expected a wind spec mapping (type: ...), got {spec!r}")
+        raise InputError(f"{where}: expected a wind spec mapping (type: ...); got {show(spec)}")
     kind = chk.choice(spec, "type", list(_BUILDERS))
     if kind is None:
-        chk.raise_if_any()
+        chk.p.raise_if_any()
     if crop_bbox is not None and not (
         crop_bbox[0] <= crop_bbox[1] and crop_bbox[2] <= crop_bbox[3]
     ):
-        raise InputError(f"{where}: crop_bbox must be (xmin, xmax, ymin, ymax) in metres, got "
+        raise InputError(f"{where}: crop_bbox must be (xmin, xmax, ymin, ymax) in metres; got "
                          f"{tuple(crop_bbox)}")
     if time_window is not None and not time_window[0] <= time_window[1]:
-        raise InputError(f"{where}: time_window must be (t0, t1) with t0 <= t1, got "
+        raise InputError(f"{where}: time_window must be (t0, t1) with t0 <= t1; got "
                          f"{tuple(time_window)}")
     ctx = _Context(frame, Path(base_dir), crop_bbox, time_window)
     field = _BUILDERS[kind](spec, chk, ctx)
@@ -200,39 +206,39 @@ class _Context:
 _UNIFORM_KEYS = ("type", "tws_kn", "tws_ms", "twd_deg", "table", "interpolation", "clamp")
 
 
-def _speed(chk: SpecChecker, spec: Mapping[str, Any], required: bool) -> float | None:
+def _speed(chk: Checker, spec: Mapping[str, Any], required: bool) -> float | None:
     has_kn, has_ms = "tws_kn" in spec, "tws_ms" in spec
     if has_kn and has_ms:
         chk.add("tws_kn", "give either tws_kn or tws_ms, not both")
         return None
     if has_kn:
-        v = chk.number(spec, "tws_kn", nonnegative=True)
+        v = chk.number(spec, "tws_kn", lo=0.0)
         return None if v is None else v * KNOT
     if has_ms:
-        return chk.number(spec, "tws_ms", nonnegative=True)
+        return chk.number(spec, "tws_ms", lo=0.0)
     if required:
         chk.add("tws_kn", "missing required key; give the wind speed as tws_kn or tws_ms")
     return None
 
 
-def _build_uniform(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
-    chk.check_keys(spec, _UNIFORM_KEYS)
+def _build_uniform(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
+    chk.keys(spec, _UNIFORM_KEYS)
     clamp = chk.boolean(spec, "clamp", False)
     interpolation = chk.choice(spec, "interpolation", ["linear", "previous"], "linear")
     table = spec.get("table")
     if table is None:
         tws = _speed(chk, spec, required=True)
         twd = chk.number(spec, "twd_deg", lo=0.0, hi=360.0)
-        chk.raise_if_any()
+        chk.p.raise_if_any()
         assert tws is not None  # required: reported above when missing or invalid
         return UniformWind(tws, twd, clamp=clamp)
     for key in ("tws_kn", "tws_ms", "twd_deg"):
         if key in spec:
             chk.add(key, "not allowed together with `table`; put speeds and directions in the rows")
     if not isinstance(table, list) or not table:
-        chk.add("table", f"expected a non-empty list of rows {{time, tws_kn, twd_deg}}, "
-                f"got {table!r}")
-        chk.raise_if_any()
+        chk.add("table", f"expected a non-empty list of rows {{time, tws_kn, twd_deg}}; "
+                f"got {show(table)}")
+        chk.p.raise_if_any()
     times: list[float] = []
     speeds: list[float] = []
     dirs: list[float] = []
@@ -240,26 +246,26 @@ def _build_uniform(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> 
     for k, row in enumerate(table):
         rchk = tchk.child(k)
         if not isinstance(row, Mapping):
-            rchk.add("time", f"expected a mapping {{time, tws_kn, twd_deg}}, got {row!r}")
+            rchk.add("time", f"expected a mapping {{time, tws_kn, twd_deg}}; got {show(row)}")
             continue
-        rchk.check_keys(row, ("time", "tws_kn", "tws_ms", "twd_deg"), ("time",))
+        rchk.keys(row, ("time", "tws_kn", "tws_ms", "twd_deg"), ("time",))
         t = None
         if "time" in row:
             try:
-                t = to_epoch(parse_time(row["time"], where=rchk.path("time")))
+                t = to_epoch(parse_time(row["time"], where=rchk.where("time")))
             except InputError as exc:
-                rchk.problems.append(str(exc))
+                rchk.p.extend([str(exc)])
         s = _speed(rchk, row, required=True)
         d = rchk.number(row, "twd_deg", lo=0.0, hi=360.0)
         if t is not None and s is not None and d is not None:
             times.append(t)
             speeds.append(s)
             dirs.append(d)
-    if not chk.problems:
+    if not chk.p:
         for k in range(1, len(times)):
             if times[k] <= times[k - 1]:
                 tchk.child(k).add("time", "table times must increase strictly from row to row")
-    chk.raise_if_any()
+    chk.p.raise_if_any()
     return UniformWind(speeds, dirs, times=times, interpolation=interpolation, clamp=clamp)
 
 
@@ -268,7 +274,7 @@ _WRF_KEYS = ("type", "path", "height_m", "time_step_min", "interpolation", "leve
              "fallback_exponent", "exponent_range", "roughness_m", "margin_m", "clamp")
 
 
-def _path(chk: SpecChecker, spec: Mapping[str, Any], ctx: _Context) -> Path | None:
+def _path(chk: Checker, spec: Mapping[str, Any], ctx: _Context) -> Path | None:
     p = chk.string(spec, "path")
     if p is None:
         return None
@@ -279,20 +285,20 @@ def _path(chk: SpecChecker, spec: Mapping[str, Any], ctx: _Context) -> Path | No
     return full
 
 
-def _wrf_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> dict[str, Any]:
+def _wrf_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[str, Any]:
     """Validate a ``type: wrf`` spec into keyword arguments of :func:`open_wrf`."""
-    chk.check_keys(spec, _WRF_KEYS, ("path",))
+    chk.keys(spec, _WRF_KEYS, ("path",))
     opts: dict[str, Any] = {
         "path": _path(chk, spec, ctx),
-        "height_m": chk.number(spec, "height_m", None, positive=True),
-        "time_step_min": chk.number(spec, "time_step_min", None, positive=True),
+        "height_m": chk.number(spec, "height_m", None, lo=0.0, lo_open=True),
+        "time_step_min": chk.number(spec, "time_step_min", None, lo=0.0, lo_open=True),
         "interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
         "levels": chk.choice(spec, "levels", ["auto", "u10", "model"], "auto"),
         "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
         "fallback_exponent": chk.number(spec, "fallback_exponent", DEFAULT_EXPONENT, lo=-1.0,
                                         hi=1.0),
-        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, positive=True),
-        "margin_m": chk.number(spec, "margin_m", None, nonnegative=True),
+        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, lo=0.0, lo_open=True),
+        "margin_m": chk.number(spec, "margin_m", None, lo=0.0),
         "clamp": chk.boolean(spec, "clamp", False),
         "exponent_range": DEFAULT_EXPONENT_RANGE,
     }
@@ -319,10 +325,10 @@ def _open_wrf_checked(opts: dict[str, Any], where: str, ctx: _Context) -> WindFi
         raise type(exc)(f"{where}: {exc}") from None
 
 
-def _build_wrf(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+def _build_wrf(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
     opts = _wrf_options(spec, chk, ctx)
-    chk.raise_if_any()
-    return _open_wrf_checked(opts, chk.where, ctx)
+    chk.p.raise_if_any()
+    return _open_wrf_checked(opts, chk.where(), ctx)
 
 
 # ---------------------------------------------------------------------------- netcdf / grib
@@ -332,21 +338,21 @@ _GRID_KEYS = ("type", "path", "variables", "time", "data_height_m", "speed_unit"
 _CF_ONLY = ("variables", "time", "data_height_m", "speed_unit", "steady", "select")
 
 
-def _grid_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context,
+def _grid_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context,
                   extra: tuple[str, ...] = ()) -> dict[str, Any]:
     """Validate a ``type: netcdf`` / ``type: grib`` spec into :func:`open_netcdf` keywords."""
-    chk.check_keys(spec, (*_GRID_KEYS, *extra))  # a missing path is reported by _path
+    chk.keys(spec, (*_GRID_KEYS, *extra))  # a missing path is reported by _path
     opts: dict[str, Any] = {
         "path": _path(chk, spec, ctx),
-        "height_m": chk.number(spec, "height_m", None, positive=True),
-        "data_height_m": chk.number(spec, "data_height_m", None, positive=True),
+        "height_m": chk.number(spec, "height_m", None, lo=0.0, lo_open=True),
+        "data_height_m": chk.number(spec, "data_height_m", None, lo=0.0, lo_open=True),
         "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
         "exponent": chk.number(spec, "exponent", DEFAULT_EXPONENT, lo=-1.0, hi=1.0),
-        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, positive=True),
-        "time_step_min": chk.number(spec, "time_step_min", None, positive=True),
+        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, lo=0.0, lo_open=True),
+        "time_step_min": chk.number(spec, "time_step_min", None, lo=0.0, lo_open=True),
         "interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
         "steady": chk.boolean(spec, "steady", False),
-        "margin_m": chk.number(spec, "margin_m", None, nonnegative=True),
+        "margin_m": chk.number(spec, "margin_m", None, lo=0.0),
         "clamp": chk.boolean(spec, "clamp", False),
         "speed_unit": None,
         "variables": None,
@@ -364,7 +370,7 @@ def _grid_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context,
             opts["select"] = {str(k): int(v) for k, v in sel.items()}
     unit = chk.string(spec, "speed_unit", None)
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
-        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph', got {unit!r}")
+        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
     else:
         opts["speed_unit"] = unit
     var = chk.mapping(spec, "variables", None)
@@ -372,10 +378,10 @@ def _grid_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context,
         from sailroute.wind.cf import DATA_KEYS
 
         vchk = chk.child("variables")
-        vchk.check_keys(var, DATA_KEYS)
+        vchk.keys(var, DATA_KEYS)
         for k, v in var.items():
             if k in DATA_KEYS and (not isinstance(v, str) or not v.strip()):
-                vchk.add(str(k), f"expected a variable name, got {v!r}")
+                vchk.add(str(k), f"expected a variable name; got {show(v)}")
         if not ({"u", "v"} <= set(var) or {"speed", "direction"} <= set(var)
                 or not set(var) & {"u", "v", "speed", "direction"}):
             chk.add("variables", "give both u and v, or both speed and direction, e.g. "
@@ -383,17 +389,17 @@ def _grid_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context,
         opts["variables"] = dict(var)
     if "time" in spec:
         try:
-            opts["time"] = to_epoch(parse_time(spec["time"], where=chk.path("time")))
+            opts["time"] = to_epoch(parse_time(spec["time"], where=chk.where("time")))
         except InputError as exc:
-            chk.problems.append(str(exc))
+            chk.p.extend([str(exc)])
     return opts
 
 
-def _build_netcdf(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+def _build_netcdf(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
     from sailroute.wind.cf import is_wrfout, open_netcdf
 
     opts = _grid_options(spec, chk, ctx)
-    chk.raise_if_any()
+    chk.p.raise_if_any()
     path = opts.pop("path")
     try:
         if is_wrfout(path):
@@ -409,21 +415,21 @@ def _build_netcdf(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> W
         return open_netcdf(path, ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window,
                            **opts)
     except InputError as exc:
-        raise type(exc)(f"{chk.where}: {exc}") from None
+        raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
-def _build_grib(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
+def _build_grib(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
     from sailroute.wind.cf import open_grib
 
     opts = _grid_options(spec, chk, ctx, extra=("filter",))
     filt = chk.mapping(spec, "filter", None)
-    chk.raise_if_any()
+    chk.p.raise_if_any()
     path = opts.pop("path")
     try:
         return open_grib(path, ctx.frame, filter_by_keys=filt, bbox=ctx.crop_bbox,
                          time_window=ctx.time_window, **opts)
     except InputError as exc:
-        raise type(exc)(f"{chk.where}: {exc}") from None
+        raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
 # ---------------------------------------------------------------------------- stations
@@ -433,13 +439,13 @@ _STATION_FIELD_KEYS = ("method", "power", "radius_m", "max_gap_s", "height_m", "
                        "exponent", "roughness_m", "clamp")
 
 
-def _read_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> dict[str, Any]:
+def _read_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[str, Any]:
     """Validate the station-file keys into keyword arguments of :func:`read_stations`."""
     opts: dict[str, Any] = {"path": _path(chk, spec, ctx),
                             "format": chk.choice(spec, "format", ["auto", "csv", "ndbc"], "auto")}
     unit = chk.string(spec, "speed_unit", None)
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
-        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph', got {unit!r}")
+        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
         unit = None
     opts["speed_unit"] = unit
     cols = chk.mapping(spec, "columns", None)
@@ -449,7 +455,7 @@ def _read_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> d
                 chk.child("columns").add(str(k), "unknown canonical column; expected one of "
                                          + ", ".join((*CANONICAL_COLUMNS, *TIME_PARTS)))
             elif not isinstance(v, str):
-                chk.child("columns").add(str(k), f"expected a column name, got {v!r}")
+                chk.child("columns").add(str(k), f"expected a column name; got {show(v)}")
     opts["columns"] = cols
     tz = chk.string(spec, "timezone", None)
     if tz is not None:
@@ -459,19 +465,19 @@ def _read_options(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> d
             chk.add("timezone", str(exc).split(": ", 1)[-1])
             tz = None
     opts["timezone"] = tz
-    opts["resample_s"] = chk.number(spec, "resample_s", None, positive=True)
+    opts["resample_s"] = chk.number(spec, "resample_s", None, lo=0.0, lo_open=True)
     st = spec.get("station")
     if st is not None and not isinstance(st, str | int):
-        chk.add("station", f"expected a station id, got {st!r}")
+        chk.add("station", f"expected a station id; got {show(st)}")
     opts["station"] = None if st is None else str(st)
     pos = chk.mapping(spec, "position", None)
     if pos is not None:
         pchk = chk.child("position")
-        pchk.check_keys(pos, ("lat", "lon"), ("lat", "lon"))
+        pchk.keys(pos, ("lat", "lon"), ("lat", "lon"))
         la = pchk.number(pos, "lat", lo=-90.0, hi=90.0) if "lat" in pos else None
         lo = pchk.number(pos, "lon", lo=-180.0, hi=360.0) if "lon" in pos else None
         opts["position"] = None if la is None or lo is None else (la, lo)
-    opts["height_m"] = chk.number(spec, "measurement_height_m", None, positive=True)
+    opts["height_m"] = chk.number(spec, "measurement_height_m", None, lo=0.0, lo_open=True)
     miss = spec.get("missing")
     if miss is not None:
         if not isinstance(miss, list) or not all(isinstance(m, str | int | float) for m in miss):
@@ -510,27 +516,27 @@ def _read_ndbc_checked(path: Path, opts: dict[str, Any], where: str) -> StationD
     return data
 
 
-def _build_stations(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
-    chk.check_keys(spec, ("type", *_READ_KEYS, *_STATION_FIELD_KEYS), ("path",))
+def _build_stations(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
+    chk.keys(spec, ("type", *_READ_KEYS, *_STATION_FIELD_KEYS), ("path",))
     ropts = _read_options(spec, chk, ctx)
     fopts = {
         "method": chk.choice(spec, "method", ["idw", "rbf"], "idw"),
-        "power": chk.number(spec, "power", 2.0, positive=True),
-        "radius_m": chk.number(spec, "radius_m", 2000.0, nonnegative=True),
-        "max_gap_s": chk.number(spec, "max_gap_s", 1800.0, positive=True),
-        "height_m": chk.number(spec, "height_m", None, positive=True),
+        "power": chk.number(spec, "power", 2.0, lo=0.0, lo_open=True),
+        "radius_m": chk.number(spec, "radius_m", 2000.0, lo=0.0),
+        "max_gap_s": chk.number(spec, "max_gap_s", 1800.0, lo=0.0, lo_open=True),
+        "height_m": chk.number(spec, "height_m", None, lo=0.0, lo_open=True),
         "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
         "exponent": chk.number(spec, "exponent", DEFAULT_EXPONENT, lo=-1.0, hi=1.0),
-        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, positive=True),
+        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, lo=0.0, lo_open=True),
         "clamp": chk.boolean(spec, "clamp", False),
     }
-    chk.raise_if_any()
-    data = _read_checked(ropts, chk.where)
+    chk.p.raise_if_any()
+    data = _read_checked(ropts, chk.where())
     try:
         return StationWind(data, ctx.frame, name=f"station wind {data.source}",
                            time_window=ctx.time_window, **fopts)
     except InputError as exc:
-        raise type(exc)(f"{chk.where}: {exc}") from None
+        raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
 # ---------------------------------------------------------------------------- blended
@@ -538,8 +544,8 @@ _BLEND_KEYS = ("type", "wrf", "stations", "length_scale_m", "time_scale_s", "min
                "ratio_range", "max_offset_deg", "clamp")
 
 
-def _build_blended(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> WindField:
-    chk.check_keys(spec, _BLEND_KEYS, ("wrf", "stations"))
+def _build_blended(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
+    chk.keys(spec, _BLEND_KEYS, ("wrf", "stations"))
     wspec = chk.mapping(spec, "wrf")
     sspec = chk.mapping(spec, "stations")
     wopts: dict[str, Any] = {}
@@ -547,17 +553,17 @@ def _build_blended(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> 
     if wspec is not None:
         wchk = chk.child("wrf")
         if wspec.get("type", "wrf") != "wrf":
-            wchk.add("type", f"expected 'wrf' (or leave it out), got {wspec.get('type')!r}")
+            wchk.add("type", f"expected 'wrf' (or leave it out); got {show(wspec.get('type'))}")
         wopts = _wrf_options({k: v for k, v in wspec.items() if k != "type"} | {"type": "wrf"},
                              wchk, ctx)
     if sspec is not None:
         schk = chk.child("stations")
-        schk.check_keys(sspec, ("type", *_READ_KEYS), ("path",))
+        schk.keys(sspec, ("type", *_READ_KEYS), ("path",))
         ropts = _read_options(sspec, schk, ctx)
     bopts: dict[str, Any] = {
-        "length_scale_m": chk.number(spec, "length_scale_m", 2000.0, positive=True),
-        "time_scale_s": chk.number(spec, "time_scale_s", 600.0, nonnegative=True),
-        "min_speed_ms": chk.number(spec, "min_speed_ms", 1.0, nonnegative=True),
+        "length_scale_m": chk.number(spec, "length_scale_m", 2000.0, lo=0.0, lo_open=True),
+        "time_scale_s": chk.number(spec, "time_scale_s", 600.0, lo=0.0),
+        "min_speed_ms": chk.number(spec, "min_speed_ms", 1.0, lo=0.0),
         "max_offset_deg": chk.number(spec, "max_offset_deg", 60.0, lo=0.0, hi=180.0),
         "clamp": chk.boolean(spec, "clamp", False),
     }
@@ -570,19 +576,19 @@ def _build_blended(spec: Mapping[str, Any], chk: SpecChecker, ctx: _Context) -> 
                     f"[0.5, 2.0]; got {rr!r}")
         else:
             bopts["ratio_range"] = (float(rr[0]), float(rr[1]))
-    chk.raise_if_any()
-    base = _open_wrf_checked(dict(wopts), f"{chk.where}.wrf", ctx)
-    data = _read_checked(ropts, f"{chk.where}.stations")
+    chk.p.raise_if_any()
+    base = _open_wrf_checked(dict(wopts), chk.where("wrf"), ctx)
+    data = _read_checked(ropts, chk.where("stations"))
     try:
         return BlendedWind(base, data, ctx.frame, height_m=wopts.get("height_m"),
                            exponent=wopts.get("fallback_exponent", DEFAULT_EXPONENT),
                            name=f"blended wind ({Path(str(wopts['path'])).name} + "
                            f"{Path(data.source).name})", **bopts)
     except InputError as exc:
-        raise type(exc)(f"{chk.where}: {exc}") from None
+        raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
-_BUILDERS: dict[str, Callable[[Mapping[str, Any], SpecChecker, _Context], WindField]] = {
+_BUILDERS: dict[str, Callable[[Mapping[str, Any], Checker, _Context], WindField]] = {
     "uniform": _build_uniform,
     "wrf": _build_wrf,
     "netcdf": _build_netcdf,

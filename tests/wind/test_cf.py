@@ -327,8 +327,8 @@ def test_course_spec_netcdf(tmp_path, tiny_wrf, frame) -> None:
                        where=where)
     msg = str(e.value)
     assert f"{where}.variables.w: unknown key" in msg
-    assert f"{where}.steady: expected true or false, got 'yes'" in msg
-    assert f"{where}.tme: unknown key (did you mean 'time'?)" in msg
+    assert f"{where}.steady: expected true or false; got 'yes'" in msg
+    assert f"{where}.tme: unknown key; did you mean 'time'?" in msg
     assert f"{where}.variables: give both u and v" in msg
     # a wrfout file named as netcdf is detected and read as WRF
     w = tiny_wrf("auto.nc")

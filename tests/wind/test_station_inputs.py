@@ -105,7 +105,7 @@ def test_ndbc_text_in_a_course_spec() -> None:
         wind_from_spec({"type": "stations", "path": NDBC_TXT.name}, frame=FRAME,
                        base_dir=WIND_DATA, where=WHERE)
     with pytest.raises(InputError, match=rf"{WHERE}.format: expected one of 'auto', 'csv', "
-                                         r"'ndbc', got 'ndbc-txt'"):
+                                         r"'ndbc'; got 'ndbc-txt' \(did you mean 'ndbc'\?\)"):
         wind_from_spec({**spec, "format": "ndbc-txt"}, frame=FRAME, base_dir=WIND_DATA,
                        where=WHERE)
 

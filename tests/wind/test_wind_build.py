@@ -43,12 +43,12 @@ def test_every_problem_listed_with_its_key_path() -> None:
         build({"type": "uniform", "tws_kn": "ten", "twd": 108, "clamp": "yes"})
     msg = str(e.value)
     assert msg.startswith(f"{WHERE}: 4 problems in the wind spec")
-    assert f"{WHERE}.tws_kn: expected a number >= 0, got 'ten'" in msg
-    assert f"{WHERE}.twd: unknown key (did you mean 'twd_deg'?)" in msg
+    assert f"{WHERE}.tws_kn: expected a number >= 0; got 'ten'" in msg
+    assert f"{WHERE}.twd: unknown key; did you mean 'twd_deg'?" in msg
     assert f"{WHERE}.twd_deg: missing required key" in msg
-    assert f"{WHERE}.clamp: expected true or false, got 'yes'" in msg
+    assert f"{WHERE}.clamp: expected true or false; got 'yes'" in msg
     with pytest.raises(InputError, match=r"scenarios.wrf10\[0\].type: expected one of 'uniform', "
-                                         r"'wrf', 'netcdf', 'grib', 'stations', 'blended', "
+                                         r"'wrf', 'netcdf', 'grib', 'stations', 'blended'; "
                                          r"got 'hdf5'"):
         build({"type": "hdf5"})
 
@@ -70,7 +70,7 @@ def test_the_briefs_example_message(tiny_wrf, tmp_path) -> None:
     with pytest.raises(InputError) as e:
         build({"type": "wrf", "path": path.name, "time_step_min": "ten"}, base_dir=path.parent)
     assert str(e.value) == (
-        "courses/x.yaml: scenarios.wrf10[0].time_step_min: expected a positive number, "
+        "courses/x.yaml: scenarios.wrf10[0].time_step_min: expected a number > 0; "
         "got 'ten'")
 
 
@@ -146,9 +146,9 @@ def test_blended_spec_and_nested_key_paths(tiny_wrf, frame, station_csv) -> None
                "stations": {"speed_unit": "kn"}, "length_scale_m": -1}, frame=frame,
               base_dir=path.parent)
     msg = str(e.value)
-    assert f"{WHERE}.wrf.heigth_m: unknown key (did you mean 'height_m'?)" in msg
+    assert f"{WHERE}.wrf.heigth_m: unknown key; did you mean 'height_m'?" in msg
     assert f"{WHERE}.stations.path: missing required key" in msg
-    assert f"{WHERE}.length_scale_m: expected a positive number, got -1" in msg
+    assert f"{WHERE}.length_scale_m: expected a number > 0; got -1" in msg
 
 
 def test_shipped_example_data_load() -> None:
