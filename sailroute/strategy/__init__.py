@@ -1,4 +1,4 @@
-"""Tack strategy on an upwind leg under wind shifts (seeds 003 and 004).
+"""Tack strategy on an upwind leg under wind shifts (Shepherd et al.; Wang et al. 2024).
 
 * :mod:`~sailroute.strategy.shiftmodel` -- OU and drift-diffusion shift models and
   their Markov chains;

@@ -1,11 +1,11 @@
-"""The Hyères R1 course (courses/hyeres-r1.yaml) against the thesis's geometry (brief §4, §7.2).
+"""The Hyères R1 course (courses/hyeres-r1.yaml) against the thesis's geometry (Pardo 2018).
 
 The marks are the brief's §4.4 reconstruction, back-projected from the thesis's Fig 5.6 leg
 lengths and bearings, which are printed to 0.01 m / 0.01°.  Legs between two marks of the file
 must therefore reproduce Fig 5.6 to about the printing precision: we allow 0.01 m and 0.01°
 (measured: at most 0.0052 m and 0.001°).  Legs through a line/gate *midpoint* differ more: the
 thesis had separate midpoint buoys (start_mid, 4_mid) that are not exactly the midpoints of the
-ends (start_mid by 0.08 m, 4_mid by 0.15 m, brief §4.4), and we use true midpoints; the
+ends (start_mid by 0.08 m, 4_mid by 0.15 m), and we use true midpoints; the
 tolerances there are 0.02 m / 0.01° (start_mid, 1→4_mid) and 0.1 m / 0.01° (4_mid→finish_mid,
 measured 0.074 m), i.e. the size of that 0.1–0.15 m disagreement.
 """
@@ -69,14 +69,14 @@ def test_fig_5_6_distances_and_bearings(r1, a, b, dist, brg, tol):
 
 
 def test_line_lengths(r1):
-    # brief §4.4: 432.4, 90.5 and 42.2 m (thesis text: "430", "about 90", "42")
+    # from the thesis's marks: 432.4, 90.5 and 42.2 m (thesis text: "430", "about 90", "42")
     assert r1.lines["start"].length_m == pytest.approx(432.4, abs=0.05)
     assert r1.gates["gate4"].length_m == pytest.approx(90.5, abs=0.05)
     assert r1.lines["finish"].length_m == pytest.approx(42.2, abs=0.05)
 
 
 def test_total_straight_line_distance_midpoints(r1):
-    # brief §4.4: 7336.5 m through the midpoints; our leg 4 goes to 4p itself (as sailed in
+    # 7336.5 m through the midpoints; our leg 4 goes to 4p itself (as sailed in
     # the thesis), so the sum is start_mid-1 + 1-4_mid + 4_mid-1 + 1-4p + 4p-finish_mid.
     p = _points(r1)
     expected = 1809.35 + 1688.90 + 1688.90 + 1689.63 + 415.67
@@ -86,7 +86,7 @@ def test_total_straight_line_distance_midpoints(r1):
 
 
 def test_wind_modes_at_108(r1):
-    # thesis eq 4.64 / brief §4.5
+    # thesis eq 4.64
     assert nominal_wind_modes(r1, 108.0) == ("upwind", "downwind", "upwind", "downwind", "reach")
 
 

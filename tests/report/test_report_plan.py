@@ -35,7 +35,7 @@ def test_make_plan_needs_one_result_per_leg(course, results):
 
 
 def test_percent_error_convention():
-    # brief §6.3 recomputation with (model - ref)/ref: WRF 10 min race 3071.97 s vs winner
+    # the thesis's errors recomputed with (model - ref)/ref: WRF 10 min race 3071.97 s vs winner
     # 2941 s is +4.45 % (the thesis printed -4.26 % with the model as denominator), and vs the
     # top-10 average 3010.40 s +2.05 %.
     assert percent_error(3071.97, 2941.0) == pytest.approx(4.453, abs=1e-3)

@@ -267,7 +267,7 @@ def test_steps_shrink_near_the_target():
 
 
 def test_thesis_validation_beat_closed_form():
-    # seed-002 §5.7: 8.5 kn from 0°, a 1809 m beat, 10 s per manoeuvre, dt 5 s, 1°
+    # the thesis (Pardo 2018, §5.7): 8.5 kn from 0°, a 1809 m beat, 10 s per manoeuvre, dt 5 s, 1°
     # headings.  The thesis's optimum (1100-1225 s) used its own Laser VPP, which is
     # not available; with this polar the closed form L / VMG* + 10 s must hold.
     st = replace(SET, tack_penalty_s=10.0, gybe_penalty_s=10.0, heading_step_deg=1.0,

@@ -1,4 +1,4 @@
-"""Expected-time SDP on an upwind leg (seed 003) against closed forms and invariants."""
+"""Expected-time SDP on an upwind leg (Shepherd et al.) against closed forms and invariants."""
 
 from __future__ import annotations
 
@@ -32,7 +32,7 @@ def sine_steady():
 
 
 def test_b6_sine_polar_zero_volatility_is_3205_s_with_one_tack(sine_steady) -> None:
-    # Brief B6 / O3: f(u) = sin u (1 m/s), seed 003 grid, steady wind, λ = 5 s:
+    # f(u) = sin u (1 m/s), the paper's grid, steady wind, λ = 5 s:
     # n = 5 gives ψ = 45° exactly, so T = 1600 / 0.5 + 5 = 3205 s to floating point,
     # one tack at x = -800 m (starboard first: wind over the right side, heading left), y = 800 m.
     pol = sine_steady
@@ -50,9 +50,9 @@ def test_b6_sine_polar_zero_volatility_is_3205_s_with_one_tack(sine_steady) -> N
 def test_zero_volatility_ilca_equals_one_tack_closed_form_within_quantisation() -> None:
     # σ = 0: the wind stays at θ = 0.  On the lattice the best heading is the quantised
     # ψ_n = atan(n δx/δy) with the best VMG, and the leg takes L / VMG(ψ_n) + λ exactly
-    # (brief O3).  Its gap to the continuous one-tack answer L / VMG* + λ (O2) is the heading
+    # (closed form).  Its gap to the continuous one-tack answer L / VMG* + λ is the heading
     # quantisation error, computed exactly here and asserted, not tolerated.  COARSE
-    # (8 m x 20 m) has the same best heading atan(0.8) as seed 003's 2 m x 10 m lattice
+    # (8 m x 20 m) has the same best heading atan(0.8) as the paper's 2 m x 10 m lattice
     # at a twentieth of the cost (the full lattice is solved in the speed test below).
     grid = COARSE
     pol = solve_expected_time(ILCA7, TWS, OUShift(0.0, 600.0), grid, 5.0)
@@ -79,8 +79,8 @@ def test_zero_volatility_ilca_equals_one_tack_closed_form_within_quantisation() 
     ids=["sigma", "timescale"],
 )
 def test_vanishing_volatility_converges_to_the_one_tack_closed_form(models) -> None:
-    # Issue 6 / brief O10: as the shifts vanish (sigma -> 0 or l_t -> inf, not just at
-    # sigma = 0), the policy's expected time tends to L / VMG(ψ_q) + λ (O3), the value
+    # Issue 6: as the shifts vanish (sigma -> 0 or l_t -> inf, not just at
+    # sigma = 0), the policy's expected time tends to L / VMG(ψ_q) + λ, the value
     # table to the steady-wind one, and every simulated run to exactly one tack.
     grid = BeatGrid(length_m=800.0, half_width_m=400.0, lateral_m=8.0, row_m=20.0)
     _, vmg_q = quantised_vmg(grid, ILCA7, TWS)
@@ -139,7 +139,7 @@ def test_volatility_tightens_routes() -> None:
 
 
 def test_mirror_symmetry() -> None:
-    # O9: reflect the course and the wind, swap tacks: same expected time.
+    # reflect the course and the wind, swap tacks: same expected time.
     pol = solve_expected_time(ILCA7, TWS, OUShift(10.0, 600.0), COARSE, 5.0)
     v = pol.value_s
     mirrored = v[:, ::-1, ::-1, ::-1]  # tack, shift and lateral position reversed

@@ -1,4 +1,4 @@
-"""Wind-shift models and their Markov-chain discretisation (seed 003 §1.3, brief O6)."""
+"""Wind-shift models and their Markov-chain discretisation (Shepherd, Haydon & Vermillion)."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ BINS = shift_bins(5.0, 45.0)
 
 
 def test_shift_bins_are_seed_003_grid() -> None:
-    # 19 states, -45..45 in 5° steps (seed 003 §1.3)
+    # 19 states, -45..45 in 5° steps (Shepherd, Haydon & Vermillion)
     assert BINS.size == 19
     assert BINS[0] == -45.0 and BINS[-1] == 45.0
     assert np.all(np.diff(BINS) == 5.0)
@@ -74,7 +74,7 @@ def test_integrate_uses_corrected_bin_limits_and_lumps_tails() -> None:
 
 @pytest.mark.parametrize(
     ("timescale_min", "sigma", "sd", "lag", "stay"),
-    # the brief's "discretisation trap" table (seed brief §1.3; its author's computation):
+    # the "discretisation trap" table (an earlier hand computation):
     # chain by exact bin integration, corrected eq 13, edge lumping, δθ = 5°, 20 s steps
     [(10, 10, 11.5, 31, 0.65), (10, 5, 6.5, 65, 0.89), (40, 10, 12.9, 254, 0.95),
      (120, 10, 13.6, None, 0.999)],
@@ -145,7 +145,7 @@ def test_ou_transition_moments_exact() -> None:
 
 
 def test_brownian_transition_moments_exact() -> None:
-    # O6: E φ(t) = φ0 + a t, Var φ(t) = s² t
+    # E φ(t) = φ0 + a t, Var φ(t) = s² t
     model = DriftDiffusionShift(0.05, 0.4)
     mean, sd = model.transition_moments(3.0, 100.0)
     assert mean == pytest.approx(8.0)
