@@ -39,6 +39,7 @@ TableUnit = Literal["kn", "m/s"]
 """Units of the polar tables the polar commands print and write."""
 Kinetics = Literal["steady", "race"]
 Tack = Literal["starboard", "port"]
+"""Tack names (``sailroute.routing.types.Side``; a test keeps them in step)."""
 Shift = Literal["ou", "drift-diffusion"]
 DeadlineInterp = Literal["linear", "cubic"]
 DeadlineRefine = Literal["none", "golden"]

@@ -190,7 +190,7 @@ class RelativeWind:
     @property
     def clamp(self) -> bool:
         """Whether the wind clamps at its edges (the router then ignores the box)."""
-        return bool(getattr(self.wind, "clamp", False))
+        return bool(self.wind.clamp)
 
     @property
     def coverage(self) -> Coverage:

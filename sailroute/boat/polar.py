@@ -376,6 +376,26 @@ class Polar:
         val = np.where(calm, 0.0, val)
         return ang.reshape(tws_in.shape), val.reshape(tws_in.shape)
 
+    # --- the BoatModel protocol (sailroute.boat.model) -------------------------------
+
+    def steady_speed(self, tws_ms: ArrayLike, twa_deg: ArrayLike) -> NDArray[np.float64]:
+        """Boat speed [m s⁻¹] at TWS [m s⁻¹] and TWA [°]: :meth:`speed` (a polar's speeds
+        are steady)."""
+        return self.speed(tws_ms, twa_deg)
+
+    def vmg_angles_deg(self, tws_ms: float) -> tuple[float, float]:
+        """Upwind and downwind best-VMG TWA [°] at ``tws_ms`` [m s⁻¹] (:meth:`vmg_upwind`,
+        :meth:`vmg_downwind`)."""
+        return float(self.vmg_upwind(tws_ms)[0]), float(self.vmg_downwind(tws_ms)[0])
+
+    def routing_polar(self) -> Polar:
+        """The polar a polar router samples: this one."""
+        return self
+
+    def dynamics(self) -> None:
+        """None: a polar has steady speeds only (no momentum model)."""
+        return None
+
     def max_speed(self, tws_ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """TWA [°] of the highest boat speed and that speed [m s⁻¹], on a 0.5° grid."""
         tws = np.asarray(tws_ms, dtype=float)
