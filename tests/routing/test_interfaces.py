@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import inspect
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 import pytest
@@ -163,9 +164,9 @@ def test_side_name_has_no_name_for_no_side(bad: float) -> None:
 
 @pytest.mark.parametrize("router", ["isochrone", "griddp"])
 @pytest.mark.parametrize("side", SIDE_NAMES)
-def test_initial_side_name_starts_the_track_on_that_sign(router: str, side: str) -> None:
+def test_initial_side_name_starts_the_track_on_that_sign(router: Any, side: Any) -> None:
     # a beat: the route starts on the tack the settings name (side_sign in the arrays)
-    s = RoutingSettings(router=router, dp_rows=5, dp_cols=9, dp_refinements=0,  # type: ignore[arg-type]
-                        initial_side=side)  # type: ignore[arg-type]
+    s = RoutingSettings(router=router, dp_rows=5, dp_cols=9, dp_refinements=0,
+                        initial_side=side)
     res = get_router(router)(*LEG, T0, UniformWind(6.0, 0.0), small_polar(), s)
     assert side_name(int(res.track.side[0])) == side
