@@ -19,6 +19,7 @@ from __future__ import annotations
 import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal, TypeVar
 
@@ -39,6 +40,7 @@ TableUnit = Literal["kn", "m/s"]
 """Units of the polar tables the polar commands print and write."""
 Kinetics = Literal["steady", "race"]
 Tack = Literal["starboard", "port"]
+"""Tack names (``sailroute.routing.types.Side``; a test keeps them in step)."""
 Shift = Literal["ou", "drift-diffusion"]
 DeadlineInterp = Literal["linear", "cubic"]
 DeadlineRefine = Literal["none", "golden"]
@@ -116,8 +118,20 @@ app = typer.Typer(
     help="Race routing for buoy courses: fastest way round, leg by leg.",
 )
 
-_STATE = {"debug": False}
 T = TypeVar("T")
+
+
+@dataclass(frozen=True)
+class _Options:
+    """Options of the root command, kept in the click context (``ctx.obj``)."""
+
+    debug: bool = False
+
+
+def _debug(ctx: typer.Context) -> bool:
+    """``--debug`` of the root command that ``ctx`` runs under."""
+    obj = ctx.find_root().obj
+    return isinstance(obj, _Options) and obj.debug
 
 
 def _version_callback(value: bool) -> None:
@@ -128,6 +142,7 @@ def _version_callback(value: bool) -> None:
 
 @app.callback()
 def _root(
+    ctx: typer.Context,
     version: Annotated[
         bool,
         typer.Option("--version", callback=_version_callback, is_eager=True, help="Show version."),
@@ -137,15 +152,16 @@ def _root(
     ] = False,
 ) -> None:
     """Race routing for buoy courses: fastest way round, leg by leg."""
-    _STATE["debug"] = debug
+    ctx.obj = _Options(debug=debug)
 
 
-def run_guarded(fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
-    """Call ``fn``; turn sailroute errors into a one-paragraph message and exit code."""
+def run_guarded(fn: Callable[[], T], *, debug: bool) -> T:
+    """Call ``fn``; turn sailroute errors into a one-paragraph message and exit code
+    (``debug``: re-raise them with the traceback instead)."""
     try:
-        return fn(*args, **kwargs)
+        return fn()
     except SailrouteError as exc:
-        if _STATE["debug"]:
+        if debug:
             raise
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(code=exc.exit_code) from None
@@ -155,7 +171,7 @@ def run_guarded(fn: Callable[..., T], *args: Any, **kwargs: Any) -> T:
     except (typer.Exit, typer.Abort):
         raise
     except Exception as exc:  # anything else is a bug: one short paragraph, exit 1
-        if _STATE["debug"]:
+        if debug:
             raise
         typer.echo(f"internal error: {type(exc).__name__}: {exc}\nThis is a bug in sailroute; "
                    "rerun with --debug (sailroute --debug COMMAND ...) for the traceback and "
@@ -267,6 +283,7 @@ SchedulerOpt = Annotated[
 @app.command("plan", cls=_Command,
              short_help="Route a course leg by leg in one wind scenario.")
 def plan_command(
+    ctx: typer.Context,
     course: CourseArg,
     scenario: Annotated[
         str | None,
@@ -298,12 +315,13 @@ def plan_command(
             return run_plan_command(loaded, scenario=scenario, router=router, out_dir=out,
                                     plots=not no_plots, backend=backend, progress=progress)
 
-    _finish(run_guarded(run), json_out, ("plan", "ensemble_json"))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("plan", "ensemble_json"))
 
 
 @app.command("compare-scenarios", cls=_Command,
              short_help="Route a course in several wind scenarios, side by side.")
 def compare_command(
+    ctx: typer.Context,
     course: CourseArg,
     scenario: Annotated[
         list[str] | None,
@@ -337,12 +355,13 @@ def compare_command(
                                        plots=not no_plots, backend=backend, progress=progress,
                                        scheduler=scheduler)
 
-    _finish(run_guarded(run), json_out, ("comparison_json",))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("comparison_json",))
 
 
 @app.command("vpp", cls=_Command,
              short_help="Laser/ILCA velocity prediction: polar and best VMG.")
 def vpp_command(
+    ctx: typer.Context,
     boat: Annotated[
         str | None,
         typer.Argument(help="Boat YAML (class, crew_mass_kg, parameter overrides); "
@@ -384,7 +403,7 @@ def vpp_command(
 
     from sailroute.report.files import POLAR_FILE_LABELS
 
-    _finish(run_guarded(run), json_out, ("json",), POLAR_FILE_LABELS)
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("json",), POLAR_FILE_LABELS)
 
 
 def _complete_polar(incomplete: str) -> list[str]:
@@ -400,6 +419,7 @@ def _complete_objective(incomplete: str) -> list[str]:
 @app.command("strategy", cls=_Command,
              short_help="Tack strategy on a beat under wind shifts.")
 def strategy_command(
+    ctx: typer.Context,
     tws_kn: Annotated[float, typer.Option("--tws-kn", metavar="KN", help="Wind speed, kn.")
                       ] = 10.0,
     polar: Annotated[
@@ -521,7 +541,7 @@ def strategy_command(
             interpolation=deadline_interpolation, refine_controls=deadline_refine,
         )
 
-    _finish(run_guarded(run), json_out)
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 polar_app = typer.Typer(cls=_Group, no_args_is_help=True, rich_markup_mode=None,
@@ -532,6 +552,7 @@ app.add_typer(polar_app, name="polar")
 @polar_app.command("fit", cls=_Command,
                    short_help="Fit a polar to a logged race.")
 def polar_fit_command(
+    ctx: typer.Context,
     log: Annotated[str, typer.Argument(help="Instrument log (CSV with tws, twa, bsp or sog) "
                                        "or GPS track (GPX/CSV, with --course).", metavar="LOG")],
     course: Annotated[
@@ -600,12 +621,13 @@ def polar_fit_command(
 
     from sailroute.report.files import POLAR_FILE_LABELS
 
-    _finish(run_guarded(run), json_out, ("json",), POLAR_FILE_LABELS)
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("json",), POLAR_FILE_LABELS)
 
 
 @app.command("analyze", cls=_Command,
              short_help="Sailed tracks against the optimal route, leg by leg.")
 def analyze_command(
+    ctx: typer.Context,
     course: Annotated[str, typer.Argument(help="Course file the boats sailed (YAML).",
                                           metavar="COURSE")],
     tracks: Annotated[
@@ -667,7 +689,7 @@ def analyze_command(
                 leg_times=leg_times, columns=columns or None, speed_unit=speed_unit,
                 time_zone=time_zone, plots=not no_plots, progress=progress)
 
-    _finish(run_guarded(run), json_out, ("analysis_json", "fleet_json"))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("analysis_json", "fleet_json"))
 
 
 def main() -> None:

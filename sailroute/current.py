@@ -22,7 +22,8 @@ and gridded NetCDF u/v (:func:`open_netcdf_current`, through the CF reader).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
@@ -84,16 +85,17 @@ class UniformCurrent:
 
     speed_ms: float
     set_deg: float
-    _u: float = field(init=False, repr=False)
-    _v: float = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.speed_ms) and self.speed_ms >= 0 and np.isfinite(self.set_deg)):
             raise InputError(f"uniform current: the rate must be finite and >= 0 and the set "
                              f"finite; got {self.speed_ms!r} m/s towards {self.set_deg!r}°")
+
+    @cached_property
+    def _uv(self) -> tuple[float, float]:
+        """Velocity components ``(u, v)`` [m s⁻¹] (east, north)."""
         u, v = current_components(self.speed_ms, self.set_deg)
-        object.__setattr__(self, "_u", float(u))
-        object.__setattr__(self, "_v", float(v))
+        return float(u), float(v)
 
     @property
     def coverage(self) -> Coverage:
@@ -103,7 +105,8 @@ class UniformCurrent:
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Current ``(u, v)`` [m s⁻¹] (broadcast shape of the inputs)."""
         t, x, y = prepare_points(self.coverage, t, x, y, clamp=False, name="uniform current")
-        return np.full(t.shape, self._u), np.full(t.shape, self._v)
+        u, v = self._uv
+        return np.full(t.shape, u), np.full(t.shape, v)
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,11 +137,13 @@ class DiamondCurrent:
     set_deg: Sequence[float]
     rate_ms: Sequence[float]
     clamp: bool = False
-    _t: NDArray = field(init=False, repr=False)
-    _u: NDArray = field(init=False, repr=False)
-    _v: NDArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        self._table  # noqa: B018  (built now: building it checks the rows)
+
+    @cached_property
+    def _table(self) -> tuple[NDArray, NDArray, NDArray]:
+        """Row times [epoch s] and velocity components ``(t, u, v)`` [m s⁻¹]."""
         h = np.asarray(self.hours, dtype=float)
         s = np.asarray(self.set_deg, dtype=float)
         r = np.asarray(self.rate_ms, dtype=float)
@@ -151,23 +156,23 @@ class DiamondCurrent:
         if np.any(np.diff(h) <= 0):
             raise InputError("tidal diamond: the hours must increase strictly from row to row")
         u, v = current_components(r, s)
-        object.__setattr__(self, "_t", float(self.high_water) + 3600.0 * h)
-        object.__setattr__(self, "_u", u)
-        object.__setattr__(self, "_v", v)
+        return float(self.high_water) + 3600.0 * h, u, v
 
     @property
     def coverage(self) -> Coverage:
         """Everywhere; from the first to the last row's time."""
         inf = float("inf")
-        return Coverage(float(self._t[0]), float(self._t[-1]), -inf, inf, -inf, inf)
+        t = self._table[0]
+        return Coverage(float(t[0]), float(t[-1]), -inf, inf, -inf, inf)
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Current ``(u, v)`` [m s⁻¹], linear in time between rows."""
         t, x, y = prepare_points(self.coverage, t, x, y, clamp=self.clamp,
                                  name="tidal-diamond current")
-        if self._t.size == 1:
-            return np.full(t.shape, self._u[0]), np.full(t.shape, self._v[0])
-        return np.interp(t, self._t, self._u), np.interp(t, self._t, self._v)
+        tt, u, v = self._table
+        if tt.size == 1:
+            return np.full(t.shape, u[0]), np.full(t.shape, v[0])
+        return np.interp(t, tt, u), np.interp(t, tt, v)
 
 
 @dataclass(frozen=True, eq=False)
@@ -190,7 +195,7 @@ class RelativeWind:
     @property
     def clamp(self) -> bool:
         """Whether the wind clamps at its edges (the router then ignores the box)."""
-        return bool(getattr(self.wind, "clamp", False))
+        return bool(self.wind.clamp)
 
     @property
     def coverage(self) -> Coverage:

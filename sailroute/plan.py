@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import cast
 
 from sailroute.backend import get_xp
+from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.boat.sanity import check_wind_range, peak_wind, require_speed
 from sailroute.course.geometry import course_bbox, leg_endpoints, race_time_window, target_of
@@ -154,7 +155,7 @@ def scenario_members(course: Course, names: Sequence[str]) -> list[str]:
 def route_course(
     course: Course,
     wind: WindField,
-    boat: object,
+    boat: BoatModel,
     settings: RoutingSettings,
     *,
     backend: str = "numpy",
@@ -170,8 +171,9 @@ def route_course(
         the best point).
     wind : WindField
         Wind field covering the course and the race time.
-    boat : Polar
-        Boat performance.
+    boat : BoatModel
+        Boat performance (a :class:`~sailroute.boat.polar.Polar` or, for the grid
+        routers, a :class:`~sailroute.boat.dynamic.DynamicBoat`).
     settings : RoutingSettings
         Router choice and numerical settings.
     backend : {"numpy", "cupy", "auto"}
@@ -262,7 +264,7 @@ def plan_course(
 
 
 def _routed(
-    course: Course, name: str, wind: WindField, boat: object, settings: RoutingSettings,
+    course: Course, name: str, wind: WindField, boat: BoatModel, settings: RoutingSettings,
     backend: str, progress: Progress | None,
 ) -> PlannedCourse:
     """Route the course in one built scenario and assemble its :class:`Plan`."""

@@ -66,12 +66,14 @@ def test_choice_sets_match_the_code():
     from sailroute.boat.build import builtin_names
     from sailroute.boat.vpp_outputs import UNITS
     from sailroute.routing.api import ROUTERS
+    from sailroute.routing.types import SIDE_NAMES
     from sailroute.strategy.api import SHIFT_KINDS
     from sailroute.units import SPEED_UNITS
 
     assert get_args(cli.Router) == tuple(ROUTERS)
     assert get_args(cli.TableUnit) == UNITS
     assert get_args(cli.Shift) == SHIFT_KINDS
+    assert set(get_args(cli.Tack)) == set(SIDE_NAMES) == {"port", "starboard"}
     assert set(get_args(cli.SpeedUnit)) <= set(SPEED_UNITS)
     assert cli._complete_polar("builtin:ilca7") == ["builtin:ilca7", "builtin:ilca7-steady"]
     assert len(cli._complete_polar("")) == len(builtin_names())

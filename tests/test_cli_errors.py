@@ -31,3 +31,16 @@ def test_a_bug_is_one_paragraph_and_exit_1(broken_plan: None, tmp_path) -> None:
 def test_debug_shows_the_exception(broken_plan: None, tmp_path) -> None:
     res = CliRunner().invoke(app, ["--debug", "plan", COURSE, "-q", "--out", str(tmp_path)])
     assert isinstance(res.exception, ZeroDivisionError)
+
+
+def test_debug_belongs_to_one_invocation(broken_plan: None, tmp_path) -> None:
+    # --debug travels in the click context (ctx.obj), not in module state: the next
+    # invocation without it gets the short message again
+    import sailroute.cli as cli
+
+    assert not hasattr(cli, "_STATE")
+    runner = CliRunner()
+    first = runner.invoke(app, ["--debug", "plan", COURSE, "-q", "--out", str(tmp_path)])
+    assert isinstance(first.exception, ZeroDivisionError)
+    second = runner.invoke(app, ["plan", COURSE, "-q", "--out", str(tmp_path)])
+    assert second.exit_code == 1 and "internal error: ZeroDivisionError" in second.output

@@ -110,7 +110,7 @@ def _builtin(key: str, interpolation: str) -> Polar:
     return polar.with_name(CLASSES[cls].name + (" steady" if kinetics == STEADY else ""))
 
 
-@lru_cache(maxsize=32)
+@lru_cache(maxsize=4)  # a run uses one or two boats; each polar holds ~3 MB once routed
 def vpp_polar(
     params: LaserParams,
     tws_ms: tuple[float, ...] | None = None,

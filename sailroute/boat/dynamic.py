@@ -232,6 +232,22 @@ class DynamicBoat:
         speed = self.steady_speed(tws[None, :], twa[:, None])
         return Polar(twa, tws, speed, name=f"{self.name} (steady state)")
 
+    # -- the BoatModel protocol (sailroute.boat.model) --------------------------
+
+    def vmg_angles_deg(self, tws_ms: float) -> tuple[float, float]:
+        """Upwind and downwind best-VMG TWA [°] (:meth:`best_vmg` on a 0.05° grid; the
+        angles do not depend on ``tws_ms`` in this model)."""
+        return self.best_vmg(True, 0.05)[0], self.best_vmg(False, 0.05)[0]
+
+    def routing_polar(self) -> None:
+        """None: the speed depends on the speed carried in, so no steady polar stands
+        for the boat (route :meth:`steady_polar` explicitly to ignore momentum)."""
+        return None
+
+    def dynamics(self) -> DynamicBoat:
+        """The segment-dynamics model the grid routers carry momentum with: this boat."""
+        return self
+
     # -- turns and segments ---------------------------------------------------
 
     def initial_speed(self, v_prev_ms: ArrayLike, cos_delta: ArrayLike) -> NDArray[np.float64]:

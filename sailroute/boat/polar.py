@@ -32,6 +32,7 @@ Edge semantics (both methods, documented in ``docs/design/boat.md``):
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Final
 
 import numpy as np
@@ -212,7 +213,7 @@ class Polar:
         """
         if self.interpolation == "linear":
             return self._speed_linear(tws_ms, twa_deg)
-        inv_twa, inv_tws, tws_max, n_twa, n_tws, cells = self._dense()
+        inv_twa, inv_tws, tws_max, n_twa, n_tws, cells = self._dense
         a = np.abs(np.asarray(twa_deg, dtype=float))
         if np.any(a > 360.0):  # NaN-safe: NaN > 360 is False
             a = np.mod(a, 360.0)
@@ -233,7 +234,7 @@ class Polar:
     def _speed_linear(self, tws_ms: ArrayLike, twa_deg: ArrayLike) -> NDArray[np.float64]:
         tws = np.asarray(tws_ms, dtype=float)
         a = fold_twa(twa_deg)
-        twa_ax, tws_ax, tab = self._extended()
+        twa_ax, tws_ax, tab = self._extended
         with np.errstate(invalid="ignore"):
             i = np.clip(np.searchsorted(twa_ax, a, side="right") - 1, 0, twa_ax.size - 2)
             fa = np.clip((a - twa_ax[i]) / (twa_ax[i + 1] - twa_ax[i]), 0.0, 1.0)
@@ -250,11 +251,9 @@ class Polar:
             + fa * fw * tab[i + 1, j + 1]
         )
 
+    @cached_property
     def _extended(self) -> tuple[NDArray, NDArray, NDArray]:
         """Table with the taper rows/column added (zero at TWA 0, TWA 180, TWS 0)."""
-        cache = self.__dict__.get("_ext")
-        if cache is not None:
-            return cache
         twa, tws, tab = self.twa_deg, self.tws_ms, self.speed_ms
         if twa[0] > 0:
             twa = np.concatenate([[0.0], twa])
@@ -265,16 +264,12 @@ class Polar:
         if tws[0] > 0:
             tws = np.concatenate([[0.0], tws])
             tab = np.hstack([np.zeros((tab.shape[0], 1)), tab])
-        ext = (twa, tws, tab)
-        object.__setattr__(self, "_ext", ext)
-        return ext
+        return twa, tws, tab
 
+    @cached_property
     def _dense(self) -> tuple[float, float, float, int, int, NDArray]:
-        """Dense regular PCHIP table (built once, cached)."""
-        cache = self.__dict__.get("_dense_cache")
-        if cache is not None:
-            return cache
-        twa, tws, tab = self._extended()
+        """Dense regular PCHIP table (built once, on first use)."""
+        twa, tws, tab = self._extended
         n_twa = round(180.0 / DENSE_TWA_STEP_DEG) + 1
         twa_d = np.linspace(0.0, 180.0, n_twa)
         by_twa = pchip(twa, tab, twa_d, axis=0)
@@ -293,7 +288,7 @@ class Polar:
             [dense[:-1, :-1], dense[:-1, 1:], dense[1:, :-1], dense[1:, 1:]], axis=-1
         ).reshape(-1, 4)
         cells.setflags(write=False)
-        cache = (
+        return (
             (n_twa - 1) / 180.0,
             (n_tws - 1) / tws_max,
             tws_max,
@@ -301,8 +296,6 @@ class Polar:
             n_tws,
             cells,
         )
-        object.__setattr__(self, "_dense_cache", cache)
-        return cache
 
     # --- VMG --------------------------------------------------------------------
 
@@ -375,6 +368,26 @@ class Polar:
         ang = np.where(calm, lo_lim if upwind else hi_lim, ang)
         val = np.where(calm, 0.0, val)
         return ang.reshape(tws_in.shape), val.reshape(tws_in.shape)
+
+    # --- the BoatModel protocol (sailroute.boat.model) -------------------------------
+
+    def steady_speed(self, tws_ms: ArrayLike, twa_deg: ArrayLike) -> NDArray[np.float64]:
+        """Boat speed [m s⁻¹] at TWS [m s⁻¹] and TWA [°]: :meth:`speed` (a polar's speeds
+        are steady)."""
+        return self.speed(tws_ms, twa_deg)
+
+    def vmg_angles_deg(self, tws_ms: float) -> tuple[float, float]:
+        """Upwind and downwind best-VMG TWA [°] at ``tws_ms`` [m s⁻¹] (:meth:`vmg_upwind`,
+        :meth:`vmg_downwind`)."""
+        return float(self.vmg_upwind(tws_ms)[0]), float(self.vmg_downwind(tws_ms)[0])
+
+    def routing_polar(self) -> Polar:
+        """The polar a polar router samples: this one."""
+        return self
+
+    def dynamics(self) -> None:
+        """None: a polar has steady speeds only (no momentum model)."""
+        return None
 
     def max_speed(self, tws_ms: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """TWA [°] of the highest boat speed and that speed [m s⁻¹], on a 0.5° grid."""

@@ -125,7 +125,10 @@ def dsyhs_table() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         for ln in _data_text("wr.dat").splitlines()
         if ln.strip() and not ln.lstrip().startswith("#")
     ]
-    return rows[0], np.vstack(rows[1:9])
+    fn, a = rows[0], np.vstack(rows[1:9])
+    for arr in (fn, a):
+        arr.setflags(write=False)  # cached and shared: read-only
+    return fn, a
 
 
 @lru_cache(maxsize=1)

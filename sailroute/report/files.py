@@ -30,6 +30,7 @@ from sailroute import __version__
 from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
 from sailroute.report.plan import Comparison, Plan, percent_error
+from sailroute.routing.types import side_name
 from sailroute.timeutil import iso
 from sailroute.units import KNOT
 from sailroute.wind.base import WindField
@@ -190,7 +191,7 @@ def write_track_csv(path: str | Path, plan: Plan) -> Path:
                     f"{tr.heading_deg[i]:.2f}", f"{tr.tws_ms[i]:.3f}",
                     f"{tr.tws_ms[i] / KNOT:.3f}", f"{tr.twd_deg[i]:.2f}",
                     f"{tr.twa_deg[i]:.2f}", f"{tr.bsp_ms[i]:.3f}", f"{tr.bsp_ms[i] / KNOT:.3f}",
-                    "starboard" if tr.side[i] > 0 else "port", events[i],
+                    side_name(int(tr.side[i])), events[i],
                     f"{sog[i]:.3f}", f"{sog[i] / KNOT:.3f}", f"{cog[i]:.2f}",
                 ])
     return p

@@ -5,9 +5,9 @@
 * :class:`Row`: one layer of grid nodes, parametrised by one number per node
   (across offset [m] for free rows, fraction along a line for start/target
   rows), so that mesh refinement only changes the parameters.
-* :class:`BoatModel`: the two boat models behind one small interface
-  (:class:`~sailroute.boat.polar.Polar` and
-  :class:`~sailroute.boat.dynamic.DynamicBoat`).
+* :class:`GridBoat`: a :class:`~sailroute.boat.model.BoatModel` (a
+  :class:`~sailroute.boat.polar.Polar` or a :class:`~sailroute.boat.dynamic.DynamicBoat`)
+  with its steady polar and its momentum model looked up once.
 * :func:`sample_chains`: wind along chains of straight pieces (segments split
   into pieces, or spline chords), sampled at the time the boat is there.
 * :func:`default_half_width`: the grid half-width from the laylines.
@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.boat.dynamic import DynamicBoat
+from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 from sailroute.routing.geometry import (
@@ -227,37 +228,43 @@ def make_grid(start: Start, target: Target, n_rows: int, zone_m: float) -> LegGr
 
 
 @dataclass(frozen=True, eq=False)
-class BoatModel:
-    """A :class:`Polar` or a :class:`DynamicBoat` behind one interface."""
+class GridBoat:
+    """A :class:`~sailroute.boat.model.BoatModel` as the grid routers use it.
 
+    Attributes
+    ----------
+    boat : BoatModel
+        The boat.
+    polar : Polar or None
+        ``boat.routing_polar()``: the steady polar, None for the dynamic model.
+    dynamic : DynamicBoat or None
+        ``boat.dynamics()``: the momentum model, None for a polar.
+    """
+
+    boat: BoatModel
     polar: Polar | None = None
     dynamic: DynamicBoat | None = None
 
     @classmethod
-    def of(cls, boat: Polar | DynamicBoat, label: str) -> BoatModel:
-        """Wrap ``boat``; raises :class:`InputError` for anything else."""
-        if isinstance(boat, DynamicBoat):
-            return cls(dynamic=boat)
-        if isinstance(boat, Polar):
-            return cls(polar=boat)
-        raise InputError(
-            f"leg {label}: the grid routers need a Polar or a DynamicBoat, got "
-            f"{type(boat).__name__}"
-        )
+    def of(cls, boat: BoatModel, label: str) -> GridBoat:
+        """Wrap ``boat``; raises :class:`InputError` for an object that is no boat model."""
+        if not isinstance(boat, BoatModel):  # the protocol's contract, not a type switch
+            raise InputError(
+                f"leg {label}: the grid routers need a boat model (a Polar or a DynamicBoat), "
+                f"got {type(boat).__name__}"
+            )
+        return cls(boat, boat.routing_polar(), boat.dynamics())
 
     def steady_speed(self, tws: NDArray, beta: NDArray) -> NDArray:
-        """Steady boat speed [m s⁻¹] at TWS [m s⁻¹] and |TWA| [rad]."""
+        """Steady boat speed [m s⁻¹] at TWS [m s⁻¹] and |TWA| [rad] (the dynamic model
+        through its segment table, as its segment costs)."""
         if self.dynamic is not None:
             return tws * self.dynamic.table().steady(beta)
-        assert self.polar is not None
-        return self.polar.speed(tws, np.degrees(beta))
+        return self.boat.steady_speed(tws, np.degrees(beta))
 
     def vmg_angles_deg(self, tws: float) -> tuple[float, float]:
         """Upwind and downwind VMG angles [°] at ``tws`` [m s⁻¹]."""
-        if self.dynamic is not None:
-            return self.dynamic.best_vmg(True, 0.05)[0], self.dynamic.best_vmg(False, 0.05)[0]
-        assert self.polar is not None
-        return float(self.polar.vmg_upwind(tws)[0]), float(self.polar.vmg_downwind(tws)[0])
+        return self.boat.vmg_angles_deg(tws)
 
 
 # --------------------------------------------------------------------------------------
@@ -306,7 +313,7 @@ def sample_wind(wind: WindField, t: NDArray, x: NDArray, y: NDArray
     cov = wind.coverage
     finite = np.isfinite(t)
     tt = np.where(finite, t, 0.0)
-    if getattr(wind, "clamp", False):
+    if wind.clamp:
         u, v = wind.sample(tt, x, y)
         return u, v, finite
     inside = cov.contains(tt, x, y) & finite
@@ -331,7 +338,7 @@ def _pieces_wind(wind: WindField, t: NDArray, mx: NDArray, my: NDArray, ux: NDAr
 
 
 def sample_chains(wind: WindField, px: NDArray, py: NDArray, t_dep: NDArray,
-                  model: BoatModel,
+                  model: GridBoat,
                   speed: Callable[[NDArray, NDArray], NDArray] | None = None) -> ChainWind:
     """Wind along chains of pieces at the time the boat sails each piece.
 
@@ -385,7 +392,7 @@ def sample_chains(wind: WindField, px: NDArray, py: NDArray, t_dep: NDArray,
 
 def node_inside(wind: WindField, x: NDArray, y: NDArray) -> NDArray:
     """Nodes inside the wind's spatial coverage (all of them for clamped fields)."""
-    if getattr(wind, "clamp", False):
+    if wind.clamp:
         return np.ones(np.shape(x), dtype=bool)
     c = wind.coverage
     return (x >= c.xmin) & (x <= c.xmax) & (y >= c.ymin) & (y <= c.ymax)
@@ -395,7 +402,7 @@ def node_inside(wind: WindField, x: NDArray, y: NDArray) -> NDArray:
 # grid size
 
 
-def default_half_width(frame: LegFrame, wind: WindField, t0: float, model: BoatModel) -> float:
+def default_half_width(frame: LegFrame, wind: WindField, t0: float, model: GridBoat) -> float:
     """Half-width of the grid [m] from the one-tack laylines.
 
     The mean wind of A, the leg midpoint and B at ``t0`` fixes the wind angle

@@ -8,10 +8,11 @@ router         function                                         module
 ``spline``     ``route_spline``                                 ``routing/multispline.py``
 =============  ===============================================  ==========================
 
-All routers share the signature
-``(start, target, t0, wind, polar, settings, *, progress=None) -> LegResult`` (routers
-with a GPU path also take ``xp=``, an array module, which :func:`route_leg` passes only for
-a non-NumPy ``backend``) and
+All routers share the signature declared by :class:`~sailroute.routing.types.Router`,
+``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy) -> LegResult``
+(``boat`` a :class:`~sailroute.boat.model.BoatModel`; ``xp``, an array module, is passed by
+:func:`route_leg` only for a non-NumPy ``backend``; each router module declares
+``_ROUTER: Router = route_...`` so that mypy checks it) and
 report through :func:`~sailroute.routing.track.make_leg_result`, so their results
 compare directly.  The grid-DP and spline routers are imported only when asked for.
 """
@@ -25,9 +26,10 @@ from typing import Any
 import numpy as np
 
 from sailroute.backend import get_xp
+from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError, RoutingError
 from sailroute.routing.geometry import leg_label
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
+from sailroute.routing.types import LegResult, Router, RoutingSettings, Start, Target
 from sailroute.wind.base import WindField
 
 ROUTERS: dict[str, tuple[str, str]] = {
@@ -38,7 +40,7 @@ ROUTERS: dict[str, tuple[str, str]] = {
 """Router name -> (module, function)."""
 
 
-def get_router(name: str) -> Callable[..., LegResult]:
+def get_router(name: str) -> Router:
     """The routing function registered under ``name``.
 
     Raises
@@ -64,7 +66,7 @@ def get_router(name: str) -> Callable[..., LegResult]:
             "installation. Use router 'isochrone', or install a sailroute version that "
             f"ships {module_name}."
         ) from None
-    func = getattr(module, func_name, None)
+    func: Router | None = getattr(module, func_name, None)
     if func is None:
         raise RoutingError(
             f"router {name!r} is not available: {module_name} has no function {func_name}. "
@@ -93,7 +95,7 @@ def route_leg(
     target: Target,
     t0: float,
     wind: WindField,
-    boat: Any,
+    boat: BoatModel,
     settings: RoutingSettings,
     *,
     progress: Callable[[float], None] | None = None,
@@ -112,8 +114,9 @@ def route_leg(
         Start time [epoch s].
     wind : WindField
         Wind field.
-    boat : Polar
-        Boat performance (a :class:`~sailroute.boat.polar.Polar`).
+    boat : BoatModel
+        Boat performance: a :class:`~sailroute.boat.polar.Polar` (every router) or a
+        :class:`~sailroute.boat.dynamic.DynamicBoat` (grid DP and spline routers).
     settings : RoutingSettings
         Router choice and numerical settings.
     progress : callable, optional

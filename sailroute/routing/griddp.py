@@ -43,10 +43,10 @@ from numpy.typing import NDArray
 
 from sailroute.backend import to_numpy
 from sailroute.boat.dynamic import DynamicBoat, SegmentTable, chain_time
-from sailroute.boat.polar import Polar
+from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError, RoutingError
 from sailroute.routing._dp_grid import (
-    BoatModel,
+    GridBoat,
     LegGrid,
     PathLimits,
     default_half_width,
@@ -55,9 +55,17 @@ from sailroute.routing._dp_grid import (
     penalty_of,
     sample_chains,
 )
-from sailroute.routing.geometry import target_barrier
+from sailroute.routing.geometry import leg_label, target_barrier
 from sailroute.routing.track import build_track, make_leg_result
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
+from sailroute.routing.types import (
+    LegResult,
+    Router,
+    RoutingSettings,
+    Start,
+    Target,
+    check_settings,
+    side_sign,
+)
 from sailroute.wind.base import WindField
 
 _SIDE_VALUE = np.array([-1, 1], dtype=np.int8)  # state index 0 = port, 1 = starboard
@@ -75,35 +83,10 @@ class GridDPOptions:
     samples: int
 
     @classmethod
-    def from_settings(cls, s: RoutingSettings, label: str) -> GridDPOptions:
-        """Validate the ``dp_*`` fields; :class:`InputError` lists every problem."""
-        problems = []
-
-        def integer(name: str, lo: int, hi: int) -> None:
-            v = getattr(s, name)
-            if not (isinstance(v, int | np.integer) and lo <= v <= hi):
-                problems.append(f"{name} must be an integer in [{lo}, {hi}], got {v!r}")
-
-        integer("dp_rows", 3, 200)
-        integer("dp_cols", 2, 1024)
-        integer("dp_refinements", 0, 20)
-        integer("dp_samples", 1, 64)
-        if not (isinstance(s.dp_shrink, int | float) and 0 < s.dp_shrink <= 1):
-            problems.append(f"dp_shrink must be in (0, 1], got {s.dp_shrink!r}")
+    def from_settings(cls, s: RoutingSettings) -> GridDPOptions:
+        """The ``dp_*`` fields of settings validated by
+        :func:`~sailroute.routing.types.check_settings`."""
         hw = s.dp_half_width_m
-        if hw is not None and not (isinstance(hw, int | float) and math.isfinite(hw) and hw > 0):
-            problems.append(f"dp_half_width_m must be > 0 m or None (automatic), got {hw!r}")
-        for name in ("tack_penalty_s", "gybe_penalty_s"):
-            v = getattr(s, name)
-            if not (isinstance(v, int | float) and math.isfinite(v) and v >= 0):
-                problems.append(f"{name} must be a number >= 0 s, got {v!r}")
-        if s.initial_side not in (None, "port", "starboard"):
-            problems.append(
-                f"initial_side must be 'port', 'starboard' or None, got {s.initial_side!r}"
-            )
-        if problems:
-            raise InputError(f"leg {label}: invalid grid-DP settings:\n" + "\n".join(
-                f"  - {p}" for p in problems))
         return cls(int(s.dp_rows), int(s.dp_cols), int(s.dp_refinements),
                    None if hw is None else float(hw), float(s.dp_shrink), int(s.dp_samples))
 
@@ -169,7 +152,7 @@ def route_griddp(
     target: Target,
     t0: float,
     wind: WindField,
-    boat: Polar | DynamicBoat,
+    boat: BoatModel,
     settings: RoutingSettings,
     *,
     progress: Callable[[float], None] | None = None,
@@ -188,7 +171,7 @@ def route_griddp(
         Start time [epoch s].
     wind : WindField
         Wind; sampled at the time the boat sails each piece.
-    boat : Polar or DynamicBoat
+    boat : BoatModel
         Boat model (see the module docstring).
     settings : RoutingSettings
         The ``dp_*`` fields, the penalties (polar model), ``initial_side``
@@ -222,19 +205,20 @@ def solve_griddp(
     target: Target,
     t0: float,
     wind: WindField,
-    boat: Polar | DynamicBoat,
+    boat: BoatModel,
     settings: RoutingSettings,
     *,
     progress: Callable[[float], None] | None = None,
     xp: ModuleType = np,
 ) -> GridDPSolution:
     """Like :func:`route_griddp`, with per-pass diagnostics (:class:`GridDPSolution`)."""
+    check_settings(settings, leg_label(start, target))
     t0 = float(t0)
-    grid = make_grid(start, target, _rows_or_raise(settings), settings.zone_m)
-    opts = GridDPOptions.from_settings(settings, grid.label)
+    grid = make_grid(start, target, settings.dp_rows, settings.zone_m)
+    opts = GridDPOptions.from_settings(settings)
     if not math.isfinite(t0):
         raise InputError(f"leg {grid.label}: start time must be finite, got {t0!r}")
-    model = BoatModel.of(boat, grid.label)
+    model = GridBoat.of(boat, grid.label)
     half = opts.half_width_m or default_half_width(grid.frame, wind, t0, model)
     n_pass = opts.refinements + 1
     params = [row.initial(opts.cols, half) for row in grid.rows]
@@ -289,11 +273,6 @@ def solve_griddp(
                           np.stack([best.node_x, best.node_y], axis=1))
 
 
-def _rows_or_raise(s: RoutingSettings) -> int:
-    v = s.dp_rows
-    return int(v) if isinstance(v, int | np.integer) and 3 <= v <= 200 else 3
-
-
 def _no_route(grid: LegGrid, band: float, k: int) -> RoutingError:
     return RoutingError(
         f"leg {grid.label}: the grid DP found no feasible path (pass {k + 1}, node band "
@@ -330,16 +309,16 @@ def _inside_pairs(wind: WindField, x0: NDArray, y0: NDArray, x1: NDArray, y1: ND
 # polar model: state (node, side of the last piece)
 
 
-def _dp_polar(model: BoatModel, wind: WindField, xy: list, t0: float, opts: GridDPOptions,
+def _dp_polar(model: GridBoat, wind: WindField, xy: list, t0: float, opts: GridDPOptions,
               s: RoutingSettings, lim: PathLimits, xp: ModuleType,
               progress: Callable[[float], None]) -> tuple[list[int] | None, float, int]:
     n_rows = len(xy)
     c0 = xy[0][0].size
     T = np.full((c0, 2), np.inf)
-    if s.initial_side in (None, "port"):
-        T[:, 0] = t0
-    if s.initial_side in (None, "starboard"):
-        T[:, 1] = t0
+    first = side_sign(s.initial_side)  # 0: either side
+    for si, sv in enumerate(_SIDE_VALUE):
+        if first in (0, sv):
+            T[:, si] = t0
     T[~node_inside(wind, *xy[0])] = np.inf
     B = np.full((c0, 2), np.nan)  # |TWA| of the last piece (NaN: none yet)
     free_start = s.initial_side is None
@@ -406,7 +385,7 @@ def _dp_polar(model: BoatModel, wind: WindField, xy: list, t0: float, opts: Grid
 def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: GridDPOptions,
                 lim: PathLimits, xp: ModuleType, progress: Callable[[float], None]
                 ) -> tuple[list[int] | None, float, int]:
-    model = BoatModel(dynamic=boat)
+    model = GridBoat(boat, None, boat)
     tab = boat.table()
     n_rows = len(xy)
     n = opts.samples
@@ -603,7 +582,7 @@ class _PathEval:
     node_y: NDArray
 
 
-def evaluate_path(model: BoatModel, wind: WindField, xs: NDArray, ys: NDArray, t0: float,
+def evaluate_path(model: GridBoat, wind: WindField, xs: NDArray, ys: NDArray, t0: float,
                   samples: int, settings: RoutingSettings, *,
                   limits: PathLimits | None = None) -> _PathEval:
     """Sail a polyline exactly as the DP costs it, segment by segment in time order.
@@ -618,7 +597,7 @@ def evaluate_path(model: BoatModel, wind: WindField, xs: NDArray, ys: NDArray, t
     f = np.linspace(0.0, 1.0, n + 1)
     t = float(t0)
     out_t, out_x, out_y, out_s, out_v = [], [], [], [], []
-    cur_side = {None: 0, "port": -1, "starboard": 1}[settings.initial_side]
+    cur_side = side_sign(settings.initial_side)
     cur_beta = math.nan
     v = 0.0
     prev_dir: tuple[float, float] | None = None
@@ -682,3 +661,6 @@ def evaluate_path(model: BoatModel, wind: WindField, xs: NDArray, ys: NDArray, t
     bsp = np.array(out_v) if model.dynamic is not None else None
     return _PathEval(t - t0, np.array(out_t), np.array(out_x), np.array(out_y), bsp,
                      np.array(out_s, dtype=np.int8), xs, ys)
+
+
+_ROUTER: Router = route_griddp  # mypy checks the shared router signature

@@ -45,6 +45,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.current import CurrentField, RelativeWind, current_rate_set
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
@@ -63,7 +64,17 @@ from sailroute.routing.geometry import (
     target_geometry,
 )
 from sailroute.routing.track import build_track, make_leg_result
-from sailroute.routing.types import Barrier, LegResult, RoutingSettings, Start, Target, Track
+from sailroute.routing.types import (
+    Barrier,
+    LegResult,
+    Router,
+    RoutingSettings,
+    Start,
+    Target,
+    Track,
+    check_settings,
+    side_sign,
+)
 from sailroute.wind.base import WindField
 
 TABLE_TWS_STEP_MS = 0.05
@@ -74,7 +85,6 @@ PATH_SAMPLES = 4
 """Wind samples along the line to the target that enter the time-to-go estimate."""
 _ROOT_SPEED_MS = 2.0  # progress speed assumed for the sampling horizon at the leg start
 _CALM_MS = 1e-9
-_SIDES = {None: 0, "starboard": 1, "port": -1}
 
 
 # --------------------------------------------------------------------------------------
@@ -159,7 +169,7 @@ def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
     if cached is not None:
         return cached
     a = np.linspace(180.0 / n_a, 180.0, n_a)
-    own = np.asarray(getattr(polar, "tws_ms", np.array([30.0])), dtype=float).ravel()
+    own = np.asarray(polar.tws_ms, dtype=float).ravel()
     top = float(own.max()) if own.size and own.max() > 0 else 30.0
     nodes = np.unique(np.concatenate([
         np.linspace(0.0, top, math.ceil(top / TABLE_TWS_STEP_MS) + 1),
@@ -378,7 +388,7 @@ def route_isochrone(
     target: Target,
     t0: float,
     wind: WindField,
-    polar: Polar,
+    boat: BoatModel,
     settings: RoutingSettings,
     *,
     progress: Callable[[float], None] | None = None,
@@ -398,8 +408,9 @@ def route_isochrone(
         Start time [epoch s].
     wind : WindField
         Wind, sampled once per step at the front points.
-    polar : Polar
-        Boat polar.
+    boat : BoatModel
+        The boat: its steady polar (:meth:`~sailroute.boat.model.BoatModel.routing_polar`)
+        is routed; a boat without one (the dynamic model) is refused.
     settings : RoutingSettings
         ``dt_s``, ``heading_step_deg``, penalties, ``initial_side`` and the
         isochrone options (``min_dt_s``, ``prune_sector_deg``,
@@ -438,8 +449,9 @@ def route_isochrone(
     label = leg_label(start, target)
     if current is not None:
         wind = RelativeWind(wind, current)
-    _check_settings(settings, label, t0)
-    _check_polar(polar, label)
+    check_settings(settings, label)
+    _check_start_time(t0, label)
+    polar = _routing_polar(boat, label)
     geom = target_geometry(target, start, settings.zone_m)
     tab = polar_tables(polar, settings.heading_step_deg)
     frame = _LegFrame.for_leg(geom.centre, start_centre(start))
@@ -454,7 +466,7 @@ def route_isochrone(
     n0 = int(x0.shape[0])
     nan = xp.full(n0, np.nan)
     layers = [_Layer(
-        t=float(t0), x=x0, y=y0, side=xp.full(n0, float(_SIDES[settings.initial_side])),
+        t=float(t0), x=x0, y=y0, side=xp.full(n0, float(side_sign(settings.initial_side))),
         debt=xp.zeros(n0), abs_twa=nan, pend_old=nan, pend_pen=xp.zeros(n0),
         parent=xp.full(n0, -1, dtype=xp.int64), heading=xp.zeros(n0), bsp=xp.zeros(n0),
         delay=xp.zeros(n0), tau_est=nan,
@@ -487,49 +499,25 @@ def route_isochrone(
 # setup
 
 
-def _check_settings(s: RoutingSettings, label: str, t0: float) -> None:
-    problems = []
-
-    def number(name: str, *, strict: bool = True) -> None:
-        v = getattr(s, name)
-        ok = isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-        if not (ok and (v > 0 if strict else v >= 0)):
-            problems.append(f"{name} must be a number {'>' if strict else '>='} 0, got {v!r}")
-
-    for name in ("dt_s", "heading_step_deg", "min_dt_s", "prune_sector_deg",
-                 "max_leg_time_s", "start_line_spacing_m", "zone_m"):
-        number(name)
-    for name in ("tack_penalty_s", "gybe_penalty_s"):
-        number(name, strict=False)
-    if isinstance(s.heading_step_deg, int | float) and s.heading_step_deg > 45:
-        problems.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
-    if not (isinstance(s.max_front_points, int) and s.max_front_points >= 8):
-        problems.append(f"max_front_points must be an integer >= 8, got {s.max_front_points!r}")
-    if s.heading_fan not in ("hull", "full"):
-        problems.append(f"heading_fan must be 'hull' or 'full', got {s.heading_fan!r}")
-    if s.initial_side not in _SIDES:
-        problems.append(
-            f"initial_side must be 'port', 'starboard' or None, got {s.initial_side!r}"
-        )
+def _check_start_time(t0: float, label: str) -> None:
     if not (isinstance(t0, int | float) and math.isfinite(t0)):
-        problems.append(f"the start time must be finite epoch seconds, got {t0!r}")
-    if problems:
         raise InputError(
-            f"leg {label}: invalid routing settings:\n" + "\n".join(f"  - {p}" for p in problems)
+            f"leg {label}: the start time must be finite epoch seconds, got {t0!r}"
         )
 
 
-def _check_polar(polar: Any, label: str) -> None:
-    """Refuse a boat without a polar interface (e.g. the dynamic boat model)."""
-    if callable(getattr(polar, "speed", None)):
-        return
+def _routing_polar(boat: BoatModel, label: str) -> Polar:
+    """The boat's steady polar; refuses a boat without one (the dynamic boat model)."""
+    polar = boat.routing_polar() if isinstance(boat, BoatModel) else None
+    if polar is not None:
+        return polar
     hint = ""
-    if callable(getattr(polar, "steady_polar", None)):
+    if isinstance(boat, BoatModel) and boat.dynamics() is not None:
         hint = (" For the dynamic boat model use router 'griddp' or 'spline', or route "
                 "its steady polar (boat.steady_polar(tws_ms)) with the isochrone router.")
     raise InputError(
         f"leg {label}: the isochrone router needs a Polar (with .speed(tws, twa)), got "
-        f"{type(polar).__name__}.{hint}"
+        f"{type(boat).__name__}.{hint}"
     )
 
 
@@ -555,7 +543,7 @@ def _context(
     cov = wind.coverage
     bounded = any(math.isfinite(v) for v in (cov.xmin, cov.xmax, cov.ymin, cov.ymax))
     box = None
-    if bounded and not getattr(wind, "clamp", False):
+    if bounded and not wind.clamp:
         box = (cov.xmin, cov.xmax, cov.ymin, cov.ymax)
     return _Context(
         label=label, t0=t0, frame=frame, geom=frame.geometry(geom),
@@ -1422,3 +1410,6 @@ def _timeout_error(
             "or raise routing.max_leg_time_s."
         )
     return RoutingError(msg)
+
+
+_ROUTER: Router = route_isochrone  # mypy checks the shared router signature

@@ -37,11 +37,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.backend import to_numpy
 from sailroute.boat.dynamic import DynamicBoat, chain_time
-from sailroute.boat.polar import Polar
+from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError, RoutingError
 from sailroute.routing._dp_grid import (
-    BoatModel,
     ChainWind,
+    GridBoat,
     LegFrame,
     PathLimits,
     Row,
@@ -51,9 +51,16 @@ from sailroute.routing._dp_grid import (
     sample_chains,
     sample_wind,
 )
-from sailroute.routing.geometry import target_barrier
+from sailroute.routing.geometry import leg_label, target_barrier
 from sailroute.routing.track import build_track, make_leg_result
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
+from sailroute.routing.types import (
+    LegResult,
+    Router,
+    RoutingSettings,
+    Start,
+    Target,
+    check_settings,
+)
 from sailroute.wind.base import WindField
 
 K_Y = 1.0 / 3.0
@@ -467,7 +474,7 @@ def route_spline(
     target: Target,
     t0: float,
     wind: WindField,
-    boat: Polar | DynamicBoat,
+    boat: BoatModel,
     settings: RoutingSettings,
     *,
     progress: Callable[[float], None] | None = None,
@@ -502,19 +509,17 @@ def solve_spline(
     target: Target,
     t0: float,
     wind: WindField,
-    boat: Polar | DynamicBoat,
+    boat: BoatModel,
     settings: RoutingSettings,
     *,
     progress: Callable[[float], None] | None = None,
     xp: ModuleType = np,
 ) -> tuple[LegResult, SplineFit]:
     """Like :func:`route_spline`, also returning the :class:`SplineFit` diagnostics."""
+    check_settings(settings, leg_label(start, target))
     t0 = float(t0)
-    rows_n = settings.dp_rows
-    grid = make_grid(start, target, rows_n if isinstance(rows_n, int) and rows_n >= 3 else 3,
-                     settings.zone_m)
-    _check(settings, grid.label)
-    model = BoatModel.of(boat, grid.label)
+    grid = make_grid(start, target, settings.dp_rows, settings.zone_m)
+    model = GridBoat.of(boat, grid.label)
     half = settings.dp_half_width_m or default_half_width(grid.frame, wind, t0, model)
     cost = _route_cost(grid.frame, wind, model, t0, settings, grid.limits, len(grid.rows))
     fit = fit_multispline(cost, grid.frame, grid.rows, n_cols=settings.spline_cols,
@@ -538,25 +543,6 @@ def solve_spline(
     if progress is not None:
         progress(1.0)
     return make_leg_result(track, "spline", target_barrier(target, start, settings.zone_m)), fit
-
-
-def _check(s: RoutingSettings, label: str) -> None:
-    problems = []
-    for name, lo in (("dp_rows", 3), ("spline_cols", 2), ("spline_slopes", 1),
-                     ("spline_refinements", 0)):
-        v = getattr(s, name)
-        if not (isinstance(v, int | np.integer) and lo <= v <= 1000):
-            problems.append(f"{name} must be an integer >= {lo}, got {v!r}")
-    for name in ("spline_carry_speed", "spline_start_from_rest"):
-        v = getattr(s, name)
-        if not isinstance(v, bool | np.bool_):
-            problems.append(f"{name} must be true or false, got {v!r}")
-    hw = s.dp_half_width_m
-    if hw is not None and not (isinstance(hw, int | float) and math.isfinite(hw) and hw > 0):
-        problems.append(f"dp_half_width_m must be > 0 m or None (automatic), got {hw!r}")
-    if problems:
-        raise InputError(f"leg {label}: invalid multi-spline settings:\n" + "\n".join(
-            f"  - {p}" for p in problems))
 
 
 @dataclass(frozen=True, eq=False)
@@ -604,7 +590,7 @@ def _turn_cosines(cw: ChainWind, hx: NDArray, hy: NDArray) -> NDArray:
     return cos_t
 
 
-def _sail_edges(frame: LegFrame, wind: WindField, model: BoatModel, t_dep: NDArray,
+def _sail_edges(frame: LegFrame, wind: WindField, model: GridBoat, t_dep: NDArray,
                 x: NDArray, y: NDArray, m0: NDArray, m1: NDArray,
                 settings: RoutingSettings, limits: PathLimits | None = None,
                 last: bool = False, v_in: NDArray | None = None) -> _EdgeSail:
@@ -739,7 +725,7 @@ def edge_time_bound(boat: DynamicBoat, cw: ChainWind, v_in: NDArray,
     return np.sum(t, axis=-1)
 
 
-def _dynamic_row(frame: LegFrame, wind: WindField, model: BoatModel, e: Edges,
+def _dynamic_row(frame: LegFrame, wind: WindField, model: GridBoat, e: Edges,
                  px: NDArray, py: NDArray, t_start: NDArray, v_start: NDArray | None,
                  limits: PathLimits | None, last: bool, cap: NDArray
                  ) -> tuple[NDArray, NDArray]:
@@ -797,7 +783,7 @@ def _dynamic_row(frame: LegFrame, wind: WindField, model: BoatModel, e: Edges,
     return cost.reshape(e.shape), v_end.reshape(e.shape)
 
 
-def _route_cost(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
+def _route_cost(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
                 settings: RoutingSettings, limits: PathLimits, n_rows: int) -> EdgeCost:
     t = np.linspace(0.0, 1.0, CHORDS + 1)
     boat = model.dynamic
@@ -831,7 +817,7 @@ def _route_cost(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
     return cost
 
 
-def _sail_curve(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
+def _sail_curve(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
                 settings: RoutingSettings, fit: SplineFit, limits: PathLimits | None = None
                 ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray | None]:
     """Sail the best curve edge by edge: track vertices at the chord ends."""
@@ -884,3 +870,6 @@ def _sail_curve(frame: LegFrame, wind: WindField, model: BoatModel, t0: float,
     bsp = np.array(out_v) if model.dynamic is not None else None
     return (np.array(out_t), np.array(out_x), np.array(out_y), np.array(out_s, dtype=np.int8),
             bsp)
+
+
+_ROUTER: Router = route_spline  # mypy checks the shared router signature

@@ -6,15 +6,64 @@ a boat and :class:`RoutingSettings`, and returns a :class:`LegResult`.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Literal
+from types import ModuleType
+from typing import TYPE_CHECKING, Final, Literal, Protocol, get_args
 
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.errors import InputError
+
+if TYPE_CHECKING:
+    from sailroute.boat.model import BoatModel
+    from sailroute.wind.base import WindField
+
 Side = Literal["port", "starboard"]
+"""A tack (or a mark's rounding side) at every public boundary: settings, files, JSON,
+the CLI.  Arrays hold :func:`side_sign` numbers instead."""
 TargetKind = Literal["mark", "gate", "line"]
 RouterName = Literal["isochrone", "griddp", "spline"]
+
+SIDE_NAMES: Final[tuple[Side, ...]] = get_args(Side)
+"""The valid :data:`Side` names, ``("port", "starboard")``."""
+_SIGNS: Final[dict[str, int]] = {"starboard": 1, "port": -1}
+
+
+def side_sign(name: Side | None) -> int:
+    """Array code of a tack: +1 starboard, -1 port, 0 not chosen (``None``).
+
+    Raises
+    ------
+    InputError
+        For any other name (the message lists the valid ones).
+    """
+    if name is None:
+        return 0
+    sign = _SIGNS.get(name) if isinstance(name, str) else None
+    if sign is None:
+        raise InputError(f"side {name!r}: expected 'port' or 'starboard'")
+    return sign
+
+
+def side_name(sign: int | np.integer | float) -> Side:
+    """Name of an array tack code: ``"starboard"`` for +1, ``"port"`` for -1.
+
+    The inverse of :func:`side_sign` on ±1; any positive number counts as starboard and
+    any negative one as port (e.g. a float array's entries).
+
+    Raises
+    ------
+    ValueError
+        For 0 (no tack chosen) or NaN: there is no name to give.
+    """
+    if sign > 0:
+        return "starboard"
+    if sign < 0:
+        return "port"
+    raise ValueError(f"side code {sign!r} has no name: expected +1 (starboard) or -1 (port)")
 
 
 @dataclass(frozen=True)
@@ -130,8 +179,8 @@ class RoutingSettings:
         Time lost per tack / gybe [s], independent of the time step.
     initial_side : {"port", "starboard"} or None
         Tack at the start of a leg; None lets the router choose freely.
-    clamp_wind : bool
-        Unused by routers (wind fields carry their own clamp flag); kept for reports.
+    extra : dict of str to float
+        Router-specific numbers not covered by the fields (kept for reports).
     zone_m : float
         Length of a mark's rounding segment [m] (see ``routing/geometry.py``):
         the leg ends when the boat crosses it, so it is how close a rounding
@@ -208,6 +257,89 @@ class RoutingSettings:
     spline_start_from_rest: bool = False
 
 
+def settings_problems(s: RoutingSettings) -> list[str]:
+    """What is wrong with ``s``, one line per field (empty when every field is valid).
+
+    The one place that validates :class:`RoutingSettings`: every router calls
+    :func:`check_settings`, which raises with these lines.
+    """
+    problems: list[str] = []
+
+    def is_number(v: object) -> bool:
+        return isinstance(v, int | float | np.integer | np.floating) and not isinstance(
+            v, bool) and math.isfinite(v)
+
+    def number(name: str, *, strict: bool = True) -> None:
+        v = getattr(s, name)
+        if not (is_number(v) and (v > 0 if strict else v >= 0)):
+            problems.append(f"{name} must be a number {'>' if strict else '>='} 0, got {v!r}")
+
+    def integer(name: str, lo: int, hi: int, text: str) -> None:
+        v = getattr(s, name)
+        if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and lo <= v <= hi):
+            problems.append(f"{name} must be an integer {text}, got {v!r}")
+
+    if s.router not in get_args(RouterName):
+        problems.append("router must be one of " + ", ".join(
+            repr(r) for r in get_args(RouterName)) + f", got {s.router!r}")
+    for name in ("dt_s", "heading_step_deg", "min_dt_s", "prune_sector_deg",
+                 "max_leg_time_s", "start_line_spacing_m", "zone_m"):
+        number(name)
+    for name in ("tack_penalty_s", "gybe_penalty_s"):
+        number(name, strict=False)
+    if is_number(s.heading_step_deg) and s.heading_step_deg > 45:
+        problems.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
+    integer("max_front_points", 8, 10**9, ">= 8")
+    if s.heading_fan not in ("hull", "full"):
+        problems.append(f"heading_fan must be 'hull' or 'full', got {s.heading_fan!r}")
+    if s.initial_side is not None and s.initial_side not in SIDE_NAMES:
+        problems.append(
+            f"initial_side must be 'port', 'starboard' or None, got {s.initial_side!r}"
+        )
+    if not (isinstance(s.extra, dict) and all(
+            isinstance(k, str) and is_number(v) for k, v in s.extra.items())):
+        problems.append(f"extra must be a mapping of names to numbers, got {s.extra!r}")
+    integer("dp_rows", 3, 200, "in [3, 200]")
+    integer("dp_cols", 2, 1024, "in [2, 1024]")
+    integer("dp_refinements", 0, 20, "in [0, 20]")
+    integer("dp_samples", 1, 64, "in [1, 64]")
+    if not (is_number(s.dp_shrink) and 0 < s.dp_shrink <= 1):
+        problems.append(f"dp_shrink must be in (0, 1], got {s.dp_shrink!r}")
+    hw = s.dp_half_width_m
+    if hw is not None and not (is_number(hw) and hw > 0):
+        problems.append(f"dp_half_width_m must be > 0 m or None (automatic), got {hw!r}")
+    for name, lo in (("spline_cols", 2), ("spline_slopes", 1), ("spline_refinements", 0)):
+        integer(name, lo, 1000, f">= {lo}")
+    for name in ("spline_carry_speed", "spline_start_from_rest"):
+        v = getattr(s, name)
+        if not isinstance(v, bool | np.bool_):
+            problems.append(f"{name} must be true or false, got {v!r}")
+    return problems
+
+
+def check_settings(s: RoutingSettings, label: str) -> None:
+    """Refuse invalid routing settings (see :func:`settings_problems`).
+
+    Parameters
+    ----------
+    s : RoutingSettings
+        The settings.
+    label : str
+        The leg, for the message (``"start -> 1"``).
+
+    Raises
+    ------
+    InputError
+        ``leg LABEL: invalid routing settings:`` and one line per bad field, with the
+        expected range and the value given.
+    """
+    problems = settings_problems(s)
+    if problems:
+        raise InputError(
+            f"leg {label}: invalid routing settings:\n" + "\n".join(f"  - {p}" for p in problems)
+        )
+
+
 @dataclass(frozen=True, eq=False)
 class Track:
     """A routed track, one row per point.
@@ -227,7 +359,7 @@ class Track:
     bsp_ms : ndarray
         Boat speed through the water [m s⁻¹].
     side : ndarray of int
-        +1 starboard tack, -1 port tack.
+        +1 starboard tack, -1 port tack (:func:`side_sign`, :func:`side_name`).
     sog_ms, cog_deg : ndarray or None
         Speed [m s⁻¹] and course [° compass] over the ground, where a surface current
         was routed (``heading_deg``/``bsp_ms`` are then through the water and
@@ -318,3 +450,28 @@ class LegResult:
     def time_s(self) -> float:
         """Leg time [s]."""
         return self.t_end - self.t_start
+
+
+class Router(Protocol):
+    """A leg router: the signature every routing function shares.
+
+    ``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy) -> LegResult``
+    (:mod:`sailroute.routing.api` lists the implementations; each router module
+    declares ``_ROUTER: Router = route_...`` so that mypy checks it against this).
+    """
+
+    def __call__(
+        self,
+        start: Start,
+        target: Target,
+        t0: float,
+        wind: WindField,
+        boat: BoatModel,
+        settings: RoutingSettings,
+        /,
+        *,
+        progress: Callable[[float], None] | None = None,
+        xp: ModuleType = ...,
+    ) -> LegResult:
+        """Fastest route of one leg (see :func:`~sailroute.routing.api.route_leg`)."""
+        ...

@@ -20,6 +20,7 @@ from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 from sailroute.outdir import check_out_dir, make_out_dir, write_output_set
 from sailroute.parallel import TaskRunner, check_scheduler, open_runner
+from sailroute.routing.types import SIDE_NAMES, side_name, side_sign
 from sailroute.strategy.deadline import (
     DeadlineGrid,
     DeadlinePolicy,
@@ -267,7 +268,7 @@ def _run_study(
             "vmg_upwind_ms": vmg,
             "vmg_twa_deg": vmg_angle,
         },
-        "settings": asdict(st),
+        "settings": {**asdict(st), "start_tack": side_name(st.start_tack)},  # names in files
         "shift_model": model.describe(),
         "fit": fit,
         "chain": {
@@ -536,9 +537,10 @@ def run_strategy_command(
     check_out_dir(out_dir)
     scheduler = check_scheduler(scheduler)
     kind = parse_shift(shift)
-    tack = {"starboard": 1, "port": -1}.get(str(start_tack).strip().lower())
-    if tack is None:
+    name = str(start_tack).strip().lower()
+    if name not in SIDE_NAMES:
         raise InputError(f"--start-tack {start_tack!r}: expected 'starboard' or 'port'")
+    tack = side_sign(name)
     if not (math.isfinite(tws_kn) and tws_kn > 0):
         raise InputError(f"--tws-kn {tws_kn}: must be > 0")
     seed = settings.get("seed", 0)

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.routing.types import side_name
 from sailroute.strategy.deadline import DeadlinePolicy, DeadlineSimulation, _nearest_nodes
 from sailroute.strategy.montecarlo import SimulationResult
 from sailroute.strategy.sdp import TACKS, ExpectedTimePolicy
@@ -79,7 +80,7 @@ def plot_policy_map(
     fig = _figure(3.2 * len(thetas_deg) + 0.6, 5.0)
     axes = fig.subplots(1, len(thetas_deg), sharey=True, squeeze=False)[0]
     cmap = ListedColormap(_POLICY_COLOURS)
-    side = "starboard" if tack == 1 else "port"
+    side = side_name(tack)
     for ax, th in zip(axes, thetas_deg, strict=True):
         cls = policy_classes(policy, th, tack)
         _, _, it = policy.state_index(0.0, tack, th)
@@ -242,7 +243,7 @@ def plot_deadline_policy(
     )
     im2 = ax2.imshow(w, origin="lower", extent=box, cmap="magma", vmin=0, vmax=1)
     fig.colorbar(im2, ax=ax2, label="P(reach the mark within the budget)")
-    side = "starboard" if tack == 1 else "port"
+    side = side_name(tack)
     for ax, title in ((ax1, f"policy on {side}"), (ax2, "success probability w")):
         ax.add_patch(_circle(g.target_radius_m))
         ax.set_xlabel("x from the mark [m]")

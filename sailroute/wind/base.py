@@ -11,6 +11,8 @@ A wind field maps arrays of ``(t, x, y)`` to arrays ``(u, v)``:
 * sampling outside :attr:`WindField.coverage` raises
   :class:`~sailroute.errors.OutOfCoverageError` naming both ranges, unless the
   field was built with ``clamp=True`` (then points are clamped to the edges);
+  :attr:`WindField.clamp` says which (routers read it to know whether the coverage
+  box bounds the route);
 * NaN in ``t``, ``x`` or ``y`` raises :class:`~sailroute.errors.OutOfCoverageError`
   in both modes (never NaN winds out).
 
@@ -132,6 +134,12 @@ class WindField(Protocol):
     @property
     def coverage(self) -> Coverage:
         """Time span and bounding box where :meth:`sample` is defined."""
+        ...
+
+    @property
+    def clamp(self) -> bool:
+        """True: points outside :attr:`coverage` are clamped to its edges; False: they
+        raise :class:`~sailroute.errors.OutOfCoverageError`."""
         ...
 
     def sample(

@@ -17,7 +17,8 @@ and turned clockwise by ``C_δ``.  Limits are discussed in ``docs/design/wind.md
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -137,9 +138,13 @@ class BlendedWind:
     exponent: float = DEFAULT_EXPONENT
     clamp: bool = False
     name: str = "blended wind"
-    _corr: tuple[StationCorrection, ...] = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        self._corr  # noqa: B018  (built now: building it checks the inputs)
+
+    @cached_property
+    def _corr(self) -> tuple[StationCorrection, ...]:
+        """The stations' corrections of the base field (checked and built once)."""
         if not (self.length_scale_m > 0) or not (self.time_scale_s >= 0):
             raise InputError(f"{self.name}: length_scale_m must be > 0 and time_scale_s >= 0")
         lo, hi = self.ratio_range
@@ -177,7 +182,7 @@ class BlendedWind:
                 corr.append(StationCorrection(
                     str(s), tv[good], x[m][good], y[m][good], lr[good],
                     np.clip(dd[good], -self.max_offset_deg, self.max_offset_deg)))
-        object.__setattr__(self, "_corr", tuple(corr))
+        return tuple(corr)
 
     @property
     def coverage(self) -> Coverage:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sailroute.checks import Checker, Problems, show
 from sailroute.errors import InputError, OutOfCoverageError
@@ -33,6 +33,9 @@ from sailroute.wind.stations import (
 )
 from sailroute.wind.uniform import UniformWind
 from sailroute.wind.wrf import open_wrf
+
+if TYPE_CHECKING:
+    from sailroute.current import CurrentField
 
 BBox = tuple[float, float, float, float]
 """Local-frame box ``(xmin, xmax, ymin, ymax)`` [m] (same order as :class:`Coverage`)."""
@@ -111,7 +114,7 @@ def wind_from_spec(
 
 
 def check_covers(
-    field: WindField,
+    field: WindField | CurrentField,
     bbox: BBox | None,
     time_window: tuple[float, float] | None,
     *,

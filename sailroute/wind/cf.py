@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -762,11 +762,8 @@ def open_netcdf(
     ul, vl = earth_to_local(ue, ve, frame.grid_north_deg(lat_w, lon_w))
     times = hdr.times[w.k0:w.k1]
     span = (float(hdr.times[0]), float(hdr.times[-1]))
-    field = GridWind(times, x, y, ul, vl, interpolation=interpolation, time_step_s=step_s,
-                     clamp=clamp, name=label or f"gridded wind {_short(name)}", frame=frame,
-                     source_span=span, allow_nan=True, steady=steady)
     nan_cells = int(both[0].sum()) if both.ndim == 3 else 0
-    info = {
+    info: dict[str, Any] = {
         "path": name,
         "format": "cf",
         "variables": hdr.names,
@@ -782,10 +779,14 @@ def open_netcdf(
         "nan_cells": nan_cells,
         "times": f"{iso(times[0])} .. {iso(times[-1])} ({times.size} of {hdr.times.size} "
                  "slices)",
-        "map_degree": field.index_map.degree,
-        "map_residual_cells": field.index_map.residual_cells,
+        "map_degree": None,  # filled in below, from the field's index map
+        "map_residual_cells": None,
     }
-    object.__setattr__(field, "info", info)
+    field = GridWind(times, x, y, ul, vl, interpolation=interpolation, time_step_s=step_s,
+                     clamp=clamp, name=label or f"gridded wind {_short(name)}", info=info,
+                     frame=frame, source_span=span, allow_nan=True, steady=steady)
+    info.update(map_degree=field.index_map.degree,
+                map_residual_cells=field.index_map.residual_cells)
     return field
 
 
@@ -845,7 +846,4 @@ def open_grib(path: str | Path, frame: LocalFrame, *,
     ds = open_grib_dataset(path, filter_by_keys=filter_by_keys)
     kwargs.setdefault("label", f"GRIB wind {Path(path).name}")
     field = open_netcdf(ds, frame, **kwargs)
-    info = dict(field.info)
-    info.update(path=str(path), format="grib")
-    object.__setattr__(field, "info", info)
-    return field
+    return replace(field, info={**field.info, "path": str(path), "format": "grib"})

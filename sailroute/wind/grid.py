@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -136,6 +137,17 @@ def fit_index_map(
 
 
 @dataclass(frozen=True, eq=False)
+class _GridState:
+    """What a :class:`GridWind` derives from its inputs (built once, when it is made)."""
+
+    t: NDArray  # slice times [epoch s]
+    uv: NDArray  # u + i v, shape (nt, ny * nx) [m s⁻¹]
+    map: IndexMap  # local frame -> grid indices
+    cov: Coverage
+    has_nan: bool  # some winds are NaN (allow_nan)
+
+
+@dataclass(frozen=True, eq=False)
 class GridWind:
     """Wind on a structured grid of cell centres, at a series of times.
 
@@ -200,13 +212,13 @@ class GridWind:
     source_span: tuple[float, float] | None = None
     allow_nan: bool = False
     steady: bool = False
-    _t: NDArray = field(init=False, repr=False)
-    _has_nan: bool = field(init=False, repr=False)
-    _uv: NDArray = field(init=False, repr=False)
-    _map: IndexMap = field(init=False, repr=False)
-    _cov: Coverage = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        self._state  # noqa: B018  (built now: building it checks the inputs)
+
+    @cached_property
+    def _state(self) -> _GridState:
+        """Arrays, index map and coverage derived from the inputs (checked here)."""
         t = np.asarray(self.times, dtype=float).ravel()
         x = np.asarray(self.x, dtype=float)
         y = np.asarray(self.y, dtype=float)
@@ -255,34 +267,30 @@ class GridWind:
             )
         imap = fit_index_map(x, y, tolerance_cells=self.map_tolerance_cells, name=self.name)
         uv = np.ascontiguousarray((u + 1j * v).reshape(t.size, -1))
-        object.__setattr__(self, "_t", t)
-        object.__setattr__(self, "_uv", uv)
-        object.__setattr__(self, "_map", imap)
         t0, t1 = (-np.inf, np.inf) if self.steady else (float(t[0]), float(t[-1]))
-        object.__setattr__(self, "_cov", Coverage(t0, t1, xmin, xmax, ymin, ymax,
-                                                   frame=self.frame,
-                                                   source_span=self.source_span))
-        object.__setattr__(self, "_has_nan", bool(np.isnan(uv).any()))
+        cov = Coverage(t0, t1, xmin, xmax, ymin, ymax, frame=self.frame,
+                       source_span=self.source_span)
+        return _GridState(t, uv, imap, cov, bool(np.isnan(uv).any()))
 
     @property
     def coverage(self) -> Coverage:
         """Time span of the slices and the box inside the grid footprint."""
-        return self._cov
+        return self._state.cov
 
     @property
     def shape(self) -> tuple[int, int, int]:
         """``(nt, ny, nx)``."""
         ny, nx = np.shape(self.x)
-        return (self._t.size, ny, nx)
+        return (self._state.t.size, ny, nx)
 
     @property
     def index_map(self) -> IndexMap:
         """The fitted local-frame -> grid-index map."""
-        return self._map
+        return self._state.map
 
     def grid_indices(self, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Fractional grid indices ``(i, j)`` (column, row) of local points [m]."""
-        return self._map(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        return self._state.map(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast).
@@ -302,17 +310,17 @@ class GridWind:
 
     def _sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike, *, refuse_nan: bool
                 ) -> tuple[NDArray, NDArray]:
-        t, x, y = prepare_points(self._cov, t, x, y, clamp=self.clamp, name=self.name)
+        t, x, y = prepare_points(self._state.cov, t, x, y, clamp=self.clamp, name=self.name)
         shape = t.shape
         t, x, y = t.ravel(), x.ravel(), y.ravel()
         nt, ny, nx = self.shape
-        tt = self._t
+        tt = self._state.t
         if self.time_step_s is not None:
             t = np.clip(np.floor(t / self.time_step_s) * self.time_step_s, tt[0], tt[-1])
-        fi, fj = self._map(x, y)
+        fi, fj = self._state.map(x, y)
         np.clip(fi, 0.0, nx - 1.0, out=fi)
         np.clip(fj, 0.0, ny - 1.0, out=fj)
-        uv = self._uv
+        uv = self._state.uv
         if nt == 1:
             k = np.zeros(t.shape, dtype=np.intp)
             wt = None
@@ -338,7 +346,7 @@ class GridWind:
             out = _bilinear(flat, base, nx, wx, wy)
             if wt is not None:
                 out = out + wt * (_bilinear(flat, base + ncell, nx, wx, wy) - out)
-        if self._has_nan and refuse_nan:
+        if self._state.has_nan and refuse_nan:
             self._refuse_nan(out, t, x, y)
         return out.real.reshape(shape).copy(), out.imag.reshape(shape).copy()
 
@@ -377,7 +385,7 @@ class GridWind:
 
         xr = require_xarray("GridWind.to_xarray()")
         nt, ny, nx = self.shape
-        uv = self._uv.reshape(nt, ny, nx)
+        uv = self._state.uv.reshape(nt, ny, nx)
         x = np.asarray(self.x, dtype=float)
         y = np.asarray(self.y, dtype=float)
         dims = ("time", "j", "i")
@@ -387,7 +395,7 @@ class GridWind:
             "v": (dims, uv.imag.copy(), {**ms, "long_name": "wind towards +y (local frame)"}),
         }
         coords: dict[str, Any] = {
-            "time": ("time", (self._t * 1e9).astype("int64").astype("datetime64[ns]")),
+            "time": ("time", (self._state.t * 1e9).astype("int64").astype("datetime64[ns]")),
             "x": (("j", "i"), x, {"units": "m", "long_name": "metres east of the origin"}),
             "y": (("j", "i"), y, {"units": "m", "long_name": "metres north of the origin"}),
         }

@@ -22,6 +22,7 @@ import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime, timedelta, timezone
+from functools import cached_property
 from pathlib import Path
 from typing import Any, Final, Literal
 
@@ -785,6 +786,16 @@ RbfKernel = Literal["thin_plate_spline", "linear", "cubic", "quintic", "multiqua
 
 
 @dataclass(frozen=True, eq=False)
+class _StationState:
+    """What a :class:`StationWind` derives from its inputs (built once, when it is made)."""
+
+    series: tuple  # per station: (id, t, x, y, u, v) arrays in the local frame
+    cov: Coverage
+    moving: bool  # some station moves (coach boat)
+    rbf: Any  # RBF interpolator of station weights (method "rbf"), else None
+
+
+@dataclass(frozen=True, eq=False)
 class StationWind:
     """Wind field interpolated from station records.
 
@@ -849,12 +860,13 @@ class StationWind:
     clamp: bool = False
     name: str = "station wind"
     time_window: tuple[float, float] | None = None
-    _series: tuple = field(init=False, repr=False)
-    _cov: Coverage = field(init=False, repr=False)
-    _moving: bool = field(init=False, repr=False)
-    _rbf: Any = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        self._state  # noqa: B018  (built now: building it checks the inputs)
+
+    @cached_property
+    def _state(self) -> _StationState:
+        """Per-station series, coverage and interpolator (checked and built once)."""
         d = self.data
         if len(d) == 0:
             raise WindDataError(f"{self.name}: no station records")
@@ -926,22 +938,20 @@ class StationWind:
         cov = Coverage(t0, t1, float(x.min()) - self.radius_m, float(x.max()) + self.radius_m,
                        float(y.min()) - self.radius_m, float(y.max()) + self.radius_m,
                        frame=self.frame, source_span=(float(d.t.min()), float(d.t.max())))
-        object.__setattr__(self, "_series", tuple(series))
-        object.__setattr__(self, "_cov", cov)
-        object.__setattr__(self, "_moving", moving)
-        object.__setattr__(self, "_rbf", rbf)
+        return _StationState(tuple(series), cov, moving, rbf)
 
     @property
     def coverage(self) -> Coverage:
         """Common time span of the stations; their box plus ``radius_m``."""
-        return self._cov
+        return self._state.cov
 
     def station_values(self, t: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
         """Per-station ``(x, y, u, v)`` interpolated at times ``t``, each shape ``(n, S)``."""
         cols: list[list[NDArray]] = [[], [], [], []]
-        for _, ts, xs, ys, us, vs in self._series:
-            for c, a, moves in zip(cols, (xs, ys, us, vs), (self._moving, self._moving, True,
-                                                            True), strict=True):
+        moving = self._state.moving
+        for _, ts, xs, ys, us, vs in self._state.series:
+            for c, a, moves in zip(cols, (xs, ys, us, vs), (moving, moving, True, True),
+                                   strict=True):
                 if not moves or a.size == 1:
                     c.append(np.full(t.shape, a[0]))
                 else:
@@ -952,7 +962,7 @@ class StationWind:
     @property
     def station_ids(self) -> tuple[str, ...]:
         """Station ids in the order of the weight columns."""
-        return tuple(s[0] for s in self._series)
+        return tuple(s[0] for s in self._state.series)
 
     def weights(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> NDArray:
         """Normalised spatial weights ``(n, S)`` of the stations at points ``(t, x, y)``.
@@ -962,20 +972,20 @@ class StationWind:
         """
         t, x, y = (a.ravel() for a in np.broadcast_arrays(
             np.asarray(t, float), np.asarray(x, float), np.asarray(y, float)))
-        if self._rbf is not None:
-            return self._rbf(np.column_stack([x, y]))
+        if self._state.rbf is not None:
+            return self._state.rbf(np.column_stack([x, y]))
         sx, sy, _, _ = self.station_values(t)
         return idw_weights(x, y, sx, sy, self.power)
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast)."""
-        t, x, y = prepare_points(self._cov, t, x, y, clamp=self.clamp, name=self.name)
+        t, x, y = prepare_points(self._state.cov, t, x, y, clamp=self.clamp, name=self.name)
         shape = t.shape
         t, x, y = t.ravel(), x.ravel(), y.ravel()
         sx, sy, su, sv = self.station_values(t)
-        if self._rbf is not None:
-            w = self._rbf(np.column_stack([x, y]))
-        elif len(self._series) == 1:
+        if self._state.rbf is not None:
+            w = self._state.rbf(np.column_stack([x, y]))
+        elif len(self._state.series) == 1:
             w = np.ones((t.size, 1))
         else:
             w = idw_weights(x, y, sx, sy, self.power)

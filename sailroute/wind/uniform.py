@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,11 +40,14 @@ class UniformWind:
     times: Sequence[float] | None = None
     interpolation: str = "linear"
     clamp: bool = False
-    _u: NDArray = field(init=False, repr=False)
-    _v: NDArray = field(init=False, repr=False)
-    _t: NDArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
+        self._table  # noqa: B018  (built now: building it checks the inputs)
+
+    @cached_property
+    def _table(self) -> tuple[NDArray, NDArray, NDArray]:
+        """Row times [epoch s] (``[-inf]`` if constant) and components ``(t, u, v)``
+        [m s⁻¹]."""
         s = np.atleast_1d(np.asarray(self.tws_ms, dtype=float))
         d = np.atleast_1d(np.asarray(self.twd_deg, dtype=float))
         if s.shape != d.shape:
@@ -68,9 +72,7 @@ class UniformWind:
                 "expected 'linear' or 'previous'"
             )
         u, v = wind_components(s, d)
-        object.__setattr__(self, "_u", u)
-        object.__setattr__(self, "_v", v)
-        object.__setattr__(self, "_t", t)
+        return t, u, v
 
     @property
     def coverage(self) -> Coverage:
@@ -78,14 +80,16 @@ class UniformWind:
         inf = float("inf")
         if self.times is None:
             return Coverage.everywhere()
-        return Coverage(float(self._t[0]), float(self._t[-1]), -inf, inf, -inf, inf)
+        t = self._table[0]
+        return Coverage(float(t[0]), float(t[-1]), -inf, inf, -inf, inf)
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s], position ``x, y`` [m] (broadcast)."""
         t, x, y = prepare_points(self.coverage, t, x, y, clamp=self.clamp, name="uniform wind")
-        if self._t.size == 1:
-            return np.full(t.shape, self._u[0]), np.full(t.shape, self._v[0])
+        tt, u, v = self._table
+        if tt.size == 1:
+            return np.full(t.shape, u[0]), np.full(t.shape, v[0])
         if self.interpolation == "previous":
-            k = np.clip(np.searchsorted(self._t, t, side="right") - 1, 0, self._t.size - 1)
-            return self._u[k], self._v[k]
-        return np.interp(t, self._t, self._u), np.interp(t, self._t, self._v)
+            k = np.clip(np.searchsorted(tt, t, side="right") - 1, 0, tt.size - 1)
+            return u[k], v[k]
+        return np.interp(t, tt, u), np.interp(t, tt, v)

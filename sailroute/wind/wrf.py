@@ -742,10 +742,7 @@ def open_wrf(
                      shear=shear, fallback_exponent=fallback_exponent,
                      exponent_range=exponent_range, roughness_m=roughness_m)
     label = f"WRF wind {Path(header.path).name}"
-    field = GridWind(dec.times, dec.x, dec.y, dec.u, dec.v, interpolation=interpolation,
-                     time_step_s=step_s, clamp=clamp, name=label, info={}, frame=frame,
-                     source_span=(float(header.times[0]), float(header.times[-1])))
-    info = {
+    info: dict[str, Any] = {
         "path": header.path,
         "levels": dec.levels,
         "height_m": dec.height_m,
@@ -753,9 +750,13 @@ def open_wrf(
         "fallback_fraction": dec.fallback_fraction,
         "window": window,
         "times": f"{iso(dec.times[0])} .. {iso(dec.times[-1])} ({dec.times.size} slices)",
-        "map_degree": field.index_map.degree,
-        "map_residual_cells": field.index_map.residual_cells,
+        "map_degree": None,  # filled in below, from the field's index map
+        "map_residual_cells": None,
         "exponent_mean": None if dec.exponent is None else float(np.mean(dec.exponent)),
     }
-    object.__setattr__(field, "info", info)
+    field = GridWind(dec.times, dec.x, dec.y, dec.u, dec.v, interpolation=interpolation,
+                     time_step_s=step_s, clamp=clamp, name=label, info=info, frame=frame,
+                     source_span=(float(header.times[0]), float(header.times[-1])))
+    info.update(map_degree=field.index_map.degree,
+                map_residual_cells=field.index_map.residual_cells)
     return field

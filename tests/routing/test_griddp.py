@@ -11,7 +11,7 @@ import pytest
 from sailroute.boat.dynamic import DynamicBoat
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError, RoutingError
-from sailroute.routing._dp_grid import BoatModel, make_grid
+from sailroute.routing._dp_grid import GridBoat, make_grid
 from sailroute.routing.geometry import target_geometry
 from sailroute.routing.griddp import evaluate_path, route_griddp, solve_griddp
 from sailroute.routing.types import RoutingSettings, Start, Target
@@ -92,7 +92,7 @@ def _brute_force(boat: Polar | DynamicBoat, wind, tgt: Target, s: RoutingSetting
     grid = make_grid(A, tgt, s.dp_rows, s.zone_m)
     half = s.dp_half_width_m
     xy = [row.points(grid.frame, row.initial(s.dp_cols, half)) for row in grid.rows]
-    model = BoatModel.of(boat, "test")
+    model = GridBoat.of(boat, "test")
     best = math.inf
     for path in itertools.product(*[range(p[0].size) for p in xy]):
         xs = np.array([xy[r][0][c] for r, c in enumerate(path)])

@@ -150,8 +150,10 @@ def _inside(c, n=5):
 
 
 def test_protocol_and_values(field_and_tol) -> None:
-    f, _, tol = field_and_tol
-    assert isinstance(f, WindField)
+    f, fc, tol = field_and_tol
+    assert isinstance(f, WindField) and isinstance(fc, WindField)
+    # the clamp flag is part of the contract: routers read it, they never probe for it
+    assert (f.clamp, fc.clamp) == (False, True)
     t, x, y = _inside(f.coverage)
     u, v = f.sample(t, x, y)
     assert u.dtype == np.float64 and v.dtype == np.float64
