@@ -30,7 +30,7 @@ from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame, wrap_lon
-from sailroute.routing.types import RouterName, RoutingSettings, Side
+from sailroute.routing.types import RouterName, RoutingSettings, Side, settings_problems
 from sailroute.timeutil import parse_time, utc_offset_s
 from sailroute.units import KNOT
 
@@ -43,7 +43,7 @@ TOP_KEYS = (
 """Keys allowed at the top level of a course file."""
 
 LAYOUT_KEYS = ("marks", "lines", "gates", "legs")
-SIDES = ("port", "starboard")
+SIDES = typing.get_args(Side)  # ("port", "starboard")
 BOAT_SOURCES = ("builtin", "polar", "vpp")
 DEFAULT_BOAT = {"builtin": "ilca7"}
 DEFAULT_TIME_LIMIT_MIN = 90.0
@@ -376,10 +376,15 @@ def _routing(c: Checker, raw: Any) -> RoutingSettings:
         if v is not None or raw[key] is None:
             kw[key] = v
     try:
-        return dataclasses.replace(defaults, **kw)
+        settings = dataclasses.replace(defaults, **kw)
     except (TypeError, ValueError) as exc:  # a future field with its own checks
         c.p.add("routing", str(exc))
         return defaults
+    # the routers' own rules (e.g. dp_cols >= 2), at load time rather than mid-plan
+    for problem in settings_problems(settings):
+        name = problem.split(" ", 1)[0]
+        c.p.add(f"routing.{name}" if name in raw else "routing", problem)
+    return settings
 
 
 def _extra(c: Checker, raw: Any) -> dict[str, float] | None:

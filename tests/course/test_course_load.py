@@ -256,6 +256,19 @@ def test_routing_problems(tmp_path, routing, expected):
     assert expected in problems(write(tmp_path, BASE + f"routing:\n  {routing}\n"))
 
 
+@pytest.mark.parametrize(("routing", "expected"), [
+    ("dp_cols: 1", "routing.dp_cols: dp_cols must be an integer in [2, 1024], got 1"),
+    ("dp_shrink: 2", "routing.dp_shrink: dp_shrink must be in (0, 1], got 2.0"),
+    ("spline_slopes: 0", "routing.spline_slopes: spline_slopes must be an integer >= 1, got 0"),
+])
+def test_router_rules_are_checked_when_the_course_loads(tmp_path, routing, expected):
+    # the routers' rules (routing.types.settings_problems) at load time, with the line:
+    # before, such a file loaded and the plan stopped at its first leg
+    n_lines = BASE.count("\n") + 2  # the key below "routing:"
+    assert f"c.yaml:{n_lines}: {expected}" in problems(
+        write(tmp_path, BASE + f"routing:\n  {routing}\n"))
+
+
 def test_references_must_have_one_time_per_leg(tmp_path):
     text = BASE + "references:\n  winner: [100, 200, 300]\n"
     assert "references.winner: expected 4 leg times (one per leg); got 3" in problems(
