@@ -30,6 +30,26 @@ The route is then backtracked through the parent indices and turned into a
 :class:`~sailroute.routing.types.Track` with the shared
 :func:`~sailroute.routing.track.build_track`.  See ``docs/design/routing.md`` for the
 method, the defaults and the measured accuracy and speed.
+
+Glossary of the kernel (symbols of ``docs/design/routing.md`` → names in the code; leg
+frame, SI units, angles in degrees):
+
+* ``σ``, the side: ``side`` (``sigma`` for the side a candidate sails): +1 starboard,
+  −1 port, 0 free (no side chosen yet, only at the leg start; a free point sails as +1
+  in block ``_KEEP`` and changes side without penalty).
+* ``ŵ``, the upwind unit vector: ``up_x, up_y``; the TWS interpolation in the polar
+  tables: node ``row`` and ``weight`` (:class:`_PointWind`).
+* ``S``, boat speed: ``bsp_ms``; ``a``, |TWA|: ``twa_deg``; ``(S cos a, S sin a)``:
+  ``sx, sy``; ``v``, velocity through the water: ``vx, vy`` (:func:`_velocity`).
+* candidates: block ``_KEEP`` (side ``σ``) and block ``_SWITCH`` (side ``-σ``, a tack or
+  gybe), each with the grid columns ``first:stop`` of the tables (the fan) and the exact
+  columns VMG up, VMG down, direct to the aim point (:class:`_ExactColumns`).
+* ``τ``, the estimated time to go, and ``G``, its gradient: ``tau_s``, ``grad_x, grad_y``
+  (:class:`_TimeToGo`); ``G·v``: ``rate``.
+* a penalty as time: ``delay`` (stopped), ``move`` (moving), ``debt`` (still owed)
+  (:class:`_Timing`); the manoeuvre bookkeeping: :class:`_ManoeuvreState`.
+* ``C``, the current: ``current_x, current_y`` (:class:`_Current`); ``Q``, the end point
+  of a move (drifted with the current): ``qx, qy``.
 """
 
 from __future__ import annotations
@@ -45,6 +65,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.backend import to_numpy
 from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.current import CurrentField, RelativeWind, current_rate_set
@@ -355,13 +376,6 @@ class _Context:
     current: CurrentField | None = None  # surface current (None: still water)
 
 
-def _host(a: Any) -> NDArray:
-    get = getattr(a, "get", None)
-    if callable(get) and type(a).__module__.startswith("cupy"):
-        return np.asarray(get())
-    return np.asarray(a)
-
-
 def _group_argmin(key: Any, score: Any, n_keys: int, xp: ModuleType) -> Any:
     """Flat indices of the smallest finite ``score`` per ``key`` (lowest index on ties)."""
     if xp is np:
@@ -558,18 +572,23 @@ def _context(
 
 @dataclass(frozen=True, eq=False)
 class _DeviceTables:
-    a: Any
-    cos_a: Any
-    sin_a: Any
-    tws: Any
-    speed: Any
-    up: Any
-    down: Any
-    up_vmg: Any
-    down_vmg: Any
-    vmax: Any
-    sup_ms: Any
-    sup_deg: Any
+    """The :class:`PolarTables` arrays in the kernel's array module ``xp`` (same units).
+
+    ``n_w`` TWS nodes (rows), ``n_a`` grid |TWA|s, ``n_b`` support directions.
+    """
+
+    twa_deg: Any  # (n_a,) grid |TWA| [°]
+    cos_a: Any  # (n_a,) its cosine
+    sin_a: Any  # (n_a,) its sine
+    tws_ms: Any  # (n_w,) TWS nodes [m s⁻¹]
+    speed_ms: Any  # (n_w, n_a) boat speed [m s⁻¹]
+    up_deg: Any  # (n_w,) upwind VMG angle [°]
+    down_deg: Any  # (n_w,) downwind VMG angle [°]
+    up_vmg_ms: Any  # (n_w,) upwind VMG [m s⁻¹]
+    down_vmg_ms: Any  # (n_w,) downwind VMG [m s⁻¹]
+    vmax_ms: Any  # (n_w,) highest boat speed [m s⁻¹]
+    sup_ms: Any  # (n_w, n_b) polar support: best speed component [m s⁻¹]
+    sup_deg: Any  # (n_w, n_b) the |TWA| giving it [°]
 
 
 def _device_tables(tab: PolarTables, xp: ModuleType) -> _DeviceTables:
@@ -582,71 +601,271 @@ def _device_tables(tab: PolarTables, xp: ModuleType) -> _DeviceTables:
 
 
 # --------------------------------------------------------------------------------------
-# one step
+# one step: the inputs of the candidate kernel
 
 _BIG_S = 1e12  # time-to-go standing in for "unknown" (calm) [s]
 _CHUNK_ELEMENTS = 15000
 """Candidate rows are processed in chunks of about this many candidates, so that the
 float64 work arrays stay below 128 KB: larger NumPy temporaries are mmap-allocated by
 glibc on every operation, which costs ~10x in this kernel."""
+_KEEP, _SWITCH = 0, 1
+"""Candidate blocks of a point: ``_KEEP`` sails on its side, ``_SWITCH`` changes side
+(tack or gybe).  A candidate's id is ``(row * 2 + block) * n_columns + column``."""
+_EXACT_OF_BLOCK = ([0, 1, 2], [0, 1, 3])
+"""The :class:`_ExactColumns` a block tries: VMG up, VMG down, its own direct column."""
 
 
 @dataclass(frozen=True, eq=False)
-class _Prep:
-    """Per-point quantities of one step (all arrays of length n)."""
+class _PointWind:
+    """The wind at the front points as the kernel uses it; arrays of shape (n,).
+
+    Attributes
+    ----------
+    tws_ms : array
+        True wind speed [m s⁻¹].
+    up_x, up_y : array
+        Upwind unit vector ``ŵ`` (pointing where the wind comes from), leg frame;
+        ``(0, 1)`` in a calm.
+    row, weight : array
+        TWS interpolation in the polar tables: the node ``row`` (int) at or below the
+        TWS and the weight of node ``row + 1``, in [0, 1].
+    up_deg, down_deg : array
+        Upwind and downwind VMG angles at that TWS [°].
+    """
+
+    tws_ms: Any
+    up_x: Any
+    up_y: Any
+    row: Any
+    weight: Any
+    up_deg: Any
+    down_deg: Any
+
+    def rows(self, sl: slice) -> _PointWind:
+        """The points ``sl`` only."""
+        return _PointWind(self.tws_ms[sl], self.up_x[sl], self.up_y[sl], self.row[sl],
+                          self.weight[sl], self.up_deg[sl], self.down_deg[sl])
+
+
+@dataclass(frozen=True, eq=False)
+class _ExactColumns:
+    """The four exact (off-grid) candidate headings of every point.
+
+    Columns: 0 upwind VMG angle, 1 downwind VMG angle, 2 direct to the aim point of the
+    point's own side (block ``_KEEP``), 3 direct to the aim point of the other side
+    (block ``_SWITCH``).
+
+    Attributes
+    ----------
+    twa_deg, bsp_ms : array, shape (n, 4)
+        Their |TWA| [°] and boat speed [m s⁻¹].
+    cos_twa, sin_twa : array, shape (n, 4)
+        Cosine and sine of that |TWA| (``sin_twa >= 0``).
+    direct_sin_keep, direct_sin_switch : array, shape (n,)
+        Signed sine of the TWA of columns 2 and 3 (positive: starboard): a direct
+        column exists only on its own side.
+    """
+
+    twa_deg: Any
+    bsp_ms: Any
+    cos_twa: Any
+    sin_twa: Any
+    direct_sin_keep: Any
+    direct_sin_switch: Any
+
+    def rows(self, sl: slice) -> _ExactColumns:
+        """The points ``sl`` only."""
+        return _ExactColumns(self.twa_deg[sl], self.bsp_ms[sl], self.cos_twa[sl],
+                             self.sin_twa[sl], self.direct_sin_keep[sl],
+                             self.direct_sin_switch[sl])
+
+
+@dataclass(frozen=True, eq=False)
+class _TimeToGo:
+    """Estimated time to go ``τ`` of the points on one side, and its gradient ``G``.
+
+    ``τ(P + d) ≈ τ(P) - d·G`` for a small move ``d`` [m]; arrays of shape (n,).
+
+    Attributes
+    ----------
+    tau_s : array
+        ``τ`` [s].
+    grad_x, grad_y : array
+        ``G`` [s m⁻¹] (leg frame).
+    """
+
+    tau_s: Any
+    grad_x: Any
+    grad_y: Any
+
+    def rows(self, sl: slice) -> _TimeToGo:
+        """The points ``sl`` only."""
+        return _TimeToGo(self.tau_s[sl], self.grad_x[sl], self.grad_y[sl])
+
+
+@dataclass(frozen=True, eq=False)
+class _ManoeuvreState:
+    """Side and penalty bookkeeping of the front points; arrays of shape (n,).
+
+    Attributes
+    ----------
+    side : array
+        ``σ``, the side sailed by block ``_KEEP``: the point's side, +1 for a free point.
+    free : array of bool
+        No side chosen yet (leg start): its first side change costs nothing.
+    pending : array of bool
+        Inside a manoeuvre whose penalty is re-priced by the next heading sailed.
+    base_twa_deg : array
+        |TWA| before the manoeuvre a side change would start [°] (NaN: unknown).
+    penalty_up_s, penalty_down_s : array
+        Penalty of a side change onto an upwind (|TWA| < 90°) or a downwind heading [s].
+    debt_s : array
+        Penalty time still owed [s].
+    charged_s : array
+        Penalty charged so far for the pending manoeuvre [s].
+    any_pending : bool
+        Whether any point is pending (the pending work is skipped when none is).
+    """
+
+    side: Any
+    free: Any
+    pending: Any
+    base_twa_deg: Any
+    penalty_up_s: Any
+    penalty_down_s: Any
+    debt_s: Any
+    charged_s: Any
+    any_pending: bool
+
+    def rows(self, sl: slice, xp: ModuleType) -> _ManoeuvreState:
+        """The points ``sl`` only."""
+        pending = self.pending[sl]
+        return _ManoeuvreState(
+            self.side[sl], self.free[sl], pending, self.base_twa_deg[sl],
+            self.penalty_up_s[sl], self.penalty_down_s[sl], self.debt_s[sl],
+            self.charged_s[sl], self.any_pending and bool(xp.any(pending)),
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class _Current:
+    """Current at the front points (leg frame) [m s⁻¹]; arrays of shape (n,).
+
+    ``move_*``: at the point's mid-step sample, moves the candidates;
+    ``mean_*``: averaged along the way to the target, enters the time to go.
+    """
+
+    move_x: Any
+    move_y: Any
+    mean_x: Any
+    mean_y: Any
+
+
+@dataclass(frozen=True, eq=False)
+class _StepInputs:
+    """What the candidate kernel needs about the ``n`` front points of one step.
+
+    Built by :func:`_prepare`; :meth:`rows` restricts it to a chunk of points.  Leg
+    frame; arrays of shape (n,).
+
+    Attributes
+    ----------
+    t : float
+        Start of the step [epoch s].
+    dt : float
+        Step length [s].
+    first, stop : int
+        The grid columns ``first:stop`` of the polar tables that are tried (the fan).
+    x, y : array
+        Positions [m].
+    wind : _PointWind
+        The wind of the move.
+    exact : _ExactColumns
+        The exact columns.
+    keep, switch : _TimeToGo
+        Time to go on the point's side ``σ`` and on the other side ``-σ``.
+    manoeuvre : _ManoeuvreState
+        Sides and penalties.
+    near_target : array of bool
+        Within one step of the target segment.
+    near_barrier : tuple
+        Per barrier of the leg (:attr:`_Context.barriers`): bool array, within one
+        step of it, or None where no point is.
+    current_x, current_y : array or None
+        Current of the move [m s⁻¹]; None: still water.
+    """
 
     t: float
     dt: float
-    n: int
-    h: int
-    lo: int
-    hi: int
-    X: Any
-    Y: Any
-    sw: Any  # upwind unit vector (leg frame)
-    cw: Any
-    j: Any  # TWS table row and weight
-    fw: Any
-    angles: Any  # (n, 4) |TWA| of VMG up, VMG down, direct (side s0), direct (side -s0)
-    v_extra: Any  # (n, 4) their boat speeds
-    cos_x: Any  # (n, 4)
-    sin_x: Any  # (n, 4) (non-negative: sines of |TWA|)
-    sin_d0: Any  # signed sine of the direct TWA of side s0 (positive: starboard)
-    sin_d1: Any  # ... of side -s0
-    tau0: Any  # time to go on side s0 (block 0) [s]
-    gx0: Any  # its gradient
-    gy0: Any
-    tau1: Any  # time to go on side -s0 (block 1) [s]
-    gx1: Any
-    gy1: Any
-    s0: Any  # side kept by block k = 0
-    free: Any  # no side yet
-    pending: Any  # inside a manoeuvre
-    base: Any  # |TWA| before the manoeuvre a switch would start (NaN: none)
-    pen_up: Any  # penalty of a side change onto an upwind heading (|TWA| < 90) [s]
-    pen_dn: Any  # ... onto a downwind heading [s]
-    debt: Any
-    pend_pen: Any
-    near: Any  # bool: within one step of the target segment
-    bar_near: list  # per barrier of ctx: bool, within one step of it (None: no point is)
-    any_pending: bool
-    cx: Any = None  # current of the move (leg frame) [m s⁻¹]; None: still water
-    cy: Any = None
+    first: int
+    stop: int
+    x: Any
+    y: Any
+    wind: _PointWind
+    exact: _ExactColumns
+    keep: _TimeToGo
+    switch: _TimeToGo
+    manoeuvre: _ManoeuvreState
+    near_target: Any
+    near_barrier: tuple[Any, ...]
+    current_x: Any = None
+    current_y: Any = None
+
+    @property
+    def n(self) -> int:
+        """Number of points."""
+        return int(self.x.shape[0])
+
+    @property
+    def n_grid(self) -> int:
+        """Number of grid columns."""
+        return self.stop - self.first
+
+    @property
+    def n_columns(self) -> int:
+        """Candidates per point and block: the grid columns and three exact ones."""
+        return self.stop - self.first + 3
+
+    def rows(self, r0: int, r1: int, xp: ModuleType) -> _StepInputs:
+        """The points ``r0:r1`` only (views)."""
+        if r0 == 0 and r1 == self.n:
+            return self
+        sl = slice(r0, r1)
+        still = self.current_x is None
+        return _StepInputs(
+            t=self.t, dt=self.dt, first=self.first, stop=self.stop, x=self.x[sl],
+            y=self.y[sl], wind=self.wind.rows(sl), exact=self.exact.rows(sl),
+            keep=self.keep.rows(sl), switch=self.switch.rows(sl),
+            manoeuvre=self.manoeuvre.rows(sl, xp), near_target=self.near_target[sl],
+            near_barrier=tuple(None if c is None else c[sl] for c in self.near_barrier),
+            current_x=None if still else self.current_x[sl],
+            current_y=None if still else self.current_y[sl],
+        )
+
+
+# --------------------------------------------------------------------------------------
+# one step: driver and survivors
 
 
 def _step(
     f: _Layer, wind: WindField, polar: Polar, dev: _DeviceTables, ctx: _Context,
     s: RoutingSettings, tau_hint: float, xp: ModuleType,
 ) -> _Arrival | tuple[_Layer, bool, float, float]:
+    """One isochrone step from the front ``f``.
+
+    Returns the arrival if a candidate crosses the target during the step, else the
+    new front, whether any point moved, the front's least estimated time to go [s] and
+    its least distance to the target [m].
+    """
     pre, tau_min, dist_min = _prepare(f, wind, polar, dev, ctx, s, tau_hint, xp)
-    n, h = pre.n, pre.h
-    rows = n if xp is not np else max(1, _CHUNK_ELEMENTS // (h + 3))
-    nk = 2 * ctx.n_bins
-    best = xp.full(nk, np.inf)
-    who = xp.zeros(nk, dtype=xp.int64)  # winner id per key: (row * 2 + block) * h + column
+    n, n_columns = pre.n, pre.n_columns
+    chunk = n if xp is not np else max(1, _CHUNK_ELEMENTS // (n_columns + 3))
+    n_keys = 2 * ctx.n_bins
+    best = xp.full(n_keys, np.inf)
+    who = xp.zeros(n_keys, dtype=xp.int64)  # winner id per key (see _KEEP)
     arrival: _Arrival | None = None
-    for r0 in range(0, n, rows):
-        r1 = min(n, r0 + rows)
+    for r0 in range(0, n, chunk):
+        r1 = min(n, r0 + chunk)
         arr, win = _expand(pre, r0, r1, dev, ctx, xp, want_winners=arrival is None)
         if arr is not None and (arrival is None or arr.t < arrival.t):
             arrival = arr
@@ -659,8 +878,8 @@ def _step(
     if arrival is not None:
         return arrival
 
-    keep = xp.flatnonzero(best < np.inf)
-    if keep.shape[0] == 0:
+    won = xp.flatnonzero(best < np.inf)  # the keys that have a winner
+    if won.shape[0] == 0:
         cov = wind.coverage
         raise RoutingError(
             f"leg {ctx.label}: every candidate position left the wind field's coverage "
@@ -668,205 +887,234 @@ def _step(
             "cannot go on.\n  Try: wind data that covers the course with a margin, or a "
             "wind field built with clamp=True (hold the edge values outside)."
         )
-    if keep.shape[0] > ctx.max_points:  # widen the sectors: merge m neighbours
-        m = -(-int(keep.shape[0]) // ctx.max_points)
-        coarse = (keep // 2 // m) * 2 + keep % 2
-        keep = xp.sort(keep[_group_argmin(coarse, best[keep], int(xp.max(coarse)) + 1, xp)])
-    wid = who[keep]
-    col = wid % h
-    blk = (wid // h) % 2
-    row = wid // (2 * h)
-    layer, moved = _survivors(pre, row, blk, col, best[keep], dev, ctx, xp)
+    if won.shape[0] > ctx.max_points:  # widen the sectors: merge m neighbours
+        m = -(-int(won.shape[0]) // ctx.max_points)
+        coarse = (won // 2 // m) * 2 + won % 2
+        won = xp.sort(won[_group_argmin(coarse, best[won], int(xp.max(coarse)) + 1, xp)])
+    wid = who[won]
+    column = wid % n_columns
+    block = (wid // n_columns) % 2
+    row = wid // (2 * n_columns)
+    layer, moved = _survivors(pre, row, block, column, best[won], dev, xp)
     return layer, moved, tau_min, dist_min
 
 
-def _column_velocity(
-    pre: _Prep, row: Any, blk: Any, col: Any, dev: _DeviceTables, xp: ModuleType
-) -> tuple[Any, Any, Any, Any, Any]:
-    """|TWA|, boat speed and the velocity parts (a1, a3, sy) of (row, block, column).
+def _velocity(up_x: Any, up_y: Any, sigma: Any, sx: Any, sy: Any) -> tuple[Any, Any]:
+    """Velocity through the water [m s⁻¹] (leg frame) of headings on side ``sigma``.
 
-    The same arithmetic, in the same order, as the matrices of :func:`_expand`, so a
+    The heading at |TWA| ``a`` on side ``σ`` is ``cos a ŵ + σ sin a ŵ⊥`` with
+    ``ŵ = (up_x, up_y)`` and ``ŵ⊥ = (-up_y, up_x)``; ``sx, sy = S cos a, S sin a``
+    with ``S`` the boat speed.  Arguments broadcast together.  Shared by the
+    candidates (:func:`_block`) and the survivors (:func:`_survivors`), so a
     survivor's position is bit-identical to the candidate that won its sector.
     """
-    lo, hi = pre.lo, pre.hi
-    hg = hi - lo
-    grid = col < hg
-    cg = xp.where(grid, col, 0) + lo
-    ce = xp.where(grid, 0, col - hg)
-    ce = xp.where((blk == 1) & (ce == 2), 3, ce)  # block 1 aims with its own direct column
-    j, fw = pre.j[row], pre.fw[row]
-    s_lo = dev.speed[j, cg]
-    bsp = xp.where(grid, s_lo + fw * (dev.speed[j + 1, cg] - s_lo), pre.v_extra[row, ce])
-    twa = xp.where(grid, dev.a[cg], pre.angles[row, ce])
-    sx = bsp * xp.where(grid, dev.cos_a[cg], pre.cos_x[row, ce])
-    sy = bsp * xp.where(grid, dev.sin_a[cg], pre.sin_x[row, ce])
-    return twa, bsp, pre.sw[row] * sx, pre.cw[row] * sx, sy
+    return up_x * sx - (sigma * up_y) * sy, up_y * sx + (sigma * up_x) * sy
+
+
+def _penalty(twa_deg: Any, upwind_s: Any, downwind_s: Any, xp: ModuleType) -> Any:
+    """Penalty [s] of a side change priced by the first |TWA| [°] sailed after it:
+    ``upwind_s`` below 90°, else ``downwind_s``."""
+    return xp.where(twa_deg < 90.0, upwind_s, downwind_s)
+
+
+def _winner_columns(
+    pre: _StepInputs, row: Any, block: Any, column: Any, dev: _DeviceTables, xp: ModuleType
+) -> tuple[Any, Any, Any, Any]:
+    """|TWA| [°], boat speed [m s⁻¹] and ``(S cos|TWA|, S sin|TWA|)`` [m s⁻¹] of the
+    winning candidates ``(row, block, column)`` (arrays of shape (m,)).
+
+    The same arithmetic, in the same order, as :func:`_grid_speeds` and :func:`_block`.
+    """
+    n_grid = pre.n_grid
+    grid = column < n_grid
+    grid_col = xp.where(grid, column, 0) + pre.first
+    exact_col = xp.where(grid, 0, column - n_grid)
+    # block _SWITCH aims with its own direct column
+    exact_col = xp.where((block == _SWITCH) & (exact_col == 2), 3, exact_col)
+    node, weight = pre.wind.row[row], pre.wind.weight[row]
+    ex = pre.exact
+    s_lo = dev.speed_ms[node, grid_col]
+    bsp = xp.where(grid, s_lo + weight * (dev.speed_ms[node + 1, grid_col] - s_lo),
+                   ex.bsp_ms[row, exact_col])
+    twa = xp.where(grid, dev.twa_deg[grid_col], ex.twa_deg[row, exact_col])
+    sx = bsp * xp.where(grid, dev.cos_a[grid_col], ex.cos_twa[row, exact_col])
+    sy = bsp * xp.where(grid, dev.sin_a[grid_col], ex.sin_twa[row, exact_col])
+    return twa, bsp, sx, sy
 
 
 def _survivors(
-    pre: _Prep, row: Any, blk: Any, col: Any, score: Any, dev: _DeviceTables, ctx: _Context,
+    pre: _StepInputs, row: Any, block: Any, column: Any, score: Any, dev: _DeviceTables,
     xp: ModuleType,
 ) -> tuple[_Layer, bool]:
-    """The new front from the winning (row, block, column) triples."""
+    """The new front from the winning ``(row, block, column)`` triples (shape (m,)) and
+    their scores (estimated time to go [s]); also whether any of them moved."""
     dt = pre.dt
-    twa, bsp, a1, a3, sy = _column_velocity(pre, row, blk, col, dev, xp)
-    s0 = pre.s0[row]
-    b2 = (s0 * pre.cw[row]) * sy
-    b4 = (s0 * pre.sw[row]) * sy
-    switch = blk == 1
-    vx = xp.where(switch, a1 + b2, a1 - b2)
-    vy = xp.where(switch, a3 - b4, a3 + b4)
-    pen = xp.where(twa < 90.0, pre.pen_up[row], pre.pen_dn[row])
-    free = pre.free[row]
-    pending = pre.pending[row]
+    twa, bsp, sx, sy = _winner_columns(pre, row, block, column, dev, xp)
+    m = pre.manoeuvre
+    side = m.side[row]
+    switch = block == _SWITCH
+    sigma = xp.where(switch, -side, side)
+    vx, vy = _velocity(pre.wind.up_x[row], pre.wind.up_y[row], sigma, sx, sy)
+    pen = _penalty(twa, m.penalty_up_s[row], m.penalty_down_s[row], xp)
+    free = m.free[row]
+    pending = m.pending[row]
     debt = xp.where(switch, xp.where(free, 0.0, pen),
-                    xp.where(pending, xp.maximum(pre.debt[row] + pen - pre.pend_pen[row], 0.0),
+                    xp.where(pending, xp.maximum(m.debt_s[row] + pen - m.charged_s[row], 0.0),
                              0.0))
     delay = xp.minimum(debt, dt)
     move = dt - delay
-    in_man = xp.where(switch, ~free, pending) & ~(move > 0)
-    nx_, ny_ = pre.X[row] + move * vx, pre.Y[row] + move * vy
-    if pre.cx is not None:  # drift with the water for the whole step
-        nx_, ny_ = nx_ + dt * pre.cx[row], ny_ + dt * pre.cy[row]
+    in_manoeuvre = xp.where(switch, ~free, pending) & ~(move > 0)
+    x, y = pre.x[row] + move * vx, pre.y[row] + move * vy
+    if pre.current_x is not None:  # drift with the water for the whole step
+        x, y = x + dt * pre.current_x[row], y + dt * pre.current_y[row]
     layer = _Layer(
-        t=pre.t + dt, x=nx_, y=ny_,
-        side=xp.where(switch, -s0, s0), debt=debt - delay, abs_twa=twa,
-        pend_old=xp.where(in_man, pre.base[row], np.nan), pend_pen=xp.where(in_man, pen, 0.0),
+        t=pre.t + dt, x=x, y=y, side=sigma, debt=debt - delay, abs_twa=twa,
+        pend_old=xp.where(in_manoeuvre, m.base_twa_deg[row], np.nan),
+        pend_pen=xp.where(in_manoeuvre, pen, 0.0),
         parent=row, heading=xp.mod(xp.degrees(xp.arctan2(vx, vy)), 360.0), bsp=bsp,
         delay=delay, tau_est=score,
     )
     return layer, bool(xp.any((move > 0) & (bsp > 0)))
 
 
-def _wind_state(
-    u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleType
-) -> tuple[Any, Any, Any, Any, Any, Any, Any]:
-    """TWS, upwind unit vector (leg frame), table row/weight and VMG angles of winds."""
+# --------------------------------------------------------------------------------------
+# one step: the inputs (wind, aim, exact columns, time to go, manoeuvres)
+
+
+def _wind_state(u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleType
+                ) -> _PointWind:
+    """The wind ``(u, v)`` [m s⁻¹] (world frame, towards; any shape) for the kernel."""
     tws = xp.sqrt(u * u + v * v)
     windy = tws > _CALM_MS
     inv = 1.0 / xp.where(windy, tws, 1.0)
-    sw, cw = fr.vec_to_leg(xp.where(windy, -u * inv, 0.0), xp.where(windy, -v * inv, 1.0))
-    nodes = dev.tws
-    j = xp.clip(xp.searchsorted(nodes, tws, side="right") - 1, 0, nodes.shape[0] - 2)
-    fw = xp.clip((tws - nodes[j]) / (nodes[j + 1] - nodes[j]), 0.0, 1.0)
-    a_up = dev.up[j] + fw * (dev.up[j + 1] - dev.up[j])
-    a_dn = dev.down[j] + fw * (dev.down[j + 1] - dev.down[j])
-    return tws, sw, cw, j, fw, a_up, a_dn
+    up_x, up_y = fr.vec_to_leg(xp.where(windy, -u * inv, 0.0), xp.where(windy, -v * inv, 1.0))
+    nodes = dev.tws_ms
+    row = xp.clip(xp.searchsorted(nodes, tws, side="right") - 1, 0, nodes.shape[0] - 2)
+    weight = xp.clip((tws - nodes[row]) / (nodes[row + 1] - nodes[row]), 0.0, 1.0)
+    up_deg = dev.up_deg[row] + weight * (dev.up_deg[row + 1] - dev.up_deg[row])
+    down_deg = dev.down_deg[row] + weight * (dev.down_deg[row + 1] - dev.down_deg[row])
+    return _PointWind(tws, up_x, up_y, row, weight, up_deg, down_deg)
 
 
 def _time_to_go(
-    tws: Any, sw: Any, cw: Any, j: Any, fw: Any, a_up: Any, a_dn: Any, ex: Any, ey: Any,
-    dist: Any, s0: Any, free: Any, tack_s: float, gybe_s: float, dev: _DeviceTables,
-    xp: ModuleType,
+    wind: _PointWind, ex: Any, ey: Any, dist: Any, sides: Any, free: Any, tack_s: float,
+    gybe_s: float, dev: _DeviceTables, xp: ModuleType,
 ) -> tuple[Any, Any, Any]:
-    """Time to go over ``dist`` along the unit vector ``(ex, ey)``, and its gradient.
+    """Time to go over ``dist`` [m] along the unit vector ``(ex, ey)``, and its gradient.
 
     Two ways to get there, the faster counts:
 
     * straight, at ``S(beta)`` (``beta``: angle between the way and the upwind unit
-      vector ``w_hat = (sw, cw)``), plus a tack or gybe if the way lies on the other
-      side of the wind than the point's side ``s0``;
+      vector ``ŵ``), plus a tack or gybe if the way lies on the other side of the
+      wind than the point's side (``sides``);
     * inside the upwind (downwind) VMG cone, two boards at the VMG angles,
-      ``v·w_hat / VMG_up`` (``-v·w_hat / VMG_dn``), plus one tack (gybe).
+      ``v·ŵ / VMG_up`` (``-v·ŵ / VMG_dn``), plus one tack (gybe).
 
-    Points with no side yet pay no penalty; then this is the time on the convex VMG hull
-    of the polar.  The gradient ``G`` (``tau = v·G + penalty``) gives the change of
-    ``tau`` for a small move ``d``: ``tau(P + d) ≈ tau(P) - d·G``.  Speeds come from the
-    polar tables (this only ranks candidates).  Calm: ``tau`` is huge and ``G = 0``.
+    Points with no side yet (``free``) pay no penalty; then this is the time on the
+    convex VMG hull of the polar.  The gradient ``G`` (``tau = v·G + penalty``) gives the
+    change of ``tau`` for a small move ``d``: ``tau(P + d) ≈ tau(P) - d·G``.  Speeds come
+    from the polar tables (this only ranks candidates).  Calm: ``tau`` is huge and
+    ``G = 0``.  ``sides`` and the way may have a leading axis (2, n) over the wind's (n,).
+
+    Returns ``tau`` [s] and ``G`` [s m⁻¹] (x and y).
     """
-    del tws
-    cos_d = xp.clip(cw * ey + sw * ex, -1.0, 1.0)
-    sin_d = sw * ey - cw * ex
-    a_d = xp.degrees(xp.arccos(cos_d))
-    vmg_up = dev.up_vmg[j] + fw * (dev.up_vmg[j + 1] - dev.up_vmg[j])
-    vmg_dn = dev.down_vmg[j] + fw * (dev.down_vmg[j + 1] - dev.down_vmg[j])
+    up_x, up_y, node, weight = wind.up_x, wind.up_y, wind.row, wind.weight
+    cos_b = xp.clip(up_y * ey + up_x * ex, -1.0, 1.0)
+    sin_b = up_x * ey - up_y * ex
+    beta_deg = xp.degrees(xp.arccos(cos_b))
+    vmg_up = dev.up_vmg_ms[node] + weight * (dev.up_vmg_ms[node + 1] - dev.up_vmg_ms[node])
+    vmg_dn = (dev.down_vmg_ms[node]
+              + weight * (dev.down_vmg_ms[node + 1] - dev.down_vmg_ms[node]))
     # polar speed and slope dS/dbeta at the direct angle, from the grid table
-    na = dev.a.shape[0]
+    na = dev.twa_deg.shape[0]
     step = 180.0 / na
-    g = a_d * (1.0 / step) - 1.0
-    kl = xp.clip(xp.floor(g).astype(xp.int64), 0, na - 2)
-    fa = xp.clip(g - kl, 0.0, 1.0)
-    sp = dev.speed
-    s_l = sp[j, kl] + fw * (sp[j + 1, kl] - sp[j, kl])
-    s_r = sp[j, kl + 1] + fw * (sp[j + 1, kl + 1] - sp[j, kl + 1])
-    spd = s_l + fa * (s_r - s_l)
+    pos = beta_deg * (1.0 / step) - 1.0
+    col = xp.clip(xp.floor(pos).astype(xp.int64), 0, na - 2)
+    frac = xp.clip(pos - col, 0.0, 1.0)
+    sp = dev.speed_ms
+    s_l = sp[node, col] + weight * (sp[node + 1, col] - sp[node, col])
+    s_r = sp[node, col + 1] + weight * (sp[node + 1, col + 1] - sp[node, col + 1])
+    spd = s_l + frac * (s_r - s_l)
     slope = (s_r - s_l) * (1.0 / math.radians(step))
-    cone_up = (a_d <= a_up) & (vmg_up > 0)
-    cone_dn = (a_d >= a_dn) & (vmg_dn > 0) & ~cone_up
+    cone_up = (beta_deg <= wind.up_deg) & (vmg_up > 0)
+    cone_dn = (beta_deg >= wind.down_deg) & (vmg_dn > 0) & ~cone_up
     cone = cone_up | cone_dn
     inv_s = 1.0 / xp.where(spd > 0, spd, 1.0)
     inv_v = xp.where(cone_up, 1.0 / xp.where(cone_up, vmg_up, 1.0),
                      -1.0 / xp.where(cone_dn, vmg_dn, 1.0))
     t_straight = xp.where(spd > 0, dist * inv_s, np.inf)
-    t_cone = xp.where(cone, dist * cos_d * inv_v, np.inf)
-    own = free | (s0 * sin_d >= 0)
+    t_cone = xp.where(cone, dist * cos_b * inv_v, np.inf)
+    own = free | (sides * sin_b >= 0)
     paid = ~free
-    t_straight = t_straight + xp.where(own | ~paid, 0.0, xp.where(a_d < 90.0, tack_s, gybe_s))
+    t_straight = t_straight + xp.where(own | ~paid, 0.0,
+                                       xp.where(beta_deg < 90.0, tack_s, gybe_s))
     t_cone = t_cone + xp.where(paid, xp.where(cone_up, tack_s, gybe_s), 0.0)
     use_cone = t_cone < t_straight
     tau = xp.minimum(t_cone, t_straight)
-    sin_b = xp.sqrt(xp.maximum(1.0 - cos_d * cos_d, 1e-18))
-    k = slope * inv_s * inv_s / sin_b
-    alpha = xp.where(use_cone, inv_v, k)
-    beta = xp.where(use_cone, 0.0, inv_s - k * cos_d)
+    sin_abs = xp.sqrt(xp.maximum(1.0 - cos_b * cos_b, 1e-18))
+    k = slope * inv_s * inv_s / sin_abs
+    along_up = xp.where(use_cone, inv_v, k)  # G = along_up ŵ + along_way e
+    along_way = xp.where(use_cone, 0.0, inv_s - k * cos_b)
     ok = tau < np.inf
     tau = xp.where(dist > 0, xp.where(ok, tau, _BIG_S), 0.0)
-    alpha = xp.where(ok, alpha, 0.0)
-    beta = xp.where(ok, beta, 0.0)
-    return tau, alpha * sw + beta * ex, alpha * cw + beta * ey
+    along_up = xp.where(ok, along_up, 0.0)
+    along_way = xp.where(ok, along_way, 0.0)
+    return tau, along_up * up_x + along_way * ex, along_up * up_y + along_way * ey
 
 
-def _support(j: Any, fw: Any, beta_deg: Any, dev: _DeviceTables, xp: ModuleType
+def _support(node: Any, weight: Any, beta_deg: Any, dev: _DeviceTables, xp: ModuleType
              ) -> tuple[Any, Any]:
-    """Polar support towards ``beta`` (from the upwind direction, towards the side) at
-    the table rows ``j, fw``: the best speed component [m s⁻¹] and its |TWA| [°],
-    interpolated bilinearly in (TWS, beta) from :attr:`PolarTables.sup_ms`."""
-    g = (beta_deg + 180.0) * (dev.sup_ms.shape[1] - 1) / 360.0
-    kb = xp.clip(xp.floor(g).astype(xp.int64), 0, dev.sup_ms.shape[1] - 2)
-    fb = xp.clip(g - kb, 0.0, 1.0)
+    """Polar support towards ``beta_deg`` (from the upwind direction, towards the side)
+    at the table rows ``node, weight``: the best speed component [m s⁻¹] and its |TWA|
+    [°], interpolated bilinearly in (TWS, beta) from :attr:`PolarTables.sup_ms`."""
+    pos = (beta_deg + 180.0) * (dev.sup_ms.shape[1] - 1) / 360.0
+    col = xp.clip(xp.floor(pos).astype(xp.int64), 0, dev.sup_ms.shape[1] - 2)
+    frac = xp.clip(pos - col, 0.0, 1.0)
     out = []
     for tab in (dev.sup_ms, dev.sup_deg):
-        lo_ = tab[j, kb] + fb * (tab[j, kb + 1] - tab[j, kb])
-        hi_ = tab[j + 1, kb] + fb * (tab[j + 1, kb + 1] - tab[j + 1, kb])
-        out.append(lo_ + fw * (hi_ - lo_))
+        below = tab[node, col] + frac * (tab[node, col + 1] - tab[node, col])
+        above = tab[node + 1, col] + frac * (tab[node + 1, col + 1] - tab[node + 1, col])
+        out.append(below + weight * (above - below))
     return out[0], out[1]
 
 
 def _fastest_aim(
-    X: Any, Y: Any, ex: Any, ey: Any, dist: Any, s0: Any, sw: Any, cw: Any, j: Any,
-    fw: Any, g: TargetGeometry, dev: _DeviceTables, xp: ModuleType,
+    x: Any, y: Any, ex: Any, ey: Any, dist: Any, side: Any, wind: _PointWind,
+    g: TargetGeometry, dev: _DeviceTables, xp: ModuleType,
     cur: tuple[Any, Any] | None = None,
 ) -> tuple[Any, Any, Any]:
     """Aim points on the target segment that the local wind reaches soonest, per side.
 
     The heading that reaches the segment's line soonest maximises the speed component
-    along the segment normal ``n`` (:func:`_support`).  For side ``s0`` (block 0) and
-    side ``-s0`` (block 1) that heading is taken on the side itself if it approaches the
-    line at all, else on the other side.  Followed from ``P`` it meets the line at
-    ``Q*``; the aim point is ``Q*`` kept ``AIM_MARGIN_M`` inside the segment.  Where no
-    heading approaches the line, the projection of ``P`` (``ex, ey, dist`` passed in)
-    is kept.  This makes the direct candidate the exact best heading to a line or gate
-    in uniform wind.  In a current ``cur`` (leg frame) the same heading is fastest (the
-    current adds the same normal speed to every heading) but its track over the ground,
-    ``S·d + C``, meets the line elsewhere.
+    along the segment normal ``n`` (:func:`_support`).  For side ``σ = side`` (block
+    ``_KEEP``) and side ``-σ`` (block ``_SWITCH``) that heading is taken on the side
+    itself if it approaches the line at all, else on the other side.  Followed from
+    ``P = (x, y)`` it meets the line at ``Q*``; the aim point is ``Q*`` kept
+    ``AIM_MARGIN_M`` inside the segment.  Where no heading approaches the line, the
+    projection of ``P`` (``ex, ey, dist`` passed in) is kept.  This makes the direct
+    candidate the exact best heading to a line or gate in uniform wind.  In a current
+    ``cur`` (leg frame) the same heading is fastest (the current adds the same normal
+    speed to every heading) but its track over the ground, ``S·d + C``, meets the line
+    elsewhere.
 
-    Returns the unit vectors ``(ex, ey)`` to the aim points and their distances, each of
-    shape (2, n): row 0 for side ``s0``, row 1 for side ``-s0``.
+    Returns the unit vectors ``(ex, ey)`` to the aim points and their distances [m],
+    each of shape (2, n): row 0 for side ``σ``, row 1 for side ``-σ``.
     """
+    up_x, up_y = wind.up_x, wind.up_y
     nx, ny = g.normal
-    p = sw * nx + cw * ny
-    q = sw * ny - cw * nx
-    sides = xp.stack([s0, -s0])
-    best, ang = _support(j, fw, xp.degrees(xp.arctan2(sides * q, p)), dev, xp)
+    p = up_x * nx + up_y * ny  # cos and sin of the angle from ŵ to n
+    q = up_x * ny - up_y * nx
+    sides = xp.stack([side, -side])
+    best, ang = _support(wind.row, wind.weight, xp.degrees(xp.arctan2(sides * q, p)), dev, xp)
     use_own = best > 0  # else take the heading of the other side (needs a manoeuvre)
     sig = xp.where(use_own, sides, -sides)
     best = xp.where(use_own, best, best[::-1])
     rb = xp.radians(xp.where(use_own, ang, ang[::-1]))
     ca_b, sa_b = xp.cos(rb), xp.sin(rb)
-    dx = sw * ca_b - sig * cw * sa_b  # heading unit vector on side sig
-    dy = cw * ca_b + sig * sw * sa_b
+    dx = up_x * ca_b - sig * up_y * sa_b  # heading unit vector on side sig
+    dy = up_y * ca_b + sig * up_x * sa_b
     ax0, ay0 = g.a
-    ahead = (ax0 - X) * nx + (ay0 - Y) * ny  # distance to the segment's line along n
+    ahead = (ax0 - x) * nx + (ay0 - y) * ny  # distance to the segment's line along n
     dn = dx * nx + dy * ny
     ok = (best > 0) & (dn > 1e-9) & (ahead > 0)
     if cur is not None:  # ground track: speed S = best / dn along d, plus the current
@@ -878,9 +1126,9 @@ def _fastest_aim(
     length = g.length_m
     ux, uy = (g.b[0] - ax0) / length, (g.b[1] - ay0) / length
     m = min(AIM_MARGIN_M, 0.5 * length)
-    r = xp.clip((X + t * dx - ax0) * ux + (Y + t * dy - ay0) * uy, m, length - m)
-    vx = ax0 + r * ux - X
-    vy = ay0 + r * uy - Y
+    r = xp.clip((x + t * dx - ax0) * ux + (y + t * dy - ay0) * uy, m, length - m)
+    vx = ax0 + r * ux - x
+    vy = ay0 + r * uy - y
     d2 = xp.sqrt(vx * vx + vy * vy)
     use = ok & (d2 > 0)
     inv = 1.0 / xp.where(use, d2, 1.0)
@@ -894,8 +1142,7 @@ _TTG_ITERATIONS = 4
 
 
 def _crab(
-    ex: Any, ey: Any, cx: Any, cy: Any, tws: Any, sw: Any, cw: Any, polar: Polar,
-    xp: ModuleType,
+    ex: Any, ey: Any, cx: Any, cy: Any, wind: _PointWind, polar: Polar, xp: ModuleType,
 ) -> tuple[Any, Any, Any, Any]:
     """The direct column in a current: the heading through the water whose velocity
     over the ground, ``S(TWA(h))·w(h) + C``, points along the unit vectors ``(ex, ey)``.
@@ -905,29 +1152,29 @@ def _crab(
     line (``|C·p| >= S``, or no speed) the still-water direction ``e`` is kept.
 
     Returns ``cos``/signed ``sin`` of the heading against the upwind unit vector
-    ``(sw, cw)``, its ``|TWA|`` [°] and boat speed [m s⁻¹], as the still-water columns.
+    ``ŵ``, its ``|TWA|`` [°] and boat speed [m s⁻¹], as the still-water columns.
     """
+    up_x, up_y = wind.up_x, wind.up_y
     px, py = ey, -ex
     cp = cx * px + cy * py
     wx, wy = ex, ey
-    tws_h = _host(tws)
+    tws_h = to_numpy(wind.tws_ms)
     for _ in range(_CRAB_ITERATIONS):
-        a_d = xp.degrees(xp.arccos(xp.clip(cw * wy + sw * wx, -1.0, 1.0)))
-        spd = xp.asarray(polar.speed(tws_h, _host(a_d)), dtype=float)
+        a_d = xp.degrees(xp.arccos(xp.clip(up_y * wy + up_x * wx, -1.0, 1.0)))
+        spd = xp.asarray(polar.speed(tws_h, to_numpy(a_d)), dtype=float)
         q = -cp / xp.where(spd > 0, spd, 1.0)
         q = xp.where((spd > 0) & (xp.abs(q) < 1.0), q, 0.0)
         r = xp.sqrt(1.0 - q * q)
         wx, wy = r * ex + q * px, r * ey + q * py
-    cos_d = xp.clip(cw * wy + sw * wx, -1.0, 1.0)
+    cos_d = xp.clip(up_y * wy + up_x * wx, -1.0, 1.0)
     a_d = xp.degrees(xp.arccos(cos_d))
-    v_d = xp.asarray(polar.speed(tws_h, _host(a_d)), dtype=float)
-    return cos_d, sw * wy - cw * wx, a_d, v_d
+    v_d = xp.asarray(polar.speed(tws_h, to_numpy(a_d)), dtype=float)
+    return cos_d, up_x * wy - up_y * wx, a_d, v_d
 
 
 def _time_to_go_current(
-    tau: Any, gx: Any, gy: Any, avg: tuple[Any, Any, Any, Any, Any, Any, Any], ex: Any, ey: Any,
-    dist: Any, cx: Any, cy: Any, sides: Any, free: Any, ctx: _Context, dev: _DeviceTables,
-    xp: ModuleType,
+    tau: Any, gx: Any, gy: Any, wind: _PointWind, ex: Any, ey: Any, dist: Any, cx: Any,
+    cy: Any, sides: Any, free: Any, ctx: _Context, dev: _DeviceTables, xp: ModuleType,
 ) -> tuple[Any, Any, Any]:
     """Time to go in a current ``C`` (averaged along the way, leg frame) and its gradient.
 
@@ -945,8 +1192,9 @@ def _time_to_go_current(
         dw = xp.sqrt(wx * wx + wy * wy)
         pos = dw > 0
         inv = 1.0 / xp.where(pos, dw, 1.0)
-        t_w, gx, gy = _time_to_go(*avg, xp.where(pos, wx * inv, ex), xp.where(pos, wy * inv, ey),
-                                  dw, sides, free, ctx.tack_s, ctx.gybe_s, dev, xp)
+        t_w, gx, gy = _time_to_go(wind, xp.where(pos, wx * inv, ex),
+                                  xp.where(pos, wy * inv, ey), dw, sides, free, ctx.tack_s,
+                                  ctx.gybe_s, dev, xp)
         der = 1.0 + gx * cx + gy * cy
         newton = der > 0.25
         tau = xp.where(ok, tt - (tt - t_w) / xp.where(newton, der, 1.0), t_w)
@@ -955,10 +1203,146 @@ def _time_to_go_current(
     return tau, gx * scale, gy * scale
 
 
+def _step_length(s: RoutingSettings, tau_hint: float) -> float:
+    """``dt_s``, shortened to ``max(min_dt_s, tau_hint / NEAR_TARGET_STEPS)`` [s] once the
+    estimated time to go ``tau_hint`` [s] is below ``NEAR_TARGET_STEPS`` steps."""
+    dt = float(s.dt_s)
+    if tau_hint < NEAR_TARGET_STEPS * dt and s.min_dt_s < dt:
+        dt = max(float(s.min_dt_s), tau_hint / NEAR_TARGET_STEPS)
+    return dt
+
+
+def _direction(dx: Any, dy: Any, xp: ModuleType) -> tuple[Any, Any, Any]:
+    """Unit vector and length [m] of ``(dx, dy)``; the unit vector is ``(0, 1)`` where the
+    length is zero."""
+    dist = xp.sqrt(dx * dx + dy * dy)
+    there = dist > 0
+    inv_d = 1.0 / xp.where(there, dist, 1.0)
+    return xp.where(there, dx * inv_d, 0.0), xp.where(there, dy * inv_d, 1.0), dist
+
+
+def _sample_step(
+    f: _Layer, dt: float, aim_x: Any, aim_y: Any, dist: Any, wind: WindField, ctx: _Context,
+    s: RoutingSettings, xp: ModuleType,
+) -> tuple[Any, Any, _Current | None]:
+    """The wind ``(u, v)`` [m s⁻¹] (world frame) of the step, shape
+    (``PATH_SAMPLES + 1``, n), and the current (None: still or slack water).
+
+    Row 0: at mid-step time at each point's predicted mid-step position (half a step
+    along its previous move); rows 1.. on the straight line to the aim point
+    ``(aim_x, aim_y)`` at their estimated passing times.  One ``wind.sample`` call, the
+    points clipped to the coverage.
+    """
+    x, y = f.x, f.y
+    n = int(x.shape[0])
+    cov = wind.coverage
+    t_mid = f.t + 0.5 * dt
+    hr = xp.radians(f.heading)
+    half = xp.where(f.debt > 0, 0.0, 0.5 * dt * f.bsp)
+    horizon = xp.where(xp.isnan(f.tau_est), dist * (1.0 / _ROOT_SPEED_MS),
+                       xp.minimum(f.tau_est, float(s.max_leg_time_s)))
+    fk = (xp.arange(PATH_SAMPLES, dtype=float) + 0.5) / PATH_SAMPLES
+    px = xp.concatenate([x + half * xp.sin(hr), (x + fk[:, None] * (aim_x - x)).reshape(-1)])
+    py = xp.concatenate([y + half * xp.cos(hr), (y + fk[:, None] * (aim_y - y)).reshape(-1)])
+    pt = xp.concatenate([xp.full(n, t_mid), (t_mid + fk[:, None] * horizon).reshape(-1)])
+    wx, wy = ctx.frame.to_world(px, py)
+    pts = (to_numpy(xp.clip(pt, cov.t0, cov.t1)), to_numpy(xp.clip(wx, cov.xmin, cov.xmax)),
+           to_numpy(xp.clip(wy, cov.ymin, cov.ymax)))
+    u, v = wind.sample(*pts)
+    u = xp.asarray(u, dtype=float).reshape(PATH_SAMPLES + 1, n)
+    v = xp.asarray(v, dtype=float).reshape(PATH_SAMPLES + 1, n)
+    if ctx.current is None:
+        return u, v, None
+    cu, cv = ctx.current.sample(*pts)
+    cu, cv = ctx.frame.vec_to_leg(xp.asarray(cu, dtype=float).reshape(PATH_SAMPLES + 1, n),
+                                  xp.asarray(cv, dtype=float).reshape(PATH_SAMPLES + 1, n))
+    if not (bool(xp.any(cu != 0.0)) or bool(xp.any(cv != 0.0))):  # slack water: still water
+        return u, v, None
+    return u, v, _Current(cu[0], cv[0], xp.mean(cu, axis=0), xp.mean(cv, axis=0))
+
+
+def _fan(dev: _DeviceTables, wind: _PointWind, hull: bool, xp: ModuleType) -> tuple[int, int]:
+    """Grid columns ``first:stop`` tried: the whole circle, or (``hull``) those strictly
+    between the smallest upwind and the largest downwind VMG angle of the front."""
+    first, stop = 0, int(dev.twa_deg.shape[0])
+    if hull:
+        lo_h = int(xp.searchsorted(dev.twa_deg, xp.min(wind.up_deg), side="right"))
+        hi_h = int(xp.searchsorted(dev.twa_deg, xp.max(wind.down_deg), side="left"))
+        if hi_h > lo_h:
+            first, stop = lo_h, hi_h
+    return first, stop
+
+
+def _exact_columns(
+    wind: _PointWind, aim_x: Any, aim_y: Any, cur: _Current | None, polar: Polar,
+    xp: ModuleType,
+) -> _ExactColumns:
+    """VMG up, VMG down and the direct columns to the aim points ``(aim_x, aim_y)`` (unit
+    vectors, shape (2, n): own side, other side); boat speeds from :meth:`Polar.speed`.
+    In a current the direct heading is the one whose ground track goes to the aim
+    (:func:`_crab`)."""
+    tws_h = to_numpy(wind.tws_ms)
+    v_vmg = xp.asarray(polar.speed(tws_h[:, None],
+                                   to_numpy(xp.stack([wind.up_deg, wind.down_deg], 1))),
+                       dtype=float)
+    if cur is None:
+        cos_d = xp.clip(wind.up_y * aim_y + wind.up_x * aim_x, -1.0, 1.0)  # (2, n)
+        sin_d = wind.up_x * aim_y - wind.up_y * aim_x
+        a_d = xp.degrees(xp.arccos(cos_d))
+        v_d = xp.asarray(polar.speed(to_numpy(wind.tws_ms), to_numpy(a_d)), dtype=float)
+    else:
+        cos_d, sin_d, a_d, v_d = _crab(aim_x, aim_y, cur.move_x, cur.move_y, wind, polar, xp)
+    twa = xp.concatenate([wind.up_deg[:, None], wind.down_deg[:, None], a_d.T], axis=1)
+    rad = xp.radians(twa[:, :2])
+    return _ExactColumns(
+        twa_deg=twa, bsp_ms=xp.concatenate([v_vmg, v_d.T], axis=1),
+        cos_twa=xp.concatenate([xp.cos(rad), cos_d.T], axis=1),
+        sin_twa=xp.concatenate([xp.sin(rad), xp.abs(sin_d).T], axis=1),
+        direct_sin_keep=sin_d[0], direct_sin_switch=sin_d[1],
+    )
+
+
+def _manoeuvre_state(f: _Layer, ctx: _Context, xp: ModuleType) -> _ManoeuvreState:
+    """Sides and penalty prices of the front ``f``.
+
+    The penalty of a side change depends on the |TWA| before it (``base_twa_deg``: the
+    one before the pending manoeuvre, else the last one sailed) and the first one
+    sailed after it (upwind < 90° <= downwind): a tack if both are upwind, a gybe if
+    both downwind, the larger of the two if mixed or the old one unknown at the start
+    (then: tack onto upwind, gybe onto downwind).
+    """
+    pending = ~xp.isnan(f.pend_old)
+    base = xp.where(pending, f.pend_old, f.abs_twa)
+    mixed = max(ctx.tack_s, ctx.gybe_s)
+    unknown = xp.isnan(base)
+    return _ManoeuvreState(
+        side=xp.where(f.side < 0, -1.0, 1.0), free=f.side == 0, pending=pending,
+        base_twa_deg=base,
+        penalty_up_s=xp.where(unknown | (base < 90.0), ctx.tack_s, mixed),
+        penalty_down_s=xp.where(unknown | (base >= 90.0), ctx.gybe_s, mixed),
+        debt_s=f.debt, charged_s=f.pend_pen, any_pending=bool(xp.any(pending)),
+    )
+
+
+def _within_reach(
+    x: Any, y: Any, step_m: Any, ctx: _Context, xp: ModuleType
+) -> tuple[Any, tuple[Any, ...]]:
+    """Points whose move (at most ``step_m`` [m], shape (n,)) can reach the target segment,
+    and per barrier of the leg those that can reach its ray (None where no point can)."""
+    near = _segment_distance(x, y, ctx.geom, xp) <= step_m + 1e-6
+    near_barrier = []
+    for b, clear in ctx.barriers:
+        ray = TargetGeometry(b.mark, (b.mark[0] + BARRIER_LENGTH_M * b.ray[0],
+                                      b.mark[1] + BARRIER_LENGTH_M * b.ray[1]), b.normal, "ray")
+        close = _segment_distance(x, y, ray, xp) <= step_m + clear + 1e-3
+        near_barrier.append(close if bool(xp.any(close)) else None)
+    return near, tuple(near_barrier)
+
+
 def _prepare(
     f: _Layer, wind: WindField, polar: Polar, dev: _DeviceTables, ctx: _Context,
     s: RoutingSettings, tau_hint: float, xp: ModuleType,
-) -> tuple[_Prep, float, float]:
+) -> tuple[_StepInputs, float, float]:
     """Step length, wind, VMG angles, direct bearing and time to go of the front points.
 
     * The step is ``dt_s``, shortened to ``max(min_dt_s, tau / 3)`` once the estimated
@@ -971,330 +1355,386 @@ def _prepare(
       points on the line at their estimated passing times), so the pruning judges a
       position by the wind still ahead rather than by the wind where it is now.
 
-    All wind samples of the step go through one ``wind.sample`` call.
+    All wind samples of the step go through one ``wind.sample`` call.  Returns the
+    inputs of the kernel, the front's least estimated time to go [s] and its least
+    distance to the aim points [m].
     """
-    X, Y = f.x, f.y
-    n = int(X.shape[0])
-    fr = ctx.frame
-    cov = wind.coverage
-    dt = float(s.dt_s)
-    if tau_hint < NEAR_TARGET_STEPS * dt and s.min_dt_s < dt:
-        dt = max(float(s.min_dt_s), tau_hint / NEAR_TARGET_STEPS)
-    t_mid = f.t + 0.5 * dt
-
-    # direct bearing to the aim point
-    ax, ay = aim_points(X, Y, ctx.geom, xp=xp)
-    ex, ey = ax - X, ay - Y
-    dist = xp.sqrt(ex * ex + ey * ey)
-    there = dist > 0
-    inv_d = 1.0 / xp.where(there, dist, 1.0)
-    ex = xp.where(there, ex * inv_d, 0.0)
-    ey = xp.where(there, ey * inv_d, 1.0)
-
-    # sample points: predicted mid-step positions, then PATH_SAMPLES points on the way
-    hr = xp.radians(f.heading)
-    half = xp.where(f.debt > 0, 0.0, 0.5 * dt * f.bsp)
-    horizon = xp.where(xp.isnan(f.tau_est), dist * (1.0 / _ROOT_SPEED_MS),
-                       xp.minimum(f.tau_est, float(s.max_leg_time_s)))
-    fk = (xp.arange(PATH_SAMPLES, dtype=float) + 0.5) / PATH_SAMPLES
-    px = xp.concatenate([X + half * xp.sin(hr), (X + fk[:, None] * (ax - X)).reshape(-1)])
-    py = xp.concatenate([Y + half * xp.cos(hr), (Y + fk[:, None] * (ay - Y)).reshape(-1)])
-    pt = xp.concatenate([xp.full(n, t_mid), (t_mid + fk[:, None] * horizon).reshape(-1)])
-    wx, wy = fr.to_world(px, py)
-    pts = (_host(xp.clip(pt, cov.t0, cov.t1)), _host(xp.clip(wx, cov.xmin, cov.xmax)),
-           _host(xp.clip(wy, cov.ymin, cov.ymax)))
-    u, v = wind.sample(*pts)
-    u = xp.asarray(u, dtype=float).reshape(PATH_SAMPLES + 1, n)
-    v = xp.asarray(v, dtype=float).reshape(PATH_SAMPLES + 1, n)
-    cur = None  # current (leg frame): of the move, and averaged along the way
-    if ctx.current is not None:
-        cu, cv = ctx.current.sample(*pts)
-        cu, cv = fr.vec_to_leg(xp.asarray(cu, dtype=float).reshape(PATH_SAMPLES + 1, n),
-                               xp.asarray(cv, dtype=float).reshape(PATH_SAMPLES + 1, n))
-        if bool(xp.any(cu != 0.0)) or bool(xp.any(cv != 0.0)):  # slack water: still water
-            cur = (cu[0], cv[0], xp.mean(cu, axis=0), xp.mean(cv, axis=0))
-
-    # the move's wind: speed, direction, VMG angles
-    tws, sw, cw, j, fw, a_up, a_dn = _wind_state(u[0], v[0], dev, fr, xp)
-    v_vmg = xp.asarray(polar.speed(_host(tws)[:, None], _host(xp.stack([a_up, a_dn], 1))),
-                       dtype=float)
-
-    # grid columns: the whole circle, or between the VMG angles ("hull")
-    na = int(dev.a.shape[0])
-    lo, hi = 0, na
-    if ctx.fan_hull:
-        lo_h = int(xp.searchsorted(dev.a, xp.min(a_up), side="right"))
-        hi_h = int(xp.searchsorted(dev.a, xp.max(a_dn), side="left"))
-        if hi_h > lo_h:
-            lo, hi = lo_h, hi_h
+    x, y = f.x, f.y
+    dt = _step_length(s, tau_hint)
+    aim_x, aim_y = aim_points(x, y, ctx.geom, xp=xp)  # direct bearing to the aim point
+    ex, ey, dist = _direction(aim_x - x, aim_y - y, xp)
+    u, v, cur = _sample_step(f, dt, aim_x, aim_y, dist, wind, ctx, s, xp)
+    move_wind = _wind_state(u[0], v[0], dev, ctx.frame, xp)
+    first, stop = _fan(dev, move_wind, ctx.fan_hull, xp)
 
     # aim, per side, at the point of the target segment reached fastest in this wind
-    s0 = xp.where(f.side < 0, -1.0, 1.0)
-    free = f.side == 0
-    aex, aey, adist = _fastest_aim(X, Y, ex, ey, dist, s0, sw, cw, j, fw, ctx.geom, dev, xp,
-                                   None if cur is None else cur[:2])
-
-    # the exact columns: VMG up, VMG down, direct to the aim (side s0), direct (side -s0)
-    if cur is None:
-        cos_d = xp.clip(cw * aey + sw * aex, -1.0, 1.0)  # (2, n)
-        sin_d = sw * aey - cw * aex
-        a_d = xp.degrees(xp.arccos(cos_d))
-        v_d = xp.asarray(polar.speed(_host(tws), _host(a_d)), dtype=float)
-    else:  # the heading through the water whose track over the ground goes to the aim
-        cos_d, sin_d, a_d, v_d = _crab(aex, aey, cur[0], cur[1], tws, sw, cw, polar, xp)
-    angles = xp.concatenate([a_up[:, None], a_dn[:, None], a_d.T], axis=1)
-    v_extra = xp.concatenate([v_vmg, v_d.T], axis=1)
-    rad = xp.radians(angles[:, :2])
-    cos_x = xp.concatenate([xp.cos(rad), cos_d.T], axis=1)
-    sin_x = xp.concatenate([xp.sin(rad), xp.abs(sin_d).T], axis=1)
+    man = _manoeuvre_state(f, ctx, xp)
+    sides = xp.stack([man.side, -man.side])
+    aex, aey, adist = _fastest_aim(x, y, ex, ey, dist, man.side, move_wind, ctx.geom, dev, xp,
+                                   None if cur is None else (cur.move_x, cur.move_y))
+    exact = _exact_columns(move_wind, aex, aey, cur, polar, xp)
 
     # time to go on either side, in the wind averaged along the way
-    avg = _wind_state(xp.mean(u, axis=0), xp.mean(v, axis=0), dev, fr, xp)
-    tau, gx, gy = _time_to_go(*avg, aex, aey, adist, xp.stack([s0, -s0]), free, ctx.tack_s,
+    mean_wind = _wind_state(xp.mean(u, axis=0), xp.mean(v, axis=0), dev, ctx.frame, xp)
+    tau, gx, gy = _time_to_go(mean_wind, aex, aey, adist, sides, man.free, ctx.tack_s,
                               ctx.gybe_s, dev, xp)
     if cur is not None:
-        tau, gx, gy = _time_to_go_current(tau, gx, gy, avg, aex, aey, adist, cur[2], cur[3],
-                                          xp.stack([s0, -s0]), free, ctx, dev, xp)
+        tau, gx, gy = _time_to_go_current(tau, gx, gy, mean_wind, aex, aey, adist, cur.mean_x,
+                                          cur.mean_y, sides, man.free, ctx, dev, xp)
     tau_min = float(xp.min(f.debt + tau[0]))
     if cur is not None:  # the drift of the step is common to all candidates of a point
-        tau = tau - dt * (gx * cur[0] + gy * cur[1])
+        tau = tau - dt * (gx * cur.move_x + gy * cur.move_y)
     dist_min = float(xp.min(adist))
 
-    # manoeuvre state
-    pending = ~xp.isnan(f.pend_old)
-    base = xp.where(pending, f.pend_old, f.abs_twa)
-    # penalty of a side change by the new |TWA| (upwind < 90 <= downwind): tack if old and
-    # new are upwind, gybe if both downwind, the larger of the two if mixed
-    mixed = max(ctx.tack_s, ctx.gybe_s)
-    unknown = xp.isnan(base)
-    pen_up = xp.where(unknown | (base < 90.0), ctx.tack_s, mixed)
-    pen_dn = xp.where(unknown | (base >= 90.0), ctx.gybe_s, mixed)
-    reach = xp.maximum(xp.maximum(dev.vmax[j], dev.vmax[j + 1]), xp.max(v_extra, axis=1))
+    # the points a move can take to the target or a barrier
+    top_ms = xp.maximum(xp.maximum(dev.vmax_ms[move_wind.row], dev.vmax_ms[move_wind.row + 1]),
+                        xp.max(exact.bsp_ms, axis=1))
     if cur is not None:
-        reach = reach + xp.sqrt(cur[0] * cur[0] + cur[1] * cur[1])
-    near = _segment_distance(X, Y, ctx.geom, xp) <= reach * dt * 1.0001 + 1e-6
-    bar_near = []  # per barrier: the points within one step of its ray (None: none)
-    for b, clear in ctx.barriers:
-        ray = TargetGeometry(b.mark, (b.mark[0] + BARRIER_LENGTH_M * b.ray[0],
-                                      b.mark[1] + BARRIER_LENGTH_M * b.ray[1]), b.normal, "ray")
-        close = _segment_distance(X, Y, ray, xp) <= reach * dt * 1.0001 + clear + 1e-3
-        bar_near.append(close if bool(xp.any(close)) else None)
+        top_ms = top_ms + xp.sqrt(cur.move_x * cur.move_x + cur.move_y * cur.move_y)
+    near, near_barrier = _within_reach(x, y, top_ms * dt * 1.0001, ctx, xp)
 
-    pre = _Prep(
-        t=f.t, dt=dt, n=n, h=hi - lo + 3, lo=lo, hi=hi, X=X, Y=Y, sw=sw, cw=cw, j=j, fw=fw,
-        angles=angles, v_extra=v_extra, cos_x=cos_x, sin_x=sin_x, sin_d0=sin_d[0],
-        sin_d1=sin_d[1], tau0=tau[0], gx0=gx[0], gy0=gy[0], tau1=tau[1], gx1=gx[1],
-        gy1=gy[1], s0=s0, free=free,
-        pending=pending, base=base, pen_up=pen_up, pen_dn=pen_dn, debt=f.debt,
-        pend_pen=f.pend_pen, near=near, bar_near=bar_near, any_pending=bool(xp.any(pending)),
-        cx=None if cur is None else cur[0], cy=None if cur is None else cur[1],
+    pre = _StepInputs(
+        t=f.t, dt=dt, first=first, stop=stop, x=x, y=y, wind=move_wind, exact=exact,
+        keep=_TimeToGo(tau[0], gx[0], gy[0]), switch=_TimeToGo(tau[1], gx[1], gy[1]),
+        manoeuvre=man, near_target=near, near_barrier=near_barrier,
+        current_x=None if cur is None else cur.move_x,
+        current_y=None if cur is None else cur.move_y,
     )
     return pre, tau_min, dist_min
 
 
+# --------------------------------------------------------------------------------------
+# one step: the candidate kernel
+
+
+@dataclass(frozen=True, eq=False)
+class _Block:
+    """The candidates of one block for a chunk of rows; arrays of shape (rows, columns).
+
+    Columns: the block's grid columns, then its three exact columns
+    (:data:`_EXACT_OF_BLOCK`).
+
+    Attributes
+    ----------
+    block : int
+        ``_KEEP`` or ``_SWITCH``.
+    sigma : array, shape (rows,)
+        The side sailed, +1 or -1.
+    first : int
+        The block's first grid column, counted from :attr:`_StepInputs.first`.
+    bsp_ms, twa_deg : array
+        Boat speed [m s⁻¹] and |TWA| [°].
+    vx, vy : array
+        Velocity through the water [m s⁻¹] (leg frame).
+    rate : array
+        Decrease of the time to go per second of move, ``G·v`` (no unit).
+    """
+
+    block: int
+    sigma: Any
+    first: int
+    bsp_ms: Any
+    twa_deg: Any
+    vx: Any
+    vy: Any
+    rate: Any
+
+
+@dataclass(frozen=True, eq=False)
+class _Timing:
+    """Penalty timing of moves [s]: stopped first for ``delay``, then moving for
+    ``move`` (``delay + move = dt``); ``debt`` still owed after the step."""
+
+    delay: Any
+    move: Any
+    debt: Any
+
+
+def _grid_speeds(c: _StepInputs, dev: _DeviceTables) -> Any:
+    """Boat speed [m s⁻¹] of the grid columns, shape (rows, n_grid)."""
+    node, weight = c.wind.row, c.wind.weight
+    s_lo = dev.speed_ms[node, c.first:c.stop]
+    return s_lo + weight[:, None] * (dev.speed_ms[node + 1, c.first:c.stop] - s_lo)
+
+
+def _block(
+    c: _StepInputs, grid_bsp: Any, block: int, first: int, dev: _DeviceTables, xp: ModuleType
+) -> _Block:
+    """Speed, |TWA|, velocity and time-to-go rate of the candidates of ``block``: grid
+    columns from ``first`` on (of ``grid_bsp``, shape (rows, n_grid)), then the exact
+    columns of the block."""
+    rows = c.n
+    lo, n_grid = c.first + first, c.n_grid - first
+    exact = _EXACT_OF_BLOCK[block]
+    bsp = xp.concatenate([grid_bsp[:, first:], c.exact.bsp_ms[:, exact]], axis=1)
+    twa = xp.concatenate([xp.broadcast_to(dev.twa_deg[lo:c.stop], (rows, n_grid)),
+                          c.exact.twa_deg[:, exact]], axis=1)
+    sx = bsp * xp.concatenate([xp.broadcast_to(dev.cos_a[lo:c.stop], (rows, n_grid)),
+                               c.exact.cos_twa[:, exact]], axis=1)
+    sy = bsp * xp.concatenate([xp.broadcast_to(dev.sin_a[lo:c.stop], (rows, n_grid)),
+                               c.exact.sin_twa[:, exact]], axis=1)
+    side = c.manoeuvre.side
+    sigma = side if block == _KEEP else -side
+    vx, vy = _velocity(c.wind.up_x[:, None], c.wind.up_y[:, None], sigma[:, None], sx, sy)
+    ttg = c.keep if block == _KEEP else c.switch
+    rate = ttg.grad_x[:, None] * vx + ttg.grad_y[:, None] * vy
+    return _Block(block, sigma, first, bsp, twa, vx, vy, rate)
+
+
+def _switch_timing(c: _StepInputs, switch: _Block, any_free: bool, xp: ModuleType) -> _Timing:
+    """Timing of block ``_SWITCH``: the penalty of the new manoeuvre, priced by the
+    heading sailed (none for a free point), is served first."""
+    m = c.manoeuvre
+    owed = _penalty(switch.twa_deg, m.penalty_up_s[:, None], m.penalty_down_s[:, None], xp)
+    if any_free:
+        owed[m.free] = 0.0
+    delay = xp.minimum(owed, c.dt)
+    return _Timing(delay, c.dt - delay, owed - delay)
+
+
+def _keep_timing(c: _StepInputs, keep: _Block, sub: Any, xp: ModuleType) -> _Timing:
+    """Timing of block ``_KEEP`` for the rows ``sub`` (shape (len(sub), n_columns)).
+
+    A pending point re-prices its manoeuvre with the heading it now sails: it owes its
+    debt plus the new price minus what was charged so far (at least 0); the others owe
+    nothing.
+    """
+    m = c.manoeuvre
+    owed = xp.zeros((sub.shape[0], c.n_columns))
+    if m.any_pending and bool(xp.any(m.pending[sub])):
+        pr = sub[m.pending[sub]]
+        pos = xp.flatnonzero(m.pending[sub])
+        price = _penalty(keep.twa_deg[pr], m.penalty_up_s[pr, None],
+                         m.penalty_down_s[pr, None], xp)
+        owed[pos] = xp.maximum(m.debt_s[pr, None] + price - m.charged_s[pr, None], 0.0)
+    delay = xp.minimum(owed, c.dt)
+    return _Timing(delay, c.dt - delay, owed - delay)
+
+
+def _drifted(c: _StepInputs, qx: Any, qy: Any) -> tuple[Any, Any]:
+    """End points moved by the current over the whole step, stopped or not."""
+    if c.current_x is None:
+        return qx, qy
+    return qx + c.dt * c.current_x[:, None], qy + c.dt * c.current_y[:, None]
+
+
+def _keep_ends(
+    c: _StepInputs, keep: _Block, pending: Any, pending_timing: _Timing | None
+) -> tuple[Any, Any]:
+    """End points [m] of the moves of block ``_KEEP``: a whole step, except for the
+    pending rows (``pending``, with their ``pending_timing``), which may still owe time."""
+    qx = c.x[:, None] + c.dt * keep.vx
+    qy = c.y[:, None] + c.dt * keep.vy
+    if pending_timing is not None:
+        qx[pending] = c.x[pending, None] + pending_timing.move * keep.vx[pending]
+        qy[pending] = c.y[pending, None] + pending_timing.move * keep.vy[pending]
+    return _drifted(c, qx, qy)
+
+
+def _switch_ends(c: _StepInputs, switch: _Block, timing: _Timing) -> tuple[Any, Any]:
+    """End points [m] of the moves of block ``_SWITCH``, after the penalty stop."""
+    return _drifted(c, c.x[:, None] + timing.move * switch.vx,
+                    c.y[:, None] + timing.move * switch.vy)
+
+
+def _barrier_blocked(
+    c: _StepInputs, ends: tuple[tuple[Any, Any], ...], ctx: _Context, xp: ModuleType
+) -> list[Any] | None:
+    """Per block, the moves (shape (rows, columns)) that pass a rounded mark on the wrong
+    side (:func:`~sailroute.routing.geometry.barrier_blocks`, rows near a barrier
+    only); None where no row is near one."""
+    blocked = None
+    for (bar, clear), close in zip(ctx.barriers, c.near_barrier, strict=True):
+        nb = None if close is None else xp.flatnonzero(close)
+        if nb is None or nb.shape[0] == 0:
+            continue
+        if blocked is None:
+            blocked = [xp.zeros(qx.shape, dtype=bool) for qx, _ in ends]
+        px_b, py_b = c.x[nb][:, None], c.y[nb][:, None]
+        for mask, (qx, qy) in zip(blocked, ends, strict=True):
+            mask[nb] |= barrier_blocks(px_b, py_b, qx[nb], qy[nb], bar, clear, xp=xp)
+    return blocked
+
+
+def _arrival(
+    c: _StepInputs, r0: int, blocks: tuple[_Block, _Block],
+    ends: tuple[tuple[Any, Any], ...], timings: tuple[_Timing, _Timing],
+    direct_ok: tuple[Any, Any], blocked: list[Any] | None, ctx: _Context, xp: ModuleType,
+) -> _Arrival | None:
+    """The earliest forward crossing of the target segment (rows within reach only).
+
+    ``timings`` are those of the rows near the target (:attr:`_StepInputs.near_target`);
+    a move crosses from its start (drifted by the current during its stop) to its end
+    point, and counts if allowed: direct column on its side, no barrier passed on the
+    wrong side, no second manoeuvre during a pending one, inside the coverage box.
+    ``r0`` is the chunk's first row in the front.
+    """
+    m = c.manoeuvre
+    near = xp.flatnonzero(c.near_target)
+    arrival = None
+    best_t = np.inf
+    for blk, (qx, qy), timing, ok in zip(blocks, ends, timings, direct_ok, strict=True):
+        px = c.x[near][:, None]
+        py = c.y[near][:, None]
+        if c.current_x is not None:  # the move starts after the drift of the penalty stop
+            px = px + timing.delay * c.current_x[near, None]
+            py = py + timing.delay * c.current_y[near, None]
+        hit, frac, _ = segment_crossing(px, py, qx[near], qy[near], ctx.geom, xp=xp)
+        hit[:, -1] &= ok[near]
+        if blocked is not None:
+            hit &= ~blocked[blk.block][near]
+        if blk.block == _SWITCH and m.any_pending:
+            hit &= ~m.pending[near, None]
+        if ctx.box is not None:
+            hit &= _in_box(qx[near], qy[near], ctx.frame, ctx.box)
+        if not bool(xp.any(hit)):
+            continue
+        t_hit = xp.where(hit, timing.delay + frac * timing.move, np.inf)
+        k = int(xp.argmin(t_hit.reshape(-1)))
+        rr, col = divmod(k, int(t_hit.shape[1]))
+        if float(t_hit[rr, col]) >= best_t:
+            continue
+        best_t = float(t_hit[rr, col])
+        p = int(near[rr])
+        ds = float(frac[rr, col])
+        x0, y0 = float(px[rr, 0]), float(py[rr, 0])
+        end_x, end_y = float(qx[p, col]), float(qy[p, col])
+        hd = (_heading_deg(end_x - x0, end_y - y0) if c.current_x is None  # through the water:
+              else _heading_deg(float(blk.vx[p, col]), float(blk.vy[p, col])))
+        arrival = _Arrival(
+            parent=r0 + p, t_start=c.t, t=c.t + best_t,
+            x=x0 + ds * (end_x - x0), y=y0 + ds * (end_y - y0),
+            heading=hd, bsp=float(blk.bsp_ms[p, col]),
+            delay=float(timing.delay[rr, col]), side=int(blk.sigma[p]),
+        )
+    return arrival
+
+
+def _keep_scores(
+    c: _StepInputs, keep: _Block, pending: Any, pending_timing: _Timing | None
+) -> Any:
+    """Estimated time to go after the moves of block ``_KEEP`` [s], ``τ - dt G·v`` (the
+    pending rows: ``τ + debt - move G·v``)."""
+    score = c.keep.tau_s[:, None] - c.dt * keep.rate
+    if pending_timing is not None:
+        score[pending] = (c.keep.tau_s[pending, None] + pending_timing.debt
+                          - pending_timing.move * keep.rate[pending])
+    return score
+
+
+def _switch_scores(c: _StepInputs, switch: _Block, timing: _Timing) -> Any:
+    """Estimated time to go after the moves of block ``_SWITCH`` [s],
+    ``τ + debt - move G·v``."""
+    return c.switch.tau_s[:, None] + timing.debt - timing.move * switch.rate
+
+
+def _drop_forbidden(
+    c: _StepInputs, scores: list[Any], ends: tuple[tuple[Any, Any], ...],
+    direct_ok: tuple[Any, Any], blocked: list[Any] | None, ctx: _Context, xp: ModuleType,
+) -> list[Any]:
+    """Scores with the forbidden candidates at infinity: a direct column on the wrong
+    side, a side change during a pending manoeuvre, a move past a rounded mark on the
+    wrong side or out of the coverage box."""
+    for score, ok in zip(scores, direct_ok, strict=True):
+        score[:, -1] = xp.where(ok, score[:, -1], np.inf)
+    if c.manoeuvre.any_pending:
+        scores[_SWITCH][c.manoeuvre.pending] = np.inf
+    if blocked is not None:
+        scores = [xp.where(mask, np.inf, score) for score, mask in zip(scores, blocked,
+                                                                        strict=True)]
+    if ctx.box is not None:
+        scores = [xp.where(_in_box(qx, qy, ctx.frame, ctx.box), score, np.inf)
+                  for score, (qx, qy) in zip(scores, ends, strict=True)]
+    return scores
+
+
+def _sector_winners(
+    c: _StepInputs, r0: int, blocks: tuple[_Block, _Block], ends: tuple[tuple[Any, Any], ...],
+    scores: list[Any], ctx: _Context, xp: ModuleType,
+) -> tuple[Any, Any, Any] | None:
+    """The best candidate per bin: sector of the bearing seen from the target and side.
+
+    Bins are ``ctx.sector_rad`` wide (float32 bearings are ample for binning); key =
+    ``sector * 2 + side index`` (0 starboard, 1 port).  Returns the keys, scores [s]
+    and candidate ids (see :data:`_KEEP`) of the winners, or None if every score is
+    infinite.
+    """
+    scale = np.float32(1.0 / ctx.sector_rad)
+    off = np.float32(ctx.n_bins // 2 + 0.5)  # keeps the argument positive: astype = floor
+    port = (c.manoeuvre.side < 0).astype(xp.int64)[:, None]  # side index of block _KEEP
+    keys = []
+    for (qx, qy), side_index in zip(ends, (port, 1 - port), strict=True):
+        phi = xp.arctan2(qx.astype(xp.float32), qy.astype(xp.float32))
+        kb = (phi * scale + off).astype(xp.int64)
+        kb *= 2
+        kb += side_index
+        keys.append(kb.reshape(-1))
+    key = xp.concatenate(keys)
+    score = xp.concatenate([scores[0].reshape(-1), scores[1].reshape(-1)])
+    flat = _group_argmin(key, score, 2 * ctx.n_bins, xp)
+    if flat.shape[0] == 0:
+        return None
+    h = c.n_columns
+    n_keep = c.n * h
+    in_keep = flat < n_keep
+    f1 = flat - n_keep
+    first = blocks[_SWITCH].first
+    h1 = h - first
+    wid = xp.where(in_keep, ((r0 + flat // h) * 2 + _KEEP) * h + flat % h,
+                   ((r0 + f1 // h1) * 2 + _SWITCH) * h + first + f1 % h1)
+    return key[flat], score[flat], wid
+
+
 def _expand(
-    pre: _Prep, r0: int, r1: int, dev: _DeviceTables, ctx: _Context, xp: ModuleType,
+    pre: _StepInputs, r0: int, r1: int, dev: _DeviceTables, ctx: _Context, xp: ModuleType,
     want_winners: bool,
 ) -> tuple[_Arrival | None, tuple[Any, Any, Any] | None]:
     """Candidates of front points ``r0:r1``: arrival check and per-sector winners.
 
-    Two blocks of candidates: block 0 keeps the point's side ``s0`` (+1 for a free
-    start) and tries every column (grid slice, VMG up, VMG down, direct to its aim
-    point); block 1 changes side and tries the exact columns only (VMG up, VMG down,
-    direct to the other side's aim point; all grid columns too for free start points,
-    which pay no penalty).  Any other heading on the new side is one step away at no
-    cost, so this loses at most one step at a slightly different angle.  Each block is
-    scored with the time to go of its own side.
+    Two blocks of candidates: block ``_KEEP`` keeps the point's side ``σ`` (+1 for a
+    free start) and tries every column (grid slice, VMG up, VMG down, direct to its aim
+    point); block ``_SWITCH`` changes side and tries the exact columns only (VMG up, VMG
+    down, direct to the other side's aim point; all grid columns too when a free start
+    point is in the chunk, which pays no penalty).  Any other heading on the new side is
+    one step away at no cost, so this loses at most one step at a slightly different
+    angle.  Each block is scored with the time to go of its own side.
+
+    Steps: velocities of the two blocks (:func:`_block`), manoeuvre timing
+    (:func:`_switch_timing`, :func:`_keep_timing`), end points with the current's drift,
+    barrier blocking, arrival (:func:`_arrival`); then, unless arrived, scores
+    (estimated time to go after the move) and the best candidate per sector and side
+    (:func:`_sector_winners`).
     """
-    r = r1 - r0
-    h, lo, hi = pre.h, pre.lo, pre.hi
-    hg = hi - lo
-    dt = pre.dt
-    sl = slice(r0, r1)
-    X, Y = pre.X[sl], pre.Y[sl]
-    j, fw = pre.j[sl], pre.fw[sl]
-    sw, cw, s0 = pre.sw[sl], pre.cw[sl], pre.s0[sl]
-    free = pre.free[sl]
-    pending = pre.pending[sl]
-    any_free = bool(xp.any(free))
-    any_pend = pre.any_pending and bool(xp.any(pending))
-    cb = 0 if any_free else hg  # first grid column of block 1
+    c = pre.rows(r0, r1, xp)
+    m = c.manoeuvre
+    any_free = bool(xp.any(m.free))
+    grid_bsp = _grid_speeds(c, dev)
+    keep = _block(c, grid_bsp, _KEEP, 0, dev, xp)
+    switch = _block(c, grid_bsp, _SWITCH, 0 if any_free else c.n_grid, dev, xp)
 
-    # boat speed, |TWA| and (speed cos|TWA|, speed sin|TWA|) of every column
-    sp = dev.speed
-    s_lo = sp[j, lo:hi]
-    grid_bsp = s_lo + fw[:, None] * (sp[j + 1, lo:hi] - s_lo)
-    ext = [0, 1, 2], [0, 1, 3]  # exact columns of block 0 and block 1
-    blocks = []
-    for b, c0 in ((0, 0), (1, cb)):
-        e = ext[b]
-        bsp = xp.concatenate([grid_bsp[:, c0:], pre.v_extra[sl][:, e]], axis=1)
-        twa = xp.concatenate([xp.broadcast_to(dev.a[lo + c0:hi], (r, hg - c0)),
-                              pre.angles[sl][:, e]], axis=1)
-        sx = bsp * xp.concatenate([xp.broadcast_to(dev.cos_a[lo + c0:hi], (r, hg - c0)),
-                                   pre.cos_x[sl][:, e]], axis=1)
-        sy = bsp * xp.concatenate([xp.broadcast_to(dev.sin_a[lo + c0:hi], (r, hg - c0)),
-                                   pre.sin_x[sl][:, e]], axis=1)
-        blocks.append((bsp, twa, sx, sy))
+    # penalties as time debt: the penalty of a manoeuvre is fixed by the first heading
+    # actually sailed after it (pending points re-price it); no turning back inside one
+    switch_timing = _switch_timing(c, switch, any_free, xp)
+    pending = xp.flatnonzero(m.pending) if m.any_pending else None
+    pending_timing = None if pending is None else _keep_timing(c, keep, pending, xp)
+    ends = (_keep_ends(c, keep, pending, pending_timing), _switch_ends(c, switch, switch_timing))
+    direct_ok = (m.side * c.exact.direct_sin_keep >= 0, m.side * c.exact.direct_sin_switch <= 0)
+    blocked = _barrier_blocked(c, ends, ctx, xp)
 
-    # On side sigma (heading = twd - sigma |twa|) the velocity is (a1 - sigma a2,
-    # a3 + sigma a4), a1 = sw sx, a2 = cw sy, a3 = cw sx, a4 = sw sy; block 0 has
-    # sigma = s0, block 1 sigma = -s0.  Rate of decrease of the time to go: G · velocity.
-    vel, rate = [], []
-    for b, (_, _, sx, sy) in enumerate(blocks):
-        a1 = sw[:, None] * sx
-        a3 = cw[:, None] * sx
-        b2 = (s0 * cw)[:, None] * sy
-        b4 = (s0 * sw)[:, None] * sy
-        gx = (pre.gx0 if b == 0 else pre.gx1)[sl, None]
-        gy = (pre.gy0 if b == 0 else pre.gy1)[sl, None]
-        if b == 0:
-            vel.append((a1 - b2, a3 + b4))
-            rate.append(gx * (a1 - b2) + gy * (a3 + b4))
-        else:
-            vel.append((a1 + b2, a3 - b4))
-            rate.append(gx * (a1 + b2) + gy * (a3 - b4))
-
-    # Penalties as time debt.  The penalty of a manoeuvre is fixed by the first heading
-    # actually sailed after it (pending points re-price it); no turning back inside one.
-    twa1 = blocks[1][1]
-    pen1 = xp.where(twa1 < 90.0, pre.pen_up[sl, None], pre.pen_dn[sl, None])
-    if any_free:
-        pen1[free] = 0.0
-    delay1 = xp.minimum(pen1, dt)
-    move1 = dt - delay1
-    debt1 = pen1 - delay1
-
-    def timing0(sub: Any) -> tuple[Any, Any, Any]:
-        """Delay, move time and remaining debt of block 0 for rows ``sub`` (pending rows
-        re-price their manoeuvre with the new heading)."""
-        dl = xp.zeros((sub.shape[0], h))
-        if any_pend and bool(xp.any(pending[sub])):
-            pr = sub[pending[sub]]
-            pos = xp.flatnonzero(pending[sub])
-            pen_r = xp.where(blocks[0][1][pr] < 90.0, pre.pen_up[sl][pr, None],
-                             pre.pen_dn[sl][pr, None])
-            dl[pos] = xp.maximum(
-                pre.debt[sl][pr, None] + pen_r - pre.pend_pen[sl][pr, None], 0.0)
-        d = xp.minimum(dl, dt)
-        return d, dt - d, dl - d
-
-    (vx0, vy0), (vx1, vy1) = vel
-    qx0 = X[:, None] + dt * vx0
-    qy0 = Y[:, None] + dt * vy0
-    prow = xp.flatnonzero(pending) if any_pend else None
-    if prow is not None:
-        _, move_p, debt_p = timing0(prow)
-        qx0[prow] = X[prow, None] + move_p * vx0[prow]
-        qy0[prow] = Y[prow, None] + move_p * vy0[prow]
-    qx1 = X[:, None] + move1 * vx1
-    qy1 = Y[:, None] + move1 * vy1
-    if pre.cx is not None:  # drift with the water for the whole step, stopped or not
-        drx, dry = dt * pre.cx[sl, None], dt * pre.cy[sl, None]
-        qx0, qy0, qx1, qy1 = qx0 + drx, qy0 + dry, qx1 + drx, qy1 + dry
-
-    # the direct columns exist on their own side only
-    ok0 = s0 * pre.sin_d0[sl] >= 0
-    ok1 = s0 * pre.sin_d1[sl] <= 0
-
-    # moves that pass a rounded mark on the wrong side (rows near a barrier only)
-    blocked = None
-    for (bar, clear), close in zip(ctx.barriers, pre.bar_near, strict=True):
-        nb = None if close is None else xp.flatnonzero(close[sl])
-        if nb is None or nb.shape[0] == 0:
-            continue
-        if blocked is None:
-            blocked = [xp.zeros(qx0.shape, dtype=bool), xp.zeros(qx1.shape, dtype=bool)]
-        px_b, py_b = X[nb][:, None], Y[nb][:, None]
-        for m, qx_b, qy_b in zip(blocked, (qx0, qx1), (qy0, qy1), strict=True):
-            m[nb] |= barrier_blocks(px_b, py_b, qx_b[nb], qy_b[nb], bar, clear, xp=xp)
-
-    # arrival: earliest forward crossing of the target segment (rows within reach only)
     arrival = None
-    near = xp.flatnonzero(pre.near[sl])
+    near = xp.flatnonzero(c.near_target)
     if near.shape[0] > 0:
-        best_t = np.inf
-        delay0, move0, _ = timing0(near)
-        for blk, (qx_b, qy_b, dl_n, mv_n, ok_b) in enumerate((
-                (qx0, qy0, delay0, move0, ok0),
-                (qx1, qy1, delay1[near], move1[near], ok1))):
-            px = X[near][:, None]
-            py = Y[near][:, None]
-            if pre.cx is not None:  # the move starts after the drift of the penalty stop
-                px = px + dl_n * pre.cx[sl][near, None]
-                py = py + dl_n * pre.cy[sl][near, None]
-            hit, sfrac, _ = segment_crossing(px, py, qx_b[near], qy_b[near], ctx.geom, xp=xp)
-            hit[:, -1] &= ok_b[near]
-            if blocked is not None:
-                hit &= ~blocked[blk][near]
-            if blk == 1 and any_pend:
-                hit &= ~pending[near, None]
-            if ctx.box is not None:
-                hit &= _in_box(qx_b[near], qy_b[near], ctx.frame, ctx.box)
-            if not bool(xp.any(hit)):
-                continue
-            t_arr = xp.where(hit, dl_n + sfrac * mv_n, np.inf)
-            kk = int(xp.argmin(t_arr.reshape(-1)))
-            rr, c = divmod(kk, int(t_arr.shape[1]))
-            if float(t_arr[rr, c]) >= best_t:
-                continue
-            best_t = float(t_arr[rr, c])
-            p = int(near[rr])
-            ds = float(sfrac[rr, c])
-            x0, y0 = float(px[rr, 0]), float(py[rr, 0])
-            q_x, q_y = float(qx_b[p, c]), float(qy_b[p, c])
-            hd = (_heading_deg(q_x - x0, q_y - y0) if pre.cx is None  # through the water:
-                  else _heading_deg(float(vel[blk][0][p, c]), float(vel[blk][1][p, c])))
-            arrival = _Arrival(
-                parent=r0 + p, t_start=pre.t, t=pre.t + best_t,
-                x=x0 + ds * (q_x - x0), y=y0 + ds * (q_y - y0),
-                heading=hd, bsp=float(blocks[blk][0][p, c]),
-                delay=float(dl_n[rr, c]), side=int(s0[p]) * (1 - 2 * blk),
-            )
+        near_timing = (_keep_timing(c, keep, near, xp),
+                       _Timing(switch_timing.delay[near], switch_timing.move[near], None))
+        arrival = _arrival(c, r0, (keep, switch), ends, near_timing, direct_ok, blocked, ctx,
+                           xp)
     if not want_winners or arrival is not None:
         return arrival, None
 
-    # score: estimated time to go after the move, tau + debt - move * (G · velocity)
-    score0 = pre.tau0[sl, None] - dt * rate[0]
-    if prow is not None:
-        score0[prow] = pre.tau0[sl][prow, None] + debt_p - move_p * rate[0][prow]
-    score1 = pre.tau1[sl, None] + debt1 - move1 * rate[1]
-    score0[:, -1] = xp.where(ok0, score0[:, -1], np.inf)
-    score1[:, -1] = xp.where(ok1, score1[:, -1], np.inf)
-    if any_pend:
-        score1[pending] = np.inf
-    if blocked is not None:
-        score0 = xp.where(blocked[0], np.inf, score0)
-        score1 = xp.where(blocked[1], np.inf, score1)
-    if ctx.box is not None:
-        score0 = xp.where(_in_box(qx0, qy0, ctx.frame, ctx.box), score0, np.inf)
-        score1 = xp.where(_in_box(qx1, qy1, ctx.frame, ctx.box), score1, np.inf)
-
-    # sector of the bearing seen from the target (float32 is ample for binning) and side
-    scale = np.float32(1.0 / ctx.sector_rad)
-    off = np.float32(ctx.n_bins // 2 + 0.5)  # keeps the argument positive: astype = floor
-    port = (s0 < 0).astype(xp.int64)[:, None]  # side index: 0 starboard, 1 port
-    keys = []
-    for qx_b, qy_b, side_b in ((qx0, qy0, port), (qx1, qy1, 1 - port)):
-        phi = xp.arctan2(qx_b.astype(xp.float32), qy_b.astype(xp.float32))
-        kb = (phi * scale + off).astype(xp.int64)
-        kb *= 2
-        kb += side_b
-        keys.append(kb.reshape(-1))
-    n0 = r * h
-    key = xp.concatenate(keys)
-    score = xp.concatenate([score0.reshape(-1), score1.reshape(-1)])
-    flat = _group_argmin(key, score, 2 * ctx.n_bins, xp)
-    if flat.shape[0] == 0:
-        return None, None
-
-    # winner ids: (global row * 2 + block) * h + column
-    in0 = flat < n0
-    f1 = flat - n0
-    h1 = h - cb
-    wid = xp.where(in0, ((r0 + flat // h) * 2) * h + flat % h,
-                   ((r0 + f1 // h1) * 2 + 1) * h + cb + f1 % h1)
-    return None, (key[flat], score[flat], wid)
+    scores = [_keep_scores(c, keep, pending, pending_timing),
+              _switch_scores(c, switch, switch_timing)]
+    scores = _drop_forbidden(c, scores, ends, direct_ok, blocked, ctx, xp)
+    return None, _sector_winners(c, r0, (keep, switch), ends, scores, ctx, xp)
 
 
 def _in_box(
