@@ -1718,6 +1718,7 @@ def _expand(
     pending = xp.flatnonzero(m.pending) if m.any_pending else None
     pending_timing = None if pending is None else _keep_timing(c, keep, pending, xp)
     ends = (_keep_ends(c, keep, pending, pending_timing), _switch_ends(c, switch, switch_timing))
+    # the direct columns exist on their own side only
     direct_ok = (m.side * c.exact.direct_sin_keep >= 0, m.side * c.exact.direct_sin_switch <= 0)
     blocked = _barrier_blocked(c, ends, ctx, xp)
 
@@ -1745,14 +1746,14 @@ def _in_box(
     return (wx >= box[0]) & (wx <= box[1]) & (wy >= box[2]) & (wy <= box[3])
 
 
-def _segment_distance(X: Any, Y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
-    """Distance from points to the target segment [m]."""
+def _segment_distance(x: Any, y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
+    """Distance from the points ``(x, y)`` to the segment ``g.a``-``g.b`` [m]."""
     ax, ay = g.a
     ex, ey = g.b[0] - ax, g.b[1] - ay
     ll = ex * ex + ey * ey
-    r = xp.clip(((X - ax) * ex + (Y - ay) * ey) / ll, 0.0, 1.0)
-    dx = X - (ax + r * ex)
-    dy = Y - (ay + r * ey)
+    r = xp.clip(((x - ax) * ex + (y - ay) * ey) / ll, 0.0, 1.0)
+    dx = x - (ax + r * ex)
+    dy = y - (ay + r * ey)
     return xp.sqrt(dx * dx + dy * dy)
 
 
