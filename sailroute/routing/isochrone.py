@@ -60,7 +60,7 @@ import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -614,9 +614,12 @@ _KEEP, _SWITCH = 0, 1
 _EXACT_OF_BLOCK = ([0, 1, 2], [0, 1, 3])
 """The :class:`_ExactColumns` a block tries: VMG up, VMG down, its own direct column."""
 
+# The records below are built every step and per chunk of rows: immutable NamedTuples
+# rather than frozen dataclasses, which take about 3x longer to construct (2.3 against
+# 0.7 µs for 8 fields) and made a leg about 1 % slower.
 
-@dataclass(frozen=True, eq=False)
-class _PointWind:
+
+class _PointWind(NamedTuple):
     """The wind at the front points as the kernel uses it; arrays of shape (n,).
 
     Attributes
@@ -647,8 +650,7 @@ class _PointWind:
                           self.weight[sl], self.up_deg[sl], self.down_deg[sl])
 
 
-@dataclass(frozen=True, eq=False)
-class _ExactColumns:
+class _ExactColumns(NamedTuple):
     """The four exact (off-grid) candidate headings of every point.
 
     Columns: 0 upwind VMG angle, 1 downwind VMG angle, 2 direct to the aim point of the
@@ -680,8 +682,7 @@ class _ExactColumns:
                              self.direct_sin_switch[sl])
 
 
-@dataclass(frozen=True, eq=False)
-class _TimeToGo:
+class _TimeToGo(NamedTuple):
     """Estimated time to go ``τ`` of the points on one side, and its gradient ``G``.
 
     ``τ(P + d) ≈ τ(P) - d·G`` for a small move ``d`` [m]; arrays of shape (n,).
@@ -703,8 +704,7 @@ class _TimeToGo:
         return _TimeToGo(self.tau_s[sl], self.grad_x[sl], self.grad_y[sl])
 
 
-@dataclass(frozen=True, eq=False)
-class _ManoeuvreState:
+class _ManoeuvreState(NamedTuple):
     """Side and penalty bookkeeping of the front points; arrays of shape (n,).
 
     Attributes
@@ -747,8 +747,7 @@ class _ManoeuvreState:
         )
 
 
-@dataclass(frozen=True, eq=False)
-class _Current:
+class _Current(NamedTuple):
     """Current at the front points (leg frame) [m s⁻¹]; arrays of shape (n,).
 
     ``move_*``: at the point's mid-step sample, moves the candidates;
@@ -761,8 +760,7 @@ class _Current:
     mean_y: Any
 
 
-@dataclass(frozen=True, eq=False)
-class _StepInputs:
+class _StepInputs(NamedTuple):
     """What the candidate kernel needs about the ``n`` front points of one step.
 
     Built by :func:`_prepare`; :meth:`rows` restricts it to a chunk of points.  Leg
@@ -1407,8 +1405,7 @@ def _prepare(
 # one step: the candidate kernel
 
 
-@dataclass(frozen=True, eq=False)
-class _Block:
+class _Block(NamedTuple):
     """The candidates of one block for a chunk of rows; arrays of shape (rows, columns).
 
     Columns: the block's grid columns, then its three exact columns
@@ -1440,8 +1437,7 @@ class _Block:
     rate: Any
 
 
-@dataclass(frozen=True, eq=False)
-class _Timing:
+class _Timing(NamedTuple):
     """Penalty timing of moves [s]: stopped first for ``delay``, then moving for
     ``move`` (``delay + move = dt``); ``debt`` still owed after the step."""
 
