@@ -35,8 +35,9 @@ Glossary of the kernel (symbols of ``docs/design/routing.md`` → names in the c
 frame, SI units, angles in degrees):
 
 * ``σ``, the side: ``side`` (``sigma`` for the side a candidate sails): +1 starboard,
-  −1 port, 0 free (no side chosen yet, only at the leg start; a free point sails as +1
-  in block ``_KEEP`` and changes side without penalty).
+  −1 port (:func:`~sailroute.routing.types.side_sign`), 0 free (no side chosen yet, only
+  at the leg start; a free point sails as +1 in block ``_KEEP`` and changes side
+  without penalty).
 * ``ŵ``, the upwind unit vector: ``up_x, up_y``; the TWS interpolation in the polar
   tables: node ``row`` and ``weight`` (:class:`_PointWind`).
 * ``S``, boat speed: ``bsp_ms``; ``a``, |TWA|: ``twa_deg``; ``(S cos a, S sin a)``:
