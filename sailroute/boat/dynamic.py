@@ -900,50 +900,52 @@ def _rk4_piece(beta: NDArray, ell: NDArray, w0: NDArray, h: NDArray, c1: float, 
                k: float, max_steps: int) -> tuple[NDArray, NDArray]:
     n = beta.size
     tau = np.zeros(n)
-    s = np.zeros(n)
-    w = np.maximum(np.asarray(w0, float).copy(), 0.0)
+    y = np.zeros((2, n))  # s, w
+    y[1] = np.maximum(np.asarray(w0, float), 0.0)
     out_tau = np.full(n, np.inf)
     out_w = np.zeros(n)
     done0 = ell <= 0
     out_tau[done0] = 0.0
-    out_w[done0] = w[done0]
+    out_w[done0] = y[1, done0]
     act = np.flatnonzero(~done0)
     steps = 0
 
     def f(wv: NDArray, bv: NDArray) -> NDArray:
         return drive(np.maximum(wv, 0.0), bv, c1, c2, k)
 
-    def rhs(y: NDArray, bv: NDArray) -> NDArray:
+    def rhs(yv: NDArray, bv: NDArray) -> NDArray:
         """``d(s, w)/dτ = (w, g(max(w, 0)))``: ``s`` rides on ``w``'s stages."""
-        return np.stack([y[1], f(y[1], bv)])
+        dy = np.empty_like(yv)  # cheaper than np.stack on these short rows (per step)
+        dy[0] = yv[1]
+        dy[1] = f(yv[1], bv)
+        return dy
 
+    no_drive = f(np.zeros_like(beta), beta) <= 0.0  # a boat at rest stays at rest
     while act.size and steps < max_steps:
         steps += 1
-        bv, wv, sv, hv = beta[act], w[act], s[act], h[act]
-        y_new, k1 = rk4_step(rhs, np.stack([sv, wv]), hv, args=(bv,))
-        s_new, w_new = y_new[0], y_new[1]
-        stopped = (w_new <= 0.0) & (f(np.zeros_like(bv), bv) <= 0.0)
-        w_new = np.maximum(w_new, 0.0)
+        bv, yv, hv = beta[act], y[:, act], h[act]
+        y_new, k1 = rk4_step(rhs, yv, hv, args=(bv,))
+        s_new = y_new[0]
+        stopped = (y_new[1] <= 0.0) & no_drive[act]
+        w_new = y_new[1] = np.maximum(y_new[1], 0.0)
         cross = s_new >= ell[act]
         if cross.any():
             i = act[cross]
-            th = hermite_crossing(sv[cross], s_new[cross], wv[cross], w_new[cross],
-                                  hv[cross], ell[i])
-            g0 = k1[1, cross]
+            sv, wv = yv[0, cross], yv[1, cross]
+            th = hermite_crossing(sv, s_new[cross], wv, w_new[cross], hv[cross], ell[i])
             g1 = f(w_new[cross], bv[cross])
             out_tau[i] = tau[i] + th * hv[cross]
-            out_w[i] = hermite(wv[cross], w_new[cross], g0, g1, th, hv[cross])
+            out_w[i] = hermite(wv, w_new[cross], k1[1, cross], g1, th, hv[cross])
         dead = stopped & ~cross
         if dead.any():
             out_tau[act[dead]] = np.inf
             out_w[act[dead]] = 0.0
         keep = ~(cross | dead)
         tau[act] = tau[act] + hv
-        s[act] = s_new
-        w[act] = w_new
+        y[:, act] = y_new
         act = act[keep]
     if act.size:  # cap reached: finish at the current (near steady) speed
-        ws = np.maximum(w[act], 1e-300)
-        out_tau[act] = tau[act] + (ell[act] - s[act]) / ws
-        out_w[act] = w[act]
+        ws = np.maximum(y[1, act], 1e-300)
+        out_tau[act] = tau[act] + (ell[act] - y[0, act]) / ws
+        out_w[act] = y[1, act]
     return out_tau, out_w
