@@ -112,7 +112,7 @@ def hermite_basis(t: Any) -> tuple[Any, Any, Any, Any]:
     return 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, 3 * t2 - 2 * t3, t3 - t2
 
 
-def hermite(y0: Any, y1: Any, d0: Any, d1: Any, t: Any, h: Any = 1.0) -> Any:
+def hermite(y0: Any, y1: Any, d0: Any, d1: Any, t: Any, h: Any = None) -> Any:
     """Cubic Hermite interpolant of one step at fractions ``t`` (broadcast).
 
     Parameters
@@ -124,8 +124,10 @@ def hermite(y0: Any, y1: Any, d0: Any, d1: Any, t: Any, h: Any = 1.0) -> Any:
     t : array
         Fraction of the step, ``(x − x0) / h`` [-]; exact for cubics, extrapolates
         outside ``[0, 1]``.
-    h : array or float
-        Step width in ``x`` (``x1 − x0``); the default 1 reads ``d0, d1`` per unit ``t``.
+    h : array or float, optional
+        Step width in ``x`` (``x1 − x0``); without it ``d0, d1`` are per unit ``t``
+        (``h = 1``, and two array products fewer: this is the hot path of the
+        dynamic boat's loss table).
 
     Returns
     -------
@@ -133,6 +135,8 @@ def hermite(y0: Any, y1: Any, d0: Any, d1: Any, t: Any, h: Any = 1.0) -> Any:
         ``h00 y0 + h10 h d0 + h01 y1 + h11 h d1`` (:func:`hermite_basis`).
     """
     h00, h10, h01, h11 = hermite_basis(t)
+    if h is None:
+        return h00 * y0 + h10 * d0 + h01 * y1 + h11 * d1
     return h00 * y0 + h10 * h * d0 + h01 * y1 + h11 * h * d1
 
 

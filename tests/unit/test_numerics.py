@@ -92,6 +92,8 @@ def test_hermite_reproduces_a_cubic_exactly() -> None:
     t = np.linspace(-0.25, 1.25, 61)  # inside the step and extrapolated
     y = hermite(CUBIC(x0), CUBIC(x0 + h), d(x0), d(x0 + h), t, h)
     np.testing.assert_allclose(y, CUBIC(x0 + t * h), rtol=0, atol=1e-13)
+    per_t = hermite(CUBIC(x0), CUBIC(x0 + h), h * d(x0), h * d(x0 + h), t)  # no h: d/dt
+    np.testing.assert_allclose(per_t, y, rtol=0, atol=1e-13)
     # d/dt = h dp/dx; power form with h = 1 (derivatives per unit t)
     dt = hermite_slope(CUBIC(x0), CUBIC(x0 + h), d(x0), d(x0 + h), t, h)
     np.testing.assert_allclose(dt, h * d(x0 + t * h), rtol=0, atol=1e-12)
