@@ -117,7 +117,7 @@ import bench_griddp  # noqa: E402
 import bench_isochrone  # noqa: E402
 
 from sailroute.boat.io import read_polar  # noqa: E402
-from sailroute.boat.polar import Polar  # noqa: E402
+from sailroute.boat.polar import Polar, fold_twa  # noqa: E402
 from sailroute.geo import LocalFrame  # noqa: E402
 from sailroute.routing.api import route_leg  # noqa: E402
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target  # noqa: E402
@@ -407,7 +407,7 @@ def _direct_arrival(
     heading = np.degrees(np.arctan2(mx - x, my - y))
     u, v = leg.wind.sample(t, x, y)
     tws, twd = wind_speed_direction(u, v)
-    twa = np.abs((heading - twd + 180.0) % 360.0 - 180.0)
+    twa = fold_twa(heading - twd)
     best = math.inf
     for d, w, a in zip(dist, tws, twa, strict=True):
         if d <= MARK_TOLERANCE_M:

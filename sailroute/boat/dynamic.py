@@ -53,6 +53,8 @@ from scipy.integrate import cumulative_simpson
 
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.numerics import hermite, hermite_coefficients, hermite_crossing, rk4_step
+from sailroute.units import wrap180
 
 # ---------------------------------------------------------------------------
 # pure kernels (radians, scaled variables; ``xp`` is numpy or a compatible module)
@@ -187,7 +189,7 @@ class DynamicBoat:
         """Along-track acceleration ``s''`` [m s⁻²] at boat speed [m s⁻¹], TWA [°], TWS [m s⁻¹]."""
         v = np.asarray(v_ms, dtype=float)
         vt = np.asarray(tws_ms, dtype=float)
-        beta = np.radians(np.abs(_wrap180(twa_deg)))
+        beta = np.radians(np.abs(wrap180(twa_deg)))
         with np.errstate(divide="ignore", invalid="ignore"):
             w = np.where(vt > 0, v / np.where(vt > 0, vt, 1.0), 0.0)
         acc = vt * vt * drive(w, beta, self.c1, self.c2, self.k)
@@ -196,7 +198,7 @@ class DynamicBoat:
     def steady_speed(self, tws_ms: ArrayLike, twa_deg: ArrayLike) -> NDArray[np.float64]:
         """Steady boat speed [m s⁻¹] (``s'' = 0``) at TWS [m s⁻¹] and TWA [°] (broadcast)."""
         tws = np.asarray(tws_ms, dtype=float)
-        beta = np.radians(np.abs(_wrap180(twa_deg)))
+        beta = np.radians(np.abs(wrap180(twa_deg)))
         return tws * steady_w(beta, self.c1, self.c2, self.k)
 
     def best_vmg(self, upwind: bool = True, step_deg: float = 0.01) -> tuple[float, float]:
@@ -285,7 +287,7 @@ class DynamicBoat:
             np.asarray(length_m, float), np.asarray(twa_deg, float),
             np.asarray(tws_ms, float), np.asarray(v0_ms, float),
         )
-        beta = np.radians(np.abs(_wrap180(twa)))
+        beta = np.radians(np.abs(wrap180(twa)))
         calm = vt <= _CALM
         vts = np.where(calm, 1.0, vt)
         tau, w1 = simulate_pieces(
@@ -312,7 +314,7 @@ class DynamicBoat:
             np.asarray(tws_ms, float), np.asarray(v0_ms, float),
         )
         shape = ell.shape
-        beta = np.radians(np.abs(_wrap180(twa))).reshape(-1, 1)
+        beta = np.radians(np.abs(wrap180(twa))).reshape(-1, 1)
         t, v1 = chain_time(
             self, beta, vt.reshape(-1, 1), ell.reshape(-1, 1), np.ones_like(beta),
             v0.reshape(-1),
@@ -322,11 +324,6 @@ class DynamicBoat:
     def table(self) -> SegmentTable:
         """The (cached) segment lookup table of this boat."""
         return _table_for(self.c1, self.c2, self.k)
-
-
-def _wrap180(a: ArrayLike) -> NDArray[np.float64]:
-    x = np.asarray(a, dtype=float)
-    return 180.0 - np.mod(180.0 - x, 360.0)
 
 
 _EPS_CONV = 1e-3  # relative speed deviation at which a transient counts as over
@@ -425,7 +422,8 @@ class SegmentTable:
     def steady(self, beta: Any, xp: ModuleType = np) -> Any:
         """Scaled steady speed at ``beta`` [rad] (0 in the no-drive zone).
 
-        Interpolated from the table, then polished by two Newton steps.
+        Interpolated from the table, then polished by two Newton steps (derivative by
+        a forward difference of ``1e-7``).
         """
         w_ss = self.arrays(xp)[0]
         j0, fb = self.column(beta, xp)
@@ -461,8 +459,8 @@ class SegmentTable:
         nv, nd = loss.shape[1], d0.shape[1]
         lv, l0, l1 = loss.reshape(-1), d0.reshape(-1), d1.reshape(-1)
         bv, bd = j0 * nv + i0, j0 * nd + i0
-        lo = hermite01(lv[bv], lv[bv + 1], l0[bd], l1[bd], fx)
-        hi = hermite01(lv[bv + nv], lv[bv + nv + 1], l0[bd + nd], l1[bd + nd], fx)
+        lo = hermite(lv[bv], lv[bv + 1], l0[bd], l1[bd], fx)
+        hi = hermite(lv[bv + nv], lv[bv + nv + 1], l0[bd + nd], l1[bd + nd], fx)
         return (1.0 - fb) * lo + fb * hi
 
     def poly(self, xp: ModuleType = np) -> Any:
@@ -475,8 +473,7 @@ class SegmentTable:
         key = ("poly", xp.__name__)
         if key not in self._xp_cache:
             y0, y1 = self.loss[:, :-1], self.loss[:, 1:]
-            d0, d1 = self.dloss0, self.dloss1
-            c = np.stack([y0, d0, 3 * (y1 - y0) - 2 * d0 - d1, 2 * (y0 - y1) + d0 + d1],
+            c = np.stack(hermite_coefficients(y0, y1, self.dloss0, self.dloss1),
                          axis=-1).reshape(-1, 4)
             self._xp_cache[key] = xp.asarray(np.ascontiguousarray(c))
         return self._xp_cache[key]
@@ -538,7 +535,8 @@ def build_table(
     ``Λ`` is integrated with the cumulative Simpson rule on ``nfine`` points per
     branch and column (the integrand is smooth: against 4097 points the largest
     difference is 2e-7 of the largest ``Λ`` for the default constants) and
-    subsampled to ``nq`` points; the transient lengths use the trapezoidal rule.
+    subsampled to ``nq`` points; the transient lengths and the no-drive coasting
+    distance use the trapezoidal rule.
     Takes well under a second; cached per constants by :meth:`DynamicBoat.table`.
     """
     if (nfine - 1) % (nq - 1):
@@ -768,7 +766,7 @@ def _exact_chain(boat: DynamicBoat, beta: Any, vt: Any, length: Any, cos_turn: A
     return xp.asarray(total), xp.asarray(v), xp.asarray(tp)
 
 
-_H_SIGMA = 0.5  # fallback RK4 step in σ [m] (error < 3e-5 s against a fine τ-reference)
+_H_SIGMA = 0.5  # smallest fallback RK4 step in σ [m] (error < 3e-5 s vs a fine τ-reference)
 _OMEGA = 0.5  # [-]: σ = ∫ (w + ω) dτ, regular from rest
 _W_STUCK = 1e-3  # scaled speed below which a decelerating boat counts as stopped
 _A_RATE = 0.1  # adaptive RK4: largest relative change of (w + ω) per step
@@ -818,10 +816,7 @@ def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, ome
         lim = np.minimum(_A_RATE * wp / np.maximum(np.abs(k1[1]), 1e-300),
                          _B_RELAX * wp / np.maximum(gw, 1e-300))
         hs = np.clip(lim, h_all[act], 40.0 * h_all[act])  # this step's h per item
-        k2 = f(yv + 0.5 * hs * k1, bv)
-        k3 = f(yv + 0.5 * hs * k2, bv)
-        k4 = f(yv + hs * k3, bv)
-        yn = yv + hs / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        yn, _ = rk4_step(f, yv, hs, k1, args=(bv,))
         # stopped for good: (nearly) at rest and decelerating (a no-drive coast
         # that has run out; at w < 1e-3 it would crawl for ages before stopping)
         stopped = (yn[1] <= _W_STUCK) & (drive(np.maximum(yn[1], 0.0), bv, c1, c2, k) <= 0.0)
@@ -831,9 +826,9 @@ def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, ome
             i = act[cross]
             f1 = f(yn[:, cross], bv[cross])
             hh = hs[cross]
-            th = _hermite_crossing(yv[0, cross], yn[0, cross], k1[0, cross], f1[0], hh, ell[i])
-            out_tau[i] = _hermite(yv[2, cross], yn[2, cross], k1[2, cross], f1[2], hh, th)
-            out_w[i] = _hermite(yv[1, cross], yn[1, cross], k1[1, cross], f1[1], hh, th)
+            th = hermite_crossing(yv[0, cross], yn[0, cross], k1[0, cross], f1[0], hh, ell[i])
+            out_tau[i] = hermite(yv[2, cross], yn[2, cross], k1[2, cross], f1[2], th, hh)
+            out_w[i] = hermite(yv[1, cross], yn[1, cross], k1[1, cross], f1[1], th, hh)
         dead = stopped & ~cross
         if dead.any():
             out_tau[act[dead]] = np.inf
@@ -921,83 +916,52 @@ def _rk4_piece(beta: NDArray, ell: NDArray, w0: NDArray, h: NDArray, c1: float, 
                k: float, max_steps: int) -> tuple[NDArray, NDArray]:
     n = beta.size
     tau = np.zeros(n)
-    s = np.zeros(n)
-    w = np.maximum(np.asarray(w0, float).copy(), 0.0)
+    y = np.zeros((2, n))  # s, w
+    y[1] = np.maximum(np.asarray(w0, float), 0.0)
     out_tau = np.full(n, np.inf)
     out_w = np.zeros(n)
     done0 = ell <= 0
     out_tau[done0] = 0.0
-    out_w[done0] = w[done0]
+    out_w[done0] = y[1, done0]
     act = np.flatnonzero(~done0)
     steps = 0
 
     def f(wv: NDArray, bv: NDArray) -> NDArray:
         return drive(np.maximum(wv, 0.0), bv, c1, c2, k)
 
+    def rhs(yv: NDArray, bv: NDArray) -> NDArray:
+        """``d(s, w)/dτ = (w, g(max(w, 0)))``: ``s`` rides on ``w``'s stages."""
+        dy = np.empty_like(yv)  # cheaper than np.stack on these short rows (per step)
+        dy[0] = yv[1]
+        dy[1] = f(yv[1], bv)
+        return dy
+
+    no_drive = f(np.zeros_like(beta), beta) <= 0.0  # a boat at rest stays at rest
     while act.size and steps < max_steps:
         steps += 1
-        bv, wv, sv, hv = beta[act], w[act], s[act], h[act]
-        k1 = f(wv, bv)
-        k2 = f(wv + 0.5 * hv * k1, bv)
-        k3 = f(wv + 0.5 * hv * k2, bv)
-        k4 = f(wv + hv * k3, bv)
-        w_new = wv + hv / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-        # ds/dτ = w integrated with the same stages (w is the RK4 state of s)
-        s_new = sv + hv / 6.0 * (
-            wv + 2 * (wv + 0.5 * hv * k1) + 2 * (wv + 0.5 * hv * k2) + (wv + hv * k3)
-        )
-        stopped = (w_new <= 0.0) & (f(np.zeros_like(bv), bv) <= 0.0)
-        w_new = np.maximum(w_new, 0.0)
+        bv, yv, hv = beta[act], y[:, act], h[act]
+        y_new, k1 = rk4_step(rhs, yv, hv, args=(bv,))
+        s_new = y_new[0]
+        stopped = (y_new[1] <= 0.0) & no_drive[act]
+        w_new = y_new[1] = np.maximum(y_new[1], 0.0)
         cross = s_new >= ell[act]
         if cross.any():
             i = act[cross]
-            th = _hermite_crossing(sv[cross], s_new[cross], wv[cross], w_new[cross],
-                                   hv[cross], ell[i])
-            g0 = k1[cross]
+            sv, wv = yv[0, cross], yv[1, cross]
+            th = hermite_crossing(sv, s_new[cross], wv, w_new[cross], hv[cross], ell[i])
             g1 = f(w_new[cross], bv[cross])
             out_tau[i] = tau[i] + th * hv[cross]
-            out_w[i] = _hermite(wv[cross], w_new[cross], g0, g1, hv[cross], th)
+            out_w[i] = hermite(wv, w_new[cross], k1[1, cross], g1, th, hv[cross])
         dead = stopped & ~cross
         if dead.any():
             out_tau[act[dead]] = np.inf
             out_w[act[dead]] = 0.0
         keep = ~(cross | dead)
         tau[act] = tau[act] + hv
-        s[act] = s_new
-        w[act] = w_new
+        y[:, act] = y_new
         act = act[keep]
     if act.size:  # cap reached: finish at the current (near steady) speed
-        ws = np.maximum(w[act], 1e-300)
-        out_tau[act] = tau[act] + (ell[act] - s[act]) / ws
-        out_w[act] = w[act]
+        ws = np.maximum(y[1, act], 1e-300)
+        out_tau[act] = tau[act] + (ell[act] - y[0, act]) / ws
+        out_w[act] = y[1, act]
     return out_tau, out_w
-
-
-def hermite01(y0: Any, y1: Any, d0: Any, d1: Any, t: Any) -> Any:
-    """Cubic Hermite on the unit interval: values ``y0, y1``, derivatives ``d0, d1``, at ``t``."""
-    t2 = t * t
-    t3 = t2 * t
-    return ((2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + t) * d0 + (3 * t2 - 2 * t3) * y1
-            + (t3 - t2) * d1)
-
-
-def _hermite(y0: NDArray, y1: NDArray, d0: NDArray, d1: NDArray, h: NDArray,
-             th: NDArray) -> NDArray:
-    t2, t3 = th * th, th * th * th
-    return ((2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + th) * h * d0
-            + (-2 * t3 + 3 * t2) * y1 + (t3 - t2) * h * d1)
-
-
-def _hermite_crossing(s0: NDArray, s1: NDArray, w0: NDArray, w1: NDArray, h: NDArray,
-                      target: NDArray) -> NDArray:
-    """Fraction θ ∈ [0, 1] of the step where the cubic Hermite s(θ) reaches ``target``."""
-    span = np.where(s1 > s0, s1 - s0, 1.0)
-    th = np.clip((target - s0) / span, 0.0, 1.0)
-    for _ in range(6):
-        val = _hermite(s0, s1, w0, w1, h, th) - target
-        t2 = th * th
-        der = ((6 * t2 - 6 * th) * s0 + (3 * t2 - 4 * th + 1) * h * w0
-               + (-6 * t2 + 6 * th) * s1 + (3 * t2 - 2 * th) * h * w1)
-        der = np.where(np.abs(der) > 1e-300, der, 1e-300)
-        th = np.clip(th - val / der, 0.0, 1.0)
-    return th

@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError
-from sailroute.numerics import pchip
+from sailroute.numerics import golden_max, pchip
 from sailroute.units import KNOT
 
 INTERPOLATIONS: Final = ("pchip", "linear")
@@ -69,7 +69,6 @@ taper rows at TWA 0 and 180 and the column at TWS 0 that the polar adds: closer 
 
 _VMG_SEARCH_STEP_DEG: Final = 0.5
 _GOLDEN_ITERATIONS: Final = 64
-_INV_PHI: Final = (np.sqrt(5.0) - 1.0) / 2.0
 
 
 def fold_twa(twa_deg: ArrayLike) -> NDArray[np.float64]:
@@ -343,22 +342,7 @@ class Polar:
         def f(x: NDArray) -> NDArray:
             return self.speed(tws, x) * (sign * np.cos(np.radians(x)))
 
-        c = hi - _INV_PHI * (hi - lo)
-        d = lo + _INV_PHI * (hi - lo)
-        fc, fd = f(c), f(d)
-        for _ in range(_GOLDEN_ITERATIONS):
-            left = fc >= fd  # keep [lo, d]
-            hi = np.where(left, d, hi)
-            lo = np.where(left, lo, c)
-            new = np.where(left, hi - _INV_PHI * (hi - lo), lo + _INV_PHI * (hi - lo))
-            fnew = f(new)
-            c, d, fc, fd = (
-                np.where(left, new, d),
-                np.where(left, c, new),
-                np.where(left, fnew, fd),
-                np.where(left, fc, fnew),
-            )
-        ang = 0.5 * (lo + hi)
+        ang = golden_max(f, lo, hi, _GOLDEN_ITERATIONS)
         val = f(ang)
         best_grid = vmg_grid[np.arange(tws.size), k]
         use_grid = best_grid > val

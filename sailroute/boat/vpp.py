@@ -46,11 +46,11 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import PchipInterpolator
 
 from sailroute.boat.laser import LaserParams, validate
-from sailroute.boat.polar import Polar
+from sailroute.boat.polar import Polar, fold_twa
 from sailroute.errors import InputError
+from sailroute.numerics import golden_max
 
 _FN_MAX: Final = 0.75
-_GOLDEN: Final = (np.sqrt(5.0) - 1.0) / 2.0
 _N_GOLDEN_FLAT: Final = 32
 _N_GOLDEN_TWIST: Final = 22
 _N_NEWTON: Final = 14
@@ -498,22 +498,6 @@ class _Ctx:
         return fx, fy, surplus, moment
 
 
-def _golden_max(f: Callable[[NDArray], NDArray], lo: NDArray, hi: NDArray, n: int) -> NDArray:
-    """Vectorised golden-section search for the maximiser of ``f`` on ``[lo, hi]``."""
-    c = hi - _GOLDEN * (hi - lo)
-    d = lo + _GOLDEN * (hi - lo)
-    fc, fd = f(c), f(d)
-    for _ in range(n):
-        left = fc >= fd
-        hi = np.where(left, d, hi)
-        lo = np.where(left, lo, c)
-        new = np.where(left, hi - _GOLDEN * (hi - lo), lo + _GOLDEN * (hi - lo))
-        fnew = f(new)
-        c, d = np.where(left, new, d), np.where(left, c, new)
-        fc, fd = np.where(left, fnew, fd), np.where(left, fc, fnew)
-    return 0.5 * (lo + hi)
-
-
 def _best_controls(
     p: LaserParams, ctx: _Ctx, rm_max: NDArray | float
 ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
@@ -521,7 +505,7 @@ def _best_controls(
     n = ctx.cl0.shape
     lo = np.full(n, p.flat_min)
     hi = np.ones(n)
-    x_u = _golden_max(lambda x: ctx.forces(x, 0.0)[2], lo, hi, _N_GOLDEN_FLAT)
+    x_u = golden_max(lambda x: ctx.forces(x, 0.0)[2], lo, hi, _N_GOLDEN_FLAT)
     _, _, s_u, m_u = ctx.forces(x_u, 0.0)
     x_best, t_best, s_best = x_u, np.zeros(n), s_u
     over = np.zeros(n, dtype=bool)
@@ -553,7 +537,7 @@ def _best_controls(
 
     tmax = p.twist_max
     if tmax > 0:
-        t_opt = _golden_max(lambda t: on_limit(t)[1], np.zeros(xu.shape),
+        t_opt = golden_max(lambda t: on_limit(t)[1], np.zeros(xu.shape),
                             np.full(xu.shape, tmax), _N_GOLDEN_TWIST)
     else:
         t_opt = np.zeros(xu.shape)
@@ -672,7 +656,7 @@ def _solve_point(
     )
     shape = tws_b.shape
     tws = tws_b.ravel().copy()
-    twa = 180.0 - np.abs(np.mod(twa_b.ravel(), 360.0) - 180.0)
+    twa = fold_twa(twa_b.ravel())
     if not (np.all(np.isfinite(tws)) and np.all(np.isfinite(twa))) or np.any(tws < 0):
         raise InputError("VPP: TWS and TWA must be finite and TWS >= 0")
     n = tws.size
@@ -748,7 +732,7 @@ def _solve_speed(
         a = grid[miss, np.maximum(k - 1, 0)]
         b = grid[miss, np.minimum(k + 1, _N_SCAN - 1)]
         tm, am = tws[miss], twa[miss]
-        peak = _golden_max(lambda v: surplus(tm, am, v), a, b, _N_GOLDEN_FLAT)
+        peak = golden_max(lambda v: surplus(tm, am, v), a, b, _N_GOLDEN_FLAT)
         g_peak = surplus(tm, am, peak)
         found = g_peak >= 0
         has[miss[found]] = True

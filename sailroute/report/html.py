@@ -48,7 +48,7 @@ from sailroute.errors import OutOfCoverageError
 from sailroute.report.plan import Comparison, Plan, percent_error
 from sailroute.report.tables import format_duration, start_point_text
 from sailroute.timeutil import iso
-from sailroute.units import KNOT, wind_speed_direction
+from sailroute.units import KNOT, wind_speed_direction, wrap180, wrap360
 from sailroute.wind.base import WindField
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -173,7 +173,7 @@ class WindLayer:
         ok = np.isfinite(self.tws_kn)
         if not ok.all():
             return False
-        d = (self.twd_deg - self.twd_deg.flat[0] + 180.0) % 360.0 - 180.0
+        d = wrap180(self.twd_deg - self.twd_deg.flat[0])
         return bool(np.ptp(self.tws_kn) < 0.01 and np.abs(d).max() < 0.1)
 
 
@@ -681,7 +681,7 @@ def wind_arrows(w: WindLayer, course: Course, m_per_kn: float
     tail_lat, tail_lon = course.frame.to_latlon(w.x - dx, w.y - dy)
     tip_lat, tip_lon = course.frame.to_latlon(w.x + dx, w.y + dy)
     nan = np.full(w.x.size, np.nan)
-    angle = np.where(np.isfinite(twd), (twd + 180.0) % 360.0, np.nan)
+    angle = np.where(np.isfinite(twd), wrap360(twd + 180.0), np.nan)
     out = []
     for k in range(spd.shape[0]):
         xs = np.column_stack([tail_lon[k], tip_lon[k], nan]).ravel()

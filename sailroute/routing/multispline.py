@@ -39,6 +39,7 @@ from sailroute.backend import to_numpy
 from sailroute.boat.dynamic import DynamicBoat, chain_time
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError, RoutingError
+from sailroute.numerics import hermite, hermite_basis
 from sailroute.routing._dp_grid import (
     ChainWind,
     GridBoat,
@@ -79,11 +80,12 @@ _MAX_SLOPE_ANGLE = math.radians(85.0)
 
 
 def hermite_y(y0: Any, m0: Any, y1: Any, m1: Any, dx: Any, t: Any) -> Any:
-    """Across coordinate of Hermite edges at parameters ``t`` (broadcast)."""
-    t2 = t * t
-    t3 = t2 * t
-    return ((2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + t) * dx * m0
-            + (3 * t2 - 2 * t3) * y1 + (t3 - t2) * dx * m1)
+    """Across coordinate of Hermite edges at parameters ``t`` (broadcast).
+
+    :func:`sailroute.numerics.hermite` in the edge's terms: ends ``y0, y1`` [m],
+    slopes ``m0, m1 = dY/dX`` [-], along span ``dx`` [m].
+    """
+    return hermite(y0, y1, m0, m1, t, dx)
 
 
 @dataclass(frozen=True, eq=False)
@@ -408,8 +410,7 @@ def l2_edge_cost(target: Callable[[NDArray], NDArray], n_gauss: int = 8) -> Edge
     """
     g, w = np.polynomial.legendre.leggauss(n_gauss)
     t = 0.5 * (g + 1.0)
-    t2, t3 = t * t, t * t * t
-    h00, h10, h01, h11 = 2 * t3 - 3 * t2 + 1, t3 - 2 * t2 + t, 3 * t2 - 2 * t3, t3 - t2
+    h00, h10, h01, h11 = hermite_basis(t)
 
     def cost(r: int, e: Edges) -> NDArray:
         x0, x1 = np.asarray(e.x0, float), np.asarray(e.x1, float)

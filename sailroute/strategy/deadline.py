@@ -50,6 +50,7 @@ from numpy.typing import NDArray
 
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.numerics import golden_max, golden_steps
 from sailroute.parallel import TaskRunner, map_tasks
 from sailroute.strategy import _deadline_jit as _jit
 from sailroute.strategy.montecarlo import CHUNK_SIZE, chunk_rng
@@ -494,8 +495,7 @@ class _SteerRefiner:
         self.cubic = grid.interpolation == "cubic"
         self.u_tab, self.f_tab = _fine_speed_table(polar, tws_ms)
         self.du = math.pi / (grid.n_controls - 1)
-        self.n_iter = max(1, math.ceil(math.log(2 * self.du / GOLDEN_TOL_RAD)
-                                       / math.log((1 + math.sqrt(5)) / 2)))
+        self.n_iter = golden_steps(2 * self.du, GOLDEN_TOL_RAD)
 
     def _value(self, x: NDArray, q: NDArray, i: NDArray, j: NDArray, u: NDArray) -> NDArray:
         f = np.interp(u, self.u_tab, self.f_tab)
@@ -515,19 +515,7 @@ class _SteerRefiner:
         ub = best[todo] * self.du
         lo = np.maximum(ub - self.du, 0.0)
         hi = np.minimum(ub + self.du, math.pi)
-        g = (math.sqrt(5) - 1) / 2
-        c = hi - g * (hi - lo)
-        d = lo + g * (hi - lo)
-        fc = self._value(x, q, i, j, c)
-        fd = self._value(x, q, i, j, d)
-        for _ in range(self.n_iter):
-            left = fc >= fd  # the maximum lies in [lo, d], else in [c, hi]
-            hi = np.where(left, d, hi)
-            lo = np.where(left, lo, c)
-            c, d = np.where(left, hi - g * (hi - lo), d), np.where(left, c, lo + g * (hi - lo))
-            f_new = self._value(x, q, i, j, np.where(left, c, d))
-            fc, fd = np.where(left, f_new, fd), np.where(left, fc, f_new)
-        u_star = 0.5 * (lo + hi)
+        u_star = golden_max(lambda u: self._value(x, q, i, j, u), lo, hi, self.n_iter)
         off = np.clip(np.rint((u_star - ub) / self.du * OFFSET_STEPS), -OFFSET_STEPS,
                       OFFSET_STEPS)
         u_q = np.clip(ub + off * self.du / OFFSET_STEPS, 0.0, math.pi)

@@ -49,9 +49,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.errors import InputError
+from sailroute.geo import wrap_lon
 from sailroute.timeutil import iso
 from sailroute.track.model import Track
-from sailroute.units import speed_factor
+from sailroute.units import speed_factor, wrap180, wrap360
 from sailroute.wind.stations import (
     DEFAULT_MISSING,
     column_speed_unit,
@@ -334,9 +335,9 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
         if c in SPEED_COLUMNS:
             channels[f"{c}_ms"] = v * speed_factor(units[c])
         elif c in _SIGNED:
-            channels[f"{c}_deg"] = 180.0 - np.mod(180.0 - v, 360.0)
+            channels[f"{c}_deg"] = wrap180(v)
         else:
-            channels[f"{c}_deg"] = np.mod(v, 360.0)
+            channels[f"{c}_deg"] = wrap360(v)
     return t, lat, lon, np.array(linenos), channels
 
 
@@ -416,6 +417,6 @@ def clean_track(t: NDArray, lat: NDArray, lon: NDArray, lines: NDArray,
         notes.append(f"gap of {dt[k]:.0f} s at {iso(ts[k])[:-5]}Z")
     if gaps.size > 5:
         notes.append(f"... and {gaps.size - 5} more gap(s) longer than {limit:.0f} s")
-    lon_w = np.mod(lon[order] + 180.0, 360.0) - 180.0
+    lon_w = np.asarray(wrap_lon(lon[order]), dtype=float)
     return Track(ts, lat[order].astype(float), lon_w, name, src,
                  {k: np.asarray(v, float)[order] for k, v in channels.items()}, tuple(notes))

@@ -46,7 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.errors import InputError, WindDataError
-from sailroute.geo import LocalFrame
+from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.timeutil import iso, parse_time
 from sailroute.units import speed_factor, wind_components
 from sailroute.wind._xr import (
@@ -589,7 +589,7 @@ def read_cf_header(
 def _orient(header: CFHeader, frame: LocalFrame) -> tuple[NDArray, NDArray]:
     """File row and column indices ordered south to north and west to east."""
     lat, lon = header.lat, header.lon
-    rel = np.mod(lon - frame.lon0 + 180.0, 360.0) - 180.0
+    rel = np.asarray(wrap_lon(lon - frame.lon0), dtype=float)
     if header.regular:
         rows = np.argsort(lat[:, 0], kind="stable")
         cols = np.argsort(rel[0, :], kind="stable")

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import WindDataError
+from sailroute.geo import wrap_lon
 
 
 def rotate_clockwise(
@@ -146,7 +147,7 @@ def rotation_from_cone(
     cosalpha, sinalpha : ndarray
     """
     lat = np.asarray(lat, dtype=float)
-    dlon = (np.asarray(lon, dtype=float) - stand_lon + 180.0) % 360.0 - 180.0
+    dlon = wrap_lon(np.asarray(lon, dtype=float) - stand_lon)
     a = np.radians(np.where(lat < 0.0, -1.0, 1.0) * dlon * cone)
     return np.cos(a), -np.sin(a)
 
