@@ -241,13 +241,19 @@ class Checker:
 
     # -- structure ---------------------------------------------------------------------
     def keys(
-        self, d: Mapping[Any, Any], allowed: Iterable[str], required: Iterable[str] = ()
+        self, d: Mapping[Any, Any], allowed: Iterable[str], required: Iterable[str] = (),
+        *, of: str = "",
     ) -> None:
-        """Record unknown keys of ``d`` (with a did-you-mean) and missing required ones."""
+        """Record unknown keys of ``d`` (with a did-you-mean) and missing required ones.
+
+        ``of`` names the owner where it helps: ``of="a 'builtin' boat"`` gives
+        ``unknown key for a 'builtin' boat; did you mean ...``.
+        """
         allowed = list(allowed)
+        unknown = f"unknown key for {of}" if of else "unknown key"
         for key in d:
             if str(key) not in allowed:
-                self.add(str(key), f"unknown key; {suggest(str(key), allowed)}valid keys: "
+                self.add(str(key), f"{unknown}; {suggest(str(key), allowed)}valid keys: "
                          + ", ".join(allowed))
         for key in required:
             if key not in d:

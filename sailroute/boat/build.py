@@ -20,7 +20,7 @@ error (:mod:`sailroute.boat.sanity`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from functools import cache, lru_cache
 from importlib import resources
 from pathlib import Path
@@ -29,10 +29,11 @@ from typing import Any, Final
 import numpy as np
 
 from sailroute.boat.io import read_polar
-from sailroute.boat.kinetics import RACE, STEADY, Kinetics, kinetics_from_spec, race_polar
-from sailroute.boat.laser import CLASSES, LaserParams, params_from_mapping
+from sailroute.boat.kinetics import RACE, STEADY, Kinetics, check_kinetics, race_polar
+from sailroute.boat.laser import CLASSES, LaserParams, check_params
 from sailroute.boat.polar import INTERPOLATIONS, Polar
-from sailroute.errors import InputError, format_problems
+from sailroute.checks import Checker, Problems, join_path, quoted, show, split_where, suggest
+from sailroute.errors import InputError
 from sailroute.units import KNOT, SPEED_UNITS
 
 BUILTIN_TWS_KN: Final = tuple(float(v) for v in range(1, 29))
@@ -158,12 +159,14 @@ def boat_from_spec(
         Folder that relative ``polar`` paths are resolved against (the course
         file's folder).
     where : str
-        File label for messages, e.g. ``"courses/x.yaml"``.
+        File label for messages, e.g. ``"courses/x.yaml"``, or ``"file:LINE"`` of
+        the ``boat`` key (the line of problems whose own line is not in ``lines``).
     key : str
         Key path of ``spec`` in the file, prefixed to problems (``"boat"``).
     lines : mapping of str to int, optional
-        1-based line of each key path of the file (the course's line map): the
-        ``vpp`` parameters' problems are reported at their own lines.
+        1-based line of each key path of the file (the course's line map): every
+        problem (form keys, ``efficiency``, ``kinetics``, ``vpp`` parameters) is
+        reported at its own key's line.
 
     Returns
     -------
@@ -172,109 +175,108 @@ def boat_from_spec(
     Raises
     ------
     InputError
-        One error listing every problem with its key path, e.g.
-        ``courses/x.yaml: boat.builtin: expected one of 'ilca4', 'ilca6',
-        'ilca7'; got 'ilca8'``.
+        One error listing every problem of the block at once, each with its key
+        path and line, in the wording of :mod:`sailroute.checks` (unknown keys with
+        a did-you-mean), e.g. ``courses/x.yaml:14: boat.builtin: expected one of
+        'ilca4', ..., 'ilca7-steady'; got 'ilca8' (did you mean 'ilca7'?)``.
     """
-    if not isinstance(spec, Mapping):
-        raise InputError(
-            f"{where}: {key}: expected a mapping such as {{builtin: ilca7}}, {{polar: FILE}} or "
-            f"{{vpp: {{class: ilca7}}}}; got {type(spec).__name__} {spec!r}"
-        )
+    file, line, root = split_where(where)
+    path = join_path(root, key) if root else key
+    known = dict(lines or {})
+    if line is not None:  # ``where`` is "file:LINE" of the block: its line if the map lacks it
+        known.setdefault(path, line)
+    probs = Problems(file, known, root=path, what="boat spec")
+    c = Checker(probs, path)
+    if not c.is_mapping(spec, "a mapping such as {builtin: ilca7}, {polar: FILE} or "
+                              "{vpp: {class: ilca7}}"):
+        probs.raise_if_any()
+    form = _form(c, spec)
+    if form is not None:
+        c.keys(spec, sorted(_ALLOWED[form]), of=f"a {form!r} boat")
+    interpolation = c.choice(spec, "interpolation", INTERPOLATIONS, "pchip")
+    c.boolean(spec, "allow_extrapolation", False)
+    factors = None
     if "efficiency" in spec:
-        from sailroute.boat.efficiency import efficiency_from_spec, scale_polar
+        from sailroute.boat.efficiency import check_efficiency
 
-        factors = efficiency_from_spec(spec["efficiency"], where=where, key=f"{key}.efficiency")
-        rest = {k: v for k, v in spec.items() if k != "efficiency"}
-        return scale_polar(boat_from_spec(rest, base_dir=base_dir, where=where, key=key,
-                                          lines=lines), **factors)
+        factors = check_efficiency(c.child("efficiency"), spec["efficiency"])
+    build = {"builtin": _check_builtin, "polar": _check_polar, "vpp": _check_vpp}
+    make = build[form](c, spec, Path(base_dir)) if form is not None else None
+    probs.raise_if_any()
+    assert make is not None
+    polar = make(interpolation)
+    if factors:
+        from sailroute.boat.efficiency import scale_polar
+
+        polar = scale_polar(polar, **factors)
+    return polar
+
+
+def _form(c: Checker, spec: Mapping[str, Any]) -> str | None:
+    """The one form key of a ``boat`` mapping, or None and a problem."""
     forms = [f for f in _FORMS if f in spec]
-    if len(forms) != 1:
-        found = f"got {', '.join(forms)}" if forms else f"got keys {sorted(map(str, spec))}"
-        raise InputError(
-            f"{where}: {key}: give exactly one of 'builtin', 'polar' or 'vpp'; {found}"
-        )
-    form = forms[0]
-    problems: list[str] = []
-    for k in spec:
-        if k not in _ALLOWED[form]:
-            problems.append(
-                f"{key}.{k}: unknown key for a {form!r} boat; allowed: "
-                + ", ".join(map(repr, sorted(_ALLOWED[form])))
-            )
-    interpolation = spec.get("interpolation", "pchip")
-    if interpolation not in INTERPOLATIONS:
-        problems.append(
-            f"{key}.interpolation: expected one of {', '.join(map(repr, INTERPOLATIONS))}; "
-            f"got {interpolation!r}"
-        )
-    allow = spec.get("allow_extrapolation", False)
-    if not isinstance(allow, bool):
-        problems.append(f"{key}.allow_extrapolation: expected true or false; got {allow!r}")
-    if form == "builtin":
-        name = spec["builtin"]
-        if not isinstance(name, str) or name.lower() not in builtin_names():
-            problems.append(
-                f"{key}.builtin: expected one of {', '.join(map(repr, builtin_names()))}; "
-                f"got {name!r}"
-            )
-        _raise(where, problems)
-        return builtin_polar(name.lower(), interpolation)
-    if form == "polar":
-        path = spec["polar"]
-        if not isinstance(path, str) or not path.strip():
-            problems.append(f"{key}.polar: expected a file path; got {path!r}")
-        for uk in ("speed_unit", "wind_unit"):
-            u = spec.get(uk)
-            if u is not None and (not isinstance(u, str) or u.strip().lower() not in SPEED_UNITS):
-                problems.append(
-                    f"{key}.{uk}: expected one of 'kn', 'm/s', 'km/h', 'mph'; got {u!r}"
-                )
-        fmt = spec.get("format")
-        if fmt is not None and fmt not in ("pol", "csv", "json"):
-            problems.append(f"{key}.format: expected one of 'pol', 'csv', 'json'; got {fmt!r}")
-        _raise(where, problems)
-        file = Path(path)
-        if not file.is_absolute():
-            file = Path(base_dir) / file
-        if not file.is_file():
-            raise InputError(
-                f"{where}: {key}.polar: file {str(file)!r} not found (paths are relative to "
-                "the course file's folder)"
-            )
-        return read_polar(
-            file,
-            speed_unit=spec.get("speed_unit"),
-            wind_unit=spec.get("wind_unit"),
-            format=fmt,
-            interpolation=interpolation,
-        )
-    # vpp
-    kinetics, kproblems = kinetics_from_spec(spec.get("kinetics", "race"), f"{key}.kinetics")
-    problems.extend(kproblems)
+    if len(forms) == 1:
+        return forms[0]
+    if forms:
+        c.add(None, f"give exactly one of 'builtin', 'polar' or 'vpp'; got {', '.join(forms)}")
+        return None
+    known = set().union(*_ALLOWED.values())
+    hints = [suggest(str(k), _FORMS).strip() for k in spec if str(k) not in known]
+    hint = next((h for h in hints if h), "")
+    c.add(None, f"give exactly one of 'builtin', 'polar' or 'vpp'; got keys "
+          f"{sorted(map(str, spec))}" + (f" ({hint})" if hint else ""))
+    return None
+
+
+_Make = Callable[[str], Polar]
+"""Builds the checked boat's polar for an interpolation (called once all checks pass)."""
+
+
+def _check_builtin(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make | None:
+    name = spec["builtin"]
+    if not isinstance(name, str) or name.lower() not in builtin_names():
+        hint = suggest(name.lower(), builtin_names()).strip() if isinstance(name, str) else ""
+        c.add("builtin", f"expected one of {quoted(builtin_names())}; got {show(name)}"
+              + (f" ({hint})" if hint else ""))
+        return None
+    return lambda interpolation: builtin_polar(name.lower(), interpolation)
+
+
+def _check_polar(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make | None:
+    before = len(c.p)
+    path = spec["polar"]
+    if not isinstance(path, str) or not path.strip():
+        c.add("polar", f"expected a file path; got {show(path)}")
+    units = ("kn", "m/s", "km/h", "mph")
+    for uk in ("speed_unit", "wind_unit"):
+        u = spec.get(uk)
+        if u is not None and (not isinstance(u, str) or u.strip().lower() not in SPEED_UNITS):
+            hint = suggest(u.strip().lower(), SPEED_UNITS).strip() if isinstance(u, str) else ""
+            c.add(uk, f"expected one of {quoted(units)}; got {show(u)}"
+                  + (f" ({hint})" if hint else ""))
+    fmt = spec.get("format")
+    if fmt is not None:
+        fmt = c.choice(spec, "format", ("pol", "csv", "json"))
+    if len(c.p) > before:
+        return None
+    file = Path(path)
+    if not file.is_absolute():
+        file = base_dir / file
+    if not file.is_file():
+        c.add("polar", f"file {str(file)!r} not found (paths are relative to the course "
+              "file's folder)")
+        return None
+    return lambda interpolation: read_polar(
+        file, speed_unit=spec.get("speed_unit"), wind_unit=spec.get("wind_unit"),
+        format=fmt, interpolation=interpolation,
+    )
+
+
+def _check_vpp(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make | None:
+    kinetics = check_kinetics(c.child("kinetics"), spec.get("kinetics", "race"))
     vspec = spec["vpp"]
-    if vspec is None:
-        vspec = {}
-    try:
-        vkey = f"{key}.vpp"
-        vlines = {k.removeprefix(vkey + "."): n for k, n in (lines or {}).items()
-                  if k.startswith(vkey + ".")}
-        params = params_from_mapping(dict(vspec) if isinstance(vspec, Mapping) else vspec,
-                                     where=where, key=vkey, lines=vlines)
-    except InputError as exc:
-        if not problems:
-            raise
-        text = str(exc).split("\n")
-        extra = [ln.strip()[2:].removeprefix(f"{where}: ") for ln in text[1:]] if len(
-            text) > 1 else [text[0].removeprefix(f"{where}: ")]
-        problems.extend(extra)
-    _raise(where, problems)
-    return vpp_polar(params, interpolation=interpolation, kinetics=kinetics)
-
-
-def _raise(where: str, problems: list[str]) -> None:
-    if not problems:
-        return
-    if len(problems) == 1:
-        raise InputError(f"{where}: {problems[0]}")
-    raise InputError(format_problems(f"{where}: {len(problems)} problems", problems))
+    params = check_params(c.child("vpp"), {} if vspec is None else vspec)
+    if kinetics is None or params is None:
+        return None
+    return lambda interpolation: vpp_polar(params, interpolation=interpolation,
+                                           kinetics=kinetics)

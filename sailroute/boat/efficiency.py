@@ -23,7 +23,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat.polar import Polar
-from sailroute.errors import InputError, format_problems
+from sailroute.checks import Checker, Problems, join_path, split_where
+from sailroute.errors import InputError
 
 BANDS: Final = ("upwind", "reach", "downwind")
 """Keys of an ``efficiency`` mapping."""
@@ -84,34 +85,71 @@ def scale_polar(polar: Polar, upwind: float = 1.0, reach: float = 1.0,
                  interpolation=polar.interpolation)
 
 
-def efficiency_from_spec(value: Any, *, where: str, key: str = "boat.efficiency"
-                         ) -> dict[str, float]:
-    """Check a course file's ``efficiency`` value and return the three factors.
+def check_efficiency(c: Checker, value: Any) -> dict[str, float] | None:
+    """Check an ``efficiency`` value (the mapping at ``c.path``), recording problems in ``c``.
+
+    Parameters
+    ----------
+    c : Checker
+        Checker of the ``efficiency`` key path (e.g. ``boat.efficiency``); its
+        :class:`~sailroute.checks.Problems` collects the problems with the rest
+        of the file's.
+    value : Any
+        The parsed value.
+
+    Returns
+    -------
+    dict of str to float or None
+        The given factors by band (``upwind``, ``reach``, ``downwind``; absent or
+        null ones left out, so they count as 1.0), or None after a problem.
+    """
+    if not c.is_mapping(value, "a mapping like {upwind: 0.92, reach: 1.0, downwind: 1.0}"):
+        return None
+    before = len(c.p)
+    c.keys(value, BANDS)
+    out = {}
+    for k in BANDS:
+        v = c.number(value, k, None, lo=0.0, hi=MAX_FACTOR, lo_open=True,
+                     what=f"a speed factor in (0, {MAX_FACTOR:g}] (1.0 = the polar as is)")
+        if v is not None:
+            out[k] = v
+    return out if len(c.p) == before else None
+
+
+def efficiency_from_spec(value: Any, *, where: str, key: str = "boat.efficiency",
+                         lines: Mapping[str, int] | None = None) -> dict[str, float]:
+    """Check a course file's ``efficiency`` value and return the given factors.
+
+    Parameters
+    ----------
+    value : Any
+        The parsed value, e.g. ``{upwind: 0.92}``.
+    where : str
+        File label for messages (``"courses/x.yaml"``, or ``"file:LINE"``).
+    key : str
+        Key path of ``value`` in the file.
+    lines : mapping of str to int, optional
+        1-based line of each key path of the file (the course's line map).
+
+    Returns
+    -------
+    dict of str to float
+        Factors by band; absent bands are left out (1.0).
 
     Raises
     ------
     InputError
-        Not a mapping, an unknown key, or a factor that is not a number in
-        (0, 1.5]; every problem listed with its key path.
+        Not a mapping, an unknown key (with a did-you-mean), or a factor that is not
+        a number in (0, 1.5]; every problem listed with its key path and line, in
+        the wording of :mod:`sailroute.checks`.
     """
-    if not isinstance(value, Mapping):
-        raise InputError(f"{where}: {key}: expected a mapping like {{upwind: 0.92, reach: 1.0, "
-                         f"downwind: 1.0}}; got {type(value).__name__} {value!r}")
-    problems = []
-    out = {}
-    for k, v in value.items():
-        if k not in BANDS:
-            problems.append(f"{key}.{k}: unknown key; allowed: "
-                            + ", ".join(map(repr, BANDS)))
-            continue
-        ok = isinstance(v, (int, float)) and not isinstance(v, bool) and np.isfinite(v)
-        if not ok or not 0.0 < v <= MAX_FACTOR:
-            problems.append(f"{key}.{k}: expected a speed factor in (0, {MAX_FACTOR:g}] "
-                            f"(1.0 = the polar as is); got {v!r}")
-            continue
-        out[k] = float(v)
-    if len(problems) == 1:
-        raise InputError(f"{where}: {problems[0]}")
-    if problems:
-        raise InputError(format_problems(f"{where}: {len(problems)} problems", problems))
+    file, line, root = split_where(where)
+    known = dict(lines or {})
+    path = join_path(root, key) if root else key
+    if line is not None:
+        known.setdefault(path, line)
+    probs = Problems(file, known, root=path, what="efficiency spec")
+    out = check_efficiency(Checker(probs, path), value)
+    probs.raise_if_any()
+    assert out is not None
     return out

@@ -54,6 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat.laser import LaserParams
 from sailroute.boat.polar import Polar
+from sailroute.checks import Checker, Problems, show
 from sailroute.errors import InputError
 from sailroute.units import KNOT
 
@@ -149,55 +150,79 @@ STEADY: Final = Kinetics(fetch_m=0.0, sea_age_h=0.0, pump_power_w_per_kg=0.0,
 """No waves, no pumping: the race model reduces to the steady VPP."""
 
 
+def check_kinetics(c: Checker, value: object) -> Kinetics | None:
+    """The race model a course file's ``kinetics`` value names, recording problems in ``c``.
+
+    Parameters
+    ----------
+    c : Checker
+        Checker of the ``kinetics`` key path (e.g. ``boat.kinetics``); its
+        :class:`~sailroute.checks.Problems` collects the problems with the rest
+        of the file's.
+    value : {"race", "steady"} or mapping
+        ``race`` (:data:`RACE`), ``steady`` (:data:`STEADY`) or a mapping of
+        :class:`Kinetics` fields overriding :data:`RACE`, e.g. ``{sea_age_h: 6,
+        fetch_m: 8000}`` (unknown keys get a did-you-mean).
+
+    Returns
+    -------
+    Kinetics or None
+        None after a problem.
+    """
+    if value == "race":
+        return RACE
+    if value == "steady":
+        return STEADY
+    if not c.is_mapping(value, "'race', 'steady' or a mapping of race-model parameters"):
+        return None
+    assert isinstance(value, Mapping)
+    before = len(c.p)
+    names = [f.name for f in fields(Kinetics)]
+    c.keys(value, names)
+    given: dict[str, Any] = {}  # field name -> float or (from, to)
+    for k in names:
+        if k not in value:
+            continue
+        v = value[k]
+        if isinstance(getattr(RACE, k), tuple):
+            if (not isinstance(v, list | tuple) or len(v) != 2
+                    or not all(_is_number(x) for x in v)):
+                c.add(k, f"expected two numbers [from, to]; got {show(v)}")
+            else:
+                given[k] = (float(v[0]), float(v[1]))
+        else:
+            x = c.number(value, k, None)
+            if x is not None:
+                given[k] = x
+    if len(c.p) > before:
+        return None
+    try:
+        return replace(RACE, **given)
+    except InputError as exc:  # the cross-field checks of Kinetics.__post_init__
+        c.add(None, str(exc).removeprefix("race kinetics: "))
+        return None
+
+
 def kinetics_from_spec(value: object, key: str = "kinetics") -> tuple[Kinetics, list[str]]:
-    """The race model a course file's ``kinetics`` value names, and its problems.
+    """The race model a ``kinetics`` value names, and its problems (:func:`check_kinetics`).
 
     Parameters
     ----------
     value : {"race", "steady"} or mapping
-        ``race`` (:data:`RACE`), ``steady`` (:data:`STEADY`) or a mapping of
-        :class:`Kinetics` fields overriding :data:`RACE`, e.g. ``{sea_age_h: 6,
-        fetch_m: 8000}``.
+        As :func:`check_kinetics`.
     key : str
-        Key path for messages.
+        Key path (or label) that starts each message.
 
     Returns
     -------
     kinetics : Kinetics
         :data:`RACE` where there are problems.
     problems : list of str
-        ``"<key>.<field>: ..."`` messages (empty when valid).
+        ``"<key>.<field>: ..."`` messages, without a file (empty when valid).
     """
-    if value == "race":
-        return RACE, []
-    if value == "steady":
-        return STEADY, []
-    if not isinstance(value, Mapping):
-        return RACE, [f"{key}: expected 'race', 'steady' or a mapping of race-model "
-                      f"parameters; got {value!r}"]
-    names = [f.name for f in fields(Kinetics)]
-    pairs = {f.name for f in fields(Kinetics) if isinstance(getattr(RACE, f.name), tuple)}
-    problems: list[str] = []
-    given: dict[str, Any] = {}  # field name -> float or (from, to)
-    for k, v in value.items():
-        if k not in names:
-            problems.append(f"{key}.{k}: unknown key; allowed: " + ", ".join(map(repr, names)))
-        elif k in pairs:
-            if (not isinstance(v, list | tuple) or len(v) != 2
-                    or not all(_is_number(x) for x in v)):
-                problems.append(f"{key}.{k}: expected two numbers [from, to]; got {v!r}")
-            else:
-                given[k] = (float(v[0]), float(v[1]))
-        elif not _is_number(v):
-            problems.append(f"{key}.{k}: expected a number; got {v!r}")
-        else:
-            given[k] = float(v)
-    if problems:
-        return RACE, problems
-    try:
-        return replace(RACE, **given), []
-    except InputError as exc:
-        return RACE, [f"{key}: {str(exc).removeprefix('race kinetics: ')}"]
+    probs = Problems("")  # no file: every message is ": <key path>: ..."
+    kinetics = check_kinetics(Checker(probs, key), value)
+    return kinetics or RACE, [m.removeprefix(": ") for m in probs.items]
 
 
 def _is_number(x: object) -> bool:

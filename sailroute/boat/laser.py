@@ -318,10 +318,39 @@ def params_from_mapping(
     if line is not None:  # ``where`` is "file:LINE" of the block: the fallback line
         known.setdefault("", line)
     probs = Problems(file, known, what="boat spec" if key else "boat file")
-    c = Checker(probs, key)
     if not isinstance(spec, dict):
         raise InputError(f"{where}: {key or 'boat'}: expected a mapping of parameters; "
                          f"got {show(spec)}")
+    params = check_params(Checker(probs, key), spec)
+    probs.raise_if_any()
+    assert params is not None
+    return params
+
+
+def check_params(c: Checker, spec: Any) -> LaserParams | None:
+    """Build parameters from the mapping at ``c.path``, recording problems in ``c``.
+
+    The checker-level form of :func:`params_from_mapping`: a course's ``boat.vpp``
+    block is checked with the rest of its ``boat:`` block, its problems collected
+    with theirs (:func:`sailroute.boat.build.boat_from_spec`).
+
+    Parameters
+    ----------
+    c : Checker
+        Checker of the block's key path (``"boat.vpp"``; ``""`` for a boat file).
+    spec : Any
+        The parsed block: ``class`` and :class:`LaserParams` fields as overrides.
+
+    Returns
+    -------
+    LaserParams or None
+        None after a problem (type and value checks first; the cross-field checks
+        of :func:`validate` only on a parameter set that passed them).
+    """
+    if not isinstance(spec, Mapping):
+        c.add(None, f"expected a mapping of parameters; got {show(spec)}")
+        return None
+    before = len(c.p)
     cls = spec.get("class", "ilca7")
     base = ILCA7
     if not isinstance(cls, str) or cls.lower() not in CLASSES:
@@ -356,13 +385,13 @@ def params_from_mapping(
             v = c.number(spec, k)
         if v is not None:
             overrides[k] = v
-    probs.raise_if_any()
+    if len(c.p) > before:
+        return None
     params = replace(base, **overrides)
     for problem in validate(params):
         name, message = problem.split(": ", 1)
         c.add(name, message)
-    probs.raise_if_any()
-    return params
+    return params if len(c.p) == before else None
 
 
 def validate(p: LaserParams) -> list[str]:
@@ -438,6 +467,7 @@ __all__ = [
     "ILCA6",
     "ILCA7",
     "LaserParams",
+    "check_params",
     "param_names",
     "params_from_mapping",
     "validate",

@@ -103,8 +103,8 @@ def test_spec_builtin_polar_and_vpp(tmp_path: Path) -> None:
          "got builtin, polar"),
         ({"name": "x"}, "give exactly one of 'builtin', 'polar' or 'vpp'; got keys \\['name'\\]"),
         ({"builtin": "ilca7", "crew": 70},
-         "boat.crew: unknown key for a 'builtin' boat; allowed: 'allow_extrapolation', "
-         "'builtin', 'efficiency', 'interpolation'"),
+         "courses/x.yaml: boat.crew: unknown key for a 'builtin' boat; valid keys: "
+         "allow_extrapolation, builtin, efficiency, interpolation"),
         ({"polar": "missing.pol"}, "boat.polar: file '.*missing.pol' not found"),
         ({"polar": "a.pol", "speed_unit": "furlong"},
          "boat.speed_unit: expected one of 'kn', 'm/s', 'km/h', 'mph'; got 'furlong'"),
@@ -123,7 +123,90 @@ def test_spec_lists_every_problem(tmp_path: Path) -> None:
             base_dir=tmp_path, where="courses/x.yaml",
         )
     msg = str(exc.value)
-    assert msg.startswith("courses/x.yaml: 3 problems")
+    assert msg.startswith("courses/x.yaml: boat: 3 problems in the boat spec\n")
     assert "boat.interpolation: expected one of 'pchip', 'linear'; got 'cubic'" in msg
     assert "boat.vpp.class: expected one of 'ilca4', 'ilca6', 'ilca7'; got 'ilca9'" in msg
     assert "boat.vpp.crew_mass_kg: expected a number; got 'heavy'" in msg
+
+
+# --- one mechanism (sailroute.checks): did-you-mean, lines, every problem at once ---------
+
+
+def _message(spec: object, tmp_path: Path, **kw: object) -> str:
+    with pytest.raises(InputError) as exc:
+        boat_from_spec(spec, base_dir=tmp_path, where="courses/x.yaml", **kw)  # type: ignore[arg-type]
+    return str(exc.value)
+
+
+def test_unknown_key_of_a_builtin_boat_gets_the_course_did_you_mean(tmp_path: Path) -> None:
+    msg = _message({"builtin": "ilca7", "interpolaton": "linear"}, tmp_path)
+    assert msg == ("courses/x.yaml: boat.interpolaton: unknown key for a 'builtin' boat; "
+                   "did you mean 'interpolation'? valid keys: allow_extrapolation, builtin, "
+                   "efficiency, interpolation")
+
+
+def test_unknown_efficiency_key_gets_the_course_did_you_mean(tmp_path: Path) -> None:
+    msg = _message({"builtin": "ilca7", "efficiency": {"upwnd": 0.9}}, tmp_path)
+    assert msg == ("courses/x.yaml: boat.efficiency.upwnd: unknown key; did you mean "
+                   "'upwind'? valid keys: upwind, reach, downwind")
+
+
+def test_unknown_kinetics_key_and_misspelt_form_get_a_did_you_mean(tmp_path: Path) -> None:
+    msg = _message({"vpp": {}, "kinetics": {"sea_age": 3}}, tmp_path)
+    assert msg.startswith("courses/x.yaml: boat.kinetics.sea_age: unknown key; did you mean "
+                          "'sea_age_h'? valid keys: fetch_m, sea_age_h, ")
+    msg = _message({"biultin": "ilca7"}, tmp_path)
+    assert msg == ("courses/x.yaml: boat: give exactly one of 'builtin', 'polar' or 'vpp'; "
+                   "got keys ['biultin'] (did you mean 'builtin'?)")
+
+
+def test_efficiency_and_other_boat_problems_are_reported_together(tmp_path: Path) -> None:
+    # before, the efficiency check raised alone and hid the other problems
+    msg = _message({"builtin": "ilca8", "efficiency": {"reach": 1.6},
+                    "interpolation": "cubic"}, tmp_path)
+    assert msg.splitlines() == [
+        "courses/x.yaml: boat: 3 problems in the boat spec",
+        "  - courses/x.yaml: boat.interpolation: expected one of 'pchip', 'linear'; "
+        "got 'cubic'",
+        "  - courses/x.yaml: boat.efficiency.reach: expected a speed factor in (0, 1.5] "
+        "(1.0 = the polar as is); got 1.6",
+        "  - courses/x.yaml: boat.builtin: expected one of 'ilca4', 'ilca4-steady', "
+        "'ilca6', 'ilca6-steady', 'ilca7', 'ilca7-steady'; got 'ilca8' "
+        "(did you mean 'ilca7'?)",
+    ]
+
+
+def test_boat_problems_carry_their_line_in_a_course_file(tmp_path: Path) -> None:
+    from sailroute.course.load import build_boat, load_course
+
+    course = tmp_path / "c.yaml"
+    course.write_text(
+        "name: lines\n"                                        # 1
+        "start_time: '2024-05-01T12:00:00+02:00'\n"            # 2
+        "marks:\n"                                              # 3
+        "  pin: {lat: 45.0, lon: 13.0}\n"                      # 4
+        "  boat: {lat: 45.0, lon: 13.002}\n"                   # 5
+        "  top: {lat: 45.009, lon: 13.001}\n"                  # 6
+        "lines:\n"                                              # 7
+        "  start: [pin, boat]\n"                                # 8
+        "legs:\n"                                               # 9
+        "  - {to: top, rounding: port}\n"                       # 10
+        "scenarios:\n"                                          # 11
+        "  steady: {type: uniform, tws_kn: 10, twd_deg: 0}\n"  # 12
+        "boat:\n"                                               # 13
+        "  builtin: ilca7\n"                                    # 14
+        "  efficiency:\n"                                       # 15
+        "    upwind: 0.9\n"                                     # 16
+        "    reachh: 1.0\n"                                     # 17
+        "  allow_extrapolation: yes please\n",                  # 18
+        encoding="utf-8",
+    )
+    with pytest.raises(InputError) as exc:
+        build_boat(load_course(course))
+    assert str(exc.value).splitlines() == [
+        f"{course}:13: boat: 2 problems in the boat spec",
+        f"  - {course}:18: boat.allow_extrapolation: expected true or false; "
+        "got 'yes please'",
+        f"  - {course}:17: boat.efficiency.reachh: unknown key; did you mean 'reach'? "
+        "valid keys: upwind, reach, downwind",
+    ]

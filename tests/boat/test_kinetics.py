@@ -226,7 +226,8 @@ def test_vpp_boat_kinetics_key_race_steady_and_overrides(tmp_path) -> None:
 
 @pytest.mark.parametrize(("value", "message"), [
     ("fast", "c.yaml: boat.kinetics: expected 'race', 'steady' or a mapping"),
-    ({"sea_age": 3}, "boat.kinetics.sea_age: unknown key; allowed: 'fetch_m', 'sea_age_h'"),
+    ({"sea_age": 3}, "boat.kinetics.sea_age: unknown key; did you mean 'sea_age_h'? valid keys: "
+     "fetch_m, sea_age_h"),
     ({"fetch_m": "far"}, "boat.kinetics.fetch_m: expected a number; got 'far'"),
     ({"pump_twa_deg": [60]}, "boat.kinetics.pump_twa_deg: expected two numbers"),
     ({"pump_efficiency": 2}, "boat.kinetics: pump_efficiency is a share, at most 1"),
