@@ -70,8 +70,9 @@ FIGS = {
 
 def so40() -> Polar:
     """Sun Odyssey 40, TWS 8 kn column, scaled to ``f_max = 0.05`` (nondimensional)."""
-    return Polar(np.array(SO40_TWA, float), np.array([1.0]),
-                 (np.array(SO40_KN) * F_MAX / 6.5)[:, None], name="SO40", interpolation="linear")
+    return Polar.from_arrays(np.array(SO40_TWA, float), np.array([1.0]),
+                             (np.array(SO40_KN) * F_MAX / 6.5)[:, None], name="SO40",
+                             interpolation="linear")
 
 
 def paper_grid(n_r_nodes: int, n_theta: int, s_max: float, interp: str,

@@ -58,7 +58,8 @@ def load_polar() -> Polar:
         twa = np.array([0, 30, 40, 45, 50, 60, 75, 90, 105, 120, 135, 150, 165, 180.0])
         g = np.array([0, .45, .68, .74, .79, .85, .92, .97, 1.0, .97, .9, .82, .66, .55])
         tws = np.array([1, 2, 3, 4, 5, 6, 7, 8, 10, 12.0])
-        return Polar(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))), name="laser-like")
+        return Polar.from_arrays(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))),
+                                 name="laser-like")
 
 
 def wrf_field():

@@ -61,7 +61,7 @@ def main() -> None:
               f"({args.n / t / 1e6:.1f} M lookups/s)")
 
     def build() -> None:
-        Polar(base.twa_deg, base.tws_ms, base.speed_ms).speed(5.0, 45.0)
+        Polar.from_arrays(base.twa_deg, base.tws_ms, base.speed_ms).speed(5.0, 45.0)
 
     print(f"dense table build (73 x 28 -> 361 x 289): {best_of(build, args.repeat) * 1e3:.1f} ms")
 

@@ -122,8 +122,9 @@ def bench_scale_out(
 
 
 def _so40() -> Polar:
-    return Polar(np.array(SO40_TWA, float), np.array([1.0]),
-                 (np.array(SO40_KN) * 0.05 / 6.5)[:, None], name="SO40", interpolation="linear")
+    return Polar.from_arrays(np.array(SO40_TWA, float), np.array([1.0]),
+                             (np.array(SO40_KN) * 0.05 / 6.5)[:, None], name="SO40",
+                             interpolation="linear")
 
 
 def bench_paper(n_r: int, n_theta: int, ds: float, runs: int, interp: str) -> None:

@@ -232,7 +232,7 @@ class DynamicBoat:
         n = int(np.ceil(180.0 / twa_step))
         twa = np.linspace(0.0, 180.0, n + 1)
         speed = self.steady_speed(tws[None, :], twa[:, None])
-        return Polar(twa, tws, speed, name=f"{self.name} (steady state)")
+        return Polar.from_arrays(twa, tws, speed, name=f"{self.name} (steady state)")
 
     # -- the BoatModel protocol (sailroute.boat.model) --------------------------
 

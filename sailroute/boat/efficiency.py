@@ -81,8 +81,8 @@ def scale_polar(polar: Polar, upwind: float = 1.0, reach: float = 1.0,
         order = np.argsort(all_twa)
         twa, tab = all_twa[order], np.vstack([tab, rows])[order]
     f = efficiency_factor(twa, upwind, reach, downwind)
-    return Polar(twa, polar.tws_ms, tab * f[:, None], name=polar.name,
-                 interpolation=polar.interpolation)
+    return Polar.from_arrays(twa, polar.tws_ms, tab * f[:, None], name=polar.name,
+                             interpolation=polar.interpolation)
 
 
 def check_efficiency(c: Checker, value: Any) -> dict[str, float] | None:

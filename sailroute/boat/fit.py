@@ -491,7 +491,7 @@ def _finish(raw: NDArray, counts: NDArray, covered: NDArray, tws_n: NDArray, twa
         i = int(np.flatnonzero(rows)[0])
         rows[i + 1 if i + 1 < rows.size else i - 1] = True
     tab = _fill(mono[np.ix_(rows, cols)], tws_n[cols], twa_n[rows])
-    return Polar(twa_n[rows], tws_n[cols], tab, name=name), rows, cols
+    return Polar.from_arrays(twa_n[rows], tws_n[cols], tab, name=name), rows, cols
 
 
 def _extended(polar: Polar, rows: NDArray, cols: NDArray, tws_edges: NDArray,
@@ -521,7 +521,7 @@ def _extended(polar: Polar, rows: NDArray, cols: NDArray, tws_edges: NDArray,
     twa, tab = ext(twa, tab, min(hi_a, 180.0), False, 0)
     tws, tab = ext(tws, tab, max(lo_w, 1e-6), True, 1)
     tws, tab = ext(tws, tab, hi_w, False, 1)
-    return Polar(twa, tws, tab, name=polar.name)
+    return Polar.from_arrays(twa, tws, tab, name=polar.name)
 
 
 # --- helpers --------------------------------------------------------------------------

@@ -416,8 +416,9 @@ def parse_pol(
                  at_tws=lambda j: f"{src}:{header_line}: cell {j + 2}",
                  at_cell=lambda i, j: f"{src}:{row_lines[i]}: cell {j + 2}")
     tab = fill_empty_cells(np.asarray(twa), tws_arr, raw_tab)
-    return Polar(np.asarray(twa), tws_arr * speed_factor(w_unit), tab * speed_factor(s_unit),
-                 name=Path(src).stem, interpolation=interpolation)
+    return Polar.from_arrays(np.asarray(twa), tws_arr * speed_factor(w_unit),
+                             tab * speed_factor(s_unit), name=Path(src).stem,
+                             interpolation=interpolation)
 
 
 def fill_empty_cells(
@@ -557,8 +558,8 @@ def parse_long_csv(
                                   f"cell {cols['tws'][0] + 1}",
                  at_cell=lambda i, j: f"{src}:{line_of[i, j]}: cell {cols['speed'][0] + 1}")
     tab = fill_empty_cells(twa_ax, tws_ax, tab)
-    return Polar(twa_ax, tws_ax * speed_factor(w_unit), tab * speed_factor(s_unit),
-                 name=Path(src).stem, interpolation=interpolation)
+    return Polar.from_arrays(twa_ax, tws_ax * speed_factor(w_unit), tab * speed_factor(s_unit),
+                             name=Path(src).stem, interpolation=interpolation)
 
 
 # --- JSON -----------------------------------------------------------------------------
@@ -602,8 +603,8 @@ def _read_json_text(
                      at_twa=lambda i: f"{p}: twa_deg[{i}]", at_tws=lambda j: f"{p}: tws[{j}]",
                      at_cell=lambda i, j: f"{p}: speed[{i}][{j}]")
     try:
-        return Polar(twa, tws * speed_factor(w_unit), tab * speed_factor(s_unit),
-                     name=str(doc.get("name") or p.stem), interpolation=interpolation)
+        return Polar.from_arrays(twa, tws * speed_factor(w_unit), tab * speed_factor(s_unit),
+                                 name=str(doc.get("name") or p.stem), interpolation=interpolation)
     except InputError as exc:
         raise InputError(f"{p}: {exc}") from None
 
@@ -678,8 +679,8 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
 def _orc_polar(p: Path, twa: NDArray, tws_kn: NDArray, tab_kn: NDArray, name: str,
                interpolation: str) -> Polar:
     try:
-        return Polar(twa, tws_kn * speed_factor("kn"), tab_kn * speed_factor("kn"), name=name,
-                     interpolation=interpolation)
+        return Polar.from_arrays(twa, tws_kn * speed_factor("kn"), tab_kn * speed_factor("kn"),
+                                 name=name, interpolation=interpolation)
     except InputError as exc:
         raise InputError(f"{p}: {exc}") from None
 

@@ -366,7 +366,8 @@ def race_polar(
     if kinetics.upwind_efficiency == 1.0:
         return polar
     scale = upwind_scale(kinetics, polar.twa_deg)
-    return replace(polar, speed_ms=polar.speed_ms * scale[:, None])
+    return Polar.from_arrays(polar.twa_deg, polar.tws_ms, polar.speed_ms * scale[:, None],
+                             name=polar.name, interpolation=polar.interpolation)
 
 
 def upwind_scale(kin: Kinetics, twa_deg: ArrayLike) -> NDArray[np.float64]:

@@ -113,22 +113,44 @@ def axis_spacing_problem(values: ArrayLike, axis: str) -> str | None:
     )
 
 
+def _frozen_copy(values: ArrayLike) -> NDArray[np.float64]:
+    """A read-only float64 copy of ``values``."""
+    arr = np.array(values, dtype=float)
+    arr.setflags(write=False)
+    return arr
+
+
+def _frozen_array_problem(value: object) -> str | None:
+    """What keeps ``value`` from being a :class:`Polar` table, or None if it can be."""
+    if not isinstance(value, np.ndarray):
+        return f"a {type(value).__name__}"
+    if value.dtype != np.float64:
+        return f"an ndarray of dtype {value.dtype}"
+    if value.flags.writeable:
+        return "a writable ndarray (the polar would change if the caller's array did)"
+    return None
+
+
 @dataclass(frozen=True, eq=False)
 class Polar:
     """Polar table with vectorised interpolation.
+
+    Build one with :meth:`Polar.from_arrays` (any array-likes); the constructor itself
+    takes the three tables only as read-only float64 arrays (e.g. another polar's) and
+    raises :class:`~sailroute.errors.InputError` for anything else.
 
     Parameters
     ----------
     twa_deg : ndarray, shape (m,)
         Strictly increasing true wind angles [°] within ``[0, 180]``, at least
-        :data:`MIN_AXIS_STEP` apart (and from 0 and 180).
+        :data:`MIN_AXIS_STEP` apart (and from 0 and 180); read-only float64.
     tws_ms : ndarray, shape (n,)
         Strictly increasing true wind speeds [m s⁻¹], ``>= 0``, at least
-        :data:`MIN_AXIS_STEP` apart (and from 0).
+        :data:`MIN_AXIS_STEP` apart (and from 0); read-only float64.
     speed_ms : ndarray, shape (m, n)
-        Boat speed [m s⁻¹] at each (TWA, TWS) node, ``>= 0``.  Neither an all-zero
-        table nor speeds above :data:`MAX_BOAT_SPEED_MS` (or TWS above
-        :data:`MAX_TWS_MS`) are refused here: analytic test boats use them; the
+        Boat speed [m s⁻¹] at each (TWA, TWS) node, ``>= 0``; read-only float64.
+        Neither an all-zero table nor speeds above :data:`MAX_BOAT_SPEED_MS` (or TWS
+        above :data:`MAX_TWS_MS`) are refused here: analytic test boats use them; the
         file readers (:mod:`sailroute.boat.io`) refuse all three.
     name : str
         Label (boat name or source file).
@@ -150,10 +172,17 @@ class Polar:
     interpolation: str = "pchip"
 
     def __post_init__(self) -> None:
-        twa = np.array(self.twa_deg, dtype=float)
-        tws = np.array(self.tws_ms, dtype=float)
-        spd = np.array(self.speed_ms, dtype=float)
         where = f"polar {self.name!r}" if self.name else "polar"
+        for label in ("twa_deg", "tws_ms", "speed_ms"):
+            problem = _frozen_array_problem(getattr(self, label))
+            if problem:
+                raise InputError(
+                    f"{where}: {label} must be a read-only float64 ndarray, got {problem}; "
+                    "build the polar with Polar.from_arrays(twa_deg, tws_ms, speed_ms, "
+                    "name=..., interpolation=...), which copies lists and arrays to "
+                    "read-only float64 arrays"
+                )
+        twa, tws, spd = self.twa_deg, self.tws_ms, self.speed_ms
         if twa.ndim != 1 or tws.ndim != 1 or spd.shape != (twa.size, tws.size):
             raise InputError(
                 f"{where}: speed table has shape {spd.shape}, expected "
@@ -175,13 +204,51 @@ class Polar:
                 f"{where}: interpolation must be one of {', '.join(map(repr, INTERPOLATIONS))}; "
                 f"got {self.interpolation!r}"
             )
-        for arr in (twa, tws, spd):
-            arr.setflags(write=False)
-        object.__setattr__(self, "twa_deg", twa)
-        object.__setattr__(self, "tws_ms", tws)
-        object.__setattr__(self, "speed_ms", spd)
 
     # --- construction helpers -------------------------------------------------
+
+    @classmethod
+    def from_arrays(
+        cls,
+        twa_deg: ArrayLike,
+        tws_ms: ArrayLike,
+        speed_ms: ArrayLike,
+        name: str = "",
+        interpolation: str = "pchip",
+    ) -> Polar:
+        """A polar from any array-likes (lists, tuples, writable arrays).
+
+        The usual way to build a :class:`Polar`: the three tables are copied to
+        read-only float64 arrays, so later changes to the caller's arrays cannot
+        reach the polar (or its cached lookup table).  The dataclass constructor
+        ``Polar(...)`` itself accepts only read-only float64 arrays (e.g. another
+        polar's) and says so otherwise.
+
+        Parameters
+        ----------
+        twa_deg : array_like, shape (m,)
+            True wind angles [°]; see :class:`Polar`.
+        tws_ms : array_like, shape (n,)
+            True wind speeds [m s⁻¹].
+        speed_ms : array_like, shape (m, n)
+            Boat speed [m s⁻¹] at each (TWA, TWS) node.
+        name : str
+            Label (boat name or source file).
+        interpolation : {"pchip", "linear"}
+            Interpolation method; see :class:`Polar`.
+
+        Returns
+        -------
+        Polar
+            The validated polar.
+
+        Raises
+        ------
+        InputError
+            If the tables break a rule of :class:`Polar` (shape, order, range, spacing).
+        """
+        return cls(_frozen_copy(twa_deg), _frozen_copy(tws_ms), _frozen_copy(speed_ms),
+                   name=name, interpolation=interpolation)
 
     def with_interpolation(self, interpolation: str) -> Polar:
         """Same table with another interpolation method (a new :class:`Polar`)."""

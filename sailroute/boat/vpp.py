@@ -809,4 +809,5 @@ def solve_polar(
     tws = np.asarray(tws_ms, dtype=float)
     twa = np.asarray(twa_deg, dtype=float)
     sol = solve_point(params, tws[None, :], twa[:, None], thrust)
-    return Polar(twa, tws, sol.speed_ms, name=name or params.name, interpolation=interpolation)
+    return Polar.from_arrays(twa, tws, sol.speed_ms, name=name or params.name,
+                             interpolation=interpolation)

@@ -10,9 +10,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 from types import MappingProxyType
+from typing import Any
 
 from sailroute.course.check import CheckedCourse
-from sailroute.course.model import Course, Gate, LegSpec, Line, Mark, ScenarioSpec
+from sailroute.course.model import Course, Gate, LegSpec, Line, Mark, ScenarioSpec, frozen_mapping
 
 __all__ = ["build_course"]
 
@@ -42,14 +43,16 @@ def build_course(
         name=checked.name,
         start_time=checked.start_time,
         frame=checked.frame,
-        marks=marks,
-        lines={k: Line(k, marks[a], marks[b]) for k, (a, b) in checked.lines.items()},
-        gates={k: Gate(k, marks[a], marks[b]) for k, (a, b) in checked.gates.items()},
+        marks=frozen_mapping(marks),
+        lines=frozen_mapping({k: Line(k, marks[a], marks[b])
+                              for k, (a, b) in checked.lines.items()}),
+        gates=frozen_mapping({k: Gate(k, marks[a], marks[b])
+                              for k, (a, b) in checked.gates.items()}),
         legs=tuple(LegSpec(*leg) for leg in checked.legs),
-        boat_spec=checked.boat,
+        boat_spec=frozen_mapping(checked.boat),
         routing=checked.routing,
-        scenarios={k: ScenarioSpec(**kw) for k, kw in checked.scenarios.items()},
-        references=checked.references,
+        scenarios=frozen_mapping({k: _scenario(kw) for k, kw in checked.scenarios.items()}),
+        references=frozen_mapping(checked.references),
         source=source,
         description=checked.description,
         template=checked.template,
@@ -58,3 +61,14 @@ def build_course(
         utc_offset_s=checked.utc_offset_s,
         key_lines=MappingProxyType(dict(key_lines or {})),
     )
+
+
+def _scenario(kw: Mapping[str, Any]) -> ScenarioSpec:
+    """The :class:`ScenarioSpec` of one checked scenario, its mappings made read-only."""
+    current = kw.get("current")
+    return ScenarioSpec(**{
+        **kw,
+        "wind": frozen_mapping(kw["wind"]),
+        "references": frozen_mapping(kw.get("references")),
+        "current": None if current is None else frozen_mapping(current),
+    })

@@ -131,13 +131,34 @@ class LegSpec:
         return f"{self.from_name} -> {self.to_name}"
 
 
-def _frozen(d: Mapping[str, Any] | None) -> Mapping[str, Any]:
+def frozen_mapping(d: Mapping[str, Any] | None) -> Mapping[str, Any]:
+    """A read-only copy of ``d`` (``None`` gives an empty one).
+
+    The mapping fields of :class:`ScenarioSpec` and :class:`Course` must be such
+    copies (:class:`types.MappingProxyType`): the course builder
+    (:mod:`sailroute.course.build`) makes them.
+    """
     return MappingProxyType(dict(d or {}))
+
+
+def _require_frozen(owner: str, field_name: str, value: object) -> None:
+    """Raise TypeError unless ``value`` is a read-only mapping (see :func:`frozen_mapping`)."""
+    if not isinstance(value, MappingProxyType):
+        raise TypeError(
+            f"{owner}.{field_name} must be a read-only mapping (types.MappingProxyType), "
+            f"got {type(value).__name__}; wrap it with "
+            f"sailroute.course.model.frozen_mapping(...), or load the course with "
+            "sailroute.course.load.load_course, whose builder does"
+        )
+
+
+def _empty() -> Mapping[str, Any]:
+    return MappingProxyType({})
 
 
 def _reduce_proxy(m: MappingProxyType) -> tuple[Any, tuple[dict[str, Any]]]:
     """Pickle a read-only mapping as a copy of its dict (for process/Dask workers)."""
-    return _frozen, (dict(m),)
+    return frozen_mapping, (dict(m),)
 
 
 copyreg.pickle(MappingProxyType, _reduce_proxy)
@@ -174,7 +195,7 @@ class ScenarioSpec:
 
     name: str
     wind: Mapping[str, Any]
-    references: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
+    references: Mapping[str, tuple[float, ...]] = field(default_factory=_empty)
     description: str = ""
     where: str = ""
     ensemble: str = ""
@@ -182,10 +203,10 @@ class ScenarioSpec:
     current_where: str = ""
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "wind", _frozen(self.wind))
-        object.__setattr__(self, "references", _frozen(self.references))
+        _require_frozen("ScenarioSpec", "wind", self.wind)
+        _require_frozen("ScenarioSpec", "references", self.references)
         if self.current is not None:
-            object.__setattr__(self, "current", _frozen(self.current))
+            _require_frozen("ScenarioSpec", "current", self.current)
 
 
 @dataclass(frozen=True, eq=False)
@@ -243,10 +264,10 @@ class Course:
     lines: Mapping[str, Line]
     gates: Mapping[str, Gate]
     legs: tuple[LegSpec, ...]
-    boat_spec: Mapping[str, Any] = field(default_factory=dict)
+    boat_spec: Mapping[str, Any] = field(default_factory=_empty)
     routing: RoutingSettings = field(default_factory=RoutingSettings)
-    scenarios: Mapping[str, ScenarioSpec] = field(default_factory=dict)
-    references: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
+    scenarios: Mapping[str, ScenarioSpec] = field(default_factory=_empty)
+    references: Mapping[str, tuple[float, ...]] = field(default_factory=_empty)
     source: Path | None = None
     description: str = ""
     template: Mapping[str, Any] | None = None
@@ -257,8 +278,12 @@ class Course:
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):
-            object.__setattr__(self, name, _frozen(getattr(self, name)))
-        object.__setattr__(self, "legs", tuple(self.legs))
+            _require_frozen("Course", name, getattr(self, name))
+        if not isinstance(self.legs, tuple):
+            raise TypeError(
+                f"Course.legs must be a tuple of LegSpec, got {type(self.legs).__name__}; "
+                "pass tuple(legs)"
+            )
 
     @property
     def start_epoch(self) -> float:

@@ -56,12 +56,21 @@ class Track:
     lon_deg: NDArray[np.float64]
     name: str = ""
     source: str = ""
-    channels: Mapping[str, NDArray[np.float64]] = field(default_factory=dict)
+    channels: Mapping[str, NDArray[np.float64]] = field(
+        default_factory=lambda: MappingProxyType({}))
     notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "channels", MappingProxyType(dict(self.channels)))
-        object.__setattr__(self, "notes", tuple(self.notes))
+        if not isinstance(self.channels, MappingProxyType):
+            raise TypeError(
+                "Track.channels must be a read-only mapping (types.MappingProxyType), got "
+                f"{type(self.channels).__name__}; pass MappingProxyType(dict(channels))"
+            )
+        if not isinstance(self.notes, tuple):
+            raise TypeError(
+                f"Track.notes must be a tuple of str, got {type(self.notes).__name__}; "
+                "pass tuple(notes)"
+            )
 
     def __len__(self) -> int:
         return int(self.t_s.size)
@@ -80,4 +89,4 @@ class Track:
         """The points with ``t0 <= t <= t1`` [epoch s] (same name, source and notes)."""
         m = (self.t_s >= t0) & (self.t_s <= t1)
         return Track(self.t_s[m], self.lat_deg[m], self.lon_deg[m], self.name, self.source,
-                     {k: v[m] for k, v in self.channels.items()}, self.notes)
+                     MappingProxyType({k: v[m] for k, v in self.channels.items()}), self.notes)

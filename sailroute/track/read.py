@@ -42,6 +42,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterator, Mapping
 from datetime import UTC, datetime, tzinfo
 from pathlib import Path
+from types import MappingProxyType
 from typing import Final, cast
 from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 
@@ -419,4 +420,5 @@ def clean_track(t: NDArray, lat: NDArray, lon: NDArray, lines: NDArray,
         notes.append(f"... and {gaps.size - 5} more gap(s) longer than {limit:.0f} s")
     lon_w = np.asarray(wrap_lon(lon[order]), dtype=float)
     return Track(ts, lat[order].astype(float), lon_w, name, src,
-                 {k: np.asarray(v, float)[order] for k, v in channels.items()}, tuple(notes))
+                 MappingProxyType({k: np.asarray(v, float)[order] for k, v in channels.items()}),
+                 tuple(notes))

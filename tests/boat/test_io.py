@@ -128,7 +128,7 @@ def vpp_like_polar() -> Polar:
     rng = np.random.default_rng(7)
     twa = np.arange(0.0, 180.1, 15.0)
     tws = np.array([1.3, 2.7, 4.4, 6.1, 9.9])
-    return Polar(twa, tws, rng.uniform(0, 4, (twa.size, tws.size)), name="rt")
+    return Polar.from_arrays(twa, tws, rng.uniform(0, 4, (twa.size, tws.size)), name="rt")
 
 
 @pytest.mark.parametrize("unit", ["kn", "m/s", "km/h"])

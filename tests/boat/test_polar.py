@@ -31,7 +31,7 @@ def small_polar(interpolation: str = "pchip") -> Polar:
             [1.0, 1.9, 3.0],
         ]
     )
-    return Polar(twa, tws, spd, name="small", interpolation=interpolation)
+    return Polar.from_arrays(twa, tws, spd, name="small", interpolation=interpolation)
 
 
 # --- construction -----------------------------------------------------------------
@@ -39,18 +39,19 @@ def small_polar(interpolation: str = "pchip") -> Polar:
 
 def test_invalid_tables_are_rejected_with_reason() -> None:
     with pytest.raises(InputError, match="shape"):
-        Polar(np.array([0.0, 90.0]), np.array([1.0, 2.0]), np.ones((2, 3)))
+        Polar.from_arrays(np.array([0.0, 90.0]), np.array([1.0, 2.0]), np.ones((2, 3)))
     with pytest.raises(InputError, match="increase strictly"):
-        Polar(np.array([90.0, 0.0]), np.array([1.0]), np.ones((2, 1)))
+        Polar.from_arrays(np.array([90.0, 0.0]), np.array([1.0]), np.ones((2, 1)))
     with pytest.raises(InputError, match=">= 0"):
-        Polar(np.array([0.0, 90.0]), np.array([1.0]), -np.ones((2, 1)))
+        Polar.from_arrays(np.array([0.0, 90.0]), np.array([1.0]), -np.ones((2, 1)))
     with pytest.raises(InputError, match="interpolation"):
-        Polar(np.array([0.0, 90.0]), np.array([1.0]), np.ones((2, 1)), interpolation="cubic")
+        Polar.from_arrays(np.array([0.0, 90.0]), np.array([1.0]), np.ones((2, 1)),
+                          interpolation="cubic")
 
 
 def test_caller_arrays_are_copied_not_frozen() -> None:
     spd = np.ones((2, 1))
-    p = Polar(np.array([0.0, 90.0]), np.array([1.0]), spd)
+    p = Polar.from_arrays(np.array([0.0, 90.0]), np.array([1.0]), spd)
     spd[0, 0] = 5.0  # the caller may still write its array
     assert p.speed_ms[0, 0] == 1.0
 
@@ -215,7 +216,7 @@ def test_debski_toy_vpp_vmg() -> None:
     tws = np.array([10.0, 12.0, 14.0])
     tab = np.array([[debski_speed(w, a) for w in tws] for a in twa])
     for method in ("pchip", "linear"):
-        p = Polar(twa, tws, tab, interpolation=method)
+        p = Polar.from_arrays(twa, tws, tab, interpolation=method)
         ang, vmg = p.vmg_upwind(12.0)
         # 1-deg table: the interpolated polar finds the optimum to ~0.1 deg and 1e-3 m/s
         assert float(ang) == pytest.approx(41.65, abs=0.15)

@@ -274,7 +274,7 @@ def test_too_close_axis_values_are_refused_not_a_scipy_traceback(text: str, mess
 
 def test_polar_constructor_refuses_a_denormal_twa() -> None:
     with pytest.raises(InputError, match="closer than 1e-06 deg"):
-        Polar(np.array([1e-320, 90.0]), np.array([5.0]), np.ones((2, 1)))
+        Polar.from_arrays(np.array([1e-320, 90.0]), np.array([5.0]), np.ones((2, 1)))
 
 
 def orc_with(tmp_path: Path, old: str, new: str) -> Path:
@@ -329,7 +329,8 @@ def test_all_zero_polar_through_the_course_is_not_reported_as_calm(tmp_path: Pat
 
 
 def test_zero_table_stays_legal_for_polar_itself_but_not_for_routing(tmp_path: Path) -> None:
-    zero = Polar(np.array([0.0, 90.0, 180.0]), np.array([0.0, 5.0]), np.zeros((3, 2)), name="z")
+    zero = Polar.from_arrays(np.array([0.0, 90.0, 180.0]), np.array([0.0, 5.0]), np.zeros((3, 2)),
+                             name="z")
     assert zero.speed(5.0, 90.0) == 0.0  # internal use (tests, tapers) may build one
     with pytest.raises(InputError, match=r"c\.yaml:3: boat: this polar \(z\) has no speed"):
         require_speed(zero, "c.yaml:3: boat")

@@ -110,7 +110,7 @@ def test_yd41_beat_optimum_against_readme() -> None:
     found = {}
     for tws in (3.0, 10.0):
         sol = vpp.solve_point(YD41, tws, twa)
-        p = Polar(twa, np.array([tws]), sol.speed_ms[:, None])
+        p = Polar.from_arrays(twa, np.array([tws]), sol.speed_ms[:, None])
         ang, vmg = p.vmg_upwind(tws)
         found[tws] = (float(ang), float(vmg) / KNOT)
     assert found[3.0][0] == pytest.approx(44.6, abs=4.0)

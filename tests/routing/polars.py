@@ -15,4 +15,5 @@ def laser_like_polar() -> Polar:
     g = np.array([0, 0.45, 0.68, 0.74, 0.79, 0.85, 0.92, 0.97, 1.0, 0.97, 0.9, 0.82, 0.66,
                   0.55])
     tws = np.array([1, 2, 3, 4, 5, 6, 7, 8, 10, 12.0])
-    return Polar(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))), name="laser-like")
+    return Polar.from_arrays(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))),
+                             name="laser-like")

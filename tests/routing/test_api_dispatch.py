@@ -24,7 +24,7 @@ def small_polar() -> Polar:
     twa = np.array([0, 40, 60, 90, 120, 150, 180.0])
     g = np.array([0, 0.7, 0.85, 0.97, 0.97, 0.8, 0.6])
     tws = np.array([2, 4, 6, 8.0])
-    return Polar(twa, tws, np.outer(g, 0.5 * tws), name="small")
+    return Polar.from_arrays(twa, tws, np.outer(g, 0.5 * tws), name="small")
 
 
 LEG = (Start((0.0, 0.0), name="start"), Target("mark", (0.0, 300.0), rounding="port", name="1"))

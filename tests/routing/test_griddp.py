@@ -21,8 +21,8 @@ from sailroute.wind.uniform import UniformWind
 BOAT = DynamicBoat()
 TOY_POLAR = BOAT.steady_polar(np.arange(0.0, 61.0, 2.0), twa_step=1.0)
 # 0.3 TWS for every TWA >= 40°: the straight line is the unique optimum of any reach
-ISO = Polar(np.array([0.0, 40.0, 180.0]), np.array([0.0, 20.0]),
-            np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]), interpolation="linear")
+ISO = Polar.from_arrays(np.array([0.0, 40.0, 180.0]), np.array([0.0, 20.0]),
+                        np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]), interpolation="linear")
 A = Start((0.0, 0.0), name="A")
 
 

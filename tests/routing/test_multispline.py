@@ -21,8 +21,8 @@ from sailroute.routing.multispline import (
 from sailroute.routing.types import RoutingSettings, Start, Target
 from sailroute.wind.uniform import UniformWind
 
-ISO = Polar(np.array([0.0, 40.0, 180.0]), np.array([0.0, 20.0]),
-            np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]), interpolation="linear")
+ISO = Polar.from_arrays(np.array([0.0, 40.0, 180.0]), np.array([0.0, 20.0]),
+                        np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]), interpolation="linear")
 
 
 def test_hermite_edge_matches_end_values_and_slopes() -> None:

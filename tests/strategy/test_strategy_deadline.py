@@ -31,8 +31,8 @@ SO40_TWA = np.array([0, 5, 10, 15, 20, 25, 32, 36, 40, 45, 52, 60, 70, 80, 90, 1
                      130, 140, 150, 160, 170, 180], dtype=float)
 SO40_KN = np.array([0.0, 0.6, 1.2, 1.8, 2.1, 2.5, 4.1, 4.6, 5.0, 5.4, 5.8, 6.2, 6.4, 6.5, 6.5,
                     6.5, 6.4, 6.2, 5.7, 5.2, 4.7, 4.2, 3.9, 3.6])
-SO40 = Polar(SO40_TWA, np.array([1.0]), (SO40_KN * 0.05 / 6.5)[:, None], name="SO40 8kn",
-             interpolation="linear")
+SO40 = Polar.from_arrays(SO40_TWA, np.array([1.0]), (SO40_KN * 0.05 / 6.5)[:, None],
+                         name="SO40 8kn", interpolation="linear")
 C = 2.0
 SIGMA = 0.05  # rad per sqrt(time unit)
 

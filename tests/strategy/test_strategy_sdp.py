@@ -19,8 +19,8 @@ from sailroute.strategy.shiftmodel import OUShift
 from sailroute.units import KNOT
 
 TWA = np.arange(0.0, 181.0)
-SIN_POLAR = Polar(TWA, np.array([1.0]), np.sin(np.radians(TWA))[:, None], name="sin",
-                  interpolation="linear")
+SIN_POLAR = Polar.from_arrays(TWA, np.array([1.0]), np.sin(np.radians(TWA))[:, None], name="sin",
+                              interpolation="linear")
 ILCA7 = builtin_polar("ilca7")
 TWS = 10 * KNOT
 COARSE = BeatGrid(lateral_m=8.0, row_m=20.0)

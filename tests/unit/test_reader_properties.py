@@ -55,7 +55,7 @@ def polars(draw: st.DrawFn) -> Polar:
                           min_size=n_twa * n_tws, max_size=n_twa * n_tws))
     # the readers refuse a polar without speed: one cell (any) is positive
     cells[draw(st.integers(0, len(cells) - 1))] = draw(st.floats(0.1, 30.0))
-    return Polar(twa, tws, np.reshape(cells, (n_twa, n_tws)), name="p")
+    return Polar.from_arrays(twa, tws, np.reshape(cells, (n_twa, n_tws)), name="p")
 
 
 @FAST
