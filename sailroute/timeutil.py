@@ -86,3 +86,10 @@ def from_epoch(t: float) -> datetime:
 def iso(t: float) -> str:
     """ISO 8601 UTC string (``...Z``, millisecond precision) of epoch seconds ``t``."""
     return from_epoch(t).isoformat(timespec="milliseconds").replace("+00:00", "Z")
+
+
+def offset_text(utc_offset_s: float) -> str:
+    """``UTC+02:00`` for an offset of 7200 s (rounded to the minute)."""
+    sign = "+" if utc_offset_s >= 0 else "-"
+    h, m = divmod(round(abs(utc_offset_s) / 60.0), 60)
+    return f"UTC{sign}{h:02d}:{m:02d}"

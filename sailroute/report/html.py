@@ -47,7 +47,7 @@ from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.report.plan import Comparison, Plan, percent_error
 from sailroute.report.tables import format_duration, start_point_text
-from sailroute.timeutil import iso
+from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, wind_speed_direction, wrap180, wrap360
 from sailroute.wind.base import WindField
 
@@ -239,13 +239,6 @@ class Report:
 
 # ---------------------------------------------------------------------------------------------
 # times
-
-
-def offset_text(utc_offset_s: float) -> str:
-    """``UTC+02:00`` for an offset of 7200 s."""
-    sign = "+" if utc_offset_s >= 0 else "-"
-    h, m = divmod(round(abs(utc_offset_s) / 60.0), 60)
-    return f"UTC{sign}{h:02d}:{m:02d}"
 
 
 def clock(t: float, utc_offset_s: float = 0.0) -> str:

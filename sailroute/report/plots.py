@@ -33,7 +33,7 @@ from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.report.plan import Comparison, Plan
 from sailroute.routing.types import LegResult
-from sailroute.timeutil import iso
+from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, circular_mean_deg, wind_speed_direction
 from sailroute.wind.base import WindField
 
@@ -164,9 +164,7 @@ def repeat_index(legs: Sequence[LegResult], tol_m: float = 30.0) -> list[int]:
 
 def local_time(t: float, utc_offset_s: float) -> str:
     """``HH:MM`` in the course's local time and its offset, e.g. ``12:10 (UTC+02:00)``."""
-    sign = "+" if utc_offset_s >= 0 else "-"
-    h, m = divmod(round(abs(utc_offset_s) / 60.0), 60)
-    return f"{iso(t + utc_offset_s)[11:16]} (UTC{sign}{h:02d}:{m:02d})"
+    return f"{iso(t + utc_offset_s)[11:16]} ({offset_text(utc_offset_s)})"
 
 
 def _latlon_axes(ax: Axes, course: Course) -> None:
