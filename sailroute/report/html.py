@@ -46,6 +46,7 @@ from sailroute.course.geometry import feature_centre
 from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.report.plan import Comparison, Plan, percent_error
+from sailroute.report.plots import repeat_index_of_ends
 from sailroute.report.tables import format_duration, start_point_text
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, wind_speed_direction, wrap180, wrap360
@@ -73,6 +74,11 @@ ROUTE_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b
                  "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
 """Route colours in scenario order (plotly's default palette)."""
 WIND_COLOUR = "#41607d"
+
+REPEAT_SHIFT = 0.015
+"""Sideways shift of a leg over the same water as an earlier one, per repeat, as a share
+of the longest leg (start to end): about 20-30 m on a dinghy course, 8-12 px at the
+page's first zoom (``route.png`` shifts such legs by 4 pt)."""
 """Colour of the wind arrows (a comparison's layers take their scenario's route colour)."""
 ARROW_FILL = 0.85
 """Length of the strongest wind's arrow as a share of the grid spacing."""
@@ -113,6 +119,10 @@ class Route:
         Line style (plotly ``dash``).
     boat : bool
         Draw a marker at the boat's position at the slider's time.
+    lat_shift, lon_shift : ndarray or None
+        Added to ``lat``/``lon`` where the line is drawn [°]: a leg over the same water
+        as an earlier one is drawn beside it (:data:`REPEAT_SHIFT`); the hover gives the
+        true position.
     """
 
     name: str
@@ -131,6 +141,14 @@ class Route:
     speed_name: str = "boat speed"
     dash: str = "solid"
     boat: bool = True
+    lat_shift: NDArray[np.float64] | None = None
+    lon_shift: NDArray[np.float64] | None = None
+
+    def drawn(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``(lat, lon)`` where the line is drawn [°]."""
+        if self.lat_shift is None or self.lon_shift is None:
+            return self.lat, self.lon
+        return self.lat + self.lat_shift, self.lon + self.lon_shift
 
 
 @dataclass(frozen=True, eq=False)
@@ -291,10 +309,32 @@ def _leg_columns(course: Course, k: int, r: LegResult, mode: str) -> dict[str, N
             "vmg": vmg / KNOT}
 
 
+def _repeat_shifts(parts: Sequence[Mapping[str, NDArray]]) -> list[tuple[float, float]]:
+    """Sideways shift ``(dx, dy)`` [m] of each leg: 0 for a first passage, then
+    :data:`REPEAT_SHIFT` of the longest leg per earlier leg over the same water, to the
+    right of the direction of travel (as on ``route.png``)."""
+    ends = []
+    for p in parts:
+        ok = np.isfinite(p["x"]) & np.isfinite(p["y"])
+        xs, ys = np.asarray(p["x"])[ok], np.asarray(p["y"])[ok]
+        ends.append(((float(xs[0]), float(ys[0])), (float(xs[-1]), float(ys[-1])))
+                    if xs.size else ((math.nan, math.nan), (math.nan, math.nan)))
+    chords = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in ends]
+    step = REPEAT_SHIFT * max((c for c in chords if math.isfinite(c)), default=0.0)
+    out = []
+    for (a, b), c, rep in zip(ends, chords, repeat_index_of_ends(ends), strict=True):
+        if rep == 0 or not c > 0:
+            out.append((0.0, 0.0))
+            continue
+        out.append((step * rep * (b[1] - a[1]) / c, -step * rep * (b[0] - a[0]) / c))
+    return out
+
+
 def _route(name: str, course: Course, parts: Sequence[Mapping[str, NDArray]],
            modes: Sequence[str], manoeuvres: Sequence[tuple[str, float, float, float]],
-           *, gaps: bool = False, **kw: Any) -> Route:
-    """Join per-leg columns into a :class:`Route` (a NaN row between legs with ``gaps``)."""
+           *, gaps: bool = False, side_by_side: bool = False, **kw: Any) -> Route:
+    """Join per-leg columns into a :class:`Route` (a NaN row between legs with ``gaps``;
+    legs over the same water drawn beside each other with ``side_by_side``)."""
     cols: dict[str, list[NDArray]] = {k: [] for k in ("t", "x", "y", "leg", "tws", "twa",
                                                       "speed", "vmg")}
     for i, p in enumerate(parts):
@@ -305,13 +345,27 @@ def _route(name: str, course: Course, parts: Sequence[Mapping[str, NDArray]],
             cols[k].append(np.asarray(p[k]))
     c = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
     lat, lon = course.frame.to_latlon(c["x"], c["y"])
+    lat, lon = np.asarray(lat, float), np.asarray(lon, float)
+    shifts = _repeat_shifts(parts) if side_by_side and parts else []
+    if any(sh != (0.0, 0.0) for sh in shifts):
+        sx = np.zeros_like(c["x"])
+        sy = np.zeros_like(c["y"])
+        for i, (dx, dy) in enumerate(shifts):
+            sx[c["leg"] == i + 1] = dx
+            sy[c["leg"] == i + 1] = dy
+        dlat, dlon = course.frame.to_latlon(c["x"] + sx, c["y"] + sy)
+        kw = {**kw, "lat_shift": np.asarray(dlat, float) - lat,
+              "lon_shift": np.asarray(dlon, float) - lon}
     man = []
     for kind, t, x, y in manoeuvres:
-        mlat, mlon = course.frame.to_latlon(x, y)
+        # drawn on its leg's line: the leg whose time span holds it
+        j = next((i for i, p in enumerate(parts) if p["t"][0] <= t <= p["t"][-1]), None)
+        dx, dy = shifts[j] if shifts and j is not None else (0.0, 0.0)
+        mlat, mlon = course.frame.to_latlon(x + dx, y + dy)
         man.append((kind, float(t), float(mlat), float(mlon)))
-    return Route(name, c["t"].astype(float), c["x"], c["y"], np.asarray(lat, float),
-                 np.asarray(lon, float), c["leg"].astype(np.int64), c["tws"], c["twa"],
-                 c["speed"], c["vmg"], tuple(modes), tuple(man), **kw)
+    return Route(name, c["t"].astype(float), c["x"], c["y"], lat, lon,
+                 c["leg"].astype(np.int64), c["tws"], c["twa"], c["speed"], c["vmg"],
+                 tuple(modes), tuple(man), **kw)
 
 
 def route_from_plan(plan: Plan, name: str | None = None) -> Route:
@@ -320,7 +374,7 @@ def route_from_plan(plan: Plan, name: str | None = None) -> Route:
     parts = [_leg_columns(plan.course, pl.spec.index, pl.result, modes[k])
              for k, pl in enumerate(plan.legs)]
     man = [(m.kind, m.t, m.x, m.y) for pl in plan.legs for m in pl.result.manoeuvres]
-    return _route(name or plan.scenario, plan.course, parts, modes, man)
+    return _route(name or plan.scenario, plan.course, parts, modes, man, side_by_side=True)
 
 
 def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
@@ -613,12 +667,13 @@ def speed_limits(values: NDArray, span: float = SPEED_SPAN_KN) -> tuple[float, f
 
 
 def _customdata(r: Route, off: float) -> list[list[Any] | None]:
-    """Hover data per point: leg, mode, local time, UTC time, TWS, |TWA|, tack, speed, VMG."""
+    """Hover data per point: leg, mode, local time, UTC time, TWS, |TWA|, tack, speed, VMG,
+    latitude, longitude (the true position, also where the line is drawn shifted)."""
     modes = [r.modes[k - 1] if 0 < k <= len(r.modes) else "" for k in r.leg.tolist()]
     cols = zip(r.leg.tolist(), modes, clocks(r.t, off), clocks(r.t), _r(r.tws_kn, 2),
                _r(np.abs(r.twa_deg), 1),
                np.where(r.twa_deg >= 0, "stbd", "port").tolist(), _r(r.speed_kn, 3),
-               _r(r.vmg_kn, 3), strict=True)
+               _r(r.vmg_kn, 3), _r(r.lat, 6), _r(r.lon, 6), strict=True)
     ok = np.isfinite(r.t).tolist()
     return [list(row) if good else None for row, good in zip(cols, ok, strict=True)]
 
@@ -628,7 +683,7 @@ def _hover(r: Route, off: float) -> str:
             f"%{{customdata[2]}} local ({offset_text(off)}) · %{{customdata[3]}} UTC<br>"
             "TWS %{customdata[4]:.1f} kn · TWA %{customdata[5]:.0f}° %{customdata[6]}<br>"
             f"{r.speed_name} %{{customdata[7]:.2f}} kn · VMG %{{customdata[8]:.2f}} kn"
-            "<br>%{y:.5f}° N %{x:.5f}° E<extra></extra>")
+            "<br>%{customdata[9]:.5f}° N %{customdata[10]:.5f}° E<extra></extra>")
 
 
 def boat_at(r: Route, times: NDArray) -> NDArray[np.int64]:
@@ -643,14 +698,18 @@ def _boat_states(r: Route, times: NDArray, off: float, custom: Sequence[Any]
                  ) -> list[dict[str, Any]]:
     """Boat marker of ``r`` at each of ``times``: the position interpolated in time, the
     hover data of the point before with the time itself."""
-    lat = _r(np.interp(times, r.t, r.lat), 7)
-    lon = _r(np.interp(times, r.t, r.lon), 7)
+    drawn_lat, drawn_lon = r.drawn()
+    lat = _r(np.interp(times, r.t, drawn_lat), 7)
+    lon = _r(np.interp(times, r.t, drawn_lon), 7)
+    true_lat = _r(np.interp(times, r.t, r.lat), 6)
+    true_lon = _r(np.interp(times, r.t, r.lon), 6)
     out = []
     for k, (i, local, utc) in enumerate(zip(boat_at(r, times).tolist(), clocks(times, off),
                                             clocks(times), strict=True)):
         row = list(custom[i] or [])
         if row:
             row[2], row[3] = local, utc
+            row[9], row[10] = true_lat[k], true_lon[k]
         out.append({"x": [lon[k]], "y": [lat[k]], "customdata": [row]})
     return out
 
@@ -730,13 +789,14 @@ def _leg_number_trace(r: Route, group: str) -> dict[str, Any]:
     """The leg numbers along ``r``, spread between 30 % and 70 % of each leg (golden-ratio
     steps, as on ``route.png``) so legs over the same water do not hide each other's."""
     xs, ys, text = [], [], []
+    lat, lon = r.drawn()
     for k in range(len(r.modes)):
         idx = np.flatnonzero(r.leg == k + 1)
         if idx.size == 0:
             continue
         i = idx[min(int((0.3 + 0.4 * ((k * 0.6180339887) % 1.0)) * idx.size), idx.size - 1)]
-        xs.append(r.lon[i])
-        ys.append(r.lat[i])
+        xs.append(lon[i])
+        ys.append(lat[i])
         text.append(str(k + 1))
     return {"type": "scatter", "mode": "markers+text", "name": "leg numbers",
             "legendgroup": group, "showlegend": False, "x": _r(xs, 7), "y": _r(ys, 7),
@@ -794,9 +854,10 @@ def figure(report: Report) -> dict[str, Any]:
         group = f"route{i}"
         colour = "#333333" if single else _colour(i)
         custom = _customdata(r, off)
+        drawn_lat, drawn_lon = r.drawn()
         tr = {"type": "scatter", "mode": "lines+markers" if single else "lines",
               "name": html.escape(r.name), "legendgroup": group,
-              "x": _r(r.lon, 7), "y": _r(r.lat, 7),
+              "x": _r(drawn_lon, 7), "y": _r(drawn_lat, 7),
               "line": {"color": colour, "width": 2.5, "dash": r.dash},
               "customdata": custom, "hovertemplate": _hover(r, off)}
         if single:

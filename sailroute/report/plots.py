@@ -153,11 +153,18 @@ def speed_limits(bsp_kn: NDArray) -> tuple[float, float]:
 def repeat_index(legs: Sequence[LegResult], tol_m: float = 30.0) -> list[int]:
     """For each leg, how many earlier legs started and ended at the same places (within
     ``tol_m``): 0 for a first passage, 1 for the second over the same water, ..."""
+    return repeat_index_of_ends([(r.start_xy, r.end_xy) for r in legs], tol_m)
+
+
+def repeat_index_of_ends(
+    ends: Sequence[tuple[tuple[float, float], tuple[float, float]]], tol_m: float = 30.0
+) -> list[int]:
+    """:func:`repeat_index` of legs given as ``(start_xy, end_xy)`` pairs [m]."""
     out = []
-    for k, r in enumerate(legs):
-        same = sum(1 for q in legs[:k]
-                   if np.hypot(*np.subtract(q.start_xy, r.start_xy)) < tol_m
-                   and np.hypot(*np.subtract(q.end_xy, r.end_xy)) < tol_m)
+    for k, (a, b) in enumerate(ends):
+        same = sum(1 for qa, qb in ends[:k]
+                   if np.hypot(*np.subtract(qa, a)) < tol_m
+                   and np.hypot(*np.subtract(qb, b)) < tol_m)
         out.append(same)
     return out
 

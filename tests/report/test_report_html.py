@@ -7,16 +7,19 @@ Chromium.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 
 import numpy as np
 import pytest
 
+from sailroute.course.load import course_from_mapping
 from sailroute.report.html import (
     ARROW_FILL,
     DIV_ID,
     N_STEPS,
+    REPEAT_SHIFT,
     WIND_GRID,
     clock,
     clocks,
@@ -31,10 +34,12 @@ from sailroute.report.html import (
     time_label,
     wind_layer,
 )
-from sailroute.report.plan import compare
+from sailroute.report.plan import compare, make_plan
 from sailroute.report.tables import format_duration
+from sailroute.routing.track import make_leg_result
 from sailroute.units import KNOT
 from sailroute.wind.analytic import AnalyticWind
+from tests.report.conftest import COURSE, timed_track
 
 STUB = "/* plotly.js stub */"
 
@@ -247,3 +252,43 @@ def test_wind_layer_clips_to_the_coverage_and_marks_missing_times(plan):
     assert not layer.steady and not layer.uniform
     outside = (2000.0, 3000.0, 2000.0, 3000.0)
     assert wind_layer("boxed", w, plan.course, outside, np.array([t0])) is None
+
+
+def test_legs_over_the_same_water_are_drawn_side_by_side(wind):
+    # start -> top -> gate -> top -> gate: leg 4 sails the water of leg 2 (same ends)
+    data = copy.deepcopy(COURSE)
+    data["legs"] = [{"to": "top"}, {"to": "gate"}, {"to": "top"}, {"to": "gate"}]
+    del data["references"], data["scenarios"]["north"]["references"]
+    course = course_from_mapping(data)
+    legs, t = [], course.start_epoch
+    for pts in ([(-50, 0), (-550, 500), (0, 1000)], [(0, 1000), (200, 600), (10, 200)],
+                [(10, 200), (-480, 690), (0, 1000)], [(0, 1000), (200, 600), (10, 200)]):
+        legs.append(make_leg_result(timed_track(pts, t, wind), "test"))
+        t = legs[-1].t_end
+    plan = make_plan(course, "north", legs, wind)
+    _, fig = page_of(plan_report(plan, wind))
+    rt = route_trace(fig, "route: north")
+    leg = np.array([row[0] for row in rt["customdata"]])
+    x, y = course.frame.to_xy(np.array(rt["y"]), np.array(rt["x"]))  # where it is drawn
+    true_x = np.concatenate([r.track.x for r in legs])
+    true_y = np.concatenate([r.track.y for r in legs])
+    # legs 1-3 are drawn where they were sailed (1e-7° of rounding: about 1 cm)
+    first = leg < 4
+    np.testing.assert_allclose(x[first], true_x[first], atol=0.02, rtol=0)
+    np.testing.assert_allclose(y[first], true_y[first], atol=0.02, rtol=0)
+    # leg 4 is shifted to the right of its direction (0, 1000) -> (10, 200) by
+    # REPEAT_SHIFT of the longest leg (start -> top, 1001.2 m): (-15.02, -0.19) m
+    step = REPEAT_SHIFT * math.hypot(50.0, 1000.0)
+    d = math.hypot(10.0, 800.0)
+    np.testing.assert_allclose(x[~first] - true_x[~first], step * -800.0 / d, atol=0.02)
+    np.testing.assert_allclose(y[~first] - true_y[~first], -step * 10.0 / d, atol=0.02)
+    # the hover gives the true position
+    lat, lon = course.frame.to_latlon(true_x, true_y)
+    np.testing.assert_allclose([row[9] for row in rt["customdata"]], lat, atol=1e-6, rtol=0)
+    np.testing.assert_allclose([row[10] for row in rt["customdata"]], lon, atol=1e-6, rtol=0)
+    assert "%{customdata[9]:.5f}° N %{customdata[10]:.5f}° E" in rt["hovertemplate"]
+    # the gybes of legs 2 and 4 (both at (200, 600)): the second drawn on the shifted line
+    (gybes,) = [tr for tr in fig["data"] if tr.get("name") == "gybes"]
+    gx, gy = course.frame.to_xy(np.array(gybes["y"]), np.array(gybes["x"]))
+    np.testing.assert_allclose(gx, [200.0, 200.0 + step * -800.0 / d], atol=0.02)
+    np.testing.assert_allclose(gy, [600.0, 600.0 - step * 10.0 / d], atol=0.02)
