@@ -18,6 +18,7 @@ from datetime import datetime
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -68,7 +69,7 @@ def check_plan_files(out: Path, course_file: Path) -> dict:
 def check_report_html(path: Path, doc: dict, course) -> None:
     """report.html agrees with plan.json and track.csv: offline page, the route's points and
     times, the marks, the leg table."""
-    from sailroute.report.html import clock, read_figure
+    from sailroute.report.html import REPEAT_SHIFT, clock, read_figure
     from sailroute.report.tables import format_duration
 
     page = path.read_text(encoding="utf-8")
@@ -78,8 +79,22 @@ def check_report_html(path: Path, doc: dict, course) -> None:
     with (path.parent / "track.csv").open() as f:
         rows = list(csv.DictReader(f))
     assert len(route["x"]) == len(rows)
-    assert route["y"] == pytest.approx([float(r["lat"]) for r in rows], abs=1e-6)
-    assert route["x"] == pytest.approx([float(r["lon"]) for r in rows], abs=1e-6)
+    lat = np.array([float(r["lat"]) for r in rows])
+    lon = np.array([float(r["lon"]) for r in rows])
+    # the hover's position is the track's; the line is drawn there, except legs over the
+    # same water as an earlier one, drawn beside it (within REPEAT_SHIFT of the longest leg)
+    assert [c[9] for c in route["customdata"]] == pytest.approx(lat.tolist(), abs=1e-6)
+    assert [c[10] for c in route["customdata"]] == pytest.approx(lon.tolist(), abs=1e-6)
+    x, y = course.frame.to_xy(np.array(route["y"]), np.array(route["x"]))
+    tx, ty = course.frame.to_xy(lat, lon)
+    shift = np.hypot(x - tx, y - ty)
+    legs = np.array([int(r["leg"]) for r in rows])
+    # Hyères: leg 4 (1 -> 4p) sails the water of leg 2 (1 -> gate 4), shifted by
+    # REPEAT_SHIFT of the longest leg (start to end); the others are drawn in place
+    chord = max(float(np.hypot(tx[legs == k][-1] - tx[legs == k][0],
+                               ty[legs == k][-1] - ty[legs == k][0])) for k in set(legs))
+    assert float(np.max(shift[legs != 4])) < 0.05
+    np.testing.assert_allclose(shift[legs == 4], REPEAT_SHIFT * chord, atol=0.05)
     assert [c[0] for c in route["customdata"]] == [int(r["leg"]) for r in rows]
     assert [c[3] for c in route["customdata"]] == [r["time"][11:19] for r in rows]  # UTC
     (marks,) = [t for t in fig["data"] if t["name"] == "marks"]
