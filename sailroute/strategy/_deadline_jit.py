@@ -37,8 +37,8 @@ except ImportError:  # pragma: no cover - exercised where numba is not installed
 
 
 def _jit(fn: Any) -> Any:
-    # cache=True writes the compiled code next to the module (__pycache__); a read-only
-    # install silently compiles in memory instead.
+    # cache=True writes the compiled code next to the module (__pycache__), or, where that
+    # folder is read-only, in numba's user-wide cache directory (NUMBA_CACHE_DIR).
     return numba.njit(cache=True, nogil=True)(fn) if AVAILABLE else fn
 
 
@@ -191,7 +191,8 @@ def _best_csr(p: int, data: Any, indices: Any, n_u: int, per_row: int, prev: Any
 
 @_jit
 def slice_update(
-    bilinear: bool, cols: Any, vals: Any, n_u: int, per_row: int, prev: Any, xpad: Any,
+    bilinear: bool, cols: Any, vals: Any, n_u: int, per_row: int, stride: int, prev: Any,
+    xpad: Any,
     sw_data: Any, sw_indices: Any, prev_c: Any, use_switch: bool,
     node_lo: int, node_hi: int, switch_eps: Any, zero_clip: Any, sure: Any,
     prev_steer: Any, prev_switch: Any, w_out: Any, steer_out: Any, switch_out: Any,
@@ -208,8 +209,9 @@ def slice_update(
         The steering operator, flattened; column indices as uint32 (numba then skips
         the negative-index wrap: 1.4x).
     n_u, per_row : int
-        Controls per node; entries per CSR row (bilinear: the padded ring length
-        ``S = n_θ + 1``).
+        Controls per node; entries per CSR row (cubic).
+    stride : int
+        The padded ring length ``S = n_θ + 1`` (bilinear).
     prev : ndarray, shape (n_nodes + 2,)
         ``w`` of the previous slice with the two ghosts.
     xpad : ndarray
@@ -228,7 +230,6 @@ def slice_update(
     """
     zero = prev.dtype.type(0.0)
     one = prev.dtype.type(1.0)
-    stride = per_row  # bilinear: the padded ring length S = n_θ + 1
     for p in range(node_lo, node_hi):
         pv = prev[p]
         if pv >= sure:  # kept whatever this slice gives: skip the row products

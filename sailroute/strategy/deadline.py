@@ -415,7 +415,9 @@ class _CompiledSteer:
     vals: NDArray
     n_u: int
     per_row: int
-    """Entries per CSR row; bilinear: the padded ring length ``n_θ + 1``."""
+    """Entries per CSR row (bicubic)."""
+    stride: int
+    """The padded ring length ``n_θ + 1`` (bilinear)."""
     xpad: NDArray
     """Scratch for the padded slice (bilinear)."""
 
@@ -426,7 +428,7 @@ class _CompiledSteer:
         u = grid.controls_rad
         if grid.interpolation == "cubic":
             op = _steer_operator(grid, speeds, a, sigma, tau, "fail", "cubic", dtype)
-            return cls(False, op.indices.view(np.uint32), op.data, u.size, op.per_row,
+            return cls(False, op.indices.view(np.uint32), op.data, u.size, op.per_row, 0,
                        np.zeros(1, dtype=dtype))
         # the same arithmetic as _feet_stencil, one pass (the angle tables from NumPy)
         q = np.arange(2)[:, None, None]
@@ -436,9 +438,9 @@ class _CompiledSteer:
         _jit.steer_stencil_bilinear(
             np.cos(ang), np.sin(ang), np.asarray(speeds, dtype=np.float64), grid.n_r,
             grid.n_theta, grid.dr, grid.dtheta, grid.target_radius_m, grid.r_max_m, tau, a,
-            1.0 * sigma * math.sqrt(tau), cols, vals)
+            sigma * math.sqrt(tau), cols, vals)
         n_pad = _jit.padded_offset(grid.n_theta) + 2 * (grid.n_r + 1) * (grid.n_theta + 1)
-        return cls(True, cols.reshape(-1), vals.reshape(-1), u.size, grid.n_theta + 1,
+        return cls(True, cols.reshape(-1), vals.reshape(-1), u.size, 8, grid.n_theta + 1,
                    np.zeros(n_pad, dtype=dtype))
 
 
@@ -755,6 +757,7 @@ def solve_deadline(
     offset = np.zeros((n_s + 1, n_nodes), dtype=np.int8) if refine is not None else None
     reach_time = (grid.r_m - grid.target_radius_m) / f_max  # per ring
     consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
+    switch_cols = switch_op.indices.view(np.uint32)  # the kernel's index type
     lo = n_in
     for k in range(1, n_s + 1):
         prev = w[k - 1]
@@ -774,7 +777,7 @@ def solve_deadline(
                     _jit.pad_slice(prev, nt, kernel.xpad)
                 _jit.slice_update(
                     kernel.bilinear, kernel.cols, kernel.vals, kernel.n_u, kernel.per_row,
-                    prev, kernel.xpad, switch_op.data, switch_op.indices.view(np.uint32),
+                    kernel.stride, prev, kernel.xpad, switch_op.data, switch_cols,
                     w[max(k - kc, 0)], k >= kc, keep_to, base + hi * nt, *consts,
                     steer[k - 1], switch[k - 1], w[k], steer[k], switch[k])
                 continue
