@@ -1,21 +1,18 @@
 """Compiled kernels of the deadline solver (optional: ``pip install 'sailroute[fast]'``).
 
-Two loops of :mod:`sailroute.strategy.deadline` written out for `numba`_, each the
+The loops of :mod:`sailroute.strategy.deadline` written out for `numba`_, each the
 same arithmetic in the same order as the NumPy code it replaces, so that the policy is
 the same bit for bit (``tests/strategy/test_strategy_deadline.py`` compares both):
 
-- :func:`steer_stencil_bilinear` fills the steering operator (bilinear feet) that
-  ``deadline._feet_stencil`` computes with array temporaries: one pass, no temporaries,
-  the cosines and sines of ``θ + s_q u`` taken from tables NumPy computed.  It stores one
-  column per foot, not four: the four points of a bilinear foot are ``c, c + 1, c + S,
-  c + S + 1`` in a copy of the slice padded to ``S = n_θ + 1`` columns per ring (the
-  periodic column repeated, :func:`pad_slice`), which cuts the operator's memory and
-  traffic from 64 to 40 bytes a row.
-- :func:`slice_update` is one budget slice over a range of nodes: the row products of the
-  steering operator (bilinear: padded form; cubic: the CSR rows), the max over the
-  controls, the switch update, the clip to ``[0, 1]`` and the "more budget never hurts"
-  keep, fused into one loop over the nodes (the NumPy path makes a sparse mat-vec, an
-  ``argmax``, a ``take_along_axis`` and five ``where`` passes over each block).
+- bilinear (the default): :func:`ring_slice` is one budget slice.  Nothing is stored per
+  row: a foot's ring offset and fraction depend only on the tack, control and angle, its
+  angular offset on those and the ring (``deadline._RingRows``), so along a ring the rows
+  fall into runs (:func:`fill_runs`, built once per solve) that read contiguous memory;
+  :func:`run_values` does a run's rows for one control, and numba vectorises it.
+  :func:`pad_rings` copies the slice into the padded form the runs read.
+- bicubic: :func:`slice_update` does the CSR rows of a node range.
+- both: :func:`finish_nodes` is the switch update, the clip to ``[0, 1]`` and the "more
+  budget never hurts" keep (the NumPy path makes five ``where`` passes over each block).
 
 Without numba, :data:`AVAILABLE` is False and the solver runs its NumPy path.
 
@@ -26,6 +23,8 @@ from __future__ import annotations
 
 import math
 from typing import Any
+
+import numpy as np
 
 try:  # optional extra
     import numba
@@ -42,137 +41,244 @@ def _jit(fn: Any) -> Any:
     return numba.njit(cache=True, nogil=True)(fn) if AVAILABLE else fn
 
 
-@_jit
-def padded_offset(nt: int) -> int:
-    """Index of node 0 in the padded slice: the two ghosts and room for a ghost foot's
-    four reads (``0, 1, S, S + 1``) come first."""
-    return nt + 3
+def _inline(fn: Any) -> Any:
+    # inlined into the caller by numba: a call passes every array as a struct of its
+    # fields, which per node or per run costs more than the work (1.3x on the slice)
+    return numba.njit(cache=True, nogil=True, inline="always")(fn) if AVAILABLE else fn
 
 
 @_jit
-def steer_stencil_bilinear(
-    cos_tab: Any, sin_tab: Any, speeds: Any, nr: int, nt: int, dr: float, dtheta: float,
-    target_radius: float, r_max: float, tau: float, a: float, sigma_sqrt_tau: float,
-    cols: Any, vals: Any,
-) -> None:
-    """Bilinear steering stencil of every node (``outer="fail"``), padded form.
+def count_runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, nt: int,
+               ring0: int, ptr: Any) -> None:
+    """Number of runs of every ``(q, i, n)`` (see :func:`fill_runs`), as offsets ``ptr``."""
+    _runs(g, b, inv_r, ca, cs, fr_in, nr, nt, ring0, ptr, False, ptr, ptr, ptr, ptr, ptr, ptr)
 
-    Parameters
-    ----------
-    cos_tab, sin_tab : ndarray, shape (2, nt, n_u)
-        ``cos`` and ``sin`` of ``θ_j + s_q u_n`` (tack ``q``, angle ``j``, control ``n``).
-    speeds : ndarray, shape (n_u,)
-        Boat speed of each control [m s⁻¹].
-    nr, nt : int
-        Intervals in ``r``; nodes in ``θ``.
-    dr, dtheta : float
-        Grid spacings [m], [rad].
-    target_radius, r_max : float
-        Mark radius and outer radius [m].
-    tau, a : float
-        Steering time step [s] and wind drift [rad s⁻¹].
-    sigma_sqrt_tau : float
-        ``σ √τ`` [rad], the Gauss–Hermite foot offset.
-    cols : ndarray of uint32, shape (n_nodes, n_u, 2)
-        Output: per foot, the padded index ``c`` of its first point (ghost feet: 0 inside
-        the mark, 1 beyond ``r_max``).
-    vals : ndarray, shape (n_nodes, n_u, 8)
-        Output: weights of ``c, c + 1, c + S, c + S + 1`` for each foot (float32 or
-        float64), ``½`` of the bilinear weights; a ghost foot ``(½, 0, 0, 0)``.
+
+@_jit
+def fill_runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, nt: int,
+              ring0: int, ptr: Any, j0: Any, j1: Any, kind: Any, di: Any, op: Any,
+              om: Any) -> None:
+    """The runs of the ring-relative bilinear rows (``deadline._RingRows``).
+
+    Along ``j`` (fixed tack ``q``, ring ``i >= ring0``, control ``n``) a row is one of: a
+    foot inside the mark (``kind`` 1, value 1), beyond ``r_max`` (2, value 0), or two feet
+    on rings ``i + di`` and ``i + di + 1`` at angle columns ``j + op`` and ``j + om`` (+ 1)
+    (``kind`` 0).  A run is a range ``j0 .. j1 - 1`` over which these do not change, so its
+    rows read contiguous memory and the slice loop over it vectorises.  ``op``/``om`` are
+    ``floor(x ± c_σ)`` with ``x = b inv_r + c_a`` in the value dtype, as :func:`run_values`
+    and the NumPy rows compute them.
     """
-    n_u = speeds.shape[0]
+    _runs(g, b, inv_r, ca, cs, fr_in, nr, nt, ring0, ptr, True, j0, j1, kind, di, op, om)
+
+
+@_jit
+def _runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, nt: int,
+          ring0: int, ptr: Any, fill: bool, j0: Any, j1: Any, kind: Any, di: Any, op: Any,
+          om: Any) -> None:
+    n_u = g.shape[1]
+    m = 0
+    for q in range(2):
+        for i in range(nr + 1):
+            ir = inv_r[i]
+            for n in range(n_u):
+                ptr[(q * (nr + 1) + i) * n_u + n] = m
+                if i < ring0:
+                    continue
+                k0, d0, p0, m0 = -1, 0, 0, 0
+                for j in range(nt):
+                    fr = i + g[q, n, j]
+                    k = 1 if fr <= fr_in else (2 if fr > nr else 0)
+                    d = p = mm = 0
+                    if k == 0:
+                        d = math.floor(g[q, n, j])
+                        x = b[q, n, j] * ir + ca
+                        p = math.floor(x + cs)
+                        mm = math.floor(x - cs)
+                    if j == 0 or k != k0 or d != d0 or p != p0 or mm != m0:
+                        if fill:
+                            if j > 0:
+                                j1[m - 1] = j
+                            j0[m] = j
+                            kind[m] = k
+                            di[m] = d
+                            op[m] = p
+                            om[m] = mm
+                        m += 1
+                        k0, d0, p0, m0 = k, d, p, mm
+                if fill:
+                    j1[m - 1] = nt
+    ptr[2 * (nr + 1) * n_u] = m
+
+
+@_jit
+def pad_rings(prev: Any, nr: int, nt: int, pad: int, ring_lo: int, ring_hi: int,
+              out: Any) -> None:
+    """Copy rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice of
+    ``deadline._RingRows`` (``pad`` periodic columns on each side of every ring)."""
+    stride = nt + 2 * pad
+    for q in range(2):
+        for i in range(max(ring_lo - 1, 0), min(ring_hi + 1, nr + 1)):
+            src = (q * (nr + 1) + i) * nt
+            dst = (q * (nr + 2) + i) * stride
+            for c in range(nt):
+                out[dst + pad + c] = prev[src + c]
+            for c in range(pad):  # the wings (pad may exceed nt on coarse grids)
+                out[dst + c] = prev[src + (c - pad) % nt]
+                out[dst + pad + nt + c] = prev[src + c % nt]
+
+
+@_inline
+def run_values(j_lo: int, j_hi: int, b: Any, tr: Any, omr: Any, ir: Any, ca: Any, cs: Any,
+               fop: Any, fom: Any, xpad: Any, ring: int, stride: int, n: Any, best_val: Any,
+               best_n: Any) -> None:
+    """Rows of one run (``kind`` 0) of control ``n``; keeps the best so far per node.
+
+    The indices are unsigned (they are >= 0 by construction), so numba drops the
+    negative-index wrap and the loop vectorises (AVX: 8 or 16 nodes at a time).
+    """
+    h = xpad.dtype.type(0.5)
+    one = np.uint64(1)
+    a_ = np.uint64(ring + int(fop))  # ring i + di, the + foot
+    b_ = a_ + np.uint64(stride)  # the next ring
+    c_ = np.uint64(ring + int(fom))  # the - foot
+    d_ = c_ + np.uint64(stride)
+    for jj in range(np.uint64(j_lo), np.uint64(j_hi)):
+        j = np.uint64(jj)
+        x = b[j] * ir + ca
+        tp = (x + cs) - fop
+        tm = (x - cs) - fom
+        a0 = xpad[a_ + j]
+        a1 = xpad[a_ + j + one]
+        b0 = xpad[b_ + j]
+        b1 = xpad[b_ + j + one]
+        c0 = xpad[c_ + j]
+        c1 = xpad[c_ + j + one]
+        d0 = xpad[d_ + j]
+        d1 = xpad[d_ + j + one]
+        s = h * (omr[j] * ((a0 + tp * (a1 - a0)) + (c0 + tm * (c1 - c0)))
+                 + tr[j] * ((b0 + tp * (b1 - b0)) + (d0 + tm * (d1 - d0))))
+        old = best_val[j]
+        better = s > old
+        best_val[j] = s if better else old
+        best_n[j] = n if better else best_n[j]
+
+
+@_jit
+def unsure_arc(prev: Any, base: int, nt: int, sure: Any) -> tuple[int, int]:
+    """``(start, length)`` of the shortest arc of ``j`` (periodic) holding every node of
+    the ring at ``prev[base:base + nt]`` with ``w < sure``: the complement of the longest
+    run of sure nodes.  ``(0, nt)`` when none is sure, length 0 when all are."""
+    best_len, best_end = 0, 0
+    run = 0
+    for jj in range(2 * nt):  # twice round: a sure run may wrap past j = 0
+        if prev[base + jj % nt] >= sure:
+            run += 1
+            if run > best_len:
+                best_len, best_end = run, jj + 1
+        else:
+            run = 0
+    if best_len >= nt:
+        return 0, 0
+    return best_end % nt, nt - best_len
+
+
+@_jit
+def ring_slice(
+    ptr: Any, j0: Any, j1: Any, kind: Any, di: Any, op: Any, om: Any, b: Any, tr: Any,
+    omr: Any, inv_r: Any, ca: Any, cs: Any, nr: int, nt: int, pad: int, xpad: Any,
+    prev: Any, sw_data: Any, sw_indices: Any, prev_c: Any, use_switch: bool, ring_lo: int,
+    ring_hi: int, switch_eps: Any, zero_clip: Any, sure: Any, prev_action: Any,
+    w_out: Any, action_out: Any, best_val: Any, best_n: Any,
+) -> None:
+    """One budget slice of the bilinear solve for rings ``ring_lo .. ring_hi - 1``.
+
+    Per ring and tack: the best control of every node over the runs of
+    :func:`fill_runs` (controls in order, the first of equal maxima kept), then
+    :func:`finish_nodes` (switch, clip, keep).  ``xpad`` holds ``prev`` padded by
+    :func:`pad_rings`; ``best_val``, ``best_n`` are scratch of ``nt`` entries.
+    """
+    n_u = b.shape[1]
+    stride = nt + 2 * pad
+    first = prev.dtype.type(-1.0)  # below any row value: control 0 always sets the best
+    one = prev.dtype.type(1.0)
+    zero = prev.dtype.type(0.0)
     per_tack = (nr + 1) * nt
-    stride = nt + 1
-    off = padded_offset(nt)
-    for p in range(2 * per_tack):
-        q = p // per_tack
-        i = (p % per_tack) // nt
-        j = p % nt
-        r = i * dr
-        th = j * dtheta
-        inv_r = 1.0 / r if r > 0 else 0.0
-        for n in range(n_u):
-            rf = r - tau * speeds[n] * cos_tab[q, j, n]
-            dth = tau * (speeds[n] * inv_r * sin_tab[q, j, n] + a)
-            inside = rf <= target_radius
-            if inside or rf > r_max:
-                ghost = 0 if inside else 1
-                cols[p, n, 0] = ghost
-                cols[p, n, 1] = ghost
-                for e in range(8):
-                    vals[p, n, e] = 0.0
-                vals[p, n, 0] = 0.5
-                vals[p, n, 4] = 0.5
-                continue
-            fr = min(max(rf / dr, 0.0), float(nr))
-            i0 = min(math.floor(fr), nr - 1)
-            t_r = fr - i0
-            w_r0 = 1 - t_r
-            ring = off + (q * (nr + 1) + i0) * stride
-            for f in range(2):
-                pm = 1.0 if f == 0 else -1.0
-                ft = (th + dth + pm * sigma_sqrt_tau) / dtheta
-                j0f = math.floor(ft)
-                t_t = ft - j0f
-                w_t0 = 1 - t_t
-                cols[p, n, f] = ring + int(j0f) % nt
-                e = 4 * f
-                vals[p, n, e] = 0.5 * (w_r0 * w_t0)
-                vals[p, n, e + 1] = 0.5 * (w_r0 * t_t)
-                vals[p, n, e + 2] = 0.5 * (t_r * w_t0)
-                vals[p, n, e + 3] = 0.5 * (t_r * t_t)
+    for q in range(2):
+        for i in range(ring_lo, ring_hi):
+            ir = inv_r[i]
+            for j in range(nt):
+                best_val[j] = first
+            # the nodes not yet sure: at most two ranges of j (a sure node keeps its value)
+            a, length = unsure_arc(prev, q * per_tack + i * nt, nt, sure)
+            spans = ((a, min(a + length, nt)), (0, max(a + length - nt, 0)))
+            for n in range(n_u):
+                nn = np.int8(n)
+                t = (q * (nr + 1) + i) * n_u + n
+                b_qn, tr_qn, omr_qn = b[q, n], tr[q, n], omr[q, n]
+                for r in range(ptr[t], ptr[t + 1]):
+                    for lo_, hi_ in spans:
+                        r0, r1 = max(j0[r], lo_), min(j1[r], hi_)
+                        if r0 >= r1:
+                            continue
+                        if kind[r] != 0:  # a ghost foot: the mark (1) or beyond r_max (0)
+                            g = one if kind[r] == 1 else zero
+                            for j in range(r0, r1):
+                                if g > best_val[j]:
+                                    best_val[j] = g
+                                    best_n[j] = nn
+                            continue
+                        ring = (q * (nr + 2) + i + di[r]) * stride + pad
+                        run_values(r0, r1, b_qn, tr_qn, omr_qn, ir, ca, cs,
+                                   prev.dtype.type(op[r]), prev.dtype.type(om[r]), xpad,
+                                   ring, stride, nn, best_val, best_n)
+            finish_nodes(q * per_tack + i * nt, best_val, best_n, prev, sw_data, sw_indices,
+                         prev_c, use_switch, switch_eps, zero_clip, sure, prev_action, w_out,
+                         action_out)
 
 
 @_jit
-def pad_slice(prev: Any, nt: int, out: Any) -> None:
-    """Copy a slice ``prev`` (``n_nodes`` values and the two ghosts) into the padded form
-    read by the bilinear rows: ghosts at 0 and 1, ring ``R`` at ``off + R S .. + nt``
-    followed by its column 0 again (periodic ``θ``)."""
-    n_nodes = prev.shape[0] - 2
-    stride = nt + 1
-    off = padded_offset(nt)
-    out[0] = prev[n_nodes]
-    out[1] = prev[n_nodes + 1]
-    for ring in range(n_nodes // nt):
-        src = ring * nt
-        dst = off + ring * stride
-        for j in range(nt):
-            out[dst + j] = prev[src + j]
-        out[dst + nt] = prev[src]
+def finish_nodes(p0: int, best_val: Any, best_n: Any, prev: Any, sw_data: Any,
+                 sw_indices: Any, prev_c: Any, use_switch: bool, switch_eps: Any,
+                 zero_clip: Any, sure: Any, prev_action: Any, w_out: Any,
+                 action_out: Any) -> None:
+    """Nodes ``p0 .. p0 + len(best_val) - 1`` given their best steering value and
+    control: the switch update, the clip to ``[0, 1]`` and the "more budget never hurts"
+    keep (a node already sure keeps its value and action).  The action is the control
+    index with bit 7 set for a switch (``deadline.DeadlinePolicy.action``).  One call per
+    ring or block: numba passes each array as a struct of its fields, which per node
+    costs more than the work (and inlining it per node made the slice 1.9x slower)."""
+    zero = prev.dtype.type(0.0)
+    one = prev.dtype.type(1.0)
+    for j in range(best_val.shape[0]):
+        p = p0 + j
+        pv = prev[p]
+        if pv >= sure:
+            w_out[p] = pv
+            action_out[p] = prev_action[p]
+            continue
+        wk = best_val[j]
+        sw = False
+        if use_switch:
+            ws = zero
+            b = p * 6
+            for e in range(6):
+                ws += sw_data[b + e] * prev_c[sw_indices[b + e]]
+            if ws > wk + switch_eps:
+                sw = True
+                wk = ws
+        if wk < zero_clip:
+            wk = zero
+        elif wk > one:
+            wk = one
+        if pv > wk:
+            w_out[p] = pv
+            action_out[p] = prev_action[p]
+        else:
+            w_out[p] = wk
+            action_out[p] = np.uint8(best_n[j]) | (np.uint8(128) if sw else np.uint8(0))
 
 
-@_jit
-def _row_bilinear(c0: int, c1: int, v: int, vals: Any, xpad: Any, stride: int) -> Any:
-    """One bilinear row: foot +, then foot - (the CSR row's order of the sums)."""
-    s = xpad.dtype.type(0.0)
-    s += vals[v] * xpad[c0]
-    s += vals[v + 1] * xpad[c0 + 1]
-    s += vals[v + 2] * xpad[c0 + stride]
-    s += vals[v + 3] * xpad[c0 + stride + 1]
-    s += vals[v + 4] * xpad[c1]
-    s += vals[v + 5] * xpad[c1 + 1]
-    s += vals[v + 6] * xpad[c1 + stride]
-    s += vals[v + 7] * xpad[c1 + stride + 1]
-    return s
-
-
-@_jit
-def _best_bilinear(p: int, cols: Any, vals: Any, n_u: int, xpad: Any, stride: int) -> Any:
-    """Best control (the first of equal maxima) and its value at node ``p`` (padded
-    bilinear rows).  (Skipping controls whose eight points all lie below the best value
-    so far reads fewer weights but costs more than it saves: 1.25x slower, measured.)"""
-    wk = xpad.dtype.type(0.0)
-    best = 0
-    for n in range(n_u):
-        c = (p * n_u + n) * 2
-        s = _row_bilinear(cols[c], cols[c + 1], (p * n_u + n) * 8, vals, xpad, stride)
-        if n == 0 or s > wk:
-            wk = s
-            best = n
-    return wk, best
-
-
-@_jit
+@_inline
 def _best_csr(p: int, data: Any, indices: Any, n_u: int, per_row: int, prev: Any) -> Any:
     """Best control and its value at node ``p`` (CSR rows, e.g. bicubic)."""
     wk = prev.dtype.type(0.0)
@@ -191,31 +297,24 @@ def _best_csr(p: int, data: Any, indices: Any, n_u: int, per_row: int, prev: Any
 
 @_jit
 def slice_update(
-    bilinear: bool, cols: Any, vals: Any, n_u: int, per_row: int, stride: int, prev: Any,
-    xpad: Any,
+    cols: Any, vals: Any, n_u: int, per_row: int, prev: Any,
     sw_data: Any, sw_indices: Any, prev_c: Any, use_switch: bool,
     node_lo: int, node_hi: int, switch_eps: Any, zero_clip: Any, sure: Any,
-    prev_steer: Any, prev_switch: Any, w_out: Any, steer_out: Any, switch_out: Any,
+    prev_action: Any, w_out: Any, action_out: Any,
 ) -> None:
-    """One budget slice for nodes ``node_lo .. node_hi - 1`` (see ``solve_deadline``).
+    """One budget slice for nodes ``node_lo .. node_hi - 1`` with CSR steering rows
+    (bicubic; see ``solve_deadline``).
 
     Parameters
     ----------
-    bilinear : bool
-        ``cols, vals`` are the padded bilinear rows of :func:`steer_stencil_bilinear`
-        (read from ``xpad``), else the node-major CSR ``indices, data`` of the steering
-        operator (``n_u`` rows of ``per_row`` entries per node; read from ``prev``).
     cols, vals : ndarray
-        The steering operator, flattened; column indices as uint32 (numba then skips
-        the negative-index wrap: 1.4x).
+        The node-major CSR ``indices`` (uint32: numba then skips the negative-index
+        wrap, 1.4x) and ``data`` of the steering operator, ``n_u`` rows of ``per_row``
+        entries per node.
     n_u, per_row : int
-        Controls per node; entries per CSR row (cubic).
-    stride : int
-        The padded ring length ``S = n_θ + 1`` (bilinear).
+        Controls per node; entries per row.
     prev : ndarray, shape (n_nodes + 2,)
         ``w`` of the previous slice with the two ghosts.
-    xpad : ndarray
-        ``prev`` padded by :func:`pad_slice` (bilinear only).
     sw_data, sw_indices : ndarray
         Switch operator entries (6 per node).
     prev_c : ndarray, shape (n_nodes + 2,)
@@ -223,42 +322,16 @@ def slice_update(
     switch_eps, zero_clip, sure : scalar of ``prev``'s dtype
         The solver's constants, in the value dtype (NumPy compares float32 arrays with
         Python floats in float32).
-    prev_steer, prev_switch : ndarray, shape (n_nodes,)
-        Action of the previous slice.
-    w_out, steer_out, switch_out : ndarray, shape (n_nodes + 2,), (n_nodes,), (n_nodes,)
+    prev_action : ndarray of uint8, shape (n_nodes,)
+        Action of the previous slice (control index, bit 7 a switch).
+    w_out, action_out : ndarray, shape (n_nodes + 2,), (n_nodes,)
         This slice's value and action (written for the node range only).
     """
-    zero = prev.dtype.type(0.0)
-    one = prev.dtype.type(1.0)
+    best_val = np.empty(node_hi - node_lo, dtype=prev.dtype)
+    best_n = np.zeros(node_hi - node_lo, dtype=np.int8)
     for p in range(node_lo, node_hi):
-        pv = prev[p]
-        if pv >= sure:  # kept whatever this slice gives: skip the row products
-            w_out[p] = pv
-            steer_out[p] = prev_steer[p]
-            switch_out[p] = prev_switch[p]
-            continue
-        if bilinear:
-            wk, best = _best_bilinear(p, cols, vals, n_u, xpad, stride)
-        else:
-            wk, best = _best_csr(p, vals, cols, n_u, per_row, prev)
-        sw = False
-        if use_switch:
-            ws = zero
-            b = p * 6
-            for e in range(6):
-                ws += sw_data[b + e] * prev_c[sw_indices[b + e]]
-            if ws > wk + switch_eps:
-                sw = True
-                wk = ws
-        if wk < zero_clip:
-            wk = zero
-        elif wk > one:
-            wk = one
-        if pv > wk:
-            w_out[p] = pv
-            steer_out[p] = prev_steer[p]
-            switch_out[p] = prev_switch[p]
-        else:
-            w_out[p] = wk
-            steer_out[p] = best
-            switch_out[p] = sw
+        if prev[p] < sure:  # a sure node keeps its value: skip its rows
+            best_val[p - node_lo], best_n[p - node_lo] = _best_csr(p, vals, cols, n_u,
+                                                                   per_row, prev)
+    finish_nodes(node_lo, best_val, best_n, prev, sw_data, sw_indices, prev_c, use_switch,
+                 switch_eps, zero_clip, sure, prev_action, w_out, action_out)

@@ -40,8 +40,9 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -76,6 +77,9 @@ REFINEMENTS = ("none", "golden")
 """Steering-angle refinement after the direct search over the fixed controls."""
 BLOCK_NODES = 8192
 """Nodes per sparse mat-vec block (the block's values stay in cache for the max)."""
+RING_BLOCK_NODES = 1024
+"""Nodes per block of the NumPy ring-relative rows (their temporaries stay in the L2
+cache: 2.3x faster than blocks of 8192)."""
 
 
 @dataclass(frozen=True)
@@ -124,8 +128,9 @@ class DeadlineGrid:
     def __post_init__(self) -> None:
         if not (self.r_max_m > 0 and math.isfinite(self.r_max_m)):
             raise InputError(f"deadline grid: r_max_m = {self.r_max_m} must be finite and > 0")
-        if self.n_r < 2 or self.n_theta < 4 or self.n_controls < 2:
-            raise InputError("deadline grid: need n_r >= 2, n_theta >= 4, n_controls >= 2")
+        if self.n_r < 2 or self.n_theta < 4 or not 2 <= self.n_controls <= 128:
+            raise InputError(
+                "deadline grid: need n_r >= 2, n_theta >= 4, 2 <= n_controls <= 128")
         if not 0 < self.target_radius_m < self.r_max_m:
             raise InputError(
                 f"deadline grid: target radius {self.target_radius_m} m must be in (0, r_max)"
@@ -405,43 +410,136 @@ def _steer_operator(
 
 
 @dataclass(frozen=True, eq=False)
-class _CompiledSteer:
-    """The steering operator in the form the numba slice kernel reads
-    (:mod:`sailroute.strategy._deadline_jit`): bilinear rows in the padded form, or the
-    CSR rows of a :class:`_RowOperator` (bicubic)."""
+class _RingRows:
+    """The bilinear steering rows written relative to the node (the default operator).
 
-    bilinear: bool
-    cols: NDArray[np.uint32]
-    vals: NDArray
-    n_u: int
-    per_row: int
-    """Entries per CSR row (bicubic)."""
-    stride: int
-    """The padded ring length ``n_θ + 1`` (bilinear)."""
-    xpad: NDArray
-    """Scratch for the padded slice (bilinear)."""
+    The feet of node ``(q, i, j)`` under control ``n`` (:func:`_feet_stencil`) lie at ring
+    ``i + g`` and angle column ``j + x ± c_σ`` [cells], with ``g = -τ f_n cos(θ_j + s_q
+    u_n)/Δr``, ``x = b/r_i + c_a``, ``b = τ f_n sin(θ_j + s_q u_n)/Δθ``, ``c_a = τa/Δθ`` and
+    ``c_σ = σ√τ/Δθ``.  ``g``, ``b`` and the radial fraction depend on ``(q, n, j)`` only,
+    so nothing is stored per row (the CSR form of :func:`_steer_operator` takes 64 bytes
+    a row, 5 GB at 801 x 1024), and along a ring the rows fall into runs that read
+    contiguous memory (``_deadline_jit.fill_runs``).  A row's value is
+
+        ½ [(1 - t_r)(A₊ + A₋) + t_r (B₊ + B₋)],   A± = a₀ + t± (a₁ - a₀)
+
+    with ``A±`` interpolated in ``θ`` on ring ``i + ⌊g⌋`` at fraction ``t± = x ± c_σ -
+    ⌊x ± c_σ⌋`` and ``B±`` on the next ring; ``x`` and the values in the value dtype.
+    The same bilinear scheme as the CSR rows up to rounding: on Wang et al.'s (2024)
+    Fig. 4b set-up at 401 x 512, ``w`` differs by at most 3.2e-6.
+    """
+
+    g: NDArray[np.float64]
+    """``(2, n_u, n_θ)``: radial offset of the feet [cells]."""
+    b: NDArray
+    """``(2, n_u, n_θ)``: ``τ f sin(θ + s u)/Δθ`` [cells m], value dtype."""
+    di: NDArray[np.int64]
+    """``⌊g⌋``."""
+    tr: NDArray
+    """``g - ⌊g⌋``, value dtype."""
+    omr: NDArray
+    """``1 - tr``."""
+    inv_r: NDArray
+    """``(n_r + 1,)``: ``1/r_i`` [m⁻¹] (0 at ``r = 0``), value dtype."""
+    ca: Any
+    """``c_a`` (value dtype scalar)."""
+    cs: Any
+    """``c_σ`` (value dtype scalar)."""
+    fr_in: float
+    """``R_D/Δr``: a foot at or inside this ring position is in the mark."""
+    pad: int
+    """Periodic columns copied on each side of a ring (more than any foot's offset)."""
+    n_r: int
+    n_theta: int
+    runs: tuple[NDArray, ...] | None
+    """``(ptr, j0, j1, kind, di, op, om)`` of ``_deadline_jit.fill_runs`` (numba only)."""
+    by_node: Mapping[str, NDArray]
+    """``g``, ``b``, ``di``, ``tr``, ``omr`` as rows ``q n_θ + j`` of ``n_u`` controls
+    (the NumPy rows gather a node's controls as one row)."""
 
     @classmethod
     def build(cls, grid: DeadlineGrid, speeds: NDArray[np.float64], a: float, sigma: float,
-              tau: float, dtype: type) -> _CompiledSteer:
-        """The steering operator of :func:`_steer_operator` (``outer="fail"``)."""
+              tau: float, dtype: type, compiled: bool) -> _RingRows:
+        """Tables of ``grid`` (and the runs when ``compiled``)."""
         u = grid.controls_rad
-        if grid.interpolation == "cubic":
-            op = _steer_operator(grid, speeds, a, sigma, tau, "fail", "cubic", dtype)
-            return cls(False, op.indices.view(np.uint32), op.data, u.size, op.per_row, 0,
-                       np.zeros(1, dtype=dtype))
-        # the same arithmetic as _feet_stencil, one pass (the angle tables from NumPy)
         q = np.arange(2)[:, None, None]
-        ang = grid.theta_rad[None, :, None] + np.where(q == 0, 1.0, -1.0) * u
-        cols = np.empty((grid.n_nodes, u.size, 2), dtype=np.uint32)
-        vals: NDArray[Any] = np.empty((grid.n_nodes, u.size, 8), dtype=dtype)
-        _jit.steer_stencil_bilinear(
-            np.cos(ang), np.sin(ang), np.asarray(speeds, dtype=np.float64), grid.n_r,
-            grid.n_theta, grid.dr, grid.dtheta, grid.target_radius_m, grid.r_max_m, tau, a,
-            sigma * math.sqrt(tau), cols, vals)
-        n_pad = _jit.padded_offset(grid.n_theta) + 2 * (grid.n_r + 1) * (grid.n_theta + 1)
-        return cls(True, cols.reshape(-1), vals.reshape(-1), u.size, 8, grid.n_theta + 1,
-                   np.zeros(n_pad, dtype=dtype))
+        ang = grid.theta_rad[None, None, :] + np.where(q == 0, 1.0, -1.0) * u[None, :, None]
+        step = tau * speeds[None, :, None]
+        g = np.ascontiguousarray(-(step * np.cos(ang)) / grid.dr)
+        di = np.floor(g).astype(np.int64)
+        tr: NDArray[Any] = (g - di).astype(dtype)
+        b: NDArray[Any] = np.ascontiguousarray((step * np.sin(ang) / grid.dtheta).astype(dtype))
+        with np.errstate(divide="ignore"):
+            inv_r: NDArray[Any] = np.where(grid.r_m > 0, 1.0 / grid.r_m, 0.0).astype(dtype)
+        ca, cs = dtype(tau * a / grid.dtheta), dtype(sigma * math.sqrt(tau) / grid.dtheta)
+        n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))
+        # the largest |x ± c_σ| over the rings outside the mark, + 2 for ⌊⌋ and the +1 column
+        pad = math.ceil(float(np.max(np.abs(b))) * float(inv_r[n_in]) + abs(float(ca))
+                        + float(cs)) + 2
+        fr_in = grid.target_radius_m / grid.dr
+        runs = None
+        if compiled:
+            ptr = np.zeros(2 * (grid.n_r + 1) * u.size + 1, dtype=np.int64)
+            _jit.count_runs(g, b, inv_r, ca, cs, fr_in, grid.n_r, grid.n_theta, n_in, ptr)
+            m = int(ptr[-1])
+            runs = (ptr, np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8),
+                    np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int64))
+            _jit.fill_runs(g, b, inv_r, ca, cs, fr_in, grid.n_r, grid.n_theta, n_in, *runs)
+        omr = (dtype(1.0) - tr).astype(dtype)
+        by_node = MappingProxyType({
+            name: np.ascontiguousarray(t.transpose(0, 2, 1).reshape(2 * grid.n_theta, -1))
+            for name, t in (("g", g), ("b", b), ("di", di), ("tr", tr), ("omr", omr))})
+        return cls(g, b, di, tr, omr, inv_r, ca, cs, fr_in, pad, grid.n_r, grid.n_theta, runs,
+                   by_node)
+
+    @property
+    def stride(self) -> int:
+        """Padded ring length."""
+        return self.n_theta + 2 * self.pad
+
+    def padded_size(self) -> int:
+        """Length of the padded slice (both tacks, plus a ring of zeros beyond ``r_max``)."""
+        return 2 * (self.n_r + 2) * self.stride
+
+    def pad_slice(self, prev: NDArray, ring_lo: int, ring_hi: int, out: NDArray) -> None:
+        """Rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice ``out``."""
+        if self.runs is not None:
+            _jit.pad_rings(prev, self.n_r, self.n_theta, self.pad, ring_lo, ring_hi, out)
+            return
+        nt, pad = self.n_theta, self.pad
+        lo, hi = max(ring_lo - 1, 0), min(ring_hi + 1, self.n_r + 1)
+        cols = np.mod(np.arange(-pad, nt + pad), nt)
+        rings = prev[: 2 * (self.n_r + 1) * nt].reshape(2, self.n_r + 1, nt)
+        view = out.reshape(2, self.n_r + 2, self.stride)
+        view[:, lo:hi] = rings[:, lo:hi][:, :, cols]
+
+    def values(self, xpad: NDArray, node_lo: int, node_hi: int) -> NDArray:
+        """Rows of nodes ``node_lo .. node_hi - 1`` (``xpad`` from :meth:`pad_slice`),
+        shape ``(nodes, n_u)``: the NumPy twin of ``_deadline_jit.run_values``."""
+        nt, stride = self.n_theta, self.stride
+        per_tack = (self.n_r + 1) * nt
+        node = np.arange(node_lo, node_hi)
+        q, i, j = node // per_tack, (node % per_tack) // nt, node % nt
+        qj = q * nt + j  # row of the node-major tables
+        i_c = i[:, None]
+        x = self.by_node["b"][qj] * self.inv_r[i_c] + self.ca
+        xp, xm = x + self.cs, x - self.cs
+        fp, fm = np.floor(xp), np.floor(xm)
+        tp, tm = xp - fp, xm - fm
+        fr = i_c + self.by_node["g"][qj]
+        inside, beyond = fr <= self.fr_in, fr > self.n_r
+        ring = ((q * (self.n_r + 2) + i) * stride + self.pad + j)[:, None] + \
+            self.by_node["di"][qj] * stride
+        top = xpad.size - stride - 2
+        up = np.clip(ring + fp.astype(np.int64), 0, top)  # clipped: ghosts, inside rings
+        um = np.clip(ring + fm.astype(np.int64), 0, top)
+        a0, a1, b0, b1 = xpad[up], xpad[up + 1], xpad[up + stride], xpad[up + stride + 1]
+        c0, c1, d0, d1 = xpad[um], xpad[um + 1], xpad[um + stride], xpad[um + stride + 1]
+        h = xpad.dtype.type(0.5)
+        s = h * (self.by_node["omr"][qj] * ((a0 + tp * (a1 - a0)) + (c0 + tm * (c1 - c0)))
+                 + self.by_node["tr"][qj] * ((b0 + tp * (b1 - b0)) + (d0 + tm * (d1 - d0))))
+        one, zero = xpad.dtype.type(1.0), xpad.dtype.type(0.0)
+        return np.where(inside, one, np.where(beyond, zero, s))
 
 
 def _switch_operator(
@@ -468,6 +566,10 @@ def _switch_operator(
     return _RowOperator.build(cols.reshape(m, 1, 6), vals.reshape(m, 1, 6), grid.n_nodes + 2)
 
 
+SWITCH_BIT = 128
+"""Bit of :attr:`DeadlinePolicy.action` set where switching tack is optimal."""
+STEER_MASK = 127
+"""Bits of :attr:`DeadlinePolicy.action` holding the steering control index."""
 OFFSET_STEPS = 127
 """``steer_offset`` units: ``Δu / 127`` (0.03° for 49 controls)."""
 FINE_SPEED_STEPS = 1440
@@ -549,10 +651,11 @@ class DeadlinePolicy:
         Boat speed at each steering angle [m s⁻¹].
     w : ndarray of float32, shape (n_s + 1, n_nodes)
         Success probability per budget slice and node (flat ``(q, i, j)``).
-    steer : ndarray of int8, shape (n_s + 1, n_nodes)
-        Best steering control index per slice and node.
-    switch : ndarray of bool, shape (n_s + 1, n_nodes)
-        True where switching tack is optimal.
+    action : ndarray of uint8, shape (n_s + 1, n_nodes)
+        Per slice and node: the best steering control index (bits 0-6) and whether
+        switching tack is optimal (bit 7, :data:`SWITCH_BIT`); one byte instead of two,
+        1.9 GB less at 801 x 1024 (:meth:`steering`, :meth:`switches`, or the
+        :attr:`steer` and :attr:`switch` arrays).
     solve_time_s : float
     steer_offset : ndarray of int8, shape (n_s + 1, n_nodes), or None
         With ``grid.refine_controls``: the refined angle is
@@ -566,15 +669,30 @@ class DeadlinePolicy:
     model: DriftDiffusionShift
     speeds_ms: NDArray[np.float64]
     w: NDArray[np.float32]
-    steer: NDArray[np.int8]
-    switch: NDArray[np.bool_]
+    action: NDArray[np.uint8]
     solve_time_s: float
     steer_offset: NDArray[np.int8] | None = None
     fine_speeds: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
 
+    @property
+    def steer(self) -> NDArray[np.int8]:
+        """Best steering control index per slice and node (a new array: index
+        :attr:`action` or use :meth:`steering` for a few nodes)."""
+        return (self.action & STEER_MASK).astype(np.int8)
+
+    @property
+    def switch(self) -> NDArray[np.bool_]:
+        """True where switching tack is optimal, per slice and node (a new array; see
+        :meth:`switches`)."""
+        return self.action >= SWITCH_BIT
+
+    def switches(self, k: NDArray | int, node: NDArray) -> NDArray[np.bool_]:
+        """Whether switching tack is optimal in slice(s) ``k`` at ``node``."""
+        return np.asarray(self.action[k, node] >= SWITCH_BIT)
+
     def steering(self, k: NDArray, node: NDArray) -> tuple[NDArray, NDArray]:
         """Steering angle [rad] and boat speed [m s⁻¹] of slice(s) ``k`` at ``node``."""
-        idx = self.steer[k, node].astype(np.int64)
+        idx = (self.action[k, node] & STEER_MASK).astype(np.int64)
         if self.steer_offset is None or self.fine_speeds is None:
             return self.grid.controls_rad[idx], self.speeds_ms[idx]
         du = math.pi / (self.grid.n_controls - 1)
@@ -677,6 +795,37 @@ def _use_compiled(engine: str) -> bool:
     return engine == "numba" or (engine == "auto" and _jit.AVAILABLE)
 
 
+def _update_block(k: int, n0: int, n1: int, vals: NDArray, w: NDArray, action: NDArray,
+                  offset: NDArray | None, refine: _SteerRefiner | None,
+                  switch_op: _RowOperator, kc: int) -> None:
+    """Slice ``k`` of nodes ``n0 .. n1 - 1`` from their steering rows ``vals`` (NumPy path;
+    ``_deadline_jit.finish_node`` is the compiled twin)."""
+    prev = w[k - 1]
+    best = np.argmax(vals, axis=1)
+    wk = np.take_along_axis(vals, best[:, None], axis=1)[:, 0]
+    off = None
+    if refine is not None:
+        wk, off = refine.refine(prev, n0, n1, best, wk)
+    if k >= kc:
+        ws = switch_op.apply(w[k - kc], n0, n1)[:, 0]
+        sw = ws > wk + SWITCH_EPS
+        wk = np.where(sw, ws, wk)
+    else:
+        sw = np.zeros(n1 - n0, dtype=bool)
+    wk = np.where(wk < ZERO_CLIP, 0.0, np.minimum(wk, 1.0))
+    # More budget never hurts: following the policy of budget s - Δs succeeds by s at
+    # least as often.  Where that beats this slice (possible with the non-monotone cubic
+    # weights), or where success was already sure (deadline upgrade: any action keeping
+    # w = 1 ties, the one of the least sure budget is the tightest), keep the previous
+    # slice's value and action.
+    p = prev[n0:n1]
+    keep = (p >= SURE) | (p > wk)
+    w[k, n0:n1] = np.where(keep, p, wk)
+    action[k, n0:n1] = np.where(keep, action[k - 1, n0:n1], best | np.where(sw, SWITCH_BIT, 0))
+    if offset is not None and off is not None:
+        offset[k, n0:n1] = np.where(keep, offset[k - 1, n0:n1], off)
+
+
 def solve_deadline(
     polar: Polar,
     tws_ms: float,
@@ -716,8 +865,9 @@ def solve_deadline(
     Returns
     -------
     DeadlinePolicy
-        Memory: ``(4 + 2) (n_s + 1) n_nodes`` bytes for ``w``, ``steer`` and ``switch``
-        (``w`` in ``dtype``), plus ``steer_offset`` with ``grid.refine_controls``.
+        Memory: ``(4 + 1) (n_s + 1) n_nodes`` bytes for ``w`` and ``action`` (``w`` in
+        ``dtype``: 8 + 1 with float64), plus ``steer_offset`` with
+        ``grid.refine_controls``.
 
     Notes
     -----
@@ -740,10 +890,11 @@ def solve_deadline(
         _SteerRefiner(grid, polar, tws_ms, a, sigma, grid.ds_s)
         if grid.refine_controls != "none" else None
     )
-    kernel = (_CompiledSteer.build(grid, f, a, sigma, grid.ds_s, ftype)
-              if compiled and refine is None else None)
-    steer_op = (None if kernel is not None else
-                _steer_operator(grid, f, a, sigma, grid.ds_s, "fail", grid.interpolation, ftype))
+    jit = compiled and refine is None  # golden refinement runs on the NumPy path
+    cubic = grid.interpolation == "cubic"
+    rows = None if cubic else _RingRows.build(grid, f, a, sigma, grid.ds_s, ftype, jit)
+    steer_op = (_steer_operator(grid, f, a, sigma, grid.ds_s, "fail", "cubic", ftype)
+                if cubic else None)
     switch_op = _switch_operator(grid, a, sigma, tack_penalty_s, ftype)
     n_s, n_nodes, nt = grid.n_s, grid.n_nodes, grid.n_theta
     per_tack = (grid.n_r + 1) * nt
@@ -752,12 +903,13 @@ def solve_deadline(
     for q in (0, 1):
         w[:, q * per_tack:q * per_tack + n_in * nt] = 1.0
     w[:, n_nodes] = 1.0  # ghost: a foot inside the mark
-    steer = np.zeros((n_s + 1, n_nodes), dtype=np.int8)
-    switch = np.zeros((n_s + 1, n_nodes), dtype=np.bool_)
+    action = np.zeros((n_s + 1, n_nodes), dtype=np.uint8)
     offset = np.zeros((n_s + 1, n_nodes), dtype=np.int8) if refine is not None else None
     reach_time = (grid.r_m - grid.target_radius_m) / f_max  # per ring
     consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
-    switch_cols = switch_op.indices.view(np.uint32)  # the kernel's index type
+    switch_cols = switch_op.indices.view(np.uint32)  # the kernels' index type
+    xpad = np.zeros(rows.padded_size() if rows is not None else 0, dtype=ftype)
+    best_val, best_n = np.empty(nt, dtype=ftype), np.zeros(nt, dtype=np.int8)
     lo = n_in
     for k in range(1, n_s + 1):
         prev = w[k - 1]
@@ -765,50 +917,34 @@ def solve_deadline(
         hi = int(np.searchsorted(reach_time, k * grid.ds_s, side="right"))
         lo = _rings_all_sure(prev, grid, lo, hi)
         for q in (0, 1):
-            base = q * per_tack
-            keep_to = base + lo * nt
-            w[k, base:keep_to] = prev[base:keep_to]
-            steer[k, base:keep_to] = steer[k - 1, base:keep_to]
-            switch[k, base:keep_to] = switch[k - 1, base:keep_to]
+            keep_to = q * per_tack + lo * nt
+            w[k, q * per_tack:keep_to] = prev[q * per_tack:keep_to]
+            action[k, q * per_tack:keep_to] = action[k - 1, q * per_tack:keep_to]
             if offset is not None:
-                offset[k, base:keep_to] = offset[k - 1, base:keep_to]
-            if kernel is not None:
-                if q == 0 and kernel.bilinear:
-                    _jit.pad_slice(prev, nt, kernel.xpad)
-                _jit.slice_update(
-                    kernel.bilinear, kernel.cols, kernel.vals, kernel.n_u, kernel.per_row,
-                    kernel.stride, prev, kernel.xpad, switch_op.data, switch_cols,
-                    w[max(k - kc, 0)], k >= kc, keep_to, base + hi * nt, *consts,
-                    steer[k - 1], switch[k - 1], w[k], steer[k], switch[k])
-                continue
+                offset[k, q * per_tack:keep_to] = offset[k - 1, q * per_tack:keep_to]
+        if rows is not None:
+            rows.pad_slice(prev, lo, hi, xpad)
+        switch_args = (switch_op.data, switch_cols, w[max(k - kc, 0)], k >= kc)
+        if jit and rows is not None and rows.runs is not None:
+            _jit.ring_slice(*rows.runs, rows.b, rows.tr, rows.omr, rows.inv_r, rows.ca,
+                            rows.cs, grid.n_r, nt, rows.pad, xpad, prev, *switch_args, lo, hi,
+                            *consts, action[k - 1], w[k], action[k], best_val, best_n)
+        elif jit:
             assert steer_op is not None
-            for n0 in range(keep_to, base + hi * nt, BLOCK_NODES):
-                n1 = min(n0 + BLOCK_NODES, base + hi * nt)
-                vals = steer_op.apply(prev, n0, n1)
-                best = np.argmax(vals, axis=1)
-                wk = np.take_along_axis(vals, best[:, None], axis=1)[:, 0]
-                off = None
-                if refine is not None:
-                    wk, off = refine.refine(prev, n0, n1, best, wk)
-                if k >= kc:
-                    ws = switch_op.apply(w[k - kc], n0, n1)[:, 0]
-                    sw = ws > wk + SWITCH_EPS
-                    wk = np.where(sw, ws, wk)
-                else:
-                    sw = np.zeros(n1 - n0, dtype=bool)
-                wk = np.where(wk < ZERO_CLIP, 0.0, np.minimum(wk, 1.0))
-                # More budget never hurts: following the policy of budget s - Δs succeeds
-                # by s at least as often.  Where that beats this slice (possible with the
-                # non-monotone cubic weights), or where success was already sure (deadline
-                # upgrade: any action keeping w = 1 ties, the one of the least sure budget
-                # is the tightest), keep the previous slice's value and action.
-                p = prev[n0:n1]
-                keep = (p >= SURE) | (p > wk)
-                w[k, n0:n1] = np.where(keep, p, wk)
-                steer[k, n0:n1] = np.where(keep, steer[k - 1, n0:n1], best)
-                switch[k, n0:n1] = np.where(keep, switch[k - 1, n0:n1], sw)
-                if offset is not None and off is not None:
-                    offset[k, n0:n1] = np.where(keep, offset[k - 1, n0:n1], off)
+            for q in (0, 1):
+                _jit.slice_update(
+                    steer_op.indices.view(np.uint32), steer_op.data, f.size, steer_op.per_row,
+                    prev, *switch_args, q * per_tack + lo * nt, q * per_tack + hi * nt,
+                    *consts, action[k - 1], w[k], action[k])
+        else:
+            block = BLOCK_NODES if rows is None else RING_BLOCK_NODES
+            for q in (0, 1):
+                for n0 in range(q * per_tack + lo * nt, q * per_tack + hi * nt, block):
+                    n1 = min(n0 + block, q * per_tack + hi * nt)
+                    vals = (rows.values(xpad, n0, n1) if rows is not None else
+                            steer_op.apply(prev, n0, n1))  # type: ignore[union-attr]
+                    _update_block(k, n0, n1, vals, w, action, offset, refine, switch_op,
+                                  kc)
         if progress is not None:
             progress(k, n_s)
     return DeadlinePolicy(
@@ -817,8 +953,7 @@ def solve_deadline(
         model=model,
         speeds_ms=f,
         w=w[:, :n_nodes],
-        steer=steer,
-        switch=switch,
+        action=action,
         solve_time_s=time.perf_counter() - t0,
         steer_offset=offset,
         fine_speeds=(refine.u_tab, refine.f_tab) if refine is not None else None,
@@ -1052,7 +1187,7 @@ def simulate_deadline_chunk(
             ra_u, ra_f = ra.steering(kk, node)
             act_u = np.where(risk_aware, ra_u, act_u)
             act_f = np.where(risk_aware, ra_f, act_f)
-            act_switch = np.where(risk_aware, ra.switch[kk, node], act_switch)
+            act_switch = np.where(risk_aware, ra.switches(kk, node), act_switch)
         # never two switches in a row (a coarse grid can make the lookups ping-pong)
         act_switch &= ~last_switch & ~done
         z = rng.standard_normal(n)

@@ -253,6 +253,7 @@ def _reference_solve(g: DeadlineGrid, m: DriftDiffusionShift) -> np.ndarray:
         SWITCH_EPS,
         ZERO_CLIP,
         _model_rates,
+        _RingRows,
         _steer_operator,
         _switch_operator,
     )
@@ -260,7 +261,18 @@ def _reference_solve(g: DeadlineGrid, m: DriftDiffusionShift) -> np.ndarray:
     a, sigma = _model_rates(m)
     f = SO40.speed(1.0, np.degrees(g.controls_rad))
     kc = g.penalty_steps(C)
-    s_op = _steer_operator(g, f, a, sigma, g.ds_s, "fail", g.interpolation)
+    if g.interpolation == "cubic":
+        s_op = _steer_operator(g, f, a, sigma, g.ds_s, "fail", "cubic")
+
+        def rows(x: np.ndarray) -> np.ndarray:
+            return s_op.apply(x, 0, g.n_nodes)
+    else:  # the ring-relative bilinear rows, the NumPy twin of the compiled ones
+        ring = _RingRows.build(g, f, a, sigma, g.ds_s, np.float32, compiled=False)
+        xpad = np.zeros(ring.padded_size(), dtype=np.float32)
+
+        def rows(x: np.ndarray) -> np.ndarray:
+            ring.pad_slice(x, 0, g.n_r + 1, xpad)
+            return ring.values(xpad, 0, g.n_nodes)
     c_op = _switch_operator(g, a, sigma, C)
     r = np.tile(np.repeat(g.r_m, g.n_theta), 2)
     out = r > g.target_radius_m
@@ -269,7 +281,7 @@ def _reference_solve(g: DeadlineGrid, m: DriftDiffusionShift) -> np.ndarray:
     w[:, g.n_nodes] = 1.0
     reach = (r - g.target_radius_m) / float(np.max(f))
     for k in range(1, g.n_s + 1):
-        wk = np.max(s_op.apply(w[k - 1], 0, g.n_nodes), axis=1)
+        wk = np.max(rows(w[k - 1]), axis=1)
         if k >= kc:
             ws = c_op.apply(w[k - kc], 0, g.n_nodes)[:, 0]
             wk = np.where(ws > wk + SWITCH_EPS, ws, wk)
@@ -357,20 +369,88 @@ def test_golden_policy_simulates(golden) -> None:
     assert np.mean(sim.n_switches == 0) > 0.5  # the bet on the shift, as the coarse policy
 
 
-@pytest.mark.parametrize(("interpolation", "fig"), [("linear", (0.05, 46.0)),
-                                                    ("cubic", (0.0, 20.0))])
-def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig) -> None:
+@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), [
+    ("linear", (0.05, 46.0, SIGMA), "float32", (40, 48)),
+    ("linear", (-0.15, 30.0, SIGMA), "float64", (40, 48)),
+    # 4 angles and a wide diffusion: the feet reach more than once round the ring
+    ("linear", (0.15, 20.0, 8.0), "float32", (12, 4)),
+    ("cubic", (0.0, 20.0, SIGMA), "float32", (40, 48)),
+])
+def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype,
+                                                       shape) -> None:
     # the numba kernels do the NumPy arithmetic in the same order: the same w and actions
     pytest.importorskip("numba")
-    a, s_max = fig
-    g = DeadlineGrid(2.0, 40, 48, 0.1, 0.4, s_max, interpolation=interpolation)
-    m = model(a, SIGMA)
-    ref = solve_deadline(SO40, 1.0, m, g, C, engine="numpy")
-    jit = solve_deadline(SO40, 1.0, m, g, C, engine="numba")
+    a, s_max, sigma = fig
+    g = DeadlineGrid(2.0, shape[0], shape[1], 0.1, 0.4, s_max, interpolation=interpolation)
+    m = model(a, sigma)
+    if shape[1] == 4:
+        from sailroute.strategy.deadline import _model_rates, _RingRows
+
+        rows = _RingRows.build(g, SO40.speed(1.0, np.degrees(g.controls_rad)),
+                               *_model_rates(m), g.ds_s, np.float32, compiled=False)
+        assert rows.pad > g.n_theta
+    ref = solve_deadline(SO40, 1.0, m, g, C, engine="numpy", dtype=dtype)
+    jit = solve_deadline(SO40, 1.0, m, g, C, engine="numba", dtype=dtype)
     assert ref.w.max() > 0.5  # a solve with something to compare
+    assert (ref.w[-1] >= 1 - 1e-6).any()  # sure nodes
+    assert ref.switch.any() or sigma > 1  # switches (none when the wind is all noise)
     assert np.array_equal(jit.w, ref.w)
-    assert np.array_equal(jit.steer, ref.steer)
-    assert np.array_equal(jit.switch, ref.switch)
+    assert np.array_equal(jit.action, ref.action)
+
+
+def test_ring_rows_agree_with_the_sparse_bilinear_rows() -> None:
+    # the ring-relative rows are the bilinear scheme of _feet_stencil up to rounding:
+    # every node and control of a random slice (float64: to 1e-12)
+    from sailroute.strategy.deadline import _model_rates, _RingRows, _steer_operator
+
+    g = DeadlineGrid(2.0, 30, 40, 0.1, 0.4, 10.0)
+    a, sigma = _model_rates(model(0.1, SIGMA))
+    f = SO40.speed(1.0, np.degrees(g.controls_rad))
+    x = np.random.default_rng(3).random(g.n_nodes + 2)
+    x[g.n_nodes], x[g.n_nodes + 1] = 1.0, 0.0  # the ghosts: in the mark, beyond r_max
+    ring = _RingRows.build(g, f, a, sigma, g.ds_s, np.float64, compiled=False)
+    xpad = np.zeros(ring.padded_size())
+    ring.pad_slice(x, 0, g.n_r + 1, xpad)
+    n_in = int(np.count_nonzero(g.r_m <= g.target_radius_m))
+    lo = n_in * g.n_theta  # rows of nodes outside the mark (inside, w = 1 anyway)
+    per_tack = (g.n_r + 1) * g.n_theta
+    csr = _steer_operator(g, f, a, sigma, g.ds_s, "fail", "linear", np.float64)
+    for q in (0, 1):
+        n0, n1 = q * per_tack + lo, (q + 1) * per_tack
+        np.testing.assert_allclose(ring.values(xpad, n0, n1), csr.apply(x, n0, n1),
+                                   rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("sure", [[], [0, 1, 2], [5, 6, 7, 0, 1], [3], list(range(8)),
+                                  [0, 2, 3, 4, 7], [7]])
+def test_unsure_arc_covers_every_unsure_node(sure: list[int]) -> None:
+    pytest.importorskip("numba")
+    from sailroute.strategy._deadline_jit import unsure_arc
+
+    nt = 8
+    prev = np.full(nt + 4, 0.5, dtype=np.float32)
+    prev[2 + np.array(sure, dtype=int)] = 1.0
+    start, length = unsure_arc(prev, 2, nt, np.float32(1 - 1e-6))
+    covered = {(start + k) % nt for k in range(length)}
+    unsure = set(range(nt)) - set(sure)
+    assert unsure <= covered
+    # the complement of the longest circular run of sure nodes
+    longest = max((n for s0 in range(nt) for n in range(nt + 1)
+                   if all((s0 + k) % nt in sure for k in range(n))), default=0)
+    assert length == nt - min(longest, nt)
+
+
+def test_policy_action_packs_steer_and_switch(fig4a) -> None:
+    ra, g = fig4a[0], fig4a[0].grid
+    assert ra.action.dtype == np.uint8
+    np.testing.assert_array_equal(ra.steer, ra.action & 127)
+    np.testing.assert_array_equal(ra.switch, ra.action >= 128)
+    k, node = np.array([g.n_s, g.n_s]), np.array([5, 2 * g.n_nodes // 3])
+    np.testing.assert_array_equal(ra.switches(k, node), ra.switch[k, node])
+    u, _ = ra.steering(k, node)
+    np.testing.assert_array_equal(u, g.controls_rad[ra.steer[k, node]])
+    with pytest.raises(InputError, match="n_controls <= 128"):
+        DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 10.0, n_controls=129)
 
 
 def test_engine_errors(monkeypatch) -> None:
