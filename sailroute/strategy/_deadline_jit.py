@@ -127,14 +127,21 @@ def pad_rings(prev: Any, nr: int, nt: int, pad: int, ring_lo: int, ring_hi: int,
                 out[dst + pad + nt + c] = prev[src + c % nt]
 
 
+LANES = 16
+"""Rows per vector chunk: a run is done over whole chunks, the rows outside it masked (a
+scalar remainder per run cost more; the tables and scratch have ``LANES`` spare columns)."""
+
+
 @_inline
 def run_values(j_lo: int, j_hi: int, b: Any, tr: Any, omr: Any, ir: Any, ca: Any, cs: Any,
                fop: Any, fom: Any, xpad: Any, ring: int, stride: int, n: Any, best_val: Any,
                best_n: Any) -> None:
-    """Rows of one run (``kind`` 0) of control ``n``; keeps the best so far per node.
+    """Rows ``j_lo .. j_hi - 1`` of one run (``kind`` 0) of control ``n``; keeps the best
+    so far per node.
 
-    The indices are unsigned (they are >= 0 by construction), so numba drops the
-    negative-index wrap and the loop vectorises (AVX: 8 or 16 nodes at a time).
+    The loop runs over whole chunks of :data:`LANES` rows with the rows outside the run
+    masked, and its indices are unsigned (>= 0 by construction), so numba drops the
+    negative-index wrap and LLVM vectorises it without a scalar remainder.
     """
     h = xpad.dtype.type(0.5)
     one = np.uint64(1)
@@ -142,7 +149,11 @@ def run_values(j_lo: int, j_hi: int, b: Any, tr: Any, omr: Any, ir: Any, ca: Any
     b_ = a_ + np.uint64(stride)  # the next ring
     c_ = np.uint64(ring + int(fom))  # the - foot
     d_ = c_ + np.uint64(stride)
-    for jj in range(np.uint64(j_lo), np.uint64(j_hi)):
+    lo = np.uint64(j_lo)
+    hi = np.uint64(j_hi)
+    start = np.uint64(j_lo - j_lo % LANES)
+    stop = np.uint64(j_hi + (-j_hi) % LANES)
+    for jj in range(start, stop):
         j = np.uint64(jj)
         x = b[j] * ir + ca
         tp = (x + cs) - fop
@@ -158,7 +169,7 @@ def run_values(j_lo: int, j_hi: int, b: Any, tr: Any, omr: Any, ir: Any, ca: Any
         s = h * (omr[j] * ((a0 + tp * (a1 - a0)) + (c0 + tm * (c1 - c0)))
                  + tr[j] * ((b0 + tp * (b1 - b0)) + (d0 + tm * (d1 - d0))))
         old = best_val[j]
-        better = s > old
+        better = (s > old) & (j >= lo) & (j < hi)
         best_val[j] = s if better else old
         best_n[j] = n if better else best_n[j]
 
@@ -231,9 +242,9 @@ def ring_slice(
                         run_values(r0, r1, b_qn, tr_qn, omr_qn, ir, ca, cs,
                                    prev.dtype.type(op[r]), prev.dtype.type(om[r]), xpad,
                                    ring, stride, nn, best_val, best_n)
-            finish_nodes(q * per_tack + i * nt, best_val, best_n, prev, sw_data, sw_indices,
-                         prev_c, use_switch, switch_eps, zero_clip, sure, prev_action, w_out,
-                         action_out)
+            finish_nodes(q * per_tack + i * nt, best_val[:nt], best_n[:nt], prev, sw_data,
+                         sw_indices, prev_c, use_switch, switch_eps, zero_clip, sure,
+                         prev_action, w_out, action_out)
 
 
 @_jit

@@ -432,7 +432,8 @@ class _RingRows:
     g: NDArray[np.float64]
     """``(2, n_u, n_θ)``: radial offset of the feet [cells]."""
     b: NDArray
-    """``(2, n_u, n_θ)``: ``τ f sin(θ + s u)/Δθ`` [cells m], value dtype."""
+    """``(2, n_u, n_θ + LANES)``: ``τ f sin(θ + s u)/Δθ`` [cells m], value dtype (the
+    compiled loop's spare chunk of zeros at the end, as ``tr`` and ``omr``)."""
     di: NDArray[np.int64]
     """``⌊g⌋``."""
     tr: NDArray
@@ -489,8 +490,8 @@ class _RingRows:
         by_node = MappingProxyType({
             name: np.ascontiguousarray(t.transpose(0, 2, 1).reshape(2 * grid.n_theta, -1))
             for name, t in (("g", g), ("b", b), ("di", di), ("tr", tr), ("omr", omr))})
-        return cls(g, b, di, tr, omr, inv_r, ca, cs, fr_in, pad, grid.n_r, grid.n_theta, runs,
-                   by_node)
+        return cls(g, _spare(b), di, _spare(tr), _spare(omr), inv_r, ca, cs, fr_in, pad,
+                   grid.n_r, grid.n_theta, runs, by_node)
 
     @property
     def stride(self) -> int:
@@ -498,8 +499,9 @@ class _RingRows:
         return self.n_theta + 2 * self.pad
 
     def padded_size(self) -> int:
-        """Length of the padded slice (both tacks, plus a ring of zeros beyond ``r_max``)."""
-        return 2 * (self.n_r + 2) * self.stride
+        """Length of the padded slice (both tacks, plus a ring of zeros beyond ``r_max``,
+        plus the compiled loop's spare chunk)."""
+        return 2 * (self.n_r + 2) * self.stride + _jit.LANES
 
     def pad_slice(self, prev: NDArray, ring_lo: int, ring_hi: int, out: NDArray) -> None:
         """Rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice ``out``."""
@@ -510,7 +512,7 @@ class _RingRows:
         lo, hi = max(ring_lo - 1, 0), min(ring_hi + 1, self.n_r + 1)
         cols = np.mod(np.arange(-pad, nt + pad), nt)
         rings = prev[: 2 * (self.n_r + 1) * nt].reshape(2, self.n_r + 1, nt)
-        view = out.reshape(2, self.n_r + 2, self.stride)
+        view = out[: 2 * (self.n_r + 2) * self.stride].reshape(2, self.n_r + 2, self.stride)
         view[:, lo:hi] = rings[:, lo:hi][:, :, cols]
 
     def values(self, xpad: NDArray, node_lo: int, node_hi: int) -> NDArray:
@@ -540,6 +542,13 @@ class _RingRows:
                  + self.by_node["tr"][qj] * ((b0 + tp * (b1 - b0)) + (d0 + tm * (d1 - d0))))
         one, zero = xpad.dtype.type(1.0), xpad.dtype.type(0.0)
         return np.where(inside, one, np.where(beyond, zero, s))
+
+
+def _spare(table: NDArray) -> NDArray:
+    """``table`` with ``_deadline_jit.LANES`` columns of zeros appended (last axis)."""
+    out = np.zeros((*table.shape[:-1], table.shape[-1] + _jit.LANES), dtype=table.dtype)
+    out[..., : table.shape[-1]] = table
+    return out
 
 
 def _switch_operator(
@@ -909,7 +918,8 @@ def solve_deadline(
     consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
     switch_cols = switch_op.indices.view(np.uint32)  # the kernels' index type
     xpad = np.zeros(rows.padded_size() if rows is not None else 0, dtype=ftype)
-    best_val, best_n = np.empty(nt, dtype=ftype), np.zeros(nt, dtype=np.int8)
+    best_val = np.zeros(nt + _jit.LANES, dtype=ftype)  # scratch of the compiled slice
+    best_n = np.zeros(nt + _jit.LANES, dtype=np.int8)
     lo = n_in
     for k in range(1, n_s + 1):
         prev = w[k - 1]
