@@ -648,6 +648,68 @@ def _controls_speed(grid: DeadlineGrid, polar: Polar, tws_ms: float) -> NDArray[
 
 
 @dataclass(frozen=True, eq=False)
+class SliceBands:
+    """``w`` and the action of every budget slice, stored for the rings the slice computed.
+
+    Slice ``k`` computes rings ``lo[k] .. hi[k] - 1`` of both tacks (``solve_deadline``):
+    rings below ``lo[k]`` are sure and keep the values of the last slice that computed
+    them, rings from ``hi[k]`` on are beyond reach at top speed (``w = 0``), rings inside
+    the mark have ``w = 1``.  Only the band is stored (Wang et al.'s (2024) Fig. 3 set-up at
+    801 x 1024: 37 % of the dense ``(n_s + 1) x n_nodes`` arrays), so memory and the first
+    touch of it shrink accordingly.
+
+    Attributes
+    ----------
+    lo, hi : ndarray of int64, shape (n_s + 1,)
+        Computed rings per slice (``lo = hi = n_in`` for slice 0).
+    start : ndarray of int64, shape (n_s + 2,)
+        Offset of slice ``k``'s band in the flat arrays (tack 0's rings, then tack 1's).
+    w : ndarray, shape (start[-1],)
+    action : ndarray of uint8, shape (start[-1],)
+        Control index (bits 0-6) and switch (bit 7, :data:`SWITCH_BIT`).
+    offset : ndarray of int8, shape (start[-1],), or None
+        Golden-refined steering offsets (``refine_controls="golden"``).
+    n_in : int
+        Rings inside the mark.
+    """
+
+    lo: NDArray[np.int64]
+    hi: NDArray[np.int64]
+    start: NDArray[np.int64]
+    w: NDArray
+    action: NDArray[np.uint8]
+    offset: NDArray[np.int8] | None
+    n_in: int
+
+    def locate(self, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int
+               ) -> tuple[NDArray[np.int64], NDArray[np.int8]]:
+        """Flat index of ``(k, node)`` (broadcast), and where it is not stored: ``-1``
+        inside the mark (``w = 1``), ``-2`` beyond reach (``w = 0``), else 0."""
+        k, node = np.broadcast_arrays(np.asarray(k, dtype=np.int64),
+                                      np.asarray(node, dtype=np.int64))
+        q, i, j = _node_coords(grid, node)
+        lo_k = self.lo[k]
+        # below lo: the last slice whose band held ring i (lo never decreases)
+        kk = np.where(i >= lo_k, k, np.searchsorted(self.lo, i, side="right") - 1)
+        lo_s, hi_s = self.lo[kk], self.hi[kk]
+        flat = self.start[kk] + ((q * (hi_s - lo_s)) + (i - lo_s)) * grid.n_theta + j
+        where = np.where(i < self.n_in, -1, np.where(i >= self.hi[k], -2, 0)).astype(np.int8)
+        return np.where(where == 0, flat, 0), where
+
+    def value(self, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int) -> NDArray:
+        """``w`` of slice(s) ``k`` at ``node``."""
+        flat, where = self.locate(grid, k, node)
+        one, zero = self.w.dtype.type(1.0), self.w.dtype.type(0.0)
+        return np.where(where == -1, one, np.where(where == -2, zero, self.w[flat]))
+
+    def gather(self, table: NDArray, grid: DeadlineGrid, k: NDArray | int,
+               node: NDArray | int) -> NDArray:
+        """``table`` (``action`` or ``offset``) at ``(k, node)``; 0 where not stored."""
+        flat, where = self.locate(grid, k, node)
+        return np.where(where == 0, table[flat], 0).astype(table.dtype)
+
+
+@dataclass(frozen=True, eq=False)
 class DeadlinePolicy:
     """Threshold-aware value ``w(r, θ, q, s) = max P(T <= s)`` and policy ``α*``.
 
@@ -658,56 +720,88 @@ class DeadlinePolicy:
     model : DriftDiffusionShift
     speeds_ms : ndarray, shape (n_controls,)
         Boat speed at each steering angle [m s⁻¹].
-    w : ndarray of float32, shape (n_s + 1, n_nodes)
-        Success probability per budget slice and node (flat ``(q, i, j)``).
-    action : ndarray of uint8, shape (n_s + 1, n_nodes)
-        Per slice and node: the best steering control index (bits 0-6) and whether
-        switching tack is optimal (bit 7, :data:`SWITCH_BIT`); one byte instead of two,
-        1.9 GB less at 801 x 1024 (:meth:`steering`, :meth:`switches`, or the
-        :attr:`steer` and :attr:`switch` arrays).
+    bands : SliceBands
+        ``w`` and the action per budget slice and node (flat ``(q, i, j)``), stored for
+        the rings each slice computed: read with :meth:`value`, :meth:`steering`,
+        :meth:`switches`, or as dense arrays :attr:`w`, :attr:`action`, :attr:`steer`,
+        :attr:`switch` (new ``(n_s + 1) x n_nodes`` arrays: small grids).
     solve_time_s : float
-    steer_offset : ndarray of int8, shape (n_s + 1, n_nodes), or None
-        With ``grid.refine_controls``: the refined angle is
-        ``u[steer] + steer_offset Δu / 127`` (:meth:`steering_rad`).
     fine_speeds : (ndarray, ndarray) or None
-        Angles [rad] and polar speeds [m s⁻¹] (0.125° table) for refined angles.
+        Angles [rad] and polar speeds [m s⁻¹] (0.125° table) for refined angles: with
+        ``grid.refine_controls``, the angle is ``u[steer] + offset Δu / 127``.
     """
 
     grid: DeadlineGrid
     tack_penalty_s: float
     model: DriftDiffusionShift
     speeds_ms: NDArray[np.float64]
-    w: NDArray[np.float32]
-    action: NDArray[np.uint8]
+    bands: SliceBands
     solve_time_s: float
-    steer_offset: NDArray[np.int8] | None = None
     fine_speeds: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+
+    def value(self, k: NDArray | int, node: NDArray | int) -> NDArray:
+        """``w`` of slice(s) ``k`` at ``node`` (broadcast)."""
+        return self.bands.value(self.grid, k, node)
+
+    def switches(self, k: NDArray | int, node: NDArray | int) -> NDArray[np.bool_]:
+        """Whether switching tack is optimal in slice(s) ``k`` at ``node``."""
+        return self.bands.gather(self.bands.action, self.grid, k, node) >= SWITCH_BIT
+
+    def steering(self, k: NDArray | int, node: NDArray | int) -> tuple[NDArray, NDArray]:
+        """Steering angle [rad] and boat speed [m s⁻¹] of slice(s) ``k`` at ``node``."""
+        return self.decide(k, node)[1:3]
+
+    def decide(self, k: NDArray | int, node: NDArray | int
+               ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
+        """``w``, steering angle [rad], boat speed [m s⁻¹] and switch of slice(s) ``k``
+        at ``node`` (one look-up, for the Monte Carlo steps)."""
+        b = self.bands
+        flat, where = b.locate(self.grid, k, node)
+        stored = where == 0
+        one, zero = b.w.dtype.type(1.0), b.w.dtype.type(0.0)
+        w = np.where(where == -1, one, np.where(where == -2, zero, b.w[flat]))
+        act = np.where(stored, b.action[flat], 0)
+        idx = (act & STEER_MASK).astype(np.int64)
+        if b.offset is None or self.fine_speeds is None:
+            u, f = self.grid.controls_rad[idx], self.speeds_ms[idx]
+        else:
+            du = math.pi / (self.grid.n_controls - 1)
+            off = np.where(stored, b.offset[flat], 0)
+            u = np.clip(self.grid.controls_rad[idx] + off * (du / OFFSET_STEPS), 0.0, math.pi)
+            f = np.interp(u, *self.fine_speeds)
+        return w, u, f, act >= SWITCH_BIT
+
+    def _dense(self, read: Callable[[NDArray, NDArray], NDArray]) -> NDArray:
+        k = np.arange(self.grid.n_s + 1)[:, None]
+        return read(k, np.arange(self.grid.n_nodes)[None, :])
+
+    @property
+    def w(self) -> NDArray:
+        """``w`` per slice and node, shape ``(n_s + 1, n_nodes)`` (a new array)."""
+        return self._dense(self.value)
+
+    @property
+    def action(self) -> NDArray[np.uint8]:
+        """Control index (bits 0-6) and switch (bit 7) per slice and node (a new array)."""
+        return self._dense(lambda k, n: self.bands.gather(self.bands.action, self.grid, k, n))
 
     @property
     def steer(self) -> NDArray[np.int8]:
-        """Best steering control index per slice and node (a new array: index
-        :attr:`action` or use :meth:`steering` for a few nodes)."""
+        """Best steering control index per slice and node (a new array)."""
         return (self.action & STEER_MASK).astype(np.int8)
 
     @property
     def switch(self) -> NDArray[np.bool_]:
-        """True where switching tack is optimal, per slice and node (a new array; see
-        :meth:`switches`)."""
+        """True where switching tack is optimal, per slice and node (a new array)."""
         return self.action >= SWITCH_BIT
 
-    def switches(self, k: NDArray | int, node: NDArray) -> NDArray[np.bool_]:
-        """Whether switching tack is optimal in slice(s) ``k`` at ``node``."""
-        return np.asarray(self.action[k, node] >= SWITCH_BIT)
-
-    def steering(self, k: NDArray, node: NDArray) -> tuple[NDArray, NDArray]:
-        """Steering angle [rad] and boat speed [m s⁻¹] of slice(s) ``k`` at ``node``."""
-        idx = (self.action[k, node] & STEER_MASK).astype(np.int64)
-        if self.steer_offset is None or self.fine_speeds is None:
-            return self.grid.controls_rad[idx], self.speeds_ms[idx]
-        du = math.pi / (self.grid.n_controls - 1)
-        u = np.clip(self.grid.controls_rad[idx]
-                    + self.steer_offset[k, node] * (du / OFFSET_STEPS), 0.0, math.pi)
-        return u, np.interp(u, *self.fine_speeds)
+    @property
+    def steer_offset(self) -> NDArray[np.int8] | None:
+        """Golden-refined steering offsets per slice and node (a new array), or None."""
+        table = self.bands.offset
+        if table is None:
+            return None
+        return self._dense(lambda k, n: self.bands.gather(table, self.grid, k, n))
 
     def node(self, r_m: float, theta_rad: float, tack: int) -> int:
         """Flat index of the node nearest to ``(r, θ)`` on ``tack`` (+1/-1)."""
@@ -715,7 +809,8 @@ class DeadlinePolicy:
 
     def success_curve(self, r_m: float, theta_rad: float, tack: int = 1) -> NDArray[np.float64]:
         """``w`` at the nearest node for every budget slice: ``P(T <= s_k)`` under ``α^{s_k}``."""
-        return self.w[:, self.node(r_m, theta_rad, tack)].astype(float)
+        k = np.arange(self.grid.n_s + 1)
+        return self.value(k, self.node(r_m, theta_rad, tack)).astype(float)
 
     @property
     def s_s(self) -> NDArray[np.float64]:
@@ -804,19 +899,21 @@ def _use_compiled(engine: str) -> bool:
     return engine == "numba" or (engine == "auto" and _jit.AVAILABLE)
 
 
-def _update_block(k: int, n0: int, n1: int, vals: NDArray, w: NDArray, action: NDArray,
-                  offset: NDArray | None, refine: _SteerRefiner | None,
-                  switch_op: _RowOperator, kc: int) -> None:
-    """Slice ``k`` of nodes ``n0 .. n1 - 1`` from their steering rows ``vals`` (NumPy path;
-    ``_deadline_jit.finish_node`` is the compiled twin)."""
-    prev = w[k - 1]
+def _update_block(n0: int, n1: int, vals: NDArray, prev: NDArray, prev_c: NDArray | None,
+                  w_out: NDArray, actions: tuple[NDArray, NDArray],
+                  offsets: tuple[NDArray, NDArray] | None, refine: _SteerRefiner | None,
+                  switch_op: _RowOperator) -> None:
+    """Nodes ``n0 .. n1 - 1`` of a slice from their steering rows ``vals`` (NumPy path;
+    ``_deadline_jit.finish_nodes`` is the compiled twin): ``prev`` is the previous slice,
+    ``prev_c`` the slice ``C`` back (None before a switch can pay), ``actions`` and
+    ``offsets`` the previous and this slice's arrays."""
     best = np.argmax(vals, axis=1)
     wk = np.take_along_axis(vals, best[:, None], axis=1)[:, 0]
     off = None
     if refine is not None:
         wk, off = refine.refine(prev, n0, n1, best, wk)
-    if k >= kc:
-        ws = switch_op.apply(w[k - kc], n0, n1)[:, 0]
+    if prev_c is not None:
+        ws = switch_op.apply(prev_c, n0, n1)[:, 0]
         sw = ws > wk + SWITCH_EPS
         wk = np.where(sw, ws, wk)
     else:
@@ -829,10 +926,11 @@ def _update_block(k: int, n0: int, n1: int, vals: NDArray, w: NDArray, action: N
     # slice's value and action.
     p = prev[n0:n1]
     keep = (p >= SURE) | (p > wk)
-    w[k, n0:n1] = np.where(keep, p, wk)
-    action[k, n0:n1] = np.where(keep, action[k - 1, n0:n1], best | np.where(sw, SWITCH_BIT, 0))
-    if offset is not None and off is not None:
-        offset[k, n0:n1] = np.where(keep, offset[k - 1, n0:n1], off)
+    w_out[n0:n1] = np.where(keep, p, wk)
+    a_prev, a_out = actions
+    a_out[n0:n1] = np.where(keep, a_prev[n0:n1], best | np.where(sw, SWITCH_BIT, 0))
+    if offsets is not None and off is not None:
+        offsets[1][n0:n1] = np.where(keep, offsets[0][n0:n1], off)
 
 
 def solve_deadline(
@@ -908,13 +1006,23 @@ def solve_deadline(
     n_s, n_nodes, nt = grid.n_s, grid.n_nodes, grid.n_theta
     per_tack = (grid.n_r + 1) * nt
     n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))  # rings inside the mark
-    w = np.zeros((n_s + 1, n_nodes + 2), dtype=ftype)
-    for q in (0, 1):
-        w[:, q * per_tack:q * per_tack + n_in * nt] = 1.0
-    w[:, n_nodes] = 1.0  # ghost: a foot inside the mark
-    action = np.zeros((n_s + 1, n_nodes), dtype=np.uint8)
-    offset = np.zeros((n_s + 1, n_nodes), dtype=np.int8) if refine is not None else None
     reach_time = (grid.r_m - grid.target_radius_m) / f_max  # per ring
+    # rings reachable at top speed within each budget; rings beyond stay 0
+    his = np.searchsorted(reach_time, grid.ds_s * np.arange(n_s + 1), side="right")
+    his[0] = n_in
+    bound = int(np.sum(his - n_in)) * 2 * nt  # the bands can be no larger (never touched)
+    band_w = np.empty(bound, dtype=ftype)
+    band_a = np.empty(bound, dtype=np.uint8)
+    band_o = np.empty(bound, dtype=np.int8) if refine is not None else None
+    los, starts = np.full(n_s + 1, n_in), np.zeros(n_s + 2, dtype=np.int64)
+    # working slices: w of the last kc + 1 budgets (the switch reads C back), the action of
+    # the last two; inside the mark w = 1, ghosts: a foot inside the mark (1), beyond (0)
+    ws = np.zeros((kc + 1, n_nodes + 2), dtype=ftype)
+    for q in (0, 1):
+        ws[:, q * per_tack:q * per_tack + n_in * nt] = 1.0
+    ws[:, n_nodes] = 1.0
+    acts = np.zeros((2, n_nodes), dtype=np.uint8)
+    offs = np.zeros((2, n_nodes), dtype=np.int8) if refine is not None else None
     consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
     switch_cols = switch_op.indices.view(np.uint32)  # the kernels' index type
     xpad = np.zeros(rows.padded_size() if rows is not None else 0, dtype=ftype)
@@ -922,30 +1030,36 @@ def solve_deadline(
     best_n = np.zeros(nt + _jit.LANES, dtype=np.int8)
     lo = n_in
     for k in range(1, n_s + 1):
-        prev = w[k - 1]
-        # rings reachable at top speed within the budget; rings beyond stay 0
-        hi = int(np.searchsorted(reach_time, k * grid.ds_s, side="right"))
+        prev, cur = ws[(k - 1) % (kc + 1)], ws[k % (kc + 1)]
+        prev_c = ws[max(k - kc, 0) % (kc + 1)]
+        a_prev, a_cur = acts[(k - 1) % 2], acts[k % 2]
+        hi = int(his[k])
         lo = _rings_all_sure(prev, grid, lo, hi)
+        # rings below lo are sure and keep their value and action: bring the reused slots
+        # up to date (they hold budget k - kc - 1, resp. k - 2; rings frozen before agree)
         for q in (0, 1):
-            keep_to = q * per_tack + lo * nt
-            w[k, q * per_tack:keep_to] = prev[q * per_tack:keep_to]
-            action[k, q * per_tack:keep_to] = action[k - 1, q * per_tack:keep_to]
-            if offset is not None:
-                offset[k, q * per_tack:keep_to] = offset[k - 1, q * per_tack:keep_to]
+            base = q * per_tack
+            lo_w = int(los[k - kc - 1]) if k > kc else n_in
+            cur[base + lo_w * nt:base + lo * nt] = prev[base + lo_w * nt:base + lo * nt]
+            lo_a = int(los[k - 2]) if k > 1 else n_in
+            a_cur[base + lo_a * nt:base + lo * nt] = a_prev[base + lo_a * nt:base + lo * nt]
+            if offs is not None:
+                offs[k % 2, base + lo_a * nt:base + lo * nt] = \
+                    offs[(k - 1) % 2, base + lo_a * nt:base + lo * nt]
         if rows is not None:
             rows.pad_slice(prev, lo, hi, xpad)
-        switch_args = (switch_op.data, switch_cols, w[max(k - kc, 0)], k >= kc)
+        switch_args = (switch_op.data, switch_cols, prev_c, k >= kc)
         if jit and rows is not None and rows.runs is not None:
             _jit.ring_slice(*rows.runs, rows.b, rows.tr, rows.omr, rows.inv_r, rows.ca,
                             rows.cs, grid.n_r, nt, rows.pad, xpad, prev, *switch_args, lo, hi,
-                            *consts, action[k - 1], w[k], action[k], best_val, best_n)
+                            *consts, a_prev, cur, a_cur, best_val, best_n)
         elif jit:
             assert steer_op is not None
             for q in (0, 1):
                 _jit.slice_update(
                     steer_op.indices.view(np.uint32), steer_op.data, f.size, steer_op.per_row,
                     prev, *switch_args, q * per_tack + lo * nt, q * per_tack + hi * nt,
-                    *consts, action[k - 1], w[k], action[k])
+                    *consts, a_prev, cur, a_cur)
         else:
             block = BLOCK_NODES if rows is None else RING_BLOCK_NODES
             for q in (0, 1):
@@ -953,19 +1067,32 @@ def solve_deadline(
                     n1 = min(n0 + block, q * per_tack + hi * nt)
                     vals = (rows.values(xpad, n0, n1) if rows is not None else
                             steer_op.apply(prev, n0, n1))  # type: ignore[union-attr]
-                    _update_block(k, n0, n1, vals, w, action, offset, refine, switch_op,
-                                  kc)
+                    _update_block(n0, n1, vals, prev, prev_c if k >= kc else None, cur,
+                                  (a_prev, a_cur), None if offs is None else
+                                  (offs[(k - 1) % 2], offs[k % 2]), refine, switch_op)
+        # store the band of rings lo .. hi - 1 (tack 0, then tack 1)
+        los[k] = lo
+        size = (hi - lo) * nt
+        starts[k + 1] = starts[k] + 2 * size
+        for q in (0, 1):
+            dst = slice(int(starts[k]) + q * size, int(starts[k]) + (q + 1) * size)
+            src = slice(q * per_tack + lo * nt, q * per_tack + hi * nt)
+            band_w[dst] = cur[src]
+            band_a[dst] = a_cur[src]
+            if band_o is not None and offs is not None:
+                band_o[dst] = offs[k % 2, src]
         if progress is not None:
             progress(k, n_s)
+    used = int(starts[-1])
+    bands = SliceBands(los, his.astype(np.int64), starts, band_w[:used], band_a[:used],
+                       None if band_o is None else band_o[:used], n_in)
     return DeadlinePolicy(
         grid=grid,
         tack_penalty_s=float(tack_penalty_s),
         model=model,
         speeds_ms=f,
-        w=w[:, :n_nodes],
-        action=action,
+        bands=bands,
         solve_time_s=time.perf_counter() - t0,
-        steer_offset=offset,
         fine_speeds=(refine.u_tab, refine.f_tab) if refine is not None else None,
     )
 
@@ -1190,14 +1317,14 @@ def simulate_deadline_chunk(
             k = np.rint(s_budget / g.ds_s).astype(np.int64)
             ok = risk_aware & (k >= 0) & (k <= g.n_s)
             kk = np.clip(k, 0, g.n_s)
-            hopeless = ok & (ra.w[kk, node] <= give_up_below)
+            ra_w, ra_u, ra_f, ra_sw = ra.decide(kk, node)
+            hopeless = ok & (ra_w <= give_up_below)
             newly = risk_aware & (~ok | hopeless) & ~done
             fell_back |= newly
             risk_aware &= ~newly
-            ra_u, ra_f = ra.steering(kk, node)
             act_u = np.where(risk_aware, ra_u, act_u)
             act_f = np.where(risk_aware, ra_f, act_f)
-            act_switch = np.where(risk_aware, ra.switches(kk, node), act_switch)
+            act_switch = np.where(risk_aware, ra_sw, act_switch)
         # never two switches in a row (a coarse grid can make the lookups ping-pong)
         act_switch &= ~last_switch & ~done
         z = rng.standard_normal(n)

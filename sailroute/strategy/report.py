@@ -209,7 +209,7 @@ def deadline_policy_image(
     node = _nearest_nodes(g, r.ravel(), theta.ravel(), q.ravel()).reshape(r.shape)
     k = int(np.clip(round(budget_s / g.ds_s), 0, g.n_s))
     u = np.degrees(policy.steering(np.full(node.shape, k), node)[0])
-    w = policy.w[k, node].astype(float)
+    w = policy.value(k, node).astype(float)
     u = np.where(policy.switches(k, node), np.nan, u)
     outside = (r > g.r_max_m) | (r <= g.target_radius_m)
     return np.where(outside, np.nan, u), np.where(r > g.r_max_m, np.nan, w)
