@@ -9,6 +9,9 @@ Usage::
                                                    # time a few budget slices only
     python benchmarks/bench_deadline.py --grid 401,512 --figs 4b --solve-only \
         --engine numpy,numba,numpy,numba           # NumPy vs the numba kernels, one run
+    git worktree add /tmp/base bc3c50e
+    python benchmarks/bench_deadline.py --grid 801,1024 --figs 3 --solve-only \
+        --engine numba --baseline /tmp/base --repeat 2   # this code vs an older checkout
 
 ``--grid NR1,NT`` gives the nodes in ``r`` (``n_r + 1``) and the intervals in ``θ``; the
 budget step is the largest ``Δs = C/n`` with ``f_max Δs <= Δr`` (the CLI's rule), the
@@ -30,7 +33,10 @@ import json  # noqa: E402
 import math  # noqa: E402
 import resource  # noqa: E402
 import subprocess  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
 import time  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
@@ -195,6 +201,26 @@ def run_fig(name: str, args: argparse.Namespace) -> dict:
     return out
 
 
+def run_baseline(fig: str, engine: str, args: argparse.Namespace) -> dict:
+    """The same solve with the code in ``args.baseline`` (its own bench script, a fresh
+    process: the solve and its peak memory)."""
+    base = Path(args.baseline).resolve()
+    flags = ["--grid", args.grid, "--figs", fig, "--engine", engine, "--interp", args.interp,
+             "--refine", args.refine, "--ds-cells", str(args.ds_cells), "--dtype", args.dtype,
+             "--solve-only"]
+    if args.s_max:
+        flags += ["--s-max", str(args.s_max)]
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "base.json"
+        env = {**os.environ, "PYTHONPATH": str(base)}
+        subprocess.run([sys.executable, str(base / "benchmarks" / "bench_deadline.py"),
+                        *flags, "--json", str(out)], env=env, check=True, capture_output=True)
+        result = json.loads(out.read_text(encoding="utf-8"))["results"][0]
+    print(f"  baseline {base.name}: risk-aware solve ({engine}) {result['solve_s']:.1f} s, "
+          f"peak RSS {result['rss_gb']:.1f} GB", flush=True)
+    return {**result, "baseline": str(base)}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -217,14 +243,23 @@ def main() -> None:
     ap.add_argument("--check-dtype", action="store_true",
                     help="solve in float32 and float64 and compare w (no Monte Carlo)")
     ap.add_argument("--json", default=None, help="write the results here")
+    ap.add_argument("--baseline", default=None,
+                    help="a checkout of older code: each solve is repeated there with its "
+                    "own copy of this script (same flags, --solve-only), alternating")
+    ap.add_argument("--repeat", type=int, default=1, help="rounds of solves (with --baseline)")
     args = ap.parse_args()
     print(uptime())
     run = check_dtype if args.check_dtype else run_fig
     results = []
-    for f in args.figs.split(","):
-        for engine in args.engine.split(","):
-            results.append(run(f.strip(), argparse.Namespace(**{**vars(args),
-                                                                "engine": engine.strip()})))
+    for _ in range(args.repeat):
+        for f in args.figs.split(","):
+            for engine in args.engine.split(","):
+                results.append(run(f.strip(), argparse.Namespace(**{**vars(args),
+                                                                    "engine": engine.strip()})))
+                if args.baseline:
+                    results.append(run_baseline(f.strip(), engine.strip(), args))
+                    print(f"  baseline / this code: "
+                          f"{results[-1]['solve_s'] / results[-2]['solve_s']:.2f}x", flush=True)
     print(uptime())
     if args.json:
         with open(args.json, "w", encoding="utf-8") as fh:

@@ -671,6 +671,9 @@ class SliceBands:
         Golden-refined steering offsets (``refine_controls="golden"``).
     n_in : int
         Rings inside the mark.
+    last : ndarray of int64, shape (n_r + 1,)
+        The last slice whose band holds ring ``i`` (``lo`` never decreases): where a
+        ring below ``lo[k]`` is read.
     """
 
     lo: NDArray[np.int64]
@@ -680,6 +683,7 @@ class SliceBands:
     action: NDArray[np.uint8]
     offset: NDArray[np.int8] | None
     n_in: int
+    last: NDArray[np.int64]
 
     def locate(self, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int
                ) -> tuple[NDArray[np.int64], NDArray[np.int8]]:
@@ -688,9 +692,7 @@ class SliceBands:
         k, node = np.broadcast_arrays(np.asarray(k, dtype=np.int64),
                                       np.asarray(node, dtype=np.int64))
         q, i, j = _node_coords(grid, node)
-        lo_k = self.lo[k]
-        # below lo: the last slice whose band held ring i (lo never decreases)
-        kk = np.where(i >= lo_k, k, np.searchsorted(self.lo, i, side="right") - 1)
+        kk = np.where(i >= self.lo[k], k, self.last[i])
         lo_s, hi_s = self.lo[kk], self.hi[kk]
         flat = self.start[kk] + ((q * (hi_s - lo_s)) + (i - lo_s)) * grid.n_theta + j
         where = np.where(i < self.n_in, -1, np.where(i >= self.hi[k], -2, 0)).astype(np.int8)
@@ -1084,8 +1086,9 @@ def solve_deadline(
         if progress is not None:
             progress(k, n_s)
     used = int(starts[-1])
+    last = np.searchsorted(los, np.arange(grid.n_r + 1), side="right") - 1
     bands = SliceBands(los, his.astype(np.int64), starts, band_w[:used], band_a[:used],
-                       None if band_o is None else band_o[:used], n_in)
+                       None if band_o is None else band_o[:used], n_in, last)
     return DeadlinePolicy(
         grid=grid,
         tack_penalty_s=float(tack_penalty_s),
