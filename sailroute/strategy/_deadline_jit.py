@@ -133,18 +133,19 @@ scalar remainder per run cost more; the tables and scratch have ``LANES`` spare 
 
 
 @_inline
-def run_values(j_lo: int, j_hi: int, b: Any, tr: Any, omr: Any, ir: Any, ca: Any, cs: Any,
+def run_values(j_lo: int, j_hi: int, b: Any, h0: Any, h1: Any, ir: Any, ca: Any, cs: Any,
                fop: Any, fom: Any, xpad: Any, ring: int, stride: int, n: Any, best_val: Any,
                best_n: Any) -> None:
     """Rows ``j_lo .. j_hi - 1`` of one run (``kind`` 0) of control ``n``; keeps the best
-    so far per node.
+    so far per node.  A row is the weighted sum of ``deadline._RingRows`` in the order of
+    its CSR entries (the NumPy path's mat-vec adds them in that order).
 
     The loop runs over whole chunks of :data:`LANES` rows with the rows outside the run
     masked, and its indices are unsigned (>= 0 by construction), so numba drops the
     negative-index wrap and LLVM vectorises it without a scalar remainder.
     """
-    h = xpad.dtype.type(0.5)
-    one = np.uint64(1)
+    one = xpad.dtype.type(1.0)
+    u1 = np.uint64(1)
     a_ = np.uint64(ring + int(fop))  # ring i + di, the + foot
     b_ = a_ + np.uint64(stride)  # the next ring
     c_ = np.uint64(ring + int(fom))  # the - foot
@@ -158,16 +159,17 @@ def run_values(j_lo: int, j_hi: int, b: Any, tr: Any, omr: Any, ir: Any, ca: Any
         x = b[j] * ir + ca
         tp = (x + cs) - fop
         tm = (x - cs) - fom
-        a0 = xpad[a_ + j]
-        a1 = xpad[a_ + j + one]
-        b0 = xpad[b_ + j]
-        b1 = xpad[b_ + j + one]
-        c0 = xpad[c_ + j]
-        c1 = xpad[c_ + j + one]
-        d0 = xpad[d_ + j]
-        d1 = xpad[d_ + j + one]
-        s = h * (omr[j] * ((a0 + tp * (a1 - a0)) + (c0 + tm * (c1 - c0)))
-                 + tr[j] * ((b0 + tp * (b1 - b0)) + (d0 + tm * (d1 - d0))))
+        w0 = h0[j]
+        w1 = h1[j]
+        s = xpad.dtype.type(0.0)
+        s += (w0 * (one - tp)) * xpad[a_ + j]
+        s += (w0 * tp) * xpad[a_ + j + u1]
+        s += (w1 * (one - tp)) * xpad[b_ + j]
+        s += (w1 * tp) * xpad[b_ + j + u1]
+        s += (w0 * (one - tm)) * xpad[c_ + j]
+        s += (w0 * tm) * xpad[c_ + j + u1]
+        s += (w1 * (one - tm)) * xpad[d_ + j]
+        s += (w1 * tm) * xpad[d_ + j + u1]
         old = best_val[j]
         better = (s > old) & (j >= lo) & (j < hi)
         best_val[j] = s if better else old
@@ -195,8 +197,8 @@ def unsure_arc(prev: Any, base: int, nt: int, sure: Any) -> tuple[int, int]:
 
 @_jit
 def ring_slice(
-    ptr: Any, j0: Any, j1: Any, kind: Any, di: Any, op: Any, om: Any, b: Any, tr: Any,
-    omr: Any, inv_r: Any, ca: Any, cs: Any, nr: int, nt: int, pad: int, xpad: Any,
+    ptr: Any, j0: Any, j1: Any, kind: Any, di: Any, op: Any, om: Any, b: Any, h0: Any,
+    h1: Any, inv_r: Any, ca: Any, cs: Any, nr: int, nt: int, pad: int, xpad: Any,
     prev: Any, sw_data: Any, sw_indices: Any, prev_c: Any, use_switch: bool, ring_lo: int,
     ring_hi: int, switch_eps: Any, zero_clip: Any, sure: Any, prev_action: Any,
     w_out: Any, action_out: Any, best_val: Any, best_n: Any,
@@ -225,7 +227,7 @@ def ring_slice(
             for n in range(n_u):
                 nn = np.int8(n)
                 t = (q * (nr + 1) + i) * n_u + n
-                b_qn, tr_qn, omr_qn = b[q, n], tr[q, n], omr[q, n]
+                b_qn, h0_qn, h1_qn = b[q, n], h0[q, n], h1[q, n]
                 for r in range(ptr[t], ptr[t + 1]):
                     for lo_, hi_ in spans:
                         r0, r1 = max(j0[r], lo_), min(j1[r], hi_)
@@ -239,7 +241,7 @@ def ring_slice(
                                     best_n[j] = nn
                             continue
                         ring = (q * (nr + 2) + i + di[r]) * stride + pad
-                        run_values(r0, r1, b_qn, tr_qn, omr_qn, ir, ca, cs,
+                        run_values(r0, r1, b_qn, h0_qn, h1_qn, ir, ca, cs,
                                    prev.dtype.type(op[r]), prev.dtype.type(om[r]), xpad,
                                    ring, stride, nn, best_val, best_n)
             finish_nodes(q * per_tack + i * nt, best_val[:nt], best_n[:nt], prev, sw_data,

@@ -25,8 +25,11 @@ periodic in ``θ``), switch update with the three-node rule (weights 1/6, 2/3,
 1/6 at ``θ + aC + {-1, 0, 1} σ √(3C)``, linear interpolation), ``w = 1`` inside
 the mark, ``w = 0`` for a foot beyond ``r_max`` (leaving the area fails), early
 zero where ``(r - R_D)/f_max > s``, switching only when ``s >= C``, ``C/Δs``
-an integer.  Each update is a sparse linear operator built once (the feet do
-not depend on ``s``), so a budget slice costs one sparse mat-vec.
+an integer.  Each update is linear in ``w`` with weights that do not depend on
+``s``: the bilinear rows are computed from small tables, relative to the node
+(:class:`_RingRows`, nothing stored per row; compiled with numba where installed),
+the bicubic and switch rows are sparse operators built once.  The policy keeps,
+per slice, only the rings that slice computed (:class:`SliceBands`).
 
 :func:`solve_risk_neutral` computes the risk-neutral counterpart (minimum
 expected time, Wang et al. (2024) eq. 5) by value iteration with the same operators,
@@ -40,9 +43,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
-from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -77,9 +79,6 @@ REFINEMENTS = ("none", "golden")
 """Steering-angle refinement after the direct search over the fixed controls."""
 BLOCK_NODES = 8192
 """Nodes per sparse mat-vec block (the block's values stay in cache for the max)."""
-RING_BLOCK_NODES = 1024
-"""Nodes per block of the NumPy ring-relative rows (their temporaries stay in the L2
-cache: 2.3x faster than blocks of 8192)."""
 
 
 @dataclass(frozen=True)
@@ -417,29 +416,31 @@ class _RingRows:
     ``i + g`` and angle column ``j + x ± c_σ`` [cells], with ``g = -τ f_n cos(θ_j + s_q
     u_n)/Δr``, ``x = b/r_i + c_a``, ``b = τ f_n sin(θ_j + s_q u_n)/Δθ``, ``c_a = τa/Δθ`` and
     ``c_σ = σ√τ/Δθ``.  ``g``, ``b`` and the radial fraction depend on ``(q, n, j)`` only,
-    so nothing is stored per row (the CSR form of :func:`_steer_operator` takes 64 bytes
-    a row, 5 GB at 801 x 1024), and along a ring the rows fall into runs that read
-    contiguous memory (``_deadline_jit.fill_runs``).  A row's value is
+    so the compiled slice stores nothing per row (the CSR form takes 64 bytes a row, 5 GB
+    at 801 x 1024), and along a ring the rows fall into runs that read contiguous memory
+    (``_deadline_jit.fill_runs``).  A row is the sum, in this order, of
 
-        ½ [(1 - t_r)(A₊ + A₋) + t_r (B₊ + B₋)],   A± = a₀ + t± (a₁ - a₀)
+        h₀(1 - t₊) a₀ + h₀ t₊ a₁ + h₁(1 - t₊) b₀ + h₁ t₊ b₁  (the + foot)
 
-    with ``A±`` interpolated in ``θ`` on ring ``i + ⌊g⌋`` at fraction ``t± = x ± c_σ -
-    ⌊x ± c_σ⌋`` and ``B±`` on the next ring; ``x`` and the values in the value dtype.
-    The same bilinear scheme as the CSR rows up to rounding: on Wang et al.'s (2024)
-    Fig. 4b set-up at 401 x 512, ``w`` differs by at most 3.2e-6.
+    and the same with ``t₋`` (the - foot), ``h₀ = ½(1 - t_r)``, ``h₁ = ½ t_r``, ``a₀, a₁``
+    on ring ``i + ⌊g⌋`` at columns ``⌊x ± c_σ⌋``, ``+ 1``, ``b₀, b₁`` on the next ring, ``t±``
+    the fractions of ``x ± c_σ``; ``x``, the weights and the sum in the value dtype.  That is
+    a CSR row in entry order, so the NumPy path (:meth:`operator`, one SciPy mat-vec per
+    block) gives the same bits.  The same bilinear scheme as :func:`_feet_stencil` up to
+    rounding (to 1e-12 in float64).
     """
 
     g: NDArray[np.float64]
     """``(2, n_u, n_θ)``: radial offset of the feet [cells]."""
     b: NDArray
     """``(2, n_u, n_θ + LANES)``: ``τ f sin(θ + s u)/Δθ`` [cells m], value dtype (the
-    compiled loop's spare chunk of zeros at the end, as ``tr`` and ``omr``)."""
+    compiled loop's spare chunk of zeros at the end, as ``h0`` and ``h1``)."""
     di: NDArray[np.int64]
     """``⌊g⌋``."""
-    tr: NDArray
-    """``g - ⌊g⌋``, value dtype."""
-    omr: NDArray
-    """``1 - tr``."""
+    h0: NDArray
+    """``½ (1 - t_r)``, ``t_r = g - ⌊g⌋``, value dtype."""
+    h1: NDArray
+    """``½ t_r``."""
     inv_r: NDArray
     """``(n_r + 1,)``: ``1/r_i`` [m⁻¹] (0 at ``r = 0``), value dtype."""
     ca: Any
@@ -454,9 +455,6 @@ class _RingRows:
     n_theta: int
     runs: tuple[NDArray, ...] | None
     """``(ptr, j0, j1, kind, di, op, om)`` of ``_deadline_jit.fill_runs`` (numba only)."""
-    by_node: Mapping[str, NDArray]
-    """``g``, ``b``, ``di``, ``tr``, ``omr`` as rows ``q n_θ + j`` of ``n_u`` controls
-    (the NumPy rows gather a node's controls as one row)."""
 
     @classmethod
     def build(cls, grid: DeadlineGrid, speeds: NDArray[np.float64], a: float, sigma: float,
@@ -469,6 +467,8 @@ class _RingRows:
         g = np.ascontiguousarray(-(step * np.cos(ang)) / grid.dr)
         di = np.floor(g).astype(np.int64)
         tr: NDArray[Any] = (g - di).astype(dtype)
+        half = dtype(0.5)
+        h0, h1 = half * (dtype(1.0) - tr), half * tr
         b: NDArray[Any] = np.ascontiguousarray((step * np.sin(ang) / grid.dtheta).astype(dtype))
         with np.errstate(divide="ignore"):
             inv_r: NDArray[Any] = np.where(grid.r_m > 0, 1.0 / grid.r_m, 0.0).astype(dtype)
@@ -486,12 +486,8 @@ class _RingRows:
             runs = (ptr, np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8),
                     np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int64))
             _jit.fill_runs(g, b, inv_r, ca, cs, fr_in, grid.n_r, grid.n_theta, n_in, *runs)
-        omr = (dtype(1.0) - tr).astype(dtype)
-        by_node = MappingProxyType({
-            name: np.ascontiguousarray(t.transpose(0, 2, 1).reshape(2 * grid.n_theta, -1))
-            for name, t in (("g", g), ("b", b), ("di", di), ("tr", tr), ("omr", omr))})
-        return cls(g, _spare(b), di, _spare(tr), _spare(omr), inv_r, ca, cs, fr_in, pad,
-                   grid.n_r, grid.n_theta, runs, by_node)
+        return cls(g, _spare(b), di, _spare(h0), _spare(h1), inv_r, ca, cs, fr_in, pad,
+                   grid.n_r, grid.n_theta, runs)
 
     @property
     def stride(self) -> int:
@@ -504,44 +500,54 @@ class _RingRows:
         return 2 * (self.n_r + 2) * self.stride + _jit.LANES
 
     def pad_slice(self, prev: NDArray, ring_lo: int, ring_hi: int, out: NDArray) -> None:
-        """Rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice ``out``."""
-        if self.runs is not None:
-            _jit.pad_rings(prev, self.n_r, self.n_theta, self.pad, ring_lo, ring_hi, out)
-            return
-        nt, pad = self.n_theta, self.pad
-        lo, hi = max(ring_lo - 1, 0), min(ring_hi + 1, self.n_r + 1)
-        cols = np.mod(np.arange(-pad, nt + pad), nt)
-        rings = prev[: 2 * (self.n_r + 1) * nt].reshape(2, self.n_r + 1, nt)
-        view = out[: 2 * (self.n_r + 2) * self.stride].reshape(2, self.n_r + 2, self.stride)
-        view[:, lo:hi] = rings[:, lo:hi][:, :, cols]
+        """Rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice ``out``
+        (the compiled path's input)."""
+        assert self.runs is not None
+        _jit.pad_rings(prev, self.n_r, self.n_theta, self.pad, ring_lo, ring_hi, out)
 
-    def values(self, xpad: NDArray, node_lo: int, node_hi: int) -> NDArray:
-        """Rows of nodes ``node_lo .. node_hi - 1`` (``xpad`` from :meth:`pad_slice`),
-        shape ``(nodes, n_u)``: the NumPy twin of ``_deadline_jit.run_values``."""
-        nt, stride = self.n_theta, self.stride
-        per_tack = (self.n_r + 1) * nt
-        node = np.arange(node_lo, node_hi)
-        q, i, j = node // per_tack, (node % per_tack) // nt, node % nt
-        qj = q * nt + j  # row of the node-major tables
-        i_c = i[:, None]
-        x = self.by_node["b"][qj] * self.inv_r[i_c] + self.ca
-        xp, xm = x + self.cs, x - self.cs
-        fp, fm = np.floor(xp), np.floor(xm)
-        tp, tm = xp - fp, xm - fm
-        fr = i_c + self.by_node["g"][qj]
-        inside, beyond = fr <= self.fr_in, fr > self.n_r
-        ring = ((q * (self.n_r + 2) + i) * stride + self.pad + j)[:, None] + \
-            self.by_node["di"][qj] * stride
-        top = xpad.size - stride - 2
-        up = np.clip(ring + fp.astype(np.int64), 0, top)  # clipped: ghosts, inside rings
-        um = np.clip(ring + fm.astype(np.int64), 0, top)
-        a0, a1, b0, b1 = xpad[up], xpad[up + 1], xpad[up + stride], xpad[up + stride + 1]
-        c0, c1, d0, d1 = xpad[um], xpad[um + 1], xpad[um + stride], xpad[um + stride + 1]
-        h = xpad.dtype.type(0.5)
-        s = h * (self.by_node["omr"][qj] * ((a0 + tp * (a1 - a0)) + (c0 + tm * (c1 - c0)))
-                 + self.by_node["tr"][qj] * ((b0 + tp * (b1 - b0)) + (d0 + tm * (d1 - d0))))
-        one, zero = xpad.dtype.type(1.0), xpad.dtype.type(0.0)
-        return np.where(inside, one, np.where(beyond, zero, s))
+    def operator(self, block_nodes: int = BLOCK_NODES) -> _RowOperator:
+        """The rows as a node-major CSR operator (the NumPy path): columns are the flat
+        nodes of the slice and its two ghosts, the entries in the order of the sum."""
+        nt, nr, nn = self.n_theta, self.n_r, 2 * (self.n_r + 1) * self.n_theta
+        n_u = self.g.shape[1]
+        cols = np.empty((nn, n_u, 8), dtype=np.int32)
+        vals = np.empty((nn, n_u, 8), dtype=self.b.dtype)
+        one = self.b.dtype.type(1.0)
+        g, b = self.g, self.b[..., :nt]
+        h0, h1, di = self.h0[..., :nt], self.h1[..., :nt], self.di
+        step = max(1, block_nodes // 8)
+        for n0 in range(0, nn, step):
+            node = np.arange(n0, min(n0 + step, nn))[:, None]
+            q, i, j = node // ((nr + 1) * nt), (node % ((nr + 1) * nt)) // nt, node % nt
+            n = np.arange(n_u)[None, :]
+            x = b[q, n, j] * self.inv_r[i] + self.ca
+            fr = i + g[q, n, j]
+            inside, beyond = fr <= self.fr_in, fr > nr
+            ring = q * (nr + 1) + i + di[q, n, j]
+            for f, xf in enumerate((x + self.cs, x - self.cs)):
+                fl = np.floor(xf)
+                t = xf - fl
+                c0 = np.mod(j + fl.astype(np.int64), nt)
+                c1 = np.mod(c0 + 1, nt)
+                nxt = np.where(ring % (nr + 1) == nr, nn + 1, (ring + 1) * nt)  # ring nr + 1: 0
+                e = 4 * f
+                cols[n0:n0 + len(node), :, e] = ring * nt + c0
+                cols[n0:n0 + len(node), :, e + 1] = ring * nt + c1
+                cols[n0:n0 + len(node), :, e + 2] = np.where(nxt == nn + 1, nn + 1, nxt + c0)
+                cols[n0:n0 + len(node), :, e + 3] = np.where(nxt == nn + 1, nn + 1, nxt + c1)
+                hh0, hh1 = h0[q, n, j], h1[q, n, j]
+                vals[n0:n0 + len(node), :, e] = hh0 * (one - t)
+                vals[n0:n0 + len(node), :, e + 1] = hh0 * t
+                vals[n0:n0 + len(node), :, e + 2] = hh1 * (one - t)
+                vals[n0:n0 + len(node), :, e + 3] = hh1 * t
+            ghost = inside | beyond
+            blk = slice(n0, n0 + len(node))
+            gc = np.where(inside, nn, nn + 1)[ghost]
+            cols[blk][ghost] = gc[:, None]
+            vals[blk][ghost] = 0.0
+            vals[blk][ghost, 0] = 0.5
+            vals[blk][ghost, 4] = 0.5
+        return _RowOperator.build(cols, vals, nn + 2, block_nodes)
 
 
 def _spare(table: NDArray) -> NDArray:
@@ -967,24 +973,26 @@ def solve_deadline(
         paper's set-up (``benchmarks/bench_deadline.py``).
     engine : {"auto", "numpy", "numba"}
         ``"numba"``: the compiled kernels of :mod:`sailroute.strategy._deadline_jit`
-        (the optional extra ``sailroute[fast]``) build the bilinear operator and march
-        the slices without golden refinement; the policy is the same bit for bit as
-        with ``"numpy"``.  ``"auto"`` (default): numba where it is installed.
+        (the optional extra ``sailroute[fast]``) march the slices (golden refinement
+        runs on the NumPy path); the policy is the same bit for bit as with
+        ``"numpy"``.  ``"auto"`` (default): numba where it is installed.
 
     Returns
     -------
     DeadlinePolicy
-        Memory: ``(4 + 1) (n_s + 1) n_nodes`` bytes for ``w`` and ``action`` (``w`` in
-        ``dtype``: 8 + 1 with float64), plus ``steer_offset`` with
-        ``grid.refine_controls``.
+        Memory: ``4 + 1`` bytes (``w`` in float32, the action; ``8 + 1`` in float64,
+        ``+ 1`` with ``grid.refine_controls``) per node and slice of the rings each
+        slice computed (:class:`SliceBands`): at most ``(n_s + 1) n_nodes`` of them.
 
     Notes
     -----
     A slice only updates the rings that can change: those that the boat can reach from
     within the budget at top speed (farther rings stay 0) and that are not yet sure
-    everywhere (``w >= 1 - 1e-6`` keeps its value and action); with the node-major
-    operators each block of nodes is one sparse mat-vec and a contiguous max over the
-    controls.
+    everywhere (``w >= 1 - 1e-6`` keeps its value and action); only those rings are
+    stored (:class:`SliceBands`).  Bilinear rows: :class:`_RingRows` (numba: runs along
+    each ring, vectorised; NumPy: the same operations, 1024 nodes at a time); bicubic:
+    node-major CSR rows, a block of nodes one sparse mat-vec and a contiguous max over
+    the controls.
     """
     t0 = time.perf_counter()
     if dtype not in ("float32", "float64"):
@@ -1002,8 +1010,12 @@ def solve_deadline(
     jit = compiled and refine is None  # golden refinement runs on the NumPy path
     cubic = grid.interpolation == "cubic"
     rows = None if cubic else _RingRows.build(grid, f, a, sigma, grid.ds_s, ftype, jit)
-    steer_op = (_steer_operator(grid, f, a, sigma, grid.ds_s, "fail", "cubic", ftype)
-                if cubic else None)
+    if cubic:
+        steer_op: _RowOperator | None = _steer_operator(grid, f, a, sigma, grid.ds_s, "fail",
+                                                        "cubic", ftype)
+    else:  # the compiled slice computes the bilinear rows; NumPy multiplies them
+        assert rows is not None
+        steer_op = None if jit else rows.operator()
     switch_op = _switch_operator(grid, a, sigma, tack_penalty_s, ftype)
     n_s, n_nodes, nt = grid.n_s, grid.n_nodes, grid.n_theta
     per_tack = (grid.n_r + 1) * nt
@@ -1027,7 +1039,7 @@ def solve_deadline(
     offs = np.zeros((2, n_nodes), dtype=np.int8) if refine is not None else None
     consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
     switch_cols = switch_op.indices.view(np.uint32)  # the kernels' index type
-    xpad = np.zeros(rows.padded_size() if rows is not None else 0, dtype=ftype)
+    xpad = np.zeros(rows.padded_size() if rows is not None and jit else 0, dtype=ftype)
     best_val = np.zeros(nt + _jit.LANES, dtype=ftype)  # scratch of the compiled slice
     best_n = np.zeros(nt + _jit.LANES, dtype=np.int8)
     lo = n_in
@@ -1048,11 +1060,11 @@ def solve_deadline(
             if offs is not None:
                 offs[k % 2, base + lo_a * nt:base + lo * nt] = \
                     offs[(k - 1) % 2, base + lo_a * nt:base + lo * nt]
-        if rows is not None:
+        if jit and rows is not None:
             rows.pad_slice(prev, lo, hi, xpad)
         switch_args = (switch_op.data, switch_cols, prev_c, k >= kc)
         if jit and rows is not None and rows.runs is not None:
-            _jit.ring_slice(*rows.runs, rows.b, rows.tr, rows.omr, rows.inv_r, rows.ca,
+            _jit.ring_slice(*rows.runs, rows.b, rows.h0, rows.h1, rows.inv_r, rows.ca,
                             rows.cs, grid.n_r, nt, rows.pad, xpad, prev, *switch_args, lo, hi,
                             *consts, a_prev, cur, a_cur, best_val, best_n)
         elif jit:
@@ -1063,12 +1075,11 @@ def solve_deadline(
                     prev, *switch_args, q * per_tack + lo * nt, q * per_tack + hi * nt,
                     *consts, a_prev, cur, a_cur)
         else:
-            block = BLOCK_NODES if rows is None else RING_BLOCK_NODES
+            assert steer_op is not None
             for q in (0, 1):
-                for n0 in range(q * per_tack + lo * nt, q * per_tack + hi * nt, block):
-                    n1 = min(n0 + block, q * per_tack + hi * nt)
-                    vals = (rows.values(xpad, n0, n1) if rows is not None else
-                            steer_op.apply(prev, n0, n1))  # type: ignore[union-attr]
+                for n0 in range(q * per_tack + lo * nt, q * per_tack + hi * nt, BLOCK_NODES):
+                    n1 = min(n0 + BLOCK_NODES, q * per_tack + hi * nt)
+                    vals = steer_op.apply(prev, n0, n1)
                     _update_block(n0, n1, vals, prev, prev_c if k >= kc else None, cur,
                                   (a_prev, a_cur), None if offs is None else
                                   (offs[(k - 1) % 2], offs[k % 2]), refine, switch_op)

@@ -263,16 +263,8 @@ def _reference_solve(g: DeadlineGrid, m: DriftDiffusionShift) -> np.ndarray:
     kc = g.penalty_steps(C)
     if g.interpolation == "cubic":
         s_op = _steer_operator(g, f, a, sigma, g.ds_s, "fail", "cubic")
-
-        def rows(x: np.ndarray) -> np.ndarray:
-            return s_op.apply(x, 0, g.n_nodes)
-    else:  # the ring-relative bilinear rows, the NumPy twin of the compiled ones
-        ring = _RingRows.build(g, f, a, sigma, g.ds_s, np.float32, compiled=False)
-        xpad = np.zeros(ring.padded_size(), dtype=np.float32)
-
-        def rows(x: np.ndarray) -> np.ndarray:
-            ring.pad_slice(x, 0, g.n_r + 1, xpad)
-            return ring.values(xpad, 0, g.n_nodes)
+    else:  # the ring-relative bilinear rows as the NumPy path multiplies them
+        s_op = _RingRows.build(g, f, a, sigma, g.ds_s, np.float32, compiled=False).operator()
     c_op = _switch_operator(g, a, sigma, C)
     r = np.tile(np.repeat(g.r_m, g.n_theta), 2)
     out = r > g.target_radius_m
@@ -281,7 +273,7 @@ def _reference_solve(g: DeadlineGrid, m: DriftDiffusionShift) -> np.ndarray:
     w[:, g.n_nodes] = 1.0
     reach = (r - g.target_radius_m) / float(np.max(f))
     for k in range(1, g.n_s + 1):
-        wk = np.max(rows(w[k - 1]), axis=1)
+        wk = np.max(s_op.apply(w[k - 1], 0, g.n_nodes), axis=1)
         if k >= kc:
             ws = c_op.apply(w[k - kc], 0, g.n_nodes)[:, 0]
             wk = np.where(ws > wk + SWITCH_EPS, ws, wk)
@@ -408,16 +400,14 @@ def test_ring_rows_agree_with_the_sparse_bilinear_rows() -> None:
     f = SO40.speed(1.0, np.degrees(g.controls_rad))
     x = np.random.default_rng(3).random(g.n_nodes + 2)
     x[g.n_nodes], x[g.n_nodes + 1] = 1.0, 0.0  # the ghosts: in the mark, beyond r_max
-    ring = _RingRows.build(g, f, a, sigma, g.ds_s, np.float64, compiled=False)
-    xpad = np.zeros(ring.padded_size())
-    ring.pad_slice(x, 0, g.n_r + 1, xpad)
+    ring = _RingRows.build(g, f, a, sigma, g.ds_s, np.float64, compiled=False).operator()
     n_in = int(np.count_nonzero(g.r_m <= g.target_radius_m))
     lo = n_in * g.n_theta  # rows of nodes outside the mark (inside, w = 1 anyway)
     per_tack = (g.n_r + 1) * g.n_theta
     csr = _steer_operator(g, f, a, sigma, g.ds_s, "fail", "linear", np.float64)
     for q in (0, 1):
         n0, n1 = q * per_tack + lo, (q + 1) * per_tack
-        np.testing.assert_allclose(ring.values(xpad, n0, n1), csr.apply(x, n0, n1),
+        np.testing.assert_allclose(ring.apply(x, n0, n1), csr.apply(x, n0, n1),
                                    rtol=0, atol=1e-12)
 
 
