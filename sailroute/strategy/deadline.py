@@ -56,6 +56,7 @@ from sailroute.errors import InputError
 from sailroute.numerics import golden_max, golden_steps
 from sailroute.parallel import TaskRunner, map_tasks
 from sailroute.strategy import _deadline_jit as _jit
+from sailroute.strategy._deadline_jit import STEER_MASK, SWITCH_BIT
 from sailroute.strategy.montecarlo import CHUNK_SIZE, chunk_rng
 from sailroute.strategy.shiftmodel import DriftDiffusionShift
 
@@ -451,8 +452,7 @@ class _RingRows:
     """``R_D/Δr``: a foot at or inside this ring position is in the mark."""
     pad: int
     """Periodic columns copied on each side of a ring (more than any foot's offset)."""
-    n_r: int
-    n_theta: int
+    grid: DeadlineGrid
     runs: tuple[NDArray, ...] | None
     """``(ptr, j0, j1, kind, di, op, om)`` of ``_deadline_jit.fill_runs`` (numba only)."""
 
@@ -486,64 +486,63 @@ class _RingRows:
             runs = (ptr, np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8),
                     np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int64))
             _jit.fill_runs(g, b, inv_r, ca, cs, fr_in, grid.n_r, grid.n_theta, n_in, *runs)
-        return cls(g, _spare(b), di, _spare(h0), _spare(h1), inv_r, ca, cs, fr_in, pad,
-                   grid.n_r, grid.n_theta, runs)
+        return cls(g, _spare(b), di, _spare(h0), _spare(h1), inv_r, ca, cs, fr_in, pad, grid,
+                   runs)
 
     @property
     def stride(self) -> int:
         """Padded ring length."""
-        return self.n_theta + 2 * self.pad
+        return self.grid.n_theta + 2 * self.pad
 
     def padded_size(self) -> int:
         """Length of the padded slice (both tacks, plus a ring of zeros beyond ``r_max``,
         plus the compiled loop's spare chunk)."""
-        return 2 * (self.n_r + 2) * self.stride + _jit.LANES
+        return 2 * (self.grid.n_r + 2) * self.stride + _jit.LANES
 
     def pad_slice(self, prev: NDArray, ring_lo: int, ring_hi: int, out: NDArray) -> None:
         """Rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice ``out``
         (the compiled path's input)."""
         assert self.runs is not None
-        _jit.pad_rings(prev, self.n_r, self.n_theta, self.pad, ring_lo, ring_hi, out)
+        _jit.pad_rings(prev, self.grid.n_r, self.grid.n_theta, self.pad, ring_lo, ring_hi, out)
 
     def operator(self, block_nodes: int = BLOCK_NODES) -> _RowOperator:
         """The rows as a node-major CSR operator (the NumPy path): columns are the flat
         nodes of the slice and its two ghosts, the entries in the order of the sum."""
-        nt, nr, nn = self.n_theta, self.n_r, 2 * (self.n_r + 1) * self.n_theta
+        nt, nr, nn = self.grid.n_theta, self.grid.n_r, self.grid.n_nodes
         n_u = self.g.shape[1]
         cols = np.empty((nn, n_u, 8), dtype=np.int32)
         vals = np.empty((nn, n_u, 8), dtype=self.b.dtype)
         one = self.b.dtype.type(1.0)
-        g, b = self.g, self.b[..., :nt]
-        h0, h1, di = self.h0[..., :nt], self.h1[..., :nt], self.di
+        b, h0, h1 = self.b[..., :nt], self.h0[..., :nt], self.h1[..., :nt]
+        n = np.arange(n_u)[None, :]
         step = max(1, block_nodes // 8)
         for n0 in range(0, nn, step):
-            node = np.arange(n0, min(n0 + step, nn))[:, None]
-            q, i, j = node // ((nr + 1) * nt), (node % ((nr + 1) * nt)) // nt, node % nt
-            n = np.arange(n_u)[None, :]
+            blk = slice(n0, min(n0 + step, nn))
+            q, i, j = _node_coords(self.grid, np.arange(blk.start, blk.stop)[:, None])
             x = b[q, n, j] * self.inv_r[i] + self.ca
-            fr = i + g[q, n, j]
-            inside, beyond = fr <= self.fr_in, fr > nr
-            ring = q * (nr + 1) + i + di[q, n, j]
+            fr = i + self.g[q, n, j]
+            ring = q * (nr + 1) + i + self.di[q, n, j]
+            # the next ring's points; a foot on the last ring weighs 0 on "ring n_r + 1":
+            # the ghost beyond r_max (value 0) stands in for it
+            last = ring % (nr + 1) == nr
+            hh0, hh1 = h0[q, n, j], h1[q, n, j]
             for f, xf in enumerate((x + self.cs, x - self.cs)):
                 fl = np.floor(xf)
                 t = xf - fl
                 c0 = np.mod(j + fl.astype(np.int64), nt)
                 c1 = np.mod(c0 + 1, nt)
-                nxt = np.where(ring % (nr + 1) == nr, nn + 1, (ring + 1) * nt)  # ring nr + 1: 0
                 e = 4 * f
-                cols[n0:n0 + len(node), :, e] = ring * nt + c0
-                cols[n0:n0 + len(node), :, e + 1] = ring * nt + c1
-                cols[n0:n0 + len(node), :, e + 2] = np.where(nxt == nn + 1, nn + 1, nxt + c0)
-                cols[n0:n0 + len(node), :, e + 3] = np.where(nxt == nn + 1, nn + 1, nxt + c1)
-                hh0, hh1 = h0[q, n, j], h1[q, n, j]
-                vals[n0:n0 + len(node), :, e] = hh0 * (one - t)
-                vals[n0:n0 + len(node), :, e + 1] = hh0 * t
-                vals[n0:n0 + len(node), :, e + 2] = hh1 * (one - t)
-                vals[n0:n0 + len(node), :, e + 3] = hh1 * t
+                cols[blk, :, e] = ring * nt + c0
+                cols[blk, :, e + 1] = ring * nt + c1
+                cols[blk, :, e + 2] = np.where(last, nn + 1, (ring + 1) * nt + c0)
+                cols[blk, :, e + 3] = np.where(last, nn + 1, (ring + 1) * nt + c1)
+                vals[blk, :, e] = hh0 * (one - t)
+                vals[blk, :, e + 1] = hh0 * t
+                vals[blk, :, e + 2] = hh1 * (one - t)
+                vals[blk, :, e + 3] = hh1 * t
+            inside, beyond = fr <= self.fr_in, fr > nr
             ghost = inside | beyond
-            blk = slice(n0, n0 + len(node))
-            gc = np.where(inside, nn, nn + 1)[ghost]
-            cols[blk][ghost] = gc[:, None]
+            cols[blk][ghost] = np.where(inside, nn, nn + 1)[ghost][:, None]
             vals[blk][ghost] = 0.0
             vals[blk][ghost, 0] = 0.5
             vals[blk][ghost, 4] = 0.5
@@ -581,10 +580,6 @@ def _switch_operator(
     return _RowOperator.build(cols.reshape(m, 1, 6), vals.reshape(m, 1, 6), grid.n_nodes + 2)
 
 
-SWITCH_BIT = 128
-"""Bit of :attr:`DeadlinePolicy.action` set where switching tack is optimal."""
-STEER_MASK = 127
-"""Bits of :attr:`DeadlinePolicy.action` holding the steering control index."""
 OFFSET_STEPS = 127
 """``steer_offset`` units: ``Δu / 127`` (0.03° for 49 controls)."""
 FINE_SPEED_STEPS = 1440
@@ -661,7 +656,7 @@ class SliceBands:
     rings below ``lo[k]`` are sure and keep the values of the last slice that computed
     them, rings from ``hi[k]`` on are beyond reach at top speed (``w = 0``), rings inside
     the mark have ``w = 1``.  Only the band is stored (Wang et al.'s (2024) Fig. 3 set-up at
-    801 x 1024: 37 % of the dense ``(n_s + 1) x n_nodes`` arrays), so memory and the first
+    801 x 1024: 44 % of the dense ``(n_s + 1) x n_nodes`` arrays), so memory and the first
     touch of it shrink accordingly.
 
     Attributes
@@ -704,17 +699,25 @@ class SliceBands:
         where = np.where(i < self.n_in, -1, np.where(i >= self.hi[k], -2, 0)).astype(np.int8)
         return np.where(where == 0, flat, 0), where
 
-    def value(self, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int) -> NDArray:
-        """``w`` of slice(s) ``k`` at ``node``."""
-        flat, where = self.locate(grid, k, node)
+    def w_at(self, flat: NDArray[np.int64], where: NDArray[np.int8]) -> NDArray:
+        """``w`` at the places :meth:`locate` returned (1 in the mark, 0 beyond reach)."""
         one, zero = self.w.dtype.type(1.0), self.w.dtype.type(0.0)
         return np.where(where == -1, one, np.where(where == -2, zero, self.w[flat]))
+
+    @staticmethod
+    def table_at(table: NDArray, flat: NDArray[np.int64], where: NDArray[np.int8]) -> NDArray:
+        """``table`` (``action`` or ``offset``) at the places :meth:`locate` returned; 0
+        where not stored."""
+        return np.where(where == 0, table[flat], 0).astype(table.dtype)
+
+    def value(self, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int) -> NDArray:
+        """``w`` of slice(s) ``k`` at ``node``."""
+        return self.w_at(*self.locate(grid, k, node))
 
     def gather(self, table: NDArray, grid: DeadlineGrid, k: NDArray | int,
                node: NDArray | int) -> NDArray:
         """``table`` (``action`` or ``offset``) at ``(k, node)``; 0 where not stored."""
-        flat, where = self.locate(grid, k, node)
-        return np.where(where == 0, table[flat], 0).astype(table.dtype)
+        return self.table_at(table, *self.locate(grid, k, node))
 
 
 @dataclass(frozen=True, eq=False)
@@ -765,19 +768,16 @@ class DeadlinePolicy:
         at ``node`` (one look-up, for the Monte Carlo steps)."""
         b = self.bands
         flat, where = b.locate(self.grid, k, node)
-        stored = where == 0
-        one, zero = b.w.dtype.type(1.0), b.w.dtype.type(0.0)
-        w = np.where(where == -1, one, np.where(where == -2, zero, b.w[flat]))
-        act = np.where(stored, b.action[flat], 0)
+        act = b.table_at(b.action, flat, where)
         idx = (act & STEER_MASK).astype(np.int64)
         if b.offset is None or self.fine_speeds is None:
             u, f = self.grid.controls_rad[idx], self.speeds_ms[idx]
         else:
             du = math.pi / (self.grid.n_controls - 1)
-            off = np.where(stored, b.offset[flat], 0)
+            off = b.table_at(b.offset, flat, where)
             u = np.clip(self.grid.controls_rad[idx] + off * (du / OFFSET_STEPS), 0.0, math.pi)
             f = np.interp(u, *self.fine_speeds)
-        return w, u, f, act >= SWITCH_BIT
+        return b.w_at(flat, where), u, f, act >= SWITCH_BIT
 
     def _dense(self, read: Callable[[NDArray, NDArray], NDArray]) -> NDArray:
         k = np.arange(self.grid.n_s + 1)[:, None]
@@ -990,9 +990,9 @@ def solve_deadline(
     within the budget at top speed (farther rings stay 0) and that are not yet sure
     everywhere (``w >= 1 - 1e-6`` keeps its value and action); only those rings are
     stored (:class:`SliceBands`).  Bilinear rows: :class:`_RingRows` (numba: runs along
-    each ring, vectorised; NumPy: the same operations, 1024 nodes at a time); bicubic:
-    node-major CSR rows, a block of nodes one sparse mat-vec and a contiguous max over
-    the controls.
+    each ring, vectorised; NumPy: the same rows as a node-major CSR operator); bicubic:
+    node-major CSR rows.  On the NumPy path a block of nodes is one sparse mat-vec and a
+    contiguous max over the controls.
     """
     t0 = time.perf_counter()
     if dtype not in ("float32", "float64"):
@@ -1039,6 +1039,7 @@ def solve_deadline(
     offs = np.zeros((2, n_nodes), dtype=np.int8) if refine is not None else None
     consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
     switch_cols = switch_op.indices.view(np.uint32)  # the kernels' index type
+    steer_cols = None if steer_op is None else steer_op.indices.view(np.uint32)
     xpad = np.zeros(rows.padded_size() if rows is not None and jit else 0, dtype=ftype)
     best_val = np.zeros(nt + _jit.LANES, dtype=ftype)  # scratch of the compiled slice
     best_n = np.zeros(nt + _jit.LANES, dtype=np.int8)
@@ -1060,10 +1061,10 @@ def solve_deadline(
             if offs is not None:
                 offs[k % 2, base + lo_a * nt:base + lo * nt] = \
                     offs[(k - 1) % 2, base + lo_a * nt:base + lo * nt]
-        if jit and rows is not None:
-            rows.pad_slice(prev, lo, hi, xpad)
         switch_args = (switch_op.data, switch_cols, prev_c, k >= kc)
-        if jit and rows is not None and rows.runs is not None:
+        if jit and rows is not None:
+            assert rows.runs is not None
+            rows.pad_slice(prev, lo, hi, xpad)
             _jit.ring_slice(*rows.runs, rows.b, rows.h0, rows.h1, rows.inv_r, rows.ca,
                             rows.cs, grid.n_r, nt, rows.pad, xpad, prev, *switch_args, lo, hi,
                             *consts, a_prev, cur, a_cur, best_val, best_n)
@@ -1071,9 +1072,9 @@ def solve_deadline(
             assert steer_op is not None
             for q in (0, 1):
                 _jit.slice_update(
-                    steer_op.indices.view(np.uint32), steer_op.data, f.size, steer_op.per_row,
-                    prev, *switch_args, q * per_tack + lo * nt, q * per_tack + hi * nt,
-                    *consts, a_prev, cur, a_cur)
+                    steer_cols, steer_op.data, f.size, steer_op.per_row, prev, *switch_args,
+                    q * per_tack + lo * nt, q * per_tack + hi * nt, *consts, a_prev, cur,
+                    a_cur)
         else:
             assert steer_op is not None
             for q in (0, 1):
