@@ -45,18 +45,21 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from types import ModuleType
 from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from sailroute.backend import get_xp, to_numpy
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 from sailroute.numerics import golden_max, golden_steps
 from sailroute.parallel import TaskRunner, map_tasks
 from sailroute.strategy import _deadline_jit as _jit
 from sailroute.strategy._deadline_jit import STEER_MASK, SWITCH_BIT
+from sailroute.strategy._deadline_xp import DeviceRows
 from sailroute.strategy.montecarlo import CHUNK_SIZE, chunk_rng
 from sailroute.strategy.shiftmodel import DriftDiffusionShift
 
@@ -508,45 +511,54 @@ class _RingRows:
     def operator(self, block_nodes: int = BLOCK_NODES) -> _RowOperator:
         """The rows as a node-major CSR operator (the NumPy path): columns are the flat
         nodes of the slice and its two ghosts, the entries in the order of the sum."""
+        cols, vals = self.entries(np, max(1, block_nodes // 8))
+        return _RowOperator.build(cols, vals, self.grid.n_nodes + 2, block_nodes)
+
+    def entries(self, xp: ModuleType = np, step: int = BLOCK_NODES // 8
+                ) -> tuple[NDArray[np.int32], NDArray]:
+        """Columns and weights ``(n_nodes, n_u, 8)`` of every row, computed on the array
+        module ``xp`` (the same operations on CuPy, so the same bits), ``step`` nodes at
+        a time."""
         nt, nr, nn = self.grid.n_theta, self.grid.n_r, self.grid.n_nodes
         n_u = self.g.shape[1]
-        cols = np.empty((nn, n_u, 8), dtype=np.int32)
-        vals = np.empty((nn, n_u, 8), dtype=self.b.dtype)
+        cols = xp.empty((nn, n_u, 8), dtype=np.int32)
+        vals = xp.empty((nn, n_u, 8), dtype=self.b.dtype)
         one = self.b.dtype.type(1.0)
-        b, h0, h1 = self.b[..., :nt], self.h0[..., :nt], self.h1[..., :nt]
-        n = np.arange(n_u)[None, :]
-        step = max(1, block_nodes // 8)
+        b, h0, h1 = (xp.asarray(t[..., :nt]) for t in (self.b, self.h0, self.h1))
+        g, di, inv_r = xp.asarray(self.g), xp.asarray(self.di), xp.asarray(self.inv_r)
+        # a foot in the mark or beyond r_max: half on each ghost column (entries 0 and 4)
+        ghost_row = xp.asarray([0.5, 0, 0, 0, 0.5, 0, 0, 0], dtype=self.b.dtype)
+        n = xp.arange(n_u)[None, :]
         for n0 in range(0, nn, step):
             blk = slice(n0, min(n0 + step, nn))
-            q, i, j = _node_coords(self.grid, np.arange(blk.start, blk.stop)[:, None])
-            x = b[q, n, j] * self.inv_r[i] + self.ca
-            fr = i + self.g[q, n, j]
-            ring = q * (nr + 1) + i + self.di[q, n, j]
+            q, i, j = _node_coords(self.grid, xp.arange(blk.start, blk.stop)[:, None])
+            x = b[q, n, j] * inv_r[i] + self.ca
+            fr = i + g[q, n, j]
+            ring = q * (nr + 1) + i + di[q, n, j]
             # the next ring's points; a foot on the last ring weighs 0 on "ring n_r + 1":
             # the ghost beyond r_max (value 0) stands in for it
             last = ring % (nr + 1) == nr
             hh0, hh1 = h0[q, n, j], h1[q, n, j]
             for f, xf in enumerate((x + self.cs, x - self.cs)):
-                fl = np.floor(xf)
+                fl = xp.floor(xf)
                 t = xf - fl
-                c0 = np.mod(j + fl.astype(np.int64), nt)
-                c1 = np.mod(c0 + 1, nt)
+                c0 = xp.mod(j + fl.astype(np.int64), nt)
+                c1 = xp.mod(c0 + 1, nt)
                 e = 4 * f
                 cols[blk, :, e] = ring * nt + c0
                 cols[blk, :, e + 1] = ring * nt + c1
-                cols[blk, :, e + 2] = np.where(last, nn + 1, (ring + 1) * nt + c0)
-                cols[blk, :, e + 3] = np.where(last, nn + 1, (ring + 1) * nt + c1)
+                cols[blk, :, e + 2] = xp.where(last, nn + 1, (ring + 1) * nt + c0)
+                cols[blk, :, e + 3] = xp.where(last, nn + 1, (ring + 1) * nt + c1)
                 vals[blk, :, e] = hh0 * (one - t)
                 vals[blk, :, e + 1] = hh0 * t
                 vals[blk, :, e + 2] = hh1 * (one - t)
                 vals[blk, :, e + 3] = hh1 * t
             inside, beyond = fr <= self.fr_in, fr > nr
             ghost = inside | beyond
-            cols[blk][ghost] = np.where(inside, nn, nn + 1)[ghost][:, None]
-            vals[blk][ghost] = 0.0
-            vals[blk][ghost, 0] = 0.5
-            vals[blk][ghost, 4] = 0.5
-        return _RowOperator.build(cols, vals, nn + 2, block_nodes)
+            cols_b, vals_b = cols[blk], vals[blk]
+            cols_b[ghost] = xp.where(inside, nn, nn + 1)[ghost][:, None]
+            vals_b[ghost] = ghost_row
+        return cols, vals
 
 
 def _spare(table: NDArray) -> NDArray:
@@ -886,16 +898,17 @@ def _rings_all_sure(w_prev: NDArray, grid: DeadlineGrid, lo: int, hi: int) -> in
     """First ring ``>= lo`` (and ``< hi``) where some node of either tack is not sure."""
     per_tack = (grid.n_r + 1) * grid.n_theta
     nt = grid.n_theta
+    sure = w_prev.dtype.type(SURE)  # as NumPy compares (on any array module)
     while lo < hi:
-        if (w_prev[lo * nt:(lo + 1) * nt] < SURE).any() or (
-            w_prev[per_tack + lo * nt:per_tack + (lo + 1) * nt] < SURE
+        if (w_prev[lo * nt:(lo + 1) * nt] < sure).any() or (
+            w_prev[per_tack + lo * nt:per_tack + (lo + 1) * nt] < sure
         ).any():
             return lo
         lo += 1
     return lo
 
 
-ENGINES = ("auto", "numpy", "numba")
+ENGINES = ("auto", "numpy", "numba", "cupy")
 
 
 def _use_compiled(engine: str) -> bool:
@@ -910,35 +923,39 @@ def _use_compiled(engine: str) -> bool:
 def _update_block(n0: int, n1: int, vals: NDArray, prev: NDArray, prev_c: NDArray | None,
                   w_out: NDArray, actions: tuple[NDArray, NDArray],
                   offsets: tuple[NDArray, NDArray] | None, refine: _SteerRefiner | None,
-                  switch_op: _RowOperator) -> None:
-    """Nodes ``n0 .. n1 - 1`` of a slice from their steering rows ``vals`` (NumPy path;
-    ``_deadline_jit.finish_nodes`` is the compiled twin): ``prev`` is the previous slice,
-    ``prev_c`` the slice ``C`` back (None before a switch can pay), ``actions`` and
-    ``offsets`` the previous and this slice's arrays."""
-    best = np.argmax(vals, axis=1)
-    wk = np.take_along_axis(vals, best[:, None], axis=1)[:, 0]
+                  switch_op: _RowOperator | DeviceRows, consts: tuple[Any, Any, Any],
+                  xp: ModuleType = np) -> None:
+    """Nodes ``n0 .. n1 - 1`` of a slice from their steering rows ``vals`` (NumPy path,
+    or any array module ``xp``; ``_deadline_jit.finish_nodes`` is the compiled twin):
+    ``prev`` is the previous slice, ``prev_c`` the slice ``C`` back (None before a switch
+    can pay), ``actions`` and ``offsets`` the previous and this slice's arrays, ``consts``
+    ``SWITCH_EPS``, ``ZERO_CLIP`` and ``SURE`` in the value dtype."""
+    eps, zero_clip, sure = consts
+    best = xp.argmax(vals, axis=1)
+    wk = xp.take_along_axis(vals, best[:, None], axis=1)[:, 0]
     off = None
     if refine is not None:
         wk, off = refine.refine(prev, n0, n1, best, wk)
     if prev_c is not None:
         ws = switch_op.apply(prev_c, n0, n1)[:, 0]
-        sw = ws > wk + SWITCH_EPS
-        wk = np.where(sw, ws, wk)
+        sw = ws > wk + eps
+        wk = xp.where(sw, ws, wk)
     else:
-        sw = np.zeros(n1 - n0, dtype=bool)
-    wk = np.where(wk < ZERO_CLIP, 0.0, np.minimum(wk, 1.0))
+        sw = xp.zeros(n1 - n0, dtype=bool)
+    wk = xp.where(wk < zero_clip, wk.dtype.type(0.0), xp.minimum(wk, wk.dtype.type(1.0)))
     # More budget never hurts: following the policy of budget s - Δs succeeds by s at
     # least as often.  Where that beats this slice (possible with the non-monotone cubic
     # weights), or where success was already sure (deadline upgrade: any action keeping
     # w = 1 ties, the one of the least sure budget is the tightest), keep the previous
     # slice's value and action.
     p = prev[n0:n1]
-    keep = (p >= SURE) | (p > wk)
-    w_out[n0:n1] = np.where(keep, p, wk)
+    keep = (p >= sure) | (p > wk)
+    w_out[n0:n1] = xp.where(keep, p, wk)
     a_prev, a_out = actions
-    a_out[n0:n1] = np.where(keep, a_prev[n0:n1], best | np.where(sw, SWITCH_BIT, 0))
+    a_out[n0:n1] = xp.where(keep, a_prev[n0:n1],
+                            (best | xp.where(sw, SWITCH_BIT, 0)).astype(np.uint8))
     if offsets is not None and off is not None:
-        offsets[1][n0:n1] = np.where(keep, offsets[0][n0:n1], off)
+        offsets[1][n0:n1] = xp.where(keep, offsets[0][n0:n1], off)
 
 
 def solve_deadline(
@@ -971,11 +988,14 @@ def solve_deadline(
         Precision of the operators and of ``w``.  ``float32`` (default) halves the
         memory and the memory traffic; it changes ``w`` by at most a few 1e-6 on the
         paper's set-up (``benchmarks/bench_deadline.py``).
-    engine : {"auto", "numpy", "numba"}
+    engine : {"auto", "numpy", "numba", "cupy"}
         ``"numba"``: the compiled kernels of :mod:`sailroute.strategy._deadline_jit`
         (the optional extra ``sailroute[fast]``) march the slices (golden refinement
         runs on the NumPy path); the policy is the same bit for bit as with
-        ``"numpy"``.  ``"auto"`` (default): numba where it is installed.
+        ``"numpy"``.  ``"cupy"``: the NumPy path's operations on the GPU, with the rows
+        and the working slices in GPU memory (the extra ``sailroute[gpu]`` and an NVIDIA
+        GPU; :mod:`sailroute.strategy._deadline_xp`); the same policy bit for bit, no
+        golden refinement.  ``"auto"`` (default): numba where it is installed.
 
     Returns
     -------
@@ -999,6 +1019,10 @@ def solve_deadline(
         raise InputError(f"dtype {dtype!r}: expected 'float32' or 'float64'")
     ftype = np.dtype(dtype).type
     compiled = _use_compiled(engine)
+    xp = get_xp("cupy") if engine == "cupy" else np
+    if xp is not np and grid.refine_controls != "none":
+        raise InputError("engine 'cupy' does not refine the steering angle: use "
+                         "refine_controls='none', or engine 'numpy' or 'numba'")
     kc = grid.penalty_steps(tack_penalty_s)
     a, sigma = _model_rates(model)
     f = _controls_speed(grid, polar, tws_ms)
@@ -1015,8 +1039,22 @@ def solve_deadline(
                                                         "cubic", ftype)
     else:  # the compiled slice computes the bilinear rows; NumPy multiplies them
         assert rows is not None
-        steer_op = None if jit else rows.operator()
+        steer_op = None if jit or xp is not np else rows.operator()
     switch_op = _switch_operator(grid, a, sigma, tack_penalty_s, ftype)
+    # the rows the NumPy code multiplies, on the array module (one block per tack band)
+    steer_x: _RowOperator | DeviceRows | None = steer_op
+    switch_x: _RowOperator | DeviceRows = switch_op
+    block = BLOCK_NODES
+    if xp is not np:
+        if steer_op is not None:
+            steer_x = DeviceRows.of(steer_op.indices.reshape(grid.n_nodes, f.size, -1),
+                                    steer_op.data.reshape(grid.n_nodes, f.size, -1), xp)
+        else:
+            assert rows is not None
+            steer_x = DeviceRows.of(*rows.entries(xp, 1 << 17), xp)
+        switch_x = DeviceRows.of(switch_op.indices.reshape(grid.n_nodes, 1, -1),
+                                 switch_op.data.reshape(grid.n_nodes, 1, -1), xp)
+        block = grid.n_nodes
     n_s, n_nodes, nt = grid.n_s, grid.n_nodes, grid.n_theta
     per_tack = (grid.n_r + 1) * nt
     n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))  # rings inside the mark
@@ -1025,17 +1063,17 @@ def solve_deadline(
     his = np.searchsorted(reach_time, grid.ds_s * np.arange(n_s + 1), side="right")
     his[0] = n_in
     bound = int(np.sum(his - n_in)) * 2 * nt  # the bands can be no larger (never touched)
-    band_w = np.empty(bound, dtype=ftype)
-    band_a = np.empty(bound, dtype=np.uint8)
+    band_w = xp.empty(bound, dtype=ftype)
+    band_a = xp.empty(bound, dtype=np.uint8)
     band_o = np.empty(bound, dtype=np.int8) if refine is not None else None
     los, starts = np.full(n_s + 1, n_in), np.zeros(n_s + 2, dtype=np.int64)
     # working slices: w of the last kc + 1 budgets (the switch reads C back), the action of
     # the last two; inside the mark w = 1, ghosts: a foot inside the mark (1), beyond (0)
-    ws = np.zeros((kc + 1, n_nodes + 2), dtype=ftype)
+    ws = xp.zeros((kc + 1, n_nodes + 2), dtype=ftype)
     for q in (0, 1):
         ws[:, q * per_tack:q * per_tack + n_in * nt] = 1.0
     ws[:, n_nodes] = 1.0
-    acts = np.zeros((2, n_nodes), dtype=np.uint8)
+    acts = xp.zeros((2, n_nodes), dtype=np.uint8)
     offs = np.zeros((2, n_nodes), dtype=np.int8) if refine is not None else None
     consts = tuple(ftype(c) for c in (SWITCH_EPS, ZERO_CLIP, SURE))  # as NumPy compares
     switch_cols = switch_op.indices.view(np.uint32)  # the kernels' index type
@@ -1076,14 +1114,15 @@ def solve_deadline(
                     q * per_tack + lo * nt, q * per_tack + hi * nt, *consts, a_prev, cur,
                     a_cur)
         else:
-            assert steer_op is not None
+            assert steer_x is not None
             for q in (0, 1):
-                for n0 in range(q * per_tack + lo * nt, q * per_tack + hi * nt, BLOCK_NODES):
-                    n1 = min(n0 + BLOCK_NODES, q * per_tack + hi * nt)
-                    vals = steer_op.apply(prev, n0, n1)
+                for n0 in range(q * per_tack + lo * nt, q * per_tack + hi * nt, block):
+                    n1 = min(n0 + block, q * per_tack + hi * nt)
+                    vals = steer_x.apply(prev, n0, n1)
                     _update_block(n0, n1, vals, prev, prev_c if k >= kc else None, cur,
                                   (a_prev, a_cur), None if offs is None else
-                                  (offs[(k - 1) % 2], offs[k % 2]), refine, switch_op)
+                                  (offs[(k - 1) % 2], offs[k % 2]), refine, switch_x,
+                                  consts, xp)
         # store the band of rings lo .. hi - 1 (tack 0, then tack 1)
         los[k] = lo
         size = (hi - lo) * nt
@@ -1099,7 +1138,8 @@ def solve_deadline(
             progress(k, n_s)
     used = int(starts[-1])
     last = np.searchsorted(los, np.arange(grid.n_r + 1), side="right") - 1
-    bands = SliceBands(los, his.astype(np.int64), starts, band_w[:used], band_a[:used],
+    bands = SliceBands(los, his.astype(np.int64), starts, to_numpy(band_w[:used]),
+                       to_numpy(band_a[:used]),
                        None if band_o is None else band_o[:used], n_in, last)
     return DeadlinePolicy(
         grid=grid,

@@ -8,6 +8,7 @@ the paper's numbers are compared in the slow test and in benchmarks/bench_strate
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -390,6 +391,37 @@ def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype
     assert np.array_equal(jit.action, ref.action)
 
 
+@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), [
+    ("linear", (0.05, 46.0, SIGMA), "float32", (40, 48)),
+    ("linear", (-0.15, 30.0, SIGMA), "float64", (40, 48)),
+    ("linear", (0.15, 20.0, 8.0), "float32", (12, 4)),
+    ("cubic", (0.0, 20.0, SIGMA), "float32", (40, 48)),
+])
+def test_array_module_engine_is_bit_for_bit_the_numpy_path(monkeypatch, interpolation, fig,
+                                                           dtype, shape) -> None:
+    # engine "cupy" runs the NumPy path's operations on another array module, with its own
+    # row sums (_deadline_xp.DeviceRows) and one block per tack band; a stand-in for NumPy
+    # takes that code path without a GPU (tests/test_gpu.py runs it on CuPy) and must give
+    # the same w and actions
+    import types
+
+    from sailroute.strategy import deadline
+
+    fake = types.ModuleType("numpy_standin")
+    fake.__getattr__ = lambda name: getattr(np, name)  # type: ignore[method-assign]
+    monkeypatch.setattr(deadline, "get_xp", lambda name: fake if name == "cupy" else np)
+    a, s_max, sigma = fig
+    g = DeadlineGrid(2.0, shape[0], shape[1], 0.1, 0.4, s_max, interpolation=interpolation)
+    m = model(a, sigma)
+    ref = solve_deadline(SO40, 1.0, m, g, C, engine="numpy", dtype=dtype)
+    dev = solve_deadline(SO40, 1.0, m, g, C, engine="cupy", dtype=dtype)
+    assert ref.w.max() > 0.5 and (ref.w[-1] >= 1 - 1e-6).any()
+    assert np.array_equal(dev.w, ref.w)
+    assert np.array_equal(dev.action, ref.action)
+    with pytest.raises(InputError, match="engine 'cupy' does not refine"):
+        solve_deadline(SO40, 1.0, m, replace(g, refine_controls="golden"), C, engine="cupy")
+
+
 def test_ring_rows_agree_with_the_sparse_bilinear_rows() -> None:
     # the ring-relative rows are the bilinear scheme of _feet_stencil up to rounding:
     # every node and control of a random slice (float64: to 1e-12)
@@ -447,7 +479,7 @@ def test_engine_errors(monkeypatch) -> None:
     from sailroute.strategy import _deadline_jit
 
     g = DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 2.0)
-    with pytest.raises(InputError, match="engine 'cuda': expected one of auto, numpy, numba"):
+    with pytest.raises(InputError, match="engine 'cuda': expected one of auto, numpy, numba, cupy"):
         solve_deadline(SO40, 1.0, model(0.0, SIGMA), g, C, engine="cuda")
     monkeypatch.setattr(_deadline_jit, "AVAILABLE", False)
     with pytest.raises(InputError, match=r"pip install 'sailroute\[fast\]'"):
