@@ -44,6 +44,7 @@ Tack = Literal["starboard", "port"]
 Shift = Literal["ou", "drift-diffusion"]
 DeadlineInterp = Literal["linear", "cubic"]
 DeadlineRefine = Literal["none", "golden"]
+DeadlineEngine = Literal["auto", "numpy", "numba", "cupy"]
 
 
 _TYPE_METAVAR = {str: "TEXT", int: "INTEGER", float: "NUMBER"}
@@ -504,6 +505,12 @@ def strategy_command(
                      help="Deadline solver steering: none (49 angles) or golden "
                      "(golden-section refinement per node)."),
     ] = "none",
+    deadline_engine: Annotated[
+        DeadlineEngine,
+        typer.Option("--deadline-engine", case_sensitive=False,
+                     help="Deadline solver kernels: auto (numba where installed), numpy, "
+                     "numba, or cupy (NVIDIA GPU); the same policy either way."),
+    ] = "auto",
     out: Annotated[str, typer.Option("--out", "-o", metavar="DIR", help="Output folder.")
                    ] = "strategy-out",
     no_plots: Annotated[bool, typer.Option("--no-plots", help="summary.json only.")] = False,
@@ -539,6 +546,7 @@ def strategy_command(
             n_workers=workers, shift=shift,
             diffusion_deg_per_sqrt_min=diffusion_deg_per_sqrt_min,
             interpolation=deadline_interpolation, refine_controls=deadline_refine,
+            deadline_engine=deadline_engine,
         )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)

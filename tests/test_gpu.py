@@ -9,6 +9,7 @@ round-to-nearest operations, so its policy is the same bit for bit.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -86,3 +87,17 @@ def test_deadline_on_cupy_is_the_numpy_policy(interpolation, fig, dtype, shape) 
     assert ref.w.max() > 0.5 and (ref.switch.any() or sigma > 1)
     assert np.array_equal(dev.w, ref.w)
     assert np.array_equal(dev.action, ref.action)
+
+
+def test_strategy_deadline_engine_cupy_gives_the_numpy_probabilities(tmp_path) -> None:
+    from sailroute.boat.build import builtin_polar
+    from sailroute.strategy.api import StrategySettings, run_strategy
+    from sailroute.strategy.shiftmodel import OUShift
+
+    st = StrategySettings(deadlines_s=(190.0,), n_r=40, n_theta=48, length_m=400.0,
+                          half_width_m=200.0, lateral_m=4.0, runs=300, deadline_engine="cupy")
+    a = run_strategy(builtin_polar("ilca7"), OUShift(10.0, 600.0), st).summary["deadline"]
+    b = run_strategy(builtin_polar("ilca7"), OUShift(10.0, 600.0),
+                     replace(st, deadline_engine="numpy")).summary["deadline"]
+    assert a["engine"] == "cupy"
+    assert a["risk_aware"] == b["risk_aware"]

@@ -27,6 +27,7 @@ from sailroute.strategy.deadline import (
     DeadlineSimulation,
     RiskNeutralPolicy,
     brownian_equivalent,
+    resolve_engine,
     simulate_deadline,
     solve_deadline,
     solve_risk_neutral,
@@ -92,6 +93,10 @@ class StrategySettings:
     refine_controls : {"none", "golden"}
         Deadline solver steering: the 49 fixed angles, or a golden-section search
         between the best angle's neighbours (:class:`DeadlineGrid`).
+    deadline_engine : {"auto", "numpy", "numba", "cupy"}
+        Deadline solver kernels (:func:`~sailroute.strategy.deadline.solve_deadline`):
+        numba where installed (``auto``), NumPy, or the GPU (``cupy``); the same policy
+        bit for bit.
     r_max_factor : float
         Outer radius of the deadline grid as a multiple of the leg length.
     s_max_factor : float
@@ -122,6 +127,7 @@ class StrategySettings:
     s_max_factor: float = 1.6
     interpolation: str = "linear"
     refine_controls: str = "none"
+    deadline_engine: str = "auto"
 
     def beat_grid(self) -> BeatGrid:
         """The SDP lattice."""
@@ -315,7 +321,8 @@ def _run_deadline(
         f"solving the deadline problem ({grid.n_r + 1} x {grid.n_theta} x 2 nodes, "
         f"{grid.n_s} budget steps of {grid.ds_s:g} s)"
     )
-    ra = solve_deadline(polar, st.tws_ms, dd, grid, st.tack_penalty_s)
+    ra = solve_deadline(polar, st.tws_ms, dd, grid, st.tack_penalty_s,
+                        engine=st.deadline_engine)
     say(f"  solved in {ra.solve_time_s:.1f} s; solving the risk-neutral problem")
     rn = solve_risk_neutral(polar, st.tws_ms, dd, grid, st.tack_penalty_s, tol_s=1e-3)
     say(f"  solved in {rn.solve_time_s:.1f} s ({rn.iterations} sweeps); simulating")
@@ -346,6 +353,7 @@ def _deadline_summary(study: DeadlineStudy, st: StrategySettings) -> dict[str, A
             "boundary, the boat stands still for the tack penalty"
         ),
         "grid": asdict(g),
+        "engine": st.deadline_engine,
         "solve_time_s": {
             "risk_aware": study.ra.solve_time_s,
             "risk_neutral": study.rn.solve_time_s,
@@ -567,6 +575,8 @@ def run_strategy_command(
         )
     except TypeError as exc:  # pragma: no cover - programming error in a caller
         raise InputError(f"strategy settings: {exc}") from None
+    if deadlines:  # before the expected-time study: say now what cannot run here
+        resolve_engine(st.deadline_engine)
     result = run_strategy(
         polar, model, st, progress=progress, fit=fit, scheduler=scheduler, n_workers=n_workers
     )

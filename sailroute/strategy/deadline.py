@@ -911,13 +911,22 @@ def _rings_all_sure(w_prev: NDArray, grid: DeadlineGrid, lo: int, hi: int) -> in
 ENGINES = ("auto", "numpy", "numba", "cupy")
 
 
-def _use_compiled(engine: str) -> bool:
-    """Whether ``engine`` selects the numba kernels (raises if it cannot)."""
+def resolve_engine(engine: str) -> tuple[bool, ModuleType]:
+    """Whether ``engine`` (one of :data:`ENGINES`) marches with the numba kernels, and the
+    array module of the slices; an :class:`InputError` saying what to install when it
+    cannot run here."""
     if engine not in ENGINES:
         raise InputError(f"engine {engine!r}: expected one of {', '.join(ENGINES)}")
     if engine == "numba" and not _jit.AVAILABLE:
         raise InputError("engine 'numba' needs numba: pip install 'sailroute[fast]'")
-    return engine == "numba" or (engine == "auto" and _jit.AVAILABLE)
+    if engine == "cupy":
+        try:
+            return False, get_xp("cupy")
+        except InputError:
+            raise InputError("engine 'cupy' needs CuPy and an NVIDIA GPU: pip install "
+                             "'sailroute[gpu]' on a machine with one, or use engine 'auto' "
+                             "(numba where installed, else NumPy)") from None
+    return engine == "numba" or (engine == "auto" and _jit.AVAILABLE), np
 
 
 def _update_block(n0: int, n1: int, vals: NDArray, prev: NDArray, prev_c: NDArray | None,
@@ -1018,8 +1027,7 @@ def solve_deadline(
     if dtype not in ("float32", "float64"):
         raise InputError(f"dtype {dtype!r}: expected 'float32' or 'float64'")
     ftype = np.dtype(dtype).type
-    compiled = _use_compiled(engine)
-    xp = get_xp("cupy") if engine == "cupy" else np
+    compiled, xp = resolve_engine(engine)
     if xp is not np and grid.refine_controls != "none":
         raise InputError("engine 'cupy' does not refine the steering angle: use "
                          "refine_controls='none', or engine 'numpy' or 'numba'")

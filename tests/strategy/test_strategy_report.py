@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from sailroute.backend import _cupy_or_none
 from sailroute.boat.build import builtin_polar
 from sailroute.cli import app
 from sailroute.errors import InputError
@@ -111,6 +113,12 @@ def test_run_strategy_with_deadline_writes_everything(tmp_path) -> None:
                      "policy_map.png", "spaghetti.png", "summary.json"]
     saved = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert saved["seed"] == 1 and saved["runs"] == 300
+    assert saved["deadline"]["engine"] == "auto"
+    # the NumPy engine gives the same policy, so the same simulated probabilities
+    d_np = run_strategy(ILCA7, OUShift(10.0, 600.0), replace(st, deadline_engine="numpy")
+                        ).summary["deadline"]
+    assert d_np["engine"] == "numpy"
+    assert d_np["risk_aware"] == d["risk_aware"]
 
 
 def test_drift_diffusion_shift_given_directly_in_minutes(tmp_path) -> None:
@@ -169,6 +177,11 @@ def test_cli_strategy_expected(tmp_path) -> None:
         (["--fit-from", "nowhere.csv"], "not found"),
         (["--seed", "-1"], "--seed -1: expected an integer >= 0"),
         (["--fit-from", str(ROOT / "data" / "trieste-coach-2018-02-15.csv")], "speed_unit"),
+        pytest.param(["--objective", "deadline=300", "--deadline-engine", "cupy"],
+                     "engine 'cupy' needs CuPy and an NVIDIA GPU",
+                     marks=pytest.mark.skipif(_cupy_or_none() is not None,
+                                              reason="a GPU is here")),
+        (["--deadline-engine", "gpu"], "--deadline-engine"),
     ],
 )
 def test_cli_strategy_errors_exit_2_without_traceback(args, message, tmp_path) -> None:
