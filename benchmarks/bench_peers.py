@@ -98,6 +98,7 @@ import platform  # noqa: E402
 import pstats  # noqa: E402
 import resource  # noqa: E402
 import shutil  # noqa: E402
+import statistics  # noqa: E402
 import subprocess  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -655,13 +656,14 @@ def section_course(args: argparse.Namespace) -> None:
 # CLI start-up
 
 
-def _time_process(cmd: Sequence[str], env: dict[str, str], repeat: int) -> tuple[Timing, int]:
+def _time_process(cmd: Sequence[str], env: dict[str, str], repeat: int,
+                  cwd: Path = ROOT) -> tuple[Timing, int]:
     """Best wall time of ``repeat`` fresh processes, its CPU time, and the last exit code."""
     best, rc = Timing(math.inf, math.inf), 0
     for _ in range(repeat):
         r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         tic = time.perf_counter()
-        rc = subprocess.run(cmd, env=env, cwd=ROOT, stdout=subprocess.DEVNULL,
+        rc = subprocess.run(cmd, env=env, cwd=cwd, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, check=False).returncode
         wall = time.perf_counter() - tic
         r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -718,7 +720,45 @@ def section_cli(args: argparse.Namespace) -> None:
         _time_process(cmd, warm, 1)  # prime the cache
         t_warm, rc = _time_process(cmd, warm, n)
         print(f"| `{label}` | {t_cold} | {t_warm} | {rc} |")
+    if args.cli_baseline:
+        _compare_plan(Path(args.cli_baseline).resolve(), warm, out, args.plan_repeat)
     shutil.rmtree(out, ignore_errors=True)
+
+
+def _compare_plan(baseline: Path, env: dict[str, str], out: Path, rounds: int) -> None:
+    """``sailroute plan`` with this tree's code and with ``baseline``'s (a checkout of older
+    code), alternating, ``rounds`` each after one warm-up of each; primed bytecode caches.
+
+    Both run as ``python -m sailroute`` from a temporary folder with ``PYTHONPATH`` set to
+    their tree (``-m`` would put the working folder first)."""
+    trees = {"baseline": baseline, "this tree": ROOT}
+    course = str(COURSE)
+    print(f"\n`sailroute plan {COURSE.relative_to(ROOT)}` against {baseline} "
+          f"({_git_rev(baseline)}), alternating, {rounds} runs each (wall s, sorted):\n")
+    print("| command | baseline | this tree | ratio of medians |")
+    print("|---|---|---|---:|")
+    for flags in ([], ["--no-plots"]):
+        walls: dict[str, list[float]] = {k: [] for k in trees}
+        for i in range(rounds + 1):
+            for name, tree in trees.items():
+                cmd = [sys.executable, "-m", "sailroute", "plan", course, "--out",
+                       str(out / "cmp"), "--quiet", *flags]
+                t, rc = _time_process(cmd, dict(env, PYTHONPATH=str(tree)), 1, cwd=out)
+                if rc != 0:
+                    raise SystemExit(f"{name}: {' '.join(cmd)} exited with {rc}")
+                if i > 0:  # the first round primes the caches
+                    walls[name].append(t.wall)
+        med = {k: statistics.median(v) for k, v in walls.items()}
+        cells = [", ".join(f"{w:.2f}" for w in sorted(walls[k])) for k in trees]
+        print(f"| `plan {' '.join(flags)}` | {cells[0]} | {cells[1]} | "
+              f"{med['this tree'] / med['baseline']:.3f} |")
+
+
+def _git_rev(tree: Path) -> str:
+    """Short commit of ``tree`` (or "?")."""
+    res = subprocess.run(["git", "-C", str(tree), "rev-parse", "--short", "HEAD"],
+                         capture_output=True, text=True, check=False)
+    return res.stdout.strip() or "?"
 
 
 # ------------------------------------------------------------------------------------
@@ -823,6 +863,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     ap.add_argument("--course-repeat", type=int, default=3)
     ap.add_argument("--cli-repeat", type=int, default=5)
     ap.add_argument("--plan-repeat", type=int, default=3)
+    ap.add_argument("--cli-baseline", default=None, metavar="DIR",
+                    help="cli section: also time `plan` against the code in DIR (a checkout "
+                    "of an older commit), alternating, --plan-repeat runs each")
     ap.add_argument("--top", type=int, default=15, help="profile rows")
     args = ap.parse_args(argv)
     if args.quick:

@@ -420,12 +420,15 @@ def run_plan_command(
         run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
 
         def write(d: Path) -> dict[str, Path]:
+            if plots:  # the child draws while the other files are written here
+                png.submit(run.plan, run.wind, d / "route.png", png_worker.DPI)
             files = dict(write_plan_outputs(d, run.plan, wind=run.wind, plot=False))
             if plots:
                 from sailroute.report.html import plan_report, write_report
 
-                files["png"] = png.draw(run.plan, run.wind, d / "route.png", png_worker.DPI)
-                files["html"] = write_report(d / "report.html", plan_report(run.plan, run.wind))
+                html = write_report(d / "report.html", plan_report(run.plan, run.wind))
+                files["png"] = png.result()
+                files["html"] = html
             return files
 
         files = write_output_set(out, write)

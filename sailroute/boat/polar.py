@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError
-from sailroute.numerics import golden_max, pchip
+from sailroute.numerics import clip, golden_max, pchip
 from sailroute.units import KNOT
 
 INTERPOLATIONS: Final = ("pchip", "linear")
@@ -284,7 +284,7 @@ class Polar:
         if np.any(a > 360.0):  # NaN-safe: NaN > 360 is False
             a = np.mod(a, 360.0)
         a = np.minimum(a, 360.0 - a) * inv_twa
-        w = np.clip(np.asarray(tws_ms, dtype=float), 0.0, tws_max) * inv_tws
+        w = clip(np.asarray(tws_ms, dtype=float), 0.0, tws_max) * inv_tws
         with np.errstate(invalid="ignore"):
             i = np.minimum(a.astype(np.intp), n_twa - 2)
             j = np.minimum(w.astype(np.intp), n_tws - 2)
@@ -302,12 +302,12 @@ class Polar:
         a = fold_twa(twa_deg)
         twa_ax, tws_ax, tab = self._extended
         with np.errstate(invalid="ignore"):
-            i = np.clip(np.searchsorted(twa_ax, a, side="right") - 1, 0, twa_ax.size - 2)
-            fa = np.clip((a - twa_ax[i]) / (twa_ax[i + 1] - twa_ax[i]), 0.0, 1.0)
+            i = clip(np.searchsorted(twa_ax, a, side="right") - 1, 0, twa_ax.size - 2)
+            fa = clip((a - twa_ax[i]) / (twa_ax[i + 1] - twa_ax[i]), 0.0, 1.0)
             if tws_ax.size == 1:
                 return (1 - fa) * tab[i, 0] + fa * tab[i + 1, 0] + 0.0 * tws
-            j = np.clip(np.searchsorted(tws_ax, tws, side="right") - 1, 0, tws_ax.size - 2)
-            fw = np.clip((tws - tws_ax[j]) / (tws_ax[j + 1] - tws_ax[j]), 0.0, 1.0)
+            j = clip(np.searchsorted(tws_ax, tws, side="right") - 1, 0, tws_ax.size - 2)
+            fw = clip((tws - tws_ax[j]) / (tws_ax[j + 1] - tws_ax[j]), 0.0, 1.0)
         fa = np.where(np.isnan(a), np.nan, fa)
         fw = np.where(np.isnan(tws), np.nan, fw)
         return (

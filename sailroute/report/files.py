@@ -428,9 +428,7 @@ def write_plan_outputs(
         "gpx": write_gpx(d / "route.gpx", plan),
     }
     if plot:
-        from sailroute.report.plots import plot_plan
+        from sailroute.report.png_worker import draw_in_process
 
-        fig = plot_plan(plan, wind)
-        fig.savefig(d / "route.png", dpi=dpi)
-        out["png"] = d / "route.png"
+        out["png"] = draw_in_process(plan, wind, d / "route.png", dpi)
     return out

@@ -61,6 +61,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.errors import InputError
+from sailroute.numerics import clip
 from sailroute.routing.types import Barrier, LegResult, Start, Target
 
 XY = tuple[float, float]
@@ -348,7 +349,7 @@ def aim_points(
     length = geom.length_m
     ux, uy = (geom.b[0] - ax) / length, (geom.b[1] - ay) / length
     m = min(margin_m, 0.5 * length)
-    r = xp.clip((px - ax) * ux + (py - ay) * uy, m, length - m)
+    r = clip((px - ax) * ux + (py - ay) * uy, m, length - m, xp=xp)
     return ax + r * ux, ay + r * uy
 
 
@@ -480,7 +481,7 @@ def barrier_blocks(
         dx, dy = qx - px, qy - py
         wx, wy = mx - px, my - py
         dd = dx * dx + dy * dy
-        f = xp.clip((wx * dx + wy * dy) / xp.where(dd > 0, dd, 1.0), 0.0, 1.0)
+        f = clip((wx * dx + wy * dy) / xp.where(dd > 0, dd, 1.0), 0.0, 1.0, xp=xp)
         cx, cy = wx - f * dx, wy - f * dy
         blocked = blocked | (cx * cx + cy * cy < clearance_m * clearance_m)
     return blocked

@@ -71,6 +71,7 @@ from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.current import CurrentField, RelativeWind, current_rate_set
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
+from sailroute.numerics import clip
 from sailroute.routing.geometry import (
     AIM_MARGIN_M,
     BARRIER_LENGTH_M,
@@ -193,10 +194,13 @@ def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
     a = np.linspace(180.0 / n_a, 180.0, n_a)
     own = np.asarray(polar.tws_ms, dtype=float).ravel()
     top = float(own.max()) if own.size and own.max() > 0 else 30.0
-    nodes = np.unique(np.concatenate([
+    nodes = np.sort(np.concatenate([
         np.linspace(0.0, top, math.ceil(top / TABLE_TWS_STEP_MS) + 1),
         own[(own >= 0) & (own <= top)],
     ]))
+    # distinct values (np.unique's result without NaNs; np.unique imports numpy.ma, 22 ms
+    # of a plan's start-up)
+    nodes = nodes[np.concatenate([[True], nodes[1:] != nodes[:-1]])]
     speed = np.asarray(polar.speed(nodes[:, None], a[None, :]), dtype=float)
     up, vu = _vmg_angles(polar, nodes, True)
     down, vd = _vmg_angles(polar, nodes, False)
@@ -988,8 +992,8 @@ def _wind_state(u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleTyp
     inv = 1.0 / xp.where(windy, tws, 1.0)
     up_x, up_y = fr.vec_to_leg(xp.where(windy, -u * inv, 0.0), xp.where(windy, -v * inv, 1.0))
     nodes = dev.tws_ms
-    row = xp.clip(xp.searchsorted(nodes, tws, side="right") - 1, 0, nodes.shape[0] - 2)
-    weight = xp.clip((tws - nodes[row]) / (nodes[row + 1] - nodes[row]), 0.0, 1.0)
+    row = clip(xp.searchsorted(nodes, tws, side="right") - 1, 0, nodes.shape[0] - 2, xp=xp)
+    weight = clip((tws - nodes[row]) / (nodes[row + 1] - nodes[row]), 0.0, 1.0, xp=xp)
     up_deg = dev.up_deg[row] + weight * (dev.up_deg[row + 1] - dev.up_deg[row])
     down_deg = dev.down_deg[row] + weight * (dev.down_deg[row + 1] - dev.down_deg[row])
     return _PointWind(tws, up_x, up_y, row, weight, up_deg, down_deg)
@@ -1018,7 +1022,7 @@ def _time_to_go(
     Returns ``tau`` [s] and ``G`` [s m⁻¹] (x and y).
     """
     up_x, up_y, node, weight = wind.up_x, wind.up_y, wind.row, wind.weight
-    cos_b = xp.clip(up_y * ey + up_x * ex, -1.0, 1.0)
+    cos_b = clip(up_y * ey + up_x * ex, -1.0, 1.0, xp=xp)
     sin_b = up_x * ey - up_y * ex
     beta_deg = xp.degrees(xp.arccos(cos_b))
     vmg_up = dev.up_vmg_ms[node] + weight * (dev.up_vmg_ms[node + 1] - dev.up_vmg_ms[node])
@@ -1028,8 +1032,8 @@ def _time_to_go(
     na = dev.twa_deg.shape[0]
     step = 180.0 / na
     pos = beta_deg * (1.0 / step) - 1.0
-    col = xp.clip(xp.floor(pos).astype(xp.int64), 0, na - 2)
-    frac = xp.clip(pos - col, 0.0, 1.0)
+    col = clip(xp.floor(pos).astype(xp.int64), 0, na - 2, xp=xp)
+    frac = clip(pos - col, 0.0, 1.0, xp=xp)
     sp = dev.speed_ms
     s_l = sp[node, col] + weight * (sp[node + 1, col] - sp[node, col])
     s_r = sp[node, col + 1] + weight * (sp[node + 1, col + 1] - sp[node, col + 1])
@@ -1067,8 +1071,8 @@ def _support(node: Any, weight: Any, beta_deg: Any, dev: _DeviceTables, xp: Modu
     at the table rows ``node, weight``: the best speed component [m s⁻¹] and its |TWA|
     [°], interpolated bilinearly in (TWS, beta) from :attr:`PolarTables.sup_ms`."""
     pos = (beta_deg + 180.0) * (dev.sup_ms.shape[1] - 1) / 360.0
-    col = xp.clip(xp.floor(pos).astype(xp.int64), 0, dev.sup_ms.shape[1] - 2)
-    frac = xp.clip(pos - col, 0.0, 1.0)
+    col = clip(xp.floor(pos).astype(xp.int64), 0, dev.sup_ms.shape[1] - 2, xp=xp)
+    frac = clip(pos - col, 0.0, 1.0, xp=xp)
     out = []
     for tab in (dev.sup_ms, dev.sup_deg):
         below = tab[node, col] + frac * (tab[node, col + 1] - tab[node, col])
@@ -1125,7 +1129,7 @@ def _fastest_aim(
     length = g.length_m
     ux, uy = (g.b[0] - ax0) / length, (g.b[1] - ay0) / length
     m = min(AIM_MARGIN_M, 0.5 * length)
-    r = xp.clip((x + t * dx - ax0) * ux + (y + t * dy - ay0) * uy, m, length - m)
+    r = clip((x + t * dx - ax0) * ux + (y + t * dy - ay0) * uy, m, length - m, xp=xp)
     vx = ax0 + r * ux - x
     vy = ay0 + r * uy - y
     d2 = xp.sqrt(vx * vx + vy * vy)
@@ -1159,13 +1163,13 @@ def _crab(
     wx, wy = ex, ey
     tws_h = to_numpy(wind.tws_ms)
     for _ in range(_CRAB_ITERATIONS):
-        a_d = xp.degrees(xp.arccos(xp.clip(up_y * wy + up_x * wx, -1.0, 1.0)))
+        a_d = xp.degrees(xp.arccos(clip(up_y * wy + up_x * wx, -1.0, 1.0, xp=xp)))
         spd = xp.asarray(polar.speed(tws_h, to_numpy(a_d)), dtype=float)
         q = -cp / xp.where(spd > 0, spd, 1.0)
         q = xp.where((spd > 0) & (xp.abs(q) < 1.0), q, 0.0)
         r = xp.sqrt(1.0 - q * q)
         wx, wy = r * ex + q * px, r * ey + q * py
-    cos_d = xp.clip(up_y * wy + up_x * wx, -1.0, 1.0)
+    cos_d = clip(up_y * wy + up_x * wx, -1.0, 1.0, xp=xp)
     a_d = xp.degrees(xp.arccos(cos_d))
     v_d = xp.asarray(polar.speed(tws_h, to_numpy(a_d)), dtype=float)
     return cos_d, up_x * wy - up_y * wx, a_d, v_d
@@ -1245,8 +1249,9 @@ def _sample_step(
     py = xp.concatenate([y + half * xp.cos(hr), (y + fk[:, None] * (aim_y - y)).reshape(-1)])
     pt = xp.concatenate([xp.full(n, t_mid), (t_mid + fk[:, None] * horizon).reshape(-1)])
     wx, wy = ctx.frame.to_world(px, py)
-    pts = (to_numpy(xp.clip(pt, cov.t0, cov.t1)), to_numpy(xp.clip(wx, cov.xmin, cov.xmax)),
-           to_numpy(xp.clip(wy, cov.ymin, cov.ymax)))
+    pts = (to_numpy(clip(pt, cov.t0, cov.t1, xp=xp)),
+           to_numpy(clip(wx, cov.xmin, cov.xmax, xp=xp)),
+           to_numpy(clip(wy, cov.ymin, cov.ymax, xp=xp)))
     u, v = wind.sample(*pts)
     u = xp.asarray(u, dtype=float).reshape(PATH_SAMPLES + 1, n)
     v = xp.asarray(v, dtype=float).reshape(PATH_SAMPLES + 1, n)
@@ -1285,7 +1290,7 @@ def _exact_columns(
                                    to_numpy(xp.stack([wind.up_deg, wind.down_deg], 1))),
                        dtype=float)
     if cur is None:
-        cos_d = xp.clip(wind.up_y * aim_y + wind.up_x * aim_x, -1.0, 1.0)  # (2, n)
+        cos_d = clip(wind.up_y * aim_y + wind.up_x * aim_x, -1.0, 1.0, xp=xp)  # (2, n)
         sin_d = wind.up_x * aim_y - wind.up_y * aim_x
         a_d = xp.degrees(xp.arccos(cos_d))
         v_d = xp.asarray(polar.speed(to_numpy(wind.tws_ms), to_numpy(a_d)), dtype=float)
@@ -1748,7 +1753,7 @@ def _segment_distance(x: Any, y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
     ax, ay = g.a
     ex, ey = g.b[0] - ax, g.b[1] - ay
     ll = ex * ex + ey * ey
-    r = xp.clip(((x - ax) * ex + (y - ay) * ey) / ll, 0.0, 1.0)
+    r = clip(((x - ax) * ex + (y - ay) * ey) / ll, 0.0, 1.0, xp=xp)
     dx = x - (ax + r * ex)
     dy = y - (ay + r * ey)
     return xp.sqrt(dx * dx + dy * dy)
