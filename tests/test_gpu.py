@@ -26,7 +26,7 @@ from sailroute.strategy.deadline import DeadlineGrid, solve_deadline
 from sailroute.units import KNOT
 from sailroute.wind.analytic import debski_test_wind
 from sailroute.wind.uniform import UniformWind
-from tests.strategy.test_strategy_deadline import SIGMA, SO40, C, model
+from tests.strategy.test_strategy_deadline import ENGINE_CASES, SIGMA, SO40, C, model
 
 pytestmark = [pytest.mark.gpu,
               pytest.mark.skipif(_cupy_or_none() is None, reason="needs CuPy and a CUDA device")]
@@ -72,14 +72,9 @@ def test_plan_on_cupy_is_the_numpy_plan() -> None:
         _same_leg(la, lb)
 
 
-@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), [
-    ("linear", (0.05, 46.0, SIGMA), "float32", (100, 128)),
-    ("linear", (-0.15, 30.0, SIGMA), "float64", (40, 48)),
-    ("linear", (0.15, 20.0, 8.0), "float32", (12, 4)),  # feet round the ring more than once
-    ("cubic", (0.0, 20.0, SIGMA), "float32", (40, 48)),
-])
+@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"),
+                         [*ENGINE_CASES, ("linear", (0.05, 46.0, SIGMA), "float32", (100, 128))])
 def test_deadline_on_cupy_is_the_numpy_policy(interpolation, fig, dtype, shape) -> None:
-    # the cases of tests/strategy/test_strategy_deadline.py's engine comparisons
     a, s_max, sigma = fig
     g = DeadlineGrid(2.0, shape[0], shape[1], 0.1, 0.4, s_max, interpolation=interpolation)
     ref = solve_deadline(SO40, 1.0, model(a, sigma), g, C, engine="numpy", dtype=dtype)

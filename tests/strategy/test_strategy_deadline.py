@@ -362,13 +362,18 @@ def test_golden_policy_simulates(golden) -> None:
     assert np.mean(sim.n_switches == 0) > 0.5  # the bet on the shift, as the coarse policy
 
 
-@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), [
+# (interpolation, (drift a, s_max, sigma), dtype, (n_r, n_theta)) of the engine comparisons
+# (also tests/test_gpu.py): drift both ways, both dtypes, bicubic, and 4 angles with a wide
+# diffusion, whose feet reach more than once round the ring
+ENGINE_CASES = [
     ("linear", (0.05, 46.0, SIGMA), "float32", (40, 48)),
     ("linear", (-0.15, 30.0, SIGMA), "float64", (40, 48)),
-    # 4 angles and a wide diffusion: the feet reach more than once round the ring
     ("linear", (0.15, 20.0, 8.0), "float32", (12, 4)),
     ("cubic", (0.0, 20.0, SIGMA), "float32", (40, 48)),
-])
+]
+
+
+@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), ENGINE_CASES)
 def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype,
                                                        shape) -> None:
     # the numba kernels do the NumPy arithmetic in the same order: the same w and actions
@@ -391,12 +396,7 @@ def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype
     assert np.array_equal(jit.action, ref.action)
 
 
-@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), [
-    ("linear", (0.05, 46.0, SIGMA), "float32", (40, 48)),
-    ("linear", (-0.15, 30.0, SIGMA), "float64", (40, 48)),
-    ("linear", (0.15, 20.0, 8.0), "float32", (12, 4)),
-    ("cubic", (0.0, 20.0, SIGMA), "float32", (40, 48)),
-])
+@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), ENGINE_CASES)
 def test_array_module_engine_is_bit_for_bit_the_numpy_path(monkeypatch, interpolation, fig,
                                                            dtype, shape) -> None:
     # engine "cupy" runs the NumPy path's operations on another array module, with its own
