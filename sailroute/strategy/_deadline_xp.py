@@ -79,7 +79,7 @@ class DeviceRows:
         (NumPy or ``xp`` arrays; copied to ``xp``)."""
         _, rows_per_node, per_row = cols.shape
         return cls(xp.ascontiguousarray(xp.asarray(vals).reshape(-1)),
-                   xp.ascontiguousarray(xp.asarray(cols).reshape(-1).astype(np.int32)),
+                   xp.ascontiguousarray(xp.asarray(cols).reshape(-1).astype(np.int32, copy=False)),
                    int(rows_per_node), int(per_row), xp)
 
     def apply(self, x: Any, node_lo: int, node_hi: int) -> Any:

@@ -27,8 +27,9 @@ the mark, ``w = 0`` for a foot beyond ``r_max`` (leaving the area fails), early
 zero where ``(r - R_D)/f_max > s``, switching only when ``s >= C``, ``C/Δs``
 an integer.  Each update is linear in ``w`` with weights that do not depend on
 ``s``: the bilinear rows are computed from small tables, relative to the node
-(:class:`_RingRows`, nothing stored per row; compiled with numba where installed),
-the bicubic and switch rows are sparse operators built once.  The policy keeps,
+(:class:`_RingRows`, nothing stored per row; compiled with numba where installed; on a
+GPU, ``engine="cupy"``, built once in GPU memory), the bicubic and switch rows are sparse
+operators built once.  The policy keeps,
 per slice, only the rings that slice computed (:class:`SliceBands`).
 
 :func:`solve_risk_neutral` computes the risk-neutral counterpart (minimum
