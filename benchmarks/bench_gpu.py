@@ -49,6 +49,7 @@ import bench_isochrone as bi  # noqa: E402
 
 from sailroute.backend import get_xp  # noqa: E402
 from sailroute.boat.dynamic import DynamicBoat  # noqa: E402
+from sailroute.errors import InputError  # noqa: E402
 from sailroute.routing import isochrone  # noqa: E402
 from sailroute.routing.griddp import solve_griddp  # noqa: E402
 from sailroute.routing.types import RoutingSettings, Start, Target  # noqa: E402
@@ -201,7 +202,10 @@ def main() -> None:
                     help="NR1,NT:FIG, solved with numba and CuPy (a trailing ! : CuPy only)")
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
-    cp = get_xp("cupy")
+    try:
+        cp = get_xp("cupy")
+    except InputError as exc:
+        raise SystemExit(f"bench_gpu.py: {exc}") from None
     dev = cp.cuda.runtime.getDeviceProperties(cp.cuda.Device().id)
     print(f"GPU {dev['name'].decode()}, {dev['totalGlobalMem'] / 2**30:.0f} GiB; CPU "
           f"{cpu_name()}, {os.cpu_count()} cores (one used); "

@@ -4,6 +4,8 @@ NumPy only, no SciPy import: this module is on the path of every ``sailroute pla
 and SciPy's import costs about 0.3-0.4 s.  The array helpers are pure and work on
 any NumPy-compatible array module (``xp``: NumPy or CuPy) where their callers need it.
 
+* :func:`clip`: ``np.clip`` at half the call overhead on small arrays (the isochrone
+  step, the polar look-up).
 * :func:`golden_max`, :func:`golden_steps`: vectorised golden-section search (one
   maximiser per item, fixed number of steps) for the VMG optima of a polar, the
   VPP's sail controls and the deadline solver's steering refinement.
@@ -40,7 +42,7 @@ INV_PHI: Final = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 # --------------------------------------------------------------------------------------
-# golden-section search
+# elementwise
 
 
 def clip(x: Any, lo: Any, hi: Any, xp: ModuleType = np) -> Any:
@@ -52,6 +54,10 @@ def clip(x: Any, lo: Any, hi: Any, xp: ModuleType = np) -> Any:
     router calls it about 20 times per step.
     """
     return xp.minimum(xp.maximum(x, lo), hi)
+
+
+# --------------------------------------------------------------------------------------
+# golden-section search
 
 
 def golden_steps(width: float, tol: float) -> int:

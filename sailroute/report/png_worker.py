@@ -19,6 +19,7 @@ every way out (:meth:`PngWorker.close`, also a context manager).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pickle
 import select
@@ -64,19 +65,19 @@ class PngWorker:
     def __init__(self, proc: subprocess.Popen[bytes] | None) -> None:
         self.proc = proc
         self._job: tuple[Any, Any, Path, int] | None = None
-        self._sent = False
 
     def submit(self, plan: Any, wind: Any, path: Path, dpi: int) -> None:
         """Hand ``plot_plan(plan, wind)`` at ``dpi`` to the child, to be written to ``path``
-        while the caller writes its other files; :meth:`result` waits for it."""
+        while the caller writes its other files; :meth:`result` waits for it.  If the job
+        cannot be handed over, the child is stopped (``proc`` is None afterwards)."""
         self._job = (plan, wind, path, dpi)
-        if self.proc is None or self.proc.stdin is None:
+        if self.proc is None:
             return
         try:
             job = pickle.dumps((plan, wind, str(path), dpi), protocol=pickle.HIGHEST_PROTOCOL)
+            assert self.proc.stdin is not None  # started with stdin=PIPE
             self.proc.stdin.write(job)
             self.proc.stdin.close()
-            self._sent = True
         except (OSError, pickle.PicklingError, TypeError, AttributeError):
             self.close()
 
@@ -85,20 +86,20 @@ class PngWorker:
         if self._job is None:
             raise RuntimeError("PngWorker.result() before submit()")
         plan, wind, path, dpi = self._job
-        proc, sent = self.proc, self._sent
-        self._job, self._sent = None, False
-        if proc is not None and sent and proc.stdout is not None:
-            try:
+        self._job = None
+        proc = self.proc  # still there only if it took the job
+        try:
+            if proc is not None and proc.stdout is not None:
                 ready, _, _ = select.select([proc.stdout], [], [], TIMEOUT_S)
-                answer = proc.stdout.readline() if ready else b""
-                if answer == _OK and path.is_file():
-                    proc.wait(timeout=EXIT_WAIT_S)  # the child leaves at once after its answer
+                if ready and proc.stdout.readline() == _OK and path.is_file():
+                    # it leaves at once after its answer; if not, close() stops it
+                    with contextlib.suppress(subprocess.TimeoutExpired):
+                        proc.wait(timeout=EXIT_WAIT_S)
                     return path
-            except (OSError, ValueError, subprocess.SubprocessError):
-                pass
-            finally:
-                self.close()
-        self.close()
+        except (OSError, ValueError):
+            pass
+        finally:
+            self.close()
         return draw_in_process(plan, wind, path, dpi)
 
     def draw(self, plan: Any, wind: Any, path: Path, dpi: int) -> Path:

@@ -82,6 +82,12 @@ class DeviceRows:
                    xp.ascontiguousarray(xp.asarray(cols).reshape(-1).astype(np.int32, copy=False)),
                    int(rows_per_node), int(per_row), xp)
 
+    @classmethod
+    def from_host(cls, op: Any, xp: ModuleType) -> DeviceRows:
+        """A copy on ``xp`` of a ``deadline._RowOperator`` (the same layout)."""
+        return cls(xp.asarray(op.data), xp.asarray(op.indices), op.rows_per_node,
+                   op.per_row, xp)
+
     def apply(self, x: Any, node_lo: int, node_hi: int) -> Any:
         """Rows of nodes ``node_lo .. node_hi - 1`` times ``x`` (an ``xp`` array of the
         value dtype), shape ``(nodes, rows_per_node)``."""

@@ -1056,13 +1056,11 @@ def solve_deadline(
     block = BLOCK_NODES
     if xp is not np:
         if steer_op is not None:
-            steer_x = DeviceRows.of(steer_op.indices.reshape(grid.n_nodes, f.size, -1),
-                                    steer_op.data.reshape(grid.n_nodes, f.size, -1), xp)
+            steer_x = DeviceRows.from_host(steer_op, xp)
         else:
             assert rows is not None
             steer_x = DeviceRows.of(*rows.entries(xp, 1 << 17), xp)
-        switch_x = DeviceRows.of(switch_op.indices.reshape(grid.n_nodes, 1, -1),
-                                 switch_op.data.reshape(grid.n_nodes, 1, -1), xp)
+        switch_x = DeviceRows.from_host(switch_op, xp)
         block = grid.n_nodes
     n_s, n_nodes, nt = grid.n_s, grid.n_nodes, grid.n_theta
     per_tack = (grid.n_r + 1) * nt
