@@ -33,14 +33,16 @@ from sailroute.analysis.loss import (
 from sailroute.analysis.manoeuvres import SailedManoeuvre, find_sailed_manoeuvres
 from sailroute.analysis.segment import (
     DETECT_M,
+    Crossing,
     Segmentation,
     leg_target,
     segment_track,
 )
+from sailroute.analysis.windsource import ABOVE_POLAR_PCT, WindSource, first_covering
 from sailroute.course.geometry import feature_centre, leg_wind_mode
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
-from sailroute.errors import InputError
+from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.plan import default_scenario, settings_for
 from sailroute.report.progress import Progress
 from sailroute.routing.api import route_leg
@@ -140,6 +142,9 @@ class LegAnalysis:
         to the target; ``lateral_*_m`` the time-mean offsets [m] (+ right).
     optimal : LegResult
         The optimal route of the leg.
+    wind_source, wind_label : str
+        The wind the leg was judged in (:data:`sailroute.analysis.windsource.KINDS`)
+        and what it is.
     """
 
     index: int
@@ -169,6 +174,14 @@ class LegAnalysis:
     lateral_sailed_m: float
     lateral_optimal_m: float
     optimal: LegResult
+    wind_source: str = "scenario"
+    wind_label: str = ""
+
+    @property
+    def above_polar(self) -> bool:
+        """Sailed above :data:`~sailroute.analysis.windsource.ABOVE_POLAR_PCT` of the polar
+        on average: the polar or the wind cannot be right for this boat."""
+        return bool(np.isfinite(self.mean_polar_pct) and self.mean_polar_pct > ABOVE_POLAR_PCT)
 
 
 @dataclass(frozen=True, eq=False)
@@ -269,6 +282,7 @@ def analyze_track(
     router: str | None = None,
     detect_m: float = DETECT_M,
     built: tuple[Any, WindField] | None = None,
+    winds: Sequence[WindSource] | None = None,
     progress: Progress | None = None,
 ) -> TrackAnalysis:
     """Analyse a sailed track against the optimal route of each leg.
@@ -289,7 +303,10 @@ def analyze_track(
     detect_m : float
         Rounding-ray length for mark detection [m].
     built : (boat, wind), optional
-        Already built boat and wind (a fleet shares them).
+        Already built boat and scenario wind (a fleet shares them).
+    winds : sequence of WindSource, optional
+        Candidate winds, best first (:func:`sailroute.analysis.windsource.wind_order`);
+        each leg is judged in the first that covers it.  Default: the scenario's.
     progress : Progress, optional
         Per-leg progress of the optimal routing.
 
@@ -310,10 +327,11 @@ def analyze_track(
     name = default_scenario(course) if scenario is None else scenario
     settings: RoutingSettings = settings_for(course, router)
     if built is None:
-        boat, winds = build_specs(course, [name])
-        wind = winds[name]
+        boat, scenario_winds = build_specs(course, [name])
+        wind = scenario_winds[name]
     else:
         boat, wind = built
+    sources = list(winds) if winds else [WindSource("scenario", wind, f"scenario {name!r}")]
     where = f"{track.source or track.name}"
     x, y = track_xy(track, course.frame)
     check_same_race(course, track, x, y)
@@ -323,9 +341,16 @@ def analyze_track(
     bounds = seg.bounds
     t_a, t_b = bounds[0].t, bounds[-1].t
     race = (t >= t_a) & (t <= t_b)
+    # each leg's wind: the first source that covers its sailed points
+    chosen = [_leg_source(sources, *_leg_points(t, x, y, bounds[i], bounds[i + 1]),
+                          f"{where}: leg {i + 1} ({spec.label})")
+              for i, spec in enumerate(course.legs)]
     # manoeuvres over the race part, with TWA from the smoothed COG
     tr, xr, yr = t[race], x[race], y[race]
-    _, twd_r = _wind_at(wind, tr, xr, yr)
+    twd_r = np.empty(tr.size)
+    for i, k in enumerate(chosen):
+        m = (tr >= bounds[i].t) & (tr <= bounds[i + 1].t)
+        twd_r[m] = _wind_at(sources[k].field, tr[m], xr[m], yr[m])[1]
     mans, _ = find_sailed_manoeuvres(tr, twd_r, bearing_deg(svx[race], svy[race]),
                                      np.hypot(svx[race], svy[race]))
 
@@ -335,22 +360,20 @@ def analyze_track(
     loss_before = 0.0
     for i, spec in enumerate(course.legs):
         a, b = bounds[i], bounds[i + 1]
-        inner = (t > a.t) & (t < b.t)
-        tl = np.concatenate([[a.t], t[inner], [b.t]])
-        xl = np.concatenate([[a.x], x[inner], [b.x]])
-        yl = np.concatenate([[a.y], y[inner], [b.y]])
+        tl, xl, yl = _leg_points(t, x, y, a, b)
         vx = np.interp(tl, t, svx)
         vy = np.interp(tl, t, svy)
         sog = np.hypot(vx, vy)
         cog = bearing_deg(vx, vy)
-        tws, twd = _wind_at(wind, tl, xl, yl)
+        chosen_field = sources[chosen[i]].field
+        tws, twd = _wind_at(chosen_field, tl, xl, yl)
         twa = signed_twa(twd, cog)
         polar = np.asarray(boat.speed(tws, np.abs(twa)), float)
         ratio = np.where(polar >= 0.3, sog / np.where(polar > 0, polar, 1.0), np.nan)
         target = leg_target(course, i)
         centre = target.centre if target.kind != "mark" else feature_centre(
             course.feature(spec.to_name))
-        mode = leg_wind_mode(wind, a.t, (a.x, a.y), centre)
+        mode = leg_wind_mode(chosen_field, a.t, (a.x, a.y), centre)
         if mode == "upwind":
             vmg = sog * np.cos(np.radians(twa))
         elif mode == "downwind":
@@ -368,8 +391,18 @@ def analyze_track(
         start = Start((a.x, a.y), None, spec.from_name, barrier)
         if progress is not None:
             progress.start_leg(i, spec.label)
-        opt = route_leg(start, target, a.t, wind, boat, settings,
-                        progress=progress.update if progress is not None else None)
+        k = chosen[i]
+        while True:  # a source whose span ends before the optimal route does: the next one
+            try:
+                opt = route_leg(start, target, a.t, sources[k].field, boat, settings,
+                                progress=progress.update if progress is not None else None)
+                break
+            except OutOfCoverageError:
+                nxt = first_covering(sources, tl, xl, yl, skip=k)
+                if nxt is None:
+                    raise
+                k = nxt
+        src = sources[k]
         if progress is not None:
             progress.end_leg(opt.time_s, f"{opt.n_tacks} tacks, {opt.n_gybes} gybes")
         sailed = b.t - a.t
@@ -400,7 +433,7 @@ def analyze_track(
             mean_polar_pct=100.0 * time_mean(tl, np.clip(ratio, 0, 2), straight),
             split=split, side_sailed=side_label(lat_s, length),
             side_optimal=side_label(lat_o, length), lateral_sailed_m=lat_s,
-            lateral_optimal_m=lat_o, optimal=opt,
+            lateral_optimal_m=lat_o, optimal=opt, wind_source=src.kind, wind_label=src.label,
         ))
         loss_before += loss
         for k, v in (("leg", np.full(tl.size, i + 1)), ("t", tl), ("x", xl), ("y", yl),
@@ -413,7 +446,31 @@ def analyze_track(
     points = PointTable(c["leg"].astype(np.int64), c["t"], c["x"], c["y"], lat, lon, c["sog"],
                         c["cog"], c["tws"], c["twd"], c["twa"], c["polar"], pct, c["vmg"],
                         c["loss"])
-    return TrackAnalysis(course, track, name, settings.router, seg, tuple(legs), points, wind)
+    return TrackAnalysis(course, track, name, settings.router, seg, tuple(legs), points,
+                         sources[chosen[0]].field if chosen else wind)
+
+
+def _leg_points(t: NDArray, x: NDArray, y: NDArray, a: Crossing, b: Crossing
+                ) -> tuple[NDArray, NDArray, NDArray]:
+    """The track points of one leg, with its start and end crossings as first and last."""
+    inner = (t > a.t) & (t < b.t)
+    return (np.concatenate([[a.t], t[inner], [b.t]]), np.concatenate([[a.x], x[inner], [b.x]]),
+            np.concatenate([[a.y], y[inner], [b.y]]))
+
+
+def _leg_source(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArray,
+                where: str) -> int:
+    """Index of the first source covering a leg; the last one's own error if none does."""
+    k = first_covering(sources, t, x, y)
+    if k is None:
+        try:
+            sources[-1].field.sample(t, x, y)
+        except OutOfCoverageError as exc:
+            raise OutOfCoverageError(f"{where}: no wind covers the leg "
+                                     f"({', '.join(s.label for s in sources)}): {exc}"
+                                     ) from None
+        raise OutOfCoverageError(f"{where}: no wind covers the leg") from None
+    return k
 
 
 def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:

@@ -1,0 +1,119 @@
+"""Which wind a sailed leg is judged in: the boat's measured wind, the fleet's, or a scenario.
+
+A race analysis is only as good as its wind.  ``analyze`` takes an ordered list of
+candidate fields (:class:`WindSource`), best first, and for each leg uses the first
+one that covers the whole leg (its sailed points and the optimal route from the leg
+start).  The usual order, :func:`wind_order`:
+
+1. ``measured``: the boat's own instruments (TWS/TWD, or apparent wind converted to
+   true), a field uniform in space that follows the log in time, with holes where the
+   log has gaps;
+2. ``fleet``: the wind measured by the other boats of the run, as one field in space
+   and time (boats' biases removed);
+3. ``inferred``: the wind rebuilt from the fleet's GPS tracks (tack and gybe headings,
+   upwind and downwind courses), for tracks without instruments;
+4. ``scenario``: the course's scenario (a sailor's estimate or a forecast).
+
+Every output names the source of each leg.  Nothing here reads files.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Final
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sailroute.errors import InputError, OutOfCoverageError
+from sailroute.wind.base import WindField
+
+KINDS: Final = ("measured", "fleet", "inferred", "scenario")
+"""Kinds of wind source, in the order ``auto`` tries them."""
+
+CHOICES: Final = ("auto", "measured", "inferred", "scenario")
+"""Values of ``analyze --wind``: ``auto`` takes the best available per leg."""
+
+ABOVE_POLAR_PCT: Final = 110.0
+"""A leg sailed above this mean polar percentage is flagged: the polar (a stand-in for
+another class?) or the wind (too light?) cannot be right [%]."""
+
+
+@dataclass(frozen=True, eq=False)
+class WindSource:
+    """One candidate wind for judging a track.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+    field : WindField
+        The wind.
+    label : str
+        What it is, for reports ("measured on board (TWS/TWD columns)",
+        "scenario 'constant'").
+    """
+
+    kind: str
+    field: WindField
+    label: str
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"WindSource.kind {self.kind!r}; expected one of {KINDS}")
+
+
+def wind_order(choice: str, available: Sequence[WindSource]) -> list[WindSource]:
+    """The candidates for ``analyze --wind CHOICE``, best first.
+
+    Parameters
+    ----------
+    choice : str
+        One of :data:`CHOICES`.  ``auto``: every available source in :data:`KINDS`
+        order; ``measured``: the boat's own then the fleet's measured wind;
+        ``inferred``: the track-inferred wind; ``scenario``: the course's.
+    available : sequence of WindSource
+        What could be built for this boat.
+
+    Raises
+    ------
+    InputError
+        Unknown choice, or nothing of the requested kind available (the message
+        says what the data lack).
+    """
+    if choice not in CHOICES:
+        raise InputError(f"--wind: expected one of {', '.join(CHOICES)}; got {choice!r}")
+    wanted = {"auto": KINDS, "measured": ("measured", "fleet"), "inferred": ("inferred",),
+              "scenario": ("scenario",)}[choice]
+    out = sorted((s for s in available if s.kind in wanted), key=lambda s: KINDS.index(s.kind))
+    if not out:
+        why = {"measured": "no track has usable wind columns (tws/twd, twa with a heading, "
+                           "or aws/awa with a heading and boat speed)",
+               "inferred": "the wind could not be inferred from the tracks (too few tacks "
+                           "and steady boards)",
+               "scenario": "the course has no scenario"}.get(choice, "no wind source")
+        raise InputError(f"--wind {choice}: {why}; use --wind auto or --wind scenario")
+    return out
+
+
+def covers(field: WindField, t: NDArray, x: NDArray, y: NDArray) -> bool:
+    """True when ``field`` can be sampled at every point ``(t, x, y)`` (no hole, no edge)."""
+    try:
+        u, v = field.sample(t, x, y)
+    except OutOfCoverageError:
+        return False
+    return bool(np.all(np.isfinite(u)) and np.all(np.isfinite(v)))
+
+
+def first_covering(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArray,
+                   skip: int = -1) -> int | None:
+    """Index of the first source (after ``skip``) that covers all points, or None."""
+    for k in range(skip + 1, len(sources)):
+        if covers(sources[k].field, t, x, y):
+            return k
+    return None
+
+
+__all__ = ["ABOVE_POLAR_PCT", "CHOICES", "KINDS", "WindSource", "covers", "first_covering",
+           "wind_order"]

@@ -1,0 +1,143 @@
+"""Which wind a leg is judged in, the above-polar flag, and the fleet-relative polar.
+
+The tracks are sailroute's own routes (tests/analysis/test_analyze.py), so the right
+answers are known: a track sailed on the optimal route loses nothing in the wind it
+was routed in, and a track sailed 25 % faster than the polar is 125 % of it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from sailroute.analysis.fleetpolar import band_factors, fleet_polar, scale_polar
+from sailroute.analysis.windsource import WindSource, first_covering, wind_order
+from sailroute.analyze import analyze_track
+from sailroute.boat.polar import Polar
+from sailroute.course.load import build_specs
+from sailroute.course.model import Course
+from sailroute.errors import InputError, OutOfCoverageError
+from sailroute.routing.types import LegResult
+from sailroute.track.model import Track
+from sailroute.units import KNOT, wind_speed_direction
+from sailroute.wind.combine import SpeedDirectionWind
+from sailroute.wind.uniform import UniformWind
+from tests.analysis import test_analyze as wl
+from tests.analysis.test_analyze import LOSS_TOL_S, _sailed
+
+routed = wl.routed  # the module fixture: the routed windward-leeward course
+
+SCENARIO = UniformWind(10 * KNOT, 0.0)
+
+
+def _faster(track: Track, factor: float, gun: float) -> Track:
+    """The same path sailed ``factor`` times faster (time compressed about the gun)."""
+    t0 = gun
+    return Track(t0 + (track.t_s - t0) / factor, track.lat_deg, track.lon_deg, track.name,
+                 track.source)
+
+
+def test_speed_from_one_field_direction_from_another() -> None:
+    a = UniformWind([4.0, 6.0], [90.0, 90.0], times=[0.0, 100.0])
+    b = UniformWind(1.0, 200.0)
+    w = SpeedDirectionWind(a, b)
+    s, d = wind_speed_direction(*w.sample(np.array([0.0, 50.0, 100.0]), 0.0, 0.0))
+    np.testing.assert_allclose(s, [4.0, 5.0, 6.0], atol=1e-12)
+    np.testing.assert_allclose(d, 200.0, atol=1e-9)
+    assert (w.coverage.t0, w.coverage.t1) == (0.0, 100.0)
+    with pytest.raises(OutOfCoverageError):
+        w.sample(101.0, 0.0, 0.0)
+
+
+def test_wind_order_best_first_and_a_missing_kind_is_a_clear_error() -> None:
+    scen = WindSource("scenario", SCENARIO, "scenario 'steady'")
+    inf = WindSource("inferred", SCENARIO, "inferred")
+    own = WindSource("measured", SCENARIO, "measured on board")
+    assert [s.kind for s in wind_order("auto", [scen, inf, own])] == [
+        "measured", "inferred", "scenario"]
+    assert [s.kind for s in wind_order("scenario", [scen, inf, own])] == ["scenario"]
+    with pytest.raises(InputError, match="wind columns"):
+        wind_order("measured", [scen, inf])
+    with pytest.raises(InputError, match="--wind: expected one of"):
+        wind_order("guess", [scen])
+    with pytest.raises(ValueError):
+        WindSource("forecast", SCENARIO, "x")
+
+
+def test_first_covering_skips_a_field_with_a_hole() -> None:
+    short = WindSource("measured", UniformWind([5.0, 5.0], [0.0, 0.0], times=[0.0, 10.0]), "m")
+    scen = WindSource("scenario", SCENARIO, "s")
+    t = np.array([0.0, 5.0, 20.0])
+    assert first_covering([short, scen], t, t * 0, t * 0) == 1
+    assert first_covering([short, scen], t[:2], t[:2] * 0, t[:2] * 0) == 0
+    assert first_covering([short], t, t * 0, t * 0) is None
+
+
+def test_each_leg_is_judged_in_the_first_wind_that_covers_it(
+        routed: tuple[Course, list[LegResult]]) -> None:
+    course, legs = routed
+    track = _sailed(course, legs)
+    base = analyze_track(course, track)
+    # "measured" = the scenario's wind, but its log ends during leg 2
+    t_end = 0.5 * (legs[1].t_start + legs[1].t_end)
+    measured = UniformWind([10 * KNOT] * 2, [0.0, 0.0], times=[track.t_s[0], t_end])
+    srcs = [WindSource("measured", measured, "measured on board"),
+            WindSource("scenario", SCENARIO, "scenario 'steady'")]
+    a = analyze_track(course, track, winds=srcs)
+    assert [leg.wind_source for leg in a.legs] == ["measured", "scenario", "scenario"]
+    assert a.legs[0].wind_label == "measured on board"
+    for leg, ref in zip(a.legs, base.legs, strict=True):
+        assert leg.loss_s == pytest.approx(ref.loss_s, abs=1e-9)
+    with pytest.raises(OutOfCoverageError, match="leg 2"):
+        analyze_track(course, track, winds=srcs[:1])
+
+
+def test_a_boat_above_its_polar_is_flagged(routed: tuple[Course, list[LegResult]]) -> None:
+    course, legs = routed
+    a = analyze_track(course, _faster(_sailed(course, legs), 1.25, course.start_epoch))
+    for leg in a.legs:
+        assert leg.mean_polar_pct == pytest.approx(125.0, abs=6.0)
+        assert leg.above_polar
+    b = analyze_track(course, _sailed(course, legs))
+    assert not any(leg.above_polar for leg in b.legs)
+
+
+def test_band_factors_take_the_percentile_per_band() -> None:
+    twa = np.concatenate([np.full(100, 42.0), np.full(100, -150.0), np.full(5, 95.0)])
+    ratio = np.concatenate([np.linspace(0.8, 1.0, 100), np.full(100, 1.3), np.full(5, 2.0)])
+    centres, f, n = band_factors(twa, ratio, percentile=90.0, band_deg=10.0, min_count=20)
+    assert n[4] == 100 and n[15] == 100 and n[9] == 5
+    assert f[4] == pytest.approx(np.percentile(np.linspace(0.8, 1.0, 100), 90))
+    assert f[15] == pytest.approx(1.3)
+    assert np.isnan(f[9])  # too few points
+    p = Polar.from_arrays([30.0, 45.0, 90.0, 150.0, 180.0], [5.0], [[2.0], [3.0], [4.0],
+                                                                    [3.5], [3.0]], name="p")
+    s = scale_polar(p, centres, f, "scaled")
+    # held beyond the outermost covered bands, interpolated between them
+    assert s.speed_ms[0, 0] == pytest.approx(2.0 * f[4])
+    assert s.speed_ms[3, 0] == pytest.approx(3.5 * np.interp(150.0, centres[[4, 15]],
+                                                             f[[4, 15]]))
+    assert s.speed_ms[4, 0] == pytest.approx(3.0 * 1.3)
+    with pytest.raises(InputError, match="no TWA band"):
+        scale_polar(p, centres, np.full(centres.size, np.nan), "x")
+
+
+def test_a_fleet_relative_polar_judges_a_fast_boat_against_itself(
+        routed: tuple[Course, list[LegResult]]) -> None:
+    course, legs = routed
+    fast = _faster(_sailed(course, legs), 1.25, course.start_epoch)
+    boat, winds = build_specs(course, ["steady"])
+    first = analyze_track(course, fast)
+    assert all(leg.loss_s < -0.1 * leg.sailed_time_s for leg in first.legs)  # "gains"
+    fp = fleet_polar([first], boat.routing_polar())
+    ok = np.isfinite(fp.factor)
+    assert ok.sum() >= 2
+    np.testing.assert_allclose(fp.factor[ok], 1.25, atol=0.04)
+    again = analyze_track(course, fast, built=(fp.polar, winds["steady"]))
+    for leg in again.legs:
+        # the optimal route at 1.25x polar speed is the sailed one, up to the manoeuvre
+        # penalties (fixed in seconds, compressed in the track) and 1 Hz crossings
+        assert abs(leg.loss_s) <= LOSS_TOL_S + 3.0, (leg.label, leg.loss_s)
+        assert leg.mean_polar_pct == pytest.approx(100.0, abs=5.0)
+        assert not leg.above_polar
+    assert "fleet-relative polar" in fp.describe()
