@@ -11,7 +11,8 @@ manoeuvres ``L_m``
     took ``W`` seconds and made ``P`` metres of progress along the leg axis (leg start
     to target centre); at the leg's straight-line progress rate ``v̄`` (progress per
     second outside the windows) that progress needs ``P / v̄``.  The sailed
-    manoeuvres cost ``W − P / v̄``; the optimal route's own manoeuvres cost its
+    manoeuvres cost ``W − P / v̄`` (each window at least 0: a turn never gains on
+    sailing straight, :func:`window_costs`); the optimal route's own manoeuvres cost its
     penalties (``n_tacks · tack_penalty_s + n_gybes · gybe_penalty_s``), which are
     subtracted: ``L_m`` is the manoeuvre time lost *beyond* what the optimal route
     spends.
@@ -142,14 +143,47 @@ def split_loss(
     dprog = np.diff(progress_m)
     straight_t = float(np.sum(dt[~win]))
     rate = float(np.sum(dprog[~win]) / straight_t) if straight_t > 0 else 0.0
-    w_time = float(np.sum(dt[win]))
     ok_rate = rate > 0.05 and bool(win.any())
-    sailed_man = w_time - float(np.sum(dprog[win])) / rate if ok_rate else 0.0
+    sailed_man = float(np.sum(window_costs(dt, dprog, win, rate))) if ok_rate else 0.0
     lm = sailed_man - optimal_penalty_s
     r_mid = 0.5 * (ratio[:-1] + ratio[1:])
     ok = ~win & np.isfinite(r_mid)
     lv = float(np.sum(dt[ok] * (1.0 - np.clip(r_mid[ok], 0.0, RATIO_MAX))))
     return LossSplit(float(loss_s), float(lm), lv, float(loss_s) - float(lm) - lv)
+
+
+def window_costs(dt: NDArray, dprog: NDArray, win: NDArray, rate: float
+                 ) -> NDArray[np.float64]:
+    """Cost [s] of each manoeuvre window: ``W − P / v̄``, at least 0.
+
+    Parameters
+    ----------
+    dt, dprog : ndarray
+        Duration [s] and axis progress [m] of each track interval.
+    win : ndarray of bool
+        Intervals inside a manoeuvre window; each run of True is one window.
+    rate : float
+        Straight-line progress rate ``v̄`` [m s⁻¹], > 0.
+
+    Returns
+    -------
+    ndarray
+        One cost per window.  A window that made more progress than ``v̄`` would
+        (negative cost) counts 0: turning through the wind never gains on sailing
+        straight, so a negative value only says ``v̄`` was a poor reference there (a
+        leg with slow stretches outside its manoeuvres, a boat that tacks at full
+        speed); counted, it would book a tactical choice (more tacks than the
+        optimum) as a manoeuvre gain.
+    """
+    w = np.asarray(win, bool)
+    if not w.any():
+        return np.zeros(0)
+    edges = np.diff(np.concatenate([[0], w.astype(np.int8), [0]]))
+    starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
+    cdt = np.concatenate([[0.0], np.cumsum(dt)])
+    cdp = np.concatenate([[0.0], np.cumsum(dprog)])
+    cost = (cdt[ends] - cdt[starts]) - (cdp[ends] - cdp[starts]) / rate
+    return np.maximum(cost, 0.0)
 
 
 def progress_loss(t_rel: NDArray, progress_m: NDArray, t_rel_opt: NDArray,

@@ -141,3 +141,26 @@ def test_a_fleet_relative_polar_judges_a_fast_boat_against_itself(
         assert leg.mean_polar_pct == pytest.approx(100.0, abs=5.0)
         assert not leg.above_polar
     assert "fleet-relative polar" in fp.describe()
+
+
+def test_a_manoeuvre_window_costs_its_time_beyond_straight_sailing_and_never_gains() -> None:
+    from sailroute.analysis.loss import split_loss, window_costs
+
+    dt = np.ones(10)
+    # straight at 2 m/s, a window of 3 s making 2 m (cost 3 - 2/2 = 2 s), straight again
+    dprog = np.array([2, 2, 2, 1, 0.5, 0.5, 2, 2, 2, 2], float)
+    win = np.array([0, 0, 0, 1, 1, 1, 0, 0, 0, 0], bool)
+    np.testing.assert_allclose(window_costs(dt, dprog, win, 2.0), [2.0])
+    # a window faster than the straight-line reference: 0, not a gain
+    fast = np.array([1, 1, 1, 3, 3, 3, 1, 1, 1, 1], float)
+    np.testing.assert_allclose(window_costs(dt, fast, win, 1.0), [0.0])
+    # two windows are two costs
+    win2 = np.array([1, 1, 0, 0, 0, 0, 0, 1, 1, 0], bool)
+    assert window_costs(dt, dprog, win2, 2.0).shape == (2,)
+    # three sailed tacks, each at least as slow as straight sailing, against the optimum's
+    # one tack of 5 s: the manoeuvre part is never below -5 s, here 0 + 0 + 0 - 5
+    t = np.arange(0.0, 121.0)
+    prog = 1.0 * t
+    s = split_loss(t, prog, np.ones(t.size), np.array([20.0, 60.0, 100.0]), 10.0, 5.0)
+    assert s.manoeuvres == pytest.approx(-5.0)
+    assert s.manoeuvres + s.speed + s.route == pytest.approx(10.0)
