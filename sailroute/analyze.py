@@ -473,6 +473,106 @@ def _leg_source(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArra
     return k
 
 
+def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind: WindField,
+                   boat: Any, choice: str = "auto") -> tuple[dict[str, list[WindSource]],
+                                                             list[str]]:
+    """The candidate winds each boat is judged in, best first, and what was found.
+
+    * ``measured``: a boat's own log (:func:`sailroute.wind.measured.sensor_from_track`),
+      when it has wind columns;
+    * ``fleet``: with two or more logs with wind, all of them as one field
+      (:func:`sailroute.wind.measured.fleet_wind`, each boat's bias removed);
+    * ``inferred``: for tracks without instruments, the direction rebuilt from all the
+      tracks of the run (:func:`sailroute.analysis.infer_wind.infer_wind`, the
+      scenario's direction at the gun resolving upwind from downwind), with the
+      scenario's speed (a polar that stands in for another class would turn the
+      speeds on each board into a wrong wind speed);
+    * ``scenario``: the course's.
+
+    Parameters
+    ----------
+    course, tracks, scenario, wind, boat
+        The course, the fleet's tracks, the scenario's name and wind, the boat.
+    choice : str
+        ``analyze --wind`` (:data:`sailroute.analysis.windsource.CHOICES`).
+
+    Returns
+    -------
+    sources : dict of str to list of WindSource
+        Per track name, in the order :func:`~sailroute.analysis.windsource.wind_order` gives.
+    notes : list of str
+        One line per finding (biases, coverage, inferred direction, tracks without wind).
+
+    Raises
+    ------
+    InputError
+        ``--wind measured`` with no usable wind columns, ``--wind inferred`` when too
+        few tacks and boards, an unknown choice.
+    """
+    from sailroute.analysis.windsource import CHOICES, wind_order
+
+    if choice not in CHOICES:
+        raise InputError(f"--wind: expected one of {', '.join(CHOICES)}; got {choice!r}")
+    frame = course.frame
+    notes: list[str] = []
+    scen = WindSource("scenario", wind, f"scenario {scenario!r}")
+    own: dict[str, WindSource] = {}
+    fleet: WindSource | None = None
+    series = {}
+    if choice in ("auto", "measured"):
+        from sailroute.wind.measured import boat_wind, fleet_wind, sensor_from_track
+
+        for tr in tracks:
+            try:
+                series[tr.name] = sensor_from_track(tr)
+            except InputError as exc:
+                notes.append(f"{tr.name}: no measured wind ({exc})")
+                continue
+            own[tr.name] = WindSource("measured", boat_wind(series[tr.name], frame),
+                                      f"measured on board ({series[tr.name].source})")
+        if len(series) >= 2:
+            fw = fleet_wind(list(series.values()), frame)
+            fleet = WindSource("fleet", fw.field,
+                               f"measured by the fleet ({len(series)} boats, biases removed)")
+            notes.extend(fw.describe())
+    inferred: WindSource | None = None
+    if choice == "inferred" or (choice == "auto" and len(series) < len(tracks)):
+        from sailroute.analysis.infer_wind import infer_wind, summary
+        from sailroute.wind.combine import SpeedDirectionWind
+
+        gun = course.start_epoch
+        cx = float(np.mean([m.x for m in course.marks.values()]))
+        cy = float(np.mean([m.y for m in course.marks.values()]))
+        tws0, twd0 = _wind_at(wind, np.array([gun]), np.array([cx]), np.array([cy]))
+        try:
+            inf = infer_wind([tr.between(gun - 300.0, gun + course.time_limit_s)
+                              for tr in tracks], frame, prior_twd_deg=float(twd0[0]),
+                             boat=boat)
+        except InputError as exc:
+            if choice == "inferred":
+                raise
+            notes.append(f"wind not inferred from the tracks: {exc}")
+        else:
+            field = SpeedDirectionWind(wind, inf.field(frame, tws_ms=float(tws0[0])),
+                                       "inferred wind")
+            sm = summary(inf)
+            inferred = WindSource("inferred", field,
+                                  f"TWD inferred from {len(tracks)} track(s), TWS of "
+                                  f"scenario {scenario!r}")
+            notes.append(f"inferred wind: {_summary_text(sm)}")
+    out: dict[str, list[WindSource]] = {}
+    for tr in tracks:
+        avail = [s for s in (own.get(tr.name), fleet, inferred, scen) if s is not None]
+        out[tr.name] = wind_order(choice, avail)
+    return out, notes
+
+
+def _summary_text(sm: Mapping[str, Any]) -> str:
+    """``infer_wind``'s summary as one line."""
+    return ", ".join(f"{k} {v:.1f}" if isinstance(v, float) else f"{k} {v}"
+                     for k, v in sm.items())
+
+
 def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
     """Rank boats per leg by sailed leg time and by elapsed time at the leg's end.
 

@@ -3,22 +3,24 @@
 A race analysis against a polar measures the polar as much as the sailing: a Snipe
 judged with the ILCA polar "gains" minutes, a boat in a light-air sea state loses to a
 flat-water VPP.  The fleet-relative reference keeps the *shape* of the course's polar
-(its best VMG angles, how speed grows with the wind) and takes its *level* from the
-fleet's own tracks:
+(its best VMG angles, how speed grows with the wind) and takes its *level* on each
+point of sail from the fleet's own tracks:
 
 1. every straight-line point of every boat (outside the manoeuvre windows, the polar
    above ``POLAR_MIN_MS``) gives a ratio ``r = SOG / polar(TWS, |TWA|)`` in the wind the
    point was judged in;
-2. per TWA band (``band_deg`` wide), the ``percentile`` of ``r`` over the fleet is the
-   band's factor (the speed the fleet's better moments reach, not its mean), for bands
-   with at least ``min_count`` points;
-3. the factors are interpolated linearly in TWA between covered bands and held
-   constant beyond the first and last (no extrapolated trend); the reference polar's
-   rows are multiplied by the factor at their TWA.
+2. on each point of sail of the course's ``efficiency`` bands (upwind below 70°, reach
+   70-120°, downwind above 120°), the ``percentile`` of ``r`` over the fleet is the
+   band's factor, for bands with at least ``min_count`` points; a band without enough
+   points takes the mean of the others;
+3. the course's polar is scaled by these factors exactly as a course's
+   ``boat: {efficiency: ...}`` scales it (:func:`sailroute.boat.efficiency.scale_polar`).
 
-One factor per band for every TWS: a race's TWS range is narrow, and a per-cell fit
-from one race's tracks would be noise.  The method and its limits are in
-``docs/analysis.md``.
+Three factors, not one per TWA row: the ratio at a single angle carries the error of
+the wind direction (a boat 10° higher than the wind it is judged in shows a high ratio
+at a low angle), and a per-angle envelope turns that noise into a polar that points
+higher than any boat.  The 75th percentile: the pace of the fleet's better moments,
+not its mean (against a mean, half of every boat's straight-line sailing "gains").
 """
 
 from __future__ import annotations
@@ -31,18 +33,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.analysis.loss import POLAR_MIN_MS, manoeuvre_mask
+from sailroute.boat.efficiency import BANDS, BOUNDARIES_DEG, scale_polar
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 
 if TYPE_CHECKING:  # pragma: no cover
     from sailroute.analyze import TrackAnalysis
 
-PERCENTILE: Final = 90.0
-"""Percentile of the fleet's speed ratios that sets each band's level [%]."""
-BAND_DEG: Final = 10.0
-"""Width of the TWA bands [°]."""
-MIN_COUNT: Final = 20
-"""Points a band needs to set its own factor."""
+PERCENTILE: Final = 75.0
+"""Percentile of the fleet's speed ratios that sets each band's factor [%]."""
+MIN_COUNT: Final = 30
+"""Straight-line points a band needs to set its own factor."""
+MAX_FACTOR: Final = 3.0
+"""A fleet more than this many times faster than the polar is an error: the wind or
+the polar cannot be the fleet's."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,13 +56,11 @@ class FleetPolar:
     Attributes
     ----------
     polar : Polar
-        The reference polar scaled per TWA row.
-    band_twa_deg : ndarray
-        Centres of the TWA bands [°].
-    factor : ndarray
-        Each band's factor (NaN: too few points) [-].
-    count : ndarray of int
-        Points per band.
+        The course's polar scaled per point of sail.
+    factor : ndarray, shape (3,)
+        Upwind, reach and downwind factors [-] (:data:`sailroute.boat.efficiency.BANDS`).
+    count : ndarray of int, shape (3,)
+        Straight-line points per band.
     percentile : float
         Percentile used [%].
     boats : tuple of str
@@ -66,86 +68,62 @@ class FleetPolar:
     """
 
     polar: Polar
-    band_twa_deg: NDArray[np.float64]
     factor: NDArray[np.float64]
     count: NDArray[np.int64]
     percentile: float
     boats: tuple[str, ...]
 
     def describe(self) -> str:
-        """One line: the factors of the covered bands."""
-        ok = np.isfinite(self.factor)
-        parts = ", ".join(f"{c:.0f}°: {f:.2f}" for c, f in zip(self.band_twa_deg[ok],
-                                                                 self.factor[ok], strict=True))
-        return (f"fleet-relative polar ({self.polar.name}): P{self.percentile:.0f} of SOG/polar "
-                f"of {len(self.boats)} track(s) per TWA band: {parts}")
+        """One line: the factors and their support."""
+        parts = ", ".join(f"{b} x{f:.2f} ({n} pts)" for b, f, n in zip(
+            BANDS, self.factor, self.count, strict=True))
+        return (f"fleet-relative polar: {self.polar.name} scaled to P{self.percentile:.0f} of "
+                f"SOG/polar of {len(self.boats)} track(s): {parts}")
 
 
 def band_factors(twa_deg: NDArray, ratio: NDArray, *, percentile: float = PERCENTILE,
-                 band_deg: float = BAND_DEG, min_count: int = MIN_COUNT
-                 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64]]:
-    """Per-band percentile of speed ratios.
+                 min_count: int = MIN_COUNT) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Upwind, reach and downwind percentiles of speed ratios.
 
     Parameters
     ----------
     twa_deg : ndarray
-        |TWA| of each point [°] (sign ignored).
+        TWA of each point [°] (sign ignored).
     ratio : ndarray
-        SOG / polar at each point [-]; non-finite values are left out.
-    percentile, band_deg, min_count
+        SOG / polar at each point [-]; non-finite and non-positive values are left out.
+    percentile, min_count
         See the module notes.
 
     Returns
     -------
-    centres, factor, count : ndarray
-        Band centres [°], factors (NaN where ``count < min_count``), counts.
-    """
-    if not 0.0 < percentile <= 100.0:
-        raise InputError(f"fleet polar: percentile must be in (0, 100]; got {percentile}")
-    if not 0.0 < band_deg <= 90.0:
-        raise InputError(f"fleet polar: band_deg must be in (0, 90]; got {band_deg}")
-    a = np.abs(np.asarray(twa_deg, float))
-    r = np.asarray(ratio, float)
-    ok = np.isfinite(a) & np.isfinite(r) & (r > 0)
-    n = int(np.ceil(180.0 / band_deg))
-    centres = (np.arange(n) + 0.5) * band_deg
-    idx = np.minimum((a[ok] / band_deg).astype(np.int64), n - 1)
-    rr = r[ok]
-    count = np.bincount(idx, minlength=n).astype(np.int64)
-    factor = np.full(n, np.nan)
-    order = np.argsort(idx, kind="stable")
-    groups = np.split(rr[order], np.cumsum(count)[:-1])
-    for k, g in enumerate(groups):
-        if g.size >= min_count:
-            factor[k] = float(np.percentile(g, percentile))
-    return centres, factor, count
-
-
-def scale_polar(reference: Polar, centres: NDArray, factor: NDArray, name: str) -> Polar:
-    """``reference`` with each TWA row multiplied by the band factor at its angle.
-
-    Factors are interpolated linearly between covered bands and held beyond the
-    outermost ones.
+    factor, count : ndarray, shape (3,)
+        Factors (a band with fewer than ``min_count`` points: the mean of the others)
+        and point counts.
 
     Raises
     ------
     InputError
-        No band has a factor.
+        A bad percentile, or no band with enough points.
     """
-    ok = np.isfinite(factor)
-    if not ok.any():
-        raise InputError("fleet polar: no TWA band has enough straight-line points to scale "
-                         "the polar; analyse more or longer tracks, or judge against the "
-                         "course's polar")
-    f = np.interp(reference.twa_deg, centres[ok], factor[ok])
-    return Polar.from_arrays(reference.twa_deg, reference.tws_ms,
-                             reference.speed_ms * f[:, None], name=name,
-                             interpolation=reference.interpolation)
+    if not 0.0 < percentile <= 100.0:
+        raise InputError(f"fleet polar: percentile must be in (0, 100]; got {percentile}")
+    a = np.abs(np.asarray(twa_deg, float))
+    r = np.asarray(ratio, float)
+    ok = np.isfinite(a) & np.isfinite(r) & (r > 0)
+    band = np.digitize(a[ok], BOUNDARIES_DEG)  # 0 upwind, 1 reach, 2 downwind
+    count = np.bincount(band, minlength=3).astype(np.int64)
+    factor = np.array([float(np.percentile(r[ok][band == k], percentile))
+                       if count[k] >= min_count else np.nan for k in range(3)])
+    if not np.isfinite(factor).any():
+        raise InputError(
+            f"fleet polar: no point of sail has {min_count} straight-line points "
+            f"(upwind {count[0]}, reach {count[1]}, downwind {count[2]}); analyse more or "
+            "longer tracks, or judge against the course's polar (--reference course)")
+    return np.where(np.isfinite(factor), factor, np.nanmean(factor)), count
 
 
 def fleet_polar(analyses: Sequence[TrackAnalysis], reference: Polar, *,
-                percentile: float = PERCENTILE, band_deg: float = BAND_DEG,
-                min_count: int = MIN_COUNT) -> FleetPolar:
+                percentile: float = PERCENTILE, min_count: int = MIN_COUNT) -> FleetPolar:
     """The fleet-relative reference from analyses made against ``reference``.
 
     Parameters
@@ -159,24 +137,26 @@ def fleet_polar(analyses: Sequence[TrackAnalysis], reference: Polar, *,
     Returns
     -------
     FleetPolar
+
+    Raises
+    ------
+    InputError
+        Too few straight-line points, or a factor above :data:`MAX_FACTOR`.
     """
-    twa: list[NDArray] = []
-    ratio: list[NDArray] = []
+    twa: list[NDArray] = [np.empty(0)]
+    ratio: list[NDArray] = [np.empty(0)]
     for a in analyses:
         p = a.points
         man_t = np.array([m.t for leg in a.legs for m in leg.manoeuvres])
-        straight = ~manoeuvre_mask(p.t, man_t)
-        good = straight & (p.polar_ms >= POLAR_MIN_MS)
+        good = ~manoeuvre_mask(p.t, man_t) & (p.polar_ms >= POLAR_MIN_MS)
         twa.append(p.twa_deg[good])
         ratio.append(p.sog_ms[good] / p.polar_ms[good])
-    centres, factor, count = band_factors(np.concatenate(twa) if twa else np.empty(0),
-                                          np.concatenate(ratio) if ratio else np.empty(0),
-                                          percentile=percentile, band_deg=band_deg,
-                                          min_count=min_count)
-    polar = scale_polar(reference, centres, factor, f"{reference.name} x fleet")
-    return FleetPolar(polar, centres, factor, count, percentile,
-                      tuple(a.track.name for a in analyses))
+    factor, count = band_factors(np.concatenate(twa), np.concatenate(ratio),
+                                 percentile=percentile, min_count=min_count)
+    polar = scale_polar(reference, *factor, max_factor=MAX_FACTOR, key="fleet polar"
+                        ).with_name(f"{reference.name} x fleet")
+    return FleetPolar(polar, factor, count, percentile, tuple(a.track.name for a in analyses))
 
 
-__all__ = ["BAND_DEG", "MIN_COUNT", "PERCENTILE", "FleetPolar", "band_factors", "fleet_polar",
-           "scale_polar"]
+__all__ = ["MAX_FACTOR", "MIN_COUNT", "PERCENTILE", "FleetPolar", "band_factors",
+           "fleet_polar"]

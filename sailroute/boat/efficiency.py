@@ -48,7 +48,8 @@ def efficiency_factor(twa_deg: ArrayLike, upwind: float = 1.0, reach: float = 1.
 
 
 def scale_polar(polar: Polar, upwind: float = 1.0, reach: float = 1.0,
-                downwind: float = 1.0) -> Polar:
+                downwind: float = 1.0, *, max_factor: float = MAX_FACTOR,
+                key: str = "efficiency") -> Polar:
     """A new :class:`Polar` with speeds scaled by point of sail (module docstring).
 
     Parameters
@@ -56,7 +57,11 @@ def scale_polar(polar: Polar, upwind: float = 1.0, reach: float = 1.0,
     polar : Polar
         The polar to scale.
     upwind, reach, downwind : float
-        Factors in (0, 1.5] for TWA < 70°, 70-120° and > 120°.
+        Factors in (0, ``max_factor``] for TWA < 70°, 70-120° and > 120°.
+    max_factor : float
+        Largest accepted factor (a course's ``efficiency``: :data:`MAX_FACTOR`).
+    key : str
+        Names the factors in the error message.
 
     Returns
     -------
@@ -65,8 +70,8 @@ def scale_polar(polar: Polar, upwind: float = 1.0, reach: float = 1.0,
         inside the table's range.  All factors 1 returns ``polar`` itself.
     """
     for k, v in (("upwind", upwind), ("reach", reach), ("downwind", downwind)):
-        if not (np.isfinite(v) and 0.0 < v <= MAX_FACTOR):
-            raise InputError(f"efficiency.{k}: expected a factor in (0, {MAX_FACTOR:g}]; got {v}")
+        if not (np.isfinite(v) and 0.0 < v <= max_factor):
+            raise InputError(f"{key}.{k}: expected a factor in (0, {max_factor:g}]; got {v}")
     if upwind == reach == downwind == 1.0:
         return polar
     b1, b2 = BOUNDARIES_DEG
