@@ -502,9 +502,10 @@ def _pair_offsets(a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_ov
         # direction anomalies about each series' own circular mean, speed anomalies
         xa = wrap180(da - _circmean(da))
         xb = wrap180(db[m] - _circmean(db[m]))
-        score[k] = _corr(xa, xb) + _corr(sa, sb[m])
+        score[k] = _corr(xa, xb, 0.05) + _corr(sa, sb[m], 0.005)
     if not np.isfinite(score).any():
         return None
+    score = score - 1e-9 * np.abs(lags)  # a flat score (steady wind) gives lag 0
     k = int(np.argmax(score))
     lag = float(lags[k])
     if 0 < k < lags.size - 1 and np.isfinite(score[k - 1]) and np.isfinite(score[k + 1]):
@@ -524,9 +525,12 @@ def _circmean(a: NDArray) -> float:
     return float(np.degrees(np.arctan2(np.mean(np.sin(r)), np.mean(np.cos(r)))))
 
 
-def _corr(a: NDArray, b: NDArray) -> float:
+def _corr(a: NDArray, b: NDArray, floor: float) -> float:
+    """Pearson correlation; 0 when either series varies less than ``floor`` (std)."""
     a = a - a.mean()
     b = b - b.mean()
+    if a.std() < floor or b.std() < floor:
+        return 0.0
     den = float(np.sqrt(np.sum(a * a) * np.sum(b * b)))
     return float(np.sum(a * b) / den) if den > 0 else 0.0
 
@@ -925,6 +929,11 @@ def _kernel(t1: NDArray, x1: NDArray, y1: NDArray, t2: NDArray, x2: NDArray, y2:
     return sigma2 * np.exp(-0.5 * q)
 
 
+NOISE_FLOOR_MS: Final = 0.05
+"""Smallest observation noise of the ``oi`` method [m s⁻¹] (an anemometer's resolution):
+keeps the covariance matrix well conditioned when the boats agree to the last digit."""
+
+
 def _fit_gp(t: NDArray, x: NDArray, y: NDArray, res: NDArray, max_points: int = 400
             ) -> tuple[float, float, float, float]:
     """Maximum-likelihood ``(sigma², length, time, noise²)`` for residuals ``(n, 2)``.
@@ -937,7 +946,7 @@ def _fit_gp(t: NDArray, x: NDArray, y: NDArray, res: NDArray, max_points: int = 
     if t.size > max_points:
         k = np.linspace(0, t.size - 1, max_points).astype(int)
         t, x, y, res = t[k], x[k], y[k], res[k]
-    var = float(np.mean(res * res)) or 1e-6
+    var = max(float(np.mean(res * res)), NOISE_FLOOR_MS ** 2)
     n = t.size
 
     def nll(p: NDArray) -> float:
@@ -953,7 +962,8 @@ def _fit_gp(t: NDArray, x: NDArray, y: NDArray, res: NDArray, max_points: int = 
 
     p0 = np.log([0.5 * var, 500.0, 120.0, 0.5 * var])
     bounds = [(np.log(var * 1e-3), np.log(var * 10)), (np.log(50.0), np.log(2e4)),
-              (np.log(10.0), np.log(3600.0)), (np.log(var * 1e-4), np.log(var * 10))]
+              (np.log(10.0), np.log(3600.0)),
+              (np.log(max(var * 1e-3, NOISE_FLOOR_MS ** 2)), np.log(var * 10))]
     r = minimize(nll, p0, method="L-BFGS-B", bounds=bounds)
     s2, lm, ts, n2 = (float(a) for a in np.exp(r.x))
     return s2, lm, ts, n2

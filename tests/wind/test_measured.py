@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from datetime import UTC, datetime
 from pathlib import Path
 from types import MappingProxyType
 
@@ -15,8 +16,13 @@ from sailroute.track.model import Track
 from sailroute.track.read import read_track
 from sailroute.units import KNOT, wind_components, wind_speed_direction, wrap180
 from sailroute.wind.measured import (
+    FLEET_METHODS,
     MeasuredSeries,
     boat_wind,
+    estimate_biases,
+    fleet_wind,
+    hull_fraction,
+    leave_one_out,
     sensor_from_track,
     smooth_vector,
     true_wind,
@@ -159,3 +165,144 @@ def test_boat_wind_is_linear_in_time_in_components() -> None:
                        np.array([2.0, 4.0]), np.array([0.0, -6.0]))
     u, v = boat_wind(s, FRAME).sample(T0 + 2.5, 1e4, -1e4)
     assert (float(u), float(v)) == pytest.approx((2.5, -1.5), abs=1e-9)
+
+
+# ------------------------------------------------------------------------------ fleet
+def _analytic_boats(biased=(1.1, 8.0, 15.0), n_s=1200):
+    """Three boats sailing loops through an oscillating wind; boat B2 biased."""
+    t = T0 + np.arange(float(n_s))
+    out = []
+    for k, (f, dd, dt) in enumerate([(1.0, 0.0, 0.0), (1.0, 0.0, 0.0), biased]):
+        x = 800 * np.sin(2 * np.pi * t / 300 + k) + 200 * k
+        y = 600 * np.cos(2 * np.pi * t / 420 + k) - 100 * k
+        tt = t - dt  # its clock is dt ahead: the wind of time t - dt is stamped t
+        d = 60 + 10 * np.sin(2 * np.pi * (tt - T0) / 360) + 0.0003 * x
+        s = 10 + 1.5 * np.sin(2 * np.pi * (tt - T0) / 240 + 1) + 0.0001 * y
+        u, v = wind_components(s * f, d + dd)
+        lat, lon = FRAME.to_latlon(x, y)
+        out.append(MeasuredSeries(f"B{k}", f"b{k}.csv", t, lat, lon, u, v, "tws/twd"))
+    return out
+
+
+def test_bias_recovery_on_synthetic_sensors() -> None:
+    b = estimate_biases(_analytic_boats())
+    assert [x.boat for x in b] == ["B0", "B1", "B2"]
+    assert b[2].speed_factor == pytest.approx(1.1, rel=0.02)
+    assert b[2].direction_offset_deg == pytest.approx(8.0, abs=1.0)
+    assert b[2].time_offset_s == pytest.approx(15.0, abs=2.0)
+    for ok in b[:2]:  # the consensus is the median boat: the biased one does not drag them
+        assert ok.speed_factor == pytest.approx(1.0, rel=0.01)
+        assert abs(ok.direction_offset_deg) < 0.5 and abs(ok.time_offset_s) < 1.0
+    assert all(x.n_samples > 2000 for x in b)
+    fw = fleet_wind(_analytic_boats(), FRAME)
+    assert fw.biases == b
+    assert any(n.startswith("bias B2: speed x1.09") for n in fw.notes)
+
+
+@pytest.mark.parametrize("method", FLEET_METHODS)
+def test_fleet_reproduces_a_uniform_wind(method: str) -> None:
+    boats = _analytic_boats()
+    uni = []
+    for s in boats:
+        lat, lon = s.lat, s.lon
+        tw = (150.0 - FRAME.grid_north_deg(lat, lon)) % 360  # constant in the local frame
+        uni.append(MeasuredSeries(s.boat, s.file, s.t, lat, lon, *wind_components(7.0, tw)))
+    rng = np.random.default_rng(3)
+    pts = (rng.uniform(T0 + 30, T0 + 1100, 500), rng.uniform(-700, 700, 500),
+           rng.uniform(-500, 500, 500))
+    u0, v0 = wind_components(7.0, 150.0)
+    u, v = fleet_wind(uni, FRAME, method=method, estimate_bias=False).field.sample(*pts)
+    np.testing.assert_allclose(u, u0, atol=1e-9)
+    np.testing.assert_allclose(v, v0, atol=1e-9)
+    # a steady wind has no bias to find (in true directions the boats differ by the
+    # meridian convergence across 1.6 km, 0.006 deg)
+    fw = fleet_wind(uni, FRAME, method=method)
+    assert all(b.speed_factor == pytest.approx(1.0, abs=1e-9) and b.time_offset_s == 0.0
+               and abs(b.direction_offset_deg) < 0.01 for b in fw.biases)
+    u, v = fw.field.sample(*pts)
+    np.testing.assert_allclose(u, u0, atol=1e-3)
+
+
+def test_hull_fraction_on_a_known_triangle() -> None:
+    t = T0 + np.arange(0.0, 601.0, 10.0)
+    sens = []
+    for k, (x, y) in enumerate([(0.0, 0.0), (1000.0, 0.0), (0.0, 1000.0)]):
+        lat, lon = FRAME.to_latlon(np.full(t.size, x), np.full(t.size, y))
+        sens.append(MeasuredSeries(f"B{k}", "", t, lat, lon, np.ones(t.size), np.ones(t.size)))
+    px = np.array([100.0, 300.0, 900.0, -10.0, 200.0])
+    py = np.array([100.0, 300.0, 900.0, 50.0, 200.0])
+    pt = np.array([T0 + 100, T0 + 300, T0 + 300, T0 + 500, T0 + 700])  # last: after the logs
+    assert hull_fraction(sens, FRAME, pt, px, py) == pytest.approx(2 / 5)
+    fw = fleet_wind(sens, FRAME, method="mean", estimate_bias=False)
+    assert fw.coverage_report(pt, px, py) == pytest.approx(0.4)
+    assert fw.extrapolation_note(pt, px, py, "the course").startswith(
+        "fleet wind: 60 % of the course (5 points) lie outside the sensors' hull")
+
+
+def test_fleet_names_the_log_that_limits_the_span_and_refuses_common_holes() -> None:
+    boats = _analytic_boats((1.0, 0.0, 0.0))
+    short = boats[2].between(T0 + 100, T0 + 900)
+    fw = fleet_wind([boats[0], boats[1], short], FRAME, estimate_bias=False)
+    assert "limited by the log of B2 (b2.csv) (starts" in fw.notes[-1]
+    with pytest.raises(OutOfCoverageError, match=r"(?s)requested.*the time span is limited by "
+                                                 r"the log of B2 \(b2\.csv\)"):
+        fw.field.sample(T0 + 50, 0.0, 0.0)
+    cut = [b.between(T0, T0 + 400) for b in boats]
+    later = [b.between(T0 + 500, T0 + 1199) for b in boats]
+    holed = [MeasuredSeries(a.boat, a.file, np.concatenate([a.t, b.t]),
+                            np.concatenate([a.lat, b.lat]), np.concatenate([a.lon, b.lon]),
+                            np.concatenate([a.u, b.u]), np.concatenate([a.v, b.v]),
+                            gaps=((T0 + 400, T0 + 500),)) for a, b in zip(cut, later, strict=True)]
+    fw = fleet_wind(holed, FRAME, estimate_bias=False, method="mean")
+    with pytest.raises(OutOfCoverageError, match=r"every log has a gap .* B0 \(b0\.csv\) "
+                                                 r"2025-01-19T03:13:20"):
+        fw.field.sample(T0 + 450, 0.0, 0.0)
+    u, _ = fw.field.sample(T0 + 399, 0.0, 0.0)
+    assert np.isfinite(u)
+
+
+def test_fleet_bad_input() -> None:
+    boats = _analytic_boats()
+    with pytest.raises(InputError, match="method 'kriging'; expected one of mean, idw"):
+        fleet_wind(boats, FRAME, method="kriging")
+    apart = [boats[0].between(T0, T0 + 100), boats[1].between(T0 + 500, T0 + 600)]
+    with pytest.raises(InputError, match="the logs never overlap in time"):
+        fleet_wind(apart, FRAME, estimate_bias=False)
+
+
+# ------------------------------------------------------------------------------ SailGP
+SAILGP = SHARED_REAL / "races" / "sailgp-auckland-2025" / "Boat_logs"
+
+
+def _race(boat: str, race: int) -> Track:
+    t0 = t1 = None
+    with (SAILGP / f"data_{boat}.csv").open() as f:
+        for row in csv.DictReader(f):
+            if row["TRK_RACE_NUM_unk"].strip() and int(float(row["TRK_RACE_NUM_unk"])) == race:
+                t = datetime.fromisoformat(row["DATETIME"]).replace(tzinfo=UTC).timestamp()
+                t0 = t if t0 is None else min(t0, t)
+                t1 = t if t1 is None else max(t1, t)
+    assert t0 is not None and t1 is not None
+    tr = read_track(SAILGP / f"data_{boat}.csv", time_zone="UTC", name=boat)
+    return tr.between(t0, t1)
+
+
+@requires_shared
+def test_sailgp_default_beats_the_sensor_mean_leaving_one_boat_out() -> None:
+    tracks = [_race(b, 25011905) for b in ("NZL", "AUS", "GBR")]
+    sens = [sensor_from_track(t) for t in tracks]
+    assert sens[0].source == "tws/twd" and sens[0].gaps == ()
+    raw = [sensor_from_track(t, smooth_s=0.0) for t in tracks]
+    rows = leave_one_out(sens, FRAME, {
+        "default": {},
+        "mean": {"method": "mean", "resample_s": 0.0, "estimate_bias": False},
+    }, targets=raw)
+    pooled = {r.label: r for r in rows if r.boat == "pooled"}
+    d, m = pooled["default"], pooled["mean"]
+    assert d.n == m.n > 1800
+    # measured (benchmarks/bench_fleet_wind.py --smoke): 1.571 kn / 3.71 deg vs 1.875 kn / 3.96 deg
+    assert d.speed_rms_kn == pytest.approx(1.571, abs=0.03)
+    assert d.dir_mae_deg == pytest.approx(3.71, abs=0.1)
+    assert m.speed_rms_kn == pytest.approx(1.875, abs=0.03)
+    assert m.dir_mae_deg == pytest.approx(3.96, abs=0.1)
+    assert d.speed_rms_kn < m.speed_rms_kn - 0.2 and d.dir_mae_deg < m.dir_mae_deg
