@@ -12,12 +12,14 @@ of the one left out, along its track.  Candidates and baselines:
 * ``mean`` — the other boats' mean at each time (as logged, and smoothed 30 s);
 * ``nearest`` — the nearest other boat at each time;
 * ``idw`` — inverse distance between the other boats at each time;
-* ``st-idw`` — inverse space-time distance over the records within ±60 s;
+* ``st-idw`` — inverse space-time distance over the records within ±60 s (with and
+  without the per-boat bias correction);
 * ``oi`` — the sensors' mean plus a Gaussian-process correction (fitted scales).
 
 The candidates use the defaults of :func:`sailroute.wind.measured.fleet_wind`
 (sensors smoothed 30 s, 10 s means, per-boat bias correction).  Prints speed RMS (kn)
-and mean absolute direction error (°) per race and pooled, then a smoothing table
+and mean absolute direction error (°) per race and pooled, the per-boat biases of each
+race, then a smoothing table
 (``mean`` and ``nearest`` against the smoothing window) and the time to build a fleet
 field of 3 boats x 20 min at 1 Hz and sample 1e5 points.  ``--smoke`` runs race
 25011905 with three methods only.
@@ -59,6 +61,7 @@ FRAME = LocalFrame(-36.83, 174.76)
 
 CANDIDATES: dict[str, dict[str, object]] = {
     "st-idw": {"method": "st-idw"},
+    "st-idw, no bias correction": {"method": "st-idw", "estimate_bias": False},
     "oi": {"method": "oi"},
     "idw": {"method": "idw"},
 }
@@ -170,6 +173,10 @@ def main(argv: list[str] | None = None) -> int:
     for k, (n, s, d, h) in pooled(rows).items():
         print(f"| {k} | {n} | {s:.3f} | {d:.2f} | {100 * h:.0f} % |")
     if not args.smoke:
+        print("\nBiases of each race's boats against the fleet (all boats of the race):\n")
+        for r, tracks in races.items():
+            fw = fleet_wind(tracks, FRAME)
+            print(f"- {r}: " + "; ".join(b.describe() for b in fw.biases))
         print("\nSmoothing of the sensors (pooled; targets as logged):\n")
         print("| smooth_s (s) | mean: speed RMS (kn) | mean: dir MAE (°) | nearest: speed RMS "
               "(kn) | nearest: dir MAE (°) | st-idw: speed RMS (kn) | st-idw: dir MAE (°) |")
