@@ -306,3 +306,39 @@ def test_sailgp_default_beats_the_sensor_mean_leaving_one_boat_out() -> None:
     assert m.speed_rms_kn == pytest.approx(1.875, abs=0.03)
     assert m.dir_mae_deg == pytest.approx(3.96, abs=0.1)
     assert d.speed_rms_kn < m.speed_rms_kn - 0.2 and d.dir_mae_deg < m.dir_mae_deg
+
+
+# ------------------------------------------------------------------------------ course spec
+def _write_log(path: Path, boat_y: float, twd: float) -> None:
+    lines = ["time,lat,lon,tws_kn,twd"]
+    for k in range(0, 900, 2):
+        lat, lon = FRAME.to_latlon(-900.0 + 2.0 * k, boat_y)
+        t = datetime.fromtimestamp(T0 + k, UTC).isoformat()
+        lines.append(f"{t},{float(lat):.7f},{float(lon):.7f},12.0,{twd}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_course_wind_type_measured(tmp_path: Path) -> None:
+    from sailroute.wind.build import wind_from_spec
+
+    for k in range(3):
+        _write_log(tmp_path / f"boat{k}.csv", 300.0 * k, 200.0)
+    spec = {"type": "measured", "tracks": [f"boat{k}.csv" for k in range(3)],
+            "method": "mean"}
+    f = wind_from_spec(spec, frame=FRAME, base_dir=tmp_path, where="c.yaml: scenarios.m",
+                       time_window=(T0 + 100, T0 + 800))
+    s, d = wind_speed_direction(*f.sample(T0 + 400.0, 0.0, 300.0))
+    assert float(s) == pytest.approx(12.0 * KNOT, rel=1e-9)
+    assert float(d) == pytest.approx(200.0 + float(FRAME.grid_north_deg(*FRAME.to_latlon(
+        0.0, 300.0))), abs=0.01)
+    with pytest.raises(InputError, match=r"c\.yaml: scenarios\.m\.tracks\.1: file not found"):
+        wind_from_spec({"type": "measured", "tracks": ["boat0.csv", "nope.csv"]}, frame=FRAME,
+                       base_dir=tmp_path, where="c.yaml: scenarios.m")
+    with pytest.raises(InputError, match=r"scenarios\.m\.method: expected one of 'mean'"):
+        wind_from_spec({"type": "measured", "tracks": ["boat0.csv"], "method": "krige"},
+                       frame=FRAME, base_dir=tmp_path, where="c.yaml: scenarios.m")
+    with pytest.raises(InputError, match=r"scenarios\.m\.tracks\[0\]: boat0\.csv has no wind "
+                                         r"records within 600 s of the race window"):
+        wind_from_spec({"type": "measured", "tracks": ["boat0.csv"]}, frame=FRAME,
+                       base_dir=tmp_path, where="c.yaml: scenarios.m",
+                       time_window=(T0 + 1e5, T0 + 2e5))
