@@ -264,7 +264,6 @@ def sensor_from_track(
         raise InputError(f"{track.source or track.name}: max_gap_s must be > 0 and smooth_s "
                          f">= 0 (got {max_gap_s}, {smooth_s})")
     ch = dict(track.channels)
-    nan = np.full(len(track), np.nan)
     if _has(ch, "tws_ms", "twd_deg"):
         source = "tws/twd"
         tws, twd = ch["tws_ms"], ch["twd_deg"]
@@ -288,7 +287,7 @@ def sensor_from_track(
             "a measured-wind sensor needs tws+twd, tws+twa with hdg or cog, or aws+awa with "
             "sog+cog or bsp+hdg"
         )
-    tws = np.asarray(tws if tws is not None else nan, float)
+    tws = np.asarray(tws, float)
     twd = np.asarray(twd, float)
     ok = np.isfinite(tws) & np.isfinite(twd) & np.isfinite(track.lat_deg) & np.isfinite(
         track.lon_deg)
@@ -722,6 +721,11 @@ class FleetField:
                              f"{', '.join(FLEET_METHODS)}")
         if not self.sensors:
             raise InputError(f"{self.name}: no sensors")
+        if not (self.power > 0 and self.speed_scale_ms >= 0 and self.window_s >= 0
+                and self.radius_m >= 0):
+            raise InputError(f"{self.name}: power must be > 0 and speed_scale_ms, window_s, "
+                             f"radius_m >= 0 (got {self.power}, {self.speed_scale_ms}, "
+                             f"{self.window_s}, {self.radius_m})")
         sens = []
         for s in self.sensors:
             if len(s) < 1:
