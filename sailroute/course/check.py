@@ -462,11 +462,12 @@ def _references(
 
 
 def _wind_spec(c: Checker, value: Any, path: str) -> bool:
-    if not c.at(path).is_mapping(value, "a wind spec {type: uniform|wrf|stations|blended, ...}"):
+    if not c.at(path).is_mapping(value, "a wind spec "
+                                 "{type: uniform|wrf|stations|blended|measured, ...}"):
         return False
     if "type" not in value:
         c.p.add(path, "the wind spec has no `type`; expected one of 'uniform', 'wrf', "
-                "'stations', 'blended' (see docs/design/wind.md)")
+                "'stations', 'blended', 'measured' (see docs/design/wind.md)")
         return False
     if not isinstance(value["type"], str):
         c.p.add(join_path(path, "type"), f"expected text such as 'uniform' or 'wrf'; "

@@ -173,8 +173,8 @@ class ScenarioSpec:
     name : str
         Scenario name (the key under ``scenarios``).
     wind : mapping
-        The raw wind spec (``{type: uniform|wrf|stations|blended, ...}``), passed to
-        ``sailroute.wind.build.wind_from_spec`` unchanged.
+        The raw wind spec (``{type: uniform|wrf|stations|blended|measured, ...}``),
+        passed to ``sailroute.wind.build.wind_from_spec`` unchanged.
     references : mapping of str to tuple of float
         Leg times [s] to compare this scenario with, in addition to the course-wide
         ``references`` (e.g. the thesis's own model output for the same wind).

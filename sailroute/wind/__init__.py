@@ -7,6 +7,8 @@
   (CF NetCDF, xarray datasets, GRIB via the ``grib`` extra);
 * :func:`read_stations` -> :class:`StationData` -> :class:`StationWind` — measured wind;
 * :class:`BlendedWind` — a model field corrected by stations;
+* :func:`sensor_from_track`, :func:`boat_wind`, :func:`fleet_wind` — the wind measured
+  on board (boat logs as moving sensors; one boat's own wind, or the fleet's field);
 * :func:`wind_from_spec` — any of these from a course-file wind spec.
 
 Design notes: ``docs/design/wind.md``.
@@ -18,6 +20,17 @@ from sailroute.wind.blended import BlendedWind
 from sailroute.wind.build import check_covers, wind_from_spec
 from sailroute.wind.cf import open_grib, open_netcdf
 from sailroute.wind.grid import GridWind
+from sailroute.wind.measured import (
+    BoatBias,
+    BoatWind,
+    FleetField,
+    FleetWind,
+    MeasuredSeries,
+    boat_wind,
+    fleet_wind,
+    sensor_from_track,
+    true_wind,
+)
 from sailroute.wind.ndbc import read_ndbc
 from sailroute.wind.stations import StationData, StationWind, read_stations, resample_stations
 from sailroute.wind.uniform import UniformWind
@@ -26,13 +39,20 @@ from sailroute.wind.wrf import open_wrf
 __all__ = [
     "AnalyticWind",
     "BlendedWind",
+    "BoatBias",
+    "BoatWind",
     "Coverage",
+    "FleetField",
+    "FleetWind",
     "GridWind",
+    "MeasuredSeries",
     "StationData",
     "StationWind",
     "UniformWind",
     "WindField",
+    "boat_wind",
     "check_covers",
+    "fleet_wind",
     "open_grib",
     "open_netcdf",
     "open_wrf",
@@ -40,5 +60,7 @@ __all__ = [
     "read_ndbc",
     "read_stations",
     "resample_stations",
+    "sensor_from_track",
+    "true_wind",
     "wind_from_spec",
 ]

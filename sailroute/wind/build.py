@@ -58,7 +58,7 @@ def wind_from_spec(
     spec : mapping
         The wind spec, e.g. ``{"type": "uniform", "tws_kn": 10, "twd_deg": 108}``;
         ``type`` is one of ``uniform``, ``wrf``, ``netcdf`` (CF lat/lon, or wrfout
-        detected), ``grib``, ``stations``, ``blended``.
+        detected), ``grib``, ``stations``, ``blended``, ``measured`` (boat logs).
     frame : LocalFrame
         The course's local frame; gridded and station data are mapped into it.
     base_dir : Path
@@ -591,6 +591,79 @@ def _build_blended(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Wind
         raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
+# ---------------------------------------------------------------------------- measured
+_MEASURED_KEYS = ("type", "tracks", "speed_unit", "time_zone", "method", "estimate_bias",
+                  "resample_s", "smooth_s", "max_gap_s", "radius_m", "clamp")
+MEASURED_MARGIN_S = 600.0
+"""Records within this of the race window [s] are used by ``type: measured``."""
+
+
+def _build_measured(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
+    """``type: measured``: the fleet's measured wind from boat logs (``fleet_wind(...).field``)."""
+    from sailroute.track.read import read_track  # track reads through wind.stations: late
+    from sailroute.wind.measured import (
+        DEFAULT_MAX_GAP_S,
+        DEFAULT_METHOD,
+        DEFAULT_RESAMPLE_S,
+        DEFAULT_SMOOTH_S,
+        FLEET_METHODS,
+        fleet_wind,
+        sensor_from_track,
+    )
+
+    chk.keys(spec, _MEASURED_KEYS, ("tracks",))
+    raw = spec.get("tracks")
+    paths: list[Path] = []
+    if raw is not None:
+        if not isinstance(raw, list) or not raw or not all(isinstance(p, str) for p in raw):
+            chk.add("tracks", f"expected a non-empty list of log paths; got {show(raw)}")
+        else:
+            tchk = chk.child("tracks")
+            for k, p in enumerate(raw):
+                full = (ctx.base_dir / p).resolve() if not Path(p).is_absolute() else Path(p)
+                if not full.is_file():
+                    tchk.add(str(k), f"file not found: {full} (paths are relative to "
+                             f"{ctx.base_dir})")
+                paths.append(full)
+    unit = chk.string(spec, "speed_unit", None)
+    if unit is not None and unit.strip().lower() not in SPEED_UNITS:
+        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
+    tz = chk.string(spec, "time_zone", None)
+    method = chk.choice(spec, "method", list(FLEET_METHODS), DEFAULT_METHOD)
+    bias = chk.boolean(spec, "estimate_bias", True)
+    resample_s = chk.number(spec, "resample_s", DEFAULT_RESAMPLE_S, lo=0.0)
+    smooth_s = chk.number(spec, "smooth_s", DEFAULT_SMOOTH_S, lo=0.0)
+    max_gap_s = chk.number(spec, "max_gap_s", DEFAULT_MAX_GAP_S, lo=0.0, lo_open=True)
+    radius_m = chk.number(spec, "radius_m", 2000.0, lo=0.0)
+    clamp = chk.boolean(spec, "clamp", False)
+    chk.p.raise_if_any()
+    series = []
+    for k, p in enumerate(paths):
+        where = chk.where(f"tracks[{k}]")
+        try:
+            s = sensor_from_track(read_track(p, speed_unit=unit, time_zone=tz),
+                                  smooth_s=smooth_s, max_gap_s=max_gap_s)
+        except InputError as exc:
+            raise type(exc)(f"{where}: {exc}") from None
+        if ctx.time_window is not None:
+            w0, w1 = ctx.time_window
+            cut = s.between(w0 - MEASURED_MARGIN_S, w1 + MEASURED_MARGIN_S)
+            if len(cut) < 2:
+                raise InputError(f"{where}: {p.name} has no wind records within "
+                                 f"{MEASURED_MARGIN_S:g} s of the race window; use the logs of "
+                                 "this race")
+            s = cut
+        series.append(s)
+    try:
+        fw = fleet_wind(series, ctx.frame, method=method, estimate_bias=bias,
+                        resample_s=resample_s, radius_m=radius_m, clamp=clamp,
+                        options={"name": "measured wind (" + ", ".join(s.boat for s in series)
+                                 + ")"})
+    except InputError as exc:
+        raise type(exc)(f"{chk.where()}: {exc}") from None
+    return fw.field
+
+
 _BUILDERS: dict[str, Callable[[Mapping[str, Any], Checker, _Context], WindField]] = {
     "uniform": _build_uniform,
     "wrf": _build_wrf,
@@ -598,4 +671,5 @@ _BUILDERS: dict[str, Callable[[Mapping[str, Any], Checker, _Context], WindField]
     "grib": _build_grib,
     "stations": _build_stations,
     "blended": _build_blended,
+    "measured": _build_measured,
 }

@@ -29,7 +29,7 @@ from typing import Any, Final, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sailroute.errors import InputError, WindDataError, format_problems
+from sailroute.errors import InputError, OutOfCoverageError, WindDataError, format_problems
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso
 from sailroute.units import speed_factor, wind_components, wind_speed_direction
@@ -793,6 +793,7 @@ class _StationState:
     cov: Coverage
     moving: bool  # some station moves (coach boat)
     rbf: Any  # RBF interpolator of station weights (method "rbf"), else None
+    limit: str = ""  # which station's records limit the common time span ("" if one station)
 
 
 @dataclass(frozen=True, eq=False)
@@ -938,7 +939,15 @@ class StationWind:
         cov = Coverage(t0, t1, float(x.min()) - self.radius_m, float(x.max()) + self.radius_m,
                        float(y.min()) - self.radius_m, float(y.max()) + self.radius_m,
                        frame=self.frame, source_span=(float(d.t.min()), float(d.t.max())))
-        return _StationState(tuple(series), cov, moving, rbf)
+        limit = ""
+        if len(series) > 1:
+            k0 = max(range(len(spans)), key=lambda k: spans[k][0])
+            k1 = min(range(len(spans)), key=lambda k: spans[k][1])
+            src = f" of {d.source}" if d.source else ""
+            limit = (f"the time span is limited by station {series[k0][0]!r}{src} (first record "
+                     f"{iso(spans[k0][0])}) and station {series[k1][0]!r} (last record "
+                     f"{iso(spans[k1][1])})")
+        return _StationState(tuple(series), cov, moving, rbf, limit)
 
     @property
     def coverage(self) -> Coverage:
@@ -978,8 +987,18 @@ class StationWind:
         return idw_weights(x, y, sx, sy, self.power)
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
-        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast)."""
-        t, x, y = prepare_points(self._state.cov, t, x, y, clamp=self.clamp, name=self.name)
+        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and local ``x, y`` [m] (broadcast).
+
+        Outside the coverage the :class:`~sailroute.errors.OutOfCoverageError` names
+        the stations (logs) whose first and last records limit the common time span.
+        """
+        try:
+            t, x, y = prepare_points(self._state.cov, t, x, y, clamp=self.clamp,
+                                     name=self.name)
+        except OutOfCoverageError as e:
+            if not self._state.limit:
+                raise
+            raise OutOfCoverageError(f"{e}\n  ({self._state.limit})") from None
         shape = t.shape
         t, x, y = t.ravel(), x.ravel(), y.ravel()
         sx, sy, su, sv = self.station_values(t)

@@ -20,6 +20,7 @@ from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import Coverage, WindField
 from sailroute.wind.blended import BlendedWind
 from sailroute.wind.cf import open_netcdf
+from sailroute.wind.measured import MeasuredSeries, boat_wind, fleet_wind
 from sailroute.wind.rotation import rotate_clockwise
 from sailroute.wind.stations import StationData, StationWind
 from sailroute.wind.uniform import UniformWind
@@ -92,9 +93,21 @@ def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
         return StationWind(stations_constant(frame), frame, clamp=clamp)
     if kind == "stations-rbf":
         return StationWind(stations_constant(frame), frame, method="rbf", clamp=clamp)
+    if kind == "boat-measured":
+        return boat_wind(boat_constant(frame), frame, clamp=clamp)
+    if kind == "fleet-measured":
+        return fleet_wind([boat_constant(frame, k) for k in range(3)], frame, clamp=clamp).field
     if kind == "blended":
         return BlendedWind(open_wrf(path, frame), stations_constant(frame), frame, clamp=clamp)
     raise AssertionError(kind)
+
+
+def boat_constant(frame: LocalFrame, k: int = 0) -> MeasuredSeries:
+    """Boat k sailing east at 5 m/s for 30 min, reading the local constant wind at 1 Hz."""
+    t = T0 + np.arange(1801.0)
+    lat, lon = frame.to_latlon(-4500.0 + 5.0 * np.arange(1801.0), np.full(1801, 300.0 * k))
+    u, v = wind_components(TWS, (TWD - frame.grid_north_deg(lat, lon)) % 360.0)
+    return MeasuredSeries(f"B{k}", f"b{k}.csv", t, lat, lon, u, v, "tws/twd")
 
 
 def cf_constant(tiny_wrf, frame: LocalFrame):
@@ -126,10 +139,11 @@ def cf_constant(tiny_wrf, frame: LocalFrame):
 
 KINDS = ["uniform", "uniform-table", "analytic", "wrf-linear", "wrf-nearest",
          "wrf-frozen-10min", "wrf-2.68m", "netcdf-cf", "stations-idw", "stations-rbf",
-         "blended"]
+         "blended", "boat-measured", "fleet-measured"]
 # Exact for the analytic sources; float32 storage in WRF files limits those to ~1e-6 m/s.
 TOL = {"uniform": 1e-12, "uniform-table": 1e-12, "analytic": 1e-12, "stations-idw": 1e-12,
-       "stations-rbf": 1e-9}
+       "stations-rbf": 1e-9, "boat-measured": 1e-12,
+       "fleet-measured": 1e-12}
 
 
 @pytest.fixture(params=KINDS)

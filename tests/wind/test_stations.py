@@ -275,6 +275,19 @@ def test_station_coverage_height_and_gaps() -> None:
         StationWind(late, frame)
 
 
+def test_coverage_error_names_the_station_that_cuts_the_span() -> None:
+    d = _two_stations()
+    # station E starts 120 s later than W and ends with it: E limits the start
+    d = StationData(d.station, d.t + np.array([0.0, 0.0, 120.0, 0.0]), d.lat, d.lon, d.speed_ms,
+                    d.direction_deg, d.height_m, d.gust_ms, source="coach.csv")
+    f = StationWind(d, LocalFrame(43.0, 6.0))
+    assert f.coverage.t0 == 120.0
+    with pytest.raises(OutOfCoverageError, match=r"(?s)requested.*the time span is limited by "
+                                                 r"station 'E' of coach\.csv \(first record "
+                                                 r"1970-01-01T00:02:00"):
+        f.sample(60.0, 0.0, 0.0)
+
+
 def test_moving_station_coverage_follows_track() -> None:
     d = read_stations(COACH, timezone="+01:00", resample_s=60)
     frame = LocalFrame(45.55, 13.65)

@@ -48,8 +48,8 @@ def test_every_problem_listed_with_its_key_path() -> None:
     assert f"{WHERE}.twd_deg: missing required key" in msg
     assert f"{WHERE}.clamp: expected true or false; got 'yes'" in msg
     with pytest.raises(InputError, match=r"scenarios.wrf10\[0\].type: expected one of 'uniform', "
-                                         r"'wrf', 'netcdf', 'grib', 'stations', 'blended'; "
-                                         r"got 'hdf5'"):
+                                         r"'wrf', 'netcdf', 'grib', 'stations', 'blended', "
+                                         r"'measured'; got 'hdf5'"):
         build({"type": "hdf5"})
 
 
