@@ -1,0 +1,807 @@
+"""Wind inferred from GPS tracks without instruments: TWD(t), and TWS(t) with a polar.
+
+A boat racing upwind sails close to its best-VMG angle on each board, so its course over
+ground is the wind direction minus (starboard) or plus (port) its tacking half-angle α;
+downwind the same holds with the gybing half-angle.  One or more boats' tracks thus hold
+the wind direction and its shifts over time.  The method (``docs/analysis.md``, "Wind
+inferred from tracks"):
+
+1. **Steady points.**  The course at each point is that of the displacement over
+   ``COG_WINDOW_S`` centred on it.  A point is kept where the boat is faster than
+   ``min_speed_ms``, its courses over the windows before and after it differ by less than
+   ``TURN_DEG`` (no manoeuvre), and no turning or slow point lies within ``PAD_S`` (the
+   acceleration after a tack or gybe).
+2. **The wind axis** from the pooled histogram of steady courses: the direction about
+   which the histogram is most symmetric (pairs of courses 2 x 15° to 2 x 60° apart: the two
+   upwind boards, the two downwind boards).  The up/down ambiguity is resolved with
+   ``prior_twd_deg`` (the axis end within 90° of it), or, without a prior, from speeds:
+   the upwind end is the one whose boards are sailed slower.
+3. **A joint fit.**  Each steady point on an upwind or downwind board is one
+   observation of TWD: ``course + α_k`` on starboard and ``course − α_k`` on port upwind,
+   ``course + 180° ∓ γ_k`` downwind (``γ_k = 180° − gybing half-angle``), with α_k and γ_k
+   unknowns per boat.  TWD(t) is piecewise linear (knots every ``KNOT_S``) with a weak
+   curvature penalty that bridges gaps; the fit is a robust (Huber) weighted least
+   squares, re-classified and re-fitted ``N_ITER`` times.  Points that fit neither board
+   (reaches) are rejected.  The tack and gybe jumps of one boat (the bisector of the
+   courses before and after, evidence that does not need the other board at the same
+   time) and the two boards' courses in the same window (their half-difference is α) fix
+   α_k; several boats pool into the one TWD(t).
+4. **The output grid**: TWD at each grid time is a local-linear kernel regression
+   (tricube kernel of half-width ``window_s / 2``) of the points' own TWD observations
+   (course ± the boat's fitted half-angle); its standard error combines the scatter of
+   those observations (each 1 Hz point counts for ``1 / CORR_S`` of an independent one:
+   course errors are correlated over several seconds), the uncertainty of the fitted
+   half-angles and an estimate of the smoothing bias (from the fitted curvature).
+5. **TWS** (only with a polar): each steady point's speed over ground, at its TWA from the
+   inferred TWD, is the polar's speed at one TWS; those TWS are smoothed like TWD.  This
+   is the wind in which the polar sails the observed speeds: right only for a boat that
+   sails to its polar.
+
+Assumptions: boats sail close to constant angles on each board (their best VMG); no
+current (COG = heading, no leeway); a symmetric polar (same angle on both boards); the
+wind uniform over the area the boats sail.  A shift between two tacks of the same board
+is seen only through the course changes on that board.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Final
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sailroute.boat.model import BoatModel
+from sailroute.errors import InputError
+from sailroute.geo import LocalFrame
+from sailroute.timeutil import iso
+from sailroute.track.kinematics import track_xy
+from sailroute.track.model import Track
+from sailroute.units import KNOT, bearing_deg, circular_mean_deg, wind_components, wrap180, wrap360
+from sailroute.wind.base import Coverage, prepare_points
+
+MIN_SPEED_MS: Final = 1.0
+"""Points slower than this [m s⁻¹] are rejected (no steady course)."""
+COG_WINDOW_S: Final = 10.0
+"""The course at a point is that of the displacement over this window centred on it [s]."""
+TURN_WINDOW_S: Final = 20.0
+"""The courses over this window before and after a point tell whether it turns [s]."""
+TURN_DEG: Final = 20.0
+"""A point whose courses over the ``TURN_WINDOW_S`` before and after differ by more than
+this [°] is turning (a manoeuvre)."""
+PAD_S: Final = 10.0
+"""Points within this of a turning or slow point are rejected too [s]."""
+MAX_GAP_S: Final = 5.0
+"""A course window that holds a gap in the log longer than this [s] is not used."""
+KNOT_S: Final = 20.0
+"""Knot spacing of the piecewise-linear TWD(t) of the joint fit [s]."""
+CORR_S: Final = 10.0
+"""Correlation time of the course errors [s]: a 1 Hz point counts for 1/10 of an
+independent observation in the standard errors."""
+N_ITER: Final = 4
+"""Classify-and-fit passes of the joint fit."""
+STEP_S: Final = 30.0
+"""Default output grid step [s]."""
+WINDOW_S: Final = 90.0
+"""Default full width of the output smoothing kernel [s]."""
+UP_HALF_DEG: Final = (15.0, 65.0)
+"""First-pass range of upwind |TWA| [°] (tacking half-angles)."""
+DOWN_OFF_DEG: Final = 50.0
+"""First pass: downwind boards lie within this of dead downwind [°]."""
+BAND_DEG: Final = 20.0
+"""Later passes: a point is on a board when its |TWA| is within this of the boat's fitted
+half-angle [°]; anything else is a reach and is rejected."""
+ALPHA_PRIOR_DEG: Final = (42.0, 10.0)
+"""Prior of a tacking half-angle without a polar: mean and sd [°] (keeps a boat that
+sails one board only solvable; the data dominate otherwise)."""
+GAMMA_PRIOR_DEG: Final = (15.0, 20.0)
+"""Prior of the downwind angle off dead downwind (180° − gybing half-angle) [°]."""
+UP_MODEL_SD: Final = 2.0
+"""How far from one constant angle a boat sails on an upwind board [°]: the VMG optimum is
+flat, so a few degrees higher or lower cost little (sailroute's own routes wander between
+41° and 46° in an oscillating wind).  Correlated along a board: it does not average down
+with the number of points."""
+RUN_MODEL_SD: Final = 7.0
+"""The same for a boat that runs (gybing half-angle above ``180 - RUN_GAMMA_DEG``) [°]: near
+dead downwind the polar is flat and the boat steers towards the mark, up to 10° by the lee
+or on a broad reach without a gybe."""
+DOWN_MODEL_SD: Final = 3.0
+"""The same for downwind boards of a boat that gybes through a clear angle [°]."""
+RUN_GAMMA_DEG: Final = 12.0
+"""A boat whose fitted angle off dead downwind is below this runs [°]."""
+MIN_OBS_S: Final = 10.0
+"""A grid time needs at least this many seconds of observations in its window."""
+
+
+@dataclass(frozen=True, eq=False)
+class InferredWind:
+    """Wind inferred from tracks, on a regular time grid.
+
+    Attributes
+    ----------
+    t : ndarray
+        Grid times [UTC epoch s].
+    twd_deg : ndarray
+        True wind direction, from [° compass, in ``[0, 360)``]; NaN where no steady
+        point lies within the window.
+    twd_sd_deg : ndarray
+        Standard error of ``twd_deg`` [°]; NaN where ``twd_deg`` is.
+    tws_ms : ndarray
+        True wind speed [m s⁻¹]; NaN where unknown (always without a polar).
+    tws_sd_ms : ndarray
+        Standard error of ``tws_ms`` [m s⁻¹]; NaN where ``tws_ms`` is.
+    n_obs : ndarray of int
+        Steady 1 Hz points (all boats) within the smoothing window of each grid time.
+    method : str
+        One line: what was used (boats, points, evidence, how up/down was decided).
+    notes : tuple of str
+        Per-boat half-angles, the up/down decision, checks and warnings.
+    half_angles_deg : dict of str to (float, float)
+        Per boat: fitted tacking half-angle α and gybing half-angle 180° − γ [°].
+    """
+
+    t: NDArray[np.float64]
+    twd_deg: NDArray[np.float64]
+    twd_sd_deg: NDArray[np.float64]
+    tws_ms: NDArray[np.float64]
+    tws_sd_ms: NDArray[np.float64]
+    n_obs: NDArray[np.int64]
+    method: str
+    notes: tuple[str, ...] = ()
+    half_angles_deg: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    def field(self, frame: LocalFrame | None = None, tws_ms: float | None = None,
+              *, clamp: bool = False) -> InferredWindField:
+        """The inferred wind as a :class:`~sailroute.wind.base.WindField`.
+
+        Uniform in space; TWD and TWS linear in time between the grid times with a
+        direction (NaN grid times are skipped).  Covers the first to the last grid time
+        with a direction.
+
+        Parameters
+        ----------
+        frame : LocalFrame, optional
+            The local frame the tracks were projected in (named in coverage messages).
+        tws_ms : float, optional
+            TWS [m s⁻¹] used where TWS was not inferred (always needed without a polar).
+        clamp : bool
+            Hold the first/last value outside the span instead of raising.
+
+        Raises
+        ------
+        InputError
+            No grid time has a direction, or TWS is missing somewhere and no ``tws_ms``
+            was given.
+        """
+        ok = np.isfinite(self.twd_deg)
+        if not ok.any():
+            raise InputError("inferred wind: no grid time has a direction; nothing to sample")
+        s = self.tws_ms[ok]
+        if np.isnan(s).any():
+            if tws_ms is None or not np.isfinite(tws_ms) or tws_ms < 0:
+                raise InputError(
+                    f"inferred wind: TWS is unknown at {int(np.isnan(s).sum())} of {s.size} "
+                    "grid times (it is inferred only with a polar); pass a fallback "
+                    "tws_ms=... (m/s, >= 0)")
+            s = np.where(np.isnan(s), float(tws_ms), s)
+        d = _unwrap_deg(self.twd_deg[ok])
+        return InferredWindField(self.t[ok].copy(), d, s, frame, clamp)
+
+
+@dataclass(frozen=True, eq=False)
+class InferredWindField:
+    """Uniform wind with TWD and TWS linear in time (:meth:`InferredWind.field`).
+
+    Parameters
+    ----------
+    times : ndarray
+        Increasing epoch times [s].
+    twd_unwrapped_deg : ndarray
+        TWD [°] at ``times``, unwrapped (no jumps of 360°).
+    tws_ms : ndarray
+        TWS [m s⁻¹] at ``times``.
+    frame : LocalFrame or None
+        For coverage messages.
+    clamp : bool
+        Hold the edge values outside the time span instead of raising.
+    """
+
+    times: NDArray[np.float64]
+    twd_unwrapped_deg: NDArray[np.float64]
+    tws_ms: NDArray[np.float64]
+    frame: LocalFrame | None = None
+    clamp: bool = False
+
+    @property
+    def coverage(self) -> Coverage:
+        """All space; the inferred time span."""
+        inf = float("inf")
+        return Coverage(float(self.times[0]), float(self.times[-1]), -inf, inf, -inf, inf,
+                        frame=self.frame)
+
+    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and ``x, y`` [m] (broadcast)."""
+        t, x, y = prepare_points(self.coverage, t, x, y, clamp=self.clamp,
+                                 name="inferred wind")
+        d = np.interp(t, self.times, self.twd_unwrapped_deg)
+        s = np.interp(t, self.times, self.tws_ms)
+        u, v = wind_components(s, d)
+        return np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _unwrap_deg(a: NDArray) -> NDArray[np.float64]:
+    return np.degrees(np.unwrap(np.radians(np.asarray(a, float))))
+
+
+def _window_course(t: NDArray, x: NDArray, y: NDArray, half: float, turn: float
+                   ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Course and speed of the displacement over ``[t - half, t + half]``, and the courses
+    over ``[t - turn, t]`` and ``[t, t + turn]`` [°, m s⁻¹, °, °]."""
+    xa, ya = np.interp(t - half, t, x), np.interp(t - half, t, y)
+    xb, yb = np.interp(t + half, t, x), np.interp(t + half, t, y)
+    span = np.minimum(t + half, t[-1]) - np.maximum(t - half, t[0])
+    dx, dy = xb - xa, yb - ya
+    with np.errstate(invalid="ignore", divide="ignore"):
+        sog = np.where(span > 0, np.hypot(dx, dy) / np.where(span > 0, span, 1.0), 0.0)
+    xp, yp = np.interp(t - turn, t, x), np.interp(t - turn, t, y)
+    xn, yn = np.interp(t + turn, t, x), np.interp(t + turn, t, y)
+    return bearing_deg(dx, dy), sog, bearing_deg(x - xp, y - yp), bearing_deg(xn - x, yn - y)
+
+
+def _near_any(t: NDArray, flag: NDArray, pad: float) -> NDArray[np.bool_]:
+    """True where a flagged point lies within ``pad`` seconds."""
+    c = np.concatenate([[0], np.cumsum(flag.astype(np.int64))])
+    lo = np.searchsorted(t, t - pad, side="left")
+    hi = np.searchsorted(t, t + pad, side="right")
+    return (c[hi] - c[lo]) > 0
+
+
+@dataclass(frozen=True)
+class _Points:
+    """Steady points of all boats (one row per point)."""
+
+    t: NDArray[np.float64]
+    cog: NDArray[np.float64]
+    sog: NDArray[np.float64]
+    boat: NDArray[np.int64]
+    weight: NDArray[np.float64]  # 1 / correlation inflation: sampling interval / CORR_S
+
+
+def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: float,
+                   min_speed_ms: float) -> tuple[_Points, list[str]]:
+    ts, cs, ss, bs, ws, notes = [], [], [], [], [], []
+    for k, tr in enumerate(tracks):
+        m = (tr.t_s >= t0 - COG_WINDOW_S) & (tr.t_s <= t1 + COG_WINDOW_S)
+        t = np.asarray(tr.t_s[m], float)
+        if t.size < 3:
+            notes.append(f"{tr.name or k}: no points in the window")
+            continue
+        x, y = track_xy(tr.between(t[0], t[-1]), frame)
+        half = 0.5 * COG_WINDOW_S
+        cog, sog, before, after = _window_course(t, x, y, half, TURN_WINDOW_S)
+        turning = np.abs(wrap180(after - before)) > TURN_DEG
+        slow = sog < min_speed_ms
+        big_gap = np.concatenate([[False], np.diff(t) > MAX_GAP_S])
+        gap_near = _near_any(t, big_gap, COG_WINDOW_S)
+        ok = ~_near_any(t, turning | slow, PAD_S) & ~gap_near & (t >= t0) & (t <= t1)
+        dt = float(np.median(np.diff(t)))
+        n_ok = int(ok.sum())
+        notes.append(f"{tr.name or k}: {n_ok} of {int(((t >= t0) & (t <= t1)).sum())} points "
+                     "steady (not turning, slow or near a gap)")
+        ts.append(t[ok])
+        cs.append(cog[ok])
+        ss.append(sog[ok])
+        bs.append(np.full(n_ok, k, dtype=np.int64))
+        ws.append(np.full(n_ok, min(1.0, dt / CORR_S)))
+    if not ts:
+        return _Points(*(np.zeros(0),) * 3, np.zeros(0, np.int64), np.zeros(0)), notes
+    t_all = np.concatenate(ts)
+    o = np.argsort(t_all, kind="stable")  # time order across boats
+    return _Points(t_all[o], np.concatenate(cs)[o], np.concatenate(ss)[o],
+                   np.concatenate(bs)[o], np.concatenate(ws)[o]), notes
+
+
+def wind_axis_deg(cog_deg: NDArray, weights: NDArray | None = None) -> tuple[float, float]:
+    """The direction about which a set of courses is most symmetric.
+
+    Parameters
+    ----------
+    cog_deg : ndarray
+        Courses [°] of steady points.
+    weights : ndarray, optional
+        Weight of each course.
+
+    Returns
+    -------
+    axis_deg : float
+        The axis [°, in ``[0, 180)``]: the wind comes from ``axis`` or ``axis + 180``.
+    strength : float
+        Share of the course pairs symmetric about the axis, in [0, 1].
+
+    Notes
+    -----
+    The courses are binned in 1° bins and smoothed (Gaussian, 3°); the score of a
+    direction θ is ``sum_d H(θ + d) H(θ − d)`` over half-separations ``d`` of 15° to 60°
+    (two boards), added for θ and θ + 180° (upwind and downwind boards).
+    """
+    h = np.bincount(np.floor(wrap360(cog_deg)).astype(int) % 360, weights=weights,
+                    minlength=360).astype(float)
+    k = np.arange(-10, 11)
+    g = np.exp(-0.5 * (k / 3.0) ** 2)
+    h = np.sum([np.roll(h, s) * w for s, w in zip(k, g, strict=True)], axis=0)
+    th = np.arange(360)[:, None] + 0.5
+    d = np.arange(15, 61)[None, :]
+    s = np.sum(h[(th + d).astype(int) % 360] * h[(th - d).astype(int) % 360], axis=1)
+    axis = s[:180] + s[180:]
+    i = int(np.argmax(axis))
+    total = float(np.sum(h) ** 2) or 1.0
+    return float(i + 0.5) % 180.0, float(axis[i] / total)
+
+
+# ---------------------------------------------------------------------------- the fit
+
+
+@dataclass(frozen=True)
+class _Fit:
+    knots: NDArray[np.float64]
+    twd: NDArray[np.float64]        # unwrapped TWD at the knots [°]
+    alpha: NDArray[np.float64]      # per boat [°]
+    gamma: NDArray[np.float64]      # per boat [°]
+    alpha_sd: NDArray[np.float64]
+    gamma_sd: NDArray[np.float64]
+    up: NDArray[np.bool_]           # per point: on an upwind board
+    used: NDArray[np.bool_]         # per point: on a board (up or down)
+    boat: NDArray[np.int64]         # per point: boat index
+    side: NDArray[np.float64]       # per point: +1 starboard, -1 port
+    obs: NDArray[np.float64]        # per point: its own TWD observation (unwrapped) [°]
+    w: NDArray[np.float64]          # per point: fit weight (1/sd^2 x robust x correlation)
+    msd: NDArray[np.float64]        # per point: model sd (UP/RUN/DOWN_MODEL_SD) [°]
+    sigma: tuple[float, float]      # residual sd upwind, downwind [°]
+
+
+def _basis(t: NDArray, knots: NDArray) -> tuple[NDArray, NDArray, NDArray]:
+    """Linear-interpolation basis: left knot index and the two weights."""
+    j = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, knots.size - 2)
+    f = np.clip((t - knots[j]) / (knots[j + 1] - knots[j]), 0.0, 1.0)
+    return j, 1.0 - f, f
+
+
+def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
+               alpha0: NDArray, gamma0: NDArray, alpha_prior_sd: float,
+               window_s: float, *, use_down: bool = True,
+               alpha_sd_fixed: NDArray | None = None) -> _Fit:
+    """Fit TWD(t) at the knots and the boats' half-angles (module notes, step 3).
+
+    ``use_down=False`` fits the upwind boards alone; ``alpha_sd_fixed`` holds the tacking
+    half-angles at ``alpha0`` (their sd as given) and fits the rest.
+    """
+    J, K = knots.size, n_boats
+    P = J + 2 * K
+    j, w0, w1 = _basis(p.t, knots)
+    twd = twd0.copy()
+    alpha, gamma = alpha0.copy(), gamma0.copy()
+    robust = np.ones(p.t.size)
+    sig_up, sig_dn = 5.0, 10.0
+    cov: NDArray[np.float64] = np.eye(P)
+    up = used = np.zeros(p.t.size, bool)
+    side = np.ones(p.t.size)
+    y = np.zeros(p.t.size)
+    coef = np.zeros(p.t.size)
+    wt = np.zeros(p.t.size)
+    for it in range(N_ITER):
+        cur = twd[j] * w0 + twd[j + 1] * w1
+        twa = wrap180(cur - p.cog)
+        a = np.abs(twa)
+        side = np.where(twa >= 0, 1.0, -1.0)
+        if it == 0 and alpha_sd_fixed is None:
+            up = (a >= UP_HALF_DEG[0]) & (a <= UP_HALF_DEG[1])
+            dn = a >= 180.0 - DOWN_OFF_DEG
+        else:
+            up = np.abs(a - alpha[p.boat]) <= BAND_DEG
+            dn = (np.abs((180.0 - a) - gamma[p.boat]) <= BAND_DEG + 5.0) if it else (
+                a >= 180.0 - DOWN_OFF_DEG)
+        if not use_down:
+            dn = np.zeros_like(up)
+        used = up | dn
+        # observation relative to the current curve: y = dTWD(t) - s alpha (up),
+        # y = dTWD(t) + s gamma (down); unknowns: knot increments, alpha, gamma (absolute)
+        y = np.where(up, wrap180(p.cog - cur), wrap180(p.cog + 180.0 - cur))
+        col = np.where(up, J + p.boat, J + K + p.boat)
+        coef = np.where(up, -side, side)
+        msd = _model_sd(up, gamma[p.boat])
+        wt = robust * p.weight * used / (np.where(up, sig_up, sig_dn) ** 2 + msd**2)
+        # normal equations by accumulation: 3 non-zeros per row
+        idx = np.stack([j, j + 1, col], axis=1)
+        val = np.stack([w0, w1, coef], axis=1)
+        rows = (idx[:, :, None] * P + idx[:, None, :]).reshape(-1)
+        prods = (val[:, :, None] * val[:, None, :] * wt[:, None, None]).reshape(-1)
+        N: NDArray[np.float64] = np.bincount(rows, weights=prods,
+                                             minlength=P * P).reshape(P, P).astype(float)
+        b: NDArray[np.float64] = np.bincount(
+            idx.reshape(-1), weights=(val * (wt * y)[:, None]).reshape(-1),
+            minlength=P).astype(float)
+        # curvature penalty on the increments (bridges gaps; resolution ~ window_s)
+        per_knot = np.bincount(j, weights=wt, minlength=J)
+        rho = float(np.median(per_knot[per_knot > 0])) if (per_knot > 0).any() else 1.0
+        lam = rho * (0.25 * window_s / (knots[1] - knots[0])) ** 4 / 16.0
+        D = np.diff(np.eye(J), 2, axis=0)
+        N[:J, :J] += lam * D.T @ D + 1e-6 * np.eye(J)
+        # penalise the curvature of the total curve, not only of the increment
+        b[:J] -= lam * D.T @ (D @ twd)
+        # priors on the half-angles (absolute values)
+        ia, ig = J + np.arange(K), J + K + np.arange(K)
+        a_sd = alpha_prior_sd if alpha_sd_fixed is None else 1e-3
+        N[ia, ia] += 1.0 / a_sd**2
+        N[ig, ig] += 1.0 / GAMMA_PRIOR_DEG[1] ** 2
+        b[ia] += alpha0 / a_sd**2
+        b[ig] += gamma0 / GAMMA_PRIOR_DEG[1] ** 2
+        try:
+            sol = np.linalg.solve(N, b)
+            cov = np.asarray(np.linalg.inv(N), dtype=float)
+        except np.linalg.LinAlgError:
+            sol = np.linalg.lstsq(N, b, rcond=None)[0]
+            cov = np.asarray(np.linalg.pinv(N), dtype=float)
+        twd = twd + sol[:J]
+        alpha, gamma = sol[ia], sol[ig]
+        # residuals and robust weights
+        fitted = sol[:J][j] * w0 + sol[:J][j + 1] * w1 + coef * sol[col]
+        r = y - fitted
+        sig_up = _mad(r[up & used]) if (up & used).sum() > 10 else sig_up
+        sig_dn = _mad(r[~up & used]) if (~up & used).sum() > 10 else sig_dn
+        sig_up, sig_dn = max(sig_up, 0.5), max(sig_dn, 0.5)
+        sc = np.where(up, sig_up, sig_dn)
+        robust = np.minimum(1.0, 1.5 * sc / np.maximum(np.abs(r), 1e-9))
+    cur = twd[j] * w0 + twd[j + 1] * w1
+    obs = cur + wrap180(np.where(up, p.cog + side * alpha[p.boat],
+                                 p.cog + 180.0 - side * gamma[p.boat]) - cur)
+    ia, ig = J + np.arange(K), J + K + np.arange(K)
+    # the covariance of a weighted fit with weights 1/sigma^2 is in deg^2 already
+    a_out = np.sqrt(np.diag(cov)[ia]) if alpha_sd_fixed is None else alpha_sd_fixed
+    return _Fit(knots, twd, alpha, gamma, a_out,
+                np.sqrt(np.diag(cov)[ig]), up & used, used, p.boat, side, obs, wt,
+                _model_sd(up, gamma[p.boat]),
+                (sig_up, sig_dn))
+
+
+def _model_sd(up: NDArray, gamma: NDArray) -> NDArray[np.float64]:
+    return np.where(up, UP_MODEL_SD, np.where(np.abs(gamma) < RUN_GAMMA_DEG, RUN_MODEL_SD,
+                                              DOWN_MODEL_SD))
+
+
+def _mad(r: NDArray) -> float:
+    return float(1.4826 * np.median(np.abs(r - np.median(r))))
+
+
+def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float
+                  ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """Local-linear kernel regression of ``v(t)`` at ``tg`` (tricube, half-width ``h``).
+
+    Returns the estimate, the equivalent-kernel weights' sums ``sum l^2 w^-1``-style
+    variance factor (see caller), the count of points in the window and the seconds of
+    data behind each estimate.  Vectorised over a dense (grid x points) matrix in blocks.
+    """
+    G = tg.size
+    est = np.full(G, np.nan)
+    var = np.full(G, np.nan)
+    n = np.zeros(G, np.int64)
+    mu2 = np.full(G, np.nan)
+    order = np.argsort(t)
+    t, v, w = t[order], v[order], w[order]
+    lo = np.searchsorted(t, tg - h, side="left")
+    hi = np.searchsorted(t, tg + h, side="right")
+    width = int(np.max(hi - lo)) if G else 0
+    if width == 0:
+        return est, var, n, mu2
+    k = lo[:, None] + np.arange(width)[None, :]
+    inside = k < hi[:, None]
+    k = np.minimum(k, t.size - 1)
+    dt = t[k] - tg[:, None]
+    kern = np.where(inside, (1.0 - np.clip(np.abs(dt) / h, 0, 1) ** 3) ** 3, 0.0) * w[k]
+    s0 = kern.sum(1)
+    s1 = (kern * dt).sum(1)
+    s2 = (kern * dt * dt).sum(1)
+    det = s0 * s2 - s1 * s1
+    # local linear only with data on both sides (a quarter of the window each); else the
+    # local mean (an extrapolated slope at the ends of the data is noise)
+    both = ((kern * (dt < -0.25 * h)).sum(1) > 0) & ((kern * (dt > 0.25 * h)).sum(1) > 0)
+    lin = both & (det > 1e-9 * np.maximum(s0 * s2, 1e-300))
+    # equivalent kernel l_i = kern_i (s2 - s1 dt_i) / det (local linear); else local mean
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lw = np.where(lin[:, None], kern * (s2[:, None] - s1[:, None] * dt) / det[:, None],
+                      kern / s0[:, None])
+    vv = v[k]
+    e = (lw * vv).sum(1)
+    r = vv - e[:, None]
+    var_ = (lw**2 * r**2 * inside).sum(1)
+    n_ = inside.sum(1)
+    m2 = (lw * dt * dt).sum(1)
+    ok = s0 > 0
+    est[ok], var[ok], n[:] = e[ok], var_[ok], n_
+    mu2[ok] = m2[ok]
+    return est, var, n, mu2
+
+
+# ---------------------------------------------------------------------------- TWS
+
+
+def _invert_polar(boat: BoatModel, twa_deg: NDArray, sog_ms: NDArray) -> NDArray[np.float64]:
+    """TWS [m s⁻¹] at which the boat's polar sails ``sog_ms`` at ``twa_deg`` (NaN where it
+    cannot: faster than the polar's top speed at that angle, or slower than at 0.5 m/s)."""
+    grid = np.arange(0.5, 25.01, 0.1)
+    ang = np.arange(0.0, 181.0)
+    table = np.asarray(boat.steady_speed(grid[None, :], ang[:, None]), float)
+    table = np.maximum.accumulate(table, axis=1)  # the rising part of each column
+    row = table[np.clip(np.rint(np.abs(twa_deg)).astype(int), 0, 180)]
+    c = (row < sog_ms[:, None]).sum(1)
+    ok = (c > 0) & (c < grid.size)
+    ci = np.clip(c, 1, grid.size - 1)
+    s0 = row[np.arange(c.size), ci - 1]
+    s1 = row[np.arange(c.size), ci]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        f = np.where(s1 > s0, (sog_ms - s0) / (s1 - s0), 0.0)
+    return np.where(ok, grid[ci - 1] + f * (grid[ci] - grid[ci - 1]), np.nan)
+
+
+# ---------------------------------------------------------------------------- public API
+
+
+def _check_inputs(tracks: Sequence[Track] | Track, step_s: float, window_s: float,
+                  prior: float | None) -> list[Track]:
+    trs = [tracks] if isinstance(tracks, Track) else list(tracks)
+    if not trs:
+        raise InputError("infer_wind: no tracks given; pass one or more Track objects")
+    for i, tr in enumerate(trs):
+        if not isinstance(tr, Track):
+            raise InputError(f"infer_wind: item {i} is a {type(tr).__name__}, not a Track; "
+                             "read tracks with sailroute.track.read_track")
+    for name, v in (("step_s", step_s), ("window_s", window_s)):
+        if not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
+            raise InputError(f"infer_wind: {name} must be a number > 0 s, got {v!r}")
+    if prior is not None and not np.isfinite(prior):
+        raise InputError(f"infer_wind: prior_twd_deg must be a finite direction, got {prior!r}")
+    return trs
+
+
+def infer_wind(
+    tracks: Sequence[Track] | Track,
+    frame: LocalFrame,
+    *,
+    prior_twd_deg: float | None = None,
+    boat: BoatModel | None = None,
+    t0: float | None = None,
+    t1: float | None = None,
+    step_s: float = STEP_S,
+    window_s: float = WINDOW_S,
+    min_speed_ms: float = MIN_SPEED_MS,
+) -> InferredWind:
+    """Estimate TWD(t), and TWS(t) with a polar, from boats' GPS tracks.
+
+    Parameters
+    ----------
+    tracks : Track or sequence of Track
+        One or more boats' tracks (positions; instrument channels are not used).
+    frame : LocalFrame
+        Local metric frame (the course's ``Course.frame``); directions are in its grid.
+    prior_twd_deg : float, optional
+        A rough TWD [°, from] (the course axis, the sailor's estimate; within ~60°) that
+        decides which end of the inferred axis the wind comes from.  Without it the
+        upwind end is the one whose boards are sailed slower.
+    boat : BoatModel, optional
+        The boats' polar: gives TWS(t) (the wind in which it sails the observed speeds)
+        and the prior tacking half-angle.  Without it TWS stays NaN.
+    t0, t1 : float, optional
+        Time span [epoch s] of the grid; default the tracks' span.
+    step_s : float
+        Grid step [s].
+    window_s : float
+        Full width of the smoothing window [s]: the time resolution of the estimate.
+    min_speed_ms : float
+        Points slower than this are rejected [m s⁻¹].
+
+    Returns
+    -------
+    InferredWind
+
+    Raises
+    ------
+    InputError
+        No tracks, bad parameters, an empty time span, or too few steady points on
+        upwind or downwind boards to infer a direction (the message says how many).
+    """
+    trs = _check_inputs(tracks, step_s, window_s, prior_twd_deg)
+    ta = min(float(tr.t_s[0]) for tr in trs if len(tr)) if any(len(tr) for tr in trs) else 0.0
+    tb = max(float(tr.t_s[-1]) for tr in trs if len(tr)) if any(len(tr) for tr in trs) else 0.0
+    t0 = ta if t0 is None else float(t0)
+    t1 = tb if t1 is None else float(t1)
+    if not t1 > t0:
+        raise InputError(f"infer_wind: empty time span {iso(t0)} .. {iso(t1)}; "
+                         "give t0 < t1 within the tracks' times")
+    names = [tr.name or f"track {i + 1}" for i, tr in enumerate(trs)]
+    p, notes = _steady_points(trs, frame, t0, t1, min_speed_ms)
+    if p.t.size < 60:
+        raise InputError(
+            f"infer_wind: only {p.t.size} steady points (faster than {min_speed_ms} m/s, "
+            f"not turning) in {iso(t0)} .. {iso(t1)}; need at least 60: give longer tracks "
+            "or the race's time span")
+    # 1. the axis and which end is upwind
+    axis, strength = wind_axis_deg(p.cog, p.weight)
+    cands = (axis, axis + 180.0)
+    if prior_twd_deg is not None:
+        twd_axis = min(cands, key=lambda c: abs(float(wrap180(c - prior_twd_deg))))
+        off = float(wrap180(twd_axis - prior_twd_deg))
+        how = f"up/down from the prior TWD {prior_twd_deg:.0f}° (tracks' axis {off:+.0f}° off it)"
+        if abs(off) > 60.0:
+            notes.append(f"the tracks' wind axis lies {off:+.0f}° from the prior "
+                         f"{prior_twd_deg:.0f}°: check the prior")
+    else:
+        speeds = []
+        for c in cands:
+            a = np.abs(wrap180(c - p.cog))
+            speeds.append((float(np.median(p.sog[a < 70])) if (a < 70).any() else np.inf,
+                           float(np.median(p.sog[a > 110])) if (a > 110).any() else np.inf))
+        # upwind end: its upwind boards slower than the downwind ones
+        score = [su - sd for su, sd in speeds]
+        twd_axis = cands[int(np.argmin(score))]
+        s_up, s_dn = speeds[int(np.argmin(score))]
+        how = (f"up/down from speeds (no prior): upwind boards {s_up / KNOT:.1f} kn, "
+               f"downwind {s_dn / KNOT:.1f} kn")
+    notes.append(f"wind axis {wrap360(twd_axis):.0f}° (symmetry {strength:.2f}); {how}")
+    # 2. the joint fit
+    K = len(trs)
+    knots = np.arange(t0, t1 + KNOT_S, KNOT_S)
+    if knots.size < 3:
+        knots = np.linspace(t0, t1, 3)
+    a0, g0 = ALPHA_PRIOR_DEG[0], GAMMA_PRIOR_DEG[0]
+    a_sd = ALPHA_PRIOR_DEG[1]
+    if boat is not None:
+        a0v, b0v = boat.vmg_angles_deg(float(np.clip(np.median(p.sog) * 1.6, 2.0, 12.0)))
+        a0, g0 = float(a0v), float(180.0 - b0v)
+    # upwind boards alone give TWD and the tacking half-angles; the downwind boards are
+    # then fitted with those held (a running boat steers for the mark within ~10° of dead
+    # downwind, which would otherwise pull the half-angles and damp the shifts)
+    fit_up = _joint_fit(p, K, knots, np.full(knots.size, float(twd_axis)),
+                        np.full(K, a0), np.full(K, g0), a_sd, window_s, use_down=False)
+    fit = _joint_fit(p, K, knots, fit_up.twd, fit_up.alpha, np.full(K, g0), a_sd, window_s,
+                     alpha_sd_fixed=fit_up.alpha_sd)
+    n_up, n_dn = int(fit.up.sum()), int((fit.used & ~fit.up).sum())
+    if n_up + n_dn < 60:
+        raise InputError(
+            f"infer_wind: only {n_up} upwind and {n_dn} downwind steady points; the tracks "
+            "hold too few board courses to infer a direction (reaches are not used)")
+    # 3. the output grid
+    tg = np.arange(t0, t1 + 1e-6, step_s)
+    h = 0.5 * window_s
+    m = fit.used
+    wgt = fit.w[m]
+    est, var, n, mu2 = _local_linear(tg, p.t[m], fit.obs[m], wgt, h)
+    infl = CORR_S  # points are 1 s apart but count for 1/CORR_S each
+    var = var * infl
+    # half-angle uncertainty: imbalance of boards within the window
+    ang_var = _group_var(tg, p.t[m], wgt, h, fit, m)
+    # smoothing bias from the fitted curvature
+    curv = np.interp(tg, fit.knots[1:-1],
+                     np.diff(fit.twd, 2) / (fit.knots[1] - fit.knots[0]) ** 2)
+    bias = 0.5 * curv * np.nan_to_num(mu2)
+    sd_all = np.sqrt(var + ang_var + bias**2)
+    secs = _seconds_in_window(tg, p.t[m], h)
+    bad = ~np.isfinite(est) | (secs < MIN_OBS_S)
+    twd = np.where(bad, np.nan, wrap360(est))
+    sd = np.where(bad, np.nan, sd_all)
+    # 4. TWS from the polar
+    tws = np.full(tg.size, np.nan)
+    tws_sd = np.full(tg.size, np.nan)
+    if boat is not None:
+        curve = np.interp(p.t, fit.knots, fit.twd)
+        twa = wrap180(curve - p.cog)
+        s_pt = _invert_polar(boat, twa, p.sog)
+        ok = m & np.isfinite(s_pt)
+        if ok.sum() >= 30:
+            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h)
+            sec2 = _seconds_in_window(tg, p.t[ok], h)
+            good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
+            tws = np.where(good, np.maximum(e2, 0.0), np.nan)
+            tws_sd = np.where(good, np.sqrt(v2 * CORR_S), np.nan)
+            notes.append(f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which "
+                         "it sails the observed speeds")
+        else:
+            notes.append("TWS not inferred: too few points within the polar's speed range")
+    half = {names[k]: (float(fit.alpha[k]), float(180.0 - fit.gamma[k])) for k in range(K)}
+    for k in range(K):
+        nk_up = int((fit.up & (p.boat == k)).sum())
+        nk_dn = int((fit.used & ~fit.up & (p.boat == k)).sum())
+        notes.append(f"{names[k]}: tacking half-angle {fit.alpha[k]:.1f} ± "
+                     f"{fit.alpha_sd[k]:.1f}°, gybing half-angle {180.0 - fit.gamma[k]:.1f} ± "
+                     f"{fit.gamma_sd[k]:.1f}° ({nk_up} upwind, {nk_dn} downwind points)")
+    method = (f"inferred from {K} track(s): {n_up} upwind and {n_dn} downwind board points "
+              f"(course ± fitted half-angles), window {window_s:.0f} s, "
+              f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
+              + ("; TWS from the polar" if boat is not None else "; TWS not inferred (no polar)"))
+    return InferredWind(tg, twd, sd, tws, tws_sd, n.astype(np.int64), method, tuple(notes),
+                        half)
+
+
+def _seconds_in_window(tg: NDArray, t: NDArray, h: float) -> NDArray[np.float64]:
+    ts = np.sort(t)
+    return (np.searchsorted(ts, tg + h, side="right")
+            - np.searchsorted(ts, tg - h, side="left")).astype(float)
+
+
+def _group_var(tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDArray
+               ) -> NDArray[np.float64]:
+    """Variance [°²] at the grid times from errors shared by a boat's board.
+
+    Two terms per boat and board (upwind, downwind), with ``f_i`` the point's share of the
+    kernel weight: the model error (``(sum f_i msd_i)²``: how far a board's angle may sit
+    from the fitted constant, the same along the board) and the uncertainty of the fitted
+    half-angle (``(sum f_i s_i)² sd²`` with ``s_i`` the board's sign: it cancels where both
+    boards are sailed in the window and adds up where only one is).
+    """
+    up, boat = fit.up[m], fit.boat[m]
+    coef = np.where(up, fit.side[m], -fit.side[m])
+    msd = fit.msd[m]
+    var = np.zeros(tg.size)
+    lo = np.searchsorted(t, tg - h, side="left")
+    hi = np.searchsorted(t, tg + h, side="right")
+    width = int(np.max(hi - lo)) if tg.size else 0
+    if width == 0:
+        return var
+    k = lo[:, None] + np.arange(width)[None, :]
+    inside = k < hi[:, None]
+    k = np.minimum(k, t.size - 1)
+    kern = np.where(inside, (1.0 - np.clip(np.abs(t[k] - tg[:, None]) / h, 0, 1) ** 3) ** 3,
+                    0.0) * w[k]
+    f = kern / np.maximum(kern.sum(1), 1e-300)[:, None]
+    for is_up, sds in ((True, fit.alpha_sd), (False, fit.gamma_sd)):
+        for b, sd in enumerate(sds):
+            sel = (up[k] == is_up) & (boat[k] == b)
+            var += ((f * coef[k] * sel).sum(1) * sd) ** 2 + ((f * msd[k] * sel).sum(1)) ** 2
+    return var
+
+
+def summary(inferred: InferredWind) -> dict[str, Any]:
+    """Numbers for reports: mean TWD, its range and shifts, TWS if known.
+
+    Parameters
+    ----------
+    inferred : InferredWind
+
+    Returns
+    -------
+    dict
+        ``twd_mean_deg`` (circular mean), ``twd_min_deg``/``twd_max_deg`` and
+        ``twd_range_deg`` (of the unwrapped series), ``twd_shift_rms_deg`` (RMS of TWD
+        about its mean), ``twd_sd_median_deg``, ``tws_mean_ms``/``tws_min_ms``/
+        ``tws_max_ms`` (None without TWS), ``t_start``/``t_end`` (ISO UTC of the grid
+        times with a direction), ``n_grid`` (of them), ``method``.  None where no grid
+        time has a direction.
+    """
+    ok = np.isfinite(inferred.twd_deg)
+    out: dict[str, Any] = {"n_grid": int(ok.sum()), "method": inferred.method}
+    if not ok.any():
+        return out | {k: None for k in ("twd_mean_deg", "twd_min_deg", "twd_max_deg",
+                                          "twd_range_deg", "twd_shift_rms_deg",
+                                          "twd_sd_median_deg", "tws_mean_ms", "tws_min_ms",
+                                          "tws_max_ms", "t_start", "t_end")}
+    d = inferred.twd_deg[ok]
+    mean = circular_mean_deg(d)
+    dev = wrap180(d - mean)
+    s = inferred.tws_ms[ok]
+    s = s[np.isfinite(s)]
+    return out | {
+        "twd_mean_deg": round(mean, 2) % 360.0,
+        "twd_min_deg": round(float(wrap360(mean + dev.min())), 2),
+        "twd_max_deg": round(float(wrap360(mean + dev.max())), 2),
+        "twd_range_deg": round(float(dev.max() - dev.min()), 2),
+        "twd_shift_rms_deg": round(float(np.sqrt(np.mean(dev**2))), 2),
+        "twd_sd_median_deg": round(float(np.median(inferred.twd_sd_deg[ok])), 2),
+        "tws_mean_ms": round(float(s.mean()), 3) if s.size else None,
+        "tws_min_ms": round(float(s.min()), 3) if s.size else None,
+        "tws_max_ms": round(float(s.max()), 3) if s.size else None,
+        "t_start": iso(float(inferred.t[ok][0])),
+        "t_end": iso(float(inferred.t[ok][-1])),
+    }
