@@ -51,6 +51,7 @@ from typing import Any, Final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.linalg import solveh_banded
 
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError
@@ -72,6 +73,12 @@ TURN_DEG: Final = 20.0
 this [°] is turning (a manoeuvre)."""
 PAD_S: Final = 10.0
 """Points within this of a turning or slow point are rejected too [s]."""
+ROUNDING_DEG: Final = 110.0
+"""A turn of more than this [°] between the ``TURN_WINDOW_S`` before and after a point is a
+mark rounding (a tack turns 80-100°)."""
+ROUNDING_PAD_S: Final = 30.0
+"""Points within this of a mark rounding are rejected [s]: boats reach in to a mark from
+above the layline, luff or bear away round it, and settle on the new leg after it."""
 MAX_GAP_S: Final = 5.0
 """A course window that holds a gap in the log longer than this [s] is not used."""
 KNOT_S: Final = 20.0
@@ -79,6 +86,10 @@ KNOT_S: Final = 20.0
 CORR_S: Final = 10.0
 """Correlation time of the course errors [s]: a 1 Hz point counts for 1/10 of an
 independent observation in the standard errors."""
+LAMBDA_SCALE: Final = 0.125
+"""The curvature penalty of the joint fit lets TWD(t) bend on a time scale of about
+``LAMBDA_SCALE * window_s`` (the equivalent kernel of a second-difference penalty spans
+``(lambda / rho) ** 0.25`` knots, rho the data weight per knot)."""
 N_ITER: Final = 4
 """Classify-and-fit passes of the joint fit."""
 STEP_S: Final = 30.0
@@ -95,23 +106,32 @@ half-angle [°]; anything else is a reach and is rejected."""
 ALPHA_PRIOR_DEG: Final = (42.0, 10.0)
 """Prior of a tacking half-angle without a polar: mean and sd [°] (keeps a boat that
 sails one board only solvable; the data dominate otherwise)."""
-GAMMA_PRIOR_DEG: Final = (15.0, 20.0)
+GAMMA_PRIOR_DEG: Final = (10.0, 5.0)
 """Prior of the downwind angle off dead downwind (180° − gybing half-angle) [°]."""
-UP_MODEL_SD: Final = 2.0
+UP_MODEL_SD: Final = 3.0
 """How far from one constant angle a boat sails on an upwind board [°]: the VMG optimum is
 flat, so a few degrees higher or lower cost little (sailroute's own routes wander between
 41° and 46° in an oscillating wind).  Correlated along a board: it does not average down
 with the number of points."""
-RUN_MODEL_SD: Final = 7.0
+RUN_MODEL_SD: Final = 8.0
 """The same for a boat that runs (gybing half-angle above ``180 - RUN_GAMMA_DEG``) [°]: near
 dead downwind the polar is flat and the boat steers towards the mark, up to 10° by the lee
 or on a broad reach without a gybe."""
 DOWN_MODEL_SD: Final = 3.0
 """The same for downwind boards of a boat that gybes through a clear angle [°]."""
+RUN_WEIGHT: Final = 0.1
+"""Runs count for this share of their variance weight [-]: they give the direction where
+no boat is on a board, but do not pull a beat's estimate towards the rhumb line (their
+error is a bias towards the mark, not noise)."""
 RUN_GAMMA_DEG: Final = 12.0
 """A boat whose fitted angle off dead downwind is below this runs [°]."""
-MIN_OBS_S: Final = 10.0
+SEPARATION_MARGIN_DEG: Final = 10.0
+"""Without a prior, the wind axis end about which the boards are this much further apart
+[°] is upwind; with a smaller difference the slower boards decide."""
+MIN_OBS_S: Final = 20.0
 """A grid time needs at least this many seconds of observations in its window."""
+MAX_SD_DEG: Final = 15.0
+"""A grid time whose direction has a larger standard error gets none (NaN) [°]."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -284,11 +304,12 @@ def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: fl
         x, y = track_xy(tr.between(t[0], t[-1]), frame)
         half = 0.5 * COG_WINDOW_S
         cog, sog, before, after = _window_course(t, x, y, half, TURN_WINDOW_S)
-        turning = np.abs(wrap180(after - before)) > TURN_DEG
+        turn = np.abs(wrap180(after - before))
         slow = sog < min_speed_ms
         big_gap = np.concatenate([[False], np.diff(t) > MAX_GAP_S])
-        gap_near = _near_any(t, big_gap, COG_WINDOW_S)
-        ok = ~_near_any(t, turning | slow, PAD_S) & ~gap_near & (t >= t0) & (t <= t1)
+        ok = (~_near_any(t, (turn > TURN_DEG) | slow, PAD_S)
+              & ~_near_any(t, turn > ROUNDING_DEG, ROUNDING_PAD_S)
+              & ~_near_any(t, big_gap, COG_WINDOW_S) & (t >= t0) & (t <= t1))
         dt = float(np.median(np.diff(t)))
         n_ok = int(ok.sum())
         notes.append(f"{tr.name or k}: {n_ok} of {int(((t >= t0) & (t <= t1)).sum())} points "
@@ -321,7 +342,8 @@ def wind_axis_deg(cog_deg: NDArray, weights: NDArray | None = None) -> tuple[flo
     axis_deg : float
         The axis [°, in ``[0, 180)``]: the wind comes from ``axis`` or ``axis + 180``.
     strength : float
-        Share of the course pairs symmetric about the axis, in [0, 1].
+        Contrast of the symmetry score, ``1 - mean / max`` over all axes, in [0, 1]: 0 for
+        courses with no preferred axis.
 
     Notes
     -----
@@ -329,18 +351,42 @@ def wind_axis_deg(cog_deg: NDArray, weights: NDArray | None = None) -> tuple[flo
     direction θ is ``sum_d H(θ + d) H(θ − d)`` over half-separations ``d`` of 15° to 60°
     (two boards), added for θ and θ + 180° (upwind and downwind boards).
     """
-    h = np.bincount(np.floor(wrap360(cog_deg)).astype(int) % 360, weights=weights,
-                    minlength=360).astype(float)
-    k = np.arange(-10, 11)
-    g = np.exp(-0.5 * (k / 3.0) ** 2)
-    h = np.sum([np.roll(h, s) * w for s, w in zip(k, g, strict=True)], axis=0)
+    h = _course_histogram(cog_deg, weights)
     th = np.arange(360)[:, None] + 0.5
     d = np.arange(15, 61)[None, :]
     s = np.sum(h[(th + d).astype(int) % 360] * h[(th - d).astype(int) % 360], axis=1)
     axis = s[:180] + s[180:]
     i = int(np.argmax(axis))
-    total = float(np.sum(h) ** 2) or 1.0
-    return float(i + 0.5) % 180.0, float(axis[i] / total)
+    strength = 1.0 - float(np.mean(axis)) / float(axis[i]) if axis[i] > 0 else 0.0
+    return float(i + 0.5) % 180.0, strength
+
+
+def _course_histogram(cog_deg: NDArray, weights: NDArray | None = None) -> NDArray[np.float64]:
+    """Courses in 1° bins (bin i holds [i, i + 1)), smoothed with a 3° Gaussian."""
+    h = np.bincount(np.floor(wrap360(cog_deg)).astype(int) % 360, weights=weights,
+                    minlength=360).astype(float)
+    k = np.arange(-10, 11)
+    g = np.exp(-0.5 * (k / 3.0) ** 2)
+    return np.asarray(np.sum([np.roll(h, s) * w for s, w in zip(k, g, strict=True)], axis=0),
+                      dtype=float)
+
+
+def half_separation_deg(cog_deg: NDArray, end_deg: float,
+                        weights: NDArray | None = None) -> float:
+    """Mean half-separation [°] of the courses symmetric about the direction ``end_deg``.
+
+    The score-weighted mean of ``d`` in 0..70° of ``sum H(end + d) H(end − d)``: about the
+    upwind end of the wind axis it is the tacking half-angle (35-55°), about the downwind
+    end the angle of the downwind boards off dead downwind (0° for a boat that runs, 20-35°
+    for one that gybes through a clear angle).
+    """
+    h = _course_histogram(cog_deg, weights)
+    d = np.arange(0, 71)
+    e = float(end_deg) % 360.0
+    i = np.floor(e).astype(int)
+    # bins i + d and i - d are symmetric about i + 0.5; the end lies within half a bin
+    s = h[(i + d) % 360] * h[(i - d) % 360]
+    return float(np.sum(d * s) / np.sum(s)) if np.sum(s) > 0 else float("nan")
 
 
 # ---------------------------------------------------------------------------- the fit
@@ -374,7 +420,8 @@ def _basis(t: NDArray, knots: NDArray) -> tuple[NDArray, NDArray, NDArray]:
 def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
                alpha0: NDArray, gamma0: NDArray, alpha_prior_sd: float,
                window_s: float, *, use_down: bool = True,
-               alpha_sd_fixed: NDArray | None = None) -> _Fit:
+               alpha_sd_fixed: NDArray | None = None,
+               gamma_prior_sd: NDArray | None = None) -> _Fit:
     """Fit TWD(t) at the knots and the boats' half-angles (module notes, step 3).
 
     ``use_down=False`` fits the upwind boards alone; ``alpha_sd_fixed`` holds the tacking
@@ -387,7 +434,13 @@ def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
     alpha, gamma = alpha0.copy(), gamma0.copy()
     robust = np.ones(p.t.size)
     sig_up, sig_dn = 5.0, 10.0
-    cov: NDArray[np.float64] = np.eye(P)
+    par_var: NDArray[np.float64] = np.ones(2 * K)
+    # D'D of the second-difference operator D, built band by band (pentadiagonal)
+    dtd = np.zeros((J, J))
+    r = np.arange(J - 2)
+    for a_, ca in enumerate((1.0, -2.0, 1.0)):
+        for b_, cb in enumerate((1.0, -2.0, 1.0)):
+            np.add.at(dtd, (r + a_, r + b_), ca * cb)
     up = used = np.zeros(p.t.size, bool)
     side = np.ones(p.t.size)
     y = np.zeros(p.t.size)
@@ -414,7 +467,9 @@ def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
         col = np.where(up, J + p.boat, J + K + p.boat)
         coef = np.where(up, -side, side)
         msd = _model_sd(up, gamma[p.boat])
-        wt = robust * p.weight * used / (np.where(up, sig_up, sig_dn) ** 2 + msd**2)
+        run = ~up & (np.abs(gamma[p.boat]) < RUN_GAMMA_DEG)
+        wt = (robust * p.weight * used * np.where(run, RUN_WEIGHT, 1.0)
+              / (np.where(up, sig_up, sig_dn) ** 2 + msd**2))
         # normal equations by accumulation: 3 non-zeros per row
         idx = np.stack([j, j + 1, col], axis=1)
         val = np.stack([w0, w1, coef], axis=1)
@@ -428,24 +483,20 @@ def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
         # curvature penalty on the increments (bridges gaps; resolution ~ window_s)
         per_knot = np.bincount(j, weights=wt, minlength=J)
         rho = float(np.median(per_knot[per_knot > 0])) if (per_knot > 0).any() else 1.0
-        lam = rho * (0.25 * window_s / (knots[1] - knots[0])) ** 4 / 16.0
-        D = np.diff(np.eye(J), 2, axis=0)
-        N[:J, :J] += lam * D.T @ D + 1e-6 * np.eye(J)
+        lam = rho * (LAMBDA_SCALE * window_s / (knots[1] - knots[0])) ** 4
+        N[:J, :J] += lam * dtd
+        N[np.arange(J), np.arange(J)] += 1e-6
         # penalise the curvature of the total curve, not only of the increment
-        b[:J] -= lam * D.T @ (D @ twd)
+        b[:J] -= lam * (dtd @ twd)
         # priors on the half-angles (absolute values)
         ia, ig = J + np.arange(K), J + K + np.arange(K)
         a_sd = alpha_prior_sd if alpha_sd_fixed is None else 1e-3
         N[ia, ia] += 1.0 / a_sd**2
-        N[ig, ig] += 1.0 / GAMMA_PRIOR_DEG[1] ** 2
+        g_sd = GAMMA_PRIOR_DEG[1] if gamma_prior_sd is None else gamma_prior_sd
+        N[ig, ig] += 1.0 / g_sd**2
         b[ia] += alpha0 / a_sd**2
-        b[ig] += gamma0 / GAMMA_PRIOR_DEG[1] ** 2
-        try:
-            sol = np.linalg.solve(N, b)
-            cov = np.asarray(np.linalg.inv(N), dtype=float)
-        except np.linalg.LinAlgError:
-            sol = np.linalg.lstsq(N, b, rcond=None)[0]
-            cov = np.asarray(np.linalg.pinv(N), dtype=float)
+        b[ig] += gamma0 / g_sd**2
+        sol, par_var = _solve_bordered(N, b, J)
         twd = twd + sol[:J]
         alpha, gamma = sol[ia], sol[ig]
         # residuals and robust weights
@@ -461,11 +512,34 @@ def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
                                  p.cog + 180.0 - side * gamma[p.boat]) - cur)
     ia, ig = J + np.arange(K), J + K + np.arange(K)
     # the covariance of a weighted fit with weights 1/sigma^2 is in deg^2 already
-    a_out = np.sqrt(np.diag(cov)[ia]) if alpha_sd_fixed is None else alpha_sd_fixed
+    a_out = np.sqrt(par_var[:K]) if alpha_sd_fixed is None else alpha_sd_fixed
     return _Fit(knots, twd, alpha, gamma, a_out,
-                np.sqrt(np.diag(cov)[ig]), up & used, used, p.boat, side, obs, wt,
+                np.sqrt(par_var[K:]), up & used, used, p.boat, side, obs, wt,
                 _model_sd(up, gamma[p.boat]),
                 (sig_up, sig_dn))
+
+
+def _solve_bordered(N: NDArray, b: NDArray, J: int
+                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Solve the normal equations ``N x = b`` whose knot block ``N[:J, :J]`` is banded
+    (pentadiagonal: linear basis plus the second-difference penalty) and bordered by a few
+    dense parameter rows, by the Schur complement in O(J); also the variances of the
+    parameters (the diagonal of the parameter block of ``N⁻¹``)."""
+    A, B, C = N[:J, :J], N[:J, J:], N[J:, J:]
+    ab = np.zeros((3, J))
+    for u in range(3):  # upper banded storage: ab[2 - u, j] = A[j - u, j]
+        ab[2 - u, u:] = np.diagonal(A, u)
+    rhs = np.column_stack([b[:J], B])
+    try:
+        z = solveh_banded(ab, rhs)
+        S = C - B.T @ z[:, 1:]
+        par = np.linalg.solve(S, b[J:] - B.T @ z[:, 0])
+        var = np.diag(np.linalg.inv(S))
+    except (np.linalg.LinAlgError, ValueError):
+        sol = np.linalg.lstsq(N, b, rcond=None)[0]
+        return sol, np.diag(np.linalg.pinv(N))[J:].astype(float)
+    x = z[:, 0] - z[:, 1:] @ par
+    return np.concatenate([x, par]), np.asarray(var, dtype=float)
 
 
 def _model_sd(up: NDArray, gamma: NDArray) -> NDArray[np.float64]:
@@ -548,6 +622,48 @@ def _invert_polar(boat: BoatModel, twa_deg: NDArray, sog_ms: NDArray) -> NDArray
 
 
 # ---------------------------------------------------------------------------- public API
+
+
+def _gamma_priors(p: _Points, n_boats: int, twd_axis: float, default: float
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Prior angle off dead downwind [°] per boat, and its sd.
+
+    From each boat's downwind courses: their half-separation about the downwind end of the
+    race's wind axis (:func:`half_separation_deg`).  Below ``RUN_GAMMA_DEG`` the boat runs:
+    its angle is held at 0 (a run has no boards to tell apart: the sign of a TWA near 180°
+    is noise); above, it is the prior mean with sd ``GAMMA_PRIOR_DEG[1]``.  A boat with
+    fewer than 30 downwind points gets ``default``.
+    """
+    a = np.abs(wrap180(p.cog - twd_axis - 180.0))
+    mean = np.full(n_boats, float(default))
+    sd = np.full(n_boats, GAMMA_PRIOR_DEG[1])
+    for k in range(n_boats):
+        sel = (p.boat == k) & (a < 50.0)
+        if sel.sum() >= 30:
+            g = half_separation_deg(p.cog[sel], twd_axis + 180.0, p.weight[sel])
+            if np.isfinite(g):
+                mean[k], sd[k] = (0.0, 1e-3) if g < RUN_GAMMA_DEG else (g, GAMMA_PRIOR_DEG[1])
+    return mean, sd
+
+
+def _upwind_end(p: _Points, cands: tuple[float, float]) -> tuple[float, str]:
+    """Which end of the wind axis is upwind, without a prior: the end about which the
+    boards are further apart (tacking half-angles exceed the downwind boards' angle off
+    dead downwind by ``SEPARATION_MARGIN_DEG`` or more); where the two differ less, the end
+    whose boards are sailed slower."""
+    sep = [half_separation_deg(p.cog, c, p.weight) for c in cands]
+    if np.all(np.isfinite(sep)) and abs(sep[0] - sep[1]) >= SEPARATION_MARGIN_DEG:
+        k = int(np.argmax(sep))
+        return cands[k], (f"up/down from the boards' separation (no prior): {sep[k]:.0f}° "
+                          f"either side upwind, {sep[1 - k]:.0f}° downwind")
+    speeds = []
+    for c in cands:
+        a = np.abs(wrap180(c - p.cog))
+        speeds.append(float(np.median(p.sog[a < 70])) if (a < 70).any() else np.inf)
+    k = int(np.argmin(speeds))  # upwind: the slower boards
+    return cands[k], (f"up/down from speeds (no prior; boards {sep[0]:.0f}° and {sep[1]:.0f}° "
+                      f"either side): upwind boards {speeds[k] / KNOT:.1f} kn, "
+                      f"downwind {speeds[1 - k] / KNOT:.1f} kn")
 
 
 def _check_inputs(tracks: Sequence[Track] | Track, step_s: float, window_s: float,
@@ -639,18 +755,8 @@ def infer_wind(
             notes.append(f"the tracks' wind axis lies {off:+.0f}° from the prior "
                          f"{prior_twd_deg:.0f}°: check the prior")
     else:
-        speeds = []
-        for c in cands:
-            a = np.abs(wrap180(c - p.cog))
-            speeds.append((float(np.median(p.sog[a < 70])) if (a < 70).any() else np.inf,
-                           float(np.median(p.sog[a > 110])) if (a > 110).any() else np.inf))
-        # upwind end: its upwind boards slower than the downwind ones
-        score = [su - sd for su, sd in speeds]
-        twd_axis = cands[int(np.argmin(score))]
-        s_up, s_dn = speeds[int(np.argmin(score))]
-        how = (f"up/down from speeds (no prior): upwind boards {s_up / KNOT:.1f} kn, "
-               f"downwind {s_dn / KNOT:.1f} kn")
-    notes.append(f"wind axis {wrap360(twd_axis):.0f}° (symmetry {strength:.2f}); {how}")
+        twd_axis, how = _upwind_end(p, cands)
+    notes.append(f"wind axis {wrap360(twd_axis):.0f}° (symmetry contrast {strength:.2f}); {how}")
     # 2. the joint fit
     K = len(trs)
     knots = np.arange(t0, t1 + KNOT_S, KNOT_S)
@@ -666,7 +772,9 @@ def infer_wind(
     # downwind, which would otherwise pull the half-angles and damp the shifts)
     fit_up = _joint_fit(p, K, knots, np.full(knots.size, float(twd_axis)),
                         np.full(K, a0), np.full(K, g0), a_sd, window_s, use_down=False)
-    fit = _joint_fit(p, K, knots, fit_up.twd, fit_up.alpha, np.full(K, g0), a_sd, window_s,
+    g0s, g_sd = _gamma_priors(p, K, float(twd_axis), g0)
+    fit = _joint_fit(p, K, knots, fit_up.twd, fit_up.alpha, g0s, a_sd, window_s,
+                     gamma_prior_sd=g_sd,
                      alpha_sd_fixed=fit_up.alpha_sd)
     n_up, n_dn = int(fit.up.sum()), int((fit.used & ~fit.up).sum())
     if n_up + n_dn < 60:
@@ -689,7 +797,7 @@ def infer_wind(
     bias = 0.5 * curv * np.nan_to_num(mu2)
     sd_all = np.sqrt(var + ang_var + bias**2)
     secs = _seconds_in_window(tg, p.t[m], h)
-    bad = ~np.isfinite(est) | (secs < MIN_OBS_S)
+    bad = ~np.isfinite(est) | (secs < MIN_OBS_S) | ~(sd_all <= MAX_SD_DEG)
     twd = np.where(bad, np.nan, wrap360(est))
     sd = np.where(bad, np.nan, sd_all)
     # 4. TWS from the polar

@@ -10,10 +10,12 @@ a known wind, sampled at 1 Hz, optionally with 2 m of white GPS noise per axis:
 
 Three boats start 0, 150 and 300 s apart from three points of the line (the first on
 starboard, the second on port, the third free), so that at most times one of them is
-beating.  The router tacks on the shifts; it also sails 2-5° lower than its best-VMG angle
-on the lifted tack (upwind TWA 43.4 ± 1.8° against 41.1°), which no course-only method can
-see, and its runs steer for the mark within 10° of dead downwind: the bounds below are
-what the method reaches on these routes, with a small margin.
+beating.  The router tacks on the shifts, but it does not hold one upwind angle: it
+keeps a compass heading of its 2° grid while the wind turns and sails lower on the lifted
+board (upwind TWA 40-50°, 43.4 ± 1.8°, against its best-VMG 41.1°), which no course-only
+method can see; and its runs steer for the mark within 10° of dead downwind (the ILCA's
+best downwind VMG is at 180°, where the polar is flat).  The bounds below are what the
+method reaches on these routes, with a small margin.
 """
 
 from __future__ import annotations
@@ -24,7 +26,13 @@ from types import MappingProxyType
 import numpy as np
 import pytest
 
-from sailroute.analysis.infer_wind import InferredWind, infer_wind, summary, wind_axis_deg
+from sailroute.analysis.infer_wind import (
+    InferredWind,
+    half_separation_deg,
+    infer_wind,
+    summary,
+    wind_axis_deg,
+)
 from sailroute.boat import builtin_polar
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.geo import LocalFrame
@@ -32,7 +40,7 @@ from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import RoutingSettings, Start, Target
 from sailroute.track.model import Track
-from sailroute.units import wind_components, wind_speed_direction, wrap180
+from sailroute.units import bearing_deg, wind_components, wind_speed_direction, wrap180
 from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import WindField
 
@@ -110,52 +118,76 @@ def errors(iw: InferredWind, wind: str):
     return err, iw.twd_sd_deg[ok], ok
 
 
-# RMS bound [°] and share of grid times whose truth lies within 2 sd, per case, as reached
-# (docs/analysis.md, "Wind inferred from tracks", gives the measured values)
+def beating(routes, wind: str, n: int, t_grid):
+    """True at the grid times when at least one of the first ``n`` boats is beating."""
+    out = np.zeros(t_grid.size, bool)
+    for t, x, y in routes[wind][:n]:
+        tm = 0.5 * (t[1:] + t[:-1])
+        up = np.abs(wrap180(TRUTH[wind](tm) - bearing_deg(np.diff(x), np.diff(y)))) < 90.0
+        i = np.clip(np.searchsorted(t, t_grid) - 1, 0, up.size - 1)
+        out |= (t_grid >= t[0]) & (t_grid <= t[-1]) & up[i]
+    return out
+
+
+# Per case, as reached with a margin of 10-20 % (docs/analysis.md, "Wind inferred from
+# tracks", gives the measured values): RMS error [°] over all grid times with a direction,
+# RMS error [°] over the grid times when at least one boat is beating, and the least share
+# of grid times whose truth lies within 2 sd.  The runs are nearly blind: a dinghy that
+# runs dead downwind steers for the mark, whatever the wind does.
 CASES = {
-    ("shift", 3, 0.0): (1.5, 0.95),
-    ("shift", 3, 2.0): (3.5, 0.95),
-    ("shift", 1, 0.0): (2.6, 0.95),
-    ("shift", 1, 2.0): (3.2, 0.95),
-    ("osc", 3, 0.0): (5.5, 0.60),
-    ("osc", 3, 2.0): (5.5, 0.90),
-    ("osc", 1, 0.0): (7.5, 0.95),  # the runs, 40 % of the time, are nearly blind
-    ("osc", 1, 2.0): (5.6, 0.95),
+    ("shift", 3, 0.0): (4.8, 1.4, 0.95),
+    ("shift", 3, 2.0): (4.8, 1.5, 0.95),
+    ("shift", 1, 0.0): (3.7, 1.0, 0.95),
+    ("shift", 1, 2.0): (4.0, 1.9, 0.95),
+    ("osc", 3, 0.0): (5.3, 3.4, 0.9),
+    ("osc", 3, 2.0): (5.3, 3.4, 0.9),
+    ("osc", 1, 0.0): (4.5, 2.8, 0.95),
+    ("osc", 1, 2.0): (4.3, 2.9, 0.95),
 }
 
 
 @pytest.mark.parametrize(("wind", "n", "noise"), list(CASES))
 def test_known_wind_is_found(routes, wind: str, n: int, noise: float) -> None:
-    rms_max, within_min = CASES[(wind, n, noise)]
+    rms_max, rms_beating_max, within_min = CASES[(wind, n, noise)]
     iw = infer_wind(tracks(routes, wind, n, noise), FRAME, prior_twd_deg=BASE + 30.0)
     err, sd, ok = errors(iw, wind)
-    assert ok.mean() > 0.95  # a direction at (nearly) every grid time of the race
-    rms = float(np.sqrt(np.mean(err**2)))
-    assert rms <= rms_max, (rms, iw.notes)
-    assert abs(float(np.mean(err))) < (3.0 if n == 3 else 4.5)
+    assert ok.mean() > 0.85  # a direction at most grid times (not round the marks)
+    assert float(np.sqrt(np.mean(err**2))) <= rms_max
+    beat = beating(routes, wind, n, iw.t)[ok]
+    assert beat.sum() > 0.4 * beat.size
+    assert float(np.sqrt(np.mean(err[beat] ** 2))) <= rms_beating_max
+    assert abs(float(np.mean(err))) < 2.0
     # honest uncertainty: the truth within 2 sd at most grid times
     assert float(np.mean(np.abs(err) <= 2.0 * sd)) >= within_min
-    # the router's tacking half-angle (best VMG 41.1° at 5 m/s, sailed 41-46°)
+    # the router's tacking half-angle (best VMG 41.1° at 5 m/s, sailed 40-50°)
     for alpha, _ in iw.half_angles_deg.values():
         assert 38.0 < alpha < 46.0
 
 
 def test_shift_is_seen_as_a_persistent_veer(routes) -> None:
     iw = infer_wind(tracks(routes, "shift", 3, 0.0), FRAME, prior_twd_deg=BASE)
-    before = np.nanmean(iw.twd_deg[iw.t < T0 + 380.0])
-    after = np.nanmean(iw.twd_deg[iw.t > T0 + 1020.0])
-    assert after - before == pytest.approx(15.0, abs=2.0)
+    beat = beating(routes, "shift", 3, iw.t)  # (the final run, all boats running, is blind)
+    before = np.nanmean(iw.twd_deg[beat & (iw.t < T0 + 380.0)])
+    after = np.nanmean(iw.twd_deg[beat & (iw.t > T0 + 1020.0)])
+    assert after - before == pytest.approx(15.0, abs=1.5)
 
 
-def test_without_a_prior_the_slower_boards_are_upwind(routes) -> None:
+def test_without_a_prior_the_wider_boards_are_upwind(routes) -> None:
     trs = tracks(routes, "shift", 3, 0.0)
     iw = infer_wind(trs, FRAME)
-    err, _, _ = errors(iw, "shift")
-    assert np.sqrt(np.mean(err**2)) < 1.5
-    assert any("up/down from speeds" in n for n in iw.notes)
+    np.testing.assert_allclose(iw.twd_deg, infer_wind(trs, FRAME, prior_twd_deg=BASE).twd_deg)
+    assert any("up/down from the boards' separation" in n for n in iw.notes)
     # a prior on the wrong end turns the answer round (and says so)
     iw2 = infer_wind(trs, FRAME, prior_twd_deg=BASE + 180.0)
     assert abs(float(wrap180(np.nanmean(iw2.twd_deg) - BASE - 180.0))) < 5.0
+
+
+def test_half_separation_tells_beats_from_runs() -> None:
+    rng = np.random.default_rng(5)
+    c = np.concatenate([rng.normal(70 - 42, 2, 500), rng.normal(70 + 42, 2, 500),
+                        rng.normal(250, 4, 600)]) % 360.0
+    assert half_separation_deg(c, 70.0) == pytest.approx(42.0, abs=3.0)
+    assert half_separation_deg(c, 250.0) < 8.0
 
 
 def test_tws_from_the_polar(routes) -> None:
