@@ -822,9 +822,11 @@ def infer_wind(
     for k in range(K):
         nk_up = int((fit.up & (p.boat == k)).sum())
         nk_dn = int((fit.used & ~fit.up & (p.boat == k)).sum())
+        down = (f"runs (downwind held at 180°, {RUN_WEIGHT:g} weight)"
+                if abs(fit.gamma[k]) < RUN_GAMMA_DEG and fit.gamma_sd[k] < 0.01 else
+                f"gybing half-angle {180.0 - fit.gamma[k]:.1f} ± {fit.gamma_sd[k]:.1f}°")
         notes.append(f"{names[k]}: tacking half-angle {fit.alpha[k]:.1f} ± "
-                     f"{fit.alpha_sd[k]:.1f}°, gybing half-angle {180.0 - fit.gamma[k]:.1f} ± "
-                     f"{fit.gamma_sd[k]:.1f}° ({nk_up} upwind, {nk_dn} downwind points)")
+                     f"{fit.alpha_sd[k]:.1f}°, {down} ({nk_up} upwind, {nk_dn} downwind points)")
     method = (f"inferred from {K} track(s): {n_up} upwind and {n_dn} downwind board points "
               f"(course ± fitted half-angles), window {window_s:.0f} s, "
               f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
