@@ -8,30 +8,35 @@ inferred from tracks"):
 
 1. **Steady points.**  The course at each point is that of the displacement over
    ``COG_WINDOW_S`` centred on it.  A point is kept where the boat is faster than
-   ``min_speed_ms``, its courses over the windows before and after it differ by less than
-   ``TURN_DEG`` (no manoeuvre), and no turning or slow point lies within ``PAD_S`` (the
-   acceleration after a tack or gybe).
+   ``min_speed_ms``, its courses over the ``TURN_WINDOW_S`` before and after it differ by
+   less than ``TURN_DEG`` (no manoeuvre), no turning or slow point lies within ``PAD_S``
+   (the acceleration after a tack or gybe), no turn of more than ``ROUNDING_DEG`` (a mark
+   rounding) within ``ROUNDING_PAD_S``, and no gap in the log nearby.
 2. **The wind axis** from the pooled histogram of steady courses: the direction about
    which the histogram is most symmetric (pairs of courses 2 x 15° to 2 x 60° apart: the two
    upwind boards, the two downwind boards).  The up/down ambiguity is resolved with
-   ``prior_twd_deg`` (the axis end within 90° of it), or, without a prior, from speeds:
-   the upwind end is the one whose boards are sailed slower.
-3. **A joint fit.**  Each steady point on an upwind or downwind board is one
-   observation of TWD: ``course + α_k`` on starboard and ``course − α_k`` on port upwind,
-   ``course + 180° ∓ γ_k`` downwind (``γ_k = 180° − gybing half-angle``), with α_k and γ_k
-   unknowns per boat.  TWD(t) is piecewise linear (knots every ``KNOT_S``) with a weak
-   curvature penalty that bridges gaps; the fit is a robust (Huber) weighted least
-   squares, re-classified and re-fitted ``N_ITER`` times.  Points that fit neither board
-   (reaches) are rejected.  The tack and gybe jumps of one boat (the bisector of the
-   courses before and after, evidence that does not need the other board at the same
-   time) and the two boards' courses in the same window (their half-difference is α) fix
-   α_k; several boats pool into the one TWD(t).
+   ``prior_twd_deg`` (the axis end within 90° of it), or, without a prior, by the boards'
+   separation (tacking half-angles exceed the downwind boards' angle off dead downwind)
+   and, where that is not clear, by speeds (the upwind boards are sailed slower).
+3. **A joint fit.**  Each steady point on an upwind board is one observation of TWD:
+   ``course + α_k`` on starboard and ``course − α_k`` on port, with α_k an unknown per
+   boat.  TWD(t) is piecewise linear (knots every ``KNOT_S``) with a weak curvature
+   penalty that bridges gaps; the fit is a robust (Huber) weighted least squares,
+   re-classified and re-fitted ``N_ITER`` times.  Points that fit neither board (reaches)
+   are rejected.  The tack jumps of one boat (the bisector of the courses before and
+   after), the two boards' courses in the same window (their half-difference is α) and
+   the course changes along a board all enter that fit; several boats pool into the one
+   TWD(t).  The downwind boards are then added with α held: ``course + 180° ∓ γ_k``
+   (``γ_k = 180° − gybing half-angle``, fitted), or, for a boat whose downwind courses
+   spread less than ``RUN_GAMMA_DEG`` about dead downwind, ``course + 180°`` at
+   ``RUN_WEIGHT`` of its weight (a run: the boat steers for the mark).
 4. **The output grid**: TWD at each grid time is a local-linear kernel regression
-   (tricube kernel of half-width ``window_s / 2``) of the points' own TWD observations
-   (course ± the boat's fitted half-angle); its standard error combines the scatter of
-   those observations (each 1 Hz point counts for ``1 / CORR_S`` of an independent one:
-   course errors are correlated over several seconds), the uncertainty of the fitted
-   half-angles and an estimate of the smoothing bias (from the fitted curvature).
+   (tricube kernel of half-width ``window_s / 2``) of the points' own TWD observations;
+   its standard error combines the scatter of those observations (each 1 Hz point counts
+   for ``1 / CORR_S`` of an independent one: course errors are correlated over several
+   seconds), per boat and board a model error that does not average down
+   (``UP_MODEL_SD``, ``RUN_MODEL_SD``, ``DOWN_MODEL_SD``) and the fitted half-angle's
+   uncertainty, and an estimate of the smoothing bias (from the fitted curvature).
 5. **TWS** (only with a polar): each steady point's speed over ground, at its TWA from the
    inferred TWD, is the polar's speed at one TWS; those TWS are smoothed like TWD.  This
    is the wind in which the polar sails the observed speeds: right only for a boat that
@@ -45,6 +50,7 @@ is seen only through the course changes on that board.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Final
@@ -110,11 +116,11 @@ GAMMA_PRIOR_DEG: Final = (10.0, 5.0)
 """Prior of the downwind angle off dead downwind (180° − gybing half-angle) [°]."""
 UP_MODEL_SD: Final = 3.0
 """How far from one constant angle a boat sails on an upwind board [°]: the VMG optimum is
-flat, so a few degrees higher or lower cost little (sailroute's own routes wander between
-41° and 46° in an oscillating wind).  Correlated along a board: it does not average down
+flat, so a few degrees higher or lower cost little (sailroute's own routes sail 40-50° in
+an oscillating wind).  Correlated along a board: it does not average down
 with the number of points."""
 RUN_MODEL_SD: Final = 8.0
-"""The same for a boat that runs (gybing half-angle above ``180 - RUN_GAMMA_DEG``) [°]: near
+"""The same for a boat that runs (``RUN_GAMMA_DEG``) [°]: near
 dead downwind the polar is flat and the boat steers towards the mark, up to 10° by the lee
 or on a broad reach without a gybe."""
 DOWN_MODEL_SD: Final = 3.0
@@ -124,10 +130,15 @@ RUN_WEIGHT: Final = 0.1
 no boat is on a board, but do not pull a beat's estimate towards the rhumb line (their
 error is a bias towards the mark, not noise)."""
 RUN_GAMMA_DEG: Final = 12.0
-"""A boat whose fitted angle off dead downwind is below this runs [°]."""
+"""A boat whose downwind courses spread less than this either side of dead downwind runs
+[°] (:func:`half_separation_deg`)."""
 SEPARATION_MARGIN_DEG: Final = 10.0
 """Without a prior, the wind axis end about which the boards are this much further apart
 [°] is upwind; with a smaller difference the slower boards decide."""
+MAX_SPAN_S: Final = 6 * 3600.0
+"""Longest time span inferred in one call [s] (one race, or one evening's races)."""
+MAX_APART_M: Final = 20_000.0
+"""Tracks whose mean positions lie further apart than this [m] are refused."""
 MIN_OBS_S: Final = 20.0
 """A grid time needs at least this many seconds of observations in its window."""
 MAX_SD_DEG: Final = 15.0
@@ -666,8 +677,26 @@ def _upwind_end(p: _Points, cands: tuple[float, float]) -> tuple[float, str]:
                       f"downwind {speeds[1 - k] / KNOT:.1f} kn")
 
 
+def _check_same_place(trs: Sequence[Track], frame: LocalFrame, t0: float, t1: float) -> None:
+    """Refuse tracks whose mean positions over the span lie more than ``MAX_APART_M``
+    apart (boats of different races: one wind does not fit both)."""
+    centres = []
+    for i, tr in enumerate(trs):
+        part = tr.between(t0, t1)
+        if len(part):
+            x, y = track_xy(part, frame)
+            centres.append((tr.name or f"track {i + 1}", float(np.mean(x)), float(np.mean(y))))
+    for (na, xa, ya), (nb, xb, yb) in itertools.combinations(centres, 2):
+        d = float(np.hypot(xb - xa, yb - ya))
+        if d > MAX_APART_M:
+            raise InputError(
+                f"infer_wind: {na!r} and {nb!r} sailed {d / 1000:.1f} km apart in the time "
+                f"span (more than {MAX_APART_M / 1000:.0f} km): one wind does not fit boats of "
+                "different places; infer each race on its own tracks")
+
+
 def _check_inputs(tracks: Sequence[Track] | Track, step_s: float, window_s: float,
-                  prior: float | None) -> list[Track]:
+                  prior: float | None, min_speed_ms: float) -> list[Track]:
     trs = [tracks] if isinstance(tracks, Track) else list(tracks)
     if not trs:
         raise InputError("infer_wind: no tracks given; pass one or more Track objects")
@@ -675,9 +704,10 @@ def _check_inputs(tracks: Sequence[Track] | Track, step_s: float, window_s: floa
         if not isinstance(tr, Track):
             raise InputError(f"infer_wind: item {i} is a {type(tr).__name__}, not a Track; "
                              "read tracks with sailroute.track.read_track")
-    for name, v in (("step_s", step_s), ("window_s", window_s)):
+    for name, v, unit in (("step_s", step_s, "s"), ("window_s", window_s, "s"),
+                          ("min_speed_ms", min_speed_ms, "m/s")):
         if not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
-            raise InputError(f"infer_wind: {name} must be a number > 0 s, got {v!r}")
+            raise InputError(f"infer_wind: {name} must be a number > 0 {unit}, got {v!r}")
     if prior is not None and not np.isfinite(prior):
         raise InputError(f"infer_wind: prior_twd_deg must be a finite direction, got {prior!r}")
     return trs
@@ -706,12 +736,15 @@ def infer_wind(
     prior_twd_deg : float, optional
         A rough TWD [°, from] (the course axis, the sailor's estimate; within ~60°) that
         decides which end of the inferred axis the wind comes from.  Without it the
-        upwind end is the one whose boards are sailed slower.
+        upwind end is the one about which the boards lie further apart (or, where that
+        is not clear, are sailed slower); ``notes`` says which decided.
     boat : BoatModel, optional
         The boats' polar: gives TWS(t) (the wind in which it sails the observed speeds)
-        and the prior tacking half-angle.  Without it TWS stays NaN.
+        and the prior half-angles (its best-VMG angles at a TWS guessed from the median
+        speed).  Without it TWS stays NaN.
     t0, t1 : float, optional
-        Time span [epoch s] of the grid; default the tracks' span.
+        Time span [epoch s] of the grid; default the tracks' span (at most
+        ``MAX_SPAN_S``).
     step_s : float
         Grid step [s].
     window_s : float
@@ -726,10 +759,11 @@ def infer_wind(
     Raises
     ------
     InputError
-        No tracks, bad parameters, an empty time span, or too few steady points on
-        upwind or downwind boards to infer a direction (the message says how many).
+        No tracks, bad parameters, an empty or too long time span, tracks sailed more
+        than ``MAX_APART_M`` apart, or too few steady points on upwind or downwind boards
+        to infer a direction (the message says how many).
     """
-    trs = _check_inputs(tracks, step_s, window_s, prior_twd_deg)
+    trs = _check_inputs(tracks, step_s, window_s, prior_twd_deg, min_speed_ms)
     ta = min(float(tr.t_s[0]) for tr in trs if len(tr)) if any(len(tr) for tr in trs) else 0.0
     tb = max(float(tr.t_s[-1]) for tr in trs if len(tr)) if any(len(tr) for tr in trs) else 0.0
     t0 = ta if t0 is None else float(t0)
@@ -737,6 +771,12 @@ def infer_wind(
     if not t1 > t0:
         raise InputError(f"infer_wind: empty time span {iso(t0)} .. {iso(t1)}; "
                          "give t0 < t1 within the tracks' times")
+    if t1 - t0 > MAX_SPAN_S:
+        raise InputError(
+            f"infer_wind: the time span {iso(t0)} .. {iso(t1)} is {(t1 - t0) / 3600:.1f} h, "
+            f"more than {MAX_SPAN_S / 3600:.0f} h (tracks of different days?); infer one race "
+            "at a time: give t0 and t1, or the tracks of one race")
+    _check_same_place(trs, frame, t0, t1)
     names = [tr.name or f"track {i + 1}" for i, tr in enumerate(trs)]
     p, notes = _steady_points(trs, frame, t0, t1, min_speed_ms)
     if p.t.size < 60:

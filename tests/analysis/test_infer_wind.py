@@ -272,6 +272,12 @@ def test_bad_input_is_refused(routes) -> None:
         infer_wind(tr, FRAME, t0=T0 + 100.0, t1=T0 + 100.0)
     with pytest.raises(InputError, match=r"only \d+ steady points"):
         infer_wind(tr, FRAME, t0=T0, t1=T0 + 40.0)
+    with pytest.raises(InputError, match=r"is 30\.0 h, more than 6 h \(tracks of different days"):
+        infer_wind(tr, FRAME, t0=T0, t1=T0 + 30 * 3600.0)
+    far = as_track(tuple(np.asarray(a) + (0.0, 3e4, 0.0)[i] for i, a in enumerate(
+        routes["shift"][1])), "far boat")
+    with pytest.raises(InputError, match=r"'boat 1' and 'far boat' sailed 30\.\d km apart"):
+        infer_wind([tr[0], far], FRAME)
 
 
 # ------------------------------------------------------------------ real tracks
