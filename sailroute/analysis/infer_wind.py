@@ -51,8 +51,9 @@ is seen only through the course changes on that board.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any, Final
 
 import numpy as np
@@ -168,7 +169,7 @@ class InferredWind:
         One line: what was used (boats, points, evidence, how up/down was decided).
     notes : tuple of str
         Per-boat half-angles, the up/down decision, checks and warnings.
-    half_angles_deg : dict of str to (float, float)
+    half_angles_deg : mapping of str to (float, float)
         Per boat: fitted tacking half-angle α and gybing half-angle 180° − γ [°].
     """
 
@@ -180,7 +181,19 @@ class InferredWind:
     n_obs: NDArray[np.int64]
     method: str
     notes: tuple[str, ...] = ()
-    half_angles_deg: dict[str, tuple[float, float]] = field(default_factory=dict)
+    half_angles_deg: Mapping[str, tuple[float, float]] = field(
+        default_factory=lambda: MappingProxyType({}))
+
+    def __post_init__(self) -> None:
+        n = np.shape(self.t)
+        bad = [k for k in ("twd_deg", "twd_sd_deg", "tws_ms", "tws_sd_ms", "n_obs")
+               if np.shape(getattr(self, k)) != n]
+        if len(n) != 1 or bad:
+            raise InputError(f"InferredWind: {', '.join(bad) or 't'} must be 1-D arrays of the "
+                             f"length of t ({n}); build it with infer_wind")
+        if not isinstance(self.half_angles_deg, MappingProxyType):
+            object.__setattr__(self, "half_angles_deg",
+                               MappingProxyType(dict(self.half_angles_deg)))
 
     def field(self, frame: LocalFrame | None = None, tws_ms: float | None = None,
               *, clamp: bool = False) -> InferredWindField:
@@ -854,8 +867,12 @@ def infer_wind(
             good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
             tws = np.where(good, np.maximum(e2, 0.0), np.nan)
             tws_sd = np.where(good, np.sqrt(v2 * CORR_S), np.nan)
+            s_med = float(np.nanmedian(tws)) if np.isfinite(tws).any() else float("nan")
+            up_pol = boat.vmg_angles_deg(s_med)[0] if np.isfinite(s_med) else float("nan")
             notes.append(f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which "
-                         "it sails the observed speeds")
+                         f"it sails the observed speeds (median {s_med / KNOT:.1f} kn); check: "
+                         f"its best-VMG upwind angle there is {up_pol:.1f}°, the boats' "
+                         "tacking half-angles " + ", ".join(f"{a:.1f}°" for a in fit.alpha))
         else:
             notes.append("TWS not inferred: too few points within the polar's speed range")
     half = {names[k]: (float(fit.alpha[k]), float(180.0 - fit.gamma[k])) for k in range(K)}

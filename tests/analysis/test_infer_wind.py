@@ -340,3 +340,9 @@ def test_j24_wind_is_the_course_axis_not_the_bridge_station() -> None:
     assert 44.0 < alpha < 56.0  # over the ground: tacking angle plus leeway
     assert 145.0 < gybe < 172.0  # boards off dead downwind: not a run (held at 180°)
     np.testing.assert_allclose(infer_wind(tr, frame, t0=t0, t1=t1).twd_deg, iw.twd_deg)
+
+
+def test_inferred_wind_refuses_arrays_of_other_lengths() -> None:
+    t = T0 + 30.0 * np.arange(4)
+    with pytest.raises(InputError, match="twd_sd_deg, n_obs must be 1-D arrays of the length"):
+        InferredWind(t, np.zeros(4), np.zeros(3), np.zeros(4), np.zeros(4), np.zeros(5), "x")
