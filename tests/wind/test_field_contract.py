@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from conftest import T0
 
+from sailroute.analysis.infer_wind import InferredWind
 from sailroute.errors import OutOfCoverageError
 from sailroute.geo import LocalFrame
 from sailroute.units import wind_components
@@ -74,6 +75,12 @@ def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
         return UniformWind(TWS, TWD, clamp=clamp)
     if kind == "uniform-table":
         return UniformWind([TWS, TWS], [TWD, TWD], times=[T0, T0 + 1800.0], clamp=clamp)
+    if kind == "inferred":  # wind inferred from tracks, 30 s grid over 30 min
+        t = T0 + 30.0 * np.arange(61)
+        n = t.size
+        return InferredWind(t, np.full(n, TWD), np.full(n, 1.0), np.full(n, np.nan),
+                            np.full(n, np.nan), np.full(n, 50), "contract").field(
+                                frame, tws_ms=TWS, clamp=clamp)
     if kind == "analytic":
         cover = Coverage(T0, T0 + 1800.0, -2000.0, 2000.0, -1500.0, 1500.0)
         return AnalyticWind(lambda t, x, y: (U0, V0), cover, clamp=clamp)
@@ -137,12 +144,12 @@ def cf_constant(tiny_wrf, frame: LocalFrame):
     return path
 
 
-KINDS = ["uniform", "uniform-table", "analytic", "wrf-linear", "wrf-nearest",
+KINDS = ["uniform", "uniform-table", "inferred", "analytic", "wrf-linear", "wrf-nearest",
          "wrf-frozen-10min", "wrf-2.68m", "netcdf-cf", "stations-idw", "stations-rbf",
          "blended", "boat-measured", "fleet-measured"]
 # Exact for the analytic sources; float32 storage in WRF files limits those to ~1e-6 m/s.
-TOL = {"uniform": 1e-12, "uniform-table": 1e-12, "analytic": 1e-12, "stations-idw": 1e-12,
-       "stations-rbf": 1e-9, "boat-measured": 1e-12,
+TOL = {"uniform": 1e-12, "uniform-table": 1e-12, "inferred": 1e-12, "analytic": 1e-12,
+       "stations-idw": 1e-12, "stations-rbf": 1e-9, "boat-measured": 1e-12,
        "fleet-measured": 1e-12}
 
 
