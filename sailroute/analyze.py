@@ -52,7 +52,7 @@ from sailroute.timeutil import iso
 from sailroute.track.kinematics import track_xy, velocity
 from sailroute.track.model import Track
 from sailroute.track.read import read_track
-from sailroute.units import bearing_deg, signed_twa, wind_speed_direction
+from sailroute.units import KNOT, bearing_deg, signed_twa, wind_speed_direction
 from sailroute.wind.base import WindField
 
 NEAR_COURSE_M = 3000.0
@@ -534,7 +534,16 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
             fw = fleet_wind(list(series.values()), frame)
             fleet = WindSource("fleet", fw.field,
                                f"measured by the fleet ({len(series)} boats, biases removed)")
-            notes.extend(fw.describe())
+            notes.extend(fw.notes)
+            t0, t1 = course.start_epoch, course.start_epoch + course.time_limit_s
+            parts = []
+            for tr in tracks:
+                m = (tr.t_s >= t0) & (tr.t_s <= t1)
+                x, y = track_xy(tr, frame)
+                parts.append((tr.t_s[m], x[m], y[m]))
+            notes.append(fw.extrapolation_note(*(np.concatenate(c) for c in zip(*parts,
+                                                                               strict=True)),
+                                               "the tracks in the race window"))
     inferred: WindSource | None = None
     if choice == "inferred" or (choice == "auto" and len(series) < len(tracks)):
         from sailroute.analysis.infer_wind import infer_wind, summary
@@ -545,16 +554,16 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
         cy = float(np.mean([m.y for m in course.marks.values()]))
         tws0, twd0 = _wind_at(wind, np.array([gun]), np.array([cx]), np.array([cy]))
         try:
-            inf = infer_wind([tr.between(gun - 300.0, gun + course.time_limit_s)
-                              for tr in tracks], frame, prior_twd_deg=float(twd0[0]),
-                             boat=boat)
+            inf = infer_wind(list(tracks), frame, prior_twd_deg=float(twd0[0]), boat=boat,
+                             t0=gun - 300.0, t1=gun + course.time_limit_s)
         except InputError as exc:
             if choice == "inferred":
                 raise
             notes.append(f"wind not inferred from the tracks: {exc}")
         else:
-            field = SpeedDirectionWind(wind, inf.field(frame, tws_ms=float(tws0[0])),
-                                       "inferred wind")
+            # held at its ends: an optimal route may run past the last tack of the fleet
+            field = SpeedDirectionWind(wind, inf.field(frame, tws_ms=float(tws0[0]),
+                                                       clamp=True), "inferred wind")
             sm = summary(inf)
             inferred = WindSource("inferred", field,
                                   f"TWD inferred from {len(tracks)} track(s), TWS of "
@@ -569,8 +578,14 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
 
 def _summary_text(sm: Mapping[str, Any]) -> str:
     """``infer_wind``'s summary as one line."""
-    return ", ".join(f"{k} {v:.1f}" if isinstance(v, float) else f"{k} {v}"
-                     for k, v in sm.items())
+    if sm.get("twd_mean_deg") is None:
+        return "no direction"
+    text = (f"TWD {sm['twd_mean_deg']:.0f}° (range {sm['twd_range_deg']:.0f}°, shifts RMS "
+            f"{sm['twd_shift_rms_deg']:.1f}°, median sd {sm['twd_sd_median_deg']:.1f}°)")
+    if sm.get("tws_mean_ms") is not None:
+        text += (f"; TWS from the polar {sm['tws_mean_ms'] / KNOT:.1f} kn (not used: the "
+                 "scenario's speed is)")
+    return text + f", {sm['t_start']} .. {sm['t_end']}"
 
 
 def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:

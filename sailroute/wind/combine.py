@@ -38,11 +38,14 @@ class SpeedDirectionWind:
 
     @property
     def coverage(self) -> Coverage:
-        """The intersection of the two coverages (frame of the speed field)."""
-        a, b = self.speed_from.coverage, self.direction_from.coverage
-        return Coverage(max(a.t0, b.t0), min(a.t1, b.t1), max(a.xmin, b.xmin),
-                        min(a.xmax, b.xmax), max(a.ymin, b.ymin), min(a.ymax, b.ymax),
-                        frame=a.frame or b.frame)
+        """The intersection of the coverages of the parts that do not clamp."""
+        parts = [f.coverage for f in (self.speed_from, self.direction_from)
+                 if not getattr(f, "clamp", False)] or [self.speed_from.coverage]
+        return Coverage(max(c.t0 for c in parts), min(c.t1 for c in parts),
+                        max(c.xmin for c in parts), min(c.xmax for c in parts),
+                        max(c.ymin for c in parts), min(c.ymax for c in parts),
+                        frame=self.speed_from.coverage.frame
+                        or self.direction_from.coverage.frame)
 
     @property
     def clamp(self) -> bool:
