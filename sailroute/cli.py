@@ -653,10 +653,11 @@ def analyze_command(
                      help="Output folder (default: out/<course>/analysis-<track>)."),
     ] = None,
     leg_times: Annotated[
-        str | None,
-        typer.Option("--leg-times", metavar="T0,T1,...", help="Override detection: n_legs+1 "
-                     "comma-separated ISO times with offset (start crossing, each leg's end); "
-                     "'-' = detect."),
+        list[str] | None,
+        typer.Option("--leg-times", metavar="[BOAT=]T0,T1,...", help="Override detection: "
+                     "n_legs+1 comma-separated ISO times with offset (start crossing, each "
+                     "leg's end); '-' = detect. Several tracks: BOAT=T0,... per boat (BOAT = "
+                     "track file name without extension; repeat)."),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
     time_zone: Annotated[

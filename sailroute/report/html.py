@@ -389,8 +389,10 @@ def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
                     float(np.interp(m.t, p.t, p.y))))
     sailed = _route(f"sailed: {a.track.name}", course, sailed_parts, modes, man,
                     speed_name="SOG")
-    opt_parts = [_leg_columns(course, leg.index, leg.optimal, leg.mode) for leg in a.legs]
-    opt_man = [(m.kind, m.t, m.x, m.y) for leg in a.legs for m in leg.optimal.manoeuvres]
+    opt_parts = [_leg_columns(course, leg.index, leg.optimal, leg.mode) for leg in a.legs
+                 if leg.optimal is not None]
+    opt_man = [(m.kind, m.t, m.x, m.y) for leg in a.legs if leg.optimal is not None
+               for m in leg.optimal.manoeuvres]
     optimal = _route("optimal from the boat's leg starts", course, opt_parts, modes,
                      opt_man, gaps=True, dash="dash", boat=False)
     return sailed, optimal
@@ -605,6 +607,12 @@ def analysis_report(a: TrackAnalysis) -> Report:
     layers = _layers({a.scenario: a.wind}, course, [sailed, optimal], times)
     rows = []
     for leg in a.legs:
+        if not leg.known:
+            rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
+                         clock(leg.t_start, off) if np.isfinite(leg.t_start) else "unknown",
+                         "unknown", format_duration(leg.optimal_time_s), "-", "-", "-", "-",
+                         "-", "-", leg.note))
+            continue
         rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
                      clock(leg.t_start, off), format_duration(leg.sailed_time_s),
                      format_duration(leg.optimal_time_s), f"{leg.loss_s:+.1f}",
@@ -613,9 +621,10 @@ def analysis_report(a: TrackAnalysis) -> Report:
                      f"{leg.sailed_tacks}/{leg.sailed_gybes} : "
                      f"{leg.optimal_tacks}/{leg.optimal_gybes}",
                      f"{leg.mean_polar_pct:.0f}", f"{leg.side_sailed} / {leg.side_optimal}"))
-    tot = [sum(getattr(leg.split, k) for leg in a.legs) for k in ("manoeuvres", "speed",
-                                                                   "route")]
-    footer = (("", "total", "", "", format_duration(a.sailed_time_s),
+    tot = [sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed",
+                                                                         "route")]
+    footer = (("", "total" if a.complete else f"{len(a.known_legs)} legs of known time", "",
+               "", format_duration(a.sailed_time_s),
                format_duration(a.optimal_time_s), f"{a.loss_s:+.1f}",
                *(f"{v:+.1f}" for v in tot), "", "", ""),)
     table = Table("Legs: sailed against optimal from the same point and time",
@@ -629,7 +638,7 @@ def analysis_report(a: TrackAnalysis) -> Report:
                f"{format_duration(a.optimal_time_s)}, lost {a.loss_s:+.1f} s")
     return Report(f"{course.name} — {a.track.name}", summary, course, (sailed, optimal),
                   tuple(layers), times, (table,),
-                  (HELP, _times_note(course), _wind_note(layers)))
+                  (HELP, *a.notes, _times_note(course), _wind_note(layers)))
 
 
 # ---------------------------------------------------------------------------------------------
