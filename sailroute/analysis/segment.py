@@ -68,6 +68,10 @@ OCS_RETURN_S = 180.0
 within this time after the gun [s] has returned to start; otherwise it is reported over
 early (``StartReport.ocs_s``) and its race is timed from the gun."""
 
+OCS_MIN_S = 1.0
+"""A crossing this close before the gun [s] is a start on time (``late_s`` in
+``[-OCS_MIN_S, 0]``), not over early: the gun and the fixes are known to about a second."""
+
 GAP_MIN_S = 10.0
 """Shortest interval between fixes that is a data gap [s] (with :data:`GAP_FACTOR`)."""
 
@@ -224,8 +228,8 @@ def _crossings(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_after
         if t1 - t0 > gap_s:
             if t1 > t_after and t0 < t_before:
                 out.append(Crossing(math.nan, cx, cy, gap=(t0, t1), note=(
-                    f"{geom.name!r} crossed inside a data gap of {t1 - t0:.0f} s ({iso(t0)} .. {iso(t1)}, "
-                    f"longer than {gap_s:.0f} s): time unknown")))
+                    f"{geom.name!r} crossed inside a data gap of {t1 - t0:.0f} s "
+                    f"({iso(t0)} .. {iso(t1)}, longer than {gap_s:.0f} s): time unknown")))
             continue
         tc = t0 + float(s[k]) * (t1 - t0)
         if t_after <= tc <= t_before:
@@ -377,7 +381,7 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
       gun (the segment extended by ``line_margin_m``; else its extension, up to
       :data:`START_EXTENSION_M` beyond each end, reported in ``line_offset_m``).
     * On the course side at the gun (over early): the last crossing before the gun gives
-      ``ocs_s``.  If the boat comes back to the pre-start side within
+      ``ocs_s`` (within :data:`OCS_MIN_S` of the gun: a start on time).  If the boat comes back to the pre-start side within
       :data:`OCS_RETURN_S`, its next crossing is the start; if not, the boat is reported
       over early and the race is timed from the gun (its position at the gun).
     * ``given``: that time, nothing detected.
@@ -409,8 +413,10 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
             raise InputError(f"{where}: the track ends at {iso(t[-1])}, before the start "
                              f"signal {iso(gun)}; is it the right track and day?")
         after = gun
-        if over:
-            early = [c for c in _crossings(t, x, y, wide, t[0], gap_s, gun) if c.known]
+        early = [c for c in _crossings(t, x, y, wide, t[0], gap_s, gun) if c.known] \
+            if over else []
+        on_time = bool(early) and gun - early[-1].t <= OCS_MIN_S
+        if over and not on_time:
             back = [c for c in _crossings(t, x, y, _reversed(wide), gun, gap_s,
                                           gun + OCS_RETURN_S) if c.known]
             if early:
@@ -419,10 +425,12 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
                 returned = True
                 after = back[0].t
                 notes.append(
-                    (f"over early: crossed the line {ocs:.0f} s before the gun, " if ocs
-                     else "over the line at the gun, ")
+                    (f"over early: crossed the line {ocs:.0f} s before the gun, "
+                     if ocs is not None else "over the line at the gun, ")
                     + f"came back at {iso(after)} and restarted")
-        if over and not returned:
+        if on_time:
+            start = early[-1]
+        elif over and not returned:
             start = Crossing(gun, gx, gy)
             notes.append(
                 (f"OCS by {ocs:.0f} s: crossed the start line {ocs:.0f} s before the gun "
@@ -441,7 +449,7 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
                     "(--leg-times)")
             start = found[0]
     f_line, off = _segment_offset(line, start.x, start.y)
-    if not start.detected or (over and not returned) or off <= line_margin_m:
+    if not start.detected or ocs is not None and not returned or off <= line_margin_m:
         off = 0.0
     else:
         if isinstance(feat0, Mark):
@@ -457,15 +465,17 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
 def _stop_near(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_from: float,
                gap_s: float, reach_m: float) -> Crossing | None:
     """The first data gap after ``t_from`` whose last fix lies within ``reach_m`` of the
-    target segment, short of it: the target is reached inside the gap (time unknown)."""
+    target segment (a line or gate: on the near side of it; a mark: its rounding ray): the
+    target is reached inside the gap, at an unknown time."""
     k0 = int(np.searchsorted(t, t_from, side="right"))
     if k0 >= t.size - 1:
         return None
     idx = k0 + np.flatnonzero(np.diff(t[k0:]) > gap_s)
     for k in idx:
         px, py = float(x[k]), float(y[k])
-        if _side(geom, px, py) <= 0 and _segment_offset(geom, px, py)[1] <= reach_m:
-            d = _segment_offset(geom, px, py)[1]
+        d = _segment_offset(geom, px, py)[1]
+        short = geom.kind == "mark" or _side(geom, px, py) <= 0
+        if short and d <= reach_m:
             t0, t1 = float(t[k]), float(t[k + 1])
             return Crossing(math.nan, px, py, gap=(t0, t1), note=(
                 f"the data stop {d:.0f} m short of {geom.name!r} at {iso(t0)} (a gap of "
