@@ -381,9 +381,10 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
       gun (the segment extended by ``line_margin_m``; else its extension, up to
       :data:`START_EXTENSION_M` beyond each end, reported in ``line_offset_m``).
     * On the course side at the gun (over early): the last crossing before the gun gives
-      ``ocs_s`` (within :data:`OCS_MIN_S` of the gun: a start on time).  If the boat comes back to the pre-start side within
-      :data:`OCS_RETURN_S`, its next crossing is the start; if not, the boat is reported
-      over early and the race is timed from the gun (its position at the gun).
+      ``ocs_s`` (within :data:`OCS_MIN_S` of the gun: a start on time).  If the boat
+      comes back to the pre-start side within :data:`OCS_RETURN_S`, its next crossing is
+      the start; if not, the boat is reported over early and the race is timed from the
+      gun (its position at the gun).
     * ``given``: that time, nothing detected.
 
     Raises
@@ -403,7 +404,7 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
             TargetGeometry(feat0.a.xy, feat0.b.xy, sg.normal, "line", sg.name))
     notes: list[str] = []
     ocs: float | None = None
-    returned = False
+    returned = on_time = False
     if given is not None:
         sx, sy = _point_at(t, x, y, given)
         start = Crossing(given, sx, sy, detected=False)
@@ -449,7 +450,8 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
                     "(--leg-times)")
             start = found[0]
     f_line, off = _segment_offset(line, start.x, start.y)
-    if not start.detected or ocs is not None and not returned or off <= line_margin_m:
+    from_gun = over and not on_time and not returned
+    if not start.detected or from_gun or off <= line_margin_m:
         off = 0.0
     else:
         if isinstance(feat0, Mark):

@@ -693,10 +693,7 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
     from sailroute.report.analysis import speed_at_gun_kn
 
     course, off = analyses[0].course, analyses[0].course.utc_offset_s
-    sailed = []
-    for a in analyses:
-        r = routes_from_analysis(a)[0]
-        sailed.append(replace(r, name=a.track.name))
+    sailed = [replace(routes_from_analysis(a)[0], name=a.track.name) for a in analyses]
     lead = _leader(analyses)
     opt = replace(routes_from_analysis(analyses[lead])[1],
                   name=f"optimal from {analyses[lead].track.name}'s leg starts")
@@ -706,17 +703,17 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
     names = [a.track.name for a in analyses]
     by = {(r["leg"], r["boat"]): r for r in rows}
     rank_rows = []
-    for i, leg in enumerate(course.legs):
+    for i, spec in enumerate(course.legs):
         cells = []
         for b in names:
-            r = by.get((i + 1, b))
-            if r is None or r["leg_rank"] is None:
+            row = by.get((i + 1, b))
+            if row is None or row["leg_rank"] is None:
                 cells.append("unknown")
             else:
-                pos = f", pos {r['position']}" if r["position"] is not None else ""
-                cells.append(f"{format_duration(r['leg_time_s'])} ({r['leg_rank']}{pos}) "
-                             f"{_signed(r['loss_s'])} s")
-        rank_rows.append((str(i + 1), leg.label.replace("->", "→"), *cells))
+                pos = f", pos {row['position']}" if row["position"] is not None else ""
+                cells.append(f"{format_duration(row['leg_time_s'])} ({row['leg_rank']}{pos}) "
+                             f"{_signed(row['loss_s'])} s")
+        rank_rows.append((str(i + 1), spec.label.replace("->", "→"), *cells))
     ranking = Table("Leg ranking: leg time (rank, position at the leg's end) and time lost "
                     "against the optimal leg", ("leg", "from → to", *names),
                     tuple(rank_rows))
