@@ -254,8 +254,10 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
     text_buf: list[str] = []
     state = {"root": False, "pt": False, "has_time": False}
 
+    local: dict[str, str] = {}
+
     def start(name: str, attrs: dict[str, str]) -> None:
-        tag = _local(name)
+        tag = local.get(name) or local.setdefault(name, _local(name))
         if not state["root"]:
             state["root"] = True
             if tag != "gpx":
