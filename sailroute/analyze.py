@@ -297,6 +297,7 @@ def analyze_track(
     built: tuple[Any, WindField] | None = None,
     progress: Progress | None = None,
     missing: str = "error",
+    gate_end: str = "line",
 ) -> TrackAnalysis:
     """Analyse a sailed track against the optimal route of each leg.
 
@@ -322,6 +323,10 @@ def analyze_track(
     missing : {"error", "unknown"}
         A leg end never found: an error (one boat), or that leg and the later ones
         unknown with a note (a fleet; :func:`sailroute.analysis.segment.segment_track`).
+    gate_end : {"line", "rounding"}
+        A gate leg ends passing between the marks, or having rounded the chosen mark
+        (:func:`sailroute.analysis.segment.gate_rounding`; the optimal leg still ends at
+        the gate line, so the leg's loss then includes that turn).
 
     Returns
     -------
@@ -349,7 +354,7 @@ def analyze_track(
     check_same_race(course, track, x, y)
     t = track.t_s
     seg = segment_track(course, t, x, y, leg_times=leg_times, detect_m=detect_m, where=where,
-                        missing=missing)
+                        missing=missing, gate_end=gate_end)
     svx, svy = _smoothed_velocity(t, x, y)
     bounds = seg.bounds
     t_a = bounds[0].t
@@ -638,6 +643,7 @@ def run_analyze_command(
     detect_m: float = DETECT_M,
     plots: bool = True,
     progress: Progress | None = None,
+    gate_end: str = "line",
 ) -> AnalyzeResult:
     """Everything ``sailroute analyze`` does, minus printing.
 
@@ -681,7 +687,8 @@ def run_analyze_command(
         analyses.append(analyze_track(course, tr, name, leg_times=times[tr.name],
                                       router=router, detect_m=detect_m,
                                       built=(boat, winds[name]), progress=progress,
-                                      missing="error" if len(read) == 1 else "unknown"))
+                                      missing="error" if len(read) == 1 else "unknown",
+                                      gate_end=gate_end))
     if len(analyses) == 1:
         files = write_output_set(out, lambda d: write_analysis(d, analyses[0], plots=plots))
         return AnalyzeResult(analysis_table(analyses[0]), files, tuple(analyses))

@@ -674,6 +674,12 @@ def analyze_command(
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Skip legs.png, loss.png and report.html.")
     ] = False,
+    gate_end: Annotated[
+        Literal["line", "rounding"],
+        typer.Option("--gate-end", case_sensitive=False,
+                     help="A gate leg ends passing between the marks (line) or having "
+                          "rounded the chosen mark (rounding, as official leg counters)."),
+    ] = "line",
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -696,7 +702,8 @@ def analyze_command(
             return run_analyze_command(
                 loaded, tracks, scenario=scenario, router=router, out_dir=out,
                 leg_times=leg_times, columns=columns or None, speed_unit=speed_unit,
-                time_zone=time_zone, plots=not no_plots, progress=progress)
+                time_zone=time_zone, plots=not no_plots, progress=progress,
+                gate_end=gate_end)
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("analysis_json", "fleet_json"))
 

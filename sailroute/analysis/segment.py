@@ -72,6 +72,11 @@ OCS_MIN_S = 1.0
 """A crossing this close before the gun [s] is a start on time (``late_s`` in
 ``[-OCS_MIN_S, 0]``), not over early: the gun and the fixes are known to about a second."""
 
+GATE_ROUNDING_S = 30.0
+"""With ``gate_end="rounding"``: the gate mark rounded is the one the boat comes closest to
+within this time after passing between the marks, and its rounding is searched in that
+time [s]."""
+
 GAP_MIN_S = 10.0
 """Shortest interval between fixes that is a data gap [s] (with :data:`GAP_FACTOR`)."""
 
@@ -288,8 +293,12 @@ def detection_geometry(course: Course, i: int, from_xy: tuple[float, float],
                            zone_m=detect_m)
     if target.kind != "mark":
         return _extended(geom, line_margin_m)
-    # the ray starts MARK_TOLERANCE_M behind the mark: marks noted from a track lie on
-    # the boat's own turning point, and buoys are placed to some metres
+    return _behind_mark(geom)
+
+
+def _behind_mark(geom: TargetGeometry) -> TargetGeometry:
+    """A mark's rounding ray started :data:`MARK_TOLERANCE_M` behind the mark: marks noted
+    from a track lie on the boat's own turning point, and buoys are placed to some metres."""
     ex, ey = geom.b[0] - geom.a[0], geom.b[1] - geom.a[1]
     n = math.hypot(ex, ey)
     a = (geom.a[0] - MARK_TOLERANCE_M * ex / n, geom.a[1] - MARK_TOLERANCE_M * ey / n)
@@ -485,6 +494,45 @@ def _stop_near(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_from:
     return None
 
 
+def gate_rounding(course: Course, i: int, passed: Crossing, from_xy: tuple[float, float],
+                  t: NDArray, x: NDArray, y: NDArray, *, gap_s: float = math.inf,
+                  detect_m: float = DETECT_M) -> Crossing | None:
+    """When the boat, having passed between the marks of leg ``i``'s gate, went round one.
+
+    The mark is the one it comes closest to within :data:`GATE_ROUNDING_S` of ``passed``;
+    it is left to port when it lies left of the boat's crossing direction, and its rounding
+    is the crossing of its rounding ray (as for a mark leg, towards the next leg's
+    target).  Official leg counters (SailGP's ``TRK_LEG_NUM``) change there.
+
+    Returns
+    -------
+    Crossing or None
+        None when the gate was passed at an unknown time or no rounding is found in the
+        window (the gate line crossing then stands).
+    """
+    if not passed.known:
+        return None
+    w = (t >= passed.t) & (t <= passed.t + GATE_ROUNDING_S)
+    if not w.any():
+        return None
+    gate = course.feature(course.legs[i].to_name)
+    if isinstance(gate, Mark):
+        return None
+    ends = (gate.a, gate.b)
+    d = [float(np.min(np.hypot(x[w] - m.x, y[w] - m.y))) for m in ends]
+    mark = ends[int(np.argmin(d))]
+    line = detection_geometry(course, i, from_xy, detect_m)
+    nx, ny = line.normal  # the crossing direction
+    left = nx * (mark.y - passed.y) - ny * (mark.x - passed.x) > 0
+    exit_xy = leg_target(course, i + 1).centre if i + 1 < course.n_legs else None
+    target = Target("mark", mark.xy, None, "port" if left else "starboard", exit_xy=exit_xy,
+                    name=mark.name)
+    geom = _behind_mark(target_geometry(target, Start(from_xy, None), zone_m=detect_m))
+    found = [c for c in _crossings(t, x, y, geom, passed.t, gap_s,
+                                   passed.t + GATE_ROUNDING_S) if c.known]
+    return found[0] if found else None
+
+
 def _closest_m(geom: TargetGeometry, x: NDArray, y: NDArray) -> float:
     """Closest approach of the points to the segment ``geom`` [m] (NaN: no points)."""
     if x.size == 0:
@@ -505,6 +553,7 @@ def segment_track(
     line_margin_m: float = LINE_MARGIN_M,
     where: str = "track",
     missing: str = "error",
+    gate_end: str = "line",
 ) -> Segmentation:
     """Find the start and the end of every leg in a track.
 
@@ -528,6 +577,10 @@ def segment_track(
     missing : {"error", "unknown"}
         A leg end never found: raise (one boat), or mark it and every later leg end
         unknown with the reason as its note (a fleet).
+    gate_end : {"line", "rounding"}
+        A gate leg ends when the boat passes between the marks (the routers' target), or
+        when it has gone round the gate mark it chose (:func:`gate_rounding`; where
+        official leg counters change).
 
     Returns
     -------
@@ -545,6 +598,8 @@ def segment_track(
         increasing, or outside the track.
     """
     n = course.n_legs
+    if gate_end not in ("line", "rounding"):
+        raise InputError(f"gate end {gate_end!r}: expected 'line' or 'rounding'")
     given: list[float | None] = list(leg_times) if leg_times is not None else [None] * (n + 1)
     if len(given) != n + 1:
         raise InputError(
@@ -589,6 +644,9 @@ def segment_track(
                 lost = f"leg {i + 1} never ended: later legs unknown"
             else:
                 end = found[0]
+                if gate_end == "rounding" and course.legs[i].kind == "gate":
+                    end = gate_rounding(course, i, end, (prev.x, prev.y), t, x, y,
+                                        gap_s=gap_s, detect_m=detect_m) or end
                 if end.note:
                     end = Crossing(end.t, end.x, end.y, end.detected, end.gap,
                                    f"leg {i + 1} ({course.legs[i].label}): {end.note}")
