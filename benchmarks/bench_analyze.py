@@ -7,9 +7,10 @@ Garmin track of 33 min, ``data/snipe-valencia-2025-06-21-ESP30782-P01.gpx``) and
 what the command does: read the files, analyse, write every output (JSON, CSV, PNG and
 report.html) into a temporary folder.
 
-* **fleet**: three boats of 20 min at 1 Hz: the real track cut to the race (gun to
-  finish, about 20 min) and two copies of it, 4 s and 9 s behind and 3 m and 6 m to the
-  side, as three GPX files in one run;
+* **fleet**: three boats of 28 min at 1 Hz (the race is 25 min; the brief's 20 min would
+  end before the finish): the real track from a minute before the gun to its end, and two
+  copies of it, 4 s and 9 s behind and 3 m and 6 m to the side, as three GPX files in one
+  run;
 * **long log**: one GPX of ``--points`` fixes (default 300 000): the real track
   interpolated to 10 Hz, with whole copies of it before and after the race (hours at
   10 Hz, as a log left running all day), written as a GPX file first (not timed).
@@ -57,11 +58,11 @@ def write_gpx(path: Path, t: np.ndarray, lat: np.ndarray, lon: np.ndarray) -> Pa
 
 
 def fleet_files(d: Path) -> list[Path]:
-    """Three 20-minute 1 Hz GPX files of the race (the real track and two shifted copies)."""
+    """Three 1 Hz GPX files of the race (the real track and two shifted copies)."""
     course = load_course(COURSE)
     tr = read_track(TRACK)
     gun = course.start_epoch
-    m = (tr.t_s >= gun - 60.0) & (tr.t_s <= gun + 1200.0)
+    m = tr.t_s >= gun - 60.0
     t, lat, lon = tr.t_s[m], tr.lat_deg[m], tr.lon_deg[m]
     out = []
     for k, (lag, side) in enumerate(((0.0, 0.0), (4.0, 3.0), (9.0, 6.0))):
@@ -81,7 +82,7 @@ def long_log(d: Path, n: int) -> Path:
     span = tq[-1] - tq[0] + 0.1
     copies = max(int(np.ceil(n / tq.size)), 1)
     before = (copies - 1) // 2
-    ts = np.concatenate([tq + (k - before) * span for k in range(copies)])[: n + before * 0]
+    ts = np.concatenate([tq + (k - before) * span for k in range(copies)])
     la = np.tile(lat, copies)
     lo = np.tile(lon, copies)
     # keep the race copy whole: trim from both ends
@@ -123,8 +124,8 @@ def main() -> None:
             return run_analyze_command(COURSE, boats, out_dir=d / f"fleet{k[0]}")
 
         t = best_of(fleet, repeat)
-        print(f"fleet: {len(boats)} boats x {sizes[0]} fixes (1 Hz), read + analyse + write: "
-              f"{t:6.2f} s")
+        print(f"fleet: {len(boats)} boats x {sizes[0]} fixes (1 Hz, {sizes[0] / 60:.0f} min), "
+              f"read + analyse + write: {t:6.2f} s")
         log = long_log(d, n)
 
         def one() -> object:
@@ -134,7 +135,8 @@ def main() -> None:
         t = best_of(one, repeat)
         res = run_analyze_command(COURSE, [log], out_dir=d / "check", plots=False)
         a = res.analyses[0]
-        print(f"long log: {len(a.track)} fixes (10 Hz, {(a.track.t_end - a.track.t_start) / 3600:.1f} h, "
+        hours = (a.track.t_end - a.track.t_start) / 3600
+        print(f"long log: {len(a.track)} fixes (10 Hz, {hours:.1f} h, "
               f"{log.stat().st_size / 1e6:.0f} MB GPX), read + analyse + write: {t:6.2f} s "
               f"(race {a.sailed_time_s:.1f} s sailed, {len(a.legs)} legs)")
     print(f"load average after: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")

@@ -699,12 +699,7 @@ def run_analyze_command(
         for s, a in zip(stems, analyses, strict=True):
             for kind, p in write_analysis(d / s, a, plots=plots).items():
                 files[f"{s}/{kind}"] = p
-        files.update(write_fleet(d, analyses, rows))
-        if plots:
-            from sailroute.report.html import fleet_report, write_report
-
-            files["html"] = write_report(d / "report.html",
-                                         fleet_report(analyses, rows, fleet_notes(analyses)))
+        files.update(write_fleet(d, analyses, rows, plots=plots))
         return files
 
     report = "\n\n".join([*(analysis_table(a) for a in analyses),

@@ -171,6 +171,9 @@ class StartReport:
         the line's extension [m]; 0 when it crossed the line itself.
     notes : tuple of str
         One sentence per finding (over early, line's extension, given time).
+    speed_at_gun_ms : float
+        Speed over the ground at the gun [m s⁻¹] (the fixes 2 either side; NaN outside
+        the track or across a data gap).
     """
 
     gun_t: float
@@ -183,6 +186,7 @@ class StartReport:
     ocs_returned: bool = False
     line_offset_m: float = 0.0
     notes: tuple[str, ...] = ()
+    speed_at_gun_ms: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -470,7 +474,22 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
         notes.append(f"crossed the start line's extension {off:.0f} m beyond {end}, not the "
                      "surveyed line: is the line laid elsewhere?")
     return StartReport(gun, start, start.t - gun, dist, "course" if over else "pre-start",
-                       float(f_line), ocs, returned, float(off), tuple(notes))
+                       float(f_line), ocs, returned, float(off), tuple(notes),
+                       speed_at(t, x, y, gun, gap_s))
+
+
+def speed_at(t: NDArray, x: NDArray, y: NDArray, tq: float, gap_s: float = math.inf) -> float:
+    """Speed over the ground at ``tq`` [m s⁻¹]: distance sailed over the fixes 2 either side
+    divided by their time span (NaN outside the track or when they span more than
+    ``2 gap_s``)."""
+    k = int(np.searchsorted(t, tq))
+    if k <= 0 or k >= t.size:
+        return math.nan
+    lo, hi = max(k - 2, 0), min(k + 2, t.size - 1)
+    if t[hi] - t[lo] > 2.0 * gap_s:
+        return math.nan
+    dist = float(np.sum(np.hypot(np.diff(x[lo:hi + 1]), np.diff(y[lo:hi + 1]))))
+    return dist / float(t[hi] - t[lo])
 
 
 def _stop_near(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_from: float,

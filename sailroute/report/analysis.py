@@ -111,21 +111,8 @@ def start_to_dict(a: TrackAnalysis) -> dict[str, Any]:
 
 
 def speed_at_gun_kn(a: TrackAnalysis) -> float:
-    """Speed over the ground at the gun [kn], from the fixes either side (NaN outside the
-    track or across a data gap)."""
-    from sailroute.analysis.segment import gap_limit_s
-
-    t, gun = a.track.t_s, a.segmentation.start.gun_t
-    k = int(np.searchsorted(t, gun))
-    if k <= 0 or k >= t.size:
-        return math.nan
-    lo, hi = max(k - 2, 0), min(k + 2, t.size - 1)
-    if t[hi] - t[lo] > 2 * gap_limit_s(t):
-        return math.nan
-    x, y = a.course.frame.to_xy(a.track.lat_deg[lo:hi + 1], a.track.lon_deg[lo:hi + 1])
-    x, y = np.asarray(x, float), np.asarray(y, float)
-    dist = float(np.sum(np.hypot(np.diff(x), np.diff(y))))
-    return dist / (t[hi] - t[lo]) / KNOT
+    """Speed over the ground at the gun [kn] (NaN outside the track or across a data gap)."""
+    return a.segmentation.start.speed_at_gun_ms / KNOT
 
 
 def _iso(t: float) -> str | None:
@@ -209,8 +196,9 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
 
 
 def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
-                rows: Sequence[Mapping[str, Any]]) -> dict[str, Path]:
-    """Write ``fleet.csv`` (one row per leg and boat) and ``fleet.json``."""
+                rows: Sequence[Mapping[str, Any]], *, plots: bool = True) -> dict[str, Path]:
+    """Write ``fleet.csv`` (one row per leg and boat), ``fleet.json`` and (with ``plots``)
+    the fleet's ``report.html`` (:func:`sailroute.report.html.fleet_report`)."""
     out = Path(out_dir)
     cp = out / "fleet.csv"
     cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s",
@@ -229,7 +217,13 @@ def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
            "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()}
                     for r in rows]}
     jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-    return {"fleet_csv": cp, "fleet_json": jp}
+    files = {"fleet_csv": cp, "fleet_json": jp}
+    if plots:
+        from sailroute.report.html import fleet_report, write_report
+
+        files["html"] = write_report(out / "report.html",
+                                     fleet_report(analyses, rows, fleet_notes(analyses)))
+    return files
 
 
 def _mss(s: float) -> str:

@@ -690,8 +690,6 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
     side and speed at the gun, over early, line offset) and the loss split per boat and
     leg.  ``notes`` (fleet-wide) and each boat's own notes go under the map.
     """
-    from sailroute.report.analysis import speed_at_gun_kn
-
     course, off = analyses[0].course, analyses[0].course.utc_offset_s
     sailed = [replace(routes_from_analysis(a)[0], name=a.track.name) for a in analyses]
     lead = _leader(analyses)
@@ -723,7 +721,7 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
         start_rows.append((
             a.track.name, clock(st.crossing.t, off), f"{st.late_s:+.1f}",
             f"{st.distance_at_gun_m:.0f} ({st.side_at_gun})",
-            f"{speed_at_gun_kn(a):.1f}" if math.isfinite(speed_at_gun_kn(a)) else "-",
+            f"{st.speed_at_gun_ms / KNOT:.1f}" if math.isfinite(st.speed_at_gun_ms) else "-",
             (f"{st.ocs_s:.0f} s" + (", returned" if st.ocs_returned else "")
              if st.ocs_s is not None else ("returned" if st.ocs_returned else "no")),
             f"{st.line_offset_m:.0f}", "; ".join(st.notes)))
