@@ -166,7 +166,9 @@ def fleet_files(routed, tmp_path_factory: pytest.TempPathFactory) -> dict[str, P
                                _with_tail(_sailed(course, legs, turn_at_s=60.0))),
             "short": _write_csv(d / "short.csv", cut),
             "odd": _write_csv(d / "<b>odd.csv", tr, dt=4.0),
-            "day": _write_csv(d / "other-day.csv", tr, dt=86400.0)}
+            "day": _write_csv(d / "other-day.csv", tr, dt=86400.0),
+            "far": _write_csv(d / "far.csv", Track(tr.t_s, tr.lat_deg + 0.45, tr.lon_deg,
+                                                   "far", "far"))}
 
 
 def _run(*args: str):
@@ -197,18 +199,24 @@ def test_fleet_with_a_track_that_stops_early(fleet_files, tmp_path: Path) -> Non
     assert "Traceback" not in res.output and not out2.exists()
 
 
-def test_fleet_with_a_boat_from_another_day_is_refused(fleet_files, tmp_path: Path) -> None:
+def test_fleet_with_a_boat_from_another_day_or_place_is_refused(fleet_files,
+                                                                tmp_path: Path) -> None:
     f = fleet_files
     out = tmp_path / "out"
     res = _run(str(f["course"]), str(f["fast"]), str(f["day"]), "-o", str(out))
     assert res.exit_code == 2
     assert "other-day.csv: the track runs" in res.output and "another day" in res.output
     assert "Traceback" not in res.output and not out.exists()
+    res = _run(str(f["course"]), str(f["far"]), str(f["fast"]), "-o", str(out))
+    assert res.exit_code == 2
+    assert "far.csv: during the race the track never comes within 3 km" in res.output
+    assert "another place" in res.output
+    assert "Traceback" not in res.output and not out.exists()
 
 
 def test_per_boat_leg_times(fleet_files, routed, tmp_path: Path) -> None:
     f = fleet_files
-    course, legs = routed
+    course, _ = routed
     t0 = iso(course.start_epoch + 5.0)
     out = tmp_path / "out"
     res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), "-o", str(out),
@@ -267,3 +275,54 @@ def test_fleet_page_in_chromium(fleet_files, tmp_path: Path) -> None:
     assert 'data-map="drawn"' in html and 'id="sailroute-error"></div>' in html
     for entry in ("fast", "slow", "short", "optimal from fast's leg starts"):
         assert f">{entry}</text>" in html, entry
+
+
+GATE_COURSE = """\
+name: gate
+start_time: "2024-05-01T12:00:00Z"
+origin: {lat: 45.0, lon: 13.0}
+marks:
+  pin: {x: -60, y: 0}
+  boat: {x: 60, y: 0}
+  G1: {x: -50, y: 500}
+  G2: {x: 50, y: 500}
+lines:
+  start: [pin, boat]
+gates:
+  G: [G1, G2]
+legs:
+  - {to: G}
+  - {to: start}
+scenarios:
+  steady: {type: uniform, tws_kn: 10, twd_deg: 180}
+"""
+
+
+def test_a_gate_leg_ends_at_the_line_or_at_the_rounding(tmp_path: Path) -> None:
+    from sailroute.analysis.segment import segment_track
+    from sailroute.course.load import load_course
+
+    p = tmp_path / "gate.yaml"
+    p.write_text(GATE_COURSE, encoding="utf-8")
+    course = load_course(p)
+    # 5 m/s north at x = -20 through the gate (y = 500 at t = 120 s), round G1 (x = -50)
+    # to port on a 30 m circle, then south-east back through the line
+    gun = course.start_epoch
+    t1 = np.arange(0.0, 120.0)
+    x1, y1 = np.full(t1.size, -20.0), -100.0 + 5.0 * t1
+    ang = np.linspace(0.0, np.pi, 20)  # from east of G1, anticlockwise over the top
+    ta = 120.0 + ang * 30.0 / 5.0
+    xa, ya = -50.0 + 30.0 * np.cos(ang), 500.0 + 30.0 * np.sin(ang)
+    t2 = ta[-1] + np.arange(1.0, 130.0)
+    x2 = -80.0 + 80.0 * (t2 - ta[-1]) / 120.0
+    y2 = 500.0 - 4.5 * (t2 - ta[-1])
+    t, x, y = (np.concatenate(v) for v in ((t1, ta, t2), (x1, xa, x2), (y1, ya, y2)))
+    line = segment_track(course, gun - 20.0 + t, x, y)
+    rnd = segment_track(course, gun - 20.0 + t, x, y, gate_end="rounding")
+    assert line.ends[0].t == pytest.approx(gun - 20.0 + 120.0, abs=1e-6)
+    late = rnd.ends[0].t - line.ends[0].t
+    assert 3.0 < late < 12.0  # over the top of G1 (a half circle takes 18.8 s)
+    assert np.hypot(rnd.ends[0].x + 50.0, rnd.ends[0].y - 500.0) == pytest.approx(30.0, abs=2.0)
+    assert abs(rnd.ends[1].t - line.ends[1].t) < 1.0  # the finish is the same
+    with pytest.raises(InputError, match="gate end 'mark': expected 'line' or 'rounding'"):
+        segment_track(course, gun - 20.0 + t, x, y, gate_end="mark")

@@ -22,7 +22,7 @@ from sailroute.track.read import read_track
 from tests.conftest import ROOT
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
-import bench_analyze  # noqa: E402
+import bench_analyze
 
 
 def test_a_60000_point_10hz_log_gives_the_same_race(tmp_path: Path) -> None:
