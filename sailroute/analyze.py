@@ -121,13 +121,15 @@ class LegAnalysis:
     mode : str
         Wind mode at the leg start (upwind / reach / downwind).
     t_start, t_end : float
-        Sailed leg start and end [epoch s].
+        Sailed leg start and end [epoch s]; NaN when unknown (a data gap, or never
+        reached: see ``note``).
     start_xy, end_xy : tuple of float
         Where the boat started and ended the leg [m].
     detected : bool
         True when the end was found from the geometry (False: given).
     sailed_time_s, optimal_time_s, loss_s : float
-        [s]; ``loss_s = sailed − optimal``.
+        [s]; ``loss_s = sailed − optimal``.  An unknown leg (``known`` False) has NaN
+        sailed time, loss and split, and an optimal time only when its start is known.
     sailed_distance_m, optimal_distance_m : float
         [m].
     sailed_tacks, sailed_gybes, optimal_tacks, optimal_gybes : int
@@ -140,8 +142,10 @@ class LegAnalysis:
     side_sailed, side_optimal : str
         ``left`` / ``middle`` / ``right`` of the leg axis, looking from the leg start
         to the target; ``lateral_*_m`` the time-mean offsets [m] (+ right).
-    optimal : LegResult
-        The optimal route of the leg.
+    optimal : LegResult or None
+        The optimal route of the leg (None: the leg's start is unknown).
+    note : str
+        Why the leg is unknown (empty when known).
     wind_source, wind_label : str
         The wind the leg was judged in (:data:`sailroute.analysis.windsource.KINDS`)
         and what it is.
@@ -173,9 +177,15 @@ class LegAnalysis:
     side_optimal: str
     lateral_sailed_m: float
     lateral_optimal_m: float
-    optimal: LegResult
+    optimal: LegResult | None
+    note: str = ""
     wind_source: str = "scenario"
     wind_label: str = ""
+
+    @property
+    def known(self) -> bool:
+        """True when the sailed time is known (both ends found outside data gaps)."""
+        return bool(np.isfinite(self.sailed_time_s))
 
     @property
     def above_polar(self) -> bool:
@@ -211,19 +221,34 @@ class TrackAnalysis:
     wind: WindField
 
     @property
+    def known_legs(self) -> tuple[LegAnalysis, ...]:
+        """The legs with a known sailed time (the totals are over these)."""
+        return tuple(leg for leg in self.legs if leg.known)
+
+    @property
+    def complete(self) -> bool:
+        """True when every leg's time is known."""
+        return all(leg.known for leg in self.legs)
+
+    @property
     def sailed_time_s(self) -> float:
-        """Start crossing to finish [s]."""
-        return sum(leg.sailed_time_s for leg in self.legs)
+        """Sum of the known legs' sailed times [s] (start crossing to finish when complete)."""
+        return sum(leg.sailed_time_s for leg in self.known_legs)
 
     @property
     def optimal_time_s(self) -> float:
-        """Sum of the optimal leg times [s]."""
-        return sum(leg.optimal_time_s for leg in self.legs)
+        """Sum of the optimal times of the known legs [s]."""
+        return sum(leg.optimal_time_s for leg in self.known_legs)
 
     @property
     def loss_s(self) -> float:
-        """Sum of the leg losses [s]."""
-        return sum(leg.loss_s for leg in self.legs)
+        """Sum of the known legs' losses [s]."""
+        return sum(leg.loss_s for leg in self.known_legs)
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """Start findings and why legs are unknown, one sentence each."""
+        return self.segmentation.notes
 
 
 def check_same_race(course: Course, track: Track, x: NDArray, y: NDArray) -> None:
@@ -284,6 +309,8 @@ def analyze_track(
     built: tuple[Any, WindField] | None = None,
     winds: Sequence[WindSource] | None = None,
     progress: Progress | None = None,
+    missing: str = "error",
+    gate_end: str = "line",
 ) -> TrackAnalysis:
     """Analyse a sailed track against the optimal route of each leg.
 
@@ -309,6 +336,13 @@ def analyze_track(
         each leg is judged in the first that covers it.  Default: the scenario's.
     progress : Progress, optional
         Per-leg progress of the optimal routing.
+    missing : {"error", "unknown"}
+        A leg end never found: an error (one boat), or that leg and the later ones
+        unknown with a note (a fleet; :func:`sailroute.analysis.segment.segment_track`).
+    gate_end : {"line", "rounding"}
+        A gate leg ends passing between the marks, or having rounded the chosen mark
+        (:func:`sailroute.analysis.segment.gate_rounding`; the optimal leg still ends at
+        the gate line, so the leg's loss then includes that turn).
 
     Returns
     -------
@@ -336,21 +370,28 @@ def analyze_track(
     x, y = track_xy(track, course.frame)
     check_same_race(course, track, x, y)
     t = track.t_s
-    seg = segment_track(course, t, x, y, leg_times=leg_times, detect_m=detect_m, where=where)
+    seg = segment_track(course, t, x, y, leg_times=leg_times, detect_m=detect_m, where=where,
+                        missing=missing, gate_end=gate_end)
     svx, svy = _smoothed_velocity(t, x, y)
     bounds = seg.bounds
-    t_a, t_b = bounds[0].t, bounds[-1].t
+    t_a = bounds[0].t
+    t_b = max(c.t_hi for c in bounds if np.isfinite(c.t_hi))
     race = (t >= t_a) & (t <= t_b)
     # each leg's wind: the first source that covers its sailed points
     chosen = [_leg_source(sources, *_leg_points(t, x, y, bounds[i], bounds[i + 1]),
-                          f"{where}: leg {i + 1} ({spec.label})")
+                          f"{where}: leg {i + 1} ({spec.label})",
+                          strict=bounds[i].known and bounds[i + 1].known)
               for i, spec in enumerate(course.legs)]
     # manoeuvres over the race part, with TWA from the smoothed COG
     tr, xr, yr = t[race], x[race], y[race]
-    twd_r = np.empty(tr.size)
+    twd_r = np.full(tr.size, np.nan)
     for i, k in enumerate(chosen):
-        m = (tr >= bounds[i].t) & (tr <= bounds[i + 1].t)
+        m = (tr >= bounds[i].t_hi) & (tr <= bounds[i + 1].t_lo)
         twd_r[m] = _wind_at(sources[k].field, tr[m], xr[m], yr[m])[1]
+    gap = np.isnan(twd_r)  # across a data gap at a leg end: the last leg's wind before it
+    if gap.any():
+        twd_r[gap] = (np.degrees(np.interp(tr[gap], tr[~gap], np.unwrap(np.radians(
+            twd_r[~gap])))) % 360.0 if (~gap).any() else 0.0)
     mans, _ = find_sailed_manoeuvres(tr, twd_r, bearing_deg(svx[race], svy[race]),
                                      np.hypot(svx[race], svy[race]))
 
@@ -373,6 +414,16 @@ def analyze_track(
         target = leg_target(course, i)
         centre = target.centre if target.kind != "mark" else feature_centre(
             course.feature(spec.to_name))
+        if not (a.known and b.known):
+            leg = _unknown_leg(course, i, bounds, sources[chosen[i]], boat, settings, target,
+                               centre, progress)
+            legs.append(leg)
+            for k, v in (("leg", np.full(tl.size, i + 1)), ("t", tl), ("x", xl), ("y", yl),
+                         ("sog", sog), ("cog", cog), ("tws", tws), ("twd", twd), ("twa", twa),
+                         ("polar", polar), ("vmg", np.full(tl.size, np.nan)),
+                         ("loss", np.full(tl.size, np.nan))):
+                cols[k].append(v)
+            continue
         mode = leg_wind_mode(chosen_field, a.t, (a.x, a.y), centre)
         if mode == "upwind":
             vmg = sog * np.cos(np.radians(twa))
@@ -382,29 +433,8 @@ def analyze_track(
             ux, uy = centre[0] - xl, centre[1] - yl
             vmg = (vx * ux + vy * uy) / np.maximum(np.hypot(ux, uy), 1e-9)
         # optimal route from the same point and time
-        barrier = None
-        if i > 0:
-            prev_start = (bounds[i - 1].x, bounds[i - 1].y)
-            barrier = target_barrier(leg_target(course, i - 1),
-                                     Start(prev_start, None, course.legs[i - 1].from_name),
-                                     settings.zone_m)
-        start = Start((a.x, a.y), None, spec.from_name, barrier)
-        if progress is not None:
-            progress.start_leg(i, spec.label)
-        k = chosen[i]
-        while True:  # a source whose span ends before the optimal route does: the next one
-            try:
-                opt = route_leg(start, target, a.t, sources[k].field, boat, settings,
-                                progress=progress.update if progress is not None else None)
-                break
-            except OutOfCoverageError:
-                nxt = first_covering(sources, tl, xl, yl, skip=k)
-                if nxt is None:
-                    raise
-                k = nxt
-        src = sources[k]
-        if progress is not None:
-            progress.end_leg(opt.time_s, f"{opt.n_tacks} tacks, {opt.n_gybes} gybes")
+        opt, src = _optimal_leg(course, i, bounds, sources, chosen[i], (tl, xl, yl), boat,
+                                settings, target, progress)
         sailed = b.t - a.t
         loss = sailed - opt.time_s
         prog = axis_progress(xl, yl, (a.x, a.y), centre)
@@ -440,7 +470,7 @@ def analyze_track(
                      ("sog", sog), ("cog", cog), ("tws", tws), ("twd", twd), ("twa", twa),
                      ("polar", polar), ("vmg", vmg), ("loss", cum)):
             cols[k].append(v)
-    c = {k: np.concatenate(v) for k, v in cols.items()}
+    c = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
     lat, lon = course.frame.to_latlon(c["x"], c["y"])
     pct = np.where(c["polar"] >= 0.3, 100.0 * c["sog"] / np.maximum(c["polar"], 1e-9), np.nan)
     points = PointTable(c["leg"].astype(np.int64), c["t"], c["x"], c["y"], lat, lon, c["sog"],
@@ -452,16 +482,22 @@ def analyze_track(
 
 def _leg_points(t: NDArray, x: NDArray, y: NDArray, a: Crossing, b: Crossing
                 ) -> tuple[NDArray, NDArray, NDArray]:
-    """The track points of one leg, with its start and end crossings as first and last."""
-    inner = (t > a.t) & (t < b.t)
-    return (np.concatenate([[a.t], t[inner], [b.t]]), np.concatenate([[a.x], x[inner], [b.x]]),
-            np.concatenate([[a.y], y[inner], [b.y]]))
+    """The track points of one leg, with its start and end crossings (when known) as
+    first and last; none inside a data gap an end lies in."""
+    inner = (t > a.t_hi) & (t < b.t_lo)  # none when an end was never found (NaN)
+    ka, kb = [a] if a.known else [], [b] if b.known else []
+    return (np.concatenate([[c.t for c in ka], t[inner], [c.t for c in kb]]),
+            np.concatenate([[c.x for c in ka], x[inner], [c.x for c in kb]]),
+            np.concatenate([[c.y for c in ka], y[inner], [c.y for c in kb]]))
 
 
 def _leg_source(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArray,
-                where: str) -> int:
-    """Index of the first source covering a leg; the last one's own error if none does."""
+                where: str, strict: bool = True) -> int:
+    """Index of the first source covering a leg; the last one's own error if none does
+    (with ``strict`` False, a leg of unknown time: the last source)."""
     k = first_covering(sources, t, x, y)
+    if k is None and not strict:
+        return len(sources) - 1
     if k is None:
         try:
             sources[-1].field.sample(t, x, y)
@@ -588,15 +624,83 @@ def _summary_text(sm: Mapping[str, Any]) -> str:
     return text + f", {sm['t_start']} .. {sm['t_end']}"
 
 
+def _optimal_leg(course: Course, i: int, bounds: Sequence[Crossing],
+                 sources: Sequence[WindSource], k: int, points: tuple[NDArray, NDArray, NDArray],
+                 boat: Any, settings: RoutingSettings, target: Any,
+                 progress: Progress | None) -> tuple[LegResult, WindSource]:
+    """The optimal route of leg ``i`` from the boat's own leg start point and time.
+
+    Routed in ``sources[k]``; when that wind ends before the optimal route does, in the
+    next source that covers the leg's sailed ``points``.
+    """
+    a = bounds[i]
+    barrier = None
+    if i > 0 and np.isfinite(bounds[i - 1].x):
+        prev_start = (bounds[i - 1].x, bounds[i - 1].y)
+        barrier = target_barrier(leg_target(course, i - 1),
+                                 Start(prev_start, None, course.legs[i - 1].from_name),
+                                 settings.zone_m)
+    spec = course.legs[i]
+    start = Start((a.x, a.y), None, spec.from_name, barrier)
+    if progress is not None:
+        progress.start_leg(i, spec.label)
+    while True:
+        try:
+            opt = route_leg(start, target, a.t, sources[k].field, boat, settings,
+                            progress=progress.update if progress is not None else None)
+            break
+        except OutOfCoverageError:
+            nxt = first_covering(sources, *points, skip=k)
+            if nxt is None:
+                raise
+            k = nxt
+    if progress is not None:
+        progress.end_leg(opt.time_s, f"{opt.n_tacks} tacks, {opt.n_gybes} gybes")
+    return opt, sources[k]
+
+
+def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing], source: WindSource,
+                 boat: Any, settings: RoutingSettings, target: Any,
+                 centre: tuple[float, float], progress: Progress | None) -> LegAnalysis:
+    """A leg whose start or end time is unknown: no sailed time, loss or split; the
+    optimal route when the start is known."""
+    nan = float("nan")
+    spec = course.legs[i]
+    a, b = bounds[i], bounds[i + 1]
+    opt = None
+    mode = ""
+    if a.known:
+        mode = leg_wind_mode(source.field, a.t, (a.x, a.y), centre)
+        opt, source = _optimal_leg(course, i, bounds, [source], 0,
+                                   (np.array([a.t]), np.array([a.x]), np.array([a.y])),
+                                   boat, settings, target, progress)
+    note = (b.note if not b.known else
+            f"leg {i + 1} ({spec.label}) starts at an unknown time: time unknown")
+    return LegAnalysis(
+        index=i, label=spec.label, mode=mode, t_start=a.t, t_end=b.t, start_xy=(a.x, a.y),
+        end_xy=(b.x, b.y), detected=b.detected, sailed_time_s=nan,
+        optimal_time_s=opt.time_s if opt is not None else nan, loss_s=nan,
+        sailed_distance_m=nan, optimal_distance_m=opt.distance_m if opt is not None else nan,
+        sailed_tacks=0, sailed_gybes=0, optimal_tacks=opt.n_tacks if opt is not None else 0,
+        optimal_gybes=opt.n_gybes if opt is not None else 0, manoeuvres=(), mean_vmg_ms=nan,
+        mean_sog_ms=nan, mean_polar_pct=nan, split=LossSplit(nan, nan, nan, nan),
+        side_sailed="", side_optimal="", lateral_sailed_m=nan, lateral_optimal_m=nan,
+        optimal=opt, note=note, wind_source=source.kind, wind_label=source.label)
+
+
 def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
     """Rank boats per leg by sailed leg time and by elapsed time at the leg's end.
+
+    A leg of unknown time (:attr:`LegAnalysis.known` False) is left out of that leg's
+    ranking (``leg_rank`` None); a leg end of unknown time out of the positions
+    (``position`` None).
 
     Returns
     -------
     list of dict
         One row per (leg, boat): ``leg`` (1-based), ``label``, ``boat``,
         ``leg_time_s``, ``leg_rank``, ``elapsed_s`` (from the gun), ``position``,
-        ``loss_s``.
+        ``loss_s`` (NaN when unknown), ``note`` (why unknown, else empty).
     """
     rows: list[dict[str, Any]] = []
     if not analyses:
@@ -605,14 +709,24 @@ def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
     for i in range(n):
         times = [a.legs[i].sailed_time_s for a in analyses]
         elapsed = [a.legs[i].t_end - a.segmentation.start.gun_t for a in analyses]
-        leg_rank = np.argsort(np.argsort(times, kind="stable"), kind="stable") + 1
-        pos = np.argsort(np.argsort(elapsed, kind="stable"), kind="stable") + 1
+        leg_rank = _ranks(times)
+        pos = _ranks(elapsed)
         for k, a in enumerate(analyses):
             rows.append({"leg": i + 1, "label": a.legs[i].label, "boat": a.track.name,
-                         "leg_time_s": times[k], "leg_rank": int(leg_rank[k]),
-                         "elapsed_s": elapsed[k], "position": int(pos[k]),
-                         "loss_s": a.legs[i].loss_s})
+                         "leg_time_s": times[k], "leg_rank": leg_rank[k],
+                         "elapsed_s": elapsed[k], "position": pos[k],
+                         "loss_s": a.legs[i].loss_s, "note": a.legs[i].note})
     return rows
+
+
+def _ranks(values: Sequence[float]) -> list[int | None]:
+    """1-based ranks of the finite values (ties in input order), None for the others."""
+    v = np.asarray(values, float)
+    ok = np.flatnonzero(np.isfinite(v))
+    out: list[int | None] = [None] * v.size
+    for r, k in enumerate(ok[np.argsort(v[ok], kind="stable")]):
+        out[int(k)] = r + 1
+    return out
 
 
 def parse_leg_times(text: str | None, n_legs: int) -> list[float | None] | None:
@@ -635,6 +749,54 @@ def parse_leg_times(text: str | None, n_legs: int) -> list[float | None] | None:
             "'-' for one to detect"
         )
     return [None if p in ("-", "") else to_epoch(parse_time(p, "--leg-times")) for p in parts]
+
+
+def parse_boat_leg_times(items: str | Sequence[str] | None, boats: Sequence[str], n_legs: int
+                         ) -> dict[str, list[float | None] | None]:
+    """``--leg-times`` for one track (``T0,T1,...``) or per boat (``BOAT=T0,T1,...``, repeated).
+
+    Parameters
+    ----------
+    items : str or sequence of str or None
+        The option's values.
+    boats : sequence of str
+        Boat names (track file stems, made unique), in track order.
+    n_legs : int
+
+    Returns
+    -------
+    dict
+        Boat name to its ``n_legs + 1`` times [epoch s] (None entries detected), or None.
+
+    Raises
+    ------
+    InputError
+        A plain value with several tracks, an unknown boat (the message lists them),
+        a boat given twice, or a bad time list (:func:`parse_leg_times`).
+    """
+    out: dict[str, list[float | None] | None] = dict.fromkeys(boats)
+    values = [items] if isinstance(items, str) else list(items or [])
+    seen: set[str] = set()
+    for item in values:
+        boat, sep, text = item.partition("=")
+        if not sep:
+            if len(boats) > 1:
+                raise InputError(
+                    f"--leg-times {item!r}: with several tracks name the boat, "
+                    f"BOAT=T0,T1,... (boats: {', '.join(boats)})")
+            boat, text = boats[0], item
+        boat = boat.strip()
+        if boat not in out:
+            raise InputError(f"--leg-times {item!r}: no track named {boat!r}; boats are "
+                             f"the track file names without extension: {', '.join(boats)}")
+        if boat in seen:
+            raise InputError(f"--leg-times: boat {boat!r} given twice")
+        seen.add(boat)
+        try:
+            out[boat] = parse_leg_times(text, n_legs)
+        except InputError as exc:
+            raise InputError(f"{exc} (boat {boat})" if len(boats) > 1 else str(exc)) from None
+    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -661,13 +823,14 @@ def run_analyze_command(
     scenario: str | None = None,
     router: str | None = None,
     out_dir: str | Path | None = None,
-    leg_times: str | None = None,
+    leg_times: str | Sequence[str] | None = None,
     columns: Mapping[str, str] | None = None,
     speed_unit: str | None = None,
     time_zone: str | None = None,
     detect_m: float = DETECT_M,
     plots: bool = True,
     progress: Progress | None = None,
+    gate_end: str = "line",
 ) -> AnalyzeResult:
     """Everything ``sailroute analyze`` does, minus printing.
 
@@ -682,34 +845,40 @@ def run_analyze_command(
     """
     from sailroute.outdir import check_out_dir, write_output_set
     from sailroute.plan import _loaded
-    from sailroute.report.analysis import analysis_table, fleet_table, write_analysis, write_fleet
+    from sailroute.report.analysis import (
+        analysis_table,
+        fleet_notes,
+        fleet_table,
+        write_analysis,
+        write_fleet,
+    )
 
     course = _loaded(course)
     if not tracks:
         raise InputError("analyze: give at least one track file")
-    if leg_times is not None and len(tracks) > 1:
-        raise InputError("--leg-times applies to one track; analyse the boats one by one")
     name = default_scenario(course) if scenario is None else scenario
-    times = parse_leg_times(leg_times, course.n_legs)
+    stems = _unique_stems(tracks)
+    times = parse_boat_leg_times(leg_times, stems, course.n_legs)
     stem = Path(course.source).stem if course.source else "course"
     default = (Path("out") / stem / (f"analysis-{Path(tracks[0]).stem}" if len(tracks) == 1
                                      else "analysis-fleet"))
     out = check_out_dir(Path(out_dir) if out_dir is not None else default)
     read = [read_track(p, columns=columns, speed_unit=speed_unit, time_zone=time_zone,
-                       name=s) for p, s in zip(tracks, _unique_stems(tracks), strict=True)]
+                       name=s) for p, s in zip(tracks, stems, strict=True)]
     settings_for(course, router)
     boat, winds = build_specs(course, [name])
     analyses = []
     for tr in read:
         if progress is not None:
             progress.set_prefix(f"{tr.name}: ")
-        analyses.append(analyze_track(course, tr, name, leg_times=times, router=router,
-                                      detect_m=detect_m, built=(boat, winds[name]),
-                                      progress=progress))
+        analyses.append(analyze_track(course, tr, name, leg_times=times[tr.name],
+                                      router=router, detect_m=detect_m,
+                                      built=(boat, winds[name]), progress=progress,
+                                      missing="error" if len(read) == 1 else "unknown",
+                                      gate_end=gate_end))
     if len(analyses) == 1:
         files = write_output_set(out, lambda d: write_analysis(d, analyses[0], plots=plots))
         return AnalyzeResult(analysis_table(analyses[0]), files, tuple(analyses))
-    stems = _unique_stems(tracks)
     rows = fleet_ranking(analyses)
 
     def write(d: Path) -> dict[str, Path]:
@@ -717,10 +886,11 @@ def run_analyze_command(
         for s, a in zip(stems, analyses, strict=True):
             for kind, p in write_analysis(d / s, a, plots=plots).items():
                 files[f"{s}/{kind}"] = p
-        files.update(write_fleet(d, analyses, rows))
+        files.update(write_fleet(d, analyses, rows, plots=plots))
         return files
 
-    report = "\n\n".join([*(analysis_table(a) for a in analyses), fleet_table(rows)])
+    report = "\n\n".join([*(analysis_table(a) for a in analyses),
+                           fleet_table(rows, fleet_notes(analyses))])
     return AnalyzeResult(report, write_output_set(out, write), tuple(analyses))
 
 

@@ -653,10 +653,11 @@ def analyze_command(
                      help="Output folder (default: out/<course>/analysis-<track>)."),
     ] = None,
     leg_times: Annotated[
-        str | None,
-        typer.Option("--leg-times", metavar="T0,T1,...", help="Override detection: n_legs+1 "
-                     "comma-separated ISO times with offset (start crossing, each leg's end); "
-                     "'-' = detect."),
+        list[str] | None,
+        typer.Option("--leg-times", metavar="[BOAT=]T0,T1,...", help="Override detection: "
+                     "n_legs+1 comma-separated ISO times with offset (start crossing, each "
+                     "leg's end); '-' = detect. Several tracks: BOAT=T0,... per boat (BOAT = "
+                     "track file name without extension; repeat)."),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
     time_zone: Annotated[
@@ -673,6 +674,12 @@ def analyze_command(
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Skip legs.png, loss.png and report.html.")
     ] = False,
+    gate_end: Annotated[
+        Literal["line", "rounding"],
+        typer.Option("--gate-end", case_sensitive=False,
+                     help="A gate leg ends passing between the marks (line) or having "
+                          "rounded the chosen mark (rounding, as official leg counters)."),
+    ] = "line",
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -695,7 +702,8 @@ def analyze_command(
             return run_analyze_command(
                 loaded, tracks, scenario=scenario, router=router, out_dir=out,
                 leg_times=leg_times, columns=columns or None, speed_unit=speed_unit,
-                time_zone=time_zone, plots=not no_plots, progress=progress)
+                time_zone=time_zone, plots=not no_plots, progress=progress,
+                gate_end=gate_end)
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("analysis_json", "fleet_json"))
 

@@ -80,9 +80,9 @@ def sides(t: NDArray, twa_deg: NDArray, sog_ms: NDArray, *, hold_s: float = HOLD
         return s
     first = int(np.argmin(slow))
     s[:first] = s[first]
-    for k in np.flatnonzero(slow):
-        if k > first:
-            s[k] = s[k - 1]
+    # a slow point keeps the side of the last point before it that was not slow
+    last_fast = np.maximum.accumulate(np.where(slow, 0, np.arange(s.size)))
+    s = s[np.maximum(last_fast, first)]
     # drop short runs: merge each run shorter than hold_s into the run before it
     for _ in range(3):
         change = np.flatnonzero(s[1:] != s[:-1]) + 1
@@ -100,7 +100,7 @@ def sides(t: NDArray, twa_deg: NDArray, sog_ms: NDArray, *, hold_s: float = HOLD
     return s
 
 
-def _mean_course(cog_deg: NDArray, sel: NDArray) -> float:
+def _mean_course(cog_deg: NDArray, sel: NDArray | slice) -> float:
     """Vector-mean course [°] of the selected points."""
     r = np.radians(cog_deg[sel])
     return float(np.degrees(np.arctan2(np.sin(r).sum(), np.cos(r).sum())))
@@ -135,14 +135,22 @@ def find_sailed_manoeuvres(t: NDArray, twd_deg: NDArray, cog_deg: NDArray, sog_m
     s = sides(t, twa, sog_ms, hold_s=hold_s, min_speed_ms=min_speed_ms)
     cog = np.asarray(cog_deg, float)
     out = []
-    for i in np.flatnonzero(s[1:] != s[:-1]) + 1:
-        before = (t >= t[i] - 2.0 * hold_s) & (t < t[i])
-        after = (t > t[i]) & (t <= t[i] + 2.0 * hold_s)
-        if before.any() and after.any():
+    # windows by index (t increases): O(log n) per side change, not a pass over the track
+    change = np.flatnonzero(s[1:] != s[:-1]) + 1
+    tc = t[change]
+    b0 = np.searchsorted(t, tc - 2.0 * hold_s, side="left")
+    a1 = np.searchsorted(t, tc + 2.0 * hold_s, side="right")
+    n0 = np.searchsorted(t, tc - hold_s, side="left")
+    n1 = np.searchsorted(t, tc + hold_s, side="right")
+    after0 = np.searchsorted(t, tc, side="right")
+    for k, i in enumerate(change.tolist()):
+        before = slice(int(b0[k]), i)
+        after = slice(int(after0[k]), int(a1[k]))
+        if before.stop > before.start and after.stop > after.start:
             turn = abs(float(wrap180(_mean_course(cog, after) - _mean_course(cog, before))))
             if turn < min_turn_deg:
                 continue
-        near = np.abs(t - t[i]) <= hold_s
+        near = slice(int(n0[k]), int(n1[k]))
         kind: Literal["tack", "gybe"] = "tack" if np.mean(np.abs(twa[near])) < 90.0 else "gybe"
         out.append(SailedManoeuvre(kind, float(t[i]), int(i)))
     return tuple(out), twa

@@ -34,7 +34,7 @@ LEG_COLUMNS = (
     "optimal_time_s", "loss_s", "loss_manoeuvres_s", "loss_speed_s", "loss_route_s",
     "sailed_distance_m", "optimal_distance_m", "sailed_tacks", "optimal_tacks", "sailed_gybes",
     "optimal_gybes", "mean_vmg_ms", "mean_sog_ms", "mean_polar_pct", "side_sailed",
-    "side_optimal", "lateral_sailed_m", "lateral_optimal_m",
+    "side_optimal", "lateral_sailed_m", "lateral_optimal_m", "note",
 )
 """Columns of ``analysis.csv``."""
 
@@ -48,15 +48,14 @@ POINT_COLUMNS = (
 def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
     """The ``analysis.json`` document (see ``docs/output-format.md``)."""
     c = a.course
-    st = a.segmentation.start
     legs = []
     for leg in a.legs:
         spec = c.legs[leg.index]
         legs.append({
             "index": leg.index + 1, "from": spec.from_name, "to": spec.to_name,
             "target_kind": spec.kind, "rounding": spec.rounding, "mode": leg.mode,
-            "start_time": iso(leg.t_start), "end_time": iso(leg.t_end),
-            "end_detected": leg.detected,
+            "start_time": _iso(leg.t_start), "end_time": _iso(leg.t_end),
+            "end_detected": leg.detected, "known": leg.known, "note": leg.note or None,
             "start_point": _point(c, leg.start_xy), "end_point": _point(c, leg.end_xy),
             "sailed_time_s": _num(leg.sailed_time_s), "optimal_time_s": _num(leg.optimal_time_s),
             "loss_s": _num(leg.loss_s),
@@ -84,19 +83,61 @@ def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
         "scenario": a.scenario,
         "router": a.router,
         "origin": {"lat": c.frame.lat0, "lon": c.frame.lon0},
-        "start": {"gun_time": iso(st.gun_t), "start_time": iso(st.crossing.t),
-                  "detected": st.crossing.detected, "late_s": _num(st.late_s),
-                  "distance_at_gun_m": _num(st.distance_at_gun_m, 1),
-                  "side_at_gun": st.side_at_gun, "line_fraction": _num(st.line_fraction),
-                  "point": _point(c, (st.crossing.x, st.crossing.y))},
-        "finish_time": iso(a.segmentation.ends[-1].t),
+        "start": start_to_dict(a),
+        "finish_time": _iso(a.segmentation.ends[-1].t),
+        "complete": a.complete,
+        "known_legs": len(a.known_legs),
+        "notes": list(a.notes),
         "sailed_time_s": _num(a.sailed_time_s),
         "optimal_time_s": _num(a.optimal_time_s),
         "loss_s": _num(a.loss_s),
-        "loss_split_s": {k: _num(sum(getattr(leg.split, k) for leg in a.legs))
+        "loss_split_s": {k: _num(sum(getattr(leg.split, k) for leg in a.known_legs))
                          for k in ("manoeuvres", "speed", "route")},
         "legs": legs,
     }
+
+
+def start_to_dict(a: TrackAnalysis) -> dict[str, Any]:
+    """The ``start`` object of ``analysis.json`` (and of each boat in ``fleet.json``)."""
+    st = a.segmentation.start
+    return {"gun_time": iso(st.gun_t), "start_time": iso(st.crossing.t),
+            "detected": st.crossing.detected, "late_s": _num(st.late_s),
+            "distance_at_gun_m": _num(st.distance_at_gun_m, 1),
+            "side_at_gun": st.side_at_gun, "speed_at_gun_kn": _num(speed_at_gun_kn(a), 2),
+            "line_fraction": _num(st.line_fraction),
+            "ocs_s": None if st.ocs_s is None else _num(st.ocs_s, 1),
+            "ocs_returned": st.ocs_returned, "line_offset_m": _num(st.line_offset_m, 1),
+            "notes": list(st.notes), "point": _point(a.course, (st.crossing.x, st.crossing.y))}
+
+
+def speed_at_gun_kn(a: TrackAnalysis) -> float:
+    """Speed over the ground at the gun [kn] (NaN outside the track or across a data gap)."""
+    return a.segmentation.start.speed_at_gun_ms / KNOT
+
+
+def _iso(t: float) -> str | None:
+    return iso(t) if math.isfinite(t) else None
+
+
+def fleet_notes(analyses: Sequence[TrackAnalysis]) -> tuple[str, ...]:
+    """Notes on the fleet as a whole (the start line: :func:`fleet_start_notes`)."""
+    from sailroute.analysis.segment import fleet_start_notes
+
+    return fleet_start_notes([a.segmentation.start for a in analyses])
+
+
+def iso_column(t: Any) -> list[str]:
+    """:func:`sailroute.timeutil.iso` of every time [epoch s], at once (``""`` where NaN)."""
+    t = np.asarray(t, float)
+    ok = np.isfinite(t)
+    # as datetime.fromtimestamp: the fraction of the second rounded to the microsecond
+    # (half to even), then cut to the millisecond by isoformat
+    t = np.where(ok, t, 0.0)
+    sec = np.floor(t)
+    us = sec.astype(np.int64) * 1_000_000 + np.round((t - sec) * 1e6).astype(np.int64)
+    ms = (us // 1000).astype("datetime64[ms]")
+    text = np.datetime_as_string(ms, unit="ms")
+    return [f"{s}Z" if good else "" for s, good in zip(text.tolist(), ok.tolist(), strict=True)]
 
 
 def _fmt(v: Any) -> Any:
@@ -123,26 +164,25 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
         for leg in a.legs:
             spec = a.course.legs[leg.index]
             w.writerow([_fmt(v) for v in (
-                leg.index + 1, spec.from_name, spec.to_name, leg.mode, iso(leg.t_start),
-                iso(leg.t_end), leg.detected, leg.sailed_time_s, leg.optimal_time_s,
+                leg.index + 1, spec.from_name, spec.to_name, leg.mode, _iso(leg.t_start) or "",
+                _iso(leg.t_end) or "", leg.detected, leg.sailed_time_s, leg.optimal_time_s,
                 leg.loss_s, leg.split.manoeuvres, leg.split.speed, leg.split.route,
                 leg.sailed_distance_m, leg.optimal_distance_m, leg.sailed_tacks,
                 leg.optimal_tacks, leg.sailed_gybes, leg.optimal_gybes, leg.mean_vmg_ms,
                 leg.mean_sog_ms, leg.mean_polar_pct, leg.side_sailed, leg.side_optimal,
-                leg.lateral_sailed_m, leg.lateral_optimal_m)])
+                leg.lateral_sailed_m, leg.lateral_optimal_m, leg.note)])
     files["analysis_csv"] = cp
     pp = out / "points.csv"
     p = a.points
-    with pp.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(POINT_COLUMNS)
-        for k in range(p.t.size):
-            w.writerow([int(p.leg[k]), iso(p.t[k]), f"{p.x[k]:.2f}", f"{p.y[k]:.2f}",
-                        f"{p.lat[k]:.8f}", f"{p.lon[k]:.8f}",
-                        *(_fmt(float(v)) for v in (
-                            p.sog_ms[k], p.sog_ms[k] / KNOT, p.cog_deg[k], p.tws_ms[k],
-                            p.twd_deg[k], p.twa_deg[k], p.polar_ms[k], p.polar_pct[k],
-                            p.vmg_ms[k], p.loss_s[k]))])
+    # one %-format per row (not per value): 220 000 rows in about a second; then the
+    # non-finite values (nan, inf) become empty cells, as _fmt writes them
+    row = "%d,%s,%.2f,%.2f,%.8f,%.8f" + ",%.3f" * 10 + "\r\n"
+    cols = (p.leg.tolist(), iso_column(p.t), *(np.asarray(v, float).tolist() for v in (
+        p.x, p.y, p.lat, p.lon, p.sog_ms, p.sog_ms / KNOT, p.cog_deg, p.tws_ms, p.twd_deg,
+        p.twa_deg, p.polar_ms, p.polar_pct, p.vmg_ms, p.loss_s)))
+    body = "".join(row % r for r in zip(*cols, strict=True))
+    body = body.replace("-inf", "").replace("inf", "").replace("nan", "")
+    pp.write_text(",".join(POINT_COLUMNS) + "\r\n" + body, encoding="utf-8", newline="")
     files["points_csv"] = pp
     if plots:
         plot_legs(a).savefig(out / "legs.png", dpi=120)
@@ -156,27 +196,39 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
 
 
 def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
-                rows: Sequence[Mapping[str, Any]]) -> dict[str, Path]:
-    """Write ``fleet.csv`` (one row per leg and boat) and ``fleet.json``."""
+                rows: Sequence[Mapping[str, Any]], *, plots: bool = True) -> dict[str, Path]:
+    """Write ``fleet.csv`` (one row per leg and boat), ``fleet.json`` and (with ``plots``)
+    the fleet's ``report.html`` (:func:`sailroute.report.html.fleet_report`)."""
     out = Path(out_dir)
     cp = out / "fleet.csv"
-    cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s")
+    cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s",
+            "note")
     with cp.open("w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for r in rows:
-            w.writerow([_fmt(r[c]) for c in cols])
+            w.writerow([_fmt(r[c]) if r[c] is not None else "" for c in cols])
     jp = out / "fleet.json"
     doc = {"schema_version": SCHEMA_VERSION, "sailroute_version": __version__,
            "course": analyses[0].course.name if analyses else None,
-           "boats": [a.track.name for a in analyses],
+           "boats": [{"name": a.track.name, "complete": a.complete, "notes": list(a.notes),
+                      "start": start_to_dict(a)} for a in analyses],
+           "notes": list(fleet_notes(analyses)),
            "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()}
                     for r in rows]}
     jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
-    return {"fleet_csv": cp, "fleet_json": jp}
+    files = {"fleet_csv": cp, "fleet_json": jp}
+    if plots:
+        from sailroute.report.html import fleet_report, write_report
+
+        files["html"] = write_report(out / "report.html",
+                                     fleet_report(analyses, rows, fleet_notes(analyses)))
+    return files
 
 
 def _mss(s: float) -> str:
+    if not math.isfinite(s):
+        return "unknown"
     sign = "-" if s < 0 else ""
     tenths = round(abs(s) * 10)
     return f"{sign}{tenths // 600}:{(tenths % 600) / 10:04.1f}"
@@ -189,11 +241,17 @@ def analysis_table(a: TrackAnalysis) -> str:
             f"start: {'detected' if st.crossing.detected else 'given'} "
             f"{iso(st.crossing.t)}, {st.late_s:+.1f} s after the gun, "
             f"{st.distance_at_gun_m:.0f} m from the line at the gun "
-            f"({st.side_at_gun} side), {100 * st.line_fraction:.0f}% along it")
+            f"({st.side_at_gun} side), {100 * st.line_fraction:.0f}% along it, "
+            f"{speed_at_gun_kn(a):.1f} kn at the gun"
+            + "".join(f"\n  start: {n}" for n in st.notes))
     cols = f"{'leg':<14}{'mode':<9}{'sailed':>9}{'optimal':>9}{'lost':>8}{'man':>7}" \
            f"{'speed':>7}{'route':>7}{'dist m':>13}{'tk/gb':>11}{'polar%':>7}{'side s/o':>15}"
     rows = [head, "", cols]
     for leg in a.legs:
+        if not leg.known:
+            rows.append(f"{leg.label:<14}{leg.mode:<9}{'unknown':>9}"
+                        f"{_mss(leg.optimal_time_s):>9}{'?':>8}  ({leg.note})")
+            continue
         rows.append(
             f"{leg.label:<14}{leg.mode:<9}{_mss(leg.sailed_time_s):>9}"
             f"{_mss(leg.optimal_time_s):>9}{leg.loss_s:>+8.1f}{leg.split.manoeuvres:>+7.1f}"
@@ -201,27 +259,34 @@ def analysis_table(a: TrackAnalysis) -> str:
             f"{leg.sailed_distance_m:>6.0f}/{leg.optimal_distance_m:<6.0f}"
             f"{leg.sailed_tacks:>3}/{leg.sailed_gybes}:{leg.optimal_tacks}/{leg.optimal_gybes:<3}"
             f"{leg.mean_polar_pct:>7.0f}{leg.side_sailed:>8}/{leg.side_optimal:<6}")
-    tot = [sum(getattr(leg.split, k) for leg in a.legs) for k in ("manoeuvres", "speed",
-                                                                   "route")]
-    rows.append(f"{'total':<14}{'':<9}{_mss(a.sailed_time_s):>9}{_mss(a.optimal_time_s):>9}"
+    tot = [sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed",
+                                                                         "route")]
+    label = "total" if a.complete else f"{len(a.known_legs)} of {len(a.legs)}"
+    rows.append(f"{label:<14}{'':<9}{_mss(a.sailed_time_s):>9}{_mss(a.optimal_time_s):>9}"
                 f"{a.loss_s:>+8.1f}{tot[0]:>+7.1f}{tot[1]:>+7.1f}{tot[2]:>+7.1f}")
     rows.append("(lost = sailed - optimal from the same point and time, split into "
-                "manoeuvres + speed + route; tk/gb sailed:optimal)")
+                "manoeuvres + speed + route; tk/gb sailed:optimal"
+                + ("" if a.complete else "; totals over the legs of known time") + ")")
     if a.track.notes:
         rows.append("track: " + "; ".join(a.track.notes))
     return "\n".join(rows)
 
 
-def fleet_table(rows: Sequence[Mapping[str, Any]]) -> str:
+def fleet_table(rows: Sequence[Mapping[str, Any]], notes: Sequence[str] = ()) -> str:
     """Boats ranked per leg: leg time (rank) and elapsed time (position)."""
     out = ["fleet: leg time (rank) | elapsed from the gun (position) | lost vs optimal"]
+    out += [f"note: {n}" for n in notes]
     leg = None
-    for r in sorted(rows, key=lambda r: (r["leg"], r["leg_rank"])):
+    for r in sorted(rows, key=lambda r: (r["leg"], r["leg_rank"] is None, r["leg_rank"] or 0)):
         if r["leg"] != leg:
             leg = r["leg"]
             out.append(f"leg {leg} ({r['label']})")
-        out.append(f"  {r['leg_rank']}. {r['boat']:<28}{_mss(r['leg_time_s']):>9}  "
-                   f"pos {r['position']} {_mss(r['elapsed_s']):>9}  {r['loss_s']:+.1f} s")
+        rank = f"{r['leg_rank']}." if r["leg_rank"] is not None else "-"
+        pos = r["position"] if r["position"] is not None else "-"
+        lost = f"{r['loss_s']:+.1f} s" if math.isfinite(r["loss_s"]) else "unknown"
+        out.append(f"  {rank:>3} {r['boat']:<28}{_mss(r['leg_time_s']):>9}  "
+                   f"pos {pos} {_mss(r['elapsed_s']):>9}  {lost}"
+                   + (f"  ({r['note']})" if r.get("note") else ""))
     return "\n".join(out)
 
 
@@ -243,25 +308,30 @@ def plot_legs(a: TrackAnalysis) -> Figure:
         m = p.leg == i + 1
         ax.plot(p.x[m], p.y[m], "-", color="tab:blue", lw=1.4, gid=f"sailed:{i + 1}",
                 label=f"sailed {_mss(leg.sailed_time_s)}")
-        o = leg.optimal.track
-        ax.plot(o.x, o.y, "--", color="tab:red", lw=1.4, gid=f"optimal:{i + 1}",
-                label=f"optimal {_mss(leg.optimal_time_s)}")
+        o = leg.optimal.track if leg.optimal is not None else None
+        if o is not None:
+            ax.plot(o.x, o.y, "--", color="tab:red", lw=1.4, gid=f"optimal:{i + 1}",
+                    label=f"optimal {_mss(leg.optimal_time_s)}")
         if leg.manoeuvres:
             idx = [int(np.argmin(np.abs(p.t[m] - mm.t))) for mm in leg.manoeuvres]
             ax.plot(p.x[m][idx], p.y[m][idx], "^", color="black", ms=4, linestyle="none",
                     label="sailed tacks/gybes")
-        xs = np.concatenate([p.x[m], o.x])
-        ys = np.concatenate([p.y[m], o.y])
+        xs = np.concatenate([p.x[m], o.x if o is not None else [], [leg.start_xy[0]]])
+        ys = np.concatenate([p.y[m], o.y if o is not None else [], [leg.start_xy[1]]])
+        xs, ys = xs[np.isfinite(xs)], ys[np.isfinite(ys)]
+        if xs.size == 0:
+            xs, ys = np.array([0.0]), np.array([0.0])
         pad = 0.1 * max(np.ptp(xs), np.ptp(ys), 50.0)
         ax.set_xlim(xs.min() - pad, xs.max() + pad)
         ax.set_ylim(ys.min() - pad, ys.max() + pad)
         ax.set_aspect("equal", adjustable="box")
-        ax.set_title(f"leg {i + 1}: {leg.label} ({leg.mode}), lost {leg.loss_s:+.0f} s",
-                     fontsize=9)
+        lost = f"lost {leg.loss_s:+.0f} s" if leg.known else "time unknown"
+        ax.set_title(f"leg {i + 1}: {leg.label} ({leg.mode}), {lost}", fontsize=9)
         ax.set_xlabel("x [m]", fontsize=8)
         ax.set_ylabel("y [m]", fontsize=8)
         ax.tick_params(labelsize=7)
-        ax.legend(fontsize=7, loc="best")
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, loc="best")
     fig.suptitle(f"{a.track.name}: sailed vs optimal ({a.scenario})", fontsize=10)
     return fig
 
@@ -276,6 +346,8 @@ def plot_loss(a: TrackAnalysis) -> Figure:
     t0 = a.segmentation.start.crossing.t
     ax.plot((p.t - t0) / 60.0, p.loss_s, "-", color="tab:red", lw=1.4, gid="loss")
     for i, leg in enumerate(a.legs):
+        if not leg.known:
+            continue
         ax.axvspan((leg.t_start - t0) / 60, (leg.t_end - t0) / 60, alpha=0.08 if i % 2 else 0.0,
                    color="grey")
         ax.annotate(f"{i + 1}", ((0.5 * (leg.t_start + leg.t_end) - t0) / 60, 0.98),

@@ -15,9 +15,10 @@ tens of milliseconds and nothing of plotly is imported unless a report is writte
 string out, and the same input gives the same bytes (fixed element ids, rounded numbers,
 no timestamps).
 
-Three builders make a :class:`Report`: :func:`plan_report` (``sailroute plan``),
-:func:`comparison_report` (``compare-scenarios`` and ``plan`` on an ensemble) and
-:func:`analysis_report` (``sailroute analyze``); :func:`render_html` turns it into the page.
+Four builders make a :class:`Report`: :func:`plan_report` (``sailroute plan``),
+:func:`comparison_report` (``compare-scenarios`` and ``plan`` on an ensemble),
+:func:`analysis_report` (``sailroute analyze``, one track) and :func:`fleet_report`
+(``sailroute analyze`` with several tracks); :func:`render_html` turns it into the page.
 The figure's JSON sits in ``<script type="application/json" id="sailroute-figure">``,
 so tests and other tools can read exactly what is drawn (:func:`read_figure`).
 
@@ -34,7 +35,7 @@ import json
 import math
 import re
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -82,6 +83,12 @@ page's first zoom (``route.png`` shifts such legs by 4 pt)."""
 """Colour of the wind arrows (a comparison's layers take their scenario's route colour)."""
 ARROW_FILL = 0.85
 """Length of the strongest wind's arrow as a share of the grid spacing."""
+MAX_ROUTE_POINTS = 4000
+"""A sailed track is drawn with at most this many points (every k-th fix, each leg's first
+and last kept): a 3-hour 10 Hz log would otherwise make a page of 100 MB that no browser
+draws; the hover text is at the drawn points."""
+FLEET_STEPS = 60
+"""Slider positions of a fleet's replay."""
 SPEED_SPAN_KN = 2.0
 """Smallest span of a colour scale [kn] (noise does not look like a change)."""
 
@@ -377,8 +384,25 @@ def route_from_plan(plan: Plan, name: str | None = None) -> Route:
     return _route(name or plan.scenario, plan.course, parts, modes, man, side_by_side=True)
 
 
+def decimated(r: Route, max_points: int = MAX_ROUTE_POINTS) -> Route:
+    """``r`` with at most about ``max_points`` points: every k-th one, plus the first and
+    last of each leg (so leg changes stay where they are)."""
+    n = r.t.size
+    if n <= max_points:
+        return r
+    step = math.ceil(n / max_points)
+    change = np.flatnonzero(np.diff(r.leg) != 0)
+    keep = np.unique(np.concatenate([np.arange(0, n, step), change, change + 1, [n - 1]]))
+    cut = {f: getattr(r, f)[keep] for f in ("t", "x", "y", "lat", "lon", "leg", "tws_kn",
+                                             "twa_deg", "speed_kn", "vmg_kn")}
+    if r.lat_shift is not None and r.lon_shift is not None:
+        cut["lat_shift"], cut["lon_shift"] = r.lat_shift[keep], r.lon_shift[keep]
+    return replace(r, **cut)
+
+
 def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
-    """The sailed track (speed over the ground) and the optimal legs from its leg starts."""
+    """The sailed track (speed over the ground; at most :data:`MAX_ROUTE_POINTS` points)
+    and the optimal legs from its leg starts (legs of unknown start left out)."""
     p, course = a.points, a.course
     modes = [leg.mode for leg in a.legs]
     sailed_parts = [{"t": p.t, "x": p.x, "y": p.y, "leg": p.leg, "tws": p.tws_ms / KNOT,
@@ -387,10 +411,12 @@ def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
     for m in (m for leg in a.legs for m in leg.manoeuvres):
         man.append((m.kind, m.t, float(np.interp(m.t, p.t, p.x)),
                     float(np.interp(m.t, p.t, p.y))))
-    sailed = _route(f"sailed: {a.track.name}", course, sailed_parts, modes, man,
-                    speed_name="SOG")
-    opt_parts = [_leg_columns(course, leg.index, leg.optimal, leg.mode) for leg in a.legs]
-    opt_man = [(m.kind, m.t, m.x, m.y) for leg in a.legs for m in leg.optimal.manoeuvres]
+    sailed = decimated(_route(f"sailed: {a.track.name}", course, sailed_parts, modes, man,
+                              speed_name="SOG"))
+    opt_parts = [_leg_columns(course, leg.index, leg.optimal, leg.mode) for leg in a.legs
+                 if leg.optimal is not None]
+    opt_man = [(m.kind, m.t, m.x, m.y) for leg in a.legs if leg.optimal is not None
+               for m in leg.optimal.manoeuvres]
     optimal = _route("optimal from the boat's leg starts", course, opt_parts, modes,
                      opt_man, gaps=True, dash="dash", boat=False)
     return sailed, optimal
@@ -605,6 +631,12 @@ def analysis_report(a: TrackAnalysis) -> Report:
     layers = _layers({a.scenario: a.wind}, course, [sailed, optimal], times)
     rows = []
     for leg in a.legs:
+        if not leg.known:
+            rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
+                         clock(leg.t_start, off) if np.isfinite(leg.t_start) else "unknown",
+                         "unknown", format_duration(leg.optimal_time_s), "-", "-", "-", "-",
+                         "-", "-", leg.note))
+            continue
         rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
                      clock(leg.t_start, off), format_duration(leg.sailed_time_s),
                      format_duration(leg.optimal_time_s), f"{leg.loss_s:+.1f}",
@@ -613,9 +645,10 @@ def analysis_report(a: TrackAnalysis) -> Report:
                      f"{leg.sailed_tacks}/{leg.sailed_gybes} : "
                      f"{leg.optimal_tacks}/{leg.optimal_gybes}",
                      f"{leg.mean_polar_pct:.0f}", f"{leg.side_sailed} / {leg.side_optimal}"))
-    tot = [sum(getattr(leg.split, k) for leg in a.legs) for k in ("manoeuvres", "speed",
-                                                                   "route")]
-    footer = (("", "total", "", "", format_duration(a.sailed_time_s),
+    tot = [sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed",
+                                                                         "route")]
+    footer = (("", "total" if a.complete else f"{len(a.known_legs)} legs of known time", "",
+               "", format_duration(a.sailed_time_s),
                format_duration(a.optimal_time_s), f"{a.loss_s:+.1f}",
                *(f"{v:+.1f}" for v in tot), "", "", ""),)
     table = Table("Legs: sailed against optimal from the same point and time",
@@ -629,7 +662,96 @@ def analysis_report(a: TrackAnalysis) -> Report:
                f"{format_duration(a.optimal_time_s)}, lost {a.loss_s:+.1f} s")
     return Report(f"{course.name} — {a.track.name}", summary, course, (sailed, optimal),
                   tuple(layers), times, (table,),
-                  (HELP, _times_note(course), _wind_note(layers)))
+                  (HELP, *a.notes, _times_note(course), _wind_note(layers)))
+
+
+def _leader(analyses: Sequence[TrackAnalysis]) -> int:
+    """Index of the boat ahead at the last leg end whose time is known for some boat."""
+    for i in reversed(range(min(len(a.legs) for a in analyses))):
+        ends = np.array([a.legs[i].t_end for a in analyses])
+        if np.isfinite(ends).any():
+            return int(np.nanargmin(ends))
+    return 0
+
+
+def _signed(v: float, nd: int = 1) -> str:
+    return f"{v:+.{nd}f}" if math.isfinite(v) else "-"
+
+
+def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, Any]],
+                 notes: Sequence[str] = ()) -> Report:
+    """The page of ``sailroute analyze`` with several tracks.
+
+    Every boat's sailed track on one map with one time slider (a marker per boat), the
+    optimal legs from the *leader's* leg starts (the boat ahead at the last leg end of
+    known time; each boat's own optimal legs are on its own page), the scenario's wind,
+    and three tables: the leg ranking (``rows`` of
+    :func:`sailroute.analyze.fleet_ranking`), the start (time late, distance to the line,
+    side and speed at the gun, over early, line offset) and the loss split per boat and
+    leg.  ``notes`` (fleet-wide) and each boat's own notes go under the map.
+    """
+    course, off = analyses[0].course, analyses[0].course.utc_offset_s
+    sailed = [replace(routes_from_analysis(a)[0], name=a.track.name) for a in analyses]
+    lead = _leader(analyses)
+    opt = replace(routes_from_analysis(analyses[lead])[1],
+                  name=f"optimal from {analyses[lead].track.name}'s leg starts")
+    routes = (*sailed, opt)
+    times = slider_times(sailed, FLEET_STEPS)
+    layers = _layers({analyses[0].scenario: analyses[0].wind}, course, routes, times)
+    names = [a.track.name for a in analyses]
+    by = {(r["leg"], r["boat"]): r for r in rows}
+    rank_rows = []
+    for i, spec in enumerate(course.legs):
+        cells = []
+        for b in names:
+            row = by.get((i + 1, b))
+            if row is None or row["leg_rank"] is None:
+                cells.append("unknown")
+            else:
+                pos = f", pos {row['position']}" if row["position"] is not None else ""
+                cells.append(f"{format_duration(row['leg_time_s'])} ({row['leg_rank']}{pos}) "
+                             f"{_signed(row['loss_s'])} s")
+        rank_rows.append((str(i + 1), spec.label.replace("->", "→"), *cells))
+    ranking = Table("Leg ranking: leg time (rank, position at the leg's end) and time lost "
+                    "against the optimal leg", ("leg", "from → to", *names),
+                    tuple(rank_rows))
+    start_rows = []
+    for a in analyses:
+        st = a.segmentation.start
+        start_rows.append((
+            a.track.name, clock(st.crossing.t, off), f"{st.late_s:+.1f}",
+            f"{st.distance_at_gun_m:.0f} ({st.side_at_gun})",
+            f"{st.speed_at_gun_ms / KNOT:.1f}" if math.isfinite(st.speed_at_gun_ms) else "-",
+            (f"{st.ocs_s:.0f} s" + (", returned" if st.ocs_returned else "")
+             if st.ocs_s is not None else ("returned" if st.ocs_returned else "no")),
+            f"{st.line_offset_m:.0f}", "; ".join(st.notes)))
+    start = Table("Start", ("boat", "start (local)", "late s", "to the line at the gun m",
+                            "speed at the gun kn", "over early", "line offset m", "notes"),
+                  tuple(start_rows))
+    split_rows = []
+    for a in analyses:
+        for leg in a.legs:
+            split_rows.append((a.track.name, str(leg.index + 1), leg.label.replace("->", "→"),
+                               _signed(leg.loss_s), _signed(leg.split.manoeuvres),
+                               _signed(leg.split.speed), _signed(leg.split.route),
+                               leg.note))
+    split = Table("Time lost per boat and leg, split into manoeuvres, speed and route",
+                  ("boat", "leg", "from → to", "lost s", "manoeuvres s", "speed s", "route s",
+                   "note"), tuple(split_rows), collapsed=len(split_rows) > 40)
+    t0 = course.start_epoch
+    summary = (
+        f"{len(analyses)} boats · scenario {analyses[0].scenario} · router "
+        f"{analyses[0].router} · gun {time_label(t0, off)} on {iso(t0 + off)[:10]}",
+        "Sailed (legs of known time): " + ", ".join(
+            f"{a.track.name} {format_duration(a.sailed_time_s)}"
+            + ("" if a.complete else f" ({len(a.known_legs)} of {len(a.legs)} legs)")
+            for a in analyses))
+    page_notes = [HELP, *notes, *(f"{a.track.name}: {n}" for a in analyses for n in a.notes),
+                  "The dashed line is the optimal route of each leg from the leader's own leg "
+                  "start point and time.", _times_note(course), _wind_note(layers)]
+    return Report(f"{course.name} — fleet of {len(analyses)}", summary, course, routes,
+                  tuple(layers), times, (ranking, start, split), tuple(page_notes),
+                  leg_numbers=False, legend_beside=True)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -883,7 +1005,8 @@ def figure(report: Report) -> dict[str, Any]:
         if r.boat:
             states = _boat_states(r, report.times, off, custom)
             st = states[0]
-            data.append({"type": "scatter", "mode": "markers", "name": f"boat: {r.name}",
+            data.append({"type": "scatter", "mode": "markers",
+                         "name": html.escape(f"boat: {r.name}"),
                          "legendgroup": group, "showlegend": False, **st,
                          "marker": {"symbol": "circle", "size": 15,
                                     "color": BOAT_COLOUR if single else colour,
