@@ -559,9 +559,8 @@ def estimate_biases(
     direction offset is the circular mean difference and the speed ratio the
     ratio of mean speeds at that lag.  The per-boat offsets are the weighted
     least-squares solution of the pairwise differences, fixed so that the fleet's
-    median boat has no
-    bias: the consensus is the median boat, so one faulty sensor out of three
-    does not drag the others.
+    median boat has no bias: the consensus is the median boat, so one faulty
+    sensor out of three does not drag the others.
 
     Parameters
     ----------
