@@ -456,8 +456,12 @@ class BoatBias:
     time_offset_s : float
         Measured minus consensus time of the same wind [s].
     n_samples : int
-        Records (1 s steps, summed over the boats it was compared with) behind the
+        Compared records (1 s steps, summed over the boats it was compared with) behind the
         estimate; 0 when the boat overlaps no other boat (no correction).
+    clock_samples : int
+        The part of ``n_samples`` from comparisons whose time offset was identified (a
+        correlation peak inside ``±max_lag_s``, not at its edge); 0: the clock offset is
+        not identified and is left at 0.
     """
 
     boat: str
@@ -465,12 +469,14 @@ class BoatBias:
     direction_offset_deg: float = 0.0
     time_offset_s: float = 0.0
     n_samples: int = 0
+    clock_samples: int = 0
 
     def describe(self) -> str:
         """One line: ``NZL: speed x1.031, direction +2.4°, time +12.0 s (1612 samples)``."""
+        clock = (f"time {self.time_offset_s:+.1f} s" if self.clock_samples else
+                 "time not identified")
         return (f"{self.boat}: speed x{self.speed_factor:.3f}, direction "
-                f"{self.direction_offset_deg:+.1f}°, time {self.time_offset_s:+.1f} s "
-                f"({self.n_samples} samples)")
+                f"{self.direction_offset_deg:+.1f}°, {clock} ({self.n_samples} samples)")
 
 
 def _sample_series(s: MeasuredSeries, t: NDArray) -> tuple[NDArray, NDArray, NDArray]:
@@ -482,8 +488,9 @@ def _sample_series(s: MeasuredSeries, t: NDArray) -> tuple[NDArray, NDArray, NDA
 
 
 def _pair_offsets(a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_overlap: int
-                  ) -> tuple[float, float, float, int] | None:
-    """``(log speed ratio, direction offset [°], time offset [s], n)`` of ``a`` against ``b``."""
+                  ) -> tuple[float, float, float, int, bool] | None:
+    """``(log speed ratio, direction offset [°], time offset [s], n, time identified)`` of
+    ``a`` against ``b``; a best lag at the edge of the search is not identified (lag 0)."""
     t0, t1 = max(a.t[0], b.t[0]), min(a.t[-1], b.t[-1])
     if t1 - t0 < min_overlap:
         return None
@@ -506,8 +513,10 @@ def _pair_offsets(a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_ov
         return None
     score = score - 1e-9 * np.abs(lags)  # a flat score (steady wind) gives lag 0
     k = int(np.argmax(score))
-    lag = float(lags[k])
-    if 0 < k < lags.size - 1 and np.isfinite(score[k - 1]) and np.isfinite(score[k + 1]):
+    identified = bool(0 < k < lags.size - 1 and np.isfinite(score[k - 1])
+                      and np.isfinite(score[k + 1]))
+    lag = float(lags[k]) if identified else 0.0
+    if identified:
         den = score[k - 1] - 2 * score[k] + score[k + 1]
         if den < 0:
             lag += float(np.clip(0.5 * (score[k - 1] - score[k + 1]) / den, -0.5, 0.5))
@@ -516,7 +525,7 @@ def _pair_offsets(a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_ov
     sa, da = wind_speed_direction(ua[m], va[m])
     ddir = _circmean(wrap180(da - db[m]))
     return (float(np.log(np.mean(sa) / np.mean(sb[m]))), float(wrap180(ddir)), lag,
-            int(m.sum()))
+            int(m.sum()), identified)
 
 
 def _circmean(a: NDArray) -> float:
@@ -545,12 +554,13 @@ def estimate_biases(
     Every pair of boats that overlaps in time for at least ``min_overlap_s`` is
     compared on a 1 s grid: the time offset maximises the correlation of the
     two direction and speed series (lags up to ``±max_lag_s``, refined to a
-    fraction of a second by a parabola), then the direction offset is the
-    circular mean difference and the speed ratio the ratio of mean speeds at
-    that lag.  The per-boat offsets are the weighted least-squares solution of
-    the pairwise differences, fixed so that the fleet's median boat has no
-    bias: the consensus is the median boat, so one faulty sensor out of three
-    does not drag the others.
+    fraction of a second by a parabola; a best lag at the edge of the search is
+    not identified and that pair does not enter the clock offsets), then the
+    direction offset is the circular mean difference and the speed ratio the
+    ratio of mean speeds at that lag.  The per-boat offsets are the weighted
+    least-squares solution of the pairwise differences, fixed so that the fleet's
+    median boat has no bias: the consensus is the median boat, so one faulty
+    sensor out of three does not drag the others.
 
     Parameters
     ----------
@@ -568,7 +578,7 @@ def estimate_biases(
         overlaps no other).
     """
     n = len(series)
-    rows: list[tuple[int, int, float, float, float, int]] = []
+    rows: list[tuple[int, int, float, float, float, int, bool]] = []
     for i in range(n):
         for j in range(i + 1, n):
             r = _pair_offsets(series[i], series[j], max_lag_s, int(min_overlap_s))
@@ -577,23 +587,27 @@ def estimate_biases(
     if not rows:
         return tuple(BoatBias(s.boat) for s in series)
     count = np.zeros(n, int)
-    for i, j, *_, m in rows:
+    clock = np.zeros(n, int)
+    for i, j, *_, m, ident in rows:
         count[i] += m
         count[j] += m
+        clock[i] += m * ident
+        clock[j] += m * ident
     sol = []
-    for q in range(3):  # log speed ratio, direction, time
+    for q, used in ((0, count), (1, count), (2, clock)):  # log speed ratio, direction, time
         a = np.zeros((len(rows) + 1, n))
         rhs = np.zeros(len(rows) + 1)
-        for k, (i, j, *vals, m) in enumerate(rows):
-            w = np.sqrt(m)
+        for k, (i, j, *vals, m, ident) in enumerate(rows):
+            w = np.sqrt(m) if (q < 2 or ident) else 0.0
             a[k, i], a[k, j], rhs[k] = w, -w, w * vals[q]
-        a[-1, count > 0] = 1.0  # gauge (replaced by the median below)
+        a[-1, used > 0] = 1.0  # gauge (replaced by the median below)
         x = np.linalg.lstsq(a, rhs, rcond=None)[0]
-        x[count > 0] -= np.median(x[count > 0])
-        x[count == 0] = 0.0
+        if (used > 0).any():
+            x[used > 0] -= np.median(x[used > 0])
+        x[used == 0] = 0.0
         sol.append(x)
     return tuple(BoatBias(s.boat, float(np.exp(sol[0][k])), float(sol[1][k]), float(sol[2][k]),
-                          int(count[k])) for k, s in enumerate(series))
+                          int(count[k]), int(clock[k])) for k, s in enumerate(series))
 
 
 def apply_bias(series: MeasuredSeries, bias: BoatBias) -> MeasuredSeries:

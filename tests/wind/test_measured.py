@@ -193,7 +193,12 @@ def test_bias_recovery_on_synthetic_sensors() -> None:
     for ok in b[:2]:  # the consensus is the median boat: the biased one does not drag them
         assert ok.speed_factor == pytest.approx(1.0, rel=0.01)
         assert abs(ok.direction_offset_deg) < 0.5 and abs(ok.time_offset_s) < 1.0
-    assert all(x.n_samples > 2000 for x in b)
+    assert all(x.n_samples > 2000 and x.clock_samples == x.n_samples for x in b)
+    # a clock offset beyond the search peaks at its edge: not identified, not corrected
+    short = estimate_biases(_analytic_boats(), max_lag_s=8.0)
+    assert short[2].clock_samples < short[2].n_samples
+    assert all(x.time_offset_s == 0.0 for x in short if x.clock_samples == 0)
+    assert short[2].time_offset_s == 0.0 and "time not identified" in short[2].describe()
     fw = fleet_wind(_analytic_boats(), FRAME)
     assert fw.biases == b
     assert any(n.startswith("bias B2: speed x1.09") for n in fw.notes)
@@ -300,12 +305,12 @@ def test_sailgp_default_beats_the_sensor_mean_leaving_one_boat_out() -> None:
     pooled = {r.label: r for r in rows if r.boat == "pooled"}
     d, m = pooled["default"], pooled["mean"]
     assert d.n == m.n > 1800
-    # measured (benchmarks/bench_fleet_wind.py --smoke): 1.571 kn / 3.71 deg vs 1.875 kn / 3.96 deg
-    assert d.speed_rms_kn == pytest.approx(1.571, abs=0.03)
-    assert d.dir_mae_deg == pytest.approx(3.71, abs=0.1)
-    assert m.speed_rms_kn == pytest.approx(1.875, abs=0.03)
+    # measured (benchmarks/bench_fleet_wind.py --smoke): 1.526 kn / 3.61 deg vs 1.877 kn / 3.96 deg
+    assert d.speed_rms_kn == pytest.approx(1.526, abs=0.03)
+    assert d.dir_mae_deg == pytest.approx(3.61, abs=0.1)
+    assert m.speed_rms_kn == pytest.approx(1.877, abs=0.03)
     assert m.dir_mae_deg == pytest.approx(3.96, abs=0.1)
-    assert d.speed_rms_kn < m.speed_rms_kn - 0.2 and d.dir_mae_deg < m.dir_mae_deg
+    assert d.speed_rms_kn < m.speed_rms_kn - 0.25 and d.dir_mae_deg < m.dir_mae_deg - 0.2
 
 
 # ------------------------------------------------------------------------------ course spec
