@@ -13,7 +13,7 @@ leg start point and time to the same target in the scenario's wind
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -55,6 +55,8 @@ from sailroute.track.read import read_track
 from sailroute.units import KNOT, bearing_deg, signed_twa, wind_speed_direction
 from sailroute.wind.base import WindField
 
+REFERENCES = ("course", "fleet")
+"""Values of ``analyze --reference``: the course's polar, or it scaled to the fleet."""
 NEAR_COURSE_M = 3000.0
 """During the race the track must come this close to a mark [m], or it is another place."""
 SMOOTH_S = 3.0
@@ -208,7 +210,10 @@ class TrackAnalysis:
     legs : tuple of LegAnalysis
     points : PointTable
     wind : WindField
-        The scenario's wind (for plots).
+        The wind of the first leg (for plots).
+    reference : str
+        The polar the boat is judged against: ``"course polar <name>"`` or the
+        fleet-relative polar's description (:mod:`sailroute.analysis.fleetpolar`).
     """
 
     course: Course
@@ -219,6 +224,7 @@ class TrackAnalysis:
     legs: tuple[LegAnalysis, ...]
     points: PointTable
     wind: WindField
+    reference: str = ""
 
     @property
     def known_legs(self) -> tuple[LegAnalysis, ...]:
@@ -809,11 +815,14 @@ class AnalyzeResult:
         The terminal tables.
     files : mapping of str to Path
     analyses : tuple of TrackAnalysis
+    notes : tuple of str
+        What the run found about the wind and the reference polar.
     """
 
     report: str
     files: Mapping[str, Path]
     analyses: tuple[TrackAnalysis, ...]
+    notes: tuple[str, ...] = ()
 
 
 def run_analyze_command(
@@ -831,6 +840,8 @@ def run_analyze_command(
     plots: bool = True,
     progress: Progress | None = None,
     gate_end: str = "line",
+    wind: str = "auto",
+    reference: str = "course",
 ) -> AnalyzeResult:
     """Everything ``sailroute analyze`` does, minus printing.
 
@@ -842,7 +853,13 @@ def run_analyze_command(
     ``out/<course>/analysis-<track stem>``).  Several: the same per boat in
     ``out_dir/<track stem>/`` plus ``fleet.csv`` and ``fleet.json`` (default
     ``out/<course>/analysis-fleet``).
+
+    ``wind`` chooses the wind each leg is judged in (:func:`analysis_winds`);
+    ``reference="fleet"`` judges every boat against the course's polar scaled to what
+    the fleet sails (:func:`sailroute.analysis.fleetpolar.fleet_polar`): the boats are
+    analysed twice.
     """
+    from sailroute.analysis.fleetpolar import fleet_polar
     from sailroute.outdir import check_out_dir, write_output_set
     from sailroute.plan import _loaded
     from sailroute.report.analysis import (
@@ -856,6 +873,9 @@ def run_analyze_command(
     course = _loaded(course)
     if not tracks:
         raise InputError("analyze: give at least one track file")
+    if reference not in REFERENCES:
+        raise InputError(f"--reference: expected one of {', '.join(REFERENCES)}; "
+                         f"got {reference!r}")
     name = default_scenario(course) if scenario is None else scenario
     stems = _unique_stems(tracks)
     times = parse_boat_leg_times(leg_times, stems, course.n_legs)
@@ -867,18 +887,34 @@ def run_analyze_command(
                        name=s) for p, s in zip(tracks, stems, strict=True)]
     settings_for(course, router)
     boat, winds = build_specs(course, [name])
-    analyses = []
-    for tr in read:
-        if progress is not None:
-            progress.set_prefix(f"{tr.name}: ")
-        analyses.append(analyze_track(course, tr, name, leg_times=times[tr.name],
-                                      router=router, detect_m=detect_m,
-                                      built=(boat, winds[name]), progress=progress,
-                                      missing="error" if len(read) == 1 else "unknown",
-                                      gate_end=gate_end))
+    polar = boat.routing_polar()
+    if reference == "fleet" and polar is None:
+        raise InputError("--reference fleet scales a polar; the course's boat has none (a "
+                         "dynamic boat model): use --reference course")
+    sources, notes = analysis_winds(course, read, name, winds[name], boat, wind)
+
+    def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
+        out_a = []
+        for tr in read:
+            if progress is not None:
+                progress.set_prefix(f"{tr.name}: ")
+            a = analyze_track(course, tr, name, leg_times=times[tr.name], router=router,
+                              detect_m=detect_m, built=(judged_by, winds[name]),
+                              winds=sources[tr.name], progress=progress,
+                              missing="error" if len(read) == 1 else "unknown",
+                              gate_end=gate_end)
+            out_a.append(replace(a, reference=label))
+        return out_a
+
+    analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())
+    if reference == "fleet":
+        fp = fleet_polar(analyses, polar)
+        notes.append(fp.describe())
+        analyses = analyse_all(fp.polar, fp.describe())
     if len(analyses) == 1:
         files = write_output_set(out, lambda d: write_analysis(d, analyses[0], plots=plots))
-        return AnalyzeResult(analysis_table(analyses[0]), files, tuple(analyses))
+        return AnalyzeResult("\n\n".join([analysis_table(analyses[0]), _notes_text(notes)]),
+                             files, tuple(analyses), tuple(notes))
     rows = fleet_ranking(analyses)
 
     def write(d: Path) -> dict[str, Path]:
@@ -890,8 +926,13 @@ def run_analyze_command(
         return files
 
     report = "\n\n".join([*(analysis_table(a) for a in analyses),
-                           fleet_table(rows, fleet_notes(analyses))])
-    return AnalyzeResult(report, write_output_set(out, write), tuple(analyses))
+                           fleet_table(rows, fleet_notes(analyses)), _notes_text(notes)])
+    return AnalyzeResult(report, write_output_set(out, write), tuple(analyses), tuple(notes))
+
+
+def _notes_text(notes: Sequence[str]) -> str:
+    """The run's wind and reference notes, one per line."""
+    return "\n".join(f"note: {n}" for n in notes)
 
 
 def _unique_stems(paths: Sequence[str | Path]) -> list[str]:

@@ -680,6 +680,19 @@ def analyze_command(
                      help="A gate leg ends passing between the marks (line) or having "
                           "rounded the chosen mark (rounding, as official leg counters)."),
     ] = "line",
+    wind: Annotated[
+        Literal["auto", "measured", "inferred", "scenario"],
+        typer.Option("--wind", case_sensitive=False,
+                     help="Wind each leg is judged in: auto (the boat's measured wind, the "
+                          "fleet's, the wind inferred from the tracks, then the scenario), "
+                          "measured, inferred or scenario."),
+    ] = "auto",
+    reference: Annotated[
+        Literal["course", "fleet"],
+        typer.Option("--reference", case_sensitive=False,
+                     help="Polar the boats are judged against: the course's, or it scaled "
+                          "to what the fleet sails (fleet)."),
+    ] = "course",
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -703,7 +716,7 @@ def analyze_command(
                 loaded, tracks, scenario=scenario, router=router, out_dir=out,
                 leg_times=leg_times, columns=columns or None, speed_unit=speed_unit,
                 time_zone=time_zone, plots=not no_plots, progress=progress,
-                gate_end=gate_end)
+                gate_end=gate_end, wind=wind, reference=reference)
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("analysis_json", "fleet_json"))
 

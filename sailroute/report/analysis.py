@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from sailroute import __version__
+from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.report.files import _num, _point
 from sailroute.timeutil import iso
 from sailroute.units import KNOT
@@ -244,8 +245,11 @@ def analysis_table(a: TrackAnalysis) -> str:
             f"({st.side_at_gun} side), {100 * st.line_fraction:.0f}% along it, "
             f"{speed_at_gun_kn(a):.1f} kn at the gun"
             + "".join(f"\n  start: {n}" for n in st.notes))
+    if a.reference:
+        head += f"\njudged against: {a.reference}"
     cols = f"{'leg':<14}{'mode':<9}{'sailed':>9}{'optimal':>9}{'lost':>8}{'man':>7}" \
-           f"{'speed':>7}{'route':>7}{'dist m':>13}{'tk/gb':>11}{'polar%':>7}{'side s/o':>15}"
+           f"{'speed':>7}{'route':>7}{'dist m':>13}{'tk/gb':>11}{'polar%':>7}{'side s/o':>15}" \
+           f"  {'wind':<9}"
     rows = [head, "", cols]
     for leg in a.legs:
         if not leg.known:
@@ -258,7 +262,8 @@ def analysis_table(a: TrackAnalysis) -> str:
             f"{leg.split.speed:>+7.1f}{leg.split.route:>+7.1f}"
             f"{leg.sailed_distance_m:>6.0f}/{leg.optimal_distance_m:<6.0f}"
             f"{leg.sailed_tacks:>3}/{leg.sailed_gybes}:{leg.optimal_tacks}/{leg.optimal_gybes:<3}"
-            f"{leg.mean_polar_pct:>7.0f}{leg.side_sailed:>8}/{leg.side_optimal:<6}")
+            f"{leg.mean_polar_pct:>6.0f}{'*' if leg.above_polar else ' '}"
+            f"{leg.side_sailed:>8}/{leg.side_optimal:<6}  {leg.wind_source:<9}")
     tot = [sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed",
                                                                          "route")]
     label = "total" if a.complete else f"{len(a.known_legs)} of {len(a.legs)}"
@@ -267,6 +272,14 @@ def analysis_table(a: TrackAnalysis) -> str:
     rows.append("(lost = sailed - optimal from the same point and time, split into "
                 "manoeuvres + speed + route; tk/gb sailed:optimal"
                 + ("" if a.complete else "; totals over the legs of known time") + ")")
+    if any(leg.above_polar for leg in a.legs):
+        rows.append(f"* sailed above {ABOVE_POLAR_PCT:.0f} % of the polar: the polar stands in "
+                    "for another class, or the wind is wrong (too light); these losses are not "
+                    "a debrief (try --reference fleet)")
+    winds = dict.fromkeys(f"{leg.wind_source}: {leg.wind_label}" for leg in a.legs
+                          if leg.wind_label)
+    if winds:
+        rows.append("wind: " + "; ".join(winds))
     if a.track.notes:
         rows.append("track: " + "; ".join(a.track.notes))
     return "\n".join(rows)
