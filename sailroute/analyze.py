@@ -372,7 +372,10 @@ def analyze_track(
     loss_before = 0.0
     for i, spec in enumerate(course.legs):
         a, b = bounds[i], bounds[i + 1]
-        inner = (t > a.t_hi) & (t < b.t_lo)  # none when an end was never found (NaN)
+        # the fixes strictly between the crossings; after a gap from its first fix on;
+        # none when an end was never found (NaN)
+        inner = ((t > a.t) if a.known else (t >= a.t_hi)) & ((t < b.t) if b.known else
+                                                             (t <= b.t_lo))
         ka, kb = [a] if a.known else [], [b] if b.known else []
         tl = np.concatenate([[c.t for c in ka], t[inner], [c.t for c in kb]])
         xl = np.concatenate([[c.x for c in ka], x[inner], [c.x for c in kb]])
@@ -487,8 +490,8 @@ def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing], wind: WindF
     if a.known:
         mode = leg_wind_mode(wind, a.t, (a.x, a.y), centre)
         opt = _optimal_leg(course, i, bounds, wind, boat, settings, target, progress)
-    note = (b.note if not b.known else
-            f"leg {i + 1} ({spec.label}) starts at an unknown time: time unknown")
+    note = (b.note if not b.known else f"leg {i + 1} ({spec.label}) starts at an unknown time "
+            f"(leg {i} ended in a data gap): sailed time unknown")
     return LegAnalysis(
         index=i, label=spec.label, mode=mode, t_start=a.t, t_end=b.t, start_xy=(a.x, a.y),
         end_xy=(b.x, b.y), detected=b.detected, sailed_time_s=nan,
