@@ -490,7 +490,10 @@ def _leg_points(t: NDArray, x: NDArray, y: NDArray, a: Crossing, b: Crossing
                 ) -> tuple[NDArray, NDArray, NDArray]:
     """The track points of one leg, with its start and end crossings (when known) as
     first and last; none inside a data gap an end lies in."""
-    inner = (t > a.t_hi) & (t < b.t_lo)  # none when an end was never found (NaN)
+    # the fixes strictly between the crossings; after a gap from its first fix on;
+    # none when an end was never found (NaN)
+    inner = ((t > a.t) if a.known else (t >= a.t_hi)) & ((t < b.t) if b.known else
+                                                         (t <= b.t_lo))
     ka, kb = [a] if a.known else [], [b] if b.known else []
     return (np.concatenate([[c.t for c in ka], t[inner], [c.t for c in kb]]),
             np.concatenate([[c.x for c in ka], x[inner], [c.x for c in kb]]),
@@ -680,8 +683,8 @@ def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing], source: Win
         opt, source = _optimal_leg(course, i, bounds, [source], 0,
                                    (np.array([a.t]), np.array([a.x]), np.array([a.y])),
                                    boat, settings, target, progress)
-    note = (b.note if not b.known else
-            f"leg {i + 1} ({spec.label}) starts at an unknown time: time unknown")
+    note = (b.note if not b.known else f"leg {i + 1} ({spec.label}) starts at an unknown time "
+            f"(leg {i} ended in a data gap): sailed time unknown")
     return LegAnalysis(
         index=i, label=spec.label, mode=mode, t_start=a.t, t_end=b.t, start_xy=(a.x, a.y),
         end_xy=(b.x, b.y), detected=b.detected, sailed_time_s=nan,

@@ -155,7 +155,8 @@ class StartReport:
     distance_at_gun_m : float
         Distance from the start line (segment) at the gun [m].
     side_at_gun : {"pre-start", "course"}
-        Side of the line the boat was on at the gun (course side = over early).
+        Side of the line the boat was on at the gun (course side = over early: abreast of
+        the line or its :data:`START_EXTENSION_M` extension, on the course side).
     line_fraction : float
         Where on the line the boat crossed: 0 at its first end, 1 at its second
         (outside [0, 1]: on the line's extension).
@@ -411,7 +412,9 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
     wide = _extended(sg, START_EXTENSION_M)
     gx, gy = _point_at(t, x, y, gun)
     _, dist = _segment_offset(sg, gx, gy)
-    over = t[0] <= gun <= t[-1] and _side(sg, gx, gy) > 0
+    # over: on the course side at the gun, abreast of the line or its searched extension
+    abreast = 0.0 <= _segment_offset(wide, gx, gy)[0] <= 1.0
+    over = t[0] <= gun <= t[-1] and abreast and _side(sg, gx, gy) > 0
     feat0 = course.feature(course.legs[0].from_name)
     line = (sg if isinstance(feat0, Mark) else
             TargetGeometry(feat0.a.xy, feat0.b.xy, sg.normal, "line", sg.name))

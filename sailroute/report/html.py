@@ -1129,7 +1129,7 @@ def _json_for_script(obj: Any) -> str:
 
 _LEFT = ' class="l"'
 _TEXT_COLUMNS = ("from → to", "mode", "start point", "tacks/gybes sailed : optimal",
-                 "side sailed / optimal")
+                 "side sailed / optimal", "boat", "note", "notes")
 """Table columns aligned left (text); the others are numbers, aligned right."""
 
 
