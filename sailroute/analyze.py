@@ -421,7 +421,7 @@ def analyze_track(
         centre = target.centre if target.kind != "mark" else feature_centre(
             course.feature(spec.to_name))
         if not (a.known and b.known):
-            leg = _unknown_leg(course, i, bounds, sources[chosen[i]], boat, settings, target,
+            leg = _unknown_leg(course, i, bounds, sources, chosen[i], boat, settings, target,
                                centre, progress)
             legs.append(leg)
             for k, v in (("leg", np.full(tl.size, i + 1)), ("t", tl), ("x", xl), ("y", yl),
@@ -668,9 +668,10 @@ def _optimal_leg(course: Course, i: int, bounds: Sequence[Crossing],
     return opt, sources[k]
 
 
-def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing], source: WindSource,
-                 boat: Any, settings: RoutingSettings, target: Any,
-                 centre: tuple[float, float], progress: Progress | None) -> LegAnalysis:
+def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing],
+                 sources: Sequence[WindSource], k: int, boat: Any, settings: RoutingSettings,
+                 target: Any, centre: tuple[float, float], progress: Progress | None
+                 ) -> LegAnalysis:
     """A leg whose start or end time is unknown: no sailed time, loss or split; the
     optimal route when the start is known."""
     nan = float("nan")
@@ -678,11 +679,15 @@ def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing], source: Win
     a, b = bounds[i], bounds[i + 1]
     opt = None
     mode = ""
+    source = sources[k]
     if a.known:
-        mode = leg_wind_mode(source.field, a.t, (a.x, a.y), centre)
-        opt, source = _optimal_leg(course, i, bounds, [source], 0,
-                                   (np.array([a.t]), np.array([a.x]), np.array([a.y])),
-                                   boat, settings, target, progress)
+        start_pt = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
+        k = first_covering(sources, *start_pt, skip=k - 1)
+        if k is None:
+            k = len(sources) - 1
+        mode = leg_wind_mode(sources[k].field, a.t, (a.x, a.y), centre)
+        opt, source = _optimal_leg(course, i, bounds, sources, k, start_pt, boat, settings,
+                                   target, progress)
     note = (b.note if not b.known else f"leg {i + 1} ({spec.label}) starts at an unknown time "
             f"(leg {i} ended in a data gap): sailed time unknown")
     return LegAnalysis(
