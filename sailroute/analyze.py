@@ -38,7 +38,12 @@ from sailroute.analysis.segment import (
     leg_target,
     segment_track,
 )
-from sailroute.analysis.windsource import ABOVE_POLAR_PCT, WindSource, first_covering
+from sailroute.analysis.windsource import (
+    ABOVE_POLAR_PCT,
+    WindSource,
+    covers,
+    first_covering,
+)
 from sailroute.course.geometry import feature_centre, leg_wind_mode
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
@@ -55,6 +60,9 @@ from sailroute.track.read import read_track
 from sailroute.units import KNOT, bearing_deg, signed_twa, wind_speed_direction
 from sailroute.wind.base import WindField
 
+BRIDGE_S = 1e9
+"""Hole limit of the measured winds the routers sample [s]: no hole (see
+:attr:`sailroute.analysis.windsource.WindSource.route_field`)."""
 REFERENCES = ("course", "fleet")
 """Values of ``analyze --reference``: the course's polar, or it scaled to the fleet."""
 NEAR_COURSE_M = 3000.0
@@ -573,12 +581,16 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
             except InputError as exc:
                 notes.append(f"{tr.name}: no measured wind ({exc})")
                 continue
-            own[tr.name] = WindSource("measured", boat_wind(series[tr.name], frame),
-                                      f"measured on board ({series[tr.name].source})")
+            own[tr.name] = WindSource(
+                "measured", boat_wind(series[tr.name], frame),
+                f"measured on board ({series[tr.name].source})",
+                route_field=boat_wind(series[tr.name], frame, max_gap_s=BRIDGE_S))
         if len(series) >= 2:
             fw = fleet_wind(list(series.values()), frame)
             fleet = WindSource("fleet", fw.field,
-                               f"measured by the fleet ({len(series)} boats, biases removed)")
+                               f"measured by the fleet ({len(series)} boats, biases removed)",
+                               route_field=fleet_wind(list(series.values()), frame,
+                                                      max_gap_s=BRIDGE_S).field)
             notes.extend(fw.notes)
             t0, t1 = course.start_epoch, course.start_epoch + course.time_limit_s
             parts = []
@@ -655,9 +667,12 @@ def _optimal_leg(course: Course, i: int, bounds: Sequence[Crossing],
         progress.start_leg(i, spec.label)
     while True:
         try:
-            opt = route_leg(start, target, a.t, sources[k].field, boat, settings,
+            opt = route_leg(start, target, a.t, sources[k].for_routing, boat, settings,
                             progress=progress.update if progress is not None else None)
-            break
+            tr = opt.track
+            if sources[k].route_field is None or covers(sources[k].field, tr.t, tr.x, tr.y):
+                break
+            sources[k].field.sample(tr.t, tr.x, tr.y)  # raises: the route crosses a hole
         except OutOfCoverageError:
             nxt = first_covering(sources, *points, skip=k)
             if nxt is None:

@@ -53,11 +53,22 @@ class WindSource:
     label : str
         What it is, for reports ("measured on board (TWS/TWD columns)",
         "scenario 'constant'").
+    route_field : WindField, optional
+        The same wind with its holes bridged, for the routers: their look-ahead samples
+        the wind along the way to the target far beyond the route's own time, and a
+        hole there says nothing about the route.  The routed track itself is then
+        checked against :attr:`field` (:func:`route_covered`).
     """
 
     kind: str
     field: WindField
     label: str
+    route_field: WindField | None = None
+
+    @property
+    def for_routing(self) -> WindField:
+        """The field a router samples (:attr:`route_field`, else :attr:`field`)."""
+        return self.route_field if self.route_field is not None else self.field
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
