@@ -192,8 +192,10 @@ class InferredWind:
             raise InputError(f"InferredWind: {', '.join(bad) or 't'} must be 1-D arrays of the "
                              f"length of t ({n}); build it with infer_wind")
         if not isinstance(self.half_angles_deg, MappingProxyType):
-            object.__setattr__(self, "half_angles_deg",
-                               MappingProxyType(dict(self.half_angles_deg)))
+            raise TypeError(
+                "InferredWind.half_angles_deg must be a read-only mapping "
+                f"(types.MappingProxyType), got {type(self.half_angles_deg).__name__}; "
+                "pass MappingProxyType(dict(half_angles))")
 
     def field(self, frame: LocalFrame | None = None, tws_ms: float | None = None,
               *, clamp: bool = False) -> InferredWindField:
@@ -889,7 +891,7 @@ def infer_wind(
               f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
               + ("; TWS from the polar" if boat is not None else "; TWS not inferred (no polar)"))
     return InferredWind(tg, twd, sd, tws, tws_sd, n.astype(np.int64), method, tuple(notes),
-                        half)
+                        MappingProxyType(half))
 
 
 def _seconds_in_window(tg: NDArray, t: NDArray, h: float) -> NDArray[np.float64]:
