@@ -140,6 +140,8 @@ MAX_SPAN_S: Final = 6 * 3600.0
 """Longest time span inferred in one call [s] (one race, or one evening's races)."""
 MAX_APART_M: Final = 20_000.0
 """Tracks whose mean positions lie further apart than this [m] are refused."""
+MIN_BOARD_POINTS: Final = 20
+"""Steady points needed on each upwind board (all boats together)."""
 MIN_OBS_S: Final = 20.0
 """A grid time needs at least this many seconds of observations in its window."""
 MAX_SD_DEG: Final = 15.0
@@ -805,10 +807,11 @@ def infer_wind(
     if prior_twd_deg is not None:
         twd_axis = min(cands, key=lambda c: abs(float(wrap180(c - prior_twd_deg))))
         off = float(wrap180(twd_axis - prior_twd_deg))
-        how = f"up/down from the prior TWD {prior_twd_deg:.0f}° (tracks' axis {off:+.0f}° off it)"
+        prior = float(wrap360(prior_twd_deg))
+        how = f"up/down from the prior TWD {prior:.0f}° (tracks' axis {off:+.0f}° off it)"
         if abs(off) > 60.0:
             notes.append(f"the tracks' wind axis lies {off:+.0f}° from the prior "
-                         f"{prior_twd_deg:.0f}°: check the prior")
+                         f"{prior:.0f}°: check the prior")
     else:
         twd_axis, how = _upwind_end(p, cands)
     notes.append(f"wind axis {wrap360(twd_axis):.0f}° (symmetry contrast {strength:.2f}); {how}")
@@ -832,10 +835,19 @@ def infer_wind(
                      gamma_prior_sd=g_sd,
                      alpha_sd_fixed=fit_up.alpha_sd)
     n_up, n_dn = int(fit.up.sum()), int((fit.used & ~fit.up).sum())
-    if n_up + n_dn < 60:
+    n_stbd = int((fit_up.up & (fit_up.side > 0)).sum())
+    n_port = int((fit_up.up & (fit_up.side < 0)).sum())
+    if n_stbd + n_port < MIN_BOARD_POINTS and n_dn >= 60:
         raise InputError(
-            f"infer_wind: only {n_up} upwind and {n_dn} downwind steady points; the tracks "
-            "hold too few board courses to infer a direction (reaches are not used)")
+            f"infer_wind: no upwind boards with the wind from {wrap360(twd_axis):.0f}° "
+            f"({how}), but {n_dn} points on downwind boards: the wind more likely comes from "
+            f"the other end of the axis, {wrap360(twd_axis + 180.0):.0f}°; check "
+            "prior_twd_deg")
+    if n_up + n_dn < 60 or min(n_stbd, n_port) < MIN_BOARD_POINTS:
+        raise InputError(
+            f"infer_wind: {n_stbd} starboard and {n_port} port upwind points, {n_dn} downwind "
+            f"(need {MIN_BOARD_POINTS} on each upwind board): the wind cannot be told from "
+            "one course; give a span with at least one beat sailed on both tacks")
     # 3. the output grid
     tg = np.arange(t0, t1 + 1e-6, step_s)
     h = 0.5 * window_s

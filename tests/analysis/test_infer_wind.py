@@ -178,9 +178,10 @@ def test_without_a_prior_the_wider_boards_are_upwind(routes) -> None:
     iw = infer_wind(trs, FRAME)
     np.testing.assert_allclose(iw.twd_deg, infer_wind(trs, FRAME, prior_twd_deg=BASE).twd_deg)
     assert any("up/down from the boards' separation" in n for n in iw.notes)
-    # a prior on the wrong end turns the answer round (and says so)
-    iw2 = infer_wind(trs, FRAME, prior_twd_deg=BASE + 180.0)
-    assert abs(float(wrap180(np.nanmean(iw2.twd_deg) - BASE - 180.0))) < 5.0
+    # a prior on the wrong end finds no beats, and says where the wind more likely is
+    with pytest.raises(InputError, match=r"no upwind boards with the wind from 20° "
+                       r"\(up/down from the prior TWD 20°.*other end of the axis, 200°"):
+        infer_wind(trs, FRAME, prior_twd_deg=BASE + 180.0)
 
 
 def test_half_separation_tells_beats_from_runs() -> None:
@@ -272,6 +273,9 @@ def test_bad_input_is_refused(routes) -> None:
         infer_wind(tr, FRAME, t0=T0 + 100.0, t1=T0 + 100.0)
     with pytest.raises(InputError, match=r"only \d+ steady points"):
         infer_wind(tr, FRAME, t0=T0, t1=T0 + 40.0)
+    # the first 160 s: starboard only, before the first tack
+    with pytest.raises(InputError, match=r"upwind points.*cannot be told from one course"):
+        infer_wind(tr, FRAME, t0=T0, t1=T0 + 160.0)
     with pytest.raises(InputError, match=r"is 30\.0 h, more than 6 h \(tracks of different days"):
         infer_wind(tr, FRAME, t0=T0, t1=T0 + 30 * 3600.0)
     far = as_track(tuple(np.asarray(a) + (0.0, 3e4, 0.0)[i] for i, a in enumerate(
