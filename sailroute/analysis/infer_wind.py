@@ -896,8 +896,12 @@ def infer_wind(
         down = (f"runs (downwind held at 180°, {RUN_WEIGHT:g} weight)"
                 if abs(fit.gamma[k]) < RUN_GAMMA_DEG and fit.gamma_sd[k] < 0.01 else
                 f"gybing half-angle {180.0 - fit.gamma[k]:.1f} ± {fit.gamma_sd[k]:.1f}°")
+        weak = (f" (weakly determined by the track: leans on its prior {a0:.0f}° ± "
+                f"{a_sd:.0f}°{', the polar' if boat is not None else ''})"
+                if fit.alpha_sd[k] > 0.5 * a_sd else "")
         notes.append(f"{names[k]}: tacking half-angle {fit.alpha[k]:.1f} ± "
-                     f"{fit.alpha_sd[k]:.1f}°, {down} ({nk_up} upwind, {nk_dn} downwind points)")
+                     f"{fit.alpha_sd[k]:.1f}°{weak}, {down} ({nk_up} upwind, {nk_dn} downwind "
+                     "points)")
     method = (f"inferred from {K} track(s): {n_up} upwind and {n_dn} downwind board points "
               f"(course ± fitted half-angles), window {window_s:.0f} s, "
               f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
