@@ -579,13 +579,33 @@ def _mad(r: NDArray) -> float:
     return float(1.4826 * np.median(np.abs(r - np.median(r))))
 
 
-def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float
-                  ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float,
+                  infl: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Local-linear kernel regression of ``v(t)`` at ``tg`` (tricube, half-width ``h``).
 
-    Returns the estimate, the equivalent-kernel weights' sums ``sum l^2 w^-1``-style
-    variance factor (see caller), the count of points in the window and the seconds of
-    data behind each estimate.  Vectorised over a dense (grid x points) matrix in blocks.
+    Parameters
+    ----------
+    tg : ndarray
+        Grid times [s].
+    t, v, w : ndarray
+        Sorted point times [s], values and weights.
+    h : float
+        Kernel half-width [s].
+    infl : ndarray
+        Variance inflation of each point (1 / its share of an independent observation).
+
+    Returns
+    -------
+    est : ndarray
+        The estimate at each grid time (NaN without points); the local mean where the
+        window has points on one side only.
+    var : ndarray
+        Its variance, ``sum l_i² r_i² infl_i`` with ``l`` the equivalent kernel and ``r``
+        the residuals about the local fit.
+    n : ndarray of int
+        Points in the window.
+    mu2 : ndarray
+        ``sum l_i (t_i − tg)²``, the kernel's second moment (for the smoothing bias).
     """
     G = tg.size
     est = np.full(G, np.nan)
@@ -593,7 +613,7 @@ def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float
     n = np.zeros(G, np.int64)
     mu2 = np.full(G, np.nan)
     order = np.argsort(t)
-    t, v, w = t[order], v[order], w[order]
+    t, v, w, infl = t[order], v[order], w[order], infl[order]
     lo = np.searchsorted(t, tg - h, side="left")
     hi = np.searchsorted(t, tg + h, side="right")
     width = int(np.max(hi - lo)) if G else 0
@@ -619,7 +639,7 @@ def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float
     vv = v[k]
     e = (lw * vv).sum(1)
     r = vv - e[:, None]
-    var_ = (lw**2 * r**2 * inside).sum(1)
+    var_ = (lw**2 * r**2 * infl[k] * inside).sum(1)
     n_ = inside.sum(1)
     m2 = (lw * dt * dt).sum(1)
     ok = s0 > 0
@@ -853,9 +873,8 @@ def infer_wind(
     h = 0.5 * window_s
     m = fit.used
     wgt = fit.w[m]
-    est, var, n, mu2 = _local_linear(tg, p.t[m], fit.obs[m], wgt, h)
-    infl = CORR_S  # points are 1 s apart but count for 1/CORR_S each
-    var = var * infl
+    # each point counts for p.weight (its sampling interval / CORR_S) of an independent one
+    est, var, n, mu2 = _local_linear(tg, p.t[m], fit.obs[m], wgt, h, 1.0 / p.weight[m])
     # half-angle uncertainty: imbalance of boards within the window
     ang_var = _group_var(tg, p.t[m], wgt, h, fit, m)
     # smoothing bias from the fitted curvature
@@ -876,11 +895,12 @@ def infer_wind(
         s_pt = _invert_polar(boat, twa, p.sog)
         ok = m & np.isfinite(s_pt)
         if ok.sum() >= 30:
-            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h)
+            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h,
+                                         1.0 / p.weight[ok])
             sec2 = _seconds_in_window(tg, p.t[ok], h)
             good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
             tws = np.where(good, np.maximum(e2, 0.0), np.nan)
-            tws_sd = np.where(good, np.sqrt(v2 * CORR_S), np.nan)
+            tws_sd = np.where(good, np.sqrt(v2), np.nan)
             s_med = float(np.nanmedian(tws)) if np.isfinite(tws).any() else float("nan")
             up_pol = boat.vmg_angles_deg(s_med)[0] if np.isfinite(s_med) else float("nan")
             notes.append(f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which "
