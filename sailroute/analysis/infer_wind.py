@@ -87,7 +87,8 @@ ROUNDING_PAD_S: Final = 30.0
 """Points within this of a mark rounding are rejected [s]: boats reach in to a mark from
 above the layline, luff or bear away round it, and settle on the new leg after it."""
 MAX_GAP_S: Final = 5.0
-"""A course window that holds a gap in the log longer than this [s] is not used."""
+"""A course window that holds a gap in the log longer than this [s] (or 2.5 sampling
+intervals, for logs slower than 0.5 Hz) is not used."""
 KNOT_S: Final = 20.0
 """Knot spacing of the piecewise-linear TWD(t) of the joint fit [s]."""
 CORR_S: Final = 10.0
@@ -334,11 +335,11 @@ def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: fl
         cog, sog, before, after = _window_course(t, x, y, half, TURN_WINDOW_S)
         turn = np.abs(wrap180(after - before))
         slow = sog < min_speed_ms
-        big_gap = np.concatenate([[False], np.diff(t) > MAX_GAP_S])
+        dt = float(np.median(np.diff(t)))
+        big_gap = np.concatenate([[False], np.diff(t) > max(MAX_GAP_S, 2.5 * dt)])
         ok = (~_near_any(t, (turn > TURN_DEG) | slow, PAD_S)
               & ~_near_any(t, turn > ROUNDING_DEG, ROUNDING_PAD_S)
               & ~_near_any(t, big_gap, COG_WINDOW_S) & (t >= t0) & (t <= t1))
-        dt = float(np.median(np.diff(t)))
         n_ok = int(ok.sum())
         notes.append(f"{tr.name or k}: {n_ok} of {int(((t >= t0) & (t <= t1)).sum())} points "
                      "steady (not turning, slow or near a gap)")
@@ -882,7 +883,7 @@ def infer_wind(
                      np.diff(fit.twd, 2) / (fit.knots[1] - fit.knots[0]) ** 2)
     bias = 0.5 * curv * np.nan_to_num(mu2)
     sd_all = np.sqrt(var + ang_var + bias**2)
-    secs = _seconds_in_window(tg, p.t[m], h)
+    secs = _seconds_in_window(tg, p.t[m], h, p.weight[m])
     bad = ~np.isfinite(est) | (secs < MIN_OBS_S) | ~(sd_all <= MAX_SD_DEG)
     twd = np.where(bad, np.nan, wrap360(est))
     sd = np.where(bad, np.nan, sd_all)
@@ -897,7 +898,7 @@ def infer_wind(
         if ok.sum() >= 30:
             e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h,
                                          1.0 / p.weight[ok])
-            sec2 = _seconds_in_window(tg, p.t[ok], h)
+            sec2 = _seconds_in_window(tg, p.t[ok], h, p.weight[ok])
             good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
             tws = np.where(good, np.maximum(e2, 0.0), np.nan)
             tws_sd = np.where(good, np.sqrt(v2), np.nan)
@@ -930,10 +931,13 @@ def infer_wind(
                         MappingProxyType(half))
 
 
-def _seconds_in_window(tg: NDArray, t: NDArray, h: float) -> NDArray[np.float64]:
-    ts = np.sort(t)
-    return (np.searchsorted(ts, tg + h, side="right")
-            - np.searchsorted(ts, tg - h, side="left")).astype(float)
+def _seconds_in_window(tg: NDArray, t: NDArray, h: float, weight: NDArray
+                       ) -> NDArray[np.float64]:
+    """Seconds of steady track within ``tg ± h``: each point stands for its sampling
+    interval, up to ``CORR_S`` (``weight * CORR_S``); ``t`` sorted."""
+    c = np.concatenate([[0.0], np.cumsum(weight * CORR_S)])
+    return np.asarray(c[np.searchsorted(t, tg + h, side="right")]
+                      - c[np.searchsorted(t, tg - h, side="left")], dtype=float)
 
 
 def _group_var(tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDArray
