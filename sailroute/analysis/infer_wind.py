@@ -280,7 +280,7 @@ class InferredWindField:
         return np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
 
 
-# ----------------------------------------------------------------------------- helpers
+# ----------------------------------------------------------------------------- internals
 
 
 def _unwrap_deg(a: NDArray) -> NDArray[np.float64]:
