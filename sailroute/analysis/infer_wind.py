@@ -87,7 +87,8 @@ ROUNDING_PAD_S: Final = 30.0
 """Points within this of a mark rounding are rejected [s]: boats reach in to a mark from
 above the layline, luff or bear away round it, and settle on the new leg after it."""
 MAX_GAP_S: Final = 5.0
-"""A course window that holds a gap in the log longer than this [s] is not used."""
+"""A course window that holds a gap in the log longer than this [s] (or 2.5 sampling
+intervals, for logs slower than 0.5 Hz) is not used."""
 KNOT_S: Final = 20.0
 """Knot spacing of the piecewise-linear TWD(t) of the joint fit [s]."""
 CORR_S: Final = 10.0
@@ -140,6 +141,8 @@ MAX_SPAN_S: Final = 6 * 3600.0
 """Longest time span inferred in one call [s] (one race, or one evening's races)."""
 MAX_APART_M: Final = 20_000.0
 """Tracks whose mean positions lie further apart than this [m] are refused."""
+MIN_BOARD_POINTS: Final = 20
+"""Steady points needed on each upwind board (all boats together)."""
 MIN_OBS_S: Final = 20.0
 """A grid time needs at least this many seconds of observations in its window."""
 MAX_SD_DEG: Final = 15.0
@@ -192,8 +195,10 @@ class InferredWind:
             raise InputError(f"InferredWind: {', '.join(bad) or 't'} must be 1-D arrays of the "
                              f"length of t ({n}); build it with infer_wind")
         if not isinstance(self.half_angles_deg, MappingProxyType):
-            object.__setattr__(self, "half_angles_deg",
-                               MappingProxyType(dict(self.half_angles_deg)))
+            raise TypeError(
+                "InferredWind.half_angles_deg must be a read-only mapping "
+                f"(types.MappingProxyType), got {type(self.half_angles_deg).__name__}; "
+                "pass MappingProxyType(dict(half_angles))")
 
     def field(self, frame: LocalFrame | None = None, tws_ms: float | None = None,
               *, clamp: bool = False) -> InferredWindField:
@@ -275,7 +280,7 @@ class InferredWindField:
         return np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
 
 
-# ----------------------------------------------------------------------------- helpers
+# ----------------------------------------------------------------------------- internals
 
 
 def _unwrap_deg(a: NDArray) -> NDArray[np.float64]:
@@ -330,11 +335,11 @@ def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: fl
         cog, sog, before, after = _window_course(t, x, y, half, TURN_WINDOW_S)
         turn = np.abs(wrap180(after - before))
         slow = sog < min_speed_ms
-        big_gap = np.concatenate([[False], np.diff(t) > MAX_GAP_S])
+        dt = float(np.median(np.diff(t)))
+        big_gap = np.concatenate([[False], np.diff(t) > max(MAX_GAP_S, 2.5 * dt)])
         ok = (~_near_any(t, (turn > TURN_DEG) | slow, PAD_S)
               & ~_near_any(t, turn > ROUNDING_DEG, ROUNDING_PAD_S)
               & ~_near_any(t, big_gap, COG_WINDOW_S) & (t >= t0) & (t <= t1))
-        dt = float(np.median(np.diff(t)))
         n_ok = int(ok.sum())
         notes.append(f"{tr.name or k}: {n_ok} of {int(((t >= t0) & (t <= t1)).sum())} points "
                      "steady (not turning, slow or near a gap)")
@@ -575,13 +580,33 @@ def _mad(r: NDArray) -> float:
     return float(1.4826 * np.median(np.abs(r - np.median(r))))
 
 
-def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float
-                  ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float,
+                  infl: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Local-linear kernel regression of ``v(t)`` at ``tg`` (tricube, half-width ``h``).
 
-    Returns the estimate, the equivalent-kernel weights' sums ``sum l^2 w^-1``-style
-    variance factor (see caller), the count of points in the window and the seconds of
-    data behind each estimate.  Vectorised over a dense (grid x points) matrix in blocks.
+    Parameters
+    ----------
+    tg : ndarray
+        Grid times [s].
+    t, v, w : ndarray
+        Sorted point times [s], values and weights.
+    h : float
+        Kernel half-width [s].
+    infl : ndarray
+        Variance inflation of each point (1 / its share of an independent observation).
+
+    Returns
+    -------
+    est : ndarray
+        The estimate at each grid time (NaN without points); the local mean where the
+        window has points on one side only.
+    var : ndarray
+        Its variance, ``sum l_i² r_i² infl_i`` with ``l`` the equivalent kernel and ``r``
+        the residuals about the local fit.
+    n : ndarray of int
+        Points in the window.
+    mu2 : ndarray
+        ``sum l_i (t_i − tg)²``, the kernel's second moment (for the smoothing bias).
     """
     G = tg.size
     est = np.full(G, np.nan)
@@ -589,7 +614,7 @@ def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float
     n = np.zeros(G, np.int64)
     mu2 = np.full(G, np.nan)
     order = np.argsort(t)
-    t, v, w = t[order], v[order], w[order]
+    t, v, w, infl = t[order], v[order], w[order], infl[order]
     lo = np.searchsorted(t, tg - h, side="left")
     hi = np.searchsorted(t, tg + h, side="right")
     width = int(np.max(hi - lo)) if G else 0
@@ -615,7 +640,7 @@ def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float
     vv = v[k]
     e = (lw * vv).sum(1)
     r = vv - e[:, None]
-    var_ = (lw**2 * r**2 * inside).sum(1)
+    var_ = (lw**2 * r**2 * infl[k] * inside).sum(1)
     n_ = inside.sum(1)
     m2 = (lw * dt * dt).sum(1)
     ok = s0 > 0
@@ -803,10 +828,11 @@ def infer_wind(
     if prior_twd_deg is not None:
         twd_axis = min(cands, key=lambda c: abs(float(wrap180(c - prior_twd_deg))))
         off = float(wrap180(twd_axis - prior_twd_deg))
-        how = f"up/down from the prior TWD {prior_twd_deg:.0f}° (tracks' axis {off:+.0f}° off it)"
+        prior = float(wrap360(prior_twd_deg))
+        how = f"up/down from the prior TWD {prior:.0f}° (tracks' axis {off:+.0f}° off it)"
         if abs(off) > 60.0:
             notes.append(f"the tracks' wind axis lies {off:+.0f}° from the prior "
-                         f"{prior_twd_deg:.0f}°: check the prior")
+                         f"{prior:.0f}°: check the prior")
     else:
         twd_axis, how = _upwind_end(p, cands)
     notes.append(f"wind axis {wrap360(twd_axis):.0f}° (symmetry contrast {strength:.2f}); {how}")
@@ -830,18 +856,26 @@ def infer_wind(
                      gamma_prior_sd=g_sd,
                      alpha_sd_fixed=fit_up.alpha_sd)
     n_up, n_dn = int(fit.up.sum()), int((fit.used & ~fit.up).sum())
-    if n_up + n_dn < 60:
+    n_stbd = int((fit_up.up & (fit_up.side > 0)).sum())
+    n_port = int((fit_up.up & (fit_up.side < 0)).sum())
+    if n_stbd + n_port < MIN_BOARD_POINTS and n_dn >= 60:
         raise InputError(
-            f"infer_wind: only {n_up} upwind and {n_dn} downwind steady points; the tracks "
-            "hold too few board courses to infer a direction (reaches are not used)")
+            f"infer_wind: no upwind boards with the wind from {wrap360(twd_axis):.0f}° "
+            f"({how}), but {n_dn} points on downwind boards: the wind more likely comes from "
+            f"the other end of the axis, {wrap360(twd_axis + 180.0):.0f}°; check "
+            "prior_twd_deg")
+    if n_up + n_dn < 60 or min(n_stbd, n_port) < MIN_BOARD_POINTS:
+        raise InputError(
+            f"infer_wind: {n_stbd} starboard and {n_port} port upwind points, {n_dn} downwind "
+            f"(need {MIN_BOARD_POINTS} on each upwind board): the wind cannot be told from "
+            "one course; give a span with at least one beat sailed on both tacks")
     # 3. the output grid
     tg = np.arange(t0, t1 + 1e-6, step_s)
     h = 0.5 * window_s
     m = fit.used
     wgt = fit.w[m]
-    est, var, n, mu2 = _local_linear(tg, p.t[m], fit.obs[m], wgt, h)
-    infl = CORR_S  # points are 1 s apart but count for 1/CORR_S each
-    var = var * infl
+    # each point counts for p.weight (its sampling interval / CORR_S) of an independent one
+    est, var, n, mu2 = _local_linear(tg, p.t[m], fit.obs[m], wgt, h, 1.0 / p.weight[m])
     # half-angle uncertainty: imbalance of boards within the window
     ang_var = _group_var(tg, p.t[m], wgt, h, fit, m)
     # smoothing bias from the fitted curvature
@@ -849,7 +883,7 @@ def infer_wind(
                      np.diff(fit.twd, 2) / (fit.knots[1] - fit.knots[0]) ** 2)
     bias = 0.5 * curv * np.nan_to_num(mu2)
     sd_all = np.sqrt(var + ang_var + bias**2)
-    secs = _seconds_in_window(tg, p.t[m], h)
+    secs = _seconds_in_window(tg, p.t[m], h, p.weight[m])
     bad = ~np.isfinite(est) | (secs < MIN_OBS_S) | ~(sd_all <= MAX_SD_DEG)
     twd = np.where(bad, np.nan, wrap360(est))
     sd = np.where(bad, np.nan, sd_all)
@@ -862,11 +896,12 @@ def infer_wind(
         s_pt = _invert_polar(boat, twa, p.sog)
         ok = m & np.isfinite(s_pt)
         if ok.sum() >= 30:
-            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h)
-            sec2 = _seconds_in_window(tg, p.t[ok], h)
+            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h,
+                                         1.0 / p.weight[ok])
+            sec2 = _seconds_in_window(tg, p.t[ok], h, p.weight[ok])
             good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
             tws = np.where(good, np.maximum(e2, 0.0), np.nan)
-            tws_sd = np.where(good, np.sqrt(v2 * CORR_S), np.nan)
+            tws_sd = np.where(good, np.sqrt(v2), np.nan)
             s_med = float(np.nanmedian(tws)) if np.isfinite(tws).any() else float("nan")
             up_pol = boat.vmg_angles_deg(s_med)[0] if np.isfinite(s_med) else float("nan")
             notes.append(f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which "
@@ -882,20 +917,27 @@ def infer_wind(
         down = (f"runs (downwind held at 180°, {RUN_WEIGHT:g} weight)"
                 if abs(fit.gamma[k]) < RUN_GAMMA_DEG and fit.gamma_sd[k] < 0.01 else
                 f"gybing half-angle {180.0 - fit.gamma[k]:.1f} ± {fit.gamma_sd[k]:.1f}°")
+        weak = (f" (weakly determined by the track: leans on its prior {a0:.0f}° ± "
+                f"{a_sd:.0f}°{', the polar' if boat is not None else ''})"
+                if fit.alpha_sd[k] > 0.5 * a_sd else "")
         notes.append(f"{names[k]}: tacking half-angle {fit.alpha[k]:.1f} ± "
-                     f"{fit.alpha_sd[k]:.1f}°, {down} ({nk_up} upwind, {nk_dn} downwind points)")
+                     f"{fit.alpha_sd[k]:.1f}°{weak}, {down} ({nk_up} upwind, {nk_dn} downwind "
+                     "points)")
     method = (f"inferred from {K} track(s): {n_up} upwind and {n_dn} downwind board points "
               f"(course ± fitted half-angles), window {window_s:.0f} s, "
               f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
               + ("; TWS from the polar" if boat is not None else "; TWS not inferred (no polar)"))
     return InferredWind(tg, twd, sd, tws, tws_sd, n.astype(np.int64), method, tuple(notes),
-                        half)
+                        MappingProxyType(half))
 
 
-def _seconds_in_window(tg: NDArray, t: NDArray, h: float) -> NDArray[np.float64]:
-    ts = np.sort(t)
-    return (np.searchsorted(ts, tg + h, side="right")
-            - np.searchsorted(ts, tg - h, side="left")).astype(float)
+def _seconds_in_window(tg: NDArray, t: NDArray, h: float, weight: NDArray
+                       ) -> NDArray[np.float64]:
+    """Seconds of steady track within ``tg ± h``: each point stands for its sampling
+    interval, up to ``CORR_S`` (``weight * CORR_S``); ``t`` sorted."""
+    c = np.concatenate([[0.0], np.cumsum(weight * CORR_S)])
+    return np.asarray(c[np.searchsorted(t, tg + h, side="right")]
+                      - c[np.searchsorted(t, tg - h, side="left")], dtype=float)
 
 
 def _group_var(tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDArray
