@@ -256,6 +256,8 @@ def test_thin_data_give_larger_uncertainty(routes) -> None:
     assert np.all(three.n_obs >= 0) and three.n_obs.max() > one.n_obs.max()
 
 
+@pytest.mark.timing
+@pytest.mark.slow
 def test_three_boats_of_20_min_take_well_under_a_second(routes) -> None:
     trs = tracks(routes, "osc", 3, 2.0)
     infer_wind(trs, FRAME, prior_twd_deg=BASE, boat=BOAT)  # warm-up (polar table)
