@@ -939,13 +939,17 @@ def run_analyze_command(
         return AnalyzeResult("\n\n".join([analysis_table(analyses[0]), _notes_text(notes)]),
                              files, tuple(analyses), tuple(notes))
     rows = fleet_ranking(analyses)
+    # the page draws the fleet-wide wind: the first boat's first candidate not its own log
+    shared = next((s for s in sources[read[0].name] if s.kind != "measured"), None)
+    fleet_wind_layer = (shared.label, shared.field) if shared is not None else None
 
     def write(d: Path) -> dict[str, Path]:
         files: dict[str, Path] = {}
         for s, a in zip(stems, analyses, strict=True):
             for kind, p in write_analysis(d / s, a, plots=plots).items():
                 files[f"{s}/{kind}"] = p
-        files.update(write_fleet(d, analyses, rows, plots=plots))
+        files.update(write_fleet(d, analyses, rows, plots=plots, notes=notes,
+                                 wind=fleet_wind_layer))
         return files
 
     report = "\n\n".join([*(analysis_table(a) for a in analyses),

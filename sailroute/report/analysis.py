@@ -27,6 +27,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
     from sailroute.analyze import TrackAnalysis
+    from sailroute.wind.base import WindField
 
 SCHEMA_VERSION = 1
 
@@ -35,7 +36,8 @@ LEG_COLUMNS = (
     "optimal_time_s", "loss_s", "loss_manoeuvres_s", "loss_speed_s", "loss_route_s",
     "sailed_distance_m", "optimal_distance_m", "sailed_tacks", "optimal_tacks", "sailed_gybes",
     "optimal_gybes", "mean_vmg_ms", "mean_sog_ms", "mean_polar_pct", "side_sailed",
-    "side_optimal", "lateral_sailed_m", "lateral_optimal_m", "note",
+    "side_optimal", "lateral_sailed_m", "lateral_optimal_m", "note", "wind_source",
+    "above_polar",
 )
 """Columns of ``analysis.csv``."""
 
@@ -72,6 +74,8 @@ def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
             "side": {"sailed": leg.side_sailed, "optimal": leg.side_optimal,
                      "lateral_sailed_m": _num(leg.lateral_sailed_m, 1),
                      "lateral_optimal_m": _num(leg.lateral_optimal_m, 1)},
+            "wind": {"source": leg.wind_source, "label": leg.wind_label},
+            "above_polar": leg.above_polar,
         })
     return {
         "schema_version": SCHEMA_VERSION,
@@ -83,6 +87,7 @@ def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
                   "notes": list(a.track.notes)},
         "scenario": a.scenario,
         "router": a.router,
+        "reference": a.reference,
         "origin": {"lat": c.frame.lat0, "lon": c.frame.lon0},
         "start": start_to_dict(a),
         "finish_time": _iso(a.segmentation.ends[-1].t),
@@ -171,7 +176,8 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
                 leg.sailed_distance_m, leg.optimal_distance_m, leg.sailed_tacks,
                 leg.optimal_tacks, leg.sailed_gybes, leg.optimal_gybes, leg.mean_vmg_ms,
                 leg.mean_sog_ms, leg.mean_polar_pct, leg.side_sailed, leg.side_optimal,
-                leg.lateral_sailed_m, leg.lateral_optimal_m, leg.note)])
+                leg.lateral_sailed_m, leg.lateral_optimal_m, leg.note, leg.wind_source,
+                leg.above_polar)])
     files["analysis_csv"] = cp
     pp = out / "points.csv"
     p = a.points
@@ -197,9 +203,14 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
 
 
 def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
-                rows: Sequence[Mapping[str, Any]], *, plots: bool = True) -> dict[str, Path]:
+                rows: Sequence[Mapping[str, Any]], *, plots: bool = True,
+                notes: Sequence[str] = (), wind: tuple[str, WindField] | None = None
+                ) -> dict[str, Path]:
     """Write ``fleet.csv`` (one row per leg and boat), ``fleet.json`` and (with ``plots``)
-    the fleet's ``report.html`` (:func:`sailroute.report.html.fleet_report`)."""
+    the fleet's ``report.html`` (:func:`sailroute.report.html.fleet_report`).
+
+    ``notes`` (the run's findings on the wind and the reference) go into ``fleet.json``
+    and the page; ``wind`` is the fleet-wide wind drawn on the page (name, field)."""
     out = Path(out_dir)
     cp = out / "fleet.csv"
     cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s",
@@ -214,7 +225,7 @@ def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
            "course": analyses[0].course.name if analyses else None,
            "boats": [{"name": a.track.name, "complete": a.complete, "notes": list(a.notes),
                       "start": start_to_dict(a)} for a in analyses],
-           "notes": list(fleet_notes(analyses)),
+           "notes": [*fleet_notes(analyses), *notes],
            "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()}
                     for r in rows]}
     jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
@@ -223,7 +234,8 @@ def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
         from sailroute.report.html import fleet_report, write_report
 
         files["html"] = write_report(out / "report.html",
-                                     fleet_report(analyses, rows, fleet_notes(analyses)))
+                                     fleet_report(analyses, rows,
+                                                  [*fleet_notes(analyses), *notes], wind))
     return files
 
 

@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute import __version__
+from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.course.geometry import feature_centre
 from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
@@ -628,14 +629,14 @@ def analysis_report(a: TrackAnalysis) -> Report:
     course, off = a.course, a.course.utc_offset_s
     sailed, optimal = routes_from_analysis(a)
     times = slider_times([sailed])
-    layers = _layers({a.scenario: a.wind}, course, [sailed, optimal], times)
+    layers = _layers({_wind_name(a): a.wind}, course, [sailed, optimal], times)
     rows = []
     for leg in a.legs:
         if not leg.known:
             rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
                          clock(leg.t_start, off) if np.isfinite(leg.t_start) else "unknown",
                          "unknown", format_duration(leg.optimal_time_s), "-", "-", "-", "-",
-                         "-", "-", leg.note))
+                         "-", "-", leg.note, leg.wind_source))
             continue
         rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
                      clock(leg.t_start, off), format_duration(leg.sailed_time_s),
@@ -644,17 +645,18 @@ def analysis_report(a: TrackAnalysis) -> Report:
                      f"{leg.split.route:+.1f}",
                      f"{leg.sailed_tacks}/{leg.sailed_gybes} : "
                      f"{leg.optimal_tacks}/{leg.optimal_gybes}",
-                     f"{leg.mean_polar_pct:.0f}", f"{leg.side_sailed} / {leg.side_optimal}"))
+                     _polar_pct(leg), f"{leg.side_sailed} / {leg.side_optimal}",
+                     leg.wind_source))
     tot = [sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed",
                                                                          "route")]
     footer = (("", "total" if a.complete else f"{len(a.known_legs)} legs of known time", "",
                "", format_duration(a.sailed_time_s),
                format_duration(a.optimal_time_s), f"{a.loss_s:+.1f}",
-               *(f"{v:+.1f}" for v in tot), "", "", ""),)
+               *(f"{v:+.1f}" for v in tot), "", "", "", ""),)
     table = Table("Legs: sailed against optimal from the same point and time",
                   ("leg", "from → to", "mode", "start", "sailed", "optimal", "lost s",
                    "manoeuvres s", "speed s", "route s", "tacks/gybes sailed : optimal",
-                   "polar %", "side sailed / optimal"), tuple(rows), footer)
+                   "polar %", "side sailed / optimal", "wind"), tuple(rows), footer)
     t0 = a.legs[0].t_start if a.legs else course.start_epoch
     summary = (f"Track {a.track.name} · scenario {a.scenario} · router {a.router} · start "
                f"{time_label(t0, off)} on {iso(t0 + off)[:10]}",
@@ -662,7 +664,40 @@ def analysis_report(a: TrackAnalysis) -> Report:
                f"{format_duration(a.optimal_time_s)}, lost {a.loss_s:+.1f} s")
     return Report(f"{course.name} — {a.track.name}", summary, course, (sailed, optimal),
                   tuple(layers), times, (table,),
-                  (HELP, *a.notes, _times_note(course), _wind_note(layers)))
+                  (HELP, *_judged_notes([a]), *a.notes, _times_note(course),
+                   _wind_note(layers)))
+
+
+def _wind_name(a: TrackAnalysis) -> str:
+    """Name of the wind drawn for an analysis: its first leg's source."""
+    return a.legs[0].wind_label if a.legs and a.legs[0].wind_label else a.scenario
+
+
+def _polar_pct(leg: Any) -> str:
+    """A leg's mean polar %, marked ``*`` above the polar."""
+    if not math.isfinite(leg.mean_polar_pct):
+        return "-"
+    return f"{leg.mean_polar_pct:.0f}" + (" *" if leg.above_polar else "")
+
+
+def _judged_notes(analyses: Sequence[TrackAnalysis]) -> list[str]:
+    """What the boats are judged against and in which wind, and the above-polar warning."""
+    out = []
+    refs = dict.fromkeys(a.reference for a in analyses if a.reference)
+    out += [f"Judged against the {r}." if r.startswith("course") else f"Judged against a {r}."
+            for r in refs]
+    winds = dict.fromkeys(f"{leg.wind_source} ({leg.wind_label})" for a in analyses
+                          for leg in a.legs if leg.wind_label)
+    if winds:
+        out.append("Wind of the legs: " + "; ".join(winds) + ".")
+    above = [f"{a.track.name} leg {leg.index + 1}" for a in analyses for leg in a.legs
+             if leg.above_polar]
+    if above:
+        out.append(f"* Sailed above {ABOVE_POLAR_PCT:.0f} % of the polar ({', '.join(above)}): "
+                   "the polar stands in for another class, or the wind is wrong (too light); "
+                   "those losses are not a debrief (analyze --reference fleet judges the boats "
+                   "against what the fleet sails).")
+    return out
 
 
 def _leader(analyses: Sequence[TrackAnalysis]) -> int:
@@ -679,7 +714,8 @@ def _signed(v: float, nd: int = 1) -> str:
 
 
 def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, Any]],
-                 notes: Sequence[str] = ()) -> Report:
+                 notes: Sequence[str] = (), wind: tuple[str, WindField] | None = None
+                 ) -> Report:
     """The page of ``sailroute analyze`` with several tracks.
 
     Every boat's sailed track on one map with one time slider (a marker per boat), the
@@ -688,7 +724,8 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
     and three tables: the leg ranking (``rows`` of
     :func:`sailroute.analyze.fleet_ranking`), the start (time late, distance to the line,
     side and speed at the gun, over early, line offset) and the loss split per boat and
-    leg.  ``notes`` (fleet-wide) and each boat's own notes go under the map.
+    leg.  ``notes`` (fleet-wide) and each boat's own notes go under the map.  ``wind``
+    (name, field) is the wind drawn; default the first boat's first leg's.
     """
     course, off = analyses[0].course, analyses[0].course.utc_offset_s
     sailed = [replace(routes_from_analysis(a)[0], name=a.track.name) for a in analyses]
@@ -697,7 +734,8 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
                   name=f"optimal from {analyses[lead].track.name}'s leg starts")
     routes = (*sailed, opt)
     times = slider_times(sailed, FLEET_STEPS)
-    layers = _layers({analyses[0].scenario: analyses[0].wind}, course, routes, times)
+    name, field = wind if wind is not None else (_wind_name(analyses[0]), analyses[0].wind)
+    layers = _layers({name: field}, course, routes, times)
     names = [a.track.name for a in analyses]
     by = {(r["leg"], r["boat"]): r for r in rows}
     rank_rows = []
@@ -734,10 +772,11 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
             split_rows.append((a.track.name, str(leg.index + 1), leg.label.replace("->", "→"),
                                _signed(leg.loss_s), _signed(leg.split.manoeuvres),
                                _signed(leg.split.speed), _signed(leg.split.route),
-                               leg.note))
+                               _polar_pct(leg), leg.wind_source, leg.note))
     split = Table("Time lost per boat and leg, split into manoeuvres, speed and route",
                   ("boat", "leg", "from → to", "lost s", "manoeuvres s", "speed s", "route s",
-                   "note"), tuple(split_rows), collapsed=len(split_rows) > 40)
+                   "polar %", "wind", "note"), tuple(split_rows),
+                  collapsed=len(split_rows) > 40)
     t0 = course.start_epoch
     summary = (
         f"{len(analyses)} boats · scenario {analyses[0].scenario} · router "
@@ -746,7 +785,8 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
             f"{a.track.name} {format_duration(a.sailed_time_s)}"
             + ("" if a.complete else f" ({len(a.known_legs)} of {len(a.legs)} legs)")
             for a in analyses))
-    page_notes = [HELP, *notes, *(f"{a.track.name}: {n}" for a in analyses for n in a.notes),
+    page_notes = [HELP, *_judged_notes(analyses), *notes,
+                  *(f"{a.track.name}: {n}" for a in analyses for n in a.notes),
                   "The dashed line is the optimal route of each leg from the leader's own leg "
                   "start point and time.", _times_note(course), _wind_note(layers)]
     return Report(f"{course.name} — fleet of {len(analyses)}", summary, course, routes,
