@@ -189,3 +189,22 @@ def test_finishes_across_data_gaps_are_unknown(fleet: AnalyzeResult) -> None:
     one = json.loads(fleet.files["data_NZL/analysis_json"].read_text())
     assert one["finish_time"] is None and one["complete"] is False
     assert one["legs"][6]["sailed_time_s"] is None and one["legs"][6]["known"] is False
+
+
+@requires_shared
+def test_losses_in_each_boats_measured_wind(fleet: AnalyzeResult) -> None:
+    for a in fleet.analyses:
+        known = a.known_legs
+        # every leg of known time judged in the boat's own log, none in the scenario
+        assert [leg.wind_source for leg in known] == ["measured"] * len(known), a.track.name
+        assert all(leg.wind_label.startswith("measured on board (tws/twd") for leg in known)
+        for leg in known:
+            if leg.mode == "upwind":
+                # more tacks than the optimum: the manoeuvres lose, they never "gain"
+                assert leg.sailed_tacks > leg.optimal_tacks
+                assert leg.split.manoeuvres > 0.0, (a.track.name, leg.label, leg.split)
+    doc = json.loads(fleet.files["data_GBR/analysis_json"].read_text())
+    assert {leg["wind"]["source"] for leg in doc["legs"]} == {"measured"}
+    # the fleet's biases and the hull check are reported
+    assert sum(n.startswith("bias data_") for n in fleet.notes) == 3
+    assert any("outside the sensors' hull" in n for n in fleet.notes)

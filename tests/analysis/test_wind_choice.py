@@ -7,12 +7,15 @@ was routed in, and a track sailed 25 % faster than the polar is 125 % of it.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from sailroute.analysis.fleetpolar import band_factors, fleet_polar
 from sailroute.analysis.windsource import WindSource, first_covering, wind_order
-from sailroute.analyze import analyze_track
+from sailroute.analyze import analyze_track, run_analyze_command
 from sailroute.course.load import build_specs
 from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
@@ -23,6 +26,7 @@ from sailroute.wind.combine import SpeedDirectionWind
 from sailroute.wind.uniform import UniformWind
 from tests.analysis import test_analyze as wl
 from tests.analysis.test_analyze import LOSS_TOL_S, _sailed
+from tests.conftest import ROOT
 
 routed = wl.routed  # the module fixture: the routed windward-leeward course
 
@@ -156,3 +160,43 @@ def test_a_manoeuvre_window_costs_its_time_beyond_straight_sailing_and_never_gai
     s = split_loss(t, prog, np.ones(t.size), np.array([20.0, 60.0, 100.0]), 10.0, 5.0)
     assert s.manoeuvres == pytest.approx(-5.0)
     assert s.manoeuvres + s.speed + s.route == pytest.approx(10.0)
+
+
+SNIPE_COURSE = ROOT / "courses" / "snipe-valencia-p01.yaml"
+SNIPE_TRACK = ROOT / "data" / "snipe-valencia-2025-06-21-ESP30782-P01.gpx"
+
+
+def test_the_snipe_example_is_judged_in_the_inferred_wind_and_its_polar_called_out(
+        tmp_path: Path) -> None:
+    # a GPS watch track: no wind in the log, so the direction is inferred from the track;
+    # the ILCA polar stands in for the faster Snipe: every leg is flagged
+    r = run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "abs")
+    a = r.analyses[0]
+    assert [leg.wind_source for leg in a.legs] == ["inferred"] * 4
+    assert all(leg.above_polar for leg in a.legs)
+    assert "sailed above 110 % of the polar" in r.report
+    assert any(n.startswith("inferred wind: TWD 1") for n in r.notes)
+    doc = json.loads(r.files["analysis_json"].read_text())
+    assert all(leg["above_polar"] and leg["wind"]["source"] == "inferred"
+               for leg in doc["legs"])
+    assert doc["reference"].startswith("course polar")
+    page = r.files["html"].read_text()
+    assert "Sailed above 110 % of the polar" in page and "inferred" in page
+    # against what this fleet (one boat) sails: no leg is a big "gain" any more
+    f = run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "fleet",
+                            reference="fleet", plots=False)
+    b = f.analyses[0]
+    assert b.reference.startswith("fleet-relative polar")
+    for leg in b.legs:
+        assert leg.loss_s >= -0.02 * leg.sailed_time_s, (leg.label, leg.loss_s)
+        assert not leg.above_polar
+
+
+def test_asking_for_a_wind_the_data_do_not_hold_is_a_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="--wind measured: no track has usable wind columns"):
+        run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "o",
+                            wind="measured", plots=False)
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(InputError, match="--reference: expected one of course, fleet"):
+        run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "p",
+                            reference="peers", plots=False)
