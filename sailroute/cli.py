@@ -389,9 +389,9 @@ def vpp_command(
     kinetics: Annotated[
         Kinetics,
         typer.Option("--kinetics", case_sensitive=False,
-                     help="steady: the VPP alone; race: with wave riding and pumping, as "
-                     "the built-in ilca7 (docs/vpp.md)."),
-    ] = "steady",
+                     help="race (default): with wave riding and pumping, as the built-in "
+                     "ilca7 that plan routes with; steady: the VPP alone (docs/vpp.md)."),
+    ] = "race",
     json_out: JsonOpt = False,
 ) -> None:
     """Run the Laser/ILCA VPP: print the polar and best VMG, write .pol/.csv/.json/.png."""

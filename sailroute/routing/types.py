@@ -257,6 +257,20 @@ class RoutingSettings:
     spline_start_from_rest: bool = False
 
 
+MIN_DT_S: Final = 0.5
+"""Smallest isochrone time step :attr:`RoutingSettings.dt_s` [s]: halving the default
+10 s down to 1.25 s moved a 1809 m beat by < 2e-5 (``docs/design/routing.md``), while
+the work grows as 1/dt (0.05 s took over 30 s for a 300 m leg; 1e-9 s never ends)."""
+MIN_MIN_DT_S: Final = 0.01
+"""Smallest :attr:`RoutingSettings.min_dt_s` [s] (the refined step near the target)."""
+MIN_HEADING_STEP_DEG: Final = 0.1
+"""Finest heading resolution :attr:`RoutingSettings.heading_step_deg` [°]: the polar is
+tabulated at ``180 / step`` angles and each front point tries them all (1e-4° hung,
+1e-9° asked for 1.3 TiB)."""
+MAX_FRONT_POINTS: Final = 100_000
+"""Largest :attr:`RoutingSettings.max_front_points` (the default is 2000)."""
+
+
 def settings_problems(s: RoutingSettings) -> list[str]:
     """What is wrong with ``s``, one line per field (empty when every field is valid).
 
@@ -289,7 +303,16 @@ def settings_problems(s: RoutingSettings) -> list[str]:
         number(name, strict=False)
     if is_number(s.heading_step_deg) and s.heading_step_deg > 45:
         problems.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
-    integer("max_front_points", 8, 10**9, ">= 8")
+    if is_number(s.heading_step_deg) and 0 < s.heading_step_deg < MIN_HEADING_STEP_DEG:
+        problems.append(
+            f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer "
+            f"steps only slow the router), got {s.heading_step_deg!r}")
+    if is_number(s.dt_s) and 0 < s.dt_s < MIN_DT_S:
+        problems.append(f"dt_s must be >= {MIN_DT_S:g} s (default 10; finer steps hardly "
+                        f"change the route and make it slow), got {s.dt_s!r}")
+    if is_number(s.min_dt_s) and 0 < s.min_dt_s < MIN_MIN_DT_S:
+        problems.append(f"min_dt_s must be >= {MIN_MIN_DT_S:g} s (default 1), got {s.min_dt_s!r}")
+    integer("max_front_points", 8, MAX_FRONT_POINTS, f"in [8, {MAX_FRONT_POINTS}]")
     if s.heading_fan not in ("hull", "full"):
         problems.append(f"heading_fan must be 'hull' or 'full', got {s.heading_fan!r}")
     if s.initial_side is not None and s.initial_side not in SIDE_NAMES:
