@@ -200,3 +200,79 @@ def test_default_output_folders_are_git_ignored():
     lines = (ROOT / ".gitignore").read_text().splitlines()
     for folder in ("out/", "vpp-out/", "strategy-out/", "polar-fit-out/"):
         assert folder in lines
+
+
+# --- strategy: option names, work estimate, one rule for a wind above the polar -------
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--runs", "0"], "--runs 0: expected a whole number of Monte Carlo runs in 1..1,000,000 "
+     "(default 4000)"),
+    (["--workers", "0", "--scheduler", "processes"],
+     "--workers 0: expected a whole number >= 1 of worker processes"),
+    (["--length-m", "0"], "--length-m 0: must be finite and > 0 m"),
+    (["--length-m", "1605"], "--length-m 1605: expected a whole number (>= 1) of 10 m rows, "
+     "e.g. 1600"),
+    (["--half-width-m", "-1"], "--half-width-m -1: must be finite and > 0 m"),
+    (["--tack-penalty-s", "-1"], "--tack-penalty-s -1.0: must be finite and >= 0"),
+    (["--sigma-deg", "-1"], "--sigma-deg -1.0: must be finite and >= 0"),
+    # the work, estimated before solving (1e9 m asked for 22 TiB)
+    (["--length-m", "1e9", "--runs", "10"],
+     "--length-m 1e+09 with --half-width-m 800: the expected-time lattice would have 3e+12 "
+     "nodes"),
+    (["--length-m", "100000"], "give a beat of at most 32840 m at this width"),
+    (["--runs", "1000000"], "--runs 1000000 over 160 rows of --length-m 1600: 1.6e+08 Monte "
+     "Carlo boat-steps per policy, more than 5e+07; use --runs <= 312500"),
+    # the polar ends at 28 kn: clamped silently before, an error as in plan now
+    (["--tws-kn", "100"], "--tws-kn 100: above the highest TWS column of --polar "
+     "builtin:ilca7 (TWS 1.0 .. 28.0 kn); the boat speed would be clamped to that column "
+     "without notice. Give --tws-kn up to 28.0, or a --polar with higher TWS columns"),
+])
+def test_strategy_errors_name_the_options(tmp_path, monkeypatch, args, message):
+    import sailroute.strategy.api
+
+    def solve(*a: object, **k: object) -> None:
+        raise AssertionError("solving started")
+
+    monkeypatch.setattr(sailroute.strategy.api, "run_strategy", solve)
+    res = runner.invoke(app, ["strategy", *args, "-q", "--no-plots", "-o", str(tmp_path / "o")])
+    assert res.exit_code == 2, res.output
+    assert res.output.startswith("error: --") and message in res.output
+    assert len(res.output.strip().splitlines()) == 1
+    for internal in ("runs =", "n_workers", "length_m", "beat grid", "tack penalty"):
+        assert internal not in res.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_strategy_wind_within_the_polar_runs(tmp_path):
+    res = runner.invoke(app, ["strategy", "--tws-kn", "28", "--length-m", "200",
+                              "--half-width-m", "100", "--runs", "20", "-q", "--no-plots",
+                              "-o", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    assert json.loads((tmp_path / "summary.json").read_text())["boat"]["tws_kn"] == 28.0
+
+
+# --- polar fit: option names ------------------------------------------------------------
+
+
+def _log(tmp_path: Path) -> Path:
+    log = tmp_path / "log.csv"
+    rows = [f"2023-01-01T00:{k // 60:02d}:{k % 60:02d}Z,59.5,{24.8 + k * 1e-5:.5f},10,"
+            f"{40 + k % 100},5" for k in range(600)]
+    log.write_text("time,lat,lon,tws_kn,twa_deg,bsp_kn\n" + "\n".join(rows) + "\n")
+    return log
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--percentile", "0"], "error: --percentile must be in (0, 100], e.g. 90; got 0.0"),
+    (["--min-count", "0"], "error: --min-count must be a whole number >= 1, e.g. 5; got 0"),
+    (["--min-count", "100000"], "a lower --min-count or looser filters"),
+    (["--min-count", "100000"], "(fewer TWS nodes: --tws-bins, a larger TWA step: --twa-step)"),
+])
+def test_polar_fit_errors_name_the_options(tmp_path, args, message):
+    res = runner.invoke(app, ["polar", "fit", str(_log(tmp_path)), *args,
+                              "-o", str(tmp_path / "o")])
+    assert res.exit_code == 2, res.output
+    assert message in res.output and "fit_polar" not in res.output
+    assert "min_count" not in res.output and len(res.output.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
