@@ -276,3 +276,65 @@ def test_polar_fit_errors_name_the_options(tmp_path, args, message):
     assert message in res.output and "fit_polar" not in res.output
     assert "min_count" not in res.output and len(res.output.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
+
+
+# --- Ctrl-C at any point: one line, exit 130 ------------------------------------------
+
+INTERRUPT_DURING_IMPORT = """\
+import builtins, sys
+real = builtins.__import__
+def interrupted_import(name, *args, **kwargs):
+    if name == {module!r}:
+        raise KeyboardInterrupt
+    return real(name, *args, **kwargs)
+builtins.__import__ = interrupted_import
+sys.argv = ["sailroute", *{args!r}]
+from sailroute.__main__ import main
+main()
+"""
+
+
+@pytest.mark.parametrize(("module", "args"), [
+    ("typer", ["--help"]),  # while the command line itself is imported
+    ("sailroute.plan", ["plan", "c.yaml"]),  # while a command imports its modules
+])
+def test_ctrl_c_during_start_up_is_one_line_and_130(tmp_path, module, args):
+    import subprocess
+    import sys
+
+    code = INTERRUPT_DURING_IMPORT.format(module=module, args=args)
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=tmp_path, timeout=60)
+    assert (res.returncode, res.stderr) == (130, "interrupted\n")
+
+
+def test_ctrl_c_outside_the_work_is_reported_too(tmp_path, monkeypatch):
+    import sailroute.cli
+
+    def interrupted(*a: object, **k: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sailroute.cli, "_finish", interrupted)  # typer exited 130 silently
+    res = runner.invoke(app, ["plan", str(course(tmp_path)), "-q", "--no-plots",
+                              "-o", str(tmp_path / "o")])
+    assert res.exit_code == 130 and res.output == "interrupted\n"
+
+
+@pytest.mark.cli
+def test_sigint_at_0_7_s_is_one_line_and_130(tmp_path):
+    import shutil
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    exe = shutil.which("sailroute", path=str(Path(sys.executable).parent))
+    assert exe is not None
+    wl = ROOT / "courses" / "windward-leeward-template.yaml"
+    proc = subprocess.Popen([exe, "plan", str(wl), "-q", "-o", str(tmp_path / "o")],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.7)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=60)
+    assert (proc.returncode, err, out) == (130, "interrupted\n", "")
+    assert not (tmp_path / "o").exists()
