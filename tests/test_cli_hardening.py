@@ -107,7 +107,12 @@ def test_removal_does_not_follow_a_symlink_out_of_the_folder(tmp_path):
     out, outside = _outside_and_link(tmp_path)
     (out / MANIFEST_NAME).write_text(json.dumps({"files": ["linkdir/v2.txt", "old.txt"]}))
     (out / "old.txt").write_text("ours")
-    write_output_set(out, lambda d: [(d / "new.txt").write_text("x") and d / "new.txt"])
+
+    def write(d: Path) -> Path:
+        (d / "new.txt").write_text("x")
+        return d / "new.txt"
+
+    write_output_set(out, write)
     assert (outside / "v2.txt").read_text() == "not sailroute's"  # was deleted
     assert (out / "linkdir").is_symlink() and not (out / "old.txt").exists()
     assert json.loads((out / MANIFEST_NAME).read_text())["files"] == ["new.txt"]
@@ -162,6 +167,14 @@ def test_usage_documents_the_router_folder():
     ("{min_dt_s: 1e-9}", "routing.min_dt_s: min_dt_s must be >= 0.01 s (default 1)"),
     ("{max_front_points: 1000000000}",
      "routing.max_front_points: max_front_points must be an integer in [8, 100000]"),
+    ("{router: griddp, dp_cols: 1024, dp_rows: 200, dp_samples: 64, dp_refinements: 20}",
+     "routing.dp_cols: dp_cols = 1024 with dp_rows = 200, dp_samples = 64 and dp_refinements "
+     "= 20 needs about 2.8e+11 wind samples per leg (rows x cols^2 x samples x passes), more "
+     "than 2e+08 (minutes of work)"),
+    ("{router: spline, spline_cols: 1000, spline_slopes: 1000}",
+     "routing.spline_cols: spline_cols = 1000 with spline_slopes = 1000 needs 1.0e+12 edges "
+     "between two rows and 4.8e+13 per leg, more than 2e+07 and 2e+09 (memory and minutes of "
+     "work)"),
 ])
 def test_routing_settings_that_would_not_finish_are_refused(tmp_path, routing, message):
     res = runner.invoke(app, ["plan", str(course(tmp_path, routing=routing)), "-q",
@@ -181,6 +194,14 @@ def test_leg_work_is_estimated_before_routing(tmp_path):
             "about") in res.output
     assert "more than 1e+10 (minutes of work per leg); use routing.dt_s >= " in res.output
     assert not (tmp_path / "o").exists()
+
+
+def test_grid_dp_and_spline_work_limits_pass_the_shipped_settings():
+    from sailroute.routing.types import RoutingSettings, settings_problems
+
+    for kw in ({}, {"dp_cols": 128, "dp_rows": 30, "dp_samples": 1, "dp_refinements": 0},
+               {"dp_cols": 128}, {"dp_cols": 1024}, {"spline_refinements": 3}):
+        assert settings_problems(RoutingSettings(**kw)) == []
 
 
 def test_leg_work_estimate_passes_the_defaults():
