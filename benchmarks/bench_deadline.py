@@ -3,6 +3,7 @@
 Usage::
 
     python benchmarks/bench_deadline.py --grid 401,512            # all three figures
+    python benchmarks/bench_deadline.py --smoke      # Fig 3 on a 21 x 32 grid, 200 runs
     python benchmarks/bench_deadline.py --grid 801,1024 --runs 20000 --json out.json
     python benchmarks/bench_deadline.py --grid 401,512 --interp cubic --figs 4b
     python benchmarks/bench_deadline.py --grid 801,1024 --solve-only --s-max 5
@@ -247,7 +248,11 @@ def main() -> None:
                     help="a checkout of older code: each solve is repeated there with its "
                     "own copy of this script (same flags, --solve-only), alternating")
     ap.add_argument("--repeat", type=int, default=1, help="rounds of solves (with --baseline)")
+    ap.add_argument("--smoke", action="store_true",
+                    help="Fig 3 on a 21 x 32 grid with 200 runs (checks the script runs)")
     args = ap.parse_args()
+    if args.smoke:
+        args.grid, args.figs, args.runs, args.dt = "21,32", "3", 200, 0.05
     print(uptime())
     run = check_dtype if args.check_dtype else run_fig
     results = []

@@ -4,6 +4,7 @@ Run::
 
     python benchmarks/bench_griddp.py            # full run (~2 min)
     python benchmarks/bench_griddp.py --quick    # C <= 64 only
+    python benchmarks/bench_griddp.py --smoke    # C = 8 table only (seconds)
 
 Prints, for Dębski's (2016) test case (800 m x 500 m, 12 m/s wind 5° off the
 leg axis) and his spatially varying analytic wind:
@@ -141,12 +142,16 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="skip C = 128")
     ap.add_argument("--backend", default="numpy",
                     help="numpy | cupy | auto: array backend of the grid-DP rows table")
+    ap.add_argument("--smoke", action="store_true",
+                    help="the grid-DP table at C = 8 only (checks the script runs)")
     args = ap.parse_args()
     print(f"# sailroute grid-DP benchmark — {platform.processor() or platform.machine()}, "
           f"Python {platform.python_version()}, numpy {np.__version__}, 1 thread")
     DynamicBoat().table()  # build the lookup table outside the timings
-    cols = [32, 64] + ([] if args.quick else [128])
+    cols = [8] if args.smoke else [32, 64] + ([] if args.quick else [128])
     _grid_rows(cols, args.quick, get_xp(args.backend))
+    if args.smoke:
+        return
     _paper_convergence(args.quick)
     _splines()
     _kernel_accuracy()

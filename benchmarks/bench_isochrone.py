@@ -147,7 +147,11 @@ def main() -> None:
     ap.add_argument("--heading-step", type=float, default=None)
     ap.add_argument("--sector", type=float, default=None)
     ap.add_argument("--backend", default="numpy", help="numpy | cupy | auto (array backend)")
+    ap.add_argument("--smoke", action="store_true",
+                    help="the uniform-wind leg once (checks the script runs)")
     args = ap.parse_args()
+    if args.smoke:
+        args.repeat = 1
     xp = get_xp(args.backend)
     kw = {k: v for k, v in (("dt_s", args.dt), ("heading_step_deg", args.heading_step),
                             ("prune_sector_deg", args.sector)) if v is not None}
@@ -160,6 +164,8 @@ def main() -> None:
     t0 = 1524567600.0  # 2018-04-24T11:00Z, inside the synthetic WRF file
     run_case("uniform 8.5 kn from 0 deg, 1809 m beat", UniformWind(8.5 * KNOT, 0.0), t0,
              polar, st, args.repeat, xp)
+    if args.smoke:
+        return
     wrf = wrf_field()
     if wrf is not None:
         c = wrf.coverage

@@ -4,6 +4,7 @@ Run::
 
     python benchmarks/bench_multispline.py            # both examples, all options (~1 min)
     python benchmarks/bench_multispline.py --quick    # Example 2 without the option runs
+    python benchmarks/bench_multispline.py --smoke    # Example 1 on a tiny set-up (seconds)
 
 One run prints, per example: the set-up, our wall time on one core
 (``OMP_NUM_THREADS=1``), the paper's serial C and OpenCL times, the ratios, and
@@ -126,6 +127,8 @@ def main() -> None:
     ap.add_argument("--ex1", nargs=4, type=int, metavar=("NR", "NC", "NTS", "NREF"),
                     default=EX1_DEFAULT, help="Example 1 set-up (default %(default)s)")
     ap.add_argument("--repeat", type=int, default=1, help="best of N runs (default 1)")
+    ap.add_argument("--smoke", action="store_true",
+                    help="Example 1 on a tiny set-up only (checks the script runs)")
     args = ap.parse_args()
     load0 = os.getloadavg()
     print(f"# sailroute multi-spline benchmark — {platform.processor() or platform.machine()}, "
@@ -133,6 +136,9 @@ def main() -> None:
           f"load average at start {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}")
     print(f"{'example':<10}{'set-up':<44}{'ours s':>9}{'serial':>9}{'OpenCL':>8}"
           f"{'/serial':>9}{'/OpenCL':>9}   result")
+    if args.smoke:
+        example1((6, 8, 4, 1), 1)
+        return
     if not args.quick:
         example1(tuple(args.ex1), args.repeat)
     example2(args.repeat, not args.quick)

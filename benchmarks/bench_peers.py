@@ -6,6 +6,7 @@ Run (from the repository root, one thread)::
     python benchmarks/bench_peers.py --quick         # fewer repeats, no C = 128
     python benchmarks/bench_peers.py --only peer     # one section: peer griddp course cli profile
     python benchmarks/bench_peers.py --only profile  # cProfile of one leg (also in the default run)
+    python benchmarks/bench_peers.py --smoke         # the profile section, 5 rows (seconds)
 
 Sections (each prints a Markdown table; ``docs/performance.md`` holds one full run):
 
@@ -867,7 +868,11 @@ def main(argv: Sequence[str] | None = None) -> None:
                     help="cli section: also time `plan` against the code in DIR (a checkout "
                     "of an older commit), alternating, --plan-repeat runs each")
     ap.add_argument("--top", type=int, default=15, help="profile rows")
+    ap.add_argument("--smoke", action="store_true",
+                    help="the profile section only, 5 rows (checks the script runs)")
     args = ap.parse_args(argv)
+    if args.smoke:
+        args.only, args.top = ["profile"], 5
     if args.quick:
         args.repeat, args.dp_repeat, args.course_repeat = 3, 1, 1
         args.cli_repeat, args.plan_repeat = 3, 1

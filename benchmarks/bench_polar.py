@@ -1,6 +1,6 @@
 """Benchmark: polar lookups, VMG optima and the Laser VPP on one core.
 
-    python benchmarks/bench_polar.py [--n 100000] [--repeat 7]
+    python benchmarks/bench_polar.py [--n 100000] [--repeat 7] [--smoke]
 
 Prints the best of ``--repeat`` runs:
 
@@ -46,7 +46,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=100_000, help="lookups per call")
     ap.add_argument("--repeat", type=int, default=7, help="repetitions (best is kept)")
+    ap.add_argument("--smoke", action="store_true",
+                    help="tiny sizes, one repetition, no full VPP run (checks the script runs)")
     args = ap.parse_args()
+    if args.smoke:
+        args.n, args.repeat = 1000, 1
     rng = np.random.default_rng(0)
     tws = rng.uniform(0.0, 15.0, args.n)
     twa = rng.uniform(-180.0, 180.0, args.n)
@@ -69,6 +73,9 @@ def main() -> None:
     t = best_of(lambda: (base.vmg_upwind(w), base.vmg_downwind(w)), max(1, args.repeat // 2))
     print(f"vmg_upwind + vmg_downwind, 1e4 TWS: {t * 1e3:.0f} ms")
 
+    if args.smoke:
+        print("VPP full ILCA 7 polar: skipped (--smoke)")
+        return
     t0 = time.perf_counter()
     vpp_polar.__wrapped__(ILCA7)  # bypass the cache
     t_vpp = time.perf_counter() - t0

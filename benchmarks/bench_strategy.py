@@ -6,6 +6,7 @@ Usage::
     python benchmarks/bench_strategy.py --paper    # + Wang et al. (2024) Figs 3, 4(a)
     python benchmarks/bench_strategy.py --scheduler processes --workers 2
                                                    # + Monte Carlo on Dask vs serial
+    python benchmarks/bench_strategy.py --smoke    # a 400 m beat, small grids, 100 runs
 
 Prints seconds (best of ``--repeat`` for the SDP) and the numbers the paper reports next to
 ours.  BLAS threads are pinned to one before numpy is imported.
@@ -49,9 +50,9 @@ SO40_KN = [0.0, 0.6, 1.2, 1.8, 2.1, 2.5, 4.1, 4.6, 5.0, 5.4, 5.8, 6.2, 6.4, 6.5,
            6.2, 5.7, 5.2, 4.7, 4.2, 3.9, 3.6]
 
 
-def bench_sdp(repeat: int, runs: int) -> ExpectedTimePolicy:
+def bench_sdp(repeat: int, runs: int, grid: BeatGrid | None = None) -> ExpectedTimePolicy:
     polar = builtin_polar("ilca7")
-    grid = BeatGrid()
+    grid = BeatGrid() if grid is None else grid
     model = OUShift(10.0, 600.0)
     times = []
     for _ in range(repeat):
@@ -70,11 +71,14 @@ def bench_sdp(repeat: int, runs: int) -> ExpectedTimePolicy:
     return pol
 
 
-def bench_deadline_physical() -> tuple[RiskNeutralPolicy, DeadlinePolicy]:
+def bench_deadline_physical(
+    n_r: int = 100, n_theta: int = 128, interps: tuple[str, ...] = ("linear", "cubic"),
+    runs: int = 4000,
+) -> tuple[RiskNeutralPolicy, DeadlinePolicy]:
     polar = builtin_polar("ilca7")
     model = DriftDiffusionShift(0.0, 0.4275)
-    for interp in ("linear", "cubic"):
-        grid = DeadlineGrid(2000.0, 100, 128, 20.0, 5.0, 1300.0, interpolation=interp)
+    for interp in interps:
+        grid = DeadlineGrid(2000.0, n_r, n_theta, 20.0, 5.0, 1300.0, interpolation=interp)
         ra = solve_deadline(polar, 10 * KNOT, model, grid, 5.0)
         print(f"deadline solve, 1600 m beat, {grid.n_r + 1} x {grid.n_theta} x 2 nodes, "
               f"{grid.n_s} budget steps of {grid.ds_s:g} s, {interp}: {ra.solve_time_s:.2f} s")
@@ -82,8 +86,8 @@ def bench_deadline_physical() -> tuple[RiskNeutralPolicy, DeadlinePolicy]:
     print(f"risk-neutral value iteration, same grid: {rn.solve_time_s:.2f} s "
           f"({rn.iterations} sweeps)")
     t0 = time.perf_counter()
-    simulate_deadline(rn, 4000, 1, (1600.0, 0.0, 1), ra=ra, deadline_s=800.0)
-    print(f"deadline Monte Carlo, 4000 runs (Δt = 1 s): {time.perf_counter() - t0:.2f} s")
+    simulate_deadline(rn, runs, 1, (1600.0, 0.0, 1), ra=ra, deadline_s=800.0)
+    print(f"deadline Monte Carlo, {runs} runs (Δt = 1 s): {time.perf_counter() - t0:.2f} s")
     return rn, ra
 
 
@@ -172,7 +176,13 @@ def main() -> None:
     ap.add_argument("--scheduler", default=None,
                     help="also time the Monte Carlo on Dask: processes | tcp://HOST:PORT")
     ap.add_argument("--workers", type=int, default=None, help="workers for --scheduler processes")
+    ap.add_argument("--smoke", action="store_true",
+                    help="a 400 m beat, small grids, 100 runs, once (checks the script runs)")
     args = ap.parse_args()
+    if args.smoke:
+        bench_sdp(1, 100, BeatGrid(length_m=400.0, half_width_m=200.0, lateral_m=4.0))
+        bench_deadline_physical(20, 32, ("linear",), 100)
+        return
     pol = bench_sdp(args.repeat, args.runs)
     rn, ra = bench_deadline_physical()
     if args.scheduler:

@@ -1,6 +1,6 @@
 """Benchmark: sample 1e6 random (t, x, y) points from wind fields on one core.
 
-    python benchmarks/bench_wind.py [--n 1000000] [--repeat 5]
+    python benchmarks/bench_wind.py [--n 1000000] [--repeat 5] [--smoke]
 
 Uses the synthetic Hyères wrfout in data/ (25 x 25 cells, 37 slices; regenerated in a
 temporary folder if missing) with a height correction to 2.68 m, and prints the best of
@@ -74,7 +74,11 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--n", type=int, default=1_000_000)
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--smoke", action="store_true",
+                    help="1000 points, one repetition (checks the script runs)")
     args = ap.parse_args()
+    if args.smoke:
+        args.n, args.repeat = 1000, 1
     path = wrf_path()
     fields = {
         "wrf bilinear + linear time": open_wrf(path, FRAME, height_m=2.68),

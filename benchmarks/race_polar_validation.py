@@ -3,6 +3,7 @@
 Usage::
 
     python benchmarks/race_polar_validation.py [--boat ilca7] [--boat ilca7-steady] [--sensitivity]
+    python benchmarks/race_polar_validation.py --smoke   # ilca7 on Snipe P01 only, 30 s steps
 
 For each race it routes the course with the built-in boat in the race's reported
 wind (uniform) and compares with the observed leg times:
@@ -28,7 +29,7 @@ import dataclasses
 from datetime import datetime
 
 from sailroute.course.load import course_from_mapping, load_course
-from sailroute.course.model import Course
+from sailroute.course.model import Course, frozen_mapping
 from sailroute.plan import plan_course
 
 SNIPE = {
@@ -70,7 +71,7 @@ VARIANTS = {
 """Race-model variants for ``--sensitivity``: one parameter moved across its plausible range."""
 
 
-def snipe_course(race: str, boat: str | dict) -> Course:
+def snipe_course(race: str, boat: str | dict, dt_s: float = 10.0) -> Course:
     tws, lat, lon, _ = SNIPE[race]
     return course_from_mapping({
         "name": f"Snipe Valencia 2025 {race} (ILCA stand-in)",
@@ -82,14 +83,16 @@ def snipe_course(race: str, boat: str | dict) -> Course:
                  {"to": "B1", "rounding": "port"},
                  {"to": "S1", "rounding": "port"}],
         "boat": {"builtin": boat} if isinstance(boat, str) else boat,
-        "routing": {"router": "isochrone", "tack_penalty_s": 5.0, "gybe_penalty_s": 5.0},
+        "routing": {"router": "isochrone", "tack_penalty_s": 5.0, "gybe_penalty_s": 5.0,
+                    "dt_s": dt_s},
         "scenarios": {"reported": {"wind": {"type": "uniform", "tws_kn": tws, "twd_deg": 110}}},
     }, source=f"<snipe {race}>")
 
 
 def ratios(boat: dict) -> tuple[float, float, float, float]:
     """Hyères total error vs the winner and the dn/up ratio errors (Hyères, P01, P02)."""
-    hy = dataclasses.replace(load_course("courses/hyeres-r1.yaml"), boat_spec=boat)
+    hy = dataclasses.replace(load_course("courses/hyeres-r1.yaml"),
+                             boat_spec=frozen_mapping(boat))
     t = [leg.time_s for leg in plan_course(hy, "constant").plan.legs]
     ref = hy.references["winner"]
     out = [sum(t) / sum(ref) - 1,
@@ -111,19 +114,35 @@ def sensitivity() -> None:
         print(f"| {name} | " + " | ".join(f"{x:+.1%}" for x in r) + " |")
 
 
+def smoke_row(boat: str) -> None:
+    """The Snipe P01 row with 30 s steps (``--smoke``)."""
+    legs = [leg.time_s for leg in plan_course(snipe_course("P01", boat, dt_s=30.0)).plan.legs]
+    run_m, beat_m = (legs[1] + legs[3]) / 2, legs[2]
+    run_o, beat_o = snipe_observed("P01")
+    print(f"| {boat} | Snipe P01 (--smoke, 30 s steps) | 6 kn 110° | {run_m / beat_m:.3f} | "
+          f"{run_o / beat_o:.3f} | {run_m / beat_m / (run_o / beat_o) - 1:+.1%} | "
+          f"run {run_m:.0f} s, beat {beat_m:.0f} s | run {run_o:.0f} s, beat {beat_o:.0f} s | "
+          f"run {run_m / run_o - 1:+.1%}, beat {beat_m / beat_o - 1:+.1%} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--boat", action="append", default=None)
     ap.add_argument("--sensitivity", action="store_true",
                     help="also move each race-model parameter across its range")
+    ap.add_argument("--smoke", action="store_true",
+                    help="ilca7 on Snipe P01 only, 30 s steps (checks the script runs)")
     args = ap.parse_args()
-    boats = args.boat or ["ilca7", "ilca7-steady"]
+    boats = ["ilca7"] if args.smoke else args.boat or ["ilca7", "ilca7-steady"]
     print("| boat | race | wind | model dn/up | observed dn/up | ratio error | model total | "
           "observed total | total error |")
     print("|---|---|---|---|---|---|---|---|---|")
     for boat in boats:
+        if args.smoke:
+            smoke_row(boat)
+            continue
         hy = load_course("courses/hyeres-r1.yaml")
-        hy = dataclasses.replace(hy, boat_spec={"builtin": boat})
+        hy = dataclasses.replace(hy, boat_spec=frozen_mapping({"builtin": boat}))
         t = [leg.time_s for leg in plan_course(hy, "constant").plan.legs]
         model = (t[1] + t[3]) / (t[0] + t[2])
         for who, ref in (("winner", hy.references["winner"]), ("top10", hy.references["top10"])):

@@ -19,7 +19,10 @@ access to a name imports its module.
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING, Any
+
+# ``typing`` is not imported at run time: ``import sailroute`` (the first thing the
+# ``sailroute`` command runs, before its Ctrl-C guard) stays a few statements long.
+TYPE_CHECKING = False
 
 __version__ = "0.1.0"
 
@@ -177,6 +180,10 @@ if TYPE_CHECKING:  # pragma: no cover - the same names, for static tools
     from sailroute.wind.stations import StationData, StationWind, read_stations
     from sailroute.wind.uniform import UniformWind
     from sailroute.wind.wrf import open_wrf
+
+
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def __getattr__(name: str) -> Any:

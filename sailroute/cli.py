@@ -21,7 +21,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal, TypeVar
+from typing import Annotated, Any, Literal, NoReturn, TypeVar
 
 import typer
 from typer._click.exceptions import BadParameter
@@ -101,10 +101,24 @@ class _Command(TyperCommand):
 
 
 class _Group(TyperGroup):
-    """A command group whose help shows metavars instead of type tags."""
+    """A command group whose help shows metavars instead of type tags, and whose
+    parsing and dispatch end in ``interrupted`` and exit 130 on Ctrl-C (typer's own
+    handler exits 130 silently)."""
 
     def get_params(self, ctx: Any) -> list[Any]:
         return _tidy(super().get_params(ctx))
+
+    def make_context(self, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return super().make_context(*args, **kwargs)
+        except KeyboardInterrupt:
+            _interrupted()
+
+    def invoke(self, ctx: Any) -> Any:
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt:
+            _interrupted()
 
 
 app = typer.Typer(
@@ -156,6 +170,12 @@ def _root(
     ctx.obj = _Options(debug=debug)
 
 
+def _interrupted() -> NoReturn:
+    """Ctrl-C: one line on stderr, exit 130 (128 + SIGINT, as shells report it)."""
+    typer.echo("interrupted", err=True)
+    raise typer.Exit(code=130) from None
+
+
 def run_guarded(fn: Callable[[], T], *, debug: bool) -> T:
     """Call ``fn``; turn sailroute errors into a one-paragraph message and exit code
     (``debug``: re-raise them with the traceback instead)."""
@@ -167,8 +187,7 @@ def run_guarded(fn: Callable[[], T], *, debug: bool) -> T:
         typer.echo(f"error: {exc}", err=True)
         raise typer.Exit(code=exc.exit_code) from None
     except KeyboardInterrupt:
-        typer.echo("interrupted", err=True)
-        raise typer.Exit(code=130) from None
+        _interrupted()
     except (typer.Exit, typer.Abort):
         raise
     except Exception as exc:  # anything else is a bug: one short paragraph, exit 1
@@ -389,9 +408,9 @@ def vpp_command(
     kinetics: Annotated[
         Kinetics,
         typer.Option("--kinetics", case_sensitive=False,
-                     help="steady: the VPP alone; race: with wave riding and pumping, as "
-                     "the built-in ilca7 (docs/vpp.md)."),
-    ] = "steady",
+                     help="race (default): with wave riding and pumping, as the built-in "
+                     "ilca7 that plan routes with; steady: the VPP alone (docs/vpp.md)."),
+    ] = "race",
     json_out: JsonOpt = False,
 ) -> None:
     """Run the Laser/ILCA VPP: print the polar and best VMG, write .pol/.csv/.json/.png."""
@@ -722,9 +741,13 @@ def analyze_command(
 
 
 def main() -> None:
-    """Console-script entry point."""
+    """Run the command line (the console script's :func:`sailroute.__main__.main` imports
+    this module inside its own Ctrl-C guard)."""
     try:
         app()
     except SailrouteError as exc:  # pragma: no cover - safety net
         typer.echo(f"error: {exc}", err=True)
         sys.exit(exc.exit_code)
+    except KeyboardInterrupt:  # outside the commands (typer's set-up): the same line
+        typer.echo("interrupted", err=True)
+        sys.exit(130)

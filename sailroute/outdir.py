@@ -14,6 +14,11 @@ Rules (``docs/usage.md``, "The output folder"):
   (``route.png`` after a ``--no-plots`` rerun) are deleted, and nothing else is.  A
   user's own files in the folder are never listed, so never deleted (only a file with
   the same name as an output is overwritten, as by any program that writes there).
+* Every file lands inside the output folder: a name that becomes a path part (a
+  scenario, an ensemble member: :func:`path_part_problem`, checked when the course is
+  read) cannot climb out of it, files are never written through a symbolic link to a
+  folder inside it, and a manifest entry under such a link is never deleted (the link
+  may point anywhere).
 """
 
 from __future__ import annotations
@@ -38,6 +43,57 @@ STAGE_PREFIX = ".sailroute-tmp-"
 """Name prefix of the staging folders :func:`write_output_set` writes into."""
 
 T = TypeVar("T")
+
+
+PATH_PART_MAX = 100
+"""Longest name (characters) that may become a file or folder name in an output folder."""
+
+
+def path_part_problem(name: str) -> str | None:
+    """Why ``name`` cannot be a file or folder name in an output folder, or None if it can.
+
+    A name that becomes a path part (a scenario's folder in ``compare-scenarios``, the
+    default ``out/<course>/<scenario>``) must be one part: not empty, not ``.`` or ``..``,
+    no ``/`` or ``\\`` (so never absolute), no ``:`` (a drive on Windows), no control
+    characters, at most :data:`PATH_PART_MAX` characters, and not starting with ``.``
+    (hidden, and the staging folders' prefix).
+
+    Parameters
+    ----------
+    name : str
+        The name.
+
+    Returns
+    -------
+    str or None
+        A short reason (for an error message), or None when the name is safe.
+    """
+    if not name:
+        return "it is empty"
+    if name.startswith("."):
+        return "it starts with '.' (a hidden or parent folder)"
+    bad = sorted({ch for ch in name if ch in "/\\:" or ord(ch) < 32 or ord(ch) == 127})
+    if bad:
+        return "it contains " + ", ".join(repr(ch) for ch in bad) + " (a path separator or " \
+            "a control character)"
+    if len(name) > PATH_PART_MAX:
+        return f"it is {len(name)} characters long (at most {PATH_PART_MAX})"
+    return None
+
+
+def safe_part(name: str, what: str) -> str:
+    """``name`` if it can be a file or folder name in an output folder, else an error.
+
+    Raises
+    ------
+    InputError
+        ``name`` is not safe (:func:`path_part_problem`); the message names ``what``.
+    """
+    why = path_part_problem(name)
+    if why is not None:
+        raise InputError(f"{what} {name!r} cannot name a folder of the output: {why}; "
+                         "use letters, digits, '-', '_' or '#'")
+    return name
 
 
 def _cannot(d: Path, why: str, option: str) -> InputError:
@@ -162,6 +218,17 @@ def _sigint_deferred() -> Iterator[None]:
         raise KeyboardInterrupt
 
 
+def _linked_parent(out: Path, rel: str) -> Path | None:
+    """The first folder between ``out`` and ``out/rel`` (exclusive) that is a symbolic
+    link (or not a folder), or None when the path stays inside ``out``."""
+    d = out
+    for part in PurePosixPath(rel).parts[:-1]:
+        d = d / part
+        if d.is_symlink() or (d.exists() and not d.is_dir()):
+            return d
+    return None
+
+
 def _prune_empty_dirs(out: Path, rel: str) -> None:
     """Remove the now-empty folders between ``out/rel`` and ``out`` (not ``out``)."""
     d = (out / rel).parent
@@ -186,6 +253,13 @@ def _commit(stage: Path, out: Path) -> None:
                 raise
             # a folder appeared at out meanwhile: merge into it as below
     old = read_manifest(out)
+    for rel in sorted(new):
+        link = _linked_parent(out, rel)
+        if link is not None:
+            raise InputError(
+                f"--out: cannot write {rel!r} into {str(out)!r}: {str(link)!r} is a symbolic "
+                "link or a file, and sailroute writes only inside the output folder; remove "
+                "it or choose another folder with --out")
     with _sigint_deferred():
         _write_manifest(out, old | new)  # everything that may be ours, until the swap is done
         for rel in sorted(new):
@@ -194,6 +268,8 @@ def _commit(stage: Path, out: Path) -> None:
             os.replace(stage / rel, dst)
         for rel in sorted(old - new):
             p = out / rel
+            if _linked_parent(out, rel) is not None:  # may point anywhere: not ours
+                continue
             if p.is_file() or p.is_symlink():
                 p.unlink(missing_ok=True)
                 _prune_empty_dirs(out, rel)

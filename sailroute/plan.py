@@ -25,7 +25,7 @@ from sailroute.course.geometry import course_bbox, leg_endpoints, race_time_wind
 from sailroute.course.load import build_current, build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError, format_problems
-from sailroute.outdir import check_out_dir, write_output_set
+from sailroute.outdir import check_out_dir, path_part_problem, safe_part, write_output_set
 from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.report import png_worker
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
@@ -380,9 +380,20 @@ def _loaded(course: Course | str | Path) -> Course:
     return course if isinstance(course, Course) else load_course(course)
 
 
-def default_out_dir(course: Course, what: str) -> Path:
-    """``out/<course file stem>/<what>``: where results go without ``--out``."""
+def default_out_dir(course: Course, what: str, router: str | None = None) -> Path:
+    """``out/<course file stem>/<what>``: where results go without ``--out``.
+
+    A ``router`` other than the course's own (``routing.router``) is added to the last
+    part, ``out/<stem>/<what>-<router>``, so that ``plan --router griddp`` does not
+    replace the folder of the default router's run.  ``what`` (a scenario name given on
+    the command line) must be one safe path part (:func:`sailroute.outdir.safe_part`).
+    """
     stem = Path(course.source).stem if course.source else "course"
+    if path_part_problem(stem) is not None:
+        stem = "course"
+    safe_part(what, "scenario")
+    if router is not None and router != course.routing.router:
+        what = f"{what}-{router}"
     return Path("out") / stem / what
 
 
@@ -412,7 +423,8 @@ def run_plan_command(
 
     course = _loaded(course)
     name = default_scenario(course) if scenario is None else scenario
-    out = check_out_dir(Path(out_dir) if out_dir is not None else default_out_dir(course, name))
+    out = check_out_dir(Path(out_dir) if out_dir is not None
+                        else default_out_dir(course, name, router))
     if name in course.ensembles:
         return _run_ensemble(course, name, router=router, out_dir=out, backend=backend,
                              progress=progress, plots=plots)
@@ -446,7 +458,7 @@ def _run_ensemble(
     cmp, plans, winds = _compare_scenarios(course, [name], router=router, backend=backend,
                                            progress=progress)
     summary = summarize_ensemble(name, plans)
-    out = Path(out_dir) if out_dir is not None else default_out_dir(course, name)
+    out = Path(out_dir) if out_dir is not None else default_out_dir(course, name, router)
 
     def write(d: Path) -> dict[str, Path]:
         files: dict[str, Path] = dict(write_ensemble(d, summary))
@@ -456,7 +468,8 @@ def _run_ensemble(
             files["html"] = write_report(d / "report.html",
                                          comparison_report(cmp, plans, winds))
         for p in plans:
-            for kind, path in write_plan_outputs(d / p.scenario, p, plot=False).items():
+            sub = d / safe_part(p.scenario, "scenario")
+            for kind, path in write_plan_outputs(sub, p, plot=False).items():
                 files[f"{p.scenario}/{kind}"] = path
         return files
 
@@ -489,7 +502,7 @@ def run_compare_command(
 
     course = _loaded(course)
     out = check_out_dir(Path(out_dir) if out_dir is not None
-                        else default_out_dir(course, "comparison"))
+                        else default_out_dir(course, "comparison", router))
     cmp, plans, winds = _compare_scenarios(course, scenarios, router=router, backend=backend,
                                            progress=progress, scheduler=scheduler)
     report = [comparison_table(cmp)]
@@ -510,10 +523,12 @@ def run_compare_command(
             files["comparison_png"] = d / "comparison.png"
             files["html"] = write_report(d / "report.html", comparison_report(cmp, plans, winds))
         for p in plans:
-            for kind, path in write_plan_outputs(d / p.scenario, p, plot=False).items():
+            sub = d / safe_part(p.scenario, "scenario")
+            for kind, path in write_plan_outputs(sub, p, plot=False).items():
                 files[f"{p.scenario}/{kind}"] = path
         for summary in summaries:
-            for kind, path in write_ensemble(d / summary.name, summary).items():
+            sub = d / safe_part(summary.name, "scenario")
+            for kind, path in write_ensemble(sub, summary).items():
                 files[f"{summary.name}/{kind}"] = path
         return files
 

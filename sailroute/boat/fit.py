@@ -57,6 +57,7 @@ The result is a valid :class:`~sailroute.boat.polar.Polar` (finite, >= 0) with
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Final
 
@@ -173,6 +174,7 @@ def fit_polar(
     min_count: int = 5,
     filters: FitFilters | None = None,
     name: str = "fitted",
+    options: Mapping[str, str] | None = None,
 ) -> PolarFit:
     """Fit a polar to logged samples (see the module docstring for the method).
 
@@ -198,6 +200,10 @@ def fit_polar(
         Filter thresholds; default :class:`FitFilters()`.
     name : str
         Name of the returned polar.
+    options : mapping of str to str, optional
+        What the messages call the parameters ``percentile``, ``min_count``,
+        ``tws_bins_ms`` and ``twa_bins_deg`` (a command line's options, e.g.
+        ``{"min_count": "--min-count"}``); default ``fit_polar: <parameter>``.
 
     Returns
     -------
@@ -225,12 +231,19 @@ def fit_polar(
         if a.size != k:
             raise InputError(f"fit_polar: {nm} has {a.size} samples, tws_ms has {k}; "
                              "give one value per sample")
-    tws_n = _check_nodes(tws_bins_ms, "tws_bins_ms", lo=0.0, hi=np.inf, strict_lo=True)
-    twa_n = _check_nodes(twa_bins_deg, "twa_bins_deg", lo=0.0, hi=180.0, strict_lo=False)
+    named = dict(options or {})
+
+    def label(param: str) -> str:
+        return named.get(param, f"fit_polar: {param}")
+
+    tws_n = _check_nodes(tws_bins_ms, label("tws_bins_ms"), lo=0.0, hi=np.inf, strict_lo=True)
+    twa_n = _check_nodes(twa_bins_deg, label("twa_bins_deg"), lo=0.0, hi=180.0,
+                         strict_lo=False)
     if not 0.0 < percentile <= 100.0:
-        raise InputError(f"fit_polar: percentile must be in (0, 100]; got {percentile}")
-    if int(min_count) != min_count or min_count < 1:
-        raise InputError(f"fit_polar: min_count must be an integer >= 1; got {min_count}")
+        raise InputError(f"{label('percentile')} must be in (0, 100], e.g. 90; got {percentile}")
+    if not np.isfinite(min_count) or int(min_count) != min_count or min_count < 1:
+        raise InputError(f"{label('min_count')} must be a whole number >= 1, e.g. 5; "
+                         f"got {min_count}")
     q = percentile / 100.0
     twa = fold_twa(twa_s)
 
@@ -275,10 +288,12 @@ def fit_polar(
     counts = counts.reshape(twa_n.size, nj)
     covered = counts >= min_count
     if not covered.any():
+        where = "" if named else "fit_polar: "
         raise InputError(
-            f"fit_polar: no TWS/TWA cell has {min_count} samples after filtering "
+            f"{where}no TWS/TWA cell has {min_count} samples after filtering "
             f"({k} samples; dropped: {_fmt_dropped(dropped)}); give a longer log, wider bins "
-            "(fewer TWS nodes, a larger TWA step), a lower min_count or looser filters"
+            f"(fewer TWS nodes: {label('tws_bins_ms')}, a larger TWA step: "
+            f"{label('twa_bins_deg')}), a lower {label('min_count')} or looser filters"
         )
     raw = np.where(covered, env.reshape(counts.shape), np.nan)
     node_tws = tws_n[g % nj]
@@ -531,9 +546,9 @@ def _check_nodes(nodes: ArrayLike, what: str, *, lo: float, hi: float,
                  strict_lo: bool) -> NDArray[np.float64]:
     a = np.asarray(nodes, dtype=float).ravel()
     if a.size < 1 or not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0):
-        raise InputError(f"fit_polar: {what} must be finite and strictly increasing; got {a}")
+        raise InputError(f"{what} must be finite and strictly increasing; got {a}")
     if (a[0] <= lo if strict_lo else a[0] < lo) or a[-1] > hi:
-        raise InputError(f"fit_polar: {what} must lie in {'(' if strict_lo else '['}{lo:g}, "
+        raise InputError(f"{what} must lie in {'(' if strict_lo else '['}{lo:g}, "
                          f"{hi:g}]; got {a}")
     return a
 

@@ -444,6 +444,12 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
     return out
 
 
+FIT_OPTIONS: Final = {"percentile": "--percentile", "min_count": "--min-count",
+                      "tws_bins_ms": "--tws-bins", "twa_bins_deg": "--twa-step"}
+"""The ``polar fit`` options that give :func:`~sailroute.boat.fit.fit_polar`'s parameters
+(named in its messages)."""
+
+
 def run_fit_command(
     log: str | Path,
     *,
@@ -525,7 +531,7 @@ def run_fit_command(
     fit = fit_polar(samples.tws_ms, samples.twa_deg, samples.bsp_ms, samples.t_s,
                     tws_bins_ms=tws_n, twa_bins_deg=twa_grid(twa_step_deg),
                     heading_deg=samples.heading_deg, percentile=percentile,
-                    min_count=min_count, filters=filters, name=stem)
+                    min_count=min_count, filters=filters, name=stem, options=FIT_OPTIONS)
     errors = compare_polars(fit, ref) if ref is not None else None
     report = fit_report(fit, samples, unit, errors, ref.name if ref is not None else "")
     files = write_output_set(

@@ -15,9 +15,11 @@ Formats
     file name (see below).  Empty cells are filled (see :func:`fill_empty_cells`).
 ``csv`` long format
     A header naming a TWS, a TWA and a speed column (``tws``, ``twa``,
-    ``speed``/``bsp``/``boat_speed``/``stw``, in any order), each optionally with
-    a unit suffix (``tws_kn``, ``speed_ms``, ``bsp_kmh``, ``twa_deg``); one row
-    per (TWS, TWA) pair.  Without a suffix the unit is knots.
+    ``speed``/``bsp``/``boat_speed``/``stw``, or ``btv`` as in an ORC speed guide's
+    ``TWS,TWA,BTV,VMG,...``, in any order), each optionally with a unit suffix
+    (``tws_kn``, ``speed_ms``, ``bsp_kmh``, ``twa_deg``); one row per (TWS, TWA) pair;
+    other columns (``VMG``, ``AWS``, ``Heel``, ...) are ignored.  Without a suffix the
+    unit is knots.
 ``json``
     sailroute's own format (written by :func:`write_polar_json`, units stated
     in the file) or an ORC certificate JSON (``jieter/orc-data``; knots), see
@@ -69,7 +71,9 @@ FORMATS: Final = ("pol", "csv", "json")
 """Values of the ``format`` argument of :func:`read_polar`."""
 
 _HEADER_LABELS: Final = {"twa\\tws", "twa/tws", "twa", "tws\\twa", "tws/twa", "twa\\\\tws", ""}
-_SPEED_NAMES: Final = ("speed", "bsp", "boat_speed", "boatspeed", "stw", "v", "vb")
+_SPEED_NAMES: Final = ("speed", "bsp", "boat_speed", "boatspeed", "stw", "v", "vb", "btv")
+"""Boat-speed column names of a long polar CSV (``btv``: the target boat speed of an ORC
+speed guide, read as published)."""
 _UNIT_SUFFIX: Final = {
     "kn": "kn",
     "kt": "kn",
@@ -498,7 +502,7 @@ def parse_long_csv(
     if missing:
         raise InputError(
             f"{src}:{start + 1}: long polar CSV needs columns tws, twa and speed (or bsp, "
-            f"boat_speed, stw), optionally with a unit suffix like tws_kn; missing "
+            f"boat_speed, stw, btv), optionally with a unit suffix like tws_kn; missing "
             f"{', '.join(missing)} in header {rows[start]!r}"
         )
     if cols["twa"][1] not in (None, "deg"):

@@ -23,7 +23,7 @@ from sailroute.boat.laser import (
     LaserParams,
     params_from_mapping,
 )
-from sailroute.boat.polar import Polar
+from sailroute.boat.polar import MAX_BOAT_SPEED_KN, MAX_BOAT_SPEED_MS, MAX_TWS_KN, MAX_TWS_MS, Polar
 from sailroute.errors import InputError
 from sailroute.outdir import check_out_dir, make_out_dir, write_output_set
 from sailroute.units import speed_factor
@@ -91,11 +91,26 @@ def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
     return params_from_mapping(doc, where=str(p), lines=lines), _slug(p.stem)
 
 
+KINETICS_LINES: Final = {
+    "race": "race polar (the VPP with wave riding and pumping, as the built-in ilca7 that "
+            "plan routes with; --kinetics steady for the VPP alone)",
+    "steady": "steady VPP (no wave riding or pumping, as the built-in ilca7-steady; "
+              "--kinetics race for the race polar)",
+}
+"""First line of the ``vpp`` report: which polar was written."""
+
+
 def parse_speed_list(text: str, unit: str, *, option: str = "--tws") -> tuple[float, ...]:
-    """Parse ``"4,6,8"`` (in ``unit``) into increasing speeds [m s⁻¹]."""
+    """Parse ``"4,6,8"`` (in ``unit``) into increasing speeds [m s⁻¹].
+
+    Each must be positive and at most :data:`~sailroute.boat.polar.MAX_TWS_KN`, the
+    highest TWS column sailroute's polar readers accept (so every table written from
+    these columns can be read back).
+    """
     f = speed_factor(unit)
     vals = []
     example = f"give comma-separated wind speeds in {unit}, e.g. '4,6,8'"
+    top = f"{MAX_TWS_KN:g} kn" if unit == "kn" else f"{MAX_TWS_MS / f:.1f} {unit}"
     for k, cell in enumerate(c for c in re.split(r"[,\s]+", text.strip()) if c):
         try:
             v = float(cell)
@@ -105,6 +120,11 @@ def parse_speed_list(text: str, unit: str, *, option: str = "--tws") -> tuple[fl
         if not v > 0 or not np.isfinite(v):
             raise InputError(
                 f"{option}: item {k + 1} ({cell!r}) must be a positive, finite speed; {example}")
+        if v * f > MAX_TWS_MS * (1 + 1e-12):
+            raise InputError(
+                f"{option}: item {k + 1} ({cell} {unit}) is above {top}, stronger than any "
+                f"wind a polar is made for (sailroute's polar readers refuse such a column); "
+                f"give wind speeds up to {top}")
         vals.append(v * f)
     if not vals:
         raise InputError(f"{option}: no wind speed given; {example}")
@@ -214,7 +234,7 @@ def run_vpp_command(
     twa_step_deg: float = 5.0,
     out_dir: str | Path = "vpp-out",
     unit: str = "kn",
-    kinetics: str = "steady",
+    kinetics: str = "race",
 ) -> VppRun:
     """Everything ``sailroute vpp`` does, minus printing.
 
@@ -232,9 +252,11 @@ def run_vpp_command(
         Output folder (checked first; written as a set, see :mod:`sailroute.outdir`).
     unit : {"kn", "m/s"}
         Unit of the printed table and the written files.
-    kinetics : {"steady", "race"}
-        ``steady``: the VPP alone; ``race``: with wave riding and pumping (the
-        model of the built-in ``ilca7``, :mod:`sailroute.boat.kinetics`).
+    kinetics : {"race", "steady"}
+        ``race`` (default): with wave riding and pumping (the model of the built-in
+        ``ilca7`` that ``plan`` routes with, :mod:`sailroute.boat.kinetics`);
+        ``steady``: the VPP alone (as ``ilca7-steady``).  The report's first line
+        says which was written.
     """
     if unit not in UNITS:
         raise InputError(f"--unit: expected one of 'kn', 'm/s'; got {unit!r}")
@@ -256,8 +278,15 @@ def run_vpp_command(
               else tuple(v * speed_factor(unit) for v in DEFAULT_TWS[unit]))
     kin = kinetics_from_spec(kinetics)[0]
     polar = vpp_polar(params, tws_ms, twa_grid(twa_step_deg), kinetics=kin)
+    fastest = float(np.nanmax(polar.speed_ms, initial=0.0))
+    if fastest > MAX_BOAT_SPEED_MS:  # the polar readers' limit: a file they would refuse
+        raise InputError(
+            f"--tws: the VPP gives boat speeds up to {fastest / speed_factor('kn'):.1f} kn, "
+            f"above {MAX_BOAT_SPEED_KN:g} kn (faster than any sailing craft has gone); "
+            "give lower wind speeds")
     files = write_output_set(out_dir, lambda d: write_outputs(polar, params, d, stem, unit, kin))
-    return VppRun(params=params, polar=polar, report=polar_report(polar, unit), files=files)
+    return VppRun(params=params, polar=polar, report=KINETICS_LINES[kinetics] + "\n"
+                  + polar_report(polar, unit), files=files)
 
 
 def _slug(text: str) -> str:

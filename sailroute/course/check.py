@@ -30,7 +30,15 @@ from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame, wrap_lon
-from sailroute.routing.types import RouterName, RoutingSettings, Side, settings_problems
+from sailroute.outdir import path_part_problem
+from sailroute.routing.types import (
+    MIN_DT_S,
+    MIN_HEADING_STEP_DEG,
+    RouterName,
+    RoutingSettings,
+    Side,
+    settings_problems,
+)
 from sailroute.timeutil import parse_time, utc_offset_s
 from sailroute.units import KNOT
 
@@ -357,9 +365,13 @@ def _routing(c: Checker, raw: Any) -> RoutingSettings:
     r = c.at("routing")
     special: dict[str, Callable[[], Any]] = {
         "router": lambda: r.choice(raw, "router", typing.get_args(RouterName)),
-        "dt_s": lambda: r.number(raw, "dt_s", lo=0.0, lo_open=True),
-        "heading_step_deg": lambda: r.number(raw, "heading_step_deg", lo=0.0, hi=45.0,
-                                             lo_open=True),
+        "dt_s": lambda: r.number(raw, "dt_s", lo=MIN_DT_S, what=(
+            f"a time step >= {MIN_DT_S:g} s (default 10; finer steps hardly change the "
+            "route and make it slow)")),
+        "heading_step_deg": lambda: r.number(raw, "heading_step_deg", lo=MIN_HEADING_STEP_DEG,
+                                             hi=45.0, what=(
+            f"a number in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer steps only slow "
+            "the router)")),
         "tack_penalty_s": lambda: r.number(raw, "tack_penalty_s", lo=0.0),
         "gybe_penalty_s": lambda: r.number(raw, "gybe_penalty_s", lo=0.0),
         "initial_side": lambda: r.choice(raw, "initial_side", (*SIDES, None)),
@@ -490,6 +502,11 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
         c.p.add("scenarios", "expected at least one scenario; got none")
     for name, value in c.at("scenarios").named_items(raw, "a scenario name"):
         path = join_path("scenarios", name)
+        why = path_part_problem(name)
+        if why is not None:  # it names a folder of the output (out/<course>/<scenario>)
+            c.p.add(path, f"the scenario name {name!r} cannot name an output folder: {why}; "
+                    "use letters, digits, '-', '_' or '#'")
+            continue
         if not c.at(path).is_mapping(value, "a wind spec {type: ...} or {wind: {type: ...}, "
                                      "references: ..., description: ...}"):
             continue

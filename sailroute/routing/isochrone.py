@@ -61,7 +61,7 @@ import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any, NamedTuple
+from typing import Any, Final, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -506,6 +506,8 @@ def route_isochrone(
         elif calm_since is None:
             calm_since = layers[-1].t
         tau_hint = tau_min - (layer.t - layers[-1].t)
+        if len(layers) == 1:  # after the first step: the time to go is known
+            check_leg_work(label, settings, ctx, tab.twa_deg.size, tau_hint)
         layers.append(layer)
         elapsed = layer.t - t0
         if progress is not None:
@@ -516,6 +518,62 @@ def route_isochrone(
 
 # --------------------------------------------------------------------------------------
 # setup
+
+MAX_LEG_WORK: Final = 1e10
+"""Most candidate moves (front points x headings tried x steps, an upper bound) one leg
+may need [-]: about 20 ns each on one core, so a few minutes.  The defaults need
+~1e7 on a 1 km beat; ``dt_s`` 0.5 s with ``heading_step_deg`` 0.1 about 2e9."""
+
+
+def leg_work(settings: RoutingSettings, n_points: int, n_angles: int,
+             time_to_go_s: float) -> tuple[float, float]:
+    """Upper bound of the work of an isochrone leg: ``(steps, candidates per step)``.
+
+    Parameters
+    ----------
+    settings : RoutingSettings
+        ``dt_s`` gives the steps.
+    n_points : int
+        Most points a front keeps (``max_front_points``, or two per pruning sector).
+    n_angles : int
+        Grid TWAs of the polar tables (``180 / heading_step_deg``).
+    time_to_go_s : float
+        Estimated time from the front to the target [s].
+
+    Returns
+    -------
+    tuple of float
+        Steps still to go and candidate moves per step (keep and switch side, each with
+        every grid TWA and the exact VMG and direct headings).
+    """
+    return time_to_go_s / float(settings.dt_s), float(n_points) * 2.0 * (n_angles + 4)
+
+
+def check_leg_work(label: str, settings: RoutingSettings, ctx: _Context, n_angles: int,
+                   time_to_go_s: float) -> None:
+    """Refuse a leg whose estimated work (:func:`leg_work`) exceeds :data:`MAX_LEG_WORK`.
+
+    Raises
+    ------
+    InputError
+        Naming ``routing.dt_s`` and ``routing.heading_step_deg`` with the values that
+        would fit.
+    """
+    if not math.isfinite(time_to_go_s) or time_to_go_s <= 0 or time_to_go_s >= _BIG_S:
+        return  # a calm: no estimate (max_leg_time_s bounds it)
+    time_to_go_s = min(time_to_go_s, float(settings.max_leg_time_s))  # then it fails anyway
+    n_points = min(ctx.max_points, 2 * ctx.n_bins)
+    steps, per_step = leg_work(settings, n_points, n_angles, time_to_go_s)
+    if steps * per_step <= MAX_LEG_WORK:
+        return
+    dt_fit = time_to_go_s * per_step / MAX_LEG_WORK
+    raise InputError(
+        f"leg {label}: routing.dt_s = {settings.dt_s:g} s with routing.heading_step_deg = "
+        f"{settings.heading_step_deg:g} needs about {steps * per_step:.1e} candidate moves "
+        f"({steps:.0f} steps to go of up to {per_step:.1e}), more than {MAX_LEG_WORK:.0e} "
+        f"(minutes of work per leg); use routing.dt_s >= {dt_fit:.2g} s, a coarser "
+        "heading_step_deg or fewer max_front_points (the defaults, 10 s and 2, are accurate "
+        "to 3e-4 of the leg time)")
 
 
 def _check_start_time(t0: float, label: str) -> None:

@@ -257,6 +257,53 @@ class RoutingSettings:
     spline_start_from_rest: bool = False
 
 
+MIN_DT_S: Final = 0.5
+"""Smallest isochrone time step :attr:`RoutingSettings.dt_s` [s]: halving the default
+10 s down to 1.25 s moved a 1809 m beat by < 2e-5 (``docs/design/routing.md``), while
+the work grows as 1/dt (0.05 s took over 30 s for a 300 m leg; 1e-9 s never ends)."""
+MIN_MIN_DT_S: Final = 0.01
+"""Smallest :attr:`RoutingSettings.min_dt_s` [s] (the refined step near the target)."""
+MIN_HEADING_STEP_DEG: Final = 0.1
+"""Finest heading resolution :attr:`RoutingSettings.heading_step_deg` [°]: the polar is
+tabulated at ``180 / step`` angles and each front point tries them all (1e-4° hung,
+1e-9° asked for 1.3 TiB)."""
+MAX_FRONT_POINTS: Final = 100_000
+"""Largest :attr:`RoutingSettings.max_front_points` (the default is 2000)."""
+MAX_DP_SEGMENT_SAMPLES: Final = 200_000_000
+"""Most wind samples along grid-DP segments per leg: ``(dp_rows - 1) * dp_cols**2 *
+dp_samples * (dp_refinements + 1)``, an upper bound [-].  About 1 µs each, so minutes;
+the defaults need 2.4e6, Dębski's C = 128 with 30 rows 4.8e5."""
+MAX_SPLINE_ROW_EDGES: Final = 20_000_000
+"""Most multi-spline edges between two rows, ``(spline_cols * spline_slopes)**2``: each
+costed edge array holds this many float64 (160 MB); the defaults have 30 625."""
+MAX_SPLINE_EDGES: Final = 2_000_000_000
+"""Most multi-spline edges per leg, ``(dp_rows - 1) * (spline_cols * spline_slopes)**2 *
+(spline_refinements + 1)`` (the defaults: 1.5e6)."""
+
+
+def _work_problems(s: RoutingSettings) -> list[str]:
+    """The grid-DP and multi-spline work of a leg, estimated from ``s`` alone (the leg's
+    length does not change it): one line per router whose work would take too long."""
+    problems: list[str] = []
+    rows, cols, ref, smp = s.dp_rows - 1, s.dp_cols, s.dp_refinements + 1, s.dp_samples
+    dp = float(rows) * cols * cols * smp * ref
+    if dp > MAX_DP_SEGMENT_SAMPLES:
+        problems.append(
+            f"dp_cols = {cols} with dp_rows = {s.dp_rows}, dp_samples = {smp} and "
+            f"dp_refinements = {ref - 1} needs about {dp:.1e} wind samples per leg (rows x "
+            f"cols^2 x samples x passes), more than {MAX_DP_SEGMENT_SAMPLES:.0e} (minutes of "
+            "work); lower them (defaults 64 columns, 13 rows, 4 samples, 2 refinements)")
+    per_row = float(s.spline_cols * s.spline_slopes) ** 2
+    total = per_row * rows * (s.spline_refinements + 1)
+    if per_row > MAX_SPLINE_ROW_EDGES or total > MAX_SPLINE_EDGES:
+        problems.append(
+            f"spline_cols = {s.spline_cols} with spline_slopes = {s.spline_slopes} needs "
+            f"{per_row:.1e} edges between two rows and {total:.1e} per leg, more than "
+            f"{MAX_SPLINE_ROW_EDGES:.0e} and {MAX_SPLINE_EDGES:.0e} (memory and minutes of "
+            "work); lower spline_cols, spline_slopes or spline_refinements (defaults 25, 7, 3)")
+    return problems
+
+
 def settings_problems(s: RoutingSettings) -> list[str]:
     """What is wrong with ``s``, one line per field (empty when every field is valid).
 
@@ -289,7 +336,16 @@ def settings_problems(s: RoutingSettings) -> list[str]:
         number(name, strict=False)
     if is_number(s.heading_step_deg) and s.heading_step_deg > 45:
         problems.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
-    integer("max_front_points", 8, 10**9, ">= 8")
+    if is_number(s.heading_step_deg) and 0 < s.heading_step_deg < MIN_HEADING_STEP_DEG:
+        problems.append(
+            f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer "
+            f"steps only slow the router), got {s.heading_step_deg!r}")
+    if is_number(s.dt_s) and 0 < s.dt_s < MIN_DT_S:
+        problems.append(f"dt_s must be >= {MIN_DT_S:g} s (default 10; finer steps hardly "
+                        f"change the route and make it slow), got {s.dt_s!r}")
+    if is_number(s.min_dt_s) and 0 < s.min_dt_s < MIN_MIN_DT_S:
+        problems.append(f"min_dt_s must be >= {MIN_MIN_DT_S:g} s (default 1), got {s.min_dt_s!r}")
+    integer("max_front_points", 8, MAX_FRONT_POINTS, f"in [8, {MAX_FRONT_POINTS}]")
     if s.heading_fan not in ("hull", "full"):
         problems.append(f"heading_fan must be 'hull' or 'full', got {s.heading_fan!r}")
     if s.initial_side is not None and s.initial_side not in SIDE_NAMES:
@@ -314,6 +370,8 @@ def settings_problems(s: RoutingSettings) -> list[str]:
         v = getattr(s, name)
         if not isinstance(v, bool | np.bool_):
             problems.append(f"{name} must be true or false, got {v!r}")
+    if not problems:  # every count a valid integer: estimate the work
+        problems += _work_problems(s)
     return problems
 
 

@@ -9,10 +9,10 @@ risk-neutral problems of Wang et al. (2024) for the same leg and simulates both.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Final
 
 import numpy as np
 
@@ -543,6 +543,8 @@ def run_strategy_command(
 
     deadlines = parse_objective(objective)
     check_out_dir(out_dir)
+    check_command_options(settings, n_workers=n_workers, sigma_deg=sigma_deg,
+                          drift_deg_per_min=drift_deg_per_min)
     scheduler = check_scheduler(scheduler)
     kind = parse_shift(shift)
     name = str(start_tack).strip().lower()
@@ -556,6 +558,7 @@ def run_strategy_command(
         raise InputError(f"--seed {seed}: expected an integer >= 0 (NumPy's generators take "
                          "no negative seeds)")
     polar = load_polar(polar_spec)
+    check_wind_in_polar(tws_kn, polar, polar_spec)
     fit = None
     if fit_from is not None:
         ou, dd = fit_station_file(fit_from, station=fit_station, timezone=fit_timezone,
@@ -582,6 +585,117 @@ def run_strategy_command(
     )
     files = write_output_set(out_dir, lambda d: write_outputs(result, d, plots=plots))
     return CommandResult(format_report(result), files, result)
+
+
+MAX_LATTICE_NODES: Final = 100_000_000
+"""Most nodes (rows x lateral nodes x shift bins x 2 tacks) of the expected-time lattice
+the ``strategy`` command solves: about 2.5 min and 2 GB; the defaults (1600 m x 800 m)
+have 4.9 million."""
+MAX_RUNS: Final = 1_000_000
+"""Most Monte Carlo runs per policy (``--runs``; the default is 4000)."""
+MAX_RUN_STEPS: Final = 50_000_000
+"""Most Monte Carlo boat-steps per policy (runs x rows; the defaults need 640 000): the
+tracks are kept, about 33 bytes per boat-step, so 1.6 GB and tens of seconds."""
+
+
+def _option(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def check_command_options(
+    settings: Mapping[str, Any], *, n_workers: int | None, sigma_deg: float,
+    drift_deg_per_min: float,
+) -> None:
+    """Refuse bad ``strategy`` options by their command-line names, before any work.
+
+    Checks ``--runs``, ``--workers``, ``--length-m``, ``--half-width-m``,
+    ``--tack-penalty-s``, ``--sigma-deg`` and ``--drift-deg-per-min``, and estimates the
+    size of the expected-time lattice (:data:`MAX_LATTICE_NODES`) and of the Monte Carlo
+    (:data:`MAX_RUNS`, :data:`MAX_RUN_STEPS`) so that a study that would not finish in
+    reasonable time or memory is refused with the range that would.
+
+    Parameters
+    ----------
+    settings : mapping
+        The :class:`StrategySettings` fields given (``length_m``, ``runs``, ...).
+    n_workers : int or None
+        ``--workers``.
+    sigma_deg, drift_deg_per_min : float
+        ``--sigma-deg`` and ``--drift-deg-per-min``.
+
+    Raises
+    ------
+    InputError
+        Naming the option, the value and the accepted range.
+    """
+    defaults = StrategySettings()
+    runs = settings.get("runs", defaults.runs)
+    if isinstance(runs, bool) or not isinstance(runs, int) or not 1 <= runs <= MAX_RUNS:
+        raise InputError(f"--runs {runs}: expected a whole number of Monte Carlo runs in "
+                         f"1..{MAX_RUNS:,} (default {defaults.runs})")
+    if n_workers is not None and (isinstance(n_workers, bool) or not isinstance(n_workers, int)
+                                  or n_workers < 1):
+        raise InputError(f"--workers {n_workers}: expected a whole number >= 1 of worker "
+                         "processes")
+    for name, lo in (("tack_penalty_s", 0.0), ("sigma_deg", 0.0)):
+        v = sigma_deg if name == "sigma_deg" else settings.get(name, getattr(defaults, name))
+        if not (math.isfinite(v) and v >= lo):
+            raise InputError(f"{_option(name)} {v}: must be finite and >= {lo:g}")
+    if not math.isfinite(drift_deg_per_min):
+        raise InputError(f"--drift-deg-per-min {drift_deg_per_min}: must be finite")
+    steps = {"length_m": ("row_m", "rows"), "half_width_m": ("lateral_m", "lateral nodes")}
+    n = {}
+    for name, (step_name, what) in steps.items():
+        v = settings.get(name, getattr(defaults, name))
+        step = settings.get(step_name, getattr(defaults, step_name))
+        if not (math.isfinite(v) and v > 0):
+            raise InputError(f"{_option(name)} {v:g}: must be finite and > 0 m")
+        k = v / step
+        if abs(k - round(k)) > 1e-9 or round(k) < 1:
+            raise InputError(f"{_option(name)} {v:g}: expected a whole number (>= 1) of "
+                             f"{step:g} m {what}, e.g. {max(1, round(k)) * step:g}")
+        n[name] = round(k)
+    grid = StrategySettings(**{**asdict(defaults), **settings}).beat_grid()
+    n_shift = grid.theta_deg.size
+    nodes = (n["length_m"] + 1) * (2 * n["half_width_m"] + 1) * n_shift * 2
+    if nodes > MAX_LATTICE_NODES:
+        per_row = (2 * n["half_width_m"] + 1) * n_shift * 2
+        longest = (MAX_LATTICE_NODES // per_row - 1) * grid.row_m
+        raise InputError(
+            f"--length-m {grid.length_m:g} with --half-width-m {grid.half_width_m:g}: the "
+            f"expected-time lattice would have {nodes:.2g} nodes (about "
+            f"{nodes * 8 * 2.5 / 2**30:.3g} GiB), more than {MAX_LATTICE_NODES:.0e} (minutes "
+            f"and gigabytes); give a beat of at most {max(longest, 0.0):g} m at this width "
+            "(a dinghy beat is 0.5-3 km), or a smaller --half-width-m")
+    if runs * n["length_m"] > MAX_RUN_STEPS:
+        raise InputError(
+            f"--runs {runs} over {n['length_m']} rows of --length-m {grid.length_m:g}: "
+            f"{runs * n['length_m']:.2g} Monte Carlo boat-steps per policy, more than "
+            f"{MAX_RUN_STEPS:.0e}; use --runs <= {MAX_RUN_STEPS // n['length_m']}")
+
+
+def check_wind_in_polar(tws_kn: float, polar: Polar, polar_spec: str) -> None:
+    """Refuse a ``--tws-kn`` above the polar's highest TWS column.
+
+    The same rule as ``plan`` (:func:`sailroute.boat.sanity.check_wind_range`): above
+    its last column the polar is clamped, so the boat would sail as in the last
+    column's wind, silently.
+
+    Raises
+    ------
+    InputError
+        Naming ``--tws-kn``, the polar and its TWS range.
+    """
+    from sailroute.boat.sanity import TOLERANCE_MS
+
+    top = float(polar.tws_ms[-1])
+    if tws_kn * KNOT > top + TOLERANCE_MS:
+        lo = float(polar.tws_ms[0])
+        raise InputError(
+            f"--tws-kn {tws_kn:g}: above the highest TWS column of --polar {polar_spec} "
+            f"(TWS {lo / KNOT:.1f} .. {top / KNOT:.1f} kn); the boat speed would be clamped "
+            f"to that column without notice. Give --tws-kn up to {top / KNOT:.1f}, or a "
+            "--polar with higher TWS columns")
 
 
 SHIFT_KINDS = ("ou", "drift-diffusion")

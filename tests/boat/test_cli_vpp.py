@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 
 from sailroute.boat.build import vpp_polar
 from sailroute.boat.io import read_polar
+from sailroute.boat.kinetics import RACE
 from sailroute.boat.laser import ILCA6, ILCA7
 from sailroute.cli import app
 from sailroute.units import KNOT
@@ -36,10 +37,13 @@ def test_vpp_default_boat_writes_readable_files(tmp_path: Path) -> None:
     for suffix in ("pol", "csv", "json", "png"):
         assert (out / f"ilca7.{suffix}").is_file()
     assert (out / "ilca7.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # the default is the race polar, the model of the built-in ilca7 that plan routes with
+    assert res.output.startswith("race polar (the VPP with wave riding and pumping")
     api = vpp_polar(
         ILCA7,
         tuple(v * KNOT for v in (4.0, 8.0, 12.0)),
         tuple(float(a) for a in range(0, 181, 15)),
+        kinetics=RACE,
     )
     # every written format reads back to the API's polar (knots, 6 decimals)
     for suffix in ("pol", "csv", "json"):
@@ -64,8 +68,10 @@ def test_vpp_boat_file_options_and_units(tmp_path: Path) -> None:
     boat = tmp_path / "radial.yaml"
     boat.write_text("class: ilca6\nname: My radial\ncrew_mass_kg: 60\n")
     res = runner.invoke(app, ["vpp", str(boat), "--crew-mass", "64", "--tws", "3,6",
-                              "--twa-step", "30", "--unit", "m/s", "--out", str(tmp_path)])
+                              "--twa-step", "30", "--unit", "m/s", "--kinetics", "steady",
+                              "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output
+    assert res.output.startswith("steady VPP (no wave riding or pumping")
     assert "My radial: boat speed [m/s]" in res.output
     back = read_polar(tmp_path / "radial.csv")  # units in the CSV header: m/s
     api = vpp_polar(replace(ILCA6, name="My radial", crew_mass_kg=64.0), (3.0, 6.0),
@@ -97,6 +103,10 @@ def test_vpp_bad_input_exits_2_and_names_the_key(tmp_path: Path) -> None:
         (None, ["--tws", ""], "--tws: no wind speed given; give comma-separated wind speeds"),
         (None, ["--tws", "8,4"], "--tws: wind speeds must increase"),
         (None, ["--tws", "4,-6"], "--tws: item 2 ('-6') must be a positive, finite speed"),
+        # the readers' TWS limit (80 kn) at the writer's input: every file written reads back
+        (None, ["--tws", "4,1000"], "--tws: item 2 (1000 kn) is above 80 kn, stronger than any "
+         "wind a polar is made for"),
+        (None, ["--tws", "2,50", "--unit", "m/s"], "--tws: item 2 (50 m/s) is above 41.2 m/s"),
         (None, ["--crew-mass", "-70"], "--crew-mass: expected a sailor mass in 20-200 kg"),
         (None, ["--twa-step", "0"], "--twa-step: expected a step between 0.1 and 90 degrees"),
         (b"crew_mass_kg: -70\n", [], "b.yaml:1: crew_mass_kg: expected a finite number > 0"),

@@ -19,10 +19,11 @@ from sailroute.boat.fit_outputs import compare_polars, run_fit_command
 from sailroute.boat.io import read_polar
 from sailroute.cli import app
 from sailroute.errors import InputError
-from tests.conftest import SHARED_REAL, requires_shared
+from tests.conftest import ROOT, SHARED_REAL, requires_shared
 
 runner = CliRunner()
 TALLINN = SHARED_REAL / "races" / "tallinn-wednesday-races-2023"
+ORC_GUIDE = ROOT / "tests" / "data" / "boat" / "ORC_Speed_Guide_Ref_04340002PIL.csv"  # MIT
 NZL_LOG = SHARED_REAL / "races" / "sailgp-auckland-2025" / "Boat_logs" / "data_NZL.csv"
 F50 = SHARED_REAL / "polars" / "sailgp-f50" / "2502_m8_APW_HSB2_HSRW.kph.csv"
 TWS_BINS = np.arange(2.0, 7.01, 1.0)
@@ -321,16 +322,27 @@ def test_gps_track_with_a_course_wind(tmp_path: Path, target) -> None:
 # --- real logs (../shared, not redistributable: read in place) ----------------------------
 
 
+def test_orc_speed_guide_reads_as_published() -> None:
+    # TWS,TWA,BTV,VMG,AWS,AWA,Heel,Reef,Flat: BTV (target boat speed) is the speed column,
+    # the rest is ignored; knots as published (row "6,52,5.11,3.14,...")
+    from sailroute.units import KNOT
+
+    guide = read_polar(ORC_GUIDE)
+    assert guide.tws_ms[0] == pytest.approx(6 * KNOT) and guide.tws_ms[-1] == pytest.approx(
+        20 * KNOT)
+    for twa, kn in ((52.0, 5.11), (144.2, 4.11), (180.0, 3.03)):
+        i = int(np.flatnonzero(guide.twa_deg == twa)[0])
+        assert guide.speed_ms[i, 0] == pytest.approx(kn * KNOT, abs=1e-12)
+
+
 @requires_shared
 def test_tallinn_log_against_its_orc_speed_guide(tmp_path: Path) -> None:
-    # The ORC guide's speed column is BTV (target boat speed); the log has no bsp, so SOG
-    # is fitted (no current in Tallinn Bay).  Measured (min_count 10, default filters):
-    # RMS 6.5 %, mean -4.1 % over 14 covered cells (docs/polar-fit.md).
-    guide = (TALLINN / "ORC_Speed_Guide_Ref_04340002PIL.csv").read_text()
-    ref = tmp_path / "orc.csv"
-    ref.write_text(guide.replace("BTV", "speed", 1))
+    # The ORC guide is read as published (its speed column is BTV, the target boat speed);
+    # the log has no bsp, so SOG is fitted (no current in Tallinn Bay).  Measured
+    # (min_count 10, default filters): RMS 6.6 %, mean -4.5 % over 14 covered cells
+    # (docs/polar-fit.md).
     run = run_fit_command(TALLINN / "kolmak_2023_09_27.csv", speed_unit="kn",
-                          out_dir=tmp_path / "out", reference=ref, min_count=10)
+                          out_dir=tmp_path / "out", reference=ORC_GUIDE, min_count=10)
     assert run.samples.speed_source == "sog"
     assert run.errors is not None and run.errors.n_cells >= 10
     assert run.errors.rms_pct < 8.0

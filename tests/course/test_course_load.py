@@ -245,10 +245,11 @@ def test_empty_legs_and_leg_to_start(tmp_path):
     ("routing", "expected"),
     [
         ("router: dijkstra", "routing.router: expected one of 'isochrone', 'griddp', 'spline'"),
-        ("dt_s: 0", "routing.dt_s: expected a number > 0; got 0"),
+        ("dt_s: 0", "routing.dt_s: expected a time step >= 0.5 s (default 10; finer steps "
+                    "hardly change the route and make it slow); got 0"),
         ("tack_penalty_s: -1", "routing.tack_penalty_s: expected a number >= 0; got -1"),
         ("tack_penalty_s: ten", "routing.tack_penalty_s: expected a number >= 0; got 'ten'"),
-        ("heading_step_deg: 90", "routing.heading_step_deg: expected a number in (0, 45]"),
+        ("heading_step_deg: 90", "routing.heading_step_deg: expected a number in [0.1, 45]"),
         ("initial_side: left", "routing.initial_side: expected one of 'port', 'starboard', None"),
     ],
 )

@@ -67,6 +67,10 @@ BAD = [
      "router must be one of 'isochrone', 'griddp', 'spline', got 'dijkstra'"),
     ("dt_s", 0.0, "dt_s must be a number > 0, got 0.0"),
     ("heading_step_deg", 60.0, "heading_step_deg must be <= 45, got 60.0"),
+    ("heading_step_deg", 0.01, "heading_step_deg must be in [0.1, 45] (default 2; finer steps "
+     "only slow the router), got 0.01"),
+    ("dt_s", 0.1, "dt_s must be >= 0.5 s (default 10; finer steps hardly change the route "
+     "and make it slow), got 0.1"),
     ("min_dt_s", -1.0, "min_dt_s must be a number > 0, got -1.0"),
     ("prune_sector_deg", float("nan"), "prune_sector_deg must be a number > 0, got nan"),
     ("max_leg_time_s", "1h", "max_leg_time_s must be a number > 0, got '1h'"),
@@ -74,7 +78,7 @@ BAD = [
     ("zone_m", True, "zone_m must be a number > 0, got True"),
     ("tack_penalty_s", -1.0, "tack_penalty_s must be a number >= 0, got -1.0"),
     ("gybe_penalty_s", float("inf"), "gybe_penalty_s must be a number >= 0, got inf"),
-    ("max_front_points", 2, "max_front_points must be an integer >= 8, got 2"),
+    ("max_front_points", 2, "max_front_points must be an integer in [8, 100000], got 2"),
     ("heading_fan", "wide", "heading_fan must be 'hull' or 'full', got 'wide'"),
     ("initial_side", "left", "initial_side must be 'port', 'starboard' or None, got 'left'"),
     ("extra", {"k": "x"}, "extra must be a mapping of names to numbers, got {'k': 'x'}"),
