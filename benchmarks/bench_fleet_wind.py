@@ -34,7 +34,6 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXP
 
 import argparse  # noqa: E402
 import csv  # noqa: E402
-import sys  # noqa: E402
 import time  # noqa: E402
 from datetime import UTC, datetime  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -153,9 +152,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--smoke", action="store_true", help="race 25011905, three methods")
     args = ap.parse_args(argv)
     if not LOGS.is_dir():
-        print(f"no SailGP logs at {LOGS}; this benchmark needs ../shared/data/real",
-              file=sys.stderr)
-        return 2
+        print(f"bench_fleet_wind.py: {LOGS} not present (the SailGP logs are read in place): "
+              "nothing measured")
+        return 0
     races = race_tracks()
     methods = {**CANDIDATES, **BASELINES}
     if args.smoke:

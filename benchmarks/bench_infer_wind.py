@@ -1,12 +1,12 @@
 """Benchmark: wind inferred from 3 boats x 20 min of 1 Hz GPS tracks, on one core.
 
-    python benchmarks/bench_infer_wind.py [--repeat 5]
+    python benchmarks/bench_infer_wind.py [--repeat 5] [--smoke]
 
 The tracks are those of the known-answer tests (tests/analysis/test_infer_wind.py:
 sailroute's own routes in the oscillating wind, 2 m of GPS noise, cut to the first
 20 min of each boat).  Prints the best of ``--repeat`` runs of
 :func:`~sailroute.analysis.infer_wind.infer_wind` in ms, without and with the polar (TWS),
-and the direction RMS against the known wind.
+and the direction RMS against the known wind.  ``--smoke``: one run of each (CI).
 """
 
 from __future__ import annotations
@@ -34,7 +34,10 @@ from tests.analysis import test_infer_wind as known  # noqa: E402
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--smoke", action="store_true", help="one run of each (CI)")
     args = ap.parse_args()
+    if args.smoke:
+        args.repeat = 1
     starts = ((-100.0, 0.0, "starboard"), (0.0, 150.0, "port"), (100.0, 300.0, None))
     routes = {"osc": [known.route_boat(known.twd_osc, *s) for s in starts]}
     tracks = [tr.between(tr.t_start, tr.t_start + 1200.0)

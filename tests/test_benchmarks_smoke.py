@@ -27,6 +27,13 @@ CASES = [
      r"^\| ilca7 \| Snipe P01 \(--smoke, 30 s steps\) \| 6 kn 110° \| 0\.\d{3} \| 0\.673 \|"),
     ("bench_griddp.py", r"^Debski analytic wind +polar +8 +3 "),
     ("bench_multispline.py", r"^Example 1 n_r=6 n_c=8 n_ts=4 refine=1 .*L2 error per pass "),
+    ("bench_analyze.py",
+     r"^fleet: 3 boats x \d+ fixes \(1 Hz, \d+ min\), read \+ analyse \+ write: "),
+    ("bench_infer_wind.py", r"^infer_wind, 3 boats, \d+ points, with polar: [\d.]+ ms "
+     r"\(best of 1\); TWD RMS \d\.\d\d°$"),
+    ("bench_fleet_wind.py",
+     r"^fleet field, 3 boats x 20 min at 1 Hz: build [\d.]+ s" if SHARED_REAL.is_dir()
+     else r"^bench_fleet_wind\.py: .* not present .*: nothing measured$"),
     ("bench_gpu.py", r"^(bench_gpu\.py: no GPU here, nothing measured: |GPU .* GiB; CPU )"),
     ("gpu_checks.sh", r"^(gpu_checks\.sh: no NVIDIA GPU here|cupy \d)"),
     pytest.param("bench_strategy.py", r"^SDP 101 x 40 rows x 2 tacks x 19 shifts, .*"
