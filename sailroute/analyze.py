@@ -612,7 +612,7 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
         tws0, twd0 = _wind_at(wind, np.array([gun]), np.array([cx]), np.array([cy]))
         try:
             inf = infer_wind(list(tracks), frame, prior_twd_deg=float(twd0[0]), boat=boat,
-                             t0=gun - 300.0, t1=gun + course.time_limit_s)
+                             t0=gun - 60.0, t1=_race_end(course, tracks))
         except InputError as exc:
             if choice == "inferred":
                 raise
@@ -631,6 +631,23 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
         avail = [s for s in (own.get(tr.name), fleet, inferred, scen) if s is not None]
         out[tr.name] = wind_order(choice, avail)
     return out, notes
+
+
+def _race_end(course: Course, tracks: Sequence[Track]) -> float:
+    """The last leg end found in any of the tracks [epoch s] (the race window's end when
+    none is): the wind is inferred over the race, not the sail home."""
+    end = course.start_epoch + course.time_limit_s
+    found = []
+    for tr in tracks:
+        x, y = track_xy(tr, course.frame)
+        try:
+            seg = segment_track(course, tr.t_s, x, y, missing="unknown")
+        except InputError:
+            continue
+        known = [c.t for c in seg.bounds[1:] if c.known]
+        if known:
+            found.append(max(known))
+    return min(end, max(found) + 60.0) if found else end
 
 
 def _summary_text(sm: Mapping[str, Any]) -> str:

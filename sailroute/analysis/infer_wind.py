@@ -111,6 +111,9 @@ DOWN_OFF_DEG: Final = 50.0
 BAND_DEG: Final = 20.0
 """Later passes: a point is on a board when its |TWA| is within this of the boat's fitted
 half-angle [°]; anything else is a reach and is rejected."""
+AXIS_TIE: Final = 0.1
+"""Two wind axes whose symmetry scores lie within this fraction of each other are a tie
+that ``prior_twd_deg`` breaks (:func:`axis_near_prior`) [-]."""
 ALPHA_PRIOR_DEG: Final = (42.0, 10.0)
 """Prior of a tacking half-angle without a polar: mean and sd [°] (keeps a boat that
 sails one board only solvable; the data dominate otherwise)."""
@@ -380,14 +383,38 @@ def wind_axis_deg(cog_deg: NDArray, weights: NDArray | None = None) -> tuple[flo
     direction θ is ``sum_d H(θ + d) H(θ − d)`` over half-separations ``d`` of 15° to 60°
     (two boards), added for θ and θ + 180° (upwind and downwind boards).
     """
+    axis = _axis_scores(cog_deg, weights)
+    i = int(np.argmax(axis))
+    strength = 1.0 - float(np.mean(axis)) / float(axis[i]) if axis[i] > 0 else 0.0
+    return float(i + 0.5) % 180.0, strength
+
+
+def _axis_scores(cog_deg: NDArray, weights: NDArray | None = None) -> NDArray[np.float64]:
+    """Symmetry score of each axis ``i + 0.5`` [°], ``i`` in 0..179 (:func:`wind_axis_deg`)."""
     h = _course_histogram(cog_deg, weights)
     th = np.arange(360)[:, None] + 0.5
     d = np.arange(15, 61)[None, :]
     s = np.sum(h[(th + d).astype(int) % 360] * h[(th - d).astype(int) % 360], axis=1)
-    axis = s[:180] + s[180:]
-    i = int(np.argmax(axis))
-    strength = 1.0 - float(np.mean(axis)) / float(axis[i]) if axis[i] > 0 else 0.0
-    return float(i + 0.5) % 180.0, strength
+    return np.asarray(s[:180] + s[180:], dtype=float)
+
+
+def axis_near_prior(cog_deg: NDArray, prior_twd_deg: float, weights: NDArray | None = None,
+                    tie: float = AXIS_TIE) -> float:
+    """The wind axis [°, in ``[0, 180)``] when the courses leave several nearly tied.
+
+    Among the local maxima of the symmetry score within ``tie`` of the best (a club
+    course's reaches make a second axis), the one closest to ``prior_twd_deg`` (either
+    end); the best alone when none ties with it.
+    """
+    sc = _axis_scores(cog_deg, weights)
+    best = float(sc.max())
+    if best <= 0.0:
+        return float(np.argmax(sc) + 0.5) % 180.0
+    peak = (sc >= np.roll(sc, 1)) & (sc >= np.roll(sc, -1)) & (sc >= (1.0 - tie) * best)
+    axes = np.nonzero(peak)[0] + 0.5
+    off = np.abs(wrap180(axes - prior_twd_deg))
+    off = np.minimum(off, 180.0 - off)
+    return float(axes[int(np.argmin(off))]) % 180.0
 
 
 def _course_histogram(cog_deg: NDArray, weights: NDArray | None = None) -> NDArray[np.float64]:
@@ -824,6 +851,13 @@ def infer_wind(
             "or the race's time span")
     # 1. the axis and which end is upwind
     axis, strength = wind_axis_deg(p.cog, p.weight)
+    if prior_twd_deg is not None:
+        tied = axis_near_prior(p.cog, float(prior_twd_deg), p.weight)
+        if tied != axis:
+            notes.append(f"the tracks' courses are nearly as symmetric about {tied:.0f}° as "
+                         f"about {axis:.0f}° (within {100 * AXIS_TIE:.0f} %): the prior "
+                         "decides")
+            axis = tied
     cands = (axis, axis + 180.0)
     if prior_twd_deg is not None:
         twd_axis = min(cands, key=lambda c: abs(float(wrap180(c - prior_twd_deg))))

@@ -398,3 +398,36 @@ def test_inferred_wind_refuses_arrays_of_other_lengths() -> None:
     t = T0 + 30.0 * np.arange(4)
     with pytest.raises(InputError, match="twd_sd_deg, n_obs must be 1-D arrays of the length"):
         InferredWind(t, np.zeros(4), np.zeros(3), np.zeros(4), np.zeros(4), np.zeros(5), "x")
+
+
+def test_a_prior_breaks_a_tie_between_two_wind_axes() -> None:
+    from sailroute.analysis.infer_wind import axis_near_prior
+
+    # boards symmetric about 0° (courses ±45°) and, as many, about 90° (courses 90 ± 40°)
+    cog = np.concatenate([np.full(100, 45.0), np.full(100, 315.0), np.full(100, 50.0),
+                          np.full(100, 130.0)])
+    cog = cog + np.random.default_rng(1).normal(0.0, 1.0, cog.size)
+    assert axis_near_prior(cog, 80.0) == pytest.approx(90.0, abs=3.0)
+    assert axis_near_prior(cog, 350.0) == pytest.approx(0.0, abs=3.0) or \
+        axis_near_prior(cog, 350.0) == pytest.approx(180.0, abs=3.0)
+    # one clear axis: the prior does not move it
+    one = cog[:200]
+    assert axis_near_prior(one, 80.0) % 180.0 == pytest.approx(0.0, abs=3.0) or \
+        axis_near_prior(one, 80.0) == pytest.approx(180.0, abs=3.0)
+
+
+@requires_shared
+def test_j24_direction_does_not_hang_on_the_window_end() -> None:
+    # the boat's courses make a second, nearly as symmetric axis (276°): five more minutes
+    # of track flipped the answer from 346° to 269° until the prior broke the tie (ten
+    # more, past the race, and 276° wins outright: infer over the race, not the evening)
+    from sailroute.track import read_track
+
+    tr = read_track(SHARED_REAL / "races" / "j24-lake-washington-2015" /
+                    "Sensor_record_20150728_211517_AndroSensor.csv", time_zone="-07:00")
+    frame = LocalFrame(float(np.mean(tr.lat_deg)), float(np.mean(tr.lon_deg)))
+    t0 = tr.t_s[0] + 0.5 * 3600.0
+    for extra in (0.0, 300.0):
+        s = summary(infer_wind(tr, frame, prior_twd_deg=320.0, t0=t0 - 300.0,
+                               t1=t0 + 7200.0 + extra))
+        assert s["twd_mean_deg"] == pytest.approx(346.0, abs=5.0), extra
