@@ -92,6 +92,9 @@ _NAME_UNITS: Final = {
 
 # --- public entry points --------------------------------------------------------
 
+_TOO_DEEP = ("not a polar: its JSON nests lists or objects too deeply to read (a polar file "
+             "has 3 levels)")
+
 
 def read_polar(
     path: str | Path,
@@ -301,6 +304,8 @@ def read_orc_json(
         raise InputError(f"{p}: ORC JSON file not found") from None
     except (OSError, json.JSONDecodeError) as exc:
         raise InputError(f"{p}: not valid JSON ({exc})") from None
+    except RecursionError:
+        raise InputError(f"{p}: {_TOO_DEEP}") from None
     return _orc_from_doc(doc, p, include_optima, interpolation)
 
 
@@ -572,6 +577,8 @@ def _read_json_text(
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise InputError(f"{p}:{exc.lineno}: not valid JSON ({exc.msg})") from None
+    except RecursionError:
+        raise InputError(f"{p}: {_TOO_DEEP}") from None
     if isinstance(doc, dict) and "vpp" in doc:
         if speed_unit not in (None, "kn") or wind_unit not in (None, "kn"):
             raise InputError(f"{p}: ORC JSON polars are in knots; do not pass another unit")
