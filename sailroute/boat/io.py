@@ -63,6 +63,7 @@ from sailroute.boat.polar import (
     axis_spacing_problem,
 )
 from sailroute.errors import InputError
+from sailroute.textin import csv_rows, excerpt, quote_header
 from sailroute.units import KNOT, speed_factor
 
 FORMATS: Final = ("pol", "csv", "json")
@@ -352,9 +353,10 @@ def parse_pol(
         head.pop()
     lineno = header_idx + 1
     if len(head) < 2:
-        raise InputError(f"{src}:{lineno}: header has no wind speeds after {head[0]!r}")
+        raise InputError(f"{src}:{lineno}: header has no wind speeds after "
+                         f"{excerpt(head[0])!r}")
     s_unit, w_unit = _file_units(src, speed_unit, wind_unit, [
-        (f"the label cell {head[0].strip()!r} (line {lineno})", _header_unit(head[0]))])
+        (f"the label cell {excerpt(head[0].strip())!r} (line {lineno})", _header_unit(head[0]))])
     header_line = lineno
     tws = [_number(c, src, lineno, k + 2, "wind speed") for k, c in enumerate(head[1:])]
     for k in range(1, len(tws)):
@@ -480,7 +482,7 @@ def parse_long_csv(
 ) -> Polar:
     """Parse a long ("tidy") polar CSV (see the module docstring)."""
     src = str(source)
-    rows = list(csv.reader(io.StringIO(text)))
+    rows = csv_rows(list(enumerate(text.splitlines(), 1)), ",", src)
     start = next((k for k, r in enumerate(rows) if r and any(c.strip() for c in r)
                   and not r[0].lstrip().startswith("#")), None)
     if start is None:
@@ -504,7 +506,7 @@ def parse_long_csv(
         raise InputError(
             f"{src}:{start + 1}: long polar CSV needs columns tws, twa and speed (or bsp, "
             f"boat_speed, stw), optionally with a unit suffix like tws_kn; missing "
-            f"{', '.join(missing)} in header {rows[start]!r}"
+            f"{', '.join(missing)} in the header ({quote_header(rows[start])})"
         )
     if cols["twa"][1] not in (None, "deg"):
         raise InputError(f"{src}:{start + 1}: TWA must be in degrees; got column "
@@ -932,10 +934,11 @@ def _number(cell: str, src: str, lineno: int, col: int, what: str) -> float:
         v = float(text)
     except ValueError:
         raise InputError(
-            f"{src}:{lineno}: cell {col} ({text!r}): expected a number ({what})"
+            f"{src}:{lineno}: cell {col} ({excerpt(text)!r}): expected a number ({what})"
         ) from None
     if not math.isfinite(v):
-        raise InputError(f"{src}:{lineno}: cell {col} ({text!r}): {what} must be finite")
+        raise InputError(f"{src}:{lineno}: cell {col} ({excerpt(text)!r}): {what} must be "
+                         "finite")
     return v
 
 
