@@ -5,6 +5,10 @@ Shared by the station and track readers (and any reader of delimited text):
 * :func:`csv_rows` splits each line on its own, so that a stray quote spoils one line
   (and is reported with its number) instead of swallowing the rest of the file;
 * :func:`looks_binary` tells a text file from a binary one before anything is parsed;
+* :func:`bad_char` finds, and :func:`clean_text` replaces, the characters that no output
+  file can carry (controls other than tab, LF and CR, lone surrogates, U+FFFE/U+FFFF):
+  the YAML reader refuses them, the other readers and every writer of XML, HTML and
+  CSV replace them;
 * :func:`excerpt` is the only form in which a file's content appears in a message:
   short, with control characters replaced, so that an error never prints a whole
   line of a file that is not what was expected (e.g. ``/etc/passwd`` given as a
@@ -16,15 +20,74 @@ from __future__ import annotations
 
 import csv
 import re
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
+from typing import IO, Any
 
 from sailroute.errors import InputError
 
-__all__ = ["EXCERPT_CHARS", "csv_rows", "excerpt", "looks_binary", "looks_like_header",
-           "quote_header"]
+__all__ = ["EXCERPT_CHARS", "CleanCsvWriter", "bad_char", "clean_text", "csv_rows", "excerpt",
+           "looks_binary", "looks_like_header", "quote_header"]
 
 EXCERPT_CHARS = 60
 """Longest excerpt of a file's content a message quotes [characters]."""
+
+
+_BAD_CHAR = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff\ufffe\uffff]")
+"""Characters no output file can carry: controls other than tab, LF and CR (XML 1.0 has no
+way to write them), lone surrogates (UTF-8 has none), U+FFFE and U+FFFF."""
+
+
+def bad_char(text: str) -> str | None:
+    """The first character of ``text`` that no output file can carry, described.
+
+    Parameters
+    ----------
+    text : str
+        User text (a name, a description).
+
+    Returns
+    -------
+    str or None
+        ``"U+0000 (a control character)"``, ``"U+D800 (a lone surrogate)"`` or
+        ``"U+FFFE (a non-character)"``; None if every character is fine (tab, line
+        feed and carriage return are).
+    """
+    m = _BAD_CHAR.search(text)
+    if m is None:
+        return None
+    code = ord(m.group())
+    kind = ("a lone surrogate" if 0xD800 <= code <= 0xDFFF
+            else "a non-character" if code >= 0xFFFE else "a control character")
+    return f"U+{code:04X} ({kind})"
+
+
+def clean_text(text: str) -> str:
+    """``text`` with every character :func:`bad_char` refuses replaced by U+FFFD."""
+    return _BAD_CHAR.sub("\ufffd", text)
+
+
+class CleanCsvWriter:
+    """A :func:`csv.writer` whose text cells go through :func:`clean_text` first.
+
+    Parameters
+    ----------
+    fh : file
+        Opened for writing text with ``newline=""``.
+    **kwargs
+        Passed to :func:`csv.writer`.
+    """
+
+    def __init__(self, fh: IO[str], **kwargs: Any) -> None:
+        self._w = csv.writer(fh, **kwargs)
+
+    def writerow(self, row: Iterable[Any]) -> None:
+        """Write one row (text cells cleaned, others as :func:`csv.writer` writes them)."""
+        self._w.writerow([clean_text(c) if isinstance(c, str) else c for c in row])
+
+    def writerows(self, rows: Iterable[Iterable[Any]]) -> None:
+        """Write several rows."""
+        for r in rows:
+            self.writerow(r)
 
 
 def excerpt(text: str, limit: int = EXCERPT_CHARS) -> str:

@@ -29,6 +29,7 @@ from typing import Any
 import yaml
 
 from sailroute.errors import InputError
+from sailroute.textin import bad_char
 
 
 class YamlLoader(yaml.SafeLoader):
@@ -84,35 +85,6 @@ MAX_DEPTH = 50
 MAX_NODES = 100_000
 """Most values (keys, scalars, mappings, lists) a YAML input may expand to, aliases
 expanded; a course file has a few hundred."""
-
-_BAD_CHAR = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f-\x9f\ud800-\udfff\ufffe\uffff]")
-"""Characters refused in YAML text: controls other than tab, LF and CR, surrogates,
-U+FFFE and U+FFFF (none can be written to XML 1.0, and surrogates not to UTF-8)."""
-
-
-def bad_char(text: str) -> str | None:
-    """The first character of ``text`` that no output file can carry, described.
-
-    Parameters
-    ----------
-    text : str
-        User text (a name, a description).
-
-    Returns
-    -------
-    str or None
-        ``"U+0000 (a control character)"``, ``"U+D800 (a lone surrogate)"`` or
-        ``"U+FFFE (a non-character)"``; None if every character is fine (tab, line
-        feed and carriage return are).
-    """
-    m = _BAD_CHAR.search(text)
-    if m is None:
-        return None
-    code = ord(m.group())
-    kind = ("a lone surrogate" if 0xD800 <= code <= 0xDFFF
-            else "a non-character" if code >= 0xFFFE else "a control character")
-    return f"U+{code:04X} ({kind})"
-
 
 def _check_events(events: Iterable[yaml.Event], where: str) -> None:
     """Refuse deep nesting, alias bombs, recursive aliases and bad characters.

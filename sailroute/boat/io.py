@@ -63,7 +63,7 @@ from sailroute.boat.polar import (
     axis_spacing_problem,
 )
 from sailroute.errors import InputError
-from sailroute.textin import csv_rows, excerpt, quote_header
+from sailroute.textin import clean_text, csv_rows, excerpt, quote_header
 from sailroute.units import KNOT, speed_factor
 
 FORMATS: Final = ("pol", "csv", "json")
@@ -424,7 +424,8 @@ def parse_pol(
                  at_cell=lambda i, j: f"{src}:{row_lines[i]}: cell {j + 2}")
     tab = fill_empty_cells(np.asarray(twa), tws_arr, raw_tab)
     return Polar.from_arrays(np.asarray(twa), tws_arr * speed_factor(w_unit),
-                             tab * speed_factor(s_unit), name=Path(src).stem,
+                             tab * speed_factor(s_unit),
+                             name=clean_text(Path(src).stem),
                              interpolation=interpolation)
 
 
@@ -566,7 +567,7 @@ def parse_long_csv(
                  at_cell=lambda i, j: f"{src}:{line_of[i, j]}: cell {cols['speed'][0] + 1}")
     tab = fill_empty_cells(twa_ax, tws_ax, tab)
     return Polar.from_arrays(twa_ax, tws_ax * speed_factor(w_unit), tab * speed_factor(s_unit),
-                             name=Path(src).stem, interpolation=interpolation)
+                             name=clean_text(Path(src).stem), interpolation=interpolation)
 
 
 # --- JSON -----------------------------------------------------------------------------
@@ -613,7 +614,8 @@ def _read_json_text(
                      at_cell=lambda i, j: f"{p}: speed[{i}][{j}]")
     try:
         return Polar.from_arrays(twa, tws * speed_factor(w_unit), tab * speed_factor(s_unit),
-                                 name=str(doc.get("name") or p.stem), interpolation=interpolation)
+                                 name=clean_text(str(doc.get("name") or p.stem)),
+                                 interpolation=interpolation)
     except InputError as exc:
         raise InputError(f"{p}: {exc}") from None
 

@@ -8,7 +8,6 @@ maps, ``loss`` on the loss chart.
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -19,6 +18,7 @@ import numpy as np
 
 from sailroute import __version__
 from sailroute.report.files import _num, _point
+from sailroute.textin import CleanCsvWriter
 from sailroute.timeutil import iso
 from sailroute.units import KNOT
 
@@ -118,7 +118,7 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
     files["analysis_json"] = jp
     cp = out / "analysis.csv"
     with cp.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
+        w = CleanCsvWriter(fh)
         w.writerow(LEG_COLUMNS)
         for leg in a.legs:
             spec = a.course.legs[leg.index]
@@ -134,7 +134,7 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
     pp = out / "points.csv"
     p = a.points
     with pp.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
+        w = CleanCsvWriter(fh)
         w.writerow(POINT_COLUMNS)
         for k in range(p.t.size):
             w.writerow([int(p.leg[k]), iso(p.t[k]), f"{p.x[k]:.2f}", f"{p.y[k]:.2f}",
@@ -162,7 +162,7 @@ def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
     cp = out / "fleet.csv"
     cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s")
     with cp.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
+        w = CleanCsvWriter(fh)
         w.writerow(cols)
         for r in rows:
             w.writerow([_fmt(r[c]) for c in cols])

@@ -49,7 +49,14 @@ from numpy.typing import NDArray
 
 from sailroute.errors import InputError
 from sailroute.geo import wrap_lon
-from sailroute.textin import csv_rows, excerpt, looks_binary, looks_like_header, quote_header
+from sailroute.textin import (
+    clean_text,
+    csv_rows,
+    excerpt,
+    looks_binary,
+    looks_like_header,
+    quote_header,
+)
 from sailroute.timeutil import iso
 from sailroute.track.model import Track
 from sailroute.units import speed_factor, wrap180, wrap360
@@ -165,7 +172,7 @@ def read_track(
         t, lat, lon, lines, channels = _read_csv(text, src, columns, speed_unit, tz)
         default_name = p.stem
     return clean_track(t, lat, lon, lines, channels, src,
-                       name if name is not None else default_name)
+                       clean_text(name if name is not None else default_name))
 
 
 # ------------------------------------------------------------------------------ times

@@ -29,7 +29,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError, WindDataError, format_problems
 from sailroute.geo import LocalFrame
-from sailroute.textin import csv_rows, excerpt, looks_binary, looks_like_header, quote_header
+from sailroute.textin import (
+    clean_text,
+    csv_rows,
+    excerpt,
+    looks_binary,
+    looks_like_header,
+    quote_header,
+)
 from sailroute.timeutil import iso
 from sailroute.units import speed_factor, wind_components, wind_speed_direction
 from sailroute.wind.base import Coverage, prepare_points
@@ -444,11 +451,11 @@ def read_stations(
         t, missing_by["time"] = _times(cols["time"], linenos, miss, tz, name,
                                        header[cmap["time"]])
     if "station" in cols:
-        st = np.array(cols["station"], dtype=object)
+        st = np.array([clean_text(v) for v in cols["station"]], dtype=object)
         st_missing = np.isin(st, list(miss))
         missing_by["station"] = int(st_missing.sum())
     else:
-        st = np.full(n, station if station is not None else p.stem, dtype=object)
+        st = np.full(n, clean_text(station if station is not None else p.stem), dtype=object)
         st_missing = np.zeros(n, dtype=bool)
     if position is not None and "lat" not in values:
         values["lat"] = np.full(n, float(position[0]))
