@@ -263,10 +263,18 @@ def crop_window(
 
     Raises
     ------
+    WindDataError
+        If the grid has fewer than 2 points along either axis.
     OutOfCoverageError
         If no cell centre lies within the box plus margin.
     """
     nt, ny, nx = header.shape
+    if ny < 2 or nx < 2:
+        raise WindDataError(
+            f"{header.path}: the wind grid has {ny} x {nx} points (rows x columns); a gridded "
+            "wind field needs at least 2 x 2 to interpolate between them"
+            + ("; for one point (a station, a buoy) use `type: stations`, for a steady wind "
+               "`type: uniform`" if ny * nx == 1 else ""))
     j0, j1, i0, i1 = 0, ny, 0, nx
     if bbox is not None:
         dx = float(header.attrs.get("DX", 0.0)) or _spacing(header, frame)
