@@ -643,16 +643,16 @@ def _template(
             v = t.number(raw, key, lo=0.0, hi=360.0)
         elif rule == _POS:
             v = t.number(raw, key, lo=0.0, lo_open=True)
-            if v is not None and v > MAX_OFFSET_M:
-                t.add(key, f"expected at most {MAX_OFFSET_M:.0f} m (a buoy course spans a "
-                      f"few km); got {v:g}")
-                v = None
         elif rule == _NONNEG:
             v = t.number(raw, key, lo=0.0)
         elif rule == "int":
             v = t.integer(raw, key, None, lo=1)
         else:
             v = t.choice(raw, key, rule)
+        if v is not None and key.endswith("_m") and v > MAX_OFFSET_M:
+            t.add(key, f"expected at most {MAX_OFFSET_M:.0f} m (a buoy course spans a few km); "
+                  f"got {v:g}")
+            v = None
         if v is not None:
             kw[key] = v
     if centre is None or any(k not in kw for k in ("twd_deg", "leg_length_m")) or any(
