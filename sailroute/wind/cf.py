@@ -51,6 +51,7 @@ from sailroute.timeutil import iso, parse_time
 from sailroute.units import speed_factor, wind_components
 from sailroute.wind._xr import (
     SOURCE_ATTR,
+    damaged_as_wind_error,
     open_dataset,
     require_xarray,
 )
@@ -357,11 +358,16 @@ def _epoch_from_values(vals: NDArray, var: Any, name: str, label: str) -> NDArra
         dts = cftime.num2date(np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel(),
                               units, calendar, only_use_cftime_datetimes=False,
                               only_use_python_datetimes=True)
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, OverflowError) as exc:
         raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
                             f"{exc}") from None
     return np.array([(d if d.tzinfo else d.replace(tzinfo=UTC)).timestamp()
                      for d in np.atleast_1d(dts)], dtype=float)
+
+
+def _size(dim: Any) -> int:
+    """Length of a dimension: an int (xarray) or a netCDF4 ``Dimension``."""
+    return dim if isinstance(dim, int) else len(dim)
 
 
 def _is_time(ds: Any, n: str) -> bool:
@@ -393,10 +399,12 @@ def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
             if v.ndim == 1 and v.dimensions[0] == d and _is_time(ds, n) and (
                     np.dtype(v.dtype).kind != "m"):
                 return d, _epoch_from_values(v[:], v, n, label), f"variable {n}"
-    big = [d for d in extra if ds.dimensions.get(d, 1) > 1] if hasattr(ds, "dimensions") else []
+    sizes = {d: _size(ds.dimensions.get(d, 1)) for d in extra} if hasattr(
+        ds, "dimensions") else {}
+    big = [d for d, n in sizes.items() if n > 1]
     if big:
         raise WindDataError(
-            f"{label}: dimension {big[0]!r} (size {ds.dimensions[big[0]]}) of the wind "
+            f"{label}: dimension {big[0]!r} (size {sizes[big[0]]}) of the wind "
             "variables is not a time with CF units; expected a time coordinate such as "
             "time(time) with units 'hours since ...'. Select one level/member first, or "
             "name the time variable with `variables: {time: NAME}`.")
@@ -475,6 +483,7 @@ def _data_height(ds: Any, var: Any, name: str, dims: tuple[str, ...]) -> tuple[f
     return None, "unknown"
 
 
+@damaged_as_wind_error
 def read_cf_header(
     source: Any,
     *,
@@ -611,6 +620,7 @@ def _index(idx: NDArray) -> slice | NDArray:
     return idx
 
 
+@damaged_as_wind_error
 def open_netcdf(
     source: Any,
     frame: LocalFrame,

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso
-from sailroute.wind._xr import is_xarray_dataset, open_dataset
+from sailroute.wind._xr import damaged_as_wind_error, is_xarray_dataset, open_dataset
 from sailroute.wind.base import Coverage
 from sailroute.wind.grid import GridWind
 from sailroute.wind.height import (
@@ -159,6 +159,7 @@ def parse_wrf_times(chars: NDArray, *, path: str = "WRF file") -> NDArray[np.flo
     return out
 
 
+@damaged_as_wind_error
 def read_wrf_header(path: str | Path) -> WrfHeader:
     """Read times, coordinates and attributes of a wrfout file.
 
@@ -679,6 +680,7 @@ def _from_model_levels(
 
 
 # ----------------------------------------------------------------------------- field
+@damaged_as_wind_error
 def open_wrf(
     path: str | Path,
     frame: LocalFrame,
