@@ -61,9 +61,14 @@ YamlLoader.add_implicit_resolver(
 )
 
 
-def _construct_int(loader: YamlLoader, node: yaml.ScalarNode) -> int:
-    """Decimal integer (the resolver above lets only ``[-+]?[0-9]+`` through)."""
-    return int(loader.construct_scalar(node), 10)
+def _construct_int(loader: YamlLoader, node: yaml.ScalarNode) -> int | str:
+    """Decimal integer (the resolver above lets only ``[-+]?[0-9]+`` through); one of
+    more digits than Python converts (4300) stays text, for the checks to refuse."""
+    text = str(loader.construct_scalar(node))
+    try:
+        return int(text, 10)
+    except ValueError:
+        return text
 
 
 YamlLoader.add_constructor("tag:yaml.org,2002:int", _construct_int)

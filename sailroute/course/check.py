@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from sailroute.checks import Checker, Problems, join_path, show, suggest
+from sailroute.checks import Checker, Problems, finite, join_path, show, suggest
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
@@ -439,9 +439,7 @@ def _leg_times(c: Checker, value: Any, path: str, n_legs: int | None) -> tuple[f
     out = []
     ok = True
     for i, v in enumerate(value):
-        if isinstance(v, bool) or not isinstance(v, int | float) or not v > 0 or not math.isfinite(
-            float(v)
-        ):
+        if isinstance(v, bool) or not isinstance(v, int | float) or not v > 0 or not finite(v):
             c.p.add(join_path(path, i), f"expected a leg time in seconds > 0; got {show(v)}")
             ok = False
         else:

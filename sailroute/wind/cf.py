@@ -182,6 +182,11 @@ class CFHeader:
         return (self.times.size, *self.lat.shape)
 
 
+MAX_WIND_MS = 150.0
+"""Strongest wind a gridded file may hold [m/s] (above any measured gust, about 113 m/s):
+larger values are a wrong unit or a fill value the file does not declare."""
+
+
 def _attr(var: Any, key: str, default: Any = None) -> Any:
     try:
         return var.getncattr(key) if key in var.ncattrs() else default
@@ -325,6 +330,9 @@ def _coords_2d(ds: Any, latn: str, lonn: str, dims: tuple[str, ...], label: str
     if np.any(np.abs(lat2) > 90.0):
         raise WindDataError(f"{label}: {latn} has values outside [-90, 90] degrees "
                             f"(max |lat| {float(np.max(np.abs(lat2))):g})")
+    if np.any(lon2 < -180.0) or np.any(lon2 > 360.0):
+        raise WindDataError(f"{label}: {lonn} has values outside [-180, 360] degrees "
+                            f"({float(np.min(lon2)):g} .. {float(np.max(lon2)):g})")
     return lat2, lon2, row_dim, col_dim, regular
 
 
@@ -355,8 +363,17 @@ def _epoch_from_values(vals: NDArray, var: Any, name: str, label: str) -> NDArra
     import cftime
 
     try:
-        dts = cftime.num2date(np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel(),
-                              units, calendar, only_use_cftime_datetimes=False,
+        values = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel()
+    except (ValueError, TypeError) as exc:
+        raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
+                            f"{exc}") from None
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise WindDataError(f"{label}: time variable {name} has {bad.size} missing or "
+                            f"non-finite value(s) (the first at index {int(bad[0])}); every "
+                            "time step needs its time")
+    try:
+        dts = cftime.num2date(values, units, calendar, only_use_cftime_datetimes=False,
                               only_use_python_datetimes=True)
     except (ValueError, TypeError, OverflowError) as exc:
         raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
@@ -755,6 +772,13 @@ def open_netcdf(
             raise WindDataError(f"{name}: {hdr.names[0]} has negative speeds (min {neg:g})")
     ue[both] = np.nan
     ve[both] = np.nan
+    with np.errstate(invalid="ignore"):
+        fast = np.nanmax(np.hypot(ue, ve)) if np.any(~both) else 0.0
+    if not fast <= MAX_WIND_MS:  # also inf
+        raise WindDataError(
+            f"{name}: {' and '.join(hdr.names)} give a wind of {fast:g} m/s; expected at most "
+            f"{MAX_WIND_MS:g} m/s (check speed_unit; a value that marks missing data needs "
+            "the variable's _FillValue or missing_value attribute)")
     if both.all():
         raise WindDataError(f"{name}: every cell in the window around the course has no wind "
                             "(NaN: land or masked); check the course position and the file")
