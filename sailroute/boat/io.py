@@ -606,7 +606,7 @@ def _read_json_text(
         twa = np.asarray(doc["twa_deg"], dtype=float)
         tws = np.asarray(doc["tws"], dtype=float)
         tab = np.asarray(doc["speed"], dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: twa_deg, tws and speed must be numbers ({exc})") from None
     if _well_formed(twa, tws, tab):
         _check_table(str(p), twa, tws, tab, s_unit, w_unit,
@@ -630,7 +630,7 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
     try:
         vpp = doc["vpp"]
         angles = [float(a) for a in vpp["angles"]]
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: {what} ({type(exc).__name__}: {exc})") from None
     _orc_check(p, "vpp.angles", np.asarray(angles), 0.0, 180.0, "an angle in [0, 180] deg")
     try:
@@ -639,7 +639,7 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
         tab = np.asarray([[float(v) for v in vpp[k]] for k in keys])
         optima = {k: np.asarray(vpp[k], dtype=float)
                   for k in ("beat_angle", "beat_vmg", "run_angle", "run_vmg")}
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: {what} ({type(exc).__name__}: {exc})") from None
     if tab.shape != (len(angles), tws.size) or any(v.shape != tws.shape for v in optima.values()):
         raise InputError(f"{p}: ORC vpp block: every list must have one value per wind speed "

@@ -651,6 +651,9 @@ def _template(
             t.add(key, f"expected at most {MAX_OFFSET_M:.0f} m (a buoy course spans a few km); "
                   f"got {v:g}")
             v = None
+        elif v is not None and rule == _POS and key.endswith("_m") and v < MIN_SEPARATION_M:
+            t.add(key, f"expected at least {MIN_SEPARATION_M:g} m; got {v:g}")
+            v = None
         if v is not None:
             kw[key] = v
     if centre is None or any(k not in kw for k in ("twd_deg", "leg_length_m")) or any(

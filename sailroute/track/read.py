@@ -372,6 +372,9 @@ def _numbers(body: list[list[str]], linenos: list[int], k: int, column: str, mis
         except ValueError:
             raise InputError(f"{src}, line {linenos[i]}, column {column!r}: cannot read "
                              f"{excerpt(c)!r} as a number") from None
+        if math.isinf(out[i]):
+            raise InputError(f"{src}, line {linenos[i]}, column {column!r}: {excerpt(c)!r} is "
+                             "not a finite number; replace it with a value or a missing marker")
     return out
 
 

@@ -58,8 +58,8 @@ _COMMON = {"database": None, "suppress_health_check": list(HealthCheck)}
 FAST = settings(max_examples=40, deadline=timedelta(seconds=10), derandomize=True, **_COMMON)
 FAST_PLAN = settings(max_examples=6, deadline=timedelta(seconds=60), derandomize=True,
                      **_COMMON)
-LONG = settings(max_examples=600, deadline=timedelta(seconds=10), **_COMMON)
-LONG_PLAN = settings(max_examples=60, deadline=timedelta(seconds=60), **_COMMON)
+LONG = settings(max_examples=2000, deadline=timedelta(seconds=10), **_COMMON)
+LONG_PLAN = settings(max_examples=150, deadline=timedelta(seconds=60), **_COMMON)
 
 
 class Hang(BaseException):
@@ -375,18 +375,6 @@ CASES = {
 }
 
 
-def run(case: str, settings_: settings) -> None:
-    """Run ``case`` with ``settings_``, recording each example's outcome as an event."""
-    fn, strategy = CASES[case]
-
-    @settings_
-    @given(strategy)
-    def examples(x: Any) -> None:
-        event(fn(x))
-
-    examples()
-
-
 def test_seeds_are_valid():
     """Unmutated, every seed reads (mutations start from a valid file), and plan routes."""
     for case, seeds in (("course", COURSE_SEEDS), ("polar", POLAR_SEEDS),
@@ -441,8 +429,51 @@ def test_plan(x: Any) -> None:
     event(_plan(x))
 
 
+# the same, with many fresh random examples each run: pytest -m slow
 @pytest.mark.slow
-@pytest.mark.parametrize("case", sorted(CASES))
-def test_long(case: str) -> None:
-    """Many fresh random examples per reader (``pytest -m slow``)."""
-    run(case, LONG_PLAN if case == "plan" else LONG)
+@LONG
+@given(CASES["course"][1])
+def test_course_yaml_long(x: Any) -> None:
+    event(_course(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["polar"][1])
+def test_polar_long(x: Any) -> None:
+    event(_polar(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["stations"][1])
+def test_station_csv_long(x: Any) -> None:
+    event(_stations(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["track"][1])
+def test_track_long(x: Any) -> None:
+    event(_track(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["netcdf_bytes"][1])
+def test_netcdf_bytes_long(x: Any) -> None:
+    event(_grid_bytes(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["netcdf_numbers"][1])
+def test_netcdf_numbers_long(x: Any) -> None:
+    event(_grid_numbers(x))
+
+
+@pytest.mark.slow
+@LONG_PLAN
+@given(CASES["plan"][1])
+def test_plan_long(x: Any) -> None:
+    event(_plan(x))

@@ -373,3 +373,73 @@ def test_one_point_grid_is_refused_before_any_arithmetic(tmp_path, ny, nx):
     assert f"g.nc: the wind grid has {ny} x {nx} points (rows x columns); a gridded wind " \
            "field needs at least 2 x 2 to interpolate between them" in msg
     assert "nan" not in msg
+
+
+# ------------------------------------------------------------------ found by the fuzz test
+@pytest.mark.parametrize("digits", [400, 5000])
+def test_integer_too_long_for_a_float(tmp_path, digits):
+    msg = plan_error(tmp_path, MINIMAL.replace("pin: {lat: 45.0000", f"pin: {{lat: {'9' * digits}"))
+    assert ":4: marks.pin.lat: expected a latitude in [-90, 90] degrees; got " in msg
+    assert len(msg) < 300
+
+
+def test_template_length_below_a_metre(tmp_path):
+    text = ("name: t\nstart_time: 2024-05-01T10:00:00Z\ntemplate: {type: windward-leeward, "
+            "twd_deg: 0, leg_length_m: 2.2e-313, centre: {lat: 45, lon: 13}}\n"
+            "scenarios:\n  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n")
+    assert plan_error(tmp_path, text).endswith(
+        ":3: template.leg_length_m: expected at least 1 m; got 2.2e-313")
+
+
+def grid_course(tmp_path: Path, **overrides: object) -> str:
+    kw: dict[str, object] = {"lat": 45.004 + 0.01 * np.arange(2),
+                             "lon": 13.001 + 0.01 * np.arange(2), "hours": [0.0, 1.0, 2.0],
+                             "u": np.zeros((3, 2, 2)), "v": np.full((3, 2, 2), -5.0)}
+    kw.update(overrides)
+    from tests.unit.test_fuzz_inputs import write_grid as write_cf_grid
+
+    write_cf_grid(tmp_path / "g.nc", "NETCDF3_CLASSIC", kw["lat"], kw["lon"], kw["hours"],
+               kw["u"], kw["v"])
+    return MINIMAL.replace("north: {type: uniform, tws_kn: 10, twd_deg: 0}",
+                           "grid: {type: netcdf, path: g.nc, clamp: true}")
+
+
+@pytest.mark.filterwarnings("error")
+@pytest.mark.parametrize(("overrides", "expected"), [
+    ({"hours": [0.0, np.nan, 2.0]}, "time variable time has 1 missing or non-finite value(s) "
+                                    "(the first at index 1); every time step needs its time"),
+    ({"u": np.full((3, 2, 2), np.inf)}, "u10 and v10 give a wind of inf m/s; expected at most "
+                                        "150 m/s"),
+    ({"u": np.full((3, 2, 2), 9999.0)}, "give a wind of 9999 m/s; expected at most 150 m/s "
+                                        "(check speed_unit; a value that marks missing data "
+                                        "needs the variable's _FillValue"),
+    ({"lon": [13.0, 573.0]}, "longitude has values outside [-180, 360] degrees (13 .. 573)"),
+])
+def test_grid_numbers_that_cannot_be_wind(tmp_path, overrides, expected):
+    assert expected in plan_error(tmp_path, grid_course(tmp_path, **overrides))
+
+
+def test_damaged_classic_netcdf_header(tmp_path):
+    text = grid_course(tmp_path)
+    data = bytearray((tmp_path / "g.nc").read_bytes())
+    data[8:12] = b"\x00\x00\x00\x0a"  # the dimension list ...
+    data[12:16] = b"\x7f\xff\xff\xff"  # ... claims 2**31 - 1 dimensions
+    (tmp_path / "g.nc").write_bytes(bytes(data))
+    msg = plan_error(tmp_path, text)
+    assert "g.nc: damaged NetCDF file: it lists 2147483647 items at offset 16, more than the " \
+           "file holds; expected a complete classic NetCDF file" in msg
+
+
+def test_polar_and_track_numbers_past_a_float(tmp_path):
+    orc = json.loads((TESTS_DATA / "boat" / "BUL_BUL7888.json").read_text())
+    orc["vpp"]["speeds"][0] = int("9" * 400)
+    p = tmp_path / "orc.json"
+    p.write_text(json.dumps(orc))
+    with pytest.raises(InputError, match=r"orc.json: not an ORC certificate polar.*OverflowError"):
+        read_polar(p)
+    t = tmp_path / "t.csv"
+    t.write_text("time,lat,lon,cog\n2024-05-01T10:00:00Z,45,13,1e309\n"
+                 "2024-05-01T10:00:01Z,45,13.0001,10\n")
+    with pytest.raises(InputError, match=r"t.csv, line 2, column 'cog': '1e309' is not a finite "
+                       r"number; replace it with a value or a missing marker"):
+        read_track(t)
