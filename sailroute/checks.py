@@ -32,7 +32,8 @@ from sailroute.errors import InputError, format_problems
 from sailroute.yamlfile import join_path
 
 __all__ = [
-    "MISSING", "Checker", "Problems", "join_path", "quoted", "show", "split_where", "suggest",
+    "MISSING", "Checker", "Problems", "finite", "join_path", "quoted", "show", "split_where",
+    "suggest",
 ]
 
 MISSING: Final = object()
@@ -64,6 +65,14 @@ def suggest(word: str, choices: Iterable[Any]) -> str:
 def quoted(choices: Iterable[Any]) -> str:
     """``'a', 'b', 'c'``: the choices, quoted and comma-separated."""
     return ", ".join(repr(c) for c in choices)
+
+
+def finite(v: float) -> bool:
+    """True for a number that is a finite float (an integer of 400 digits is not)."""
+    try:
+        return math.isfinite(float(v))
+    except OverflowError:
+        return False
 
 
 def show(value: Any) -> str:
@@ -312,7 +321,7 @@ class Checker:
         if key not in d or d[key] is None:
             return self.absent(key, default, what)
         v = d[key]
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(float(v)):
+        if isinstance(v, bool) or not isinstance(v, int | float) or not finite(v):
             self.add(key, f"expected {what}; got {show(v)}")
             return None
         v = float(v)

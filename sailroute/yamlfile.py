@@ -3,11 +3,25 @@
 One reader for every YAML input, so that they share scalar rules and errors:
 :class:`YamlLoader` reads YAML 1.2 core-schema scalars, and :func:`read_yaml` returns
 the document with the line of every key path and any key given twice.
+
+Before anything is built, :func:`read_yaml` walks the parser's events once (no
+recursion) and refuses, with the line of the offending node:
+
+* nesting deeper than :data:`MAX_DEPTH` levels (aliases count with the depth of
+  what they stand for);
+* a document of more than :data:`MAX_NODES` values once every alias is expanded
+  (the "billion laughs" of nested aliases: a few hundred bytes that expand to
+  billions of values);
+* an alias inside the node it refers to (``x: &r [*r]``);
+* text holding a control character (other than tab, line feed and carriage return),
+  a lone surrogate (``"\\ud800"``) or U+FFFE/U+FFFF, which double-quoted escapes can
+  write but which no output file (GPX, HTML, CSV) can carry.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -15,6 +29,7 @@ from typing import Any
 import yaml
 
 from sailroute.errors import InputError
+from sailroute.textin import bad_char
 
 
 class YamlLoader(yaml.SafeLoader):
@@ -46,12 +61,96 @@ YamlLoader.add_implicit_resolver(
 )
 
 
-def _construct_int(loader: YamlLoader, node: yaml.ScalarNode) -> int:
-    """Decimal integer (the resolver above lets only ``[-+]?[0-9]+`` through)."""
-    return int(loader.construct_scalar(node), 10)
+def _construct_int(loader: YamlLoader, node: yaml.ScalarNode) -> int | str:
+    """Decimal integer (the resolver above lets only ``[-+]?[0-9]+`` through); one of
+    more digits than Python converts (4300) stays text, for the checks to refuse."""
+    text = str(loader.construct_scalar(node))
+    try:
+        return int(text, 10)
+    except ValueError:
+        return text
 
 
 YamlLoader.add_constructor("tag:yaml.org,2002:int", _construct_int)
+
+
+def _construct_timestamp(loader: YamlLoader, node: yaml.ScalarNode) -> Any:
+    """An unquoted date or time; one that is not a real instant (``2024-02-30``, second
+    60) stays text, so that it gets the same message as when it is quoted."""
+    try:
+        return yaml.SafeLoader.construct_yaml_timestamp(loader, node)
+    except (ValueError, OverflowError):
+        return str(loader.construct_scalar(node))
+
+
+YamlLoader.add_constructor("tag:yaml.org,2002:timestamp", _construct_timestamp)
+
+MAX_DEPTH = 50
+"""Deepest nesting of mappings and lists a YAML input may have (course files need 6)."""
+MAX_NODES = 100_000
+"""Most values (keys, scalars, mappings, lists) a YAML input may expand to, aliases
+expanded; a course file has a few hundred."""
+
+def _check_events(events: Iterable[yaml.Event], where: str) -> None:
+    """Refuse deep nesting, alias bombs, recursive aliases and bad characters.
+
+    One pass over the parser's events, without recursion: each anchor's expanded
+    size and depth are known when its node ends, so an alias adds them without
+    being walked.
+    """
+    n = 0  # values so far, aliases expanded
+    # open collections: (anchor or None, n at start, depth at start, deepest inside)
+    stack: list[list[Any]] = []
+    size: dict[str, int] = {}
+    height: dict[str, int] = {}
+
+    def at(ev: yaml.Event) -> str:
+        m = ev.start_mark
+        return f"{where}:{m.line + 1}:{m.column + 1}" if m is not None else where
+
+    def grow(ev: yaml.Event, count: int, depth: int, alias: str | None = None) -> None:
+        nonlocal n
+        n += count
+        if stack:
+            stack[-1][3] = max(stack[-1][3], depth)
+        if depth > MAX_DEPTH:
+            via = f" through the alias *{alias}" if alias else ""
+            raise InputError(f"{at(ev)}: nested more than {MAX_DEPTH} levels deep{via}; "
+                             "a course or boat file needs a few levels")
+        if n > MAX_NODES:
+            via = (f" once the alias *{alias} and those before it are expanded"
+                   if alias else "")
+            raise InputError(f"{at(ev)}: more than {MAX_NODES} values{via}; "
+                             "a course or boat file has at most a few thousand")
+
+    for ev in events:
+        if isinstance(ev, yaml.ScalarEvent):
+            bad = bad_char(ev.value)
+            if bad is not None:
+                text = ev.value if len(ev.value) <= 40 else ev.value[:37] + "..."
+                raise InputError(
+                    f"{at(ev)}: the text {text!a} holds {bad}, which no output "
+                    "file can carry; remove it (or the escape that writes it)")
+            grow(ev, 1, len(stack) + 1)
+            if ev.anchor is not None:
+                size[ev.anchor], height[ev.anchor] = 1, 1
+        elif isinstance(ev, yaml.MappingStartEvent | yaml.SequenceStartEvent):
+            grow(ev, 1, len(stack) + 1)
+            stack.append([ev.anchor, n - 1, len(stack), len(stack) + 1])
+        elif isinstance(ev, yaml.MappingEndEvent | yaml.SequenceEndEvent):
+            anchor, n0, d0, deepest = stack.pop()
+            if anchor is not None:
+                size[anchor], height[anchor] = n - n0, deepest - d0
+            if stack:
+                stack[-1][3] = max(stack[-1][3], deepest)
+        elif isinstance(ev, yaml.AliasEvent):
+            if ev.anchor is not None and any(s[0] == ev.anchor for s in stack):
+                raise InputError(
+                    f"{at(ev)}: the alias *{ev.anchor} is inside the node &{ev.anchor} "
+                    "it refers to (a value that contains itself); refer to a finished node")
+            name = ev.anchor or ""
+            # an undefined alias is left to the composer's own message
+            grow(ev, size.get(name, 1), len(stack) + height.get(name, 1), ev.anchor)
 
 
 def join_path(path: str, key: str | int) -> str:
@@ -128,8 +227,10 @@ def read_yaml(path: str | Path, *, what: str = "course file", hint: str = "") ->
     Raises
     ------
     InputError
-        Missing file, a folder, not UTF-8, unreadable, or a YAML syntax error (with
-        line and column).
+        Missing file, a folder, not UTF-8, unreadable, a YAML syntax error (with
+        line and column), nesting deeper than :data:`MAX_DEPTH`, more than
+        :data:`MAX_NODES` values with aliases expanded, an alias inside its own
+        node, or text with a control character (see the module docstring).
     """
     p = Path(path)
     if not p.exists():
@@ -143,8 +244,13 @@ def read_yaml(path: str | Path, *, what: str = "course file", hint: str = "") ->
     except OSError as exc:
         raise InputError(f"{p}: cannot read the {what} ({exc.strerror or exc})") from None
     try:
-        node = yaml.compose(text, Loader=YamlLoader)
-        data = yaml.load(text, Loader=YamlLoader)  # YamlLoader is a SafeLoader
+        _check_events(yaml.parse(text, Loader=YamlLoader), str(p))
+        loader = YamlLoader(text)  # a SafeLoader
+        try:
+            node = loader.get_single_node()
+            data = loader.construct_document(node) if node is not None else None
+        finally:
+            loader.dispose()
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         where = f"{p}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(p)

@@ -65,6 +65,7 @@ from sailroute.boat.polar import (
     axis_spacing_problem,
 )
 from sailroute.errors import InputError
+from sailroute.textin import clean_text, csv_rows, excerpt, quote_header
 from sailroute.units import KNOT, speed_factor
 
 FORMATS: Final = ("pol", "csv", "json")
@@ -95,6 +96,9 @@ _NAME_UNITS: Final = {
 
 
 # --- public entry points --------------------------------------------------------
+
+_TOO_DEEP = ("not a polar: its JSON nests lists or objects too deeply to read (a polar file "
+             "has 3 levels)")
 
 
 def read_polar(
@@ -305,6 +309,8 @@ def read_orc_json(
         raise InputError(f"{p}: ORC JSON file not found") from None
     except (OSError, json.JSONDecodeError) as exc:
         raise InputError(f"{p}: not valid JSON ({exc})") from None
+    except RecursionError:
+        raise InputError(f"{p}: {_TOO_DEEP}") from None
     return _orc_from_doc(doc, p, include_optima, interpolation)
 
 
@@ -351,9 +357,10 @@ def parse_pol(
         head.pop()
     lineno = header_idx + 1
     if len(head) < 2:
-        raise InputError(f"{src}:{lineno}: header has no wind speeds after {head[0]!r}")
+        raise InputError(f"{src}:{lineno}: header has no wind speeds after "
+                         f"{excerpt(head[0])!r}")
     s_unit, w_unit = _file_units(src, speed_unit, wind_unit, [
-        (f"the label cell {head[0].strip()!r} (line {lineno})", _header_unit(head[0]))])
+        (f"the label cell {excerpt(head[0].strip())!r} (line {lineno})", _header_unit(head[0]))])
     header_line = lineno
     tws = [_number(c, src, lineno, k + 2, "wind speed") for k, c in enumerate(head[1:])]
     for k in range(1, len(tws)):
@@ -421,7 +428,8 @@ def parse_pol(
                  at_cell=lambda i, j: f"{src}:{row_lines[i]}: cell {j + 2}")
     tab = fill_empty_cells(np.asarray(twa), tws_arr, raw_tab)
     return Polar.from_arrays(np.asarray(twa), tws_arr * speed_factor(w_unit),
-                             tab * speed_factor(s_unit), name=Path(src).stem,
+                             tab * speed_factor(s_unit),
+                             name=clean_text(Path(src).stem),
                              interpolation=interpolation)
 
 
@@ -479,7 +487,7 @@ def parse_long_csv(
 ) -> Polar:
     """Parse a long ("tidy") polar CSV (see the module docstring)."""
     src = str(source)
-    rows = list(csv.reader(io.StringIO(text)))
+    rows = csv_rows(list(enumerate(text.splitlines(), 1)), ",", src)
     start = next((k for k, r in enumerate(rows) if r and any(c.strip() for c in r)
                   and not r[0].lstrip().startswith("#")), None)
     if start is None:
@@ -503,7 +511,7 @@ def parse_long_csv(
         raise InputError(
             f"{src}:{start + 1}: long polar CSV needs columns tws, twa and speed (or bsp, "
             f"boat_speed, stw, btv), optionally with a unit suffix like tws_kn; missing "
-            f"{', '.join(missing)} in header {rows[start]!r}"
+            f"{', '.join(missing)} in the header ({quote_header(rows[start])})"
         )
     if cols["twa"][1] not in (None, "deg"):
         raise InputError(f"{src}:{start + 1}: TWA must be in degrees; got column "
@@ -563,7 +571,7 @@ def parse_long_csv(
                  at_cell=lambda i, j: f"{src}:{line_of[i, j]}: cell {cols['speed'][0] + 1}")
     tab = fill_empty_cells(twa_ax, tws_ax, tab)
     return Polar.from_arrays(twa_ax, tws_ax * speed_factor(w_unit), tab * speed_factor(s_unit),
-                             name=Path(src).stem, interpolation=interpolation)
+                             name=clean_text(Path(src).stem), interpolation=interpolation)
 
 
 # --- JSON -----------------------------------------------------------------------------
@@ -576,6 +584,8 @@ def _read_json_text(
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
         raise InputError(f"{p}:{exc.lineno}: not valid JSON ({exc.msg})") from None
+    except RecursionError:
+        raise InputError(f"{p}: {_TOO_DEEP}") from None
     if isinstance(doc, dict) and "vpp" in doc:
         if speed_unit not in (None, "kn") or wind_unit not in (None, "kn"):
             raise InputError(f"{p}: ORC JSON polars are in knots; do not pass another unit")
@@ -600,7 +610,7 @@ def _read_json_text(
         twa = np.asarray(doc["twa_deg"], dtype=float)
         tws = np.asarray(doc["tws"], dtype=float)
         tab = np.asarray(doc["speed"], dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: twa_deg, tws and speed must be numbers ({exc})") from None
     if _well_formed(twa, tws, tab):
         _check_table(str(p), twa, tws, tab, s_unit, w_unit,
@@ -608,7 +618,8 @@ def _read_json_text(
                      at_cell=lambda i, j: f"{p}: speed[{i}][{j}]")
     try:
         return Polar.from_arrays(twa, tws * speed_factor(w_unit), tab * speed_factor(s_unit),
-                                 name=str(doc.get("name") or p.stem), interpolation=interpolation)
+                                 name=clean_text(str(doc.get("name") or p.stem)),
+                                 interpolation=interpolation)
     except InputError as exc:
         raise InputError(f"{p}: {exc}") from None
 
@@ -623,7 +634,7 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
     try:
         vpp = doc["vpp"]
         angles = [float(a) for a in vpp["angles"]]
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: {what} ({type(exc).__name__}: {exc})") from None
     _orc_check(p, "vpp.angles", np.asarray(angles), 0.0, 180.0, "an angle in [0, 180] deg")
     try:
@@ -632,7 +643,7 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
         tab = np.asarray([[float(v) for v in vpp[k]] for k in keys])
         optima = {k: np.asarray(vpp[k], dtype=float)
                   for k in ("beat_angle", "beat_vmg", "run_angle", "run_vmg")}
-    except (KeyError, TypeError, ValueError) as exc:
+    except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: {what} ({type(exc).__name__}: {exc})") from None
     if tab.shape != (len(angles), tws.size) or any(v.shape != tws.shape for v in optima.values()):
         raise InputError(f"{p}: ORC vpp block: every list must have one value per wind speed "
@@ -929,10 +940,11 @@ def _number(cell: str, src: str, lineno: int, col: int, what: str) -> float:
         v = float(text)
     except ValueError:
         raise InputError(
-            f"{src}:{lineno}: cell {col} ({text!r}): expected a number ({what})"
+            f"{src}:{lineno}: cell {col} ({excerpt(text)!r}): expected a number ({what})"
         ) from None
     if not math.isfinite(v):
-        raise InputError(f"{src}:{lineno}: cell {col} ({text!r}): {what} must be finite")
+        raise InputError(f"{src}:{lineno}: cell {col} ({excerpt(text)!r}): {what} must be "
+                         "finite")
     return v
 
 

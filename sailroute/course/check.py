@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from sailroute.checks import Checker, Problems, join_path, show, suggest
+from sailroute.checks import Checker, Problems, finite, join_path, show, suggest
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
@@ -57,6 +57,9 @@ DEFAULT_BOAT = {"builtin": "ilca7"}
 DEFAULT_TIME_LIMIT_MIN = 90.0
 MIN_SEPARATION_M = 1.0
 """Two marks of a line or gate, or the two ends of a leg, must be at least this far apart [m]."""
+MAX_OFFSET_M = 100_000.0
+"""Every mark lies within this distance of the local frame's origin [m] (a buoy course
+spans a few km; far-off values are typing errors that the routers cannot use)."""
 
 Position = tuple[str, tuple[float, float]]
 """``("ll", (lat, lon))`` [deg] or ``("xy", (x, y))`` [m], as the file gives it."""
@@ -170,8 +173,11 @@ def _position(
     if has_ll:
         ll = _latlon(c, value, path)
         return None if ll is None else ("ll", ll)
-    x = c.at(path).number(value, "x", what="metres east of the origin")
-    y = c.at(path).number(value, "y", what="metres north of the origin")
+    span = f"in [{-MAX_OFFSET_M:.0f}, {MAX_OFFSET_M:.0f}]"
+    x = c.at(path).number(value, "x", lo=-MAX_OFFSET_M, hi=MAX_OFFSET_M,
+                          what=f"metres east of the origin, {span}")
+    y = c.at(path).number(value, "y", lo=-MAX_OFFSET_M, hi=MAX_OFFSET_M,
+                          what=f"metres north of the origin, {span}")
     return None if x is None or y is None else ("xy", (x, y))
 
 
@@ -445,9 +451,7 @@ def _leg_times(c: Checker, value: Any, path: str, n_legs: int | None) -> tuple[f
     out = []
     ok = True
     for i, v in enumerate(value):
-        if isinstance(v, bool) or not isinstance(v, int | float) or not v > 0 or not math.isfinite(
-            float(v)
-        ):
+        if isinstance(v, bool) or not isinstance(v, int | float) or not v > 0 or not finite(v):
             c.p.add(join_path(path, i), f"expected a leg time in seconds > 0; got {show(v)}")
             ok = False
         else:
@@ -661,6 +665,13 @@ def _template(
             v = t.integer(raw, key, None, lo=1)
         else:
             v = t.choice(raw, key, rule)
+        if v is not None and key.endswith("_m") and v > MAX_OFFSET_M:
+            t.add(key, f"expected at most {MAX_OFFSET_M:.0f} m (a buoy course spans a few km); "
+                  f"got {v:g}")
+            v = None
+        elif v is not None and rule == _POS and key.endswith("_m") and v < MIN_SEPARATION_M:
+            t.add(key, f"expected at least {MIN_SEPARATION_M:g} m; got {v:g}")
+            v = None
         if v is not None:
             kw[key] = v
     if centre is None or any(k not in kw for k in ("twd_deg", "leg_length_m")) or any(
@@ -766,6 +777,8 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         latlons = [centre[1]] if centre is not None and centre[0] == "ll" else []
     frame = _frame(c, data, latlons, needs)
     marks = _place(positions, centre, frame) if frame is not None else {}
+    if frame is not None:
+        _near_origin(c, marks, frame, "origin" in data, template is not None)
     xy = {k: (m[0], m[1]) for k, m in marks.items()}
 
     taken = set(marks)
@@ -804,6 +817,29 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         references=references,
         template=dict(template) if template is not None else None,
     )
+
+
+def _near_origin(
+    c: Checker, marks: Mapping[str, tuple[float, float, float, float]], frame: LocalFrame,
+    given: bool, template: bool,
+) -> None:
+    """A problem for each mark farther than :data:`MAX_OFFSET_M` from the frame's origin
+    (``given``: the file has ``origin``, else the origin is the mean of the marks; a
+    ``template`` course gets one problem, at ``template.centre``)."""
+    origin = (f"the origin ({frame.lat0:.6f}, {frame.lon0:.6f})" if given else
+              f"the course's centre ({frame.lat0:.6f}, {frame.lon0:.6f}, the mean of the "
+              "marks' lat/lon)")
+    for k, m in marks.items():
+        d = math.hypot(m[0], m[1])
+        if d <= MAX_OFFSET_M:  # False for NaN
+            continue
+        far = f"{d / 1000.0:.0f} km" if d < 1e7 else "more than 10000 km"
+        where = "template.centre" if template else join_path("marks", k)
+        c.p.add(where, f"mark {k!r} ({m[2]:.6f}, {m[3]:.6f}) lies {far} from {origin}; "
+                f"expected every mark within {MAX_OFFSET_M / 1000.0:.0f} km of it (check the "
+                "marks for a typing error)")
+        if template:
+            return
 
 
 def _place(

@@ -8,7 +8,6 @@ maps, ``loss`` on the loss chart.
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from collections.abc import Mapping, Sequence
@@ -20,6 +19,7 @@ import numpy as np
 from sailroute import __version__
 from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.report.files import _num, _point
+from sailroute.textin import CleanCsvWriter
 from sailroute.timeutil import iso
 from sailroute.units import KNOT
 
@@ -165,7 +165,7 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
     files["analysis_json"] = jp
     cp = out / "analysis.csv"
     with cp.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
+        w = CleanCsvWriter(fh)
         w.writerow(LEG_COLUMNS)
         for leg in a.legs:
             spec = a.course.legs[leg.index]
@@ -216,7 +216,7 @@ def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
     cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s",
             "note")
     with cp.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
+        w = CleanCsvWriter(fh)
         w.writerow(cols)
         for r in rows:
             w.writerow([_fmt(r[c]) if r[c] is not None else "" for c in cols])

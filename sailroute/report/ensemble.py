@@ -11,7 +11,6 @@ the leg length): "left"/"right" looking from the leg's start to its end.
 
 from __future__ import annotations
 
-import csv
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -24,6 +23,7 @@ from numpy.typing import NDArray
 from sailroute.analysis.loss import lateral_offset, side_label, time_mean
 from sailroute.errors import InputError
 from sailroute.report.plan import Plan
+from sailroute.textin import CleanCsvWriter
 
 STATS: Final = ("min", "p10", "median", "p90", "max")
 """Columns of the spread, in order."""
@@ -157,7 +157,7 @@ def write_ensemble(out_dir: Path, summary: EnsembleSummary) -> dict[str, Path]:
     cs = out_dir / "ensemble.csv"
     sp, sh = summary.spread(), summary.side_shares()
     with cs.open("w", newline="", encoding="utf-8") as f:
-        w = csv.writer(f)
+        w = CleanCsvWriter(f)
         w.writerow(["leg", "label", *(f"{s}_s" for s in STATS),
                     *(f"share_{s}" for s in SIDES)])
         for k, label in enumerate(summary.leg_labels):

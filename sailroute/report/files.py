@@ -16,7 +16,6 @@ Schemas, with units, are documented in ``docs/output-format.md``; bump
 
 from __future__ import annotations
 
-import csv
 import json
 import math
 from collections.abc import Mapping
@@ -31,6 +30,7 @@ from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
 from sailroute.report.plan import Comparison, Plan, percent_error
 from sailroute.routing.types import side_name
+from sailroute.textin import CleanCsvWriter, clean_text
 from sailroute.timeutil import iso
 from sailroute.units import KNOT
 from sailroute.wind.base import WindField
@@ -176,7 +176,7 @@ def write_track_csv(path: str | Path, plan: Plan) -> Path:
     p = Path(path)
     t0 = plan.t_start
     with p.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
+        w = CleanCsvWriter(fh)
         w.writerow(TRACK_COLUMNS)
         for pl in plan.legs:
             tr = pl.result.track
@@ -200,7 +200,7 @@ def write_track_csv(path: str | Path, plan: Plan) -> Path:
 def _sub(parent: ET.Element, tag: str, text: str | None = None, **attrib: str) -> ET.Element:
     el = ET.SubElement(parent, f"{{{GPX_NS}}}{tag}", attrib)
     if text is not None:
-        el.text = text
+        el.text = clean_text(text)  # XML 1.0 cannot carry control characters
     return el
 
 
@@ -315,7 +315,7 @@ def write_comparison(out_dir: str | Path, cmp: Comparison) -> tuple[Path, Path]:
     cp = d / "comparison.csv"
     refs = list(cmp.references)
     with cp.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
+        w = CleanCsvWriter(fh)
         w.writerow(["leg", "label", "scenario", "time_s",
                     *[c for r in refs for c in (f"{r}_s", f"{r}_error_pct")]])
         for k, label in enumerate(cmp.leg_labels):

@@ -50,6 +50,7 @@ from sailroute.errors import OutOfCoverageError
 from sailroute.report.plan import Comparison, Plan, percent_error
 from sailroute.report.plots import repeat_index_of_ends
 from sailroute.report.tables import format_duration, start_point_text
+from sailroute.textin import clean_text
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, wind_speed_direction, wrap180, wrap360
 from sailroute.wind.base import WindField
@@ -932,13 +933,13 @@ def _course_traces(course: Course) -> list[dict[str, Any]]:
                     "legendgroup": "course", "showlegend": first,
                     "x": _r([ln.a.lon, ln.b.lon], 7), "y": _r([ln.a.lat, ln.b.lat], 7),
                     "line": {"color": "black", "width": 2, "dash": dash},
-                    "hovertemplate": f"{html.escape(ln.name)}<extra></extra>"})
+                    "hovertemplate": f"{_label(ln.name)}<extra></extra>"})
         first = False
     marks = list(course.marks.values())
     out.append({"type": "scatter", "mode": "markers+text", "name": "marks",
                 "legendgroup": "course",
                 "x": _r([m.lon for m in marks], 7), "y": _r([m.lat for m in marks], 7),
-                "text": [html.escape(m.name) for m in marks],
+                "text": [_label(m.name) for m in marks],
                 "textposition": label_positions(course),
                 "textfont": {"size": 12, "color": "#222"},
                 "marker": {"color": "darkorange", "size": 11,
@@ -992,7 +993,7 @@ def figure(report: Report) -> dict[str, Any]:
         rows = wind_arrows(w, course, m_per_kn)
         shafts, heads = rows[0]
         group = f"wind{i}"
-        common = {"type": "scatter", "legendgroup": group, "name": html.escape(name),
+        common = {"type": "scatter", "legendgroup": group, "name": _label(name),
                   **({} if i == 0 else {"visible": "legendonly"})}
         data.append({**common, "mode": "lines", **shafts, "hoverinfo": "skip",
                      "line": {"color": colour, "width": 1.3}, "opacity": 0.75})
@@ -1001,7 +1002,7 @@ def figure(report: Report) -> dict[str, Any]:
                                 "angle": heads["marker"]["angle"], "line": {"width": 0}},
                      "opacity": 0.75,
                      "hovertemplate": "wind %{customdata[0]:.1f} kn from "
-                                      f"%{{customdata[1]:.0f}}°<extra>{html.escape(w.name)}"
+                                      f"%{{customdata[1]:.0f}}°<extra>{_label(w.name)}"
                                       "</extra>"})
         if not w.steady:
             moving.append((len(data) - 2, [sh for sh, _ in rows]))
@@ -1018,7 +1019,7 @@ def figure(report: Report) -> dict[str, Any]:
         custom = _customdata(r, off)
         drawn_lat, drawn_lon = r.drawn()
         tr = {"type": "scatter", "mode": "lines+markers" if single else "lines",
-              "name": html.escape(r.name), "legendgroup": group,
+              "name": _label(r.name), "legendgroup": group,
               "x": _r(drawn_lon, 7), "y": _r(drawn_lat, 7),
               "line": {"color": colour, "width": 2.5, "dash": r.dash},
               "customdata": custom, "hovertemplate": _hover(r, off)}
@@ -1039,14 +1040,14 @@ def figure(report: Report) -> dict[str, Any]:
                                   for m in pts],
                          "marker": {"symbol": symbol, "color": mc, "size": 10,
                                     "line": {"color": "white", "width": 1}},
-                         "hovertemplate": f"%{{text}}<extra>{html.escape(r.name)}</extra>"})
+                         "hovertemplate": f"%{{text}}<extra>{_label(r.name)}</extra>"})
         if i == 0 and report.leg_numbers:
             data.append(_leg_number_trace(r, group))
         if r.boat:
             states = _boat_states(r, report.times, off, custom)
             st = states[0]
             data.append({"type": "scatter", "mode": "markers",
-                         "name": html.escape(f"boat: {r.name}"),
+                         "name": _label(f"boat: {r.name}"),
                          "legendgroup": group, "showlegend": False, **st,
                          "marker": {"symbol": "circle", "size": 15,
                                     "color": BOAT_COLOUR if single else colour,
@@ -1161,6 +1162,22 @@ _JS = """
 """
 
 
+def _h(text: str) -> str:
+    """User text for the page's HTML: escaped, control characters replaced."""
+    return html.escape(clean_text(text))
+
+
+def _label(text: str) -> str:
+    """User text (a name) for plotly: trace names, hover text and mark labels.
+
+    Plotly draws these as its own small markup (``<b>``, ``<a href>``, ``<br>``, entities)
+    and reads ``%{...}`` in a hover template as a placeholder: ``&``, ``<`` and ``>``
+    become entities, ``%`` becomes ``&#37;``, control characters U+FFFD.  (``&quot;``
+    is not among the entities plotly knows, so quotes stay as they are.)
+    """
+    return html.escape(clean_text(text), quote=False).replace("%", "&#37;")
+
+
 def _json_for_script(obj: Any) -> str:
     """JSON safe inside a ``<script>`` element (no ``<``, ``>`` or ``&`` characters)."""
     text = json.dumps(obj, ensure_ascii=False, separators=(",", ":"), allow_nan=False)
@@ -1177,7 +1194,7 @@ def _table_html(t: Table) -> str:
     left = {i for i, h in enumerate(t.headers) if h in _TEXT_COLUMNS}
 
     def cells(row: Sequence[str], tag: str) -> str:
-        return "".join(f"<{tag}{_LEFT if i in left else ''}>{html.escape(c)}</{tag}>"
+        return "".join(f"<{tag}{_LEFT if i in left else ''}>{_h(c)}</{tag}>"
                        for i, c in enumerate(row))
 
     body = "\n".join(f"<tr>{cells(r, 'td')}</tr>" for r in t.rows)
@@ -1186,8 +1203,8 @@ def _table_html(t: Table) -> str:
              f"</tbody>\n" + (f"<tfoot>\n{foot}\n</tfoot>\n" if foot else "") + "</table>")
     table = f'<div class="table">\n{table}\n</div>'
     if t.collapsed:
-        return f"<details><summary>{html.escape(t.caption)}</summary>\n{table}\n</details>"
-    return f"<h2>{html.escape(t.caption)}</h2>\n{table}"
+        return f"<details><summary>{_h(t.caption)}</summary>\n{table}\n</details>"
+    return f"<h2>{_h(t.caption)}</h2>\n{table}"
 
 
 def map_height(report: Report) -> int:
@@ -1213,27 +1230,27 @@ def render_html(report: Report, plotly_source: str) -> str:
         A complete HTML document that needs no network.
     """
     fig = figure(report)
-    notes = "\n".join(f'<p class="note">{html.escape(n)}</p>' for n in report.notes)
-    summary = "\n".join(f'<p class="summary">{html.escape(s)}</p>' for s in report.summary)
+    notes = "\n".join(f'<p class="note">{_h(n)}</p>' for n in report.notes)
+    summary = "\n".join(f'<p class="summary">{_h(s)}</p>' for s in report.summary)
     tables = "\n".join(_table_html(t) for t in report.tables)
     js = _JS % {"fig": FIGURE_ID, "div": DIV_ID}
     return f"""<!DOCTYPE html>
 <html lang="en">
 <head>
 <meta charset="utf-8">
-<meta name="generator" content="sailroute {html.escape(__version__)}">
-<title>{html.escape(report.title)}</title>
+<meta name="generator" content="sailroute {_h(__version__)}">
+<title>{_h(report.title)}</title>
 <style>{_CSS}</style>
 <script>{plotly_source}</script>
 </head>
 <body>
-<h1>{html.escape(report.title)}</h1>
+<h1>{_h(report.title)}</h1>
 {summary}
 <div id="sailroute-error"></div>
 <div id="{DIV_ID}" style="height: {map_height(report)}px"></div>
 {notes}
 {tables}
-<footer>Written by sailroute {html.escape(__version__)}; drawing: plotly.js (MIT licence),
+<footer>Written by sailroute {_h(__version__)}; drawing: plotly.js (MIT licence),
 inlined.</footer>
 <script type="application/json" id="{FIGURE_ID}">{_json_for_script(fig)}</script>
 <script>{js}</script>

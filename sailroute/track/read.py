@@ -34,8 +34,6 @@ with fewer than two points left is an error.
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 import re
 from collections.abc import Callable, Mapping
@@ -50,6 +48,14 @@ from numpy.typing import NDArray
 
 from sailroute.errors import InputError
 from sailroute.geo import wrap_lon
+from sailroute.textin import (
+    clean_text,
+    csv_rows,
+    excerpt,
+    looks_binary,
+    looks_like_header,
+    quote_header,
+)
 from sailroute.timeutil import iso
 from sailroute.track.model import Track
 from sailroute.units import speed_factor, wrap180, wrap360
@@ -149,6 +155,9 @@ def read_track(
     if not p.is_file():
         raise InputError(f"{src}: track file not found; check the path")
     text = p.read_text(encoding="utf-8-sig", errors="replace")
+    if looks_binary(text):
+        raise InputError(f"{src}: not a text file (binary content); expected a GPX or CSV "
+                         "track with time, lat, lon")
     if not text.strip():
         raise InputError(f"{src}: the track file is empty; expected GPX or CSV with "
                          "time, lat, lon")
@@ -162,7 +171,7 @@ def read_track(
         t, lat, lon, lines, channels = _read_csv(text, src, columns, speed_unit, tz)
         default_name = p.stem
     return clean_track(t, lat, lon, lines, channels, src,
-                       name if name is not None else default_name)
+                       clean_text(name if name is not None else default_name))
 
 
 # ------------------------------------------------------------------------------ times
@@ -189,7 +198,7 @@ def parse_epoch(cell: str, tz: tzinfo | None, where: str, utc_column: bool = Fal
         pass
     else:
         if not math.isfinite(v):
-            raise InputError(f"{where}: {cell!r} is not a time")
+            raise InputError(f"{where}: {excerpt(cell)!r} is not a time")
         return v / 1000.0 if abs(v) > 1e11 else v
     m = _PHONE_MS.match(s)
     if m:
@@ -200,7 +209,7 @@ def parse_epoch(cell: str, tz: tzinfo | None, where: str, utc_column: bool = Fal
         dt = datetime.fromisoformat(s)
     except ValueError:
         raise InputError(
-            f"{where}: cannot read {cell!r} as a time; expected ISO 8601 with an offset "
+            f"{where}: cannot read {excerpt(cell)!r} as a time; expected ISO 8601 with an offset "
             "(2025-06-21T11:18:29Z), or epoch seconds"
         ) from None
     if dt.tzinfo is None:
@@ -329,8 +338,11 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
               ) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray]]:
     lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
              if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError(f"{src}: the track file holds only comments; expected GPX or CSV "
+                         "with time, lat, lon")
     delim = max((",", ";", "\t"), key=lines[0][1].count)
-    rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
+    rows = csv_rows(lines, delim, src)
     header, body = rows[0], rows[1:]
     linenos = [k for k, _ in lines[1:]]
     stems = [header_stem(h) for h in header]
@@ -343,10 +355,15 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
             explicit[canon] = col  # map_columns reports it
     cmap = map_columns(stems, explicit, where=src, aliases=TRACK_ALIASES)
     absent = [c for c in ("time", "lat", "lon") if c not in cmap]
+    if absent and not looks_like_header(header):
+        raise InputError(
+            f"{src}: not a track: line {lines[0][0]} is not a header of column names; expected "
+            "GPX, or CSV with a header row such as time,lat,lon,sog_kn (names and aliases: "
+            "docs/usage.md, 'sailroute analyze')")
     if absent:
         raise InputError(
             f"{src}: no column for {', '.join(absent)}; header is "
-            f"{', '.join(h.strip() for h in header)}. Name the columns time, lat, lon (see "
+            f"{quote_header(header)}. Name the columns time, lat, lon (see "
             "docs/usage.md, 'sailroute analyze') or map them with --column CANON=NAME"
         )
     if not body:
@@ -390,8 +407,11 @@ def _numbers(body: list[list[str]], linenos: list[int], k: int, column: str, mis
         try:
             out[i] = float(c)
         except ValueError:
-            raise InputError(f"{src}, line {linenos[i]}, column {column!r}: cannot read {c!r} "
-                             "as a number") from None
+            raise InputError(f"{src}, line {linenos[i]}, column {column!r}: cannot read "
+                             f"{excerpt(c)!r} as a number") from None
+        if math.isinf(out[i]):
+            raise InputError(f"{src}, line {linenos[i]}, column {column!r}: {excerpt(c)!r} is "
+                             "not a finite number; replace it with a value or a missing marker")
     return out
 
 

@@ -11,12 +11,16 @@ one reader serves files and datasets.  xarray itself is an optional extra
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
-from typing import Any
+import functools
+from collections.abc import Callable, Iterator, Mapping
+from typing import Any, ParamSpec, TypeVar
 
 import numpy as np
 
-from sailroute.errors import InputError
+from sailroute.errors import InputError, WindDataError
+
+P = ParamSpec("P")
+R = TypeVar("R")
 
 
 def require_xarray(what: str) -> Any:
@@ -140,11 +144,11 @@ def open_dataset(source: Any, kind: str, expected: str) -> tuple[Any, str]:
     InputError
         The file does not exist.
     WindDataError
-        It is empty or not NetCDF (a GRIB file is pointed to ``type: grib``).
+        It is empty, not NetCDF (a GRIB file is pointed to ``type: grib``), or a classic
+        NetCDF file whose header does not fit in it
+        (:func:`~sailroute.wind.ncheader.check_classic_header`).
     """
     from pathlib import Path
-
-    from sailroute.errors import WindDataError
 
     if is_xarray_dataset(source):
         label = str(source.attrs.get(SOURCE_ATTR, "xarray.Dataset"))
@@ -157,8 +161,17 @@ def open_dataset(source: Any, kind: str, expected: str) -> tuple[Any, str]:
                          "course file's folder)")
     if p.stat().st_size == 0:
         raise WindDataError(f"{p}: the file is empty (0 bytes); expected {expected}")
+    from sailroute.wind.ncheader import check_classic_header
+
+    check_classic_header(p)
     try:
         ds = netCDF4.Dataset(str(p), "r")
+    except UnicodeDecodeError:  # a damaged file: the names of its variables are not text
+        raise WindDataError(f"{p}: cannot be read as NetCDF (variable or attribute names that "
+                            f"are not UTF-8: the file is damaged); expected {expected}.") from None
+    except RuntimeError as exc:  # the library found the file damaged after opening it
+        raise WindDataError(f"{p}: cannot be read as NetCDF ({exc}: the file is damaged); "
+                            f"expected {expected}.") from None
     except OSError as exc:
         hint = (" GRIB files are read with `type: grib`." if p.suffix.lower() in _GRIB_SUFFIXES
                 else "")
@@ -166,3 +179,21 @@ def open_dataset(source: Any, kind: str, expected: str) -> tuple[Any, str]:
                             f"{hint}") from None
     ds.set_auto_mask(True)
     return ds, str(p)
+
+
+def damaged_as_wind_error(fn: Callable[P, R]) -> Callable[P, R]:
+    """Decorate a reader whose first argument is a file (or dataset): a ``RuntimeError`` of
+    the netCDF library while it reads (``NetCDF: HDF error`` of a damaged file) becomes a
+    :class:`~sailroute.errors.WindDataError` naming the file."""
+
+    @functools.wraps(fn)
+    def read(*args: P.args, **kwargs: P.kwargs) -> R:
+        try:
+            return fn(*args, **kwargs)
+        except RuntimeError as exc:
+            src = args[0] if args else "the file"
+            label = "xarray.Dataset" if is_xarray_dataset(src) else str(src)
+            raise WindDataError(f"{label}: cannot read the NetCDF data ({exc}: the file is "
+                                "damaged); copy or download it again") from None
+
+    return read

@@ -51,6 +51,7 @@ from sailroute.timeutil import iso, parse_time
 from sailroute.units import speed_factor, wind_components
 from sailroute.wind._xr import (
     SOURCE_ATTR,
+    damaged_as_wind_error,
     open_dataset,
     require_xarray,
 )
@@ -179,6 +180,11 @@ class CFHeader:
     def shape(self) -> tuple[int, int, int]:
         """``(nt, nrow, ncol)`` in file order."""
         return (self.times.size, *self.lat.shape)
+
+
+MAX_WIND_MS = 150.0
+"""Strongest wind a gridded file may hold [m/s] (above any measured gust, about 113 m/s):
+larger values are a wrong unit or a fill value the file does not declare."""
 
 
 def _attr(var: Any, key: str, default: Any = None) -> Any:
@@ -324,6 +330,9 @@ def _coords_2d(ds: Any, latn: str, lonn: str, dims: tuple[str, ...], label: str
     if np.any(np.abs(lat2) > 90.0):
         raise WindDataError(f"{label}: {latn} has values outside [-90, 90] degrees "
                             f"(max |lat| {float(np.max(np.abs(lat2))):g})")
+    if np.any(lon2 < -180.0) or np.any(lon2 > 360.0):
+        raise WindDataError(f"{label}: {lonn} has values outside [-180, 360] degrees "
+                            f"({float(np.min(lon2)):g} .. {float(np.max(lon2)):g})")
     return lat2, lon2, row_dim, col_dim, regular
 
 
@@ -354,14 +363,28 @@ def _epoch_from_values(vals: NDArray, var: Any, name: str, label: str) -> NDArra
     import cftime
 
     try:
-        dts = cftime.num2date(np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel(),
-                              units, calendar, only_use_cftime_datetimes=False,
-                              only_use_python_datetimes=True)
+        values = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel()
     except (ValueError, TypeError) as exc:
+        raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
+                            f"{exc}") from None
+    bad = np.flatnonzero(~np.isfinite(values))
+    if bad.size:
+        raise WindDataError(f"{label}: time variable {name} has {bad.size} missing or "
+                            f"non-finite value(s) (the first at index {int(bad[0])}); every "
+                            "time step needs its time")
+    try:
+        dts = cftime.num2date(values, units, calendar, only_use_cftime_datetimes=False,
+                              only_use_python_datetimes=True)
+    except (ValueError, TypeError, OverflowError) as exc:
         raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
                             f"{exc}") from None
     return np.array([(d if d.tzinfo else d.replace(tzinfo=UTC)).timestamp()
                      for d in np.atleast_1d(dts)], dtype=float)
+
+
+def _size(dim: Any) -> int:
+    """Length of a dimension: an int (xarray) or a netCDF4 ``Dimension``."""
+    return dim if isinstance(dim, int) else len(dim)
 
 
 def _is_time(ds: Any, n: str) -> bool:
@@ -393,10 +416,12 @@ def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
             if v.ndim == 1 and v.dimensions[0] == d and _is_time(ds, n) and (
                     np.dtype(v.dtype).kind != "m"):
                 return d, _epoch_from_values(v[:], v, n, label), f"variable {n}"
-    big = [d for d in extra if ds.dimensions.get(d, 1) > 1] if hasattr(ds, "dimensions") else []
+    sizes = {d: _size(ds.dimensions.get(d, 1)) for d in extra} if hasattr(
+        ds, "dimensions") else {}
+    big = [d for d, n in sizes.items() if n > 1]
     if big:
         raise WindDataError(
-            f"{label}: dimension {big[0]!r} (size {ds.dimensions[big[0]]}) of the wind "
+            f"{label}: dimension {big[0]!r} (size {sizes[big[0]]}) of the wind "
             "variables is not a time with CF units; expected a time coordinate such as "
             "time(time) with units 'hours since ...'. Select one level/member first, or "
             "name the time variable with `variables: {time: NAME}`.")
@@ -475,6 +500,7 @@ def _data_height(ds: Any, var: Any, name: str, dims: tuple[str, ...]) -> tuple[f
     return None, "unknown"
 
 
+@damaged_as_wind_error
 def read_cf_header(
     source: Any,
     *,
@@ -611,6 +637,7 @@ def _index(idx: NDArray) -> slice | NDArray:
     return idx
 
 
+@damaged_as_wind_error
 def open_netcdf(
     source: Any,
     frame: LocalFrame,
@@ -745,6 +772,13 @@ def open_netcdf(
             raise WindDataError(f"{name}: {hdr.names[0]} has negative speeds (min {neg:g})")
     ue[both] = np.nan
     ve[both] = np.nan
+    with np.errstate(invalid="ignore"):
+        fast = np.nanmax(np.hypot(ue, ve)) if np.any(~both) else 0.0
+    if not fast <= MAX_WIND_MS:  # also inf
+        raise WindDataError(
+            f"{name}: {' and '.join(hdr.names)} give a wind of {fast:g} m/s; expected at most "
+            f"{MAX_WIND_MS:g} m/s (check speed_unit; a value that marks missing data needs "
+            "the variable's _FillValue or missing_value attribute)")
     if both.all():
         raise WindDataError(f"{name}: every cell in the window around the course has no wind "
                             "(NaN: land or masked); check the course position and the file")

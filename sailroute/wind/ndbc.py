@@ -86,7 +86,7 @@ def read_ndbc(
         try:
             t[k] = datetime(int(f[col["YY"]]), int(f[col["MM"]]), int(f[col["DD"]]),
                             int(f[col["hh"]]), int(f[col["mm"]]), tzinfo=UTC).timestamp()
-        except ValueError:
+        except (ValueError, OverflowError):
             raise WindDataError(f"{name}, line {lineno}: cannot read the date/time columns "
                                 f"{' '.join(f[:5])!r}") from None
         for key, arr, c in (("speed", spd, "WSPD"), ("direction", dirn, "WDIR"),

@@ -16,8 +16,6 @@ position is interpolated in time like its wind.
 
 from __future__ import annotations
 
-import csv
-import io
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -31,6 +29,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError, format_problems
 from sailroute.geo import LocalFrame
+from sailroute.textin import (
+    clean_text,
+    csv_rows,
+    excerpt,
+    looks_binary,
+    looks_like_header,
+    quote_header,
+)
 from sailroute.timeutil import iso
 from sailroute.units import speed_factor, wind_components, wind_speed_direction
 from sailroute.wind.base import Coverage, prepare_points
@@ -217,7 +223,7 @@ def map_columns(
             continue
         if not isinstance(col, str) or col.strip().lower() not in norm:
             problems.append(f"columns.{canon}: column {col!r} is not in the header "
-                            f"({', '.join(h.strip() for h in header)})")
+                            f"({quote_header(header)})")
             continue
         out[canon] = norm.index(col.strip().lower())
     for canon, names in aliases.items():
@@ -297,7 +303,11 @@ def _table_text(source: Any) -> tuple[str, str]:
     p = Path(source)
     if not p.is_file():
         raise InputError(f"{p}: station file not found; check the `path`")
-    return p.read_text(encoding="utf-8-sig", errors="replace"), str(p)
+    text = p.read_text(encoding="utf-8-sig", errors="replace")
+    if looks_binary(text):
+        raise WindDataError(f"{p}: not a text file (binary content); expected a station CSV "
+                            "with a header row such as time,station,lat,lon,speed,direction")
+    return text, str(p)
 
 
 def read_stations(
@@ -378,7 +388,7 @@ def read_stations(
         delim = " "  # blank separated (NDBC-like text)
         rows = [ln.split() for _, ln in lines]
     else:
-        rows = list(csv.reader(io.StringIO("\n".join(ln for _, ln in lines)), delimiter=delim))
+        rows = csv_rows(lines, delim, name)
     header, body = rows[0], rows[1:]
     linenos = [k for k, _ in lines[1:]]
     canon_cols = {k: v for k, v in (columns or {}).items() if k not in TIME_PARTS}
@@ -390,10 +400,15 @@ def read_stations(
             timezone = "Z"  # NDBC's #YY MM DD hh mm columns are UTC
     need = list(REQUIRED_COLUMNS) + ([] if position is not None else ["lat", "lon"])
     absent = [c for c in need if c not in cmap and not (c == "time" and parts)]
+    if absent and not looks_like_header(header):
+        raise InputError(
+            f"{name}: not a station CSV: line {lines[0][0]} is not a header of column names; "
+            "expected a header row such as time,station,lat,lon,speed_kn,direction (names and "
+            "aliases: docs/course-format.md)")
     if absent:
         raise InputError(
             f"{name}: no column for {', '.join(absent)}; header is "
-            f"{', '.join(h.strip() for h in header)}. Rename the columns to the canonical "
+            f"{quote_header(header)}. Rename the columns to the canonical "
             "names (time, station, lat, lon, speed, direction) or map them with `columns: "
             "{canonical: file_column}`" + (" or give `position: {lat, lon}` for a fixed "
                                            "station" if "lat" in absent else "")
@@ -436,11 +451,11 @@ def read_stations(
         t, missing_by["time"] = _times(cols["time"], linenos, miss, tz, name,
                                        header[cmap["time"]])
     if "station" in cols:
-        st = np.array(cols["station"], dtype=object)
+        st = np.array([clean_text(v) for v in cols["station"]], dtype=object)
         st_missing = np.isin(st, list(miss))
         missing_by["station"] = int(st_missing.sum())
     else:
-        st = np.full(n, station if station is not None else p.stem, dtype=object)
+        st = np.full(n, clean_text(station if station is not None else p.stem), dtype=object)
         st_missing = np.zeros(n, dtype=bool)
     if position is not None and "lat" not in values:
         values["lat"] = np.full(n, float(position[0]))
@@ -543,13 +558,13 @@ def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss
             v = float(c)
         except ValueError:
             raise WindDataError(
-                f"{name}, line {linenos[k]}, column {column!r}: cannot read {c!r} as a number "
-                f"({canon}); if it marks missing data, add it to `missing`"
+                f"{name}, line {linenos[k]}, column {column!r}: cannot read {excerpt(c)!r} as a "
+                f"number ({canon}); if it marks missing data, add it to `missing`"
             ) from None
         if np.isinf(v):
             raise WindDataError(
-                f"{name}, line {linenos[k]}, column {column!r}: {c!r} is not a finite number "
-                f"({canon}); replace it with a value or a missing marker"
+                f"{name}, line {linenos[k]}, column {column!r}: {excerpt(c)!r} is not a finite "
+                f"number ({canon}); replace it with a value or a missing marker"
             )
         return v
 
@@ -564,8 +579,8 @@ def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | 
             dt = datetime.fromisoformat(s)
         except ValueError:
             raise WindDataError(
-                f"{name}, line {linenos[k]}, column {column!r}: cannot read {c!r} as an ISO "
-                "8601 time; expected e.g. 2018-02-15T10:34:58+01:00"
+                f"{name}, line {linenos[k]}, column {column!r}: cannot read {excerpt(c)!r} as an "
+                "ISO 8601 time; expected e.g. 2018-02-15T10:34:58+01:00"
             ) from None
         if dt.tzinfo is None:
             if tz is None:
@@ -603,7 +618,7 @@ def _part_times(cells: Mapping[str, list[str]], headers: Mapping[str, str], line
             out[k] = datetime(year, num["month"], num["day"], num["hour"], num.get("minute", 0),
                               num.get("second", 0), tzinfo=tz).timestamp()
         except ValueError:
-            shown = " ".join(f"{headers[q]}={v}" for q, v in vals.items())
+            shown = excerpt(" ".join(f"{headers[q]}={v}" for q, v in vals.items()))
             raise WindDataError(
                 f"{name}, line {linenos[k]}: cannot read the date/time columns ({shown}) as a "
                 "date; expected whole numbers (year, month 1-12, day, hour 0-23, ...)"

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso
-from sailroute.wind._xr import is_xarray_dataset, open_dataset
+from sailroute.wind._xr import damaged_as_wind_error, is_xarray_dataset, open_dataset
 from sailroute.wind.base import Coverage
 from sailroute.wind.grid import GridWind
 from sailroute.wind.height import (
@@ -159,6 +159,7 @@ def parse_wrf_times(chars: NDArray, *, path: str = "WRF file") -> NDArray[np.flo
     return out
 
 
+@damaged_as_wind_error
 def read_wrf_header(path: str | Path) -> WrfHeader:
     """Read times, coordinates and attributes of a wrfout file.
 
@@ -263,10 +264,18 @@ def crop_window(
 
     Raises
     ------
+    WindDataError
+        If the grid has fewer than 2 points along either axis.
     OutOfCoverageError
         If no cell centre lies within the box plus margin.
     """
     nt, ny, nx = header.shape
+    if ny < 2 or nx < 2:
+        raise WindDataError(
+            f"{header.path}: the wind grid has {ny} x {nx} points (rows x columns); a gridded "
+            "wind field needs at least 2 x 2 to interpolate between them"
+            + ("; for one point (a station, a buoy) use `type: stations`, for a steady wind "
+               "`type: uniform`" if ny * nx == 1 else ""))
     j0, j1, i0, i1 = 0, ny, 0, nx
     if bbox is not None:
         dx = float(header.attrs.get("DX", 0.0)) or _spacing(header, frame)
@@ -671,6 +680,7 @@ def _from_model_levels(
 
 
 # ----------------------------------------------------------------------------- field
+@damaged_as_wind_error
 def open_wrf(
     path: str | Path,
     frame: LocalFrame,
