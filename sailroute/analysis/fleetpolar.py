@@ -75,8 +75,9 @@ class FleetPolar:
 
     def describe(self) -> str:
         """One line: the factors and their support."""
-        parts = ", ".join(f"{b} x{f:.2f} ({n} pts)" for b, f, n in zip(
-            BANDS, self.factor, self.count, strict=True))
+        parts = ", ".join(
+            f"{b} x{f:.2f} ({n} pts{'' if n >= MIN_COUNT else ', too few: the others mean'})"
+            for b, f, n in zip(BANDS, self.factor, self.count, strict=True))
         return (f"fleet-relative polar: {self.polar.name} scaled to P{self.percentile:.0f} of "
                 f"SOG/polar of {len(self.boats)} track(s): {parts}")
 
