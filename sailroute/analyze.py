@@ -399,9 +399,9 @@ def analyze_track(
     # manoeuvres over the race part, with TWA from the smoothed COG
     tr, xr, yr = t[race], x[race], y[race]
     twd_r = np.full(tr.size, np.nan)
-    for i, k in enumerate(chosen):
+    for i, ks in enumerate(chosen):
         m = (tr >= bounds[i].t_hi) & (tr <= bounds[i + 1].t_lo)
-        twd_r[m] = _wind_at(sources[k].field, tr[m], xr[m], yr[m])[1]
+        twd_r[m] = _wind_at(sources[ks].field, tr[m], xr[m], yr[m])[1]
     gap = np.isnan(twd_r)  # across a data gap at a leg end: the last leg's wind before it
     if gap.any():
         twd_r[gap] = (np.degrees(np.interp(tr[gap], tr[~gap], np.unwrap(np.radians(
@@ -598,8 +598,8 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
                 m = (tr.t_s >= t0) & (tr.t_s <= t1)
                 x, y = track_xy(tr, frame)
                 parts.append((tr.t_s[m], x[m], y[m]))
-            notes.append(fw.extrapolation_note(*(np.concatenate(c) for c in zip(*parts,
-                                                                               strict=True)),
+            t_all, x_all, y_all = (np.concatenate(c) for c in zip(*parts, strict=True))
+            notes.append(fw.extrapolation_note(t_all, x_all, y_all,
                                                "the tracks in the race window"))
     inferred: WindSource | None = None
     if choice == "inferred" or (choice == "auto" and len(series) < len(tracks)):
@@ -714,9 +714,8 @@ def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing],
     source = sources[k]
     if a.known:
         start_pt = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
-        k = first_covering(sources, *start_pt, skip=k - 1)
-        if k is None:
-            k = len(sources) - 1
+        found = first_covering(sources, *start_pt, skip=k - 1)
+        k = len(sources) - 1 if found is None else found
         mode = leg_wind_mode(sources[k].field, a.t, (a.x, a.y), centre)
         opt, source = _optimal_leg(course, i, bounds, sources, k, start_pt, boat, settings,
                                    target, progress)

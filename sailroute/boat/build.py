@@ -208,7 +208,8 @@ def boat_from_spec(
     if factors:
         from sailroute.boat.efficiency import scale_polar
 
-        polar = scale_polar(polar, **factors)
+        polar = scale_polar(polar, factors.get("upwind", 1.0), factors.get("reach", 1.0),
+                            factors.get("downwind", 1.0))
     return polar
 
 
