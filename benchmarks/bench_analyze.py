@@ -124,8 +124,10 @@ def main() -> None:
             return run_analyze_command(COURSE, boats, out_dir=d / f"fleet{k[0]}")
 
         t = best_of(fleet, repeat)
+        res = run_analyze_command(COURSE, boats, out_dir=d / "fleet-check", plots=False)
+        winds = sorted({leg.wind_source for a in res.analyses for leg in a.legs})
         print(f"fleet: {len(boats)} boats x {sizes[0]} fixes (1 Hz, {sizes[0] / 60:.0f} min), "
-              f"read + analyse + write: {t:6.2f} s")
+              f"read + analyse + write: {t:6.2f} s (wind: {', '.join(winds)})")
         log = long_log(d, n)
 
         def one() -> object:
