@@ -28,9 +28,8 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXP
     os.environ[_v] = "1"
 
 import argparse  # noqa: E402
+import sys  # noqa: E402
 import tempfile  # noqa: E402
-import time  # noqa: E402
-from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -39,6 +38,9 @@ from sailroute.analyze import run_analyze_command  # noqa: E402
 from sailroute.course.load import load_course  # noqa: E402
 from sailroute.timeutil import iso  # noqa: E402
 from sailroute.track.read import read_track  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_polar import best_of  # noqa: E402  (one timing rule for the benchmarks)
 
 ROOT = Path(__file__).resolve().parents[1]
 COURSE = ROOT / "courses" / "snipe-valencia-p01.yaml"
@@ -90,16 +92,6 @@ def long_log(d: Path, n: int) -> Path:
     cut0 = min(extra // 2, before * tq.size)
     sl = slice(cut0, cut0 + n)
     return write_gpx(d / "long.gpx", ts[sl], la[sl], lo[sl])
-
-
-def best_of(fn: Callable[[], object], repeat: int) -> float:
-    """Best wall time of ``repeat`` calls [s]."""
-    best = float("inf")
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def main() -> None:
