@@ -363,7 +363,7 @@ def _epoch_from_values(vals: NDArray, var: Any, name: str, label: str) -> NDArra
     import cftime
 
     try:
-        values = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel()
+        values: NDArray[np.float64] = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel()
     except (ValueError, TypeError) as exc:
         raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
                             f"{exc}") from None
