@@ -1,7 +1,8 @@
 """Fuzzing the input readers and ``plan`` with mutated copies of small valid files (hypothesis).
 
 Seeds are small valid inputs of the project (``tests/data``, ``data/``, the built-in
-polars) or written here (a 3 x 3 CF NetCDF grid in the classic and the NetCDF-4 format).
+polars) or written here (a 3 x 3 CF NetCDF grid in the classic and the NetCDF-4 format;
+the bytes of the classic one are mutated, the numbers of both).
 Each example mutates a seed, either its numbers (a number replaced by 0, -1, 1e20, 1e309,
 nan, inf, a 400-digit integer, an empty cell, ...) or its bytes (bytes replaced, deleted,
 inserted or duplicated, the file truncated; inserted bytes favour the structural ones:
@@ -366,8 +367,11 @@ CASES = {
     "polar": (_polar, mutated(POLAR_SEEDS)),
     "stations": (_stations, mutated(STATION_SEEDS)),
     "track": (_track, mutated(TRACK_SEEDS)),
-    "netcdf_bytes": (_grid_bytes, st.sampled_from(sorted(GRID_SEEDS)).flatmap(
-        lambda n: st.tuples(st.just(n), byte_mutations(GRID_SEEDS[n])))),
+    # bytes of the classic file only: a damaged NetCDF-4 (HDF5) file can hang inside the
+    # HDF5 library at open, where no Python signal reaches (a 107-byte shorter file with a
+    # few bytes of its superblock replaced did); its numbers are mutated below
+    "netcdf_bytes": (_grid_bytes, byte_mutations(GRID_SEEDS["NETCDF3_CLASSIC.nc"]).map(
+        lambda b: ("NETCDF3_CLASSIC.nc", b))),
     "netcdf_numbers": (_grid_numbers, grid_numbers()),
     # plan: mostly plausible values, so that many examples are routed
     "plan": (_plan, number_mutations(PLAN_SEED, VALUE, ("odd", "float", "scaled", "nudged",
