@@ -182,9 +182,10 @@ class CFHeader:
         return (self.times.size, *self.lat.shape)
 
 
-MAX_WIND_MS = 150.0
-"""Strongest wind a gridded file may hold [m/s] (above any measured gust, about 113 m/s):
-larger values are a wrong unit or a fill value the file does not declare."""
+MAX_WIND_MS = 500.0
+"""Strongest wind a gridded file may hold [m/s]: far above any measured gust (about
+113 m/s), so that larger values are fill values the file does not declare (-999, 9999,
+1e20) or infinities; synthetic test fields may exceed the physical range below it."""
 
 
 def _attr(var: Any, key: str, default: Any = None) -> Any:

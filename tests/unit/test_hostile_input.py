@@ -409,8 +409,8 @@ def grid_course(tmp_path: Path, **overrides: object) -> str:
     ({"hours": [0.0, np.nan, 2.0]}, "time variable time has 1 missing or non-finite value(s) "
                                     "(the first at index 1); every time step needs its time"),
     ({"u": np.full((3, 2, 2), np.inf)}, "u10 and v10 give a wind of inf m/s; expected at most "
-                                        "150 m/s"),
-    ({"u": np.full((3, 2, 2), 9999.0)}, "give a wind of 9999 m/s; expected at most 150 m/s "
+                                        "500 m/s"),
+    ({"u": np.full((3, 2, 2), 9999.0)}, "give a wind of 9999 m/s; expected at most 500 m/s "
                                         "(check speed_unit; a value that marks missing data "
                                         "needs the variable's _FillValue"),
     ({"lon": [13.0, 573.0]}, "longitude has values outside [-180, 360] degrees (13 .. 573)"),
