@@ -284,6 +284,10 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
     def end(name: str) -> None:
         tag = stack.pop()
         if tag == "time" and state["pt"] and stack and stack[-1] == "trkpt":
+            if state["has_time"]:
+                raise InputError(f"{src}: line {parser.CurrentLineNumber}: a <trkpt> with a "
+                                 "second <time> (GPX gives each point one); is the file "
+                                 "damaged?")
             times.append("".join(text_buf).strip())
             state["has_time"] = True
         elif tag == "name" and stack and stack[-1] == "trk":

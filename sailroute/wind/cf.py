@@ -755,8 +755,13 @@ def open_netcdf(
             order = [hdr.dims.index(d) for d in (hdr.time_dim, hdr.row_dim, hdr.col_dim)
                      if d is not None]
             order += [k for k in range(a.ndim) if k not in order]
-            a = np.transpose(a, order).reshape(
-                (w.k1 - w.k0 if hdr.time_dim else 1), r_file.size, c_file.size)
+            shape = (w.k1 - w.k0 if hdr.time_dim is not None else 1, r_file.size, c_file.size)
+            if a.size != shape[0] * shape[1] * shape[2]:  # a damaged or unusual header
+                raise WindDataError(
+                    f"{name}: {vname} holds {a.size} values where its dimensions "
+                    f"{tuple(hdr.dims)} give {shape[0]} x {shape[1]} x {shape[2]}; the file's "
+                    "header does not describe its data (a damaged file?)")
+            a = np.transpose(a, order).reshape(shape)
             # back from sorted file order to south-north / west-east order
             a = a[:, np.searchsorted(r_sorted, r_file)][:, :, np.searchsorted(c_sorted, c_file)]
             arrays.append(a)

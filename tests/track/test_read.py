@@ -79,6 +79,10 @@ def test_gpx10_and_name_override(tmp_path: Path) -> None:
      "line 3: <trkpt> has no <time>"),
     ('<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2">\n</trk></gpx>',
      r"e\.gpx:4:\d+: not well-formed XML"),
+    # found by the fuzz test: two times in one point gave one time more than points
+    ('<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2"><time>2025-06-21T11:18:31Z'
+     '</time>\n<time>2025-06-21T11:18:30Z</time></trkpt>\n</trkseg></trk></gpx>',
+     "line 4: a <trkpt> with a second <time>"),
 ])
 def test_bad_gpx(tmp_path: Path, text: str, match: str) -> None:
     with pytest.raises(InputError, match=match):

@@ -461,3 +461,15 @@ def test_grib_without_cfgrib_says_how_to_install(monkeypatch) -> None:
     with pytest.raises(InputError, match=r"reading GRIB needs the optional packages cfgrib and "
                                          r"eccodes .*`pip install 'sailroute\[grib\]'`"):
         open_grib(GRIB, FRAME)
+
+
+def test_a_dimension_with_an_empty_name_is_still_the_time_axis() -> None:
+    # found by the fuzz test: a damaged header names the time dimension "" (a NUL byte);
+    # the reader treated "" as no time axis and failed reshaping 3 x 3 x 3 values as 1 x 3 x 3
+    from tests.unit.test_fuzz_inputs import FRAME
+
+    w = open_netcdf(Path(__file__).parents[1] / "data" / "wind" / "damaged_dims.nc", FRAME,
+                    clamp=True)
+    assert w.info["times"].endswith("(3 of 3 slices)")
+    u, v = w.sample(w.times[1], 0.0, 0.0)
+    assert float(u) == pytest.approx(1.0, abs=1e-3) and float(v) == pytest.approx(-5.0, abs=1e-3)
