@@ -7,7 +7,7 @@ Garmin track of 33 min, ``data/snipe-valencia-2025-06-21-ESP30782-P01.gpx``) and
 what the command does: read the files, analyse, write every output (JSON, CSV, PNG and
 report.html) into a temporary folder.
 
-* **fleet**: three boats of 28 min at 1 Hz (the race is 25 min; the brief's 20 min would
+* **fleet**: three boats of 28 min at 1 Hz (the race is 25 min; 20 min would
   end before the finish): the real track from a minute before the gun to its end, and two
   copies of it, 4 s and 9 s behind and 3 m and 6 m to the side, as three GPX files in one
   run;
