@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -38,12 +38,7 @@ from sailroute.analysis.segment import (
     leg_target,
     segment_track,
 )
-from sailroute.analysis.windsource import (
-    ABOVE_POLAR_PCT,
-    WindSource,
-    covers,
-    first_covering,
-)
+from sailroute.analysis.windsource import ABOVE_POLAR_PCT, WindSource, first_covering
 from sailroute.course.geometry import feature_centre, leg_wind_mode
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
@@ -59,6 +54,10 @@ from sailroute.track.model import Track
 from sailroute.track.read import read_track
 from sailroute.units import KNOT, bearing_deg, signed_twa, wind_speed_direction
 from sailroute.wind.base import WindField
+
+if TYPE_CHECKING:  # pragma: no cover
+    from sailroute.analysis.fleetpolar import FleetPolar
+    from sailroute.boat.polar import Polar
 
 BRIDGE_S = 1e9
 """Hole limit of the measured winds the routers sample [s]: no hole (see
@@ -686,10 +685,9 @@ def _optimal_leg(course: Course, i: int, bounds: Sequence[Crossing],
         try:
             opt = route_leg(start, target, a.t, sources[k].for_routing, boat, settings,
                             progress=progress.update if progress is not None else None)
-            tr = opt.track
-            if sources[k].route_field is None or covers(sources[k].field, tr.t, tr.x, tr.y):
-                break
-            sources[k].field.sample(tr.t, tr.x, tr.y)  # raises: the route crosses a hole
+            if sources[k].route_field is not None:  # raises if the route crosses a hole
+                sources[k].field.sample(opt.track.t, opt.track.x, opt.track.y)
+            break
         except OutOfCoverageError:
             nxt = first_covering(sources, *points, skip=k)
             if nxt is None:
@@ -762,6 +760,17 @@ def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
                          "elapsed_s": elapsed[k], "position": pos[k],
                          "loss_s": a.legs[i].loss_s, "note": a.legs[i].note})
     return rows
+
+
+def fleet_reference(analyses: Sequence[TrackAnalysis], reference: Polar) -> FleetPolar:
+    """The fleet-relative polar (:func:`sailroute.analysis.fleetpolar.fleet_polar`) from
+    tracks analysed against ``reference``: their straight-line points' TWA and SOG/polar."""
+    from sailroute.analysis.fleetpolar import fleet_polar, straight_ratios
+
+    samples = [straight_ratios(a.points.t, a.points.twa_deg, a.points.sog_ms, a.points.polar_ms,
+                               np.array([m.t for leg in a.legs for m in leg.manoeuvres]))
+               for a in analyses]
+    return fleet_polar(samples, reference, [a.track.name for a in analyses])
 
 
 def _ranks(values: Sequence[float]) -> list[int | None]:
@@ -898,7 +907,6 @@ def run_analyze_command(
     the fleet sails (:func:`sailroute.analysis.fleetpolar.fleet_polar`): the boats are
     analysed twice.
     """
-    from sailroute.analysis.fleetpolar import fleet_polar
     from sailroute.outdir import check_out_dir, write_output_set
     from sailroute.plan import _loaded
     from sailroute.report.analysis import (
@@ -947,7 +955,7 @@ def run_analyze_command(
 
     analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())
     if reference == "fleet":
-        fp = fleet_polar(analyses, polar)
+        fp = fleet_reference(analyses, polar)
         notes.append(fp.describe())
         analyses = analyse_all(fp.polar, fp.describe())
     if len(analyses) == 1:
@@ -999,5 +1007,5 @@ def load_and_analyze(course_path: str | Path, track_path: str | Path, scenario: 
 
 
 __all__ = ["AnalyzeResult", "LegAnalysis", "PointTable", "TrackAnalysis", "analyze_track",
-           "check_same_race", "fleet_ranking", "load_and_analyze",
+           "check_same_race", "fleet_ranking", "fleet_reference", "load_and_analyze",
            "parse_leg_times", "run_analyze_command"]

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Final
+from typing import Final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -36,9 +36,6 @@ from sailroute.analysis.loss import POLAR_MIN_MS, manoeuvre_mask
 from sailroute.boat.efficiency import BANDS, BOUNDARIES_DEG, scale_polar
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
-
-if TYPE_CHECKING:  # pragma: no cover
-    from sailroute.analyze import TrackAnalysis
 
 PERCENTILE: Final = 75.0
 """Percentile of the fleet's speed ratios that sets each band's factor [%]."""
@@ -123,17 +120,37 @@ def band_factors(twa_deg: NDArray, ratio: NDArray, *, percentile: float = PERCEN
     return np.where(np.isfinite(factor), factor, np.nanmean(factor)), count
 
 
-def fleet_polar(analyses: Sequence[TrackAnalysis], reference: Polar, *,
-                percentile: float = PERCENTILE, min_count: int = MIN_COUNT) -> FleetPolar:
-    """The fleet-relative reference from analyses made against ``reference``.
+def straight_ratios(t: NDArray, twa_deg: NDArray, sog_ms: NDArray, polar_ms: NDArray,
+                    man_t: NDArray) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """One track's straight-line points: their TWA [°] and SOG / polar [-].
 
     Parameters
     ----------
-    analyses : sequence of TrackAnalysis
-        The fleet's tracks analysed once against the course's polar (their
-        per-point TWA, SOG and polar speed, and their manoeuvre times).
+    t, twa_deg, sog_ms, polar_ms : ndarray
+        Per point: time [epoch s], TWA in the point's wind [°], SOG and polar speed
+        [m s⁻¹].
+    man_t : ndarray
+        Times of the track's sailed manoeuvres [epoch s]; points inside their windows
+        (:func:`sailroute.analysis.loss.manoeuvre_mask`) are left out, as are points
+        where the polar is below ``POLAR_MIN_MS``.
+    """
+    good = ~manoeuvre_mask(t, man_t) & (polar_ms >= POLAR_MIN_MS)
+    return twa_deg[good], sog_ms[good] / polar_ms[good]
+
+
+def fleet_polar(samples: Sequence[tuple[NDArray, NDArray]], reference: Polar,
+                boats: Sequence[str], *, percentile: float = PERCENTILE,
+                min_count: int = MIN_COUNT) -> FleetPolar:
+    """The fleet-relative reference from the fleet's straight-line speed ratios.
+
+    Parameters
+    ----------
+    samples : sequence of (ndarray, ndarray)
+        Per track, :func:`straight_ratios` of its points judged against ``reference``.
     reference : Polar
         The course's polar.
+    boats : sequence of str
+        The tracks' names (for the description).
 
     Returns
     -------
@@ -144,20 +161,13 @@ def fleet_polar(analyses: Sequence[TrackAnalysis], reference: Polar, *,
     InputError
         Too few straight-line points, or a factor above :data:`MAX_FACTOR`.
     """
-    twa: list[NDArray] = [np.empty(0)]
-    ratio: list[NDArray] = [np.empty(0)]
-    for a in analyses:
-        p = a.points
-        man_t = np.array([m.t for leg in a.legs for m in leg.manoeuvres])
-        good = ~manoeuvre_mask(p.t, man_t) & (p.polar_ms >= POLAR_MIN_MS)
-        twa.append(p.twa_deg[good])
-        ratio.append(p.sog_ms[good] / p.polar_ms[good])
-    factor, count = band_factors(np.concatenate(twa), np.concatenate(ratio),
-                                 percentile=percentile, min_count=min_count)
+    twa = np.concatenate([np.empty(0), *(a for a, _ in samples)])
+    ratio = np.concatenate([np.empty(0), *(r for _, r in samples)])
+    factor, count = band_factors(twa, ratio, percentile=percentile, min_count=min_count)
     polar = scale_polar(reference, *factor, max_factor=MAX_FACTOR, key="fleet polar"
                         ).with_name(f"{reference.name} x fleet")
-    return FleetPolar(polar, factor, count, percentile, tuple(a.track.name for a in analyses))
+    return FleetPolar(polar, factor, count, percentile, tuple(boats))
 
 
 __all__ = ["MAX_FACTOR", "MIN_COUNT", "PERCENTILE", "FleetPolar", "band_factors",
-           "fleet_polar"]
+           "fleet_polar", "straight_ratios"]

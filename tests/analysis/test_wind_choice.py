@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sailroute.analysis.fleetpolar import band_factors, fleet_polar
+from sailroute.analysis.fleetpolar import band_factors
 from sailroute.analysis.windsource import WindSource, first_covering, wind_order
-from sailroute.analyze import analyze_track, run_analyze_command
+from sailroute.analyze import analyze_track, fleet_reference, run_analyze_command
 from sailroute.course.load import build_specs
 from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
@@ -126,7 +126,7 @@ def test_a_fleet_relative_polar_judges_a_fast_boat_against_itself(
     boat, winds = build_specs(course, ["steady"])
     first = analyze_track(course, fast)
     assert all(leg.loss_s < -0.1 * leg.sailed_time_s for leg in first.legs)  # "gains"
-    fp = fleet_polar([first], boat.routing_polar())
+    fp = fleet_reference([first], boat.routing_polar())
     assert fp.count[0] > 100 and fp.count[2] > 100  # a beat and a run
     np.testing.assert_allclose(fp.factor, 1.25, atol=0.04)
     again = analyze_track(course, fast, built=(fp.polar, winds["steady"]))
