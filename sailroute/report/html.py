@@ -721,7 +721,7 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
 
     Every boat's sailed track on one map with one time slider (a marker per boat), the
     optimal legs from the *leader's* leg starts (the boat ahead at the last leg end of
-    known time; each boat's own optimal legs are on its own page), the scenario's wind,
+    known time; each boat's own optimal legs are on its own page), the wind (``wind``),
     and three tables: the leg ranking (``rows`` of
     :func:`sailroute.analyze.fleet_ranking`), the start (time late, distance to the line,
     side and speed at the gun, over early, line offset) and the loss split per boat and
