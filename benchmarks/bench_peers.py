@@ -570,7 +570,7 @@ def section_griddp(args: argparse.Namespace) -> None:
 
 
 class _LegClock:
-    """A stand-in for :class:`~sailroute.report.progress.Progress` that times each leg."""
+    """A stand-in for :class:`~sailroute.progress.Progress` that times each leg."""
 
     def __init__(self) -> None:
         self.times: list[Timing] = []

@@ -44,7 +44,7 @@ from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.plan import default_scenario, settings_for
-from sailroute.report.progress import Progress
+from sailroute.progress import Progress
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import target_barrier
 from sailroute.routing.types import LegResult, RoutingSettings, Start

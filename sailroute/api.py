@@ -26,7 +26,7 @@ from sailroute.boat.polar import Polar
 from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.plan import PlannedCourse
-from sailroute.report.progress import Progress
+from sailroute.progress import Progress
 from sailroute.wind.base import WindField
 
 

@@ -212,7 +212,7 @@ def _check_out(out: str | None) -> None:
 
 def _progress(n_legs: int, quiet: bool) -> Any:
     """Progress display on stderr: a rich bar on a terminal, plain lines otherwise."""
-    from sailroute.report.progress import make_progress
+    from sailroute.progress import make_progress
 
     return make_progress(n_legs, enabled=not quiet)
 

@@ -21,7 +21,7 @@ from sailroute.boat.sanity import check_wind_range, peak_wind, require_speed
 from sailroute.course.load import course_from_mapping
 from sailroute.errors import InputError
 from sailroute.plan import check_boat_and_winds, compare_scenarios, plan_course
-from sailroute.report.progress import Progress
+from sailroute.progress import Progress
 from sailroute.units import KMH
 from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import Coverage

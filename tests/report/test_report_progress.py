@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import io
 
-from sailroute.report.progress import Progress
+from sailroute.progress import Progress
 
 
 def test_line_mode_writes_start_and_end_only():
@@ -54,7 +54,7 @@ class _Tty(io.StringIO):
 
 
 def test_rich_bar_on_a_terminal_plain_lines_elsewhere():
-    from sailroute.report.progress import RichProgress, make_progress
+    from sailroute.progress import RichProgress, make_progress
 
     assert type(make_progress(2, stream=io.StringIO())) is Progress
     assert type(make_progress(2, stream=_Tty(), enabled=False)) is Progress  # -q: no bar

@@ -6,7 +6,7 @@ This is the only place where the layers meet: a loaded
 :func:`~sailroute.routing.api.route_leg` starting where and when the previous leg
 ended, and the results become a :class:`~sailroute.report.plan.Plan`.  Nothing
 here reads files except through those factories, and nothing prints: progress
-goes to an optional :class:`~sailroute.report.progress.Progress`.
+goes to an optional :class:`~sailroute.progress.Progress`.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from sailroute.outdir import check_out_dir, path_part_problem, safe_part, write_
 from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.report import png_worker
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
-from sailroute.report.progress import Progress
+from sailroute.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import LegResult, RouterName, RoutingSettings
