@@ -34,7 +34,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from sailroute.analyze import run_analyze_command  # noqa: E402
+from sailroute.commands.analyze import run_analyze_command  # noqa: E402
 from sailroute.course.load import load_course  # noqa: E402
 from sailroute.timeutil import iso  # noqa: E402
 from sailroute.track.read import read_track  # noqa: E402
@@ -117,7 +117,7 @@ def main() -> None:
 
         t = best_of(fleet, repeat)
         res = run_analyze_command(COURSE, boats, out_dir=d / "fleet-check", plots=False)
-        winds = sorted({leg.wind_source for a in res.analyses for leg in a.legs})
+        winds = sorted({leg.wind_source for a in res.data for leg in a.legs})
         print(f"fleet: {len(boats)} boats x {sizes[0]} fixes (1 Hz, {sizes[0] / 60:.0f} min), "
               f"read + analyse + write: {t:6.2f} s (wind: {', '.join(winds)})")
         log = long_log(d, n)
@@ -128,7 +128,7 @@ def main() -> None:
 
         t = best_of(one, repeat)
         res = run_analyze_command(COURSE, [log], out_dir=d / "check", plots=False)
-        a = res.analyses[0]
+        a = res.data[0]
         hours = (a.track.t_end - a.track.t_start) / 3600
         print(f"long log: {len(a.track)} fixes (10 Hz, {hours:.1f} h, "
               f"{log.stat().st_size / 1e6:.0f} MB GPX), read + analyse + write: {t:6.2f} s "

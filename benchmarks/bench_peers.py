@@ -27,7 +27,7 @@ Sections (each prints a Markdown table; ``docs/performance.md`` holds one full r
 ``course``
     Our isochrone router per leg and per full course on ``courses/hyeres-r1.yaml``,
     scenarios ``constant`` and ``wrf10``, with the course's own routing settings;
-    plus :func:`sailroute.plan.plan_course` end to end (wind and boat built inside).
+    plus :func:`sailroute.planning.route.plan_course` end to end (wind and boat built inside).
 ``cli``
     Wall time of ``python -c "import sailroute.cli"``, ``sailroute --help`` and
     ``sailroute plan courses/hyeres-r1.yaml`` as fresh processes (best of N), with
@@ -600,10 +600,10 @@ def _route_course(course: Any, wind: WindField, boat: Any, st: RoutingSettings
                   ) -> list[tuple[Timing, LegResult]]:
     """Route every leg in order, chained in time and place; ``(timing, result)`` per leg.
 
-    Uses :func:`sailroute.plan.route_course` (the ``plan`` command's leg chaining,
+    Uses :func:`planning.route.route_course` (the ``plan`` command's leg chaining,
     rounding rules included), timed per leg through its progress hooks.
     """
-    from sailroute.plan import route_course
+    from sailroute.planning.route import route_course
 
     clock = _LegClock()
     results = route_course(course, wind, boat, st, progress=clock)
@@ -611,8 +611,8 @@ def _route_course(course: Any, wind: WindField, boat: Any, st: RoutingSettings
 
 
 def _plan_course_wall(course: Any, scenario: str, repeat: int) -> str:
-    """Best wall time of :func:`sailroute.plan.plan_course`, with its route time."""
-    from sailroute.plan import plan_course
+    """Best wall time of :func:`sailroute.planning.route.plan_course`, with its route time."""
+    from sailroute.planning.route import plan_course
 
     tm, out = best_of(lambda: plan_course(course, scenario), repeat)
     return f"{tm} wall (cpu), route {out.plan.total_time_s:.1f} s"
@@ -627,7 +627,7 @@ def section_course(args: argparse.Namespace) -> None:
     print(f"\n## Isochrone router per leg and per course: {COURSE.relative_to(ROOT)}\n")
     print(f"Course settings: dt {st.dt_s:g} s, heading step {st.heading_step_deg:g}°, tack "
           f"{st.tack_penalty_s:g} s, gybe {st.gybe_penalty_s:g} s.  Legs chained in time and "
-          f"place by `sailroute.plan.route_course` (as `sailroute plan` does); wind and boat "
+          f"place by `planning.route.route_course` (as `sailroute plan` does); wind and boat "
           f"built once outside the leg timings.  Best of "
           f"{args.course_repeat} after a warm-up (per leg: best over the runs).\n")
     boat = build_boat(course)
@@ -686,7 +686,8 @@ def _cli_commands(out: Path) -> dict[str, list[str]]:
     exe, py = _sailroute_exe(), sys.executable
     course = str(COURSE.relative_to(ROOT))
     imports = {m: [py, "-c", f"import {m}"] for m in (
-        "numpy", "scipy.interpolate", "matplotlib.pyplot", "sailroute.cli", "sailroute.plan")}
+        "numpy", "scipy.interpolate", "matplotlib.pyplot", "sailroute.cli",
+        "sailroute.planning.route")}
     return {
         'python -c "pass"': [py, "-c", "pass"],
         **{f'python -c "import {m}"': c for m, c in imports.items()},

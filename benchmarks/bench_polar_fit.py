@@ -27,14 +27,14 @@ from pathlib import Path
 import numpy as np
 
 from sailroute.boat.fit import fit_polar
-from sailroute.boat.fit_outputs import (
+from sailroute.boat.fit_samples import (
     auto_tws_bins,
     compare_polars,
     samples_from_log,
 )
 from sailroute.boat.io import read_polar
 from sailroute.boat.polar import fold_twa
-from sailroute.boat.vpp_outputs import twa_grid
+from sailroute.commands.vpp import twa_grid
 from sailroute.track.read import read_track
 from sailroute.units import KNOT
 

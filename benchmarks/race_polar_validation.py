@@ -30,7 +30,7 @@ from datetime import datetime
 
 from sailroute.course.load import course_from_mapping, load_course
 from sailroute.course.model import Course, frozen_mapping
-from sailroute.plan import plan_course
+from sailroute.planning.route import plan_course
 
 SNIPE = {
     # race: (TWS kn, B1 lat, B1 lon, observed [(run1, beat2, run2) per boat] from README times)

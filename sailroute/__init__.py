@@ -36,14 +36,14 @@ _EXPORTS: dict[str, str] = {
     "leg_endpoints": "sailroute.course.geometry",
     "load_course": "sailroute.course.load",
     # planning a course
-    "Comparison": "sailroute.report.plan",
-    "Plan": "sailroute.report.plan",
-    "PlannedCourse": "sailroute.plan",
-    "PlannedLeg": "sailroute.report.plan",
-    "compare_scenarios": "sailroute.plan",
-    "plan_course": "sailroute.plan",
+    "Comparison": "sailroute.planning.result",
+    "Plan": "sailroute.planning.result",
+    "PlannedCourse": "sailroute.planning.route",
+    "PlannedLeg": "sailroute.planning.result",
+    "compare_scenarios": "sailroute.planning.route",
+    "plan_course": "sailroute.planning.route",
     "plan_with_wind": "sailroute.api",
-    "route_course": "sailroute.plan",
+    "route_course": "sailroute.planning.route",
     "write_plan_outputs": "sailroute.report.files",
     # routing one leg
     "LegResult": "sailroute.routing.types",
@@ -73,16 +73,16 @@ _EXPORTS: dict[str, str] = {
     "vpp": "sailroute.api",
     "write_pol": "sailroute.boat.io",
     # race analysis
-    "TrackAnalysis": "sailroute.analyze",
-    "analyze_track": "sailroute.analyze",
-    "fleet_ranking": "sailroute.analyze",
+    "TrackAnalysis": "sailroute.analysis.debrief",
+    "analyze_track": "sailroute.analysis.debrief",
+    "fleet_ranking": "sailroute.analysis.debrief",
     "read_track": "sailroute.track.read",
     # tack strategy
     "DriftDiffusionShift": "sailroute.strategy.shiftmodel",
     "OUShift": "sailroute.strategy.shiftmodel",
-    "StrategyResult": "sailroute.strategy.api",
-    "StrategySettings": "sailroute.strategy.api",
-    "run_strategy": "sailroute.strategy.api",
+    "StrategyResult": "sailroute.strategy.study",
+    "StrategySettings": "sailroute.strategy.study",
+    "run_strategy": "sailroute.strategy.study",
     # errors
     "InputError": "sailroute.errors",
     "OutOfCoverageError": "sailroute.errors",
@@ -147,7 +147,7 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:  # pragma: no cover - the same names, for static tools
-    from sailroute.analyze import TrackAnalysis, analyze_track, fleet_ranking
+    from sailroute.analysis.debrief import TrackAnalysis, analyze_track, fleet_ranking
     from sailroute.api import open_wind, plan_with_wind, vpp
     from sailroute.boat.build import builtin_polar
     from sailroute.boat.fit import fit_polar
@@ -164,13 +164,13 @@ if TYPE_CHECKING:  # pragma: no cover - the same names, for static tools
         SailrouteError,
         WindDataError,
     )
-    from sailroute.plan import PlannedCourse, compare_scenarios, plan_course, route_course
+    from sailroute.planning.result import Comparison, Plan, PlannedLeg
+    from sailroute.planning.route import PlannedCourse, compare_scenarios, plan_course, route_course
     from sailroute.report.files import write_plan_outputs
-    from sailroute.report.plan import Comparison, Plan, PlannedLeg
     from sailroute.routing.api import route_leg
     from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
-    from sailroute.strategy.api import StrategyResult, StrategySettings, run_strategy
     from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
+    from sailroute.strategy.study import StrategyResult, StrategySettings, run_strategy
     from sailroute.track.read import read_track
     from sailroute.wind.base import WindField
     from sailroute.wind.blended import BlendedWind

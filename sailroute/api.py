@@ -25,7 +25,7 @@ from typing import Any
 from sailroute.boat.polar import Polar
 from sailroute.course.model import Course
 from sailroute.errors import InputError
-from sailroute.plan import PlannedCourse
+from sailroute.planning.route import PlannedCourse
 from sailroute.progress import Progress
 from sailroute.wind.base import WindField
 
@@ -170,8 +170,8 @@ def plan_with_wind(
     from sailroute.boat.sanity import check_wind_range, peak_wind, require_speed
     from sailroute.course.geometry import course_bbox, race_time_window
     from sailroute.course.load import build_boat
-    from sailroute.plan import route_course, settings_for
-    from sailroute.report.plan import make_plan
+    from sailroute.planning.result import make_plan
+    from sailroute.planning.route import route_course, settings_for
     from sailroute.routing.api import check_current_router
 
     settings = settings_for(course, router, backend)
@@ -236,10 +236,10 @@ def vpp(
     """
     import numpy as np
 
+    from sailroute.boat.boatfile import load_boat_file
     from sailroute.boat.build import vpp_polar
     from sailroute.boat.kinetics import Kinetics, kinetics_from_spec
     from sailroute.boat.laser import CLASSES, CREW_MASS_RANGE_KG, LaserParams, params_from_mapping
-    from sailroute.boat.vpp_outputs import load_boat_file
     from sailroute.errors import format_problems
 
     if isinstance(boat, LaserParams):

@@ -17,11 +17,10 @@ imported inside the commands.
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Annotated, Any, Literal, NoReturn, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, Literal, NoReturn, TypeVar
 
 import typer
 from typer._click.exceptions import BadParameter
@@ -29,6 +28,9 @@ from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 from sailroute import __version__
 from sailroute.errors import SailrouteError
+
+if TYPE_CHECKING:
+    from sailroute.commands.result import CommandResult
 
 # --- fixed sets of values (checked by the parser, listed in --help, completed by the shell)
 Router = Literal["isochrone", "griddp", "spline"]
@@ -231,30 +233,20 @@ def _terminal_tables(json_out: bool) -> Iterator[None]:
         yield
 
 
-def _finish(
-    res: Any, json_out: bool, main: Sequence[str] = (),
-    labels: Mapping[str, str] | None = None,
-) -> None:
-    """Print the report and the files written, or (``--json``) the main JSON file only.
-
-    ``res.files`` maps kinds to paths (or is a list of paths); ``main`` names the kinds
-    whose file is the command's JSON document, first match wins.
-    """
-    files = res.files
-    items = list(files.items()) if isinstance(files, Mapping) else [(None, p) for p in files]
+def _finish(res: CommandResult, json_out: bool) -> None:
+    """Print the report and the files written, or (``--json``) the main JSON file only."""
     if json_out:
-        path = next((p for k in main for kind, p in items if kind == k), None)
-        if path is None:  # a command whose files are a list: its first .json
-            path = next(p for _, p in items if Path(p).suffix == ".json")
-        sys.stdout.write(Path(path).read_text(encoding="utf-8"))
-        sys.stdout.flush()
+        path = res.main_json()
+        if path is not None:
+            sys.stdout.write(path.read_text(encoding="utf-8"))
+            sys.stdout.flush()
         return
     from sailroute.report.files import FILE_LABELS, file_label
 
     typer.echo(res.report)
     typer.echo("")
-    for kind, path in items:
-        typer.echo(f"wrote {file_label(kind, path, labels or FILE_LABELS)}: {path}")
+    for kind, path in res.files.items():
+        typer.echo(f"wrote {file_label(kind, path, res.labels or FILE_LABELS)}: {path}")
 
 
 # --- commands -------------------------------------------------------------------
@@ -324,7 +316,8 @@ def plan_command(
     backend: BackendOpt = "numpy",
 ) -> None:
     """Route a course leg by leg: leg times, start points, tacks; writes JSON/CSV/GPX/PNG/HTML."""
-    from sailroute.plan import run_plan_command
+    from sailroute.commands.plan import run_plan_command
+    from sailroute.planning.route import RunOptions
 
     def run() -> Any:
         _check_out(out)
@@ -332,10 +325,10 @@ def plan_command(
 
         loaded = load_course(course)
         with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
-            return run_plan_command(loaded, scenario=scenario, router=router, out_dir=out,
-                                    plots=not no_plots, backend=backend, progress=progress)
+            return run_plan_command(loaded, scenario=scenario, out_dir=out, plots=not no_plots,
+                                    options=RunOptions(router, backend, progress))
 
-    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("plan", "ensemble_json"))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 @app.command("compare-scenarios", cls=_Command,
@@ -363,7 +356,8 @@ def compare_command(
     scheduler: SchedulerOpt = None,
 ) -> None:
     """Route a course in every wind scenario; legs x scenarios table with reference errors."""
-    from sailroute.plan import run_compare_command
+    from sailroute.commands.plan import run_compare_command
+    from sailroute.planning.route import RunOptions
 
     def run() -> Any:
         _check_out(out)
@@ -371,11 +365,11 @@ def compare_command(
 
         loaded = load_course(course)
         with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
-            return run_compare_command(loaded, scenarios=scenario, router=router, out_dir=out,
-                                       plots=not no_plots, backend=backend, progress=progress,
-                                       scheduler=scheduler)
+            return run_compare_command(loaded, scenarios=scenario, out_dir=out,
+                                       plots=not no_plots,
+                                       options=RunOptions(router, backend, progress, scheduler))
 
-    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("comparison_json",))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 @app.command("vpp", cls=_Command,
@@ -414,16 +408,14 @@ def vpp_command(
     json_out: JsonOpt = False,
 ) -> None:
     """Run the Laser/ILCA VPP: print the polar and best VMG, write .pol/.csv/.json/.png."""
-    from sailroute.boat.vpp_outputs import run_vpp_command
+    from sailroute.commands.vpp import run_vpp_command
 
     def run() -> Any:
         _check_out(out)
         return run_vpp_command(boat, crew_mass_kg=crew_mass, tws=tws, twa_step_deg=twa_step,
                                out_dir=out, unit=unit, kinetics=kinetics)
 
-    from sailroute.report.files import POLAR_FILE_LABELS
-
-    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("json",), POLAR_FILE_LABELS)
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 def _complete_polar(incomplete: str) -> list[str]:
@@ -549,7 +541,7 @@ def strategy_command(
     json_out: JsonOpt = False,
 ) -> None:
     """Tack strategy on an upwind leg under wind shifts: expected-time or deadline policies."""
-    from sailroute.strategy.api import run_strategy_command
+    from sailroute.commands.strategy import run_strategy_command
 
     def run() -> Any:
         _check_out(out)
@@ -636,7 +628,7 @@ def polar_fit_command(
     json_out: JsonOpt = False,
 ) -> None:
     """Fit a polar to a logged race: filtered percentile envelope; writes .pol/.csv/.json/.png."""
-    from sailroute.boat.fit_outputs import run_fit_command
+    from sailroute.commands.polar_fit import run_fit_command
 
     def run() -> Any:
         _check_out(out)
@@ -646,9 +638,7 @@ def polar_fit_command(
             tws_bins=tws_bins, twa_step_deg=twa_step, out_dir=out, unit=unit,
             reference=reference, reference_unit=reference_unit)
 
-    from sailroute.report.files import POLAR_FILE_LABELS
-
-    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("json",), POLAR_FILE_LABELS)
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 @app.command("analyze", cls=_Command,
@@ -716,7 +706,7 @@ def analyze_command(
     json_out: JsonOpt = False,
 ) -> None:
     """Race analysis: a sailed track against the optimal route, leg by leg (time lost where)."""
-    from sailroute.analyze import run_analyze_command
+    from sailroute.commands.analyze import run_analyze_command
 
     def run() -> Any:
         _check_out(out)
@@ -737,7 +727,7 @@ def analyze_command(
                 time_zone=time_zone, plots=not no_plots, progress=progress,
                 gate_end=gate_end, wind=wind, reference=reference)
 
-    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("analysis_json", "fleet_json"))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 def main() -> None:

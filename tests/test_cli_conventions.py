@@ -64,10 +64,10 @@ def test_shell_completion_is_on_and_completes_choices(monkeypatch):
 
 def test_choice_sets_match_the_code():
     from sailroute.boat.build import builtin_names
-    from sailroute.boat.vpp_outputs import UNITS
+    from sailroute.commands.strategy import SHIFT_KINDS
+    from sailroute.commands.vpp import UNITS
     from sailroute.routing.api import ROUTERS
     from sailroute.routing.types import SIDE_NAMES
-    from sailroute.strategy.api import SHIFT_KINDS
     from sailroute.units import SPEED_UNITS
 
     assert get_args(cli.Router) == tuple(ROUTERS)
@@ -129,20 +129,20 @@ def test_wrote_lines_have_human_labels(tmp_path):
     ["polar", "fit", "log.csv"], ["analyze", WL, "track.gpx"],
 ])
 def test_out_that_is_a_file_fails_before_any_work(tmp_path, monkeypatch, args):
-    import sailroute.analyze
-    import sailroute.boat.fit_outputs
-    import sailroute.boat.vpp_outputs
+    import sailroute.commands.analyze
+    import sailroute.commands.polar_fit
+    import sailroute.commands.strategy
+    import sailroute.commands.vpp
     import sailroute.course.load
-    import sailroute.strategy.api
 
     def work(*a: object, **k: object) -> None:
         raise AssertionError("the work started before --out was checked")
 
     for mod, name in [(sailroute.course.load, "load_course"),
-                      (sailroute.boat.vpp_outputs, "vpp_polar"),
-                      (sailroute.strategy.api, "run_strategy"),
-                      (sailroute.boat.fit_outputs, "fit_polar"),
-                      (sailroute.analyze, "analyze_track")]:
+                      (sailroute.commands.vpp, "vpp_polar"),
+                      (sailroute.commands.strategy, "run_strategy"),
+                      (sailroute.commands.polar_fit, "fit_polar"),
+                      (sailroute.commands.analyze, "analyze_track")]:
         monkeypatch.setattr(mod, name, work)
     taken = tmp_path / "taken"
     taken.write_text("a file")
@@ -154,17 +154,17 @@ def test_out_that_is_a_file_fails_before_any_work(tmp_path, monkeypatch, args):
 
 
 def test_api_checks_the_default_out_before_routing(tmp_path, monkeypatch):
-    import sailroute.plan
+    import sailroute.commands.plan
     from sailroute.errors import InputError
 
     def route(*a: object, **k: object) -> None:
         raise AssertionError("routed before --out was checked")
 
-    monkeypatch.setattr(sailroute.plan, "plan_course", route)
+    monkeypatch.setattr(sailroute.commands.plan, "plan_course", route)
     monkeypatch.chdir(tmp_path)
     (tmp_path / "out").write_text("a file where out/<course>/<scenario> should go")
     with pytest.raises(InputError, match="is a file, not a folder"):
-        sailroute.plan.run_plan_command(WL)
+        sailroute.commands.plan.run_plan_command(WL)
 
 
 def test_rerun_without_plots_removes_the_old_png_and_keeps_user_files(tmp_path):
@@ -211,7 +211,7 @@ def test_strategy_prints_the_model_in_words(tmp_path):
 
 
 def test_shift_model_text_drift_diffusion():
-    from sailroute.strategy.api import shift_model_text
+    from sailroute.report.strategy import shift_model_text
     from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
 
     assert shift_model_text(DriftDiffusionShift(0.5 / 60, 1.2 / 60 ** 0.5)) == (

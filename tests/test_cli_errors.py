@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from typer.testing import CliRunner
 
-import sailroute.plan
+import sailroute.commands.plan
 from sailroute.cli import app
 from tests.conftest import ROOT
 
@@ -17,7 +17,7 @@ def broken_plan(monkeypatch: pytest.MonkeyPatch) -> None:
     def boom(*args: object, **kwargs: object) -> None:
         raise ZeroDivisionError("float division by zero")
 
-    monkeypatch.setattr(sailroute.plan, "run_plan_command", boom)
+    monkeypatch.setattr(sailroute.commands.plan, "run_plan_command", boom)
 
 
 def test_a_bug_is_one_paragraph_and_exit_1(broken_plan: None, tmp_path) -> None:

@@ -250,12 +250,12 @@ def test_default_output_folders_are_git_ignored():
      "without notice. Give --tws-kn up to 28.0, or a --polar with higher TWS columns"),
 ])
 def test_strategy_errors_name_the_options(tmp_path, monkeypatch, args, message):
-    import sailroute.strategy.api
+    import sailroute.strategy.study
 
     def solve(*a: object, **k: object) -> None:
         raise AssertionError("solving started")
 
-    monkeypatch.setattr(sailroute.strategy.api, "run_strategy", solve)
+    monkeypatch.setattr(sailroute.strategy.study, "run_strategy", solve)
     res = runner.invoke(app, ["strategy", *args, "-q", "--no-plots", "-o", str(tmp_path / "o")])
     assert res.exit_code == 2, res.output
     assert res.output.startswith("error: --") and message in res.output
@@ -317,7 +317,7 @@ main()
 
 @pytest.mark.parametrize(("module", "args"), [
     ("typer", ["--help"]),  # while the command line itself is imported
-    ("sailroute.plan", ["plan", "c.yaml"]),  # while a command imports its modules
+    ("sailroute.planning.route", ["plan", "c.yaml"]),  # while a command imports its modules
 ])
 def test_ctrl_c_during_start_up_is_one_line_and_130(tmp_path, module, args):
     import subprocess

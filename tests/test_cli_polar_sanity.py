@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from sailroute.cli import app
 from sailroute.course.load import build_specs, load_course
-from sailroute.plan import check_boat_and_winds
+from sailroute.planning.route import check_boat_and_winds
 from tests.conftest import COURSES, TESTS_DATA
 
 runner = CliRunner()

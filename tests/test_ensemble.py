@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 from sailroute.cli import app
 from sailroute.course.load import load_course
 from sailroute.errors import InputError
-from sailroute.plan import compare_scenarios, default_scenario, plan_course
+from sailroute.planning.route import compare_scenarios, default_scenario, plan_course
 from sailroute.report.ensemble import SIDES, route_side, summarize_ensemble
 from tests.conftest import ROOT
 

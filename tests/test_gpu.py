@@ -19,7 +19,7 @@ from sailroute.backend import _cupy_or_none
 from sailroute.boat.dynamic import DynamicBoat
 from sailroute.boat.io import read_polar
 from sailroute.course.load import load_course
-from sailroute.plan import plan_course
+from sailroute.planning.route import RunOptions, plan_course
 from sailroute.routing.api import route_leg
 from sailroute.routing.types import RoutingSettings, Start, Target
 from sailroute.strategy.deadline import DeadlineGrid, solve_deadline
@@ -66,7 +66,7 @@ def test_griddp_on_cupy_is_the_numpy_route(boat) -> None:
 def test_plan_on_cupy_is_the_numpy_plan() -> None:
     course = load_course(ROOT / "courses" / "hyeres-r1.yaml")
     a = plan_course(course, "constant").plan
-    b = plan_course(course, "constant", backend="cupy").plan
+    b = plan_course(course, "constant", RunOptions(backend="cupy")).plan
     assert b.total_time_s == pytest.approx(a.total_time_s, rel=1e-9)
     for la, lb in zip(a.results, b.results, strict=True):
         _same_leg(la, lb)
@@ -86,8 +86,8 @@ def test_deadline_on_cupy_is_the_numpy_policy(interpolation, fig, dtype, shape) 
 
 def test_strategy_deadline_engine_cupy_gives_the_numpy_probabilities(tmp_path) -> None:
     from sailroute.boat.build import builtin_polar
-    from sailroute.strategy.api import StrategySettings, run_strategy
     from sailroute.strategy.shiftmodel import OUShift
+    from sailroute.strategy.study import StrategySettings, run_strategy
 
     st = StrategySettings(deadlines_s=(190.0,), n_r=40, n_theta=48, length_m=400.0,
                           half_width_m=200.0, lateral_m=4.0, runs=300, deadline_engine="cupy")

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from sailroute.boat.build import builtin_polar
+from sailroute.commands.strategy import run_strategy_command
 from sailroute.errors import InputError
 from sailroute.parallel import (
     INSTALL_HINT,
@@ -21,9 +22,9 @@ from sailroute.parallel import (
     map_tasks,
     open_runner,
 )
-from sailroute.strategy.api import StrategySettings, run_strategy, run_strategy_command
 from sailroute.strategy.montecarlo import CHUNK_SIZE, chunk_rng, simulate
 from sailroute.strategy.shiftmodel import OUShift
+from sailroute.strategy.study import StrategySettings, run_strategy
 
 ITEMS = [7, 3, 11, 0, 5, 2, 9]
 SQUARES = [49, 9, 121, 0, 25, 4, 81]
@@ -212,12 +213,13 @@ def test_compare_scenarios_on_a_cluster_equals_serial(cluster) -> None:
     from pathlib import Path
 
     from sailroute.course.load import load_course
-    from sailroute.plan import compare_scenarios
+    from sailroute.planning.route import RunOptions, compare_scenarios
 
     course = load_course(Path(__file__).resolve().parents[1] / "courses"
                          / "windward-leeward-template.yaml")
     serial_cmp, serial_plans = compare_scenarios(course)
-    dist_cmp, dist_plans = compare_scenarios(course, scheduler=cluster.scheduler_address)
+    dist_cmp, dist_plans = compare_scenarios(
+        course, options=RunOptions(scheduler=cluster.scheduler_address))
     assert dist_cmp.scenarios == serial_cmp.scenarios == ("steady-12kn", "veered-10deg")
     np.testing.assert_array_equal(dist_cmp.times, serial_cmp.times)
     for a, b in zip(serial_plans, dist_plans, strict=True):

@@ -1,4 +1,4 @@
-"""The orchestrator (``sailroute.plan``) on the shipped courses: chaining, closed forms, errors.
+"""Planning (``sailroute.planning.route``) on the shipped courses: chaining, closed forms, errors.
 
 Tolerances: in uniform wind a leg between two points sailed at the best VMG angle
 takes exactly ``(upwind distance) / VMG* + n_tacks * tack_penalty``, whatever the
@@ -17,9 +17,10 @@ import pickle
 import numpy as np
 import pytest
 
+from sailroute.commands.plan import run_plan_command
 from sailroute.course.load import build_boat, course_from_mapping, load_course
 from sailroute.errors import InputError, OutOfCoverageError
-from sailroute.plan import compare_scenarios, plan_course, run_plan_command
+from sailroute.planning.route import RunOptions, compare_scenarios, plan_course
 from sailroute.units import wrap180
 from tests.conftest import COURSES, ROOT
 
@@ -91,7 +92,7 @@ def test_every_mark_is_rounded_on_its_side(course_file, router):
     from tests.routing.test_rounding import string_winding_deg, winding_deg
 
     course = load_course(COURSES / course_file)
-    legs = plan_course(course, router=router).plan.legs
+    legs = plan_course(course, options=RunOptions(router=router)).plan.legs
     checked = 0
     for a, b in itertools.pairwise(legs):
         if a.spec.rounding is None:
@@ -149,9 +150,9 @@ def test_bad_names_fail_before_routing(hyeres):
     with pytest.raises(InputError, match=r"no scenario .wrf5.*scenarios are: constant, wrf60"):
         plan_course(hyeres, "wrf5")
     with pytest.raises(InputError, match="unknown router 'fast'"):
-        plan_course(hyeres, "constant", router="fast")
+        plan_course(hyeres, "constant", RunOptions(router="fast"))
     with pytest.raises(InputError, match="backend 'gpu'"):
-        plan_course(hyeres, "constant", backend="gpu")
+        plan_course(hyeres, "constant", RunOptions(backend="gpu"))
 
 
 def test_wind_not_covering_the_race_is_an_error(tmp_path):
@@ -175,6 +176,6 @@ def test_compare_checks_the_scheduler_name_before_building_any_wind(tmp_path):
     path = tmp_path / "late.yaml"
     path.write_text(text)
     with pytest.raises(InputError, match="scheduler 'tcp:/bad': expected 'serial'"):
-        compare_scenarios(load_course(path), scheduler="tcp:/bad")
+        compare_scenarios(load_course(path), options=RunOptions(scheduler="tcp:/bad"))
     with pytest.raises(OutOfCoverageError):  # a valid name gets as far as the wind
-        compare_scenarios(load_course(path), scheduler=" Serial ")
+        compare_scenarios(load_course(path), options=RunOptions(scheduler=" Serial "))

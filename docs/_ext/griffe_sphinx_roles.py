@@ -1,7 +1,7 @@
 """Griffe extension for the API reference: Sphinx roles in docstrings -> links.
 
 The docstrings are numpydoc and use Sphinx cross-reference roles
-(``:func:`~sailroute.plan.plan_course```), which Markdown would print as they are.
+(``:func:`~sailroute.planning.route.plan_course```), which Markdown would print as they are.
 This rewrites each role into an optional mkdocs-autorefs reference in a code span:
 a link where the target is rendered in the site (``docs/api.md``), plain code
 where it is not (optional references never warn).  A ``~`` shows the last

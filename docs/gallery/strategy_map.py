@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 import sailroute
-from sailroute.strategy.report import plot_policy_map, policy_classes, save_figure
+from sailroute.report.strategy import plot_policy_map, policy_classes, save_figure
 
 KNOT = 1852.0 / 3600.0  # m/s
 OUT = Path(sys.argv[1] if len(sys.argv) > 1

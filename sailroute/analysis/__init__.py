@@ -6,5 +6,5 @@
 * :mod:`sailroute.analysis.infer_wind`: TWD(t) (and TWS(t) with a polar) inferred from
   GPS tracks without instruments.
 
-The orchestration is :func:`sailroute.analyze.analyze_track`.
+The orchestration is :func:`sailroute.analysis.debrief.analyze_track`.
 """

@@ -29,6 +29,9 @@ class CommandResult:
     main : tuple of str
         The kinds in ``files`` whose file is the command's JSON document (``--json``
         prints the first one present).
+    labels : mapping of str to str, optional
+        Kind -> human name of the files (``wrote <name>: <path>``); None: the plan and
+        analysis names (:data:`sailroute.report.files.FILE_LABELS`).
     """
 
     report: str
@@ -36,6 +39,7 @@ class CommandResult:
     data: Any = None
     notes: tuple[str, ...] = ()
     main: tuple[str, ...] = field(default=("json",))
+    labels: Mapping[str, str] | None = None
 
     def main_json(self) -> Path | None:
         """The command's JSON document: the first of ``main`` written, else the first ``.json``.

@@ -1,10 +1,10 @@
-"""Orchestration: route a whole course in one wind scenario, or in several.
+"""Route a whole course in one wind scenario, or in several.
 
-This is the only place where the layers meet: a loaded
+A loaded
 :class:`~sailroute.course.model.Course` gives the boat and the scenario's wind
 (``course/load.py``), each leg is routed with
 :func:`~sailroute.routing.api.route_leg` starting where and when the previous leg
-ended, and the results become a :class:`~sailroute.report.plan.Plan`.  Nothing
+ended, and the results become a :class:`~sailroute.planning.result.Plan`.  Nothing
 here reads files except through those factories, and nothing prints: progress
 goes to an optional :class:`~sailroute.progress.Progress`.
 """
@@ -14,7 +14,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import cast
 
 from sailroute.backend import get_xp
@@ -22,19 +21,46 @@ from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.boat.sanity import check_wind_range, peak_wind, require_speed
 from sailroute.course.geometry import course_bbox, leg_endpoints, race_time_window, target_of
-from sailroute.course.load import build_current, build_specs, load_course
+from sailroute.course.load import build_current, build_specs
 from sailroute.course.model import Course
 from sailroute.errors import InputError, format_problems
-from sailroute.outdir import check_out_dir, path_part_problem, safe_part, write_output_set
 from sailroute.parallel import SERIAL, check_scheduler, map_tasks
-from sailroute.report import png_worker
-from sailroute.report.plan import Comparison, Plan, compare, make_plan
+from sailroute.planning.result import Comparison, Plan, compare, make_plan
 from sailroute.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import LegResult, RouterName, RoutingSettings
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """How to run a plan: which router, on which array backend, where to report, where to run.
+
+    Attributes
+    ----------
+    router : str, optional
+        ``"isochrone"``, ``"griddp"`` or ``"spline"``; overrides the course's
+        ``routing.router``.  None: the course's own.
+    backend : {"numpy", "cupy", "auto"}
+        Array backend of the router kernels.
+    progress : Progress, optional
+        Per-leg progress display (serial runs only).
+    scheduler : str, optional
+        None or ``"serial"``: scenarios one after the other here; ``"processes"``: a local
+        Dask cluster; ``"tcp://HOST:PORT"``: an existing Dask scheduler
+        (``docs/scale-out.md``).  The results are identical.
+    """
+
+    router: str | None = None
+    backend: str = "numpy"
+    progress: Progress | None = None
+    scheduler: str | None = None
+
+
+DEFAULT_RUN = RunOptions()
+"""The course's router, NumPy, no progress display, serial."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -211,12 +237,7 @@ def route_course(
 
 
 def plan_course(
-    course: Course,
-    scenario: str | None = None,
-    *,
-    router: str | None = None,
-    backend: str = "numpy",
-    progress: Progress | None = None,
+    course: Course, scenario: str | None = None, options: RunOptions = DEFAULT_RUN,
 ) -> PlannedCourse:
     """Route ``course`` in one of its wind scenarios.
 
@@ -226,13 +247,8 @@ def plan_course(
         A loaded course (:func:`sailroute.course.load.load_course`).
     scenario : str, optional
         Scenario name; default the first one in the file.
-    router : str, optional
-        ``"isochrone"``, ``"griddp"`` or ``"spline"``; overrides the course's
-        ``routing.router``.
-    backend : {"numpy", "cupy", "auto"}
-        Array backend of the router kernels.
-    progress : Progress, optional
-        Progress display.
+    options : RunOptions, optional
+        Router, backend and progress display (the scheduler is not used: one scenario).
 
     Returns
     -------
@@ -255,44 +271,39 @@ def plan_course(
             f"{len(course.ensembles[name])} members; route them all with "
             "`sailroute plan --scenario NAME` (run_plan_command) or compare_scenarios, or "
             f"one member by its name ({course.ensembles[name][0]!r}, ...)")
-    settings = settings_for(course, router, backend)
+    settings = settings_for(course, options.router, options.backend)
     boat, winds = build_specs(course, [name])
     notes = check_boat_and_winds(course, boat, winds)
-    _warn(progress, notes)
-    run = _routed(course, name, winds[name], boat, settings, backend, progress)
+    _warn(options.progress, notes)
+    run = _routed(course, name, winds[name], boat, settings, options)
     return dataclasses.replace(run, notes=tuple(notes.values()))
 
 
 def _routed(
     course: Course, name: str, wind: WindField, boat: BoatModel, settings: RoutingSettings,
-    backend: str, progress: Progress | None,
+    options: RunOptions,
 ) -> PlannedCourse:
     """Route the course in one built scenario and assemble its :class:`Plan`."""
+    progress = options.progress
     if progress is not None:
         for line in wind_notes(wind):
             progress.note(line)
     current = build_current(course, name)
     if current is not None:
         check_current_router(settings.router)
-    results = route_course(course, wind, boat, settings, backend=backend, progress=progress,
-                           current=current)
+    results = route_course(course, wind, boat, settings, backend=options.backend,
+                           progress=progress, current=current)
     return PlannedCourse(make_plan(course, name, results, wind, router=settings.router), wind)
 
 
 def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:
     """One scenario of :func:`compare_scenarios` (top level, so Dask can pickle it)."""
     course, name, router, backend = task
-    return plan_course(course, name, router=router, backend=backend).plan
+    return plan_course(course, name, RunOptions(router=router, backend=backend)).plan
 
 
 def compare_scenarios(
-    course: Course,
-    scenarios: Sequence[str] | None = None,
-    *,
-    router: str | None = None,
-    backend: str = "numpy",
-    progress: Progress | None = None,
-    scheduler: str | None = None,
+    course: Course, scenarios: Sequence[str] | None = None, options: RunOptions = DEFAULT_RUN,
 ) -> tuple[Comparison, list[Plan]]:
     """Route ``course`` in several scenarios and put the leg times side by side.
 
@@ -302,18 +313,9 @@ def compare_scenarios(
         A loaded course.
     scenarios : sequence of str, optional
         Scenario names, in the order to report them; default all, in file order.
-    router : str, optional
-        ``"isochrone"``, ``"griddp"`` or ``"spline"``; overrides the course's
-        ``routing.router``.
-    backend : {"numpy", "cupy", "auto"}
-        Array backend of the router kernels.
-    progress : Progress, optional
-        Per-leg progress (serial runs only; a distributed run reports nothing
-        until all scenarios are back).
-    scheduler : str, optional
-        None or ``"serial"``: route the scenarios one after the other here;
-        ``"processes"``: a local Dask cluster; ``"tcp://HOST:PORT"``: an existing
-        Dask scheduler (see ``docs/scale-out.md``).  The results are identical.
+    options : RunOptions, optional
+        Router, backend, progress display (serial runs only; a distributed run reports
+        nothing until all scenarios are back) and scheduler.
 
     Returns
     -------
@@ -322,24 +324,18 @@ def compare_scenarios(
     plans : list of Plan
         One per scenario, in the same order.
     """
-    cmp, plans, _ = _compare_scenarios(course, scenarios, router=router, backend=backend,
-                                       progress=progress, scheduler=scheduler)
+    cmp, plans, _ = route_scenarios(course, scenarios, options)
     return cmp, plans
 
 
-def _compare_scenarios(
-    course: Course,
-    scenarios: Sequence[str] | None = None,
-    *,
-    router: str | None = None,
-    backend: str = "numpy",
-    progress: Progress | None = None,
-    scheduler: str | None = None,
+def route_scenarios(
+    course: Course, scenarios: Sequence[str] | None = None, options: RunOptions = DEFAULT_RUN,
 ) -> tuple[Comparison, list[Plan], dict[str, WindField]]:
     """:func:`compare_scenarios`, plus the scenarios' built winds (for ``report.html``)."""
+    router, backend, progress = options.router, options.backend, options.progress
     names = list(course.scenarios) if not scenarios else scenario_members(course, scenarios)
     settings = settings_for(course, router, backend)
-    where = check_scheduler(scheduler)  # a bad name fails before any work
+    where = check_scheduler(options.scheduler)  # a bad name fails before any work
     # every problem of every scenario in one error, up front
     boat, winds = build_specs(course, names)
     _warn(progress, check_boat_and_winds(course, boat, winds))
@@ -348,188 +344,9 @@ def _compare_scenarios(
         for n in names:
             if progress is not None:
                 progress.set_prefix(f"{n}: ")
-            plans.append(_routed(course, n, winds[n], boat, settings, backend, progress).plan)
+            plans.append(_routed(course, n, winds[n], boat, settings, options).plan)
     else:
         # workers build their own scenario (a wind field is not worth shipping)
         plans = map_tasks(_plan_task, [(course, n, router, backend) for n in names],
                           scheduler=where)
     return compare(plans), plans, winds
-
-
-@dataclass(frozen=True, eq=False)
-class CommandResult:
-    """What ``sailroute plan`` / ``compare-scenarios`` print and wrote.
-
-    Attributes
-    ----------
-    report : str
-        The terminal table.
-    files : mapping of str to Path
-        Kind (``plan``, ``track``, ``gpx``, ``png``, ``comparison_json``, ...) -> path.
-    plans : tuple of Plan
-        The routed plans (one for ``plan``).
-    """
-
-    report: str
-    files: Mapping[str, Path]
-    plans: tuple[Plan, ...]
-
-
-def _loaded(course: Course | str | Path) -> Course:
-    """``course`` itself, or the course loaded from that path."""
-    return course if isinstance(course, Course) else load_course(course)
-
-
-def default_out_dir(course: Course, what: str, router: str | None = None) -> Path:
-    """``out/<course file stem>/<what>``: where results go without ``--out``.
-
-    A ``router`` other than the course's own (``routing.router``) is added to the last
-    part, ``out/<stem>/<what>-<router>``, so that ``plan --router griddp`` does not
-    replace the folder of the default router's run.  ``what`` (a scenario name given on
-    the command line) must be one safe path part (:func:`sailroute.outdir.safe_part`).
-    """
-    stem = Path(course.source).stem if course.source else "course"
-    if path_part_problem(stem) is not None:
-        stem = "course"
-    safe_part(what, "scenario")
-    if router is not None and router != course.routing.router:
-        what = f"{what}-{router}"
-    return Path("out") / stem / what
-
-
-def run_plan_command(
-    course: Course | str | Path,
-    *,
-    scenario: str | None = None,
-    router: str | None = None,
-    out_dir: str | Path | None = None,
-    plots: bool = True,
-    backend: str = "numpy",
-    progress: Progress | None = None,
-) -> CommandResult:
-    """Everything ``sailroute plan`` does, minus printing.
-
-    Writes ``plan.json``, ``track.csv``, ``route.gpx``, ``route.png`` and ``report.html``
-    (the last two unless ``plots`` is False) into ``out_dir`` (default
-    ``out/<course>/<scenario>``; checked before routing, written as a set:
-    :func:`sailroute.outdir.write_output_set`).  For an ensemble scenario it routes every
-    member and writes ``ensemble.json`` and ``ensemble.csv`` (the spread of leg times, the
-    side of the course), ``report.html`` with every member's route (unless ``plots`` is
-    False) plus each
-    member's plan files in ``out_dir/<member>/``.
-    """
-    from sailroute.report.files import write_plan_outputs
-    from sailroute.report.tables import plan_table
-
-    course = _loaded(course)
-    name = default_scenario(course) if scenario is None else scenario
-    out = check_out_dir(Path(out_dir) if out_dir is not None
-                        else default_out_dir(course, name, router))
-    if name in course.ensembles:
-        return _run_ensemble(course, name, router=router, out_dir=out, backend=backend,
-                             progress=progress, plots=plots)
-    with png_worker.start(plots) as png:  # loads matplotlib on another core meanwhile
-        run = plan_course(course, scenario, router=router, backend=backend, progress=progress)
-
-        def write(d: Path) -> dict[str, Path]:
-            if plots:  # the child draws while the other files are written here
-                png.submit(run.plan, run.wind, d / "route.png", png_worker.DPI)
-            files = dict(write_plan_outputs(d, run.plan, wind=run.wind, plot=False))
-            if plots:
-                from sailroute.report.html import plan_report, write_report
-
-                html = write_report(d / "report.html", plan_report(run.plan, run.wind))
-                files["png"] = png.result()
-                files["html"] = html
-            return files
-
-        files = write_output_set(out, write)
-    return CommandResult(plan_table(run.plan), files, (run.plan,))
-
-
-def _run_ensemble(
-    course: Course, name: str, *, router: str | None, out_dir: str | Path | None,
-    backend: str, progress: Progress | None, plots: bool = True,
-) -> CommandResult:
-    """``sailroute plan`` on an ensemble scenario: every member, then the spread."""
-    from sailroute.report.ensemble import ensemble_table, summarize_ensemble, write_ensemble
-    from sailroute.report.files import write_plan_outputs
-
-    cmp, plans, winds = _compare_scenarios(course, [name], router=router, backend=backend,
-                                           progress=progress)
-    summary = summarize_ensemble(name, plans)
-    out = Path(out_dir) if out_dir is not None else default_out_dir(course, name, router)
-
-    def write(d: Path) -> dict[str, Path]:
-        files: dict[str, Path] = dict(write_ensemble(d, summary))
-        if plots:
-            from sailroute.report.html import comparison_report, write_report
-
-            files["html"] = write_report(d / "report.html",
-                                         comparison_report(cmp, plans, winds))
-        for p in plans:
-            sub = d / safe_part(p.scenario, "scenario")
-            for kind, path in write_plan_outputs(sub, p, plot=False).items():
-                files[f"{p.scenario}/{kind}"] = path
-        return files
-
-    return CommandResult(ensemble_table(summary), write_output_set(out, write), tuple(plans))
-
-
-def run_compare_command(
-    course: Course | str | Path,
-    *,
-    scenarios: Sequence[str] | None = None,
-    router: str | None = None,
-    out_dir: str | Path | None = None,
-    plots: bool = True,
-    backend: str = "numpy",
-    progress: Progress | None = None,
-    scheduler: str | None = None,
-) -> CommandResult:
-    """Everything ``sailroute compare-scenarios`` does, minus printing.
-
-    Writes ``comparison.json``, ``comparison.csv``, ``comparison.png`` and ``report.html``
-    (the last two unless ``plots`` is False) into ``out_dir`` (default
-    ``out/<course>/comparison``), and
-    each scenario's ``plan.json``, ``track.csv`` and ``route.gpx`` into
-    ``out_dir/<scenario>/``; for each ensemble whose members were all routed, its
-    spread in ``out_dir/<ensemble>/ensemble.json`` and ``ensemble.csv``.
-    """
-    from sailroute.report.ensemble import ensemble_table, summarize_ensemble, write_ensemble
-    from sailroute.report.files import write_comparison, write_plan_outputs
-    from sailroute.report.tables import comparison_table
-
-    course = _loaded(course)
-    out = check_out_dir(Path(out_dir) if out_dir is not None
-                        else default_out_dir(course, "comparison", router))
-    cmp, plans, winds = _compare_scenarios(course, scenarios, router=router, backend=backend,
-                                           progress=progress, scheduler=scheduler)
-    report = [comparison_table(cmp)]
-    by_name = {p.scenario: p for p in plans}
-    summaries = [summarize_ensemble(ens, [by_name[m] for m in members])
-                 for ens, members in course.ensembles.items()
-                 if all(m in by_name for m in members)]
-    report += [ensemble_table(summary) for summary in summaries]
-
-    def write(d: Path) -> dict[str, Path]:
-        js, cs = write_comparison(d, cmp)
-        files: dict[str, Path] = {"comparison_json": js, "comparison_csv": cs}
-        if plots:
-            from sailroute.report.html import comparison_report, write_report
-            from sailroute.report.plots import plot_comparison
-
-            plot_comparison(cmp, plans).savefig(d / "comparison.png", dpi=150)
-            files["comparison_png"] = d / "comparison.png"
-            files["html"] = write_report(d / "report.html", comparison_report(cmp, plans, winds))
-        for p in plans:
-            sub = d / safe_part(p.scenario, "scenario")
-            for kind, path in write_plan_outputs(sub, p, plot=False).items():
-                files[f"{p.scenario}/{kind}"] = path
-        for summary in summaries:
-            sub = d / safe_part(summary.name, "scenario")
-            for kind, path in write_ensemble(sub, summary).items():
-                files[f"{summary.name}/{kind}"] = path
-        return files
-
-    return CommandResult("\n\n".join(report), write_output_set(out, write), tuple(plans))

@@ -26,7 +26,7 @@ from sailroute.units import KNOT
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
-    from sailroute.analyze import TrackAnalysis
+    from sailroute.analysis.result import TrackAnalysis
     from sailroute.wind.base import WindField
 
 SCHEMA_VERSION = 1

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from sailroute.analysis.loss import lateral_offset, side_label, time_mean
 from sailroute.errors import InputError
-from sailroute.report.plan import Plan
+from sailroute.planning.result import Plan
 from sailroute.textin import CleanCsvWriter
 
 STATS: Final = ("min", "p10", "median", "p90", "max")

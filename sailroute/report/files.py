@@ -28,7 +28,7 @@ import numpy as np
 from sailroute import __version__
 from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
-from sailroute.report.plan import Comparison, Plan, percent_error
+from sailroute.planning.result import Comparison, Plan, percent_error
 from sailroute.routing.types import side_name
 from sailroute.textin import CleanCsvWriter, clean_text
 from sailroute.timeutil import iso

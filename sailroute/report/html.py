@@ -47,7 +47,7 @@ from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.course.geometry import feature_centre
 from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
-from sailroute.report.plan import Comparison, Plan, percent_error
+from sailroute.planning.result import Comparison, Plan, percent_error
 from sailroute.report.plots import repeat_index_of_ends
 from sailroute.report.tables import format_duration, start_point_text
 from sailroute.textin import clean_text
@@ -56,7 +56,7 @@ from sailroute.units import KNOT, wind_speed_direction, wrap180, wrap360
 from sailroute.wind.base import WindField
 
 if TYPE_CHECKING:  # pragma: no cover
-    from sailroute.analyze import TrackAnalysis
+    from sailroute.analysis.result import TrackAnalysis
     from sailroute.routing.types import LegResult
 
 DIV_ID = "sailroute-map"
@@ -723,7 +723,7 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
     optimal legs from the *leader's* leg starts (the boat ahead at the last leg end of
     known time; each boat's own optimal legs are on its own page), the wind (``wind``),
     and three tables: the leg ranking (``rows`` of
-    :func:`sailroute.analyze.fleet_ranking`), the start (time late, distance to the line,
+    :func:`sailroute.analysis.debrief.fleet_ranking`), the start (time late, distance to the line,
     side and speed at the gun, over early, line offset) and the loss split per boat and
     leg.  ``notes`` (fleet-wide) and each boat's own notes go under the map.  ``wind``
     (name, field) is the wind drawn; default the first boat's first leg's.

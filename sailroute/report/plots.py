@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
-from sailroute.report.plan import Comparison, Plan
+from sailroute.planning.result import Comparison, Plan
 from sailroute.routing.types import LegResult
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, circular_mean_deg, wind_speed_direction

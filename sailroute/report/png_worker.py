@@ -159,7 +159,7 @@ def _child() -> int:
     import matplotlib.transforms  # noqa: F401
     from matplotlib.figure import Figure
 
-    import sailroute.plan
+    import sailroute.planning.result
     import sailroute.report.plots  # noqa: F401
 
     # first text drawn loads the fonts: do it while the parent is still routing

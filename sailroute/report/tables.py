@@ -14,7 +14,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Any
 
-from sailroute.report.plan import Comparison, Plan, PlannedLeg, percent_error
+from sailroute.planning.result import Comparison, Plan, PlannedLeg, percent_error
 from sailroute.timeutil import iso
 
 

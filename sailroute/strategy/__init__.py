@@ -7,8 +7,8 @@
 * :mod:`~sailroute.strategy.montecarlo` -- seeded, chunked Monte Carlo of a policy;
 * :mod:`~sailroute.strategy.deadline` -- the risk-aware (deadline) and risk-neutral
   target-relative solvers and their Monte Carlo;
-* :mod:`~sailroute.strategy.report` -- figures and JSON;
-* :mod:`~sailroute.strategy.api` -- a whole study (used by ``sailroute strategy``).
+* :mod:`~sailroute.report.strategy` -- figures and JSON;
+* :mod:`~sailroute.strategy.study` -- a whole study (used by ``sailroute strategy``).
 
 See ``docs/strategy.md`` and ``docs/design/strategy.md``.
 """

@@ -9,12 +9,13 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from sailroute.analyze import analyze_track, run_analyze_command
+from sailroute.analysis.debrief import analyze_track
 from sailroute.cli import app
+from sailroute.commands.analyze import run_analyze_command
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError
-from sailroute.plan import route_course, settings_for
+from sailroute.planning.route import route_course, settings_for
 from sailroute.routing.types import LegResult
 from sailroute.timeutil import iso, parse_time, to_epoch
 from sailroute.track.model import Track

@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from sailroute.analysis.debrief import analyze_track, parse_boat_leg_times
 from sailroute.analysis.segment import find_start, gap_limit_s
-from sailroute.analyze import analyze_track, parse_boat_leg_times
 from sailroute.cli import app
 from sailroute.course.load import build_specs
 from sailroute.course.model import Course
 from sailroute.errors import InputError
-from sailroute.plan import route_course, settings_for
+from sailroute.planning.route import route_course, settings_for
 from sailroute.routing.types import LegResult
 from sailroute.timeutil import iso
 from sailroute.track.model import Track

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sailroute.analyze import analyze_track
+from sailroute.analysis.debrief import analyze_track
 from sailroute.course.load import load_course
 from sailroute.report.html import MAX_ROUTE_POINTS, analysis_report, decimated
 from sailroute.track.read import read_track

@@ -14,8 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sailroute.analysis.debrief import analyze_track
 from sailroute.analysis.segment import turn_deg
-from sailroute.analyze import analyze_track
 from sailroute.course.load import load_course
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso

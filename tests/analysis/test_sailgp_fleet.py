@@ -30,7 +30,8 @@ import numpy as np
 import pytest
 
 from sailroute.analysis.segment import segment_track
-from sailroute.analyze import AnalyzeResult, run_analyze_command
+from sailroute.commands.analyze import run_analyze_command
+from sailroute.commands.result import CommandResult
 from sailroute.course.load import load_course
 from sailroute.timeutil import parse_time, to_epoch
 from sailroute.track import read_track
@@ -103,7 +104,7 @@ def leg_counter_changes(boat: str) -> list[float]:
 
 
 @pytest.fixture(scope="module")
-def fleet(tmp_path_factory: pytest.TempPathFactory) -> AnalyzeResult:
+def fleet(tmp_path_factory: pytest.TempPathFactory) -> CommandResult:
     tmp = tmp_path_factory.mktemp("sailgp")
     tracks = [RACE / "Boat_logs" / f"data_{b}.csv" for b in BOATS]
     # the race-mean measured wind of the three boats, gun to gun + 9 min
@@ -122,8 +123,8 @@ def fleet(tmp_path_factory: pytest.TempPathFactory) -> AnalyzeResult:
 
 
 @requires_shared
-def test_the_course_read_from_the_xml(fleet: AnalyzeResult) -> None:
-    c = fleet.analyses[0].course
+def test_the_course_read_from_the_xml(fleet: CommandResult) -> None:
+    c = fleet.data[0].course
     assert [leg.to_name for leg in c.legs] == ["M1", "LG", "WG", "LG", "WG", "LG1", "finish"]
     assert [leg.rounding for leg in c.legs] == ["port", None, None, None, None, "port", None]
     assert c.start_epoch == to_epoch(parse_time("2025-01-19T03:08:00Z", "t"))
@@ -131,8 +132,8 @@ def test_the_course_read_from_the_xml(fleet: AnalyzeResult) -> None:
 
 @requires_shared
 @pytest.mark.parametrize("k", range(3))
-def test_leg_changes_against_the_leg_counter(fleet: AnalyzeResult, k: int) -> None:
-    a = fleet.analyses[k]
+def test_leg_changes_against_the_leg_counter(fleet: CommandResult, k: int) -> None:
+    a = fleet.data[k]
     counter = np.array(leg_counter_changes(BOATS[k]))
     assert len(counter) == 7  # start + 6 leg changes (the finish is not in the log)
     ours = np.array([c.t for c in a.segmentation.bounds[:7]])
@@ -150,9 +151,9 @@ def test_leg_changes_against_the_leg_counter(fleet: AnalyzeResult, k: int) -> No
 
 
 @requires_shared
-def test_the_start_is_found_over_early(fleet: AnalyzeResult) -> None:
+def test_the_start_is_found_over_early(fleet: CommandResult) -> None:
     ocs = {}
-    for b, a in zip(BOATS, fleet.analyses, strict=True):
+    for b, a in zip(BOATS, fleet.data, strict=True):
         st = a.segmentation.start
         assert st.side_at_gun == "course" and not st.ocs_returned
         assert st.crossing.t == st.gun_t and st.late_s == 0.0
@@ -171,9 +172,9 @@ def test_the_start_is_found_over_early(fleet: AnalyzeResult) -> None:
 
 
 @requires_shared
-def test_finishes_across_data_gaps_are_unknown(fleet: AnalyzeResult) -> None:
+def test_finishes_across_data_gaps_are_unknown(fleet: CommandResult) -> None:
     notes = {}
-    for b, a in zip(BOATS, fleet.analyses, strict=True):
+    for b, a in zip(BOATS, fleet.data, strict=True):
         last = a.legs[-1]
         assert not last.known and not a.complete
         assert np.isnan(last.t_end) and np.isnan(last.sailed_time_s) and np.isnan(last.loss_s)
@@ -192,8 +193,8 @@ def test_finishes_across_data_gaps_are_unknown(fleet: AnalyzeResult) -> None:
 
 
 @requires_shared
-def test_losses_in_each_boats_measured_wind(fleet: AnalyzeResult) -> None:
-    for a in fleet.analyses:
+def test_losses_in_each_boats_measured_wind(fleet: CommandResult) -> None:
+    for a in fleet.data:
         known = a.known_legs
         # every leg of known time judged in the boat's own log, none in the scenario
         assert [leg.wind_source for leg in known] == ["measured"] * len(known), a.track.name

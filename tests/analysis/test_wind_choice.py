@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sailroute.analysis.debrief import analyze_track, fleet_reference
 from sailroute.analysis.fleetpolar import band_factors
 from sailroute.analysis.windsource import WindSource, first_covering, wind_order
-from sailroute.analyze import analyze_track, fleet_reference, run_analyze_command
+from sailroute.commands.analyze import run_analyze_command
 from sailroute.course.load import build_specs
 from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
@@ -171,7 +172,7 @@ def test_the_snipe_example_is_judged_in_the_inferred_wind_and_its_polar_called_o
     # a GPS watch track: no wind in the log, so the direction is inferred from the track;
     # the ILCA polar stands in for the faster Snipe: every leg is flagged
     r = run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "abs")
-    a = r.analyses[0]
+    a = r.data[0]
     assert [leg.wind_source for leg in a.legs] == ["inferred"] * 4
     assert all(leg.above_polar for leg in a.legs)
     assert "sailed above 110 % of the polar" in r.report
@@ -185,7 +186,7 @@ def test_the_snipe_example_is_judged_in_the_inferred_wind_and_its_polar_called_o
     # against what this fleet (one boat) sails: no leg is a big "gain" any more
     f = run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "fleet",
                             reference="fleet", plots=False)
-    b = f.analyses[0]
+    b = f.data[0]
     assert b.reference.startswith("fleet-relative polar")
     for leg in b.legs:
         assert leg.loss_s >= -0.02 * leg.sailed_time_s, (leg.label, leg.loss_s)

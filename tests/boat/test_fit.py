@@ -15,9 +15,10 @@ from typer.testing import CliRunner
 from sailroute.boat.build import boat_from_spec, builtin_polar
 from sailroute.boat.efficiency import efficiency_factor, scale_polar
 from sailroute.boat.fit import FitFilters, fit_polar
-from sailroute.boat.fit_outputs import compare_polars, run_fit_command
+from sailroute.boat.fit_samples import compare_polars
 from sailroute.boat.io import read_polar
 from sailroute.cli import app
+from sailroute.commands.polar_fit import run_fit_command
 from sailroute.errors import InputError
 from tests.conftest import ROOT, SHARED_REAL, requires_shared
 
@@ -313,9 +314,9 @@ def test_gps_track_with_a_course_wind(tmp_path: Path, target) -> None:
         "scenarios: {north: {wind: {type: uniform, tws_kn: 10, twd_deg: 0}}}\n")
     run = run_fit_command(tmp_path / "track.csv", course=tmp_path / "course.yaml",
                           tws_bins="10", out_dir=tmp_path / "out", min_count=30)
-    assert run.samples.speed_source == "sog (from positions)"
-    assert "scenario north" in run.samples.wind_source
-    err = compare_polars(run.fit, target)
+    assert run.data.samples.speed_source == "sog (from positions)"
+    assert "scenario north" in run.data.samples.wind_source
+    err = compare_polars(run.data.fit, target)
     assert err.rms_pct < 4.0  # SOG from 1 Hz positions of a turning track: a few %
 
 
@@ -343,10 +344,10 @@ def test_tallinn_log_against_its_orc_speed_guide(tmp_path: Path) -> None:
     # (docs/polar-fit.md).
     run = run_fit_command(TALLINN / "kolmak_2023_09_27.csv", speed_unit="kn",
                           out_dir=tmp_path / "out", reference=ORC_GUIDE, min_count=10)
-    assert run.samples.speed_source == "sog"
-    assert run.errors is not None and run.errors.n_cells >= 10
-    assert run.errors.rms_pct < 8.0
-    assert run.fit.dropped["manoeuvre"] > 100  # a race with many tacks
+    assert run.data.samples.speed_source == "sog"
+    assert run.data.errors is not None and run.data.errors.n_cells >= 10
+    assert run.data.errors.rms_pct < 8.0
+    assert run.data.fit.dropped["manoeuvre"] > 100  # a race with many tacks
 
 
 @requires_shared
@@ -356,6 +357,6 @@ def test_sailgp_nzl_log_against_the_f50_polar(tmp_path: Path) -> None:
     # one 10-deg bin (foiling take-off) and the log's TWA is noisy.
     run = run_fit_command(NZL_LOG, time_zone="UTC", out_dir=tmp_path / "out", reference=F50,
                           reference_unit="km/h", min_count=20)
-    assert run.samples.speed_source == "bsp"
-    assert run.errors is not None and run.errors.n_cells >= 15
-    assert run.errors.rms_pct < 25.0
+    assert run.data.samples.speed_source == "bsp"
+    assert run.data.errors is not None and run.data.errors.n_cells >= 15
+    assert run.data.errors.rms_pct < 25.0

@@ -23,7 +23,7 @@ from sailroute.boat.laser import CLASSES
 from sailroute.boat.vpp import _surplus_at, solve_point, solve_polar
 from sailroute.course.load import course_from_mapping, load_course
 from sailroute.errors import InputError
-from sailroute.plan import plan_course
+from sailroute.planning.route import plan_course
 from sailroute.units import KNOT
 from tests.conftest import ROOT
 

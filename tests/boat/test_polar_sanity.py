@@ -20,7 +20,12 @@ from sailroute.boat.polar import MAX_BOAT_SPEED_KN, MAX_TWS_KN, Polar
 from sailroute.boat.sanity import check_wind_range, peak_wind, require_speed
 from sailroute.course.load import course_from_mapping
 from sailroute.errors import InputError
-from sailroute.plan import check_boat_and_winds, compare_scenarios, plan_course
+from sailroute.planning.route import (
+    RunOptions,
+    check_boat_and_winds,
+    compare_scenarios,
+    plan_course,
+)
 from sailroute.progress import Progress
 from sailroute.units import KMH
 from sailroute.wind.analytic import AnalyticWind
@@ -81,7 +86,7 @@ def test_allow_extrapolation_turns_the_error_into_one_warning(tmp_path):
                   {"gale": {"type": "uniform", "tws_kn": 30, "twd_deg": 270}})
     stream = io.StringIO()
     progress = Progress(course.n_legs, stream, enabled=False)  # --quiet still warns
-    run = plan_course(course, progress=progress)
+    run = plan_course(course, options=RunOptions(progress=progress))
     text = stream.getvalue()
     assert text.count("warning:") == 1
     assert "30.0 kn" in text and "allow_extrapolation is true" in text

@@ -42,7 +42,7 @@ def test_plan_with_current_end_to_end(tmp_path):
     import csv
 
     from sailroute.course.load import load_course
-    from sailroute.plan import plan_course
+    from sailroute.planning.route import plan_course
     from sailroute.report.files import plan_to_dict, write_track_csv
 
     course = load_course(course_file(tmp_path))
@@ -66,7 +66,7 @@ def test_plan_with_current_end_to_end(tmp_path):
 
 def test_plan_with_current_and_griddp_is_refused(tmp_path):
     from sailroute.course.load import load_course
-    from sailroute.plan import plan_course
+    from sailroute.planning.route import plan_course
 
     course = load_course(course_file(tmp_path, "griddp"))
     with pytest.raises(InputError, match=r"set routing\.router: isochrone"):
@@ -75,7 +75,7 @@ def test_plan_with_current_and_griddp_is_refused(tmp_path):
 
 def test_course_current_spec_error_names_file_and_key(tmp_path):
     from sailroute.course.load import load_course
-    from sailroute.plan import plan_course
+    from sailroute.planning.route import plan_course
 
     p = course_file(tmp_path)
     p.write_text(p.read_text().replace("speed_kn: 0,", "speed_kn: -1,"), encoding="utf-8")

@@ -14,7 +14,7 @@ import pytest
 
 from sailroute.boat.polar import Polar
 from sailroute.course.load import course_from_mapping
-from sailroute.report.plan import make_plan
+from sailroute.planning.result import make_plan
 from sailroute.routing.track import build_track, make_leg_result
 from sailroute.units import bearing_deg, signed_twa
 from sailroute.wind.uniform import UniformWind

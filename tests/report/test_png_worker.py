@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from sailroute.course.load import load_course
-from sailroute.plan import plan_course
+from sailroute.planning.route import plan_course
 from sailroute.report import png_worker
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sailroute.planning.result import compare
 from sailroute.report.html import (
     BOAT_COLOUR,
     N_STEPS,
@@ -35,7 +36,6 @@ from sailroute.report.html import (
     plan_report,
     write_report,
 )
-from sailroute.report.plan import compare
 
 
 def find_chromium() -> str | None:

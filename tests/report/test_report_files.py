@@ -10,6 +10,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 import pytest
 
+from sailroute.planning.result import compare
 from sailroute.report.files import (
     GPX_NS,
     SCHEMA_VERSION,
@@ -21,7 +22,6 @@ from sailroute.report.files import (
     write_plan_outputs,
     write_track_csv,
 )
-from sailroute.report.plan import compare
 from sailroute.timeutil import iso, parse_time, to_epoch
 
 NS = {"g": GPX_NS, "sr": SR_NS}

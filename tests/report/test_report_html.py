@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from sailroute.course.load import course_from_mapping
+from sailroute.planning.result import compare, make_plan
 from sailroute.report.html import (
     ARROW_FILL,
     DIV_ID,
@@ -34,7 +35,6 @@ from sailroute.report.html import (
     time_label,
     wind_layer,
 )
-from sailroute.report.plan import compare, make_plan
 from sailroute.report.tables import format_duration
 from sailroute.routing.track import make_leg_result
 from sailroute.units import KNOT

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from sailroute.errors import InputError
-from sailroute.report.plan import compare, make_plan, percent_error
+from sailroute.planning.result import compare, make_plan, percent_error
 from sailroute.routing.track import build_track, make_leg_result
 from sailroute.wind.uniform import UniformWind
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sailroute.report.plan import compare
+from sailroute.planning.result import compare
 from sailroute.report.plots import WIND_GRID, plot_comparison, plot_plan, plot_route
 from sailroute.units import wind_components
 from sailroute.wind.analytic import AnalyticWind

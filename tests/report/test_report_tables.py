@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from sailroute.report.plan import compare
+from sailroute.planning.result import compare
 from sailroute.report.tables import (
     comparison_table,
     format_duration,

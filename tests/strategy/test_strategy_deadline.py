@@ -297,7 +297,7 @@ def test_windowed_solve_equals_updating_every_node(interpolation: str) -> None:
 
 
 def test_bilinear_is_the_default() -> None:
-    from sailroute.strategy.api import StrategySettings, deadline_grid_for
+    from sailroute.strategy.study import StrategySettings, deadline_grid_for
 
     assert DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 10.0).interpolation == "linear"
     assert DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 10.0).refine_controls == "none"

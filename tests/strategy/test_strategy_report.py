@@ -13,19 +13,14 @@ from typer.testing import CliRunner
 from sailroute.backend import _cupy_or_none
 from sailroute.boat.build import builtin_polar
 from sailroute.cli import app
+from sailroute.commands.strategy import parse_objective, parse_shift, run_strategy_command
 from sailroute.errors import InputError
-from sailroute.strategy import report
-from sailroute.strategy.api import (
-    StrategySettings,
-    parse_objective,
-    parse_shift,
-    run_strategy,
-    run_strategy_command,
-    write_outputs,
-)
+from sailroute.report import strategy as report
+from sailroute.report.strategy import write_strategy_outputs
 from sailroute.strategy.montecarlo import simulate
 from sailroute.strategy.sdp import BeatGrid, solve_expected_time
 from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
+from sailroute.strategy.study import StrategySettings, run_strategy
 from sailroute.units import KNOT
 from tests.conftest import ROOT, SHARED_REAL, TESTS_DATA, requires_shared
 
@@ -107,8 +102,8 @@ def test_run_strategy_with_deadline_writes_everything(tmp_path) -> None:
     ra = d["risk_aware"]["190"]
     assert 0.0 <= ra["w_at_start"] <= 1.0
     assert d["grid"]["ds_s"] * round(5.0 / d["grid"]["ds_s"]) == pytest.approx(5.0)
-    files = write_outputs(res, tmp_path / "out")
-    names = sorted(p.name for p in files)
+    files = write_strategy_outputs(res, tmp_path / "out")
+    names = sorted(p.name for p in files.values())
     assert names == ["deadline_policy.png", "deadline_tracks.png", "leg_times.png",
                      "policy_map.png", "spaghetti.png", "summary.json"]
     saved = json.loads((tmp_path / "out" / "summary.json").read_text())
@@ -220,8 +215,8 @@ def test_drift_diffusion_fitted_from_a_station_file(tmp_path) -> None:
         shift="drift-diffusion", fit_from=str(COACH_EXCERPT), fit_timezone="+01:00",
         out_dir=tmp_path, plots=False, length_m=200.0, half_width_m=100.0, runs=50,
     )
-    dd = res.result.summary["fit"]["drift_diffusion"]
-    assert res.result.model == DriftDiffusionShift(dd["drift_deg_per_s"],
+    dd = res.data.summary["fit"]["drift_diffusion"]
+    assert res.data.model == DriftDiffusionShift(dd["drift_deg_per_s"],
                                                    dd["sigma_deg_per_sqrt_s"])
     assert "diffusion" in res.report and "°/√min" in res.report
 

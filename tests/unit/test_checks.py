@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from sailroute.boat.vpp_outputs import load_boat_file
+from sailroute.boat.boatfile import load_boat_file
 from sailroute.checks import Checker, Problems, split_where, suggest
 from sailroute.course.load import build_boat, load_course, validate_specs
 from sailroute.errors import InputError

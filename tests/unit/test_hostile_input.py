@@ -26,9 +26,9 @@ from sailroute.boat.io import read_polar
 from sailroute.cli import app
 from sailroute.course.load import course_from_mapping, load_course
 from sailroute.errors import InputError
+from sailroute.planning.result import make_plan
 from sailroute.report.files import write_gpx, write_track_csv
 from sailroute.report.html import figure, plan_report
-from sailroute.report.plan import make_plan
 from sailroute.routing.track import make_leg_result
 from sailroute.textin import CleanCsvWriter, clean_text, csv_rows, excerpt, looks_like_header
 from sailroute.track.read import read_track

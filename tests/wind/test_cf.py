@@ -231,7 +231,7 @@ def test_plan_near_land_cells_routes_and_checks_the_polar_over_the_sea(tmp_path)
     # samples the area with holes (it once stopped here with the NaN error), the legs
     # stay on the sea and route
     from sailroute.course.load import course_from_mapping
-    from sailroute.plan import plan_course
+    from sailroute.planning.route import plan_course
 
     lats = np.arange(43.3, 42.69, -0.05)
     lons = np.arange(6.6, 7.41, 0.05)

@@ -1,19 +1,19 @@
-"""Race analysis orchestration: a sailed track against the optimal route, leg by leg.
+"""Race analysis: a sailed track against the optimal route, leg by leg.
 
-``analyze_track`` is where the layers meet (as :mod:`sailroute.plan` for routing):
+``analyze_track`` is where the layers meet (as :mod:`sailroute.planning.route` for routing):
 the track (``sailroute.track``) is projected into the course frame, split into legs
 (:mod:`sailroute.analysis.segment`), its tacks and gybes found
 (:mod:`sailroute.analysis.manoeuvres`), and each leg is routed from the boat's own
 leg start point and time to the same target in the scenario's wind
 (:func:`sailroute.routing.api.route_leg`), then compared
-(:mod:`sailroute.analysis.loss`).  Nothing here prints or writes;
-``run_analyze_command`` adds reading, file output and the terminal table.
+(:mod:`sailroute.analysis.loss`); the results are :mod:`sailroute.analysis.result`.
+Nothing here prints or writes; :func:`sailroute.commands.analyze.run_analyze_command`
+adds reading, file output and the terminal table.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -30,20 +30,20 @@ from sailroute.analysis.loss import (
     split_loss,
     time_mean,
 )
-from sailroute.analysis.manoeuvres import SailedManoeuvre, find_sailed_manoeuvres
+from sailroute.analysis.manoeuvres import find_sailed_manoeuvres
+from sailroute.analysis.result import LegAnalysis, PointTable, TrackAnalysis
 from sailroute.analysis.segment import (
     DETECT_M,
     Crossing,
-    Segmentation,
     leg_target,
     segment_track,
 )
-from sailroute.analysis.windsource import ABOVE_POLAR_PCT, WindSource, first_covering
+from sailroute.analysis.windsource import WindSource, first_covering
 from sailroute.course.geometry import feature_centre, leg_wind_mode
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
-from sailroute.plan import default_scenario, settings_for
+from sailroute.planning.route import default_scenario, settings_for
 from sailroute.progress import Progress
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import target_barrier
@@ -68,200 +68,6 @@ NEAR_COURSE_M = 3000.0
 """During the race the track must come this close to a mark [m], or it is another place."""
 SMOOTH_S = 3.0
 """Window of the velocity smoothing used for COG, TWA and the manoeuvre detection [s]."""
-
-
-@dataclass(frozen=True, eq=False)
-class PointTable:
-    """Per-point quantities of the analysed part of a track (start crossing to finish).
-
-    All arrays have the same length.  ``leg`` is 1-based; a boundary time appears
-    twice (end of one leg, start of the next), as in ``track.csv`` of ``plan``.
-
-    Attributes
-    ----------
-    leg : ndarray of int
-    t : ndarray
-        [epoch s].
-    x, y : ndarray
-        [m], course frame.
-    lat, lon : ndarray
-        [°].
-    sog_ms, cog_deg : ndarray
-        Speed [m s⁻¹] and course [°] over ground (smoothed over ``SMOOTH_S``).
-    tws_ms, twd_deg, twa_deg : ndarray
-        Scenario wind at the point and TWA from COG [m s⁻¹, °, ° signed].
-    polar_ms, polar_pct : ndarray
-        Polar speed [m s⁻¹] and ``100 · SOG / polar`` [%] (NaN where the polar is
-        below ``POLAR_MIN_MS``).
-    vmg_ms : ndarray
-        Velocity made good [m s⁻¹]: against the wind on upwind legs, with it on
-        downwind legs, towards the target centre on reaches.
-    loss_s : ndarray
-        Cumulative time lost against the optimal legs [s].
-    """
-
-    leg: NDArray[np.int64]
-    t: NDArray[np.float64]
-    x: NDArray[np.float64]
-    y: NDArray[np.float64]
-    lat: NDArray[np.float64]
-    lon: NDArray[np.float64]
-    sog_ms: NDArray[np.float64]
-    cog_deg: NDArray[np.float64]
-    tws_ms: NDArray[np.float64]
-    twd_deg: NDArray[np.float64]
-    twa_deg: NDArray[np.float64]
-    polar_ms: NDArray[np.float64]
-    polar_pct: NDArray[np.float64]
-    vmg_ms: NDArray[np.float64]
-    loss_s: NDArray[np.float64]
-
-
-@dataclass(frozen=True, eq=False)
-class LegAnalysis:
-    """One leg, sailed against optimal.
-
-    Attributes
-    ----------
-    index : int
-        0-based leg index.
-    label : str
-        ``"from -> to"``.
-    mode : str
-        Wind mode at the leg start (upwind / reach / downwind).
-    t_start, t_end : float
-        Sailed leg start and end [epoch s]; NaN when unknown (a data gap, or never
-        reached: see ``note``).
-    start_xy, end_xy : tuple of float
-        Where the boat started and ended the leg [m].
-    detected : bool
-        True when the end was found from the geometry (False: given).
-    sailed_time_s, optimal_time_s, loss_s : float
-        [s]; ``loss_s = sailed − optimal``.  An unknown leg (``known`` False) has NaN
-        sailed time, loss and split, and an optimal time only when its start is known.
-    sailed_distance_m, optimal_distance_m : float
-        [m].
-    sailed_tacks, sailed_gybes, optimal_tacks, optimal_gybes : int
-    manoeuvres : tuple of SailedManoeuvre
-        Sailed tacks/gybes in this leg.
-    mean_vmg_ms, mean_sog_ms, mean_polar_pct : float
-        Time-weighted means over the leg (polar % outside manoeuvre windows).
-    split : LossSplit
-        ``loss_s`` split into manoeuvres, speed and route (``analysis/loss.py``).
-    side_sailed, side_optimal : str
-        ``left`` / ``middle`` / ``right`` of the leg axis, looking from the leg start
-        to the target; ``lateral_*_m`` the time-mean offsets [m] (+ right).
-    optimal : LegResult or None
-        The optimal route of the leg (None: the leg's start is unknown).
-    note : str
-        Why the leg is unknown (empty when known).
-    wind_source, wind_label : str
-        The wind the leg was judged in (:data:`sailroute.analysis.windsource.KINDS`)
-        and what it is.
-    """
-
-    index: int
-    label: str
-    mode: str
-    t_start: float
-    t_end: float
-    start_xy: tuple[float, float]
-    end_xy: tuple[float, float]
-    detected: bool
-    sailed_time_s: float
-    optimal_time_s: float
-    loss_s: float
-    sailed_distance_m: float
-    optimal_distance_m: float
-    sailed_tacks: int
-    sailed_gybes: int
-    optimal_tacks: int
-    optimal_gybes: int
-    manoeuvres: tuple[SailedManoeuvre, ...]
-    mean_vmg_ms: float
-    mean_sog_ms: float
-    mean_polar_pct: float
-    split: LossSplit
-    side_sailed: str
-    side_optimal: str
-    lateral_sailed_m: float
-    lateral_optimal_m: float
-    optimal: LegResult | None
-    note: str = ""
-    wind_source: str = "scenario"
-    wind_label: str = ""
-
-    @property
-    def known(self) -> bool:
-        """True when the sailed time is known (both ends found outside data gaps)."""
-        return bool(np.isfinite(self.sailed_time_s))
-
-    @property
-    def above_polar(self) -> bool:
-        """Sailed above :data:`~sailroute.analysis.windsource.ABOVE_POLAR_PCT` of the polar
-        on average: the polar or the wind cannot be right for this boat."""
-        return bool(np.isfinite(self.mean_polar_pct) and self.mean_polar_pct > ABOVE_POLAR_PCT)
-
-
-@dataclass(frozen=True, eq=False)
-class TrackAnalysis:
-    """A whole track analysed.
-
-    Attributes
-    ----------
-    course : Course
-    track : Track
-    scenario, router : str
-    segmentation : Segmentation
-        Start report and leg boundaries.
-    legs : tuple of LegAnalysis
-    points : PointTable
-    wind : WindField
-        The wind of the first leg (for plots).
-    reference : str
-        The polar the boat is judged against: ``"course polar <name>"`` or the
-        fleet-relative polar's description (:mod:`sailroute.analysis.fleetpolar`).
-    """
-
-    course: Course
-    track: Track
-    scenario: str
-    router: str
-    segmentation: Segmentation
-    legs: tuple[LegAnalysis, ...]
-    points: PointTable
-    wind: WindField
-    reference: str = ""
-
-    @property
-    def known_legs(self) -> tuple[LegAnalysis, ...]:
-        """The legs with a known sailed time (the totals are over these)."""
-        return tuple(leg for leg in self.legs if leg.known)
-
-    @property
-    def complete(self) -> bool:
-        """True when every leg's time is known."""
-        return all(leg.known for leg in self.legs)
-
-    @property
-    def sailed_time_s(self) -> float:
-        """Sum of the known legs' sailed times [s] (start crossing to finish when complete)."""
-        return sum(leg.sailed_time_s for leg in self.known_legs)
-
-    @property
-    def optimal_time_s(self) -> float:
-        """Sum of the optimal times of the known legs [s]."""
-        return sum(leg.optimal_time_s for leg in self.known_legs)
-
-    @property
-    def loss_s(self) -> float:
-        """Sum of the known legs' losses [s]."""
-        return sum(leg.loss_s for leg in self.known_legs)
-
-    @property
-    def notes(self) -> tuple[str, ...]:
-        """Start findings and why legs are unknown, one sentence each."""
-        return self.segmentation.notes
 
 
 def check_same_race(course: Course, track: Track, x: NDArray, y: NDArray) -> None:
@@ -853,152 +659,6 @@ def parse_boat_leg_times(items: str | Sequence[str] | None, boats: Sequence[str]
     return out
 
 
-@dataclass(frozen=True, eq=False)
-class AnalyzeResult:
-    """What ``sailroute analyze`` prints and wrote.
-
-    Attributes
-    ----------
-    report : str
-        The terminal tables.
-    files : mapping of str to Path
-    analyses : tuple of TrackAnalysis
-    notes : tuple of str
-        What the run found about the wind and the reference polar.
-    """
-
-    report: str
-    files: Mapping[str, Path]
-    analyses: tuple[TrackAnalysis, ...]
-    notes: tuple[str, ...] = ()
-
-
-def run_analyze_command(
-    course: Course | str | Path,
-    tracks: Sequence[str | Path],
-    *,
-    scenario: str | None = None,
-    router: str | None = None,
-    out_dir: str | Path | None = None,
-    leg_times: str | Sequence[str] | None = None,
-    columns: Mapping[str, str] | None = None,
-    speed_unit: str | None = None,
-    time_zone: str | None = None,
-    detect_m: float = DETECT_M,
-    plots: bool = True,
-    progress: Progress | None = None,
-    gate_end: str = "line",
-    wind: str = "auto",
-    reference: str = "course",
-) -> AnalyzeResult:
-    """Everything ``sailroute analyze`` does, minus printing.
-
-    ``out_dir`` is checked first; every track is read and analysed before anything is
-    written, and the files are written as a set
-    (:func:`sailroute.outdir.write_output_set`), so a bad input or an interrupted run
-    leaves the folder as it was.  One track: ``analysis.json``, ``analysis.csv``,
-    ``points.csv``, ``legs.png``, ``loss.png`` in ``out_dir`` (default
-    ``out/<course>/analysis-<track stem>``).  Several: the same per boat in
-    ``out_dir/<track stem>/`` plus ``fleet.csv`` and ``fleet.json`` (default
-    ``out/<course>/analysis-fleet``).
-
-    ``wind`` chooses the wind each leg is judged in (:func:`analysis_winds`);
-    ``reference="fleet"`` judges every boat against the course's polar scaled to what
-    the fleet sails (:func:`sailroute.analysis.fleetpolar.fleet_polar`): the boats are
-    analysed twice.
-    """
-    from sailroute.outdir import check_out_dir, write_output_set
-    from sailroute.plan import _loaded
-    from sailroute.report.analysis import (
-        analysis_table,
-        fleet_notes,
-        fleet_table,
-        write_analysis,
-        write_fleet,
-    )
-
-    course = _loaded(course)
-    if not tracks:
-        raise InputError("analyze: give at least one track file")
-    if reference not in REFERENCES:
-        raise InputError(f"--reference: expected one of {', '.join(REFERENCES)}; "
-                         f"got {reference!r}")
-    name = default_scenario(course) if scenario is None else scenario
-    stems = _unique_stems(tracks)
-    times = parse_boat_leg_times(leg_times, stems, course.n_legs)
-    stem = Path(course.source).stem if course.source else "course"
-    default = (Path("out") / stem / (f"analysis-{Path(tracks[0]).stem}" if len(tracks) == 1
-                                     else "analysis-fleet"))
-    out = check_out_dir(Path(out_dir) if out_dir is not None else default)
-    read = [read_track(p, columns=columns, speed_unit=speed_unit, time_zone=time_zone,
-                       name=s) for p, s in zip(tracks, stems, strict=True)]
-    settings_for(course, router)
-    boat, winds = build_specs(course, [name])
-    polar = boat.routing_polar()
-    if reference == "fleet" and polar is None:
-        raise InputError("--reference fleet scales a polar; the course's boat has none (a "
-                         "dynamic boat model): use --reference course")
-    sources, notes = analysis_winds(course, read, name, winds[name], boat, wind)
-
-    def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
-        out_a = []
-        for tr in read:
-            if progress is not None:
-                progress.set_prefix(f"{tr.name}: ")
-            a = analyze_track(course, tr, name, leg_times=times[tr.name], router=router,
-                              detect_m=detect_m, built=(judged_by, winds[name]),
-                              winds=sources[tr.name], progress=progress,
-                              missing="error" if len(read) == 1 else "unknown",
-                              gate_end=gate_end)
-            out_a.append(replace(a, reference=label))
-        return out_a
-
-    analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())
-    if reference == "fleet":
-        fp = fleet_reference(analyses, polar)
-        notes.append(fp.describe())
-        analyses = analyse_all(fp.polar, fp.describe())
-    if len(analyses) == 1:
-        files = write_output_set(out, lambda d: write_analysis(d, analyses[0], plots=plots))
-        return AnalyzeResult("\n\n".join([analysis_table(analyses[0]), _notes_text(notes)]),
-                             files, tuple(analyses), tuple(notes))
-    rows = fleet_ranking(analyses)
-    # the page draws the fleet-wide wind: the first boat's first candidate not its own log
-    shared = next((s for s in sources[read[0].name] if s.kind != "measured"), None)
-    fleet_wind_layer = (shared.label, shared.field) if shared is not None else None
-
-    def write(d: Path) -> dict[str, Path]:
-        files: dict[str, Path] = {}
-        for s, a in zip(stems, analyses, strict=True):
-            for kind, p in write_analysis(d / s, a, plots=plots).items():
-                files[f"{s}/{kind}"] = p
-        files.update(write_fleet(d, analyses, rows, plots=plots, notes=notes,
-                                 wind=fleet_wind_layer))
-        return files
-
-    report = "\n\n".join([*(analysis_table(a) for a in analyses),
-                           fleet_table(rows, fleet_notes(analyses)), _notes_text(notes)])
-    return AnalyzeResult(report, write_output_set(out, write), tuple(analyses), tuple(notes))
-
-
-def _notes_text(notes: Sequence[str]) -> str:
-    """The run's wind and reference notes, one per line."""
-    return "\n".join(f"note: {n}" for n in notes)
-
-
-def _unique_stems(paths: Sequence[str | Path]) -> list[str]:
-    out: list[str] = []
-    for p in paths:
-        s = Path(p).stem
-        k = 2
-        base = s
-        while s in out:
-            s = f"{base}-{k}"
-            k += 1
-        out.append(s)
-    return out
-
-
 def load_and_analyze(course_path: str | Path, track_path: str | Path, scenario: str | None = None,
                      **read_kw: Any) -> TrackAnalysis:
     """Convenience: load a course, read a track, analyse (the Python API in one call)."""
@@ -1006,6 +666,16 @@ def load_and_analyze(course_path: str | Path, track_path: str | Path, scenario: 
     return analyze_track(course, read_track(track_path, **read_kw), scenario)
 
 
-__all__ = ["AnalyzeResult", "LegAnalysis", "PointTable", "TrackAnalysis", "analyze_track",
-           "check_same_race", "fleet_ranking", "fleet_reference", "load_and_analyze",
-           "parse_leg_times", "run_analyze_command"]
+__all__ = [
+    "LegAnalysis",
+    "PointTable",
+    "TrackAnalysis",
+    "analysis_winds",
+    "analyze_track",
+    "check_same_race",
+    "fleet_ranking",
+    "fleet_reference",
+    "load_and_analyze",
+    "parse_boat_leg_times",
+    "parse_leg_times",
+]

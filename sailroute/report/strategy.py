@@ -1,4 +1,4 @@
-"""Figures and JSON for tack strategies (matplotlib object API, no pyplot).
+"""Figures, JSON and text of tack strategies (matplotlib object API, no pyplot).
 
 * :func:`plot_policy_map` -- tack/continue regions of an expected-time policy
   over the course, one panel per wind shift;
@@ -27,10 +27,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.outdir import make_out_dir
 from sailroute.routing.types import side_name
 from sailroute.strategy.deadline import DeadlinePolicy, DeadlineSimulation, _nearest_nodes
 from sailroute.strategy.montecarlo import SimulationResult
 from sailroute.strategy.sdp import TACKS, ExpectedTimePolicy
+from sailroute.strategy.shiftmodel import ShiftModel
+from sailroute.strategy.study import StrategyResult
 
 _CONTINUE, _TACK, _NONE = 0, 1, 2
 _POLICY_COLOURS = ("#9ecae1", "#fb6a4a", "#e0e0e0")
@@ -303,3 +306,136 @@ def write_json(summary: Mapping[str, Any], path: str | Path) -> Path:
     p = Path(path)
     p.write_text(json.dumps(_clean(summary), indent=2, allow_nan=False) + "\n", encoding="utf-8")
     return p
+
+
+def write_strategy_outputs(result: StrategyResult, out_dir: str | Path, plots: bool = True
+                           ) -> dict[str, Path]:
+    """Write ``summary.json`` and (unless ``plots=False``) the PNG figures into ``out_dir``.
+
+    Returns
+    -------
+    dict of str to Path
+        File stem (``summary``, ``policy_map``, ...) -> file written.
+    """
+    out = make_out_dir(out_dir)
+    written = [write_json(result.summary, out / "summary.json")]
+    if not plots:
+        return {p.stem: p for p in written}
+    pol = result.policy
+    written.append(
+        save_figure(plot_policy_map(pol, tack=result.settings.start_tack),
+                           out / "policy_map.png")
+    )
+    written.append(save_figure(plot_spaghetti(result.sim), out / "spaghetti.png"))
+    samples = {"expected-time SDP (lattice, OU/chain wind)": result.sim.leg_time_s}
+    curves = None
+    study = result.deadline
+    if study is not None:
+        samples = {"risk-neutral μ*": study.sim_rn.leg_time_s}
+        r0, th0, q0 = study.start
+        curves = {"w(s): best possible P(T ≤ s)": (study.ra.s_s,
+                                                     study.ra.success_curve(r0, th0, q0))}
+        for d, sim in study.sims_ra.items():
+            samples[f"risk-aware α^{d:g}"] = sim.leg_time_s
+    written.append(
+        save_figure(
+            plot_leg_times(samples, result.settings.deadlines_s, curves),
+            out / "leg_times.png",
+        )
+    )
+    if study is not None:
+        d0 = float(result.settings.deadlines_s[0])
+        written.append(
+            save_figure(
+                plot_deadline_policy(study.ra, d0, result.settings.start_tack,
+                                            extent_m=result.settings.length_m * 1.1),
+                out / "deadline_policy.png",
+            )
+        )
+        tracks = {"risk-neutral μ*": study.sim_rn}
+        tracks.update({f"risk-aware α^{d:g}": s for d, s in study.sims_ra.items()})
+        written.append(
+            save_figure(
+                plot_deadline_tracks(tracks, result.settings.mark_radius_m),
+                out / "deadline_tracks.png",
+            )
+        )
+    return {p.stem: p for p in written}
+
+
+def shift_model_text(model: ShiftModel) -> str:
+    """The shift model in words with sensible precision (degrees and minutes), e.g.
+    ``"oscillating (OU): sd 10.0°, time scale 10.0 min"``."""
+    d = model.describe()
+    if d["kind"] == "ou":
+        tl = float(d["timescale_s"])
+        text = (f"oscillating (OU): sd {float(d['sigma_deg']):.1f}°, time scale "
+                + ("infinite (frozen wind)" if math.isinf(tl) else f"{tl / 60:.1f} min"))
+        mean = float(d["mean_deg"])
+        return text + (f", mean {mean:+.1f}°" if mean else "")
+    return (f"persistent (drift-diffusion): drift {60 * float(d['drift_deg_per_s']):+.2f}°/min, "
+            f"diffusion {math.sqrt(60) * float(d['sigma_deg_per_sqrt_s']):.2f}°/√min")
+
+
+def format_report(result: StrategyResult) -> str:
+    """Short human-readable summary of a study."""
+    s = result.summary
+    e = s["expected_time_policy"]
+    mc = e["monte_carlo"]
+    b = s["boat"]
+    lines = [
+        f"boat {b['polar']} at {b['tws_kn']:.1f} kn: upwind VMG {b['vmg_upwind_ms']:.3f} m/s "
+        f"at TWA {b['vmg_twa_deg']:.1f}°",
+        f"shift model: {shift_model_text(result.model)}",
+    ]
+    if s.get("fit") and result.model.kind == "ou":
+        ou = s["fit"]["ou"]
+        lines.append(
+            f"fitted from {s['fit']['source']}: sigma {ou['sigma_deg']:.1f} ± "
+            f"{ou['sigma_se_deg']:.1f}°, time scale {ou['timescale_s'] / 60:.1f} ± "
+            f"{ou['timescale_se_s'] / 60:.1f} min"
+        )
+    elif s.get("fit"):
+        dd = s["fit"]["drift_diffusion"]
+        lines.append(
+            f"fitted from {s['fit']['source']}: drift {60 * dd['drift_deg_per_s']:.2f} ± "
+            f"{60 * dd['drift_se_deg_per_s']:.2f}°/min, diffusion "
+            f"{math.sqrt(60) * dd['sigma_deg_per_sqrt_s']:.2f} ± "
+            f"{math.sqrt(60) * dd['sigma_se_deg_per_sqrt_s']:.2f}°/√min"
+        )
+    diag = s["chain"]["diagnostics_at_stage_time"]
+    sd_err = diag["stationary_sd_deg"] / diag["target_sd_deg"] - 1.0
+    if math.isfinite(sd_err) and abs(sd_err) > 0.1:
+        lines.append(
+            f"note: the shift chain's sd is {diag['stationary_sd_deg']:.1f}° for a target of "
+            f"{diag['target_sd_deg']:.1f}° ({100 * sd_err:+.0f} %): the 5° bins are too coarse "
+            "or the ±45° range too narrow for this sigma"
+        )
+    pct = mc.get("percentiles_s", {})
+    lines += [
+        f"expected-time policy: solved in {e['solve_time_s']:.2f} s; "
+        f"E[T] {e['expected_time_s']:.1f} s "
+        f"(steady-wind one tack {e['steady_wind_one_tack_s']:.1f} s)",
+        f"  Monte Carlo ({mc['n_runs']} runs): mean {mc.get('mean_s', math.nan):.1f} s "
+        f"± {mc.get('se_mean_s', math.nan):.1f}, P10 {pct.get('10', math.nan):.1f}, "
+        f"P50 {pct.get('50', math.nan):.1f}, P90 {pct.get('90', math.nan):.1f} s, "
+        f"tacks {mc['tacks']['mean']:.2f} on average",
+    ]
+    d = s.get("deadline")
+    if d:
+        rn = d["risk_neutral"]["monte_carlo"]
+        lines.append(
+            f"deadline problem ({d['model']['sigma_deg_per_sqrt_s']:.3f}°/√s Brownian shift): "
+            f"solved in {d['solve_time_s']['risk_aware']:.1f} s (+ "
+            f"{d['solve_time_s']['risk_neutral']:.1f} s risk-neutral)"
+        )
+        for key, ra in d["risk_aware"].items():
+            p_ra = ra["monte_carlo"]["p_within_deadline"][key]
+            p_rn = rn["p_within_deadline"][key]
+            lines.append(
+                f"  deadline {key} s: P(T <= deadline) risk-neutral {100 * p_rn['p']:.1f}% -> "
+                f"risk-aware {100 * p_ra['p']:.1f}% (± {100 * p_ra['se']:.1f}); means "
+                f"{rn.get('mean_s', math.nan):.1f} -> "
+                f"{ra['monte_carlo'].get('mean_s', math.nan):.1f} s"
+            )
+    return "\n".join(lines)
