@@ -26,6 +26,7 @@ import math
 import re
 from collections.abc import Iterable, Iterator, Mapping
 from datetime import datetime
+from pathlib import Path
 from typing import Any, Final
 
 from sailroute.errors import InputError, format_problems
@@ -203,6 +204,17 @@ class Problems:
         raise InputError(format_problems(title, self.items))
 
 
+def resolve_path(base_dir: Path, path: str | Path) -> Path:
+    """A path from a spec: as given when absolute, else relative to ``base_dir`` (resolved)."""
+    p = Path(path)
+    return p if p.is_absolute() else (Path(base_dir) / p).resolve()
+
+
+def missing_file_message(full: Path, base_dir: Path) -> str:
+    """The one wording of a spec's missing file: the path tried and where relative paths start."""
+    return f"file not found: {full} (paths are relative to {base_dir}, the course file's folder)"
+
+
 # ----------------------------------------------------------------------------- checker
 class Checker:
     """Typed getters over the mapping at key path ``path``, recording problems.
@@ -364,6 +376,22 @@ class Checker:
             self.add(key, f"expected non-empty text; got {show(v)}")
             return None
         return v
+
+    def file(self, d: Mapping[str, Any], key: str | int, base_dir: Path,
+             value: Any = MISSING) -> Path | None:
+        """An existing file named by ``d[key]`` (or ``value``), relative to ``base_dir``.
+
+        Records "file not found" (with the resolved path and the folder relative
+        paths start from) and returns None when there is no such file.
+        """
+        p = self.string(d, str(key)) if value is MISSING else value
+        if p is None:
+            return None
+        full = resolve_path(base_dir, p)
+        if not full.is_file():
+            self.add(key, missing_file_message(full, base_dir))
+            return None
+        return full
 
     def boolean(self, d: Mapping[str, Any], key: str, default: bool) -> bool:
         """``true`` or ``false`` (the default after a problem)."""

@@ -260,12 +260,8 @@ def _check_polar(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make |
         fmt = c.choice(spec, "format", ("pol", "csv", "json"))
     if len(c.p) > before:
         return None
-    file = Path(path)
-    if not file.is_absolute():
-        file = base_dir / file
-    if not file.is_file():
-        c.add("polar", f"file {str(file)!r} not found (paths are relative to the course "
-              "file's folder)")
+    file = c.file(spec, "polar", base_dir, value=path)
+    if file is None:
         return None
     return lambda interpolation: read_polar(
         file, speed_unit=spec.get("speed_unit"), wind_unit=spec.get("wind_unit"),

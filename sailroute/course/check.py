@@ -25,7 +25,16 @@ from typing import Any
 
 import numpy as np
 
-from sailroute.checks import Checker, Problems, finite, join_path, show, suggest
+from sailroute.checks import (
+    Checker,
+    Problems,
+    finite,
+    join_path,
+    missing_file_message,
+    resolve_path,
+    show,
+    suggest,
+)
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
@@ -41,6 +50,7 @@ from sailroute.routing.types import (
 )
 from sailroute.timeutil import parse_time, utc_offset_s
 from sailroute.units import KNOT
+from sailroute.wind.build import CURRENT_BUILDERS, WIND_TYPES
 
 __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
@@ -478,12 +488,12 @@ def _references(
 
 
 def _wind_spec(c: Checker, value: Any, path: str) -> bool:
-    if not c.at(path).is_mapping(value, "a wind spec "
-                                 "{type: uniform|wrf|stations|blended|measured, ...}"):
+    if not c.at(path).is_mapping(value, "a wind spec {type: " + "|".join(WIND_TYPES)
+                                 + ", ...}"):
         return False
     if "type" not in value:
-        c.p.add(path, "the wind spec has no `type`; expected one of 'uniform', 'wrf', "
-                "'stations', 'blended', 'measured' (see docs/design/wind.md)")
+        c.p.add(path, "the wind spec has no `type`; expected one of "
+                + ", ".join(repr(t) for t in WIND_TYPES) + " (see docs/design/wind.md)")
         return False
     if not isinstance(value["type"], str):
         c.p.add(join_path(path, "type"), f"expected text such as 'uniform' or 'wrf'; "
@@ -515,7 +525,7 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
                                      "references: ..., description: ...}"):
             continue
         keys = ("wind", "members", "references", "description", "current")
-        cur, cwhere = None, ""  # surface current spec (sailroute.current), key path
+        cur, cwhere = None, ""  # surface current spec (sailroute.wind.current), key path
         if "type" in value or not any(k in value for k in keys):
             # shorthand: the scenario is the wind spec itself
             wind, wpath, refs, desc = value, path, {}, ""
@@ -529,7 +539,8 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
             desc = c.at(path).string(value, "description", "") or ""
             cchk = c.at(join_path(path, "current"))
             if value.get("current") is not None and cchk.is_mapping(
-                    value["current"], "a current spec {type: uniform|diamonds|netcdf, ...}"):
+                    value["current"], "a current spec {type: "
+                    + "|".join(CURRENT_BUILDERS) + ", ...}"):
                 cur, cwhere = dict(value["current"]), cchk.where()
             if "members" in value:
                 mpath = join_path(path, "members")
@@ -578,24 +589,23 @@ def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], s
     if wind.get("type") != "netcdf" or not isinstance(wind.get("path"), str):
         c.p.add(wpath, "members along a dimension need `type: netcdf` with a `path`")
         return []
-    n = _dimension_size(c, Path(c.p.file).parent / wind["path"], dim, wpath)
+    base = Path(c.p.file).parent
+    n = _dimension_size(c, resolve_path(base, wind["path"]), base, dim, wpath)
     if n is None:
         return []
     return [({**wind, "select": {**dict(wind.get("select") or {}), dim: k}}, wpath)
             for k in range(n)]
 
 
-def _dimension_size(c: Checker, file: Path, dim: str, path: str) -> int | None:
+def _dimension_size(c: Checker, file: Path, base: Path, dim: str, path: str) -> int | None:
     """Size of dimension ``dim`` in a NetCDF file (a problem at ``path`` if it has none)."""
-    import netCDF4
+    from sailroute.wind.cf import dimension_sizes
 
     if not file.is_file():
-        c.p.add(join_path(path, "path"), f"file {str(file)!r} not found (paths are relative to "
-                "the course file's folder)")
+        c.p.add(join_path(path, "path"), missing_file_message(file, base))
         return None
     try:
-        with netCDF4.Dataset(str(file), "r") as ds:
-            dims = {k: len(v) for k, v in ds.dimensions.items()}
+        dims = dimension_sizes(file)
     except OSError as exc:
         c.p.add(join_path(path, "path"), f"{file.name} cannot be read as NetCDF ({exc})")
         return None

@@ -173,7 +173,8 @@ class ScenarioSpec:
     name : str
         Scenario name (the key under ``scenarios``).
     wind : mapping
-        The raw wind spec (``{type: uniform|wrf|stations|blended|measured, ...}``),
+        The raw wind spec (``{type: ..., ...}``, a type of
+        :data:`sailroute.wind.build.WIND_TYPES`),
         passed to ``sailroute.wind.build.wind_from_spec`` unchanged.
     references : mapping of str to tuple of float
         Leg times [s] to compare this scenario with, in addition to the course-wide
@@ -188,7 +189,7 @@ class ScenarioSpec:
         member itself is called ``"<ensemble>#<k>"`` (k from 1).  Empty otherwise.
     current : mapping or None
         The raw surface-current spec (``scenarios.<name>.current``, built by
-        ``sailroute.current.current_from_spec``); None: still water.
+        ``sailroute.wind.build.current_from_spec``); None: still water.
     current_where : str
         Key path of the current spec for error messages.
     """

@@ -2,7 +2,7 @@
 
 A :class:`~sailroute.course.model.Course` keeps its boat, wind and current specs
 raw; these functions hand them to their factories (:mod:`sailroute.boat.build`,
-:mod:`sailroute.wind.build`, :mod:`sailroute.current`) with the course's folder,
+:mod:`sailroute.wind.build`, :mod:`sailroute.wind.current`) with the course's folder,
 local frame, bounding box, race time window and line map, so that every problem
 is reported as ``file:line: key.path: ...``.
 """
@@ -65,13 +65,13 @@ def build_wind(course: Course, scenario: str) -> Any:
 
 
 def build_current(course: Course, scenario: str) -> Any:
-    """Build the surface current of one scenario (:mod:`sailroute.current`), or None.
+    """Build the surface current of one scenario (:mod:`sailroute.wind.current`), or None.
 
     Like :func:`build_wind`: relative paths resolve against the course file's folder
     and the current must cover the course box and the race time window.
     """
     from sailroute.course.geometry import course_bbox, race_time_window
-    from sailroute.current import current_from_spec
+    from sailroute.wind.build import current_from_spec
 
     sc = course.scenarios.get(scenario)
     if sc is None or sc.current is None:  # (an unknown name is build_wind's error)

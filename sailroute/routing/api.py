@@ -125,7 +125,7 @@ def route_leg(
         Array backend of the router's data-parallel kernels
         (:func:`sailroute.backend.get_xp`); results agree within float tolerance.
     current : CurrentField, optional
-        Surface current (:mod:`sailroute.current`); only the isochrone router takes one.
+        Surface current (:mod:`sailroute.wind.current`); only the isochrone router takes one.
 
     Returns
     -------

@@ -69,7 +69,6 @@ from numpy.typing import NDArray
 from sailroute.backend import to_numpy
 from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
-from sailroute.current import CurrentField, RelativeWind, current_rate_set
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
 from sailroute.numerics import clip
 from sailroute.routing.geometry import (
@@ -99,6 +98,7 @@ from sailroute.routing.types import (
     side_sign,
 )
 from sailroute.wind.base import WindField
+from sailroute.wind.current import CurrentField, RelativeWind, current_rate_set
 
 TABLE_TWS_STEP_MS = 0.05
 """TWS spacing of the cached polar table of the grid candidates [m s⁻¹]."""
@@ -442,7 +442,7 @@ def route_isochrone(
         operations, the wind and polar are sampled on the host).
     current : CurrentField, optional
         Surface current (water velocity over the ground, towards).  The polar is then
-        entered with the wind relative to the water (:class:`~sailroute.current.RelativeWind`),
+        entered with the wind relative to the water (:class:`~sailroute.wind.current.RelativeWind`),
         each move goes over the ground by (velocity through the water + current) and
         the track carries SOG/COG; a boat stopped by a penalty drifts with the water.
         None (default): still water, the unchanged code path.

@@ -10,15 +10,23 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from sailroute.checks import Checker, Problems, show
+import numpy as np
+
+from sailroute.checks import Checker, Problems, resolve_path, show
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import parse_time, to_epoch
 from sailroute.units import KNOT, SPEED_UNITS
 from sailroute.wind.base import Coverage, WindField
 from sailroute.wind.blended import BlendedWind
+from sailroute.wind.current import (
+    CurrentField,
+    DiamondCurrent,
+    UniformCurrent,
+    open_netcdf_current,
+)
 from sailroute.wind.height import DEFAULT_EXPONENT, DEFAULT_EXPONENT_RANGE, DEFAULT_ROUGHNESS_M
 from sailroute.wind.ndbc import is_ndbc_text, read_ndbc
 from sailroute.wind.stations import (
@@ -33,9 +41,6 @@ from sailroute.wind.stations import (
 )
 from sailroute.wind.uniform import UniformWind
 from sailroute.wind.wrf import open_wrf
-
-if TYPE_CHECKING:
-    from sailroute.current import CurrentField
 
 BBox = tuple[float, float, float, float]
 """Local-frame box ``(xmin, xmax, ymin, ymax)`` [m] (same order as :class:`Coverage`)."""
@@ -198,11 +203,13 @@ class _Context:
         base_dir: Path,
         crop_bbox: BBox | None,
         time_window: tuple[float, float] | None,
+        where: str = "",
     ) -> None:
         self.frame = frame
         self.base_dir = base_dir
         self.crop_bbox = crop_bbox
         self.time_window = time_window
+        self.where = where  # message prefix of the spec (file, line, key path)
 
 
 # ---------------------------------------------------------------------------- uniform
@@ -278,14 +285,7 @@ _WRF_KEYS = ("type", "path", "height_m", "time_step_min", "interpolation", "leve
 
 
 def _path(chk: Checker, spec: Mapping[str, Any], ctx: _Context) -> Path | None:
-    p = chk.string(spec, "path")
-    if p is None:
-        return None
-    full = (ctx.base_dir / p).resolve() if not Path(p).is_absolute() else Path(p)
-    if not full.is_file():
-        chk.add("path", f"file not found: {full} (paths are relative to {ctx.base_dir})")
-        return None
-    return full
+    return chk.file(spec, "path", ctx.base_dir)
 
 
 def _wrf_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[str, Any]:
@@ -620,11 +620,8 @@ def _build_measured(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Win
         else:
             tchk = chk.child("tracks")
             for k, p in enumerate(raw):
-                full = (ctx.base_dir / p).resolve() if not Path(p).is_absolute() else Path(p)
-                if not full.is_file():
-                    tchk.add(str(k), f"file not found: {full} (paths are relative to "
-                             f"{ctx.base_dir})")
-                paths.append(full)
+                tchk.file(raw, k, ctx.base_dir, value=p)
+                paths.append(resolve_path(ctx.base_dir, p))
     unit = chk.string(spec, "speed_unit", None)
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
         chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
@@ -673,3 +670,174 @@ _BUILDERS: dict[str, Callable[[Mapping[str, Any], Checker, _Context], WindField]
     "blended": _build_blended,
     "measured": _build_measured,
 }
+
+WIND_TYPES: tuple[str, ...] = tuple(_BUILDERS)
+"""Values of a wind spec's ``type``."""
+
+
+# ---------------------------------------------------------------------------- currents
+_CURRENT_UNIFORM_KEYS = ("type", "speed_kn", "speed_ms", "set_deg")
+_CURRENT_DIAMOND_KEYS = ("type", "high_water", "table", "rate_unit", "clamp")
+_CURRENT_NETCDF_KEYS = ("type", "path", "variables", "speed_unit", "select", "interpolation",
+                        "steady", "clamp")
+
+
+def current_from_spec(
+    spec: Mapping[str, Any],
+    *,
+    frame: LocalFrame,
+    base_dir: Path,
+    where: str,
+    crop_bbox: BBox | None = None,
+    time_window: tuple[float, float] | None = None,
+    lines: Mapping[str, int] | None = None,
+) -> CurrentField:
+    """Build a current field from a scenario's ``current:`` mapping.
+
+    Parameters
+    ----------
+    spec : mapping
+        ``{type: uniform, speed_kn | speed_ms, set_deg}``,
+        ``{type: diamonds, high_water, table: [[hour, set_deg, rate_kn], ...]}`` or
+        ``{type: netcdf, path, variables, ...}`` (``docs/course-format.md``); the types
+        are the keys of :data:`CURRENT_BUILDERS`.
+    frame : LocalFrame
+        The course's local frame.
+    base_dir : Path
+        Folder that a relative ``path`` resolves against.
+    where : str
+        Key-path prefix of messages, e.g. ``"courses/x.yaml:12: scenarios.spring.current"``.
+    crop_bbox, time_window : optional
+        Course box [m] and race window [epoch s] that the current must cover
+        (unless ``clamp: true``), as for a wind spec.
+    lines : mapping of str to int, optional
+        1-based line of each key path of the file (the course's line map): each
+        problem is reported at its own key's line.
+
+    Raises
+    ------
+    InputError
+        Every problem of the spec at once, each with its key path.
+    OutOfCoverageError
+        The current does not cover the course or the race time.
+    """
+    probs = Problems.below(where, lines, what="current spec")
+    chk = Checker(probs, probs.root)
+    if not isinstance(spec, Mapping):
+        raise InputError(f"{where}: expected a current spec mapping, e.g. {{type: uniform, "
+                         f"speed_kn: 1.5, set_deg: 90}}; got {show(spec)}")
+    kind = chk.choice(spec, "type", list(CURRENT_BUILDERS))
+    chk.p.raise_if_any()
+    assert kind is not None  # an unknown or missing type was raised just above
+    field = CURRENT_BUILDERS[kind](spec, chk, _Context(frame, Path(base_dir), crop_bbox,
+                                                       time_window, where))
+    if not spec.get("clamp", False):
+        check_covers(field, crop_bbox, time_window, name=f"{where}: {kind} current",
+                     frame=frame)
+    return field
+
+
+def _current_rate(chk: Checker, spec: Mapping[str, Any]) -> float | None:
+    """The rate of a uniform current [m s⁻¹] from ``speed_kn`` or ``speed_ms``."""
+    if "speed_kn" in spec and "speed_ms" in spec:
+        chk.add("speed_kn", "give either speed_kn or speed_ms, not both")
+        return None
+    if "speed_ms" in spec:
+        return chk.number(spec, "speed_ms", lo=0.0)
+    if "speed_kn" in spec:
+        rate = chk.number(spec, "speed_kn", lo=0.0)
+        return None if rate is None else rate * KNOT
+    chk.add("speed_kn", "missing required key; give the rate as speed_kn or speed_ms")
+    return None
+
+
+def _build_uniform_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
+                           ) -> CurrentField:
+    """``type: uniform``: one rate and set everywhere, all the time."""
+    chk.keys(spec, _CURRENT_UNIFORM_KEYS, ("set_deg",))
+    rate = _current_rate(chk, spec)
+    set_deg = chk.number(spec, "set_deg", lo=0.0, hi=360.0) if "set_deg" in spec else None
+    chk.p.raise_if_any()
+    assert set_deg is not None  # required key: reported above when missing
+    return UniformCurrent(rate, set_deg)
+
+
+def _diamond_rows(chk: Checker, table: Any, scale: float) -> list[tuple[float, float, float]]:
+    """The rows ``(hour, set_deg, rate_ms)`` of a tidal-diamond table, problems to ``chk``."""
+    rows: list[tuple[float, float, float]] = []
+    tchk = chk.child("table")
+    for k, row in enumerate(table):
+        ok = (isinstance(row, list | tuple) and len(row) == 3 and all(
+            isinstance(a, int | float) and not isinstance(a, bool) and np.isfinite(a)
+            for a in row))
+        if not ok:
+            tchk.add(k, f"expected [hour, set_deg, rate_{'kn' if scale != 1 else 'ms'}]"
+                     f" (three numbers); got {row!r}")
+        elif not (0.0 <= row[1] <= 360.0 and row[2] >= 0):
+            tchk.add(k, f"expected a set in [0, 360] and a rate >= 0; got {row!r}")
+        elif rows and row[0] <= rows[-1][0]:
+            tchk.add(k, f"the hours must increase strictly from row to row "
+                     f"({row[0]:g} after {rows[-1][0]:g})")
+        else:
+            rows.append((float(row[0]), float(row[1]), float(row[2]) * scale))
+    return rows
+
+
+def _build_diamond_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
+                           ) -> CurrentField:
+    """``type: diamonds``: a tidal-diamond table of set and rate by hour from high water."""
+    chk.keys(spec, _CURRENT_DIAMOND_KEYS, ("high_water", "table"))
+    unit = chk.choice(spec, "rate_unit", ["kn", "m/s"], "kn")
+    scale = KNOT if unit == "kn" else 1.0
+    clamp = chk.boolean(spec, "clamp", False)
+    hw = None
+    if "high_water" in spec:
+        try:
+            hw = to_epoch(parse_time(spec["high_water"], where=chk.where("high_water")))
+        except InputError as exc:
+            chk.p.extend([str(exc)])
+    rows: list[tuple[float, float, float]] = []
+    table = spec.get("table")
+    if "table" in spec and (not isinstance(table, list) or not table):
+        chk.add("table", "expected a non-empty list of rows [hour, set_deg, rate_kn], "
+                f"e.g. [[-6, 250, 0.4], [0, 70, 1.2]]; got {show(table)}")
+    elif isinstance(table, list):
+        rows = _diamond_rows(chk, table, scale)
+    chk.p.raise_if_any()
+    h, s, r = (list(c) for c in zip(*rows, strict=True))
+    assert hw is not None  # required key: reported above when missing or unreadable
+    return DiamondCurrent(hw, h, s, r, clamp=clamp)
+
+
+def _build_netcdf_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
+                          ) -> CurrentField:
+    """``type: netcdf``: a gridded current (u, v) from a NetCDF file."""
+    chk.keys(spec, _CURRENT_NETCDF_KEYS, ("path",))
+    path = _path(chk, spec, ctx)
+    var = chk.mapping(spec, "variables", None)
+    if var is not None and not ({"u", "v"} == set(var) and all(
+            isinstance(v, str) and v for v in var.values())):
+        chk.add("variables", f"expected {{u: NAME, v: NAME}}, e.g. {{u: uo, v: vo}}; "
+                f"got {dict(var)!r}")
+    unit = chk.string(spec, "speed_unit", None)
+    if unit is not None and unit.strip().lower() not in SPEED_UNITS:
+        chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
+    sel = chk.mapping(spec, "select", None)
+    opts = {"interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
+            "steady": chk.boolean(spec, "steady", False),
+            "clamp": chk.boolean(spec, "clamp", False)}
+    chk.p.raise_if_any()
+    assert path is not None  # required key: reported above when missing
+    try:
+        return open_netcdf_current(path, ctx.frame, variables=var, speed_unit=unit, select=sel,
+                                   bbox=ctx.crop_bbox, time_window=ctx.time_window, **opts)
+    except InputError as exc:
+        raise type(exc)(f"{ctx.where}: {exc}") from None
+
+
+CURRENT_BUILDERS: dict[str, Callable[[Mapping[str, Any], Checker, _Context], CurrentField]] = {
+    "uniform": _build_uniform_current,
+    "diamonds": _build_diamond_current,
+    "netcdf": _build_netcdf_current,
+}
+"""Current spec ``type`` -> builder (the types ``current:`` accepts)."""

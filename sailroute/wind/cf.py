@@ -638,6 +638,20 @@ def _index(idx: NDArray) -> slice | NDArray:
     return idx
 
 
+def dimension_sizes(path: str | Path) -> dict[str, int]:
+    """The dimensions of a NetCDF file and their sizes (the header only; no data read).
+
+    Raises
+    ------
+    OSError
+        The file cannot be read as NetCDF.
+    """
+    import netCDF4
+
+    with netCDF4.Dataset(str(path), "r") as ds:
+        return {k: len(v) for k, v in ds.dimensions.items()}
+
+
 @damaged_as_wind_error
 def open_netcdf(
     source: Any,

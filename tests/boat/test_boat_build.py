@@ -105,7 +105,7 @@ def test_spec_builtin_polar_and_vpp(tmp_path: Path) -> None:
         ({"builtin": "ilca7", "crew": 70},
          "courses/x.yaml: boat.crew: unknown key for a 'builtin' boat; valid keys: "
          "allow_extrapolation, builtin, efficiency, interpolation"),
-        ({"polar": "missing.pol"}, "boat.polar: file '.*missing.pol' not found"),
+        ({"polar": "missing.pol"}, "boat.polar: file not found: .*missing.pol"),
         ({"polar": "a.pol", "speed_unit": "furlong"},
          "boat.speed_unit: expected one of 'kn', 'm/s', 'km/h', 'mph'; got 'furlong'"),
         ("ilca7", "boat: expected a mapping"),

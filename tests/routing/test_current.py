@@ -15,13 +15,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from sailroute.current import DiamondCurrent, RelativeWind, UniformCurrent, current_from_spec
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
 from sailroute.routing.api import route_leg
 from sailroute.routing.isochrone import route_isochrone
 from sailroute.routing.types import RoutingSettings, Start, Target
 from sailroute.units import KNOT
+from sailroute.wind.build import current_from_spec
+from sailroute.wind.current import DiamondCurrent, RelativeWind, UniformCurrent
 from sailroute.wind.uniform import UniformWind
 from tests.routing.polars import laser_like_polar
 

@@ -122,7 +122,7 @@ def test_drift_diffusion_shift_given_directly_in_minutes(tmp_path) -> None:
     res = run_strategy_command(
         shift="Drift_Diffusion", drift_deg_per_min=0.6, diffusion_deg_per_sqrt_min=3.0,
         out_dir=tmp_path, plots=False, length_m=200.0, half_width_m=100.0, runs=50,
-    ).result
+    ).data
     assert res.model == DriftDiffusionShift(0.01, 3.0 / math.sqrt(60.0))
     assert res.policy.model == res.model
     assert res.summary["shift_model"]["kind"] == "drift-diffusion"

@@ -18,10 +18,10 @@ from sailroute.boat.polar import Polar
 from sailroute.boat.vpp import dsyhs_table
 from sailroute.course.load import load_course
 from sailroute.course.model import ScenarioSpec, frozen_mapping
-from sailroute.current import DiamondCurrent, UniformCurrent
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.track.model import Track
 from sailroute.wind.blended import BlendedWind
+from sailroute.wind.current import DiamondCurrent, UniformCurrent
 from sailroute.wind.grid import GridWind
 from sailroute.wind.stations import StationWind
 from sailroute.wind.uniform import UniformWind

@@ -336,7 +336,7 @@ def test_course_wind_type_measured(tmp_path: Path) -> None:
     assert float(s) == pytest.approx(12.0 * KNOT, rel=1e-9)
     assert float(d) == pytest.approx(200.0 + float(FRAME.grid_north_deg(*FRAME.to_latlon(
         0.0, 300.0))), abs=0.01)
-    with pytest.raises(InputError, match=r"c\.yaml: scenarios\.m\.tracks\.1: file not found"):
+    with pytest.raises(InputError, match=r"c\.yaml: scenarios\.m\.tracks\[1\]: file not found"):
         wind_from_spec({"type": "measured", "tracks": ["boat0.csv", "nope.csv"]}, frame=FRAME,
                        base_dir=tmp_path, where="c.yaml: scenarios.m")
     with pytest.raises(InputError, match=r"scenarios\.m\.method: expected one of 'mean'"):
