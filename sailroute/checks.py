@@ -377,7 +377,7 @@ class Checker:
             return None
         return v
 
-    def file(self, d: Mapping[str, Any], key: str | int, base_dir: Path,
+    def file(self, d: Any, key: str | int, base_dir: Path,
              value: Any = MISSING) -> Path | None:
         """An existing file named by ``d[key]`` (or ``value``), relative to ``base_dir``.
 

@@ -758,7 +758,7 @@ def _build_uniform_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
     rate = _current_rate(chk, spec)
     set_deg = chk.number(spec, "set_deg", lo=0.0, hi=360.0) if "set_deg" in spec else None
     chk.p.raise_if_any()
-    assert set_deg is not None  # required key: reported above when missing
+    assert set_deg is not None and rate is not None  # required: reported above when missing
     return UniformCurrent(rate, set_deg)
 
 
