@@ -1,0 +1,124 @@
+"""The package's layers: no module imports a higher layer, and no import cycle.
+
+The layers, low to high (``docs/design.md``): the base modules (units, errors, geometry
+helpers, parsing helpers, progress), then ``track``, ``wind``, ``boat``, ``routing``,
+``course``, ``planning``, ``analysis``, ``strategy``, ``report``, ``commands`` and, on
+top, the API facade, the CLI and the package namespace.  A module may import its own
+package and any lower layer, lazily (inside a function) or for typing alike.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Iterator
+from pathlib import Path
+
+from tests.conftest import ROOT
+
+PACKAGE = ROOT / "sailroute"
+BASE = ("units", "errors", "geo", "timeutil", "textin", "yamlfile", "numerics", "backend",
+        "checks", "parallel", "outdir", "progress", "tabular")
+LAYERS: tuple[tuple[str, ...], ...] = (
+    BASE, ("track",), ("wind",), ("boat",), ("routing",), ("course",), ("planning",),
+    ("analysis",), ("strategy",), ("report",), ("commands",),
+    ("api", "cli", "__main__", "__init__"),
+)
+RANK = {name: k for k, names in enumerate(LAYERS) for name in names}
+
+
+def _unit(module: str) -> str:
+    """The layer unit of a dotted module name: its top-level package or module."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "__init__"
+
+
+def _modules() -> Iterator[tuple[str, Path]]:
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(ROOT).with_suffix("")
+        parts = rel.parts[:-1] if rel.name == "__init__" else rel.parts
+        yield ".".join(parts), path
+
+
+def _imports(module: str, path: Path) -> Iterator[tuple[int, str, tuple[str, ...]]]:
+    """(line, imported module, imported names) of every sailroute import in a file."""
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.split(".")[0] == "sailroute":
+                    yield node.lineno, alias.name, ()
+        elif isinstance(node, ast.ImportFrom) and node.module is not None:
+            target = node.module
+            if node.level:  # relative import: resolve against this module's package
+                base = module.split(".")
+                target = ".".join(base[: len(base) - node.level + (path.name == "__init__.py")]
+                                  + [node.module])
+            if target.split(".")[0] == "sailroute":
+                yield node.lineno, target, tuple(a.name for a in node.names)
+
+
+def test_every_module_belongs_to_a_layer() -> None:
+    units = {_unit(m) for m, _ in _modules() if m != "sailroute"}
+    assert units <= set(RANK), f"place these in LAYERS: {sorted(units - set(RANK))}"
+
+
+def test_no_import_goes_up_the_layers() -> None:
+    bad = []
+    for module, path in _modules():
+        src = _unit(module)
+        for line, target, names in _imports(module, path):
+            dst = _unit(target)
+            if target == "sailroute" and set(names) <= {"__version__"}:
+                continue  # the version constant of the package namespace
+            if dst == src:
+                continue
+            peers = src in BASE or src in LAYERS[-1]  # base modules, and the top, use each other
+            if RANK[dst] > RANK[src] or (RANK[dst] == RANK[src] and not peers):
+                bad.append(f"{path.relative_to(ROOT)}:{line}: {src} imports {target}")
+    assert not bad, "imports up the layers:\n" + "\n".join(bad)
+
+
+def test_no_import_cycle_between_modules() -> None:
+    known = {m for m, _ in _modules()}
+    graph: dict[str, set[str]] = {}
+    for module, path in _modules():
+        deps = set()
+        for _, target, names in _imports(module, path):
+            if target == "sailroute" and set(names) <= {"__version__"}:
+                continue  # a constant of the namespace, whose other imports are lazy
+            for cand in (*(f"{target}.{n}" for n in names), target):
+                if cand in known and cand != module:
+                    deps.add(cand)
+                    break
+        graph[module] = deps
+    # Tarjan's strongly connected components: any component of two or more is a cycle
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on: set[str] = set()
+    cycles: list[list[str]] = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                cycles.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    assert not cycles, f"import cycles: {cycles}"
