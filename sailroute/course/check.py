@@ -315,58 +315,80 @@ def _legs(
             prev = None
             continue
         c.at(path).keys(item, ("from", "to", "rounding"), ("to",))
-        frm: str | None
-        if i == 0:
-            if "from" in item:
-                frm = c.at(join_path(path, "from")).name(item["from"], "a line or mark name")
-                if frm is not None and frm not in features:
-                    if frm not in c.declared:
-                        c.p.add(join_path(path, "from"), f"unknown line or mark {frm!r}; "
-                                f"{suggest(frm, features)}known: {', '.join(features)}")
-                    frm = None
-            elif "start" in lines:
-                frm = "start"
-            elif "start" in c.declared:
-                frm = None  # the start line itself is invalid (reported there)
-            else:
-                c.p.add(path, "the first leg needs `from: LINE_OR_MARK`, or define a line "
-                        "named 'start' under `lines`")
-                frm = None
-        else:
-            if "from" in item:
-                c.p.add(join_path(path, "from"), "only the first leg may give `from`; later legs "
-                        "start where the previous leg ended")
-            frm = prev
-        to = c.at(join_path(path, "to")).name(item["to"], "a mark, gate or line name") if (
-            "to" in item) else None
-        if to is not None and to not in features:
-            if to not in c.declared:
-                c.p.add(join_path(path, "to"), f"unknown mark, gate or line {to!r}; "
-                        f"{suggest(to, features)}known: {', '.join(features)}")
-            to = None
+        frm = _leg_from(c, item, path, features, lines) if i == 0 else _later_from(c, item, path,
+                                                                                    prev)
+        to = _feature(c, item, "to", path, features, "mark, gate or line")
         kind = features.get(to) if to is not None else None
-        rounding = None
-        if kind == "mark" or (kind is None and "rounding" in item):
-            rounding = c.at(path).choice(item, "rounding", SIDES, "port")
-        elif kind is not None and "rounding" in item:
-            c.p.add(join_path(path, "rounding"), f"{to!r} is a {kind}; boats pass through a "
-                    f"{kind}, so `rounding` applies to marks only (remove it)")
+        rounding = _rounding(c, item, path, to, kind)
         if to is not None and frm is not None:
-            if to == frm:
-                what = "the previous leg ends" if i > 0 else "the leg starts"
-                c.p.add(join_path(path, "to"), f"{to!r} is where {what}; a leg must go to a "
-                        "different mark, gate or line")
-            else:
-                a = _centre(centres, marks, frm)
-                b = _centre(centres, marks, to)
-                d = math.hypot(b[0] - a[0], b[1] - a[1])
-                if d < MIN_SEPARATION_M:
-                    c.p.add(path, f"the leg {frm!r} -> {to!r} is {d:.2f} m long; "
-                            f"expected at least {MIN_SEPARATION_M:g} m")
+            _check_leg_length(c, path, i, frm, to, _centre(centres, marks, frm),
+                              _centre(centres, marks, to))
         if to is not None and kind is not None and frm is not None:
             out.append((i, frm, to, kind, rounding))
         prev = to
     return out
+
+
+def _feature(c: Checker, item: Mapping[str, Any], key: str, path: str,
+             features: Mapping[str, LegKind], what: str) -> str | None:
+    """The mark, gate or line named by ``item[key]``, or None (a problem recorded)."""
+    if key not in item:
+        return None
+    name = c.at(join_path(path, key)).name(item[key], f"a {what} name")
+    if name is not None and name not in features:
+        if name not in c.declared:
+            c.p.add(join_path(path, key), f"unknown {what} {name!r}; "
+                    f"{suggest(name, features)}known: {', '.join(features)}")
+        return None
+    return name
+
+
+def _leg_from(c: Checker, item: Mapping[str, Any], path: str,
+              features: Mapping[str, LegKind], lines: Mapping[str, tuple[str, str]]
+              ) -> str | None:
+    """Where the first leg starts: its ``from``, else the line named ``start``."""
+    if "from" in item:
+        return _feature(c, item, "from", path, features, "line or mark")
+    if "start" in lines:
+        return "start"
+    if "start" not in c.declared:  # (an invalid start line is reported there)
+        c.p.add(path, "the first leg needs `from: LINE_OR_MARK`, or define a line "
+                "named 'start' under `lines`")
+    return None
+
+
+def _later_from(c: Checker, item: Mapping[str, Any], path: str, prev: str | None
+                ) -> str | None:
+    """Where a later leg starts: where the previous one ended (``from`` is refused)."""
+    if "from" in item:
+        c.p.add(join_path(path, "from"), "only the first leg may give `from`; later legs "
+                "start where the previous leg ended")
+    return prev
+
+
+def _rounding(c: Checker, item: Mapping[str, Any], path: str, to: str | None,
+              kind: LegKind | None) -> str | None:
+    """The side a mark is rounded on (default port); gates and lines take none."""
+    if kind == "mark" or (kind is None and "rounding" in item):
+        return c.at(path).choice(item, "rounding", SIDES, "port")
+    if kind is not None and "rounding" in item:
+        c.p.add(join_path(path, "rounding"), f"{to!r} is a {kind}; boats pass through a "
+                f"{kind}, so `rounding` applies to marks only (remove it)")
+    return None
+
+
+def _check_leg_length(c: Checker, path: str, i: int, frm: str, to: str,
+                      a: tuple[float, float], b: tuple[float, float]) -> None:
+    """A leg goes somewhere else, at least :data:`MIN_SEPARATION_M` away."""
+    if to == frm:
+        what = "the previous leg ends" if i > 0 else "the leg starts"
+        c.p.add(join_path(path, "to"), f"{to!r} is where {what}; a leg must go to a "
+                "different mark, gate or line")
+        return
+    d = math.hypot(b[0] - a[0], b[1] - a[1])
+    if d < MIN_SEPARATION_M:
+        c.p.add(path, f"the leg {frm!r} -> {to!r} is {d:.2f} m long; "
+                f"expected at least {MIN_SEPARATION_M:g} m")
 
 
 def _routing(c: Checker, raw: Any) -> RoutingSettings:
