@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from sailroute.checks import Checker, Problems, finite, join_path, show, suggest
+from sailroute.course.areas import AREA_KEYS, Area, check_areas
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
@@ -46,7 +47,7 @@ __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
 TOP_KEYS = (
     "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
-    "legs", "template", "boat", "routing", "scenarios", "references",
+    "legs", "template", "boat", "routing", "scenarios", "references", *AREA_KEYS,
 )
 """Keys allowed at the top level of a course file."""
 
@@ -123,6 +124,8 @@ class CheckedCourse:
     scenarios: dict[str, dict[str, Any]]
     references: dict[str, tuple[float, ...]]
     template: dict[str, Any] | None
+    boundary: Area | None = None
+    obstacles: tuple[Area, ...] = ()
 
 
 # ----------------------------------------------------------------------------- sections
@@ -796,6 +799,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     routing = _routing(c, data.get("routing"))
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
+    boundary, obstacles = check_areas(c, data, frame)
     probs.raise_if_any()
 
     assert frame is not None and start_time is not None  # guaranteed when no problems
@@ -816,6 +820,8 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         scenarios=scenarios,
         references=references,
         template=dict(template) if template is not None else None,
+        boundary=boundary,
+        obstacles=obstacles,
     )
 
 
