@@ -233,11 +233,11 @@ def write_gpx(path: str | Path, plan: Plan) -> Path:
         _sub(w, "type", "mark")
     rte = _sub(root, "rte")
     _sub(rte, "name", f"{c.name} ({plan.scenario})")
-    for pt in route_points(plan):  # start, each tack and gybe, each leg's end
-        rp = _sub(rte, "rtept", lat=f"{pt.lat:.8f}", lon=f"{pt.lon:.8f}")
-        _sub(rp, "time", iso(pt.t))
-        _sub(rp, "name", pt.name)
-        _sub(rp, "type", pt.kind)
+    for wp in route_points(plan):  # start, each tack and gybe, each leg's end
+        rp = _sub(rte, "rtept", lat=f"{wp.lat:.8f}", lon=f"{wp.lon:.8f}")
+        _sub(rp, "time", iso(wp.t))
+        _sub(rp, "name", wp.name)
+        _sub(rp, "type", wp.kind)
     trk = _sub(root, "trk")
     _sub(trk, "name", f"{c.name} ({plan.scenario})")
     for pl in plan.legs:

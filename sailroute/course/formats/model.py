@@ -140,7 +140,7 @@ def parse_type(text: str, where: str) -> PointType:
     if t not in POINT_TYPES:
         raise InputError(f"{where}: type {text!r}; expected one of {', '.join(POINT_TYPES)} "
                          "(or leave it empty for a mark)")
-    return t  # type: ignore[return-value]
+    return t
 
 
 def parse_rounding(text: str, where: str) -> Side | None:
