@@ -149,3 +149,13 @@ def test_the_plan_files_include_kml_and_nmea(tmp_path, plan):
     out = write_plan_outputs(tmp_path, plan, plot=False)
     assert out["kml"] == tmp_path / "route.kml" and out["nmea"] == tmp_path / "route.nmea"
     assert sum(1 for _ in out["nmea"].open()) == len(route_points(plan)) + 1
+
+
+def test_control_characters_in_names_leave_kml_well_formed_and_nmea_ascii(tmp_path, plan):
+    import dataclasses
+
+    evil = dataclasses.replace(plan, course=dataclasses.replace(plan.course, name="a\x00b\x1b"))
+    root = ET.parse(write_kml(tmp_path / "route.kml", evil)).getroot()  # a NUL would not parse
+    assert root.find("k:Document/k:name", K).text == "a\ufffdb\ufffd (north)"
+    text = write_nmea(tmp_path / "route.nmea", evil).read_bytes()
+    assert all(32 <= b < 127 for b in text.replace(b"\r\n", b""))
