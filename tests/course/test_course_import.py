@@ -323,3 +323,23 @@ def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path):
     assert res.output.startswith("error: ") and "ilca99" in res.output
     assert "Traceback" not in res.output
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["m.csv"]
+
+
+def test_boat_option_forms(tmp_path):
+    import os
+
+    from sailroute.commands.course_import import boat_spec_of
+
+    polar = tmp_path / "polars" / "mine.pol"
+    polar.parent.mkdir()
+    polar.write_text("TWA\\TWS\t6\t10\n45\t3.5\t4.5\n90\t4.5\t5.5\n")
+    out = tmp_path / "courses" / "c.yaml"
+    assert boat_spec_of(str(polar), out) == {"polar": os.path.join("..", "polars", "mine.pol")}
+    assert boat_spec_of("ilca6", out) == {"builtin": "ilca6"}
+    assert boat_spec_of("{polar: f.csv, speed_unit: km/h}", out) == {
+        "polar": "f.csv", "speed_unit": "km/h"}
+    assert boat_spec_of(None, out) is None
+    with pytest.raises(InputError, match="no such polar file"):
+        boat_spec_of(str(tmp_path / "missing.pol"), out)
+    with pytest.raises(InputError, match=r"--boat '\{1, 2': not a YAML mapping"):
+        boat_spec_of("{1, 2", out)
