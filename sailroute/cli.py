@@ -730,6 +730,58 @@ def analyze_command(
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
+# --- course import (one block: the `course` sub-app) ------------------------------------
+course_app = typer.Typer(cls=_Group, no_args_is_help=True, rich_markup_mode=None,
+                         help="Course files from other programs.")
+app.add_typer(course_app, name="course")
+
+
+@course_app.command("import", cls=_Command,
+                    short_help="A course file (YAML) from GPX, CSV, KML or race XML.")
+def course_import_command(
+    ctx: typer.Context,
+    source: Annotated[str, typer.Argument(help="GPX, CSV, KML or SailGP race XML file.",
+                                          metavar="FILE")],
+    out: Annotated[
+        str | None,
+        typer.Option("--out", "-o", metavar="COURSE.yaml",
+                     help="Course file to write (default: <FILE stem>.yaml here)."),
+    ] = None,
+    fmt: Annotated[
+        Literal["auto", "gpx", "csv", "kml", "racexml"],
+        typer.Option("--format", case_sensitive=False,
+                     help="Input format (auto: by suffix, or the root element of .xml)."),
+    ] = "auto",
+    boat: Annotated[
+        str | None,
+        typer.Option("--boat", metavar="BOAT", help="Built-in polar (ilca7), a polar file, "
+                     "or a mapping '{polar: f50.csv, speed_unit: km/h}' (default: none)."),
+    ] = None,
+    wind_twd: Annotated[
+        float | None, typer.Option("--wind-twd", metavar="DEG",
+                                   help="Uniform wind direction, degrees (from); required."),
+    ] = None,
+    wind_tws: Annotated[
+        float | None, typer.Option("--wind-tws", metavar="KN",
+                                   help="Uniform wind speed, knots; required."),
+    ] = None,
+    start_time: Annotated[
+        str | None,
+        typer.Option("--start-time", metavar="TIME", help="Start, ISO 8601 with offset "
+                     "(required unless the file gives it, as race XML does)."),
+    ] = None,
+) -> None:
+    """Import a course: marks, lines, gates, legs, boundary; writes a course file that plans."""
+    from sailroute.commands.course_import import run_course_import_command
+
+    def run() -> Any:
+        return run_course_import_command(source, out=out, fmt=fmt, boat=boat,
+                                         wind_twd_deg=wind_twd, wind_tws_kn=wind_tws,
+                                         start_time=start_time)
+
+    _finish(run_guarded(run, debug=_debug(ctx)), False)
+
+
 def main() -> None:
     """Run the command line (the console script's :func:`sailroute.__main__.main` imports
     this module inside its own Ctrl-C guard)."""

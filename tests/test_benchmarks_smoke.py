@@ -22,6 +22,7 @@ CASES = [
     ("bench_polar_fit.py",
      r"^Tallinn 2023 vs ORC guide +14 +6\.6 %" if SHARED_REAL.is_dir()
      else r"^bench_polar_fit\.py: .* not present .*: nothing measured$"),
+    ("bench_course_io.py", r"^export gpx\+kml\+nmea +[\d.]+ ms +\(6 legs, \d+ track points\)$"),
     ("bench_isochrone.py", r"^  leg time \d+\.\d s, \d+ tacks, 0 gybes"),
     ("race_polar_validation.py",
      r"^\| ilca7 \| Snipe P01 \(--smoke, 30 s steps\) \| 6 kn 110° \| 0\.\d{3} \| 0\.673 \|"),

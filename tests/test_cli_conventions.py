@@ -174,7 +174,8 @@ def test_rerun_without_plots_removes_the_old_png_and_keeps_user_files(tmp_path):
     res = runner.invoke(app, ["plan", WL, "-q", "--no-plots", "-o", str(tmp_path)])
     assert res.exit_code == 0, res.output
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == [MANIFEST_NAME, "my-notes.txt", "plan.json", "route.gpx", "track.csv"]
+    assert names == [MANIFEST_NAME, "my-notes.txt", "plan.json", "route.gpx", "route.kml",
+                     "route.nmea", "track.csv"]
 
 
 @pytest.mark.parametrize(("exc", "code"), [(RuntimeError("disk on fire"), 1),

@@ -50,8 +50,8 @@ def _imports(module: str, path: Path) -> Iterator[tuple[int, str, tuple[str, ...
             target = node.module
             if node.level:  # relative import: resolve against this module's package
                 base = module.split(".")
-                target = ".".join(base[: len(base) - node.level + (path.name == "__init__.py")]
-                                  + [node.module])
+                keep = len(base) - node.level + (path.name == "__init__.py")
+                target = ".".join([*base[:keep], node.module])
             if target.split(".")[0] == "sailroute":
                 yield node.lineno, target, tuple(a.name for a in node.names)
 

@@ -35,6 +35,7 @@ from sailroute.checks import (
     show,
     suggest,
 )
+from sailroute.course.areas import AREA_KEYS, Area, check_areas
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
@@ -56,7 +57,7 @@ __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
 TOP_KEYS = (
     "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
-    "legs", "template", "boat", "routing", "scenarios", "references",
+    "legs", "template", "boat", "routing", "scenarios", "references", *AREA_KEYS,
 )
 """Keys allowed at the top level of a course file."""
 
@@ -133,6 +134,8 @@ class CheckedCourse:
     scenarios: dict[str, dict[str, Any]]
     references: dict[str, tuple[float, ...]]
     template: dict[str, Any] | None
+    boundary: Area | None = None
+    obstacles: tuple[Area, ...] = ()
 
 
 # ----------------------------------------------------------------------------- sections
@@ -367,10 +370,11 @@ def _later_from(c: Checker, item: Mapping[str, Any], path: str, prev: str | None
 
 
 def _rounding(c: Checker, item: Mapping[str, Any], path: str, to: str | None,
-              kind: LegKind | None) -> str | None:
+              kind: LegKind | None) -> Side | None:
     """The side a mark is rounded on (default port); gates and lines take none."""
     if kind == "mark" or (kind is None and "rounding" in item):
-        return c.at(path).choice(item, "rounding", SIDES, "port")
+        side: Side | None = c.at(path).choice(item, "rounding", SIDES, "port")
+        return side
     if kind is not None and "rounding" in item:
         c.p.add(join_path(path, "rounding"), f"{to!r} is a {kind}; boats pass through a "
                 f"{kind}, so `rounding` applies to marks only (remove it)")
@@ -828,6 +832,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     routing = _routing(c, data.get("routing"))
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
+    boundary, obstacles = check_areas(c, data, frame)
     probs.raise_if_any()
 
     assert frame is not None and start_time is not None  # guaranteed when no problems
@@ -848,6 +853,8 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         scenarios=scenarios,
         references=references,
         template=dict(template) if template is not None else None,
+        boundary=boundary,
+        obstacles=obstacles,
     )
 
 

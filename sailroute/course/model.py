@@ -23,6 +23,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from sailroute.course.areas import Area
 from sailroute.geo import LocalFrame
 from sailroute.routing.types import RoutingSettings, Side
 from sailroute.timeutil import to_epoch
@@ -256,6 +257,10 @@ class Course:
         1-based line of each key path of the course file (``"scenarios.a.wind.tws_kn"``),
         so that the wind, current and boat factories report problems at their lines;
         empty for a course built from a mapping.
+    boundary : Area or None
+        The race area routes stay inside (``boundary``; not used by the routers yet).
+    obstacles : tuple of Area
+        Areas routes stay out of (``obstacles``; not used by the routers yet).
     """
 
     name: str
@@ -276,6 +281,8 @@ class Course:
     boat_where: str = ""
     utc_offset_s: float = 0.0
     key_lines: Mapping[str, int] = field(default_factory=dict)
+    boundary: Area | None = None
+    obstacles: tuple[Area, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):

@@ -2,8 +2,11 @@
 
 * ``plan.json``: course, scenario, totals and one record per leg;
 * ``track.csv``: one row per track point of every leg;
-* ``route.gpx``: GPX 1.1 with the marks (``wpt``), the route through the leg
-  start/end points (``rte``) and the timed track (``trk``, one segment per leg);
+* ``route.gpx``: GPX 1.1 with the marks (``wpt``), the route through the start, every
+  tack and gybe and each leg's end (``rte``) and the timed track (``trk``, one segment
+  per leg);
+* ``route.kml``, ``route.nmea``: the same route for chart software and plotters
+  (:mod:`sailroute.report.route_export`);
 * ``comparison.json`` / ``comparison.csv``: legs × scenarios with errors.
 
 :func:`file_label` names a written file for the "wrote ..." lines of the CLI.  The
@@ -29,6 +32,7 @@ from sailroute import __version__
 from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
 from sailroute.planning.result import Comparison, Plan, percent_error
+from sailroute.report.route_export import route_points, write_kml, write_nmea
 from sailroute.routing.types import side_name
 from sailroute.textin import CleanCsvWriter, clean_text
 from sailroute.timeutil import iso
@@ -208,8 +212,10 @@ def write_gpx(path: str | Path, plan: Plan) -> Path:
     """Write ``route.gpx`` (GPX 1.1).
 
     * ``wpt``: every mark, named;
-    * ``rte``: the start point of every leg and the final arrival point, named
-      after the leg's start (``start``, ``1``, ...) and the last target;
+    * ``rte``: the route's waypoints (:func:`sailroute.report.route_export.route_points`):
+      the start point, each tack (``T1``, ...) and gybe (``G1``, ...) and each leg's
+      end, named after its target, each with its ``<time>`` and a ``<type>``
+      (``start``, ``tack``, ``gybe``, ``mark``, ``gate``, ``line``);
     * ``trk``: one ``trkseg`` per leg with timed points; each point carries
       ``<extensions>`` in the ``urn:x-sailroute:gpx:1`` namespace with ``bsp_ms``,
       ``tws_ms``, ``twd_deg``, ``twa_deg`` and ``heading_deg``.
@@ -227,15 +233,11 @@ def write_gpx(path: str | Path, plan: Plan) -> Path:
         _sub(w, "type", "mark")
     rte = _sub(root, "rte")
     _sub(rte, "name", f"{c.name} ({plan.scenario})")
-    points = [(pl.spec.from_name, pl.result.start_xy, pl.result.t_start) for pl in plan.legs]
-    if plan.legs:
-        last = plan.legs[-1]
-        points.append((last.spec.to_name, last.result.end_xy, last.result.t_end))
-    for name, xy, t in points:
-        lat, lon = c.frame.to_latlon(*xy)
-        rp = _sub(rte, "rtept", lat=f"{float(lat):.8f}", lon=f"{float(lon):.8f}")
-        _sub(rp, "time", iso(t))
-        _sub(rp, "name", name)
+    for wp in route_points(plan):  # start, each tack and gybe, each leg's end
+        rp = _sub(rte, "rtept", lat=f"{wp.lat:.8f}", lon=f"{wp.lon:.8f}")
+        _sub(rp, "time", iso(wp.t))
+        _sub(rp, "name", wp.name)
+        _sub(rp, "type", wp.kind)
     trk = _sub(root, "trk")
     _sub(trk, "name", f"{c.name} ({plan.scenario})")
     for pl in plan.legs:
@@ -336,6 +338,9 @@ FILE_LABELS: dict[str, str] = {
     "plan": "plan (JSON)",
     "track": "track (CSV)",
     "gpx": "route (GPX)",
+    "kml": "route (KML)",
+    "nmea": "route (NMEA 0183)",
+    "course": "course (YAML)",
     "png": "route map (PNG)",
     "comparison_json": "comparison (JSON)",
     "comparison_csv": "comparison (CSV)",
@@ -401,7 +406,8 @@ def write_plan_outputs(
     plot: bool = True,
     dpi: int = 150,
 ) -> Mapping[str, Path]:
-    """Write ``plan.json``, ``track.csv``, ``route.gpx`` and (if ``plot``) ``route.png``.
+    """Write ``plan.json``, ``track.csv``, ``route.gpx``, ``route.kml``, ``route.nmea``
+    and (if ``plot``) ``route.png``.
 
     Parameters
     ----------
@@ -419,7 +425,7 @@ def write_plan_outputs(
     Returns
     -------
     mapping of str to Path
-        ``{"plan": ..., "track": ..., "gpx": ..., "png": ...}``.
+        ``{"plan": ..., "track": ..., "gpx": ..., "kml": ..., "nmea": ..., "png": ...}``.
     """
     d = make_out_dir(out_dir)
     out = {
@@ -427,6 +433,8 @@ def write_plan_outputs(
         "track": write_track_csv(d / "track.csv", plan),
         "gpx": write_gpx(d / "route.gpx", plan),
     }
+    out["kml"] = write_kml(d / "route.kml", plan)
+    out["nmea"] = write_nmea(d / "route.nmea", plan)
     if plot:
         from sailroute.report.png_worker import draw_in_process
 

@@ -1,4 +1,4 @@
-"""Polar fitting (``sailroute.boat.fit``, ``fit_outputs``, ``sailroute polar fit``) and the
+"""Polar fitting (``sailroute.boat.fit``, ``commands.polar_fit``, ``sailroute polar fit``) and the
 ``efficiency`` key: known answers from synthetic logs, filter counts, real logs vs their
 reference polars, CLI and errors.
 """

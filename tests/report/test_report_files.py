@@ -94,7 +94,13 @@ def test_gpx(tmp_path, plan):
     wpts = root.findall("g:wpt", NS)
     assert sorted(w.find("g:name", NS).text for w in wpts) == sorted(plan.course.marks)
     rtepts = root.findall("g:rte/g:rtept", NS)
-    assert [p.find("g:name", NS).text for p in rtepts] == ["start", "top", "gate", "finish"]
+    # the start, each leg's end and, between, the plan's one tack (leg 1) and one gybe (leg 2)
+    assert [p.find("g:name", NS).text for p in rtepts] == ["start", "T1", "top", "G1", "gate",
+                                                           "finish"]
+    assert [p.find("g:type", NS).text for p in rtepts] == ["start", "tack", "mark", "gybe",
+                                                           "gate", "line"]
+    # GPX 1.1 rteptType order: time before name before type
+    assert [c.tag.split("}")[1] for c in rtepts[0]] == ["time", "name", "type"]
     segs = root.findall("g:trk/g:trkseg", NS)
     assert len(segs) == len(plan.legs)
     frame = plan.course.frame
@@ -144,7 +150,7 @@ def test_comparison_files(tmp_path, plan):
 
 def test_write_plan_outputs(tmp_path, plan, wind):
     out = write_plan_outputs(tmp_path / "new" / "dir", plan, wind=wind, dpi=40)
-    assert set(out) == {"plan", "track", "gpx", "png"}
+    assert set(out) == {"plan", "track", "gpx", "kml", "nmea", "png"}
     assert out["png"].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     out = write_plan_outputs(tmp_path / "np", plan, plot=False)
     assert "png" not in out and not (tmp_path / "np" / "route.png").exists()
