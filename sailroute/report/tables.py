@@ -134,7 +134,8 @@ def plan_table(plan: Plan) -> str:
 
     Columns: leg, from -> to, wind mode, time (m:ss.s and seconds), tacks, gybes,
     distance [m], start point on the line/gate the leg started from, then for each
-    reference its leg time and ``(model − ref)/ref``.
+    reference its leg time and ``(model − ref)/ref``; under it the "start line" block
+    (:func:`sailroute.report.startline.start_line_text`) when the plan has one.
     """
     refs = list(plan.references.items())
     headers = ["leg", "from -> to", "mode", "time", "time s", "tacks", "gybes", "dist m",
@@ -165,7 +166,11 @@ def plan_table(plan: Plan) -> str:
         f"start {iso(plan.t_start)}"
     )
     align = "rllrrrrrl" + "rr" * len(refs)
-    return title + "\n" + render_table(headers, rows, align=align, footer=[total])
+    from sailroute.report.startline import start_line_text
+
+    start = start_line_text(plan.start_line)
+    return (title + "\n" + render_table(headers, rows, align=align, footer=[total])
+            + (f"\n\n{start}" if start else ""))
 
 
 def comparison_table(cmp: Comparison) -> str:
