@@ -43,9 +43,10 @@ def parse_position(text: str, option: str = "--at") -> tuple[float, float]:
             raise ValueError
         a, b = float(parts[0]), float(parts[1])
     except ValueError:
+        example = ("43.0645,6.2295 (LAT,LON in degrees)" if option == "--at"
+                   else "-150,80 (X,Y in metres)")
         raise InputError(
-            f"{option} {text!r}: expected two comma-separated numbers, e.g. "
-            f"{'43.0645,6.2295 (LAT,LON in degrees)' if option == '--at' else '-150,80 (x,y in metres)'}"
+            f"{option} {text!r}: expected two comma-separated numbers, e.g. {example}"
         ) from None
     if not (math.isfinite(a) and math.isfinite(b)):
         raise InputError(f"{option} {text!r}: the numbers must be finite")
@@ -162,7 +163,8 @@ def run_start_command(
     """
     from sailroute.course.load import build_specs, load_course
     from sailroute.outdir import check_out_dir, write_output_set
-    from sailroute.report.startline import approach_table, approach_to_dict
+    from sailroute.report.startline import approach_to_dict
+    from sailroute.report.tables import approach_table
     from sailroute.routing.startline import line_approach, require_start_line, start_line_numbers
 
     course = course if isinstance(course, Course) else load_course(course)

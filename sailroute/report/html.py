@@ -574,7 +574,8 @@ def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
         f"{time_label(plan.t_end, off)}",
     )
     # the start line numbers, laylines and favoured end (report/startline.py)
-    from sailroute.report.startline import plotly_traces, start_line_rows
+    from sailroute.report.startline import plotly_traces
+    from sailroute.report.tables import start_line_rows
 
     start = () if plan.start_line is None else (
         Table("Start line", ("", "at the gun"), tuple(start_line_rows(plan.start_line))),)

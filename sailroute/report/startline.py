@@ -1,11 +1,11 @@
-"""Start line numbers, laylines and the approach to the line: text, JSON and drawings.
+"""Start line numbers, laylines and the approach to the line: JSON and drawings.
 
 Pure writers of :class:`~sailroute.routing.startline.StartLineNumbers`,
 :class:`~sailroute.routing.laylines.Layline` and
-:class:`~sailroute.routing.startline.LineApproach` (the ``start_line`` object and
-``legs[].laylines`` of ``plan.json``, ``start.json``, the "start line" block of the
-terminal table, the marks on ``route.png`` and ``report.html``).  Formats:
-``docs/output-format.md``.
+:class:`~sailroute.routing.startline.LineApproach`: the ``start_line`` object and
+``legs[].laylines`` of ``plan.json``, ``start.json``, the marks on ``route.png`` and
+``report.html``.  Formats: ``docs/output-format.md``; the terminal text is in
+:mod:`sailroute.report.tables`.
 """
 
 from __future__ import annotations
@@ -39,51 +39,7 @@ def _point(frame: LocalFrame, xy: tuple[float, float]) -> dict[str, float | None
             "lon": _num(float(lon), 7)}
 
 
-def _signed(v: float, nd: int = 1) -> str:
-    return f"{v:+.{nd}f}" if math.isfinite(v) else "-"
-
-
-def _duration(seconds: float) -> str:
-    from sailroute.report.tables import format_duration
-
-    return format_duration(seconds)
-
-
 # --- plan: the start line -------------------------------------------------------------
-
-
-def bias_text(sl: StartLineNumbers) -> str:
-    """``"+6.0° (starboard end start2 favoured)"`` or ``"+0.2° (square)"``."""
-    if sl.favoured_end is None:
-        return f"{_signed(sl.bias_deg)}° (square)"
-    return f"{_signed(sl.bias_deg)}° ({sl.favoured_side} end {sl.favoured_end} favoured)"
-
-
-def start_line_rows(sl: StartLineNumbers) -> list[tuple[str, str]]:
-    """The start line numbers as (name, value) rows (terminal block and HTML table)."""
-    rows = [
-        ("line", f"{sl.a_name} - {sl.b_name}, {sl.length_m:.0f} m"),
-        ("wind at the gun", f"{sl.tws_ms / KNOT:.1f} kn from {sl.twd_deg:.0f}°"),
-        ("bias", bias_text(sl)),
-        ("ends", f"starboard end {sl.starboard_end}, port end {sl.port_end}"),
-    ]
-    if sl.favoured_end is not None:
-        rows.append(("gain at the favoured end",
-                     f"{sl.gain_m:.1f} m upwind, {sl.gain_s:.1f} s at "
-                     f"{sl.vmg_ms / KNOT:.2f} kn VMG"))
-    if sl.window_s > 0:
-        rows.append((f"bias range, {sl.window_s / 60:.0f} min before",
-                     f"{_signed(sl.bias_min_deg)}° .. {_signed(sl.bias_max_deg)}°"))
-    return rows
-
-
-def start_line_text(sl: StartLineNumbers | None) -> str:
-    """The "start line" block under the plan table (empty without a start line)."""
-    if sl is None:
-        return ""
-    rows = start_line_rows(sl)
-    w = max(len(k) for k, _ in rows)
-    return "start line\n" + "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
 
 
 def start_line_to_dict(sl: StartLineNumbers | None, frame: LocalFrame) -> dict[str, Any] | None:
@@ -174,39 +130,6 @@ def plotly_traces(sl: StartLineNumbers | None, laylines: Sequence[Sequence[Layli
 
 
 # --- the start command ----------------------------------------------------------------
-
-
-def _approach_row(ap: Approach) -> list[str]:
-    if not ap.reaches:
-        return [ap.label, ap.tack, f"{ap.heading_deg:.0f}", f"{ap.twa_deg:.0f}",
-                f"{ap.speed_ms / KNOT:.2f}", "misses", "-", "-"]
-    return [ap.label, ap.tack, f"{ap.heading_deg:.0f}", f"{ap.twa_deg:.0f}",
-            f"{ap.speed_ms / KNOT:.2f}", f"{ap.distance_m:.0f}", f"{ap.time_s:.1f}",
-            f"{100 * ap.fraction:.0f}%"]
-
-
-def approach_table(ap: LineApproach, course_name: str, line_names: tuple[str, str]) -> str:
-    """The terminal report of ``sailroute start``."""
-    from sailroute.report.tables import render_table
-
-    head = [
-        f"{course_name} | start line {line_names[0]} - {line_names[1]} | at "
-        f"x {ap.p_xy[0]:.0f} m, y {ap.p_xy[1]:.0f} m | {iso(ap.t)}",
-        f"wind {ap.tws_ms / KNOT:.1f} kn from {ap.twd_deg:.0f}° | distance to the line "
-        f"{ap.distance_m:.0f} m{' (on the course side)' if ap.course_side else ''}",
-    ]
-    rows = [_approach_row(a) for a in (*ap.close_hauled, *ap.to_ends, *ap.tacks)]
-    table = render_table(["approach", "tack", "heading °", "TWA °", "speed kn", "path m",
-                          "time s", "on line"], rows, align="llrrrrrr")
-    f = ap.fastest
-    tail = [
-        f"fastest: {f.tack} tack, heading {f.heading_deg:.0f}°, "
-        f"{f.time_s:.1f} s to {100 * f.fraction:.0f}% along the line",
-        f"time to the gun {_duration(ap.time_to_gun_s)}, time to burn "
-        f"{_duration(ap.time_to_burn_s)}"
-        + (" (late: the line cannot be reached by the gun)" if ap.time_to_burn_s < 0 else ""),
-    ]
-    return "\n".join([*head, table, *tail])
 
 
 def _approach_dict(ap: Approach, frame: LocalFrame) -> dict[str, Any]:

@@ -260,7 +260,7 @@ def course_laylines(
         if kind is None or spec.kind == "line":
             out.append(())
             continue
-        ends = [feat] if isinstance(feat, Mark) else [feat.a, feat.b]  # type: ignore[union-attr]
+        ends = [feat] if isinstance(feat, Mark) else [feat.a, feat.b]
         cx = float(np.mean([m.x for m in ends]))
         cy = float(np.mean([m.y for m in ends]))
         length = math.hypot(cx - res.start_xy[0], cy - res.start_xy[1])
