@@ -9,7 +9,8 @@ the distance back from the mark, ``TWA*`` the best-VMG angle at the local wind s
 
     d(x, y)/ds = −(sin h, cos h),    dt/ds = −1 / V(TWS, TWA*),
 
-integrated with the midpoint rule (second order).  The time runs backwards from the
+integrated with the midpoint rule (second order; the best-VMG angle is interpolated on
+a TWS grid of 0.05 m s⁻¹).  The time runs backwards from the
 moment the boat rounds the mark, so a wind that changes in time is followed too.  In a
 uniform steady wind the layline is straight, at the bearing ``h + 180°`` from the mark.
 A trace stops where the wind field's coverage ends (a field built with ``clamp``
@@ -102,12 +103,16 @@ class _VmgTable:
 
 
 def _state(
-    wind: WindField, vmg: _VmgTable, boat: BoatModel, sign: NDArray,
-    t: NDArray, x: NDArray, y: NDArray,
+    wind: WindField, tables: tuple[_VmgTable, _VmgTable], boat: BoatModel, sign: NDArray,
+    tack: NDArray, t: NDArray, x: NDArray, y: NDArray,
 ) -> tuple[NDArray, NDArray]:
-    """Heading sailed [°] and boat speed [m s⁻¹] at the given points (vectorised)."""
+    """Heading sailed [°] and boat speed [m s⁻¹] at the given points (vectorised);
+    ``tack`` marks the points of tack laylines (the others are gybe laylines)."""
     tws, twd = wind_speed_direction(*wind.sample(t, x, y))
-    twa = vmg(tws)
+    twa = np.empty_like(tws)
+    for table, on in ((tables[0], tack), (tables[1], ~tack)):
+        if on.any():
+            twa[on] = table(tws[on])
     heading = wrap360(twd - sign * twa)  # starboard (+1): wind over the right side
     return heading, np.asarray(boat.steady_speed(tws, twa), dtype=float)
 
@@ -167,32 +172,49 @@ def trace_laylines(
         For each mark in order: starboard, then port.  A trace that leaves the wind's
         coverage ends at its last point inside it.
     """
-    n = 2 * len(marks)
-    sign = np.tile([1.0, -1.0], len(marks))
-    x = np.repeat([float(m[1][0]) for m in marks], 2)
-    y = np.repeat([float(m[1][1]) for m in marks], 2)
-    t = np.full(n, float(t_mark))
-    ds = float(length_m) / n_steps
+    specs = [(name, xy, float(t_mark), float(length_m)) for name, xy in marks]
+    return _traced(specs, kind_of=[kind] * len(specs), wind=wind, boat=boat,
+                   n_steps=n_steps)
+
+
+def _traced(
+    specs: Sequence[tuple[str, tuple[float, float], float, float]],
+    kind_of: Sequence[LaylineKind],
+    wind: WindField,
+    boat: BoatModel,
+    n_steps: int,
+) -> tuple[Layline, ...]:
+    """Starboard and port laylines of each ``(mark, xy, t_mark, length)`` in ``specs``,
+    traced together (one wind sample per half step for all of them)."""
+    n = 2 * len(specs)
+    sign = np.tile([1.0, -1.0], len(specs))
+    tack = np.repeat([k == "tack" for k in kind_of], 2)
+    x = np.repeat([float(sp[1][0]) for sp in specs], 2)
+    y = np.repeat([float(sp[1][1]) for sp in specs], 2)
+    t = np.repeat([sp[2] for sp in specs], 2)
+    ds_all = np.repeat([sp[3] / n_steps for sp in specs], 2)
     xs, ys, ts, hs = [x.copy()], [y.copy()], [t.copy()], []
     active = _inside(wind, t, x, y)
     h = np.full(n, np.nan)
-    vmg = _VmgTable(boat, kind)
+    tables = (_VmgTable(boat, "tack"), _VmgTable(boat, "gybe"))
     for _ in range(n_steps):
         if not active.any():
             break
         a = np.flatnonzero(active)
-        h1, v1 = _state(wind, vmg, boat, sign[a], t[a], x[a], y[a])
+        ds = ds_all[a]
+        h1, v1 = _state(wind, tables, boat, sign[a], tack[a], t[a], x[a], y[a])
         h[a] = h1
         ex, ey = heading_unit(h1)
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
             dt1 = np.where(v1 > 0, ds / v1, 0.0)
         xm, ym, tm = x[a] - 0.5 * ds * ex, y[a] - 0.5 * ds * ey, t[a] - 0.5 * dt1
         ok = _inside(wind, tm, xm, ym)
         h2, v2 = h1.copy(), v1.copy()
         if ok.any():
-            h2[ok], v2[ok] = _state(wind, vmg, boat, sign[a][ok], tm[ok], xm[ok], ym[ok])
+            h2[ok], v2[ok] = _state(wind, tables, boat, sign[a][ok], tack[a][ok], tm[ok],
+                                    xm[ok], ym[ok])
         ex2, ey2 = heading_unit(h2)
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):
             dt2 = np.where(v2 > 0, ds / v2, 0.0)
         nx, ny, nt = x[a] - ds * ex2, y[a] - ds * ey2, t[a] - dt2
         keep = ok & _inside(wind, nt, nx, ny)
@@ -203,16 +225,17 @@ def trace_laylines(
         ys.append(np.where(active, y, np.nan))
         ts.append(np.where(active, t, np.nan))
         hs.append(h.copy())
+    px_all, py_all, pt_all = np.array(xs), np.array(ys), np.array(ts)  # (steps + 1, n)
+    ph_all = np.array(hs) if hs else np.empty((0, n))
     out = []
     for k in range(n):
-        px = np.array([p[k] for p in xs])
-        good = np.isfinite(px)
-        heads = [hs[j][k] for j in range(len(hs)) if j + 1 < len(xs) and good[j + 1]]
-        last = heads[-1] if heads else float("nan")
+        good = np.isfinite(px_all[:, k])
+        m = int(good.sum())  # a prefix: a trace that stops stays stopped
+        heads = ph_all[: max(m - 1, 0), k]
+        last = heads[-1] if heads.size else float("nan")
         out.append(Layline(
-            marks[k // 2][0], kind, "starboard" if sign[k] > 0 else "port",
-            px[good], np.array([p[k] for p in ys])[good], np.array([p[k] for p in ts])[good],
-            np.array([*heads, last])[: int(good.sum())],
+            specs[k // 2][0], kind_of[k // 2], "starboard" if sign[k] > 0 else "port",
+            px_all[:m, k], py_all[:m, k], pt_all[:m, k], np.append(heads, last)[:m],
         ))
     return tuple(out)
 
@@ -253,20 +276,22 @@ def course_laylines(
         leg, gybe laylines for a downwind leg, none for a reach or a leg to a line.
         Each is about as long as the leg (its start point to its target).
     """
-    out: list[tuple[Layline, ...]] = []
+    specs: list[tuple[str, tuple[float, float], float, float]] = []
+    kinds: list[LaylineKind] = []
+    counts: list[int] = []
     for spec, (mode, res) in zip(course.legs, legs, strict=True):
         kind = leg_layline_kind(mode)
         feat = course.feature(spec.to_name)
-        if kind is None or spec.kind == "line":
-            out.append(())
-            continue
         ends = [feat] if isinstance(feat, Mark) else [feat.a, feat.b]
         cx = float(np.mean([m.x for m in ends]))
         cy = float(np.mean([m.y for m in ends]))
         length = math.hypot(cx - res.start_xy[0], cy - res.start_xy[1])
-        if length <= 0:
-            out.append(())
+        if kind is None or spec.kind == "line" or length <= 0:
+            counts.append(0)
             continue
-        out.append(trace_laylines([(m.name, m.xy) for m in ends], res.t_end, wind, boat,
-                                  kind, length, n_steps=n_steps))
-    return tuple(out)
+        specs += [(m.name, m.xy, float(res.t_end), length) for m in ends]
+        kinds += [kind] * len(ends)
+        counts.append(2 * len(ends))
+    lines = _traced(specs, kinds, wind, boat, n_steps) if specs else ()
+    bounds = np.cumsum([0, *counts])
+    return tuple(tuple(lines[bounds[i]:bounds[i + 1]]) for i in range(len(counts)))
