@@ -91,7 +91,9 @@ def test_plan_table_report_and_map(planned):
     output, out = planned
     assert "start line" in output
     assert "bias                      +5.0° (starboard end boat favoured)" in output
-    fig = read_figure((out / "report.html").read_text(encoding="utf-8"))
+    page = (out / "report.html").read_text(encoding="utf-8")
+    assert "Start line" in page and "+5.0° (starboard end boat favoured)" in page
+    fig = read_figure(page)
     names = [t.get("name") for t in fig["data"]]
     assert "favoured end" in names and names.count("laylines") == 4
     star = next(t for t in fig["data"] if t.get("name") == "favoured end")
@@ -155,3 +157,19 @@ def test_start_refuses_a_course_without_a_start_line(tmp_path):
     p.write_text(yaml.safe_dump(course_mapping(first_from="bottom")), encoding="utf-8")
     _refused(["start", str(p), "--xy", "0,-100", "--time", "-60"], tmp_path,
              "the first leg starts from 'bottom', which is not a line")
+
+
+def test_route_png_draws_laylines_and_the_favoured_end(course_file):
+    from sailroute.plan import plan_course
+    from sailroute.report.plots import plot_plan
+
+    run = plan_course(load_course(course_file))
+    ax = plot_plan(run.plan, run.wind).axes[0]
+    gids = {a.get_gid() for a in ax.get_lines()}
+    assert {"layline:1:top:starboard", "layline:1:top:port", "layline:2:bottom:starboard",
+            "layline:2:bottom:port", "favoured-end"} <= gids
+    star = next(a for a in ax.get_lines() if a.get_gid() == "favoured-end")
+    assert (star.get_xdata()[0], star.get_ydata()[0]) == pytest.approx((HALF, END_Y))
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "laylines" in labels and "favoured start end" in labels
+    assert ax.get_legend().get_title().get_text().startswith("grey arrows: wind")
