@@ -104,7 +104,7 @@ def draw_start_and_laylines(ax: Any, sl: StartLineNumbers | None,
         ax.annotate(f"favoured +{sl.gain_m:.0f} m", (fx, fy), xytext=(8, -12),
                     textcoords="offset points", fontsize=7, color="#1b5e20", zorder=9)
     old = ax.get_legend()
-    if old is not None and (not first or sl is not None and sl.favoured_xy is not None):
+    if old is not None and (not first or (sl is not None and sl.favoured_xy is not None)):
         ax.legend(loc="best", fontsize=8, title=old.get_title().get_text(), title_fontsize=8)
 
 
