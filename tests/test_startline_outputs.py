@@ -173,3 +173,16 @@ def test_route_png_draws_laylines_and_the_favoured_end(course_file):
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "laylines" in labels and "favoured start end" in labels
     assert ax.get_legend().get_title().get_text().startswith("grey arrows: wind")
+
+
+def test_plan_from_a_mark_has_no_start_line():
+    from sailroute.course.load import course_from_mapping
+    from sailroute.plan import plan_course
+    from sailroute.report.files import plan_to_dict
+    from sailroute.report.tables import plan_table
+
+    plan = plan_course(course_from_mapping(course_mapping(first_from="bottom"))).plan
+    assert plan.start_line is None
+    assert plan_to_dict(plan)["start_line"] is None
+    assert "\nstart line\n" not in plan_table(plan) and "bias" not in plan_table(plan)
+    assert [ll.kind for ll in plan.laylines[0]] == ["tack", "tack"]  # bottom -> top: a beat
