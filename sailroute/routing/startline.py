@@ -198,12 +198,17 @@ def start_line_numbers(
 
     Raises
     ------
+    InputError
+        Both ends at the same place.
     OutOfCoverageError
         The wind does not cover the line's midpoint at the gun.
     """
     mid = (0.5 * (a_xy[0] + b_xy[0]), 0.5 * (a_xy[1] + b_xy[1]))
     tws, twd = (float(v) for v in _wind_at(wind, t_gun, mid))
     length = float(np.hypot(b_xy[0] - a_xy[0], b_xy[1] - a_xy[1]))
+    if not length > 0:
+        raise InputError(f"start line {names[0]} - {names[1]}: both ends are at the same "
+                         "place; a line needs two distinct marks")
     bias_arr, b_star = line_bias_deg(a_xy, b_xy, twd)
     bias = float(bias_arr)
     starboard, port = (names[1], names[0]) if b_star else (names[0], names[1])
@@ -217,7 +222,7 @@ def start_line_numbers(
     try:
         _, twds = _wind_at(wind, times, mid)
     except OutOfCoverageError:  # a field that covers the gun but not the minutes before
-        twds = np.array([twd])
+        twds, t0 = np.array([twd]), float(t_gun)
     window = line_bias_deg(a_xy, b_xy, np.append(twd, twds))[0]  # ends named at the gun
     # the bias relative to the gun's, so a range across ±180° stays contiguous
     rel = wrap180(window - bias)

@@ -199,3 +199,22 @@ def test_boat_above_the_line_is_on_the_course_side():
     assert ap.distance_m == pytest.approx(50.0)
     assert all(not a.reaches for a in ap.close_hauled)  # close-hauled leads away from it
     assert ap.fastest.reaches and ap.fastest.twa_deg > 90.0  # back down to it
+
+
+def test_wind_outside_its_time_span_is_taken_at_the_edge_with_a_note():
+    wind = UniformWind([TWS, TWS], [0.0, 0.0], times=[T_GUN - 60.0, T_GUN + 600.0])
+    west, east = rotated_line(300.0, 0.0)
+    ap = line_approach((0.0, -100.0), T_GUN - 120.0, west, east, wind, POLAR, T_GUN)
+    assert ap.tws_ms == pytest.approx(TWS) and ap.twd_deg == pytest.approx(0.0)
+    assert "the wind data cover" in ap.wind_note and "is used" in ap.wind_note
+    inside = line_approach((0.0, -100.0), T_GUN - 30.0, west, east, wind, POLAR, T_GUN)
+    assert inside.wind_note == ""
+    assert inside.fastest.time_s == pytest.approx(ap.fastest.time_s, rel=1e-12)
+
+
+def test_a_line_of_zero_length_is_refused():
+    from sailroute.errors import InputError
+
+    with pytest.raises(InputError, match="both ends are at the same place"):
+        start_line_numbers((1.0, 2.0), (1.0, 2.0), UniformWind(TWS, 0.0), POLAR, T_GUN,
+                           names=("p", "q"))
