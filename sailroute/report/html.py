@@ -983,9 +983,8 @@ def figure(report: Report) -> dict[str, Any]:
 
     Trace order: wind layers, course (lines and gates, marks), the overlays, then per
     route its line, tacks, gybes (and leg numbers on the first route) and the boat
-    marker.  Frame ``k``
-    (named ``str(k)``) moves every boat marker and every time-varying wind layer to
-    ``report.times[k]``; the slider's steps animate to them.
+    marker.  Frame ``k`` (named ``str(k)``) moves every boat marker and every
+    time-varying wind layer to ``report.times[k]``; the slider's steps animate to them.
     """
     course, off = report.course, report.course.utc_offset_s
     data: list[dict[str, Any]] = []
