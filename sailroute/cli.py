@@ -331,6 +331,55 @@ def plan_command(
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
+@app.command("start", cls=_Command,
+             short_help="Time to the start line from a position, and the time to burn.")
+def start_command(
+    ctx: typer.Context,
+    course: CourseArg,
+    time: Annotated[
+        str,
+        typer.Option("--time", "-t", metavar="T",
+                     help="When the boat is there: ISO 8601 with offset "
+                     "(2018-04-24T12:08:30+02:00) or seconds from the gun (-90)."),
+    ],
+    at: Annotated[
+        str | None,
+        typer.Option("--at", metavar="LAT,LON", help="The boat's position in degrees."),
+    ] = None,
+    xy: Annotated[
+        str | None,
+        typer.Option("--xy", metavar="X,Y",
+                     help="The boat's position in metres east and north of the course origin "
+                     "(instead of --at)."),
+    ] = None,
+    scenario: Annotated[
+        str | None,
+        typer.Option("--scenario", "-s", metavar="NAME",
+                     help="Wind scenario (default: the first in the file)."),
+    ] = None,
+    out: Annotated[
+        str | None,
+        typer.Option("--out", "-o", metavar="DIR",
+                     help="Output folder (default: out/<course>/start)."),
+    ] = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Distance and time to the start line on each tack, the fastest approach, time to burn."""
+    from sailroute.commands.start import run_start_command
+
+    def run() -> Any:
+        _check_out(out)
+        with _terminal_tables(json_out):
+            return run_start_command(course, time=time, at=at, xy=xy, scenario=scenario,
+                                     out_dir=out)
+
+    res = run_guarded(run, debug=_debug(ctx))
+    if not json_out:
+        for note in res.notes:
+            typer.echo(f"note: {note}", err=True)
+    _finish(res, json_out)
+
+
 @app.command("compare-scenarios", cls=_Command,
              short_help="Route a course in several wind scenarios, side by side.")
 def compare_command(

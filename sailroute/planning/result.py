@@ -16,6 +16,8 @@ import numpy as np
 from sailroute.course.geometry import WindMode, feature_centre, leg_wind_mode
 from sailroute.course.model import Course, LegSpec, Line
 from sailroute.errors import InputError
+from sailroute.routing.laylines import Layline
+from sailroute.routing.startline import StartLineNumbers
 from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
@@ -64,6 +66,12 @@ class Plan:
         Reference leg times [s] to compare with (course-wide plus the scenario's).
     router : str
         Router name.
+    start_line : StartLineNumbers or None
+        The start line in the wind at the gun (bias, favoured end; None without a
+        start line or when not computed).
+    laylines : tuple of tuple of Layline
+        Per leg, the laylines to its mark or gate (empty tuples for reaches and lines;
+        empty when not computed).
     """
 
     course: Course
@@ -71,6 +79,8 @@ class Plan:
     legs: tuple[PlannedLeg, ...]
     references: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
     router: str = ""
+    start_line: StartLineNumbers | None = None
+    laylines: tuple[tuple[Layline, ...], ...] = ()
 
     @property
     def total_time_s(self) -> float:

@@ -293,7 +293,14 @@ def _routed(
         check_current_router(settings.router)
     results = route_course(course, wind, boat, settings, backend=options.backend,
                            progress=progress, current=current)
-    return PlannedCourse(make_plan(course, name, results, wind, router=settings.router), wind)
+    plan = make_plan(course, name, results, wind, router=settings.router)
+    # start line numbers and laylines (routing/startline.py, routing/laylines.py)
+    from sailroute.planning.startline import course_laylines, course_start_line_numbers
+
+    plan = dataclasses.replace(
+        plan, start_line=course_start_line_numbers(course, wind, boat),
+        laylines=course_laylines(course, [(pl.mode, pl.result) for pl in plan.legs], wind, boat))
+    return PlannedCourse(plan, wind)
 
 
 def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:

@@ -33,6 +33,7 @@ from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
 from sailroute.planning.result import Comparison, Plan, percent_error
 from sailroute.report.route_export import route_points, write_kml, write_nmea
+from sailroute.report.startline import laylines_to_dicts, start_line_to_dict
 from sailroute.routing.types import side_name
 from sailroute.textin import CleanCsvWriter, clean_text
 from sailroute.timeutil import iso
@@ -78,8 +79,9 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
     dict
         Keys ``schema_version``, ``sailroute_version``, ``course``, ``source``,
         ``scenario``, ``router``, ``start_time``, ``end_time``, ``total_time_s``,
-        ``total_distance_m``, ``total_tacks``, ``total_gybes``, ``legs``,
-        ``references``; see ``docs/output-format.md``.
+        ``total_distance_m``, ``total_tacks``, ``total_gybes``, ``start_line``,
+        ``legs`` (each with its ``laylines``), ``references``; see
+        ``docs/output-format.md``.
     """
     c = plan.course
     legs = []
@@ -111,6 +113,7 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
                 name: _num(percent_error(r.time_s, times[k]), 3)
                 for name, times in plan.references.items()
             },
+            "laylines": laylines_to_dicts(plan.laylines[k] if plan.laylines else (), c.frame),
         })
     total = plan.total_time_s
     return {
@@ -128,6 +131,7 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
         "total_gybes": int(sum(pl.result.n_gybes for pl in plan.legs)),
         "origin": {"lat": c.frame.lat0, "lon": c.frame.lon0},
         "current": _current_of(plan),
+        "start_line": start_line_to_dict(plan.start_line, c.frame),
         "legs": legs,
         "references": {
             name: {"total_time_s": _num(sum(times)),

@@ -249,6 +249,8 @@ class Report:
         Put the leg numbers on the first route.
     legend_beside : bool
         Legend in a column right of the map (many entries) instead of a row above it.
+    overlays : tuple of dict
+        More plotly traces drawn over the course (laylines, the favoured start end).
     """
 
     title: str
@@ -262,6 +264,7 @@ class Report:
     colour_by_speed: bool = False
     leg_numbers: bool = True
     legend_beside: bool = False
+    overlays: tuple[dict[str, Any], ...] = ()
 
 
 # ---------------------------------------------------------------------------------------------
@@ -570,9 +573,16 @@ def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
         f"{sum(pl.result.n_gybes for pl in plan.legs)} gybes; arrival "
         f"{time_label(plan.t_end, off)}",
     )
+    # the start line numbers, laylines and favoured end (report/startline.py)
+    from sailroute.report.startline import plotly_traces
+    from sailroute.report.tables import start_line_rows
+
+    start = () if plan.start_line is None else (
+        Table("Start line", ("", "at the gun"), tuple(start_line_rows(plan.start_line))),)
     return Report(f"{c.name} — {plan.scenario}", summary, c, (route,), tuple(layers), times,
-                  (_plan_table(plan, "Legs"),), (HELP, _times_note(c), _wind_note(layers)),
-                  colour_by_speed=True)
+                  (_plan_table(plan, "Legs"), *start),
+                  (HELP, _times_note(c), _wind_note(layers)), colour_by_speed=True,
+                  overlays=tuple(plotly_traces(plan.start_line, plan.laylines, c.frame)))
 
 
 def _layers(winds: Mapping[str, WindField], course: Course, routes: Sequence[Route],
@@ -971,10 +981,10 @@ def _leg_number_trace(r: Route, group: str) -> dict[str, Any]:
 def figure(report: Report) -> dict[str, Any]:
     """The plotly figure of the page: ``{"data", "layout", "frames", "config"}``.
 
-    Trace order: wind layers, course (lines and gates, marks), then per route its line,
-    tacks, gybes (and leg numbers on the first route) and the boat marker.  Frame ``k``
-    (named ``str(k)``) moves every boat marker and every time-varying wind layer to
-    ``report.times[k]``; the slider's steps animate to them.
+    Trace order: wind layers, course (lines and gates, marks), the overlays, then per
+    route its line, tacks, gybes (and leg numbers on the first route) and the boat
+    marker.  Frame ``k`` (named ``str(k)``) moves every boat marker and every
+    time-varying wind layer to ``report.times[k]``; the slider's steps animate to them.
     """
     course, off = report.course, report.course.utc_offset_s
     data: list[dict[str, Any]] = []
@@ -1009,6 +1019,7 @@ def figure(report: Report) -> dict[str, Any]:
             moving.append((len(data) - 1, [hd for _, hd in rows]))
 
     data += _course_traces(course)
+    data += list(report.overlays)
 
     single = report.colour_by_speed and len(report.routes) == 1
     slo, shi = speed_limits(np.concatenate([r.speed_kn for r in report.routes])) \

@@ -330,14 +330,19 @@ def plot_route(
 
 
 def plot_plan(plan: Plan, wind: WindField | None = None) -> Figure:
-    """:func:`plot_route` of a :class:`Plan` with a title giving scenario and total time."""
+    """:func:`plot_route` of a :class:`Plan` with a title giving scenario and total time,
+    its laylines (dashed grey) and the favoured end of the start line (green star)."""
     from sailroute.report.tables import format_duration
 
     off = plan.course.utc_offset_s
     title = (f"{plan.course.name} - {plan.scenario}: {format_duration(plan.total_time_s)} "
              f"({plan.total_time_s:.0f} s), start {local_time(plan.t_start, off)}")
-    return plot_route(plan.course, plan.results, wind, plan.t_start, title=title,
-                      utc_offset_s=off)
+    fig = plot_route(plan.course, plan.results, wind, plan.t_start, title=title,
+                     utc_offset_s=off)
+    from sailroute.report.startline import draw_start_and_laylines
+
+    draw_start_and_laylines(fig.axes[0], plan.start_line, plan.laylines)
+    return fig
 
 
 def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:

@@ -15,7 +15,9 @@ from contextvars import ContextVar
 from typing import Any
 
 from sailroute.planning.result import Comparison, Plan, PlannedLeg, percent_error
+from sailroute.routing.startline import Approach, LineApproach, StartLineNumbers
 from sailroute.timeutil import iso
+from sailroute.units import KNOT
 
 
 def format_duration(seconds: float) -> str:
@@ -134,7 +136,8 @@ def plan_table(plan: Plan) -> str:
 
     Columns: leg, from -> to, wind mode, time (m:ss.s and seconds), tacks, gybes,
     distance [m], start point on the line/gate the leg started from, then for each
-    reference its leg time and ``(model − ref)/ref``.
+    reference its leg time and ``(model − ref)/ref``; under it the "start line" block
+    (:func:`start_line_text`) when the plan has one.
     """
     refs = list(plan.references.items())
     headers = ["leg", "from -> to", "mode", "time", "time s", "tacks", "gybes", "dist m",
@@ -165,7 +168,9 @@ def plan_table(plan: Plan) -> str:
         f"start {iso(plan.t_start)}"
     )
     align = "rllrrrrrl" + "rr" * len(refs)
-    return title + "\n" + render_table(headers, rows, align=align, footer=[total])
+    start = start_line_text(plan.start_line)
+    return (title + "\n" + render_table(headers, rows, align=align, footer=[total])
+            + (f"\n\n{start}" if start else ""))
 
 
 def comparison_table(cmp: Comparison) -> str:
@@ -217,3 +222,80 @@ def comparison_table(cmp: Comparison) -> str:
                    render_table(["scenario", "reference", "legs", "total"], lines,
                                 align="lllr")]
     return "\n".join(blocks)
+
+
+# --- start line numbers (plan) and the approach to the line (start) ---------------------
+
+
+def _signed(v: float, nd: int = 1) -> str:
+    return f"{v:+.{nd}f}" if math.isfinite(v) else "-"
+
+
+def bias_text(sl: StartLineNumbers) -> str:
+    """``"+6.0° (starboard end start2 favoured)"`` or ``"+0.2° (square)"``."""
+    if sl.favoured_end is None:
+        return f"{_signed(sl.bias_deg)}° (square)"
+    return f"{_signed(sl.bias_deg)}° ({sl.favoured_side} end {sl.favoured_end} favoured)"
+
+
+def start_line_rows(sl: StartLineNumbers) -> list[tuple[str, str]]:
+    """The start line numbers as (name, value) rows (terminal block and HTML table)."""
+    rows = [
+        ("line", f"{sl.a_name} - {sl.b_name}, {sl.length_m:.0f} m"),
+        ("wind at the gun", f"{sl.tws_ms / KNOT:.1f} kn from {sl.twd_deg:.0f}°"),
+        ("bias", bias_text(sl)),
+        ("ends", f"starboard end {sl.starboard_end}, port end {sl.port_end}"),
+    ]
+    if sl.favoured_end is not None:
+        rows.append(("gain at the favoured end",
+                     f"{sl.gain_m:.1f} m upwind, {sl.gain_s:.1f} s at "
+                     f"{sl.vmg_ms / KNOT:.2f} kn VMG"))
+    if sl.window_s > 0:
+        steady = sl.bias_min_deg == sl.bias_max_deg
+        rows.append((f"bias range, {sl.window_s / 60:.0f} min before",
+                     f"{_signed(sl.bias_min_deg)}° (steady)" if steady else
+                     f"{_signed(sl.bias_min_deg)}° .. {_signed(sl.bias_max_deg)}°"))
+    return rows
+
+
+def start_line_text(sl: StartLineNumbers | None) -> str:
+    """The "start line" block under the plan table (empty without a start line)."""
+    if sl is None:
+        return ""
+    rows = start_line_rows(sl)
+    w = max(len(k) for k, _ in rows)
+    return "start line\n" + "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
+
+
+
+
+def _approach_row(ap: Approach) -> list[str]:
+    if not ap.reaches:
+        return [ap.label, ap.tack, f"{ap.heading_deg:.0f}", f"{ap.twa_deg:.0f}",
+                f"{ap.speed_ms / KNOT:.2f}", "misses", "-", "-"]
+    return [ap.label, ap.tack, f"{ap.heading_deg:.0f}", f"{ap.twa_deg:.0f}",
+            f"{ap.speed_ms / KNOT:.2f}", f"{ap.distance_m:.0f}", f"{ap.time_s:.1f}",
+            f"{100 * ap.fraction:.0f}%"]
+
+
+def approach_table(ap: LineApproach, course_name: str, line_names: tuple[str, str]) -> str:
+    """The terminal report of ``sailroute start``."""
+    head = [
+        f"{course_name} | start line {line_names[0]} - {line_names[1]} | at "
+        f"x {ap.p_xy[0]:.0f} m, y {ap.p_xy[1]:.0f} m | {iso(ap.t)}",
+        f"wind {ap.tws_ms / KNOT:.1f} kn from {ap.twd_deg:.0f}° | distance to the line "
+        f"{ap.distance_m:.0f} m{' (on the course side)' if ap.course_side else ''}",
+    ]
+    rows = [_approach_row(a) for a in (*ap.close_hauled, *ap.to_ends, *ap.tacks)]
+    table = render_table(["approach", "tack", "heading °", "TWA °", "speed kn", "path m",
+                          "time s", "on line"], rows, align="llrrrrrr")
+    f = ap.fastest
+    tail = [
+        f"fastest: {f.tack} tack, heading {f.heading_deg:.0f}°, "
+        f"{f.time_s:.1f} s to {100 * f.fraction:.0f}% along the line" if f.reaches else
+        "fastest: none, the boat has no speed in this wind",
+        f"time to the gun {format_duration(ap.time_to_gun_s)}, time to burn "
+        f"{format_duration(ap.time_to_burn_s)}"
+        + (" (late: the line cannot be reached by the gun)" if ap.time_to_burn_s < 0 else ""),
+    ]
+    return "\n".join([*head, table, *tail])
