@@ -26,11 +26,13 @@ from typing import Any
 import numpy as np
 
 from sailroute.checks import Checker, Problems, finite, join_path, show, suggest
+from sailroute.course.area import AREA_KEYS, check_area
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.outdir import path_part_problem
+from sailroute.routing.obstacles import RaceArea
 from sailroute.routing.types import (
     MIN_DT_S,
     MIN_HEADING_STEP_DEG,
@@ -46,7 +48,7 @@ __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
 TOP_KEYS = (
     "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
-    "legs", "template", "boat", "routing", "scenarios", "references",
+    "legs", "template", "boat", "routing", "scenarios", "references", *AREA_KEYS,
 )
 """Keys allowed at the top level of a course file."""
 
@@ -105,6 +107,9 @@ class CheckedCourse:
         Course-wide reference leg times [s].
     template : dict or None
         The ``template`` mapping, if the layout came from one.
+    area : RaceArea
+        ``boundary``, ``obstacles`` and ``wind_land_is_obstacle`` in the local frame
+        (:mod:`sailroute.course.area`).
     """
 
     name: str
@@ -123,6 +128,7 @@ class CheckedCourse:
     scenarios: dict[str, dict[str, Any]]
     references: dict[str, tuple[float, ...]]
     template: dict[str, Any] | None
+    area: RaceArea = dataclasses.field(default_factory=RaceArea)
 
 
 # ----------------------------------------------------------------------------- sections
@@ -796,6 +802,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     routing = _routing(c, data.get("routing"))
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
+    area = check_area(c, data, frame, xy, _position)
     probs.raise_if_any()
 
     assert frame is not None and start_time is not None  # guaranteed when no problems
@@ -816,6 +823,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         scenarios=scenarios,
         references=references,
         template=dict(template) if template is not None else None,
+        area=area,
     )
 
 

@@ -24,6 +24,7 @@ from typing import Any, Literal
 import numpy as np
 
 from sailroute.geo import LocalFrame
+from sailroute.routing.obstacles import RaceArea
 from sailroute.routing.types import RoutingSettings, Side
 from sailroute.timeutil import to_epoch
 
@@ -255,6 +256,9 @@ class Course:
         1-based line of each key path of the course file (``"scenarios.a.wind.tws_kn"``),
         so that the wind, current and boat factories report problems at their lines;
         empty for a course built from a mapping.
+    area : RaceArea
+        The race area: ``boundary``, ``obstacles`` and ``wind_land_is_obstacle``,
+        polygons in the local frame (:mod:`sailroute.routing.obstacles`).
     """
 
     name: str
@@ -275,6 +279,7 @@ class Course:
     boat_where: str = ""
     utc_offset_s: float = 0.0
     key_lines: Mapping[str, int] = field(default_factory=dict)
+    area: RaceArea = field(default_factory=RaceArea)
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):
