@@ -3,7 +3,7 @@
     python benchmarks/bench_obstacles.py [--laps 2] [--repeat 3] [--router isochrone] [--smoke]
 
 The course is a windward-leeward of 1000 m legs laid by the template in a uniform
-12 kn wind (no data files).  The obstructed copy adds a boundary 400 m round the marks
+12 kn wind (no data files).  The obstructed copy adds a boundary 350 m or more round the marks
 (20 m clearance) and ten 40 m x 40 m obstacles (10 m clearance) scattered over the
 course area, some across the direct routes.  Each plan is timed as ``plan_course`` does
 it (wind, boat, every leg routed), the best of ``--repeat``; the script prints the
@@ -58,16 +58,17 @@ scenarios:
   steady: {type: uniform, tws_kn: 12, twd_deg: 270}
 """
 
-# ten 40 m squares (centres, metres from the course centre; the course axis runs west):
-# some on or near the direct routes, some off them
-CENTRES = [(-150.0, 60.0), (-300.0, -120.0), (-420.0, 20.0), (-560.0, 180.0), (-700.0, -60.0),
-           (-840.0, 90.0), (-250.0, 260.0), (-620.0, -260.0), (-120.0, -220.0), (-900.0, -150.0)]
+# ten 40 m squares (centres, metres from the course centre; the windward mark is at
+# (-500, 0), the leeward gate at (500, +-25), the start line at x = 550): some on or near
+# the direct routes, some off them
+CENTRES = [(350.0, 60.0), (200.0, -120.0), (80.0, 20.0), (-60.0, 180.0), (-200.0, -60.0),
+           (-340.0, 90.0), (250.0, 260.0), (-120.0, -260.0), (380.0, -220.0), (-400.0, -150.0)]
 
 
 def area_yaml() -> str:
     """The boundary and the ten obstacles as course keys."""
-    lines = ["boundary:", "  clearance_m: 20", "  points: [{x: 500, y: -600}, {x: 500, y: 600}, "
-             "{x: -1500, y: 600}, {x: -1500, y: -600}]", "obstacles:"]
+    lines = ["boundary:", "  clearance_m: 20", "  points: [{x: 900, y: -600}, {x: 900, y: 600}, "
+             "{x: -900, y: 600}, {x: -900, y: -600}]", "obstacles:"]
     for k, (cx, cy) in enumerate(CENTRES):
         pts = ", ".join(f"{{x: {cx + dx:.0f}, y: {cy + dy:.0f}}}"
                         for dx, dy in ((-20, -20), (20, -20), (20, 20), (-20, 20)))
@@ -108,7 +109,7 @@ def main() -> None:
     assert obs is not None
     rng = np.random.default_rng(0)
     n = 20_000 if args.smoke else 200_000
-    x0, y0 = rng.uniform(-1500, 500, n), rng.uniform(-600, 600, n)
+    x0, y0 = rng.uniform(-900, 900, n), rng.uniform(-600, 600, n)
     ang = rng.uniform(0, 2 * np.pi, n)
     x1, y1 = x0 + 60 * np.sin(ang), y0 + 60 * np.cos(ang)
     for label, fn in (("edge test (NumPy)", obs.segments_free),

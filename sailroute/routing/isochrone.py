@@ -650,14 +650,24 @@ def _context(
 
 def _detour_origin(frame: _LegFrame, geom: TargetGeometry, obstacles: Obstacles | None,
                    start_xy: tuple[float, float]) -> tuple[float, float] | None:
-    """The start centre in the leg frame if the obstacles block the straight line from it
-    to the target centre (then the pruning sectors are seen from it), else None."""
+    """The start centre in the leg frame if the way round the obstacles that block the
+    straight line from it to the target centre is more than :data:`DETOUR_FRACTION`
+    longer (then the pruning sectors are seen from it), else None.  Sectors seen from
+    the start keep a whole circle of points (several times the work): a small obstacle
+    is passed as well with the target's sectors, whose front slides along it."""
     if obstacles is None:
         return None
     cx, cy = geom.centre
-    if bool(obstacles.segments_free(start_xy[0], start_xy[1], cx, cy)):
+    extra = obstacles.detour_m(start_xy, (cx, cy))
+    if extra <= DETOUR_FRACTION * math.hypot(cx - start_xy[0], cy - start_xy[1]):
         return None
     return _floats(frame.to_leg(*start_xy))
+
+
+DETOUR_FRACTION: Final = 0.005
+"""Estimated detour (:meth:`~sailroute.routing.obstacles.Obstacles.detour_m`), as a
+fraction of the straight start-target distance, above which the pruning sectors are seen
+from the start."""
 
 
 @dataclass(frozen=True, eq=False)

@@ -27,6 +27,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Final
 
+import math
+
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
@@ -43,7 +45,7 @@ BOUNDARY_NAME: Final = "the race-area boundary"
 QUAD_SEGS: Final = 4
 """Segments per quarter circle of a clearance buffer's rounded corners (the chord
 cuts at most ``1 - cos(11.25°)``, 1.9 %, of the clearance at a corner)."""
-_CHUNK: Final = 1 << 21
+_CHUNK: Final = 1 << 18
 """Most segment x edge pairs tested at once (memory of the orientation test)."""
 
 
@@ -150,9 +152,15 @@ class Obstacles:
     blocked : shapely geometry or None
         The union of the obstacles grown by their clearances (prepared); None: none.
     edges : ndarray
-        ``(E, 4)`` every ring edge ``x0, y0, x1, y1`` [m].
+        ``(E, 4)`` every ring edge ``x0, y0, x1, y1`` [m], grouped: each obstacle's
+        edges in runs of :data:`OBSTACLE_RUN`, then the boundary's in runs of
+        :data:`BOUNDARY_RUN`.
     owner : ndarray of int
         ``(E,)`` index into ``names`` of each edge.
+    group_box : ndarray
+        ``(G, 4)`` bounding box ``xmin, ymin, xmax, ymax`` [m] of each group of edges.
+    group_start : ndarray of int
+        ``(G + 1,)`` the groups' first edges (and the end).
     """
 
     names: tuple[str, ...]
@@ -160,6 +168,8 @@ class Obstacles:
     blocked: Any
     edges: NDArray[np.float64]
     owner: NDArray[np.int64]
+    group_box: NDArray[np.float64]
+    group_start: NDArray[np.int64]
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -206,8 +216,18 @@ class Obstacles:
         for g in (inside, blocked):
             if g is not None:
                 shapely.prepare(g)
-        return cls(tuple(names), inside, blocked, _edges(rings),
-                   np.asarray(owners, dtype=np.int64))
+        edges = _edges(rings)
+        own = np.asarray(owners, dtype=np.int64)
+        run = [BOUNDARY_RUN if n == BOUNDARY_NAME else OBSTACLE_RUN for n in names]
+        starts = [0] + [i for i in range(1, own.size) if own[i] != own[i - 1]
+                        or (i - _first(own, i)) % run[own[i]] == 0]
+        bounds = np.asarray([*starts, own.size], dtype=np.int64)
+        box = np.array([[min(edges[a:b, 0].min(), edges[a:b, 2].min()),
+                         min(edges[a:b, 1].min(), edges[a:b, 3].min()),
+                         max(edges[a:b, 0].max(), edges[a:b, 2].max()),
+                         max(edges[a:b, 1].max(), edges[a:b, 3].max())]
+                        for a, b in zip(bounds[:-1], bounds[1:], strict=True)]).reshape(-1, 4)
+        return cls(tuple(names), inside, blocked, edges, own, box, bounds)
 
     # ------------------------------------------------------------------ predicates
     def points_free(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
@@ -224,43 +244,31 @@ class Obstacles:
     def segments_cross(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
                        ) -> NDArray[np.bool_]:
         """True where the segment touches or crosses any ring edge (orientation test,
-        touching included, so a move through a vertex counts)."""
+        touching included, so a move through a vertex counts).  Each group of edges is
+        tested only against the segments whose bounding box meets the group's."""
         a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
         shape = a[0].shape
         sx0, sy0, sx1, sy1 = (v.reshape(-1) for v in a)
         hit = np.zeros(sx0.size, dtype=bool)
-        e = self.edges
-        if e.shape[0] == 0 or sx0.size == 0:
+        if sx0.size == 0:
             return hit.reshape(shape)
-        step = max(1, _CHUNK // e.shape[0])
-        ex0, ey0, ex1, ey1 = (e[:, k] for k in range(4))
-        exmin, exmax = np.minimum(ex0, ex1), np.maximum(ex0, ex1)
-        eymin, eymax = np.minimum(ey0, ey1), np.maximum(ey0, ey1)
-        for i in range(0, sx0.size, step):
-            sl = slice(i, i + step)
-            px0, py0 = sx0[sl, None], sy0[sl, None]
-            px1, py1 = sx1[sl, None], sy1[sl, None]
-            box = ((np.minimum(px0, px1) <= exmax) & (np.maximum(px0, px1) >= exmin)
-                   & (np.minimum(py0, py1) <= eymax) & (np.maximum(py0, py1) >= eymin))
-            if not box.any():
-                continue
-            si, ei = np.nonzero(box)
-            qx0, qy0 = sx0[sl][si], sy0[sl][si]
-            qx1, qy1 = sx1[sl][si], sy1[sl][si]
-            o1 = _orient(qx0, qy0, qx1, qy1, ex0[ei], ey0[ei])
-            o2 = _orient(qx0, qy0, qx1, qy1, ex1[ei], ey1[ei])
-            o3 = _orient(ex0[ei], ey0[ei], ex1[ei], ey1[ei], qx0, qy0)
-            o4 = _orient(ex0[ei], ey0[ei], ex1[ei], ey1[ei], qx1, qy1)
-            cross = (o1 * o2 <= 0.0) & (o3 * o4 <= 0.0)
-            hit[sl][si[cross]] = True
+        xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
+        ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
+        for g in range(self.group_box.shape[0]):
+            b = self.group_box[g]
+            idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
+            if idx.size:
+                e = self.edges[self.group_start[g]:self.group_start[g + 1]]
+                hit[idx] |= _cross(sx0[idx], sy0[idx], sx1[idx], sy1[idx], e)
         return hit.reshape(shape)
 
     def segments_free(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
                       ) -> NDArray[np.bool_]:
         """True where the straight move ``(x0, y0) -> (x1, y1)`` [m] stays in free
-        water: both ends free and no ring edge touched or crossed."""
-        return (self.points_free(x0, y0) & self.points_free(x1, y1)
-                & ~self.segments_cross(x0, y0, x1, y1))
+        water: its start is free and no ring edge is touched or crossed (so its end is
+        free too)."""
+        a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
+        return self.points_free(a[0], a[1]) & ~self.segments_cross(*a)
 
     def segments_free_shapely(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike,
                               y1: ArrayLike) -> NDArray[np.bool_]:
@@ -291,18 +299,31 @@ class Obstacles:
         Returns
         -------
         ndarray of bool, shape (n, m)
-            A row whose start is farther from every edge than its longest move is
-            decided by its start alone; the others are tested move by move
-            (:meth:`segments_free`).
+            A row whose start is farther than its longest move from every group's
+            bounding box is decided by its start alone; the others are tested move by
+            move (:meth:`segments_cross`).
         """
         px, py = np.asarray(px, dtype=float), np.asarray(py, dtype=float)
         qx, qy = np.asarray(qx, dtype=float), np.asarray(qy, dtype=float)
         start_ok = self.points_free(px, py)
         out = np.broadcast_to(start_ok[:, None], qx.shape).copy()
         reach = np.max(np.hypot(qx - px[:, None], qy - py[:, None]), axis=1, initial=0.0)
-        near = np.flatnonzero(self.edge_distance(px, py) <= reach)
-        if near.size:
-            out[near] = self.segments_free(px[near, None], py[near, None], qx[near], qy[near])
+        r = reach[:, None]
+        b = self.group_box
+        near = ((px[:, None] + r >= b[:, 0]) & (px[:, None] - r <= b[:, 2])
+                & (py[:, None] + r >= b[:, 1]) & (py[:, None] - r <= b[:, 3]))
+        for g in np.flatnonzero(near.any(axis=0)):
+            rows = np.flatnonzero(near[:, g])
+            sx1, sy1 = qx[rows], qy[rows]
+            sx0 = np.broadcast_to(px[rows, None], sx1.shape)
+            sy0 = np.broadcast_to(py[rows, None], sx1.shape)
+            box = ((np.maximum(sx0, sx1) >= b[g, 0]) & (np.minimum(sx0, sx1) <= b[g, 2])
+                   & (np.maximum(sy0, sy1) >= b[g, 1]) & (np.minimum(sy0, sy1) <= b[g, 3]))
+            ri, ci = np.nonzero(box)
+            if ri.size:
+                e = self.edges[self.group_start[g]:self.group_start[g + 1]]
+                hit = _cross(sx0[ri, ci], sy0[ri, ci], sx1[ri, ci], sy1[ri, ci], e)
+                out[rows[ri[hit]], ci[hit]] = False
         return out
 
     def edge_distance(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
@@ -334,6 +355,32 @@ class Obstacles:
         f = np.clip((ux * dx + uy * dy) / np.maximum(dx * dx + dy * dy, 1e-300), 0.0, 1.0)
         j = int(np.argmin(np.hypot(ux - f * dx, uy - f * dy)))
         return self.names[int(self.owner[j])]
+
+    def detour_m(self, a: tuple[float, float], b: tuple[float, float]) -> float:
+        """Estimated extra length [m] of the way from ``a`` to ``b`` round what blocks the
+        straight line: 0 when it is free, infinite when it leaves the boundary; else, for
+        the worst obstacle crossing it, the two-piece path past its nearer side (its
+        farthest vertex on that side from the line, at the obstacle's middle along it)."""
+        if bool(self.segments_free(a[0], a[1], b[0], b[1])):
+            return 0.0
+        line = shapely.LineString([a, b])
+        if self.inside is not None and not shapely.covers(self.inside, line):
+            return math.inf
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        if self.blocked is None or length == 0.0:
+            return 0.0
+        ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+        worst = 0.0
+        for part in shapely.get_parts(self.blocked):
+            if not shapely.intersects(part, line):
+                continue
+            c = shapely.get_coordinates(shapely.convex_hull(part))
+            u = (c[:, 0] - a[0]) * ux + (c[:, 1] - a[1]) * uy
+            v = (c[:, 1] - a[1]) * ux - (c[:, 0] - a[0]) * uy
+            w = min(max(float(v.max()), 0.0), max(float(-v.min()), 0.0))
+            d1 = min(max(float(np.median(u)), 0.0), length)
+            worst = max(worst, math.hypot(d1, w) + math.hypot(length - d1, w) - length)
+        return worst
 
     def separated(self, a: tuple[float, float], b: tuple[float, float]) -> str | None:
         """The name of what separates the points ``a`` and ``b`` [m] (the constraint
@@ -373,6 +420,45 @@ class Obstacles:
         if BOUNDARY_NAME in self.names:
             parts.append(BOUNDARY_NAME)
         return " and ".join(parts)
+
+
+BOUNDARY_RUN: Final = 1
+"""Edges of the boundary per group of the segment test's bounding-box filter (one: the
+boundary's box holds every point, an edge's box only those near it)."""
+OBSTACLE_RUN: Final = 32
+"""Most edges of an obstacle per group (a grown rectangle has 20: one group)."""
+
+
+def _first(owner: NDArray[np.int64], i: int) -> int:
+    """Index of the first edge with the owner of edge ``i``."""
+    return int(np.flatnonzero(owner == owner[i])[0])
+
+
+def _cross(sx0: Any, sy0: Any, sx1: Any, sy1: Any, e: NDArray[np.float64]) -> Any:
+    """Segments (shape (m,)) that touch or cross any of the edges ``e`` (shape (k, 4)),
+    in chunks of at most :data:`_CHUNK` pairs."""
+    hit = np.zeros(sx0.size, dtype=bool)
+    ex0, ey0, ex1, ey1 = (e[:, k] for k in range(4))
+    step = max(1, _CHUNK // max(1, e.shape[0]))
+    for i in range(0, sx0.size, step):
+        a0, b0 = sx0[i:i + step, None], sy0[i:i + step, None]
+        a1, b1 = sx1[i:i + step, None], sy1[i:i + step, None]
+        o1 = _orient(a0, b0, a1, b1, ex0, ey0)
+        o2 = _orient(a0, b0, a1, b1, ex1, ey1)
+        o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
+        o4 = _orient(ex0, ey0, ex1, ey1, a1, b1)
+        both = (o1 * o2 <= 0.0) & (o3 * o4 <= 0.0)
+        # collinear pairs (and a point on an edge's line) meet only where their extents
+        # overlap
+        line = (o1 == 0.0) & (o2 == 0.0) & (o3 == 0.0) & (o4 == 0.0)
+        if line.any():
+            over = ((np.minimum(a0, a1) <= np.maximum(ex0, ex1))
+                    & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
+                    & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
+                    & (np.maximum(b0, b1) >= np.minimum(ey0, ey1)))
+            both = np.where(line, over, both)
+        hit[i:i + step] = both.any(axis=1)
+    return hit
 
 
 def _orient(ax: Any, ay: Any, bx: Any, by: Any, cx: Any, cy: Any) -> Any:

@@ -222,3 +222,13 @@ def test_registry_says_what_each_router_supports() -> None:
     with pytest.raises(InputError, match=r"set routing\.router: isochrone"):
         route_leg(*REACH, T0, REACH_WIND, constant_polar(), reach_settings("spline"),
                   obstacles=obs)
+
+
+def test_a_point_move_crosses_nothing_in_an_edges_box() -> None:
+    # a zero-length move (a penalty stop) inside the bounding box of a long diagonal
+    # edge but far from it: free (its two ends are collinear with every edge)
+    tri = AreaPolygon("bound", (0.0, 1000.0, 0.0), (0.0, 1000.0, 1000.0))
+    obs = Obstacles.build(RaceArea(tri))
+    assert obs is not None
+    assert obs.segments_free([100.0, 500.0], [700.0, 500.0], [100.0, 500.0],
+                             [700.0, 500.0]).tolist() == [True, False]
