@@ -165,6 +165,13 @@ def check_current_router(router: str) -> None:
     check_router_supports(router, current=True)
 
 
+def _is_dynamic(boat: object) -> bool:
+    """A boat model without a steady polar but with segment dynamics (the dynamic boat);
+    anything else is left to the router's own check."""
+    return (isinstance(boat, BoatModel) and boat.routing_polar() is None
+            and boat.dynamics() is not None)
+
+
 def _check_passage(obstacles: Obstacles, start: Start, target: Target) -> None:
     """Refuse a leg whose start and target lie in separate parts of free water."""
     name = obstacles.separated(start_centre(start), target.centre)
@@ -240,7 +247,7 @@ def route_leg(
     extra: dict[str, Any] = {} if xp is np else {"xp": xp}  # NumPy is every router's default
     check_router_supports(settings.router, current=current is not None,
                           obstacles=obstacles is not None,
-                          dynamic_boat=boat.routing_polar() is None)
+                          dynamic_boat=_is_dynamic(boat))
     if current is not None:
         extra["current"] = current
     if obstacles is not None:

@@ -1664,12 +1664,12 @@ def _obstacle_blocked(
     (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`; the drift during a
     penalty stop is not tested separately)."""
     px, py = (to_numpy(v) for v in frame.to_world(c.x, c.y))
-    out = []
-    for k, (qx, qy) in enumerate(ends):
-        wx, wy = (to_numpy(v) for v in frame.to_world(qx, qy))
-        bad = xp.asarray(~obstacles.moves_free(px, py, wx, wy))
-        out.append(bad if blocked is None else blocked[k] | bad)
-    return out
+    qx = np.hstack([to_numpy(q[0]) for q in ends])  # both blocks in one call
+    qy = np.hstack([to_numpy(q[1]) for q in ends])
+    bad = ~obstacles.moves_free(px, py, *frame.to_world(qx, qy))
+    cut = int(ends[0][0].shape[1])
+    out = [xp.asarray(bad[:, :cut]), xp.asarray(bad[:, cut:])]
+    return out if blocked is None else [b | o for b, o in zip(blocked, out, strict=True)]
 
 
 def _blocked_error(f: _Layer, ctx: _Context, t: float) -> RoutingError:

@@ -23,11 +23,11 @@ Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C).
 
 from __future__ import annotations
 
+import itertools
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Final
-
-import math
 
 import numpy as np
 import shapely
@@ -226,7 +226,7 @@ class Obstacles:
                          min(edges[a:b, 1].min(), edges[a:b, 3].min()),
                          max(edges[a:b, 0].max(), edges[a:b, 2].max()),
                          max(edges[a:b, 1].max(), edges[a:b, 3].max())]
-                        for a, b in zip(bounds[:-1], bounds[1:], strict=True)]).reshape(-1, 4)
+                        for a, b in itertools.pairwise(bounds)]).reshape(-1, 4)
         return cls(tuple(names), inside, blocked, edges, own, box, bounds)
 
     # ------------------------------------------------------------------ predicates
