@@ -133,6 +133,28 @@ def test_spline_router_refuses_an_area(tmp_path):
         plan_course(load_course(write(tmp_path, router="spline")), "reach")
 
 
+@pytest.mark.parametrize(("area", "router", "code", "message"), [
+    (AREA.replace("y: 600}, {x: 350, y: 600}", "y: -20}, {x: 350, y: -20}"), "isochrone", 2,
+     "mark 'pin' (-50, 0 m) lies inside obstacle 'breakwater'"),
+    (AREA, "spline", 2, "honoured by the isochrone and griddp routers only"),
+    (AREA.replace("{x: -250, y: 600}, {x: 350, y: 600}, {x: 350, y: 750}, {x: -250, y: 750}",
+                  "{x: -700, y: 600}, {x: 700, y: 600}, {x: 700, y: 750}, {x: -700, y: 750}"),
+     "isochrone", 3, "no route round obstacle 'breakwater'"),
+])
+def test_cli_exit_codes_and_nothing_written(tmp_path, area, router, code, message):
+    from typer.testing import CliRunner
+
+    from sailroute.cli import app
+
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, ["plan", str(write(tmp_path, area, router)), "-o", str(out),
+                                   "-q", "--no-plots"])
+    assert res.exit_code == code, res.output
+    assert message in " ".join(res.output.split())
+    assert "Traceback" not in res.output
+    assert not out.exists() or not any(out.iterdir())
+
+
 # ---------------------------------------------------------------------- real: SailGP
 RACE = SHARED_REAL / "races" / "sailgp-auckland-2025"
 
