@@ -32,7 +32,7 @@ from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.geometry import chain_leg
-from sailroute.routing.obstacles import obstacles_for
+from sailroute.routing.obstacles import land_filled, obstacles_for
 from sailroute.routing.types import LegResult, RouterName, RoutingSettings
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
@@ -195,6 +195,7 @@ def route_course(
     """
     results: list[LegResult] = []
     obstacles = obstacles_for(course.area, wind)
+    wind = land_filled(course.area, wind)  # the NaN (land) cells, now obstacles, filled
     for i, spec in enumerate(course.legs):
         previous = results[-1] if results else None
         # chain_leg starts the leg at the previous arrival; a mark is rounded on its side:

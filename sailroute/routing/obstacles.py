@@ -23,6 +23,7 @@ Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Sequence
@@ -36,8 +37,8 @@ from numpy.typing import ArrayLike, NDArray
 from sailroute.wind.grid import GridWind
 
 __all__ = [
-    "BOUNDARY_NAME", "AreaPolygon", "Obstacles", "RaceArea", "land_obstacle", "obstacles_for",
-    "polygon_problem",
+    "BOUNDARY_NAME", "AreaPolygon", "Obstacles", "RaceArea", "land_filled", "land_obstacle",
+    "obstacles_for", "polygon_problem",
 ]
 
 BOUNDARY_NAME: Final = "the race-area boundary"
@@ -495,6 +496,32 @@ def land_obstacle(x: ArrayLike, y: ArrayLike, nan: ArrayLike, name: str = "land"
     cx, cy = xa[jj, ii], ya[jj, ii]
     boxes = shapely.box(cx - hx, cy - hy, cx + hx, cy + hy)
     return name, shapely.union_all(boxes)
+
+
+def land_filled(area: RaceArea, wind: Any) -> Any:
+    """The wind to route in: with ``wind_land_is_obstacle`` and a gridded wind holding
+    NaN (land) cells, a copy whose NaN nodes take the value of the nearest valid node.
+
+    Routes stay out of the land (:func:`obstacles_for`), but the isochrone router's time
+    to go samples the wind along the straight line to the target, which may cross it;
+    the filled values serve only there: every point in free water lies a grid spacing or
+    more from a NaN node, so its interpolated wind is unchanged.  Any other wind (or
+    course) is returned as it is.
+    """
+    if not (area.wind_land_is_obstacle and isinstance(wind, GridWind)):
+        return wind
+    u, v = np.asarray(wind.u, dtype=float), np.asarray(wind.v, dtype=float)
+    nan = np.isnan(u) | np.isnan(v)
+    if not nan.any() or nan.all():
+        return wind
+    from scipy.ndimage import distance_transform_edt
+
+    fu, fv = u.copy(), v.copy()
+    for k in range(u.shape[0]):
+        if nan[k].any():
+            _, (jj, ii) = distance_transform_edt(nan[k], return_indices=True)
+            fu[k], fv[k] = u[k][jj, ii], v[k][jj, ii]
+    return dataclasses.replace(wind, u=fu, v=fv, allow_nan=False)
 
 
 def obstacles_for(area: RaceArea, wind: object = None) -> Obstacles | None:

@@ -155,6 +155,33 @@ def test_cli_exit_codes_and_nothing_written(tmp_path, area, router, code, messag
     assert not out.exists() or not any(out.iterdir())
 
 
+def test_land_cells_of_a_gridded_wind_become_an_obstacle(tmp_path):
+    """An island of NaN cells across the direct route: without `wind_land_is_obstacle`
+    the route samples the hole and stops; with it, it goes round in wind everywhere."""
+    from sailroute.course.load import build_boat
+    from sailroute.errors import OutOfCoverageError, RoutingError
+    from sailroute.plan import route_course
+    from sailroute.wind.grid import GridWind
+
+    y, x = np.mgrid[-300:2001:50.0, -800:801:50.0]
+    u = np.full((1,) + x.shape, 6.0)  # from the west, 6 m/s
+    island = (np.abs(x) <= 150) & (np.abs(y - 800) <= 100)
+    u[0, island] = np.nan
+    wind = GridWind([0.0], x, y, u, np.zeros_like(u), allow_nan=True, steady=True)
+    plain = load_course(write(tmp_path, area=""))
+    with pytest.raises((OutOfCoverageError, RoutingError), match="NaN|no wind"):
+        route_course(plain, wind, build_boat(plain), plain.routing)
+    course = load_course(write(tmp_path, area="wind_land_is_obstacle: true", name="land.yaml"))
+    assert course.area.wind_land_is_obstacle
+    obs = obstacles_for(course.area, wind)
+    assert obs is not None and obs.names == ("land",)
+    (leg,) = route_course(course, wind, build_boat(course), course.routing)
+    tr = leg.track
+    assert np.all(np.isfinite(tr.tws_ms))
+    assert np.all(obs.segments_free(tr.x[:-1], tr.y[:-1], tr.x[1:], tr.y[1:]))
+    assert np.max(np.abs(tr.x)) > 150.0  # round the island, not through it
+
+
 # ---------------------------------------------------------------------- real: SailGP
 RACE = SHARED_REAL / "races" / "sailgp-auckland-2025"
 
