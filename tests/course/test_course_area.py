@@ -164,12 +164,12 @@ def test_land_cells_of_a_gridded_wind_become_an_obstacle(tmp_path):
     from sailroute.wind.grid import GridWind
 
     y, x = np.mgrid[-300:2001:50.0, -800:801:50.0]
-    u = np.full((1,) + x.shape, 6.0)  # from the west, 6 m/s
+    u = np.full((1, *x.shape), 6.0)  # from the west, 6 m/s
     island = (np.abs(x) <= 150) & (np.abs(y - 800) <= 100)
     u[0, island] = np.nan
     wind = GridWind([0.0], x, y, u, np.zeros_like(u), allow_nan=True, steady=True)
     plain = load_course(write(tmp_path, area=""))
-    with pytest.raises((OutOfCoverageError, RoutingError), match="NaN|no wind"):
+    with pytest.raises((OutOfCoverageError, RoutingError), match=r"NaN|no wind"):
         route_course(plain, wind, build_boat(plain), plain.routing)
     course = load_course(write(tmp_path, area="wind_land_is_obstacle: true", name="land.yaml"))
     assert course.area.wind_land_is_obstacle
