@@ -1662,7 +1662,7 @@ def _obstacle_blocked(
     """``blocked`` (:func:`_barrier_blocked`) with the moves that leave free water added:
     each move from its row's point to its end, in the world frame
     (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`; the drift during a
-    penalty stop is not tested separately)."""
+    penalty pause is not tested separately)."""
     px, py = (to_numpy(v) for v in frame.to_world(c.x, c.y))
     qx = np.hstack([to_numpy(q[0]) for q in ends])  # both blocks in one call
     qy = np.hstack([to_numpy(q[1]) for q in ends])

@@ -157,7 +157,7 @@ def test_cli_exit_codes_and_nothing_written(tmp_path, area, router, code, messag
 
 def test_land_cells_of_a_gridded_wind_become_an_obstacle(tmp_path):
     """An island of NaN cells across the direct route: without `wind_land_is_obstacle`
-    the route samples the hole and stops; with it, it goes round in wind everywhere."""
+    the route samples the hole and fails; with it, it goes round in wind everywhere."""
     from sailroute.course.load import build_boat
     from sailroute.errors import OutOfCoverageError, RoutingError
     from sailroute.plan import route_course

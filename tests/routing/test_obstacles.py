@@ -226,7 +226,7 @@ def test_registry_says_what_each_router_supports() -> None:
 
 
 def test_a_point_move_crosses_nothing_in_an_edges_box() -> None:
-    # a zero-length move (a penalty stop) inside the bounding box of a long diagonal
+    # a zero-length move (a penalty pause) inside the bounding box of a long diagonal
     # edge but far from it: free (its two ends are collinear with every edge)
     tri = AreaPolygon("bound", (0.0, 1000.0, 0.0), (0.0, 1000.0, 1000.0))
     obs = Obstacles.build(RaceArea(tri))
