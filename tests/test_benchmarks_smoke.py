@@ -37,6 +37,7 @@ CASES = [
      else r"^bench_fleet_wind\.py: .* not present .*: nothing measured$"),
     ("bench_gpu.py", r"^(bench_gpu\.py: no GPU here, nothing measured: |GPU .* GiB; CPU )"),
     ("gpu_checks.sh", r"^(gpu_checks\.sh: no NVIDIA GPU here|cupy \d)"),
+    ("bench_obstacles.py", r"^  ratio \d+\.\d\d \(target <= 1\.30\)$"),
     pytest.param("bench_strategy.py", r"^SDP 101 x 40 rows x 2 tacks x 19 shifts, .*"
                  r"E\[T\] = \d+\.\d s$", marks=SLOW),
     pytest.param("bench_deadline.py", r"^  Monte Carlo 200 runs/policy ", marks=SLOW),

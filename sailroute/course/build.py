@@ -60,8 +60,7 @@ def build_course(
         boat_where=checked.boat_where,
         utc_offset_s=checked.utc_offset_s,
         key_lines=MappingProxyType(dict(key_lines or {})),
-        boundary=checked.boundary,
-        obstacles=checked.obstacles,
+        area=checked.area,
     )
 
 

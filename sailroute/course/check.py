@@ -35,12 +35,13 @@ from sailroute.checks import (
     show,
     suggest,
 )
-from sailroute.course.areas import AREA_KEYS, Area, check_areas
+from sailroute.course.area import AREA_KEYS, check_area
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.outdir import path_part_problem
+from sailroute.routing.obstacles import RaceArea
 from sailroute.routing.types import (
     MIN_DT_S,
     MIN_HEADING_STEP_DEG,
@@ -116,6 +117,9 @@ class CheckedCourse:
         Course-wide reference leg times [s].
     template : dict or None
         The ``template`` mapping, if the layout came from one.
+    area : RaceArea
+        ``boundary``, ``obstacles`` and ``wind_land_is_obstacle`` in the local frame
+        (:mod:`sailroute.course.area`).
     """
 
     name: str
@@ -134,8 +138,7 @@ class CheckedCourse:
     scenarios: dict[str, dict[str, Any]]
     references: dict[str, tuple[float, ...]]
     template: dict[str, Any] | None
-    boundary: Area | None = None
-    obstacles: tuple[Area, ...] = ()
+    area: RaceArea = dataclasses.field(default_factory=RaceArea)
 
 
 # ----------------------------------------------------------------------------- sections
@@ -832,7 +835,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     routing = _routing(c, data.get("routing"))
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
-    boundary, obstacles = check_areas(c, data, frame)
+    area = check_area(c, data, frame, xy, _position)
     probs.raise_if_any()
 
     assert frame is not None and start_time is not None  # guaranteed when no problems
@@ -853,8 +856,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         scenarios=scenarios,
         references=references,
         template=dict(template) if template is not None else None,
-        boundary=boundary,
-        obstacles=obstacles,
+        area=area,
     )
 
 

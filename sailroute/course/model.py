@@ -23,8 +23,8 @@ from typing import Any, Literal
 
 import numpy as np
 
-from sailroute.course.areas import Area
 from sailroute.geo import LocalFrame
+from sailroute.routing.obstacles import RaceArea
 from sailroute.routing.types import RoutingSettings, Side
 from sailroute.timeutil import to_epoch
 
@@ -257,10 +257,9 @@ class Course:
         1-based line of each key path of the course file (``"scenarios.a.wind.tws_kn"``),
         so that the wind, current and boat factories report problems at their lines;
         empty for a course built from a mapping.
-    boundary : Area or None
-        The race area routes stay inside (``boundary``; not used by the routers yet).
-    obstacles : tuple of Area
-        Areas routes stay out of (``obstacles``; not used by the routers yet).
+    area : RaceArea
+        The race area: ``boundary``, ``obstacles`` and ``wind_land_is_obstacle``,
+        polygons in the local frame (:mod:`sailroute.routing.obstacles`).
     """
 
     name: str
@@ -281,8 +280,7 @@ class Course:
     boat_where: str = ""
     utc_offset_s: float = 0.0
     key_lines: Mapping[str, int] = field(default_factory=dict)
-    boundary: Area | None = None
-    obstacles: tuple[Area, ...] = ()
+    area: RaceArea = field(default_factory=RaceArea)
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):

@@ -29,6 +29,7 @@ from sailroute.planning.result import Comparison, Plan, compare, make_plan
 from sailroute.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.geometry import chain_leg
+from sailroute.routing.obstacles import land_filled, obstacles_for
 from sailroute.routing.types import LegResult, RouterName, RoutingSettings
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
@@ -214,9 +215,13 @@ def route_course(
     list of LegResult
         One per leg; ``results[i].t_start == results[i - 1].t_end`` and
         ``results[i].start_xy == results[i - 1].end_xy``.  A leg to a mark ends once
-        the mark is rounded on its side, and the next leg may not cross back.
+        the mark is rounded on its side, and the next leg may not cross back.  Every
+        leg stays inside the course's boundary and round its obstacles
+        (:func:`~sailroute.routing.obstacles.obstacles_for`).
     """
     results: list[LegResult] = []
+    obstacles = obstacles_for(course.area, wind)
+    wind = land_filled(course.area, wind)  # the NaN (land) cells, now obstacles, filled
     for i, spec in enumerate(course.legs):
         previous = results[-1] if results else None
         # chain_leg starts the leg at the previous arrival; a mark is rounded on its side:
@@ -229,7 +234,8 @@ def route_course(
             progress.start_leg(i, spec.label)
         res = route_leg(start, target, t0, wind, boat, settings, backend=backend,
                         progress=progress.update if progress is not None else None,
-                        **({} if current is None else {"current": current}))
+                        **({} if current is None else {"current": current}),
+                        obstacles=obstacles)
         if progress is not None:
             progress.end_leg(res.time_s, f"{res.n_tacks} tacks, {res.n_gybes} gybes")
         results.append(res)

@@ -40,6 +40,7 @@ from sailroute.routing.geometry import (
     start_centre,
     target_geometry,
 )
+from sailroute.routing.obstacles import Obstacles
 from sailroute.routing.types import Barrier, Start, Target
 from sailroute.units import wind_speed_direction, wrap180
 from sailroute.wind.base import WindField
@@ -167,10 +168,15 @@ class PathLimits:
         The leg's barriers with their mark clearances [m]
         (:func:`~sailroute.routing.geometry.leg_barriers`): the target's entry
         barrier and the previous leg's rounding ray (``Start.barrier``).
+    obstacles : Obstacles or None
+        The race area: a piece must stay in free water
+        (:meth:`~sailroute.routing.obstacles.Obstacles.segments_free`), so nodes inside
+        an obstacle or outside the boundary are never reached.
     """
 
     normal: tuple[float, float]
     barriers: tuple[tuple[Barrier, float], ...] = ()
+    obstacles: Obstacles | None = None
 
     def allowed(self, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, last: bool
                 ) -> NDArray:
@@ -181,6 +187,8 @@ class PathLimits:
             ok &= (x1 - x0) * self.normal[0] + (y1 - y0) * self.normal[1] > 0
         for bar, clear in self.barriers:
             ok &= ~barrier_blocks(x0, y0, x1, y1, bar, clear)
+        if self.obstacles is not None:
+            ok &= self.obstacles.segments_free(x0, y0, x1, y1)
         return ok
 
 

@@ -9,9 +9,12 @@ router         function                                         module
 =============  ===============================================  ==========================
 
 All routers share the signature declared by :class:`~sailroute.routing.types.Router`,
-``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy) -> LegResult``
-(``boat`` a :class:`~sailroute.boat.model.BoatModel`; ``xp``, an array module, is passed by
-:func:`route_leg` only for a non-NumPy ``backend``; each router module declares
+``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy, current=None,
+obstacles=None) -> LegResult`` (``boat`` a :class:`~sailroute.boat.model.BoatModel`; ``xp``,
+an array module, is passed by :func:`route_leg` only for a non-NumPy ``backend``;
+``current`` and ``obstacles`` only when given, and only to a router whose
+:class:`RouterEntry` supports them; a router that does not refuses them with a message
+(:func:`check_router_supports`); each router module declares
 ``_ROUTER: Router = route_...`` so that mypy checks it) and
 report through :func:`~sailroute.routing.track.make_leg_result`, so their results
 compare directly.  The grid-DP and spline routers are imported only when asked for.
@@ -21,23 +24,56 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from sailroute.backend import get_xp
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError, RoutingError
-from sailroute.routing.geometry import leg_label
+from sailroute.routing.geometry import leg_label, start_centre
 from sailroute.routing.types import LegResult, Router, RoutingSettings, Start, Target
 from sailroute.wind.base import WindField
 
-ROUTERS: dict[str, tuple[str, str]] = {
-    "isochrone": ("sailroute.routing.isochrone", "route_isochrone"),
-    "griddp": ("sailroute.routing.griddp", "route_griddp"),
-    "spline": ("sailroute.routing.multispline", "route_spline"),
+if TYPE_CHECKING:
+    from sailroute.routing.obstacles import Obstacles
+
+
+@dataclass(frozen=True)
+class RouterEntry:
+    """A registered router: where it lives and what it supports.
+
+    Attributes
+    ----------
+    module, function : str
+        The routing function ``module.function`` (imported when first asked for).
+    current : bool
+        Routes a surface current (``current=`` keyword).
+    obstacles : bool
+        Honours a race-area boundary and obstacles (``obstacles=`` keyword).
+    dynamic_boat : bool
+        Routes a boat without a steady polar (the dynamic model).
+    backends : tuple of str
+        Array backends of its kernels (:func:`sailroute.backend.get_xp`).
+    """
+
+    module: str
+    function: str
+    current: bool = False
+    obstacles: bool = False
+    dynamic_boat: bool = False
+    backends: tuple[str, ...] = ("numpy", "cupy")
+
+
+ROUTERS: dict[str, RouterEntry] = {
+    "isochrone": RouterEntry("sailroute.routing.isochrone", "route_isochrone",
+                             current=True, obstacles=True),
+    "griddp": RouterEntry("sailroute.routing.griddp", "route_griddp",
+                          obstacles=True, dynamic_boat=True),
+    "spline": RouterEntry("sailroute.routing.multispline", "route_spline", dynamic_boat=True),
 }
-"""Router name -> (module, function)."""
+"""Router name -> :class:`RouterEntry`."""
 
 
 def get_router(name: str) -> Router:
@@ -55,7 +91,7 @@ def get_router(name: str) -> Router:
             f"routing.router: unknown router {name!r}; expected one of "
             + ", ".join(repr(k) for k in ROUTERS)
         )
-    module_name, func_name = ROUTERS[name]
+    module_name, func_name = ROUTERS[name].module, ROUTERS[name].function
     try:
         module = importlib.import_module(module_name)
     except ModuleNotFoundError as exc:
@@ -75,19 +111,77 @@ def get_router(name: str) -> Router:
     return func
 
 
+def check_router_supports(
+    router: str, *, current: bool = False, obstacles: bool = False,
+    dynamic_boat: bool = False,
+) -> None:
+    """Refuse what a course asks of a router that the router does not support.
+
+    Parameters
+    ----------
+    router : str
+        The router's name (see :data:`ROUTERS`).
+    current, obstacles, dynamic_boat : bool
+        Whether the course routes a surface current, a race-area boundary or
+        obstacles, a boat without a steady polar.
+
+    Raises
+    ------
+    InputError
+        Naming the router, what it lacks, and the routers that have it.
+    """
+    entry = ROUTERS.get(router)
+    if entry is None:
+        get_router(router)  # raises the unknown-router message
+        return
+    wants = (
+        (current, entry.current, "current",
+         "a current is supported by the {who} router{s} only; set routing.router: {first} "
+         "(or remove the scenario's `current:`)"),
+        (obstacles, entry.obstacles, "obstacles",
+         "a race-area boundary or obstacles are honoured by the {who} router{s} only; set "
+         "routing.router: {first} (or remove the course's `boundary:`/`obstacles:`)"),
+        (dynamic_boat, entry.dynamic_boat, "dynamic_boat",
+         "a boat without a steady polar is routed by the {who} router{s} only; set "
+         "routing.router: {first} (or give the boat a polar)"),
+    )
+    for asked, has, attr, text in wants:
+        if asked and not has:
+            able = [k for k, e in ROUTERS.items() if getattr(e, attr)]
+            who = " and ".join(repr(k).strip("'") for k in able)
+            raise InputError(f"routing.router: {router!r}: " + text.format(
+                who=who, s="s" if len(able) > 1 else "", first=able[0] if able else "isochrone"))
+
+
 def check_current_router(router: str) -> None:
-    """Refuse a surface current for a router that cannot route one.
+    """Refuse a surface current for a router that cannot route one
+    (:func:`check_router_supports` with ``current=True``).
 
     Raises
     ------
     InputError
         For any router but ``isochrone``.
     """
-    if router != "isochrone":
-        raise InputError(
-            f"routing.router: {router!r}: a current is supported by the isochrone router "
-            "only; set routing.router: isochrone (or remove the scenario's `current:`)"
-        )
+    check_router_supports(router, current=True)
+
+
+def _is_dynamic(boat: object) -> bool:
+    """A boat model without a steady polar but with segment dynamics (the dynamic boat);
+    anything else is left to the router's own check."""
+    return (isinstance(boat, BoatModel) and boat.routing_polar() is None
+            and boat.dynamics() is not None)
+
+
+def _check_passage(obstacles: Obstacles, start: Start, target: Target) -> None:
+    """Refuse a leg whose start and target lie in separate parts of free water."""
+    name = obstacles.separated(start_centre(start), target.centre)
+    if name is not None:
+        what = name if name.startswith("the ") else f"obstacle {name!r}"
+        raise RoutingError(
+            f"leg {leg_label(start, target)}: no route round {what}: the start and the "
+            f"target lie in separate parts of free water ({obstacles.describe()}).\n  Try: "
+            "leave a passage between the obstacles and the boundary wider than their "
+            "clearances, or move the marks.")
 
 
 def route_leg(
@@ -101,6 +195,7 @@ def route_leg(
     progress: Callable[[float], None] | None = None,
     backend: str = "numpy",
     current: Any = None,
+    obstacles: Obstacles | None = None,
 ) -> LegResult:
     """Fastest route of one leg with the router chosen in ``settings.router``.
 
@@ -125,7 +220,11 @@ def route_leg(
         Array backend of the router's data-parallel kernels
         (:func:`sailroute.backend.get_xp`); results agree within float tolerance.
     current : CurrentField, optional
-        Surface current (:mod:`sailroute.wind.current`); only the isochrone router takes one.
+        Surface current (:mod:`sailroute.wind.current`); only the routers whose
+        :class:`RouterEntry` says so take one.
+    obstacles : Obstacles, optional
+        Race-area boundary and obstacles (:mod:`sailroute.routing.obstacles`); the
+        route stays in free water.  Refused by a router that cannot honour them.
 
     Returns
     -------
@@ -134,7 +233,9 @@ def route_leg(
     Raises
     ------
     InputError
-        Unknown router or backend, or invalid settings/geometry.
+        Unknown router or backend, invalid settings/geometry, or a current, obstacles
+        or a dynamic boat given to a router that does not support them
+        (:func:`check_router_supports`).
     RoutingError
         The router is not installed, or the leg cannot be routed (the message
         names the leg, why, and what to try).
@@ -143,10 +244,15 @@ def route_leg(
     """
     func = get_router(settings.router)
     xp = get_xp(backend)
-    extra = {} if xp is np else {"xp": xp}  # NumPy is every router's default
+    extra: dict[str, Any] = {} if xp is np else {"xp": xp}  # NumPy is every router's default
+    check_router_supports(settings.router, current=current is not None,
+                          obstacles=obstacles is not None,
+                          dynamic_boat=_is_dynamic(boat))
     if current is not None:
-        check_current_router(settings.router)
         extra["current"] = current
+    if obstacles is not None:
+        _check_passage(obstacles, start, target)
+        extra["obstacles"] = obstacles
     try:
         return func(start, target, t0, wind, boat, settings, progress=progress, **extra)
     except RoutingError as exc:

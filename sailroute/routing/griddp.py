@@ -34,9 +34,9 @@ from __future__ import annotations
 import math
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -67,6 +67,10 @@ from sailroute.routing.types import (
     side_sign,
 )
 from sailroute.wind.base import WindField
+
+if TYPE_CHECKING:
+    from sailroute.routing.obstacles import Obstacles
+    from sailroute.wind.current import CurrentField
 
 _SIDE_VALUE = np.array([-1, 1], dtype=np.int8)  # state index 0 = port, 1 = starboard
 
@@ -157,6 +161,8 @@ def route_griddp(
     *,
     progress: Callable[[float], None] | None = None,
     xp: ModuleType = np,
+    current: CurrentField | None = None,
+    obstacles: Obstacles | None = None,
 ) -> LegResult:
     """Fastest route of one leg by layered-grid DP with mesh refinement.
 
@@ -180,6 +186,13 @@ def route_griddp(
         Called with the fraction done, in [0, 1].
     xp : module
         Array module of the relaxation kernels (NumPy; CuPy-compatible).
+    current : CurrentField, optional
+        Refused (the grid DP routes still water only): an :class:`InputError`.
+    obstacles : Obstacles, optional
+        Race-area boundary and obstacles: every straight piece between two nodes must
+        stay in free water (:class:`~sailroute.routing._dp_grid.PathLimits`), so nodes
+        inside an obstacle are never reached; widen ``dp_half_width_m`` for a detour
+        longer than the layline band.
 
     Returns
     -------
@@ -197,7 +210,11 @@ def route_griddp(
     OutOfCoverageError
         The race outlasts the wind's time span (from the track builder).
     """
-    return solve_griddp(start, target, t0, wind, boat, settings, progress=progress, xp=xp).result
+    if current is not None:
+        raise InputError(f"leg {leg_label(start, target)}: the griddp router routes still water "
+                         "only; set routing.router: isochrone to route a current")
+    return solve_griddp(start, target, t0, wind, boat, settings, progress=progress, xp=xp,
+                        obstacles=obstacles).result
 
 
 def solve_griddp(
@@ -210,6 +227,7 @@ def solve_griddp(
     *,
     progress: Callable[[float], None] | None = None,
     xp: ModuleType = np,
+    obstacles: Obstacles | None = None,
 ) -> GridDPSolution:
     """Like :func:`route_griddp`, with per-pass diagnostics (:class:`GridDPSolution`)."""
     check_settings(settings, leg_label(start, target))
@@ -237,7 +255,7 @@ def solve_griddp(
             if progress is not None:
                 progress((k + frac) / n_pass)
 
-        lim = grid.limits
+        lim = grid.limits if obstacles is None else replace(grid.limits, obstacles=obstacles)
         if model.dynamic is not None:
             path, dp_time, evals = _dp_dynamic(model.dynamic, wind, xy, t0, opts, lim, xp,
                                                rowprog)

@@ -85,6 +85,7 @@ from sailroute.routing.geometry import (
     target_barrier,
     target_geometry,
 )
+from sailroute.routing.obstacles import Obstacles
 from sailroute.routing.track import build_track, make_leg_result
 from sailroute.routing.types import (
     Barrier,
@@ -379,6 +380,12 @@ class _Context:
     box: tuple[float, float, float, float] | None  # world coverage box to stay in, or None
     barriers: tuple[tuple[Barrier, float], ...] = ()  # (leg frame, mark clearance [m])
     current: CurrentField | None = None  # surface current (None: still water)
+    obstacles: Obstacles | None = None  # race area, world frame (None: open water)
+    # when an obstacle blocks the straight line from the start to the target, the pruning
+    # sectors are seen from the start centre (this point, leg frame), not from the target:
+    # a detour's points then keep their own sectors instead of losing them to the points
+    # held up behind the obstacle (nearer the target); None: seen from the target
+    bin_origin: tuple[float, float] | None = None
 
 
 def _group_argmin(key: Any, score: Any, n_keys: int, xp: ModuleType) -> Any:
@@ -413,6 +420,7 @@ def route_isochrone(
     progress: Callable[[float], None] | None = None,
     xp: ModuleType = np,
     current: CurrentField | None = None,
+    obstacles: Obstacles | None = None,
 ) -> LegResult:
     """Fastest route of one leg by isochrones.
 
@@ -446,6 +454,10 @@ def route_isochrone(
         each move goes over the ground by (velocity through the water + current) and
         the track carries SOG/COG; a boat stopped by a penalty drifts with the water.
         None (default): still water, the unchanged code path.
+    obstacles : Obstacles, optional
+        Race-area boundary and obstacles: every candidate move whose segment leaves
+        free water (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`) is
+        dropped, so the route stays inside the boundary and round the obstacles.
 
     Returns
     -------
@@ -459,8 +471,9 @@ def route_isochrone(
     InputError
         Invalid settings or target geometry.
     RoutingError
-        The front leaves the wind coverage entirely, or no route arrives
-        within ``max_leg_time_s``.
+        The front leaves the wind coverage entirely, every move is blocked by the
+        obstacles (the message names the nearest), or no route arrives within
+        ``max_leg_time_s``.
     OutOfCoverageError
         The wind field cannot be sampled at the start, or the race outlasts
         its time span (propagated from the wind field).
@@ -475,7 +488,7 @@ def route_isochrone(
     tab = polar_tables(polar, settings.heading_step_deg)
     frame = _LegFrame.for_leg(geom.centre, start_centre(start))
     ctx = _context(label, float(t0), frame, geom, wind, settings,
-                   leg_barriers(start, target), current)
+                   leg_barriers(start, target), current, obstacles, start_centre(start))
     if ctx.box is not None:
         _check_target_covered(geom, ctx.box, wind, label)
     dev = _device_tables(tab, xp)
@@ -615,7 +628,8 @@ def _check_target_covered(
 def _context(
     label: str, t0: float, frame: _LegFrame, geom: TargetGeometry, wind: WindField,
     s: RoutingSettings, barriers: tuple[tuple[Barrier, float], ...] = (),
-    current: CurrentField | None = None,
+    current: CurrentField | None = None, obstacles: Obstacles | None = None,
+    start_xy: tuple[float, float] = (0.0, 0.0),
 ) -> _Context:
     cov = wind.coverage
     bounded = any(math.isfinite(v) for v in (cov.xmin, cov.xmax, cov.ymin, cov.ymax))
@@ -630,7 +644,30 @@ def _context(
         max_points=int(s.max_front_points),
         fan_hull=s.heading_fan == "hull", box=box,
         barriers=tuple((frame.barrier(b), c) for b, c in barriers), current=current,
+        obstacles=obstacles, bin_origin=_detour_origin(frame, geom, obstacles, start_xy),
     )
+
+
+def _detour_origin(frame: _LegFrame, geom: TargetGeometry, obstacles: Obstacles | None,
+                   start_xy: tuple[float, float]) -> tuple[float, float] | None:
+    """The start centre in the leg frame if the way round the obstacles that block the
+    straight line from it to the target centre is more than :data:`DETOUR_FRACTION`
+    longer (then the pruning sectors are seen from it), else None.  Sectors seen from
+    the start keep a whole circle of points (several times the work): a small obstacle
+    is passed as well with the target's sectors, whose front slides along it."""
+    if obstacles is None:
+        return None
+    cx, cy = geom.centre
+    extra = obstacles.detour_m(start_xy, (cx, cy))
+    if extra <= DETOUR_FRACTION * math.hypot(cx - start_xy[0], cy - start_xy[1]):
+        return None
+    return _floats(frame.to_leg(*start_xy))
+
+
+DETOUR_FRACTION: Final = 0.005
+"""Estimated detour (:meth:`~sailroute.routing.obstacles.Obstacles.detour_m`), as a
+fraction of the straight start-target distance, above which the pruning sectors are seen
+from the start."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -940,6 +977,8 @@ def _step(
         return arrival
 
     won = xp.flatnonzero(best < np.inf)  # the keys that have a winner
+    if won.shape[0] == 0 and ctx.obstacles is not None:
+        raise _blocked_error(f, ctx, pre.t)
     if won.shape[0] == 0:
         cov = wind.coverage
         raise RoutingError(
@@ -1616,6 +1655,37 @@ def _barrier_blocked(
     return blocked
 
 
+def _obstacle_blocked(
+    c: _StepInputs, ends: tuple[tuple[Any, Any], ...], blocked: list[Any] | None,
+    frame: _LegFrame, obstacles: Obstacles, xp: ModuleType,
+) -> list[Any]:
+    """``blocked`` (:func:`_barrier_blocked`) with the moves that leave free water added:
+    each move from its row's point to its end, in the world frame
+    (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`; the drift during a
+    penalty pause is not tested separately)."""
+    px, py = (to_numpy(v) for v in frame.to_world(c.x, c.y))
+    qx = np.hstack([to_numpy(q[0]) for q in ends])  # both blocks in one call
+    qy = np.hstack([to_numpy(q[1]) for q in ends])
+    bad = ~obstacles.moves_free(px, py, *frame.to_world(qx, qy))
+    cut = int(ends[0][0].shape[1])
+    out = [xp.asarray(bad[:, :cut]), xp.asarray(bad[:, cut:])]
+    return out if blocked is None else [b | o for b, o in zip(blocked, out, strict=True)]
+
+
+def _blocked_error(f: _Layer, ctx: _Context, t: float) -> RoutingError:
+    """No candidate move of the front ``f`` stays in free water."""
+    assert ctx.obstacles is not None
+    wx, wy = (to_numpy(v) for v in ctx.frame.to_world(f.x, f.y))
+    name = ctx.obstacles.nearest_name(wx, wy)
+    what = name if name.startswith("the ") else f"obstacle {name!r}"
+    return RoutingError(
+        f"leg {ctx.label}: no route round {what}: every move from the front "
+        f"{t - ctx.t0:.0f} s after the leg start leaves free water ({ctx.obstacles.describe()}) "
+        "or the wind coverage.\n  Try: check that the obstacles leave a passage to the "
+        "target wider than their clearances, and that the boundary encloses the leg."
+    )
+
+
 def _arrival(
     c: _StepInputs, r0: int, blocks: tuple[_Block, _Block],
     ends: tuple[tuple[Any, Any], ...], timings: tuple[_Timing, _Timing],
@@ -1781,6 +1851,8 @@ def _expand(
     # the direct columns exist on their own side only
     direct_ok = (m.side * c.exact.direct_sin_keep >= 0, m.side * c.exact.direct_sin_switch <= 0)
     blocked = _barrier_blocked(c, ends, ctx, xp)
+    if ctx.obstacles is not None:
+        blocked = _obstacle_blocked(c, ends, blocked, ctx.frame, ctx.obstacles, xp)
 
     arrival = None
     near = xp.flatnonzero(c.near_target)
@@ -1795,6 +1867,9 @@ def _expand(
     scores = [_keep_scores(c, keep, pending, pending_timing),
               _switch_scores(c, switch, switch_timing)]
     scores = _drop_forbidden(c, scores, ends, direct_ok, blocked, ctx, xp)
+    if ctx.bin_origin is not None:  # sectors seen from the start: see _Context.bin_origin
+        ox, oy = ctx.bin_origin
+        ends = ((ends[0][0] - ox, ends[0][1] - oy), (ends[1][0] - ox, ends[1][1] - oy))
     return None, _sector_winners(c, r0, (keep, switch), ends, scores, ctx, xp)
 
 

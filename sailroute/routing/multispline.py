@@ -30,7 +30,7 @@ import time as _time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -63,6 +63,10 @@ from sailroute.routing.types import (
     check_settings,
 )
 from sailroute.wind.base import WindField
+
+if TYPE_CHECKING:
+    from sailroute.routing.obstacles import Obstacles
+    from sailroute.wind.current import CurrentField
 
 K_Y = 1.0 / 3.0
 """Shrink factor of the node ranges per refinement (paper value)."""
@@ -480,6 +484,8 @@ def route_spline(
     *,
     progress: Callable[[float], None] | None = None,
     xp: ModuleType = np,
+    current: CurrentField | None = None,
+    obstacles: Obstacles | None = None,
 ) -> LegResult:
     """Fastest C¹ route of one leg by adaptive multi-spline refinement.
 
@@ -489,6 +495,10 @@ def route_spline(
         As :func:`~sailroute.routing.griddp.route_griddp`; the grid uses
         ``dp_rows``, ``dp_half_width_m``, ``spline_cols``, ``spline_slopes`` and
         ``spline_refinements``.
+    current, obstacles : optional
+        Refused with an :class:`InputError`: the spline router routes still, open
+        water only (a smooth curve round an obstacle would need its tangents fitted to
+        the obstacle; route such a course with the isochrone or grid-DP router).
 
     Returns
     -------
@@ -497,10 +507,17 @@ def route_spline(
 
     Raises
     ------
+    InputError
+        Invalid settings, or a current or obstacles given.
     RoutingError
         No smooth route is feasible on the grid (typically a leg that needs a
         tack: use the grid DP).
     """
+    for given, what in ((current, "a current"), (obstacles, "a race-area boundary or obstacles")):
+        if given is not None:
+            raise InputError(
+                f"leg {leg_label(start, target)}: the spline router cannot honour {what}; "
+                "set routing.router: isochrone (or griddp for obstacles)")
     sol = solve_spline(start, target, t0, wind, boat, settings, progress=progress, xp=xp)
     return sol[0]
 

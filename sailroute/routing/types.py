@@ -19,7 +19,9 @@ from sailroute.errors import InputError
 
 if TYPE_CHECKING:
     from sailroute.boat.model import BoatModel
+    from sailroute.routing.obstacles import Obstacles
     from sailroute.wind.base import WindField
+    from sailroute.wind.current import CurrentField
 
 Side = Literal["port", "starboard"]
 """A tack (or a mark's rounding side) at every public boundary: settings, files, JSON,
@@ -513,9 +515,13 @@ class LegResult:
 class Router(Protocol):
     """A leg router: the signature every routing function shares.
 
-    ``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy) -> LegResult``
-    (:mod:`sailroute.routing.api` lists the implementations; each router module
-    declares ``_ROUTER: Router = route_...`` so that mypy checks it against this).
+    ``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy, current=None,
+    obstacles=None) -> LegResult`` (:mod:`sailroute.routing.api` lists the
+    implementations and what each supports; each router module declares
+    ``_ROUTER: Router = route_...`` so that mypy checks it against this).  ``current``
+    is a surface current (:class:`~sailroute.wind.current.CurrentField`), ``obstacles`` the
+    race area (:class:`~sailroute.routing.obstacles.Obstacles`); a router that cannot
+    honour one refuses it with an :class:`~sailroute.errors.InputError`.
     """
 
     def __call__(
@@ -530,6 +536,8 @@ class Router(Protocol):
         *,
         progress: Callable[[float], None] | None = None,
         xp: ModuleType = ...,
+        current: CurrentField | None = None,
+        obstacles: Obstacles | None = None,
     ) -> LegResult:
         """Fastest route of one leg (see :func:`~sailroute.routing.api.route_leg`)."""
         ...

@@ -53,7 +53,8 @@ def test_unknown_router_is_an_input_error_listing_the_choices():
 
 
 def test_missing_router_module_is_a_routing_error(monkeypatch):
-    monkeypatch.setitem(api.ROUTERS, "griddp", ("sailroute.routing._no_such_module", "f"))
+    monkeypatch.setitem(api.ROUTERS, "griddp",
+                        api.RouterEntry("sailroute.routing._no_such_module", "f"))
     with pytest.raises(RoutingError, match=r"'griddp' is not available.*_no_such_module"):
         get_router("griddp")
 
@@ -61,7 +62,8 @@ def test_missing_router_module_is_a_routing_error(monkeypatch):
 def test_module_without_the_function_is_a_routing_error(monkeypatch):
     mod = types.ModuleType("sailroute_fake_router")
     monkeypatch.setitem(sys.modules, "sailroute_fake_router", mod)
-    monkeypatch.setitem(api.ROUTERS, "spline", ("sailroute_fake_router", "route_spline"))
+    monkeypatch.setitem(api.ROUTERS, "spline",
+                        api.RouterEntry("sailroute_fake_router", "route_spline"))
     with pytest.raises(RoutingError, match="has no function route_spline"):
         get_router("spline")
 
@@ -76,7 +78,8 @@ def test_other_routers_are_called_lazily_with_the_shared_signature(monkeypatch):
 
     mod.route_griddp = route_griddp  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "sailroute_fake_griddp", mod)
-    monkeypatch.setitem(api.ROUTERS, "griddp", ("sailroute_fake_griddp", "route_griddp"))
+    monkeypatch.setitem(api.ROUTERS, "griddp",
+                        api.RouterEntry("sailroute_fake_griddp", "route_griddp"))
     st = replace(RoutingSettings(), router="griddp")
     # a router's RoutingError without the leg gets the leg label prepended
     with pytest.raises(RoutingError, match=r"^leg start -> 1 \(griddp router\): no feasible"):

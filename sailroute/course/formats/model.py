@@ -21,10 +21,11 @@ from datetime import datetime
 from typing import Literal
 
 import numpy as np
+import shapely
 
-from sailroute.course.areas import contains, ring_problem
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
+from sailroute.routing.rings import ring_problem
 from sailroute.routing.types import Side
 
 __all__ = [
@@ -282,7 +283,7 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
         problem = ring_problem(xy)
         if problem is not None:
             raise InputError(f"{r.where}: polygon {r.name!r}: {problem}")
-        inside = contains(xy, mx, my)
+        inside = shapely.contains_xy(shapely.Polygon(xy), mx, my)
         if "boundary" in r.name.lower():
             if boundary is not None:
                 raise InputError(f"{r.where}: a second boundary {r.name!r} (the first is at "

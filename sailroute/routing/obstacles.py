@@ -1,0 +1,553 @@
+"""The race area: a boundary routes stay inside and obstacles they stay out of.
+
+A course may name a ``boundary`` polygon (the race area) and ``obstacles`` polygons
+(breakwaters, moorings, land), each with a clearance [m] kept from its edge
+(``docs/course-format.md``).  The course loader stores them as :class:`AreaPolygon`
+values in a :class:`RaceArea` (course frame, metres); :meth:`Obstacles.build` turns
+that into one frozen object with the geometry buffered by the clearances and two
+vectorised predicates that every router uses:
+
+* :meth:`Obstacles.points_free`: which points lie in free water (inside the shrunk
+  boundary, outside every grown obstacle);
+* :meth:`Obstacles.segments_free`: which straight moves stay in free water: both
+  ends free and no edge of any ring crossed (an orientation test against every edge,
+  vectorised in NumPy; :meth:`Obstacles.segments_free_shapely` is the same predicate
+  through ``shapely.intersects`` on linestrings, kept for comparison: see
+  ``benchmarks/bench_obstacles.py``);
+* :meth:`Obstacles.moves_free`: the same for a fan of moves from each of ``n``
+  points (the isochrone's candidates), testing exactly only the points that lie
+  within one move of an edge.
+
+Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Final
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike, NDArray
+
+from sailroute.routing.rings import ring_problem
+from sailroute.wind.grid import GridWind
+
+__all__ = [
+    "BOUNDARY_NAME", "AreaPolygon", "Obstacles", "RaceArea", "land_filled", "land_obstacle",
+    "obstacles_for", "polygon_problem",
+]
+
+BOUNDARY_NAME: Final = "the race-area boundary"
+"""How messages name the boundary."""
+QUAD_SEGS: Final = 4
+"""Segments per quarter circle of a clearance buffer's rounded corners (the chord
+cuts at most ``1 - cos(11.25°)``, 1.9 %, of the clearance at a corner)."""
+_CHUNK: Final = 1 << 18
+"""Most segment x edge pairs tested at once (memory of the orientation test)."""
+
+
+@dataclass(frozen=True)
+class AreaPolygon:
+    """A polygon of the race area in the course frame.
+
+    Attributes
+    ----------
+    name : str
+        Name for messages (``"breakwater"``; the boundary is ``"boundary"``).
+    x, y : tuple of float
+        Vertices [m east, m north of the course origin]: one ring, the first vertex
+        not repeated.
+    clearance_m : float
+        Distance kept from the edge [m]: obstacles grow by it, the boundary shrinks.
+    where : str
+        Key path of the polygon in the course file, for messages.
+    """
+
+    name: str
+    x: tuple[float, ...]
+    y: tuple[float, ...]
+    clearance_m: float = 0.0
+    where: str = ""
+
+    def polygon(self) -> Any:
+        """The ring as a shapely Polygon (no clearance)."""
+        return shapely.polygons(np.column_stack([self.x, self.y]))
+
+
+@dataclass(frozen=True)
+class RaceArea:
+    """The race area of a course: boundary, obstacles and the land rule.
+
+    Attributes
+    ----------
+    boundary : AreaPolygon or None
+        Routes stay inside it; None: unbounded.
+    obstacles : tuple of AreaPolygon
+        Routes stay out of each.
+    wind_land_is_obstacle : bool
+        NaN (land) cells of a gridded wind become obstacles too.
+    """
+
+    boundary: AreaPolygon | None = None
+    obstacles: tuple[AreaPolygon, ...] = ()
+    wind_land_is_obstacle: bool = False
+
+    @property
+    def is_empty(self) -> bool:
+        """True when nothing constrains the routes."""
+        return self.boundary is None and not self.obstacles and not self.wind_land_is_obstacle
+
+
+def polygon_problem(x: Sequence[float], y: Sequence[float], clearance_m: float = 0.0,
+                    *, boundary: bool = False) -> str | None:
+    """What is wrong with a ring, or None: fewer than 3 vertices, a zero area,
+    self-intersection (shapely's ``explain_validity``), a boundary that a clearance
+    leaves empty; the ring checks and wording of :func:`sailroute.routing.rings.ring_problem`
+    come first."""
+    ring = ring_problem(np.column_stack([x, y]))
+    if ring is not None:
+        return ring
+    poly = shapely.Polygon(np.column_stack([x, y]))
+    if not shapely.is_valid(poly):
+        return (f"the polygon is not valid ({shapely.is_valid_reason(poly)}): "
+                "its edges must not cross; list the points in order round the ring")
+    if poly.area <= 0.0:
+        return "the polygon has no area (its points are on one line)"
+    if boundary and clearance_m > 0 and poly.buffer(-clearance_m).is_empty:
+        return (f"clearance_m = {clearance_m:g} leaves no water inside the boundary; "
+                "use a smaller clearance")
+    return None
+
+
+def _rings(geom: Any) -> list[NDArray[np.float64]]:
+    """Vertex arrays (closed) of every ring of a (multi)polygon."""
+    out = []
+    for part in shapely.get_parts(geom):
+        for ring in shapely.get_rings(part):
+            out.append(shapely.get_coordinates(ring))
+    return out
+
+
+def _edges(rings: list[NDArray[np.float64]]) -> NDArray[np.float64]:
+    """``(E, 4)`` edges ``x0, y0, x1, y1`` of closed rings."""
+    if not rings:
+        return np.zeros((0, 4))
+    return np.concatenate([np.hstack([r[:-1], r[1:]]) for r in rings])
+
+
+@dataclass(frozen=True, eq=False)
+class Obstacles:
+    """The race area's constraints, ready for the routers (course frame, metres).
+
+    Build with :meth:`build`.  Every predicate broadcasts its array arguments.
+
+    Attributes
+    ----------
+    names : tuple of str
+        One name per constraint; index ``-1`` (the last) is the boundary when there is
+        one (:data:`BOUNDARY_NAME`).
+    inside : shapely geometry or None
+        The boundary shrunk by its clearance (prepared); None: unbounded.
+    blocked : shapely geometry or None
+        The union of the obstacles grown by their clearances (prepared); None: none.
+    edges : ndarray
+        ``(E, 4)`` every ring edge ``x0, y0, x1, y1`` [m], grouped: each obstacle's
+        edges in runs of :data:`OBSTACLE_RUN`, then the boundary's in runs of
+        :data:`BOUNDARY_RUN`.
+    owner : ndarray of int
+        ``(E,)`` index into ``names`` of each edge.
+    group_box : ndarray
+        ``(G, 4)`` bounding box ``xmin, ymin, xmax, ymax`` [m] of each group of edges.
+    group_start : ndarray of int
+        ``(G + 1,)`` the groups' first edges (and the end).
+    """
+
+    names: tuple[str, ...]
+    inside: Any
+    blocked: Any
+    edges: NDArray[np.float64]
+    owner: NDArray[np.int64]
+    group_box: NDArray[np.float64]
+    group_start: NDArray[np.int64]
+
+    @classmethod
+    def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
+        """The constraints of ``area`` (None when it has none).
+
+        Parameters
+        ----------
+        area : RaceArea
+            Boundary and obstacles (validated by the course loader).
+        extra : sequence of (str, shapely geometry)
+            More obstacles, already in the course frame (e.g. land cells of a wind
+            grid, :func:`land_obstacle`), without clearance.
+        """
+        names: list[str] = []
+        grown: list[Any] = []
+        owners: list[int] = []
+        rings: list[NDArray[np.float64]] = []
+        for ob in area.obstacles:
+            g = ob.polygon()
+            if ob.clearance_m > 0:
+                g = shapely.buffer(g, ob.clearance_m, quad_segs=QUAD_SEGS)
+            grown.append(g)
+            names.append(ob.name)
+        for name, g in extra:
+            grown.append(g)
+            names.append(name)
+        for k, g in enumerate(grown):
+            r = _rings(g)
+            rings += r
+            owners += [k] * sum(len(a) - 1 for a in r)
+        inside = None
+        if area.boundary is not None:
+            b = area.boundary
+            inside = b.polygon()
+            if b.clearance_m > 0:
+                inside = shapely.buffer(inside, -b.clearance_m, quad_segs=QUAD_SEGS)
+            r = _rings(inside)
+            rings += r
+            names.append(BOUNDARY_NAME)
+            owners += [len(names) - 1] * sum(len(a) - 1 for a in r)
+        if not names:
+            return None
+        blocked = shapely.union_all(grown) if grown else None
+        for g in (inside, blocked):
+            if g is not None:
+                shapely.prepare(g)
+        edges = _edges(rings)
+        own = np.asarray(owners, dtype=np.int64)
+        run = [BOUNDARY_RUN if n == BOUNDARY_NAME else OBSTACLE_RUN for n in names]
+        starts = [0] + [i for i in range(1, own.size) if own[i] != own[i - 1]
+                        or (i - _first(own, i)) % run[own[i]] == 0]
+        bounds = np.asarray([*starts, own.size], dtype=np.int64)
+        box = np.array([[min(edges[a:b, 0].min(), edges[a:b, 2].min()),
+                         min(edges[a:b, 1].min(), edges[a:b, 3].min()),
+                         max(edges[a:b, 0].max(), edges[a:b, 2].max()),
+                         max(edges[a:b, 1].max(), edges[a:b, 3].max())]
+                        for a, b in itertools.pairwise(bounds)]).reshape(-1, 4)
+        return cls(tuple(names), inside, blocked, edges, own, box, bounds)
+
+    # ------------------------------------------------------------------ predicates
+    def points_free(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
+        """True where ``(x, y)`` [m] is in free water (strictly inside the shrunk
+        boundary, not in or on a grown obstacle)."""
+        xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        ok = np.ones(xa.shape, dtype=bool)
+        if self.inside is not None:
+            ok &= shapely.contains_xy(self.inside, xa, ya)
+        if self.blocked is not None:
+            ok &= ~shapely.intersects_xy(self.blocked, xa, ya)
+        return ok
+
+    def segments_cross(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
+                       ) -> NDArray[np.bool_]:
+        """True where the segment touches or crosses any ring edge (orientation test,
+        touching included, so a move through a vertex counts).  Each group of edges is
+        tested only against the segments whose bounding box meets the group's."""
+        a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
+        shape = a[0].shape
+        sx0, sy0, sx1, sy1 = (v.reshape(-1) for v in a)
+        hit = np.zeros(sx0.size, dtype=bool)
+        if sx0.size == 0:
+            return hit.reshape(shape)
+        xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
+        ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
+        for g in range(self.group_box.shape[0]):
+            b = self.group_box[g]
+            idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
+            if idx.size:
+                e = self.edges[self.group_start[g]:self.group_start[g + 1]]
+                hit[idx] |= _cross(sx0[idx], sy0[idx], sx1[idx], sy1[idx], e)
+        return hit.reshape(shape)
+
+    def segments_free(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
+                      ) -> NDArray[np.bool_]:
+        """True where the straight move ``(x0, y0) -> (x1, y1)`` [m] stays in free
+        water: its start is free and no ring edge is touched or crossed (so its end is
+        free too)."""
+        a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
+        return self.points_free(a[0], a[1]) & ~self.segments_cross(*a)
+
+    def segments_free_shapely(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike,
+                              y1: ArrayLike) -> NDArray[np.bool_]:
+        """:meth:`segments_free` through ``shapely.intersects`` on linestrings (the same
+        answer up to touching; slower per segment, see ``benchmarks/bench_obstacles.py``)."""
+        a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
+        shape = a[0].shape
+        coords = np.stack([np.column_stack([a[0].ravel(), a[1].ravel()]),
+                           np.column_stack([a[2].ravel(), a[3].ravel()])], axis=1)
+        lines = np.asarray(shapely.linestrings(coords))
+        ok = np.ones(lines.shape, dtype=bool)
+        if self.inside is not None:
+            ok &= shapely.contains_properly(self.inside, lines)
+        if self.blocked is not None:
+            ok &= ~shapely.intersects(self.blocked, lines)
+        return ok.reshape(shape)
+
+    def moves_free(self, px: Any, py: Any, qx: Any, qy: Any) -> NDArray[np.bool_]:
+        """Which moves of a fan stay in free water.
+
+        Parameters
+        ----------
+        px, py : array, shape (n,)
+            Start of the moves of each row [m].
+        qx, qy : array, shape (n, m)
+            Their end points [m].
+
+        Returns
+        -------
+        ndarray of bool, shape (n, m)
+            A row whose start is farther than its longest move from every group's
+            bounding box is decided by its start alone; the others are tested move by
+            move (:meth:`segments_cross`).
+        """
+        px, py = np.asarray(px, dtype=float), np.asarray(py, dtype=float)
+        qx, qy = np.asarray(qx, dtype=float), np.asarray(qy, dtype=float)
+        start_ok = self.points_free(px, py)
+        out = np.broadcast_to(start_ok[:, None], qx.shape).copy()
+        reach = np.max(np.hypot(qx - px[:, None], qy - py[:, None]), axis=1, initial=0.0)
+        r = reach[:, None]
+        b = self.group_box
+        near = ((px[:, None] + r >= b[:, 0]) & (px[:, None] - r <= b[:, 2])
+                & (py[:, None] + r >= b[:, 1]) & (py[:, None] - r <= b[:, 3]))
+        for g in np.flatnonzero(near.any(axis=0)):
+            rows = np.flatnonzero(near[:, g])
+            sx1, sy1 = qx[rows], qy[rows]
+            sx0 = np.broadcast_to(px[rows, None], sx1.shape)
+            sy0 = np.broadcast_to(py[rows, None], sx1.shape)
+            box = ((np.maximum(sx0, sx1) >= b[g, 0]) & (np.minimum(sx0, sx1) <= b[g, 2])
+                   & (np.maximum(sy0, sy1) >= b[g, 1]) & (np.minimum(sy0, sy1) <= b[g, 3]))
+            ri, ci = np.nonzero(box)
+            if ri.size:
+                e = self.edges[self.group_start[g]:self.group_start[g + 1]]
+                hit = _cross(sx0[ri, ci], sy0[ri, ci], sx1[ri, ci], sy1[ri, ci], e)
+                out[rows[ri[hit]], ci[hit]] = False
+        return out
+
+    def edge_distance(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
+        """Distance [m] from each point to the nearest ring edge."""
+        xa, ya = (np.asarray(v, dtype=float).reshape(-1) for v in (x, y))
+        best = np.full(xa.size, np.inf)
+        e = self.edges
+        if e.shape[0] == 0:
+            return best
+        dx, dy = e[:, 2] - e[:, 0], e[:, 3] - e[:, 1]
+        den = np.maximum(dx * dx + dy * dy, 1e-300)
+        step = max(1, _CHUNK // e.shape[0])
+        for i in range(0, xa.size, step):
+            ux = xa[i:i + step, None] - e[:, 0]
+            uy = ya[i:i + step, None] - e[:, 1]
+            f = np.clip((ux * dx + uy * dy) / den, 0.0, 1.0)
+            best[i:i + step] = np.min(np.hypot(ux - f * dx, uy - f * dy), axis=1)
+        return best
+
+    def nearest_name(self, x: ArrayLike, y: ArrayLike) -> str:
+        """The name of the constraint whose edge is nearest to any of the points."""
+        xa, ya = (np.asarray(v, dtype=float).reshape(-1) for v in (x, y))
+        if xa.size == 0 or self.edges.shape[0] == 0:
+            return self.names[0]
+        k = int(np.argmin(self.edge_distance(xa, ya)))
+        e = self.edges
+        dx, dy = e[:, 2] - e[:, 0], e[:, 3] - e[:, 1]
+        ux, uy = xa[k] - e[:, 0], ya[k] - e[:, 1]
+        f = np.clip((ux * dx + uy * dy) / np.maximum(dx * dx + dy * dy, 1e-300), 0.0, 1.0)
+        j = int(np.argmin(np.hypot(ux - f * dx, uy - f * dy)))
+        return self.names[int(self.owner[j])]
+
+    def detour_m(self, a: tuple[float, float], b: tuple[float, float]) -> float:
+        """Estimated extra length [m] of the way from ``a`` to ``b`` round what blocks the
+        straight line: 0 when it is free, infinite when it leaves the boundary; else, for
+        the worst obstacle crossing it, the two-piece path past its nearer side (its
+        farthest vertex on that side from the line, at the obstacle's middle along it)."""
+        if bool(self.segments_free(a[0], a[1], b[0], b[1])):
+            return 0.0
+        line = shapely.LineString([a, b])
+        if self.inside is not None and not shapely.covers(self.inside, line):
+            return math.inf
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        if self.blocked is None or length == 0.0:
+            return 0.0
+        ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+        worst = 0.0
+        for part in shapely.get_parts(self.blocked):
+            if not shapely.intersects(part, line):
+                continue
+            c = shapely.get_coordinates(shapely.convex_hull(part))
+            u = (c[:, 0] - a[0]) * ux + (c[:, 1] - a[1]) * uy
+            v = (c[:, 1] - a[1]) * ux - (c[:, 0] - a[0]) * uy
+            w = min(max(float(v.max()), 0.0), max(float(-v.min()), 0.0))
+            d1 = min(max(float(np.median(u)), 0.0), length)
+            worst = max(worst, math.hypot(d1, w) + math.hypot(length - d1, w) - length)
+        return worst
+
+    def separated(self, a: tuple[float, float], b: tuple[float, float]) -> str | None:
+        """The name of what separates the points ``a`` and ``b`` [m] (the constraint
+        nearest to ``a`` round its part of free water), or None when one part of free
+        water holds both (or either is not in free water: the routers report that)."""
+        if not bool(np.all(self.points_free([a[0], b[0]], [a[1], b[1]]))):
+            return None
+        water = self.inside
+        if water is None:
+            assert self.blocked is not None
+            x0, y0, x1, y1 = shapely.bounds(self.blocked)
+            pad = 1000.0 + abs(a[0]) + abs(a[1]) + abs(b[0]) + abs(b[1])
+            water = shapely.box(x0 - pad, y0 - pad, x1 + pad, y1 + pad)
+        if self.blocked is not None:
+            water = shapely.difference(water, self.blocked)
+        for part in shapely.get_parts(water):
+            if shapely.intersects_xy(part, *a):
+                if shapely.intersects_xy(part, *b):
+                    return None
+                return self._enclosing(part)
+        return None
+
+    def _enclosing(self, part: Any) -> str:
+        """The name of an obstacle whose edge bounds ``part`` (the boundary if none)."""
+        e = self.edges
+        lines = shapely.linestrings(np.stack([e[:, :2], e[:, 2:]], axis=1))
+        touching = self.owner[shapely.distance(shapely.boundary(part), lines) < 1e-6]
+        names = [self.names[int(k)] for k in np.unique(touching)]
+        named = [n for n in names if n != BOUNDARY_NAME]
+        return named[0] if named else BOUNDARY_NAME
+
+    def describe(self) -> str:
+        """``"obstacles 'a', 'b' and the race-area boundary"`` for messages."""
+        named = [repr(n) for n in self.names if n != BOUNDARY_NAME]
+        parts = ([f"obstacle{'s' if len(named) > 1 else ''} " + ", ".join(named)]
+                 if named else [])
+        if BOUNDARY_NAME in self.names:
+            parts.append(BOUNDARY_NAME)
+        return " and ".join(parts)
+
+
+BOUNDARY_RUN: Final = 1
+"""Edges of the boundary per group of the segment test's bounding-box filter (one: the
+boundary's box holds every point, an edge's box only those near it)."""
+OBSTACLE_RUN: Final = 32
+"""Most edges of an obstacle per group (a grown rectangle has 20: one group)."""
+
+
+def _first(owner: NDArray[np.int64], i: int) -> int:
+    """Index of the first edge with the owner of edge ``i``."""
+    return int(np.flatnonzero(owner == owner[i])[0])
+
+
+def _cross(sx0: Any, sy0: Any, sx1: Any, sy1: Any, e: NDArray[np.float64]) -> Any:
+    """Segments (shape (m,)) that touch or cross any of the edges ``e`` (shape (k, 4)),
+    in chunks of at most :data:`_CHUNK` pairs."""
+    hit = np.zeros(sx0.size, dtype=bool)
+    ex0, ey0, ex1, ey1 = (e[:, k] for k in range(4))
+    step = max(1, _CHUNK // max(1, e.shape[0]))
+    for i in range(0, sx0.size, step):
+        a0, b0 = sx0[i:i + step, None], sy0[i:i + step, None]
+        a1, b1 = sx1[i:i + step, None], sy1[i:i + step, None]
+        o1 = _orient(a0, b0, a1, b1, ex0, ey0)
+        o2 = _orient(a0, b0, a1, b1, ex1, ey1)
+        o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
+        o4 = _orient(ex0, ey0, ex1, ey1, a1, b1)
+        both = (o1 * o2 <= 0.0) & (o3 * o4 <= 0.0)
+        # collinear pairs (and a point on an edge's line) meet only where their extents
+        # overlap
+        line = (o1 == 0.0) & (o2 == 0.0) & (o3 == 0.0) & (o4 == 0.0)
+        if line.any():
+            over = ((np.minimum(a0, a1) <= np.maximum(ex0, ex1))
+                    & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
+                    & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
+                    & (np.maximum(b0, b1) >= np.minimum(ey0, ey1)))
+            both = np.where(line, over, both)
+        hit[i:i + step] = both.any(axis=1)
+    return hit
+
+
+def _orient(ax: Any, ay: Any, bx: Any, by: Any, cx: Any, cy: Any) -> Any:
+    """Twice the signed area of the triangle ``a, b, c`` (> 0: counter-clockwise)."""
+    return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+
+
+def land_obstacle(x: ArrayLike, y: ArrayLike, nan: ArrayLike, name: str = "land"
+                  ) -> tuple[str, Any] | None:
+    """The NaN cells of a wind grid as one obstacle.
+
+    Parameters
+    ----------
+    x, y : array
+        Grid node coordinates [m] (course frame), 2-D ``(ny, nx)``.
+    nan : array of bool
+        ``(ny, nx)``: True where the grid has no wind at some time.
+    name : str
+        Name for messages.
+
+    Returns
+    -------
+    tuple of (str, shapely geometry) or None
+        None when no node is NaN.  Each NaN node blocks the box of one grid spacing
+        round it: every point whose interpolation touches the node (axis-aligned boxes,
+        so a rotated grid is covered with a margin of its rotation).
+    """
+    xa, ya = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    jj, ii = np.nonzero(np.asarray(nan, dtype=bool))
+    if jj.size == 0:
+        return None
+    hx = float(np.max(np.abs(np.diff(xa, axis=1)))) if xa.shape[1] > 1 else 1.0
+    hy = float(np.max(np.abs(np.diff(ya, axis=0)))) if ya.shape[0] > 1 else 1.0
+    cx, cy = xa[jj, ii], ya[jj, ii]
+    boxes = shapely.box(cx - hx, cy - hy, cx + hx, cy + hy)
+    return name, shapely.union_all(boxes)
+
+
+def land_filled(area: RaceArea, wind: Any) -> Any:
+    """The wind to route in: with ``wind_land_is_obstacle`` and a gridded wind holding
+    NaN (land) cells, a copy whose NaN nodes take the value of the nearest valid node.
+
+    Routes stay out of the land (:func:`obstacles_for`), but the isochrone router's time
+    to go samples the wind along the straight line to the target, which may cross it;
+    the filled values serve only there: every point in free water lies a grid spacing or
+    more from a NaN node, so its interpolated wind is unchanged.  Any other wind (or
+    course) is returned as it is.
+    """
+    if not (area.wind_land_is_obstacle and isinstance(wind, GridWind)):
+        return wind
+    u, v = np.asarray(wind.u, dtype=float), np.asarray(wind.v, dtype=float)
+    nan = np.isnan(u) | np.isnan(v)
+    if not nan.any() or nan.all():
+        return wind
+    from scipy.ndimage import distance_transform_edt
+
+    fu, fv = u.copy(), v.copy()
+    for k in range(u.shape[0]):
+        if nan[k].any():
+            _, (jj, ii) = distance_transform_edt(nan[k], return_indices=True)
+            fu[k], fv[k] = u[k][jj, ii], v[k][jj, ii]
+    return dataclasses.replace(wind, u=fu, v=fv, allow_nan=False)
+
+
+def obstacles_for(area: RaceArea, wind: object = None) -> Obstacles | None:
+    """The :class:`Obstacles` of a course's race area in the wind it is routed in.
+
+    Parameters
+    ----------
+    area : RaceArea
+        The course's ``boundary``, ``obstacles`` and ``wind_land_is_obstacle``.
+    wind : WindField, optional
+        With ``wind_land_is_obstacle``, a gridded wind
+        (:class:`~sailroute.wind.grid.GridWind`) whose NaN cells become the obstacle
+        ``"land"`` (:func:`land_obstacle`); any other wind adds none.
+
+    Returns
+    -------
+    Obstacles or None
+        None when the course constrains nothing.
+    """
+    extra = []
+    if area.wind_land_is_obstacle and isinstance(wind, GridWind):
+        nan = np.isnan(np.asarray(wind.u, dtype=float)).any(axis=0)
+        land = land_obstacle(wind.x, wind.y, nan)
+        if land is not None:
+            extra.append(land)
+    return Obstacles.build(area, extra)

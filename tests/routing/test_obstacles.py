@@ -1,0 +1,252 @@
+"""Routes round obstacles and inside a boundary, against closed-form paths.
+
+A reach at constant boat speed blocked by a rectangle: the fastest route is the
+shortest path round the rectangle's corners, so its time is that length over the speed.
+A beat up a channel: boards at the VMG angle cross the channel, so the number of tacks
+follows from the channel's width, its length and the VMG angle.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import shapely
+
+from sailroute.boat.polar import Polar
+from sailroute.errors import InputError, RoutingError
+from sailroute.routing.api import ROUTERS, check_router_supports, route_leg
+from sailroute.routing.griddp import route_griddp
+from sailroute.routing.isochrone import route_isochrone
+from sailroute.routing.obstacles import (
+    BOUNDARY_NAME,
+    AreaPolygon,
+    Obstacles,
+    RaceArea,
+    land_obstacle,
+    obstacles_for,
+)
+from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
+from sailroute.wind.uniform import UniformWind
+from tests.routing.polars import laser_like_polar
+
+T0 = 1_524_567_600.0
+SPEED = 5.0  # boat speed of the constant polar [m/s]
+
+
+def constant_polar() -> Polar:
+    """5 m/s at every TWA from 40° to 180° (flat nodes: PCHIP keeps it flat)."""
+    twa = np.array([0, 30, 40, 60, 90, 120, 150, 180.0])
+    g = np.array([0, 0.5, 1, 1, 1, 1, 1, 1.0])
+    tws = np.array([2, 6, 10.0])
+    return Polar.from_arrays(twa, tws, np.outer(g, np.full(3, SPEED)), name="constant")
+
+
+def rect(name: str, x0: float, x1: float, y0: float, y1: float, clearance: float = 0.0
+         ) -> AreaPolygon:
+    return AreaPolygon(name, (x0, x1, x1, x0), (y0, y0, y1, y1), clearance)
+
+
+# the blocked reach: wind from the west, course north from (0, 0) to a short line at
+# y = 2000; a 800 m x 600 m block across the direct path, nearer its left (west) corners
+BLOCK = rect("block", -300.0, 500.0, 700.0, 1300.0)
+REACH = (Start((0.0, 0.0), name="start"),
+         Target("line", (-50.0, 2000.0), (50.0, 2000.0), name="finish"))
+REACH_WIND = UniformWind(6.0, 270.0)
+# shortest path: start -> (-300, 700) -> (-300, 1300) -> line end (-50, 2000)
+REACH_LENGTH = math.hypot(300, 700) + 600 + math.hypot(250, 700)
+
+
+def reach_settings(router: str = "isochrone") -> RoutingSettings:
+    return RoutingSettings(router=router, dt_s=5.0, tack_penalty_s=0.0, gybe_penalty_s=0.0,
+                           heading_step_deg=1.0, dp_half_width_m=600.0, dp_cols=96,
+                           dp_rows=17, dp_refinements=3)
+
+
+def track_free(res: LegResult, obs: Obstacles) -> bool:
+    x, y = res.track.x, res.track.y
+    return bool(np.all(obs.segments_free(x[:-1], y[:-1], x[1:], y[1:])))
+
+
+# ---------------------------------------------------------------------- predicates
+def test_points_and_segments_free_by_hand() -> None:
+    obs = Obstacles.build(RaceArea(rect("bound", -100, 100, -100, 100),
+                                   (rect("b", -10, 10, -10, 10),)))
+    assert obs is not None
+    assert obs.points_free([0, 50, 150, 10], [0, 50, 0, 0]).tolist() == [False, True, False, False]
+    # through the block, round it, out of the boundary, through a corner exactly
+    free = obs.segments_free([-50, -50, 0, -50], [0, 20, 50, 50],
+                             [50, 50, 0, 50], [0, 20, 150, -50])
+    assert free.tolist() == [False, True, False, False]
+
+
+def test_edge_test_agrees_with_shapely_linestrings() -> None:
+    area = RaceArea(rect("bound", -500, 500, -500, 500, clearance=20.0),
+                    tuple(rect(f"o{k}", -400 + 80 * k, -350 + 80 * k, -100, 60 + 10 * k, 5.0)
+                          for k in range(10)))
+    obs = Obstacles.build(area)
+    assert obs is not None
+    rng = np.random.default_rng(1)
+    x0, y0 = rng.uniform(-550, 550, (2, 20000))
+    ang, length = rng.uniform(0, 2 * np.pi, 20000), rng.uniform(0, 120, 20000)
+    x1, y1 = x0 + length * np.sin(ang), y0 + length * np.cos(ang)
+    ours = obs.segments_free(x0, y0, x1, y1)
+    theirs = obs.segments_free_shapely(x0, y0, x1, y1)
+    assert 0.2 < ours.mean() < 0.9  # both outcomes are exercised
+    assert np.array_equal(ours, theirs)
+    # the fan form (rows decided by their start when no edge is within reach) agrees too
+    px, py = x0[:200], y0[:200]
+    qx, qy = x1[:200 * 100].reshape(200, 100) - x0[:200 * 100].reshape(200, 100) + px[:, None], \
+        y1[:200 * 100].reshape(200, 100) - y0[:200 * 100].reshape(200, 100) + py[:, None]
+    assert np.array_equal(obs.moves_free(px, py, qx, qy),
+                          obs.segments_free(px[:, None], py[:, None], qx, qy))
+
+
+def test_clearance_grows_obstacles_and_shrinks_the_boundary() -> None:
+    obs = Obstacles.build(RaceArea(rect("bound", 0, 100, 0, 100, clearance=10.0),
+                                   (rect("b", 40, 60, 40, 60, clearance=5.0),)))
+    assert obs is not None
+    assert obs.points_free([5, 15, 36, 34], [50, 50, 50, 50]).tolist() == [False, True, False, True]
+    assert obs.nearest_name([5.0], [50.0]) == BOUNDARY_NAME
+    assert obs.nearest_name([37.0], [50.0]) == "b"
+
+
+def test_land_cells_of_a_wind_grid_become_one_obstacle() -> None:
+    y, x = np.mgrid[0:500:100.0, 0:500:100.0]
+    nan = np.zeros(x.shape, dtype=bool)
+    nan[2, 3] = True  # the node (300, 200)
+    name, geom = land_obstacle(x, y, nan)
+    assert name == "land"
+    # one spacing round the node: every point whose interpolation uses it
+    assert shapely.contains_xy(geom, [250.0, 390.0], [150.0, 290.0]).tolist() == [True, True]
+    assert not shapely.contains_xy(geom, 150.0, 200.0)
+    assert land_obstacle(x, y, np.zeros_like(nan)) is None
+    assert obstacles_for(RaceArea()) is None
+
+
+# ---------------------------------------------------------------------- isochrone
+@pytest.fixture(scope="module")
+def blocked_reach() -> tuple[LegResult, Obstacles]:
+    obs = Obstacles.build(RaceArea(obstacles=(BLOCK,)))
+    assert obs is not None
+    res = route_isochrone(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(),
+                          obstacles=obs)
+    return res, obs
+
+
+def test_blocked_reach_goes_round_the_near_corners(blocked_reach: tuple[LegResult, Obstacles]
+                                                   ) -> None:
+    res, obs = blocked_reach
+    assert track_free(res, obs)
+    # constant speed: time = shortest length / speed, within 0.5 %
+    assert res.time_s == pytest.approx(REACH_LENGTH / SPEED, rel=5e-3)
+    assert res.distance_m == pytest.approx(REACH_LENGTH, rel=5e-3)
+    assert res.distance_m > 2000.0 * 1.04  # not through the block
+    assert np.min(res.track.x) == pytest.approx(-300.0, abs=15.0)  # the west corners
+    assert np.max(res.track.x[1:]) < 0.0
+
+
+def test_open_reach_is_straight() -> None:
+    res = route_isochrone(*REACH, T0, REACH_WIND, constant_polar(), reach_settings())
+    assert res.time_s == pytest.approx(2000.0 / SPEED, rel=2e-3)
+
+
+def test_griddp_agrees_with_isochrone_round_the_block(
+        blocked_reach: tuple[LegResult, Obstacles]) -> None:
+    iso, obs = blocked_reach
+    dp = route_griddp(*REACH, T0, REACH_WIND, constant_polar(), reach_settings("griddp"),
+                      obstacles=obs)
+    assert track_free(dp, obs)
+    # the grid's corner nodes lie off the corners: within 1 % of the isochrone and of
+    # the closed form
+    assert dp.time_s == pytest.approx(iso.time_s, rel=1e-2)
+    assert dp.time_s == pytest.approx(REACH_LENGTH / SPEED, rel=1e-2)
+    assert np.max(dp.track.x[1:]) < 0.0
+
+
+def test_beat_up_a_channel_tacks_at_its_edges() -> None:
+    polar = laser_like_polar()
+    tws = 6.0
+    up, _ = polar.vmg_angles_deg(tws)
+    width = 100.0
+    # boards from the centre: the first crosses half the channel, then whole widths;
+    # n tacks cover (width / 2 + n width) / tan(up) along it: 3.5 boards' worth -> 4 tacks
+    along = (0.5 * width + 3.5 * width) / math.tan(math.radians(up))
+    n_expected = 4
+    channel = rect("channel", -width / 2, width / 2, -50.0, along + 50.0)
+    obs = Obstacles.build(RaceArea(boundary=channel))
+    assert obs is not None
+    start = Start((0.0, 0.0), name="start")
+    target = Target("line", (-width / 2 + 1, along), (width / 2 - 1, along), name="top")
+    s = RoutingSettings(dt_s=5.0, tack_penalty_s=10.0, heading_step_deg=1.0)
+    res = route_isochrone(start, target, T0, UniformWind(tws, 0.0), polar, s, obstacles=obs)
+    assert track_free(res, obs)
+    assert res.n_tacks == n_expected
+    # the tacks are at the channel's edges, alternately (the last board has half a
+    # board's width to spare, so the last tack may come early)
+    tacks_x = np.array([m.x for m in res.manoeuvres if m.kind == "tack"])
+    assert np.all(np.abs(tacks_x[:-1]) > 0.5 * width - 8.0)
+    assert np.all(np.sign(tacks_x[1:]) == -np.sign(tacks_x[:-1]))
+    # time: the along distance at the VMG, plus the penalties (within 3 %)
+    vmg = float(polar.speed(tws, up)) * math.cos(math.radians(up))
+    assert res.time_s == pytest.approx(along / vmg + n_expected * 10.0, rel=3e-2)
+
+
+def test_a_start_inside_an_obstacle_is_a_clear_error() -> None:
+    obs = Obstacles.build(RaceArea(obstacles=(rect("pier", -20, 20, -20, 20),)))
+    with pytest.raises(RoutingError, match="no route round obstacle 'pier'"):
+        route_isochrone(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(),
+                        obstacles=obs)
+
+
+def test_a_walled_off_target_is_refused_before_routing() -> None:
+    wall = rect("reef", -1000, 1000, 900, 1000)
+    obs = Obstacles.build(RaceArea(rect("bound", -800, 800, -200, 2200), (wall,)))
+    for router in ("isochrone", "griddp"):
+        with pytest.raises(RoutingError, match="no route round obstacle 'reef'"):
+            route_leg(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(router),
+                      obstacles=obs)
+
+
+# ---------------------------------------------------------------------- registry
+def test_registry_says_what_each_router_supports() -> None:
+    assert {k: (e.current, e.obstacles) for k, e in ROUTERS.items()} == {
+        "isochrone": (True, True), "griddp": (False, True), "spline": (False, False)}
+    with pytest.raises(InputError, match="'spline': a race-area boundary or obstacles are "
+                       "honoured by the isochrone and griddp routers only"):
+        check_router_supports("spline", obstacles=True)
+    with pytest.raises(InputError, match="supported by the isochrone router only"):
+        check_router_supports("griddp", current=True)
+    obs = Obstacles.build(RaceArea(obstacles=(BLOCK,)))
+    with pytest.raises(InputError, match=r"set routing\.router: isochrone"):
+        route_leg(*REACH, T0, REACH_WIND, constant_polar(), reach_settings("spline"),
+                  obstacles=obs)
+
+
+def test_a_point_move_crosses_nothing_in_an_edges_box() -> None:
+    # a zero-length move (a penalty pause) inside the bounding box of a long diagonal
+    # edge but far from it: free (its two ends are collinear with every edge)
+    tri = AreaPolygon("bound", (0.0, 1000.0, 0.0), (0.0, 1000.0, 1000.0))
+    obs = Obstacles.build(RaceArea(tri))
+    assert obs is not None
+    assert obs.segments_free([100.0, 500.0], [700.0, 500.0], [100.0, 500.0],
+                             [700.0, 500.0]).tolist() == [True, False]
+
+
+def test_generic_array_module_path_goes_round_the_same_way() -> None:
+    # the path a CuPy backend takes (one chunk per step; the obstacle test on the host)
+    # through a thin stand-in for NumPy: the same route round a smaller block
+    import types
+
+    fake = types.ModuleType("numpy_standin")
+    fake.__getattr__ = lambda name: getattr(np, name)  # type: ignore[method-assign]
+    obs = Obstacles.build(RaceArea(obstacles=(rect("block", -150, 250, 300, 500),)))
+    start, target = Start((0.0, 0.0)), Target("line", (-20.0, 800.0), (20.0, 800.0))
+    s = replace(reach_settings(), dt_s=10.0)
+    a = route_isochrone(start, target, T0, REACH_WIND, constant_polar(), s, obstacles=obs)
+    b = route_isochrone(start, target, T0, REACH_WIND, constant_polar(), s, obstacles=obs,
+                        xp=fake)
+    assert b.time_s == pytest.approx(a.time_s, rel=1e-12)
+    assert np.min(a.track.x) < -140.0
