@@ -85,9 +85,10 @@ def test_lat_lon_points_and_files_give_the_same_polygon(tmp_path):
 
 @pytest.mark.parametrize(("area", "message"), [
     (AREA.replace("{x: 350, y: 750}, {x: -250, y: 750}", "{x: -250, y: 750}, {x: 350, y: 750}"),
-     r"c.yaml:\d+: obstacles\[0\]: the polygon is not valid \(Self-intersection"),
+     r"c.yaml:\d+: obstacles\[0\]: expected a simple polygon; its edge from point \d to \d "
+     r"crosses the edge"),
     (AREA.replace(", {x: 350, y: 750}, {x: -250, y: 750}", ""),
-     r"obstacles\[0\]: expected at least 3 points .*got 2"),
+     r"obstacles\[0\]: expected a ring of at least 3 points; got 2"),
     (AREA.replace("y: 600}, {x: 350, y: 600}", "y: -20}, {x: 350, y: -20}"),
      r"obstacles\[0\]: mark 'pin' \(-50, 0 m\) lies inside obstacle 'breakwater' with its "
      r"clearance_m = 10 m; move the mark"),

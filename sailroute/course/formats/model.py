@@ -288,10 +288,13 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
             if boundary is not None:
                 raise InputError(f"{r.where}: a second boundary {r.name!r} (the first is at "
                                  f"{boundary_where}); expected one (rename the other)")
-            boundary, boundary_where = r.points, r.where
             outside = [m[0] for m, ok in zip(course.marks, inside, strict=True) if not ok]
-            if outside:
-                notes.append(f"marks outside the boundary {r.name!r}: {', '.join(outside)}")
+            if outside:  # a course file's boundary holds every mark (course-format.md)
+                notes.append(f"the boundary {r.name!r} ({r.where}) leaves the marks "
+                             f"{', '.join(outside)} outside: left out (routes are not kept "
+                             "inside it); add a `boundary:` that holds every mark to use one")
+            else:
+                boundary, boundary_where = r.points, r.where
         elif inside.all():
             notes.append(f"polygon {r.name!r} ({r.where}) holds every mark: an outer limit "
                          "around the race area, not an area to stay out of; left out")
