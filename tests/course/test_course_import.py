@@ -13,8 +13,8 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
-import shapely
 import pytest
+import shapely
 from typer.testing import CliRunner
 
 from sailroute.cli import app
