@@ -99,7 +99,7 @@ def leg_endpoints(
     return start_of(course, i, previous_end_xy), target_of(course, i)
 
 
-def leg_bearing_deg(from_xy: XY, to_xy: XY) -> float:
+def xy_bearing_deg(from_xy: XY, to_xy: XY) -> float:
     """Compass bearing θ = atan2(dx, dy) from ``from_xy`` to ``to_xy`` [°, in [0, 360)]."""
     return float(bearing_deg(to_xy[0] - from_xy[0], to_xy[1] - from_xy[1]))
 
@@ -136,7 +136,7 @@ def leg_wind_mode(wind: WindField, t: float, from_xy: XY, to_xy: XY) -> WindMode
     """
     u, v = wind.sample(t, from_xy[0], from_xy[1])
     _, twd = wind_speed_direction(u, v)
-    return wind_mode(leg_bearing_deg(from_xy, to_xy), float(twd))
+    return wind_mode(xy_bearing_deg(from_xy, to_xy), float(twd))
 
 
 @dataclass(frozen=True)
@@ -176,7 +176,7 @@ def nominal_legs(course: Course) -> tuple[NominalLeg, ...]:
         out.append(
             NominalLeg(
                 leg.index, leg.from_name, leg.to_name, a, b,
-                float(math.hypot(b[0] - a[0], b[1] - a[1])), leg_bearing_deg(a, b),
+                float(math.hypot(b[0] - a[0], b[1] - a[1])), xy_bearing_deg(a, b),
             )
         )
     return tuple(out)

@@ -8,12 +8,12 @@ import pytest
 
 from sailroute.course.geometry import (
     course_bbox,
-    leg_bearing_deg,
     leg_wind_mode,
     omega_deg,
     race_time_window,
     thesis_time_window,
     wind_mode,
+    xy_bearing_deg,
 )
 from sailroute.course.load import load_course
 from sailroute.timeutil import to_epoch
@@ -28,7 +28,7 @@ CEST = timezone(timedelta(hours=2))
     [(0, 1, 0.0), (1, 0, 90.0), (0, -1, 180.0), (-1, 0, 270.0), (1, 1, 45.0), (-1, 1, 315.0)],
 )
 def test_leg_bearing_is_compass(dx, dy, bearing):
-    assert leg_bearing_deg((10.0, 20.0), (10.0 + dx, 20.0 + dy)) == pytest.approx(bearing)
+    assert xy_bearing_deg((10.0, 20.0), (10.0 + dx, 20.0 + dy)) == pytest.approx(bearing)
 
 
 @pytest.mark.parametrize(

@@ -20,12 +20,12 @@ import pytest
 
 from sailroute.course.geometry import (
     course_bbox,
-    leg_bearing_deg,
     leg_endpoints,
     nominal_legs,
     nominal_wind_modes,
     start_of,
     target_of,
+    xy_bearing_deg,
 )
 from sailroute.course.load import load_course
 from tests.conftest import ROOT
@@ -65,7 +65,7 @@ FIG_5_6 = [
 def test_fig_5_6_distances_and_bearings(r1, a, b, dist, brg, tol):
     p = _points(r1)
     assert math.dist(p[a], p[b]) == pytest.approx(dist, abs=tol)
-    assert leg_bearing_deg(p[a], p[b]) == pytest.approx(brg, abs=0.01)
+    assert xy_bearing_deg(p[a], p[b]) == pytest.approx(brg, abs=0.01)
 
 
 def test_line_lengths(r1):

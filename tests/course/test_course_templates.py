@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from sailroute.course.geometry import leg_bearing_deg, wind_mode
+from sailroute.course.geometry import wind_mode, xy_bearing_deg
 from sailroute.course.templates import trapezoid, windward_leeward
 from sailroute.errors import InputError
 from sailroute.units import signed_twa, wrap180
@@ -41,7 +41,7 @@ def test_windward_leeward_geometry(twd):
     m1 = lay.marks["1"]
     g4 = mid(lay, "4s", "4p")
     # the windward leg goes straight into the wind, with the requested length, about the centre
-    assert leg_bearing_deg(g4, m1) == pytest.approx(twd % 360.0, abs=1e-9)
+    assert xy_bearing_deg(g4, m1) == pytest.approx(twd % 360.0, abs=1e-9)
     assert math.dist(g4, m1) == pytest.approx(900.0, abs=1e-9)
     np.testing.assert_allclose(np.add(g4, m1) / 2, centre, atol=1e-9)
     # gate: width, square to the wind, 4p on the right looking upwind (left of a boat running down)
@@ -49,12 +49,12 @@ def test_windward_leeward_geometry(twd):
     up = (m1[0] - g4[0], m1[1] - g4[1])
     to_4p = (lay.marks["4p"][0] - g4[0], lay.marks["4p"][1] - g4[1])
     assert cross(up, to_4p) < 0  # clockwise from upwind = right
-    assert abs(wrap180(leg_bearing_deg(lay.marks["4s"], lay.marks["4p"]) - twd)) == pytest.approx(
+    assert abs(wrap180(xy_bearing_deg(lay.marks["4s"], lay.marks["4p"]) - twd)) == pytest.approx(
         90.0, abs=1e-9)
     # start line: length, square to the wind, start_offset below the gate, boat at the right end
     st = mid(lay, "start_pin", "start_boat")
     assert math.dist(lay.marks["start_pin"], lay.marks["start_boat"]) == pytest.approx(200.0)
-    assert leg_bearing_deg(st, g4) == pytest.approx(twd % 360.0, abs=1e-9)
+    assert xy_bearing_deg(st, g4) == pytest.approx(twd % 360.0, abs=1e-9)
     assert math.dist(st, g4) == pytest.approx(60.0, abs=1e-9)
     pin_to_boat = np.subtract(lay.marks["start_boat"], lay.marks["start_pin"])
     assert cross(up, pin_to_boat) < 0
@@ -101,18 +101,18 @@ def test_trapezoid_geometry(twd, angle):
     g3, g4 = mid(lay, "3s", "3p"), mid(lay, "4s", "4p")
     # reach 1 -> 2: length 2/3 L, at TWA 180 - angle on starboard tack (after a port rounding)
     assert math.dist(m1, m2) == pytest.approx(2 * L / 3, abs=1e-9)
-    twa = float(signed_twa(twd, leg_bearing_deg(m1, m2)))
+    twa = float(signed_twa(twd, xy_bearing_deg(m1, m2)))
     assert twa == pytest.approx(180.0 - angle, abs=1e-9)
     # run 2 -> 3 dead downwind, and gate 3 level with gate 4 (same distance along the wind axis)
-    assert leg_bearing_deg(m2, g3) == pytest.approx((twd + 180.0) % 360.0, abs=1e-9)
+    assert xy_bearing_deg(m2, g3) == pytest.approx((twd + 180.0) % 360.0, abs=1e-9)
     up = (math.sin(math.radians(twd)), math.cos(math.radians(twd)))
     assert np.dot(g3, up) == pytest.approx(np.dot(g4, up), abs=1e-9)
     # 3p on the right looking upwind; finish line 250 m right of gate 3, along the wind
     assert cross(up, np.subtract(lay.marks["3p"], g3)) < 0
     fin = mid(lay, "finish_pin", "finish_boat")
     assert math.dist(g3, fin) == pytest.approx(250.0, abs=1e-9)
-    assert leg_bearing_deg(g3, fin) == pytest.approx((twd + 90.0) % 360.0, abs=1e-9)
-    assert abs(wrap180(leg_bearing_deg(lay.marks["finish_boat"], lay.marks["finish_pin"]) - twd)
+    assert xy_bearing_deg(g3, fin) == pytest.approx((twd + 90.0) % 360.0, abs=1e-9)
+    assert abs(wrap180(xy_bearing_deg(lay.marks["finish_boat"], lay.marks["finish_pin"]) - twd)
                ) == pytest.approx(0.0, abs=1e-9)
 
 
@@ -141,7 +141,7 @@ def test_trapezoid_outer_wind_modes():
     pts["3"] = mid(lay, "3s", "3p")
     pts["finish"] = mid(lay, "finish_pin", "finish_boat")
     names = ["start", *seq(lay)]
-    modes = [wind_mode(leg_bearing_deg(pts[a], pts[b]), twd)
+    modes = [wind_mode(xy_bearing_deg(pts[a], pts[b]), twd)
              for a, b in itertools.pairwise(names)]
     assert modes == ["upwind", "reach", "downwind", "upwind", "downwind", "reach"]
 
