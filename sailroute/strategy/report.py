@@ -28,7 +28,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.routing.types import side_name
-from sailroute.strategy.deadline import DeadlinePolicy, DeadlineSimulation, _nearest_nodes
+from sailroute.strategy.deadline import DeadlinePolicy, DeadlineSimulation
+from sailroute.strategy.deadline_grid import _nearest_nodes
 from sailroute.strategy.montecarlo import SimulationResult
 from sailroute.strategy.sdp import TACKS, ExpectedTimePolicy
 
