@@ -54,6 +54,7 @@ _UNIT_SUFFIXES: Final = (("_m_s", "m/s"), ("_ms", "m/s"), ("_mps", "m/s"), ("_kn
                          ("_kt", "kn"), ("_kts", "kn"), ("_knots", "kn"), ("_kmh", "km/h"),
                          ("_kph", "km/h"), ("_mph", "mph"))
 
+
 def unit_from_header(column: str) -> str | None:
     """Speed unit implied by a header suffix (``tws_kn`` -> ``"kn"``), or None."""
     c = column.strip().lower()
@@ -61,6 +62,7 @@ def unit_from_header(column: str) -> str | None:
         if c.endswith(suffix):
             return unit
     return None
+
 
 def parse_offset(text: str, where: str = "timezone") -> timezone:
     """Parse a fixed UTC offset such as ``"+01:00"``, ``"-0530"``, ``"Z"`` or ``"UTC"``."""
@@ -78,6 +80,7 @@ def parse_offset(text: str, where: str = "timezone") -> timezone:
     if delta > timedelta(hours=14):
         raise InputError(f"{where}: offset {text!r} is larger than 14 hours")
     return timezone(sign * delta)
+
 
 def map_columns(
     header: Sequence[str], columns: Mapping[str, str] | None = None, *, where: str = "CSV",
@@ -136,6 +139,7 @@ def map_columns(
         raise InputError(format_problems(f"{where}: cannot map the CSV columns", problems))
     return out
 
+
 TIME_PARTS: Final = ("year", "month", "day", "hour", "minute", "second")
 """Split date/time columns that can stand in for ``time`` (``columns`` may map them)."""
 
@@ -149,6 +153,7 @@ _PART_ALIASES: Final[dict[str, tuple[str, ...]]] = {
 }
 
 _PART_CASED: Final = {"MM": "month", "mm": "minute"}  # NDBC: '#YY MM DD hh mm'
+
 
 def time_part_columns(header: Sequence[str], columns: Mapping[str, str] | None = None, *,
                       where: str = "CSV") -> dict[str, int]:
@@ -183,6 +188,7 @@ def time_part_columns(header: Sequence[str], columns: Mapping[str, str] | None =
                          "with `columns: {month: mm}` or `columns: {minute: mm}` (NDBC writes "
                          "the month as MM and the minute as mm)")
     return out if all(q in out for q in TIME_PARTS[:4]) else {}
+
 
 def column_speed_unit(
     column: str, declared: str | None, where: str, implied: str | None = None
@@ -224,6 +230,7 @@ def column_speed_unit(
             f"(which says {implied!r}); fix one of them"
         )
     return declared
+
 
 def table_lines(text: str) -> list[tuple[int, str]]:
     """``(line number, line)`` of the header and data lines of a station table.

@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 
 from sailroute.errors import InputError, WindDataError
 from sailroute.textin import clean_text, excerpt, looks_binary
-from sailroute.timeutil import iso
+from sailroute.timeutil import iso, iso_datetime
 from sailroute.units import speed_factor, wind_components, wind_speed_direction
 from sailroute.wind.stationformat import (
     DEFAULT_MISSING,
@@ -98,8 +98,10 @@ class StationData:
         """Northward wind component [m s⁻¹] (true north)."""
         return wind_components(self.speed_ms, self.direction_deg)[1]
 
+
 _ARRAY_FIELDS: Final = ("station", "t", "lat", "lon", "speed_ms", "direction_deg", "height_m",
                         "gust_ms")
+
 
 def _table_text(source: Any) -> tuple[str, str]:
     """``(text, name)`` of a station table: a CSV file, or a pandas DataFrame as CSV."""
@@ -118,6 +120,7 @@ def _table_text(source: Any) -> tuple[str, str]:
         raise WindDataError(f"{p}: not a text file (binary content); expected a station CSV "
                             "with a header row such as time,station,lat,lon,speed,direction")
     return text, str(p)
+
 
 def read_stations(
     path: str | Path | Any,
@@ -299,6 +302,7 @@ def _check_ranges(name: str, linenos: list[int], header: Sequence[str],
         _check_range(name, linenos, header[cmap["lon"]], lon, -180.0, 360.0,
                      "longitude in [-180, 360]")
 
+
 def _parse_cells(cells: list[str], miss: set[str], parse: Callable[[int, str], float]
                  ) -> tuple[NDArray, int]:
     """Parse a column cell by cell: ``parse(k, cell)``, or NaN for a missing marker.
@@ -308,6 +312,7 @@ def _parse_cells(cells: list[str], miss: set[str], parse: Callable[[int, str], f
     out = np.array([np.nan if c in miss else parse(k, c) for k, c in enumerate(cells)],
                    dtype=float)
     return out, int(np.count_nonzero(np.isnan(out)))
+
 
 def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss: set[str],
              name: str) -> tuple[NDArray, int]:
@@ -328,12 +333,12 @@ def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss
 
     return _parse_cells(cells, miss, number)
 
+
 def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | None, name: str,
            column: str) -> tuple[NDArray, int]:
     def epoch(k: int, c: str) -> float:
-        s = c[:-1] + "+00:00" if c.endswith(("Z", "z")) else c
         try:
-            dt = datetime.fromisoformat(s)
+            dt = iso_datetime(c)
         except ValueError:
             raise WindDataError(
                 f"{name}, line {linenos[k]}, column {column!r}: cannot read {excerpt(c)!r} as an "
@@ -350,6 +355,7 @@ def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | 
         return dt.timestamp()
 
     return _parse_cells(cells, miss, epoch)
+
 
 def _part_times(cells: Mapping[str, list[str]], headers: Mapping[str, str], linenos: list[int],
                 miss: set[str], tz: timezone | None, name: str) -> tuple[NDArray, int]:
@@ -381,6 +387,7 @@ def _part_times(cells: Mapping[str, list[str]], headers: Mapping[str, str], line
             ) from None
     return out, int(np.count_nonzero(np.isnan(out)))
 
+
 def _check_range(name: str, linenos: list[int], column: str, a: NDArray, lo: float, hi: float,
                  what: str) -> None:
     bad = np.nonzero((a < lo) | (a > hi))[0]
@@ -391,8 +398,10 @@ def _check_range(name: str, linenos: list[int], column: str, a: NDArray, lo: flo
             f"({what}); {bad.size} row(s) affected"
         )
 
+
 def _fmt_counts(d: Mapping[str, int]) -> str:
     return ", ".join(f"{k} {v}" for k, v in d.items() if v) or "none"
+
 
 def _sorted_checked(data: StationData, linenos: NDArray, name: str, *,
                     allow_repeats: bool = False) -> StationData:
@@ -422,6 +431,7 @@ def _sorted_checked(data: StationData, linenos: NDArray, name: str, *,
             f"must increase within each station. {fix}"
         )
     return data
+
 
 def resample_stations(data: StationData, interval_s: float, *, min_fill: float = 0.5
                       ) -> StationData:

@@ -68,6 +68,7 @@ __all__ = [
     "unit_from_header",
 ]
 
+
 def local_records(
     data: StationData,
     frame: LocalFrame,
@@ -126,9 +127,11 @@ def local_records(
     u, v = earth_to_local(ue, ve, frame.grid_north_deg(data.lat, data.lon))
     return x, y, u, v
 
+
 RbfKernel = Literal["thin_plate_spline", "linear", "cubic", "quintic", "multiquadric",
                     "inverse_multiquadric", "inverse_quadratic", "gaussian"]
 """Kernel names of :class:`scipy.interpolate.RBFInterpolator`."""
+
 
 @dataclass(frozen=True, eq=False)
 class _StationState:
@@ -139,6 +142,7 @@ class _StationState:
     moving: bool  # some station moves (coach boat)
     rbf: Any  # RBF interpolator of station weights (method "rbf"), else None
     limit: str = ""  # which station's records limit the common time span ("" if one station)
+
 
 @dataclass(frozen=True, eq=False)
 class StationWind:
@@ -356,6 +360,7 @@ class StationWind:
         v = np.einsum("ns,ns->n", w, sv)
         return u.reshape(shape), v.reshape(shape)
 
+
 def _gap_free_span(ts: NDArray, window: tuple[float, float], max_gap_s: float
                    ) -> tuple[float, float]:
     """The stretch of records around ``window`` without a gap longer than ``max_gap_s``.
@@ -373,6 +378,7 @@ def _gap_free_span(ts: NDArray, window: tuple[float, float], max_gap_s: float
     if first >= starts.size or last < 0 or first > last:
         return float(ts[0]), float(ts[-1])
     return float(ts[starts[first]]), float(ts[ends[last]])
+
 
 def idw_weights(x: NDArray, y: NDArray, sx: NDArray, sy: NDArray, power: float = 2.0
                 ) -> NDArray[np.float64]:
