@@ -72,7 +72,7 @@ def test_plot_comparison(plan, with_map):
     assert len(fig.axes) == (2 if with_map else 1)
 
 
-# --- route.png conventions (issue 13 item 2) ------------------------------------------------
+# --- route.png conventions --------------------------------------------------------------------
 from sailroute.report.plots import OFFSET_PT, local_time, repeat_index, speed_limits  # noqa: E402
 
 
