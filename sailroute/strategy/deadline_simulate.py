@@ -1,5 +1,6 @@
-"""Seeded Monte Carlo of the deadline policies: Euler–Maruyama in Cartesian coordinates,
-with the deadline upgrade and the fallback to the risk-neutral policy (Wang et al. 2024)."""
+"""Monte Carlo of the deadline policies: Euler–Maruyama in Cartesian coordinates, with the
+deadline upgrade and the fallback to the risk-neutral policy (Wang et al. 2024); one random
+stream per chunk of runs, as in :mod:`sailroute.strategy.montecarlo`."""
 
 from __future__ import annotations
 
