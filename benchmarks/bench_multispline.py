@@ -14,7 +14,7 @@ our result next to the paper's:
   answer): fit ``r_t(θ)`` on ``[0, π]`` with ``r(0) = r(π) = 0``
   (:func:`~sailroute.routing.multispline.fit_function`); result = L2 error
   (the DP minimises its square).  The paper's serial C time of its Table 1
-  set-up is 56.5 s; the set-up's parameters are not in our brief, so
+  set-up is 56.5 s; the set-up's parameters are not known in full, so
   ``--ex1 NR NC NTS NREF`` takes them (default 16 rows, 64 nodes, 32 slopes,
   3 refinements).
 * **Example 2** (routing in Dębski's spatially varying analytic wind, A = (0, 0)
@@ -51,7 +51,7 @@ PAPER = {
     "ex1": {"serial_s": 56.5, "opencl_s": None, "result": None},
     "ex2": {"serial_s": 25.6, "opencl_s": 7.6, "result": 161.0},
 }
-"""Dębski (2016b) as quoted in issue 15: times [s] and results (t_f [s] for Example 2)."""
+"""Dębski (2016b) as published: times [s] and results (t_f [s] for Example 2)."""
 EX1_DEFAULT = (16, 64, 32, 3)
 EX2 = {"dp_rows": 16, "spline_cols": 32, "spline_slopes": 8, "spline_refinements": 3}
 POINT_ZONE_M = 0.01  # the paper's B is a point: a 1 cm rounding segment
@@ -91,7 +91,7 @@ def example1(setup: tuple[int, int, int, int], repeat: int) -> None:
     errs = " -> ".join(f"{math.sqrt(p.cost):.5f}" for p in fit.passes)
     edges = sum(p.edges for p in fit.passes)
     _row("Example 1", f"n_r={nr} n_c={nc} n_ts={nts} refine={nref}", wall, PAPER["ex1"],
-         f"L2 error per pass {errs} ({edges / 1e6:.0f} M edges; paper: not in the brief)")
+         f"L2 error per pass {errs} ({edges / 1e6:.0f} M edges; paper: not given)")
 
 
 def example2(repeat: int, options: bool) -> None:

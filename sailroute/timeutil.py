@@ -36,16 +36,32 @@ def parse_time(text: str | datetime, where: str = "time") -> datetime:
     return _aware(text, where).astimezone(UTC)
 
 
+def iso_datetime(text: str) -> datetime:
+    """An ISO 8601 time as written: aware with its UTC offset (a trailing ``Z`` or ``z``
+    is UTC), or naive when it carries none.
+
+    The one ISO 8601 parser of the package: :func:`parse_time` (which refuses a naive
+    time) and the track and station readers (which may apply a declared zone) build on it
+    and word their own messages.
+
+    Raises
+    ------
+    ValueError
+        If ``text`` (blanks around it ignored) is not ISO 8601.
+    """
+    s = text.strip()
+    if s.endswith(("Z", "z")):
+        s = s[:-1] + "+00:00"
+    return datetime.fromisoformat(s)
+
+
 def _aware(text: str | datetime, where: str) -> datetime:
     """The time as written, with its own UTC offset (checks as :func:`parse_time`)."""
     if isinstance(text, datetime):
         dt = text
     else:
-        s = str(text).strip()
-        if s.endswith(("Z", "z")):
-            s = s[:-1] + "+00:00"
         try:
-            dt = datetime.fromisoformat(s)
+            dt = iso_datetime(str(text))
         except ValueError:
             raise InputError(
                 f"{where}: cannot read {text!r} as an ISO 8601 time; "

@@ -91,6 +91,18 @@ MAX_NODES = 100_000
 """Most values (keys, scalars, mappings, lists) a YAML input may expand to, aliases
 expanded; a course file has a few hundred."""
 
+
+def _refuse_bad_chars(value: str, where: str) -> None:
+    """An error at ``where`` when the scalar ``value`` holds a character that no output
+    file can carry (:func:`~sailroute.textin.bad_char`)."""
+    bad = bad_char(value)
+    if bad is not None:
+        text = value if len(value) <= 40 else value[:37] + "..."
+        raise InputError(
+            f"{where}: the text {text!a} holds {bad}, which no output "
+            "file can carry; remove it (or the escape that writes it)")
+
+
 def _check_events(events: Iterable[yaml.Event], where: str) -> None:
     """Refuse deep nesting, alias bombs, recursive aliases and bad characters.
 
@@ -125,12 +137,7 @@ def _check_events(events: Iterable[yaml.Event], where: str) -> None:
 
     for ev in events:
         if isinstance(ev, yaml.ScalarEvent):
-            bad = bad_char(ev.value)
-            if bad is not None:
-                text = ev.value if len(ev.value) <= 40 else ev.value[:37] + "..."
-                raise InputError(
-                    f"{at(ev)}: the text {text!a} holds {bad}, which no output "
-                    "file can carry; remove it (or the escape that writes it)")
+            _refuse_bad_chars(ev.value, at(ev))
             grow(ev, 1, len(stack) + 1)
             if ev.anchor is not None:
                 size[ev.anchor], height[ev.anchor] = 1, 1

@@ -1,5 +1,5 @@
-"""CLI conventions (issue 13 items 4-5): help without type tags and with the choices,
-``-h``, shell completion, choices checked by the parser, ``--json`` for scripts,
+"""CLI conventions: help without type tags and with the choices, ``-h``, shell
+completion, choices checked by the parser, ``--json`` for scripts,
 ``--out`` checked before the work, and output folders written as a set."""
 
 from __future__ import annotations

@@ -58,96 +58,121 @@ from typing import Any, Final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.linalg import solveh_banded
 
+from sailroute.analysis.infer_courses import (
+    AXIS_TIE,
+    COG_WINDOW_S,
+    CORR_S,
+    MAX_GAP_S,
+    PAD_S,
+    ROUNDING_DEG,
+    ROUNDING_PAD_S,
+    TURN_DEG,
+    TURN_WINDOW_S,
+    _Points,
+    _steady_points,
+    axis_near_prior,
+    half_separation_deg,
+    wind_axis_deg,
+)
+from sailroute.analysis.infer_fit import (
+    BAND_DEG,
+    DOWN_MODEL_SD,
+    DOWN_OFF_DEG,
+    GAMMA_PRIOR_DEG,
+    LAMBDA_SCALE,
+    N_ITER,
+    RUN_GAMMA_DEG,
+    RUN_MODEL_SD,
+    RUN_WEIGHT,
+    UP_HALF_DEG,
+    UP_MODEL_SD,
+    _group_var,
+    _joint_fit,
+    _local_linear,
+)
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import iso
 from sailroute.track.kinematics import track_xy
 from sailroute.track.model import Track
-from sailroute.units import KNOT, bearing_deg, circular_mean_deg, wind_components, wrap180, wrap360
+from sailroute.units import KNOT, circular_mean_deg, wind_components, wrap180, wrap360
 from sailroute.wind.base import Coverage, prepare_points
+
+__all__ = [
+    "ALPHA_PRIOR_DEG",
+    "AXIS_TIE",
+    "BAND_DEG",
+    "COG_WINDOW_S",
+    "CORR_S",
+    "DOWN_MODEL_SD",
+    "DOWN_OFF_DEG",
+    "GAMMA_PRIOR_DEG",
+    "KNOT_S",
+    "LAMBDA_SCALE",
+    "MAX_APART_M",
+    "MAX_GAP_S",
+    "MAX_SD_DEG",
+    "MAX_SPAN_S",
+    "MIN_BOARD_POINTS",
+    "MIN_OBS_S",
+    "MIN_SPEED_MS",
+    "N_ITER",
+    "PAD_S",
+    "ROUNDING_DEG",
+    "ROUNDING_PAD_S",
+    "RUN_GAMMA_DEG",
+    "RUN_MODEL_SD",
+    "RUN_WEIGHT",
+    "SEPARATION_MARGIN_DEG",
+    "STEP_S",
+    "TURN_DEG",
+    "TURN_WINDOW_S",
+    "UP_HALF_DEG",
+    "UP_MODEL_SD",
+    "WINDOW_S",
+    "InferredWind",
+    "InferredWindField",
+    "axis_near_prior",
+    "half_separation_deg",
+    "infer_wind",
+    "summary",
+    "wind_axis_deg",
+]
 
 MIN_SPEED_MS: Final = 1.0
 """Points slower than this [m s⁻¹] are rejected (no steady course)."""
-COG_WINDOW_S: Final = 10.0
-"""The course at a point is that of the displacement over this window centred on it [s]."""
-TURN_WINDOW_S: Final = 20.0
-"""The courses over this window before and after a point tell whether it turns [s]."""
-TURN_DEG: Final = 20.0
-"""A point whose courses over the ``TURN_WINDOW_S`` before and after differ by more than
-this [°] is turning (a manoeuvre)."""
-PAD_S: Final = 10.0
-"""Points within this of a turning or slow point are rejected too [s]."""
-ROUNDING_DEG: Final = 110.0
-"""A turn of more than this [°] between the ``TURN_WINDOW_S`` before and after a point is a
-mark rounding (a tack turns 80-100°)."""
-ROUNDING_PAD_S: Final = 30.0
-"""Points within this of a mark rounding are rejected [s]: boats reach in to a mark from
-above the layline, luff or bear away round it, and settle on the new leg after it."""
-MAX_GAP_S: Final = 5.0
-"""A course window that holds a gap in the log longer than this [s] (or 2.5 sampling
-intervals, for logs slower than 0.5 Hz) is not used."""
+
 KNOT_S: Final = 20.0
 """Knot spacing of the piecewise-linear TWD(t) of the joint fit [s]."""
-CORR_S: Final = 10.0
-"""Correlation time of the course errors [s]: a 1 Hz point counts for 1/10 of an
-independent observation in the standard errors."""
-LAMBDA_SCALE: Final = 0.125
-"""The curvature penalty of the joint fit lets TWD(t) bend on a time scale of about
-``LAMBDA_SCALE * window_s`` (the equivalent kernel of a second-difference penalty spans
-``(lambda / rho) ** 0.25`` knots, rho the data weight per knot)."""
-N_ITER: Final = 4
-"""Classify-and-fit passes of the joint fit."""
+
 STEP_S: Final = 30.0
 """Default output grid step [s]."""
+
 WINDOW_S: Final = 90.0
 """Default full width of the output smoothing kernel [s]."""
-UP_HALF_DEG: Final = (15.0, 65.0)
-"""First-pass range of upwind |TWA| [°] (tacking half-angles)."""
-DOWN_OFF_DEG: Final = 50.0
-"""First pass: downwind boards lie within this of dead downwind [°]."""
-BAND_DEG: Final = 20.0
-"""Later passes: a point is on a board when its |TWA| is within this of the boat's fitted
-half-angle [°]; anything else is a reach and is rejected."""
-AXIS_TIE: Final = 0.1
-"""Two wind axes whose symmetry scores lie within this fraction of each other are a tie
-that ``prior_twd_deg`` breaks (:func:`axis_near_prior`) [-]."""
+
 ALPHA_PRIOR_DEG: Final = (42.0, 10.0)
 """Prior of a tacking half-angle without a polar: mean and sd [°] (keeps a boat that
 sails one board only solvable; the data dominate otherwise)."""
-GAMMA_PRIOR_DEG: Final = (10.0, 5.0)
-"""Prior of the downwind angle off dead downwind (180° − gybing half-angle) [°]."""
-UP_MODEL_SD: Final = 3.0
-"""How far from one constant angle a boat sails on an upwind board [°]: the VMG optimum is
-flat, so a few degrees higher or lower cost little (sailroute's own routes sail 40-50° in
-an oscillating wind).  Correlated along a board: it does not average down
-with the number of points."""
-RUN_MODEL_SD: Final = 8.0
-"""The same for a boat that runs (``RUN_GAMMA_DEG``) [°]: near
-dead downwind the polar is flat and the boat steers towards the mark, up to 10° by the lee
-or on a broad reach without a gybe."""
-DOWN_MODEL_SD: Final = 3.0
-"""The same for downwind boards of a boat that gybes through a clear angle [°]."""
-RUN_WEIGHT: Final = 0.1
-"""Runs count for this share of their variance weight [-]: they give the direction where
-no boat is on a board, but do not pull a beat's estimate towards the rhumb line (their
-error is a bias towards the mark, not noise)."""
-RUN_GAMMA_DEG: Final = 12.0
-"""A boat whose downwind courses spread less than this either side of dead downwind runs
-[°] (:func:`half_separation_deg`)."""
+
 SEPARATION_MARGIN_DEG: Final = 10.0
 """Without a prior, the wind axis end about which the boards are this much further apart
 [°] is upwind; with a smaller difference the slower boards decide."""
+
 MAX_SPAN_S: Final = 6 * 3600.0
 """Longest time span inferred in one call [s] (one race, or one evening's races)."""
+
 MAX_APART_M: Final = 20_000.0
 """Tracks whose mean positions lie further apart than this [m] are refused."""
+
 MIN_BOARD_POINTS: Final = 20
 """Steady points needed on each upwind board (all boats together)."""
+
 MIN_OBS_S: Final = 20.0
 """A grid time needs at least this many seconds of observations in its window."""
+
 MAX_SD_DEG: Final = 15.0
 """A grid time whose direction has a larger standard error gets none (NaN) [°]."""
 
@@ -283,400 +308,8 @@ class InferredWindField:
         return np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
 
 
-# ----------------------------------------------------------------------------- internals
-
-
 def _unwrap_deg(a: NDArray) -> NDArray[np.float64]:
     return np.degrees(np.unwrap(np.radians(np.asarray(a, float))))
-
-
-def _window_course(t: NDArray, x: NDArray, y: NDArray, half: float, turn: float
-                   ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
-    """Course and speed of the displacement over ``[t - half, t + half]``, and the courses
-    over ``[t - turn, t]`` and ``[t, t + turn]`` [°, m s⁻¹, °, °]."""
-    xa, ya = np.interp(t - half, t, x), np.interp(t - half, t, y)
-    xb, yb = np.interp(t + half, t, x), np.interp(t + half, t, y)
-    span = np.minimum(t + half, t[-1]) - np.maximum(t - half, t[0])
-    dx, dy = xb - xa, yb - ya
-    with np.errstate(invalid="ignore", divide="ignore"):
-        sog = np.where(span > 0, np.hypot(dx, dy) / np.where(span > 0, span, 1.0), 0.0)
-    xp, yp = np.interp(t - turn, t, x), np.interp(t - turn, t, y)
-    xn, yn = np.interp(t + turn, t, x), np.interp(t + turn, t, y)
-    return bearing_deg(dx, dy), sog, bearing_deg(x - xp, y - yp), bearing_deg(xn - x, yn - y)
-
-
-def _near_any(t: NDArray, flag: NDArray, pad: float) -> NDArray[np.bool_]:
-    """True where a flagged point lies within ``pad`` seconds."""
-    c = np.concatenate([[0], np.cumsum(flag.astype(np.int64))])
-    lo = np.searchsorted(t, t - pad, side="left")
-    hi = np.searchsorted(t, t + pad, side="right")
-    return (c[hi] - c[lo]) > 0
-
-
-@dataclass(frozen=True)
-class _Points:
-    """Steady points of all boats (one row per point)."""
-
-    t: NDArray[np.float64]
-    cog: NDArray[np.float64]
-    sog: NDArray[np.float64]
-    boat: NDArray[np.int64]
-    weight: NDArray[np.float64]  # 1 / correlation inflation: sampling interval / CORR_S
-
-
-def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: float,
-                   min_speed_ms: float) -> tuple[_Points, list[str]]:
-    ts, cs, ss, bs, ws, notes = [], [], [], [], [], []
-    for k, tr in enumerate(tracks):
-        m = (tr.t_s >= t0 - COG_WINDOW_S) & (tr.t_s <= t1 + COG_WINDOW_S)
-        t = np.asarray(tr.t_s[m], float)
-        if t.size < 3:
-            notes.append(f"{tr.name or k}: no points in the window")
-            continue
-        x, y = track_xy(tr.between(t[0], t[-1]), frame)
-        half = 0.5 * COG_WINDOW_S
-        cog, sog, before, after = _window_course(t, x, y, half, TURN_WINDOW_S)
-        turn = np.abs(wrap180(after - before))
-        slow = sog < min_speed_ms
-        dt = float(np.median(np.diff(t)))
-        big_gap = np.concatenate([[False], np.diff(t) > max(MAX_GAP_S, 2.5 * dt)])
-        ok = (~_near_any(t, (turn > TURN_DEG) | slow, PAD_S)
-              & ~_near_any(t, turn > ROUNDING_DEG, ROUNDING_PAD_S)
-              & ~_near_any(t, big_gap, COG_WINDOW_S) & (t >= t0) & (t <= t1))
-        n_ok = int(ok.sum())
-        notes.append(f"{tr.name or k}: {n_ok} of {int(((t >= t0) & (t <= t1)).sum())} points "
-                     "steady (not turning, slow or near a gap)")
-        ts.append(t[ok])
-        cs.append(cog[ok])
-        ss.append(sog[ok])
-        bs.append(np.full(n_ok, k, dtype=np.int64))
-        ws.append(np.full(n_ok, min(1.0, dt / CORR_S)))
-    if not ts:
-        return _Points(*(np.zeros(0),) * 3, np.zeros(0, np.int64), np.zeros(0)), notes
-    t_all = np.concatenate(ts)
-    o = np.argsort(t_all, kind="stable")  # time order across boats
-    return _Points(t_all[o], np.concatenate(cs)[o], np.concatenate(ss)[o],
-                   np.concatenate(bs)[o], np.concatenate(ws)[o]), notes
-
-
-def wind_axis_deg(cog_deg: NDArray, weights: NDArray | None = None) -> tuple[float, float]:
-    """The direction about which a set of courses is most symmetric.
-
-    Parameters
-    ----------
-    cog_deg : ndarray
-        Courses [°] of steady points.
-    weights : ndarray, optional
-        Weight of each course.
-
-    Returns
-    -------
-    axis_deg : float
-        The axis [°, in ``[0, 180)``]: the wind comes from ``axis`` or ``axis + 180``.
-    strength : float
-        Contrast of the symmetry score, ``1 - mean / max`` over all axes, in [0, 1]: 0 for
-        courses with no preferred axis.
-
-    Notes
-    -----
-    The courses are binned in 1° bins and smoothed (Gaussian, 3°); the score of a
-    direction θ is ``sum_d H(θ + d) H(θ − d)`` over half-separations ``d`` of 15° to 60°
-    (two boards), added for θ and θ + 180° (upwind and downwind boards).
-    """
-    axis = _axis_scores(cog_deg, weights)
-    i = int(np.argmax(axis))
-    strength = 1.0 - float(np.mean(axis)) / float(axis[i]) if axis[i] > 0 else 0.0
-    return float(i + 0.5) % 180.0, strength
-
-
-def _axis_scores(cog_deg: NDArray, weights: NDArray | None = None) -> NDArray[np.float64]:
-    """Symmetry score of each axis ``i + 0.5`` [°], ``i`` in 0..179 (:func:`wind_axis_deg`)."""
-    h = _course_histogram(cog_deg, weights)
-    th = np.arange(360)[:, None] + 0.5
-    d = np.arange(15, 61)[None, :]
-    s = np.sum(h[(th + d).astype(int) % 360] * h[(th - d).astype(int) % 360], axis=1)
-    return np.asarray(s[:180] + s[180:], dtype=float)
-
-
-def axis_near_prior(cog_deg: NDArray, prior_twd_deg: float, weights: NDArray | None = None,
-                    tie: float = AXIS_TIE) -> float:
-    """The wind axis [°, in ``[0, 180)``] when the courses leave several nearly tied.
-
-    Among the local maxima of the symmetry score within ``tie`` of the best (a club
-    course's reaches make a second axis), the one closest to ``prior_twd_deg`` (either
-    end); the best alone when none ties with it.
-    """
-    sc = _axis_scores(cog_deg, weights)
-    best = float(sc.max())
-    if best <= 0.0:
-        return float(np.argmax(sc) + 0.5) % 180.0
-    peak = (sc >= np.roll(sc, 1)) & (sc >= np.roll(sc, -1)) & (sc >= (1.0 - tie) * best)
-    axes = np.nonzero(peak)[0] + 0.5
-    off = np.abs(wrap180(axes - prior_twd_deg))
-    off = np.minimum(off, 180.0 - off)
-    return float(axes[int(np.argmin(off))]) % 180.0
-
-
-def _course_histogram(cog_deg: NDArray, weights: NDArray | None = None) -> NDArray[np.float64]:
-    """Courses in 1° bins (bin i holds [i, i + 1)), smoothed with a 3° Gaussian."""
-    h = np.bincount(np.floor(wrap360(cog_deg)).astype(int) % 360, weights=weights,
-                    minlength=360).astype(float)
-    k = np.arange(-10, 11)
-    g = np.exp(-0.5 * (k / 3.0) ** 2)
-    return np.asarray(np.sum([np.roll(h, s) * w for s, w in zip(k, g, strict=True)], axis=0),
-                      dtype=float)
-
-
-def half_separation_deg(cog_deg: NDArray, end_deg: float,
-                        weights: NDArray | None = None) -> float:
-    """Mean half-separation [°] of the courses symmetric about the direction ``end_deg``.
-
-    The score-weighted mean of ``d`` in 0..70° of ``sum H(end + d) H(end − d)``: about the
-    upwind end of the wind axis it is the tacking half-angle (35-55°), about the downwind
-    end the angle of the downwind boards off dead downwind (0° for a boat that runs, 20-35°
-    for one that gybes through a clear angle).
-    """
-    h = _course_histogram(cog_deg, weights)
-    d = np.arange(0, 71)
-    e = float(end_deg) % 360.0
-    i = np.floor(e).astype(int)
-    # bins i + d and i - d are symmetric about i + 0.5; the end lies within half a bin
-    s = h[(i + d) % 360] * h[(i - d) % 360]
-    return float(np.sum(d * s) / np.sum(s)) if np.sum(s) > 0 else float("nan")
-
-
-# ---------------------------------------------------------------------------- the fit
-
-
-@dataclass(frozen=True)
-class _Fit:
-    knots: NDArray[np.float64]
-    twd: NDArray[np.float64]        # unwrapped TWD at the knots [°]
-    alpha: NDArray[np.float64]      # per boat [°]
-    gamma: NDArray[np.float64]      # per boat [°]
-    alpha_sd: NDArray[np.float64]
-    gamma_sd: NDArray[np.float64]
-    up: NDArray[np.bool_]           # per point: on an upwind board
-    used: NDArray[np.bool_]         # per point: on a board (up or down)
-    boat: NDArray[np.int64]         # per point: boat index
-    side: NDArray[np.float64]       # per point: +1 starboard, -1 port
-    obs: NDArray[np.float64]        # per point: its own TWD observation (unwrapped) [°]
-    w: NDArray[np.float64]          # per point: fit weight (1/sd^2 x robust x correlation)
-    msd: NDArray[np.float64]        # per point: model sd (UP/RUN/DOWN_MODEL_SD) [°]
-    sigma: tuple[float, float]      # residual sd upwind, downwind [°]
-
-
-def _basis(t: NDArray, knots: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """Linear-interpolation basis: left knot index and the two weights."""
-    j = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, knots.size - 2)
-    f = np.clip((t - knots[j]) / (knots[j + 1] - knots[j]), 0.0, 1.0)
-    return j, 1.0 - f, f
-
-
-def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
-               alpha0: NDArray, gamma0: NDArray, alpha_prior_sd: float,
-               window_s: float, *, use_down: bool = True,
-               alpha_sd_fixed: NDArray | None = None,
-               gamma_prior_sd: NDArray | None = None) -> _Fit:
-    """Fit TWD(t) at the knots and the boats' half-angles (module notes, step 3).
-
-    ``use_down=False`` fits the upwind boards alone; ``alpha_sd_fixed`` holds the tacking
-    half-angles at ``alpha0`` (their sd as given) and fits the rest.
-    """
-    J, K = knots.size, n_boats
-    P = J + 2 * K
-    j, w0, w1 = _basis(p.t, knots)
-    twd = twd0.copy()
-    alpha, gamma = alpha0.copy(), gamma0.copy()
-    robust = np.ones(p.t.size)
-    sig_up, sig_dn = 5.0, 10.0
-    par_var: NDArray[np.float64] = np.ones(2 * K)
-    # D'D of the second-difference operator D, built band by band (pentadiagonal)
-    dtd = np.zeros((J, J))
-    r = np.arange(J - 2)
-    for a_, ca in enumerate((1.0, -2.0, 1.0)):
-        for b_, cb in enumerate((1.0, -2.0, 1.0)):
-            np.add.at(dtd, (r + a_, r + b_), ca * cb)
-    up = used = np.zeros(p.t.size, bool)
-    side = np.ones(p.t.size)
-    y = np.zeros(p.t.size)
-    coef = np.zeros(p.t.size)
-    wt = np.zeros(p.t.size)
-    for it in range(N_ITER):
-        cur = twd[j] * w0 + twd[j + 1] * w1
-        twa = wrap180(cur - p.cog)
-        a = np.abs(twa)
-        side = np.where(twa >= 0, 1.0, -1.0)
-        if it == 0 and alpha_sd_fixed is None:
-            up = (a >= UP_HALF_DEG[0]) & (a <= UP_HALF_DEG[1])
-            dn = a >= 180.0 - DOWN_OFF_DEG
-        else:
-            up = np.abs(a - alpha[p.boat]) <= BAND_DEG
-            dn = (np.abs((180.0 - a) - gamma[p.boat]) <= BAND_DEG + 5.0) if it else (
-                a >= 180.0 - DOWN_OFF_DEG)
-        if not use_down:
-            dn = np.zeros_like(up)
-        used = up | dn
-        # observation relative to the current curve: y = dTWD(t) - s alpha (up),
-        # y = dTWD(t) + s gamma (down); unknowns: knot increments, alpha, gamma (absolute)
-        y = np.where(up, wrap180(p.cog - cur), wrap180(p.cog + 180.0 - cur))
-        col = np.where(up, J + p.boat, J + K + p.boat)
-        coef = np.where(up, -side, side)
-        msd = _model_sd(up, gamma[p.boat])
-        run = ~up & (np.abs(gamma[p.boat]) < RUN_GAMMA_DEG)
-        wt = (robust * p.weight * used * np.where(run, RUN_WEIGHT, 1.0)
-              / (np.where(up, sig_up, sig_dn) ** 2 + msd**2))
-        # normal equations by accumulation: 3 non-zeros per row
-        idx = np.stack([j, j + 1, col], axis=1)
-        val = np.stack([w0, w1, coef], axis=1)
-        rows = (idx[:, :, None] * P + idx[:, None, :]).reshape(-1)
-        prods = (val[:, :, None] * val[:, None, :] * wt[:, None, None]).reshape(-1)
-        N: NDArray[np.float64] = np.bincount(rows, weights=prods,
-                                             minlength=P * P).reshape(P, P).astype(float)
-        b: NDArray[np.float64] = np.bincount(
-            idx.reshape(-1), weights=(val * (wt * y)[:, None]).reshape(-1),
-            minlength=P).astype(float)
-        # curvature penalty on the increments (bridges gaps; resolution ~ window_s)
-        per_knot = np.bincount(j, weights=wt, minlength=J)
-        rho = float(np.median(per_knot[per_knot > 0])) if (per_knot > 0).any() else 1.0
-        lam = rho * (LAMBDA_SCALE * window_s / (knots[1] - knots[0])) ** 4
-        N[:J, :J] += lam * dtd
-        N[np.arange(J), np.arange(J)] += 1e-6
-        # penalise the curvature of the total curve, not only of the increment
-        b[:J] -= lam * (dtd @ twd)
-        # priors on the half-angles (absolute values)
-        ia, ig = J + np.arange(K), J + K + np.arange(K)
-        a_sd = alpha_prior_sd if alpha_sd_fixed is None else 1e-3
-        N[ia, ia] += 1.0 / a_sd**2
-        g_sd = GAMMA_PRIOR_DEG[1] if gamma_prior_sd is None else gamma_prior_sd
-        N[ig, ig] += 1.0 / g_sd**2
-        b[ia] += alpha0 / a_sd**2
-        b[ig] += gamma0 / g_sd**2
-        sol, par_var = _solve_bordered(N, b, J)
-        twd = twd + sol[:J]
-        alpha, gamma = sol[ia], sol[ig]
-        # residuals and robust weights
-        fitted = sol[:J][j] * w0 + sol[:J][j + 1] * w1 + coef * sol[col]
-        r = y - fitted
-        sig_up = _mad(r[up & used]) if (up & used).sum() > 10 else sig_up
-        sig_dn = _mad(r[~up & used]) if (~up & used).sum() > 10 else sig_dn
-        sig_up, sig_dn = max(sig_up, 0.5), max(sig_dn, 0.5)
-        sc = np.where(up, sig_up, sig_dn)
-        robust = np.minimum(1.0, 1.5 * sc / np.maximum(np.abs(r), 1e-9))
-    cur = twd[j] * w0 + twd[j + 1] * w1
-    obs = cur + wrap180(np.where(up, p.cog + side * alpha[p.boat],
-                                 p.cog + 180.0 - side * gamma[p.boat]) - cur)
-    ia, ig = J + np.arange(K), J + K + np.arange(K)
-    # the covariance of a weighted fit with weights 1/sigma^2 is in deg^2 already
-    a_out = np.sqrt(par_var[:K]) if alpha_sd_fixed is None else alpha_sd_fixed
-    return _Fit(knots, twd, alpha, gamma, a_out,
-                np.sqrt(par_var[K:]), up & used, used, p.boat, side, obs, wt,
-                _model_sd(up, gamma[p.boat]),
-                (sig_up, sig_dn))
-
-
-def _solve_bordered(N: NDArray, b: NDArray, J: int
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Solve the normal equations ``N x = b`` whose knot block ``N[:J, :J]`` is banded
-    (pentadiagonal: linear basis plus the second-difference penalty) and bordered by a few
-    dense parameter rows, by the Schur complement in O(J); also the variances of the
-    parameters (the diagonal of the parameter block of ``N⁻¹``)."""
-    A, B, C = N[:J, :J], N[:J, J:], N[J:, J:]
-    ab = np.zeros((3, J))
-    for u in range(3):  # upper banded storage: ab[2 - u, j] = A[j - u, j]
-        ab[2 - u, u:] = np.diagonal(A, u)
-    rhs = np.column_stack([b[:J], B])
-    try:
-        z = solveh_banded(ab, rhs)
-        S = C - B.T @ z[:, 1:]
-        par = np.linalg.solve(S, b[J:] - B.T @ z[:, 0])
-        var = np.diag(np.linalg.inv(S))
-    except (np.linalg.LinAlgError, ValueError):
-        sol = np.linalg.lstsq(N, b, rcond=None)[0]
-        return sol, np.diag(np.linalg.pinv(N))[J:].astype(float)
-    x = z[:, 0] - z[:, 1:] @ par
-    return np.concatenate([x, par]), np.asarray(var, dtype=float)
-
-
-def _model_sd(up: NDArray, gamma: NDArray) -> NDArray[np.float64]:
-    return np.where(up, UP_MODEL_SD, np.where(np.abs(gamma) < RUN_GAMMA_DEG, RUN_MODEL_SD,
-                                              DOWN_MODEL_SD))
-
-
-def _mad(r: NDArray) -> float:
-    return float(1.4826 * np.median(np.abs(r - np.median(r))))
-
-
-def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float,
-                  infl: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
-    """Local-linear kernel regression of ``v(t)`` at ``tg`` (tricube, half-width ``h``).
-
-    Parameters
-    ----------
-    tg : ndarray
-        Grid times [s].
-    t, v, w : ndarray
-        Sorted point times [s], values and weights.
-    h : float
-        Kernel half-width [s].
-    infl : ndarray
-        Variance inflation of each point (1 / its share of an independent observation).
-
-    Returns
-    -------
-    est : ndarray
-        The estimate at each grid time (NaN without points); the local mean where the
-        window has points on one side only.
-    var : ndarray
-        Its variance, ``sum l_i² r_i² infl_i`` with ``l`` the equivalent kernel and ``r``
-        the residuals about the local fit.
-    n : ndarray of int
-        Points in the window.
-    mu2 : ndarray
-        ``sum l_i (t_i − tg)²``, the kernel's second moment (for the smoothing bias).
-    """
-    G = tg.size
-    est = np.full(G, np.nan)
-    var = np.full(G, np.nan)
-    n = np.zeros(G, np.int64)
-    mu2 = np.full(G, np.nan)
-    order = np.argsort(t)
-    t, v, w, infl = t[order], v[order], w[order], infl[order]
-    lo = np.searchsorted(t, tg - h, side="left")
-    hi = np.searchsorted(t, tg + h, side="right")
-    width = int(np.max(hi - lo)) if G else 0
-    if width == 0:
-        return est, var, n, mu2
-    k = lo[:, None] + np.arange(width)[None, :]
-    inside = k < hi[:, None]
-    k = np.minimum(k, t.size - 1)
-    dt = t[k] - tg[:, None]
-    kern = np.where(inside, (1.0 - np.clip(np.abs(dt) / h, 0, 1) ** 3) ** 3, 0.0) * w[k]
-    s0 = kern.sum(1)
-    s1 = (kern * dt).sum(1)
-    s2 = (kern * dt * dt).sum(1)
-    det = s0 * s2 - s1 * s1
-    # local linear only with data on both sides (a quarter of the window each); else the
-    # local mean (an extrapolated slope at the ends of the data is noise)
-    both = ((kern * (dt < -0.25 * h)).sum(1) > 0) & ((kern * (dt > 0.25 * h)).sum(1) > 0)
-    lin = both & (det > 1e-9 * np.maximum(s0 * s2, 1e-300))
-    # equivalent kernel l_i = kern_i (s2 - s1 dt_i) / det (local linear); else local mean
-    with np.errstate(invalid="ignore", divide="ignore"):
-        lw = np.where(lin[:, None], kern * (s2[:, None] - s1[:, None] * dt) / det[:, None],
-                      kern / s0[:, None])
-    vv = v[k]
-    e = (lw * vv).sum(1)
-    r = vv - e[:, None]
-    var_ = (lw**2 * r**2 * infl[k] * inside).sum(1)
-    n_ = inside.sum(1)
-    m2 = (lw * dt * dt).sum(1)
-    ok = s0 > 0
-    est[ok], var[ok], n[:] = e[ok], var_[ok], n_
-    mu2[ok] = m2[ok]
-    return est, var, n, mu2
-
-
-# ---------------------------------------------------------------------------- TWS
 
 
 def _invert_polar(boat: BoatModel, twa_deg: NDArray, sog_ms: NDArray) -> NDArray[np.float64]:
@@ -695,9 +328,6 @@ def _invert_polar(boat: BoatModel, twa_deg: NDArray, sog_ms: NDArray) -> NDArray
     with np.errstate(invalid="ignore", divide="ignore"):
         f = np.where(s1 > s0, (sog_ms - s0) / (s1 - s0), 0.0)
     return np.where(ok, grid[ci - 1] + f * (grid[ci] - grid[ci - 1]), np.nan)
-
-
-# ---------------------------------------------------------------------------- public API
 
 
 def _gamma_priors(p: _Points, n_boats: int, twd_axis: float, default: float
@@ -972,38 +602,6 @@ def _seconds_in_window(tg: NDArray, t: NDArray, h: float, weight: NDArray
     c = np.concatenate([[0.0], np.cumsum(weight * CORR_S)])
     return np.asarray(c[np.searchsorted(t, tg + h, side="right")]
                       - c[np.searchsorted(t, tg - h, side="left")], dtype=float)
-
-
-def _group_var(tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDArray
-               ) -> NDArray[np.float64]:
-    """Variance [°²] at the grid times from errors shared by a boat's board.
-
-    Two terms per boat and board (upwind, downwind), with ``f_i`` the point's share of the
-    kernel weight: the model error (``(sum f_i msd_i)²``: how far a board's angle may sit
-    from the fitted constant, the same along the board) and the uncertainty of the fitted
-    half-angle (``(sum f_i s_i)² sd²`` with ``s_i`` the board's sign: it cancels where both
-    boards are sailed in the window and adds up where only one is).
-    """
-    up, boat = fit.up[m], fit.boat[m]
-    coef = np.where(up, fit.side[m], -fit.side[m])
-    msd = fit.msd[m]
-    var = np.zeros(tg.size)
-    lo = np.searchsorted(t, tg - h, side="left")
-    hi = np.searchsorted(t, tg + h, side="right")
-    width = int(np.max(hi - lo)) if tg.size else 0
-    if width == 0:
-        return var
-    k = lo[:, None] + np.arange(width)[None, :]
-    inside = k < hi[:, None]
-    k = np.minimum(k, t.size - 1)
-    kern = np.where(inside, (1.0 - np.clip(np.abs(t[k] - tg[:, None]) / h, 0, 1) ** 3) ** 3,
-                    0.0) * w[k]
-    f = kern / np.maximum(kern.sum(1), 1e-300)[:, None]
-    for is_up, sds in ((True, fit.alpha_sd), (False, fit.gamma_sd)):
-        for b, sd in enumerate(sds):
-            sel = (up[k] == is_up) & (boat[k] == b)
-            var += ((f * coef[k] * sel).sum(1) * sd) ** 2 + ((f * msd[k] * sel).sum(1)) ** 2
-    return var
 
 
 def summary(inferred: InferredWind) -> dict[str, Any]:

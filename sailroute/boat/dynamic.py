@@ -789,23 +789,14 @@ def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, ome
     n = beta.size
     w_ss = steady_w(beta, c1, c2, k)
     h_all = np.broadcast_to(np.asarray(h, float), (n,))
-    y = np.zeros((3, n))  # s, w, tau
-    y[1] = np.maximum(np.asarray(w0, float), 0.0)
-    out_tau = np.full(n, np.inf)
-    out_w = np.zeros(n)
-    done0 = ell <= 0
-    out_tau[done0] = 0.0
-    out_w[done0] = y[1, done0]
-    act = np.flatnonzero(~done0)
+    y, out_tau, out_w, act = _piece_start(n, w0, ell, 3)  # s, w, tau
 
     def f(yv: NDArray, bv: NDArray) -> NDArray:
         wv = np.maximum(yv[1], 0.0)
         inv = 1.0 / (wv + omega)
         return np.stack([wv * inv, drive(wv, bv, c1, c2, k) * inv, inv])
 
-    steps = 0
-    while act.size and steps < max_steps:
-        steps += 1
+    def step(act: NDArray[np.int64]) -> NDArray[np.bool_]:
         bv, yv = beta[act], y[:, act]
         k1 = f(yv, bv)
         # adaptive: at most 10 % change of (w + ω) and a tenth of the local
@@ -849,11 +840,9 @@ def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, ome
                 out_w[i] = w_end[ok]
                 done[cand[ok]] = True
         y[:, act] = yn
-        act = act[~done]
-    if act.size:  # cap reached: finish at the current speed
-        ws = np.maximum(y[1, act], 1e-300)
-        out_tau[act] = y[2, act] + (ell[act] - y[0, act]) / ws
-        out_w[act] = y[1, act]
+        return done
+
+    _march_piece(step, act, max_steps, y, y[2], ell, (out_tau, out_w))
     return out_tau, out_w
 
 
@@ -916,15 +905,7 @@ def _rk4_piece(beta: NDArray, ell: NDArray, w0: NDArray, h: NDArray, c1: float, 
                k: float, max_steps: int) -> tuple[NDArray, NDArray]:
     n = beta.size
     tau = np.zeros(n)
-    y = np.zeros((2, n))  # s, w
-    y[1] = np.maximum(np.asarray(w0, float), 0.0)
-    out_tau = np.full(n, np.inf)
-    out_w = np.zeros(n)
-    done0 = ell <= 0
-    out_tau[done0] = 0.0
-    out_w[done0] = y[1, done0]
-    act = np.flatnonzero(~done0)
-    steps = 0
+    y, out_tau, out_w, act = _piece_start(n, w0, ell, 2)  # s, w
 
     def f(wv: NDArray, bv: NDArray) -> NDArray:
         return drive(np.maximum(wv, 0.0), bv, c1, c2, k)
@@ -937,8 +918,8 @@ def _rk4_piece(beta: NDArray, ell: NDArray, w0: NDArray, h: NDArray, c1: float, 
         return dy
 
     no_drive = f(np.zeros_like(beta), beta) <= 0.0  # a boat at rest stays at rest
-    while act.size and steps < max_steps:
-        steps += 1
+
+    def step(act: NDArray[np.int64]) -> NDArray[np.bool_]:
         bv, yv, hv = beta[act], y[:, act], h[act]
         y_new, k1 = rk4_step(rhs, yv, hv, args=(bv,))
         s_new = y_new[0]
@@ -956,12 +937,43 @@ def _rk4_piece(beta: NDArray, ell: NDArray, w0: NDArray, h: NDArray, c1: float, 
         if dead.any():
             out_tau[act[dead]] = np.inf
             out_w[act[dead]] = 0.0
-        keep = ~(cross | dead)
         tau[act] = tau[act] + hv
         y[:, act] = y_new
-        act = act[keep]
-    if act.size:  # cap reached: finish at the current (near steady) speed
+        return cross | dead
+
+    _march_piece(step, act, max_steps, y, tau, ell, (out_tau, out_w))
+    return out_tau, out_w
+
+
+def _piece_start(n: int, w0: ArrayLike, ell: NDArray, n_state: int
+                 ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.int64]]:
+    """Start of an RK4 piece of ``n`` items: the state ``(n_state, n)`` (``s = 0``, ``w``
+    the entry speed clipped at 0, the rest 0), the scaled time and exit speed (0 and the
+    entry speed for an empty piece, ``inf`` and 0 until known), the items to integrate."""
+    y = np.zeros((n_state, n))
+    y[1] = np.maximum(np.asarray(w0, float), 0.0)
+    out_tau = np.full(n, np.inf)
+    out_w = np.zeros(n)
+    done0 = ell <= 0
+    out_tau[done0] = 0.0
+    out_w[done0] = y[1, done0]
+    return y, out_tau, out_w, np.flatnonzero(~done0)
+
+
+def _march_piece(step: Callable[[NDArray[np.int64]], NDArray[np.bool_]],
+                 act: NDArray[np.int64], max_steps: int, y: NDArray, tau: NDArray,
+                 ell: NDArray, out: tuple[NDArray, NDArray]) -> None:
+    """The RK4 loop over a constant-wind piece: ``step(items) -> done`` advances the active
+    items one step (the state ``y`` = ``(s, w, ...)`` and scaled time ``tau`` [m]; the
+    results ``out = (τ, w_end)`` of the items it ends) until none is left.  After
+    ``max_steps`` steps the items still running finish at their current (near steady)
+    speed."""
+    steps = 0
+    while act.size and steps < max_steps:
+        steps += 1
+        act = act[~step(act)]
+    if act.size:  # cap reached: finish at the current speed
+        out_tau, out_w = out
         ws = np.maximum(y[1, act], 1e-300)
         out_tau[act] = tau[act] + (ell[act] - y[0, act]) / ws
         out_w[act] = y[1, act]
-    return out_tau, out_w

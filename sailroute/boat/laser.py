@@ -396,6 +396,12 @@ def check_params(c: Checker, spec: Any) -> LaserParams | None:
 
 def validate(p: LaserParams) -> list[str]:
     """Problems with a parameter set (empty if it is usable), each naming its field."""
+    return [*_number_problems(p), *_model_problems(p), *_sail_crew_problems(p)]
+
+
+def _number_problems(p: LaserParams) -> list[str]:
+    """Fields that must be finite and positive, non-negative or in [0, 1]; the sail's
+    centre of effort above its foot."""
     out: list[str] = []
     positive = (
         "hull_mass_kg", "crew_mass_kg", "loa_m", "beam_m", "lwl_m", "bwl_m",
@@ -433,6 +439,12 @@ def validate(p: LaserParams) -> list[str]:
             f"ce_height_m: must be above sail_foot_height_m ({p.sail_foot_height_m}); "
             f"got {p.ce_height_m}"
         )
+    return out
+
+
+def _model_problems(p: LaserParams) -> list[str]:
+    """Hull and stability models known; a righting-arm curve of increasing heel."""
+    out: list[str] = []
     if p.hull_model not in HULL_MODELS:
         out.append(f"hull_model: expected one of {', '.join(map(repr, HULL_MODELS))}; "
                    f"got {p.hull_model!r}")
@@ -443,6 +455,13 @@ def validate(p: LaserParams) -> list[str]:
         out.append("gz_heel_deg, gz_m: need two lists of the same length (at least 2)")
     elif any(b <= a for a, b in zip(p.gz_heel_deg, p.gz_heel_deg[1:], strict=False)):
         out.append("gz_heel_deg: must increase strictly")
+    return out
+
+
+def _sail_crew_problems(p: LaserParams) -> list[str]:
+    """Heights of the headsails' centres of effort, the headsail table, the crew mass of a
+    hiking dinghy and some stability with ``stability: heel``."""
+    out: list[str] = []
     if p.jib_area_m2 > 0 and p.jib_ce_height_m <= 0:
         out.append("jib_ce_height_m: must be > 0 when jib_area_m2 > 0")
     if p.kite_area_m2 > 0 and p.kite_ce_height_m <= 0:

@@ -48,7 +48,7 @@ from sailroute.course.geometry import feature_centre
 from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.planning.result import Comparison, Plan, percent_error
-from sailroute.report.plots import repeat_index_of_ends
+from sailroute.report.plots import SPEED_SPAN_KN, repeat_index_of_ends, speed_limits
 from sailroute.report.tables import format_duration, start_point_text
 from sailroute.textin import clean_text
 from sailroute.timeutil import iso, offset_text
@@ -91,8 +91,6 @@ and last kept): a 3-hour 10 Hz log would otherwise make a page of 100 MB that no
 draws; the hover text is at the drawn points."""
 FLEET_STEPS = 60
 """Slider positions of a fleet's replay."""
-SPEED_SPAN_KN = 2.0
-"""Smallest span of a colour scale [kn] (noise does not look like a change)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -826,19 +824,6 @@ def _colour(i: int) -> str:
     return ROUTE_COLOURS[i % len(ROUTE_COLOURS)]
 
 
-def speed_limits(values: NDArray, span: float = SPEED_SPAN_KN) -> tuple[float, float]:
-    """Colour-scale limits: 2nd-98th percentile of the finite values > 0.05, ≥ ``span`` wide."""
-    v = np.asarray(values, float)
-    v = v[np.isfinite(v) & (v > 0.05)]
-    if v.size == 0:
-        return 0.0, span
-    lo, hi = (float(x) for x in np.percentile(v, [2.0, 98.0]))
-    if hi - lo < span:
-        lo = max(0.5 * (lo + hi - span), 0.0)
-        hi = lo + span
-    return round(lo, 2), round(hi, 2)
-
-
 def _customdata(r: Route, off: float) -> list[list[Any] | None]:
     """Hover data per point: leg, mode, local time, UTC time, TWS, |TWA|, tack, speed, VMG,
     latitude, longitude (the true position, also where the line is drawn shifted)."""
@@ -1022,7 +1007,7 @@ def figure(report: Report) -> dict[str, Any]:
     data += list(report.overlays)
 
     single = report.colour_by_speed and len(report.routes) == 1
-    slo, shi = speed_limits(np.concatenate([r.speed_kn for r in report.routes])) \
+    slo, shi = speed_limits(np.concatenate([r.speed_kn for r in report.routes]), decimals=2) \
         if report.routes else (0.0, SPEED_SPAN_KN)
     for i, r in enumerate(report.routes):
         group = f"route{i}"

@@ -133,21 +133,31 @@ def _draw_wind(ax: Axes, fig: Figure, wind: WindField, t: float,
 
 
 SPEED_SPAN_KN = 2.0
-"""Smallest span of the boat-speed colour scale [kn]."""
+"""Smallest span of a boat-speed colour scale [kn] (noise does not look like a change)."""
 OFFSET_PT = 4.0
 """Sideways shift of a leg that repeats an earlier one [points]."""
 
 
-def speed_limits(bsp_kn: NDArray) -> tuple[float, float]:
-    """Colour-scale limits [kn]: 2nd-98th percentile of moving speeds, >= SPEED_SPAN_KN wide."""
-    moving = bsp_kn[bsp_kn > 0.05]
-    if moving.size == 0:
-        return 0.0, SPEED_SPAN_KN
-    lo, hi = (float(v) for v in np.percentile(moving, [2.0, 98.0]))
-    if hi - lo < SPEED_SPAN_KN:
-        lo = max(0.5 * (lo + hi - SPEED_SPAN_KN), 0.0)
-        hi = lo + SPEED_SPAN_KN
-    return lo, hi
+def speed_limits(values: NDArray, span: float = SPEED_SPAN_KN, decimals: int | None = None
+                 ) -> tuple[float, float]:
+    """Colour-scale limits [kn] of boat speeds ``values`` [kn].
+
+    The 2nd-98th percentile of the finite speeds above 0.05 kn (moving), widened about its
+    middle to at least ``span`` [kn] (so that noise does not look like a change) and kept
+    >= 0; ``(0, span)`` when nothing moves.  ``decimals``: round both limits (the web
+    page writes them so).
+    """
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v) & (v > 0.05)]
+    if v.size == 0:
+        return 0.0, span
+    lo, hi = (float(x) for x in np.percentile(v, [2.0, 98.0]))
+    if hi - lo < span:
+        lo = max(0.5 * (lo + hi - span), 0.0)
+        hi = lo + span
+    if decimals is None:
+        return lo, hi
+    return round(lo, decimals), round(hi, decimals)
 
 
 def repeat_index(legs: Sequence[LegResult], tol_m: float = 30.0) -> list[int]:

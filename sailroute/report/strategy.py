@@ -29,7 +29,8 @@ from numpy.typing import NDArray
 
 from sailroute.outdir import make_out_dir
 from sailroute.routing.types import side_name
-from sailroute.strategy.deadline import DeadlinePolicy, DeadlineSimulation, _nearest_nodes
+from sailroute.strategy.deadline import DeadlinePolicy, DeadlineSimulation
+from sailroute.strategy.deadline_grid import _nearest_nodes
 from sailroute.strategy.montecarlo import SimulationResult
 from sailroute.strategy.sdp import TACKS, ExpectedTimePolicy
 from sailroute.strategy.shiftmodel import ShiftModel

@@ -6,7 +6,7 @@ the same bit for bit (``tests/strategy/test_strategy_deadline.py`` compares both
 
 - bilinear (the default): :func:`ring_slice` is one budget slice.  Nothing is stored per
   row: a foot's ring offset and fraction depend only on the tack, control and angle, its
-  angular offset on those and the ring (``deadline._RingRows``), so along a ring the rows
+  angular offset on those and the ring (``deadline_rows._RingRows``), so along a ring the rows
   fall into runs (:func:`fill_runs`, built once per solve) that read contiguous memory;
   :func:`run_values` does a run's rows for one control, and numba vectorises it.
   :func:`pad_rings` copies the slice into the padded form the runs read.
@@ -65,7 +65,7 @@ def count_runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: i
 def fill_runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, nt: int,
               ring0: int, ptr: Any, j0: Any, j1: Any, kind: Any, di: Any, op: Any,
               om: Any) -> None:
-    """The runs of the ring-relative bilinear rows (``deadline._RingRows``).
+    """The runs of the ring-relative bilinear rows (``deadline_rows._RingRows``).
 
     Along ``j`` (fixed tack ``q``, ring ``i >= ring0``, control ``n``) a row is one of: a
     foot inside the mark (``kind`` 1, value 1), beyond ``r_max`` (2, value 0), or two feet
@@ -121,7 +121,7 @@ def _runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, n
 def pad_rings(prev: Any, nr: int, nt: int, pad: int, ring_lo: int, ring_hi: int,
               out: Any) -> None:
     """Copy rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice of
-    ``deadline._RingRows`` (``pad`` periodic columns on each side of every ring)."""
+    ``deadline_rows._RingRows`` (``pad`` periodic columns on each side of every ring)."""
     stride = nt + 2 * pad
     for q in range(2):
         for i in range(max(ring_lo - 1, 0), min(ring_hi + 1, nr + 1)):
@@ -144,7 +144,7 @@ def run_values(j_lo: int, j_hi: int, b: Any, h0: Any, h1: Any, ir: Any, ca: Any,
                fop: Any, fom: Any, xpad: Any, ring: int, stride: int, n: Any, best_val: Any,
                best_n: Any) -> None:
     """Rows ``j_lo .. j_hi - 1`` of one run (``kind`` 0) of control ``n``; keeps the best
-    so far per node.  A row is the weighted sum of ``deadline._RingRows`` in the order of
+    so far per node.  A row is the weighted sum of ``deadline_rows._RingRows`` in the order of
     its CSR entries (the NumPy path's mat-vec adds them in that order).
 
     The loop runs over whole chunks of :data:`LANES` rows with the rows outside the run

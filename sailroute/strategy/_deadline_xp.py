@@ -62,7 +62,7 @@ def _kernel(dtype_name: str) -> Any:
 class DeviceRows:
     """``rows_per_node`` rows of ``per_row`` entries for every node, on array module ``xp``.
 
-    The layout of ``deadline._RowOperator`` (node-major, the entries of a row adjacent
+    The layout of ``deadline_rows._RowOperator`` (node-major, the entries of a row adjacent
     and in the order of the sum), held as flat ``data`` (value dtype) and ``cols``
     (int32) arrays of ``xp``.
     """
@@ -84,7 +84,7 @@ class DeviceRows:
 
     @classmethod
     def from_host(cls, op: Any, xp: ModuleType) -> DeviceRows:
-        """A copy on ``xp`` of a ``deadline._RowOperator`` (the same layout)."""
+        """A copy on ``xp`` of a ``deadline_rows._RowOperator`` (the same layout)."""
         return cls(xp.asarray(op.data), xp.asarray(op.indices), op.rows_per_node,
                    op.per_row, xp)
 

@@ -37,10 +37,10 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable, Mapping
-from datetime import UTC, datetime, tzinfo
+from datetime import UTC, tzinfo
 from pathlib import Path
 from types import MappingProxyType
-from typing import Final
+from typing import Any, Final
 from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 
 import numpy as np
@@ -56,7 +56,7 @@ from sailroute.textin import (
     looks_like_header,
     quote_header,
 )
-from sailroute.timeutil import iso
+from sailroute.timeutil import iso, iso_datetime
 from sailroute.track.model import Track
 from sailroute.units import speed_factor, wrap180, wrap360
 from sailroute.wind.stations import (
@@ -203,10 +203,8 @@ def parse_epoch(cell: str, tz: tzinfo | None, where: str, utc_column: bool = Fal
     m = _PHONE_MS.match(s)
     if m:
         s = f"{m.group(1)}.{m.group(2).ljust(3, '0')}"
-    if s.endswith(("Z", "z")):
-        s = s[:-1] + "+00:00"
     try:
-        dt = datetime.fromisoformat(s)
+        dt = iso_datetime(s)
     except ValueError:
         raise InputError(
             f"{where}: cannot read {excerpt(cell)!r} as a time; expected ISO 8601 with an offset "
@@ -254,57 +252,10 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
     from xml.parsers import expat
 
     parser = expat.ParserCreate()
-    times: list[str] = []
-    lat_s: list[str] = []
-    lon_s: list[str] = []
-    lines: list[int] = []
-    names: list[str] = []
-    stack: list[str] = []
-    text_buf: list[str] = []
-    state = {"root": False, "pt": False, "has_time": False}
-
-    local: dict[str, str] = {}
-
-    def start(name: str, attrs: dict[str, str]) -> None:
-        tag = local.get(name) or local.setdefault(name, _local(name))
-        if not state["root"]:
-            state["root"] = True
-            if tag != "gpx":
-                raise InputError(f"{src}: line {parser.CurrentLineNumber}: root element "
-                                 f"<{tag}>; expected <gpx> (a GPX 1.0/1.1 file)")
-        stack.append(tag)
-        if tag == "trkpt":
-            state["pt"], state["has_time"] = True, False
-            lat_s.append(attrs.get("lat", ""))
-            lon_s.append(attrs.get("lon", ""))
-            lines.append(parser.CurrentLineNumber)
-        elif tag in ("time", "name"):
-            text_buf.clear()
-
-    def end(name: str) -> None:
-        tag = stack.pop()
-        if tag == "time" and state["pt"] and stack and stack[-1] == "trkpt":
-            if state["has_time"]:
-                raise InputError(f"{src}: line {parser.CurrentLineNumber}: a <trkpt> with a "
-                                 "second <time> (GPX gives each point one); is the file "
-                                 "damaged?")
-            times.append("".join(text_buf).strip())
-            state["has_time"] = True
-        elif tag == "name" and stack and stack[-1] == "trk":
-            names.append("".join(text_buf).strip())
-        elif tag == "trkpt" and state["pt"]:
-            state["pt"] = False
-            if not state["has_time"] or not times[-1]:
-                raise InputError(f"{src}: line {lines[-1]}: <trkpt> has no <time>; a track "
-                                 "for analysis needs a time on every point")
-
-    def data(chunk: str) -> None:
-        if stack and stack[-1] in ("time", "name"):
-            text_buf.append(chunk)
-
-    parser.StartElementHandler = start
-    parser.EndElementHandler = end
-    parser.CharacterDataHandler = data
+    gpx = _GpxPoints(parser, src)
+    parser.StartElementHandler = gpx.start
+    parser.EndElementHandler = gpx.end
+    parser.CharacterDataHandler = gpx.data
     parser.buffer_text = True
     try:
         parser.Parse(text, True)
@@ -312,20 +263,80 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
         raise InputError(f"{src}:{exc.lineno}:{exc.offset + 1}: not well-formed XML "
                          f"({expat.errors.messages[exc.code]}: line {exc.lineno}, column "
                          f"{exc.offset}); is the file a complete GPX export?") from None
-    if not state["root"]:
+    if not gpx.root:
         raise InputError(f"{src}: no XML element found; expected a GPX file")
-    if not times:
+    if not gpx.times:
         raise InputError(f"{src}: the GPX file has no track points (<trk><trkseg><trkpt>); "
                          "export the activity as a track with times")
+    lines = gpx.lines
     try:
-        lat, lon = np.array(lat_s, dtype=float), np.array(lon_s, dtype=float)
+        lat, lon = np.array(gpx.lat_s, dtype=float), np.array(gpx.lon_s, dtype=float)
     except ValueError:
-        k = next(i for i, (a, b) in enumerate(zip(lat_s, lon_s, strict=True))
+        k = next(i for i, (a, b) in enumerate(zip(gpx.lat_s, gpx.lon_s, strict=True))
                  if not _is_float(a) or not _is_float(b))
-        raise InputError(f"{src}: line {lines[k]}: <trkpt lat={lat_s[k]!r} lon={lon_s[k]!r}>: "
-                         "expected decimal degrees") from None
-    t = parse_epochs(times, tz, lambda k: f"{src}: line {lines[k]}")
-    return t, lat, lon, np.array(lines), names[0] if names else "", {}
+        raise InputError(f"{src}: line {lines[k]}: <trkpt lat={gpx.lat_s[k]!r} "
+                         f"lon={gpx.lon_s[k]!r}>: expected decimal degrees") from None
+    t = parse_epochs(gpx.times, tz, lambda k: f"{src}: line {lines[k]}")
+    return t, lat, lon, np.array(lines), gpx.names[0] if gpx.names else "", {}
+
+
+class _GpxPoints:
+    """The expat callbacks of :func:`_read_gpx`: the position cells, line and ``<time>``
+    text of each ``<trkpt>``, and the names of the ``<trk>`` elements."""
+
+    def __init__(self, parser: Any, src: str) -> None:
+        self.parser, self.src = parser, src
+        self.times: list[str] = []
+        self.lat_s: list[str] = []
+        self.lon_s: list[str] = []
+        self.lines: list[int] = []
+        self.names: list[str] = []
+        self.stack: list[str] = []
+        self.text_buf: list[str] = []
+        self.root = self.pt = self.has_time = False
+        self.local: dict[str, str] = {}
+
+    def start(self, name: str, attrs: dict[str, str]) -> None:
+        """An element opens: the root must be ``<gpx>``; a ``<trkpt>`` starts a point."""
+        tag = self.local.get(name) or self.local.setdefault(name, _local(name))
+        if not self.root:
+            self.root = True
+            if tag != "gpx":
+                raise InputError(f"{self.src}: line {self.parser.CurrentLineNumber}: root "
+                                 f"element <{tag}>; expected <gpx> (a GPX 1.0/1.1 file)")
+        self.stack.append(tag)
+        if tag == "trkpt":
+            self.pt, self.has_time = True, False
+            self.lat_s.append(attrs.get("lat", ""))
+            self.lon_s.append(attrs.get("lon", ""))
+            self.lines.append(self.parser.CurrentLineNumber)
+        elif tag in ("time", "name"):
+            self.text_buf.clear()
+
+    def end(self, name: str) -> None:
+        """An element closes: a point's one ``<time>``, a track's ``<name>``, a point that
+        must have had a time."""
+        tag = self.stack.pop()
+        parent = self.stack[-1] if self.stack else None
+        if tag == "time" and self.pt and parent == "trkpt":
+            if self.has_time:
+                raise InputError(f"{self.src}: line {self.parser.CurrentLineNumber}: a "
+                                 "<trkpt> with a second <time> (GPX gives each point one); "
+                                 "is the file damaged?")
+            self.times.append("".join(self.text_buf).strip())
+            self.has_time = True
+        elif tag == "name" and parent == "trk":
+            self.names.append("".join(self.text_buf).strip())
+        elif tag == "trkpt" and self.pt:
+            self.pt = False
+            if not self.has_time or not self.times[-1]:
+                raise InputError(f"{self.src}: line {self.lines[-1]}: <trkpt> has no <time>; "
+                                 "a track for analysis needs a time on every point")
+
+    def data(self, chunk: str) -> None:
+        """Text inside a ``<time>`` or ``<name>``."""
+        if self.stack and self.stack[-1] in ("time", "name"):
+            self.text_buf.append(chunk)
 
 
 def _is_float(text: str) -> bool:

@@ -201,26 +201,55 @@ def _std(var: Any) -> str:
 
 def _find_winds(ds: Any, variables: Mapping[str, str] | None, label: str
                 ) -> tuple[str, tuple[str, str], str, bool]:
+    """``(kind, names, how, to_direction)`` of the wind variables: ``"uv"`` or ``"sd"``,
+    found through ``variables``, a CF ``standard_name`` or a conventional name."""
     names = list(ds.variables)
-    if variables:
-        unknown = [k for k in variables if k not in DATA_KEYS]
-        if unknown:
-            raise InputError(f"{label}: variables: unknown key(s) {', '.join(unknown)}; "
-                             f"expected some of {', '.join(DATA_KEYS)}")
-        missing = [f"{k}: {v!r}" for k, v in variables.items() if v not in ds.variables]
-        if missing:
-            raise InputError(f"{label}: variables: {', '.join(missing)} not in the file "
-                             f"(variables: {', '.join(names)})")
-        if "u" in variables or "v" in variables:
-            if not ("u" in variables and "v" in variables):
-                raise InputError(f"{label}: variables: give both u and v (or speed and "
-                                 "direction)")
-            return "uv", (variables["u"], variables["v"]), "variables", False
-        if "speed" in variables and "direction" in variables:
-            to_dir = _std(ds.variables[variables["direction"]]) == "wind_to_direction"
-            return "sd", (variables["speed"], variables["direction"]), "variables", to_dir
-        if any(k in variables for k in ("speed", "direction")):
-            raise InputError(f"{label}: variables: give both speed and direction (or u and v)")
+    found = _given_winds(ds, variables, label) if variables else None
+    if found is None:
+        found = _standard_winds(ds, names)
+    if found is not None:
+        return found
+    by_std = {_std(ds.variables[n]) for n in names}
+    hint = (" The file has grid-relative x_wind/y_wind: rotate them to eastward/northward "
+            "first (or name them with `variables:` if the grid axes point east and north)."
+            if "x_wind" in by_std or "grid_eastward_wind" in by_std else "")
+    raise WindDataError(
+        f"{label}: no wind variables found; expected CF standard_name eastward_wind and "
+        "northward_wind (or wind_speed and wind_from_direction), or variables named u10/v10, "
+        f"U10/V10, uas/vas, u/v, ... (found: {', '.join(names) or 'none'}). Name them with "
+        f"`variables: {{u: NAME, v: NAME}}` (or `{{speed: NAME, direction: NAME}}`).{hint}"
+    )
+
+
+def _given_winds(ds: Any, variables: Mapping[str, str], label: str
+                 ) -> tuple[str, tuple[str, str], str, bool] | None:
+    """The wind variables that ``variables`` names (None when it names none of u, v,
+    speed, direction); unknown keys, absent variables and half pairs are errors."""
+    unknown = [k for k in variables if k not in DATA_KEYS]
+    if unknown:
+        raise InputError(f"{label}: variables: unknown key(s) {', '.join(unknown)}; "
+                         f"expected some of {', '.join(DATA_KEYS)}")
+    missing = [f"{k}: {v!r}" for k, v in variables.items() if v not in ds.variables]
+    if missing:
+        raise InputError(f"{label}: variables: {', '.join(missing)} not in the file "
+                         f"(variables: {', '.join(ds.variables)})")
+    if "u" in variables or "v" in variables:
+        if not ("u" in variables and "v" in variables):
+            raise InputError(f"{label}: variables: give both u and v (or speed and "
+                             "direction)")
+        return "uv", (variables["u"], variables["v"]), "variables", False
+    if "speed" in variables and "direction" in variables:
+        to_dir = _std(ds.variables[variables["direction"]]) == "wind_to_direction"
+        return "sd", (variables["speed"], variables["direction"]), "variables", to_dir
+    if any(k in variables for k in ("speed", "direction")):
+        raise InputError(f"{label}: variables: give both speed and direction (or u and v)")
+    return None
+
+
+def _standard_winds(ds: Any, names: list[str]
+                    ) -> tuple[str, tuple[str, str], str, bool] | None:
+    """The first wind pair by CF ``standard_name`` (:data:`STANDARD_UV`, then
+    :data:`STANDARD_SD`), else by name (:data:`NAMES_UV`, :data:`NAMES_SD`; at least 2-D)."""
     by_std: dict[str, str] = {}
     for n in names:
         s = _std(ds.variables[n])
@@ -232,22 +261,11 @@ def _find_winds(ds: Any, variables: Mapping[str, str] | None, label: str
     for a, b in STANDARD_SD:
         if a in by_std and b in by_std:
             return "sd", (by_std[a], by_std[b]), "standard_name", b == "wind_to_direction"
-    grid_rel = "x_wind" in by_std or "grid_eastward_wind" in by_std
-    for a, b in NAMES_UV:
-        if a in ds.variables and b in ds.variables and ds.variables[a].ndim >= 2:
-            return "uv", (a, b), "name", False
-    for a, b in NAMES_SD:
-        if a in ds.variables and b in ds.variables and ds.variables[a].ndim >= 2:
-            return "sd", (a, b), "name", False
-    hint = (" The file has grid-relative x_wind/y_wind: rotate them to eastward/northward "
-            "first (or name them with `variables:` if the grid axes point east and north)."
-            if grid_rel else "")
-    raise WindDataError(
-        f"{label}: no wind variables found; expected CF standard_name eastward_wind and "
-        "northward_wind (or wind_speed and wind_from_direction), or variables named u10/v10, "
-        f"U10/V10, uas/vas, u/v, ... (found: {', '.join(names) or 'none'}). Name them with "
-        f"`variables: {{u: NAME, v: NAME}}` (or `{{speed: NAME, direction: NAME}}`).{hint}"
-    )
+    for kind, pairs in (("uv", NAMES_UV), ("sd", NAMES_SD)):
+        for a, b in pairs:
+            if a in ds.variables and b in ds.variables and ds.variables[a].ndim >= 2:
+                return kind, (a, b), "name", False
+    return None
 
 
 def _is_lat(ds: Any, n: str) -> bool:
@@ -398,17 +416,48 @@ def _is_time(ds: Any, n: str) -> bool:
 def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
                 given: str | None, time: str | float | None, label: str
                 ) -> tuple[str | None, NDArray[np.float64], str]:
+    """``(time dimension or None, epoch seconds [s], source)`` of the wind variables: the
+    ``given`` variable, a time coordinate on one of their dimensions, the ``time``
+    argument, a scalar time variable, or a global attribute (UTC)."""
     extra = [d for d in dims if d not in grid_dims]
     if given is not None:
-        v = ds.variables[given]
-        if v.ndim == 1 and v.dimensions[0] in extra:
-            return v.dimensions[0], _epoch_from_values(v[:], v, given, label), f"variable {given}"
-        if v.ndim == 0:
-            return None, _epoch_from_values(np.atleast_1d(v[()]), v, given, label), \
-                f"variable {given}"
-        raise WindDataError(f"{label}: time variable {given} has dimensions {v.dimensions}; "
-                            f"expected one of the wind's dimensions ({', '.join(extra)}) or none")
-    # a time dimension: its coordinate variable, or a time-like 1-D variable on it
+        return _given_time(ds, given, extra, label)
+    found = _dimension_time(ds, extra, label)
+    if found is not None:
+        return found
+    _refuse_extra_dims(ds, extra, label)
+    if time is not None:
+        if isinstance(time, int | float) and not isinstance(time, bool):
+            return None, np.array([float(time)]), "argument"
+        return None, np.array([parse_time(str(time), f"{label}: time").timestamp()]), "argument"
+    found = _scalar_time(ds, label)
+    if found is not None:
+        return found
+    raise WindDataError(
+        f"{label}: no time found: the wind variables have no time dimension and there is no "
+        f"time variable or global attribute ({', '.join(TIME_ATTRS)}); give the time the "
+        "field is valid at with `time: '2014-10-07T12:00:00Z'`"
+    )
+
+
+def _given_time(ds: Any, given: str, extra: list[str], label: str
+                ) -> tuple[str | None, NDArray[np.float64], str]:
+    """The time variable named by ``variables: {time: ...}``: 1-D on one of the wind's
+    ``extra`` dimensions, or a scalar."""
+    v = ds.variables[given]
+    if v.ndim == 1 and v.dimensions[0] in extra:
+        return v.dimensions[0], _epoch_from_values(v[:], v, given, label), f"variable {given}"
+    if v.ndim == 0:
+        return None, _epoch_from_values(np.atleast_1d(v[()]), v, given, label), \
+            f"variable {given}"
+    raise WindDataError(f"{label}: time variable {given} has dimensions {v.dimensions}; "
+                        f"expected one of the wind's dimensions ({', '.join(extra)}) or none")
+
+
+def _dimension_time(ds: Any, extra: list[str], label: str
+                    ) -> tuple[str | None, NDArray[np.float64], str] | None:
+    """A time dimension among ``extra``: its coordinate variable, or a time-like 1-D
+    variable on it (not a duration); None if there is none."""
     for d in extra:
         cands = ([d] if d in ds.variables else []) + [n for n in TIME_NAMES if n in ds.variables]
         cands += [n for n in ds.variables if n not in cands]
@@ -417,6 +466,11 @@ def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
             if v.ndim == 1 and v.dimensions[0] == d and _is_time(ds, n) and (
                     np.dtype(v.dtype).kind != "m"):
                 return d, _epoch_from_values(v[:], v, n, label), f"variable {n}"
+    return None
+
+
+def _refuse_extra_dims(ds: Any, extra: list[str], label: str) -> None:
+    """An error when a dimension other than the grid's, of size > 1, is not a time."""
     sizes = {d: _size(ds.dimensions.get(d, 1)) for d in extra} if hasattr(
         ds, "dimensions") else {}
     big = [d for d, n in sizes.items() if n > 1]
@@ -426,10 +480,11 @@ def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
             "variables is not a time with CF units; expected a time coordinate such as "
             "time(time) with units 'hours since ...'. Select one level/member first, or "
             "name the time variable with `variables: {time: NAME}`.")
-    if time is not None:
-        if isinstance(time, int | float) and not isinstance(time, bool):
-            return None, np.array([float(time)]), "argument"
-        return None, np.array([parse_time(str(time), f"{label}: time").timestamp()]), "argument"
+
+
+def _scalar_time(ds: Any, label: str) -> tuple[str | None, NDArray[np.float64], str] | None:
+    """A scalar time variable (not a duration), else a global attribute of
+    :data:`TIME_ATTRS` read as an ISO 8601 time (UTC unless it says); None if neither."""
     for n in TIME_NAMES + tuple(ds.variables):
         if n in ds.variables and ds.variables[n].ndim == 0 and _is_time(ds, n):
             v = ds.variables[n]
@@ -448,11 +503,7 @@ def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
             if dt.tzinfo is None:
                 dt = dt.replace(tzinfo=UTC)
             return None, np.array([dt.timestamp()]), f"global attribute {key} (UTC)"
-    raise WindDataError(
-        f"{label}: no time found: the wind variables have no time dimension and there is no "
-        f"time variable or global attribute ({', '.join(TIME_ATTRS)}); give the time the "
-        "field is valid at with `time: '2014-10-07T12:00:00Z'`"
-    )
+    return None
 
 
 def _speed_units(var: Any, name: str, label: str, declared: str | None) -> tuple[float, str]:
@@ -499,6 +550,56 @@ def _data_height(ds: Any, var: Any, name: str, dims: tuple[str, ...]) -> tuple[f
     if m:
         return float(m.group(1)), f"long_name of {name}"
     return None, "unknown"
+
+
+def _check_times(times: NDArray[np.float64], time_dim: str | None, dims: tuple[str, ...],
+                 shape: tuple[int, ...], label: str) -> None:
+    """One finite time per slice of ``time_dim`` (if any), strictly increasing."""
+    if time_dim is not None and times.size != dict(zip(dims, shape, strict=True))[time_dim]:
+        raise WindDataError(f"{label}: the time coordinate has {times.size} values but "
+                            f"dimension {time_dim!r} has {shape[dims.index(time_dim)]}")
+    if not np.all(np.isfinite(times)):
+        raise WindDataError(f"{label}: the time coordinate has missing values")
+    bad = np.nonzero(np.diff(times) <= 0)[0]
+    if bad.size:
+        k = int(bad[0])
+        raise WindDataError(
+            f"{label}: times must increase strictly, but time[{k}] = {iso(times[k])} and "
+            f"time[{k + 1}] = {iso(times[k + 1])}; remove duplicated or out-of-order slices")
+
+
+def _fixed_indices(dims: tuple[str, ...], shape: tuple[int, ...],
+                   field_dims: tuple[str, str, str | None], select: Mapping[str, int] | None,
+                   label: str) -> dict[str, int]:
+    """Index taken along each dimension other than the grid's and the time's
+    (``field_dims``): the one ``select`` names, else 0 for a dimension of size 1."""
+    fixed: dict[str, int] = {}
+    chosen = dict(select or {})
+    unknown = sorted(set(chosen) - set(dims))
+    if unknown:
+        raise InputError(f"{label}: select names {', '.join(map(repr, unknown))}, which "
+                         f"the wind variables do not have (dimensions: {', '.join(dims)})")
+    for d, n in zip(dims, shape, strict=True):
+        if d in field_dims:
+            if d in chosen:
+                raise InputError(f"{label}: select {d!r}: that is a time or grid "
+                                 "dimension; select only members or levels")
+            continue
+        if d in chosen:
+            k = chosen[d]
+            if not 0 <= k < n:
+                raise InputError(f"{label}: select {d}: {k} is out of range; that "
+                                 f"dimension has indices 0 .. {n - 1}")
+            fixed[d] = int(k)
+            continue
+        if n != 1:
+            raise WindDataError(
+                f"{label}: the wind variables have an extra dimension {d!r} of size {n} "
+                "(levels or ensemble members); pick one with `select: {"
+                f"{d}: 0}}` in the wind spec (an ensemble scenario's `members: {{dim: "
+                f"{d}, ...}}` takes them all), or with xarray `ds.isel({{{d!r}: 0}})`")
+        fixed[d] = 0
+    return fixed
 
 
 @damaged_as_wind_error
@@ -554,44 +655,9 @@ def read_cf_header(
         lat, lon, row_dim, col_dim, regular = _coords_2d(ds, latn, lonn, dims, label)
         time_dim, times, tsrc = _find_times(ds, dims, (row_dim, col_dim), vmap.get("time"),
                                             time, label)
-        if time_dim is not None and times.size != dict(zip(dims, va.shape, strict=True)
-                                                       )[time_dim]:
-            raise WindDataError(f"{label}: the time coordinate has {times.size} values but "
-                                f"dimension {time_dim!r} has {va.shape[dims.index(time_dim)]}")
-        if not np.all(np.isfinite(times)):
-            raise WindDataError(f"{label}: the time coordinate has missing values")
-        bad = np.nonzero(np.diff(times) <= 0)[0]
-        if bad.size:
-            k = int(bad[0])
-            raise WindDataError(
-                f"{label}: times must increase strictly, but time[{k}] = {iso(times[k])} and "
-                f"time[{k + 1}] = {iso(times[k + 1])}; remove duplicated or out-of-order slices")
-        fixed: dict[str, int] = {}
-        chosen = dict(select or {})
-        unknown = sorted(set(chosen) - set(dims))
-        if unknown:
-            raise InputError(f"{label}: select names {', '.join(map(repr, unknown))}, which "
-                             f"the wind variables do not have (dimensions: {', '.join(dims)})")
-        for d, n in zip(dims, va.shape, strict=True):
-            if d in (row_dim, col_dim, time_dim):
-                if d in chosen:
-                    raise InputError(f"{label}: select {d!r}: that is a time or grid "
-                                     "dimension; select only members or levels")
-                continue
-            if d in chosen:
-                k = chosen[d]
-                if not 0 <= k < n:
-                    raise InputError(f"{label}: select {d}: {k} is out of range; that "
-                                     f"dimension has indices 0 .. {n - 1}")
-                fixed[d] = int(k)
-                continue
-            if n != 1:
-                raise WindDataError(
-                    f"{label}: the wind variables have an extra dimension {d!r} of size {n} "
-                    "(levels or ensemble members); pick one with `select: {"
-                    f"{d}: 0}}` in the wind spec (an ensemble scenario's `members: {{dim: "
-                    f"{d}, ...}}` takes them all), or with xarray `ds.isel({{{d!r}: 0}})`")
-            fixed[d] = 0
+        _check_times(times, time_dim, dims, tuple(va.shape), label)
+        fixed = _fixed_indices(dims, tuple(va.shape), (row_dim, col_dim, time_dim), select,
+                               label)
         if str(_attr(va, "GRIB_uvRelativeToGrid", 0)) == "1":
             raise WindDataError(
                 f"{label}: {names[0]}/{names[1]} are relative to the GRIB grid's axes "

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from sailroute.errors import InputError, WindDataError
-from sailroute.wind.stations import StationData, _sorted_checked
+from sailroute.wind.stationread import StationData, _sorted_checked
 
 _MISSING = {"MM", "999", "99.0", "9999", "999.0", "99", "9999.0"}
 

@@ -14,7 +14,7 @@ C1, C2, K = 0.03, 0.005, 0.7
 
 
 def closed_form_speed(tws: float, twa_deg: float) -> float:
-    """Root of k s² = (c1 β_a − c2) v_a² written as in the brief (arccos form), by brentq."""
+    """Root of k s² = (c1 β_a − c2) v_a² written in Dębski's arccos form, by brentq."""
     bt = np.radians(twa_deg)
 
     def residual(s: float) -> float:
@@ -35,9 +35,9 @@ def test_steady_speed_matches_independent_closed_form(tws: float, twa: float) ->
     assert BOAT.steady_speed(tws, twa) == pytest.approx(closed_form_speed(tws, twa), rel=1e-10)
 
 
-def test_brief_numbers_at_12_ms() -> None:
-    # seeds-003-004.md §3, derived with β_a in radians: tolerance 1e-3 m/s on speeds,
-    # 0.05° on the angle (the VMG curve is flat at its maximum)
+def test_published_model_numbers_at_12_ms() -> None:
+    # derived from Dębski's model (as Wang et al. 2024 use it) with β_a in radians:
+    # tolerance 1e-3 m/s on speeds, 0.05° on the angle (the VMG curve is flat at its maximum)
     twa = np.arange(0.0, 180.0001, 0.01)
     sp = BOAT.steady_speed(12.0, twa)
     vmg = sp * np.cos(np.radians(twa))

@@ -153,7 +153,7 @@ def test_builtin_race_polar_vmg_ratio_and_steady_name() -> None:
     assert ratio_race < 0.62 < 0.8 < ratio_steady
 
 
-# --- real races (acceptance of issue 10; measured, not fitted: see docs/vpp.md) ------------
+# --- real races (measured, not fitted: see docs/vpp.md) ------------
 
 
 def _dn_up(legs: list[float], down: list[int], up: list[int]) -> float:
@@ -165,7 +165,7 @@ def test_hyeres_r1_race_polar_total_and_downwind_upwind_ratio() -> None:
     assert course.boat_spec == {"builtin": "ilca7"}
     legs = [leg.time_s for leg in plan_course(course, "constant").plan.legs]
     winner = list(course.references["winner"])  # 984 / 500 / 871 / 480 / 106 s
-    # the issue's acceptance: total within 5 % of the winner, ratio within 15 % (measured
+    # acceptance: total within 5 % of the winner, ratio within 15 % (measured
     # +1.4 % and +8.4 %; the steady VPP gave +10.5 % and +56 %)
     assert abs(sum(legs) / sum(winner) - 1) < 0.05
     assert abs(_dn_up(legs, [1, 3], [0, 2]) / _dn_up(winner, [1, 3], [0, 2]) - 1) < 0.15

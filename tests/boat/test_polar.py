@@ -195,7 +195,7 @@ def test_vmg_shapes_and_calm() -> None:
 
 
 def debski_speed(tws: float, twa_deg: float) -> float:
-    """Steady state of Dębski's model: k s² = (c1 β_a - c2) v_a² (seeds-003-004 §3)."""
+    """Steady state of Dębski's model: k s² = (c1 β_a - c2) v_a² (Dębski 2016, Wang et al. 2024)."""
     c1, c2, k = 0.03, 0.005, 0.7
     b = math.radians(twa_deg)
 
@@ -210,7 +210,7 @@ def debski_speed(tws: float, twa_deg: float) -> float:
 
 
 def test_debski_toy_vpp_vmg() -> None:
-    # Known answers (seeds-003-004 §3, derived from the published model): at 12 m/s, upwind
+    # Known answers (derived from Dębski's published model, as Wang et al. 2024): at 12 m/s, upwind
     # VMG* = 1.424 m/s at TWA 41.65 deg (boat speed 1.906); dead downwind 3.157 m/s.
     twa = np.arange(0.0, 180.01, 1.0)
     tws = np.array([10.0, 12.0, 14.0])

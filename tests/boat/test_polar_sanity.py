@@ -1,4 +1,4 @@
-"""Polar sanity (issue 10 part 3): wind above the polar, absurd speeds, units from
+"""Polar sanity: wind above the polar, absurd speeds, units from
 file names and headers, degenerate axes, all-zero tables (docs/usage.md, "Polar sanity").
 
 Every test here failed before the checks existed: the values were accepted silently

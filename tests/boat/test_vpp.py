@@ -255,7 +255,7 @@ def test_crew_mass_effect_sign_and_size() -> None:
         leg = 3600.0 / (1 / u0 + 1 / d0)
         return leg * (1 / u1 + 1 / d1) - 3600.0
 
-    # heavier is faster upwind in strong wind, slower in light wind (thesis/issue target)
+    # heavier is faster upwind in strong wind, slower in light wind (as in the thesis)
     assert upwind(90.0, 10.0) > upwind(70.0, 10.0)
     assert upwind(90.0, 2.5) < upwind(70.0, 2.5)
     # Day (2017): 10 kg changes a 1-hour race by more than 60 s.  Here, in 8 m/s, +10 kg saves

@@ -1,14 +1,12 @@
 """The Hyères R1 course (courses/hyeres-r1.yaml) against the thesis's geometry (Pardo 2018).
 
-The marks are the brief's §4.4 reconstruction, back-projected from the thesis's Fig 5.6 leg
-lengths and bearings, which are printed to 0.01 m / 0.01°.  Legs between two marks of the file
-must therefore reproduce Fig 5.6 to about the printing precision: we allow 0.01 m and 0.01°
-(measured: at most 0.0052 m and 0.001°).  Legs through a line/gate *midpoint* differ more: the
-thesis had separate midpoint buoys (start_mid, 4_mid) that are not exactly the midpoints of the
-ends (start_mid by 0.08 m, 4_mid by 0.15 m), and we use true midpoints; the
-tolerances there are 0.02 m / 0.01° (start_mid, 1→4_mid) and 0.1 m / 0.01° (4_mid→finish_mid,
-measured 0.074 m), i.e. the size of that 0.1–0.15 m disagreement.
-"""
+The marks are back-projected from the thesis's Fig 5.6 leg lengths and bearings, which are printed
+to 0.01 m / 0.01°.  Legs between two marks of the file must therefore reproduce Fig 5.6 to about
+the printing precision: we allow 0.01 m and 0.01° (measured: at most 0.0052 m and 0.001°).  Legs
+through a line/gate *midpoint* differ more: the thesis had separate midpoint buoys (start_mid,
+4_mid) that are not exactly the midpoints of the ends (start_mid by 0.08 m, 4_mid by 0.15 m), and
+we use true midpoints; the tolerances there are 0.02 m / 0.01° (start_mid, 1→4_mid) and 0.1 m /
+0.01° (4_mid→finish_mid, measured 0.074 m), i.e. the size of that 0.1–0.15 m disagreement."""
 
 from __future__ import annotations
 

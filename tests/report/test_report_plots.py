@@ -72,7 +72,7 @@ def test_plot_comparison(plan, with_map):
     assert len(fig.axes) == (2 if with_map else 1)
 
 
-# --- route.png conventions (issue 13 item 2) ------------------------------------------------
+# --- route.png conventions --------------------------------------------------------------------
 from sailroute.report.plots import OFFSET_PT, local_time, repeat_index, speed_limits  # noqa: E402
 
 
@@ -85,6 +85,18 @@ def test_speed_scale_ignores_stops_and_is_at_least_2_kn_wide():
     lo, hi = speed_limits(wide)
     assert lo == pytest.approx(np.percentile(wide, 2)) and hi == pytest.approx(
         np.percentile(wide, 98))
+
+
+def test_speed_scale_skips_non_finite_speeds_and_rounds_for_the_web_page():
+    # one scale for route.png and report.html: NaN and inf speeds do not count; the page
+    # writes the limits to 2 decimals
+    bsp = np.r_[np.linspace(3.0, 9.0, 101), np.nan, np.inf, -np.inf]
+    assert speed_limits(bsp) == speed_limits(np.linspace(3.0, 9.0, 101))
+    lo, hi = speed_limits(bsp, decimals=2)
+    assert (lo, hi) == (round(np.percentile(np.linspace(3.0, 9.0, 101), 2), 2),
+                        round(np.percentile(np.linspace(3.0, 9.0, 101), 98), 2))
+    assert speed_limits(np.zeros(5)) == (0.0, 2.0)
+    assert speed_limits(np.full(3, np.nan), span=3.0) == (0.0, 3.0)
 
 
 def test_local_time_names_the_offset(plan):

@@ -87,7 +87,7 @@ def test_reach_to_a_mark_is_distance_over_polar_speed(twa):
     # leg north, wind from TWD = twa: starboard tack, heading 0, TWA = twa.  The leg ends
     # on the mark's 13 m rounding segment, so the closed form is the best straight line
     # to a point of it; the router aims 1 m inside its ends.  Where the polar is flat or
-    # rising towards the wind side (60°, 90°) this is L / S(twa) within 1e-3, the issue's
+    # rising towards the wind side (60°, 90°) this is L / S(twa) within 1e-3, the
     # tolerance; at 125° heading up gains 0.4 %, so the far end of the segment pays.
     L = 800.0
     r = route(Start((0.0, 0.0)), north_mark(L), UniformWind(TWS, twa))
@@ -531,7 +531,7 @@ WRF_FILE = Path(__file__).resolve().parents[2] / "data" / "hyeres-2018-04-24-syn
 @pytest.mark.timing
 @pytest.mark.slow
 def test_wrf_beat_routes_well_under_a_second():
-    # the issue's speed target: a 1.8 km beat at default resolution in a WRF field, one
+    # the speed target: a 1.8 km beat at default resolution in a WRF field, one
     # core.  Measured 0.15-0.23 s (benchmarks/bench_isochrone.py, ILCA 7 polar); the
     # bound is 1 s (best of 3, after a warm-up that builds the polar tables)
     from sailroute.geo import LocalFrame

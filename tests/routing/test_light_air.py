@@ -1,4 +1,4 @@
-"""Light-air runs (issue 14): a run in uniform wind has at most one gybe, and every gybe
+"""Light-air runs: a run in uniform wind has at most one gybe, and every gybe
 changes side.  Reported: 9 gybes on one run in a frozen 1.7 m/s wind, flipping between
 TWA 180° and -150°, one "gybe" from 180° to 180°."""
 

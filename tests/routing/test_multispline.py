@@ -110,7 +110,7 @@ def test_invalid_spline_settings() -> None:
 
 
 # ---------------------------------------------------------------------------------------
-# issue 15: pruned dynamic rows, the separable fitting cost, carried speed, start from rest
+# pruned dynamic rows, the separable fitting cost, carried speed, start from rest
 
 def _debski_small(carry: bool = False, rest: bool = False) -> tuple:
     from sailroute.boat.dynamic import DynamicBoat

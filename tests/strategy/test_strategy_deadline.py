@@ -121,7 +121,7 @@ def test_switching_needs_a_budget_of_at_least_c(fig4a) -> None:
 
 
 def test_risk_aware_beats_risk_neutral_at_its_deadline(fig4a) -> None:
-    # Seed 004 Fig. 4(a): P(T <= 42) 5.8 % (μ*) -> 17.2 % (α^42), "nearly triples";
+    # Wang et al. (2024) Fig. 4(a): P(T <= 42) 5.8 % (μ*) -> 17.2 % (α^42), "nearly triples";
     # μ* switches twice in 99.9 % of runs, α^42 never in 99.1 %.  On this coarse grid we
     # assert the ordering within MC error, a factor >= 2, and the switch patterns.
     _, _, _, sim_rn, sim_ra = fig4a

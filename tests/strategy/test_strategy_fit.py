@@ -137,6 +137,6 @@ def test_coach_boat_log_fit() -> None:
     assert 20.0 < ou.sigma_deg < 35.0
     assert 60.0 < ou.timescale_s < 300.0
     assert ou_ar1.timescale_s < 0.3 * ou.timescale_s
-    # the direction has no significant trend over the session
+    # the direction has no significant trend over the record
     assert abs(dd.drift_deg_per_s) < 2 * dd.drift_se_deg_per_s
     assert 35.0 < ou.mean_deg < 80.0  # TWD mostly 40..90° (README of the data set)

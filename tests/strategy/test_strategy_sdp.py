@@ -79,7 +79,7 @@ def test_zero_volatility_ilca_equals_one_tack_closed_form_within_quantisation() 
     ids=["sigma", "timescale"],
 )
 def test_vanishing_volatility_converges_to_the_one_tack_closed_form(models) -> None:
-    # Issue 6: as the shifts vanish (sigma -> 0 or l_t -> inf, not just at
+    # As the shifts vanish (sigma -> 0 or l_t -> inf, not just at
     # sigma = 0), the policy's expected time tends to L / VMG(ψ_q) + λ, the value
     # table to the steady-wind one, and every simulated run to exactly one tack.
     grid = BeatGrid(length_m=800.0, half_width_m=400.0, lateral_m=8.0, row_m=20.0)
@@ -122,7 +122,7 @@ def test_shifts_are_worth_time_and_tacks() -> None:
 
 
 def test_volatility_tightens_routes() -> None:
-    # Seed 003 (Figs 5-7, conclusion 1): shorter time scale or larger variance -> tighter
+    # Shepherd et al. (Figs 5-7, conclusion 1): shorter time scale or larger variance -> tighter
     # routes.  Measured by the distance from the centreline |x| pooled over rows and runs
     # (the P10-P90 band of x is one-sided at low volatility because every run starts on
     # starboard).  Asserted monotone on its mean and on its 75th and 90th percentiles.
@@ -191,8 +191,8 @@ def test_decision_reports_the_segment(sine_steady) -> None:
     assert dec["time_s"] == pytest.approx(20.0)
 
 
-def test_solve_time_at_seed_003_resolution_is_seconds() -> None:
-    # The issue asks for "seconds" at 801 x 160 x 19 x 2 (single thread ~1 s measured;
+def test_solve_time_at_shepherd_et_al_resolution_is_seconds() -> None:
+    # "Seconds" at 801 x 160 x 19 x 2 (single thread ~1 s measured;
     # generous bound for a loaded CI machine)
     pol = solve_expected_time(ILCA7, TWS, OUShift(10.0, 600.0), BeatGrid(), 5.0)
     assert pol.value_s.shape == (161, 2, 19, 801)

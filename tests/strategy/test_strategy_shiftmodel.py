@@ -23,7 +23,7 @@ from sailroute.strategy.shiftmodel import (
 BINS = shift_bins(5.0, 45.0)
 
 
-def test_shift_bins_are_seed_003_grid() -> None:
+def test_shift_bins_are_shepherd_et_al_grid() -> None:
     # 19 states, -45..45 in 5° steps (Shepherd, Haydon & Vermillion)
     assert BINS.size == 19
     assert BINS[0] == -45.0 and BINS[-1] == 45.0

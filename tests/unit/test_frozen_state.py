@@ -33,7 +33,7 @@ T0 = 1_524_567_600.0
 @pytest.mark.parametrize("cls", [Polar, UniformCurrent, DiamondCurrent, UniformWind, GridWind,
                                  StationWind, BlendedWind])
 def test_every_field_is_an_input(cls: type) -> None:
-    # derived state used to be init=False fields patched in by __post_init__
+    # no derived state as init=False fields patched in by __post_init__
     assert [f.name for f in dataclasses.fields(cls) if not f.init] == []
 
 

@@ -10,7 +10,7 @@ from pyproj import Geod
 
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
-from sailroute.timeutil import iso, parse_time, to_epoch
+from sailroute.timeutil import iso, iso_datetime, parse_time, to_epoch
 from sailroute.units import (
     KNOT,
     bearing_deg,
@@ -95,3 +95,16 @@ def test_parse_time_requires_offset() -> None:
         parse_time("2018-04-24T12:10:00", where="course.yaml: start_time")
     with pytest.raises(InputError, match="ISO 8601"):
         parse_time("yesterday")
+
+
+def test_iso_datetime_keeps_the_time_as_written() -> None:
+    # the one ISO 8601 parser: Z or z is UTC, an offset is kept, a naive time stays naive
+    # (the track and station readers may apply a declared zone to it)
+    z = iso_datetime(" 2018-04-24T10:10:00z ")
+    assert z == datetime(2018, 4, 24, 10, 10, tzinfo=UTC) and z.utcoffset().total_seconds() == 0
+    plus2 = iso_datetime("2018-04-24T12:10:00.5+02:00")
+    assert plus2.utcoffset().total_seconds() == 7200.0
+    assert plus2.timestamp() == datetime(2018, 4, 24, 10, 10, 0, 500000, tzinfo=UTC).timestamp()
+    assert iso_datetime("2018-04-24 12:10").tzinfo is None
+    with pytest.raises(ValueError):
+        iso_datetime("24/04/2018 12:10")

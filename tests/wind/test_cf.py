@@ -267,7 +267,7 @@ def test_single_time_needs_steady_and_coverage_message_names_lat_lon(tmp_path) -
 
 def test_cropped_window_message_names_the_files_whole_span(tiny_wrf, frame) -> None:
     # the race starts after the file's last slice: only that slice is read, and the
-    # message must still say what the file holds (issue 12: "covered 14:00Z..14:00Z")
+    # message must still say what the file holds (not "covered 14:00Z..14:00Z")
     path = tiny_wrf("late.nc")
     t_last = 1524556800.0 + 1800.0
     f = open_wrf(path, frame, time_window=(t_last + 3600.0, t_last + 7200.0))

@@ -1,4 +1,4 @@
-"""Station inputs people have (issue 12): long records with gaps, raw NDBC text in course
+"""Station inputs people have: long records with gaps, raw NDBC text in course
 files, split date/time columns, pandas DataFrames, dropped-row counts."""
 
 from __future__ import annotations

@@ -65,7 +65,7 @@ def test_wind_direction_outside_the_compass_is_an_error() -> None:
     assert float(wind_speed_direction(*f.sample(0.0, 0.0, 0.0))[1]) % 360.0 == pytest.approx(0.0)
 
 
-def test_the_briefs_example_message(tiny_wrf, tmp_path) -> None:
+def test_a_non_number_names_file_key_and_value(tiny_wrf, tmp_path) -> None:
     path = tiny_wrf()
     with pytest.raises(InputError) as e:
         build({"type": "wrf", "path": path.name, "time_step_min": "ten"}, base_dir=path.parent)
