@@ -48,6 +48,13 @@ from numpy.typing import NDArray
 
 from sailroute.errors import InputError
 from sailroute.geo import wrap_lon
+from sailroute.tabular import (
+    DEFAULT_MISSING,
+    column_speed_unit,
+    map_columns,
+    parse_offset,
+    unit_from_header,
+)
 from sailroute.textin import (
     clean_text,
     csv_rows,
@@ -59,13 +66,6 @@ from sailroute.textin import (
 from sailroute.timeutil import iso, iso_datetime
 from sailroute.track.model import Track
 from sailroute.units import speed_factor, wrap180, wrap360
-from sailroute.wind.stations import (
-    DEFAULT_MISSING,
-    column_speed_unit,
-    map_columns,
-    parse_offset,
-    unit_from_header,
-)
 
 TRACK_ALIASES: Final[dict[str, tuple[str, ...]]] = {
     "time": ("time", "datetime", "timestamp", "date_time", "time_utc", "datetime_utc", "utc",

@@ -1,6 +1,6 @@
 """Station records (:class:`StationData`): read from a CSV or a DataFrame, checked, resampled.
 
-:func:`read_stations` reads the cells of the columns that :mod:`sailroute.wind.stationformat`
+:func:`read_stations` reads the cells of the columns that :mod:`sailroute.tabular`
 found, missing markers counted and their rows dropped, values in SI units and checked
 (ranges, times increasing per station); :func:`resample_stations` averages 1-20 Hz logs into
 fixed intervals.
@@ -18,10 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.errors import InputError, WindDataError
-from sailroute.textin import clean_text, excerpt, looks_binary
-from sailroute.timeutil import iso, iso_datetime
-from sailroute.units import speed_factor, wind_components, wind_speed_direction
-from sailroute.wind.stationformat import (
+from sailroute.tabular import (
     DEFAULT_MISSING,
     parse_offset,
     speed_units,
@@ -29,6 +26,9 @@ from sailroute.wind.stationformat import (
     station_columns,
     table_lines,
 )
+from sailroute.textin import clean_text, excerpt, looks_binary
+from sailroute.timeutil import iso, iso_datetime
+from sailroute.units import speed_factor, wind_components, wind_speed_direction
 
 
 @dataclass(frozen=True)

@@ -25,16 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError, OutOfCoverageError, WindDataError
 from sailroute.geo import LocalFrame
-from sailroute.timeutil import iso
-from sailroute.wind.base import Coverage, prepare_points
-from sailroute.wind.height import (
-    DEFAULT_EXPONENT,
-    DEFAULT_ROUGHNESS_M,
-    log_law_factor,
-    power_law_factor,
-)
-from sailroute.wind.rotation import earth_to_local
-from sailroute.wind.stationformat import (
+from sailroute.tabular import (
     CANONICAL_COLUMNS,
     COLUMN_ALIASES,
     DEFAULT_MISSING,
@@ -46,6 +37,15 @@ from sailroute.wind.stationformat import (
     time_part_columns,
     unit_from_header,
 )
+from sailroute.timeutil import iso
+from sailroute.wind.base import Coverage, prepare_points
+from sailroute.wind.height import (
+    DEFAULT_EXPONENT,
+    DEFAULT_ROUGHNESS_M,
+    log_law_factor,
+    power_law_factor,
+)
+from sailroute.wind.rotation import earth_to_local
 from sailroute.wind.stationread import StationData, read_stations, resample_stations
 
 __all__ = [

@@ -1,10 +1,11 @@
-"""The shape of a station table: header aliases, separators, units, UTC offsets.
+"""The shape of a delimited table: header aliases, separators, units, UTC offsets.
 
-What a station CSV looks like before its cells are read (:mod:`sailroute.wind.stations`):
+What a station CSV or a track log looks like before its cells are read
+(:mod:`sailroute.wind.stationread`, :mod:`sailroute.track.read`):
 which header is which canonical column (:func:`map_columns`, :data:`COLUMN_ALIASES`), split
 date/time columns (:func:`time_part_columns`), the separator (:func:`split_fields`), the
 speed unit from the declared ``speed_unit`` or a header suffix (:func:`column_speed_unit`),
-and a fixed UTC offset (:func:`parse_offset`).  The track reader uses the same rules.
+and a fixed UTC offset (:func:`parse_offset`).
 """
 
 from __future__ import annotations
