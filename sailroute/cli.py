@@ -292,6 +292,13 @@ def _complete_scheduler(incomplete: str) -> list[str]:
     return [s for s in ("serial", "processes", "tcp://") if s.startswith(incomplete)]
 
 
+EnsembleOpt = Annotated[
+    int | None,
+    typer.Option("--ensemble", metavar="N",
+                 help="Leg-time bands: route N members drawn from the course's `uncertainty:` "
+                 "(or the defaults, docs/course-format.md) and report P10/P50/P90 per leg, "
+                 "the widest source and the sides; writes bands.json/csv/png."),
+]
 SchedulerOpt = Annotated[
     str | None,
     typer.Option("--scheduler", metavar="WHERE", autocompletion=_complete_scheduler,
@@ -322,6 +329,7 @@ def plan_command(
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
     backend: BackendOpt = "numpy",
+    ensemble: EnsembleOpt = None,
 ) -> None:
     """Route a course leg by leg: leg times, start points, tacks; writes JSON/CSV/GPX/PNG/HTML."""
     from sailroute.plan import run_plan_command
@@ -332,10 +340,18 @@ def plan_command(
 
         loaded = load_course(course)
         with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
+            if ensemble is not None:  # leg-time bands (sailroute/commands/bands.py)
+                from sailroute.commands.bands import run_bands_command
+
+                return run_bands_command(loaded, scenarios=[scenario] if scenario else None,
+                                         members=ensemble, router=router, out_dir=out,
+                                         plots=not no_plots, backend=backend,
+                                         progress=progress)
             return run_plan_command(loaded, scenario=scenario, router=router, out_dir=out,
                                     plots=not no_plots, backend=backend, progress=progress)
 
-    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("plan", "ensemble_json"))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out,
+            ("plan", "ensemble_json", "bands_json"))
 
 
 @app.command("compare-scenarios", cls=_Command,
@@ -361,6 +377,7 @@ def compare_command(
     json_out: JsonOpt = False,
     backend: BackendOpt = "numpy",
     scheduler: SchedulerOpt = None,
+    ensemble: EnsembleOpt = None,
 ) -> None:
     """Route a course in every wind scenario; legs x scenarios table with reference errors."""
     from sailroute.plan import run_compare_command
@@ -371,11 +388,20 @@ def compare_command(
 
         loaded = load_course(course)
         with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
+            if ensemble is not None:  # leg-time bands of every scenario (commands/bands.py)
+                from sailroute.commands.bands import run_bands_command
+
+                names = scenario or [n for n in loaded.scenario_names
+                                     if n not in loaded.ensembles]
+                return run_bands_command(loaded, scenarios=names, members=ensemble,
+                                         router=router, out_dir=out, plots=not no_plots,
+                                         backend=backend, progress=progress,
+                                         what="comparison")
             return run_compare_command(loaded, scenarios=scenario, router=router, out_dir=out,
                                        plots=not no_plots, backend=backend, progress=progress,
                                        scheduler=scheduler)
 
-    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("comparison_json",))
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out, ("comparison_json", "bands_json"))
 
 
 @app.command("vpp", cls=_Command,

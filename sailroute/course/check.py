@@ -28,6 +28,7 @@ import numpy as np
 from sailroute.checks import Checker, Problems, finite, join_path, show, suggest
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
+from sailroute.course.uncertainty import UncertaintySpec, check_uncertainty
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.outdir import path_part_problem
@@ -46,7 +47,7 @@ __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
 TOP_KEYS = (
     "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
-    "legs", "template", "boat", "routing", "scenarios", "references",
+    "legs", "template", "boat", "routing", "scenarios", "references", "uncertainty",
 )
 """Keys allowed at the top level of a course file."""
 
@@ -105,6 +106,8 @@ class CheckedCourse:
         Course-wide reference leg times [s].
     template : dict or None
         The ``template`` mapping, if the layout came from one.
+    uncertainty : UncertaintySpec or None
+        The ``uncertainty`` section (leg-time bands), if given.
     """
 
     name: str
@@ -123,6 +126,7 @@ class CheckedCourse:
     scenarios: dict[str, dict[str, Any]]
     references: dict[str, tuple[float, ...]]
     template: dict[str, Any] | None
+    uncertainty: UncertaintySpec | None = None
 
 
 # ----------------------------------------------------------------------------- sections
@@ -796,6 +800,9 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     routing = _routing(c, data.get("routing"))
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
+    uncertainty = check_uncertainty(
+        c.at("uncertainty"), data["uncertainty"],
+        Path(probs.file).parent) if data.get("uncertainty") is not None else None
     probs.raise_if_any()
 
     assert frame is not None and start_time is not None  # guaranteed when no problems
@@ -816,6 +823,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         scenarios=scenarios,
         references=references,
         template=dict(template) if template is not None else None,
+        uncertainty=uncertainty,
     )
 
 

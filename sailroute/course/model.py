@@ -23,6 +23,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.geo import LocalFrame
 from sailroute.routing.types import RoutingSettings, Side
 from sailroute.timeutil import to_epoch
@@ -255,6 +256,9 @@ class Course:
         1-based line of each key path of the course file (``"scenarios.a.wind.tws_kn"``),
         so that the wind, current and boat factories report problems at their lines;
         empty for a course built from a mapping.
+    uncertainty : UncertaintySpec or None
+        The ``uncertainty`` section (how far the leg-time bands of ``plan --ensemble``
+        spread, :mod:`sailroute.course.uncertainty`); None: not given.
     """
 
     name: str
@@ -275,6 +279,7 @@ class Course:
     boat_where: str = ""
     utc_offset_s: float = 0.0
     key_lines: Mapping[str, int] = field(default_factory=dict)
+    uncertainty: UncertaintySpec | None = None
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):
