@@ -189,8 +189,8 @@ def test_boat_parameters_need_a_race_polar(tmp_path) -> None:
     data = yaml.safe_load(p.read_text())
     data["boat"] = {"builtin": "ilca7-steady"}
     p.write_text(yaml.safe_dump(data))
-    with pytest.raises(InputError, match="uncertainty.boat: race-polar parameters need a race "
-                                         "polar"):
+    with pytest.raises(InputError, match=r"uncertainty\.boat: race-polar parameters need a "
+                                         "race polar"):
         run_bands_command(p, out_dir=tmp_path / "o", plots=False)
     assert not (tmp_path / "o" / "bands.json").exists()
 

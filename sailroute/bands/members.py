@@ -244,7 +244,7 @@ def member_wind(base: WindField, member: Member, t0: float) -> WindField:
 
 def _race_form(boat_spec: Mapping[str, Any], where: str) -> dict[str, Any]:
     """The course's boat as a ``vpp`` spec with a ``kinetics`` mapping, for boat members."""
-    from sailroute.boat.build import builtin_names, builtin_kind
+    from sailroute.boat.build import builtin_kind, builtin_names
     from sailroute.boat.kinetics import STEADY
 
     spec = dict(boat_spec)

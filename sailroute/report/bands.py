@@ -80,7 +80,7 @@ def bands_table(b: BandSummary) -> str:
 
 
 def bands_dict(summaries: Sequence[BandSummary], course_name: str = "") -> dict[str, Any]:
-    """``bands.json`` content: ``{"course": ..., "scenarios": [...]}`` (``docs/output-format.md``)."""
+    """``bands.json``: ``{"course": ..., "scenarios": [...]}`` (``docs/output-format.md``)."""
     return {"course": course_name, "scenarios": [b.to_dict() for b in summaries]}
 
 

@@ -177,7 +177,7 @@ def _wind_of(plan: Plan, winds: Mapping[str, WindField] | None) -> WindField:
         return winds[plan.scenario]
     from sailroute.course.specs import build_wind
 
-    return build_wind(plan.course, plan.scenario)  # type: ignore[no-any-return]
+    return build_wind(plan.course, plan.scenario)
 
 
 def _boat_of(plan: Plan, boat: BoatModel | None) -> BoatModel:
@@ -185,7 +185,7 @@ def _boat_of(plan: Plan, boat: BoatModel | None) -> BoatModel:
         return boat
     from sailroute.course.specs import build_boat
 
-    return build_boat(plan.course)  # type: ignore[no-any-return]
+    return build_boat(plan.course)
 
 
 def _mmss(seconds: float) -> str:
