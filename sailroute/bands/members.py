@@ -95,7 +95,7 @@ def fit_shifts(shifts: ShiftSpec) -> ShiftSpec:
         return shifts
     from sailroute.strategy.fit import fit_station_file
 
-    ou, _ = fit_station_file(shifts.fit, shifts.station)
+    ou, _ = fit_station_file(shifts.fit, shifts.station, speed_unit=shifts.speed_unit)
     if not (np.isfinite(ou.sigma_deg) and np.isfinite(ou.timescale_s) and ou.timescale_s > 0):
         raise InputError(f"uncertainty.shifts.fit: {shifts.fit}: the direction series gives no "
                          f"usable shift model (sigma {ou.sigma_deg:g}°, timescale "
@@ -291,7 +291,7 @@ def member_boat(
         return base_boat
     form = _race_form(boat_spec, where)
     form["kinetics"] = {**form["kinetics"], **{k: float(v) for k, v in member.boat}}
-    return _built(_freeze(form), str(base_dir), where)
+    return _built(_freeze(form), str(base_dir))
 
 
 def _freeze(value: Any) -> Any:
@@ -310,9 +310,10 @@ def _thaw(value: Any) -> Any:
     return value
 
 
-@lru_cache(maxsize=16)
-def _built(frozen: Any, base_dir: str, where: str) -> Any:
-    """A boat spec built once (members that share boat parameters share the polar)."""
+@lru_cache(maxsize=32)
+def _built(frozen: Any, base_dir: str) -> Any:
+    """A race polar built once (members, and courses, that share boat parameters share it;
+    the spec was checked by the course already, so problems cannot arise here)."""
     from sailroute.boat.build import boat_from_spec
 
-    return boat_from_spec(_thaw(frozen), base_dir=Path(base_dir), where=where)
+    return boat_from_spec(_thaw(frozen), base_dir=Path(base_dir), where="uncertainty.boat")

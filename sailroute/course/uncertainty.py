@@ -75,6 +75,8 @@ class ShiftSpec:
         report; the fit itself is done by :mod:`sailroute.bands.members`.
     station : str or None
         Station of ``fit`` (files with several stations).
+    speed_unit : str or None
+        Unit of the file's unsuffixed speed column (``kn``, ``m/s``, ...).
     """
 
     model: str
@@ -85,6 +87,7 @@ class ShiftSpec:
     rate_deg_per_s: float = 0.0
     fit: Path | None = None
     station: str | None = None
+    speed_unit: str | None = None
 
 
 @dataclass(frozen=True)
@@ -165,9 +168,10 @@ def _shifts(c: Checker, raw: Any, base_dir: Path | None) -> ShiftSpec | None:
     if not c.is_mapping(raw, "{model: oscillating|ou|persistent, ...} or {fit: PATH}"):
         return None
     if "fit" in raw:
-        c.keys(raw, ("fit", "station"))
+        c.keys(raw, ("fit", "station", "speed_unit"))
         path = c.string(raw, "fit")
         station = c.string(raw, "station", None)
+        unit = c.choice(raw, "speed_unit", ("kn", "m/s", "km/h", "mph"), None)
         if path is None:
             return None
         p = Path(path)
@@ -177,7 +181,7 @@ def _shifts(c: Checker, raw: Any, base_dir: Path | None) -> ShiftSpec | None:
             c.add("fit", f"no station CSV at {p}; give a file of measured wind "
                   "(docs/measured-wind.md) relative to the course file")
             return None
-        return ShiftSpec("ou", fit=p, station=station)
+        return ShiftSpec("ou", fit=p, station=station, speed_unit=unit)
     model = c.choice(raw, "model", SHIFT_MODELS)
     if model is None:
         return None
