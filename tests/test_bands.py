@@ -203,6 +203,33 @@ def test_cli_ensemble_option_bad_values_exit_2_and_write_nothing(tmp_path) -> No
     assert not (tmp_path / "o" / "bands.json").exists()
 
 
+def test_cli_plan_ensemble_writes_the_bands_and_prints_them_as_json(tmp_path) -> None:
+    out = tmp_path / "o"
+    course = beat_course(tmp_path, {"tws_kn": 1.0, "twd_deg": 5.0, "members": 8})
+    r = CliRunner().invoke(app, ["plan", str(course), "--ensemble", "3", "-q", "-o", str(out),
+                                 "--json", "--no-plots"])
+    assert r.exit_code == 0, r.output
+    doc = json.loads(r.stdout)
+    assert doc == json.loads((out / "bands.json").read_text())
+    (sc,) = doc["scenarios"]
+    assert sc["members"] == ["m1", "m2", "m3"] and len(sc["legs"]) == 2
+    assert set(sc["total"]["width_by_source_s"]) == {"tws", "twd"}
+    assert sc["uncertainty"]["twd_sd_deg"] == 5.0
+    for leg in [*sc["legs"], sc["total"]]:
+        t = leg["time_s"]
+        assert t["p10"] <= t["p50"] <= t["p90"]
+    assert not (out / "bands.png").exists()
+
+
+@pytest.mark.slow
+def test_bands_page_and_chart(tmp_path) -> None:
+    c = load_course(beat_course(tmp_path, {"tws_kn": 1.0, "members": 3}))
+    res = run_bands_command(c, out_dir=tmp_path / "o")
+    page = res.files["html"].read_text()
+    assert "Leg-time bands, steady: 3 members; TWS ±1 kn" in page
+    assert res.files["bands_png"].read_bytes()[:4] == b"\x89PNG"
+
+
 # --- sides --------------------------------------------------------------------------------
 
 

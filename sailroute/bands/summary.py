@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.course.uncertainty import UncertaintySpec
+from sailroute.routing.types import LegResult
 
 __all__ = ["BAND_STATS", "SIDE_LABELS", "BandSummary"]
 
@@ -54,6 +55,8 @@ class BandSummary:
         What was uncertain (after fitting a shift model).
     notes : tuple of str
         How the uncertainty was chosen (e.g. defaults used).
+    nominal_legs : tuple of LegResult
+        The routed legs of the scenario as given (for maps and the page).
     """
 
     scenario: str
@@ -66,6 +69,7 @@ class BandSummary:
     references: Mapping[str, tuple[float, ...]] = field(default_factory=dict)
     uncertainty: UncertaintySpec = field(default_factory=UncertaintySpec)
     notes: tuple[str, ...] = ()
+    nominal_legs: tuple[LegResult, ...] = ()
 
     @property
     def totals_s(self) -> NDArray[np.float64]:

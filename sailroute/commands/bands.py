@@ -171,6 +171,7 @@ def band_summary(
         references=course.references_for(scenario),
         uncertainty=spec,
         notes=tuple(notes),
+        nominal_legs=tuple(res_of[NOMINAL.name]),
     )
 
 
@@ -214,7 +215,8 @@ def run_bands_command(
         ``report``: one table per scenario; ``files``: ``bands_json``, ``bands_csv``,
         ``bands_png``; ``data``: the tuple of :class:`BandSummary`.
     """
-    from sailroute.report.bands import bands_table, write_bands
+    from sailroute.report.bands import bands_page, bands_table, write_bands
+    from sailroute.report.html import write_report
 
     if members is not None and members < 3:
         raise InputError(f"--ensemble {members}: a band needs at least 3 members; give N >= 3")
@@ -243,7 +245,11 @@ def run_bands_command(
         for n in names)
 
     def write(d: Path) -> dict[str, Path]:
-        return write_bands(d, summaries, course_name=course.name, plot=plots)
+        files = write_bands(d, summaries, course_name=course.name, plot=plots)
+        if plots:
+            files["html"] = write_report(d / "report.html", bands_page(
+                course, summaries, winds, router=settings.router))
+        return files
 
     files = write_output_set(out, write)
     return CommandResult("\n\n".join(bands_table(b) for b in summaries), files, summaries,

@@ -9,7 +9,7 @@ references.
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +18,8 @@ import numpy as np
 from sailroute.bands.summary import BAND_STATS, SIDE_LABELS, BandSummary
 from sailroute.textin import CleanCsvWriter
 
-__all__ = ["bands_dict", "bands_table", "plot_bands", "write_bands"]
+__all__ = ["bands_dict", "bands_html_table", "bands_page", "bands_table", "plot_bands",
+           "write_bands"]
 
 
 def _mmss(seconds: float) -> str:
@@ -79,6 +80,49 @@ def bands_table(b: BandSummary) -> str:
     return "\n".join(lines)
 
 
+def bands_html_table(b: BandSummary) -> Any:
+    """The bands of one scenario as a table of ``report.html``."""
+    from sailroute.report.html import Table
+
+    bd, dom, sh, widths = b.bands(), b.dominant(), b.side_shares(), b.oat_widths()
+    rows = []
+    for k, label in enumerate(b.leg_labels):
+        rows.append((f"{k + 1} {label}", *(_mmss(v) for v in bd[k]), _mmss(b.nominal_s[k]),
+                     f"{dom[k]} {widths[dom[k]][k]:.0f} s" if dom[k] else "",
+                     " ".join(f"{lab} {100 * v:.0f}%" for lab, v in zip(SIDE_LABELS, sh[k],
+                                                                       strict=True) if v > 0)))
+    foot = (("total", *(_mmss(v) for v in bd[-1]), _mmss(float(np.sum(b.nominal_s))),
+             f"{dom[-1]} {widths[dom[-1]][-1]:.0f} s" if dom[-1] else "", ""),)
+    return Table(f"Leg-time bands, {b.scenario}: {len(b.members)} members; {_describe(b)}",
+                 ("leg", "P10", "P50", "P90", "nominal", "widest source", "sides"),
+                 tuple(rows), foot)
+
+
+def bands_page(
+    course: Any, summaries: Sequence[BandSummary], winds: Mapping[str, Any], *,
+    router: str = "",
+) -> Any:
+    """``report.html`` of a bands run: the nominal route(s) on the map and the band tables."""
+    import dataclasses
+
+    from sailroute.report.html import comparison_report, plan_report
+    from sailroute.report.plan import compare, make_plan
+
+    plans = [make_plan(course, b.scenario, b.nominal_legs, winds.get(b.scenario),
+                       router=router) for b in summaries]
+    if len(plans) == 1:
+        page = plan_report(plans[0], winds.get(plans[0].scenario))
+    else:
+        page = comparison_report(compare(plans), plans, {p.scenario: winds[p.scenario]
+                                                         for p in plans})
+    notes = ("Leg-time bands: P10/P50/P90 of the members' leg times; the nominal time is the "
+             "scenario as given; the widest source is the one whose one-at-a-time band "
+             "(P10-P90, the other sources nominal) is widest; a side counts only when it beats "
+             "the other side's layline extreme by more than the margin, else tie.",)
+    return dataclasses.replace(page, tables=(*(bands_html_table(b) for b in summaries),
+                                             *page.tables), notes=(*notes, *page.notes))
+
+
 def bands_dict(summaries: Sequence[BandSummary], course_name: str = "") -> dict[str, Any]:
     """``bands.json``: ``{"course": ..., "scenarios": [...]}`` (``docs/output-format.md``)."""
     return {"course": course_name, "scenarios": [b.to_dict() for b in summaries]}
@@ -108,6 +152,7 @@ def plot_bands(summaries: Sequence[BandSummary]) -> Any:
                 ax.plot(x, 100 * (rv / nom - 1), "o", markersize=4,
                         label=f"{r}" if i == 0 else None)
     ax.axhline(0.0, color="grey", lw=0.8)
+    ax.margins(y=0.08)
     ax.set_xticks(np.arange(n_legs))
     ax.set_xticklabels([f"{k + 1}" for k in range(n_legs - 1)] + ["total"])
     ax.set_xlabel("leg")
