@@ -396,7 +396,7 @@ def compare_command(
                 return run_bands_command(loaded, scenarios=names, members=ensemble,
                                          router=router, out_dir=out, plots=not no_plots,
                                          backend=backend, progress=progress,
-                                         what="comparison")
+                                         what="comparison", scheduler=scheduler)
             return run_compare_command(loaded, scenarios=scenario, router=router, out_dir=out,
                                        plots=not no_plots, backend=backend, progress=progress,
                                        scheduler=scheduler)

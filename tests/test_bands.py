@@ -195,12 +195,19 @@ def test_boat_parameters_need_a_race_polar(tmp_path) -> None:
     assert not (tmp_path / "o" / "bands.json").exists()
 
 
-def test_cli_ensemble_option_bad_values_exit_2_and_write_nothing(tmp_path) -> None:
-    r = CliRunner().invoke(app, ["plan", str(beat_course(tmp_path)), "--ensemble", "2", "-q",
-                                 "-o", str(tmp_path / "o")])
+@pytest.mark.parametrize(("args", "message"), [
+    (["plan", "--ensemble", "2"], "error: --ensemble 2: a band needs at least 3 members; give "
+     "N >= 3"),
+    (["compare-scenarios", "--ensemble", "3", "--scheduler", "processes"],
+     "error: --scheduler processes: --ensemble routes its members here"),
+])
+def test_cli_ensemble_option_bad_values_exit_2_and_write_nothing(tmp_path, args,
+                                                                 message) -> None:
+    r = CliRunner().invoke(app, [args[0], str(beat_course(tmp_path)), *args[1:], "-q", "-o",
+                                 str(tmp_path / "o")])
     assert r.exit_code == 2
-    assert "--ensemble 2: a band needs at least 3 members" in r.output
-    assert not (tmp_path / "o" / "bands.json").exists()
+    assert message in r.output
+    assert not (tmp_path / "o").exists()
 
 
 def test_cli_plan_ensemble_writes_the_bands_and_prints_them_as_json(tmp_path) -> None:

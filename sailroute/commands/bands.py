@@ -186,6 +186,7 @@ def run_bands_command(
     backend: str = "numpy",
     progress: Progress | None = None,
     what: str = "bands",
+    scheduler: str | None = None,
 ) -> CommandResult:
     """Leg-time bands of one or more scenarios: what ``plan``/``compare-scenarios --ensemble N`` do.
 
@@ -208,6 +209,8 @@ def run_bands_command(
         Also write ``bands.png``.
     what : str
         Name of the default folder for several scenarios (``comparison``).
+    scheduler : str, optional
+        None or ``"serial"`` only: the members are routed here, one after the other.
 
     Returns
     -------
@@ -220,6 +223,9 @@ def run_bands_command(
 
     if members is not None and members < 3:
         raise InputError(f"--ensemble {members}: a band needs at least 3 members; give N >= 3")
+    if scheduler not in (None, "serial"):
+        raise InputError(f"--scheduler {scheduler}: --ensemble routes its members here, one "
+                         "after the other; leave out --scheduler (or use serial)")
     course = course if isinstance(course, Course) else load_course(course)
     names = list(scenarios) if scenarios else [course.scenario_names[0]]
     for n in names:
