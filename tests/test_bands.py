@@ -10,7 +10,14 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
-from sailroute.bands.members import NOMINAL, Member, draw_members, member_wind, one_at_a_time
+from sailroute.bands.members import (
+    NOMINAL,
+    Member,
+    draw_members,
+    member_wind,
+    one_at_a_time,
+    resolve_shifts,
+)
 from sailroute.bands.summary import BandSummary
 from sailroute.cli import app
 from sailroute.commands.bands import run_bands_command, spec_for
@@ -93,6 +100,26 @@ def test_same_seed_same_members_and_latin_hypercube_strata() -> None:
     ages = np.sort([dict(m.boat)["sea_age_h"] for m in a])
     assert np.all(np.floor((ages - 2.0) / (2.0 / 12)) == np.arange(12))
     assert sorted(m.name for m in a) == sorted(f"m{k}" for k in range(1, 13))
+
+
+def test_shift_members_are_deterministic_and_fitted_from_measured_wind() -> None:
+    osc = uncertainty_from_mapping({"shifts": {"model": "oscillating", "amplitude_deg": 8,
+                                               "period_min": 6}, "members": 4})
+    a = draw_members(osc, 1200.0)
+    assert a == draw_members(osc, 1200.0)
+    for m in a:  # amplitude 8°, one value every 10 s over the 20 min
+        assert len(m.shift_deg) == 121 and max(np.abs(m.shift_deg)) <= 8.0 + 1e-9
+    ou = resolve_shifts(uncertainty_from_mapping(
+        {"shifts": {"fit": "trieste-coach-2018-02-15.csv", "speed_unit": "kn"}},
+        base_dir=ROOT / "data"))
+    assert ou.shifts is not None and ou.shifts.model == "ou"
+    # the Trieste coach boat's directions (docs/strategy.md): 28.4° and 1.9 min
+    assert ou.shifts.sigma_deg == pytest.approx(28.4, abs=0.1)
+    assert ou.shifts.timescale_s / 60 == pytest.approx(1.9, abs=0.1)
+    b = draw_members(ou, 600.0)
+    assert b == draw_members(ou, 600.0)
+    with pytest.raises(InputError, match=r"uncertainty\.shifts\.fit: no station CSV at "):
+        uncertainty_from_mapping({"shifts": {"fit": "nowhere.csv"}}, base_dir=ROOT)
 
 
 def test_one_at_a_time_varies_only_its_source() -> None:

@@ -3,7 +3,7 @@
 Percentiles are ``numpy.percentile`` (linear) over the members' leg times; the race
 time of a member is the sum of its legs, so the race band is not the sum of the leg
 bands.  The one-at-a-time breakdown gives, per source, the range (max - min) of the
-times of the members at that source's quantiles 0.1 ... 0.9 with the other sources at
+times of the members at that source's quantiles 0.1, 0.5 and 0.9 with the other sources at
 their nominal values: the source's P10-P90 width when its effect is monotonic.
 """
 

@@ -128,14 +128,17 @@ def route_side(plan: Plan, k: int, wind: WindField | None = None,
     """Side of the course (:data:`SIDES`) that leg ``k`` of ``plan`` used.
 
     With the plan's ``wind`` and ``boat`` the side counts only when it beats the other
-    side (:func:`honest_side`); without them it is the route's side as sailed.
+    side (:func:`honest_side`; the margin of the course's ``uncertainty`` section, else
+    ``max(2 s, 0.5 %)``); without them it is the route's side as sailed.
     """
     res = plan.legs[k].result
     if wind is None or boat is None:
         return leg_side(res)
-    st = plan.course.routing
+    st, unc = plan.course.routing, plan.course.uncertainty
+    margins = {} if unc is None else {"margin_s": unc.side_margin_s,
+                                      "margin_pct": unc.side_margin_pct}
     return honest_side(res, wind, boat, tack_penalty_s=st.tack_penalty_s,
-                       gybe_penalty_s=st.gybe_penalty_s)
+                       gybe_penalty_s=st.gybe_penalty_s, **margins)
 
 
 def summarize_ensemble(
