@@ -118,6 +118,10 @@ def test_shift_members_are_deterministic_and_fitted_from_measured_wind() -> None
     assert ou.shifts.timescale_s / 60 == pytest.approx(1.9, abs=0.1)
     b = draw_members(ou, 600.0)
     assert b == draw_members(ou, 600.0)
+    # the OU paths keep the stationary spread (40 members x 61 values)
+    many = draw_members(uncertainty_from_mapping(
+        {"shifts": {"model": "ou", "sigma_deg": 10, "timescale_min": 3}, "members": 40}), 600.0)
+    assert np.std([m.shift_deg for m in many]) == pytest.approx(10.0, rel=0.15)
     with pytest.raises(InputError, match=r"uncertainty\.shifts\.fit: no station CSV at "):
         uncertainty_from_mapping({"shifts": {"fit": "nowhere.csv"}}, base_dir=ROOT)
 

@@ -10,7 +10,8 @@ Conover 1979), so even a small ``n`` spans the tails.  A stratum value ``u`` bec
 * ``twd``: a constant direction offset ``z · twd_deg``;
 * ``shifts``: ``oscillating``, the phase ``2π u``; ``persistent``, a rate
   ``z · rate``; ``ou``, the starting shift ``z · sigma`` of an Ornstein-Uhlenbeck
-  path (AR(1) in 10 s steps, its innovations from the member's own generator);
+  path (:class:`sailroute.strategy.shiftmodel.OUShift`, stepped every 10 s with its exact
+  transition, the innovations from the seeded generator);
 * ``boat.<parameter>``: ``low + u (high - low)``.
 
 :func:`one_at_a_time` gives, per source, members at that source's quantiles 0.1, 0.5 and 0.9
@@ -129,16 +130,19 @@ def _shift_series(
         s = shifts.amplitude_deg * np.sin(2 * np.pi * t / shifts.period_s + 2 * np.pi * u)
     elif shifts.model == "persistent":
         s = z * shifts.rate_deg_per_s * t
-    else:  # ou: AR(1) with the step's exact autocorrelation
+    else:  # ou: the strategy module's shift model, stepped with its exact transition
+        from sailroute.strategy.shiftmodel import OUShift
+
         if not shifts.sigma_deg > 0 or not shifts.timescale_s > 0:
             raise InputError("uncertainty.shifts: an OU shift needs sigma_deg > 0 and "
                              "timescale_min > 0 (or `fit:` a station file)")
-        phi = float(np.exp(-SHIFT_STEP_S / shifts.timescale_s))
+        model = OUShift(shifts.sigma_deg, shifts.timescale_s)
         eps = rng.standard_normal(t.size)
         s = np.empty(t.size)
-        s[0] = z * shifts.sigma_deg
+        s[0] = z * shifts.sigma_deg  # the stationary distribution's quantile u
         for i in range(1, t.size):
-            s[i] = phi * s[i - 1] + shifts.sigma_deg * np.sqrt(1 - phi * phi) * eps[i]
+            mean, sd = model.transition_moments(s[i - 1], SHIFT_STEP_S)
+            s[i] = float(mean) + float(sd) * eps[i]
     return tuple(float(v) for v in t), tuple(float(v) for v in s)
 
 
