@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import json
 from pathlib import Path
 
@@ -257,6 +258,10 @@ def test_cli_plan_ensemble_writes_the_bands_and_prints_them_as_json(tmp_path) ->
         t = leg["time_s"]
         assert t["p10"] <= t["p50"] <= t["p90"]
     assert not (out / "bands.png").exists()
+    rows = list(csv.DictReader((out / "bands.csv").open()))
+    assert [r["leg"] for r in rows] == ["1", "2", "total"]
+    assert float(rows[-1]["width_tws_s"]) == pytest.approx(sc["total"]["width_by_source_s"]["tws"],
+                                                           abs=1e-3)
 
 
 @pytest.mark.slow

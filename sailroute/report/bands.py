@@ -76,6 +76,17 @@ def bands_table(b: BandSummary) -> str:
                                for i, (c, x) in enumerate(zip(r, w, strict=True))).rstrip())
         if j == 0:
             lines.append("  ".join("-" * x for x in w))
+    if widths:
+        lines += ["", "width by source [s] (one source at its P10 / P50 / P90, the others "
+                  "nominal)"]
+        wrows = [("source", *(str(k + 1) for k in range(len(b.leg_labels))), "total")]
+        wrows += [(src, *(f"{v:.0f}" for v in w)) for src, w in widths.items()]
+        ww = [max(len(r[i]) for r in wrows) for i in range(len(wrows[0]))]
+        for j, r in enumerate(wrows):
+            lines.append("  ".join(c.ljust(x) if i == 0 else c.rjust(x)
+                                   for i, (c, x) in enumerate(zip(r, ww, strict=True))))
+            if j == 0:
+                lines.append("  ".join("-" * x for x in ww))
     lines += [f"note: {n}" for n in b.notes]
     return "\n".join(lines)
 
@@ -173,17 +184,25 @@ def write_bands(
     js.write_text(json.dumps(bands_dict(summaries, course_name), indent=2) + "\n",
                   encoding="utf-8")
     cs = out_dir / "bands.csv"
+    sources = list(dict.fromkeys(src for b in summaries for src in b.oat_s))
     with cs.open("w", newline="", encoding="utf-8") as f:
         w = CleanCsvWriter(f)
         w.writerow(["scenario", "leg", "label", *(f"{s}_s" for s in BAND_STATS), "nominal_s",
-                    "widest_source", *(f"share_{s}" for s in SIDE_LABELS)])
+                    "widest_source", *(f"width_{s}_s" for s in sources),
+                    *(f"share_{s}" for s in SIDE_LABELS)])
         for b in summaries:
-            bd, dom, sh = b.bands(), b.dominant(), b.side_shares()
+            bd, dom, sh, wid = b.bands(), b.dominant(), b.side_shares(), b.oat_widths()
+
+            def widths_at(k: int, wid: dict[str, Any] = wid) -> list[str]:
+                return [f"{wid[s][k]:.3f}" if s in wid else "" for s in sources]
+
             for k, label in enumerate(b.leg_labels):
                 w.writerow([b.scenario, k + 1, label, *(f"{v:.3f}" for v in bd[k]),
-                            f"{b.nominal_s[k]:.3f}", dom[k], *(f"{v:.4f}" for v in sh[k])])
+                            f"{b.nominal_s[k]:.3f}", dom[k], *widths_at(k),
+                            *(f"{v:.4f}" for v in sh[k])])
             w.writerow([b.scenario, "total", "", *(f"{v:.3f}" for v in bd[-1]),
-                        f"{np.sum(b.nominal_s):.3f}", dom[-1], *("" for _ in SIDE_LABELS)])
+                        f"{np.sum(b.nominal_s):.3f}", dom[-1], *widths_at(-1),
+                        *("" for _ in SIDE_LABELS)])
     files = {"bands_json": js, "bands_csv": cs}
     if plot:
         import matplotlib.pyplot as plt
