@@ -11,6 +11,7 @@ angles veer the wind (clockwise, the direction it comes from increases).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -57,8 +58,8 @@ class PerturbedWind:
     speed_scale: float = 1.0
     speed_add_ms: float = 0.0
     direction_offset_deg: float = 0.0
-    shift_times: NDArray[np.float64] = field(default_factory=lambda: _frozen([]))
-    shift_deg: NDArray[np.float64] = field(default_factory=lambda: _frozen([]))
+    shift_times: ArrayLike = field(default_factory=lambda: _frozen([]))
+    shift_deg: ArrayLike = field(default_factory=lambda: _frozen([]))
     name: str = "perturbed wind"
 
     def __post_init__(self) -> None:
@@ -70,7 +71,7 @@ class PerturbedWind:
         if not np.isfinite(self.direction_offset_deg):
             raise InputError(f"{self.name}: direction_offset_deg must be finite; got "
                              f"{self.direction_offset_deg}")
-        t, s = _frozen(self.shift_times), _frozen(self.shift_deg)
+        t, s = self._series
         if t.shape != s.shape:
             raise InputError(f"{self.name}: {t.size} shift times but {s.size} shifts; give one "
                              "shift per time")
@@ -78,8 +79,11 @@ class PerturbedWind:
                        or not np.all(np.isfinite(s))):
             raise InputError(f"{self.name}: shift times must be finite and increase strictly, "
                              "shifts finite")
-        object.__setattr__(self, "shift_times", t)
-        object.__setattr__(self, "shift_deg", s)
+
+    @cached_property
+    def _series(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Read-only copies of the shift times [epoch s] and shifts [°]."""
+        return _frozen(self.shift_times), _frozen(self.shift_deg)
 
     @property
     def coverage(self) -> Coverage:
@@ -94,9 +98,10 @@ class PerturbedWind:
     def turn_deg(self, t: ArrayLike) -> NDArray[np.float64]:
         """Total turn of the direction at epoch ``t`` [s]: offset plus shift [°]."""
         tt = np.asarray(t, dtype=float)
-        if self.shift_times.size == 0:
+        times, shifts = self._series
+        if times.size == 0:
             return np.full(tt.shape, float(self.direction_offset_deg))
-        return self.direction_offset_deg + np.interp(tt, self.shift_times, self.shift_deg)
+        return self.direction_offset_deg + np.interp(tt, times, shifts)
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -115,7 +120,7 @@ class PerturbedWind:
             new = np.maximum(self.speed_scale * speed + self.speed_add_ms, 0.0)
             # a calm point stays calm: it has no direction to add the speed along
             factor = np.divide(new, speed, out=np.zeros_like(speed), where=speed > 0)
-        if self.shift_times.size or self.direction_offset_deg != 0.0:
+        if self._series[0].size or self.direction_offset_deg != 0.0:
             turn = self.turn_deg(np.broadcast_to(np.asarray(t, dtype=float), np.shape(u)))
             u, v = rotate_clockwise(u, v, turn)
         return factor * u, factor * v
