@@ -284,6 +284,13 @@ def _complete_scheduler(incomplete: str) -> list[str]:
     return [s for s in ("serial", "processes", "tcp://") if s.startswith(incomplete)]
 
 
+EnsembleOpt = Annotated[
+    int | None,
+    typer.Option("--ensemble", metavar="N",
+                 help="Leg-time bands: route N members drawn from the course's `uncertainty:` "
+                 "(or the defaults, docs/course-format.md) and report P10/P50/P90 per leg, "
+                 "the widest source and the sides; writes bands.json/csv/png."),
+]
 SchedulerOpt = Annotated[
     str | None,
     typer.Option("--scheduler", metavar="WHERE", autocompletion=_complete_scheduler,
@@ -314,6 +321,7 @@ def plan_command(
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
     backend: BackendOpt = "numpy",
+    ensemble: EnsembleOpt = None,
 ) -> None:
     """Route a course leg by leg: leg times, start points, tacks; writes JSON/CSV/GPX/PNG/HTML."""
     from sailroute.commands.plan import run_plan_command
@@ -325,8 +333,15 @@ def plan_command(
 
         loaded = load_course(course)
         with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
+            options = RunOptions(router, backend, progress)
+            if ensemble is not None:  # leg-time bands (sailroute/commands/bands.py)
+                from sailroute.commands.bands import run_bands_command
+
+                return run_bands_command(loaded, scenarios=[scenario] if scenario else None,
+                                         members=ensemble, out_dir=out, plots=not no_plots,
+                                         options=options)
             return run_plan_command(loaded, scenario=scenario, out_dir=out, plots=not no_plots,
-                                    options=RunOptions(router, backend, progress))
+                                    options=options)
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
@@ -403,6 +418,7 @@ def compare_command(
     json_out: JsonOpt = False,
     backend: BackendOpt = "numpy",
     scheduler: SchedulerOpt = None,
+    ensemble: EnsembleOpt = None,
 ) -> None:
     """Route a course in every wind scenario; legs x scenarios table with reference errors."""
     from sailroute.commands.plan import run_compare_command
@@ -414,9 +430,17 @@ def compare_command(
 
         loaded = load_course(course)
         with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
+            options = RunOptions(router, backend, progress, scheduler)
+            if ensemble is not None:  # leg-time bands of every scenario (commands/bands.py)
+                from sailroute.commands.bands import run_bands_command
+
+                names = scenario or [n for n in loaded.scenario_names
+                                     if n not in loaded.ensembles]
+                return run_bands_command(loaded, scenarios=names, members=ensemble,
+                                         out_dir=out, plots=not no_plots, options=options,
+                                         what="comparison")
             return run_compare_command(loaded, scenarios=scenario, out_dir=out,
-                                       plots=not no_plots,
-                                       options=RunOptions(router, backend, progress, scheduler))
+                                       plots=not no_plots, options=options)
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 

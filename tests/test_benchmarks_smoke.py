@@ -41,6 +41,8 @@ CASES = [
     pytest.param("bench_strategy.py", r"^SDP 101 x 40 rows x 2 tacks x 19 shifts, .*"
                  r"E\[T\] = \d+\.\d s$", marks=SLOW),
     pytest.param("bench_deadline.py", r"^  Monte Carlo 200 runs/policy ", marks=SLOW),
+    pytest.param("bands_calibration.py", r"^\| Snipe Valencia P01 \| TWS 1\.0 kn, TWD 10° \| "
+                 r"6 legs \(boat 1, boat 2\) \| \d/6 = \d+ % \| \d+ s \(", marks=SLOW),
     pytest.param("bench_peers.py", r"^- expansion and arrival test \(`_expand`\): [\d.]+ %$",
                  marks=SLOW),
 ]

@@ -11,7 +11,7 @@ import yaml
 from typer.testing import CliRunner
 
 from sailroute.cli import app
-from sailroute.course.load import load_course
+from sailroute.course.load import build_boat, build_wind, load_course
 from sailroute.errors import InputError
 from sailroute.planning.route import compare_scenarios, default_scenario, plan_course
 from sailroute.report.ensemble import SIDES, route_side, summarize_ensemble
@@ -74,8 +74,14 @@ def test_spread_is_the_percentiles_of_the_members_routed_alone(tmp_path) -> None
     assert s.spread()[-1, 0] == pytest.approx(alone.sum(axis=1).min())
     shares = s.side_shares()
     np.testing.assert_allclose(shares.sum(axis=1), 1.0)
-    assert [row[0] for row in s.sides] == [route_side(p, 0) for p in plans]
+    boat = build_boat(c)
+    assert [row[0] for row in s.sides] == [route_side(p, 0, build_wind(c, p.scenario), boat)
+                                           for p in plans]
     assert set(np.ravel(s.sides)) <= set(SIDES)
+    # steady, uniform winds: whichever side a route took, the other side's layline extreme
+    # is as fast, so no beat or run counts as a side (a route taken alone still has one)
+    assert {row[0] for row in s.sides} == {"tie"}
+    assert {route_side(p, 0) for p in plans} <= {"left", "right"}
 
 
 def test_cli_plan_on_an_ensemble_writes_the_spread(tmp_path) -> None:

@@ -105,7 +105,7 @@ def _run_ensemble(
     from sailroute.report.files import write_plan_outputs
 
     cmp, plans, winds = route_scenarios(course, [name], options)
-    summary = summarize_ensemble(name, plans)
+    summary = summarize_ensemble(name, plans, winds)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, name, options.router)
 
     def write(d: Path) -> dict[str, Path]:
@@ -152,7 +152,7 @@ def run_compare_command(
     cmp, plans, winds = route_scenarios(course, scenarios, options)
     report = [comparison_table(cmp)]
     by_name = {p.scenario: p for p in plans}
-    summaries = [summarize_ensemble(ens, [by_name[m] for m in members])
+    summaries = [summarize_ensemble(ens, [by_name[m] for m in members], winds)
                  for ens, members in course.ensembles.items()
                  if all(m in by_name for m in members)]
     report += [ensemble_table(summary) for summary in summaries]

@@ -56,6 +56,7 @@ def build_course(
         source=source,
         description=checked.description,
         template=checked.template,
+        uncertainty=checked.uncertainty,
         time_limit_s=checked.time_limit_min * 60.0,
         boat_where=checked.boat_where,
         utc_offset_s=checked.utc_offset_s,

@@ -38,6 +38,7 @@ from sailroute.checks import (
 from sailroute.course.area import AREA_KEYS, check_area
 from sailroute.course.model import LegKind
 from sailroute.course.templates import TEMPLATES, CourseLayout
+from sailroute.course.uncertainty import UncertaintySpec, check_uncertainty
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.outdir import path_part_problem
@@ -58,7 +59,8 @@ __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
 TOP_KEYS = (
     "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
-    "legs", "template", "boat", "routing", "scenarios", "references", *AREA_KEYS,
+    "legs", "template", "boat", "routing", "scenarios", "references", "uncertainty",
+    *AREA_KEYS,
 )
 """Keys allowed at the top level of a course file."""
 
@@ -120,6 +122,8 @@ class CheckedCourse:
     area : RaceArea
         ``boundary``, ``obstacles`` and ``wind_land_is_obstacle`` in the local frame
         (:mod:`sailroute.course.area`).
+    uncertainty : UncertaintySpec or None
+        The ``uncertainty`` section (leg-time bands), if given.
     """
 
     name: str
@@ -139,6 +143,7 @@ class CheckedCourse:
     references: dict[str, tuple[float, ...]]
     template: dict[str, Any] | None
     area: RaceArea = dataclasses.field(default_factory=RaceArea)
+    uncertainty: UncertaintySpec | None = None
 
 
 # ----------------------------------------------------------------------------- sections
@@ -836,6 +841,9 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
     area = check_area(c, data, frame, xy, _position)
+    uncertainty = check_uncertainty(
+        c.at("uncertainty"), data["uncertainty"],
+        Path(probs.file).parent) if data.get("uncertainty") is not None else None
     probs.raise_if_any()
 
     assert frame is not None and start_time is not None  # guaranteed when no problems
@@ -857,6 +865,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         references=references,
         template=dict(template) if template is not None else None,
         area=area,
+        uncertainty=uncertainty,
     )
 
 

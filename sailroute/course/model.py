@@ -23,6 +23,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.geo import LocalFrame
 from sailroute.routing.obstacles import RaceArea
 from sailroute.routing.types import RoutingSettings, Side
@@ -260,6 +261,9 @@ class Course:
     area : RaceArea
         The race area: ``boundary``, ``obstacles`` and ``wind_land_is_obstacle``,
         polygons in the local frame (:mod:`sailroute.routing.obstacles`).
+    uncertainty : UncertaintySpec or None
+        The ``uncertainty`` section (how far the leg-time bands of ``plan --ensemble``
+        spread, :mod:`sailroute.course.uncertainty`); None: not given.
     """
 
     name: str
@@ -281,6 +285,7 @@ class Course:
     utc_offset_s: float = 0.0
     key_lines: Mapping[str, int] = field(default_factory=dict)
     area: RaceArea = field(default_factory=RaceArea)
+    uncertainty: UncertaintySpec | None = None
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):

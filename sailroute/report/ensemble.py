@@ -3,16 +3,21 @@
 An ensemble scenario (``members:`` in the course file) is routed member by member; the
 summary gives per leg and for the race the minimum, 10th percentile, median, 90th
 percentile and maximum time over the members (``numpy.percentile``, linear), and for each
-leg how often the route went left, right or up the middle of the course.  The side of a
-route is the time-mean signed distance of its track from the leg's rhumb line, labelled
-as in race analysis (:func:`sailroute.analysis.loss.side_label`: "middle" within 5 % of
-the leg length): "left"/"right" looking from the leg's start to its end.
+leg how often the route went left, right or up the middle of the course, or whether
+the sides were a tie.  The side of a route is the time-mean signed distance of its
+track from the leg's rhumb line, labelled as in race analysis
+(:func:`sailroute.analysis.loss.side_label`: "middle" within 5 % of the leg length):
+"left"/"right" looking from the leg's start to its end.  It counts only when the route
+beats the other side's layline extreme, sailed in the member's wind
+(:func:`sailroute.routing.sides.layline_times`), by more than
+``max(2 s, 0.5 %)`` of the leg time; otherwise the leg is a "tie" (in a steady, uniform
+wind every path inside the laylines takes the same time).
 """
 
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Final
@@ -21,13 +26,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.analysis.loss import lateral_offset, side_label, time_mean
+from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError
 from sailroute.planning.result import Plan
+from sailroute.routing.sides import layline_times, side_verdict
+from sailroute.routing.types import LegResult
 from sailroute.textin import CleanCsvWriter
+from sailroute.wind.base import WindField
 
 STATS: Final = ("min", "p10", "median", "p90", "max")
 """Columns of the spread, in order."""
-SIDES: Final = ("left", "middle", "right")
+SIDES: Final = ("left", "middle", "right", "tie")
 """Side labels, in order."""
 _PERCENTILES: Final = (0.0, 10.0, 50.0, 90.0, 100.0)
 
@@ -78,9 +87,8 @@ class EnsembleSummary:
                          for k in range(len(self.leg_labels))])
 
 
-def route_side(plan: Plan, k: int) -> str:
-    """Side of the course (:data:`SIDES`) that leg ``k`` of ``plan`` used."""
-    res = plan.legs[k].result
+def leg_side(res: LegResult) -> str:
+    """Side of the course (left, middle, right) that a routed leg used."""
     tr = res.track
     a, b = res.start_xy, res.end_xy
     off = lateral_offset(np.asarray(tr.x), np.asarray(tr.y), a, b)
@@ -88,8 +96,69 @@ def route_side(plan: Plan, k: int) -> str:
     return side_label(time_mean(np.asarray(tr.t), off), length)
 
 
-def summarize_ensemble(name: str, plans: Sequence[Plan]) -> EnsembleSummary:
-    """The :class:`EnsembleSummary` of an ensemble's member plans (same course)."""
+def honest_side(
+    res: LegResult, wind: WindField, boat: BoatModel, *, tack_penalty_s: float = 0.0,
+    gybe_penalty_s: float = 0.0, margin_s: float = 2.0, margin_pct: float = 0.5,
+) -> str:
+    """The side a routed leg used if it beat the other side by more than the margin, else "tie".
+
+    Parameters
+    ----------
+    res : LegResult
+        The routed leg.
+    wind : WindField
+        The wind it was routed in.
+    boat : BoatModel
+        The boat it was routed with.
+    tack_penalty_s, gybe_penalty_s : float
+        Manoeuvre penalties of the routing settings [s].
+    margin_s, margin_pct : float
+        Margin ``max(margin_s, margin_pct % of the leg time)``
+        (:func:`sailroute.routing.sides.side_verdict`).
+    """
+    t_left, t_right = layline_times(
+        res.start_xy, res.end_xy, res.t_start, wind, boat, tack_penalty_s=tack_penalty_s,
+        gybe_penalty_s=gybe_penalty_s, max_time_s=max(4.0 * res.time_s, 600.0))
+    return side_verdict(leg_side(res), res.time_s, t_left, t_right, margin_s=margin_s,
+                        margin_pct=margin_pct)
+
+
+def route_side(plan: Plan, k: int, wind: WindField | None = None,
+               boat: BoatModel | None = None) -> str:
+    """Side of the course (:data:`SIDES`) that leg ``k`` of ``plan`` used.
+
+    With the plan's ``wind`` and ``boat`` the side counts only when it beats the other
+    side (:func:`honest_side`; the margin of the course's ``uncertainty`` section, else
+    ``max(2 s, 0.5 %)``); without them it is the route's side as sailed.
+    """
+    res = plan.legs[k].result
+    if wind is None or boat is None:
+        return leg_side(res)
+    st, unc = plan.course.routing, plan.course.uncertainty
+    margins = {} if unc is None else {"margin_s": unc.side_margin_s,
+                                      "margin_pct": unc.side_margin_pct}
+    return honest_side(res, wind, boat, tack_penalty_s=st.tack_penalty_s,
+                       gybe_penalty_s=st.gybe_penalty_s, **margins)
+
+
+def summarize_ensemble(
+    name: str, plans: Sequence[Plan], winds: Mapping[str, WindField] | None = None,
+    boat: BoatModel | None = None,
+) -> EnsembleSummary:
+    """The :class:`EnsembleSummary` of an ensemble's member plans (same course).
+
+    Parameters
+    ----------
+    name : str
+        Ensemble name.
+    plans : sequence of Plan
+        The members' plans.
+    winds : mapping of str to WindField, optional
+        Member name -> its wind; default: built again from the course
+        (:func:`sailroute.course.specs.build_wind`).
+    boat : BoatModel, optional
+        The boat; default: built from the course.
+    """
     if len(plans) < 2:
         raise InputError(f"ensemble {name!r}: needs at least 2 routed members; got "
                          f"{len(plans)}")
@@ -101,8 +170,25 @@ def summarize_ensemble(name: str, plans: Sequence[Plan]) -> EnsembleSummary:
         members=tuple(p.scenario for p in plans),
         leg_labels=tuple(leg.spec.label for leg in plans[0].legs),
         times_s=np.array([[leg.time_s for leg in p.legs] for p in plans], dtype=float),
-        sides=tuple(tuple(route_side(p, k) for k in range(n)) for p in plans),
+        sides=tuple(tuple(route_side(p, k, _wind_of(p, winds), _boat_of(p, boat))
+                          for k in range(n)) for p in plans),
     )
+
+
+def _wind_of(plan: Plan, winds: Mapping[str, WindField] | None) -> WindField:
+    if winds is not None and plan.scenario in winds:
+        return winds[plan.scenario]
+    from sailroute.course.specs import build_wind
+
+    return build_wind(plan.course, plan.scenario)
+
+
+def _boat_of(plan: Plan, boat: BoatModel | None) -> BoatModel:
+    if boat is not None:
+        return boat
+    from sailroute.course.specs import build_boat
+
+    return build_boat(plan.course)
 
 
 def _mmss(seconds: float) -> str:
@@ -114,12 +200,13 @@ def ensemble_table(summary: EnsembleSummary) -> str:
     """Terminal table: per leg the spread of times and the side shares."""
     sp, sh = summary.spread(), summary.side_shares()
     head = (f"ensemble {summary.name}: {len(summary.members)} members; leg times over the "
-            "members (min / P10 / median / P90 / max) and the side of the course routes took")
-    rows: list[tuple[str, ...]] = [("leg", *STATS, "left", "middle", "right")]
+            "members (min / P10 / median / P90 / max) and the side of the course routes took "
+            "(tie: neither side beat the other by more than max(2 s, 0.5 %))")
+    rows: list[tuple[str, ...]] = [("leg", *STATS, *SIDES)]
     for k, label in enumerate(summary.leg_labels):
         rows.append((f"{k + 1} {label}", *(_mmss(v) for v in sp[k]),
                      *(f"{100 * v:.0f}%" for v in sh[k])))
-    rows.append(("total", *(_mmss(v) for v in sp[-1]), "", "", ""))
+    rows.append(("total", *(_mmss(v) for v in sp[-1]), *("" for _ in SIDES)))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines = [head]
     for j, r in enumerate(rows):
@@ -163,5 +250,5 @@ def write_ensemble(out_dir: Path, summary: EnsembleSummary) -> dict[str, Path]:
         for k, label in enumerate(summary.leg_labels):
             w.writerow([k + 1, label, *(f"{v:.3f}" for v in sp[k]),
                         *(f"{v:.4f}" for v in sh[k])])
-        w.writerow(["total", "", *(f"{v:.3f}" for v in sp[-1]), "", "", ""])
+        w.writerow(["total", "", *(f"{v:.3f}" for v in sp[-1]), *("" for _ in SIDES)])
     return {"ensemble_json": js, "ensemble_csv": cs}

@@ -1,0 +1,126 @@
+"""A wind field with its speed scaled and its direction turned: one member of a band.
+
+Leg-time bands (:mod:`sailroute.bands`) route a course in many versions of one
+scenario's wind: the speed a few per cent up or down, the direction a few degrees
+veered or backed, and a shift that changes in time (an oscillation, or a sample path
+of a fitted shift model).  :class:`PerturbedWind` is that version: it samples the base
+field and returns ``max(0, scale x TWS + add)`` from ``TWD + offset + shift(t)``.  Positive
+angles veer the wind (clockwise, the direction it comes from increases).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from sailroute.errors import InputError
+from sailroute.wind.base import Coverage, WindField
+from sailroute.wind.rotation import rotate_clockwise
+
+__all__ = ["PerturbedWind"]
+
+
+def _frozen(values: ArrayLike) -> NDArray[np.float64]:
+    out = np.array(values, dtype=float, copy=True).reshape(-1)
+    out.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class PerturbedWind:
+    """``base`` with its speed scaled and its direction turned, optionally in time.
+
+    Parameters
+    ----------
+    base : WindField
+        The scenario's wind.
+    speed_scale : float
+        Factor on the true wind speed (1: unchanged), ``>= 0``.
+    speed_add_ms : float
+        Added to the scaled speed [m s⁻¹] (0: unchanged); the result is held at
+        ``>= 0`` and a calm point stays calm.
+    direction_offset_deg : float
+        Constant turn of the direction [°], positive clockwise (a veer).
+    shift_times : array_like, optional
+        Epoch times [s] of a time-varying shift, strictly increasing; with
+        ``shift_deg``.  Empty: no time-varying shift.
+    shift_deg : array_like, optional
+        Shift [°] at ``shift_times`` (positive clockwise), interpolated linearly and
+        held constant before the first and after the last time.
+    name : str
+        Label for messages.
+    """
+
+    base: WindField
+    speed_scale: float = 1.0
+    speed_add_ms: float = 0.0
+    direction_offset_deg: float = 0.0
+    shift_times: ArrayLike = field(default_factory=lambda: _frozen([]))
+    shift_deg: ArrayLike = field(default_factory=lambda: _frozen([]))
+    name: str = "perturbed wind"
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.speed_scale) and self.speed_scale >= 0):
+            raise InputError(f"{self.name}: speed_scale must be finite and >= 0; got "
+                             f"{self.speed_scale}")
+        if not np.isfinite(self.speed_add_ms):
+            raise InputError(f"{self.name}: speed_add_ms must be finite; got {self.speed_add_ms}")
+        if not np.isfinite(self.direction_offset_deg):
+            raise InputError(f"{self.name}: direction_offset_deg must be finite; got "
+                             f"{self.direction_offset_deg}")
+        t, s = self._series
+        if t.shape != s.shape:
+            raise InputError(f"{self.name}: {t.size} shift times but {s.size} shifts; give one "
+                             "shift per time")
+        if t.size and (np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t))
+                       or not np.all(np.isfinite(s))):
+            raise InputError(f"{self.name}: shift times must be finite and increase strictly, "
+                             "shifts finite")
+
+    @cached_property
+    def _series(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Read-only copies of the shift times [epoch s] and shifts [°]."""
+        return _frozen(self.shift_times), _frozen(self.shift_deg)
+
+    @property
+    def coverage(self) -> Coverage:
+        """The base field's coverage."""
+        return self.base.coverage
+
+    @property
+    def clamp(self) -> bool:
+        """The base field's clamping."""
+        return bool(getattr(self.base, "clamp", False))
+
+    def turn_deg(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Total turn of the direction at epoch ``t`` [s]: offset plus shift [°]."""
+        tt = np.asarray(t, dtype=float)
+        times, shifts = self._series
+        if times.size == 0:
+            return np.full(tt.shape, float(self.direction_offset_deg))
+        return self.direction_offset_deg + np.interp(tt, times, shifts)
+
+    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s], local ``x, y`` [m] (broadcast).
+
+        Raises
+        ------
+        OutOfCoverageError
+            The base field does not cover a point (its own message).
+        """
+        u, v = self.base.sample(t, x, y)
+        if self.speed_add_ms == 0.0:
+            factor: NDArray[np.float64] | float = self.speed_scale
+        else:
+            speed = np.hypot(u, v)
+            new = np.maximum(self.speed_scale * speed + self.speed_add_ms, 0.0)
+            # a calm point stays calm: it has no direction to add the speed along
+            factor = np.divide(new, speed, out=np.zeros_like(speed), where=speed > 0)
+        if self._series[0].size or self.direction_offset_deg != 0.0:
+            turn = self.turn_deg(np.broadcast_to(np.asarray(t, dtype=float), np.shape(u)))
+            u, v = rotate_clockwise(u, v, turn)
+        return factor * u, factor * v
