@@ -3,6 +3,7 @@ instruments, and turn instrument logs into NMEA 0183 replay files."""
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable
 from pathlib import Path
 
@@ -135,10 +136,8 @@ def run_live_command(
             if engine.nmea is not None:
                 announce(f"NMEA 0183 out (RMB, APB, WPL, RTE): tcp://127.0.0.1:"
                          f"{engine.nmea.port}")
-        try:
+        with contextlib.suppress(KeyboardInterrupt):
             engine.wait(duration_s)
-        except KeyboardInterrupt:
-            pass
     finally:
         engine.close()
     files = {"log": Path(log)} if log is not None else {}

@@ -384,7 +384,8 @@ class SignalKDecoder:
                         v = float(wrap360(v))
                     elif name in _SIGNED:
                         v = float(wrap180(v))
-                    r, used = replace(r, **{name: v}), True
+                    fields: dict[str, Any] = {name: v}
+                    r, used = replace(r, **fields), True
             if used:
                 self.counts.by_kind["delta"] += 1
                 out.append(r)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import _thread
+import itertools
 import json
 import socket
 import threading
@@ -62,7 +63,7 @@ def test_tcp_feed_replans_page_and_nmea_out(tmp_path: Path) -> None:
     plans = _plans(log)
     assert len(plans) >= 3 and {p["leg"] for p in plans} == {2}
     to_mark = [p["time_to_mark_s"] for p in plans]
-    assert all(b < a for a, b in zip(to_mark, to_mark[1:], strict=False)), to_mark
+    assert all(b < a for a, b in itertools.pairwise(to_mark)), to_mark
     # the boat closes at 2.5 m/s: 20 s of data time later the mark is nearer by ~20 s or more
     assert to_mark[0] - to_mark[-1] > 0.5 * (plans[-1]["t"] - plans[0]["t"])
     # the page shows a logged re-plan (one more may have finished after the page was read)
@@ -128,8 +129,7 @@ def test_dropped_connection_reconnects_and_marks_stale(tmp_path: Path) -> None:
     assert [u for i, u in enumerate(ups) if i == 0 or u != ups[i - 1]] == [
         True, False, True, False]
     tries = [r["wall"] for r in links if not r["up"]][:-1]
-    assert len(tries) >= 2 and all(b - a >= 0.4 for a, b in zip(tries, tries[1:],
-                                                                strict=False))
+    assert len(tries) >= 2 and all(b - a >= 0.4 for a, b in itertools.pairwise(tries))
     inputs = [r for r in _records(log) if r["kind"] == "input" and "lat" in r]
     assert len(inputs) == 60  # every fix arrived, none twice
     assert inputs[-1]["t"] == pytest.approx(rows[-1].t)

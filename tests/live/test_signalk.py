@@ -9,6 +9,7 @@ another ``signalk-server`` executable).
 
 from __future__ import annotations
 
+import itertools
 import json
 import os
 import shutil
@@ -124,4 +125,4 @@ def test_live_from_a_real_signalk_server(signalk: tuple[int, list], tmp_path: Pa
     plans = [r for r in records if r["kind"] == "plan"]
     assert len(plans) >= 3
     to_mark = [p["time_to_mark_s"] for p in plans]
-    assert all(b < a for a, b in zip(to_mark, to_mark[1:], strict=False)), to_mark
+    assert all(b < a for a, b in itertools.pairwise(to_mark)), to_mark
