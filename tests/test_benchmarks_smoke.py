@@ -39,6 +39,8 @@ CASES = [
     pytest.param("bench_strategy.py", r"^SDP 101 x 40 rows x 2 tacks x 19 shifts, .*"
                  r"E\[T\] = \d+\.\d s$", marks=SLOW),
     pytest.param("bench_deadline.py", r"^  Monte Carlo 200 runs/policy ", marks=SLOW),
+    pytest.param("bench_live.py", r"^wind change -> route, 3-leg remainder, 2 shifts of 15°",
+                 marks=SLOW),
     pytest.param("bench_peers.py", r"^- expansion and arrival test \(`_expand`\): [\d.]+ %$",
                  marks=SLOW),
 ]
