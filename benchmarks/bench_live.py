@@ -25,6 +25,7 @@ comparable at similar load).  ``--smoke``: 2 shifts and a 10-minute replay (CI).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -39,8 +40,6 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-
-import contextlib
 
 from sailroute.commands.live import start_live  # noqa: E402
 from sailroute.course.load import load_course  # noqa: E402

@@ -13,6 +13,7 @@ from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.live.convert import convert_log
 from sailroute.live.engine import LiveEngine, LiveSettings
+from sailroute.live.planner import ProcessPlanner
 from sailroute.live.sources import parse_source
 from sailroute.plan import default_scenario, settings_for
 from sailroute.timeutil import iso, parse_time, to_epoch
@@ -24,7 +25,7 @@ def start_live(
     course: Course | str | Path, *, source: str, scenario: str | None = None,
     every_s: float = 10.0, speed: float = 1.0, port: int | None = 8080,
     nmea_port: int | None = 10110, log: str | Path | None = None, router: str | None = None,
-    leg: int = 1, settings: LiveSettings | None = None,
+    leg: int = 1, settings: LiveSettings | None = None, worker: bool = True,
 ) -> LiveEngine:
     """Load the course and its forecast, open the ports and start the live threads.
 
@@ -51,9 +52,10 @@ def start_live(
     base = settings or LiveSettings()
     live = LiveSettings(every_s, base.shift_deg, base.change_ms, base.fade_s, base.window_s,
                         base.stale_s, base.reach_m, base.side)
+    planner = ProcessPlanner(loaded, name, router) if worker else None
     return LiveEngine(loaded, winds[name], boat, routing, src, live, port=port,
                       nmea_port=nmea_port, log=None if log is None else Path(log),
-                      leg=leg - 1).start()
+                      leg=leg - 1, planner=planner).start()
 
 
 def live_report(engine: LiveEngine) -> str:
@@ -84,6 +86,7 @@ def run_live_command(
     nmea_port: int | None = 10110, log: str | Path | None = None,
     duration_s: float | None = None, router: str | None = None, leg: int = 1,
     announce: Callable[[str], None] | None = None, settings: LiveSettings | None = None,
+    worker: bool = True,
 ) -> CommandResult:
     """Everything ``sailroute live`` does, minus printing.
 
@@ -119,6 +122,10 @@ def run_live_command(
         Receives the page URL and the NMEA port once they are open.
     settings : LiveSettings, optional
         Re-plan rules (wind thresholds, fade time); ``every_s`` replaces its interval.
+    worker : bool
+        Compute the re-plans in a worker process (default), so that routing never slows
+        the input reader (:mod:`sailroute.live.planner`); False: in a thread of this
+        process (no start-up time, for tests and short runs).
 
     Returns
     -------
@@ -128,7 +135,7 @@ def run_live_command(
     """
     engine = start_live(course, source=source, scenario=scenario, every_s=every_s,
                         speed=speed, port=port, nmea_port=nmea_port, log=log, router=router,
-                        leg=leg, settings=settings)
+                        leg=leg, settings=settings, worker=worker)
     try:
         if announce is not None:
             if engine.page is not None:

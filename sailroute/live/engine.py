@@ -30,6 +30,7 @@ import math
 import threading
 import time
 from collections.abc import Mapping
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import IO, Any
@@ -39,23 +40,10 @@ from sailroute.course.geometry import feature_centre
 from sailroute.course.model import Course
 from sailroute.errors import InputError, SailrouteError
 from sailroute.live.decode import NmeaDecoder, Reading, SignalKDecoder
-from sailroute.live.livewind import (
-    DEFAULT_FADE_S,
-    LiveWind,
-    RollingWind,
-    apparent_to_true,
-    wind_changed,
-)
+from sailroute.live.livewind import DEFAULT_FADE_S, RollingWind, apparent_to_true, wind_changed
 from sailroute.live.nmeaout import NmeaServer, route_sentences, steer_sentences
-from sailroute.live.replan import (
-    DEFAULT_REACH_M,
-    LivePlan,
-    current_leg,
-    leg_target,
-    route_remaining,
-    side_that_pays,
-    summarise,
-)
+from sailroute.live.planner import PlanCore, Planner, PlanRequest, ThreadPlanner
+from sailroute.live.replan import DEFAULT_REACH_M, LivePlan, current_leg
 from sailroute.live.sources import Source
 from sailroute.live.web import PageServer
 from sailroute.routing.types import RoutingSettings
@@ -160,14 +148,20 @@ class LiveEngine:
         JSON-lines log.
     leg : int
         The leg being sailed at the start (0-based).
+    planner : Planner, optional
+        Where re-plans are computed; default: in the planner thread
+        (:class:`~sailroute.live.planner.ThreadPlanner`).  The engine closes it.
     """
 
     def __init__(
         self, course: Course, forecast: WindField, boat: BoatModel, routing: RoutingSettings,
         source: Source, settings: LiveSettings = LiveSettings(), *, port: int | None = 0,
         nmea_port: int | None = 0, log: Path | None = None, leg: int = 0,
+        planner: Planner | None = None,
     ) -> None:
         self.course, self.forecast, self.boat, self.routing = course, forecast, boat, routing
+        self.planner: Planner = planner or ThreadPlanner(PlanCore(course, forecast, boat,
+                                                                   routing))
         self.source, self.settings = source, settings
         self._lock = threading.Lock()
         self._planning = threading.Lock()  # one re-plan at a time
@@ -197,11 +191,17 @@ class LiveEngine:
         self.n_drops = 0
         self.plan_wall: list[float] = []  # wall time each plan was published (benchmark)
         self.log = JsonLog(log)
-        self.page = PageServer(self.state, port) if port is not None else None
+        try:
+            self.page = PageServer(self.state, port) if port is not None else None
+        except OSError as exc:
+            self.planner.close()
+            raise InputError(f"--port {port}: cannot serve the page ({exc.strerror}); pick "
+                             "a free port") from None
         try:
             self.nmea = NmeaServer(nmea_port) if nmea_port is not None else None
         except OSError as exc:
             self._close_servers()
+            self.planner.close()
             raise InputError(f"--nmea-port {nmea_port}: cannot listen ({exc.strerror}); "
                              "pick a free port") from None
         self._threads: list[threading.Thread] = []
@@ -352,14 +352,12 @@ class LiveEngine:
             self._plan_wind, self._plan_t = (tws, twd), t
         if leg >= self.course.n_legs:
             return None
-        wind = LiveWind(self.forecast, t, x, y, tws, twd, frame, self.settings.fade_s)
+        req = PlanRequest(self.n_plans + 1, reason, t, x, y, leg, tws, twd,
+                          self.settings.fade_s)
         w0 = time.perf_counter()
         try:
-            results = route_remaining(self.course, wind, self.boat, self.routing, leg, (x, y), t)
-            plan = summarise(self.course, results, number=self.n_plans + 1, t=t, leg=leg,
-                             wind=wind, boat=self.boat, measured=(tws, twd), reason=reason,
-                             compute_s=time.perf_counter() - w0)
-        except SailrouteError as exc:
+            plan = self.planner.route(req)
+        except (SailrouteError, BrokenProcessPool) as exc:
             with self._lock:
                 self.error = str(exc)
             self.log.write({"kind": "error", "t": t, "message": str(exc)})
@@ -367,9 +365,8 @@ class LiveEngine:
         self._publish(plan)
         if self.settings.side:
             try:
-                side = side_that_pays(results[0], leg_target(self.course, leg), wind,
-                                      self.boat, self.routing)
-            except SailrouteError as exc:
+                side = self.planner.side(plan.number)
+            except (SailrouteError, BrokenProcessPool) as exc:
                 self.log.write({"kind": "error", "t": t, "message": f"side: {exc}"})
             else:
                 plan = replace(plan, side=side, compute_s=time.perf_counter() - w0)
@@ -439,6 +436,7 @@ class LiveEngine:
         for th in self._threads:
             th.join(timeout=30.0)
         self._close_servers()
+        self.planner.close()
         if getattr(self, "nmea", None) is not None:
             assert self.nmea is not None
             self.nmea.close()

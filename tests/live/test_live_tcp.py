@@ -36,7 +36,7 @@ def test_tcp_feed_replans_page_and_nmea_out(tmp_path: Path) -> None:
     log = tmp_path / "live.jsonl"
     engine = start_live(course, source=f"nmea+tcp://127.0.0.1:{feed.port}", scenario="mean",
                         every_s=20, port=0, nmea_port=0, log=log, leg=3,
-                        settings=LiveSettings(side=False))
+                        worker=False, settings=LiveSettings(side=False))
     assert engine.nmea is not None and engine.page is not None
     plotter = socket.create_connection(("127.0.0.1", engine.nmea.port), timeout=5)
     try:
@@ -91,7 +91,7 @@ def test_wind_shift_changes_the_side_that_pays(tmp_path: Path) -> None:
     res = run_live_command(course, source=str(write_feed(tmp_path / "f.nmea", rows)),
                            scenario="mean", every_s=1000, speed=15, port=None,
                            nmea_port=None, log=log, duration_s=30, leg=3,
-                           settings=LiveSettings(fade_s=300, window_s=10))
+                           worker=False, settings=LiveSettings(fade_s=300, window_s=10))
     plans = _plans(log)
     assert [p["reason"] for p in plans][:1] == ["first"]
     assert any(p["reason"] == "wind" for p in plans[1:])
@@ -110,7 +110,7 @@ def test_dropped_connection_reconnects_and_marks_stale(tmp_path: Path) -> None:
     log = tmp_path / "live.jsonl"
     engine = start_live(course, source=f"nmea+tcp://127.0.0.1:{feed.port}", scenario="mean",
                         port=None, nmea_port=None, log=log, leg=4, every_s=1000,
-                        settings=LiveSettings(side=False, stale_s=0.5))
+                        worker=False, settings=LiveSettings(side=False, stale_s=0.5))
     stale_seen = False
     try:
         end = time.monotonic() + 20
@@ -151,7 +151,7 @@ def test_bad_sentences_are_counted_and_skipped(tmp_path: Path) -> None:
     log = tmp_path / "live.jsonl"
     run_live_command(course, source=str(path), scenario="mean", speed=100, port=None,
                      nmea_port=None, log=log, duration_s=10, leg=4, every_s=1000,
-                     settings=LiveSettings(side=False))
+                     worker=False, settings=LiveSettings(side=False))
     end = _records(log)[-1]
     n = len(lines)
     assert end["counts"]["bad_checksum"] == len(range(3, n, 10))
@@ -167,7 +167,7 @@ def test_udp_source(tmp_path: Path) -> None:
     log = tmp_path / "live.jsonl"
     engine = start_live(course, source=f"nmea+udp://127.0.0.1:{port}", scenario="mean",
                         port=None, nmea_port=None, log=log, leg=4, every_s=1000,
-                        settings=LiveSettings(side=False))
+                        worker=False, settings=LiveSettings(side=False))
     try:
         time.sleep(0.3)
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx:
@@ -190,7 +190,8 @@ def test_ctrl_c_ends_cleanly_with_the_log_flushed(tmp_path: Path) -> None:
     timer = threading.Timer(1.5, _thread.interrupt_main)
     timer.start()
     res = run_live_command(course, source=str(feed), scenario="mean", speed=20, port=0,
-                           nmea_port=0, log=log, leg=4, settings=LiveSettings(side=False))
+                           nmea_port=0, log=log, leg=4, worker=False,
+                           settings=LiveSettings(side=False))
     timer.join()
     records = _records(log)
     assert records[-1]["kind"] == "end"

@@ -93,14 +93,15 @@ def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
 @pytest.mark.slow
 def test_live_from_a_real_signalk_server(signalk: tuple[int, list], tmp_path: Path) -> None:
     """Positions, SOG and the true wind of the recorded file arrive through Signal K (SI
-    units, radians converted), and the re-plans close on mark 1."""
+    units, radians converted), and the re-plans (in a worker process, as the command
+    line computes them) close on mark 1."""
     from sailroute.commands.live import start_live
 
     port, rows = signalk
     log = tmp_path / "live.jsonl"
     engine = start_live(trieste(), source=f"signalk://127.0.0.1:{port}", scenario="mean",
                         every_s=15, port=None, nmea_port=None, log=log, leg=3,
-                        settings=LiveSettings(side=False))
+                        settings=LiveSettings(side=False))  # re-plans in a worker process
     try:
         end = time.monotonic() + 40
         while time.monotonic() < end and (engine.n_plans < 3 or engine.stale()):
