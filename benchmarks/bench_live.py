@@ -1,7 +1,7 @@
 """Benchmark: ``sailroute live`` latency from a wind change to the new route, and memory
 over a one-hour replay.
 
-    python benchmarks/bench_live.py [--shifts 5] [--hour-speed 60] [--smoke]
+    python benchmarks/bench_live.py [--shifts 5] [--hour-speed 60] [--tracemalloc] [--smoke]
 
 1. Latency.  A TCP feed sends one second of instrument sentences (RMC, HDT, VHW, MWD)
    every wall second, as a 1 Hz instrument network does, for a boat on leg 2 of the
@@ -15,8 +15,9 @@ over a one-hour replay.
    step crosses the 5° threshold after 20 s of data, on top of it.
 2. Memory.  A one-hour feed (the boat circling the course, the wind oscillating ±10°) is
    replayed from a file at ``--hour-speed`` times real time with a re-plan every 60 s of
-   data; the process's resident memory is sampled every 0.5 s and Python's allocations
-   (tracemalloc) at each quarter: growth between the first quarter and the end is printed.
+   data; the process's resident memory is sampled every 0.5 s (with ``--tracemalloc`` also
+   Python's heap, which slows the replay) and its growth between the end of the first
+   quarter and the end is printed, with the replay's wall time against the feed's.
 
 Prints the load average before and after (the machine is shared: the numbers are only
 comparable at similar load).  ``--smoke``: 2 shifts and a 10-minute replay (CI).
@@ -121,7 +122,7 @@ def latency(course: Course, shifts: int) -> None:
     try:
         while not (s := state())["plan"]:
             time.sleep(0.05)
-        page_ms, nmea_ms, route_ms = [], [], []
+        page_ms, nmea_ms, route_ms, cpu_ms = [], [], [], []
         for k in range(shifts):
             time.sleep(1.5)
             before = s["plan"]["number"]
@@ -137,6 +138,7 @@ def latency(course: Course, shifts: int) -> None:
                     if p["number"] > before and abs(p["wind_twd_deg"] - new) < 1.0:
                         got_page = time.monotonic()
                         route_ms.append(1000 * p["compute_s"])
+                        cpu_ms.append(1000 * p["compute_cpu_s"])
                 with contextlib.suppress(TimeoutError):
                     buf += plotter.recv(65536)
                 if got_nmea is None and f",live{before + 1},".encode() in buf:
@@ -156,10 +158,11 @@ def latency(course: Course, shifts: int) -> None:
           f"max {max(page_ms):.0f} ms")
     print(f"  NMEA port (RTE)    median {sorted(nmea_ms)[len(nmea_ms) // 2]:.0f} ms, "
           f"max {max(nmea_ms):.0f} ms")
-    print(f"  of which routing   median {sorted(route_ms)[len(route_ms) // 2]:.0f} ms")
+    print(f"  of which routing   median {sorted(route_ms)[len(route_ms) // 2]:.0f} ms wall, "
+          f"{sorted(cpu_ms)[len(cpu_ms) // 2]:.0f} ms CPU (the rest: waiting for a core)")
 
 
-def memory(course: Course, seconds: int, speed: float) -> None:
+def memory(course: Course, seconds: int, speed: float, trace: bool) -> None:
     frame = course.frame
     cx, cy = course.marks["1"].xy
     rows = []
@@ -173,7 +176,8 @@ def memory(course: Course, seconds: int, speed: float) -> None:
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "hour.nmea"
         path.write_text("".join(line + "\r\n" for r in rows for line in nmea_lines(r)))
-        tracemalloc.start()
+        if trace:
+            tracemalloc.start()
         engine = start_live(course, source=str(path), scenario="mean", every_s=60.0,
                             speed=speed, port=0, nmea_port=0, log=Path(d) / "live.jsonl",
                             leg=1, settings=LiveSettings(side=False))
@@ -182,24 +186,27 @@ def memory(course: Course, seconds: int, speed: float) -> None:
         try:
             while not engine.source_ended.is_set():
                 rss.append(_rss_mb())
-                traced.append(tracemalloc.get_traced_memory()[0] / 2**20)
+                traced.append(tracemalloc.get_traced_memory()[0] / 2**20 if trace else 0.0)
                 time.sleep(0.5)
+            replay = time.monotonic() - w0
             engine.wait(60)
         finally:
             engine.close()
         wall = time.monotonic() - w0
-        tracemalloc.stop()
     q = max(len(rss) // 4, 1)
-    print(f"{seconds / 60:.0f}-min replay at {speed:g}x: {wall:.1f} s wall, "
+    print(f"{seconds / 60:.0f}-min replay at {speed:g}x: read in {replay:.1f} s "
+          f"(the feed's pace: {seconds / speed:.1f} s), {wall:.1f} s with the last re-plan; "
           f"{engine.n_readings} readings, {engine.n_plans} re-plans")
+    heap = f"; Python heap {traced[q - 1]:.1f} -> {traced[-1]:.1f} MiB" if trace else ""
     print(f"  RSS after the first quarter {rss[q - 1]:.1f} MiB, at the end {rss[-1]:.1f} MiB "
-          f"(max {max(rss):.1f}); Python heap {traced[q - 1]:.1f} -> {traced[-1]:.1f} MiB")
+          f"(max {max(rss):.1f}){heap}")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--shifts", type=int, default=5)
     ap.add_argument("--hour-speed", type=float, default=60.0)
+    ap.add_argument("--tracemalloc", action="store_true", help="also trace Python's heap")
     ap.add_argument("--smoke", action="store_true", help="2 shifts, a 10-min replay (CI)")
     args = ap.parse_args()
     course = load_course(COURSE)
@@ -208,7 +215,7 @@ def main() -> None:
         args.shifts, seconds, args.hour_speed = 2, 600, 120.0
     print(f"load average before: {_load()} ({os.cpu_count()} CPUs)")
     latency(course, args.shifts)
-    memory(course, seconds, args.hour_speed)
+    memory(course, seconds, args.hour_speed, args.tracemalloc)
     print(f"load average after: {_load()}")
 
 

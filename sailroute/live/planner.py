@@ -77,7 +77,7 @@ class PlanCore:
 
     def route(self, req: PlanRequest) -> LivePlan:
         """The remaining course for ``req`` (raises the routers' errors)."""
-        w0 = time.perf_counter()
+        w0, c0 = time.perf_counter(), time.thread_time()
         wind = LiveWind(self.forecast, req.t, req.x, req.y, req.tws_ms, req.twd_deg,
                         self.course.frame, req.fade_s)
         results = route_remaining(self.course, wind, self.boat, self.routing, req.leg,
@@ -85,7 +85,8 @@ class PlanCore:
         self._last = (req, wind, results[0])
         return summarise(self.course, results, number=req.number, t=req.t, leg=req.leg,
                          wind=wind, boat=self.boat, measured=(req.tws_ms, req.twd_deg),
-                         reason=req.reason, compute_s=time.perf_counter() - w0)
+                         reason=req.reason, compute_s=time.perf_counter() - w0,
+                         compute_cpu_s=time.thread_time() - c0)
 
     def side(self, number: int) -> SidePays | None:
         """The side that pays on the first leg of re-plan ``number`` (None if not the last)."""

@@ -264,6 +264,9 @@ class LivePlan:
         What triggered it (``"interval"``, ``"wind"``, ``"first"``).
     compute_s : float
         Wall time the routing took [s].
+    compute_cpu_s : float
+        CPU time of the thread that routed [s] (wall minus CPU: time spent waiting for
+        a core).
     """
 
     number: int
@@ -283,6 +286,7 @@ class LivePlan:
     laylines: tuple[Layline, ...]
     reason: str
     compute_s: float
+    compute_cpu_s: float = 0.0
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready form (for the page, the log)."""
@@ -304,13 +308,14 @@ class LivePlan:
             "laylines": [{"tack": ll.tack, "bearing_deg": round(ll.bearing_deg, 1)}
                          for ll in self.laylines],
             "reason": self.reason, "compute_s": round(self.compute_s, 3),
+            "compute_cpu_s": round(self.compute_cpu_s, 3),
         }
 
 
 def summarise(
     course: Course, results: Sequence[LegResult], *, number: int, t: float, leg: int,
     wind: WindField, boat: BoatModel, measured: tuple[float, float], reason: str,
-    compute_s: float, side: SidePays | None = None,
+    compute_s: float, side: SidePays | None = None, compute_cpu_s: float = 0.0,
 ) -> LivePlan:
     """Assemble the :class:`LivePlan` of routed remaining legs ``results`` (from ``leg``)."""
     frame = course.frame
@@ -344,4 +349,5 @@ def summarise(
         time_to_mark_s=etas[0] - t, time_to_finish_s=etas[-1] - t,
         route_lat=tuple(map(float, lat)), route_lon=tuple(map(float, lon)),
         waypoints=tuple(points), wind_tws_ms=measured[0], wind_twd_deg=measured[1],
-        side=side, laylines=lls, reason=reason, compute_s=compute_s)
+        side=side, laylines=lls, reason=reason, compute_s=compute_s,
+        compute_cpu_s=compute_cpu_s)

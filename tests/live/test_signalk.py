@@ -68,7 +68,7 @@ def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
     with open(tmp_path / "server.log", "w") as out:
         proc = subprocess.Popen([str(exe), "-c", str(conf), "-s", "settings.json"], env=env,
                                 cwd=conf, stdout=out, stderr=subprocess.STDOUT,
-                                start_new_session=True)
+                                process_group=0)
     try:
         end = time.monotonic() + 60
         while True:
