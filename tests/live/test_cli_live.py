@@ -66,3 +66,14 @@ def test_live_convert(tmp_path: Path) -> None:
     res = CliRunner().invoke(app, ["live-convert", str(csv), "--format", "tallinn",
                                    "-o", str(out)])
     assert res.exit_code == 2 and f"{csv}:2: not a row of the Tallinn race log" in res.output
+
+
+def test_help_lists_the_options() -> None:
+    res = CliRunner().invoke(app, ["live", "--help"])
+    assert res.exit_code == 0
+    for text in ("--source SOURCE", "--every S", "--speed X", "--nmea-port", "--log FILE",
+                 "--duration S", "--router [isochrone|griddp|spline]", "-h, --help"):
+        assert text in res.output, text
+    assert "<float>" not in res.output and "<int>" not in res.output
+    conv = CliRunner().invoke(app, ["live-convert", "-h"])
+    assert conv.exit_code == 0 and "--format [trieste|tallinn]" in conv.output
