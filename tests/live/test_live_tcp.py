@@ -188,9 +188,13 @@ def test_ctrl_c_ends_cleanly_with_the_log_flushed(tmp_path: Path) -> None:
     feed = write_feed(tmp_path / "f.nmea", approach(course, 600))
     log = tmp_path / "live.jsonl"
     timer = threading.Timer(1.5, _thread.interrupt_main)
-    timer.start()
+
+    def announce(line: str) -> None:  # the run is under way: Ctrl-C in 1.5 s
+        if line.startswith("page:"):
+            timer.start()
+
     res = run_live_command(course, source=str(feed), scenario="mean", speed=20, port=0,
-                           nmea_port=0, log=log, leg=4, worker=False,
+                           nmea_port=0, log=log, leg=4, worker=False, announce=announce,
                            settings=LiveSettings(side=False))
     timer.join()
     records = _records(log)
