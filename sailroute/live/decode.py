@@ -17,8 +17,11 @@ time of the last ``RMC``/``GGA``/``GLL``/``ZDA`` (instruments send them every se
 Signal K paths read: ``navigation.position``, ``navigation.courseOverGroundTrue``,
 ``navigation.speedOverGround``, ``navigation.headingTrue``,
 ``navigation.speedThroughWater``, ``environment.wind.directionTrue``,
-``environment.wind.speedTrue`` (or ``speedOverGround``), ``environment.wind.angleApparent``,
-``environment.wind.speedApparent`` (Signal K is in SI units and radians already).
+``environment.wind.speedTrue`` (or ``speedOverGround``), ``angleTrueWater`` or
+``angleTrueGround`` (with the heading), ``environment.wind.angleApparent``,
+``environment.wind.speedApparent`` (Signal K is in SI units and radians already).  An
+angle and its speed are used together when they come in one update (as a server that
+reads NMEA 0183 sends them).
 """
 
 from __future__ import annotations
@@ -289,6 +292,7 @@ _SK_PATHS: dict[str, tuple[str, float]] = {
     "environment.wind.speedTrue": ("tws_ms", 1.0),
     "environment.wind.speedOverGround": ("tws_ms", 1.0),
     "environment.wind.angleTrueGround": ("twa_deg", math.degrees(1.0)),
+    "environment.wind.angleTrueWater": ("twa_deg", math.degrees(1.0)),
     "environment.wind.angleApparent": ("awa_deg", math.degrees(1.0)),
     "environment.wind.speedApparent": ("aws_ms", 1.0),
 }
