@@ -855,6 +855,75 @@ def course_import_command(
     _finish(run_guarded(run, debug=_debug(ctx)), False)
 
 
+# --- live (re-plan from the instruments) ----------------------------------------------
+@app.command("live", cls=_Command,
+             short_help="Re-plan the rest of a race from a boat's instruments, live.")
+def live_command(
+    ctx: typer.Context,
+    course: CourseArg,
+    source: Annotated[
+        str, typer.Option("--source", metavar="SOURCE",
+                          help="signalk://HOST:PORT, nmea+tcp://HOST:PORT, nmea+udp://:PORT "
+                               "or a recorded .nmea file.")],
+    scenario: Annotated[
+        str | None, typer.Option("--scenario", "-s", metavar="NAME",
+                                 help="Forecast scenario (default: the first in the file).")
+    ] = None,
+    every: Annotated[float, typer.Option("--every", metavar="S",
+                                         help="Re-plan at least every S seconds.")] = 10.0,
+    speed: Annotated[float, typer.Option("--speed", metavar="X",
+                                         help="Replay speed of a recorded file.")] = 1.0,
+    port: Annotated[int, typer.Option("--port", help="Port of the page on 127.0.0.1.")] = 8080,
+    nmea_port: Annotated[int, typer.Option(
+        "--nmea-port", help="TCP port of the NMEA 0183 output on 127.0.0.1.")] = 10110,
+    log: Annotated[str | None, typer.Option("--log", metavar="FILE",
+                                            help="JSON-lines log of inputs and re-plans.")
+                   ] = None,
+    duration: Annotated[float | None, typer.Option(
+        "--duration", metavar="S", help="Run S seconds (default: until Ctrl-C or the end "
+                                        "of a recorded file).")] = None,
+    leg: Annotated[int, typer.Option("--leg", help="Leg being sailed now (1-based).")] = 1,
+    router: RouterOpt = None,
+) -> None:
+    """Re-plan the rest of the course from live instruments; page, NMEA out and a log."""
+    from sailroute.commands.live import run_live_command
+
+    def run() -> Any:
+        return run_live_command(course, source=source, scenario=scenario, every_s=every,
+                                speed=speed, port=port, nmea_port=nmea_port, log=log,
+                                duration_s=duration, router=router, leg=leg,
+                                announce=typer.echo)
+
+    _finish(run_guarded(run, debug=_debug(ctx)), False)
+
+
+@app.command("live-convert", cls=_Command,
+             short_help="Turn an instrument log into an NMEA 0183 replay file.")
+def live_convert_command(
+    ctx: typer.Context,
+    log: Annotated[str, typer.Argument(help="The instrument log (CSV).", metavar="LOG")],
+    fmt: Annotated[Literal["trieste", "tallinn"], typer.Option(
+        "--format", case_sensitive=False, help="Log format (docs/live.md).")],
+    out: Annotated[str, typer.Option("--out", "-o", metavar="FILE",
+                                     help="The .nmea file to write.")],
+    utc_offset: Annotated[str, typer.Option(
+        "--utc-offset", metavar="+HH:MM", help="The logger clock's UTC offset (trieste).")
+    ] = "+01:00",
+    start: Annotated[str | None, typer.Option("--from", metavar="TIME",
+                                              help="First time kept (ISO 8601).")] = None,
+    end: Annotated[str | None, typer.Option("--to", metavar="TIME",
+                                            help="Last time kept (ISO 8601).")] = None,
+) -> None:
+    """Convert an instrument log (Trieste coach boat, Tallinn race) to NMEA 0183."""
+    from sailroute.commands.live import run_live_convert_command
+
+    def run() -> Any:
+        return run_live_convert_command(log, fmt=fmt, out=out, utc_offset=utc_offset,
+                                        start=start, end=end)
+
+    _finish(run_guarded(run, debug=_debug(ctx)), False)
+
+
 def main() -> None:
     """Run the command line (the console script's :func:`sailroute.__main__.main` imports
     this module inside its own Ctrl-C guard)."""

@@ -43,6 +43,8 @@ CASES = [
     pytest.param("bench_deadline.py", r"^  Monte Carlo 200 runs/policy ", marks=SLOW),
     pytest.param("bands_calibration.py", r"^\| Snipe Valencia P01 \| TWS 1\.0 kn, TWD 10° \| "
                  r"6 legs \(boat 1, boat 2\) \| \d/6 = \d+ % \| \d+ s \(", marks=SLOW),
+    pytest.param("bench_live.py", r"^wind change -> route, 3-leg remainder, 2 shifts of 15°",
+                 marks=SLOW),
     pytest.param("bench_peers.py", r"^- expansion and arrival test \(`_expand`\): [\d.]+ %$",
                  marks=SLOW),
 ]

@@ -2,9 +2,9 @@
 
 The layers, low to high (``docs/design.md``): the base modules (units, errors, geometry
 helpers, parsing helpers, progress), then ``track``, ``wind``, ``boat``, ``routing``,
-``course``, ``planning``, ``analysis``, ``strategy``, ``bands``, ``report``, ``commands``
-and, on top, the API facade, the CLI and the package namespace.  A module may import its own
-package and any lower layer, lazily (inside a function) or for typing alike.
+``course``, ``planning``, ``analysis``, ``strategy``, ``bands``, ``live``, ``report``,
+``commands`` and, on top, the API facade, the CLI and the package namespace.  A module may
+import its own package and any lower layer, lazily (inside a function) or for typing alike.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ BASE = ("units", "errors", "geo", "timeutil", "textin", "yamlfile", "numerics", 
         "checks", "parallel", "outdir", "progress", "tabular")
 LAYERS: tuple[tuple[str, ...], ...] = (
     BASE, ("track",), ("wind",), ("boat",), ("routing",), ("course",), ("planning",),
-    ("analysis",), ("strategy",), ("bands",), ("report",), ("commands",),
+    ("analysis",), ("strategy",), ("bands",), ("live",), ("report",), ("commands",),
     ("api", "cli", "__main__", "__init__"),
 )
 RANK = {name: k for k, names in enumerate(LAYERS) for name in names}

@@ -1,0 +1,396 @@
+"""Instrument readings from NMEA 0183 sentences and Signal K deltas.
+
+Both decoders turn their input into :class:`Reading` objects: one per sentence or
+Signal K value, with the data time and only the quantities that input carries, in SI
+units (m s⁻¹, degrees true).  Bad input never raises: a sentence with a wrong
+checksum, a malformed sentence and a delta that is not JSON are counted in
+:class:`Counts` and skipped, so that one noisy instrument does not take the feed
+down.
+
+NMEA 0183 sentences read (with pynmea2): ``RMC`` (time, date, position, SOG, COG),
+``GGA``/``GLL`` (position), ``VTG`` (COG, SOG), ``HDT``/``HDG`` (heading, true;
+``HDG`` with its variation), ``VHW`` (heading and speed through the water), ``MWV``
+(wind angle and speed; ``R``: apparent, ``T``: true, both from the bow), ``MWD``
+(true wind direction and speed).  A sentence without a time of its own takes the
+time of the last ``RMC``/``GGA``/``GLL``/``ZDA`` (instruments send them every second).
+
+Signal K paths read: ``navigation.position``, ``navigation.courseOverGroundTrue``,
+``navigation.speedOverGround``, ``navigation.headingTrue``,
+``navigation.speedThroughWater``, ``environment.wind.directionTrue``,
+``environment.wind.speedTrue`` (or ``speedOverGround``), ``angleTrueWater`` or
+``angleTrueGround`` (with the heading), ``environment.wind.angleApparent``,
+``environment.wind.speedApparent`` (Signal K is in SI units and radians already).  An
+angle and its speed are used together when they come in one update (as a server that
+reads NMEA 0183 sends them).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import Counter
+from dataclasses import dataclass, field, replace
+from datetime import UTC, date, datetime, time
+from typing import Any
+
+import pynmea2
+
+from sailroute.units import wrap180, wrap360
+
+KN: float = 1852.0 / 3600.0
+"""One knot [m s⁻¹]."""
+
+
+@dataclass(frozen=True)
+class Reading:
+    """What one sentence or delta value says; None where it says nothing.
+
+    Attributes
+    ----------
+    t : float
+        Data time [epoch s] (the instruments' GPS clock).
+    lat, lon : float or None
+        Position [°].
+    sog_ms, cog_deg : float or None
+        Speed [m s⁻¹] and course [° true] over the ground.
+    hdg_deg : float or None
+        Heading [° true].
+    stw_ms : float or None
+        Speed through the water [m s⁻¹].
+    tws_ms, twd_deg : float or None
+        True wind speed [m s⁻¹] and the direction it comes from [° true].
+    twa_deg : float or None
+        True wind angle from the bow [°, + starboard] (``MWV`` reference ``T``).
+    aws_ms, awa_deg : float or None
+        Apparent wind speed [m s⁻¹] and angle from the bow [°, + starboard].
+    timed : bool
+        The input carried its own time (``RMC``, ``GGA``, a Signal K timestamp).
+    """
+
+    t: float
+    lat: float | None = None
+    lon: float | None = None
+    sog_ms: float | None = None
+    cog_deg: float | None = None
+    hdg_deg: float | None = None
+    stw_ms: float | None = None
+    tws_ms: float | None = None
+    twd_deg: float | None = None
+    twa_deg: float | None = None
+    aws_ms: float | None = None
+    awa_deg: float | None = None
+    timed: bool = False
+
+    def as_dict(self) -> dict[str, float]:
+        """The quantities given (for the JSON-lines log), rounded to what they resolve."""
+        out: dict[str, float] = {"t": round(self.t, 3)}
+        for name in ("lat", "lon"):
+            v = getattr(self, name)
+            if v is not None:
+                out[name] = round(v, 7)
+        for name in ("sog_ms", "cog_deg", "hdg_deg", "stw_ms", "tws_ms", "twd_deg",
+                     "twa_deg", "aws_ms", "awa_deg"):
+            v = getattr(self, name)
+            if v is not None:
+                out[name] = round(v, 3)
+        return out
+
+
+@dataclass
+class Counts:
+    """What a decoder has seen (mutable; read it under the owner's lock).
+
+    Attributes
+    ----------
+    by_kind : Counter
+        ``"RMC"``, ``"MWV"``, ... for sentences used; ``"bad_checksum"``,
+        ``"malformed"``, ``"untimed"`` (no clock yet), ``"ignored"`` (a sentence type not
+        read, or flagged void by the instrument), ``"empty"`` (a wind sentence without
+        values).
+    """
+
+    by_kind: Counter[str] = field(default_factory=Counter)
+
+    @property
+    def bad(self) -> int:
+        """Sentences or deltas skipped as broken (bad checksum or malformed)."""
+        return self.by_kind["bad_checksum"] + self.by_kind["malformed"]
+
+
+def _f(value: Any) -> float | None:
+    """``float(value)``, or None for an empty field.
+
+    Raises
+    ------
+    ValueError
+        A field that is not a number (the sentence is counted as malformed).
+    """
+    if value is None or value == "":
+        return None
+    out = float(value)
+    if not math.isfinite(out):
+        raise ValueError(f"{value!r} is not a finite number")
+    return out
+
+
+def _epoch(d: date, tm: time) -> float:
+    tz = tm.tzinfo or UTC
+    return datetime.combine(d, tm.replace(tzinfo=None)).replace(tzinfo=tz).timestamp()
+
+
+class NmeaDecoder:
+    """Decode NMEA 0183 sentences, one line at a time, keeping the data clock.
+
+    Attributes
+    ----------
+    counts : Counts
+        Sentences used and skipped.
+    """
+
+    def __init__(self) -> None:
+        self.counts = Counts()
+        self._date: date | None = None
+        self._t: float | None = None
+        self._variation: float = 0.0
+
+    @property
+    def clock(self) -> float | None:
+        """The last data time seen [epoch s], or None before the first timed sentence."""
+        return self._t
+
+    def _timed(self, tm: time | None) -> float | None:
+        """Epoch time of a time-of-day on the last date seen (rolls over midnight)."""
+        if tm is None or self._date is None:
+            return None
+        t = _epoch(self._date, tm)
+        if self._t is not None and t < self._t - 43200:  # past midnight since the last RMC
+            t += 86400.0
+        return t
+
+    def feed(self, line: str) -> Reading | None:
+        """Decode one line; None when it says nothing usable (the reason is counted).
+
+        Parameters
+        ----------
+        line : str
+            One sentence, ``$`` or ``!`` first, checksum optional, line end optional.
+
+        Returns
+        -------
+        Reading or None
+        """
+        text = line.strip()
+        if not text:
+            return None
+        try:
+            msg = pynmea2.parse(text)
+        except pynmea2.ChecksumError:
+            self.counts.by_kind["bad_checksum"] += 1
+            return None
+        except (pynmea2.ParseError, ValueError, TypeError, AttributeError):
+            self.counts.by_kind["malformed"] += 1
+            return None
+        try:
+            reading = self._reading(msg)
+        except (ValueError, TypeError, AttributeError, IndexError):
+            self.counts.by_kind["malformed"] += 1
+            return None
+        if reading is None:
+            return None
+        self.counts.by_kind[msg.sentence_type] += 1
+        return reading
+
+    def _reading(self, msg: Any) -> Reading | None:
+        kind = msg.sentence_type
+        if kind == "RMC":
+            if msg.status != "A" or msg.datestamp is None or msg.timestamp is None:
+                self.counts.by_kind["ignored"] += 1
+                return None
+            self._date = msg.datestamp
+            self._t = _epoch(msg.datestamp, msg.timestamp)
+            var = _f(msg.mag_variation)
+            if var is not None:
+                self._variation = -var if msg.mag_var_dir == "W" else var
+            sog = _f(msg.spd_over_grnd)
+            return Reading(self._t, lat=float(msg.latitude), lon=float(msg.longitude),
+                           sog_ms=None if sog is None else sog * KN,
+                           cog_deg=_f(msg.true_course), timed=True)
+        if kind in ("GGA", "GLL"):
+            if kind == "GGA" and str(msg.gps_qual) in ("", "0"):
+                self.counts.by_kind["ignored"] += 1
+                return None
+            t = self._timed(msg.timestamp)
+            if t is None:
+                self.counts.by_kind["untimed"] += 1
+                return None
+            self._t = t
+            return Reading(t, lat=float(msg.latitude), lon=float(msg.longitude), timed=True)
+        if kind == "ZDA":
+            if msg.datestamp is not None and msg.timestamp is not None:
+                self._date = msg.datestamp
+                self._t = _epoch(msg.datestamp, msg.timestamp)
+            return None
+        if self._t is None:
+            self.counts.by_kind["untimed"] += 1
+            return None
+        t = self._t
+        if kind == "VTG":
+            sog = _f(msg.spd_over_grnd_kts)
+            return Reading(t, cog_deg=_f(msg.true_track),
+                           sog_ms=None if sog is None else sog * KN)
+        if kind == "HDT":
+            return Reading(t, hdg_deg=_f(msg.heading))
+        if kind == "HDG":
+            h = _f(msg.heading)
+            if h is None:
+                return None
+            var = _f(msg.variation)
+            v = self._variation if var is None else (-var if msg.var_dir == "W" else var)
+            dev = _f(msg.deviation) or 0.0
+            dev = -dev if msg.dev_dir == "W" else dev
+            return Reading(t, hdg_deg=float(wrap360(h + dev + v)))
+        if kind == "VHW":
+            stw = _f(msg.water_speed_knots)
+            return Reading(t, hdg_deg=_f(msg.heading_true),
+                           stw_ms=None if stw is None else stw * KN)
+        if kind == "MWV":
+            if len(msg.data) < 5:  # angle, reference, speed, unit, status
+                raise ValueError("MWV needs 5 fields")
+            if msg.status != "A":
+                self.counts.by_kind["ignored"] += 1
+                return None
+            angle, speed = _f(msg.wind_angle), _f(msg.wind_speed)
+            if angle is None or speed is None:
+                self.counts.by_kind["empty"] += 1
+                return None
+            unit = {"N": KN, "M": 1.0, "K": 1 / 3.6}.get(str(msg.wind_speed_units))
+            if unit is None:
+                self.counts.by_kind["malformed"] += 1
+                return None
+            a = float(wrap180(angle))
+            if msg.reference == "R":
+                return Reading(t, aws_ms=speed * unit, awa_deg=a)
+            return Reading(t, tws_ms=speed * unit, twa_deg=a)
+        if kind == "MWD":
+            d = _f(msg.direction_true)
+            ms, kn = _f(msg.wind_speed_meters), _f(msg.wind_speed_knots)
+            s = ms if ms is not None else (None if kn is None else kn * KN)
+            if d is None or s is None:
+                return None
+            return Reading(t, tws_ms=s, twd_deg=float(wrap360(d)))
+        self.counts.by_kind["ignored"] += 1
+        return None
+
+
+# ------------------------------------------------------------------------------ Signal K
+_SK_PATHS: dict[str, tuple[str, float]] = {
+    "navigation.courseOverGroundTrue": ("cog_deg", math.degrees(1.0)),
+    "navigation.speedOverGround": ("sog_ms", 1.0),
+    "navigation.headingTrue": ("hdg_deg", math.degrees(1.0)),
+    "navigation.speedThroughWater": ("stw_ms", 1.0),
+    "environment.wind.directionTrue": ("twd_deg", math.degrees(1.0)),
+    "environment.wind.speedTrue": ("tws_ms", 1.0),
+    "environment.wind.speedOverGround": ("tws_ms", 1.0),
+    "environment.wind.angleTrueGround": ("twa_deg", math.degrees(1.0)),
+    "environment.wind.angleTrueWater": ("twa_deg", math.degrees(1.0)),
+    "environment.wind.angleApparent": ("awa_deg", math.degrees(1.0)),
+    "environment.wind.speedApparent": ("aws_ms", 1.0),
+}
+_ANGLES = {"cog_deg", "hdg_deg", "twd_deg"}
+_SIGNED = {"twa_deg", "awa_deg"}
+
+
+def _sk_f(value: Any) -> float | None:
+    """A Signal K number, or None (null, text, NaN)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return None
+    return float(value) if math.isfinite(value) else None
+
+
+def _sk_time(text: Any) -> float | None:
+    if not isinstance(text, str):
+        return None
+    try:
+        dt = datetime.fromisoformat(text.replace("Z", "+00:00"))
+    except ValueError:
+        return None
+    return (dt if dt.tzinfo else dt.replace(tzinfo=UTC)).timestamp()
+
+
+class SignalKDecoder:
+    """Decode Signal K delta messages (JSON text) of the own vessel.
+
+    A delta is ``{"context": ..., "updates": [{"timestamp": ..., "values": [{"path": ...,
+    "value": ...}]}]}``; the server's hello message and other vessels' deltas (AIS) are
+    ignored.  Values at one update's timestamp become one :class:`Reading`.
+
+    Attributes
+    ----------
+    counts : Counts
+        ``"delta"`` for deltas used, ``"malformed"`` for text that is not a delta.
+    self_context : str or None
+        The own vessel's context (from the hello message ``self``); deltas of other
+        contexts are skipped.  None until the hello arrives: then every context counts.
+    """
+
+    def __init__(self) -> None:
+        self.counts = Counts()
+        self.self_context: str | None = None
+
+    def feed(self, text: str) -> list[Reading]:
+        """Decode one WebSocket message; an empty list when it says nothing usable."""
+        try:
+            msg = json.loads(text)
+        except ValueError:
+            self.counts.by_kind["malformed"] += 1
+            return []
+        if not isinstance(msg, dict):
+            self.counts.by_kind["malformed"] += 1
+            return []
+        if "updates" not in msg:
+            if isinstance(msg.get("self"), str):  # the hello message
+                self.self_context = msg["self"]
+            return []
+        ctx = msg.get("context")
+        if self.self_context is not None and ctx not in (None, self.self_context, "vessels.self"):
+            self.counts.by_kind["ignored"] += 1
+            return []
+        out: list[Reading] = []
+        updates = msg["updates"]
+        if not isinstance(updates, list):
+            self.counts.by_kind["malformed"] += 1
+            return []
+        for up in updates:
+            if not isinstance(up, dict) or not isinstance(up.get("values"), list):
+                self.counts.by_kind["malformed"] += 1
+                continue
+            t = _sk_time(up.get("timestamp"))
+            if t is None:
+                self.counts.by_kind["untimed"] += 1
+                continue
+            r = Reading(t, timed=True)
+            used = False
+            for item in up["values"]:
+                if not isinstance(item, dict):
+                    continue
+                path, value = item.get("path"), item.get("value")
+                if path == "navigation.position" and isinstance(value, dict):
+                    lat, lon = _sk_f(value.get("latitude")), _sk_f(value.get("longitude"))
+                    if lat is not None and lon is not None:
+                        r, used = replace(r, lat=lat, lon=lon), True
+                elif isinstance(path, str) and path in _SK_PATHS:
+                    v = _sk_f(value)
+                    if v is None:
+                        continue
+                    name, scale = _SK_PATHS[path]
+                    v *= scale
+                    if name in _ANGLES:
+                        v = float(wrap360(v))
+                    elif name in _SIGNED:
+                        v = float(wrap180(v))
+                    fields: dict[str, Any] = {name: v}
+                    r, used = replace(r, **fields), True
+            if used:
+                self.counts.by_kind["delta"] += 1
+                out.append(r)
+        return out

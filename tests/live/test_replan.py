@@ -1,0 +1,129 @@
+"""The live wind blend, the remaining-course routing and the NMEA sentences out."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pynmea2
+import pytest
+
+from sailroute.course.load import build_specs
+from sailroute.errors import InputError
+from sailroute.live.livewind import LiveWind, RollingWind, wind_changed
+from sailroute.live.nmeaout import route_sentences, steer_sentences
+from sailroute.live.replan import current_leg, laylines, route_remaining
+from sailroute.live.sources import NmeaFileSource, NmeaTcpSource, SignalKSource, parse_source
+from sailroute.planning.route import route_course
+from sailroute.units import wind_speed_direction
+from sailroute.wind.uniform import UniformWind
+from tests.live.feed import trieste
+
+
+def test_live_wind_is_measured_now_and_the_forecast_ahead() -> None:
+    course = trieste()
+    fc = UniformWind(tws_ms=2.5, twd_deg=65.0)
+    now = course.start_epoch
+    w = LiveWind(fc, now, 100.0, -50.0, 3.5, 50.0, course.frame, fade_s=600.0)
+    s, d = wind_speed_direction(*w.sample(now, 100.0, -50.0))
+    # the measured wind is earth-true, the frame's north differs from it by its grid angle
+    grid = float(course.frame.grid_north_deg(*course.frame.to_latlon(100.0, -50.0)))
+    assert abs(grid) < 0.01  # near the frame's origin
+    assert float(s) == pytest.approx(3.5) and float(d) == pytest.approx(50.0, abs=0.01)
+    s, d = wind_speed_direction(*w.sample(now + 600.0, 100.0, -50.0))
+    # one fade time ahead: a weight of 1/e on the log speed ratio and the shift
+    assert float(s) == pytest.approx(2.5 * (3.5 / 2.5) ** math.exp(-1))
+    assert float(d) == pytest.approx(65.0 + (50.0 - 65.0) * math.exp(-1), abs=0.01)
+    s, d = wind_speed_direction(*w.sample(now + 10 * 3600.0, 0.0, 0.0))
+    assert float(s) == pytest.approx(2.5, abs=1e-3) and float(d) == pytest.approx(65.0, abs=0.01)
+
+
+def test_rolling_wind_is_a_vector_mean_over_its_window() -> None:
+    rw = RollingWind(window_s=9.5)
+    for k in range(30):
+        rw.add(1000.0 + k, 4.0, 350.0 if k % 2 else 10.0)
+    tws, twd = rw.mean() or (0.0, 0.0)
+    assert twd == pytest.approx(0.0, abs=1e-6) or twd == pytest.approx(360.0, abs=1e-6)
+    assert tws == pytest.approx(4.0 * math.cos(math.radians(10.0)))
+    rw.add(1030.0, 4.0, 90.0)
+    assert len(rw._recent) == 10  # 1021 .. 1030
+    assert [t for t, _, _ in rw.trend()] == [1000.0, 1010.0, 1020.0, 1030.0]
+    assert wind_changed(None, (4.0, 10.0))
+    assert wind_changed((4.0, 358.0), (4.0, 3.0))  # 5° across north
+    assert not wind_changed((4.0, 358.0), (4.4, 2.0))
+    assert wind_changed((4.0, 10.0), (4.6, 10.0))  # 0.6 m/s > 1 kn
+
+
+def test_remaining_course_from_a_mark_matches_the_full_plan() -> None:
+    """Routed from where the full plan rounds mark 1, the rest of the course takes what the
+    full plan's last three legs take (the full plan also carries mark 1's rounding ray)."""
+    course = trieste()
+    boat, winds = build_specs(course, ["mean"])
+    full = route_course(course, winds["mean"], boat, course.routing)
+    rest = route_remaining(course, winds["mean"], boat, course.routing, 1, full[0].end_xy,
+                           full[0].t_end)
+    assert len(rest) == 3
+    np.testing.assert_allclose([r.time_s for r in rest], [r.time_s for r in full[1:]],
+                               rtol=0.03)
+    assert rest[-1].t_end == pytest.approx(full[-1].t_end, rel=0, abs=30.0)
+
+
+def test_current_leg_advances_at_the_mark() -> None:
+    course = trieste()
+    m1 = course.marks["1"].xy
+    assert current_leg(course, 0, (m1[0] - 100.0, m1[1])) == 0
+    assert current_leg(course, 0, (m1[0] - 10.0, m1[1])) == 1
+    gate = course.gates["4"].midpoint
+    assert current_leg(course, 1, gate) == 2
+    finish = course.lines["finish"].midpoint
+    assert current_leg(course, 3, finish) == 4
+
+
+def test_laylines_are_the_polars_vmg_angles() -> None:
+    course = trieste()
+    boat, _ = build_specs(course, ["mean"])
+    up, down = boat.vmg_angles_deg(2.5)
+    star, port = laylines(boat, 2.5, 65.0, upwind=True)
+    assert star.bearing_deg == pytest.approx((65.0 - up) % 360)
+    assert port.bearing_deg == pytest.approx((65.0 + up) % 360)
+    assert 30.0 < up < 60.0 and 120.0 < down <= 180.0
+    star, port = laylines(boat, 2.5, 65.0, upwind=False)
+    assert star.bearing_deg == pytest.approx((65.0 - down) % 360)
+    assert port.bearing_deg == pytest.approx((65.0 + down) % 360)
+
+
+def test_nmea_out_sentences_parse_and_measure() -> None:
+    wps = [("T301", 45.5633, 13.6751), ("1", 45.566951, 13.676702),
+           ("finish", 45.564859, 13.6703175)]
+    out = route_sentences(7, wps)
+    msgs = [pynmea2.parse(s.strip()) for s in out]  # checksums verified by pynmea2
+    wpl = [m for m in msgs if m.sentence_type == "WPL"]
+    assert [m.waypoint_id for m in wpl] == ["T301", "1", "FINISH"]
+    assert wpl[1].lat == "4534.0171" and wpl[1].lon == "01340.6021"  # ddmm.mmmm
+    rte = [m for m in msgs if m.sentence_type == "RTE"]
+    assert rte[0].data[3] == "live7" and rte[0].data[4:] == ["T301", "1", "FINISH"]
+    # 1 nm due north of the waypoint, steering to it: range 1 nm, bearing 180°
+    lat = 45.566951 + 1852.0 / 111_132.0
+    rmb, apb = (pynmea2.parse(s.strip()) for s in steer_sentences(
+        lat, 13.676702, 2.0, 180.0, ("BOAT", lat, 13.676702), wps[1]))
+    assert float(rmb.data[9]) == pytest.approx(1.0, abs=0.01)
+    assert float(rmb.data[10]) == pytest.approx(180.0, abs=0.1)
+    assert float(rmb.data[11]) == pytest.approx(2.0 * 3600 / 1852, abs=0.05)  # closing speed
+    assert apb.data[9] == "1" and float(apb.data[10]) == pytest.approx(180.0, abs=0.1)
+
+
+def test_parse_source() -> None:
+    assert parse_source("nmea+tcp://10.0.0.5:10110") == NmeaTcpSource("10.0.0.5", 10110)
+    sk = parse_source("signalk://boat.local:3000")
+    assert isinstance(sk, SignalKSource)
+    assert sk.url == "ws://boat.local:3000/signalk/v1/stream?subscribe=all"
+    path = "tests/data/live/tallinn-2023-09-27.nmea"
+    assert parse_source(path, 5.0) == NmeaFileSource(__import__("pathlib").Path(path), 5.0)
+    with pytest.raises(InputError, match="no port number"):
+        parse_source("nmea+tcp://host")
+    with pytest.raises(InputError, match="unknown scheme 'http'"):
+        parse_source("http://host:80")
+    with pytest.raises(InputError, match="no such file"):
+        parse_source("missing.nmea")
+    with pytest.raises(InputError, match="--speed 0"):
+        parse_source(path, 0.0)
