@@ -69,7 +69,8 @@ def check_plan_files(out: Path, course_file: Path) -> dict:
 def check_report_html(path: Path, doc: dict, course) -> None:
     """report.html agrees with plan.json and track.csv: offline page, the route's points and
     times, the marks, the leg table."""
-    from sailroute.report.html import REPEAT_SHIFT, clock, read_figure
+    from sailroute.report.page import REPEAT_SHIFT, clock
+    from sailroute.report.page_render import read_figure
     from sailroute.report.tables import format_duration
 
     page = path.read_text(encoding="utf-8")
@@ -173,7 +174,7 @@ def test_compare_scenarios_table_files_and_per_scenario_plans(tmp_path):
     with (tmp_path / "comparison.csv").open() as f:
         assert len(list(csv.DictReader(f))) == 2 * 6 + 2  # legs x scenarios + totals
     assert (tmp_path / "comparison.png").read_bytes()[:4] == b"\x89PNG"
-    from sailroute.report.html import read_figure
+    from sailroute.report.page_render import read_figure
 
     fig = read_figure((tmp_path / "report.html").read_text(encoding="utf-8"))
     routes = [t for t in fig["data"] if t.get("legendgroup", "").startswith("route")

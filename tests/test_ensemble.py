@@ -95,7 +95,7 @@ def test_cli_plan_on_an_ensemble_writes_the_spread(tmp_path) -> None:
     assert doc["total_s"]["min"] == pytest.approx(min(totals))
     assert doc["total_s"]["median"] == pytest.approx(float(np.median(totals)))
     assert (tmp_path / "o" / "spread#3" / "plan.json").is_file()
-    from sailroute.report.html import read_figure
+    from sailroute.report.page_render import read_figure
 
     fig = read_figure((tmp_path / "o" / "report.html").read_text(encoding="utf-8"))
     assert [t["name"] for t in fig["data"] if t.get("legendgroup", "").startswith("route")

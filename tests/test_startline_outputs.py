@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from sailroute.cli import app
 from sailroute.course.load import build_boat, load_course
-from sailroute.report.html import read_figure
+from sailroute.report.page_render import read_figure
 from sailroute.units import bearing_deg, wrap180
 
 TWS, BIAS, HALF = 5.0, 5.0, 150.0

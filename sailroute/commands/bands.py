@@ -222,7 +222,7 @@ def run_bands_command(
         ``bands_png``; ``data``: the tuple of :class:`BandSummary`.
     """
     from sailroute.report.bands import bands_page, bands_table, write_bands
-    from sailroute.report.html import write_report
+    from sailroute.report.page_render import write_report
 
     router, backend, progress = options.router, options.backend, options.progress
     scheduler = options.scheduler

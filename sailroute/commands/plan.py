@@ -84,7 +84,8 @@ def run_plan_command(
                 png.submit(run.plan, run.wind, d / "route.png", png_worker.DPI)
             files = dict(write_plan_outputs(d, run.plan, wind=run.wind, plot=False))
             if plots:
-                from sailroute.report.html import plan_report, write_report
+                from sailroute.report.html import plan_report
+                from sailroute.report.page_render import write_report
 
                 html = write_report(d / "report.html", plan_report(run.plan, run.wind))
                 files["png"] = png.result()
@@ -111,7 +112,8 @@ def _run_ensemble(
     def write(d: Path) -> dict[str, Path]:
         files: dict[str, Path] = dict(write_ensemble(d, summary))
         if plots:
-            from sailroute.report.html import comparison_report, write_report
+            from sailroute.report.html import comparison_report
+            from sailroute.report.page_render import write_report
 
             files["html"] = write_report(d / "report.html",
                                          comparison_report(cmp, plans, winds))
@@ -161,7 +163,8 @@ def run_compare_command(
         js, cs = write_comparison(d, cmp)
         files: dict[str, Path] = {"comparison_json": js, "comparison_csv": cs}
         if plots:
-            from sailroute.report.html import comparison_report, write_report
+            from sailroute.report.html import comparison_report
+            from sailroute.report.page_render import write_report
             from sailroute.report.plots import plot_comparison
 
             plot_comparison(cmp, plans).savefig(d / "comparison.png", dpi=150)

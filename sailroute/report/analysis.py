@@ -196,7 +196,8 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
         files["legs_png"] = out / "legs.png"
         plot_loss(a).savefig(out / "loss.png", dpi=120)
         files["loss_png"] = out / "loss.png"
-        from sailroute.report.html import analysis_report, write_report
+        from sailroute.report.html import analysis_report
+        from sailroute.report.page_render import write_report
 
         files["html"] = write_report(out / "report.html", analysis_report(a))
     return files
@@ -231,7 +232,8 @@ def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
     jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     files = {"fleet_csv": cp, "fleet_json": jp}
     if plots:
-        from sailroute.report.html import fleet_report, write_report
+        from sailroute.report.html import fleet_report
+        from sailroute.report.page_render import write_report
 
         files["html"] = write_report(out / "report.html",
                                      fleet_report(analyses, rows,

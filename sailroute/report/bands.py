@@ -93,7 +93,7 @@ def bands_table(b: BandSummary) -> str:
 
 def bands_html_table(b: BandSummary) -> Any:
     """The bands of one scenario as a table of ``report.html``."""
-    from sailroute.report.html import Table
+    from sailroute.report.page import Table
 
     bd, dom, sh, widths = b.bands(), b.dominant(), b.side_shares(), b.oat_widths()
     rows = []

@@ -190,7 +190,7 @@ def test_shipped_example_runs_and_writes_every_file(tmp_path: Path) -> None:
     assert rows[0].startswith("leg,time,x_m,y_m,lat,lon,sog_ms")
     assert len(rows) > 1400
     # report.html: the sailed track point by point, the optimal legs in 4 pieces
-    from sailroute.report.html import read_figure
+    from sailroute.report.page_render import read_figure
 
     fig = read_figure((out / "report.html").read_text(encoding="utf-8"))
     (sailed,) = [t for t in fig["data"] if t["name"].startswith("sailed: ")

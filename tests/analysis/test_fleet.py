@@ -239,7 +239,7 @@ def test_per_boat_leg_times(fleet_files, routed, tmp_path: Path) -> None:
 
 
 def test_fleet_page_escapes_names_and_draws_every_boat(fleet_files, tmp_path: Path) -> None:
-    from sailroute.report.html import read_figure
+    from sailroute.report.page_render import read_figure
 
     f = fleet_files
     out = tmp_path / "out"

@@ -17,7 +17,8 @@ import pytest
 
 from sailroute.analysis.debrief import analyze_track
 from sailroute.course.load import load_course
-from sailroute.report.html import MAX_ROUTE_POINTS, analysis_report, decimated
+from sailroute.report.html import analysis_report
+from sailroute.report.page import MAX_ROUTE_POINTS, decimated
 from sailroute.track.read import read_track
 from tests.conftest import ROOT
 

@@ -27,15 +27,9 @@ import numpy as np
 import pytest
 
 from sailroute.planning.result import compare
-from sailroute.report.html import (
-    BOAT_COLOUR,
-    N_STEPS,
-    SEA,
-    clock,
-    comparison_report,
-    plan_report,
-    write_report,
-)
+from sailroute.report.html import comparison_report, plan_report
+from sailroute.report.page import BOAT_COLOUR, N_STEPS, SEA, clock
+from sailroute.report.page_render import write_report
 
 
 def find_chromium() -> str | None:

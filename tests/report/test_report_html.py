@@ -16,7 +16,8 @@ import pytest
 
 from sailroute.course.load import course_from_mapping
 from sailroute.planning.result import compare, make_plan
-from sailroute.report.html import (
+from sailroute.report.html import comparison_report, offset_text, plan_report
+from sailroute.report.page import (
     ARROW_FILL,
     DIV_ID,
     N_STEPS,
@@ -24,17 +25,13 @@ from sailroute.report.html import (
     WIND_GRID,
     clock,
     clocks,
-    comparison_report,
     course_area,
-    figure,
-    offset_text,
-    plan_report,
-    read_figure,
-    render_html,
     route_from_plan,
     time_label,
     wind_layer,
 )
+from sailroute.report.page_figure import figure
+from sailroute.report.page_render import read_figure, render_html
 from sailroute.report.tables import format_duration
 from sailroute.routing.track import make_leg_result
 from sailroute.units import KNOT

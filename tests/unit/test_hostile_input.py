@@ -28,7 +28,8 @@ from sailroute.course.load import course_from_mapping, load_course
 from sailroute.errors import InputError
 from sailroute.planning.result import make_plan
 from sailroute.report.files import write_gpx, write_track_csv
-from sailroute.report.html import figure, plan_report
+from sailroute.report.html import plan_report
+from sailroute.report.page_figure import figure
 from sailroute.routing.track import make_leg_result
 from sailroute.textin import CleanCsvWriter, clean_text, csv_rows, excerpt, looks_like_header
 from sailroute.track.read import read_track
