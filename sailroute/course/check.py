@@ -429,12 +429,7 @@ def _routing(c: Checker, raw: Any) -> RoutingSettings:
     for key in raw:
         if key not in fields:
             continue
-        if key in special:
-            v = special[key]()
-        elif key == "extra":
-            v = _extra(c, raw["extra"])
-        else:
-            v = _generic(c, raw, key, str(fields[key].type))
+        v = special[key]() if key in special else _generic(c, raw, key, str(fields[key].type))
         if v is not None or raw[key] is None:
             kw[key] = v
     try:
@@ -447,17 +442,6 @@ def _routing(c: Checker, raw: Any) -> RoutingSettings:
         name = problem.split(" ", 1)[0]
         c.p.add(f"routing.{name}" if name in raw else "routing", problem)
     return settings
-
-
-def _extra(c: Checker, raw: Any) -> dict[str, float] | None:
-    if not c.at("routing.extra").is_mapping(raw, "a mapping of router-specific settings"):
-        return None
-    out = {}
-    for k in raw:
-        v = c.at("routing.extra").number(raw, k)
-        if v is not None:
-            out[str(k)] = v
-    return out
 
 
 def _generic(c: Checker, raw: Mapping[str, Any], key: str, type_text: str) -> Any:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING, Final, Literal, Protocol, get_args
 
@@ -181,8 +181,6 @@ class RoutingSettings:
         Time lost per tack / gybe [s], independent of the time step.
     initial_side : {"port", "starboard"} or None
         Tack at the start of a leg; None lets the router choose freely.
-    extra : dict of str to float
-        Router-specific numbers not covered by the fields (kept for reports).
     zone_m : float
         Length of a mark's rounding segment [m] (see ``routing/geometry.py``):
         the leg ends when the boat crosses it, so it is how close a rounding
@@ -238,7 +236,6 @@ class RoutingSettings:
     tack_penalty_s: float = 5.0
     gybe_penalty_s: float = 3.0
     initial_side: Side | None = None
-    extra: dict[str, float] = field(default_factory=dict)
     zone_m: float = 13.0
     start_line_spacing_m: float = 5.0
     max_leg_time_s: float = 10800.0
@@ -306,75 +303,102 @@ def _work_problems(s: RoutingSettings) -> list[str]:
     return problems
 
 
+def _is_number(v: object) -> bool:
+    """A finite real number (not a bool)."""
+    return isinstance(v, int | float | np.integer | np.floating) and not isinstance(
+        v, bool) and math.isfinite(v)
+
+
+class _Problems(list[str]):
+    """The problems of one settings object, with the two common checks."""
+
+    def __init__(self, s: RoutingSettings) -> None:
+        super().__init__()
+        self.s = s
+
+    def number(self, name: str, *, strict: bool = True) -> None:
+        v = getattr(self.s, name)
+        if not (_is_number(v) and (v > 0 if strict else v >= 0)):
+            self.append(f"{name} must be a number {'>' if strict else '>='} 0, got {v!r}")
+
+    def integer(self, name: str, lo: int, hi: int, text: str) -> None:
+        v = getattr(self.s, name)
+        if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and lo <= v <= hi):
+            self.append(f"{name} must be an integer {text}, got {v!r}")
+
+
+def _common_problems(p: _Problems) -> None:
+    """The router name, the time limit, the penalties and the start-line spacing."""
+    s = p.s
+    if s.router not in get_args(RouterName):
+        p.append("router must be one of " + ", ".join(
+            repr(r) for r in get_args(RouterName)) + f", got {s.router!r}")
+    for name in ("dt_s", "heading_step_deg", "min_dt_s", "prune_sector_deg",
+                 "max_leg_time_s", "start_line_spacing_m", "zone_m"):
+        p.number(name)
+    for name in ("tack_penalty_s", "gybe_penalty_s"):
+        p.number(name, strict=False)
+    if s.initial_side is not None and s.initial_side not in SIDE_NAMES:
+        p.append(f"initial_side must be 'port', 'starboard' or None, got {s.initial_side!r}")
+
+
+def _isochrone_problems(p: _Problems) -> None:
+    """The isochrone router's steps, fan and front size."""
+    s = p.s
+    if _is_number(s.heading_step_deg) and s.heading_step_deg > 45:
+        p.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
+    if _is_number(s.heading_step_deg) and 0 < s.heading_step_deg < MIN_HEADING_STEP_DEG:
+        p.append(f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer "
+                 f"steps only slow the router), got {s.heading_step_deg!r}")
+    if _is_number(s.dt_s) and 0 < s.dt_s < MIN_DT_S:
+        p.append(f"dt_s must be >= {MIN_DT_S:g} s (default 10; finer steps hardly "
+                 f"change the route and make it slow), got {s.dt_s!r}")
+    if _is_number(s.min_dt_s) and 0 < s.min_dt_s < MIN_MIN_DT_S:
+        p.append(f"min_dt_s must be >= {MIN_MIN_DT_S:g} s (default 1), got {s.min_dt_s!r}")
+    p.integer("max_front_points", 8, MAX_FRONT_POINTS, f"in [8, {MAX_FRONT_POINTS}]")
+    if s.heading_fan not in ("hull", "full"):
+        p.append(f"heading_fan must be 'hull' or 'full', got {s.heading_fan!r}")
+
+
+def _griddp_problems(p: _Problems) -> None:
+    """The grid-DP router's rows, columns, refinements and corridor."""
+    s = p.s
+    p.integer("dp_rows", 3, 200, "in [3, 200]")
+    p.integer("dp_cols", 2, 1024, "in [2, 1024]")
+    p.integer("dp_refinements", 0, 20, "in [0, 20]")
+    p.integer("dp_samples", 1, 64, "in [1, 64]")
+    if not (_is_number(s.dp_shrink) and 0 < s.dp_shrink <= 1):
+        p.append(f"dp_shrink must be in (0, 1], got {s.dp_shrink!r}")
+    hw = s.dp_half_width_m
+    if hw is not None and not (_is_number(hw) and hw > 0):
+        p.append(f"dp_half_width_m must be > 0 m or None (automatic), got {hw!r}")
+
+
+def _spline_problems(p: _Problems) -> None:
+    """The spline router's columns, slopes, refinements and switches."""
+    s = p.s
+    for name, lo in (("spline_cols", 2), ("spline_slopes", 1), ("spline_refinements", 0)):
+        p.integer(name, lo, 1000, f">= {lo}")
+    for name in ("spline_carry_speed", "spline_start_from_rest"):
+        v = getattr(s, name)
+        if not isinstance(v, bool | np.bool_):
+            p.append(f"{name} must be true or false, got {v!r}")
+
+
 def settings_problems(s: RoutingSettings) -> list[str]:
     """What is wrong with ``s``, one line per field (empty when every field is valid).
 
     The one place that validates :class:`RoutingSettings`: every router calls
-    :func:`check_settings`, which raises with these lines.
+    :func:`check_settings`, which raises with these lines.  Every field is checked,
+    whichever router is chosen (a course may switch router on the command line): the
+    common fields, then each router's own.
     """
-    problems: list[str] = []
-
-    def is_number(v: object) -> bool:
-        return isinstance(v, int | float | np.integer | np.floating) and not isinstance(
-            v, bool) and math.isfinite(v)
-
-    def number(name: str, *, strict: bool = True) -> None:
-        v = getattr(s, name)
-        if not (is_number(v) and (v > 0 if strict else v >= 0)):
-            problems.append(f"{name} must be a number {'>' if strict else '>='} 0, got {v!r}")
-
-    def integer(name: str, lo: int, hi: int, text: str) -> None:
-        v = getattr(s, name)
-        if not (isinstance(v, int | np.integer) and not isinstance(v, bool) and lo <= v <= hi):
-            problems.append(f"{name} must be an integer {text}, got {v!r}")
-
-    if s.router not in get_args(RouterName):
-        problems.append("router must be one of " + ", ".join(
-            repr(r) for r in get_args(RouterName)) + f", got {s.router!r}")
-    for name in ("dt_s", "heading_step_deg", "min_dt_s", "prune_sector_deg",
-                 "max_leg_time_s", "start_line_spacing_m", "zone_m"):
-        number(name)
-    for name in ("tack_penalty_s", "gybe_penalty_s"):
-        number(name, strict=False)
-    if is_number(s.heading_step_deg) and s.heading_step_deg > 45:
-        problems.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
-    if is_number(s.heading_step_deg) and 0 < s.heading_step_deg < MIN_HEADING_STEP_DEG:
-        problems.append(
-            f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer "
-            f"steps only slow the router), got {s.heading_step_deg!r}")
-    if is_number(s.dt_s) and 0 < s.dt_s < MIN_DT_S:
-        problems.append(f"dt_s must be >= {MIN_DT_S:g} s (default 10; finer steps hardly "
-                        f"change the route and make it slow), got {s.dt_s!r}")
-    if is_number(s.min_dt_s) and 0 < s.min_dt_s < MIN_MIN_DT_S:
-        problems.append(f"min_dt_s must be >= {MIN_MIN_DT_S:g} s (default 1), got {s.min_dt_s!r}")
-    integer("max_front_points", 8, MAX_FRONT_POINTS, f"in [8, {MAX_FRONT_POINTS}]")
-    if s.heading_fan not in ("hull", "full"):
-        problems.append(f"heading_fan must be 'hull' or 'full', got {s.heading_fan!r}")
-    if s.initial_side is not None and s.initial_side not in SIDE_NAMES:
-        problems.append(
-            f"initial_side must be 'port', 'starboard' or None, got {s.initial_side!r}"
-        )
-    if not (isinstance(s.extra, dict) and all(
-            isinstance(k, str) and is_number(v) for k, v in s.extra.items())):
-        problems.append(f"extra must be a mapping of names to numbers, got {s.extra!r}")
-    integer("dp_rows", 3, 200, "in [3, 200]")
-    integer("dp_cols", 2, 1024, "in [2, 1024]")
-    integer("dp_refinements", 0, 20, "in [0, 20]")
-    integer("dp_samples", 1, 64, "in [1, 64]")
-    if not (is_number(s.dp_shrink) and 0 < s.dp_shrink <= 1):
-        problems.append(f"dp_shrink must be in (0, 1], got {s.dp_shrink!r}")
-    hw = s.dp_half_width_m
-    if hw is not None and not (is_number(hw) and hw > 0):
-        problems.append(f"dp_half_width_m must be > 0 m or None (automatic), got {hw!r}")
-    for name, lo in (("spline_cols", 2), ("spline_slopes", 1), ("spline_refinements", 0)):
-        integer(name, lo, 1000, f">= {lo}")
-    for name in ("spline_carry_speed", "spline_start_from_rest"):
-        v = getattr(s, name)
-        if not isinstance(v, bool | np.bool_):
-            problems.append(f"{name} must be true or false, got {v!r}")
-    if not problems:  # every count a valid integer: estimate the work
-        problems += _work_problems(s)
-    return problems
+    p = _Problems(s)
+    for group in (_common_problems, _isochrone_problems, _griddp_problems, _spline_problems):
+        group(p)
+    if not p:  # every count a valid integer: estimate the work
+        p += _work_problems(s)
+    return list(p)
 
 
 def check_settings(s: RoutingSettings, label: str) -> None:

@@ -81,7 +81,6 @@ BAD = [
     ("max_front_points", 2, "max_front_points must be an integer in [8, 100000], got 2"),
     ("heading_fan", "wide", "heading_fan must be 'hull' or 'full', got 'wide'"),
     ("initial_side", "left", "initial_side must be 'port', 'starboard' or None, got 'left'"),
-    ("extra", {"k": "x"}, "extra must be a mapping of names to numbers, got {'k': 'x'}"),
     ("dp_rows", 2, "dp_rows must be an integer in [3, 200], got 2"),
     ("dp_cols", 1, "dp_cols must be an integer in [2, 1024], got 1"),
     ("dp_refinements", 1.5, "dp_refinements must be an integer in [0, 20], got 1.5"),
@@ -101,7 +100,7 @@ BAD = [
 def test_default_settings_are_valid() -> None:
     assert settings_problems(RoutingSettings()) == []
     check_settings(RoutingSettings(router="spline", initial_side="port",
-                                   dp_half_width_m=400.0, extra={"a": 1.0}), "x")
+                                   dp_half_width_m=400.0), "x")
 
 
 def test_every_field_is_checked() -> None:
