@@ -29,7 +29,7 @@ from __future__ import annotations
 import json
 import math
 from collections import Counter
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from datetime import UTC, date, datetime, time
 from typing import Any
 
@@ -202,84 +202,106 @@ class NmeaDecoder:
 
     def _reading(self, msg: Any) -> Reading | None:
         kind = msg.sentence_type
-        if kind == "RMC":
-            if msg.status != "A" or msg.datestamp is None or msg.timestamp is None:
-                self.counts.by_kind["ignored"] += 1
-                return None
-            self._date = msg.datestamp
-            self._t = _epoch(msg.datestamp, msg.timestamp)
-            var = _f(msg.mag_variation)
-            if var is not None:
-                self._variation = -var if msg.mag_var_dir == "W" else var
-            sog = _f(msg.spd_over_grnd)
-            return Reading(self._t, lat=float(msg.latitude), lon=float(msg.longitude),
-                           sog_ms=None if sog is None else sog * KN,
-                           cog_deg=_f(msg.true_course), timed=True)
-        if kind in ("GGA", "GLL"):
-            if kind == "GGA" and str(msg.gps_qual) in ("", "0"):
-                self.counts.by_kind["ignored"] += 1
-                return None
-            t = self._timed(msg.timestamp)
-            if t is None:
-                self.counts.by_kind["untimed"] += 1
-                return None
-            self._t = t
-            return Reading(t, lat=float(msg.latitude), lon=float(msg.longitude), timed=True)
-        if kind == "ZDA":
-            if msg.datestamp is not None and msg.timestamp is not None:
-                self._date = msg.datestamp
-                self._t = _epoch(msg.datestamp, msg.timestamp)
-            return None
+        timed = {"RMC": self._rmc, "GGA": self._fix, "GLL": self._fix, "ZDA": self._zda}
+        if kind in timed:
+            return timed[kind](msg)
         if self._t is None:
             self.counts.by_kind["untimed"] += 1
             return None
-        t = self._t
-        if kind == "VTG":
-            sog = _f(msg.spd_over_grnd_kts)
-            return Reading(t, cog_deg=_f(msg.true_track),
-                           sog_ms=None if sog is None else sog * KN)
-        if kind == "HDT":
-            return Reading(t, hdg_deg=_f(msg.heading))
-        if kind == "HDG":
-            h = _f(msg.heading)
-            if h is None:
-                return None
-            var = _f(msg.variation)
-            v = self._variation if var is None else (-var if msg.var_dir == "W" else var)
-            dev = _f(msg.deviation) or 0.0
-            dev = -dev if msg.dev_dir == "W" else dev
-            return Reading(t, hdg_deg=float(wrap360(h + dev + v)))
-        if kind == "VHW":
-            stw = _f(msg.water_speed_knots)
-            return Reading(t, hdg_deg=_f(msg.heading_true),
-                           stw_ms=None if stw is None else stw * KN)
-        if kind == "MWV":
-            if len(msg.data) < 5:  # angle, reference, speed, unit, status
-                raise ValueError("MWV needs 5 fields")
-            if msg.status != "A":
-                self.counts.by_kind["ignored"] += 1
-                return None
-            angle, speed = _f(msg.wind_angle), _f(msg.wind_speed)
-            if angle is None or speed is None:
-                self.counts.by_kind["empty"] += 1
-                return None
-            unit = {"N": KN, "M": 1.0, "K": 1 / 3.6}.get(str(msg.wind_speed_units))
-            if unit is None:
-                self.counts.by_kind["malformed"] += 1
-                return None
-            a = float(wrap180(angle))
-            if msg.reference == "R":
-                return Reading(t, aws_ms=speed * unit, awa_deg=a)
-            return Reading(t, tws_ms=speed * unit, twa_deg=a)
-        if kind == "MWD":
-            d = _f(msg.direction_true)
-            ms, kn = _f(msg.wind_speed_meters), _f(msg.wind_speed_knots)
-            s = ms if ms is not None else (None if kn is None else kn * KN)
-            if d is None or s is None:
-                return None
-            return Reading(t, tws_ms=s, twd_deg=float(wrap360(d)))
+        untimed = {"VTG": self._vtg, "HDT": self._hdt, "HDG": self._hdg, "VHW": self._vhw,
+                   "MWV": self._mwv, "MWD": self._mwd}
+        if kind in untimed:
+            return untimed[kind](msg, self._t)
         self.counts.by_kind["ignored"] += 1
         return None
+
+    def _rmc(self, msg: Any) -> Reading | None:
+        """Position, SOG, COG and the date; sets the clock and the magnetic variation."""
+        if msg.status != "A" or msg.datestamp is None or msg.timestamp is None:
+            self.counts.by_kind["ignored"] += 1
+            return None
+        self._date = msg.datestamp
+        self._t = _epoch(msg.datestamp, msg.timestamp)
+        var = _f(msg.mag_variation)
+        if var is not None:
+            self._variation = -var if msg.mag_var_dir == "W" else var
+        sog = _f(msg.spd_over_grnd)
+        return Reading(self._t, lat=float(msg.latitude), lon=float(msg.longitude),
+                       sog_ms=None if sog is None else sog * KN,
+                       cog_deg=_f(msg.true_course), timed=True)
+
+    def _fix(self, msg: Any) -> Reading | None:
+        """GGA or GLL: a position at a time of day (dated by the last RMC or ZDA)."""
+        if msg.sentence_type == "GGA" and str(msg.gps_qual) in ("", "0"):
+            self.counts.by_kind["ignored"] += 1
+            return None
+        t = self._timed(msg.timestamp)
+        if t is None:
+            self.counts.by_kind["untimed"] += 1
+            return None
+        self._t = t
+        return Reading(t, lat=float(msg.latitude), lon=float(msg.longitude), timed=True)
+
+    def _zda(self, msg: Any) -> Reading | None:
+        """The date and time only."""
+        if msg.datestamp is not None and msg.timestamp is not None:
+            self._date = msg.datestamp
+            self._t = _epoch(msg.datestamp, msg.timestamp)
+        return None
+
+    @staticmethod
+    def _vtg(msg: Any, t: float) -> Reading | None:
+        sog = _f(msg.spd_over_grnd_kts)
+        return Reading(t, cog_deg=_f(msg.true_track), sog_ms=None if sog is None else sog * KN)
+
+    @staticmethod
+    def _hdt(msg: Any, t: float) -> Reading | None:
+        return Reading(t, hdg_deg=_f(msg.heading))
+
+    def _hdg(self, msg: Any, t: float) -> Reading | None:
+        """Magnetic heading corrected by deviation and variation (the RMC's when absent)."""
+        h = _f(msg.heading)
+        if h is None:
+            return None
+        var = _f(msg.variation)
+        v = self._variation if var is None else (-var if msg.var_dir == "W" else var)
+        dev = _f(msg.deviation) or 0.0
+        dev = -dev if msg.dev_dir == "W" else dev
+        return Reading(t, hdg_deg=float(wrap360(h + dev + v)))
+
+    @staticmethod
+    def _vhw(msg: Any, t: float) -> Reading | None:
+        stw = _f(msg.water_speed_knots)
+        return Reading(t, hdg_deg=_f(msg.heading_true), stw_ms=None if stw is None else stw * KN)
+
+    def _mwv(self, msg: Any, t: float) -> Reading | None:
+        """Wind angle and speed, apparent (reference R) or true."""
+        if len(msg.data) < 5:  # angle, reference, speed, unit, status
+            raise ValueError("MWV needs 5 fields")
+        if msg.status != "A":
+            self.counts.by_kind["ignored"] += 1
+            return None
+        angle, speed = _f(msg.wind_angle), _f(msg.wind_speed)
+        if angle is None or speed is None:
+            self.counts.by_kind["empty"] += 1
+            return None
+        unit = {"N": KN, "M": 1.0, "K": 1 / 3.6}.get(str(msg.wind_speed_units))
+        if unit is None:
+            self.counts.by_kind["malformed"] += 1
+            return None
+        a = float(wrap180(angle))
+        if msg.reference == "R":
+            return Reading(t, aws_ms=speed * unit, awa_deg=a)
+        return Reading(t, tws_ms=speed * unit, twa_deg=a)
+
+    @staticmethod
+    def _mwd(msg: Any, t: float) -> Reading | None:
+        d = _f(msg.direction_true)
+        ms, kn = _f(msg.wind_speed_meters), _f(msg.wind_speed_knots)
+        s = ms if ms is not None else (None if kn is None else kn * KN)
+        if d is None or s is None:
+            return None
+        return Reading(t, tws_ms=s, twd_deg=float(wrap360(d)))
 
 
 # ------------------------------------------------------------------------------ Signal K
@@ -298,6 +320,25 @@ _SK_PATHS: dict[str, tuple[str, float]] = {
 }
 _ANGLES = {"cog_deg", "hdg_deg", "twd_deg"}
 _SIGNED = {"twa_deg", "awa_deg"}
+
+
+def _sk_fields(path: Any, value: Any) -> dict[str, Any]:
+    """The :class:`Reading` fields of one Signal K path and value (empty when unused)."""
+    if path == "navigation.position" and isinstance(value, dict):
+        lat, lon = _sk_f(value.get("latitude")), _sk_f(value.get("longitude"))
+        return {} if lat is None or lon is None else {"lat": lat, "lon": lon}
+    if not (isinstance(path, str) and path in _SK_PATHS):
+        return {}
+    v = _sk_f(value)
+    if v is None:
+        return {}
+    name, scale = _SK_PATHS[path]
+    v *= scale
+    if name in _ANGLES:
+        v = float(wrap360(v))
+    elif name in _SIGNED:
+        v = float(wrap180(v))
+    return {name: v}
 
 
 def _sk_f(value: Any) -> float | None:
@@ -355,42 +396,27 @@ class SignalKDecoder:
         if self.self_context is not None and ctx not in (None, self.self_context, "vessels.self"):
             self.counts.by_kind["ignored"] += 1
             return []
-        out: list[Reading] = []
         updates = msg["updates"]
         if not isinstance(updates, list):
             self.counts.by_kind["malformed"] += 1
             return []
-        for up in updates:
-            if not isinstance(up, dict) or not isinstance(up.get("values"), list):
-                self.counts.by_kind["malformed"] += 1
-                continue
-            t = _sk_time(up.get("timestamp"))
-            if t is None:
-                self.counts.by_kind["untimed"] += 1
-                continue
-            r = Reading(t, timed=True)
-            used = False
-            for item in up["values"]:
-                if not isinstance(item, dict):
-                    continue
-                path, value = item.get("path"), item.get("value")
-                if path == "navigation.position" and isinstance(value, dict):
-                    lat, lon = _sk_f(value.get("latitude")), _sk_f(value.get("longitude"))
-                    if lat is not None and lon is not None:
-                        r, used = replace(r, lat=lat, lon=lon), True
-                elif isinstance(path, str) and path in _SK_PATHS:
-                    v = _sk_f(value)
-                    if v is None:
-                        continue
-                    name, scale = _SK_PATHS[path]
-                    v *= scale
-                    if name in _ANGLES:
-                        v = float(wrap360(v))
-                    elif name in _SIGNED:
-                        v = float(wrap180(v))
-                    fields: dict[str, Any] = {name: v}
-                    r, used = replace(r, **fields), True
-            if used:
-                self.counts.by_kind["delta"] += 1
-                out.append(r)
+        out = [r for r in (self._update(up) for up in updates) if r is not None]
         return out
+
+    def _update(self, up: Any) -> Reading | None:
+        """One update of a delta: its values at its time, or None when none is usable."""
+        if not isinstance(up, dict) or not isinstance(up.get("values"), list):
+            self.counts.by_kind["malformed"] += 1
+            return None
+        t = _sk_time(up.get("timestamp"))
+        if t is None:
+            self.counts.by_kind["untimed"] += 1
+            return None
+        fields: dict[str, Any] = {}
+        for item in up["values"]:
+            if isinstance(item, dict):
+                fields.update(_sk_fields(item.get("path"), item.get("value")))
+        if not fields:
+            return None
+        self.counts.by_kind["delta"] += 1
+        return Reading(t, timed=True, **fields)
