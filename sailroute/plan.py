@@ -31,6 +31,7 @@ from sailroute.report import png_worker
 from sailroute.report.plan import Comparison, Plan, compare, make_plan
 from sailroute.report.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
+from sailroute.routing.batch import batchable, route_course_batch
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import LegResult, RouterName, RoutingSettings
 from sailroute.wind.base import WindField
@@ -335,15 +336,24 @@ def _compare_scenarios(
     backend: str = "numpy",
     progress: Progress | None = None,
     scheduler: str | None = None,
+    batch: bool = False,
 ) -> tuple[Comparison, list[Plan], dict[str, WindField]]:
-    """:func:`compare_scenarios`, plus the scenarios' built winds (for ``report.html``)."""
+    """:func:`compare_scenarios`, plus the scenarios' built winds (for ``report.html``);
+    ``batch``: route the scenarios together (:func:`~sailroute.routing.batch.batchable`)."""
     names = list(course.scenarios) if not scenarios else scenario_members(course, scenarios)
     settings = settings_for(course, router, backend)
     where = check_scheduler(scheduler)  # a bad name fails before any work
     # every problem of every scenario in one error, up front
     boat, winds = build_specs(course, names)
     _warn(progress, check_boat_and_winds(course, boat, winds))
-    if where == SERIAL:
+    if where == SERIAL and batch and batchable(settings, backend,
+                                                [build_current(course, n) for n in names]):
+        # the members as one front per leg (routing/batch.py)
+        results = route_course_batch(course, [winds[n] for n in names], boat, settings,
+                                     progress=progress)
+        plans = [make_plan(course, n, r, winds[n], router=settings.router)
+                 for n, r in zip(names, results, strict=True)]
+    elif where == SERIAL:
         plans = []
         for n in names:
             if progress is not None:
@@ -456,7 +466,7 @@ def _run_ensemble(
     from sailroute.report.files import write_plan_outputs
 
     cmp, plans, winds = _compare_scenarios(course, [name], router=router, backend=backend,
-                                           progress=progress)
+                                           progress=progress, batch=True)
     summary = summarize_ensemble(name, plans)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, name, router)
 

@@ -15,13 +15,17 @@ finishes its leg alone, from its own front, with the isochrone driver.  Every st
 member takes is therefore the step the single-member router takes, with the same
 numbers:
 
-* members that start from the same :class:`~sailroute.routing.types.Start` as the
-  first member get the :class:`~sailroute.routing.types.LegResult` that
+* when every member starts from the same :class:`~sailroute.routing.types.Start` (the
+  first leg of a course; an ensemble of winds or of start times), each gets the
+  :class:`~sailroute.routing.types.LegResult` that
   :func:`~sailroute.routing.isochrone.route_isochrone` gives, bit for bit;
 * a member starting elsewhere (a later leg of a course, each member starting where its
-  previous leg ended) is routed in the leg frame and target geometry of the first
-  member's start: the rounding segment of a mark and the sectors of the pruning turn by
-  the small angle between the two starts seen from the target.  Its leg time then
+  previous leg ended) is routed in the leg frame, target geometry and barriers of the
+  first member's start: the rounding segment of a mark (and the barrier the leg hands on
+  to the next leg, so that every member ends on the segment it starts the next leg
+  behind) and the sectors of the pruning turn by the small angle between the two starts
+  seen from the target; the clearance kept from the mark just rounded is the smallest
+  of the members' (:func:`~sailroute.routing.geometry.barrier_clearance`).  Its leg time then
   differs from its single-member route by the pruning's own tolerance
   (``docs/design/routing.md``; measured on Hyères R1 in ``docs/performance.md``).
 
@@ -39,9 +43,13 @@ from typing import Any
 import numpy as np
 
 from sailroute.boat.model import BoatModel
+from sailroute.course.geometry import leg_endpoints, target_of
+from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.numerics import clip
 from sailroute.routing.geometry import (
+    barrier_clearance,
+    chain_leg,
     leg_barriers,
     leg_label,
     start_centre,
@@ -80,7 +88,66 @@ from sailroute.routing.track import make_leg_result
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target, check_settings
 from sailroute.wind.base import Coverage, WindField
 
-__all__ = ["route_leg_batch"]
+__all__ = ["batchable", "route_course_batch", "route_leg_batch"]
+
+
+def batchable(settings: RoutingSettings, backend: str, currents: Sequence[object]) -> bool:
+    """Whether :func:`route_course_batch` can route these members: the isochrone router
+    on NumPy, every member in still water (``currents`` all None)."""
+    return (settings.router == "isochrone" and backend == "numpy"
+            and all(c is None for c in currents))
+
+
+def route_course_batch(
+    course: Course,
+    winds: Sequence[WindField],
+    boat: BoatModel,
+    settings: RoutingSettings,
+    *,
+    progress: Any = None,
+) -> list[list[LegResult]]:
+    """Route every leg of ``course`` for every member wind, leg by leg as one front.
+
+    The batched counterpart of :func:`sailroute.plan.route_course` (isochrone router,
+    NumPy, still water): each member's leg starts where and when its previous leg ended.
+
+    Parameters
+    ----------
+    course : Course
+        The course.
+    winds : sequence of WindField
+        One wind per member.
+    boat : BoatModel
+        The boat.
+    settings : RoutingSettings
+        Isochrone settings.
+    progress : Progress, optional
+        Per leg: ``start_leg``, ``update`` (share of members arrived) and ``end_leg``
+        (the members' median leg time).
+
+    Returns
+    -------
+    list of list of LegResult
+        Per member, its legs in order.
+    """
+    results: list[list[LegResult]] = [[] for _ in winds]
+    for i, spec in enumerate(course.legs):
+        following = target_of(course, i + 1) if i + 1 < course.n_legs else None
+        ends = leg_endpoints(course, i)
+        target = chain_leg(*ends, None, following)[1]
+        starts = [chain_leg(*ends, legs[-1] if legs else None, following)[0]
+                  for legs in results]
+        t0s = [legs[-1].t_end if legs else course.start_epoch for legs in results]
+        if progress is not None:
+            progress.start_leg(i, spec.label)
+        done = route_leg_batch(starts, target, t0s, winds, boat, settings,
+                               progress=progress.update if progress is not None else None)
+        if progress is not None:
+            progress.end_leg(float(np.median([r.time_s for r in done])),
+                             f"median of {len(done)} members")
+        for legs, res in zip(results, done, strict=True):
+            legs.append(res)
+    return results
 
 
 def route_leg_batch(
@@ -142,6 +209,10 @@ def route_leg_batch(
     geom = target_geometry(target, starts[0], settings.zone_m)
     frame = _LegFrame.for_leg(geom.centre, start_centre(starts[0]))
     barriers = leg_barriers(starts[0], target)
+    if starts[0].barrier is not None:  # no member may start inside the mark's clearance
+        clear = min(barrier_clearance(dataclasses.replace(st, barrier=starts[0].barrier))
+                    for st in starts)
+        barriers = ((barriers[0][0], clear), *barriers[1:])
     ctxs = []
     for t0, wind in zip(t0s, winds, strict=True):
         _check_start_time(t0, label)
@@ -150,7 +221,8 @@ def route_leg_batch(
             _check_target_covered(geom, ctx.box, wind, label)
         ctxs.append(ctx)
     leg = _Leg(target, settings, polar, frame, _device_tables(tab, np),
-               int(tab.twa_deg.size), progress, n)
+               int(tab.twa_deg.size), progress, n,
+               target_barrier(target, starts[0], settings.zone_m))
     members = [_Member(k, starts[k], winds[k], ctxs[k],
                        start_points(starts[k], settings.start_line_spacing_m))
                for k in range(n)]
@@ -179,6 +251,7 @@ class _Leg:
     n_angles: int
     progress: Callable[[float], None] | None
     n_members: int
+    barrier: Any  # the rounding ray the legs end on (of the common target geometry)
 
 
 @dataclass(eq=False)
@@ -400,5 +473,4 @@ def _own_layers(m: _Member, history: list[_Front]) -> list[_Layer]:
 def _result(m: _Member, layers: list[_Layer], arrival: _Arrival, leg: _Leg) -> LegResult:
     """The member's :class:`LegResult`, as the single-member router assembles it."""
     track = _backtrack(layers, arrival, leg.frame, m.wind, leg.polar, m.world_start)
-    return make_leg_result(track, "isochrone",
-                           target_barrier(leg.target, m.start, leg.settings.zone_m))
+    return make_leg_result(track, "isochrone", leg.barrier)
