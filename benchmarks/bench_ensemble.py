@@ -16,7 +16,8 @@ together, ... ``--repeat`` times; the best of each is reported) in one process, 
 and CPU time, with the load average before and after; both give the same leg times for
 the members whose legs start at the same point (the first leg), and the script prints
 how far the others differ (``routing/batch.py`` explains why they may).
-``--smoke``: 3 members, the first two legs (checks the script runs).
+``--only together`` (or ``one-by-one``) times one way only.  ``--smoke``: 3 members, the
+first two legs (checks the script runs).
 """
 
 from __future__ import annotations
@@ -71,6 +72,8 @@ def main() -> None:
     ap.add_argument("--members", type=int, default=100)
     ap.add_argument("--wind", choices=("wrf", "uniform"), default="wrf")
     ap.add_argument("--repeat", type=int, default=1, help="alternate runs of each way")
+    ap.add_argument("--only", choices=("together", "one-by-one"), default=None,
+                    help="time one way only (no ratio, no comparison)")
     ap.add_argument("--smoke", action="store_true", help="3 members, 2 legs")
     args = ap.parse_args()
     n = 3 if args.smoke else args.members
@@ -87,7 +90,8 @@ def main() -> None:
                for d, e in zip(turn, scale, strict=True)]
     s = course.routing
 
-    best = {"one by one": (np.inf, np.inf), "together": (np.inf, np.inf)}
+    ways = ("one by one", "together") if args.only is None else (args.only.replace("-", " "),)
+    best = {way: (np.inf, np.inf) for way in ways}
     out: dict[str, list[list[Any]]] = {}
     for _ in range(args.repeat):
         for way in best:
@@ -104,6 +108,8 @@ def main() -> None:
           f"dt {s.dt_s:g} s, {s.heading_step_deg:g}°: best of {args.repeat}, wall (CPU)")
     for way, (wall, cpu) in best.items():
         print(f"  {way:<11} {wall:8.2f} s ({cpu:.2f} s)  {wall / n * 1e3:7.1f} ms per member")
+    if args.only is not None:
+        return
     ratio_w = best["one by one"][0] / best["together"][0]
     ratio_c = best["one by one"][1] / best["together"][1]
     print(f"  ratio one by one / together: {ratio_w:.2f}x wall ({ratio_c:.2f}x CPU)")

@@ -24,8 +24,8 @@ numbers:
   first member's start: the rounding segment of a mark (and the barrier the leg hands on
   to the next leg, so that every member ends on the segment it starts the next leg
   behind) and the sectors of the pruning turn by the small angle between the two starts
-  seen from the target; the clearance kept from the mark just rounded is the smallest
-  of the members' (:func:`~sailroute.routing.geometry.barrier_clearance`).  Its leg time then
+  seen from the target (each keeps its own clearance from the mark just rounded,
+  :func:`~sailroute.routing.geometry.barrier_clearance`).  Its leg time then
   differs from its single-member route by the pruning's own tolerance
   (``docs/design/routing.md``; measured on Hyères R1 in ``docs/performance.md``).
 
@@ -209,14 +209,16 @@ def route_leg_batch(
     geom = target_geometry(target, starts[0], settings.zone_m)
     frame = _LegFrame.for_leg(geom.centre, start_centre(starts[0]))
     barriers = leg_barriers(starts[0], target)
-    if starts[0].barrier is not None:  # no member may start inside the mark's clearance
-        clear = min(barrier_clearance(dataclasses.replace(st, barrier=starts[0].barrier))
-                    for st in starts)
-        barriers = ((barriers[0][0], clear), *barriers[1:])
+    clearances = None
+    if starts[0].barrier is not None:  # each member keeps its own clearance from the mark
+        clearances = [barrier_clearance(dataclasses.replace(st, barrier=starts[0].barrier))
+                      for st in starts]
     ctxs = []
-    for t0, wind in zip(t0s, winds, strict=True):
+    for k, (t0, wind) in enumerate(zip(t0s, winds, strict=True)):
         _check_start_time(t0, label)
-        ctx = _context(label, float(t0), frame, geom, wind, settings, barriers)
+        own = barriers if clearances is None \
+            else ((barriers[0][0], clearances[k]), *barriers[1:])
+        ctx = _context(label, float(t0), frame, geom, wind, settings, own)
         if ctx.box is not None:
             _check_target_covered(geom, ctx.box, wind, label)
         ctxs.append(ctx)
@@ -224,7 +226,8 @@ def route_leg_batch(
                int(tab.twa_deg.size), progress, n,
                target_barrier(target, starts[0], settings.zone_m))
     members = [_Member(k, starts[k], winds[k], ctxs[k],
-                       start_points(starts[k], settings.start_line_spacing_m))
+                       start_points(starts[k], settings.start_line_spacing_m),
+                       None if clearances is None else clearances[k])
                for k in range(n)]
     results: dict[int, LegResult] = {}
     by_box: dict[Any, list[_Member]] = {}
@@ -263,6 +266,7 @@ class _Member:
     wind: WindField
     ctx: _Context
     world_start: tuple[Any, Any]
+    clearance: float | None  # from the mark of the start's barrier [m]; None: no barrier
     calm_since: float | None = None
     tau_hint: float = math.inf
 
@@ -334,7 +338,7 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
         t0.append(np.full(lx.shape[0], m.ctx.t0))
     sizes = [a.shape[0] for a in x0]
     root = _root_layer(np.concatenate(t0), np.concatenate(x0), np.concatenate(y0), s, np)
-    history = [_Front(root, tuple(members), Groups.of_sizes(sizes))]
+    history = [_Front(root, tuple(members), _groups(members, sizes))]
     dt = float(s.dt_s)
     while history[-1].members:
         front = history[-1]
@@ -358,6 +362,14 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
             continue
         history.append(out)
         _after_step(front, out, tau_min, dist_min, leg)
+
+
+def _groups(members: Sequence[_Member], sizes: Any) -> Groups:
+    """The :class:`Groups` of ``members`` with ``sizes`` points each, with their
+    clearances from the start's mark (if the leg starts at a rounded mark)."""
+    clear = None if members[0].clearance is None \
+        else np.array([m.clearance for m in members])
+    return Groups.of_sizes(sizes, clear)
 
 
 def _common_step(pre: Any, front: _Front, ctx: _Context, leg: _Leg) -> _Front | list[_Member]:
@@ -402,7 +414,7 @@ def _common_step(pre: Any, front: _Front, ctx: _Context, leg: _Leg) -> _Front | 
     block = (wid // n_columns) % 2
     row = wid // (2 * n_columns)
     layer, moved = _survivors(pre, row, block, column, best[won], leg.dev, np)
-    return _Front(layer, front.members, Groups.of_sizes(counts), moved)
+    return _Front(layer, front.members, _groups(front.members, counts), moved)
 
 
 def _after_step(
@@ -447,14 +459,14 @@ def _finish_alone(
     sizes = [front.block(m)[1] - front.block(m)[0] for m in stay]
     layer = _Layer(**{f.name: getattr(front.layer, f.name)[rows]
                       for f in dataclasses.fields(_Layer)})
-    history[-1] = _Front(layer, stay, Groups.of_sizes(sizes) if stay
+    history[-1] = _Front(layer, stay, _groups(stay, sizes) if stay
                          else Groups(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
 
 
 def _own_layers(m: _Member, history: list[_Front]) -> list[_Layer]:
     """The fronts of member ``m`` alone, as the single-member router keeps them (its
     points, parents counted within its own previous front, a float time)."""
-    out = []
+    out: list[_Layer] = []
     prev_lo = 0
     for front in history:
         lo, hi = front.block(m)

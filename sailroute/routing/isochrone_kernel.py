@@ -294,7 +294,7 @@ def _floats(p: tuple[Any, Any]) -> tuple[float, float]:
 class _Layer:
     """Front at one time (leg frame), with the move that led to each point."""
 
-    t: float  # time of this front [epoch s]
+    t: Any  # time of this front [epoch s] (per point for members routed together)
     x: Any  # leg-frame position [m]
     y: Any
     side: Any  # +1, -1 (0 only at the leg start: free)
@@ -588,6 +588,12 @@ class _StepInputs(NamedTuple):
     fan_lo, fan_hi : array of int or None
         Each point's own fan of grid columns ``fan_lo:fan_hi`` (its member's,
         :func:`_group_fans`) inside the common ``first:stop``; None: ``first:stop``.
+    box_clear : bool
+        No move of the step can leave the coverage box (:func:`_box_holds`), so the
+        candidates are not tested against it.
+    first_clear : array or None
+        Members: each point's clearance from the mark of the first barrier of the leg
+        (the start's, :attr:`Groups.clearance`) [m]; None: the barrier's own.
     """
 
     t: Any
@@ -609,6 +615,8 @@ class _StepInputs(NamedTuple):
     n_groups: int = 1
     fan_lo: Any = None
     fan_hi: Any = None
+    box_clear: bool = True
+    first_clear: Any = None
 
     @property
     def n(self) -> int:
@@ -642,6 +650,8 @@ class _StepInputs(NamedTuple):
             group=None if self.group is None else self.group[sl], n_groups=self.n_groups,
             fan_lo=None if self.fan_lo is None else self.fan_lo[sl],
             fan_hi=None if self.fan_hi is None else self.fan_hi[sl],
+            box_clear=self.box_clear,
+            first_clear=None if self.first_clear is None else self.first_clear[sl],
         )
 
 
@@ -1087,22 +1097,27 @@ class Groups(NamedTuple):
         Index of each member's first point.
     member : ndarray of int, shape (n,)
         The member of each point, 0 .. M - 1.
+    clearance : ndarray, shape (M,), or None
+        Each member's clearance from the mark of the leg's first barrier, the start's
+        (:func:`~sailroute.routing.geometry.barrier_clearance`) [m]; None: no start
+        barrier.
     """
 
     starts: Any
     member: Any
+    clearance: Any = None
 
     @property
-    def count(self) -> int:
+    def n_members(self) -> int:
         """Number of members ``M``."""
         return int(self.starts.shape[0])
 
     @classmethod
-    def of_sizes(cls, sizes: Any) -> Groups:
+    def of_sizes(cls, sizes: Any, clearance: Any = None) -> Groups:
         """Members of ``sizes[k]`` consecutive points each (every size > 0)."""
         sizes = np.asarray(sizes, dtype=np.int64)
         starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-        return cls(starts, np.repeat(np.arange(sizes.shape[0]), sizes))
+        return cls(starts, np.repeat(np.arange(sizes.shape[0]), sizes), clearance)
 
 
 def _least(values: Any, groups: Groups | None, xp: ModuleType) -> Any:
@@ -1119,8 +1134,8 @@ def _group_fans(
     """:func:`_fan` per member: the common grid columns ``first:stop`` (all members'
     fans together) and each point's own ``fan_lo, fan_hi`` (shape (n,))."""
     n_a = int(dev.twa_deg.shape[0])
-    lo = np.zeros(groups.count, dtype=np.int64)
-    hi = np.full(groups.count, n_a, dtype=np.int64)
+    lo = np.zeros(groups.n_members, dtype=np.int64)
+    hi = np.full(groups.n_members, n_a, dtype=np.int64)
     if hull:
         lo_h = np.searchsorted(dev.twa_deg, np.minimum.reduceat(wind.up_deg, groups.starts),
                                side="right")
@@ -1183,13 +1198,16 @@ def _manoeuvre_state(f: _Layer, ctx: _Context, xp: ModuleType) -> _ManoeuvreStat
 
 
 def _within_reach(
-    x: Any, y: Any, step_m: Any, ctx: _Context, xp: ModuleType
+    x: Any, y: Any, step_m: Any, ctx: _Context, xp: ModuleType, first_clear: Any = None,
 ) -> tuple[Any, tuple[Any, ...]]:
     """Points whose move (at most ``step_m`` [m], shape (n,)) can reach the target segment,
-    and per barrier of the leg those that can reach its ray (None where no point can)."""
+    and per barrier of the leg those that can reach its ray (None where no point can);
+    ``first_clear``: the first barrier's clearance per point [m] (shape (n,)), or None."""
     near = _segment_distance(x, y, ctx.geom, xp) <= step_m + 1e-6
     near_barrier = []
-    for b, clear in ctx.barriers:
+    for i, (b, clear) in enumerate(ctx.barriers):
+        if i == 0 and first_clear is not None:
+            clear = first_clear
         ray = TargetGeometry(b.mark, (b.mark[0] + BARRIER_LENGTH_M * b.ray[0],
                                       b.mark[1] + BARRIER_LENGTH_M * b.ray[1]), b.normal, "ray")
         close = _segment_distance(x, y, ray, xp) <= step_m + clear + 1e-3
@@ -1253,7 +1271,10 @@ def _prepare(
                         xp.max(exact.bsp_ms, axis=1))
     if cur is not None:
         top_ms = top_ms + xp.sqrt(cur.move_x * cur.move_x + cur.move_y * cur.move_y)
-    near, near_barrier = _within_reach(x, y, top_ms * dt * 1.0001, ctx, xp)
+    first_clear = None if groups is None or groups.clearance is None \
+        else groups.clearance[groups.member]
+    near, near_barrier = _within_reach(x, y, top_ms * dt * 1.0001, ctx, xp, first_clear)
+    box_clear = ctx.box is None or _box_holds(x, y, top_ms * dt * 1.0001, ctx, xp)
 
     pre = _StepInputs(
         t=f.t, dt=dt, first=first, stop=stop, x=x, y=y, wind=move_wind, exact=exact,
@@ -1262,7 +1283,8 @@ def _prepare(
         current_x=None if cur is None else cur.move_x,
         current_y=None if cur is None else cur.move_y,
         group=None if groups is None else groups.member,
-        n_groups=1 if groups is None else groups.count, fan_lo=fan_lo, fan_hi=fan_hi,
+        n_groups=1 if groups is None else groups.n_members, fan_lo=fan_lo, fan_hi=fan_hi,
+        box_clear=box_clear, first_clear=first_clear,
     )
     return pre, tau_min, dist_min
 
@@ -1406,10 +1428,12 @@ def _barrier_blocked(
     side (:func:`~sailroute.routing.geometry.barrier_blocks`, rows near a barrier
     only); None where no row is near one."""
     blocked = None
-    for (bar, clear), close in zip(ctx.barriers, c.near_barrier, strict=True):
+    for i, ((bar, clear), close) in enumerate(zip(ctx.barriers, c.near_barrier, strict=True)):
         nb = None if close is None else xp.flatnonzero(close)
         if nb is None or nb.shape[0] == 0:
             continue
+        if i == 0 and c.first_clear is not None:  # members: each its own clearance
+            clear = c.first_clear[nb][:, None]
         if blocked is None:
             blocked = [xp.zeros(qx.shape, dtype=bool) for qx, _ in ends]
         px_b, py_b = c.x[nb][:, None], c.y[nb][:, None]
@@ -1447,7 +1471,7 @@ def _arrival(
             hit &= ~blocked[blk.block][near]
         if blk.block == _SWITCH and m.any_pending:
             hit &= ~m.pending[near, None]
-        if ctx.box is not None:
+        if ctx.box is not None and not c.box_clear:
             hit &= _in_box(qx[near], qy[near], ctx.frame, ctx.box)
         if not bool(xp.any(hit)):
             continue
@@ -1510,7 +1534,7 @@ def _drop_forbidden(
     if blocked is not None:
         scores = [xp.where(mask, np.inf, score) for score, mask in zip(scores, blocked,
                                                                         strict=True)]
-    if ctx.box is not None:
+    if ctx.box is not None and not c.box_clear:
         scores = [xp.where(_in_box(qx, qy, ctx.frame, ctx.box), score, np.inf)
                   for score, (qx, qy) in zip(scores, ends, strict=True)]
     return scores
@@ -1615,6 +1639,16 @@ def _in_box(
     """Candidates (leg frame) whose world position lies inside the coverage box."""
     wx, wy = fr.to_world(qx, qy)
     return (wx >= box[0]) & (wx <= box[1]) & (wy >= box[2]) & (wy <= box[3])
+
+
+def _box_holds(x: Any, y: Any, reach_m: Any, ctx: _Context, xp: ModuleType) -> bool:
+    """Whether every move of the step stays in the coverage box ``ctx.box``: each point
+    (leg frame) with its reach [m] (shape (n,)) lies that far inside it."""
+    assert ctx.box is not None
+    wx, wy = ctx.frame.to_world(x, y)
+    xmin, xmax, ymin, ymax = ctx.box
+    return bool(xp.all((wx - reach_m >= xmin) & (wx + reach_m <= xmax)
+                       & (wy - reach_m >= ymin) & (wy + reach_m <= ymax)))
 
 
 def _segment_distance(x: Any, y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
