@@ -1,7 +1,7 @@
 """Benchmark: route a 1.8 km beat with the isochrone router on one core.
 
     python benchmarks/bench_isochrone.py [--repeat 7] [--dt 5] [--heading-step 2]
-                                         [--sector 0.5]
+                                         [--sector 0.5] [--penalty 0] [--smoke]
 
 Cases (Laser/ILCA 7 polar from ``sailroute/boat/data/ilca7.pol`` when present, else a
 synthetic Laser-like table):
@@ -13,10 +13,12 @@ synthetic Laser-like table):
 * a gridded analytic field (500 m cells, 10-min slices, shifts and pressure bands)
   sampled bilinearly by :class:`~sailroute.wind.grid.GridWind`, same geometry.
 
-Prints, per case, the best and median wall and CPU time per leg over ``--repeat`` runs
-(after one warm-up run, which also builds the cached polar tables), the number of
-steps, the mean and largest front size, the candidates tried per step, and the leg
-time.  The machine's load matters: compare numbers taken on the same machine.
+Prints the command and the load average, then per case the best and median wall and
+CPU time per leg over ``--repeat`` runs (after one warm-up run, which also builds the
+cached polar tables), the number of steps, the mean and largest front size, the
+candidates tried per step, the CPU time of a step split into a fixed part and a part per
+front point (least squares over the steps of one run), and the leg time.  The machine's
+load matters: compare numbers taken on the same machine, in one run.
 """
 
 from __future__ import annotations
@@ -105,18 +107,27 @@ def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repe
              xp=np):
     start, target = beat(wind, t0)
     sizes: list[int] = []
+    step_s: list[float] = []
     orig = isochrone._step
 
-    def counting(f, *a, **k):  # front size per step
+    def counting(f, *a, **k):  # front size and CPU time per step
         sizes.append(int(f.x.shape[0]))
-        return orig(f, *a, **k)
+        c0 = time.process_time()
+        out = orig(f, *a, **k)
+        step_s.append(time.process_time() - c0)
+        return out
 
     isochrone._step = counting
     try:
         res = isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)  # warm-up
+        sizes.clear()
+        step_s.clear()
+        isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)  # timed steps
         steps, mean_n, max_n = len(sizes), float(np.mean(sizes)), max(sizes)
     finally:
         isochrone._step = orig
+    # CPU time of a step = fixed + per point x front size (least squares over the steps)
+    per_point, fixed = np.polyfit(np.asarray(sizes, dtype=float), np.asarray(step_s), 1)
     walls, cpus = [], []
     for _ in range(repeat):
         w0, c0 = time.perf_counter(), time.process_time()
@@ -135,6 +146,8 @@ def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repe
     print(f"  {steps} steps, front {mean_n:.0f} points mean / {max_n} max, "
           f"{hull + 3} + 3 candidates per point (grid TWAs between the VMG angles "
           f"{a_up:.1f}-{a_dn:.1f} deg + 3 exact; 3 after a side change)")
+    print(f"  per step (CPU, least squares over the {steps} steps): {1e6 * fixed:.0f} us "
+          f"fixed + {1e6 * per_point:.2f} us per front point")
     print(f"  leg time {res.time_s:.1f} s, {res.n_tacks} tacks, {res.n_gybes} gybes, "
           f"sailed {res.distance_m:.0f} m, start -> end ({res.end_xy[0]:.0f}, "
           f"{res.end_xy[1]:.0f}) m")
@@ -146,6 +159,8 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=None, help="dt_s (default: RoutingSettings)")
     ap.add_argument("--heading-step", type=float, default=None)
     ap.add_argument("--sector", type=float, default=None)
+    ap.add_argument("--penalty", type=float, default=None,
+                    help="tack and gybe penalty [s] (default: RoutingSettings)")
     ap.add_argument("--backend", default="numpy", help="numpy | cupy | auto (array backend)")
     ap.add_argument("--smoke", action="store_true",
                     help="the uniform-wind leg once (checks the script runs)")
@@ -154,9 +169,13 @@ def main() -> None:
         args.repeat = 1
     xp = get_xp(args.backend)
     kw = {k: v for k, v in (("dt_s", args.dt), ("heading_step_deg", args.heading_step),
-                            ("prune_sector_deg", args.sector)) if v is not None}
+                            ("prune_sector_deg", args.sector),
+                            ("tack_penalty_s", args.penalty), ("gybe_penalty_s", args.penalty))
+          if v is not None}
     st = RoutingSettings(**kw)
     polar = load_polar()
+    print(f"command: python {' '.join(sys.argv)}; load average (1, 5, 15 min): "
+          f"{', '.join(f'{x:.2f}' for x in os.getloadavg())}")
     print(f"isochrone router, one thread, numpy {np.__version__}; polar {polar.name!r}; "
           f"dt {st.dt_s:g} s, heading step {st.heading_step_deg:g} deg, sectors "
           f"{st.prune_sector_deg:g} deg, tack {st.tack_penalty_s:g} s, gybe "

@@ -24,6 +24,7 @@ CASES = [
      else r"^bench_polar_fit\.py: .* not present .*: nothing measured$"),
     ("bench_course_io.py", r"^export gpx\+kml\+nmea +[\d.]+ ms +\(6 legs, \d+ track points\)$"),
     ("bench_isochrone.py", r"^  leg time \d+\.\d s, \d+ tacks, 0 gybes"),
+    ("bench_ensemble.py", r"^  leg 1: 3/3 leg times identical; largest difference 0\.000 s"),
     ("race_polar_validation.py",
      r"^\| ilca7 \| Snipe P01 \(--smoke, 30 s steps\) \| 6 kn 110° \| 0\.\d{3} \| 0\.673 \|"),
     ("bench_griddp.py", r"^Debski analytic wind +polar +8 +3 "),

@@ -105,7 +105,7 @@ def _run_ensemble(
     from sailroute.report.ensemble import ensemble_table, summarize_ensemble, write_ensemble
     from sailroute.report.files import write_plan_outputs
 
-    cmp, plans, winds = route_scenarios(course, [name], options)
+    cmp, plans, winds = route_scenarios(course, [name], options, batch=True)
     summary = summarize_ensemble(name, plans, winds)
     out = Path(out_dir) if out_dir is not None else default_out_dir(course, name, options.router)
 

@@ -28,8 +28,9 @@ from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.planning.result import Comparison, Plan, compare, make_plan
 from sailroute.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
+from sailroute.routing.batch import batchable, route_course_batch
 from sailroute.routing.geometry import chain_leg
-from sailroute.routing.obstacles import land_filled, obstacles_for
+from sailroute.routing.obstacles import RaceArea, land_filled, obstacles_for
 from sailroute.routing.types import LegResult, RouterName, RoutingSettings
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
@@ -299,14 +300,19 @@ def _routed(
         check_current_router(settings.router)
     results = route_course(course, wind, boat, settings, backend=options.backend,
                            progress=progress, current=current)
-    plan = make_plan(course, name, results, wind, router=settings.router)
-    # start line numbers and laylines (routing/startline.py, routing/laylines.py)
+    return PlannedCourse(_plan_of(course, name, results, wind, boat, settings), wind)
+
+
+def _plan_of(course: Course, name: str, results: Sequence[LegResult], wind: WindField,
+             boat: BoatModel, settings: RoutingSettings) -> Plan:
+    """The :class:`Plan` of routed legs, with the start line's numbers and the laylines
+    (:mod:`sailroute.planning.startline`)."""
     from sailroute.planning.startline import course_laylines, course_start_line_numbers
 
-    plan = dataclasses.replace(
+    plan = make_plan(course, name, list(results), wind, router=settings.router)
+    return dataclasses.replace(
         plan, start_line=course_start_line_numbers(course, wind, boat),
         laylines=course_laylines(course, [(pl.mode, pl.result) for pl in plan.legs], wind, boat))
-    return PlannedCourse(plan, wind)
 
 
 def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:
@@ -343,8 +349,10 @@ def compare_scenarios(
 
 def route_scenarios(
     course: Course, scenarios: Sequence[str] | None = None, options: RunOptions = DEFAULT_RUN,
+    *, batch: bool = False,
 ) -> tuple[Comparison, list[Plan], dict[str, WindField]]:
-    """:func:`compare_scenarios`, plus the scenarios' built winds (for ``report.html``)."""
+    """:func:`compare_scenarios`, plus the scenarios' built winds (for ``report.html``);
+    ``batch``: route the scenarios together (:func:`~sailroute.routing.batch.batchable`)."""
     router, backend, progress = options.router, options.backend, options.progress
     names = list(course.scenarios) if not scenarios else scenario_members(course, scenarios)
     settings = settings_for(course, router, backend)
@@ -352,7 +360,15 @@ def route_scenarios(
     # every problem of every scenario in one error, up front
     boat, winds = build_specs(course, names)
     _warn(progress, check_boat_and_winds(course, boat, winds))
-    if where == SERIAL:
+    open_water = course.area == RaceArea()  # the batch routes without a race area
+    if where == SERIAL and batch and open_water and batchable(
+            settings, backend, [build_current(course, n) for n in names]):
+        # the members as one front per leg (routing/batch.py)
+        results = route_course_batch(course, [winds[n] for n in names], boat, settings,
+                                     progress=progress)
+        plans = [_plan_of(course, n, r, winds[n], boat, settings)
+                 for n, r in zip(names, results, strict=True)]
+    elif where == SERIAL:
         plans = []
         for n in names:
             if progress is not None:

@@ -447,7 +447,7 @@ def barrier_clearance(start: Start) -> float:
 
 def barrier_blocks(
     px: NDArray, py: NDArray, qx: NDArray, qy: NDArray, barrier: Barrier,
-    clearance_m: float = 0.0, *, xp: ModuleType = np,
+    clearance_m: float | NDArray = 0.0, *, xp: ModuleType = np,
 ) -> NDArray:
     """Which straight moves ``P → Q`` a barrier forbids.
 
@@ -457,9 +457,9 @@ def barrier_blocks(
         Move starts and ends [m] (broadcast).
     barrier : Barrier
         Ray of the mark just rounded.
-    clearance_m : float
+    clearance_m : float or ndarray
         Moves passing closer than this to the mark are forbidden too [m]
-        (:func:`barrier_clearance`).
+        (:func:`barrier_clearance`); an array broadcasts with the moves.
     xp : module
         Array module.
 
@@ -477,7 +477,7 @@ def barrier_blocks(
     back = TargetGeometry((ax, ay), (ax + BARRIER_LENGTH_M * rx, ay + BARRIER_LENGTH_M * ry),
                           (-nx, -ny), "barrier", barrier.name)
     blocked, _, _ = segment_crossing(px, py, qx, qy, back, xp=xp)
-    if clearance_m > 0:
+    if isinstance(clearance_m, np.ndarray) or clearance_m > 0:  # an array: one per move
         dx, dy = qx - px, qy - py
         wx, wy = mx - px, my - py
         dd = dx * dx + dy * dy
