@@ -33,8 +33,7 @@ from typing import Any
 import numpy as np
 
 from sailroute.course.load import build_specs, load_course
-from sailroute.planning.route import route_course
-from sailroute.routing.batch import route_course_batch
+from sailroute.planning.route import route_course, route_course_batch
 from sailroute.wind.base import Coverage
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -16,6 +16,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import cast
 
+import numpy as np
+
 from sailroute.backend import get_xp
 from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
@@ -28,7 +30,7 @@ from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.planning.result import Comparison, Plan, compare, make_plan
 from sailroute.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
-from sailroute.routing.batch import batchable, route_course_batch
+from sailroute.routing.batch import batchable, route_leg_batch
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.obstacles import RaceArea, land_filled, obstacles_for
 from sailroute.routing.types import LegResult, RouterName, RoutingSettings
@@ -240,6 +242,58 @@ def route_course(
         if progress is not None:
             progress.end_leg(res.time_s, f"{res.n_tacks} tacks, {res.n_gybes} gybes")
         results.append(res)
+    return results
+
+
+def route_course_batch(
+    course: Course,
+    winds: Sequence[WindField],
+    boat: BoatModel,
+    settings: RoutingSettings,
+    *,
+    progress: Progress | None = None,
+) -> list[list[LegResult]]:
+    """Route every leg of ``course`` for every member wind, leg by leg as one front.
+
+    The batched counterpart of :func:`route_course` (isochrone router,
+    NumPy, still water): each member's leg starts where and when its previous leg ended.
+
+    Parameters
+    ----------
+    course : Course
+        The course.
+    winds : sequence of WindField
+        One wind per member.
+    boat : BoatModel
+        The boat.
+    settings : RoutingSettings
+        Isochrone settings.
+    progress : Progress, optional
+        Per leg: ``start_leg``, ``update`` (share of members arrived) and ``end_leg``
+        (the members' median leg time).
+
+    Returns
+    -------
+    list of list of LegResult
+        Per member, its legs in order.
+    """
+    results: list[list[LegResult]] = [[] for _ in winds]
+    for i, spec in enumerate(course.legs):
+        following = target_of(course, i + 1) if i + 1 < course.n_legs else None
+        ends = leg_endpoints(course, i)
+        target = chain_leg(*ends, None, following)[1]
+        starts = [chain_leg(*ends, legs[-1] if legs else None, following)[0]
+                  for legs in results]
+        t0s = [legs[-1].t_end if legs else course.start_epoch for legs in results]
+        if progress is not None:
+            progress.start_leg(i, spec.label)
+        done = route_leg_batch(starts, target, t0s, winds, boat, settings,
+                               progress=progress.update if progress is not None else None)
+        if progress is not None:
+            progress.end_leg(float(np.median([r.time_s for r in done])),
+                             f"median of {len(done)} members")
+        for legs, res in zip(results, done, strict=True):
+            legs.append(res)
     return results
 
 

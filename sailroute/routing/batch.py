@@ -43,13 +43,10 @@ from typing import Any
 import numpy as np
 
 from sailroute.boat.model import BoatModel
-from sailroute.course.geometry import leg_endpoints, target_of
-from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.numerics import clip
 from sailroute.routing.geometry import (
     barrier_clearance,
-    chain_leg,
     leg_barriers,
     leg_label,
     start_centre,
@@ -88,66 +85,17 @@ from sailroute.routing.track import make_leg_result
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target, check_settings
 from sailroute.wind.base import Coverage, WindField
 
-__all__ = ["batchable", "route_course_batch", "route_leg_batch"]
+__all__ = ["batchable", "route_leg_batch"]
 
 
 def batchable(settings: RoutingSettings, backend: str, currents: Sequence[object]) -> bool:
-    """Whether :func:`route_course_batch` can route these members: the isochrone router
-    on NumPy, every member in still water (``currents`` all None)."""
+    """Whether :func:`~sailroute.planning.route.route_course_batch` can route these
+    members: the isochrone router on NumPy, every member in still water (``currents`` all
+    None)."""
     return (settings.router == "isochrone" and backend == "numpy"
             and all(c is None for c in currents))
 
 
-def route_course_batch(
-    course: Course,
-    winds: Sequence[WindField],
-    boat: BoatModel,
-    settings: RoutingSettings,
-    *,
-    progress: Any = None,
-) -> list[list[LegResult]]:
-    """Route every leg of ``course`` for every member wind, leg by leg as one front.
-
-    The batched counterpart of :func:`sailroute.planning.route.route_course` (isochrone router,
-    NumPy, still water): each member's leg starts where and when its previous leg ended.
-
-    Parameters
-    ----------
-    course : Course
-        The course.
-    winds : sequence of WindField
-        One wind per member.
-    boat : BoatModel
-        The boat.
-    settings : RoutingSettings
-        Isochrone settings.
-    progress : Progress, optional
-        Per leg: ``start_leg``, ``update`` (share of members arrived) and ``end_leg``
-        (the members' median leg time).
-
-    Returns
-    -------
-    list of list of LegResult
-        Per member, its legs in order.
-    """
-    results: list[list[LegResult]] = [[] for _ in winds]
-    for i, spec in enumerate(course.legs):
-        following = target_of(course, i + 1) if i + 1 < course.n_legs else None
-        ends = leg_endpoints(course, i)
-        target = chain_leg(*ends, None, following)[1]
-        starts = [chain_leg(*ends, legs[-1] if legs else None, following)[0]
-                  for legs in results]
-        t0s = [legs[-1].t_end if legs else course.start_epoch for legs in results]
-        if progress is not None:
-            progress.start_leg(i, spec.label)
-        done = route_leg_batch(starts, target, t0s, winds, boat, settings,
-                               progress=progress.update if progress is not None else None)
-        if progress is not None:
-            progress.end_leg(float(np.median([r.time_s for r in done])),
-                             f"median of {len(done)} members")
-        for legs, res in zip(results, done, strict=True):
-            legs.append(res)
-    return results
 
 
 def route_leg_batch(
