@@ -4,10 +4,10 @@ from sailroute.routing.types import (
     Barrier,
     LegResult,
     Manoeuvre,
+    RouteTrack,
     RoutingSettings,
     Start,
     Target,
-    Track,
 )
 
-__all__ = ["Barrier", "LegResult", "Manoeuvre", "RoutingSettings", "Start", "Target", "Track"]
+__all__ = ["Barrier", "LegResult", "Manoeuvre", "RouteTrack", "RoutingSettings", "Start", "Target"]

@@ -27,7 +27,7 @@ of length ``dt`` (10 s by default, shorter near the target):
    along the way, with the manoeuvre the point still needs).
 
 The route is then backtracked through the parent indices and turned into a
-:class:`~sailroute.routing.types.Track` with the shared
+:class:`~sailroute.routing.types.RouteTrack` with the shared
 :func:`~sailroute.routing.track.build_track`.  See ``docs/design/routing.md`` for the
 method, the defaults and the measured accuracy and speed.
 
@@ -80,10 +80,10 @@ from sailroute.routing.types import (
     Barrier,
     LegResult,
     Router,
+    RouteTrack,
     RoutingSettings,
     Start,
     Target,
-    Track,
     check_settings,
     side_sign,
 )
@@ -398,7 +398,7 @@ from the start."""
 def _backtrack(
     layers: list[_Layer], arr: _Arrival, frame: _LegFrame, wind: WindField, polar: Polar,
     world_start: tuple[NDArray, NDArray], current: CurrentField | None = None,
-) -> Track:
+) -> RouteTrack:
     """Polyline of the chosen route: step starts, penalty stops, exact arrival (world frame).
 
     The vertices at the start point get its world coordinates ``world_start[k][root]``

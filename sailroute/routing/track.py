@@ -1,4 +1,4 @@
-"""Build :class:`~sailroute.routing.types.Track` and :class:`LegResult` from a polyline.
+"""Build :class:`~sailroute.routing.types.RouteTrack` and :class:`LegResult` from a polyline.
 
 Every router ends with a time-stamped polyline; this module turns it into the
 common output (wind and angles at each point, tack side, manoeuvre counts), so
@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat.polar import Polar
-from sailroute.routing.types import Barrier, LegResult, Manoeuvre, Track
+from sailroute.routing.types import Barrier, LegResult, Manoeuvre, RouteTrack
 from sailroute.units import bearing_deg, signed_twa, wind_speed_direction
 from sailroute.wind.base import WindField
 
@@ -52,8 +52,8 @@ def build_track(
     heading_deg: ArrayLike | None = None,
     bsp_ms: ArrayLike | None = None,
     side: ArrayLike | None = None,
-) -> Track:
-    """Sample wind along a time-stamped polyline and assemble a :class:`Track`.
+) -> RouteTrack:
+    """Sample wind along a time-stamped polyline and assemble a :class:`RouteTrack`.
 
     Parameters
     ----------
@@ -73,7 +73,7 @@ def build_track(
 
     Returns
     -------
-    Track
+    RouteTrack
     """
     t = np.asarray(t, dtype=float)
     x = np.asarray(x, dtype=float)
@@ -89,13 +89,13 @@ def build_track(
     else:
         bsp = np.asarray(bsp_ms, dtype=float)
     sd = np.where(twa >= 0, 1, -1) if side is None else np.asarray(side)
-    return Track(
+    return RouteTrack(
         t=t, x=x, y=y, heading_deg=h, tws_ms=tws, twd_deg=twd, twa_deg=twa,
         bsp_ms=bsp, side=sd.astype(np.int8),
     )
 
 
-def find_manoeuvres(track: Track) -> tuple[Manoeuvre, ...]:
+def find_manoeuvres(track: RouteTrack) -> tuple[Manoeuvre, ...]:
     """Tacks and gybes along a track: every change of ``side`` between vertices.
 
     A change is a tack when the mean |TWA| of the two vertices is below 90°,
@@ -113,7 +113,7 @@ def find_manoeuvres(track: Track) -> tuple[Manoeuvre, ...]:
     return tuple(out)
 
 
-def make_leg_result(track: Track, router: str, barrier: Barrier | None = None) -> LegResult:
+def make_leg_result(track: RouteTrack, router: str, barrier: Barrier | None = None) -> LegResult:
     """Assemble the :class:`LegResult` of a finished track (first/last rows = start/arrival).
 
     ``barrier`` is the rounding ray the leg ended on, handed on to the next leg

@@ -425,7 +425,7 @@ def check_settings(s: RoutingSettings, label: str) -> None:
 
 
 @dataclass(frozen=True, eq=False)
-class Track:
+class RouteTrack:
     """A routed track, one row per point.
 
     Attributes
@@ -508,7 +508,7 @@ class LegResult:
         Manoeuvre counts.
     manoeuvres : tuple of Manoeuvre
         Where and when each happened.
-    track : Track
+    track : RouteTrack
         The route, first row at ``t_start``, last at ``t_end``.
     router : str
         Router that produced it.
@@ -526,7 +526,7 @@ class LegResult:
     n_tacks: int
     n_gybes: int
     manoeuvres: tuple[Manoeuvre, ...]
-    track: Track
+    track: RouteTrack
     router: str
     barrier: Barrier | None = None
 
