@@ -70,24 +70,42 @@ def snipe_observed_legs(race: str) -> list[tuple[str, list[float]]]:
     return out
 
 
-def races(smoke: bool) -> list[tuple[str, Course, str, dict[str, Any], list[int],
-                                     list[tuple[str, list[float]]]]]:
+def races(
+    smoke: bool,
+) -> list[tuple[str, Course, str, dict[str, Any], list[int], list[tuple[str, list[float]]]]]:
     """(name, course, scenario, uncertainty, model legs compared, observations)."""
     dt = 30.0 if smoke else 10.0
     out = []
     if not smoke:
         hy = load_course(ROOT / "courses" / "hyeres-r1.yaml")
         refs = [(who, list(hy.references[who])) for who in ("winner", "top10")]
-        out.append(("Hyères 2018 R1", hy, "constant", {"tws_kn": 1.5, "twd_deg": 10},
-                    [0, 1, 2, 3, 4], refs))
-    for race in (("P01",) if smoke else ("P01", "P02")):
-        out.append((f"Snipe Valencia {race}", snipe_course(race, "ilca7", dt_s=dt), "reported",
-                    {"tws_kn": 1.0, "twd_deg": 10}, [1, 2, 3], snipe_observed_legs(race)))
+        out.append(
+            (
+                "Hyères 2018 R1",
+                hy,
+                "constant",
+                {"tws_kn": 1.5, "twd_deg": 10},
+                [0, 1, 2, 3, 4],
+                refs,
+            )
+        )
+    for race in ("P01",) if smoke else ("P01", "P02"):
+        out.append(
+            (
+                f"Snipe Valencia {race}",
+                snipe_course(race, "ilca7", dt_s=dt),
+                "reported",
+                {"tws_kn": 1.0, "twd_deg": 10},
+                [1, 2, 3],
+                snipe_observed_legs(race),
+            )
+        )
     return out
 
 
-def sailgp(tmp: Path) -> list[tuple[str, Course, str, dict[str, Any], list[int],
-                                     list[tuple[str, list[float]]]]]:
+def sailgp(
+    tmp: Path,
+) -> list[tuple[str, Course, str, dict[str, Any], list[int], list[tuple[str, list[float]]]]]:
     """SailGP Auckland race 25011905, if the shared data are here (else nothing)."""
     from tests.analysis.test_sailgp_fleet import (
         BOATS,
@@ -116,12 +134,20 @@ def sailgp(tmp: Path) -> list[tuple[str, Course, str, dict[str, Any], list[int],
     mean_d = float(circular_mean_deg(d))
     sd_tws = float(np.nanstd(sp)) / KNOT
     sd_twd = float(np.std((d - mean_d + 180.0) % 360.0 - 180.0))
-    course = load_course(course_from_xml(XML, float(np.nanmean(sp)) / KNOT, mean_d,
-                                         tmp / "sailgp.yaml"))
+    course = load_course(
+        course_from_xml(XML, float(np.nanmean(sp)) / KNOT, mean_d, tmp / "sailgp.yaml")
+    )
     observed = [(b, list(np.diff(leg_counter_changes(b))[1:6])) for b in BOATS]
-    return [("SailGP Auckland 25011905", course, "race-mean",
-             {"tws_kn": round(sd_tws, 1), "twd_deg": round(sd_twd, 1)}, [1, 2, 3, 4, 5],
-             observed)]
+    return [
+        (
+            "SailGP Auckland 25011905",
+            course,
+            "race-mean",
+            {"tws_kn": round(sd_tws, 1), "twd_deg": round(sd_twd, 1)},
+            [1, 2, 3, 4, 5],
+            observed,
+        )
+    ]
 
 
 def main() -> None:
@@ -133,14 +159,18 @@ def main() -> None:
     ap.add_argument("--only", default="", help="races whose name contains this text")
     args = ap.parse_args()
     n = 3 if args.smoke else args.members
-    print("| race | uncertainty (1 sigma; boat ranges uniform) | observations | inside P10-P90 | "
-          "mean width P90-P10 | run time |")
+    print(
+        "| race | uncertainty (1 sigma; boat ranges uniform) | observations | inside P10-P90 | "
+        "mean width P90-P10 | run time |"
+    )
     print("|---|---|---|---|---|---|")
     import tempfile
 
     tmp = Path(tempfile.mkdtemp(prefix="bands-calibration-"))
     for name, course, scenario, unc, legs, observed in [
-            *races(args.smoke), *([] if args.smoke else sailgp(tmp))]:
+        *races(args.smoke),
+        *([] if args.smoke else sailgp(tmp)),
+    ]:
         if args.only not in name:
             continue
         raw = {**unc, "members": n, "seed": args.seed}
@@ -154,8 +184,15 @@ def main() -> None:
         course = dataclasses.replace(course, uncertainty=spec)
         t0 = time.perf_counter()
         boat, winds = build_specs(course, [scenario])
-        b = band_summary(course, scenario, spec, wind=winds[scenario], boat=boat,
-                         settings=settings_for(course), oat=False)
+        b = band_summary(
+            course,
+            scenario,
+            spec,
+            wind=winds[scenario],
+            boat=boat,
+            settings=settings_for(course),
+            oat=False,
+        )
         bands = b.bands()[legs]
         inside, total = 0, 0
         for _, obs in observed:
@@ -164,17 +201,29 @@ def main() -> None:
             total += o.size
         width = bands[:, 2] - bands[:, 0]
         pct = 100 * np.mean(width / bands[:, 1])
-        desc = (f"TWS {unc['tws_kn']} kn, TWD {unc['twd_deg']}°"
-                + (f", OU shifts {spec.shifts.sigma_deg:.0f}° {spec.shifts.timescale_s / 60:.1f}"
-                   " min" if spec.shifts is not None else "") + (", boat" if spec.boat else ""))
+        desc = (
+            f"TWS {unc['tws_kn']} kn, TWD {unc['twd_deg']}°"
+            + (
+                f", OU shifts {spec.shifts.sigma_deg:.0f}° {spec.shifts.timescale_s / 60:.1f} min"
+                if spec.shifts is not None
+                else ""
+            )
+            + (", boat" if spec.boat else "")
+        )
         who = ", ".join(w for w, _ in observed)
-        print(f"| {name} | {desc} | {total} legs ({who}) | {inside}/{total} = "
-              f"{100 * inside / total:.0f} % | {np.mean(width):.0f} s ({pct:.1f} %) | "
-              f"{time.perf_counter() - t0:.0f} s |", flush=True)
+        print(
+            f"| {name} | {desc} | {total} legs ({who}) | {inside}/{total} = "
+            f"{100 * inside / total:.0f} % | {np.mean(width):.0f} s ({pct:.1f} %) | "
+            f"{time.perf_counter() - t0:.0f} s |",
+            flush=True,
+        )
         for k, leg in enumerate(legs):
             obs_k = ", ".join(f"{o[k]:.0f}" for _, o in observed)
-            print(f"|   leg {leg + 1} | P10/P50/P90 {bands[k, 0]:.0f} / {bands[k, 1]:.0f} / "
-                  f"{bands[k, 2]:.0f} s | observed {obs_k} s | | | |", flush=True)
+            print(
+                f"|   leg {leg + 1} | P10/P50/P90 {bands[k, 0]:.0f} / {bands[k, 1]:.0f} / "
+                f"{bands[k, 2]:.0f} s | observed {obs_k} s | | | |",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

@@ -49,11 +49,15 @@ TRACK = ROOT / "data" / "snipe-valencia-2025-06-21-ESP30782-P01.gpx"
 
 def write_gpx(path: Path, t: np.ndarray, lat: np.ndarray, lon: np.ndarray) -> Path:
     """A minimal GPX 1.1 track of the fixes (times [epoch s], degrees)."""
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-             '<gpx version="1.1" creator="bench_analyze" '
-             'xmlns="http://www.topografix.com/GPX/1/1"><trk><name>bench</name><trkseg>']
-    lines += [f'<trkpt lat="{la:.8f}" lon="{lo:.8f}"><time>{iso(float(tt))}</time></trkpt>'
-              for tt, la, lo in zip(t, lat, lon, strict=True)]
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        '<gpx version="1.1" creator="bench_analyze" '
+        'xmlns="http://www.topografix.com/GPX/1/1"><trk><name>bench</name><trkseg>',
+    ]
+    lines += [
+        f'<trkpt lat="{la:.8f}" lon="{lo:.8f}"><time>{iso(float(tt))}</time></trkpt>'
+        for tt, la, lo in zip(t, lat, lon, strict=True)
+    ]
     lines.append("</trkseg></trk></gpx>")
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
@@ -103,8 +107,10 @@ def main() -> None:
     args = ap.parse_args()
     n = 20_000 if args.smoke else args.points
     repeat = 1 if args.smoke else args.repeat
-    print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} "
-          f"({os.cpu_count()} CPUs)")
+    print(
+        f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} "
+        f"({os.cpu_count()} CPUs)"
+    )
     with tempfile.TemporaryDirectory(prefix="bench-analyze-") as tmp:
         d = Path(tmp)
         boats = fleet_files(d)
@@ -118,8 +124,10 @@ def main() -> None:
         t = best_of(fleet, repeat)
         res = run_analyze_command(COURSE, boats, out_dir=d / "fleet-check", plots=False)
         winds = sorted({leg.wind_source for a in res.data for leg in a.legs})
-        print(f"fleet: {len(boats)} boats x {sizes[0]} fixes (1 Hz, {sizes[0] / 60:.0f} min), "
-              f"read + analyse + write: {t:6.2f} s (wind: {', '.join(winds)})")
+        print(
+            f"fleet: {len(boats)} boats x {sizes[0]} fixes (1 Hz, {sizes[0] / 60:.0f} min), "
+            f"read + analyse + write: {t:6.2f} s (wind: {', '.join(winds)})"
+        )
         log = long_log(d, n)
 
         def one() -> object:
@@ -130,9 +138,11 @@ def main() -> None:
         res = run_analyze_command(COURSE, [log], out_dir=d / "check", plots=False)
         a = res.data[0]
         hours = (a.track.t_end - a.track.t_start) / 3600
-        print(f"long log: {len(a.track)} fixes (10 Hz, {hours:.1f} h, "
-              f"{log.stat().st_size / 1e6:.0f} MB GPX), read + analyse + write: {t:6.2f} s "
-              f"(race {a.sailed_time_s:.1f} s sailed, {len(a.legs)} legs)")
+        print(
+            f"long log: {len(a.track)} fixes (10 Hz, {hours:.1f} h, "
+            f"{log.stat().st_size / 1e6:.0f} MB GPX), read + analyse + write: {t:6.2f} s "
+            f"(race {a.sailed_time_s:.1f} s sailed, {len(a.legs)} legs)"
+        )
     print(f"load average after: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 

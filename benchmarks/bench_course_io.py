@@ -39,8 +39,9 @@ from bench_polar import best_of  # noqa: E402  (one timing rule for the benchmar
 
 ROOT = Path(__file__).resolve().parents[1]
 COURSE = ROOT / "courses" / "windward-leeward-template.yaml"
-SHARED_XML = ROOT.parent / "shared" / "data" / "real" / "races" / "sailgp-auckland-2025" / \
-    "Race_XMLs"
+SHARED_XML = (
+    ROOT.parent / "shared" / "data" / "real" / "races" / "sailgp-auckland-2025" / "Race_XMLs"
+)
 WIND = {"wind_twd_deg": 270.0, "wind_tws_kn": 10.0}
 
 
@@ -66,27 +67,39 @@ def write_inputs(course: Course, d: Path) -> dict[str, Path]:
     """The course as a GPX route, a CSV, a KML file and a race XML."""
     seq = sequence(course)
     m = course.marks
-    gpx = "".join(f'<rtept lat="{m[n].lat}" lon="{m[n].lon}"><name>{n}</name>'
-                  f"<type>{t if t != 'mark' else s}</type></rtept>\n" for n, t, s in seq)
-    (d / "c.gpx").write_text('<gpx version="1.1" creator="bench" xmlns="http://www.topografix'
-                             f'.com/GPX/1/1"><rte>\n{gpx}</rte></gpx>\n')
+    gpx = "".join(
+        f'<rtept lat="{m[n].lat}" lon="{m[n].lon}"><name>{n}</name>'
+        f"<type>{t if t != 'mark' else s}</type></rtept>\n"
+        for n, t, s in seq
+    )
+    (d / "c.gpx").write_text(
+        '<gpx version="1.1" creator="bench" xmlns="http://www.topografix'
+        f'.com/GPX/1/1"><rte>\n{gpx}</rte></gpx>\n'
+    )
     rows = ["name,lat,lon,type,rounding"] + [
-        f"{n},{m[n].lat},{m[n].lon},{t},{s if t == 'mark' else ''}" for n, t, s in seq]
+        f"{n},{m[n].lat},{m[n].lon},{t},{s if t == 'mark' else ''}" for n, t, s in seq
+    ]
     (d / "c.csv").write_text("\n".join(rows) + "\n")
     pms = "".join(
-        f"<Placemark><name>{n}</name><ExtendedData><Data name=\"type\"><value>{t}</value>"
+        f'<Placemark><name>{n}</name><ExtendedData><Data name="type"><value>{t}</value>'
         f"</Data></ExtendedData><Point><coordinates>{m[n].lon},{m[n].lat}</coordinates>"
-        "</Point></Placemark>\n" for n, t, _ in seq)
-    (d / "c.kml").write_text('<kml xmlns="http://www.opengis.net/kml/2.2"><Document>\n'
-                             f"{pms}</Document></kml>\n")
+        "</Point></Placemark>\n"
+        for n, t, _ in seq
+    )
+    (d / "c.kml").write_text(
+        f'<kml xmlns="http://www.opengis.net/kml/2.2"><Document>\n{pms}</Document></kml>\n'
+    )
     cms, corners, k = [], [], 0
     i = 0
     while i < len(seq):
         n, t, s = seq[i]
         k += 1
         pair = [seq[i]] if t == "mark" else [seq[i], seq[i + 1]]
-        marks = "".join(f'<Mark SeqID="{j + 1}" Name="{p[0]}" TargetLat="{m[p[0]].lat}" '
-                        f'TargetLng="{m[p[0]].lon}" />' for j, p in enumerate(pair))
+        marks = "".join(
+            f'<Mark SeqID="{j + 1}" Name="{p[0]}" TargetLat="{m[p[0]].lat}" '
+            f'TargetLng="{m[p[0]].lon}" />'
+            for j, p in enumerate(pair)
+        )
         cms.append(f'<CompoundMark CompoundMarkID="{k}" Name="{n}">{marks}</CompoundMark>')
         rounding = ("Port" if s == "port" else "Stbd") if t == "mark" else "SP"
         corners.append(f'<Corner SeqID="{k}" CompoundMarkID="{k}" Rounding="{rounding}" />')
@@ -94,7 +107,8 @@ def write_inputs(course: Course, d: Path) -> dict[str, Path]:
     (d / "c.xml").write_text(
         f'<Race><RaceStartTime Start="{course.start_time.isoformat()}" /><RaceID>1</RaceID>'
         f"<Course>{''.join(cms)}</Course><CompoundMarkSequence>{''.join(corners)}"
-        "</CompoundMarkSequence></Race>\n")
+        "</CompoundMarkSequence></Race>\n"
+    )
     return {"gpx": d / "c.gpx", "csv": d / "c.csv", "kml": d / "c.kml", "racexml": d / "c.xml"}
 
 
@@ -106,24 +120,33 @@ def main() -> None:
     args = ap.parse_args()
     if args.smoke:
         args.repeat = 1
-    print(f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} "
-          f"({os.cpu_count()} CPUs)")
+    print(
+        f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} "
+        f"({os.cpu_count()} CPUs)"
+    )
     course = load_course(COURSE)
     plan = plan_course(course).plan
     t0 = course.start_time.isoformat()
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
         for fmt, src in write_inputs(course, d).items():
+
             def run(src: Path = src) -> object:
-                return run_course_import_command(src, out=d / "out.yaml", start_time=t0,
-                                                 boat="ilca7", **WIND)
+                return run_course_import_command(
+                    src, out=d / "out.yaml", start_time=t0, boat="ilca7", **WIND
+                )
+
             n_legs = len(run().data.legs)  # type: ignore[attr-defined]
-            print(f"import {fmt:<8} {best_of(run, args.repeat) * 1e3:8.1f} ms  "
-                  f"({len(course.marks)} marks, {n_legs} legs)")
+            print(
+                f"import {fmt:<8} {best_of(run, args.repeat) * 1e3:8.1f} ms  "
+                f"({len(course.marks)} marks, {n_legs} legs)"
+            )
         if SHARED_XML.is_dir():
             for xml in sorted(SHARED_XML.glob("*.xml")):
+
                 def run_xml(src: Path = xml) -> object:
                     return run_course_import_command(src, out=d / "out.yaml", **WIND)
+
                 print(f"import SailGP {xml.name} {best_of(run_xml, args.repeat) * 1e3:8.1f} ms")
 
         def export() -> None:
@@ -132,8 +155,10 @@ def main() -> None:
             write_nmea(d / "route.nmea", plan)
 
         n_pts = sum(len(pl.result.track) for pl in plan.legs)
-        print(f"export gpx+kml+nmea {best_of(export, args.repeat) * 1e3:8.1f} ms  "
-              f"({len(plan.legs)} legs, {n_pts} track points)")
+        print(
+            f"export gpx+kml+nmea {best_of(export, args.repeat) * 1e3:8.1f} ms  "
+            f"({len(plan.legs)} legs, {n_pts} track points)"
+        )
     print(f"load average after: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 

@@ -71,8 +71,12 @@ def main() -> None:
     ap.add_argument("--members", type=int, default=100)
     ap.add_argument("--wind", choices=("wrf", "uniform"), default="wrf")
     ap.add_argument("--repeat", type=int, default=1, help="alternate runs of each way")
-    ap.add_argument("--only", choices=("together", "one-by-one"), default=None,
-                    help="time one way only (no ratio, no comparison)")
+    ap.add_argument(
+        "--only",
+        choices=("together", "one-by-one"),
+        default=None,
+        help="time one way only (no ratio, no comparison)",
+    )
     ap.add_argument("--smoke", action="store_true", help="3 members, 2 legs")
     args = ap.parse_args()
     n = 3 if args.smoke else args.members
@@ -85,8 +89,9 @@ def main() -> None:
     boat, winds = build_specs(course, [scenario])
     rng = np.random.default_rng(2018)
     turn, scale = rng.normal(0.0, 3.0, n), 1.0 + rng.normal(0.0, 0.05, n)
-    members = [Perturbed(winds[scenario], float(d), float(e))
-               for d, e in zip(turn, scale, strict=True)]
+    members = [
+        Perturbed(winds[scenario], float(d), float(e)) for d, e in zip(turn, scale, strict=True)
+    ]
     s = course.routing
 
     ways = ("one by one", "together") if args.only is None else (args.only.replace("-", " "),)
@@ -103,8 +108,10 @@ def main() -> None:
             best[way] = (min(best[way][0], wall), min(best[way][1], cpu))
             out[way] = res
     print(f"load average at the end: {load()}")
-    print(f"Hyères R1, {n} members ({args.wind}), {len(course.legs)} legs, isochrone "
-          f"dt {s.dt_s:g} s, {s.heading_step_deg:g}°: best of {args.repeat}, wall (CPU)")
+    print(
+        f"Hyères R1, {n} members ({args.wind}), {len(course.legs)} legs, isochrone "
+        f"dt {s.dt_s:g} s, {s.heading_step_deg:g}°: best of {args.repeat}, wall (CPU)"
+    )
     for way, (wall, cpu) in best.items():
         print(f"  {way:<11} {wall:8.2f} s ({cpu:.2f} s)  {wall / n * 1e3:7.1f} ms per member")
     if args.only is not None:
@@ -117,12 +124,16 @@ def main() -> None:
         a = np.array([r[leg].time_s for r in one])
         b = np.array([r[leg].time_s for r in tog])
         same = int(np.sum(a == b))
-        print(f"  leg {leg + 1}: {same}/{n} leg times identical; largest difference "
-              f"{np.max(np.abs(a - b)):.3f} s (median leg time {np.median(b):.1f} s)")
+        print(
+            f"  leg {leg + 1}: {same}/{n} leg times identical; largest difference "
+            f"{np.max(np.abs(a - b)):.3f} s (median leg time {np.median(b):.1f} s)"
+        )
     ta = np.array([sum(x.time_s for x in r) for r in one])
     tb = np.array([sum(x.time_s for x in r) for r in tog])
-    print(f"  race time: largest difference {np.max(np.abs(ta - tb)):.3f} s, "
-          f"mean {np.mean(tb - ta):+.3f} s (together - one by one)")
+    print(
+        f"  race time: largest difference {np.max(np.abs(ta - tb)):.3f} s, "
+        f"mean {np.mean(tb - ta):+.3f} s (together - one by one)"
+    )
 
 
 if __name__ == "__main__":

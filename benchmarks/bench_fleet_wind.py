@@ -96,13 +96,18 @@ def race_tracks() -> dict[int, list[Track]]:
     return out
 
 
-def table(races: dict[int, list[Track]], methods: dict[str, dict[str, object]],
-          smooth_s: float | None = None) -> list[tuple[int, LooRow]]:
+def table(
+    races: dict[int, list[Track]],
+    methods: dict[str, dict[str, object]],
+    smooth_s: float | None = None,
+) -> list[tuple[int, LooRow]]:
     """``(race, row)`` of :func:`leave_one_out` for every race; targets as logged."""
     rows = []
     for r, tracks in races.items():
-        sens = [sensor_from_track(t) if smooth_s is None else
-                sensor_from_track(t, smooth_s=smooth_s) for t in tracks]
+        sens = [
+            sensor_from_track(t) if smooth_s is None else sensor_from_track(t, smooth_s=smooth_s)
+            for t in tracks
+        ]
         raw = [sensor_from_track(t, smooth_s=0.0) for t in tracks]
         rows += [(r, row) for row in leave_one_out(sens, FRAME, methods, targets=raw)]
     return rows
@@ -116,7 +121,7 @@ def pooled(rows: list[tuple[int, LooRow]]) -> dict[str, tuple[int, float, float,
             continue
         a = acc.setdefault(row.label, [0, 0.0, 0.0, 0.0])
         a[0] += row.n
-        a[1] += row.n * row.speed_rms_kn ** 2
+        a[1] += row.n * row.speed_rms_kn**2
         a[2] += row.n * row.dir_mae_deg
         a[3] += row.n * row.inside_hull
     return {k: (int(n), float(np.sqrt(s / n)), d / n, h / n) for k, (n, s, d, h) in acc.items()}
@@ -134,8 +139,11 @@ def timing() -> tuple[float, float]:
         u, v = wind_components(10 + np.sin((t - t0) / 40), 60 + 10 * np.sin((t - t0) / 57))
         series.append(MeasuredSeries(f"B{k}", "", t, lat, lon, u, v))
     rng = np.random.default_rng(1)
-    q = (rng.uniform(t0 + 60, t0 + 1100, 100_000), rng.uniform(-800, 800, 100_000),
-         rng.uniform(-600, 600, 100_000))
+    q = (
+        rng.uniform(t0 + 60, t0 + 1100, 100_000),
+        rng.uniform(-800, 800, 100_000),
+        rng.uniform(-600, 600, 100_000),
+    )
     best_b, best_s = np.inf, np.inf
     for _ in range(3):
         a = time.perf_counter()
@@ -152,8 +160,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--smoke", action="store_true", help="race 25011905, three methods")
     args = ap.parse_args(argv)
     if not LOGS.is_dir():
-        print(f"bench_fleet_wind.py: {LOGS} not present (the SailGP logs are read in place): "
-              "nothing measured")
+        print(
+            f"bench_fleet_wind.py: {LOGS} not present (the SailGP logs are read in place): "
+            "nothing measured"
+        )
         return 0
     races = race_tracks()
     methods = {**CANDIDATES, **BASELINES}
@@ -164,8 +174,10 @@ def main(argv: list[str] | None = None) -> int:
     print("| race | method | boat left out | n | speed RMS (kn) | direction MAE (°) | in hull |")
     print("|---|---|---|---|---|---|---|")
     for r, row in rows:
-        print(f"| {r} | {row.label} | {row.boat} | {row.n} | {row.speed_rms_kn:.2f} | "
-              f"{row.dir_mae_deg:.2f} | {100 * row.inside_hull:.0f} % |")
+        print(
+            f"| {r} | {row.label} | {row.boat} | {row.n} | {row.speed_rms_kn:.2f} | "
+            f"{row.dir_mae_deg:.2f} | {100 * row.inside_hull:.0f} % |"
+        )
     print("\nPooled over the races:\n")
     print("| method | n | speed RMS (kn) | direction MAE (°) | in hull |")
     print("|---|---|---|---|---|")
@@ -177,18 +189,24 @@ def main(argv: list[str] | None = None) -> int:
             fw = fleet_wind(tracks, FRAME)
             print(f"- {r}: " + "; ".join(b.describe() for b in fw.biases))
         print("\nSmoothing of the sensors (pooled; targets as logged):\n")
-        print("| smooth_s (s) | mean: speed RMS (kn) | mean: dir MAE (°) | nearest: speed RMS "
-              "(kn) | nearest: dir MAE (°) | st-idw: speed RMS (kn) | st-idw: dir MAE (°) |")
+        print(
+            "| smooth_s (s) | mean: speed RMS (kn) | mean: dir MAE (°) | nearest: speed RMS "
+            "(kn) | nearest: dir MAE (°) | st-idw: speed RMS (kn) | st-idw: dir MAE (°) |"
+        )
         print("|---|---|---|---|---|---|---|")
-        sm = {"mean": BASELINES["mean at each time"], "nearest": BASELINES["nearest sensor"],
-              "st-idw": CANDIDATES["st-idw"]}
+        sm = {
+            "mean": BASELINES["mean at each time"],
+            "nearest": BASELINES["nearest sensor"],
+            "st-idw": CANDIDATES["st-idw"],
+        }
         for s in (0.0, 10.0, 30.0, 60.0, 120.0):
             p = pooled(table(races, sm, smooth_s=s))
-            print(f"| {s:g} | " + " | ".join(f"{p[k][1]:.3f} | {p[k][2]:.2f}" for k in sm)
-                  + " |")
+            print(f"| {s:g} | " + " | ".join(f"{p[k][1]:.3f} | {p[k][2]:.2f}" for k in sm) + " |")
     b, s = timing()
-    print(f"\nfleet field, 3 boats x 20 min at 1 Hz: build {b:.3f} s, sample 1e5 points "
-          f"{s:.3f} s (best of 3)")
+    print(
+        f"\nfleet field, 3 boats x 20 min at 1 Hz: build {b:.3f} s, sample 1e5 points "
+        f"{s:.3f} s (best of 3)"
+    )
     return 0
 
 

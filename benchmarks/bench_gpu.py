@@ -91,8 +91,9 @@ def row(name: str, cpu: float, gpu: float, diff: str) -> dict:
 
 
 def header(title: str, cpu: str) -> None:
-    print(f"\n## {title}\n  {'case':<46}{cpu:>10}{'CuPy s':>10}{'ratio':>9}  difference",
-          flush=True)
+    print(
+        f"\n## {title}\n  {'case':<46}{cpu:>10}{'CuPy s':>10}{'ratio':>9}  difference", flush=True
+    )
 
 
 def iso_section(cp: Any, repeat: int) -> list[dict]:
@@ -105,14 +106,24 @@ def iso_section(cp: Any, repeat: int) -> list[dict]:
     wrf = bi.wrf_field()
     if wrf is not None:
         c = wrf.coverage
-        cases.append(("synthetic WRF, 1809 m beat", wrf, c.t0 + 0.25 * (c.t1 - c.t0),
-                      RoutingSettings()))
-    cases.append(("gridded field, 1809 m beat", bi.gridded_field(t0), t0 + 600.0,
-                  RoutingSettings()))
+        cases.append(
+            ("synthetic WRF, 1809 m beat", wrf, c.t0 + 0.25 * (c.t1 - c.t0), RoutingSettings())
+        )
+    cases.append(
+        ("gridded field, 1809 m beat", bi.gridded_field(t0), t0 + 600.0, RoutingSettings())
+    )
     st0 = RoutingSettings()
-    cases.append(("uniform, headings/4, sectors/10 (big fronts)", UniformWind(8.5 * KNOT, 0.0),
-                  t0, RoutingSettings(heading_step_deg=st0.heading_step_deg / 4,
-                                      prune_sector_deg=st0.prune_sector_deg / 10)))
+    cases.append(
+        (
+            "uniform, headings/4, sectors/10 (big fronts)",
+            UniformWind(8.5 * KNOT, 0.0),
+            t0,
+            RoutingSettings(
+                heading_step_deg=st0.heading_step_deg / 4,
+                prune_sector_deg=st0.prune_sector_deg / 10,
+            ),
+        )
+    )
     out = []
     sync = cp.cuda.Device().synchronize
     for name, wind, t, st in cases:
@@ -120,11 +131,14 @@ def iso_section(cp: Any, repeat: int) -> list[dict]:
 
         def run(xp: Any, start=start, target=target, t=t, wind=wind, st=st) -> Any:
             return isochrone.route_isochrone(start, target, t, wind, polar, st, xp=xp)
+
         cpu, a = best_of(lambda run=run: run(np), repeat, lambda: None)
         gpu, b = best_of(lambda run=run: run(cp), repeat, sync)
         dxy = np.concatenate([a.track.x - b.track.x, a.track.y - b.track.y])
-        diff = (f"leg {a.time_s:.3f} s, Δ {b.time_s - a.time_s:+.1e} s; track Δ "
-                f"{np.max(np.abs(dxy)):.1e} m")
+        diff = (
+            f"leg {a.time_s:.3f} s, Δ {b.time_s - a.time_s:+.1e} s; track Δ "
+            f"{np.max(np.abs(dxy)):.1e} m"
+        )
         out.append(row(name, cpu, gpu, diff))
     return out
 
@@ -138,17 +152,31 @@ def dp_section(cp: Any, repeat: int) -> list[dict]:
     out = []
     for model_name, b in (("dynamic", boat), ("polar", polar)):
         for c in (32, 64, 128):
-            s = RoutingSettings(router="griddp", dp_cols=c, dp_rows=13, dp_refinements=0,
-                                dp_half_width_m=400.0, tack_penalty_s=0.0, gybe_penalty_s=0.0,
-                                zone_m=0.01)
+            s = RoutingSettings(
+                router="griddp",
+                dp_cols=c,
+                dp_rows=13,
+                dp_refinements=0,
+                dp_half_width_m=400.0,
+                tack_penalty_s=0.0,
+                gybe_penalty_s=0.0,
+                zone_m=0.01,
+            )
             rep = repeat if c < 128 else 1
 
             def run(xp: Any, s: RoutingSettings = s, b: Any = b) -> Any:
                 return solve_griddp(Start((0.0, 0.0)), tgt, 0.0, wind, b, s, xp=xp).result
+
             cpu, ra = best_of(lambda run=run: run(np), rep, lambda: None)
             gpu, rb = best_of(lambda run=run: run(cp), rep, sync)
-            out.append(row(f"{model_name}, C = {c}", cpu, gpu,
-                           f"route {ra.time_s:.3f} s, Δ {rb.time_s - ra.time_s:+.1e} s"))
+            out.append(
+                row(
+                    f"{model_name}, C = {c}",
+                    cpu,
+                    gpu,
+                    f"route {ra.time_s:.3f} s, Δ {rb.time_s - ra.time_s:+.1e} s",
+                )
+            )
     return out
 
 
@@ -168,26 +196,43 @@ def deadline_section(cp: Any, grids: list[str]) -> list[dict]:
         g = bd.paper_grid(n_r1, n_t, 1.05 * max(deadlines), "linear", "none")
         m = DriftDiffusionShift(-math.degrees(a), math.degrees(bd.SIGMA))
         polar = bd.so40()
-        engines = ["cupy"] if gpu_only else [cpu, "cupy"] + (
-            ["numpy"] if cpu != "numpy" and n_r1 * n_t <= 401 * 512 else [])
+        engines = (
+            ["cupy"]
+            if gpu_only
+            else [cpu, "cupy"] + (["numpy"] if cpu != "numpy" and n_r1 * n_t <= 401 * 512 else [])
+        )
         pols = {}
         for e in engines:
             pool.free_all_blocks()
             pols[e] = solve_deadline(polar, 1.0, m, g, bd.C, engine=e)
-            print(f"  Fig {fig} {n_r1} x {n_t} ({g.n_s} slices), {e}: "
-                  f"{pols[e].solve_time_s:.2f} s" + (
-                      f", GPU pool {pool.total_bytes() / 1e9:.1f} GB" if e == "cupy" else ""),
-                  flush=True)
+            print(
+                f"  Fig {fig} {n_r1} x {n_t} ({g.n_s} slices), {e}: "
+                f"{pols[e].solve_time_s:.2f} s"
+                + (f", GPU pool {pool.total_bytes() / 1e9:.1f} GB" if e == "cupy" else ""),
+                flush=True,
+            )
         if gpu_only:
-            out.append({"case": f"Fig {fig}, {n_r1} x {n_t}", "gpu_s": pols["cupy"].solve_time_s,
-                        "gpu_pool_gb": pool.total_bytes() / 1e9})
+            out.append(
+                {
+                    "case": f"Fig {fig}, {n_r1} x {n_t}",
+                    "gpu_s": pols["cupy"].solve_time_s,
+                    "gpu_pool_gb": pool.total_bytes() / 1e9,
+                }
+            )
             continue
         ref, dev = pols[cpu], pols["cupy"]
-        same = (np.array_equal(ref.bands.w, dev.bands.w)
-                and np.array_equal(ref.bands.action, dev.bands.action))
+        same = np.array_equal(ref.bands.w, dev.bands.w) and np.array_equal(
+            ref.bands.action, dev.bands.action
+        )
         dw = float(np.max(np.abs(ref.bands.w.astype(float) - dev.bands.w)))
-        out.append(row(f"Fig {fig}, {n_r1} x {n_t}, {g.n_s} slices", ref.solve_time_s,
-                       dev.solve_time_s, f"bit for bit: {same} (max |Δw| {dw:.1e})"))
+        out.append(
+            row(
+                f"Fig {fig}, {n_r1} x {n_t}, {g.n_s} slices",
+                ref.solve_time_s,
+                dev.solve_time_s,
+                f"bit for bit: {same} (max |Δw| {dw:.1e})",
+            )
+        )
         if "numpy" in pols:
             t_np = pols["numpy"].solve_time_s
             print(f"  (NumPy {t_np:.2f} s: {t_np / dev.solve_time_s:.1f}x the CuPy time)")
@@ -199,11 +244,16 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--skip", default="", help="comma list of iso, dp, deadline")
-    ap.add_argument("--deadline-grids", nargs="*", default=["401,512:4b", "801,1024:3"],
-                    help="NR1,NT:FIG, solved with numba and CuPy (a trailing ! : CuPy only)")
+    ap.add_argument(
+        "--deadline-grids",
+        nargs="*",
+        default=["401,512:4b", "801,1024:3"],
+        help="NR1,NT:FIG, solved with numba and CuPy (a trailing ! : CuPy only)",
+    )
     ap.add_argument("--json", default=None)
-    ap.add_argument("--smoke", action="store_true",
-                    help="the isochrone section once (checks the script runs)")
+    ap.add_argument(
+        "--smoke", action="store_true", help="the isochrone section once (checks the script runs)"
+    )
     args = ap.parse_args()
     if args.smoke:
         args.repeat, args.skip = 1, "dp,deadline"
@@ -213,14 +263,19 @@ def main() -> None:
         print(f"bench_gpu.py: no GPU here, nothing measured: {exc}")
         sys.exit(0)
     dev = cp.cuda.runtime.getDeviceProperties(cp.cuda.Device().id)
-    print(f"GPU {dev['name'].decode()}, {dev['totalGlobalMem'] / 2**30:.0f} GiB; CPU "
-          f"{cpu_name()}, {os.cpu_count()} cores (one used); "
-          f"numpy {np.__version__}, cupy {cp.__version__}", flush=True)
+    print(
+        f"GPU {dev['name'].decode()}, {dev['totalGlobalMem'] / 2**30:.0f} GiB; CPU "
+        f"{cpu_name()}, {os.cpu_count()} cores (one used); "
+        f"numpy {np.__version__}, cupy {cp.__version__}",
+        flush=True,
+    )
     skip = set(args.skip.split(","))
     results: dict[str, list[dict]] = {}
-    for key, fn in (("iso", lambda: iso_section(cp, args.repeat)),
-                    ("dp", lambda: dp_section(cp, args.repeat)),
-                    ("deadline", lambda: deadline_section(cp, args.deadline_grids))):
+    for key, fn in (
+        ("iso", lambda: iso_section(cp, args.repeat)),
+        ("dp", lambda: dp_section(cp, args.repeat)),
+        ("deadline", lambda: deadline_section(cp, args.deadline_grids)),
+    ):
         if key in skip:
             continue
         try:

@@ -53,23 +53,35 @@ def _grid_rows(cols: list[int], quick: bool, xp=np) -> None:
     paper_tgt = Target("mark", (0.0, 500.0))
     debski, debski_tgt = debski_test_wind(), Target("mark", (500.0, 0.0))
     print("\n## Grid DP, R = 13 rows, half-width 400 m (one core)")
-    print(f"{'case':<22}{'model':<9}{'C':>5}{'passes':>7}{'wall s':>9}{'evals':>13}"
-          f"{'Mevals/s':>10}{'route s':>10}")
-    for name, wind, tgt in (("paper 12 m/s, 5 deg", paper_wind, paper_tgt),
-                            ("Debski analytic wind", debski, debski_tgt)):
+    print(
+        f"{'case':<22}{'model':<9}{'C':>5}{'passes':>7}{'wall s':>9}{'evals':>13}"
+        f"{'Mevals/s':>10}{'route s':>10}"
+    )
+    for name, wind, tgt in (
+        ("paper 12 m/s, 5 deg", paper_wind, paper_tgt),
+        ("Debski analytic wind", debski, debski_tgt),
+    ):
         for model_name, b in (("dynamic", boat), ("polar", polar)):
             for c in cols:
                 for ref in (0, 2):
-                    s = RoutingSettings(router="griddp", dp_cols=c, dp_rows=13,
-                                        dp_refinements=ref, dp_half_width_m=400.0,
-                                        tack_penalty_s=0.0, gybe_penalty_s=0.0,
-                                        zone_m=POINT_ZONE_M)
+                    s = RoutingSettings(
+                        router="griddp",
+                        dp_cols=c,
+                        dp_rows=13,
+                        dp_refinements=ref,
+                        dp_half_width_m=400.0,
+                        tack_penalty_s=0.0,
+                        gybe_penalty_s=0.0,
+                        zone_m=POINT_ZONE_M,
+                    )
                     tic = time.perf_counter()
                     sol = solve_griddp(A, tgt, 0.0, wind, b, s, xp=xp)
                     wall = time.perf_counter() - tic
                     ev = sum(p.segment_evals for p in sol.passes)
-                    print(f"{name:<22}{model_name:<9}{c:>5}{ref + 1:>7}{wall:>9.2f}{ev:>13,d}"
-                          f"{ev / wall / 1e6:>10.1f}{sol.result.time_s:>10.2f}")
+                    print(
+                        f"{name:<22}{model_name:<9}{c:>5}{ref + 1:>7}{wall:>9.2f}{ev:>13,d}"
+                        f"{ev / wall / 1e6:>10.1f}{sol.result.time_s:>10.2f}"
+                    )
     del quick
 
 
@@ -80,12 +92,20 @@ def _paper_convergence(quick: bool) -> None:
     print("   (the paper's row count is not stated; R = 30 reproduces its C = 8 value)")
     print(f"{'C':>5}{'t_f here s':>12}{'paper t_f s':>13}{'wall s':>9}")
     for c in cols:
-        s = RoutingSettings(router="griddp", dp_cols=c, dp_rows=30, dp_refinements=0,
-                            dp_half_width_m=400.0, dp_samples=1, zone_m=POINT_ZONE_M)
+        s = RoutingSettings(
+            router="griddp",
+            dp_cols=c,
+            dp_rows=30,
+            dp_refinements=0,
+            dp_half_width_m=400.0,
+            dp_samples=1,
+            zone_m=POINT_ZONE_M,
+        )
         tic = time.perf_counter()
         sol = solve_griddp(A, Target("mark", (0.0, 500.0)), 0.0, UniformWind(12.0, 5.0), boat, s)
-        print(f"{c:>5}{sol.result.time_s:>12.2f}{PAPER_TF[c]:>13.2f}"
-              f"{time.perf_counter() - tic:>9.2f}")
+        print(
+            f"{c:>5}{sol.result.time_s:>12.2f}{PAPER_TF[c]:>13.2f}{time.perf_counter() - tic:>9.2f}"
+        )
     bound = 500.0 * np.cos(np.radians(5.0)) / (12.0 * boat.best_vmg()[1])
     print(f"  lower bound L cos5°/VMG* = {bound:.2f} s (plus momentum losses at start/tack)")
 
@@ -96,22 +116,31 @@ def _splines() -> None:
     fit = fit_function(n_refine=4)
     wall = time.perf_counter() - tic
     errs = ", ".join(f"{np.sqrt(p.cost):.4f}" for p in fit.passes)
-    print(f"function fitting (10 rows, 25 nodes, 7 slopes, 4 refinements): {wall:.2f} s; "
-          f"L2 error per pass: {errs}")
+    print(
+        f"function fitting (10 rows, 25 nodes, 7 slopes, 4 refinements): {wall:.2f} s; "
+        f"L2 error per pass: {errs}"
+    )
     boat = DynamicBoat()
     polar = boat.steady_polar(np.arange(0.0, 61.0, 2.0), twa_step=1.0)
     for model_name, b, pens in (("polar", polar, (0.0, 1e3)), ("dynamic", boat, (0.0,))):
         for pen in pens:
-            s = RoutingSettings(router="spline", dp_rows=13, dp_half_width_m=400.0,
-                                tack_penalty_s=pen, gybe_penalty_s=pen, zone_m=POINT_ZONE_M)
+            s = RoutingSettings(
+                router="spline",
+                dp_rows=13,
+                dp_half_width_m=400.0,
+                tack_penalty_s=pen,
+                gybe_penalty_s=pen,
+                zone_m=POINT_ZONE_M,
+            )
             tic = time.perf_counter()
-            res, fit = solve_spline(A, Target("mark", (500.0, 0.0)), 0.0, debski_test_wind(), b,
-                                    s)
+            res, fit = solve_spline(A, Target("mark", (500.0, 0.0)), 0.0, debski_test_wind(), b, s)
             wall = time.perf_counter() - tic
             edges = sum(p.edges for p in fit.passes)
-            print(f"Debski wind, {model_name:<8} penalty {pen:>6.0f} s: {wall:6.2f} s, "
-                  f"{edges:,d} edges, route {res.time_s:.2f} s, tacks {res.n_tacks}, "
-                  f"course {res.track.heading_deg[0]:.1f}° -> {res.track.heading_deg[-2]:.1f}°")
+            print(
+                f"Debski wind, {model_name:<8} penalty {pen:>6.0f} s: {wall:6.2f} s, "
+                f"{edges:,d} edges, route {res.time_s:.2f} s, tacks {res.n_tacks}, "
+                f"course {res.track.heading_deg[0]:.1f}° -> {res.track.heading_deg[-2]:.1f}°"
+            )
 
 
 def _kernel_accuracy() -> None:
@@ -133,20 +162,30 @@ def _kernel_accuracy() -> None:
     t_fast, _ = boat.segment(ell, twa, tws, v0)
     t_f = time.perf_counter() - tic
     err = np.abs(t_fast - t_ref)
-    print(f"{n} random segments: RK4 (dt 2 ms) {t_rk:.2f} s, table {t_f * 1e3:.1f} ms; "
-          f"max |error| {err.max():.2e} s, max relative {np.max(err / t_ref):.1e}")
+    print(
+        f"{n} random segments: RK4 (dt 2 ms) {t_rk:.2f} s, table {t_f * 1e3:.1f} ms; "
+        f"max |error| {err.max():.2e} s, max relative {np.max(err / t_ref):.1e}"
+    )
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="skip C = 128")
-    ap.add_argument("--backend", default="numpy",
-                    help="numpy | cupy | auto: array backend of the grid-DP rows table")
-    ap.add_argument("--smoke", action="store_true",
-                    help="the grid-DP table at C = 8 only (checks the script runs)")
+    ap.add_argument(
+        "--backend",
+        default="numpy",
+        help="numpy | cupy | auto: array backend of the grid-DP rows table",
+    )
+    ap.add_argument(
+        "--smoke",
+        action="store_true",
+        help="the grid-DP table at C = 8 only (checks the script runs)",
+    )
     args = ap.parse_args()
-    print(f"# sailroute grid-DP benchmark — {platform.processor() or platform.machine()}, "
-          f"Python {platform.python_version()}, numpy {np.__version__}, 1 thread")
+    print(
+        f"# sailroute grid-DP benchmark — {platform.processor() or platform.machine()}, "
+        f"Python {platform.python_version()}, numpy {np.__version__}, 1 thread"
+    )
     DynamicBoat().table()  # build the lookup table outside the timings
     cols = [8] if args.smoke else [32, 64] + ([] if args.quick else [128])
     _grid_rows(cols, args.quick, get_xp(args.backend))

@@ -40,8 +40,9 @@ def main() -> None:
         args.repeat = 1
     starts = ((-100.0, 0.0, "starboard"), (0.0, 150.0, "port"), (100.0, 300.0, None))
     routes = {"osc": [known.route_boat(known.twd_osc, *s) for s in starts]}
-    tracks = [tr.between(tr.t_start, tr.t_start + 1200.0)
-              for tr in known.tracks(routes, "osc", 3, 2.0)]
+    tracks = [
+        tr.between(tr.t_start, tr.t_start + 1200.0) for tr in known.tracks(routes, "osc", 3, 2.0)
+    ]
     n = sum(len(tr) for tr in tracks)
     for boat in (None, known.BOAT):
         best = np.inf
@@ -51,8 +52,10 @@ def main() -> None:
             best = min(best, time.perf_counter() - tic)
         ok = np.isfinite(iw.twd_deg)
         rms = float(np.sqrt(np.mean(wrap180(iw.twd_deg[ok] - known.twd_osc(iw.t[ok])) ** 2)))
-        print(f"infer_wind, 3 boats, {n} points, {'with' if boat else 'without'} polar: "
-              f"{1e3 * best:.1f} ms (best of {args.repeat}); TWD RMS {rms:.2f}°")
+        print(
+            f"infer_wind, 3 boats, {n} points, {'with' if boat else 'without'} polar: "
+            f"{1e3 * best:.1f} ms (best of {args.repeat}); TWD RMS {rms:.2f}°"
+        )
 
 
 if __name__ == "__main__":

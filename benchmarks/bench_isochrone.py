@@ -58,10 +58,13 @@ def load_polar() -> Polar:
         return read_polar(POLAR_FILE)
     except Exception:  # boat I/O not available: a smooth Laser-like table
         twa = np.array([0, 30, 40, 45, 50, 60, 75, 90, 105, 120, 135, 150, 165, 180.0])
-        g = np.array([0, .45, .68, .74, .79, .85, .92, .97, 1.0, .97, .9, .82, .66, .55])
+        g = np.array(
+            [0, 0.45, 0.68, 0.74, 0.79, 0.85, 0.92, 0.97, 1.0, 0.97, 0.9, 0.82, 0.66, 0.55]
+        )
         tws = np.array([1, 2, 3, 4, 5, 6, 7, 8, 10, 12.0])
-        return Polar.from_arrays(twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))),
-                                 name="laser-like")
+        return Polar.from_arrays(
+            twa, tws, np.outer(g, 3.4 * (1 - np.exp(-tws / 3.5))), name="laser-like"
+        )
 
 
 def wrf_field():
@@ -100,11 +103,11 @@ def beat(wind, t0: float) -> tuple[Start, Target]:
     _, twd = wind_speed_direction(u, v)
     th = math.radians(float(twd))
     return Start((0.0, 0.0), name="start"), Target(
-        "mark", (LEG_M * math.sin(th), LEG_M * math.cos(th)), rounding="port", name="1")
+        "mark", (LEG_M * math.sin(th), LEG_M * math.cos(th)), rounding="port", name="1"
+    )
 
 
-def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repeat: int,
-             xp=np):
+def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repeat: int, xp=np):
     start, target = beat(wind, t0)
     sizes: list[int] = []
     step_s: list[float] = []
@@ -141,16 +144,24 @@ def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repe
     a_dn = float(np.interp(tws, tab.tws_ms, tab.down_deg))
     hull = int(np.count_nonzero((tab.twa_deg > a_up) & (tab.twa_deg < a_dn)))
     print(f"{name}")
-    print(f"  wall {1e3 * min(walls):7.1f} ms best, {1e3 * statistics.median(walls):7.1f} ms "
-          f"median; cpu {1e3 * min(cpus):7.1f} ms best  ({repeat} runs)")
-    print(f"  {steps} steps, front {mean_n:.0f} points mean / {max_n} max, "
-          f"{hull + 3} + 3 candidates per point (grid TWAs between the VMG angles "
-          f"{a_up:.1f}-{a_dn:.1f} deg + 3 exact; 3 after a side change)")
-    print(f"  per step (CPU, least squares over the {steps} steps): {1e6 * fixed:.0f} us "
-          f"fixed + {1e6 * per_point:.2f} us per front point")
-    print(f"  leg time {res.time_s:.1f} s, {res.n_tacks} tacks, {res.n_gybes} gybes, "
-          f"sailed {res.distance_m:.0f} m, start -> end ({res.end_xy[0]:.0f}, "
-          f"{res.end_xy[1]:.0f}) m")
+    print(
+        f"  wall {1e3 * min(walls):7.1f} ms best, {1e3 * statistics.median(walls):7.1f} ms "
+        f"median; cpu {1e3 * min(cpus):7.1f} ms best  ({repeat} runs)"
+    )
+    print(
+        f"  {steps} steps, front {mean_n:.0f} points mean / {max_n} max, "
+        f"{hull + 3} + 3 candidates per point (grid TWAs between the VMG angles "
+        f"{a_up:.1f}-{a_dn:.1f} deg + 3 exact; 3 after a side change)"
+    )
+    print(
+        f"  per step (CPU, least squares over the {steps} steps): {1e6 * fixed:.0f} us "
+        f"fixed + {1e6 * per_point:.2f} us per front point"
+    )
+    print(
+        f"  leg time {res.time_s:.1f} s, {res.n_tacks} tacks, {res.n_gybes} gybes, "
+        f"sailed {res.distance_m:.0f} m, start -> end ({res.end_xy[0]:.0f}, "
+        f"{res.end_xy[1]:.0f}) m"
+    )
 
 
 def main() -> None:
@@ -159,42 +170,73 @@ def main() -> None:
     ap.add_argument("--dt", type=float, default=None, help="dt_s (default: RoutingSettings)")
     ap.add_argument("--heading-step", type=float, default=None)
     ap.add_argument("--sector", type=float, default=None)
-    ap.add_argument("--penalty", type=float, default=None,
-                    help="tack and gybe penalty [s] (default: RoutingSettings)")
+    ap.add_argument(
+        "--penalty",
+        type=float,
+        default=None,
+        help="tack and gybe penalty [s] (default: RoutingSettings)",
+    )
     ap.add_argument("--backend", default="numpy", help="numpy | cupy | auto (array backend)")
-    ap.add_argument("--smoke", action="store_true",
-                    help="the uniform-wind leg once (checks the script runs)")
+    ap.add_argument(
+        "--smoke", action="store_true", help="the uniform-wind leg once (checks the script runs)"
+    )
     args = ap.parse_args()
     if args.smoke:
         args.repeat = 1
     xp = get_xp(args.backend)
-    kw = {k: v for k, v in (("dt_s", args.dt), ("heading_step_deg", args.heading_step),
-                            ("prune_sector_deg", args.sector),
-                            ("tack_penalty_s", args.penalty), ("gybe_penalty_s", args.penalty))
-          if v is not None}
+    kw = {
+        k: v
+        for k, v in (
+            ("dt_s", args.dt),
+            ("heading_step_deg", args.heading_step),
+            ("prune_sector_deg", args.sector),
+            ("tack_penalty_s", args.penalty),
+            ("gybe_penalty_s", args.penalty),
+        )
+        if v is not None
+    }
     st = RoutingSettings(**kw)
     polar = load_polar()
-    print(f"command: python {' '.join(sys.argv)}; load average (1, 5, 15 min): "
-          f"{', '.join(f'{x:.2f}' for x in os.getloadavg())}")
-    print(f"isochrone router, one thread, numpy {np.__version__}; polar {polar.name!r}; "
-          f"dt {st.dt_s:g} s, heading step {st.heading_step_deg:g} deg, sectors "
-          f"{st.prune_sector_deg:g} deg, tack {st.tack_penalty_s:g} s, gybe "
-          f"{st.gybe_penalty_s:g} s; backend {xp_name(xp)}")
+    print(
+        f"command: python {' '.join(sys.argv)}; load average (1, 5, 15 min): "
+        f"{', '.join(f'{x:.2f}' for x in os.getloadavg())}"
+    )
+    print(
+        f"isochrone router, one thread, numpy {np.__version__}; polar {polar.name!r}; "
+        f"dt {st.dt_s:g} s, heading step {st.heading_step_deg:g} deg, sectors "
+        f"{st.prune_sector_deg:g} deg, tack {st.tack_penalty_s:g} s, gybe "
+        f"{st.gybe_penalty_s:g} s; backend {xp_name(xp)}"
+    )
     t0 = 1524567600.0  # 2018-04-24T11:00Z, inside the synthetic WRF file
-    run_case("uniform 8.5 kn from 0 deg, 1809 m beat", UniformWind(8.5 * KNOT, 0.0), t0,
-             polar, st, args.repeat, xp)
+    run_case(
+        "uniform 8.5 kn from 0 deg, 1809 m beat",
+        UniformWind(8.5 * KNOT, 0.0),
+        t0,
+        polar,
+        st,
+        args.repeat,
+        xp,
+    )
     if args.smoke:
         return
     wrf = wrf_field()
     if wrf is not None:
         c = wrf.coverage
         t_w = c.t0 + 0.25 * (c.t1 - c.t0)
-        run_case(f"WRF {wrf.name} (grid {wrf.shape}), 1809 m beat", wrf, t_w, polar, st,
-                 args.repeat, xp)
+        run_case(
+            f"WRF {wrf.name} (grid {wrf.shape}), 1809 m beat", wrf, t_w, polar, st, args.repeat, xp
+        )
     else:
         print("WRF reader not available: WRF case skipped")
-    run_case("gridded analytic field (17 x 17 cells, 10-min slices), 1809 m beat",
-             gridded_field(t0), t0 + 600.0, polar, st, args.repeat, xp)
+    run_case(
+        "gridded analytic field (17 x 17 cells, 10-min slices), 1809 m beat",
+        gridded_field(t0),
+        t0 + 600.0,
+        polar,
+        st,
+        args.repeat,
+        xp,
+    )
 
 
 if __name__ == "__main__":

@@ -83,11 +83,11 @@ class LiveFeed:
         s = 0
         while not self._quit.is_set():
             f = min(s / 1200.0, 0.5)  # 1 -> gate at ~0.4 m/s
-            lat, lon = self.course.frame.to_latlon(m1[0] + (gate[0] - m1[0]) * f - 30.0,
-                                                   m1[1] + (gate[1] - m1[1]) * f)
+            lat, lon = self.course.frame.to_latlon(
+                m1[0] + (gate[0] - m1[0]) * f - 30.0, m1[1] + (gate[1] - m1[1]) * f
+            )
             twd = self.twd
-            row = Row(t + s, float(lat), float(lon), 0.8, 245.0, 245.0, 0.8, None, None,
-                      5.0, twd)
+            row = Row(t + s, float(lat), float(lon), 0.8, 245.0, 245.0, 0.8, None, None, 5.0, twd)
             data = "".join(line + "\r\n" for line in nmea_lines(row)).encode()
             if twd != self._sent_twd and self.changed_at is None:
                 self.changed_at = time.monotonic()
@@ -106,9 +106,16 @@ class LiveFeed:
 
 def latency(course: Course, shifts: int) -> None:
     feed = LiveFeed(course)
-    engine = start_live(course, source=f"nmea+tcp://127.0.0.1:{feed.port}", scenario="mean",
-                        every_s=10_000, port=0, nmea_port=0, leg=2,
-                        settings=LiveSettings(window_s=0.5, side=False))
+    engine = start_live(
+        course,
+        source=f"nmea+tcp://127.0.0.1:{feed.port}",
+        scenario="mean",
+        every_s=10_000,
+        port=0,
+        nmea_port=0,
+        leg=2,
+        settings=LiveSettings(window_s=0.5, side=False),
+    )
     assert engine.page is not None and engine.nmea is not None
     url = f"http://127.0.0.1:{engine.page.port}/state.json"
     plotter = socket.create_connection(("127.0.0.1", engine.nmea.port))
@@ -154,12 +161,18 @@ def latency(course: Course, shifts: int) -> None:
         feed.close()
         plotter.close()
     print(f"wind change -> route, {legs}-leg remainder, {shifts} shifts of 15°, 1 Hz feed:")
-    print(f"  page (/state.json) median {sorted(page_ms)[len(page_ms) // 2]:.0f} ms, "
-          f"max {max(page_ms):.0f} ms")
-    print(f"  NMEA port (RTE)    median {sorted(nmea_ms)[len(nmea_ms) // 2]:.0f} ms, "
-          f"max {max(nmea_ms):.0f} ms")
-    print(f"  of which routing   median {sorted(route_ms)[len(route_ms) // 2]:.0f} ms wall, "
-          f"{sorted(cpu_ms)[len(cpu_ms) // 2]:.0f} ms CPU (the rest: waiting for a core)")
+    print(
+        f"  page (/state.json) median {sorted(page_ms)[len(page_ms) // 2]:.0f} ms, "
+        f"max {max(page_ms):.0f} ms"
+    )
+    print(
+        f"  NMEA port (RTE)    median {sorted(nmea_ms)[len(nmea_ms) // 2]:.0f} ms, "
+        f"max {max(nmea_ms):.0f} ms"
+    )
+    print(
+        f"  of which routing   median {sorted(route_ms)[len(route_ms) // 2]:.0f} ms wall, "
+        f"{sorted(cpu_ms)[len(cpu_ms) // 2]:.0f} ms CPU (the rest: waiting for a core)"
+    )
 
 
 def memory(course: Course, seconds: int, speed: float, trace: bool) -> None:
@@ -168,19 +181,39 @@ def memory(course: Course, seconds: int, speed: float, trace: bool) -> None:
     rows = []
     for s in range(seconds):  # circling 200 m around a point below mark 1, 2.5 m/s
         a = 2.5 * s / 200.0
-        lat, lon = frame.to_latlon(cx - 250.0 + 200.0 * math.sin(a), cy - 250 + 200.0
-                                   * math.cos(a))
-        rows.append(Row(course.start_epoch + s, float(lat), float(lon), 2.5 / KN,
-                        math.degrees(a + math.pi / 2) % 360, None, None, None, None,
-                        5.0 + math.sin(s / 300.0), 65.0 + 10.0 * math.sin(s / 420.0)))
+        lat, lon = frame.to_latlon(cx - 250.0 + 200.0 * math.sin(a), cy - 250 + 200.0 * math.cos(a))
+        rows.append(
+            Row(
+                course.start_epoch + s,
+                float(lat),
+                float(lon),
+                2.5 / KN,
+                math.degrees(a + math.pi / 2) % 360,
+                None,
+                None,
+                None,
+                None,
+                5.0 + math.sin(s / 300.0),
+                65.0 + 10.0 * math.sin(s / 420.0),
+            )
+        )
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "hour.nmea"
         path.write_text("".join(line + "\r\n" for r in rows for line in nmea_lines(r)))
         if trace:
             tracemalloc.start()
-        engine = start_live(course, source=str(path), scenario="mean", every_s=60.0,
-                            speed=speed, port=0, nmea_port=0, log=Path(d) / "live.jsonl",
-                            leg=1, settings=LiveSettings(side=False))
+        engine = start_live(
+            course,
+            source=str(path),
+            scenario="mean",
+            every_s=60.0,
+            speed=speed,
+            port=0,
+            nmea_port=0,
+            log=Path(d) / "live.jsonl",
+            leg=1,
+            settings=LiveSettings(side=False),
+        )
         rss, traced = [], []
         w0 = time.monotonic()
         try:
@@ -194,12 +227,16 @@ def memory(course: Course, seconds: int, speed: float, trace: bool) -> None:
             engine.close()
         wall = time.monotonic() - w0
     q = max(len(rss) // 4, 1)
-    print(f"{seconds / 60:.0f}-min replay at {speed:g}x: read in {replay:.1f} s "
-          f"(the feed's pace: {seconds / speed:.1f} s), {wall:.1f} s with the last re-plan; "
-          f"{engine.n_readings} readings, {engine.n_plans} re-plans")
+    print(
+        f"{seconds / 60:.0f}-min replay at {speed:g}x: read in {replay:.1f} s "
+        f"(the feed's pace: {seconds / speed:.1f} s), {wall:.1f} s with the last re-plan; "
+        f"{engine.n_readings} readings, {engine.n_plans} re-plans"
+    )
     heap = f"; Python heap {traced[q - 1]:.1f} -> {traced[-1]:.1f} MiB" if trace else ""
-    print(f"  RSS after the first quarter {rss[q - 1]:.1f} MiB, at the end {rss[-1]:.1f} MiB "
-          f"(max {max(rss):.1f}){heap}")
+    print(
+        f"  RSS after the first quarter {rss[q - 1]:.1f} MiB, at the end {rss[-1]:.1f} MiB "
+        f"(max {max(rss):.1f}){heap}"
+    )
 
 
 def main() -> None:

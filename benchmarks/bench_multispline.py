@@ -78,20 +78,28 @@ def _best(fn, repeat: int):
 
 
 def _row(example: str, setup: str, wall: float, paper: dict, result: str) -> None:
-    print(f"{example:<10}{setup:<44}{wall:>9.2f}{_fmt(paper['serial_s'], '9.1f'):>9}"
-          f"{_fmt(paper['opencl_s'], '8.1f'):>8}{_ratio(wall, paper['serial_s']):>9}"
-          f"{_ratio(wall, paper['opencl_s']):>9}   {result}")
+    print(
+        f"{example:<10}{setup:<44}{wall:>9.2f}{_fmt(paper['serial_s'], '9.1f'):>9}"
+        f"{_fmt(paper['opencl_s'], '8.1f'):>8}{_ratio(wall, paper['serial_s']):>9}"
+        f"{_ratio(wall, paper['opencl_s']):>9}   {result}"
+    )
 
 
 def example1(setup: tuple[int, int, int, int], repeat: int) -> None:
     """The paper's function-fitting test problem."""
     nr, nc, nts, nref = setup
-    wall, fit = _best(lambda: fit_function(n_rows=nr, n_cols=nc, n_slopes=nts, n_refine=nref),
-                      repeat)
+    wall, fit = _best(
+        lambda: fit_function(n_rows=nr, n_cols=nc, n_slopes=nts, n_refine=nref), repeat
+    )
     errs = " -> ".join(f"{math.sqrt(p.cost):.5f}" for p in fit.passes)
     edges = sum(p.edges for p in fit.passes)
-    _row("Example 1", f"n_r={nr} n_c={nc} n_ts={nts} refine={nref}", wall, PAPER["ex1"],
-         f"L2 error per pass {errs} ({edges / 1e6:.0f} M edges; paper: not given)")
+    _row(
+        "Example 1",
+        f"n_r={nr} n_c={nc} n_ts={nts} refine={nref}",
+        wall,
+        PAPER["ex1"],
+        f"L2 error per pass {errs} ({edges / 1e6:.0f} M edges; paper: not given)",
+    )
 
 
 def example2(repeat: int, options: bool) -> None:
@@ -100,42 +108,71 @@ def example2(repeat: int, options: bool) -> None:
     boat.table()  # built once per boat, outside the timings
     variants = [("flying start", False, False)]
     if options:
-        variants += [("carry speed", True, False), ("from rest", False, True),
-                     ("carry speed + from rest", True, True)]
+        variants += [
+            ("carry speed", True, False),
+            ("from rest", False, True),
+            ("carry speed + from rest", True, True),
+        ]
     for name, carry, rest in variants:
-        s = RoutingSettings(router="spline", dp_half_width_m=400.0, tack_penalty_s=0.0,
-                            gybe_penalty_s=0.0, zone_m=POINT_ZONE_M, spline_carry_speed=carry,
-                            spline_start_from_rest=rest, **EX2)
+        s = RoutingSettings(
+            router="spline",
+            dp_half_width_m=400.0,
+            tack_penalty_s=0.0,
+            gybe_penalty_s=0.0,
+            zone_m=POINT_ZONE_M,
+            spline_carry_speed=carry,
+            spline_start_from_rest=rest,
+            **EX2,
+        )
 
         def run(s: RoutingSettings = s):
-            return solve_spline(Start((0.0, 0.0)), Target("mark", (500.0, 0.0)), 0.0,
-                                debski_test_wind(), boat, s)
+            return solve_spline(
+                Start((0.0, 0.0)), Target("mark", (500.0, 0.0)), 0.0, debski_test_wind(), boat, s
+            )
 
         wall, (res, fit) = _best(run, repeat)
         edges = sum(p.edges for p in fit.passes)
         setup = f"n_r=16 n_c=32 n_ts=8 refine=3, {name}"
-        _row("Example 2", setup, wall, PAPER["ex2"],
-             f"t_f {res.time_s:.3f} s (paper {PAPER['ex2']['result']:.0f} s; "
-             f"{edges / 1e6:.1f} M edges; course {res.track.heading_deg[0]:.1f}° -> "
-             f"{res.track.heading_deg[-2]:.1f}°)")
+        _row(
+            "Example 2",
+            setup,
+            wall,
+            PAPER["ex2"],
+            f"t_f {res.time_s:.3f} s (paper {PAPER['ex2']['result']:.0f} s; "
+            f"{edges / 1e6:.1f} M edges; course {res.track.heading_deg[0]:.1f}° -> "
+            f"{res.track.heading_deg[-2]:.1f}°)",
+        )
 
 
 def main() -> None:
     """Command-line entry point."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="Example 2 only, no option runs")
-    ap.add_argument("--ex1", nargs=4, type=int, metavar=("NR", "NC", "NTS", "NREF"),
-                    default=EX1_DEFAULT, help="Example 1 set-up (default %(default)s)")
+    ap.add_argument(
+        "--ex1",
+        nargs=4,
+        type=int,
+        metavar=("NR", "NC", "NTS", "NREF"),
+        default=EX1_DEFAULT,
+        help="Example 1 set-up (default %(default)s)",
+    )
     ap.add_argument("--repeat", type=int, default=1, help="best of N runs (default 1)")
-    ap.add_argument("--smoke", action="store_true",
-                    help="Example 1 on a tiny set-up only (checks the script runs)")
+    ap.add_argument(
+        "--smoke",
+        action="store_true",
+        help="Example 1 on a tiny set-up only (checks the script runs)",
+    )
     args = ap.parse_args()
     load0 = os.getloadavg()
-    print(f"# sailroute multi-spline benchmark — {platform.processor() or platform.machine()}, "
-          f"Python {platform.python_version()}, numpy {np.__version__}, 1 thread; "
-          f"load average at start {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}")
-    print(f"{'example':<10}{'set-up':<44}{'ours s':>9}{'serial':>9}{'OpenCL':>8}"
-          f"{'/serial':>9}{'/OpenCL':>9}   result")
+    print(
+        f"# sailroute multi-spline benchmark — {platform.processor() or platform.machine()}, "
+        f"Python {platform.python_version()}, numpy {np.__version__}, 1 thread; "
+        f"load average at start {load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f}"
+    )
+    print(
+        f"{'example':<10}{'set-up':<44}{'ours s':>9}{'serial':>9}{'OpenCL':>8}"
+        f"{'/serial':>9}{'/OpenCL':>9}   result"
+    )
     if args.smoke:
         example1((6, 8, 4, 1), 1)
         return

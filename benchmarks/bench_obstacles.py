@@ -61,17 +61,33 @@ scenarios:
 # ten 40 m squares (centres, metres from the course centre; the windward mark is at
 # (-500, 0), the leeward gate at (500, +-25), the start line at x = 550): some on or near
 # the direct routes, some off them
-CENTRES = [(350.0, 60.0), (200.0, -120.0), (80.0, 20.0), (-60.0, 180.0), (-200.0, -60.0),
-           (-340.0, 90.0), (250.0, 260.0), (-120.0, -260.0), (380.0, -220.0), (-400.0, -150.0)]
+CENTRES = [
+    (350.0, 60.0),
+    (200.0, -120.0),
+    (80.0, 20.0),
+    (-60.0, 180.0),
+    (-200.0, -60.0),
+    (-340.0, 90.0),
+    (250.0, 260.0),
+    (-120.0, -260.0),
+    (380.0, -220.0),
+    (-400.0, -150.0),
+]
 
 
 def area_yaml() -> str:
     """The boundary and the ten obstacles as course keys."""
-    lines = ["boundary:", "  clearance_m: 20", "  points: [{x: 900, y: -600}, {x: 900, y: 600}, "
-             "{x: -900, y: 600}, {x: -900, y: -600}]", "obstacles:"]
+    lines = [
+        "boundary:",
+        "  clearance_m: 20",
+        "  points: [{x: 900, y: -600}, {x: 900, y: 600}, {x: -900, y: 600}, {x: -900, y: -600}]",
+        "obstacles:",
+    ]
     for k, (cx, cy) in enumerate(CENTRES):
-        pts = ", ".join(f"{{x: {cx + dx:.0f}, y: {cy + dy:.0f}}}"
-                        for dx, dy in ((-20, -20), (20, -20), (20, 20), (-20, 20)))
+        pts = ", ".join(
+            f"{{x: {cx + dx:.0f}, y: {cy + dy:.0f}}}"
+            for dx, dy in ((-20, -20), (20, -20), (20, 20), (-20, 20))
+        )
         lines.append(f"  - {{name: buoy-field-{k + 1}, clearance_m: 10, points: [{pts}]}}")
     return "\n".join(lines) + "\n"
 
@@ -112,13 +128,16 @@ def main() -> None:
     x0, y0 = rng.uniform(-900, 900, n), rng.uniform(-600, 600, n)
     ang = rng.uniform(0, 2 * np.pi, n)
     x1, y1 = x0 + 60 * np.sin(ang), y0 + 60 * np.cos(ang)
-    for label, fn in (("edge test (NumPy)", obs.segments_free),
-                      ("shapely.intersects", obs.segments_free_shapely)):
+    for label, fn in (
+        ("edge test (NumPy)", obs.segments_free),
+        ("shapely.intersects", obs.segments_free_shapely),
+    ):
         tic = time.perf_counter()
         free = fn(x0, y0, x1, y1)
         dt = time.perf_counter() - tic
-        print(f"  segments_free {label:19s} {dt * 1e3:8.1f} ms per {n} moves "
-              f"({free.mean():.3f} free)")
+        print(
+            f"  segments_free {label:19s} {dt * 1e3:8.1f} ms per {n} moves ({free.mean():.3f} free)"
+        )
     print(f"load average after: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 

@@ -222,12 +222,15 @@ def cpu_model() -> str:
     except (OSError, ValueError):
         pass
     name = info.get("model name") or platform.processor() or platform.machine()
-    return (f"{name} ({info.get('cpu MHz', '?')} MHz, cache "
-            f"{info.get('cache size', '?')}), {os.cpu_count()} logical cores{info.get('mem', '')}")
+    return (
+        f"{name} ({info.get('cpu MHz', '?')} MHz, cache "
+        f"{info.get('cache size', '?')}), {os.cpu_count()} logical cores{info.get('mem', '')}"
+    )
 
 
 def machine_lines() -> list[str]:
     """Machine and library versions, one ``- key: value`` line each."""
+
     def version(dist: str) -> str:
         try:
             return metadata.version(dist)
@@ -380,7 +383,10 @@ def polar_mismatch(ours: Polar, peer: Any) -> float:
 
 
 def _direct_arrival(
-    front_ll: Sequence[tuple[float, float]], t: float, leg: PeerLeg, peer_polar: Any,
+    front_ll: Sequence[tuple[float, float]],
+    t: float,
+    leg: PeerLeg,
+    peer_polar: Any,
 ) -> tuple[float, float]:
     """Earliest straight-line arrival at the mark from a peer front.
 
@@ -420,8 +426,9 @@ def _direct_arrival(
     return t + best, best
 
 
-def run_peer(leg: PeerLeg, peer_polar: Any, dt_s: float, max_steps: int | None = None,
-             subdiv: float = 1.0) -> PeerRun:
+def run_peer(
+    leg: PeerLeg, peer_polar: Any, dt_s: float, max_steps: int | None = None, subdiv: float = 1.0
+) -> PeerRun:
     """Route ``leg`` with weatherrouting's ``LinearBestIsoRouter`` (see module docstring).
 
     Parameters
@@ -446,8 +453,14 @@ def run_peer(leg: PeerLeg, peer_polar: Any, dt_s: float, max_steps: int | None =
     lat1, lon1 = leg.frame.to_latlon(*leg.target.a)
     start_ll, end_ll = (float(lat0), float(lon0)), (float(lat1), float(lon1))
     t_start = datetime.fromtimestamp(leg.t0, UTC)
-    routing = wr.Routing(wr.routers.linearbestisorouter.LinearBestIsoRouter, peer_polar,
-                         [end_ll], grib, t_start, start_position=start_ll)
+    routing = wr.Routing(
+        wr.routers.linearbestisorouter.LinearBestIsoRouter,
+        peer_polar,
+        [end_ll],
+        grib,
+        t_start,
+        start_position=start_ll,
+    )
     routing.algorithm.set_param_value("subdiv", subdiv)
     routing.algorithm.set_param_value("concurrent", False)
     routing.algorithm.set_param_value("min_increase", 0.0)  # own arrival test: see docstring
@@ -460,10 +473,16 @@ def run_peer(leg: PeerLeg, peer_polar: Any, dt_s: float, max_steps: int | None =
         if not front or len(sizes) * dt_s > MAX_PEER_LEG_S:
             raise RuntimeError(f"peer: no route on {leg.name} after {len(sizes)} steps")
         sizes.append(len(front))
-        arrival, reach = _direct_arrival([p.pos for p in front], leg.t0 + len(sizes) * dt_s,
-                                         leg, peer_polar)
-    return PeerRun(arrival - leg.t0, len(sizes), float(np.mean(sizes)) if sizes else 0.0,
-                   grib.calls, grib.seconds)
+        arrival, reach = _direct_arrival(
+            [p.pos for p in front], leg.t0 + len(sizes) * dt_s, leg, peer_polar
+        )
+    return PeerRun(
+        arrival - leg.t0,
+        len(sizes),
+        float(np.mean(sizes)) if sizes else 0.0,
+        grib.calls,
+        grib.seconds,
+    )
 
 
 def our_settings(dt_s: float) -> dict[str, RoutingSettings]:
@@ -471,7 +490,8 @@ def our_settings(dt_s: float) -> dict[str, RoutingSettings]:
     common = dict(tack_penalty_s=0.0, gybe_penalty_s=0.0, zone_m=MARK_TOLERANCE_M)
     return {
         f"ours, same settings (dt {dt_s:g} s, 5°)": RoutingSettings(
-            dt_s=dt_s, heading_step_deg=5.0, prune_sector_deg=1.0, **common),
+            dt_s=dt_s, heading_step_deg=5.0, prune_sector_deg=1.0, **common
+        ),
         "ours, defaults (dt 10 s, 2°)": RoutingSettings(**common),
     }
 
@@ -480,47 +500,58 @@ def section_peer(args: argparse.Namespace) -> None:
     """Print the peer comparison table."""
     print("\n## Peer comparison: weatherrouting vs sailroute isochrone router\n")
     if wr is None:
-        print("weatherrouting is not installed: peer comparison skipped "
-              "(pip install -e '.[bench]' or pip install weatherrouting==0.2.3)")
+        print(
+            "weatherrouting is not installed: peer comparison skipped "
+            "(pip install -e '.[bench]' or pip install weatherrouting==0.2.3)"
+        )
         return
     ours_polar = read_polar(bench_isochrone.POLAR_FILE, interpolation="linear")
     peer_polar = wr.Polar(str(bench_isochrone.POLAR_FILE))
-    print(f"Polar {bench_isochrone.POLAR_FILE.name}: bilinear in both; largest speed "
-          f"difference {polar_mismatch(ours_polar, peer_polar):.1e} m/s.  Both routers: "
-          f"dt {args.dt:g} s (ours also at its defaults), no manoeuvre cost, pass within "
-          f"{MARK_TOLERANCE_M:g} m of the mark; peer sectors {args.peer_subdiv:g}°.  Peer: "
-          f"best of {args.peer_repeat} after a {PEER_WARMUP_STEPS}-step warm-up; ours: best "
-          f"of {args.repeat} after a warm-up.  Times are wall (CPU of that run).\n")
-    print("| leg (1809 m) | router | wall (cpu) | peer / ours wall (cpu) | route time s "
-          "| ours − peer s "
-          "| notes |")
+    print(
+        f"Polar {bench_isochrone.POLAR_FILE.name}: bilinear in both; largest speed "
+        f"difference {polar_mismatch(ours_polar, peer_polar):.1e} m/s.  Both routers: "
+        f"dt {args.dt:g} s (ours also at its defaults), no manoeuvre cost, pass within "
+        f"{MARK_TOLERANCE_M:g} m of the mark; peer sectors {args.peer_subdiv:g}°.  Peer: "
+        f"best of {args.peer_repeat} after a {PEER_WARMUP_STEPS}-step warm-up; ours: best "
+        f"of {args.repeat} after a warm-up.  Times are wall (CPU of that run).\n"
+    )
+    print(
+        "| leg (1809 m) | router | wall (cpu) | peer / ours wall (cpu) | route time s "
+        "| ours − peer s "
+        "| notes |"
+    )
     print("|---|---|---:|---:|---:|---:|---|")
     legs = peer_cases()
     for i in args.legs or range(len(legs)):
         _peer_rows(legs[i], ours_polar, peer_polar, args)
 
 
-def _peer_rows(leg: PeerLeg, ours_polar: Polar, peer_polar: Any,
-               args: argparse.Namespace) -> None:
+def _peer_rows(leg: PeerLeg, ours_polar: Polar, peer_polar: Any, args: argparse.Namespace) -> None:
     """Print the rows of one leg: the peer, then ours in both configurations."""
+
     def peer_run(max_steps: int | None = None) -> PeerRun:
         return run_peer(leg, peer_polar, args.dt, max_steps=max_steps, subdiv=args.peer_subdiv)
 
     peer_run(PEER_WARMUP_STEPS)
     tp, peer = best_of(peer_run, args.peer_repeat, warmup=False)
-    print(f"| {leg.name} | weatherrouting 0.2.3 | {tp} | | {peer.time_s:.1f} | | "
-          f"{peer.steps} steps, front {peer.mean_front:.0f} pts mean; wind callback "
-          f"{peer.wind_calls} calls, {100 * peer.wind_s / tp.wall:.1f} % of wall |")
+    print(
+        f"| {leg.name} | weatherrouting 0.2.3 | {tp} | | {peer.time_s:.1f} | | "
+        f"{peer.steps} steps, front {peer.mean_front:.0f} pts mean; wind callback "
+        f"{peer.wind_calls} calls, {100 * peer.wind_s / tp.wall:.1f} % of wall |"
+    )
     for label, st in our_settings(args.dt).items():
+
         def ours(st: RoutingSettings = st) -> LegResult:
             return route_leg(leg.start, leg.target, leg.t0, leg.wind, ours_polar, st)
 
         to, res = best_of(ours, args.repeat)
         diff = res.time_s - peer.time_s
-        print(f"| | {label} | {to} | {tp.wall / to.wall:,.0f}x ({tp.cpu / to.cpu:,.0f}x) | "
-              f"{res.time_s:.1f} | "
-              f"{diff:+.1f} ({100 * diff / peer.time_s:+.2f} %) | {res.n_tacks} tacks, "
-              f"{res.n_gybes} gybes, sailed {res.distance_m:.0f} m |")
+        print(
+            f"| | {label} | {to} | {tp.wall / to.wall:,.0f}x ({tp.cpu / to.cpu:,.0f}x) | "
+            f"{res.time_s:.1f} | "
+            f"{diff:+.1f} ({100 * diff / peer.time_s:+.2f} %) | {res.n_tacks} tacks, "
+            f"{res.n_gybes} gybes, sailed {res.distance_m:.0f} m |"
+        )
 
 
 # ------------------------------------------------------------------------------------
@@ -535,34 +566,44 @@ def section_griddp(args: argparse.Namespace) -> None:
     boat = DynamicBoat()
     tic = time.perf_counter()
     boat.table()
-    print(f"Dynamic boat, 800 m x 500 m, 12 m/s wind 5° off the leg axis, one core.  Segment "
-          f"lookup table built once outside the timings ({time.perf_counter() - tic:.2f} s).  "
-          f"Paper setup: R = {PAPER_ROWS} rows, one pass, wind sampled once per segment; "
-          "defaults: R = 13, 3 passes (2 refinements), 4 wind samples per segment.  Best of "
-          f"{args.dp_repeat} after a warm-up.\n")
-    print("| setup | C | wall (cpu) | route t_f s | paper t_f s | paper wall (C = 128) "
-          "| paper / ours |")
+    print(
+        f"Dynamic boat, 800 m x 500 m, 12 m/s wind 5° off the leg axis, one core.  Segment "
+        f"lookup table built once outside the timings ({time.perf_counter() - tic:.2f} s).  "
+        f"Paper setup: R = {PAPER_ROWS} rows, one pass, wind sampled once per segment; "
+        "defaults: R = 13, 3 passes (2 refinements), 4 wind samples per segment.  Best of "
+        f"{args.dp_repeat} after a warm-up.\n"
+    )
+    print(
+        "| setup | C | wall (cpu) | route t_f s | paper t_f s | paper wall (C = 128) "
+        "| paper / ours |"
+    )
     print("|---|---:|---:|---:|---:|---|---:|")
     wind, target = UniformWind(12.0, 5.0), Target("mark", (0.0, 500.0))
     cols = (32, 64) if args.quick else (32, 64, 128)
     setups = {
-        f"paper (R {PAPER_ROWS}, 1 pass)": dict(dp_rows=PAPER_ROWS, dp_refinements=0,
-                                                dp_samples=1),
+        f"paper (R {PAPER_ROWS}, 1 pass)": dict(dp_rows=PAPER_ROWS, dp_refinements=0, dp_samples=1),
         "defaults (R 13, 3 passes)": {},
     }
     for name, kw in setups.items():
         for c in cols:
-            st = RoutingSettings(router="griddp", dp_cols=c, dp_half_width_m=400.0,
-                                 zone_m=bench_griddp.POINT_ZONE_M, **kw)
+            st = RoutingSettings(
+                router="griddp",
+                dp_cols=c,
+                dp_half_width_m=400.0,
+                zone_m=bench_griddp.POINT_ZONE_M,
+                **kw,
+            )
             tm, res = best_of(
-                lambda st=st: route_leg(bench_griddp.A, target, 0.0, wind, boat, st),
-                args.dp_repeat)
+                lambda st=st: route_leg(bench_griddp.A, target, 0.0, wind, boat, st), args.dp_repeat
+            )
             paper = ratio = ""
             if c == 128:
                 paper = f"{PAPER_SERIAL_S:g} s serial / {PAPER_GPU_S:g} s GPU"
                 ratio = f"{PAPER_SERIAL_S / tm.wall:,.0f}x / {PAPER_GPU_S / tm.wall:,.1f}x"
-            print(f"| {name} | {c} | {tm} | {res.time_s:.2f} | "
-                  f"{bench_griddp.PAPER_TF[c]:.2f} | {paper} | {ratio} |")
+            print(
+                f"| {name} | {c} | {tm} | {res.time_s:.2f} | "
+                f"{bench_griddp.PAPER_TF[c]:.2f} | {paper} | {ratio} |"
+            )
 
 
 # ------------------------------------------------------------------------------------
@@ -588,16 +629,18 @@ class _LegClock:
     def end_leg(self, leg_time_s: float, summary: str = "") -> None:
         """Stop the clock of the current leg."""
         del leg_time_s, summary
-        self.times.append(Timing(time.perf_counter() - self._start[0],
-                                 time.process_time() - self._start[1]))
+        self.times.append(
+            Timing(time.perf_counter() - self._start[0], time.process_time() - self._start[1])
+        )
 
     def set_prefix(self, text: str) -> None:
         """Scenario prefix (ignored)."""
         del text
 
 
-def _route_course(course: Any, wind: WindField, boat: Any, st: RoutingSettings
-                  ) -> list[tuple[Timing, LegResult]]:
+def _route_course(
+    course: Any, wind: WindField, boat: Any, st: RoutingSettings
+) -> list[tuple[Timing, LegResult]]:
     """Route every leg in order, chained in time and place; ``(timing, result)`` per leg.
 
     Uses :func:`planning.route.route_course` (the ``plan`` command's leg chaining,
@@ -625,11 +668,13 @@ def section_course(args: argparse.Namespace) -> None:
     course = load_course(COURSE)
     st = dataclasses.replace(course.routing, router="isochrone")
     print(f"\n## Isochrone router per leg and per course: {COURSE.relative_to(ROOT)}\n")
-    print(f"Course settings: dt {st.dt_s:g} s, heading step {st.heading_step_deg:g}°, tack "
-          f"{st.tack_penalty_s:g} s, gybe {st.gybe_penalty_s:g} s.  Legs chained in time and "
-          f"place by `planning.route.route_course` (as `sailroute plan` does); wind and boat "
-          f"built once outside the leg timings.  Best of "
-          f"{args.course_repeat} after a warm-up (per leg: best over the runs).\n")
+    print(
+        f"Course settings: dt {st.dt_s:g} s, heading step {st.heading_step_deg:g}°, tack "
+        f"{st.tack_penalty_s:g} s, gybe {st.gybe_penalty_s:g} s.  Legs chained in time and "
+        f"place by `planning.route.route_course` (as `sailroute plan` does); wind and boat "
+        f"built once outside the leg timings.  Best of "
+        f"{args.course_repeat} after a warm-up (per leg: best over the runs).\n"
+    )
     boat = build_boat(course)
     for scenario in COURSE_SCENARIOS:
         tic = time.perf_counter()
@@ -644,28 +689,34 @@ def section_course(args: argparse.Namespace) -> None:
         for i, spec in enumerate(course.legs):
             tm = min((r[i][0] for r in runs), key=lambda t: t.wall)
             res = legs[i][1]
-            print(f"| {i + 1} | {spec.label} | {tm} | {res.time_s:.1f} | "
-                  f"{res.n_tacks} | {res.n_gybes} |")
+            print(
+                f"| {i + 1} | {spec.label} | {tm} | {res.time_s:.1f} | "
+                f"{res.n_tacks} | {res.n_gybes} |"
+            )
         route = sum(res.time_s for _, res in legs)
         total = min(totals, key=lambda t: t.wall)
         print(f"| | **course** | **{total}** | **{route:.1f}** | | |")
-        print(f"\n`plan_course` end to end (validates the specs, builds wind and boat, "
-              f"routes, makes the plan): {_plan_course_wall(course, scenario, 1)}\n")
+        print(
+            f"\n`plan_course` end to end (validates the specs, builds wind and boat, "
+            f"routes, makes the plan): {_plan_course_wall(course, scenario, 1)}\n"
+        )
 
 
 # ------------------------------------------------------------------------------------
 # CLI start-up
 
 
-def _time_process(cmd: Sequence[str], env: dict[str, str], repeat: int,
-                  cwd: Path = ROOT) -> tuple[Timing, int]:
+def _time_process(
+    cmd: Sequence[str], env: dict[str, str], repeat: int, cwd: Path = ROOT
+) -> tuple[Timing, int]:
     """Best wall time of ``repeat`` fresh processes, its CPU time, and the last exit code."""
     best, rc = Timing(math.inf, math.inf), 0
     for _ in range(repeat):
         r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
         tic = time.perf_counter()
-        rc = subprocess.run(cmd, env=env, cwd=cwd, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, check=False).returncode
+        rc = subprocess.run(
+            cmd, env=env, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=False
+        ).returncode
         wall = time.perf_counter() - tic
         r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
@@ -685,19 +736,47 @@ def _cli_commands(out: Path) -> dict[str, list[str]]:
     """Label -> command line of the start-up and main-job timings."""
     exe, py = _sailroute_exe(), sys.executable
     course = str(COURSE.relative_to(ROOT))
-    imports = {m: [py, "-c", f"import {m}"] for m in (
-        "numpy", "scipy.interpolate", "matplotlib.pyplot", "sailroute.cli",
-        "sailroute.planning.route")}
+    imports = {
+        m: [py, "-c", f"import {m}"]
+        for m in (
+            "numpy",
+            "scipy.interpolate",
+            "matplotlib.pyplot",
+            "sailroute.cli",
+            "sailroute.planning.route",
+        )
+    }
     return {
         'python -c "pass"': [py, "-c", "pass"],
         **{f'python -c "import {m}"': c for m, c in imports.items()},
         "sailroute --help": [exe, "--help"],
         "sailroute plan courses/hyeres-r1.yaml --no-plots": [
-            exe, "plan", course, "--out", str(out / "plan"), "--quiet", "--no-plots"],
+            exe,
+            "plan",
+            course,
+            "--out",
+            str(out / "plan"),
+            "--quiet",
+            "--no-plots",
+        ],
         "sailroute plan courses/hyeres-r1.yaml": [
-            exe, "plan", course, "--out", str(out / "plan"), "--quiet"],
+            exe,
+            "plan",
+            course,
+            "--out",
+            str(out / "plan"),
+            "--quiet",
+        ],
         "sailroute plan courses/hyeres-r1.yaml -s wrf10": [
-            exe, "plan", course, "-s", "wrf10", "--out", str(out / "plan"), "--quiet"],
+            exe,
+            "plan",
+            course,
+            "-s",
+            "wrf10",
+            "--out",
+            str(out / "plan"),
+            "--quiet",
+        ],
     }
 
 
@@ -709,11 +788,13 @@ def section_cli(args: argparse.Namespace) -> None:
     warm = {k: v for k, v in base.items() if k != "PYTHONDONTWRITEBYTECODE"}
     warm["PYTHONPYCACHEPREFIX"] = str(out / "pycache")
     print("\n## CLI start-up and the main job (fresh processes)\n")
-    print(f"Best of {args.cli_repeat} (plan: best of {args.plan_repeat}), wall (CPU of the "
-          "child).  *No bytecode cache*: every module is compiled at import (how this "
-          "sandbox runs: PYTHONDONTWRITEBYTECODE=1 and no .pyc files in the venv); *with "
-          "cache*: a primed .pyc cache in a temporary PYTHONPYCACHEPREFIX, as after a normal "
-          "pip install.  `plan` writes JSON/CSV/GPX and, without --no-plots, route.png.\n")
+    print(
+        f"Best of {args.cli_repeat} (plan: best of {args.plan_repeat}), wall (CPU of the "
+        "child).  *No bytecode cache*: every module is compiled at import (how this "
+        "sandbox runs: PYTHONDONTWRITEBYTECODE=1 and no .pyc files in the venv); *with "
+        "cache*: a primed .pyc cache in a temporary PYTHONPYCACHEPREFIX, as after a normal "
+        "pip install.  `plan` writes JSON/CSV/GPX and, without --no-plots, route.png.\n"
+    )
     print("| command | no bytecode cache | with cache | exit |")
     print("|---|---:|---:|---:|")
     for label, cmd in _cli_commands(out).items():
@@ -735,16 +816,27 @@ def _compare_plan(baseline: Path, env: dict[str, str], out: Path, rounds: int) -
     their tree (``-m`` would put the working folder first)."""
     trees = {"baseline": baseline, "this tree": ROOT}
     course = str(COURSE)
-    print(f"\n`sailroute plan {COURSE.relative_to(ROOT)}` against {baseline} "
-          f"({_git_rev(baseline)}), alternating, {rounds} runs each (wall s, sorted):\n")
+    print(
+        f"\n`sailroute plan {COURSE.relative_to(ROOT)}` against {baseline} "
+        f"({_git_rev(baseline)}), alternating, {rounds} runs each (wall s, sorted):\n"
+    )
     print("| command | baseline | this tree | ratio of medians |")
     print("|---|---|---|---:|")
     for flags in ([], ["--no-plots"]):
         walls: dict[str, list[float]] = {k: [] for k in trees}
         for i in range(rounds + 1):
             for name, tree in trees.items():
-                cmd = [sys.executable, "-m", "sailroute", "plan", course, "--out",
-                       str(out / "cmp"), "--quiet", *flags]
+                cmd = [
+                    sys.executable,
+                    "-m",
+                    "sailroute",
+                    "plan",
+                    course,
+                    "--out",
+                    str(out / "cmp"),
+                    "--quiet",
+                    *flags,
+                ]
                 t, rc = _time_process(cmd, dict(env, PYTHONPATH=str(tree)), 1, cwd=out)
                 if rc != 0:
                     raise SystemExit(f"{name}: {' '.join(cmd)} exited with {rc}")
@@ -752,14 +844,20 @@ def _compare_plan(baseline: Path, env: dict[str, str], out: Path, rounds: int) -
                     walls[name].append(t.wall)
         med = {k: statistics.median(v) for k, v in walls.items()}
         cells = [", ".join(f"{w:.2f}" for w in sorted(walls[k])) for k in trees]
-        print(f"| `plan {' '.join(flags)}` | {cells[0]} | {cells[1]} | "
-              f"{med['this tree'] / med['baseline']:.3f} |")
+        print(
+            f"| `plan {' '.join(flags)}` | {cells[0]} | {cells[1]} | "
+            f"{med['this tree'] / med['baseline']:.3f} |"
+        )
 
 
 def _git_rev(tree: Path) -> str:
     """Short commit of ``tree`` (or "?")."""
-    res = subprocess.run(["git", "-C", str(tree), "rev-parse", "--short", "HEAD"],
-                         capture_output=True, text=True, check=False)
+    res = subprocess.run(
+        ["git", "-C", str(tree), "rev-parse", "--short", "HEAD"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     return res.stdout.strip() or "?"
 
 
@@ -785,20 +883,27 @@ def section_profile(args: argparse.Namespace) -> None:
     stats = pstats.Stats(prof)
     total = sum(v[2] for v in stats.stats.values())  # type: ignore[attr-defined]
     print("\n## Profile: `route_leg`, Hyères R1 leg 1 (start line -> 1), scenario wrf10\n")
-    print(f"Unprofiled {tm} wall (cpu), best of 3; route {res.time_s:.1f} s.  Under "
-          f"cProfile {_fmt_s(total)} of own time in all functions; top {args.top} by own "
-          "time (cumulative = with callees):\n")
+    print(
+        f"Unprofiled {tm} wall (cpu), best of 3; route {res.time_s:.1f} s.  Under "
+        f"cProfile {_fmt_s(total)} of own time in all functions; top {args.top} by own "
+        "time (cumulative = with callees):\n"
+    )
     print("| function | calls | own s | own % | cumulative % |")
     print("|---|---:|---:|---:|---:|")
     rows = sorted(stats.stats.items(), key=lambda kv: kv[1][2], reverse=True)  # type: ignore[attr-defined]
     for (file, line, func), (_, ncalls, own, cum, _) in rows[: args.top]:
         where = _short_path(file)
-        print(f"| `{func}` ({where}:{line}) | {ncalls} | {own:.3f} | {100 * own / total:.1f} | "
-              f"{100 * cum / total:.1f} |")
+        print(
+            f"| `{func}` ({where}:{line}) | {ncalls} | {own:.3f} | {100 * own / total:.1f} | "
+            f"{100 * cum / total:.1f} |"
+        )
     print("\nCumulative share of some entry points (with callees):\n")
     for label, (part, name) in PROFILE_GROUPS.items():
-        cum = sum(v[3] for (f, _, fn), v in stats.stats.items()  # type: ignore[attr-defined]
-                  if part in f.replace(os.sep, "/") and fn == name)
+        cum = sum(
+            v[3]
+            for (f, _, fn), v in stats.stats.items()  # type: ignore[attr-defined]
+            if part in f.replace(os.sep, "/") and fn == name
+        )
         print(f"- {label}: {100 * cum / total:.1f} %")
 
 
@@ -816,7 +921,9 @@ PROFILE_GROUPS: dict[str, tuple[str, str]] = {
     "wind sampling (`GridWind.sample`)": ("sailroute/wind/grid.py", "sample"),
     "polar lookups (`Polar.speed`)": ("sailroute/boat/polar.py", "speed"),
     "polar tables (`polar_tables`, cached after the first leg)": (
-        "sailroute/routing/isochrone_kernel.py", "polar_tables"),
+        "sailroute/routing/isochrone_kernel.py",
+        "polar_tables",
+    ),
     "candidate set-up (`_prepare`)": ("sailroute/routing/isochrone_kernel.py", "_prepare"),
     "expansion and arrival test (`_expand`)": ("sailroute/routing/isochrone_kernel.py", "_expand"),
     "pruning (`_survivors`)": ("sailroute/routing/isochrone_kernel.py", "_survivors"),
@@ -857,20 +964,36 @@ def main(argv: Sequence[str] | None = None) -> None:
     ap.add_argument("--dt", type=float, default=30.0, help="time step of both routers [s]")
     ap.add_argument("--repeat", type=int, default=7, help="our runs per leg")
     ap.add_argument("--peer-repeat", type=int, default=1, help="peer runs per leg")
-    ap.add_argument("--peer-subdiv", type=float, default=1.0,
-                    help="peer pruning sector width [deg] (its `subdiv`)")
-    ap.add_argument("--legs", type=int, nargs="+", default=None,
-                    help="peer legs to run, by index (0 beat, 1 reach, 2 run, 3 WRF beat)")
+    ap.add_argument(
+        "--peer-subdiv",
+        type=float,
+        default=1.0,
+        help="peer pruning sector width [deg] (its `subdiv`)",
+    )
+    ap.add_argument(
+        "--legs",
+        type=int,
+        nargs="+",
+        default=None,
+        help="peer legs to run, by index (0 beat, 1 reach, 2 run, 3 WRF beat)",
+    )
     ap.add_argument("--dp-repeat", type=int, default=3)
     ap.add_argument("--course-repeat", type=int, default=3)
     ap.add_argument("--cli-repeat", type=int, default=5)
     ap.add_argument("--plan-repeat", type=int, default=3)
-    ap.add_argument("--cli-baseline", default=None, metavar="DIR",
-                    help="cli section: also time `plan` against the code in DIR (a checkout "
-                    "of an older commit), alternating, --plan-repeat runs each")
+    ap.add_argument(
+        "--cli-baseline",
+        default=None,
+        metavar="DIR",
+        help="cli section: also time `plan` against the code in DIR (a checkout "
+        "of an older commit), alternating, --plan-repeat runs each",
+    )
     ap.add_argument("--top", type=int, default=15, help="profile rows")
-    ap.add_argument("--smoke", action="store_true",
-                    help="the profile section only, 5 rows (checks the script runs)")
+    ap.add_argument(
+        "--smoke",
+        action="store_true",
+        help="the profile section only, 5 rows (checks the script runs)",
+    )
     args = ap.parse_args(argv)
     if args.smoke:
         args.only, args.top = ["profile"], 5

@@ -46,8 +46,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--n", type=int, default=100_000, help="lookups per call")
     ap.add_argument("--repeat", type=int, default=7, help="repetitions (best is kept)")
-    ap.add_argument("--smoke", action="store_true",
-                    help="tiny sizes, one repetition, no full VPP run (checks the script runs)")
+    ap.add_argument(
+        "--smoke",
+        action="store_true",
+        help="tiny sizes, one repetition, no full VPP run (checks the script runs)",
+    )
     args = ap.parse_args()
     if args.smoke:
         args.n, args.repeat = 1000, 1
@@ -61,8 +64,10 @@ def main() -> None:
         p = base.with_interpolation(method)
         p.speed(tws[:10], twa[:10])  # build caches
         t = best_of(lambda p=p: p.speed(tws, twa), args.repeat)
-        print(f"Polar.speed [{method:6s}]: {t * 1e6 * scale:9.0f} us per 1e5 lookups "
-              f"({args.n / t / 1e6:.1f} M lookups/s)")
+        print(
+            f"Polar.speed [{method:6s}]: {t * 1e6 * scale:9.0f} us per 1e5 lookups "
+            f"({args.n / t / 1e6:.1f} M lookups/s)"
+        )
 
     def build() -> None:
         Polar.from_arrays(base.twa_deg, base.tws_ms, base.speed_ms).speed(5.0, 45.0)
@@ -83,8 +88,10 @@ def main() -> None:
     for w in (4.0, 6.0, 8.0):
         ua, uv = base.vmg_upwind(w)
         da, dv = base.vmg_downwind(w)
-        print(f"ILCA 7 at {w:.0f} m/s: beat {float(ua):5.1f} deg VMG {float(uv):.3f} m/s; "
-              f"run {float(da):5.1f} deg VMG {float(dv):.3f} m/s")
+        print(
+            f"ILCA 7 at {w:.0f} m/s: beat {float(ua):5.1f} deg VMG {float(uv):.3f} m/s; "
+            f"run {float(da):5.1f} deg VMG {float(dv):.3f} m/s"
+        )
 
 
 if __name__ == "__main__":

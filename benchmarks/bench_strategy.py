@@ -44,10 +44,58 @@ from sailroute.strategy import (  # noqa: E402
 )
 from sailroute.units import KNOT  # noqa: E402
 
-SO40_TWA = [0, 5, 10, 15, 20, 25, 32, 36, 40, 45, 52, 60, 70, 80, 90, 100, 110, 120, 130, 140,
-            150, 160, 170, 180]
-SO40_KN = [0.0, 0.6, 1.2, 1.8, 2.1, 2.5, 4.1, 4.6, 5.0, 5.4, 5.8, 6.2, 6.4, 6.5, 6.5, 6.5, 6.4,
-           6.2, 5.7, 5.2, 4.7, 4.2, 3.9, 3.6]
+SO40_TWA = [
+    0,
+    5,
+    10,
+    15,
+    20,
+    25,
+    32,
+    36,
+    40,
+    45,
+    52,
+    60,
+    70,
+    80,
+    90,
+    100,
+    110,
+    120,
+    130,
+    140,
+    150,
+    160,
+    170,
+    180,
+]
+SO40_KN = [
+    0.0,
+    0.6,
+    1.2,
+    1.8,
+    2.1,
+    2.5,
+    4.1,
+    4.6,
+    5.0,
+    5.4,
+    5.8,
+    6.2,
+    6.4,
+    6.5,
+    6.5,
+    6.5,
+    6.4,
+    6.2,
+    5.7,
+    5.2,
+    4.7,
+    4.2,
+    3.9,
+    3.6,
+]
 
 
 def bench_sdp(repeat: int, runs: int, grid: BeatGrid | None = None) -> ExpectedTimePolicy:
@@ -59,20 +107,26 @@ def bench_sdp(repeat: int, runs: int, grid: BeatGrid | None = None) -> ExpectedT
         pol = solve_expected_time(polar, 10 * KNOT, model, grid, 5.0)
         times.append(pol.solve_time_s)
     n_cand = grid.n_x * (2 * grid.d_max + 1) * grid.theta_deg.size * grid.n_rows
-    print(f"SDP {grid.n_x} x {grid.n_rows} rows x 2 tacks x {grid.theta_deg.size} shifts, "
-          f"|x'-x| <= {grid.d_max} nodes ({n_cand:.2e} candidates; naive 3.9e9): "
-          f"{min(times):.2f} s (best of {repeat}); E[T] = {pol.expected_time():.1f} s")
+    print(
+        f"SDP {grid.n_x} x {grid.n_rows} rows x 2 tacks x {grid.theta_deg.size} shifts, "
+        f"|x'-x| <= {grid.d_max} nodes ({n_cand:.2e} candidates; naive 3.9e9): "
+        f"{min(times):.2f} s (best of {repeat}); E[T] = {pol.expected_time():.1f} s"
+    )
     t0 = time.perf_counter()
     sim = simulate(pol, runs, seed=1)
     dt = time.perf_counter() - t0
     s = sim.summary()
-    print(f"Monte Carlo {runs} runs: {dt:.2f} s; mean {s['mean_s']:.1f} ± {s['se_mean_s']:.1f} s, "
-          f"tacks {s['tacks']['mean']:.2f}")
+    print(
+        f"Monte Carlo {runs} runs: {dt:.2f} s; mean {s['mean_s']:.1f} ± {s['se_mean_s']:.1f} s, "
+        f"tacks {s['tacks']['mean']:.2f}"
+    )
     return pol
 
 
 def bench_deadline_physical(
-    n_r: int = 100, n_theta: int = 128, interps: tuple[str, ...] = ("linear", "cubic"),
+    n_r: int = 100,
+    n_theta: int = 128,
+    interps: tuple[str, ...] = ("linear", "cubic"),
     runs: int = 4000,
 ) -> tuple[RiskNeutralPolicy, DeadlinePolicy]:
     polar = builtin_polar("ilca7")
@@ -80,11 +134,14 @@ def bench_deadline_physical(
     for interp in interps:
         grid = DeadlineGrid(2000.0, n_r, n_theta, 20.0, 5.0, 1300.0, interpolation=interp)
         ra = solve_deadline(polar, 10 * KNOT, model, grid, 5.0)
-        print(f"deadline solve, 1600 m beat, {grid.n_r + 1} x {grid.n_theta} x 2 nodes, "
-              f"{grid.n_s} budget steps of {grid.ds_s:g} s, {interp}: {ra.solve_time_s:.2f} s")
+        print(
+            f"deadline solve, 1600 m beat, {grid.n_r + 1} x {grid.n_theta} x 2 nodes, "
+            f"{grid.n_s} budget steps of {grid.ds_s:g} s, {interp}: {ra.solve_time_s:.2f} s"
+        )
     rn = solve_risk_neutral(polar, 10 * KNOT, model, grid, 5.0, tol_s=1e-3)
-    print(f"risk-neutral value iteration, same grid: {rn.solve_time_s:.2f} s "
-          f"({rn.iterations} sweeps)")
+    print(
+        f"risk-neutral value iteration, same grid: {rn.solve_time_s:.2f} s ({rn.iterations} sweeps)"
+    )
     t0 = time.perf_counter()
     simulate_deadline(rn, runs, 1, (1600.0, 0.0, 1), ra=ra, deadline_s=800.0)
     print(f"deadline Monte Carlo, {runs} runs (Δt = 1 s): {time.perf_counter() - t0:.2f} s")
@@ -108,8 +165,12 @@ def bench_scale_out(
         for n in (runs, 5 * runs):
             cases = (
                 ("expected-time MC", lambda sch, n=n: simulate(pol, n, 1, scheduler=sch)),
-                ("deadline MC", lambda sch, n=n: simulate_deadline(
-                    rn, n, 1, start, ra=ra, deadline_s=800.0, scheduler=sch)),
+                (
+                    "deadline MC",
+                    lambda sch, n=n: simulate_deadline(
+                        rn, n, 1, start, ra=ra, deadline_s=800.0, scheduler=sch
+                    ),
+                ),
             )
             for name, run in cases:
                 t_serial, t_dist = math.inf, math.inf
@@ -121,63 +182,97 @@ def bench_scale_out(
                     b = run(runner)
                     t_dist = min(t_dist, time.perf_counter() - t0)
                 same = np.array_equal(a.leg_time_s, b.leg_time_s)
-                print(f"  {name}, {n} runs: serial {t_serial:.2f} s, Dask {t_dist:.2f} s "
-                      f"(best of {repeat}), identical leg times: {same}")
+                print(
+                    f"  {name}, {n} runs: serial {t_serial:.2f} s, Dask {t_dist:.2f} s "
+                    f"(best of {repeat}), identical leg times: {same}"
+                )
 
 
 def _so40() -> Polar:
-    return Polar.from_arrays(np.array(SO40_TWA, float), np.array([1.0]),
-                             (np.array(SO40_KN) * 0.05 / 6.5)[:, None], name="SO40",
-                             interpolation="linear")
+    return Polar.from_arrays(
+        np.array(SO40_TWA, float),
+        np.array([1.0]),
+        (np.array(SO40_KN) * 0.05 / 6.5)[:, None],
+        name="SO40",
+        interpolation="linear",
+    )
 
 
 def bench_paper(n_r: int, n_theta: int, ds: float, runs: int, interp: str) -> None:
     polar = _so40()
     cases = [
-        ("Fig 3", 0.0, (1.93, 0.56, 1), (53.0, 56.0), 62.0,
-         "E[T] μ* 54.46, α53 55.57, α56 55.95; P(T<=56) 52.5% -> 58.9% (α56)"),
-        ("Fig 4a", 0.05, (1.80, 2.67, 1), (42.0,), 48.0,
-         "E[T] 43.83 -> 44.30; P(T<=42) 5.8% -> 17.2%; switches μ* 2 (99.9%), α 0 (99.1%)"),
+        (
+            "Fig 3",
+            0.0,
+            (1.93, 0.56, 1),
+            (53.0, 56.0),
+            62.0,
+            "E[T] μ* 54.46, α53 55.57, α56 55.95; P(T<=56) 52.5% -> 58.9% (α56)",
+        ),
+        (
+            "Fig 4a",
+            0.05,
+            (1.80, 2.67, 1),
+            (42.0,),
+            48.0,
+            "E[T] 43.83 -> 44.30; P(T<=42) 5.8% -> 17.2%; switches μ* 2 (99.9%), α 0 (99.1%)",
+        ),
     ]
     for name, a, start, deadlines, s_max, paper in cases:
         grid = DeadlineGrid(2.0, n_r, n_theta, 0.1, ds, s_max, interpolation=interp)
         m = DriftDiffusionShift(-math.degrees(a), math.degrees(0.05))
         ra = solve_deadline(polar, 1.0, m, grid, 2.0)
         rn = solve_risk_neutral(polar, 1.0, m, grid, 2.0, tol_s=1e-3)
-        print(f"{name}: grid {n_r + 1} x {n_theta} x 2, Δs {ds:g}, {interp}: risk-aware "
-              f"{ra.solve_time_s:.1f} s, risk-neutral {rn.solve_time_s:.1f} s "
-              f"({rn.iterations} sweeps)")
+        print(
+            f"{name}: grid {n_r + 1} x {n_theta} x 2, Δs {ds:g}, {interp}: risk-aware "
+            f"{ra.solve_time_s:.1f} s, risk-neutral {rn.solve_time_s:.1f} s "
+            f"({rn.iterations} sweeps)"
+        )
         print(f"  paper: {paper}")
         sim_rn = simulate_deadline(rn, runs, 1, start, dt_s=0.01)
         t = sim_rn.leg_time_s
         probs = ", ".join(f"P(T<={d:g}) {100 * np.mean(t <= d):.1f}%" for d in deadlines)
         sw = np.bincount(sim_rn.n_switches) / runs
-        print(f"  μ*: value {rn.expected_time(*start):.2f}, MC mean {np.mean(t):.2f}, {probs}, "
-              f"switches {np.argmax(sw)} ({100 * sw.max():.1f}%)")
+        print(
+            f"  μ*: value {rn.expected_time(*start):.2f}, MC mean {np.mean(t):.2f}, {probs}, "
+            f"switches {np.argmax(sw)} ({100 * sw.max():.1f}%)"
+        )
         curve = ra.success_curve(*start)
         for d in deadlines:
             sim = simulate_deadline(rn, runs, 1, start, ra=ra, deadline_s=d, dt_s=0.01)
             t = sim.leg_time_s
             sw = np.bincount(sim.n_switches) / runs
-            print(f"  α^{d:g}: w {curve[round(d / ds)]:.3f}, MC P(T<={d:g}) "
-                  f"{100 * np.mean(t <= d):.1f}%, mean {np.mean(t):.2f}, switches "
-                  f"{np.argmax(sw)} ({100 * sw.max():.1f}%)")
+            print(
+                f"  α^{d:g}: w {curve[round(d / ds)]:.3f}, MC P(T<={d:g}) "
+                f"{100 * np.mean(t <= d):.1f}%, mean {np.mean(t):.2f}, switches "
+                f"{np.argmax(sw)} ({100 * sw.max():.1f}%)"
+            )
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--runs", type=int, default=4000)
-    ap.add_argument("--paper", action="store_true",
-                    help="reproduce Wang et al. (2024) Figs 3 and 4(a)")
-    ap.add_argument("--paper-grid", default="200,256,0.2",
-                    help="n_r,n_theta,ds for --paper (default 200,256,0.2)")
+    ap.add_argument(
+        "--paper", action="store_true", help="reproduce Wang et al. (2024) Figs 3 and 4(a)"
+    )
+    ap.add_argument(
+        "--paper-grid",
+        default="200,256,0.2",
+        help="n_r,n_theta,ds for --paper (default 200,256,0.2)",
+    )
     ap.add_argument("--paper-interp", default="linear", choices=("linear", "cubic"))
-    ap.add_argument("--scheduler", default=None,
-                    help="also time the Monte Carlo on Dask: processes | tcp://HOST:PORT")
+    ap.add_argument(
+        "--scheduler",
+        default=None,
+        help="also time the Monte Carlo on Dask: processes | tcp://HOST:PORT",
+    )
     ap.add_argument("--workers", type=int, default=None, help="workers for --scheduler processes")
-    ap.add_argument("--smoke", action="store_true",
-                    help="a 400 m beat, small grids, 100 runs, once (checks the script runs)")
+    ap.add_argument(
+        "--smoke",
+        action="store_true",
+        help="a 400 m beat, small grids, 100 runs, once (checks the script runs)",
+    )
     args = ap.parse_args()
     if args.smoke:
         bench_sdp(1, 100, BeatGrid(length_m=400.0, half_width_m=200.0, lateral_m=4.0))

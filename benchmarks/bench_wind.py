@@ -52,12 +52,28 @@ def stations(t0: float, t1: float) -> StationData:
     for k, (x, y) in enumerate(xy):
         la, lo = FRAME.to_latlon(x, y)
         for j, tt in enumerate(t):
-            rec.append((f"S{k}", tt, float(la), float(lo), 4.0 + 0.5 * np.sin(j / 7 + k),
-                        140.0 + 5 * np.cos(j / 11 + k)))
+            rec.append(
+                (
+                    f"S{k}",
+                    tt,
+                    float(la),
+                    float(lo),
+                    4.0 + 0.5 * np.sin(j / 7 + k),
+                    140.0 + 5 * np.cos(j / 11 + k),
+                )
+            )
     a = list(zip(*rec, strict=True))
     n = len(rec)
-    return StationData(np.array(a[0]), np.array(a[1]), np.array(a[2]), np.array(a[3]),
-                       np.array(a[4]), np.array(a[5]), np.full(n, np.nan), np.full(n, np.nan))
+    return StationData(
+        np.array(a[0]),
+        np.array(a[1]),
+        np.array(a[2]),
+        np.array(a[3]),
+        np.array(a[4]),
+        np.array(a[5]),
+        np.full(n, np.nan),
+        np.full(n, np.nan),
+    )
 
 
 def best_ms(fn, repeat: int) -> float:
@@ -74,16 +90,16 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--n", type=int, default=1_000_000)
     ap.add_argument("--repeat", type=int, default=5)
-    ap.add_argument("--smoke", action="store_true",
-                    help="1000 points, one repetition (checks the script runs)")
+    ap.add_argument(
+        "--smoke", action="store_true", help="1000 points, one repetition (checks the script runs)"
+    )
     args = ap.parse_args()
     if args.smoke:
         args.n, args.repeat = 1000, 1
     path = wrf_path()
     fields = {
         "wrf bilinear + linear time": open_wrf(path, FRAME, height_m=2.68),
-        "wrf nearest + linear time": open_wrf(path, FRAME, height_m=2.68,
-                                              interpolation="nearest"),
+        "wrf nearest + linear time": open_wrf(path, FRAME, height_m=2.68, interpolation="nearest"),
         "wrf bilinear, frozen 10 min": open_wrf(path, FRAME, height_m=2.68, time_step_min=10),
     }
     base = fields["wrf bilinear + linear time"]
@@ -97,9 +113,11 @@ def main() -> None:
     x = rng.uniform(-3000.0, 3000.0, n)
     y = rng.uniform(-3000.0, 3000.0, n)
     info = base.info
-    print(f"WRF field: {Path(info['path']).name}, grid {base.shape} (nt, ny, nx), "
-          f"levels={info['levels']}, height {info['height_m']} m, map degree "
-          f"{info['map_degree']} (misfit {info['map_residual_cells']:.1e} cells)")
+    print(
+        f"WRF field: {Path(info['path']).name}, grid {base.shape} (nt, ny, nx), "
+        f"levels={info['levels']}, height {info['height_m']} m, map degree "
+        f"{info['map_degree']} (misfit {info['map_residual_cells']:.1e} cells)"
+    )
     print(f"{n:,} random points, best of {args.repeat}, one thread (numpy {np.__version__})")
     for name, f in fields.items():
         ms = best_ms(lambda f=f: f.sample(t, x, y), args.repeat)
@@ -112,8 +130,10 @@ def main() -> None:
         ry = rng.uniform(rc.ymin, rc.ymax, n)
         ms = best_ms(lambda: real.sample(rt, rx, ry), args.repeat)
         label = f"real wrfout {real.shape}"
-        print(f"  {label:30s} {ms:8.1f} ms  {n / ms / 1e3:6.2f} Mpoints/s  "
-              f"(wrf-python CI crop, map degree {real.index_map.degree})")
+        print(
+            f"  {label:30s} {ms:8.1f} ms  {n / ms / 1e3:6.2f} Mpoints/s  "
+            f"(wrf-python CI crop, map degree {real.index_map.degree})"
+        )
 
 
 if __name__ == "__main__":

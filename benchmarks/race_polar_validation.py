@@ -34,12 +34,24 @@ from sailroute.planning.route import plan_course
 
 SNIPE = {
     # race: (TWS kn, B1 lat, B1 lon, observed [(run1, beat2, run2) per boat] from README times)
-    "P01": (6.0, 39.40691, -0.31500,
-            [("11:31:49", "11:37:14", "11:44:40", "11:49:10"),
-             ("11:31:52", "11:37:16", "11:44:27", "11:48:49")]),
-    "P02": (8.0, 39.40615, -0.31310,
-            [("12:15:58", "12:21:29", "12:30:34", "12:36:32"),
-             ("12:15:51", "12:21:20", "12:29:46", "12:35:35")]),
+    "P01": (
+        6.0,
+        39.40691,
+        -0.31500,
+        [
+            ("11:31:49", "11:37:14", "11:44:40", "11:49:10"),
+            ("11:31:52", "11:37:16", "11:44:27", "11:48:49"),
+        ],
+    ),
+    "P02": (
+        8.0,
+        39.40615,
+        -0.31310,
+        [
+            ("12:15:58", "12:21:29", "12:30:34", "12:36:32"),
+            ("12:15:51", "12:21:20", "12:29:46", "12:35:35"),
+        ],
+    ),
 }
 S1 = (39.40921, -0.32253)
 
@@ -73,30 +85,40 @@ VARIANTS = {
 
 def snipe_course(race: str, boat: str | dict, dt_s: float = 10.0) -> Course:
     tws, lat, lon, _ = SNIPE[race]
-    return course_from_mapping({
-        "name": f"Snipe Valencia 2025 {race} (ILCA stand-in)",
-        "start_time": "2025-06-21T12:00:00+00:00",
-        "time_limit_min": 90,
-        "marks": {"S1": {"lat": S1[0], "lon": S1[1]}, "B1": {"lat": lat, "lon": lon}},
-        "legs": [{"from": "S1", "to": "B1", "rounding": "port"},
-                 {"to": "S1", "rounding": "port"},
-                 {"to": "B1", "rounding": "port"},
-                 {"to": "S1", "rounding": "port"}],
-        "boat": {"builtin": boat} if isinstance(boat, str) else boat,
-        "routing": {"router": "isochrone", "tack_penalty_s": 5.0, "gybe_penalty_s": 5.0,
-                    "dt_s": dt_s},
-        "scenarios": {"reported": {"wind": {"type": "uniform", "tws_kn": tws, "twd_deg": 110}}},
-    }, source=f"<snipe {race}>")
+    return course_from_mapping(
+        {
+            "name": f"Snipe Valencia 2025 {race} (ILCA stand-in)",
+            "start_time": "2025-06-21T12:00:00+00:00",
+            "time_limit_min": 90,
+            "marks": {"S1": {"lat": S1[0], "lon": S1[1]}, "B1": {"lat": lat, "lon": lon}},
+            "legs": [
+                {"from": "S1", "to": "B1", "rounding": "port"},
+                {"to": "S1", "rounding": "port"},
+                {"to": "B1", "rounding": "port"},
+                {"to": "S1", "rounding": "port"},
+            ],
+            "boat": {"builtin": boat} if isinstance(boat, str) else boat,
+            "routing": {
+                "router": "isochrone",
+                "tack_penalty_s": 5.0,
+                "gybe_penalty_s": 5.0,
+                "dt_s": dt_s,
+            },
+            "scenarios": {"reported": {"wind": {"type": "uniform", "tws_kn": tws, "twd_deg": 110}}},
+        },
+        source=f"<snipe {race}>",
+    )
 
 
 def ratios(boat: dict) -> tuple[float, float, float, float]:
     """Hyères total error vs the winner and the dn/up ratio errors (Hyères, P01, P02)."""
-    hy = dataclasses.replace(load_course("courses/hyeres-r1.yaml"),
-                             boat_spec=frozen_mapping(boat))
+    hy = dataclasses.replace(load_course("courses/hyeres-r1.yaml"), boat_spec=frozen_mapping(boat))
     t = [leg.time_s for leg in plan_course(hy, "constant").plan.legs]
     ref = hy.references["winner"]
-    out = [sum(t) / sum(ref) - 1,
-           (t[1] + t[3]) / (t[0] + t[2]) / ((ref[1] + ref[3]) / (ref[0] + ref[2])) - 1]
+    out = [
+        sum(t) / sum(ref) - 1,
+        (t[1] + t[3]) / (t[0] + t[2]) / ((ref[1] + ref[3]) / (ref[0] + ref[2])) - 1,
+    ]
     for race in SNIPE:
         legs = [leg.time_s for leg in plan_course(snipe_course(race, boat)).plan.legs]
         run_o, beat_o = snipe_observed(race)
@@ -106,8 +128,7 @@ def ratios(boat: dict) -> tuple[float, float, float, float]:
 
 def sensitivity() -> None:
     """Print the acceptance numbers for each race-model variant."""
-    print("| variant | Hyères total vs winner | Hyères dn/up | Snipe P01 dn/up | "
-          "Snipe P02 dn/up |")
+    print("| variant | Hyères total vs winner | Hyères dn/up | Snipe P01 dn/up | Snipe P02 dn/up |")
     print("|---|---|---|---|---|")
     for name, kin in VARIANTS.items():
         r = ratios({"vpp": {"class": "ilca7"}, "kinetics": kin or "race"})
@@ -119,23 +140,33 @@ def smoke_row(boat: str) -> None:
     legs = [leg.time_s for leg in plan_course(snipe_course("P01", boat, dt_s=30.0)).plan.legs]
     run_m, beat_m = (legs[1] + legs[3]) / 2, legs[2]
     run_o, beat_o = snipe_observed("P01")
-    print(f"| {boat} | Snipe P01 (--smoke, 30 s steps) | 6 kn 110° | {run_m / beat_m:.3f} | "
-          f"{run_o / beat_o:.3f} | {run_m / beat_m / (run_o / beat_o) - 1:+.1%} | "
-          f"run {run_m:.0f} s, beat {beat_m:.0f} s | run {run_o:.0f} s, beat {beat_o:.0f} s | "
-          f"run {run_m / run_o - 1:+.1%}, beat {beat_m / beat_o - 1:+.1%} |")
+    print(
+        f"| {boat} | Snipe P01 (--smoke, 30 s steps) | 6 kn 110° | {run_m / beat_m:.3f} | "
+        f"{run_o / beat_o:.3f} | {run_m / beat_m / (run_o / beat_o) - 1:+.1%} | "
+        f"run {run_m:.0f} s, beat {beat_m:.0f} s | run {run_o:.0f} s, beat {beat_o:.0f} s | "
+        f"run {run_m / run_o - 1:+.1%}, beat {beat_m / beat_o - 1:+.1%} |"
+    )
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--boat", action="append", default=None)
-    ap.add_argument("--sensitivity", action="store_true",
-                    help="also move each race-model parameter across its range")
-    ap.add_argument("--smoke", action="store_true",
-                    help="ilca7 on Snipe P01 only, 30 s steps (checks the script runs)")
+    ap.add_argument(
+        "--sensitivity",
+        action="store_true",
+        help="also move each race-model parameter across its range",
+    )
+    ap.add_argument(
+        "--smoke",
+        action="store_true",
+        help="ilca7 on Snipe P01 only, 30 s steps (checks the script runs)",
+    )
     args = ap.parse_args()
     boats = ["ilca7"] if args.smoke else args.boat or ["ilca7", "ilca7-steady"]
-    print("| boat | race | wind | model dn/up | observed dn/up | ratio error | model total | "
-          "observed total | total error |")
+    print(
+        "| boat | race | wind | model dn/up | observed dn/up | ratio error | model total | "
+        "observed total | total error |"
+    )
     print("|---|---|---|---|---|---|---|---|---|")
     for boat in boats:
         if args.smoke:
@@ -147,18 +178,22 @@ def main() -> None:
         model = (t[1] + t[3]) / (t[0] + t[2])
         for who, ref in (("winner", hy.references["winner"]), ("top10", hy.references["top10"])):
             obs = (ref[1] + ref[3]) / (ref[0] + ref[2])
-            print(f"| {boat} | Hyères R1 vs {who} | 10.9 kn 108° | {model:.3f} | {obs:.3f} | "
-                  f"{model / obs - 1:+.1%} | {sum(t):.0f} s | {sum(ref):.0f} s | "
-                  f"{sum(t) / sum(ref) - 1:+.1%} |")
+            print(
+                f"| {boat} | Hyères R1 vs {who} | 10.9 kn 108° | {model:.3f} | {obs:.3f} | "
+                f"{model / obs - 1:+.1%} | {sum(t):.0f} s | {sum(ref):.0f} s | "
+                f"{sum(t) / sum(ref) - 1:+.1%} |"
+            )
         for race in SNIPE:
             legs = [leg.time_s for leg in plan_course(snipe_course(race, boat)).plan.legs]
             run_m, beat_m = (legs[1] + legs[3]) / 2, legs[2]
             run_o, beat_o = snipe_observed(race)
             wind = f"{SNIPE[race][0]:.0f} kn 110°"
-            print(f"| {boat} | Snipe {race} | {wind} | {run_m / beat_m:.3f} | "
-                  f"{run_o / beat_o:.3f} | {run_m / beat_m / (run_o / beat_o) - 1:+.1%} | "
-                  f"run {run_m:.0f} s, beat {beat_m:.0f} s | run {run_o:.0f} s, beat {beat_o:.0f} s"
-                  f" | run {run_m / run_o - 1:+.1%}, beat {beat_m / beat_o - 1:+.1%} |")
+            print(
+                f"| {boat} | Snipe {race} | {wind} | {run_m / beat_m:.3f} | "
+                f"{run_o / beat_o:.3f} | {run_m / beat_m / (run_o / beat_o) - 1:+.1%} | "
+                f"run {run_m:.0f} s, beat {beat_m:.0f} s | run {run_o:.0f} s, beat {beat_o:.0f} s"
+                f" | run {run_m / run_o - 1:+.1%}, beat {beat_m / beat_o - 1:+.1%} |"
+            )
     if args.sensitivity:
         print()
         sensitivity()

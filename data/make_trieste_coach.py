@@ -20,8 +20,15 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-SOURCE = HERE.parents[1] / "shared" / "data" / "real" / "wind" / "anemomind-coach-trieste" / (
-    "coach_wind_1hz.csv")
+SOURCE = (
+    HERE.parents[1]
+    / "shared"
+    / "data"
+    / "real"
+    / "wind"
+    / "anemomind-coach-trieste"
+    / ("coach_wind_1hz.csv")
+)
 OUT = HERE / "trieste-coach-2018-02-15.csv"
 OFFSET = "+01:00"
 
@@ -33,8 +40,16 @@ def main(source: Path = SOURCE, out: Path = OUT) -> Path:
         w = csv.writer(f, lineterminator="\n")
         w.writerow(["time", "station", "lat", "lon", "speed", "direction"])
         for r in rows:
-            w.writerow([r["datetime_local"] + OFFSET, "coach", r["lat"], r["lon"], r["tws_kn"],
-                        r["twd_deg"]])
+            w.writerow(
+                [
+                    r["datetime_local"] + OFFSET,
+                    "coach",
+                    r["lat"],
+                    r["lon"],
+                    r["tws_kn"],
+                    r["twd_deg"],
+                ]
+            )
     return out
 
 

@@ -190,8 +190,10 @@ def __getattr__(name: str) -> Any:
     """Import the module of a public name on first access (PEP 562) and cache it."""
     module = _EXPORTS.get(name)
     if module is None:
-        raise AttributeError(f"module 'sailroute' has no attribute {name!r}; the public names "
-                             "are listed in sailroute.__all__ (docs/api.md)")
+        raise AttributeError(
+            f"module 'sailroute' has no attribute {name!r}; the public names "
+            "are listed in sailroute.__all__ (docs/api.md)"
+        )
     value = getattr(importlib.import_module(module), name)
     globals()[name] = value
     return value

@@ -90,12 +90,17 @@ def open_wind(
 
     merged = _plain({**(dict(spec) if spec is not None else {}), **keys})
     if not merged:
-        raise InputError("open_wind: give a wind spec, e.g. open_wind(course, type='uniform', "
-                         "tws_kn=10, twd_deg=108) (keys as in docs/course-format.md, 'wind:')")
+        raise InputError(
+            "open_wind: give a wind spec, e.g. open_wind(course, type='uniform', "
+            "tws_kn=10, twd_deg=108) (keys as in docs/course-format.md, 'wind:')"
+        )
     kind = merged.get("type", "?")
     return wind_from_spec(
-        merged, frame=course.frame, base_dir=Path.cwd() if base_dir is None else Path(base_dir),
-        where=f"open_wind({kind})", crop_bbox=course_bbox(course),
+        merged,
+        frame=course.frame,
+        base_dir=Path.cwd() if base_dir is None else Path(base_dir),
+        where=f"open_wind({kind})",
+        crop_bbox=course_bbox(course),
         time_window=race_time_window(course),
     )
 
@@ -181,12 +186,17 @@ def plan_with_wind(
     where = f"plan_with_wind({name})"
     require_speed(polar, f"{where}: boat")
     allow = course.boat_spec.get("allow_extrapolation", False) is True
-    note = check_wind_range(polar, peak_wind(wind, course_bbox(course), race_time_window(course)),
-                            allow_extrapolation=allow, where=where)
+    note = check_wind_range(
+        polar,
+        peak_wind(wind, course_bbox(course), race_time_window(course)),
+        allow_extrapolation=allow,
+        where=where,
+    )
     if note is not None and progress is not None:
         progress.warn(note)
-    results = route_course(course, wind, polar, settings, backend=backend, progress=progress,
-                           current=current)
+    results = route_course(
+        course, wind, polar, settings, backend=backend, progress=progress, current=current
+    )
     plan = make_plan(course, name, results, wind, router=settings.router)
     return PlannedCourse(plan, wind, () if note is None else (note,))
 
@@ -251,21 +261,25 @@ def vpp(
     elif isinstance(boat, str | Path):
         params = load_boat_file(boat)[0]
     else:
-        raise InputError(f"vpp: boat must be a class name ({', '.join(map(repr, CLASSES))}), "
-                         f"a boat YAML path, a mapping or LaserParams; got {boat!r}")
+        raise InputError(
+            f"vpp: boat must be a class name ({', '.join(map(repr, CLASSES))}), "
+            f"a boat YAML path, a mapping or LaserParams; got {boat!r}"
+        )
     if crew_mass_kg is not None:
         lo, hi = CREW_MASS_RANGE_KG
         if not lo <= crew_mass_kg <= hi:
-            raise InputError(f"vpp: crew_mass_kg = {crew_mass_kg}: expected a sailor mass in "
-                             f"{lo:g}-{hi:g} kg")
+            raise InputError(
+                f"vpp: crew_mass_kg = {crew_mass_kg}: expected a sailor mass in {lo:g}-{hi:g} kg"
+            )
         params = dataclasses.replace(params, crew_mass_kg=float(crew_mass_kg))
     if isinstance(kinetics, Kinetics):
         kin = kinetics
     else:
         kin, problems = kinetics_from_spec(kinetics, key="vpp: kinetics")
         if problems:
-            raise InputError(problems[0] if len(problems) == 1
-                             else format_problems("vpp: kinetics", problems))
+            raise InputError(
+                problems[0] if len(problems) == 1 else format_problems("vpp: kinetics", problems)
+            )
 
     def grid(values: Sequence[float] | None) -> tuple[float, ...] | None:
         return None if values is None else tuple(float(v) for v in np.asarray(values).ravel())

@@ -33,7 +33,14 @@ from sailroute.errors import InputError, format_problems
 from sailroute.yamlfile import join_path
 
 __all__ = [
-    "MISSING", "Checker", "Problems", "finite", "join_path", "quoted", "show", "split_where",
+    "MISSING",
+    "Checker",
+    "Problems",
+    "finite",
+    "join_path",
+    "quoted",
+    "show",
+    "split_where",
     "suggest",
 ]
 
@@ -144,9 +151,7 @@ class Problems:
         self.items: list[str] = []
 
     @classmethod
-    def below(
-        cls, where: str, lines: Mapping[str, int] | None = None, *, what: str
-    ) -> Problems:
+    def below(cls, where: str, lines: Mapping[str, int] | None = None, *, what: str) -> Problems:
         """Problems of the part of a file that the prefix ``where`` names (:func:`split_where`).
 
         A line in ``where`` locates the part's own key when ``lines`` does not.
@@ -262,8 +267,12 @@ class Checker:
 
     # -- structure ---------------------------------------------------------------------
     def keys(
-        self, d: Mapping[Any, Any], allowed: Iterable[str], required: Iterable[str] = (),
-        *, of: str = "",
+        self,
+        d: Mapping[Any, Any],
+        allowed: Iterable[str],
+        required: Iterable[str] = (),
+        *,
+        of: str = "",
     ) -> None:
         """Record unknown keys of ``d`` (with a did-you-mean) and missing required ones.
 
@@ -274,8 +283,10 @@ class Checker:
         unknown = f"unknown key for {of}" if of else "unknown key"
         for key in d:
             if str(key) not in allowed:
-                self.add(str(key), f"{unknown}; {suggest(str(key), allowed)}valid keys: "
-                         + ", ".join(allowed))
+                self.add(
+                    str(key),
+                    f"{unknown}; {suggest(str(key), allowed)}valid keys: " + ", ".join(allowed),
+                )
         for key in required:
             if key not in d:
                 self.add(key, "missing required key")
@@ -299,7 +310,10 @@ class Checker:
 
     # -- typed getters -----------------------------------------------------------------
     def mapping(
-        self, d: Mapping[str, Any], key: str, default: Any = MISSING,
+        self,
+        d: Mapping[str, Any],
+        key: str,
+        default: Any = MISSING,
         what: str = "a mapping (key: value pairs)",
     ) -> Any:
         """A nested mapping."""
@@ -362,8 +376,11 @@ class Checker:
         v = d[key]
         if v not in choices:
             hint = suggest(v, choices) if isinstance(v, str) else ""
-            self.add(key, f"expected one of {quoted(choices)}; got {show(v)}"
-                     + (f" ({hint.strip()})" if hint else ""))
+            self.add(
+                key,
+                f"expected one of {quoted(choices)}; got {show(v)}"
+                + (f" ({hint.strip()})" if hint else ""),
+            )
             return None
         return v
 
@@ -377,8 +394,7 @@ class Checker:
             return None
         return v
 
-    def file(self, d: Any, key: str | int, base_dir: Path,
-             value: Any = MISSING) -> Path | None:
+    def file(self, d: Any, key: str | int, base_dir: Path, value: Any = MISSING) -> Path | None:
         """An existing file named by ``d[key]`` (or ``value``), relative to ``base_dir``.
 
         Records "file not found" (with the resolved path and the folder relative
@@ -416,8 +432,10 @@ class Checker:
 
     def name(self, value: Any, what: str = "a name") -> str | None:
         """A mark/line/gate/scenario name at :attr:`path`: text, or a whole number as text."""
-        if isinstance(value, bool) or not isinstance(value, str | int) or (
-            isinstance(value, str) and not value.strip()
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, str | int)
+            or (isinstance(value, str) and not value.strip())
         ):
             self.add(None, f"expected {what} (text or a whole number); got {show(value)}")
             return None

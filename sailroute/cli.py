@@ -71,8 +71,11 @@ def _tidy(params: list[Any]) -> list[Any]:
             elif p.metavar is None:
                 desc = p.type_descriptor
                 if desc.is_choice:
-                    p.metavar = "[" + "|".join(
-                        str(getattr(c, "value", c)) for c in desc.choices or ()) + "]"
+                    p.metavar = (
+                        "["
+                        + "|".join(str(getattr(c, "value", c)) for c in desc.choices or ())
+                        + "]"
+                    )
                 else:
                     p.metavar = _TYPE_METAVAR.get(desc.annotation, "TEXT")
     return params
@@ -195,9 +198,12 @@ def run_guarded(fn: Callable[[], T], *, debug: bool) -> T:
     except Exception as exc:  # anything else is a bug: one short paragraph, exit 1
         if debug:
             raise
-        typer.echo(f"internal error: {type(exc).__name__}: {exc}\nThis is a bug in sailroute; "
-                   "rerun with --debug (sailroute --debug COMMAND ...) for the traceback and "
-                   "please report it.", err=True)
+        typer.echo(
+            f"internal error: {type(exc).__name__}: {exc}\nThis is a bug in sailroute; "
+            "rerun with --debug (sailroute --debug COMMAND ...) for the traceback and "
+            "please report it.",
+            err=True,
+        )
         raise typer.Exit(code=1) from None
 
 
@@ -252,17 +258,25 @@ def _finish(res: CommandResult, json_out: bool) -> None:
 # --- commands -------------------------------------------------------------------
 # Each command parses options and delegates to the package API.  Keep logic out.
 
-CourseArg = Annotated[str, typer.Argument(help="Course file (YAML, see docs/course-format.md).",
-                                          metavar="COURSE")]
+CourseArg = Annotated[
+    str, typer.Argument(help="Course file (YAML, see docs/course-format.md).", metavar="COURSE")
+]
 RouterOpt = Annotated[
     Router | None,
-    typer.Option("--router", "-r", case_sensitive=False,
-                 help="Router (default: the course's routing.router)."),
+    typer.Option(
+        "--router",
+        "-r",
+        case_sensitive=False,
+        help="Router (default: the course's routing.router).",
+    ),
 ]
 BackendOpt = Annotated[
     Backend,
-    typer.Option("--backend", case_sensitive=False,
-                 help="Array backend of the router kernels (cupy needs an NVIDIA GPU)."),
+    typer.Option(
+        "--backend",
+        case_sensitive=False,
+        help="Array backend of the router kernels (cupy needs an NVIDIA GPU).",
+    ),
 ]
 NoPlotsOpt = Annotated[bool, typer.Option("--no-plots", help="Skip the PNG charts.")]
 QuietOpt = Annotated[
@@ -270,13 +284,17 @@ QuietOpt = Annotated[
 ]
 JsonOpt = Annotated[
     bool,
-    typer.Option("--json", help="Print the result as JSON on stdout (the main JSON file "
-                 "written) and nothing else; for scripts."),
+    typer.Option(
+        "--json",
+        help="Print the result as JSON on stdout (the main JSON file "
+        "written) and nothing else; for scripts.",
+    ),
 ]
 SpeedUnitOpt = Annotated[
     SpeedUnit | None,
-    typer.Option("--speed-unit", case_sensitive=False,
-                 help="Unit of the input's unsuffixed speed columns."),
+    typer.Option(
+        "--speed-unit", case_sensitive=False, help="Unit of the input's unsuffixed speed columns."
+    ),
 ]
 
 
@@ -286,34 +304,45 @@ def _complete_scheduler(incomplete: str) -> list[str]:
 
 EnsembleOpt = Annotated[
     int | None,
-    typer.Option("--ensemble", metavar="N",
-                 help="Leg-time bands: route N members drawn from the course's `uncertainty:` "
-                 "(or the defaults, docs/course-format.md) and report P10/P50/P90 per leg, "
-                 "the widest source and the sides; writes bands.json/csv/png."),
+    typer.Option(
+        "--ensemble",
+        metavar="N",
+        help="Leg-time bands: route N members drawn from the course's `uncertainty:` "
+        "(or the defaults, docs/course-format.md) and report P10/P50/P90 per leg, "
+        "the widest source and the sides; writes bands.json/csv/png.",
+    ),
 ]
 SchedulerOpt = Annotated[
     str | None,
-    typer.Option("--scheduler", metavar="WHERE", autocompletion=_complete_scheduler,
-                 help="serial (here, default), processes (a local Dask cluster) or "
-                 "tcp://HOST:PORT (an existing Dask scheduler); results are identical."),
+    typer.Option(
+        "--scheduler",
+        metavar="WHERE",
+        autocompletion=_complete_scheduler,
+        help="serial (here, default), processes (a local Dask cluster) or "
+        "tcp://HOST:PORT (an existing Dask scheduler); results are identical.",
+    ),
 ]
 
 
-@app.command("plan", cls=_Command,
-             short_help="Route a course leg by leg in one wind scenario.")
+@app.command("plan", cls=_Command, short_help="Route a course leg by leg in one wind scenario.")
 def plan_command(
     ctx: typer.Context,
     course: CourseArg,
     scenario: Annotated[
         str | None,
-        typer.Option("--scenario", "-s", metavar="NAME",
-                     help="Wind scenario (default: the first in the file)."),
+        typer.Option(
+            "--scenario",
+            "-s",
+            metavar="NAME",
+            help="Wind scenario (default: the first in the file).",
+        ),
     ] = None,
     router: RouterOpt = None,
     out: Annotated[
         str | None,
-        typer.Option("--out", "-o", metavar="DIR",
-                     help="Output folder (default: out/<course>/<scenario>)."),
+        typer.Option(
+            "--out", "-o", metavar="DIR", help="Output folder (default: out/<course>/<scenario>)."
+        ),
     ] = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Skip route.png and report.html.")
@@ -337,25 +366,38 @@ def plan_command(
             if ensemble is not None:  # leg-time bands (sailroute/commands/bands.py)
                 from sailroute.commands.bands import run_bands_command
 
-                return run_bands_command(loaded, scenarios=[scenario] if scenario else None,
-                                         members=ensemble, out_dir=out, plots=not no_plots,
-                                         options=options)
-            return run_plan_command(loaded, scenario=scenario, out_dir=out, plots=not no_plots,
-                                    options=options)
+                return run_bands_command(
+                    loaded,
+                    scenarios=[scenario] if scenario else None,
+                    members=ensemble,
+                    out_dir=out,
+                    plots=not no_plots,
+                    options=options,
+                )
+            return run_plan_command(
+                loaded, scenario=scenario, out_dir=out, plots=not no_plots, options=options
+            )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
-@app.command("start", cls=_Command,
-             short_help="Time to the start line from a position, and the time to burn.")
+@app.command(
+    "start",
+    cls=_Command,
+    short_help="Time to the start line from a position, and the time to burn.",
+)
 def start_command(
     ctx: typer.Context,
     course: CourseArg,
     time: Annotated[
         str,
-        typer.Option("--time", "-t", metavar="T",
-                     help="When the boat is there: ISO 8601 with offset "
-                     "(2018-04-24T12:08:30+02:00) or seconds from the gun (-90)."),
+        typer.Option(
+            "--time",
+            "-t",
+            metavar="T",
+            help="When the boat is there: ISO 8601 with offset "
+            "(2018-04-24T12:08:30+02:00) or seconds from the gun (-90).",
+        ),
     ],
     at: Annotated[
         str | None,
@@ -363,19 +405,27 @@ def start_command(
     ] = None,
     xy: Annotated[
         str | None,
-        typer.Option("--xy", metavar="X,Y",
-                     help="The boat's position in metres east and north of the course origin "
-                     "(instead of --at)."),
+        typer.Option(
+            "--xy",
+            metavar="X,Y",
+            help="The boat's position in metres east and north of the course origin "
+            "(instead of --at).",
+        ),
     ] = None,
     scenario: Annotated[
         str | None,
-        typer.Option("--scenario", "-s", metavar="NAME",
-                     help="Wind scenario (default: the first in the file)."),
+        typer.Option(
+            "--scenario",
+            "-s",
+            metavar="NAME",
+            help="Wind scenario (default: the first in the file).",
+        ),
     ] = None,
     out: Annotated[
         str | None,
-        typer.Option("--out", "-o", metavar="DIR",
-                     help="Output folder (default: out/<course>/start)."),
+        typer.Option(
+            "--out", "-o", metavar="DIR", help="Output folder (default: out/<course>/start)."
+        ),
     ] = None,
     json_out: JsonOpt = False,
 ) -> None:
@@ -385,8 +435,9 @@ def start_command(
     def run() -> Any:
         _check_out(out)
         with _terminal_tables(json_out):
-            return run_start_command(course, time=time, at=at, xy=xy, scenario=scenario,
-                                     out_dir=out)
+            return run_start_command(
+                course, time=time, at=at, xy=xy, scenario=scenario, out_dir=out
+            )
 
     res = run_guarded(run, debug=_debug(ctx))
     if not json_out:
@@ -395,21 +446,26 @@ def start_command(
     _finish(res, json_out)
 
 
-@app.command("compare-scenarios", cls=_Command,
-             short_help="Route a course in several wind scenarios, side by side.")
+@app.command(
+    "compare-scenarios",
+    cls=_Command,
+    short_help="Route a course in several wind scenarios, side by side.",
+)
 def compare_command(
     ctx: typer.Context,
     course: CourseArg,
     scenario: Annotated[
         list[str] | None,
-        typer.Option("--scenario", "-s", metavar="NAME",
-                     help="Scenario to include (repeat; default: all)."),
+        typer.Option(
+            "--scenario", "-s", metavar="NAME", help="Scenario to include (repeat; default: all)."
+        ),
     ] = None,
     router: RouterOpt = None,
     out: Annotated[
         str | None,
-        typer.Option("--out", "-o", metavar="DIR",
-                     help="Output folder (default: out/<course>/comparison)."),
+        typer.Option(
+            "--out", "-o", metavar="DIR", help="Output folder (default: out/<course>/comparison)."
+        ),
     ] = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Skip comparison.png and report.html.")
@@ -434,25 +490,33 @@ def compare_command(
             if ensemble is not None:  # leg-time bands of every scenario (commands/bands.py)
                 from sailroute.commands.bands import run_bands_command
 
-                names = scenario or [n for n in loaded.scenario_names
-                                     if n not in loaded.ensembles]
-                return run_bands_command(loaded, scenarios=names, members=ensemble,
-                                         out_dir=out, plots=not no_plots, options=options,
-                                         what="comparison")
-            return run_compare_command(loaded, scenarios=scenario, out_dir=out,
-                                       plots=not no_plots, options=options)
+                names = scenario or [n for n in loaded.scenario_names if n not in loaded.ensembles]
+                return run_bands_command(
+                    loaded,
+                    scenarios=names,
+                    members=ensemble,
+                    out_dir=out,
+                    plots=not no_plots,
+                    options=options,
+                    what="comparison",
+                )
+            return run_compare_command(
+                loaded, scenarios=scenario, out_dir=out, plots=not no_plots, options=options
+            )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
-@app.command("vpp", cls=_Command,
-             short_help="Laser/ILCA velocity prediction: polar and best VMG.")
+@app.command("vpp", cls=_Command, short_help="Laser/ILCA velocity prediction: polar and best VMG.")
 def vpp_command(
     ctx: typer.Context,
     boat: Annotated[
         str | None,
-        typer.Argument(help="Boat YAML (class, crew_mass_kg, parameter overrides); "
-                       "default: the shipped ILCA 7.", metavar="BOAT"),
+        typer.Argument(
+            help="Boat YAML (class, crew_mass_kg, parameter overrides); "
+            "default: the shipped ILCA 7.",
+            metavar="BOAT",
+        ),
     ] = None,
     crew_mass: Annotated[
         float | None,
@@ -460,23 +524,28 @@ def vpp_command(
     ] = None,
     tws: Annotated[
         str | None,
-        typer.Option("--tws", metavar="LIST",
-                     help="Comma-separated TWS list in --unit, e.g. '4,6,8,10'."),
+        typer.Option(
+            "--tws", metavar="LIST", help="Comma-separated TWS list in --unit, e.g. '4,6,8,10'."
+        ),
     ] = None,
     twa_step: Annotated[
         float, typer.Option("--twa-step", metavar="DEG", help="TWA row step, degrees.")
     ] = 5.0,
-    out: Annotated[str, typer.Option("--out", "-o", metavar="DIR", help="Output folder.")
-                   ] = "vpp-out",
+    out: Annotated[
+        str, typer.Option("--out", "-o", metavar="DIR", help="Output folder.")
+    ] = "vpp-out",
     unit: Annotated[
         TableUnit,
         typer.Option("--unit", case_sensitive=False, help="Speed unit of the table and files."),
     ] = "kn",
     kinetics: Annotated[
         Kinetics,
-        typer.Option("--kinetics", case_sensitive=False,
-                     help="race (default): with wave riding and pumping, as the built-in "
-                     "ilca7 that plan routes with; steady: the VPP alone (docs/vpp.md)."),
+        typer.Option(
+            "--kinetics",
+            case_sensitive=False,
+            help="race (default): with wave riding and pumping, as the built-in "
+            "ilca7 that plan routes with; steady: the VPP alone (docs/vpp.md).",
+        ),
     ] = "race",
     json_out: JsonOpt = False,
 ) -> None:
@@ -485,8 +554,15 @@ def vpp_command(
 
     def run() -> Any:
         _check_out(out)
-        return run_vpp_command(boat, crew_mass_kg=crew_mass, tws=tws, twa_step_deg=twa_step,
-                               out_dir=out, unit=unit, kinetics=kinetics)
+        return run_vpp_command(
+            boat,
+            crew_mass_kg=crew_mass,
+            tws=tws,
+            twa_step_deg=twa_step,
+            out_dir=out,
+            unit=unit,
+            kinetics=kinetics,
+        )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
@@ -501,114 +577,154 @@ def _complete_objective(incomplete: str) -> list[str]:
     return [s for s in ("expected", "deadline=") if s.startswith(incomplete)]
 
 
-@app.command("strategy", cls=_Command,
-             short_help="Tack strategy on a beat under wind shifts.")
+@app.command("strategy", cls=_Command, short_help="Tack strategy on a beat under wind shifts.")
 def strategy_command(
     ctx: typer.Context,
-    tws_kn: Annotated[float, typer.Option("--tws-kn", metavar="KN", help="Wind speed, kn.")
-                      ] = 10.0,
+    tws_kn: Annotated[float, typer.Option("--tws-kn", metavar="KN", help="Wind speed, kn.")] = 10.0,
     polar: Annotated[
         str,
-        typer.Option("--polar", metavar="POLAR", autocompletion=_complete_polar,
-                     help="builtin:ilca7 | builtin:ilca6 | builtin:ilca4 (race polars; add "
-                     "-steady for the steady VPP) or a polar file."),
+        typer.Option(
+            "--polar",
+            metavar="POLAR",
+            autocompletion=_complete_polar,
+            help="builtin:ilca7 | builtin:ilca6 | builtin:ilca4 (race polars; add "
+            "-steady for the steady VPP) or a polar file.",
+        ),
     ] = "builtin:ilca7",
-    length_m: Annotated[float, typer.Option("--length-m", metavar="M", help="Beat length, m.")
-                        ] = 1600.0,
+    length_m: Annotated[
+        float, typer.Option("--length-m", metavar="M", help="Beat length, m.")
+    ] = 1600.0,
     half_width_m: Annotated[
         float, typer.Option("--half-width-m", metavar="M", help="Course half-width, m.")
     ] = 800.0,
     sigma_deg: Annotated[
-        float, typer.Option("--sigma-deg", metavar="DEG",
-                            help="Standard deviation of the wind direction, deg.")
+        float,
+        typer.Option(
+            "--sigma-deg", metavar="DEG", help="Standard deviation of the wind direction, deg."
+        ),
     ] = 10.0,
     timescale_min: Annotated[
-        float, typer.Option("--timescale-min", metavar="MIN",
-                            help="Time scale (e-folding) of the shifts, min.")
+        float,
+        typer.Option(
+            "--timescale-min", metavar="MIN", help="Time scale (e-folding) of the shifts, min."
+        ),
     ] = 10.0,
     drift_deg_per_min: Annotated[
         float,
-        typer.Option("--drift-deg-per-min", metavar="DEG/MIN",
-                     help="Persistent shift for the deadline objective, deg/min (+ veers)."),
+        typer.Option(
+            "--drift-deg-per-min",
+            metavar="DEG/MIN",
+            help="Persistent shift for the deadline objective, deg/min (+ veers).",
+        ),
     ] = 0.0,
     fit_from: Annotated[
         str | None,
-        typer.Option("--fit-from", metavar="CSV",
-                     help="Station CSV: fit sigma and time scale from it."),
+        typer.Option(
+            "--fit-from", metavar="CSV", help="Station CSV: fit sigma and time scale from it."
+        ),
     ] = None,
     fit_station: Annotated[
         str | None, typer.Option("--fit-station", metavar="ID", help="Station id in --fit-from.")
     ] = None,
     fit_timezone: Annotated[
         str | None,
-        typer.Option("--fit-timezone", metavar="OFFSET",
-                     help="UTC offset for naive times in --fit-from, e.g. +01:00."),
+        typer.Option(
+            "--fit-timezone",
+            metavar="OFFSET",
+            help="UTC offset for naive times in --fit-from, e.g. +01:00.",
+        ),
     ] = None,
     fit_speed_unit: Annotated[
         SpeedUnit | None,
-        typer.Option("--fit-speed-unit", case_sensitive=False,
-                     help="Unit of the speed column of --fit-from when its header does not "
-                     "say."),
+        typer.Option(
+            "--fit-speed-unit",
+            case_sensitive=False,
+            help="Unit of the speed column of --fit-from when its header does not say.",
+        ),
     ] = None,
     tack_penalty_s: Annotated[
         float, typer.Option("--tack-penalty-s", metavar="S", help="Time lost per tack, s.")
     ] = 5.0,
     objective: Annotated[
         str,
-        typer.Option("--objective", metavar="OBJECTIVE", autocompletion=_complete_objective,
-                     help="expected (minimise the expected time) or deadline=S[,S...] "
-                     "(maximise the probability of finishing within S seconds)."),
+        typer.Option(
+            "--objective",
+            metavar="OBJECTIVE",
+            autocompletion=_complete_objective,
+            help="expected (minimise the expected time) or deadline=S[,S...] "
+            "(maximise the probability of finishing within S seconds).",
+        ),
     ] = "expected",
-    runs: Annotated[int, typer.Option("--runs", metavar="N", help="Monte Carlo runs per policy.")
-                    ] = 4000,
+    runs: Annotated[
+        int, typer.Option("--runs", metavar="N", help="Monte Carlo runs per policy.")
+    ] = 4000,
     seed: Annotated[int, typer.Option("--seed", metavar="N", help="Random seed.")] = 1,
     start_tack: Annotated[
         Tack, typer.Option("--start-tack", case_sensitive=False, help="Tack at the start.")
     ] = "starboard",
     shift: Annotated[
         Shift,
-        typer.Option("--shift", case_sensitive=False,
-                     help="Wind-shift model of the expected-time policy: ou (oscillating, "
-                     "mean-reverting) or drift-diffusion (persistent)."),
+        typer.Option(
+            "--shift",
+            case_sensitive=False,
+            help="Wind-shift model of the expected-time policy: ou (oscillating, "
+            "mean-reverting) or drift-diffusion (persistent).",
+        ),
     ] = "ou",
     diffusion_deg_per_sqrt_min: Annotated[
         float | None,
-        typer.Option("--diffusion-deg-per-sqrt-min", metavar="X",
-                     help="Diffusion of the direction for --shift drift-diffusion, "
-                     "deg/sqrt(min) (default: fitted or from sigma)."),
+        typer.Option(
+            "--diffusion-deg-per-sqrt-min",
+            metavar="X",
+            help="Diffusion of the direction for --shift drift-diffusion, "
+            "deg/sqrt(min) (default: fitted or from sigma).",
+        ),
     ] = None,
     deadline_interpolation: Annotated[
         DeadlineInterp,
-        typer.Option("--deadline-interpolation", case_sensitive=False,
-                     help="Deadline solver interpolation: linear (bilinear, reproduces "
-                     "Wang et al. 2024) or cubic."),
+        typer.Option(
+            "--deadline-interpolation",
+            case_sensitive=False,
+            help="Deadline solver interpolation: linear (bilinear, reproduces "
+            "Wang et al. 2024) or cubic.",
+        ),
     ] = "linear",
     deadline_refine: Annotated[
         DeadlineRefine,
-        typer.Option("--deadline-refine", case_sensitive=False,
-                     help="Deadline solver steering: none (49 angles) or golden "
-                     "(golden-section refinement per node)."),
+        typer.Option(
+            "--deadline-refine",
+            case_sensitive=False,
+            help="Deadline solver steering: none (49 angles) or golden "
+            "(golden-section refinement per node).",
+        ),
     ] = "none",
     deadline_engine: Annotated[
         DeadlineEngine,
-        typer.Option("--deadline-engine", case_sensitive=False,
-                     help="Deadline solver kernels: auto (numba where installed), numpy, "
-                     "numba, or cupy (NVIDIA GPU); the same policy either way."),
+        typer.Option(
+            "--deadline-engine",
+            case_sensitive=False,
+            help="Deadline solver kernels: auto (numba where installed), numpy, "
+            "numba, or cupy (NVIDIA GPU); the same policy either way.",
+        ),
     ] = "auto",
-    out: Annotated[str, typer.Option("--out", "-o", metavar="DIR", help="Output folder.")
-                   ] = "strategy-out",
+    out: Annotated[
+        str, typer.Option("--out", "-o", metavar="DIR", help="Output folder.")
+    ] = "strategy-out",
     no_plots: Annotated[bool, typer.Option("--no-plots", help="summary.json only.")] = False,
     scheduler: Annotated[
         str | None,
-        typer.Option("--scheduler", metavar="WHERE", autocompletion=_complete_scheduler,
-                     help="Where the Monte Carlo runs: serial (here, default), processes (a "
-                     "local Dask cluster) or tcp://HOST:PORT (an existing Dask scheduler); "
-                     "results are identical."),
+        typer.Option(
+            "--scheduler",
+            metavar="WHERE",
+            autocompletion=_complete_scheduler,
+            help="Where the Monte Carlo runs: serial (here, default), processes (a "
+            "local Dask cluster) or tcp://HOST:PORT (an existing Dask scheduler); "
+            "results are identical.",
+        ),
     ] = None,
     workers: Annotated[
         int | None,
-        typer.Option("--workers", metavar="N", help="Worker processes for --scheduler "
-                     "processes."),
+        typer.Option("--workers", metavar="N", help="Worker processes for --scheduler processes."),
     ] = None,
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
@@ -619,84 +735,129 @@ def strategy_command(
     def run() -> Any:
         _check_out(out)
         return run_strategy_command(
-            polar_spec=polar, tws_kn=tws_kn, sigma_deg=sigma_deg,
-            timescale_min=timescale_min, drift_deg_per_min=drift_deg_per_min,
-            fit_from=fit_from, fit_station=fit_station, fit_timezone=fit_timezone,
-            fit_speed_unit=fit_speed_unit, objective=objective, out_dir=out,
+            polar_spec=polar,
+            tws_kn=tws_kn,
+            sigma_deg=sigma_deg,
+            timescale_min=timescale_min,
+            drift_deg_per_min=drift_deg_per_min,
+            fit_from=fit_from,
+            fit_station=fit_station,
+            fit_timezone=fit_timezone,
+            fit_speed_unit=fit_speed_unit,
+            objective=objective,
+            out_dir=out,
             plots=not no_plots,
             progress=None if quiet else (lambda msg: typer.echo(msg, err=True)),
-            length_m=length_m, half_width_m=half_width_m, tack_penalty_s=tack_penalty_s,
-            runs=runs, seed=seed, start_tack=start_tack, scheduler=scheduler,
-            n_workers=workers, shift=shift,
+            length_m=length_m,
+            half_width_m=half_width_m,
+            tack_penalty_s=tack_penalty_s,
+            runs=runs,
+            seed=seed,
+            start_tack=start_tack,
+            scheduler=scheduler,
+            n_workers=workers,
+            shift=shift,
             diffusion_deg_per_sqrt_min=diffusion_deg_per_sqrt_min,
-            interpolation=deadline_interpolation, refine_controls=deadline_refine,
+            interpolation=deadline_interpolation,
+            refine_controls=deadline_refine,
             deadline_engine=deadline_engine,
         )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
-polar_app = typer.Typer(cls=_Group, no_args_is_help=True, rich_markup_mode=None,
-                        help="Boat polars: fit one from logged data.")
+polar_app = typer.Typer(
+    cls=_Group,
+    no_args_is_help=True,
+    rich_markup_mode=None,
+    help="Boat polars: fit one from logged data.",
+)
 app.add_typer(polar_app, name="polar")
 
 
-@polar_app.command("fit", cls=_Command,
-                   short_help="Fit a polar to a logged race.")
+@polar_app.command("fit", cls=_Command, short_help="Fit a polar to a logged race.")
 def polar_fit_command(
     ctx: typer.Context,
-    log: Annotated[str, typer.Argument(help="Instrument log (CSV with tws, twa, bsp or sog) "
-                                       "or GPS track (GPX/CSV, with --course).", metavar="LOG")],
+    log: Annotated[
+        str,
+        typer.Argument(
+            help="Instrument log (CSV with tws, twa, bsp or sog) "
+            "or GPS track (GPX/CSV, with --course).",
+            metavar="LOG",
+        ),
+    ],
     course: Annotated[
         str | None,
-        typer.Option("--course", metavar="COURSE", help="Course file whose scenario wind "
-                     "gives TWS/TWA at the track points (GPS track input)."),
+        typer.Option(
+            "--course",
+            metavar="COURSE",
+            help="Course file whose scenario wind "
+            "gives TWS/TWA at the track points (GPS track input).",
+        ),
     ] = None,
     scenario: Annotated[
-        str | None, typer.Option("--scenario", "-s", metavar="NAME",
-                                 help="Scenario of --course (default: the first).")
+        str | None,
+        typer.Option(
+            "--scenario", "-s", metavar="NAME", help="Scenario of --course (default: the first)."
+        ),
     ] = None,
     columns: Annotated[
         str | None,
-        typer.Option("--columns", metavar="MAP", help="Log columns the reader does not "
-                     "recognise, e.g. 'time=Time,bsp=BSP,tws=TWS,twa=TWA'."),
+        typer.Option(
+            "--columns",
+            metavar="MAP",
+            help="Log columns the reader does not "
+            "recognise, e.g. 'time=Time,bsp=BSP,tws=TWS,twa=TWA'.",
+        ),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
     time_zone: Annotated[
         str | None,
-        typer.Option("--time-zone", metavar="ZONE",
-                     help="Zone of naive log times: UTC, +02:00, Europe/Tallinn."),
+        typer.Option(
+            "--time-zone",
+            metavar="ZONE",
+            help="Zone of naive log times: UTC, +02:00, Europe/Tallinn.",
+        ),
     ] = None,
     percentile: Annotated[
         float, typer.Option("--percentile", metavar="P", help="Envelope percentile per cell.")
     ] = 90.0,
     min_count: Annotated[
-        int, typer.Option("--min-count", metavar="N",
-                          help="Samples a cell needs to count as covered.")
+        int,
+        typer.Option("--min-count", metavar="N", help="Samples a cell needs to count as covered."),
     ] = 5,
     tws_bins: Annotated[
         str | None,
-        typer.Option("--tws-bins", metavar="LIST", help="Comma-separated TWS columns in --unit "
-                     "(default: every 2 kn / 1 m/s over the data)."),
+        typer.Option(
+            "--tws-bins",
+            metavar="LIST",
+            help="Comma-separated TWS columns in --unit "
+            "(default: every 2 kn / 1 m/s over the data).",
+        ),
     ] = None,
-    twa_step: Annotated[float, typer.Option("--twa-step", metavar="DEG",
-                                            help="TWA row step, degrees.")] = 10.0,
-    out: Annotated[str, typer.Option("--out", "-o", metavar="DIR", help="Output folder.")
-                   ] = "polar-fit-out",
+    twa_step: Annotated[
+        float, typer.Option("--twa-step", metavar="DEG", help="TWA row step, degrees.")
+    ] = 10.0,
+    out: Annotated[
+        str, typer.Option("--out", "-o", metavar="DIR", help="Output folder.")
+    ] = "polar-fit-out",
     unit: Annotated[
         TableUnit,
         typer.Option("--unit", case_sensitive=False, help="Speed unit of the table and files."),
     ] = "kn",
     reference: Annotated[
         str | None,
-        typer.Option("--reference", metavar="POLAR",
-                     help="Polar to compare with: RMS and per-angle errors."),
+        typer.Option(
+            "--reference", metavar="POLAR", help="Polar to compare with: RMS and per-angle errors."
+        ),
     ] = None,
     reference_unit: Annotated[
         SpeedUnit | None,
-        typer.Option("--reference-unit", case_sensitive=False,
-                     help="Speed unit of --reference (default: the reader's, knots for "
-                     ".pol/CSV)."),
+        typer.Option(
+            "--reference-unit",
+            case_sensitive=False,
+            help="Speed unit of --reference (default: the reader's, knots for .pol/CSV).",
+        ),
     ] = None,
     json_out: JsonOpt = False,
 ) -> None:
@@ -706,51 +867,80 @@ def polar_fit_command(
     def run() -> Any:
         _check_out(out)
         return run_fit_command(
-            log, course=course, scenario=scenario, columns=columns, speed_unit=speed_unit,
-            time_zone=time_zone, percentile=percentile, min_count=min_count,
-            tws_bins=tws_bins, twa_step_deg=twa_step, out_dir=out, unit=unit,
-            reference=reference, reference_unit=reference_unit)
+            log,
+            course=course,
+            scenario=scenario,
+            columns=columns,
+            speed_unit=speed_unit,
+            time_zone=time_zone,
+            percentile=percentile,
+            min_count=min_count,
+            tws_bins=tws_bins,
+            twa_step_deg=twa_step,
+            out_dir=out,
+            unit=unit,
+            reference=reference,
+            reference_unit=reference_unit,
+        )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
-@app.command("analyze", cls=_Command,
-             short_help="Sailed tracks against the optimal route, leg by leg.")
+@app.command(
+    "analyze", cls=_Command, short_help="Sailed tracks against the optimal route, leg by leg."
+)
 def analyze_command(
     ctx: typer.Context,
-    course: Annotated[str, typer.Argument(help="Course file the boats sailed (YAML).",
-                                          metavar="COURSE")],
+    course: Annotated[
+        str, typer.Argument(help="Course file the boats sailed (YAML).", metavar="COURSE")
+    ],
     tracks: Annotated[
-        list[str], typer.Argument(help="Track file(s): GPX or CSV; several = a fleet.",
-                                  metavar="TRACK...")
+        list[str],
+        typer.Argument(help="Track file(s): GPX or CSV; several = a fleet.", metavar="TRACK..."),
     ],
     scenario: Annotated[
         str | None,
-        typer.Option("--scenario", "-s", metavar="NAME",
-                     help="Wind scenario (default: the first in the file)."),
+        typer.Option(
+            "--scenario",
+            "-s",
+            metavar="NAME",
+            help="Wind scenario (default: the first in the file).",
+        ),
     ] = None,
     out: Annotated[
         str | None,
-        typer.Option("--out", "-o", metavar="DIR",
-                     help="Output folder (default: out/<course>/analysis-<track>)."),
+        typer.Option(
+            "--out",
+            "-o",
+            metavar="DIR",
+            help="Output folder (default: out/<course>/analysis-<track>).",
+        ),
     ] = None,
     leg_times: Annotated[
         list[str] | None,
-        typer.Option("--leg-times", metavar="[BOAT=]T0,T1,...", help="Override detection: "
-                     "n_legs+1 comma-separated ISO times with offset (start crossing, each "
-                     "leg's end); '-' = detect. Several tracks: BOAT=T0,... per boat (BOAT = "
-                     "track file name without extension; repeat)."),
+        typer.Option(
+            "--leg-times",
+            metavar="[BOAT=]T0,T1,...",
+            help="Override detection: "
+            "n_legs+1 comma-separated ISO times with offset (start crossing, each "
+            "leg's end); '-' = detect. Several tracks: BOAT=T0,... per boat (BOAT = "
+            "track file name without extension; repeat).",
+        ),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
     time_zone: Annotated[
         str | None,
-        typer.Option("--time-zone", metavar="ZONE",
-                     help="Zone of naive track times: '+02:00', 'UTC' or an IANA name."),
+        typer.Option(
+            "--time-zone",
+            metavar="ZONE",
+            help="Zone of naive track times: '+02:00', 'UTC' or an IANA name.",
+        ),
     ] = None,
     column: Annotated[
         list[str] | None,
-        typer.Option("--column", metavar="CANON=NAME",
-                     help="CSV column mapping, e.g. time=when (repeat)."),
+        typer.Option(
+            "--column", metavar="CANON=NAME", help="CSV column mapping, e.g. time=when (repeat)."
+        ),
     ] = None,
     router: RouterOpt = None,
     no_plots: Annotated[
@@ -758,22 +948,31 @@ def analyze_command(
     ] = False,
     gate_end: Annotated[
         Literal["line", "rounding"],
-        typer.Option("--gate-end", case_sensitive=False,
-                     help="A gate leg ends passing between the marks (line) or having "
-                          "rounded the chosen mark (rounding, as official leg counters)."),
+        typer.Option(
+            "--gate-end",
+            case_sensitive=False,
+            help="A gate leg ends passing between the marks (line) or having "
+            "rounded the chosen mark (rounding, as official leg counters).",
+        ),
     ] = "line",
     wind: Annotated[
         Literal["auto", "measured", "inferred", "scenario"],
-        typer.Option("--wind", case_sensitive=False,
-                     help="Wind each leg is judged in: auto (the boat's measured wind, the "
-                          "fleet's, the wind inferred from the tracks, then the scenario), "
-                          "measured, inferred or scenario."),
+        typer.Option(
+            "--wind",
+            case_sensitive=False,
+            help="Wind each leg is judged in: auto (the boat's measured wind, the "
+            "fleet's, the wind inferred from the tracks, then the scenario), "
+            "measured, inferred or scenario.",
+        ),
     ] = "auto",
     reference: Annotated[
         Literal["course", "fleet"],
-        typer.Option("--reference", case_sensitive=False,
-                     help="Polar the boats are judged against: the course's, or it scaled "
-                          "to what the fleet sails (fleet)."),
+        typer.Option(
+            "--reference",
+            case_sensitive=False,
+            help="Polar the boats are judged against: the course's, or it scaled "
+            "to what the fleet sails (fleet).",
+        ),
     ] = "course",
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
@@ -795,93 +994,153 @@ def analyze_command(
         loaded = load_course(course)
         with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
             return run_analyze_command(
-                loaded, tracks, scenario=scenario, router=router, out_dir=out,
-                leg_times=leg_times, columns=columns or None, speed_unit=speed_unit,
-                time_zone=time_zone, plots=not no_plots, progress=progress,
-                gate_end=gate_end, wind=wind, reference=reference)
+                loaded,
+                tracks,
+                scenario=scenario,
+                router=router,
+                out_dir=out,
+                leg_times=leg_times,
+                columns=columns or None,
+                speed_unit=speed_unit,
+                time_zone=time_zone,
+                plots=not no_plots,
+                progress=progress,
+                gate_end=gate_end,
+                wind=wind,
+                reference=reference,
+            )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 # --- course import (one block: the `course` sub-app) ------------------------------------
-course_app = typer.Typer(cls=_Group, no_args_is_help=True, rich_markup_mode=None,
-                         help="Course files from other programs.")
+course_app = typer.Typer(
+    cls=_Group,
+    no_args_is_help=True,
+    rich_markup_mode=None,
+    help="Course files from other programs.",
+)
 app.add_typer(course_app, name="course")
 
 
-@course_app.command("import", cls=_Command,
-                    short_help="A course file (YAML) from GPX, CSV, KML or race XML.")
+@course_app.command(
+    "import", cls=_Command, short_help="A course file (YAML) from GPX, CSV, KML or race XML."
+)
 def course_import_command(
     ctx: typer.Context,
-    source: Annotated[str, typer.Argument(help="GPX, CSV, KML or SailGP race XML file.",
-                                          metavar="FILE")],
+    source: Annotated[
+        str, typer.Argument(help="GPX, CSV, KML or SailGP race XML file.", metavar="FILE")
+    ],
     out: Annotated[
         str | None,
-        typer.Option("--out", "-o", metavar="COURSE.yaml",
-                     help="Course file to write (default: <FILE stem>.yaml here)."),
+        typer.Option(
+            "--out",
+            "-o",
+            metavar="COURSE.yaml",
+            help="Course file to write (default: <FILE stem>.yaml here).",
+        ),
     ] = None,
     fmt: Annotated[
         Literal["auto", "gpx", "csv", "kml", "racexml"],
-        typer.Option("--format", case_sensitive=False,
-                     help="Input format (auto: by suffix, or the root element of .xml)."),
+        typer.Option(
+            "--format",
+            case_sensitive=False,
+            help="Input format (auto: by suffix, or the root element of .xml).",
+        ),
     ] = "auto",
     boat: Annotated[
         str | None,
-        typer.Option("--boat", metavar="BOAT", help="Built-in polar (ilca7), a polar file, "
-                     "or a mapping '{polar: f50.csv, speed_unit: km/h}' (default: none)."),
+        typer.Option(
+            "--boat",
+            metavar="BOAT",
+            help="Built-in polar (ilca7), a polar file, "
+            "or a mapping '{polar: f50.csv, speed_unit: km/h}' (default: none).",
+        ),
     ] = None,
     wind_twd: Annotated[
-        float | None, typer.Option("--wind-twd", metavar="DEG",
-                                   help="Uniform wind direction, degrees (from); required."),
+        float | None,
+        typer.Option(
+            "--wind-twd", metavar="DEG", help="Uniform wind direction, degrees (from); required."
+        ),
     ] = None,
     wind_tws: Annotated[
-        float | None, typer.Option("--wind-tws", metavar="KN",
-                                   help="Uniform wind speed, knots; required."),
+        float | None,
+        typer.Option("--wind-tws", metavar="KN", help="Uniform wind speed, knots; required."),
     ] = None,
     start_time: Annotated[
         str | None,
-        typer.Option("--start-time", metavar="TIME", help="Start, ISO 8601 with offset "
-                     "(required unless the file gives it, as race XML does)."),
+        typer.Option(
+            "--start-time",
+            metavar="TIME",
+            help="Start, ISO 8601 with offset "
+            "(required unless the file gives it, as race XML does).",
+        ),
     ] = None,
 ) -> None:
     """Import a course: marks, lines, gates, legs, boundary; writes a course file that plans."""
     from sailroute.commands.course_import import run_course_import_command
 
     def run() -> Any:
-        return run_course_import_command(source, out=out, fmt=fmt, boat=boat,
-                                         wind_twd_deg=wind_twd, wind_tws_kn=wind_tws,
-                                         start_time=start_time)
+        return run_course_import_command(
+            source,
+            out=out,
+            fmt=fmt,
+            boat=boat,
+            wind_twd_deg=wind_twd,
+            wind_tws_kn=wind_tws,
+            start_time=start_time,
+        )
 
     _finish(run_guarded(run, debug=_debug(ctx)), False)
 
 
 # --- live (re-plan from the instruments) ----------------------------------------------
-@app.command("live", cls=_Command,
-             short_help="Re-plan the rest of a race from a boat's instruments, live.")
+@app.command(
+    "live", cls=_Command, short_help="Re-plan the rest of a race from a boat's instruments, live."
+)
 def live_command(
     ctx: typer.Context,
     course: CourseArg,
     source: Annotated[
-        str, typer.Option("--source", metavar="SOURCE",
-                          help="signalk://HOST:PORT, nmea+tcp://HOST:PORT, nmea+udp://:PORT "
-                               "or a recorded .nmea file.")],
+        str,
+        typer.Option(
+            "--source",
+            metavar="SOURCE",
+            help="signalk://HOST:PORT, nmea+tcp://HOST:PORT, nmea+udp://:PORT "
+            "or a recorded .nmea file.",
+        ),
+    ],
     scenario: Annotated[
-        str | None, typer.Option("--scenario", "-s", metavar="NAME",
-                                 help="Forecast scenario (default: the first in the file).")
+        str | None,
+        typer.Option(
+            "--scenario",
+            "-s",
+            metavar="NAME",
+            help="Forecast scenario (default: the first in the file).",
+        ),
     ] = None,
-    every: Annotated[float, typer.Option("--every", metavar="S",
-                                         help="Re-plan at least every S seconds.")] = 10.0,
-    speed: Annotated[float, typer.Option("--speed", metavar="X",
-                                         help="Replay speed of a recorded file.")] = 1.0,
+    every: Annotated[
+        float, typer.Option("--every", metavar="S", help="Re-plan at least every S seconds.")
+    ] = 10.0,
+    speed: Annotated[
+        float, typer.Option("--speed", metavar="X", help="Replay speed of a recorded file.")
+    ] = 1.0,
     port: Annotated[int, typer.Option("--port", help="Port of the page on 127.0.0.1.")] = 8080,
-    nmea_port: Annotated[int, typer.Option(
-        "--nmea-port", help="TCP port of the NMEA 0183 output on 127.0.0.1.")] = 10110,
-    log: Annotated[str | None, typer.Option("--log", metavar="FILE",
-                                            help="JSON-lines log of inputs and re-plans.")
-                   ] = None,
-    duration: Annotated[float | None, typer.Option(
-        "--duration", metavar="S", help="Run S seconds (default: until Ctrl-C or the end "
-                                        "of a recorded file).")] = None,
+    nmea_port: Annotated[
+        int, typer.Option("--nmea-port", help="TCP port of the NMEA 0183 output on 127.0.0.1.")
+    ] = 10110,
+    log: Annotated[
+        str | None,
+        typer.Option("--log", metavar="FILE", help="JSON-lines log of inputs and re-plans."),
+    ] = None,
+    duration: Annotated[
+        float | None,
+        typer.Option(
+            "--duration",
+            metavar="S",
+            help="Run S seconds (default: until Ctrl-C or the end of a recorded file).",
+        ),
+    ] = None,
     leg: Annotated[int, typer.Option("--leg", help="Leg being sailed now (1-based).")] = 1,
     router: RouterOpt = None,
 ) -> None:
@@ -889,37 +1148,57 @@ def live_command(
     from sailroute.commands.live import run_live_command
 
     def run() -> Any:
-        return run_live_command(course, source=source, scenario=scenario, every_s=every,
-                                speed=speed, port=port, nmea_port=nmea_port, log=log,
-                                duration_s=duration, router=router, leg=leg,
-                                announce=typer.echo)
+        return run_live_command(
+            course,
+            source=source,
+            scenario=scenario,
+            every_s=every,
+            speed=speed,
+            port=port,
+            nmea_port=nmea_port,
+            log=log,
+            duration_s=duration,
+            router=router,
+            leg=leg,
+            announce=typer.echo,
+        )
 
     _finish(run_guarded(run, debug=_debug(ctx)), False)
 
 
-@app.command("live-convert", cls=_Command,
-             short_help="Turn an instrument log into an NMEA 0183 replay file.")
+@app.command(
+    "live-convert", cls=_Command, short_help="Turn an instrument log into an NMEA 0183 replay file."
+)
 def live_convert_command(
     ctx: typer.Context,
     log: Annotated[str, typer.Argument(help="The instrument log (CSV).", metavar="LOG")],
-    fmt: Annotated[Literal["trieste", "tallinn"], typer.Option(
-        "--format", case_sensitive=False, help="Log format (docs/live.md).")],
-    out: Annotated[str, typer.Option("--out", "-o", metavar="FILE",
-                                     help="The .nmea file to write.")],
-    utc_offset: Annotated[str, typer.Option(
-        "--utc-offset", metavar="+HH:MM", help="The logger clock's UTC offset (trieste).")
+    fmt: Annotated[
+        Literal["trieste", "tallinn"],
+        typer.Option("--format", case_sensitive=False, help="Log format (docs/live.md)."),
+    ],
+    out: Annotated[
+        str, typer.Option("--out", "-o", metavar="FILE", help="The .nmea file to write.")
+    ],
+    utc_offset: Annotated[
+        str,
+        typer.Option(
+            "--utc-offset", metavar="+HH:MM", help="The logger clock's UTC offset (trieste)."
+        ),
     ] = "+01:00",
-    start: Annotated[str | None, typer.Option("--from", metavar="TIME",
-                                              help="First time kept (ISO 8601).")] = None,
-    end: Annotated[str | None, typer.Option("--to", metavar="TIME",
-                                            help="Last time kept (ISO 8601).")] = None,
+    start: Annotated[
+        str | None, typer.Option("--from", metavar="TIME", help="First time kept (ISO 8601).")
+    ] = None,
+    end: Annotated[
+        str | None, typer.Option("--to", metavar="TIME", help="Last time kept (ISO 8601).")
+    ] = None,
 ) -> None:
     """Convert an instrument log (Trieste coach boat, Tallinn race) to NMEA 0183."""
     from sailroute.commands.live import run_live_convert_command
 
     def run() -> Any:
-        return run_live_convert_command(log, fmt=fmt, out=out, utc_offset=utc_offset,
-                                        start=start, end=end)
+        return run_live_convert_command(
+            log, fmt=fmt, out=out, utc_offset=utc_offset, start=start, end=end
+        )
 
     _finish(run_guarded(run, debug=_debug(ctx)), False)
 

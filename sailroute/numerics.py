@@ -76,8 +76,7 @@ def golden_steps(width: float, tol: float) -> int:
     return max(1, math.ceil(math.log(width / tol) / math.log((1.0 + math.sqrt(5.0)) / 2.0)))
 
 
-def golden_max(f: Callable[[Any], Any], lo: Any, hi: Any, n: int,
-               xp: ModuleType = np) -> Any:
+def golden_max(f: Callable[[Any], Any], lo: Any, hi: Any, n: int, xp: ModuleType = np) -> Any:
     """Vectorised golden-section search for the maximiser of ``f`` on ``[lo, hi]``.
 
     Parameters
@@ -160,8 +159,12 @@ def hermite(y0: Any, y1: Any, d0: Any, d1: Any, t: Any, h: Any = None) -> Any:
 def hermite_slope(y0: Any, y1: Any, d0: Any, d1: Any, t: Any, h: Any = 1.0) -> Any:
     """``d/dt`` of :func:`hermite` (same parameters): the derivative per unit ``t``."""
     t2 = t * t
-    return ((6 * t2 - 6 * t) * y0 + (3 * t2 - 4 * t + 1) * h * d0
-            + (-6 * t2 + 6 * t) * y1 + (3 * t2 - 2 * t) * h * d1)
+    return (
+        (6 * t2 - 6 * t) * y0
+        + (3 * t2 - 4 * t + 1) * h * d0
+        + (-6 * t2 + 6 * t) * y1
+        + (3 * t2 - 2 * t) * h * d1
+    )
 
 
 def hermite_coefficients(y0: Any, y1: Any, d0: Any, d1: Any) -> tuple[Any, Any, Any, Any]:
@@ -173,8 +176,15 @@ def hermite_coefficients(y0: Any, y1: Any, d0: Any, d1: Any) -> tuple[Any, Any, 
     return y0, d0, 3 * (y1 - y0) - 2 * d0 - d1, 2 * (y0 - y1) + d0 + d1
 
 
-def hermite_crossing(y0: NDArray, y1: NDArray, d0: NDArray, d1: NDArray, h: NDArray,
-                     target: NDArray, iterations: int = 6) -> NDArray:
+def hermite_crossing(
+    y0: NDArray,
+    y1: NDArray,
+    d0: NDArray,
+    d1: NDArray,
+    h: NDArray,
+    target: NDArray,
+    iterations: int = 6,
+) -> NDArray:
     """Fraction ``t ∈ [0, 1]`` of a step where the Hermite cubic reaches ``target``.
 
     Newton iterations on ``hermite(y0, y1, d0, d1, t, h) = target`` from the linear
@@ -210,8 +220,9 @@ def hermite_crossing(y0: NDArray, y1: NDArray, d0: NDArray, d1: NDArray, h: NDAr
 # Runge-Kutta
 
 
-def rk4_step(f: Callable[..., Any], y: Any, h: Any, k1: Any = None,
-             args: tuple[Any, ...] = ()) -> tuple[Any, Any]:
+def rk4_step(
+    f: Callable[..., Any], y: Any, h: Any, k1: Any = None, args: tuple[Any, ...] = ()
+) -> tuple[Any, Any]:
     """One classical fourth-order Runge-Kutta step of the autonomous system ``y' = f(y)``.
 
     Parameters

@@ -74,8 +74,10 @@ def path_part_problem(name: str) -> str | None:
         return "it starts with '.' (a hidden or parent folder)"
     bad = sorted({ch for ch in name if ch in "/\\:" or ord(ch) < 32 or ord(ch) == 127})
     if bad:
-        return "it contains " + ", ".join(repr(ch) for ch in bad) + " (a path separator or " \
+        return (
+            "it contains " + ", ".join(repr(ch) for ch in bad) + " (a path separator or "
             "a control character)"
+        )
     if len(name) > PATH_PART_MAX:
         return f"it is {len(name)} characters long (at most {PATH_PART_MAX})"
     return None
@@ -91,14 +93,18 @@ def safe_part(name: str, what: str) -> str:
     """
     why = path_part_problem(name)
     if why is not None:
-        raise InputError(f"{what} {name!r} cannot name a folder of the output: {why}; "
-                         "use letters, digits, '-', '_' or '#'")
+        raise InputError(
+            f"{what} {name!r} cannot name a folder of the output: {why}; "
+            "use letters, digits, '-', '_' or '#'"
+        )
     return name
 
 
 def _cannot(d: Path, why: str, option: str) -> InputError:
-    return InputError(f"{option}: cannot create the output folder {str(d)!r} ({why}); "
-                      f"choose another folder with {option}")
+    return InputError(
+        f"{option}: cannot create the output folder {str(d)!r} ({why}); "
+        f"choose another folder with {option}"
+    )
 
 
 def check_out_dir(path: str | Path, option: str = "--out") -> Path:
@@ -129,8 +135,10 @@ def check_out_dir(path: str | Path, option: str = "--out") -> Path:
         if not d.is_dir():
             raise _cannot(d, "a file of that name exists", option)
         if not os.access(d, os.W_OK | os.X_OK):
-            raise InputError(f"{option}: cannot write into the output folder {str(d)!r} (no "
-                             f"permission); choose another folder with {option}")
+            raise InputError(
+                f"{option}: cannot write into the output folder {str(d)!r} (no "
+                f"permission); choose another folder with {option}"
+            )
         return d
     parent = d.absolute().parent
     while not parent.exists() and parent != parent.parent:
@@ -188,14 +196,18 @@ def _write_manifest(folder: Path, names: set[str]) -> None:
     from sailroute import __version__
 
     tmp = folder / f"{MANIFEST_NAME}.{secrets.token_hex(4)}"
-    tmp.write_text(json.dumps({"written_by": f"sailroute {__version__}",
-                               "files": sorted(names)}, indent=1) + "\n", encoding="utf-8")
+    tmp.write_text(
+        json.dumps({"written_by": f"sailroute {__version__}", "files": sorted(names)}, indent=1)
+        + "\n",
+        encoding="utf-8",
+    )
     os.replace(tmp, folder / MANIFEST_NAME)
 
 
 def _files_under(folder: Path) -> set[str]:
-    return {p.relative_to(folder).as_posix() for p in folder.rglob("*")
-            if p.is_file() or p.is_symlink()}
+    return {
+        p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file() or p.is_symlink()
+    }
 
 
 @contextmanager
@@ -259,7 +271,8 @@ def _commit(stage: Path, out: Path) -> None:
             raise InputError(
                 f"--out: cannot write {rel!r} into {str(out)!r}: {str(link)!r} is a symbolic "
                 "link or a file, and sailroute writes only inside the output folder; remove "
-                "it or choose another folder with --out")
+                "it or choose another folder with --out"
+            )
     with _sigint_deferred():
         _write_manifest(out, old | new)  # everything that may be ours, until the swap is done
         for rel in sorted(new):

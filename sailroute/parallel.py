@@ -171,17 +171,18 @@ def open_runner(
         return
     n = (os.cpu_count() or 1) if n_workers is None else n_workers
     if name == PROCESSES and (isinstance(n, bool) or not (isinstance(n, int) and n >= 1)):
-        raise InputError(
-            f"n_workers = {n_workers!r}: need a whole number >= 1 of worker processes"
-        )
+        raise InputError(f"n_workers = {n_workers!r}: need a whole number >= 1 of worker processes")
     distributed = _import_distributed(name)
     if name == PROCESSES:
         import dask
 
         # the workers inherit the ignored SIGINT (Ctrl-C is the parent's to handle) and
         # this logging config (a cancelled run must not print each cancelled task)
-        with _sigint_ignored(), dask.config.set(
-            {"logging": {"distributed.worker": "error", "distributed.nanny": "error"}}
+        with (
+            _sigint_ignored(),
+            dask.config.set(
+                {"logging": {"distributed.worker": "error", "distributed.nanny": "error"}}
+            ),
         ):
             cluster = distributed.LocalCluster(
                 n_workers=n,

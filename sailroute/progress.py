@@ -59,8 +59,12 @@ class Progress:
     def __enter__(self) -> Progress:
         return self
 
-    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
-                 tb: TracebackType | None) -> None:
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
         self.close()
 
     def close(self) -> None:
@@ -172,24 +176,30 @@ class RichProgress(Progress):
         min_interval_s: float = 0.1,
         force_terminal: bool | None = None,
     ) -> None:
-        super().__init__(n_legs, stream, enabled=enabled, min_interval_s=min_interval_s,
-                         live=True)
+        super().__init__(n_legs, stream, enabled=enabled, min_interval_s=min_interval_s, live=True)
         from rich.console import Console
         from rich.progress import BarColumn, TaskProgressColumn, TextColumn, TimeElapsedColumn
         from rich.progress import Progress as Bar
 
-        self.console = Console(file=self.stream, force_terminal=force_terminal,
-                               highlight=False)
-        self._bar = Bar(TextColumn("{task.description}"), BarColumn(), TaskProgressColumn(),
-                        TimeElapsedColumn(), TextColumn("{task.fields[note]}"),
-                        console=self.console, transient=True, auto_refresh=False)
+        self.console = Console(file=self.stream, force_terminal=force_terminal, highlight=False)
+        self._bar = Bar(
+            TextColumn("{task.description}"),
+            BarColumn(),
+            TaskProgressColumn(),
+            TimeElapsedColumn(),
+            TextColumn("{task.fields[note]}"),
+            console=self.console,
+            transient=True,
+            auto_refresh=False,
+        )
         self._task: Any = None
         self._running = False
 
     def _write(self, text: str, *, end: str) -> None:
         style = "yellow" if text.startswith("warning: ") else None
-        self.console.print(self.prefix + text, end=end, style=style, markup=False,
-                           highlight=False, soft_wrap=True)
+        self.console.print(
+            self.prefix + text, end=end, style=style, markup=False, highlight=False, soft_wrap=True
+        )
 
     def start_leg(self, index: int, label: str) -> None:
         """Start the bar of leg ``index`` (0-based)."""
@@ -239,8 +249,7 @@ class RichProgress(Progress):
             self._running = False
 
 
-def make_progress(n_legs: int, *, enabled: bool = True, stream: TextIO | None = None
-                  ) -> Progress:
+def make_progress(n_legs: int, *, enabled: bool = True, stream: TextIO | None = None) -> Progress:
     """A :class:`RichProgress` if ``stream`` (default stderr) is a terminal, else a
     plain :class:`Progress`; ``enabled=False`` (``--quiet``) prints warnings only."""
     s = stream if stream is not None else sys.stderr

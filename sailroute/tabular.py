@@ -21,8 +21,16 @@ from sailroute.errors import InputError, format_problems
 from sailroute.textin import csv_rows, looks_like_header, quote_header
 from sailroute.units import speed_factor
 
-CANONICAL_COLUMNS: Final = ("time", "station", "lat", "lon", "speed", "direction", "height_m",
-                            "gust")
+CANONICAL_COLUMNS: Final = (
+    "time",
+    "station",
+    "lat",
+    "lon",
+    "speed",
+    "direction",
+    "height_m",
+    "gust",
+)
 """Column names of the canonical station CSV schema."""
 
 REQUIRED_COLUMNS: Final = ("time", "speed", "direction")
@@ -31,29 +39,82 @@ REQUIRED_COLUMNS: Final = ("time", "speed", "direction")
 _SPEED_SUFFIXES: Final = ("_kn", "_kt", "_kts", "_ms", "_m_s", "_mps", "_kmh", "_kph", "_mph")
 
 COLUMN_ALIASES: Final[dict[str, tuple[str, ...]]] = {
-    "time": ("time", "time_utc", "datetime", "datetime_utc", "datetime_local", "timestamp",
-             "date_time", "utc", "time_iso", "t"),
+    "time": (
+        "time",
+        "time_utc",
+        "datetime",
+        "datetime_utc",
+        "datetime_local",
+        "timestamp",
+        "date_time",
+        "utc",
+        "time_iso",
+        "t",
+    ),
     "station": ("station", "station_id", "stationid", "id", "name", "sensor"),
     "lat": ("lat", "latitude", "lat_deg"),
     "lon": ("lon", "lng", "long", "longitude", "lon_deg"),
-    "speed": ("speed", "tws", "wspd", "wind_speed", "windspeed", "ws",
-              *(f"{base}{suffix}" for base in ("speed", "tws", "wspd", "wind_speed")
-                for suffix in _SPEED_SUFFIXES)),
-    "direction": ("direction", "twd", "twd_deg", "wdir", "wdir_deg", "wdir_deg_true",
-                  "wind_direction", "wind_dir", "winddir", "wd", "direction_deg", "dir"),
+    "speed": (
+        "speed",
+        "tws",
+        "wspd",
+        "wind_speed",
+        "windspeed",
+        "ws",
+        *(
+            f"{base}{suffix}"
+            for base in ("speed", "tws", "wspd", "wind_speed")
+            for suffix in _SPEED_SUFFIXES
+        ),
+    ),
+    "direction": (
+        "direction",
+        "twd",
+        "twd_deg",
+        "wdir",
+        "wdir_deg",
+        "wdir_deg_true",
+        "wind_direction",
+        "wind_dir",
+        "winddir",
+        "wd",
+        "direction_deg",
+        "dir",
+    ),
     "height_m": ("height_m", "height", "z", "z_m", "anemometer_height_m", "sensor_height_m"),
     "gust": ("gust", "gst", "wind_gust", "gust_speed", *(f"gust{x}" for x in _SPEED_SUFFIXES)),
 }
 """Built-in header aliases (case-insensitive) for each canonical column."""
 
-DEFAULT_MISSING: Final = ("", "NA", "N/A", "NaN", "nan", "NAN", "null", "NULL", "None", "MM",
-                          "-", "--")
+DEFAULT_MISSING: Final = (
+    "",
+    "NA",
+    "N/A",
+    "NaN",
+    "nan",
+    "NAN",
+    "null",
+    "NULL",
+    "None",
+    "MM",
+    "-",
+    "--",
+)
 """Cell values read as missing by default (add e.g. ``"999"`` for NDBC codes)."""
 
-_UNIT_SUFFIXES: Final = (("_m_s", "m/s"), ("_ms", "m/s"), ("_mps", "m/s"), ("_kn", "kn"),
-                         ("_km_h", "km/h"),
-                         ("_kt", "kn"), ("_kts", "kn"), ("_knots", "kn"), ("_kmh", "km/h"),
-                         ("_kph", "km/h"), ("_mph", "mph"))
+_UNIT_SUFFIXES: Final = (
+    ("_m_s", "m/s"),
+    ("_ms", "m/s"),
+    ("_mps", "m/s"),
+    ("_kn", "kn"),
+    ("_km_h", "km/h"),
+    ("_kt", "kn"),
+    ("_kts", "kn"),
+    ("_knots", "kn"),
+    ("_kmh", "km/h"),
+    ("_kph", "km/h"),
+    ("_mph", "mph"),
+)
 
 
 def unit_from_header(column: str) -> str | None:
@@ -84,7 +145,10 @@ def parse_offset(text: str, where: str = "timezone") -> timezone:
 
 
 def map_columns(
-    header: Sequence[str], columns: Mapping[str, str] | None = None, *, where: str = "CSV",
+    header: Sequence[str],
+    columns: Mapping[str, str] | None = None,
+    *,
+    where: str = "CSV",
     aliases: Mapping[str, Sequence[str]] = COLUMN_ALIASES,
 ) -> dict[str, int]:
     """Map canonical column names to indices of ``header``.
@@ -117,12 +181,14 @@ def map_columns(
     problems: list[str] = []
     for canon, col in (columns or {}).items():
         if canon not in aliases:
-            problems.append(f"columns.{canon}: unknown canonical column; expected one of "
-                            + ", ".join(aliases))
+            problems.append(
+                f"columns.{canon}: unknown canonical column; expected one of " + ", ".join(aliases)
+            )
             continue
         if not isinstance(col, str) or col.strip().lower() not in norm:
-            problems.append(f"columns.{canon}: column {col!r} is not in the header "
-                            f"({quote_header(header)})")
+            problems.append(
+                f"columns.{canon}: column {col!r} is not in the header ({quote_header(header)})"
+            )
             continue
         out[canon] = norm.index(col.strip().lower())
     for canon, names in aliases.items():
@@ -156,8 +222,9 @@ _PART_ALIASES: Final[dict[str, tuple[str, ...]]] = {
 _PART_CASED: Final = {"MM": "month", "mm": "minute"}  # NDBC: '#YY MM DD hh mm'
 
 
-def time_part_columns(header: Sequence[str], columns: Mapping[str, str] | None = None, *,
-                      where: str = "CSV") -> dict[str, int]:
+def time_part_columns(
+    header: Sequence[str], columns: Mapping[str, str] | None = None, *, where: str = "CSV"
+) -> dict[str, int]:
     """Indices of split date/time columns (year, month, day, hour[, minute, second]).
 
     ``MM`` (upper case) is the month and ``mm`` the minute, as in NDBC's
@@ -175,8 +242,10 @@ def time_part_columns(header: Sequence[str], columns: Mapping[str, str] | None =
     for part, col in (columns or {}).items():
         if part in TIME_PARTS:
             if col.strip().lower() not in norm:
-                raise InputError(f"{where}: columns.{part}: column {col!r} is not in the header "
-                                 f"({', '.join(stripped)})")
+                raise InputError(
+                    f"{where}: columns.{part}: column {col!r} is not in the header "
+                    f"({', '.join(stripped)})"
+                )
             out[part] = norm.index(col.strip().lower())
     for k, h in enumerate(stripped):
         found = _PART_CASED.get(h)
@@ -185,9 +254,11 @@ def time_part_columns(header: Sequence[str], columns: Mapping[str, str] | None =
         if found is not None and found not in out and k not in out.values():
             out[found] = k
     if "minute" in out and "month" not in out and stripped[out["minute"]] == "mm":
-        raise InputError(f"{where}: column 'mm' could be the month or the minute; say which "
-                         "with `columns: {month: mm}` or `columns: {minute: mm}` (NDBC writes "
-                         "the month as MM and the minute as mm)")
+        raise InputError(
+            f"{where}: column 'mm' could be the month or the minute; say which "
+            "with `columns: {month: mm}` or `columns: {minute: mm}` (NDBC writes "
+            "the month as MM and the minute as mm)"
+        )
     return out if all(q in out for q in TIME_PARTS[:4]) else {}
 
 
@@ -240,8 +311,11 @@ def table_lines(text: str) -> list[tuple[int, str]]:
     ``#YY MM DD hh mm`` header (its ``#`` removed).
     """
     all_lines = text.splitlines()
-    lines = [(k + 1, ln) for k, ln in enumerate(all_lines)
-             if ln.strip() and not ln.lstrip().startswith("#")]
+    lines = [
+        (k + 1, ln)
+        for k, ln in enumerate(all_lines)
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if all_lines and all_lines[0].startswith(("#YY", "#yy", "#YYYY")):  # NDBC-style header
         lines = [(1, all_lines[0].lstrip("#")), *lines]
     return lines
@@ -257,8 +331,13 @@ def split_fields(lines: list[tuple[int, str]], name: str) -> tuple[list[list[str
 
 
 def station_columns(
-    header: Sequence[str], columns: Mapping[str, str] | None, *, position: bool,
-    timezone: str | None, name: str, lineno: int,
+    header: Sequence[str],
+    columns: Mapping[str, str] | None,
+    *,
+    position: bool,
+    timezone: str | None,
+    name: str,
+    lineno: int,
 ) -> tuple[dict[str, int], dict[str, int], str | None]:
     """Canonical columns, split date/time columns and the UTC offset of a station header.
 
@@ -302,22 +381,27 @@ def station_columns(
         raise InputError(
             f"{name}: not a station CSV: line {lineno} is not a header of column names; "
             "expected a header row such as time,station,lat,lon,speed_kn,direction (names and "
-            "aliases: docs/course-format.md)")
+            "aliases: docs/course-format.md)"
+        )
     if absent:
         raise InputError(
             f"{name}: no column for {', '.join(absent)}; header is "
             f"{quote_header(header)}. Rename the columns to the canonical "
             "names (time, station, lat, lon, speed, direction) or map them with `columns: "
-            "{canonical: file_column}`" + (" or give `position: {lat, lon}` for a fixed "
-                                           "station" if "lat" in absent else "")
-            + (". The time may also come from year, month, day, hour[, minute, second] "
-               "columns" if "time" in absent else "")
+            "{canonical: file_column}`"
+            + (" or give `position: {lat, lon}` for a fixed station" if "lat" in absent else "")
+            + (
+                ". The time may also come from year, month, day, hour[, minute, second] columns"
+                if "time" in absent
+                else ""
+            )
         )
     return cmap, parts, timezone
 
 
-def speed_units(header: Sequence[str], cmap: Mapping[str, int], declared: str | None,
-                name: str) -> tuple[str, str]:
+def speed_units(
+    header: Sequence[str], cmap: Mapping[str, int], declared: str | None, name: str
+) -> tuple[str, str]:
     """Units of the ``speed`` and ``gust`` columns (:func:`column_speed_unit`); the gust
     column's own unit suffix counts when no ``speed_unit`` is declared."""
     column = header[cmap["speed"]]

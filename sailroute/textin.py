@@ -25,8 +25,17 @@ from typing import IO, Any
 
 from sailroute.errors import InputError
 
-__all__ = ["EXCERPT_CHARS", "CleanCsvWriter", "bad_char", "clean_text", "csv_rows", "excerpt",
-           "looks_binary", "looks_like_header", "quote_header"]
+__all__ = [
+    "EXCERPT_CHARS",
+    "CleanCsvWriter",
+    "bad_char",
+    "clean_text",
+    "csv_rows",
+    "excerpt",
+    "looks_binary",
+    "looks_like_header",
+    "quote_header",
+]
 
 EXCERPT_CHARS = 60
 """Longest excerpt of a file's content a message quotes [characters]."""
@@ -56,8 +65,13 @@ def bad_char(text: str) -> str | None:
     if m is None:
         return None
     code = ord(m.group())
-    kind = ("a lone surrogate" if 0xD800 <= code <= 0xDFFF
-            else "a non-character" if code >= 0xFFFE else "a control character")
+    kind = (
+        "a lone surrogate"
+        if 0xD800 <= code <= 0xDFFF
+        else "a non-character"
+        if code >= 0xFFFE
+        else "a control character"
+    )
     return f"U+{code:04X} ({kind})"
 
 
@@ -167,6 +181,7 @@ def csv_rows(lines: Sequence[tuple[int, str]], delimiter: str, src: str) -> list
         except csv.Error as exc:
             raise InputError(
                 f"{src}, line {lineno}: cannot split the line into fields ({exc}); check "
-                "its quotes: a field that starts with \" must end with \" before the next "
-                f"{delimiter!r}") from None
+                'its quotes: a field that starts with " must end with " before the next '
+                f"{delimiter!r}"
+            ) from None
     return out

@@ -67,9 +67,7 @@ def speed_factor(unit: str) -> float:
     """
     key = unit.strip().lower()
     if key not in SPEED_UNITS:
-        raise InputError(
-            f"unknown speed unit {unit!r}; expected one of 'm/s', 'kn', 'km/h', 'mph'"
-        )
+        raise InputError(f"unknown speed unit {unit!r}; expected one of 'm/s', 'kn', 'km/h', 'mph'")
     return SPEED_UNITS[key]
 
 

@@ -55,8 +55,10 @@ YamlLoader.add_implicit_resolver(
 )
 YamlLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
-    re.compile(r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
-               r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"),
+    re.compile(
+        r"^(?:[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?"
+        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"
+    ),
     list("-+0123456789."),
 )
 
@@ -100,7 +102,8 @@ def _refuse_bad_chars(value: str, where: str) -> None:
         text = value if len(value) <= 40 else value[:37] + "..."
         raise InputError(
             f"{where}: the text {text!a} holds {bad}, which no output "
-            "file can carry; remove it (or the escape that writes it)")
+            "file can carry; remove it (or the escape that writes it)"
+        )
 
 
 def _check_events(events: Iterable[yaml.Event], where: str) -> None:
@@ -127,13 +130,16 @@ def _check_events(events: Iterable[yaml.Event], where: str) -> None:
             stack[-1][3] = max(stack[-1][3], depth)
         if depth > MAX_DEPTH:
             via = f" through the alias *{alias}" if alias else ""
-            raise InputError(f"{at(ev)}: nested more than {MAX_DEPTH} levels deep{via}; "
-                             "a course or boat file needs a few levels")
+            raise InputError(
+                f"{at(ev)}: nested more than {MAX_DEPTH} levels deep{via}; "
+                "a course or boat file needs a few levels"
+            )
         if n > MAX_NODES:
-            via = (f" once the alias *{alias} and those before it are expanded"
-                   if alias else "")
-            raise InputError(f"{at(ev)}: more than {MAX_NODES} values{via}; "
-                             "a course or boat file has at most a few thousand")
+            via = f" once the alias *{alias} and those before it are expanded" if alias else ""
+            raise InputError(
+                f"{at(ev)}: more than {MAX_NODES} values{via}; "
+                "a course or boat file has at most a few thousand"
+            )
 
     for ev in events:
         if isinstance(ev, yaml.ScalarEvent):
@@ -154,7 +160,8 @@ def _check_events(events: Iterable[yaml.Event], where: str) -> None:
             if ev.anchor is not None and any(s[0] == ev.anchor for s in stack):
                 raise InputError(
                     f"{at(ev)}: the alias *{ev.anchor} is inside the node &{ev.anchor} "
-                    "it refers to (a value that contains itself); refer to a finished node")
+                    "it refers to (a value that contains itself); refer to a finished node"
+                )
             name = ev.anchor or ""
             # an undefined alias is left to the composer's own message
             grow(ev, size.get(name, 1), len(stack) + height.get(name, 1), ev.anchor)

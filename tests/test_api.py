@@ -27,11 +27,19 @@ HEAVY = ("numpy", "scipy", "matplotlib", "netCDF4", "pyproj", "yaml")
 
 def _modules_after(code: str) -> list[str]:
     """Top-level packages among ``HEAVY`` imported by ``code`` in a fresh interpreter."""
-    probe = (f"import sys\n{code}\n"
-             f"print(__import__('json').dumps(sorted({{m.split('.')[0] for m in sys.modules}}"
-             f" & set({list(HEAVY)!r}))))")
-    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
-                         cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)}, check=True)
+    probe = (
+        f"import sys\n{code}\n"
+        f"print(__import__('json').dumps(sorted({{m.split('.')[0] for m in sys.modules}}"
+        f" & set({list(HEAVY)!r}))))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", probe],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        check=True,
+    )
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -65,10 +73,17 @@ def test_every_public_name_resolves_to_its_module_object() -> None:
 
 def test_type_checking_imports_match_the_lazy_table() -> None:
     tree = ast.parse((ROOT / "sailroute" / "__init__.py").read_text(encoding="utf-8"))
-    guarded = next(n for n in tree.body if isinstance(n, ast.If)
-                   and isinstance(n.test, ast.Name) and n.test.id == "TYPE_CHECKING")
-    imported = {alias.name: node.module for node in guarded.body
-                if isinstance(node, ast.ImportFrom) for alias in node.names}
+    guarded = next(
+        n
+        for n in tree.body
+        if isinstance(n, ast.If) and isinstance(n.test, ast.Name) and n.test.id == "TYPE_CHECKING"
+    )
+    imported = {
+        alias.name: node.module
+        for node in guarded.body
+        if isinstance(node, ast.ImportFrom)
+        for alias in node.names
+    }
     assert imported == sailroute._EXPORTS
 
 
@@ -93,8 +108,9 @@ def minimal() -> sailroute.Course:
 
 
 def test_open_wind_uniform_from_keywords(minimal: sailroute.Course) -> None:
-    wind = sailroute.open_wind(minimal, {"type": "uniform", "tws_kn": 5}, tws_kn=10,
-                               twd_deg=108)  # keywords win over the mapping
+    wind = sailroute.open_wind(
+        minimal, {"type": "uniform", "tws_kn": 5}, tws_kn=10, twd_deg=108
+    )  # keywords win over the mapping
     u, v = wind.sample(minimal.start_epoch, 0.0, 0.0)
     s = 10 * 1852 / 3600
     # FROM 108°: the air moves towards 288°
@@ -104,19 +120,29 @@ def test_open_wind_uniform_from_keywords(minimal: sailroute.Course) -> None:
 
 def test_open_wind_resolves_paths_against_base_dir(minimal: sailroute.Course) -> None:
     hyeres = sailroute.load_course(COURSES / "hyeres-r1.yaml")
-    by_path = sailroute.open_wind(hyeres, type="wrf", height_m=2.68,
-                                  path=ROOT / "data" / "hyeres-2018-04-24-synthetic-wrfout.nc")
-    by_name = sailroute.open_wind(hyeres, {"type": "wrf", "height_m": 2.68,
-                                           "path": "hyeres-2018-04-24-synthetic-wrfout.nc"},
-                                  base_dir=ROOT / "data")
+    by_path = sailroute.open_wind(
+        hyeres,
+        type="wrf",
+        height_m=2.68,
+        path=ROOT / "data" / "hyeres-2018-04-24-synthetic-wrfout.nc",
+    )
+    by_name = sailroute.open_wind(
+        hyeres,
+        {"type": "wrf", "height_m": 2.68, "path": "hyeres-2018-04-24-synthetic-wrfout.nc"},
+        base_dir=ROOT / "data",
+    )
     t = hyeres.start_epoch + np.array([0.0, 1800.0])
-    np.testing.assert_array_equal(by_path.sample(t, -900.0, 300.0),
-                                  by_name.sample(t, -900.0, 300.0))
+    np.testing.assert_array_equal(
+        by_path.sample(t, -900.0, 300.0), by_name.sample(t, -900.0, 300.0)
+    )
 
 
 def test_open_wind_errors_teach(minimal: sailroute.Course) -> None:
-    with pytest.raises(InputError, match=r"give a wind spec, e\.g\. open_wind\(course, "
-                                         r"type='uniform'"):
+    with pytest.raises(
+        InputError,
+        match=r"give a wind spec, e\.g\. open_wind\(course, "
+        r"type='uniform'",
+    ):
         sailroute.open_wind(minimal)
     with pytest.raises(InputError, match=r"open_wind\(uniform\).*twd_deg"):
         sailroute.open_wind(minimal, type="uniform", tws_kn=10)
@@ -132,8 +158,7 @@ def test_plan_with_wind_equals_plan_course_in_the_same_wind(minimal: sailroute.C
     assert isinstance(mine, sailroute.PlannedCourse)
     assert mine.plan.scenario == "north" and mine.notes == ()
     assert [leg.time_s for leg in mine.plan.legs] == [leg.time_s for leg in planned.legs]
-    assert mine.plan.total_time_s == pytest.approx(mine.plan.t_end - mine.plan.t_start,
-                                                   abs=1e-9)
+    assert mine.plan.total_time_s == pytest.approx(mine.plan.t_end - mine.plan.t_start, abs=1e-9)
 
 
 def test_plan_with_wind_refuses_wind_above_the_polar(minimal: sailroute.Course) -> None:
@@ -163,8 +188,9 @@ def test_vpp_crew_mass_and_race_kinetics() -> None:
     np.testing.assert_array_equal(light.speed_ms, ref.speed_ms)
     assert not np.array_equal(light.speed_ms, vpp_polar(ILCA7, TWS, TWA).speed_ms)
     race = sailroute.vpp("ilca7", tws_ms=(6.0,), twa_deg=TWA, kinetics="race")
-    np.testing.assert_array_equal(race.speed_ms,
-                                  vpp_polar(ILCA7, (6.0,), TWA, kinetics=RACE).speed_ms)
+    np.testing.assert_array_equal(
+        race.speed_ms, vpp_polar(ILCA7, (6.0,), TWA, kinetics=RACE).speed_ms
+    )
     steady = sailroute.vpp("ilca7", tws_ms=(6.0,), twa_deg=TWA)
     assert np.max(np.abs(race.speed_ms - steady.speed_ms)) > 0.1  # the race model matters
 

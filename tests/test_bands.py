@@ -35,8 +35,13 @@ from sailroute.wind.uniform import UniformWind
 from tests.conftest import ROOT
 
 TEMPLATE = yaml.safe_load((ROOT / "courses" / "windward-leeward-template.yaml").read_text())
-FAST = {"router": "isochrone", "tack_penalty_s": 5.0, "gybe_penalty_s": 3.0, "dt_s": 10.0,
-        "heading_step_deg": 4.0}
+FAST = {
+    "router": "isochrone",
+    "tack_penalty_s": 5.0,
+    "gybe_penalty_s": 3.0,
+    "dt_s": 10.0,
+    "heading_step_deg": 4.0,
+}
 
 
 def beat_course(tmp_path: Path, uncertainty: dict | None = None, twd: float = 270.0) -> Path:
@@ -55,7 +60,8 @@ def beat_course(tmp_path: Path, uncertainty: dict | None = None, twd: float = 27
 def reach_course(tmp_path: Path, uncertainty: dict) -> Path:
     """One 800 m beam reach east, wind from the north."""
     data = {
-        "name": "reach", "start_time": "2024-05-01T10:00:00Z",
+        "name": "reach",
+        "start_time": "2024-05-01T10:00:00Z",
         "origin": {"lat": 45.0, "lon": 13.0},
         "marks": {"a": {"x": 0.0, "y": 0.0}, "b": {"x": 800.0, "y": 0.0}},
         "legs": [{"from": "a", "to": "b", "rounding": "port"}],
@@ -78,8 +84,9 @@ def test_perturbed_wind_scales_adds_and_veers_analytically() -> None:
     # speed 1.2 * 5 + 0.5 = 6.5, from 360 (north): air moves south
     assert float(u) == pytest.approx(0.0, abs=1e-12)
     assert float(v) == pytest.approx(-6.5)
-    shifted = PerturbedWind(base, shift_times=np.array([0.0, 100.0]),
-                            shift_deg=np.array([0.0, 20.0]))
+    shifted = PerturbedWind(
+        base, shift_times=np.array([0.0, 100.0]), shift_deg=np.array([0.0, 20.0])
+    )
     np.testing.assert_allclose(shifted.turn_deg([0.0, 50.0, 100.0, 500.0]), [0, 10, 20, 20])
     with pytest.raises(InputError, match="2 shift times but 1 shifts"):
         PerturbedWind(base, shift_times=np.array([0.0, 1.0]), shift_deg=np.array([1.0]))
@@ -88,8 +95,9 @@ def test_perturbed_wind_scales_adds_and_veers_analytically() -> None:
 # --- members ------------------------------------------------------------------------------
 
 
-SPEC = UncertaintySpec(tws_add_ms=1.5 * KNOT, twd_deg=10.0, members=12, seed=3,
-                       boat=(("sea_age_h", 2.0, 4.0),))
+SPEC = UncertaintySpec(
+    tws_add_ms=1.5 * KNOT, twd_deg=10.0, members=12, seed=3, boat=(("sea_age_h", 2.0, 4.0),)
+)
 
 
 def test_same_seed_same_members_and_latin_hypercube_strata() -> None:
@@ -104,15 +112,19 @@ def test_same_seed_same_members_and_latin_hypercube_strata() -> None:
 
 
 def test_shift_members_are_deterministic_and_fitted_from_measured_wind() -> None:
-    osc = uncertainty_from_mapping({"shifts": {"model": "oscillating", "amplitude_deg": 8,
-                                               "period_min": 6}, "members": 4})
+    osc = uncertainty_from_mapping(
+        {"shifts": {"model": "oscillating", "amplitude_deg": 8, "period_min": 6}, "members": 4}
+    )
     a = draw_members(osc, 1200.0)
     assert a == draw_members(osc, 1200.0)
     for m in a:  # amplitude 8°, one value every 10 s over the 20 min
         assert len(m.shift_deg) == 121 and max(np.abs(m.shift_deg)) <= 8.0 + 1e-9
-    ou = resolve_shifts(uncertainty_from_mapping(
-        {"shifts": {"fit": "trieste-coach-2018-02-15.csv", "speed_unit": "kn"}},
-        base_dir=ROOT / "data"))
+    ou = resolve_shifts(
+        uncertainty_from_mapping(
+            {"shifts": {"fit": "trieste-coach-2018-02-15.csv", "speed_unit": "kn"}},
+            base_dir=ROOT / "data",
+        )
+    )
     assert ou.shifts is not None and ou.shifts.model == "ou"
     # the Trieste coach boat's directions (docs/strategy.md): 28.4° and 1.9 min
     assert ou.shifts.sigma_deg == pytest.approx(28.4, abs=0.1)
@@ -120,8 +132,12 @@ def test_shift_members_are_deterministic_and_fitted_from_measured_wind() -> None
     b = draw_members(ou, 600.0)
     assert b == draw_members(ou, 600.0)
     # the OU paths keep the stationary spread (40 members x 61 values)
-    many = draw_members(uncertainty_from_mapping(
-        {"shifts": {"model": "ou", "sigma_deg": 10, "timescale_min": 3}, "members": 40}), 600.0)
+    many = draw_members(
+        uncertainty_from_mapping(
+            {"shifts": {"model": "ou", "sigma_deg": 10, "timescale_min": 3}, "members": 40}
+        ),
+        600.0,
+    )
     assert np.std([m.shift_deg for m in many]) == pytest.approx(10.0, rel=0.15)
     with pytest.raises(InputError, match=r"uncertainty\.shifts\.fit: no station CSV at "):
         uncertainty_from_mapping({"shifts": {"fit": "nowhere.csv"}}, base_dir=ROOT)
@@ -145,8 +161,14 @@ def test_one_at_a_time_varies_only_its_source() -> None:
 def test_bands_are_ordered_percentiles_of_the_members() -> None:
     rng = np.random.default_rng(0)
     times = rng.uniform(100.0, 200.0, size=(9, 3))
-    b = BandSummary("s", ("a", "b", "c"), tuple(f"m{k}" for k in range(9)), times,
-                    times.mean(axis=0), oat_s={"tws": times[:3], "twd": times[3:6] * 0 + 150})
+    b = BandSummary(
+        "s",
+        ("a", "b", "c"),
+        tuple(f"m{k}" for k in range(9)),
+        times,
+        times.mean(axis=0),
+        oat_s={"tws": times[:3], "twd": times[3:6] * 0 + 150},
+    )
     bd = b.bands()
     assert bd.shape == (4, 3)
     assert np.all(bd[:, 0] <= bd[:, 1]) and np.all(bd[:, 1] <= bd[:, 2])
@@ -174,8 +196,7 @@ def test_uniform_speed_members_follow_the_closed_form_reach_time(tmp_path) -> No
     assert np.argsort(b.times_s[:, 0]).tolist() == np.argsort(-tws).tolist()
     bd = b.bands()
     assert np.all(bd[:, 0] <= bd[:, 1]) and np.all(bd[:, 1] <= bd[:, 2])
-    assert b.nominal_s[0] == pytest.approx(800.0 / float(boat.speed(10 * KNOT, 90.0)),
-                                           rel=0.01)
+    assert b.nominal_s[0] == pytest.approx(800.0 / float(boat.speed(10 * KNOT, 90.0)), rel=0.01)
     doc = json.loads((tmp_path / "out" / "bands.json").read_text())
     leg = doc["scenarios"][0]["legs"][0]
     assert leg["time_s"]["p10"] == pytest.approx(bd[0, 0])
@@ -193,19 +214,26 @@ def test_default_uncertainty_is_stated(tmp_path) -> None:
 # --- bad input ----------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(("raw", "key", "message"), [
-    ({"tws_knots": 1}, "uncertainty.tws_knots", "unknown key; did you mean 'tws_kn'?"),
-    ({"twd_deg": -3}, "uncertainty.twd_deg", "expected a number in [0, 90]; got -3"),
-    ({"members": 2}, "uncertainty.members", "expected a whole number >= 3; got 2"),
-    ({"shifts": {"model": "wobbly"}}, "uncertainty.shifts.model", "expected one of"),
-    ({"shifts": {"model": "oscillating", "amplitude_deg": 5}},
-     "uncertainty.shifts.period_min", "missing required key"),
-    ({"boat": {"sea_age": [2, 4]}}, "uncertainty.boat.sea_age", "did you mean 'sea_age_h'"),
-    ({"boat": {"sea_age_h": [4, 2]}}, "uncertainty.boat.sea_age_h", "low <= high"),
-    ({"tws_kn": 1, "tws_pct": 5}, "uncertainty.tws_pct", "give one of tws_kn, tws_ms, tws_pct"),
-])
-def test_bad_uncertainty_keys_are_one_line_errors_naming_the_key(tmp_path, raw, key,
-                                                                 message) -> None:
+@pytest.mark.parametrize(
+    ("raw", "key", "message"),
+    [
+        ({"tws_knots": 1}, "uncertainty.tws_knots", "unknown key; did you mean 'tws_kn'?"),
+        ({"twd_deg": -3}, "uncertainty.twd_deg", "expected a number in [0, 90]; got -3"),
+        ({"members": 2}, "uncertainty.members", "expected a whole number >= 3; got 2"),
+        ({"shifts": {"model": "wobbly"}}, "uncertainty.shifts.model", "expected one of"),
+        (
+            {"shifts": {"model": "oscillating", "amplitude_deg": 5}},
+            "uncertainty.shifts.period_min",
+            "missing required key",
+        ),
+        ({"boat": {"sea_age": [2, 4]}}, "uncertainty.boat.sea_age", "did you mean 'sea_age_h'"),
+        ({"boat": {"sea_age_h": [4, 2]}}, "uncertainty.boat.sea_age_h", "low <= high"),
+        ({"tws_kn": 1, "tws_pct": 5}, "uncertainty.tws_pct", "give one of tws_kn, tws_ms, tws_pct"),
+    ],
+)
+def test_bad_uncertainty_keys_are_one_line_errors_naming_the_key(
+    tmp_path, raw, key, message
+) -> None:
     with pytest.raises(InputError) as e:
         load_course(beat_course(tmp_path, raw))
     text = str(e.value)
@@ -221,22 +249,32 @@ def test_boat_parameters_need_a_race_polar(tmp_path) -> None:
     data = yaml.safe_load(p.read_text())
     data["boat"] = {"builtin": "ilca7-steady"}
     p.write_text(yaml.safe_dump(data))
-    with pytest.raises(InputError, match=r"uncertainty\.boat: race-polar parameters need a "
-                                         "race polar"):
+    with pytest.raises(
+        InputError,
+        match=r"uncertainty\.boat: race-polar parameters need a "
+        "race polar",
+    ):
         run_bands_command(p, out_dir=tmp_path / "o", plots=False)
     assert not (tmp_path / "o" / "bands.json").exists()
 
 
-@pytest.mark.parametrize(("args", "message"), [
-    (["plan", "--ensemble", "2"], "error: --ensemble 2: a band needs at least 3 members; give "
-     "N >= 3"),
-    (["compare-scenarios", "--ensemble", "3", "--scheduler", "processes"],
-     "error: --scheduler processes: --ensemble routes its members here"),
-])
-def test_cli_ensemble_option_bad_values_exit_2_and_write_nothing(tmp_path, args,
-                                                                 message) -> None:
-    r = CliRunner().invoke(app, [args[0], str(beat_course(tmp_path)), *args[1:], "-q", "-o",
-                                 str(tmp_path / "o")])
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (
+            ["plan", "--ensemble", "2"],
+            "error: --ensemble 2: a band needs at least 3 members; give N >= 3",
+        ),
+        (
+            ["compare-scenarios", "--ensemble", "3", "--scheduler", "processes"],
+            "error: --scheduler processes: --ensemble routes its members here",
+        ),
+    ],
+)
+def test_cli_ensemble_option_bad_values_exit_2_and_write_nothing(tmp_path, args, message) -> None:
+    r = CliRunner().invoke(
+        app, [args[0], str(beat_course(tmp_path)), *args[1:], "-q", "-o", str(tmp_path / "o")]
+    )
     assert r.exit_code == 2
     assert message in r.output
     assert not (tmp_path / "o").exists()
@@ -245,8 +283,9 @@ def test_cli_ensemble_option_bad_values_exit_2_and_write_nothing(tmp_path, args,
 def test_cli_plan_ensemble_writes_the_bands_and_prints_them_as_json(tmp_path) -> None:
     out = tmp_path / "o"
     course = beat_course(tmp_path, {"tws_kn": 1.0, "twd_deg": 5.0, "members": 8})
-    r = CliRunner().invoke(app, ["plan", str(course), "--ensemble", "3", "-q", "-o", str(out),
-                                 "--json", "--no-plots"])
+    r = CliRunner().invoke(
+        app, ["plan", str(course), "--ensemble", "3", "-q", "-o", str(out), "--json", "--no-plots"]
+    )
     assert r.exit_code == 0, r.output
     doc = json.loads(r.stdout)
     assert doc == json.loads((out / "bands.json").read_text())
@@ -260,8 +299,9 @@ def test_cli_plan_ensemble_writes_the_bands_and_prints_them_as_json(tmp_path) ->
     assert not (out / "bands.png").exists()
     rows = list(csv.DictReader((out / "bands.csv").open()))
     assert [r["leg"] for r in rows] == ["1", "2", "total"]
-    assert float(rows[-1]["width_tws_s"]) == pytest.approx(sc["total"]["width_by_source_s"]["tws"],
-                                                           abs=1e-3)
+    assert float(rows[-1]["width_tws_s"]) == pytest.approx(
+        sc["total"]["width_by_source_s"]["tws"], abs=1e-3
+    )
 
 
 @pytest.mark.slow
@@ -289,8 +329,9 @@ def test_steady_beat_is_a_tie_and_a_persistent_right_shift_pays_right(tmp_path) 
     boat = build_boat(c)
     run = plan_course(c)
     beat = run.plan.legs[0].result
-    t_left, t_right = layline_times(beat.start_xy, beat.end_xy, beat.t_start, run.wind, boat,
-                                    tack_penalty_s=5.0)
+    t_left, t_right = layline_times(
+        beat.start_xy, beat.end_xy, beat.t_start, run.wind, boat, tack_penalty_s=5.0
+    )
     assert t_left == pytest.approx(t_right, abs=0.5)  # the same parallelogram
     assert honest_side(beat, run.wind, boat, tack_penalty_s=5.0) == "tie"
     # the wind veers 1.5° per minute from the start: go right, towards the new wind
@@ -300,7 +341,8 @@ def test_steady_beat_is_a_tie_and_a_persistent_right_shift_pays_right(tmp_path) 
     from sailroute.planning.route import route_course
 
     legs = route_course(c, wind, boat, c.routing)
-    t_left, t_right = layline_times(legs[0].start_xy, legs[0].end_xy, legs[0].t_start, wind,
-                                    boat, tack_penalty_s=5.0)
+    t_left, t_right = layline_times(
+        legs[0].start_xy, legs[0].end_xy, legs[0].t_start, wind, boat, tack_penalty_s=5.0
+    )
     assert t_right < t_left - 10.0
     assert honest_side(legs[0], wind, boat, tack_penalty_s=5.0) == "right"

@@ -19,35 +19,58 @@ SLOW = pytest.mark.slow
 CASES = [
     ("bench_polar.py", r"^Polar\.speed \[pchip \]: +\d+ us per 1e5 lookups"),
     ("bench_wind.py", r"^  wrf bilinear \+ linear time +[\d.]+ ms +[\d.]+ Mpoints/s$"),
-    ("bench_polar_fit.py",
-     r"^Tallinn 2023 vs ORC guide +14 +6\.6 %" if SHARED_REAL.is_dir()
-     else r"^bench_polar_fit\.py: .* not present .*: nothing measured$"),
+    (
+        "bench_polar_fit.py",
+        r"^Tallinn 2023 vs ORC guide +14 +6\.6 %"
+        if SHARED_REAL.is_dir()
+        else r"^bench_polar_fit\.py: .* not present .*: nothing measured$",
+    ),
     ("bench_course_io.py", r"^export gpx\+kml\+nmea +[\d.]+ ms +\(6 legs, \d+ track points\)$"),
     ("bench_isochrone.py", r"^  leg time \d+\.\d s, \d+ tacks, 0 gybes"),
     ("bench_ensemble.py", r"^  leg 1: 3/3 leg times identical; largest difference 0\.000 s"),
-    ("race_polar_validation.py",
-     r"^\| ilca7 \| Snipe P01 \(--smoke, 30 s steps\) \| 6 kn 110° \| 0\.\d{3} \| 0\.673 \|"),
+    (
+        "race_polar_validation.py",
+        r"^\| ilca7 \| Snipe P01 \(--smoke, 30 s steps\) \| 6 kn 110° \| 0\.\d{3} \| 0\.673 \|",
+    ),
     ("bench_griddp.py", r"^Debski analytic wind +polar +8 +3 "),
     ("bench_multispline.py", r"^Example 1 n_r=6 n_c=8 n_ts=4 refine=1 .*L2 error per pass "),
-    ("bench_analyze.py",
-     r"^fleet: 3 boats x \d+ fixes \(1 Hz, \d+ min\), read \+ analyse \+ write: "),
-    ("bench_infer_wind.py", r"^infer_wind, 3 boats, \d+ points, with polar: [\d.]+ ms "
-     r"\(best of 1\); TWD RMS \d\.\d\d°$"),
-    ("bench_fleet_wind.py",
-     r"^fleet field, 3 boats x 20 min at 1 Hz: build [\d.]+ s" if SHARED_REAL.is_dir()
-     else r"^bench_fleet_wind\.py: .* not present .*: nothing measured$"),
+    (
+        "bench_analyze.py",
+        r"^fleet: 3 boats x \d+ fixes \(1 Hz, \d+ min\), read \+ analyse \+ write: ",
+    ),
+    (
+        "bench_infer_wind.py",
+        r"^infer_wind, 3 boats, \d+ points, with polar: [\d.]+ ms "
+        r"\(best of 1\); TWD RMS \d\.\d\d°$",
+    ),
+    (
+        "bench_fleet_wind.py",
+        r"^fleet field, 3 boats x 20 min at 1 Hz: build [\d.]+ s"
+        if SHARED_REAL.is_dir()
+        else r"^bench_fleet_wind\.py: .* not present .*: nothing measured$",
+    ),
     ("bench_gpu.py", r"^(bench_gpu\.py: no GPU here, nothing measured: |GPU .* GiB; CPU )"),
     ("gpu_checks.sh", r"^(gpu_checks\.sh: no NVIDIA GPU here|cupy \d)"),
     ("bench_obstacles.py", r"^  ratio \d+\.\d\d \(target <= 1\.30\)$"),
-    pytest.param("bench_strategy.py", r"^SDP 101 x 40 rows x 2 tacks x 19 shifts, .*"
-                 r"E\[T\] = \d+\.\d s$", marks=SLOW),
+    pytest.param(
+        "bench_strategy.py",
+        r"^SDP 101 x 40 rows x 2 tacks x 19 shifts, .*"
+        r"E\[T\] = \d+\.\d s$",
+        marks=SLOW,
+    ),
     pytest.param("bench_deadline.py", r"^  Monte Carlo 200 runs/policy ", marks=SLOW),
-    pytest.param("bands_calibration.py", r"^\| Snipe Valencia P01 \| TWS 1\.0 kn, TWD 10° \| "
-                 r"6 legs \(boat 1, boat 2\) \| \d/6 = \d+ % \| \d+ s \(", marks=SLOW),
-    pytest.param("bench_live.py", r"^wind change -> route, 3-leg remainder, 2 shifts of 15°",
-                 marks=SLOW),
-    pytest.param("bench_peers.py", r"^- expansion and arrival test \(`_expand`\): [\d.]+ %$",
-                 marks=SLOW),
+    pytest.param(
+        "bands_calibration.py",
+        r"^\| Snipe Valencia P01 \| TWS 1\.0 kn, TWD 10° \| "
+        r"6 legs \(boat 1, boat 2\) \| \d/6 = \d+ % \| \d+ s \(",
+        marks=SLOW,
+    ),
+    pytest.param(
+        "bench_live.py", r"^wind change -> route, 3-leg remainder, 2 shifts of 15°", marks=SLOW
+    ),
+    pytest.param(
+        "bench_peers.py", r"^- expansion and arrival test \(`_expand`\): [\d.]+ %$", marks=SLOW
+    ),
 ]
 
 
@@ -59,8 +82,11 @@ def test_every_script_is_listed():
 @pytest.mark.parametrize(("script", "line"), CASES)
 def test_benchmark_runs_with_smoke(script, line, tmp_path):
     path = BENCH / script
-    cmd = ["bash", str(path), "--smoke", str(tmp_path / "gpu")] if script.endswith(".sh") \
+    cmd = (
+        ["bash", str(path), "--smoke", str(tmp_path / "gpu")]
+        if script.endswith(".sh")
         else [sys.executable, str(path), "--smoke"]
+    )
     res = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-2000:]
     assert re.search(line, res.stdout, flags=re.MULTILINE), res.stdout[-2000:]

@@ -46,14 +46,16 @@ def check_plan_files(out: Path, course_file: Path) -> dict:
     doc = json.loads((out / "plan.json").read_text())
     legs = doc["legs"]
     assert [(leg["from"], leg["to"]) for leg in legs] == [
-        (spec.from_name, spec.to_name) for spec in course.legs]
+        (spec.from_name, spec.to_name) for spec in course.legs
+    ]
     assert iso(legs[0]["start_time"]) == pytest.approx(course.start_epoch, abs=1e-3)
     for prev, nxt in itertools.pairwise(legs):
         assert nxt["start_time"] == prev["end_time"]
     for leg in legs:
         assert leg["time_s"] > 0 and leg["distance_m"] > 0
-        assert iso(leg["end_time"]) - iso(leg["start_time"]) == pytest.approx(leg["time_s"],
-                                                                               abs=2e-3)
+        assert iso(leg["end_time"]) - iso(leg["start_time"]) == pytest.approx(
+            leg["time_s"], abs=2e-3
+        )
     assert doc["total_time_s"] == pytest.approx(sum(leg["time_s"] for leg in legs), abs=0.01)
     with (out / "track.csv").open() as f:
         rows = list(csv.DictReader(f))
@@ -92,22 +94,27 @@ def check_report_html(path: Path, doc: dict, course) -> None:
     legs = np.array([int(r["leg"]) for r in rows])
     # Hyères: leg 4 (1 -> 4p) sails the water of leg 2 (1 -> gate 4), shifted by
     # REPEAT_SHIFT of the longest leg (start to end); the others are drawn in place
-    chord = max(float(np.hypot(tx[legs == k][-1] - tx[legs == k][0],
-                               ty[legs == k][-1] - ty[legs == k][0])) for k in set(legs))
+    chord = max(
+        float(np.hypot(tx[legs == k][-1] - tx[legs == k][0], ty[legs == k][-1] - ty[legs == k][0]))
+        for k in set(legs)
+    )
     assert float(np.max(shift[legs != 4])) < 0.05
     np.testing.assert_allclose(shift[legs == 4], REPEAT_SHIFT * chord, atol=0.05)
     assert [c[0] for c in route["customdata"]] == [int(r["leg"]) for r in rows]
     assert [c[3] for c in route["customdata"]] == [r["time"][11:19] for r in rows]  # UTC
     (marks,) = [t for t in fig["data"] if t["name"] == "marks"]
     for name, lon, lat in zip(marks["text"], marks["x"], marks["y"], strict=True):
-        assert (lat, lon) == pytest.approx((course.marks[name].lat, course.marks[name].lon),
-                                           abs=1e-6)
+        assert (lat, lon) == pytest.approx(
+            (course.marks[name].lat, course.marks[name].lon), abs=1e-6
+        )
     off = course.utc_offset_s
     for leg in doc["legs"]:  # leg table: local start and arrival, the leg time
-        assert (f"<tr><td>{leg['index']}</td><td class=\"l\">{leg['from']} → {leg['to']}</td>"
-                f"<td class=\"l\">{leg['mode']}</td><td>{clock(iso(leg['start_time']), off)}"
-                f"</td><td>{clock(iso(leg['end_time']), off)}</td>"
-                f"<td>{format_duration(leg['time_s'])}</td>") in page
+        assert (
+            f'<tr><td>{leg["index"]}</td><td class="l">{leg["from"]} → {leg["to"]}</td>'
+            f'<td class="l">{leg["mode"]}</td><td>{clock(iso(leg["start_time"]), off)}'
+            f"</td><td>{clock(iso(leg['end_time']), off)}</td>"
+            f"<td>{format_duration(leg['time_s'])}</td>"
+        ) in page
 
 
 def test_plan_hyeres_constant_writes_consistent_files(tmp_path):
@@ -117,7 +124,12 @@ def test_plan_hyeres_constant_writes_consistent_files(tmp_path):
     doc = check_plan_files(out, COURSES / "hyeres-r1.yaml")
     assert doc["scenario"] == "constant" and doc["router"] == "isochrone"
     assert [leg["mode"] for leg in doc["legs"]] == [
-        "upwind", "downwind", "upwind", "downwind", "reach"]
+        "upwind",
+        "downwind",
+        "upwind",
+        "downwind",
+        "reach",
+    ]
     assert [leg["tacks"] for leg in doc["legs"]] == [1, 0, 1, 0, 0]
     png = out / "route.png"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -128,11 +140,14 @@ def test_plan_hyeres_constant_writes_consistent_files(tmp_path):
     assert "leg 5/5 4p -> finish" in res.output  # progress lines (stderr, mixed in here)
 
 
-@pytest.mark.parametrize(("course", "scenario", "n_legs"), [
-    ("trieste-coach-wl.yaml", "measured", 4),
-    ("windward-leeward-template.yaml", "veered-10deg", 6),
-    ("trapezoid-outer-template.yaml", None, 6),
-])
+@pytest.mark.parametrize(
+    ("course", "scenario", "n_legs"),
+    [
+        ("trieste-coach-wl.yaml", "measured", 4),
+        ("windward-leeward-template.yaml", "veered-10deg", 6),
+        ("trapezoid-outer-template.yaml", None, 6),
+    ],
+)
 def test_plan_other_shipped_courses(tmp_path, course, scenario, n_legs):
     args = ["plan", str(COURSES / course), "--out", str(tmp_path), "--no-plots", "--quiet"]
     if scenario:
@@ -148,8 +163,9 @@ def test_plan_other_shipped_courses(tmp_path, course, scenario, n_legs):
 
 def test_plan_measured_wind_beats_tack_with_the_shifts(tmp_path):
     """Real wind (coach-boat log): the beats are upwind legs and the shifts make them tack."""
-    res = invoke("plan", str(COURSES / "trieste-coach-wl.yaml"), "-o", str(tmp_path),
-                 "--no-plots", "-q")
+    res = invoke(
+        "plan", str(COURSES / "trieste-coach-wl.yaml"), "-o", str(tmp_path), "--no-plots", "-q"
+    )
     assert res.exit_code == 0, res.output
     legs = json.loads((tmp_path / "plan.json").read_text())["legs"]
     assert [leg["mode"] for leg in legs] == ["upwind", "downwind", "upwind", "downwind"]
@@ -165,7 +181,8 @@ def test_compare_scenarios_table_files_and_per_scenario_plans(tmp_path):
     for name in doc["scenarios"]:
         plan = check_plan_files(tmp_path / name, course)
         assert [leg["time_s"] for leg in plan["legs"]] == pytest.approx(
-            [leg["time_s"][name] for leg in doc["legs"]], abs=1e-3)
+            [leg["time_s"][name] for leg in doc["legs"]], abs=1e-3
+        )
         assert plan["total_time_s"] == pytest.approx(doc["totals"]["time_s"][name], abs=1e-3)
     beat = doc["legs"][2]["time_s"]
     # a 10 deg veer the committee did not follow makes the beats shorter in time: part of
@@ -177,8 +194,11 @@ def test_compare_scenarios_table_files_and_per_scenario_plans(tmp_path):
     from sailroute.report.page_render import read_figure
 
     fig = read_figure((tmp_path / "report.html").read_text(encoding="utf-8"))
-    routes = [t for t in fig["data"] if t.get("legendgroup", "").startswith("route")
-              and t["mode"] == "lines"]
+    routes = [
+        t
+        for t in fig["data"]
+        if t.get("legendgroup", "").startswith("route") and t["mode"] == "lines"
+    ]
     assert [t["name"] for t in routes] == doc["scenarios"]
     for t, name in zip(routes, doc["scenarios"], strict=True):
         with (tmp_path / name / "track.csv").open() as f:
@@ -186,8 +206,16 @@ def test_compare_scenarios_table_files_and_per_scenario_plans(tmp_path):
 
 
 def test_compare_reference_errors_follow_the_stated_convention(tmp_path):
-    res = invoke("compare-scenarios", str(COURSES / "hyeres-r1.yaml"), "-s", "constant",
-                 "-o", str(tmp_path), "--no-plots", "-q")
+    res = invoke(
+        "compare-scenarios",
+        str(COURSES / "hyeres-r1.yaml"),
+        "-s",
+        "constant",
+        "-o",
+        str(tmp_path),
+        "--no-plots",
+        "-q",
+    )
     assert res.exit_code == 0, res.output
     assert "(model - winner)/winner" in res.output
     with (tmp_path / "comparison.csv").open() as f:
@@ -197,18 +225,29 @@ def test_compare_reference_errors_follow_the_stated_convention(tmp_path):
     assert float(row["winner_error_pct"]) == pytest.approx(100 * (model - ref) / ref, abs=2e-3)
 
 
-@pytest.mark.parametrize(("args", "message"), [
-    (["plan", "nope.yaml"], "nope.yaml: course file not found"),
-    (["plan", str(COURSES / "windward-leeward-template.yaml"), "-s", "steady"],
-     "did you mean 'steady-12kn'? scenarios are: steady-12kn, veered-10deg"),
-    (["plan", str(COURSES / "windward-leeward-template.yaml"), "-r", "fast"],
-     "Invalid value for '--router' / '-r': 'fast' is not one of 'isochrone', 'griddp', "
-     "'spline'"),
-    (["compare-scenarios", str(COURSES / "windward-leeward-template.yaml"), "-s", "calm"],
-     "no scenario 'calm'"),
-    (["plan", str(ROOT / "tests" / "data" / "course" / "many-problems.yaml")],
-     "7 problems in the course file"),
-])
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["plan", "nope.yaml"], "nope.yaml: course file not found"),
+        (
+            ["plan", str(COURSES / "windward-leeward-template.yaml"), "-s", "steady"],
+            "did you mean 'steady-12kn'? scenarios are: steady-12kn, veered-10deg",
+        ),
+        (
+            ["plan", str(COURSES / "windward-leeward-template.yaml"), "-r", "fast"],
+            "Invalid value for '--router' / '-r': 'fast' is not one of 'isochrone', 'griddp', "
+            "'spline'",
+        ),
+        (
+            ["compare-scenarios", str(COURSES / "windward-leeward-template.yaml"), "-s", "calm"],
+            "no scenario 'calm'",
+        ),
+        (
+            ["plan", str(ROOT / "tests" / "data" / "course" / "many-problems.yaml")],
+            "7 problems in the course file",
+        ),
+    ],
+)
 def test_bad_input_exits_2_with_a_message(tmp_path, args, message):
     res = invoke(*args, "--out", str(tmp_path / "out"))
     assert res.exit_code == 2
@@ -222,16 +261,22 @@ def test_installed_console_script_runs_the_readme_example(tmp_path):
     assert exe is not None, "console script not installed next to this Python"
     version = subprocess.run([exe, "--version"], capture_output=True, text=True, check=True)
     assert version.stdout.startswith("sailroute ")
-    mod = subprocess.run([sys.executable, "-m", "sailroute", "--version"], capture_output=True,
-                         text=True, check=True)
+    mod = subprocess.run(
+        [sys.executable, "-m", "sailroute", "--version"], capture_output=True, text=True, check=True
+    )
     assert mod.stdout == version.stdout
-    proc = subprocess.run([exe, "plan", str(COURSES / "windward-leeward-template.yaml"),
-                           "--no-plots"], cwd=tmp_path, capture_output=True, text=True)
+    proc = subprocess.run(
+        [exe, "plan", str(COURSES / "windward-leeward-template.yaml"), "--no-plots"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+    )
     assert proc.returncode == 0, proc.stderr
     out = tmp_path / "out" / "windward-leeward-template" / "steady-12kn"  # the default --out
     check_plan_files(out, COURSES / "windward-leeward-template.yaml")
-    bad = subprocess.run([exe, "plan", "missing.yaml"], cwd=tmp_path, capture_output=True,
-                         text=True)
+    bad = subprocess.run(
+        [exe, "plan", "missing.yaml"], cwd=tmp_path, capture_output=True, text=True
+    )
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
     assert bad.stderr.startswith("error: missing.yaml: course file not found")
 
@@ -239,8 +284,16 @@ def test_installed_console_script_runs_the_readme_example(tmp_path):
 def test_out_that_is_a_file_exits_2_with_a_message(tmp_path):
     taken = tmp_path / "taken"
     taken.write_text("not a folder")
-    res = invoke("plan", str(COURSES / "windward-leeward-template.yaml"), "--no-plots", "-q",
-                 "--out", str(taken))
+    res = invoke(
+        "plan",
+        str(COURSES / "windward-leeward-template.yaml"),
+        "--no-plots",
+        "-q",
+        "--out",
+        str(taken),
+    )
     assert res.exit_code == 2
-    assert f"--out: cannot create the output folder {str(taken)!r} (a file of that name " \
-           "exists); choose another folder with --out" in res.output
+    assert (
+        f"--out: cannot create the output folder {str(taken)!r} (a file of that name "
+        "exists); choose another folder with --out" in res.output
+    )

@@ -19,8 +19,16 @@ from tests.conftest import COURSES
 
 runner = CliRunner()
 WL = str(COURSES / "windward-leeward-template.yaml")
-COMMANDS = [["plan"], ["compare-scenarios"], ["vpp"], ["strategy"], ["analyze"],
-            ["polar", "fit"], ["polar"], []]
+COMMANDS = [
+    ["plan"],
+    ["compare-scenarios"],
+    ["vpp"],
+    ["strategy"],
+    ["analyze"],
+    ["polar", "fit"],
+    ["polar"],
+    [],
+]
 
 
 @pytest.mark.parametrize("cmd", COMMANDS, ids=lambda c: " ".join(c) or "sailroute")
@@ -34,18 +42,46 @@ def test_help_has_no_type_tags_and_h_is_help(cmd):
     assert short.exit_code == 0 and short.output == res.output
 
 
-@pytest.mark.parametrize(("cmd", "shown"), [
-    (["plan"], ["-r, --router [isochrone|griddp|spline]", "--backend [numpy|cupy|auto]",
-                "-o, --out DIR", "Usage: root plan [OPTIONS] COURSE"]),
-    (["compare-scenarios"], ["--router [isochrone|griddp|spline]", "--scheduler WHERE"]),
-    (["vpp"], ["--unit [kn|m/s]", "--kinetics [steady|race]", "[BOAT]"]),
-    (["strategy"], ["--start-tack [starboard|port]", "--shift [ou|drift-diffusion]",
-                    "--fit-speed-unit [kn|m/s|km/h|mph]"]),
-    (["analyze"], ["--speed-unit [kn|m/s|km/h|mph]", "--router [isochrone|griddp|spline]",
-                   "COURSE TRACK..."]),
-    (["polar", "fit"], ["--speed-unit [kn|m/s|km/h|mph]", "--unit [kn|m/s]",
-                        "--reference-unit [kn|m/s|km/h|mph]"]),
-])
+@pytest.mark.parametrize(
+    ("cmd", "shown"),
+    [
+        (
+            ["plan"],
+            [
+                "-r, --router [isochrone|griddp|spline]",
+                "--backend [numpy|cupy|auto]",
+                "-o, --out DIR",
+                "Usage: root plan [OPTIONS] COURSE",
+            ],
+        ),
+        (["compare-scenarios"], ["--router [isochrone|griddp|spline]", "--scheduler WHERE"]),
+        (["vpp"], ["--unit [kn|m/s]", "--kinetics [steady|race]", "[BOAT]"]),
+        (
+            ["strategy"],
+            [
+                "--start-tack [starboard|port]",
+                "--shift [ou|drift-diffusion]",
+                "--fit-speed-unit [kn|m/s|km/h|mph]",
+            ],
+        ),
+        (
+            ["analyze"],
+            [
+                "--speed-unit [kn|m/s|km/h|mph]",
+                "--router [isochrone|griddp|spline]",
+                "COURSE TRACK...",
+            ],
+        ),
+        (
+            ["polar", "fit"],
+            [
+                "--speed-unit [kn|m/s|km/h|mph]",
+                "--unit [kn|m/s]",
+                "--reference-unit [kn|m/s|km/h|mph]",
+            ],
+        ),
+    ],
+)
 def test_help_lists_the_choices(cmd, shown):
     out = runner.invoke(app, [*cmd, "--help"]).output
     for text in shown:
@@ -79,14 +115,23 @@ def test_choice_sets_match_the_code():
     assert len(cli._complete_polar("")) == len(builtin_names())
 
 
-@pytest.mark.parametrize(("args", "message"), [
-    (["plan", WL, "--backend", "gpu"],
-     "Invalid value for '--backend': 'gpu' is not one of 'numpy', 'cupy', 'auto'."),
-    (["strategy", "--shift", "random"],
-     "Invalid value for '--shift': 'random' is not one of 'ou', 'drift-diffusion'."),
-    (["analyze", WL, "t.gpx", "--speed-unit", "knots"],
-     "'knots' is not one of 'kn', 'm/s', 'km/h', 'mph'."),
-])
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (
+            ["plan", WL, "--backend", "gpu"],
+            "Invalid value for '--backend': 'gpu' is not one of 'numpy', 'cupy', 'auto'.",
+        ),
+        (
+            ["strategy", "--shift", "random"],
+            "Invalid value for '--shift': 'random' is not one of 'ou', 'drift-diffusion'.",
+        ),
+        (
+            ["analyze", WL, "t.gpx", "--speed-unit", "knots"],
+            "'knots' is not one of 'kn', 'm/s', 'km/h', 'mph'.",
+        ),
+    ],
+)
 def test_a_bad_choice_exits_2_naming_the_choices(tmp_path, args, message):
     res = runner.invoke(app, [*args, "--out", str(tmp_path / "o")])
     assert res.exit_code == 2 and message in res.output
@@ -94,8 +139,9 @@ def test_a_bad_choice_exits_2_naming_the_choices(tmp_path, args, message):
 
 
 def test_choices_ignore_case(tmp_path):
-    res = runner.invoke(app, ["plan", WL, "-r", "ISOCHRONE", "--no-plots", "-q", "--json",
-                              "-o", str(tmp_path)])
+    res = runner.invoke(
+        app, ["plan", WL, "-r", "ISOCHRONE", "--no-plots", "-q", "--json", "-o", str(tmp_path)]
+    )
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout)["router"] == "isochrone"
 
@@ -110,8 +156,9 @@ def test_json_prints_plan_json_and_nothing_else(tmp_path):
 
 
 def test_compare_json_is_comparison_json(tmp_path):
-    res = runner.invoke(app, ["compare-scenarios", WL, "--no-plots", "-q", "--json",
-                              "-o", str(tmp_path)])
+    res = runner.invoke(
+        app, ["compare-scenarios", WL, "--no-plots", "-q", "--json", "-o", str(tmp_path)]
+    )
     assert res.exit_code == 0, res.output
     assert json.loads(res.stdout) == json.loads((tmp_path / "comparison.json").read_text())
 
@@ -124,10 +171,17 @@ def test_wrote_lines_have_human_labels(tmp_path):
     assert "wrote plan:" not in res.stdout and "_json" not in res.stdout
 
 
-@pytest.mark.parametrize("args", [
-    ["plan", WL], ["compare-scenarios", WL], ["vpp"], ["strategy"],
-    ["polar", "fit", "log.csv"], ["analyze", WL, "track.gpx"],
-])
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["plan", WL],
+        ["compare-scenarios", WL],
+        ["vpp"],
+        ["strategy"],
+        ["polar", "fit", "log.csv"],
+        ["analyze", WL, "track.gpx"],
+    ],
+)
 def test_out_that_is_a_file_fails_before_any_work(tmp_path, monkeypatch, args):
     import sailroute.commands.analyze
     import sailroute.commands.polar_fit
@@ -138,18 +192,21 @@ def test_out_that_is_a_file_fails_before_any_work(tmp_path, monkeypatch, args):
     def work(*a: object, **k: object) -> None:
         raise AssertionError("the work started before --out was checked")
 
-    for mod, name in [(sailroute.course.load, "load_course"),
-                      (sailroute.commands.vpp, "vpp_polar"),
-                      (sailroute.commands.strategy, "run_strategy"),
-                      (sailroute.commands.polar_fit, "fit_polar"),
-                      (sailroute.commands.analyze, "analyze_track")]:
+    for mod, name in [
+        (sailroute.course.load, "load_course"),
+        (sailroute.commands.vpp, "vpp_polar"),
+        (sailroute.commands.strategy, "run_strategy"),
+        (sailroute.commands.polar_fit, "fit_polar"),
+        (sailroute.commands.analyze, "analyze_track"),
+    ]:
         monkeypatch.setattr(mod, name, work)
     taken = tmp_path / "taken"
     taken.write_text("a file")
     res = runner.invoke(app, [*args, "--out", str(taken)])
     assert res.exit_code == 2, res.output
-    assert (f"--out: cannot create the output folder {str(taken)!r} (a file of that name "
-            "exists)") in res.output
+    assert (
+        f"--out: cannot create the output folder {str(taken)!r} (a file of that name exists)"
+    ) in res.output
     assert taken.read_text() == "a file"
 
 
@@ -174,14 +231,21 @@ def test_rerun_without_plots_removes_the_old_png_and_keeps_user_files(tmp_path):
     res = runner.invoke(app, ["plan", WL, "-q", "--no-plots", "-o", str(tmp_path)])
     assert res.exit_code == 0, res.output
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == [MANIFEST_NAME, "my-notes.txt", "plan.json", "route.gpx", "route.kml",
-                     "route.nmea", "track.csv"]
+    assert names == [
+        MANIFEST_NAME,
+        "my-notes.txt",
+        "plan.json",
+        "route.gpx",
+        "route.kml",
+        "route.nmea",
+        "track.csv",
+    ]
 
 
-@pytest.mark.parametrize(("exc", "code"), [(RuntimeError("disk on fire"), 1),
-                                           (KeyboardInterrupt(), 130)])
-def test_a_run_that_dies_while_writing_leaves_the_previous_set(tmp_path, monkeypatch, exc,
-                                                               code):
+@pytest.mark.parametrize(
+    ("exc", "code"), [(RuntimeError("disk on fire"), 1), (KeyboardInterrupt(), 130)]
+)
+def test_a_run_that_dies_while_writing_leaves_the_previous_set(tmp_path, monkeypatch, exc, code):
     import sailroute.report.files
 
     out = tmp_path / "o"
@@ -194,17 +258,33 @@ def test_a_run_that_dies_while_writing_leaves_the_previous_set(tmp_path, monkeyp
         raise exc
 
     monkeypatch.setattr(sailroute.report.files, "write_gpx", broken)
-    res = runner.invoke(app, ["plan", WL, "-q", "--no-plots", "-s", "veered-10deg",
-                              "-o", str(out)])
+    res = runner.invoke(app, ["plan", WL, "-q", "--no-plots", "-s", "veered-10deg", "-o", str(out)])
     assert res.exit_code == code, res.output
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
     assert [p.name for p in tmp_path.iterdir()] == ["o"]  # no staging folder left
 
 
 def test_strategy_prints_the_model_in_words(tmp_path):
-    res = runner.invoke(app, ["strategy", "--length-m", "200", "--half-width-m", "100",
-                              "--runs", "50", "--sigma-deg", "8", "--timescale-min", "5",
-                              "--no-plots", "-q", "-o", str(tmp_path)])
+    res = runner.invoke(
+        app,
+        [
+            "strategy",
+            "--length-m",
+            "200",
+            "--half-width-m",
+            "100",
+            "--runs",
+            "50",
+            "--sigma-deg",
+            "8",
+            "--timescale-min",
+            "5",
+            "--no-plots",
+            "-q",
+            "-o",
+            str(tmp_path),
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert "shift model: oscillating (OU): sd 8.0°, time scale 5.0 min\n" in res.stdout
     assert "{'kind'" not in res.output and res.stderr == ""  # -q: no progress lines
@@ -215,19 +295,28 @@ def test_shift_model_text_drift_diffusion():
     from sailroute.report.strategy import shift_model_text
     from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
 
-    assert shift_model_text(DriftDiffusionShift(0.5 / 60, 1.2 / 60 ** 0.5)) == (
-        "persistent (drift-diffusion): drift +0.50°/min, diffusion 1.20°/√min")
+    assert shift_model_text(DriftDiffusionShift(0.5 / 60, 1.2 / 60**0.5)) == (
+        "persistent (drift-diffusion): drift +0.50°/min, diffusion 1.20°/√min"
+    )
     assert shift_model_text(OUShift(6.0, float("inf"), 2.0)) == (
-        "oscillating (OU): sd 6.0°, time scale infinite (frozen wind), mean +2.0°")
+        "oscillating (OU): sd 6.0°, time scale infinite (frozen wind), mean +2.0°"
+    )
 
 
 def test_no_heavy_imports_for_help():
     import subprocess
     import sys
 
-    code = ("import sys, sailroute.cli; "
-            "print(sorted(m for m in ('numpy', 'matplotlib', 'scipy', 'rich', 'pydantic') "
-            "if m in sys.modules))")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, cwd=Path(cli.__file__).parents[1])
+    code = (
+        "import sys, sailroute.cli; "
+        "print(sorted(m for m in ('numpy', 'matplotlib', 'scipy', 'rich', 'pydantic') "
+        "if m in sys.modules))"
+    )
+    res = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        check=True,
+        cwd=Path(cli.__file__).parents[1],
+    )
     assert res.stdout.strip() == "[]"

@@ -45,8 +45,9 @@ def course_file(tmp_path: Path, boat: str = "{builtin: ilca7}", tws_kn: float = 
 
 
 def plan(tmp_path: Path, course: Path):
-    res = runner.invoke(app, ["plan", str(course), "--no-plots", "-q",
-                              "--out", str(tmp_path / "out")])
+    res = runner.invoke(
+        app, ["plan", str(course), "--no-plots", "-q", "--out", str(tmp_path / "out")]
+    )
     assert "Traceback" not in res.output
     return res
 
@@ -58,16 +59,28 @@ def orc_file(tmp_path: Path, old: str, new: str) -> str:
     return "orc.json"
 
 
-@pytest.mark.parametrize(("name", "text", "message"), [
-    ("tiny.pol", POL.replace("\n45\t", "\n1e-320\t"),
-     "tiny.pol:2: cell 1: TWA 0.0 and 1e-320 deg are closer than 1e-06 deg"),
-    ("fast.pol", POL.replace("\t6.5\t", "\t1e300\t"),
-     "fast.pol:3: cell 3: boat speed 1e+300 kn"),
-    ("zero.pol", "TWA\\TWS\t6\t12\n45\t0\t0\n90\t0\t0\n", "zero.pol: this polar has no speed"),
-    ("f50.kph.csv", "TWA/TWS,18,36\n60,30,60\n120,40,80\n",
-     "speed_unit='kn' says the boat speed unit is 'kn' but the file name 'f50.kph.csv' says "
-     "'km/h'"),
-])
+@pytest.mark.parametrize(
+    ("name", "text", "message"),
+    [
+        (
+            "tiny.pol",
+            POL.replace("\n45\t", "\n1e-320\t"),
+            "tiny.pol:2: cell 1: TWA 0.0 and 1e-320 deg are closer than 1e-06 deg",
+        ),
+        (
+            "fast.pol",
+            POL.replace("\t6.5\t", "\t1e300\t"),
+            "fast.pol:3: cell 3: boat speed 1e+300 kn",
+        ),
+        ("zero.pol", "TWA\\TWS\t6\t12\n45\t0\t0\n90\t0\t0\n", "zero.pol: this polar has no speed"),
+        (
+            "f50.kph.csv",
+            "TWA/TWS,18,36\n60,30,60\n120,40,80\n",
+            "speed_unit='kn' says the boat speed unit is 'kn' but the file name 'f50.kph.csv' says "
+            "'km/h'",
+        ),
+    ],
+)
 def test_bad_polar_file_exits_2_with_the_file_and_line(tmp_path, name, text, message):
     (tmp_path / name).write_text(text)
     unit = ", speed_unit: kn" if name.endswith(".kph.csv") else ""
@@ -76,14 +89,26 @@ def test_bad_polar_file_exits_2_with_the_file_and_line(tmp_path, name, text, mes
     assert message in res.output
 
 
-@pytest.mark.parametrize(("old", "new", "message"), [
-    ('"beat_angle": [43.6', '"beat_angle": [1e400',
-     "orc.json: vpp.beat_angle[0]: expected an angle in (0, 90) deg; got inf"),
-    ('"beat_angle": [43.6', '"beat_angle": [Infinity',
-     "orc.json: vpp.beat_angle[0]: expected an angle in (0, 90) deg; got inf"),
-    ('"angles": [52', '"angles": [-Infinity',
-     "orc.json: vpp.angles[0]: expected an angle in [0, 180] deg; got -inf"),
-])
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            '"beat_angle": [43.6',
+            '"beat_angle": [1e400',
+            "orc.json: vpp.beat_angle[0]: expected an angle in (0, 90) deg; got inf",
+        ),
+        (
+            '"beat_angle": [43.6',
+            '"beat_angle": [Infinity',
+            "orc.json: vpp.beat_angle[0]: expected an angle in (0, 90) deg; got inf",
+        ),
+        (
+            '"angles": [52',
+            '"angles": [-Infinity',
+            "orc.json: vpp.angles[0]: expected an angle in [0, 180] deg; got -inf",
+        ),
+    ],
+)
 def test_orc_non_finite_values_exit_2(tmp_path, old, new, message):
     name = orc_file(tmp_path, old, new)
     res = plan(tmp_path, course_file(tmp_path, f"{{polar: {name}}}"))
@@ -97,8 +122,9 @@ def test_wind_above_the_polar_exits_2_and_allow_extrapolation_warns_once(tmp_pat
     assert "c.yaml:14: scenarios.s: the wind reaches 18.0 m/s (35.0 kn)" in res.output
     assert "allow_extrapolation: true" in res.output
     assert not (tmp_path / "out").exists()
-    res = plan(tmp_path, course_file(tmp_path, "{builtin: ilca7, allow_extrapolation: true}",
-                                     tws_kn=35))
+    res = plan(
+        tmp_path, course_file(tmp_path, "{builtin: ilca7, allow_extrapolation: true}", tws_kn=35)
+    )
     assert res.exit_code == 0, res.output
     assert res.output.count("warning:") == 1  # printed once, even with -q
     assert "35.0 kn" in res.output and (tmp_path / "out" / "plan.json").is_file()
@@ -110,8 +136,9 @@ def test_denormal_twa_through_the_console_script_has_no_traceback(tmp_path):
     assert exe is not None
     (tmp_path / "tiny.pol").write_text(POL.replace("\n45\t", "\n1e-320\t"))
     course = course_file(tmp_path, "{polar: tiny.pol}")
-    proc = subprocess.run([exe, "plan", str(course), "--no-plots", "-q"], cwd=tmp_path,
-                          capture_output=True, text=True)
+    proc = subprocess.run(
+        [exe, "plan", str(course), "--no-plots", "-q"], cwd=tmp_path, capture_output=True, text=True
+    )
     assert proc.returncode == 2
     assert "Traceback" not in proc.stderr
     assert "closer than 1e-06 deg" in proc.stderr

@@ -35,9 +35,15 @@ def members(dirs=DIRS) -> list[dict]:
 
 
 def test_members_expand_to_scenarios_and_the_ensemble_keeps_its_name(tmp_path) -> None:
-    c = load_course(write_course(tmp_path, {
-        "spread": {"members": members(), "description": "five directions"},
-        "steady": {"type": "uniform", "tws_kn": 12, "twd_deg": 270}}))
+    c = load_course(
+        write_course(
+            tmp_path,
+            {
+                "spread": {"members": members(), "description": "five directions"},
+                "steady": {"type": "uniform", "tws_kn": 12, "twd_deg": 270},
+            },
+        )
+    )
     assert list(c.scenarios) == [f"spread#{k}" for k in range(1, 6)] + ["steady"]
     assert c.ensembles == {"spread": tuple(f"spread#{k}" for k in range(1, 6))}
     assert c.scenario_names == ("spread", "steady")
@@ -47,14 +53,21 @@ def test_members_expand_to_scenarios_and_the_ensemble_keeps_its_name(tmp_path) -
         plan_course(c, "spread")
 
 
-@pytest.mark.parametrize(("spec", "message"), [
-    ({"members": members(), "wind": members()[0]}, "give exactly one of `wind:"),
-    ({"members": members()[:1]}, "an ensemble needs at least 2 members; got 1"),
-    ({"members": [members()[0], {"tws_kn": 3}]}, "scenarios.e.members[1]: the wind spec has "
-                                                 "no `type`"),
-    ({"members": {"dim": "number", "wind": {"type": "uniform", "tws_kn": 3, "twd_deg": 0}}},
-     "members along a dimension need `type: netcdf`"),
-])
+@pytest.mark.parametrize(
+    ("spec", "message"),
+    [
+        ({"members": members(), "wind": members()[0]}, "give exactly one of `wind:"),
+        ({"members": members()[:1]}, "an ensemble needs at least 2 members; got 1"),
+        (
+            {"members": [members()[0], {"tws_kn": 3}]},
+            "scenarios.e.members[1]: the wind spec has no `type`",
+        ),
+        (
+            {"members": {"dim": "number", "wind": {"type": "uniform", "tws_kn": 3, "twd_deg": 0}}},
+            "members along a dimension need `type: netcdf`",
+        ),
+    ],
+)
 def test_member_problems_name_the_key(tmp_path, spec, message) -> None:
     with pytest.raises(InputError) as e:
         load_course(write_course(tmp_path, {"e": spec}))
@@ -65,18 +78,21 @@ def test_spread_is_the_percentiles_of_the_members_routed_alone(tmp_path) -> None
     c = load_course(write_course(tmp_path, {"spread": {"members": members()}}))
     _, plans = compare_scenarios(c, ["spread"])
     s = summarize_ensemble("spread", plans)
-    alone = np.array([[leg.time_s for leg in plan_course(c, f"spread#{k}").plan.legs]
-                      for k in range(1, 6)])
+    alone = np.array(
+        [[leg.time_s for leg in plan_course(c, f"spread#{k}").plan.legs] for k in range(1, 6)]
+    )
     np.testing.assert_array_equal(s.times_s, alone)
     table = np.column_stack([alone, alone.sum(axis=1)])
-    np.testing.assert_allclose(s.spread(), np.percentile(table, [0, 10, 50, 90, 100], axis=0).T,
-                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        s.spread(), np.percentile(table, [0, 10, 50, 90, 100], axis=0).T, rtol=0, atol=1e-9
+    )
     assert s.spread()[-1, 0] == pytest.approx(alone.sum(axis=1).min())
     shares = s.side_shares()
     np.testing.assert_allclose(shares.sum(axis=1), 1.0)
     boat = build_boat(c)
-    assert [row[0] for row in s.sides] == [route_side(p, 0, build_wind(c, p.scenario), boat)
-                                           for p in plans]
+    assert [row[0] for row in s.sides] == [
+        route_side(p, 0, build_wind(c, p.scenario), boat) for p in plans
+    ]
     assert set(np.ravel(s.sides)) <= set(SIDES)
     # steady, uniform winds: whichever side a route took, the other side's layline extreme
     # is as fast, so no beat or run counts as a side (a route taken alone still has one)
@@ -98,10 +114,14 @@ def test_cli_plan_on_an_ensemble_writes_the_spread(tmp_path) -> None:
     from sailroute.report.page_render import read_figure
 
     fig = read_figure((tmp_path / "o" / "report.html").read_text(encoding="utf-8"))
-    assert [t["name"] for t in fig["data"] if t.get("legendgroup", "").startswith("route")
-            and t["mode"] == "lines"] == doc["members"]
-    cmp = CliRunner().invoke(app, ["compare-scenarios", str(course), "-q", "--no-plots",
-                                   "--out", str(tmp_path / "c")])
+    assert [
+        t["name"]
+        for t in fig["data"]
+        if t.get("legendgroup", "").startswith("route") and t["mode"] == "lines"
+    ] == doc["members"]
+    cmp = CliRunner().invoke(
+        app, ["compare-scenarios", str(course), "-q", "--no-plots", "--out", str(tmp_path / "c")]
+    )
     assert cmp.exit_code == 0, cmp.output
     assert (tmp_path / "c" / "spread" / "ensemble.json").is_file()
 
@@ -147,6 +167,9 @@ def test_netcdf_member_dimension_gives_one_member_per_index(tmp_path) -> None:
         load_course(write_course(tmp_path, {"nc": bad}, "bad.yaml"))
     one = {"type": "netcdf", "path": "ens.nc", "select": {"number": 5}}
     c2 = load_course(write_course(tmp_path, {"one": one}, "one.yaml"))
-    with pytest.raises(InputError, match=r"select number: 5 is out of range; that dimension "
-                                         r"has indices 0 \.\. 2"):
+    with pytest.raises(
+        InputError,
+        match=r"select number: 5 is out of range; that dimension "
+        r"has indices 0 \.\. 2",
+    ):
         build_specs(c2, ["one"])

@@ -28,8 +28,14 @@ SCRIPTS = ("plan_course", "wrf_vs_stations", "vpp_polar", "strategy_map", "analy
 def run_script(name: str, out: Path) -> tuple[dict[str, str], str]:
     """Run ``docs/gallery/<name>.py OUT``; its ``key = value`` lines and its stdout."""
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
-    proc = subprocess.run([sys.executable, str(GALLERY / f"{name}.py"), str(out)],
-                          capture_output=True, text=True, cwd=out, env=env, timeout=300)
+    proc = subprocess.run(
+        [sys.executable, str(GALLERY / f"{name}.py"), str(out)],
+        capture_output=True,
+        text=True,
+        cwd=out,
+        env=env,
+        timeout=300,
+    )
     assert proc.returncode == 0, proc.stderr
     values = dict(re.findall(r"^(\S+) = (.+)$", proc.stdout, flags=re.MULTILINE))
     return values, proc.stdout
@@ -52,7 +58,8 @@ def test_plan_course(tmp_path: Path) -> None:
     assert len(legs) == 5
     assert sum(legs) == pytest.approx(total, abs=5 * 5e-4)  # chained legs
     assert float(v["vs_winner_pct"]) == pytest.approx(
-        100 * (total - float(v["winner_s"])) / float(v["winner_s"]), abs=0.01)
+        100 * (total - float(v["winner_s"])) / float(v["winner_s"]), abs=0.01
+    )
     out = tmp_path / "plan_course"
     doc = json.loads((out / "plan.json").read_text(encoding="utf-8"))
     assert doc["total_time_s"] == pytest.approx(total, abs=0.01)
@@ -66,12 +73,17 @@ def test_wrf_vs_stations(tmp_path: Path) -> None:
     assert float(v["station_max_error_ms"]) < 1e-9
     for name in ("wrf", "stations"):
         assert sum(floats(v[f"{name}_legs_s"])) == pytest.approx(
-            float(v[f"{name}_total_s"]), abs=5 * 5e-4)
+            float(v[f"{name}_total_s"]), abs=5 * 5e-4
+        )
     assert abs(float(v["stations_total_s"]) - float(v["wrf_total_s"])) < 5.0
     # independently: the CSV read back with read_stations is the forecast at the stations
     course = sailroute.load_course(COURSES / "hyeres-r1.yaml")
-    wrf = sailroute.open_wind(course, type="wrf", height_m=2.68,
-                              path=ROOT / "data" / "hyeres-2018-04-24-synthetic-wrfout.nc")
+    wrf = sailroute.open_wind(
+        course,
+        type="wrf",
+        height_m=2.68,
+        path=ROOT / "data" / "hyeres-2018-04-24-synthetic-wrfout.nc",
+    )
     data = sailroute.read_stations(tmp_path / "wrf_vs_stations" / "stations.csv")
     assert data.stations == ("1", "start2", "fin1") and len(data) == 3 * 19
     x, y = course.frame.to_xy(data.lat, data.lon)
@@ -87,8 +99,9 @@ def test_wrf_vs_stations(tmp_path: Path) -> None:
 
 def test_vpp_polar(tmp_path: Path) -> None:
     v, _ = run_script("vpp_polar", tmp_path)
-    polar = sailroute.read_polar(tmp_path / "vpp_polar" / "ilca7-70kg.pol",
-                                 speed_unit="kn", wind_unit="kn")
+    polar = sailroute.read_polar(
+        tmp_path / "vpp_polar" / "ilca7-70kg.pol", speed_unit="kn", wind_unit="kn"
+    )
     knot = 1852 / 3600
     np.testing.assert_allclose(polar.tws_ms, np.array([6.0, 10.0, 14.0]) * knot, atol=1e-9)
     twa = np.linspace(25.0, 90.0, 6501)
@@ -102,8 +115,9 @@ def test_vpp_polar(tmp_path: Path) -> None:
 
 def test_strategy_map(tmp_path: Path) -> None:
     v, _ = run_script("strategy_map", tmp_path)
-    expected, mean, se = (float(v[k]) for k in
-                          ("expected_time_s", "monte_carlo_mean_s", "monte_carlo_se_s"))
+    expected, mean, se = (
+        float(v[k]) for k in ("expected_time_s", "monte_carlo_mean_s", "monte_carlo_se_s")
+    )
     assert 0 < se < 2.0
     assert abs(mean - expected) <= 4 * se  # the simulation runs the DP's own chain
     back, none, veer = (float(v[f"tack_share[{k}]"]) for k in ("-10", "+0", "+10"))
@@ -123,10 +137,14 @@ def test_analyze_track(tmp_path: Path) -> None:
     legs = [{k: float(x) for k, x in leg.items()} for leg in legs]
     for leg in legs:
         assert leg["loss"] == pytest.approx(leg["sailed"] - leg["optimal"], abs=2e-3)
-        assert leg["loss"] == pytest.approx(leg["manoeuvres"] + leg["speed"] + leg["route"],
-                                            abs=2e-3)
-    for key, total in (("sailed", "sailed_time_s"), ("optimal", "optimal_time_s"),
-                       ("loss", "loss_s")):
+        assert leg["loss"] == pytest.approx(
+            leg["manoeuvres"] + leg["speed"] + leg["route"], abs=2e-3
+        )
+    for key, total in (
+        ("sailed", "sailed_time_s"),
+        ("optimal", "optimal_time_s"),
+        ("loss", "loss_s"),
+    ):
         assert sum(leg[key] for leg in legs) == pytest.approx(float(v[total]), abs=4e-3)
     # the sailed times are the leg boundaries written to analysis.json
     doc = json.loads((tmp_path / "analyze_track" / "analysis.json").read_text(encoding="utf-8"))

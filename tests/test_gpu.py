@@ -28,8 +28,10 @@ from sailroute.wind.analytic import debski_test_wind
 from sailroute.wind.uniform import UniformWind
 from tests.strategy.test_strategy_deadline import ENGINE_CASES, SIGMA, SO40, C, model
 
-pytestmark = [pytest.mark.gpu,
-              pytest.mark.skipif(_cupy_or_none() is None, reason="needs CuPy and a CUDA device")]
+pytestmark = [
+    pytest.mark.gpu,
+    pytest.mark.skipif(_cupy_or_none() is None, reason="needs CuPy and a CUDA device"),
+]
 
 ROOT = Path(__file__).resolve().parents[1]
 POLAR = read_polar(ROOT / "sailroute" / "boat" / "data" / "ilca7.pol")
@@ -55,8 +57,9 @@ def test_isochrone_on_cupy_is_the_numpy_route(start) -> None:
 @pytest.mark.parametrize("boat", ["dynamic", "polar"])
 def test_griddp_on_cupy_is_the_numpy_route(boat) -> None:
     model = DynamicBoat() if boat == "dynamic" else POLAR
-    st = RoutingSettings(router="griddp", dp_cols=32, dp_rows=9, dp_refinements=1,
-                         dp_half_width_m=400.0)
+    st = RoutingSettings(
+        router="griddp", dp_cols=32, dp_rows=9, dp_refinements=1, dp_half_width_m=400.0
+    )
     tgt = Target("mark", (500.0, 0.0))
     a = route_leg(Start((0.0, 0.0)), tgt, 0.0, debski_test_wind(), model, st)
     b = route_leg(Start((0.0, 0.0)), tgt, 0.0, debski_test_wind(), model, st, backend="cupy")
@@ -72,8 +75,10 @@ def test_plan_on_cupy_is_the_numpy_plan() -> None:
         _same_leg(la, lb)
 
 
-@pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"),
-                         [*ENGINE_CASES, ("linear", (0.05, 46.0, SIGMA), "float32", (100, 128))])
+@pytest.mark.parametrize(
+    ("interpolation", "fig", "dtype", "shape"),
+    [*ENGINE_CASES, ("linear", (0.05, 46.0, SIGMA), "float32", (100, 128))],
+)
 def test_deadline_on_cupy_is_the_numpy_policy(interpolation, fig, dtype, shape) -> None:
     a, s_max, sigma = fig
     g = DeadlineGrid(2.0, shape[0], shape[1], 0.1, 0.4, s_max, interpolation=interpolation)
@@ -89,10 +94,19 @@ def test_strategy_deadline_engine_cupy_gives_the_numpy_probabilities(tmp_path) -
     from sailroute.strategy.shiftmodel import OUShift
     from sailroute.strategy.study import StrategySettings, run_strategy
 
-    st = StrategySettings(deadlines_s=(190.0,), n_r=40, n_theta=48, length_m=400.0,
-                          half_width_m=200.0, lateral_m=4.0, runs=300, deadline_engine="cupy")
+    st = StrategySettings(
+        deadlines_s=(190.0,),
+        n_r=40,
+        n_theta=48,
+        length_m=400.0,
+        half_width_m=200.0,
+        lateral_m=4.0,
+        runs=300,
+        deadline_engine="cupy",
+    )
     a = run_strategy(builtin_polar("ilca7"), OUShift(10.0, 600.0), st).summary["deadline"]
-    b = run_strategy(builtin_polar("ilca7"), OUShift(10.0, 600.0),
-                     replace(st, deadline_engine="numpy")).summary["deadline"]
+    b = run_strategy(
+        builtin_polar("ilca7"), OUShift(10.0, 600.0), replace(st, deadline_engine="numpy")
+    ).summary["deadline"]
     assert a["engine"] == "cupy"
     assert a["risk_aware"] == b["risk_aware"]

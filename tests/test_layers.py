@@ -16,11 +16,35 @@ from pathlib import Path
 from tests.conftest import ROOT
 
 PACKAGE = ROOT / "sailroute"
-BASE = ("units", "errors", "geo", "timeutil", "textin", "yamlfile", "numerics", "backend",
-        "checks", "parallel", "outdir", "progress", "tabular")
+BASE = (
+    "units",
+    "errors",
+    "geo",
+    "timeutil",
+    "textin",
+    "yamlfile",
+    "numerics",
+    "backend",
+    "checks",
+    "parallel",
+    "outdir",
+    "progress",
+    "tabular",
+)
 LAYERS: tuple[tuple[str, ...], ...] = (
-    BASE, ("track",), ("wind",), ("boat",), ("routing",), ("course",), ("planning",),
-    ("analysis",), ("strategy",), ("bands",), ("live",), ("report",), ("commands",),
+    BASE,
+    ("track",),
+    ("wind",),
+    ("boat",),
+    ("routing",),
+    ("course",),
+    ("planning",),
+    ("analysis",),
+    ("strategy",),
+    ("bands",),
+    ("live",),
+    ("report",),
+    ("commands",),
     ("api", "cli", "__main__", "__init__"),
 )
 RANK = {name: k for k, names in enumerate(LAYERS) for name in names}

@@ -168,9 +168,12 @@ def test_unreachable_scheduler_says_how_to_fix_it() -> None:
 
 def test_scheduler_without_workers_is_reported_not_waited_for() -> None:
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(
-        n_workers=0, processes=True, host="127.0.0.1", dashboard_address=":0"
-    ) as empty, pytest.raises(InputError, match="has no workers") as err:
+    with (
+        distributed.LocalCluster(
+            n_workers=0, processes=True, host="127.0.0.1", dashboard_address=":0"
+        ) as empty,
+        pytest.raises(InputError, match="has no workers") as err,
+    ):
         map_tasks(pow, [1], shared=(2,), scheduler=empty.scheduler_address, timeout_s=0.5)
     assert f"dask worker {empty.scheduler_address}" in str(err.value)
 
@@ -215,11 +218,13 @@ def test_compare_scenarios_on_a_cluster_equals_serial(cluster) -> None:
     from sailroute.course.load import load_course
     from sailroute.planning.route import RunOptions, compare_scenarios
 
-    course = load_course(Path(__file__).resolve().parents[1] / "courses"
-                         / "windward-leeward-template.yaml")
+    course = load_course(
+        Path(__file__).resolve().parents[1] / "courses" / "windward-leeward-template.yaml"
+    )
     serial_cmp, serial_plans = compare_scenarios(course)
     dist_cmp, dist_plans = compare_scenarios(
-        course, options=RunOptions(scheduler=cluster.scheduler_address))
+        course, options=RunOptions(scheduler=cluster.scheduler_address)
+    )
     assert dist_cmp.scenarios == serial_cmp.scenarios == ("steady-12kn", "veered-10deg")
     np.testing.assert_array_equal(dist_cmp.times, serial_cmp.times)
     for a, b in zip(serial_plans, dist_plans, strict=True):

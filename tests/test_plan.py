@@ -76,11 +76,14 @@ def test_constant_wind_matches_closed_forms(hyeres, hyeres_constant):
     assert r.time_s == pytest.approx(math.hypot(dx, dy) / float(boat.speed(tws, twa)), rel=1e-3)
 
 
-@pytest.mark.parametrize(("course_file", "router"), [
-    ("windward-leeward-template.yaml", "isochrone"),
-    ("hyeres-r1.yaml", "isochrone"),
-    ("trapezoid-outer-template.yaml", "griddp"),
-])
+@pytest.mark.parametrize(
+    ("course_file", "router"),
+    [
+        ("windward-leeward-template.yaml", "isochrone"),
+        ("hyeres-r1.yaml", "isochrone"),
+        ("trapezoid-outer-template.yaml", "griddp"),
+    ],
+)
 def test_every_mark_is_rounded_on_its_side(course_file, router):
     """The track of the two legs meeting at a mark winds round it like the taut string.
 
@@ -108,18 +111,28 @@ def test_every_mark_is_rounded_on_its_side(course_file, router):
 
 def test_later_legs_see_later_wind():
     """A wind that turns at a known time: the leg sailed after it is a beat, not a reach."""
-    course = course_from_mapping({
-        "name": "switch", "start_time": "2024-05-01T12:00:00Z",
-        "origin": {"lat": 45.0, "lon": 13.0},
-        "marks": {"a": {"x": 0, "y": 0}, "b": {"x": 0, "y": 600}, "c": {"x": 0, "y": 1200}},
-        "legs": [{"from": "a", "to": "b", "rounding": "port"},
-                 {"to": "c", "rounding": "port"}],
-        "scenarios": {"turn": {"wind": {
-            "type": "uniform", "interpolation": "previous",  # a step change at 12:02:30
-            "table": [{"time": "2024-05-01T12:00:00Z", "tws_ms": 5.0, "twd_deg": 90.0},
-                      {"time": "2024-05-01T12:02:30Z", "tws_ms": 5.0, "twd_deg": 0.0},
-                      {"time": "2024-05-01T14:00:00Z", "tws_ms": 5.0, "twd_deg": 0.0}]}}},
-    })
+    course = course_from_mapping(
+        {
+            "name": "switch",
+            "start_time": "2024-05-01T12:00:00Z",
+            "origin": {"lat": 45.0, "lon": 13.0},
+            "marks": {"a": {"x": 0, "y": 0}, "b": {"x": 0, "y": 600}, "c": {"x": 0, "y": 1200}},
+            "legs": [{"from": "a", "to": "b", "rounding": "port"}, {"to": "c", "rounding": "port"}],
+            "scenarios": {
+                "turn": {
+                    "wind": {
+                        "type": "uniform",
+                        "interpolation": "previous",  # a step change at 12:02:30
+                        "table": [
+                            {"time": "2024-05-01T12:00:00Z", "tws_ms": 5.0, "twd_deg": 90.0},
+                            {"time": "2024-05-01T12:02:30Z", "tws_ms": 5.0, "twd_deg": 0.0},
+                            {"time": "2024-05-01T14:00:00Z", "tws_ms": 5.0, "twd_deg": 0.0},
+                        ],
+                    }
+                }
+            },
+        }
+    )
     legs = plan_course(course).plan.legs
     r1, r2 = legs[0].result, legs[1].result
     assert r1.t_end > course.start_epoch + 151  # the first leg is still sailing when it turns
@@ -140,8 +153,12 @@ def test_compare_equals_individual_plans(hyeres, hyeres_constant):
 def test_course_pickles_for_workers(hyeres):
     back = pickle.loads(pickle.dumps(hyeres))
     assert back.scenarios["wrf10"].wind["time_step_min"] == 10
-    np.testing.assert_allclose(back.frame.to_latlon(500.0, -300.0),
-                               hyeres.frame.to_latlon(500.0, -300.0), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        back.frame.to_latlon(500.0, -300.0),
+        hyeres.frame.to_latlon(500.0, -300.0),
+        rtol=0,
+        atol=1e-12,
+    )
     with pytest.raises(TypeError):  # still read-only after the round trip
         back.scenarios["wrf10"].wind["time_step_min"] = 60  # type: ignore[index]
 

@@ -26,13 +26,20 @@ END_Y = HALF * math.tan(math.radians(BIAS))
 
 def course_mapping(first_from: str = "start") -> dict:
     return {
-        "name": "start line test", "start_time": "2024-05-01T12:00:00Z",
+        "name": "start line test",
+        "start_time": "2024-05-01T12:00:00Z",
         "origin": {"lat": 45.0, "lon": 13.0},
-        "marks": {"pin": {"x": -HALF, "y": -END_Y}, "boat": {"x": HALF, "y": END_Y},
-                  "top": {"x": 0.0, "y": 700.0}, "bottom": {"x": 0.0, "y": 100.0}},
+        "marks": {
+            "pin": {"x": -HALF, "y": -END_Y},
+            "boat": {"x": HALF, "y": END_Y},
+            "top": {"x": 0.0, "y": 700.0},
+            "bottom": {"x": 0.0, "y": 100.0},
+        },
         "lines": {"start": ["pin", "boat"]},
-        "legs": [{"from": first_from, "to": "top", "rounding": "port"},
-                 {"to": "bottom", "rounding": "port"}],
+        "legs": [
+            {"from": first_from, "to": "top", "rounding": "port"},
+            {"to": "bottom", "rounding": "port"},
+        ],
         "scenarios": {"steady": {"wind": {"type": "uniform", "tws_ms": TWS, "twd_deg": 0.0}}},
     }
 
@@ -73,8 +80,10 @@ def test_plan_json_laylines(course_file, planned):
     _, out = planned
     legs = json.loads((out / "plan.json").read_text())["legs"]
     up, down = build_boat(load_course(course_file)).vmg_angles_deg(TWS)
-    for leg, kind, twa, mark in ((legs[0], "tack", up, (0.0, 700.0)),
-                                 (legs[1], "gybe", down, (0.0, 100.0))):
+    for leg, kind, twa, mark in (
+        (legs[0], "tack", up, (0.0, 700.0)),
+        (legs[1], "gybe", down, (0.0, 100.0)),
+    ):
         lls = leg["laylines"]
         assert [(ll["kind"], ll["tack"]) for ll in lls] == [(kind, "starboard"), (kind, "port")]
         for ll, sign in zip(lls, (1.0, -1.0), strict=True):
@@ -106,8 +115,20 @@ def test_start_command_closed_form(course_file, tmp_path):
     boat = build_boat(load_course(course_file))
     up, _ = boat.vmg_angles_deg(TWS)
     d = 120.0
-    res = CliRunner().invoke(app, ["start", course_file, "--xy", f"0,{-d}", "--time", "-100",
-                                   "--out", str(tmp_path), "--json"])
+    res = CliRunner().invoke(
+        app,
+        [
+            "start",
+            course_file,
+            "--xy",
+            f"0,{-d}",
+            "--time",
+            "-100",
+            "--out",
+            str(tmp_path),
+            "--json",
+        ],
+    )
     assert res.exit_code == 0, res.output
     doc = json.loads(res.output)
     star = doc["close_hauled"]["starboard"]
@@ -118,8 +139,10 @@ def test_start_command_closed_form(course_file, tmp_path):
     assert star["time_s"] == pytest.approx(s / float(boat.speed(TWS, up)), abs=0.01)
     assert doc["distance_to_line_m"] == pytest.approx(d * math.cos(math.radians(BIAS)), abs=0.01)
     assert doc["time_to_burn_s"] == pytest.approx(100.0 - doc["fastest"]["time_s"], abs=0.01)
-    assert doc["fastest"]["time_s"] <= min(star["time_s"],
-                                           doc["close_hauled"]["port"]["time_s"]) + 1e-9
+    assert (
+        doc["fastest"]["time_s"]
+        <= min(star["time_s"], doc["close_hauled"]["port"]["time_s"]) + 1e-9
+    )
     assert doc["start_line"]["favoured_end"] == "boat"
     assert json.loads((tmp_path / "start.json").read_text()) == doc
 
@@ -136,27 +159,42 @@ def _refused(args: list[str], tmp_path, expected: str) -> None:
 
 
 def test_start_refuses_a_far_position(course_file, tmp_path):
-    _refused(["start", course_file, "--at", "45.3,13.0", "--time", "-60"], tmp_path,
-             "the position is 33 km from the course area")
+    _refused(
+        ["start", course_file, "--at", "45.3,13.0", "--time", "-60"],
+        tmp_path,
+        "the position is 33 km from the course area",
+    )
 
 
 def test_start_refuses_an_unparsable_time(course_file, tmp_path):
-    _refused(["start", course_file, "--xy", "0,-100", "--time", "five to twelve"], tmp_path,
-             "--time 'five to twelve': expected an ISO 8601 time")
+    _refused(
+        ["start", course_file, "--xy", "0,-100", "--time", "five to twelve"],
+        tmp_path,
+        "--time 'five to twelve': expected an ISO 8601 time",
+    )
 
 
 def test_start_refuses_a_bad_position(course_file, tmp_path):
-    _refused(["start", course_file, "--at", "45.0", "--time", "-60"], tmp_path,
-             "--at '45.0': expected two comma-separated numbers")
-    _refused(["start", course_file, "--time", "-60"], tmp_path,
-             "give the boat's position with --at LAT,LON")
+    _refused(
+        ["start", course_file, "--at", "45.0", "--time", "-60"],
+        tmp_path,
+        "--at '45.0': expected two comma-separated numbers",
+    )
+    _refused(
+        ["start", course_file, "--time", "-60"],
+        tmp_path,
+        "give the boat's position with --at LAT,LON",
+    )
 
 
 def test_start_refuses_a_course_without_a_start_line(tmp_path):
     p = tmp_path / "nostart.yaml"
     p.write_text(yaml.safe_dump(course_mapping(first_from="bottom")), encoding="utf-8")
-    _refused(["start", str(p), "--xy", "0,-100", "--time", "-60"], tmp_path,
-             "the first leg starts from 'bottom', which is not a line")
+    _refused(
+        ["start", str(p), "--xy", "0,-100", "--time", "-60"],
+        tmp_path,
+        "the first leg starts from 'bottom', which is not a line",
+    )
 
 
 def test_route_png_draws_laylines_and_the_favoured_end(course_file):
@@ -166,8 +204,13 @@ def test_route_png_draws_laylines_and_the_favoured_end(course_file):
     run = plan_course(load_course(course_file))
     ax = plot_plan(run.plan, run.wind).axes[0]
     gids = {a.get_gid() for a in ax.get_lines()}
-    assert {"layline:1:top:starboard", "layline:1:top:port", "layline:2:bottom:starboard",
-            "layline:2:bottom:port", "favoured-end"} <= gids
+    assert {
+        "layline:1:top:starboard",
+        "layline:1:top:port",
+        "layline:2:bottom:starboard",
+        "layline:2:bottom:port",
+        "favoured-end",
+    } <= gids
     star = next(a for a in ax.get_lines() if a.get_gid() == "favoured-end")
     assert (star.get_xdata()[0], star.get_ydata()[0]) == pytest.approx((HALF, END_Y))
     labels = [t.get_text() for t in ax.get_legend().get_texts()]

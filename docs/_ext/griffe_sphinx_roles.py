@@ -22,7 +22,8 @@ from typing import Any
 from griffe import Extension, Object
 
 ROLE = re.compile(
-    r":(?:py:)?(?:func|class|meth|mod|attr|data|exc|obj|const|term|ref):`(?P<body>[^`]+)`")
+    r":(?:py:)?(?:func|class|meth|mod|attr|data|exc|obj|const|term|ref):`(?P<body>[^`]+)`"
+)
 EXPLICIT = re.compile(r"^(?P<title>.+?)\s*<(?P<target>[^<>]+)>$")
 LITERAL_MARKER = re.compile(r"(\S)::$", flags=re.MULTILINE)
 CODE_SPAN = re.compile(r"(``.+?``|`[^`]+`)")
@@ -39,8 +40,10 @@ def _reference(match: re.Match[str], module: str) -> str:
         title = target.rsplit(".", 1)[-1] if body.startswith("~") else target
     if "." not in target and module:
         target = f"{module}.{target}"  # a name of the same module
-    return (f'<autoref identifier="{html.escape(target)}" optional>'
-            f"<code>{html.escape(title)}</code></autoref>")
+    return (
+        f'<autoref identifier="{html.escape(target)}" optional>'
+        f"<code>{html.escape(title)}</code></autoref>"
+    )
 
 
 def _brackets(line: str) -> str:

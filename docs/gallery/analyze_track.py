@@ -20,26 +20,36 @@ import sailroute
 from sailroute.report.analysis import write_analysis
 
 ROOT = Path(__file__).resolve().parents[2]
-OUT = Path(sys.argv[1] if len(sys.argv) > 1
-           else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")) / "analyze_track"
+OUT = (
+    Path(
+        sys.argv[1] if len(sys.argv) > 1 else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")
+    )
+    / "analyze_track"
+)
 
 course = sailroute.load_course(ROOT / "courses" / "snipe-valencia-p01.yaml")
 track = sailroute.read_track(ROOT / "data" / "snipe-valencia-2025-06-21-ESP30782-P01.gpx")
 result = sailroute.analyze_track(course, track)
 
 print(f"{track.name} on {course.name}")
-print(f"{'leg':<10} {'mode':<9} {'sailed s':>8} {'optimal s':>9} {'lost s':>7} "
-      f"{'manoeuv.':>8} {'speed':>7} {'route':>7} {'side':>14}")
+print(
+    f"{'leg':<10} {'mode':<9} {'sailed s':>8} {'optimal s':>9} {'lost s':>7} "
+    f"{'manoeuv.':>8} {'speed':>7} {'route':>7} {'side':>14}"
+)
 for leg in result.legs:
     s = leg.split
-    print(f"{leg.label:<10} {leg.mode:<9} {leg.sailed_time_s:8.1f} {leg.optimal_time_s:9.1f} "
-          f"{leg.loss_s:7.1f} {s.manoeuvres:8.1f} {s.speed:7.1f} {s.route:7.1f} "
-          f"{leg.side_sailed + '/' + leg.side_optimal:>14}")
+    print(
+        f"{leg.label:<10} {leg.mode:<9} {leg.sailed_time_s:8.1f} {leg.optimal_time_s:9.1f} "
+        f"{leg.loss_s:7.1f} {s.manoeuvres:8.1f} {s.speed:7.1f} {s.route:7.1f} "
+        f"{leg.side_sailed + '/' + leg.side_optimal:>14}"
+    )
 for leg in result.legs:
     s = leg.split
-    print(f"leg[{leg.index}] = sailed {leg.sailed_time_s:.3f} optimal {leg.optimal_time_s:.3f} "
-          f"loss {leg.loss_s:.3f} manoeuvres {s.manoeuvres:.3f} speed {s.speed:.3f} "
-          f"route {s.route:.3f}")
+    print(
+        f"leg[{leg.index}] = sailed {leg.sailed_time_s:.3f} optimal {leg.optimal_time_s:.3f} "
+        f"loss {leg.loss_s:.3f} manoeuvres {s.manoeuvres:.3f} speed {s.speed:.3f} "
+        f"route {s.route:.3f}"
+    )
 print(f"sailed_time_s = {result.sailed_time_s:.3f}")
 print(f"optimal_time_s = {result.optimal_time_s:.3f}")
 print(f"loss_s = {result.loss_s:.3f}")

@@ -16,8 +16,12 @@ from pathlib import Path
 import sailroute
 
 ROOT = Path(__file__).resolve().parents[2]  # the repository (courses/, data/)
-OUT = Path(sys.argv[1] if len(sys.argv) > 1
-           else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")) / "plan_course"
+OUT = (
+    Path(
+        sys.argv[1] if len(sys.argv) > 1 else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")
+    )
+    / "plan_course"
+)
 
 course = sailroute.load_course(ROOT / "courses" / "hyeres-r1.yaml")
 run = sailroute.plan_course(course, "constant")
@@ -27,8 +31,10 @@ print(f"{course.name}, scenario {plan.scenario!r}, {plan.router} router")
 print(f"{'leg':<14} {'mode':<9} {'time s':>8} {'tacks':>5} {'gybes':>5} {'dist m':>7}")
 for leg in plan.legs:
     r = leg.result
-    print(f"{leg.spec.label:<14} {leg.mode or '?':<9} {leg.time_s:8.1f} {r.n_tacks:5d} "
-          f"{r.n_gybes:5d} {r.distance_m:7.0f}")
+    print(
+        f"{leg.spec.label:<14} {leg.mode or '?':<9} {leg.time_s:8.1f} {r.n_tacks:5d} "
+        f"{r.n_gybes:5d} {r.distance_m:7.0f}"
+    )
 
 winner = sum(plan.references["winner"])  # the real race's winner [s]
 print(f"legs_s = {','.join(f'{leg.time_s:.3f}' for leg in plan.legs)}")

@@ -19,19 +19,26 @@ import sailroute
 from sailroute.report.strategy import plot_policy_map, policy_classes, save_figure
 
 KNOT = 1852.0 / 3600.0  # m/s
-OUT = Path(sys.argv[1] if len(sys.argv) > 1
-           else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")) / "strategy_map"
+OUT = (
+    Path(
+        sys.argv[1] if len(sys.argv) > 1 else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")
+    )
+    / "strategy_map"
+)
 
-settings = sailroute.StrategySettings(tws_ms=10 * KNOT, length_m=1000.0, half_width_m=500.0,
-                                      lateral_m=4.0, runs=2000, seed=1)
+settings = sailroute.StrategySettings(
+    tws_ms=10 * KNOT, length_m=1000.0, half_width_m=500.0, lateral_m=4.0, runs=2000, seed=1
+)
 shifts = sailroute.OUShift(sigma_deg=10.0, timescale_s=300.0)
 result = sailroute.run_strategy(sailroute.builtin_polar("ilca7"), shifts, settings)
 
 policy, sim = result.policy, result.sim.summary()
 steady = result.summary["expected_time_policy"]["steady_wind_one_tack_s"]
 expected = policy.expected_time(0.0, settings.start_tack, 0.0)
-print(f"{result.polar.name} at 10 kn, {settings.length_m:.0f} m beat, shifts "
-      f"sd {shifts.sigma_deg:g}° over {shifts.timescale_s / 60:g} min")
+print(
+    f"{result.polar.name} at 10 kn, {settings.length_m:.0f} m beat, shifts "
+    f"sd {shifts.sigma_deg:g}° over {shifts.timescale_s / 60:g} min"
+)
 print(f"expected_time_s = {expected:.2f}")
 print(f"monte_carlo_mean_s = {sim['mean_s']:.2f}")
 print(f"monte_carlo_se_s = {sim['se_mean_s']:.2f}")

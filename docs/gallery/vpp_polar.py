@@ -18,12 +18,17 @@ import numpy as np
 import sailroute
 
 KNOT = 1852.0 / 3600.0  # m/s
-OUT = Path(sys.argv[1] if len(sys.argv) > 1
-           else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")) / "vpp_polar"
+OUT = (
+    Path(
+        sys.argv[1] if len(sys.argv) > 1 else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")
+    )
+    / "vpp_polar"
+)
 
 tws_kn = np.array([6.0, 10.0, 14.0])
-light = sailroute.vpp("ilca7", crew_mass_kg=70, tws_ms=tws_kn * KNOT,
-                      twa_deg=np.arange(30.0, 181.0, 5.0))
+light = sailroute.vpp(
+    "ilca7", crew_mass_kg=70, tws_ms=tws_kn * KNOT, twa_deg=np.arange(30.0, 181.0, 5.0)
+)
 builtin = sailroute.builtin_polar("ilca7-steady")  # 80 kg sailor, steady VPP
 
 up_a, up_v = light.vmg_upwind(light.tws_ms)
@@ -31,11 +36,15 @@ dn_a, dn_v = light.vmg_downwind(light.tws_ms)
 ref_up = builtin.vmg_upwind(light.tws_ms)[1]
 ref_dn = builtin.vmg_downwind(light.tws_ms)[1]
 print(f"{light.name}, 70 kg sailor, against {builtin.name} (80 kg)")
-print(f"{'TWS kn':>6} {'beat TWA':>8} {'VMG kn':>7} {'80 kg':>6} {'run TWA':>8} {'VMG kn':>7} "
-      f"{'80 kg':>6}")
+print(
+    f"{'TWS kn':>6} {'beat TWA':>8} {'VMG kn':>7} {'80 kg':>6} {'run TWA':>8} {'VMG kn':>7} "
+    f"{'80 kg':>6}"
+)
 for k, tws in enumerate(tws_kn):
-    print(f"{tws:6.1f} {up_a[k]:8.1f} {up_v[k] / KNOT:7.3f} {ref_up[k] / KNOT:6.3f} "
-          f"{dn_a[k]:8.1f} {dn_v[k] / KNOT:7.3f} {ref_dn[k] / KNOT:6.3f}")
+    print(
+        f"{tws:6.1f} {up_a[k]:8.1f} {up_v[k] / KNOT:7.3f} {ref_up[k] / KNOT:6.3f} "
+        f"{dn_a[k]:8.1f} {dn_v[k] / KNOT:7.3f} {ref_dn[k] / KNOT:6.3f}"
+    )
 
 for k, tws in enumerate(tws_kn):
     print(f"vmg_upwind_ms[{tws:g}] = {up_v[k]:.6f}")

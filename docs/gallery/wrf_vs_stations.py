@@ -24,12 +24,17 @@ import sailroute
 from sailroute.units import wind_speed_direction
 
 ROOT = Path(__file__).resolve().parents[2]
-OUT = Path(sys.argv[1] if len(sys.argv) > 1
-           else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")) / "wrf_vs_stations"
+OUT = (
+    Path(
+        sys.argv[1] if len(sys.argv) > 1 else os.environ.get("SAILROUTE_GALLERY_OUT", "out/gallery")
+    )
+    / "wrf_vs_stations"
+)
 
 course = sailroute.load_course(ROOT / "courses" / "hyeres-r1.yaml")
-wrf = sailroute.open_wind(course, type="wrf", height_m=2.68,
-                          path=ROOT / "data" / "hyeres-2018-04-24-synthetic-wrfout.nc")
+wrf = sailroute.open_wind(
+    course, type="wrf", height_m=2.68, path=ROOT / "data" / "hyeres-2018-04-24-synthetic-wrfout.nc"
+)
 
 # three "anemometers": on the windward mark, at the north end of the start line and
 # at the finish (the course's corners), one record every 5 min of the race window
@@ -66,8 +71,10 @@ mid = xy.mean(axis=0)
 uw, vw = wrf.sample(t0, mid[0], mid[1])
 us, vs = stations.sample(t0, mid[0], mid[1])
 
-plans = {"wrf": sailroute.plan_with_wind(course, wrf, name="wrf").plan,
-         "stations": sailroute.plan_with_wind(course, stations, name="stations").plan}
+plans = {
+    "wrf": sailroute.plan_with_wind(course, wrf, name="wrf").plan,
+    "stations": sailroute.plan_with_wind(course, stations, name="stations").plan,
+}
 print(f"{'leg':<14} {'WRF s':>8} {'stations s':>10} {'diff s':>7}")
 for a, b in zip(plans["wrf"].legs, plans["stations"].legs, strict=True):
     print(f"{a.spec.label:<14} {a.time_s:8.1f} {b.time_s:10.1f} {b.time_s - a.time_s:7.1f}")

@@ -189,18 +189,32 @@ def analyze_track(
     x, y = track_xy(track, course.frame)
     check_same_race(course, track, x, y)
     t = track.t_s
-    seg = segment_track(course, t, x, y, leg_times=leg_times, detect_m=detect_m, where=where,
-                        missing=missing, gate_end=gate_end)
+    seg = segment_track(
+        course,
+        t,
+        x,
+        y,
+        leg_times=leg_times,
+        detect_m=detect_m,
+        where=where,
+        missing=missing,
+        gate_end=gate_end,
+    )
     svx, svy = _smoothed_velocity(t, x, y)
     bounds = seg.bounds
     t_a = bounds[0].t
     t_b = max(c.t_hi for c in bounds if np.isfinite(c.t_hi))
     race = (t >= t_a) & (t <= t_b)
     # each leg's wind: the first source that covers its sailed points
-    chosen = [_leg_source(sources, *_leg_points(t, x, y, bounds[i], bounds[i + 1]),
-                          f"{where}: leg {i + 1} ({spec.label})",
-                          strict=bounds[i].known and bounds[i + 1].known)
-              for i, spec in enumerate(course.legs)]
+    chosen = [
+        _leg_source(
+            sources,
+            *_leg_points(t, x, y, bounds[i], bounds[i + 1]),
+            f"{where}: leg {i + 1} ({spec.label})",
+            strict=bounds[i].known and bounds[i + 1].known,
+        )
+        for i, spec in enumerate(course.legs)
+    ]
     # manoeuvres over the race part, with TWA from the smoothed COG
     tr, xr, yr = t[race], x[race], y[race]
     twd_r = np.full(tr.size, np.nan)
@@ -209,14 +223,20 @@ def analyze_track(
         twd_r[m] = _wind_at(sources[ks].field, tr[m], xr[m], yr[m])[1]
     gap = np.isnan(twd_r)  # across a data gap at a leg end: the last leg's wind before it
     if gap.any():
-        twd_r[gap] = (np.degrees(np.interp(tr[gap], tr[~gap], np.unwrap(np.radians(
-            twd_r[~gap])))) % 360.0 if (~gap).any() else 0.0)
-    mans, _ = find_sailed_manoeuvres(tr, twd_r, bearing_deg(svx[race], svy[race]),
-                                     np.hypot(svx[race], svy[race]))
+        twd_r[gap] = (
+            np.degrees(np.interp(tr[gap], tr[~gap], np.unwrap(np.radians(twd_r[~gap])))) % 360.0
+            if (~gap).any()
+            else 0.0
+        )
+    mans, _ = find_sailed_manoeuvres(
+        tr, twd_r, bearing_deg(svx[race], svy[race]), np.hypot(svx[race], svy[race])
+    )
 
     legs: list[LegAnalysis] = []
-    cols: dict[str, list[NDArray]] = {k: [] for k in (
-        "leg", "t", "x", "y", "sog", "cog", "tws", "twd", "twa", "polar", "vmg", "loss")}
+    cols: dict[str, list[NDArray]] = {
+        k: []
+        for k in ("leg", "t", "x", "y", "sog", "cog", "tws", "twd", "twa", "polar", "vmg", "loss")
+    }
     loss_before = 0.0
     for i, spec in enumerate(course.legs):
         a, b = bounds[i], bounds[i + 1]
@@ -231,16 +251,28 @@ def analyze_track(
         polar = np.asarray(boat.speed(tws, np.abs(twa)), float)
         ratio = np.where(polar >= 0.3, sog / np.where(polar > 0, polar, 1.0), np.nan)
         target = leg_target(course, i)
-        centre = target.centre if target.kind != "mark" else feature_centre(
-            course.feature(spec.to_name))
+        centre = (
+            target.centre if target.kind != "mark" else feature_centre(course.feature(spec.to_name))
+        )
         if not (a.known and b.known):
-            leg = _unknown_leg(course, i, bounds, sources, chosen[i], boat, settings, target,
-                               centre, progress)
+            leg = _unknown_leg(
+                course, i, bounds, sources, chosen[i], boat, settings, target, centre, progress
+            )
             legs.append(leg)
-            for k, v in (("leg", np.full(tl.size, i + 1)), ("t", tl), ("x", xl), ("y", yl),
-                         ("sog", sog), ("cog", cog), ("tws", tws), ("twd", twd), ("twa", twa),
-                         ("polar", polar), ("vmg", np.full(tl.size, np.nan)),
-                         ("loss", np.full(tl.size, np.nan))):
+            for k, v in (
+                ("leg", np.full(tl.size, i + 1)),
+                ("t", tl),
+                ("x", xl),
+                ("y", yl),
+                ("sog", sog),
+                ("cog", cog),
+                ("tws", tws),
+                ("twd", twd),
+                ("twa", twa),
+                ("polar", polar),
+                ("vmg", np.full(tl.size, np.nan)),
+                ("loss", np.full(tl.size, np.nan)),
+            ):
                 cols[k].append(v)
             continue
         mode = leg_wind_mode(chosen_field, a.t, (a.x, a.y), centre)
@@ -252,8 +284,9 @@ def analyze_track(
             ux, uy = centre[0] - xl, centre[1] - yl
             vmg = (vx * ux + vy * uy) / np.maximum(np.hypot(ux, uy), 1e-9)
         # optimal route from the same point and time
-        opt, src = _optimal_leg(course, i, bounds, sources, chosen[i], (tl, xl, yl), boat,
-                                settings, target, progress)
+        opt, src = _optimal_leg(
+            course, i, bounds, sources, chosen[i], (tl, xl, yl), boat, settings, target, progress
+        )
         sailed = b.t - a.t
         loss = sailed - opt.time_s
         prog = axis_progress(xl, yl, (a.x, a.y), centre)
@@ -265,56 +298,114 @@ def analyze_track(
         penalty = opt.n_tacks * settings.tack_penalty_s + opt.n_gybes * settings.gybe_penalty_s
         split = split_loss(tl, prog, ratio, lm_t, loss, penalty)
         lat_s = time_mean(tl, lateral_offset(xl, yl, (a.x, a.y), centre))
-        lat_o = time_mean(opt.track.t, lateral_offset(opt.track.x, opt.track.y, (a.x, a.y),
-                                                      centre))
+        lat_o = time_mean(opt.track.t, lateral_offset(opt.track.x, opt.track.y, (a.x, a.y), centre))
         length = float(np.hypot(centre[0] - a.x, centre[1] - a.y))
         straight = ~manoeuvre_mask(tl, lm_t)
-        legs.append(LegAnalysis(
-            index=i, label=spec.label, mode=mode, t_start=a.t, t_end=b.t,
-            start_xy=(a.x, a.y), end_xy=(b.x, b.y), detected=b.detected,
-            sailed_time_s=sailed, optimal_time_s=opt.time_s, loss_s=loss,
-            sailed_distance_m=float(np.sum(np.hypot(np.diff(xl), np.diff(yl)))),
-            optimal_distance_m=opt.distance_m,
-            sailed_tacks=sum(m.kind == "tack" for m in leg_mans),
-            sailed_gybes=sum(m.kind == "gybe" for m in leg_mans),
-            optimal_tacks=opt.n_tacks, optimal_gybes=opt.n_gybes, manoeuvres=leg_mans,
-            mean_vmg_ms=time_mean(tl, vmg), mean_sog_ms=time_mean(tl, sog),
-            mean_polar_pct=100.0 * time_mean(tl, np.clip(ratio, 0, 2), straight),
-            split=split, side_sailed=side_label(lat_s, length),
-            side_optimal=side_label(lat_o, length), lateral_sailed_m=lat_s,
-            lateral_optimal_m=lat_o, optimal=opt, wind_source=src.kind, wind_label=src.label,
-        ))
+        legs.append(
+            LegAnalysis(
+                index=i,
+                label=spec.label,
+                mode=mode,
+                t_start=a.t,
+                t_end=b.t,
+                start_xy=(a.x, a.y),
+                end_xy=(b.x, b.y),
+                detected=b.detected,
+                sailed_time_s=sailed,
+                optimal_time_s=opt.time_s,
+                loss_s=loss,
+                sailed_distance_m=float(np.sum(np.hypot(np.diff(xl), np.diff(yl)))),
+                optimal_distance_m=opt.distance_m,
+                sailed_tacks=sum(m.kind == "tack" for m in leg_mans),
+                sailed_gybes=sum(m.kind == "gybe" for m in leg_mans),
+                optimal_tacks=opt.n_tacks,
+                optimal_gybes=opt.n_gybes,
+                manoeuvres=leg_mans,
+                mean_vmg_ms=time_mean(tl, vmg),
+                mean_sog_ms=time_mean(tl, sog),
+                mean_polar_pct=100.0 * time_mean(tl, np.clip(ratio, 0, 2), straight),
+                split=split,
+                side_sailed=side_label(lat_s, length),
+                side_optimal=side_label(lat_o, length),
+                lateral_sailed_m=lat_s,
+                lateral_optimal_m=lat_o,
+                optimal=opt,
+                wind_source=src.kind,
+                wind_label=src.label,
+            )
+        )
         loss_before += loss
-        for k, v in (("leg", np.full(tl.size, i + 1)), ("t", tl), ("x", xl), ("y", yl),
-                     ("sog", sog), ("cog", cog), ("tws", tws), ("twd", twd), ("twa", twa),
-                     ("polar", polar), ("vmg", vmg), ("loss", cum)):
+        for k, v in (
+            ("leg", np.full(tl.size, i + 1)),
+            ("t", tl),
+            ("x", xl),
+            ("y", yl),
+            ("sog", sog),
+            ("cog", cog),
+            ("tws", tws),
+            ("twd", twd),
+            ("twa", twa),
+            ("polar", polar),
+            ("vmg", vmg),
+            ("loss", cum),
+        ):
             cols[k].append(v)
     c = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
     lat, lon = course.frame.to_latlon(c["x"], c["y"])
     pct = np.where(c["polar"] >= 0.3, 100.0 * c["sog"] / np.maximum(c["polar"], 1e-9), np.nan)
-    points = PointTable(c["leg"].astype(np.int64), c["t"], c["x"], c["y"], lat, lon, c["sog"],
-                        c["cog"], c["tws"], c["twd"], c["twa"], c["polar"], pct, c["vmg"],
-                        c["loss"])
-    return TrackAnalysis(course, track, name, settings.router, seg, tuple(legs), points,
-                         sources[chosen[0]].field if chosen else wind)
+    points = PointTable(
+        c["leg"].astype(np.int64),
+        c["t"],
+        c["x"],
+        c["y"],
+        lat,
+        lon,
+        c["sog"],
+        c["cog"],
+        c["tws"],
+        c["twd"],
+        c["twa"],
+        c["polar"],
+        pct,
+        c["vmg"],
+        c["loss"],
+    )
+    return TrackAnalysis(
+        course,
+        track,
+        name,
+        settings.router,
+        seg,
+        tuple(legs),
+        points,
+        sources[chosen[0]].field if chosen else wind,
+    )
 
 
-def _leg_points(t: NDArray, x: NDArray, y: NDArray, a: Crossing, b: Crossing
-                ) -> tuple[NDArray, NDArray, NDArray]:
+def _leg_points(
+    t: NDArray, x: NDArray, y: NDArray, a: Crossing, b: Crossing
+) -> tuple[NDArray, NDArray, NDArray]:
     """The track points of one leg, with its start and end crossings (when known) as
     first and last; none inside a data gap an end lies in."""
     # the fixes strictly between the crossings; after a gap from its first fix on;
     # none when an end was never found (NaN)
-    inner = ((t > a.t) if a.known else (t >= a.t_hi)) & ((t < b.t) if b.known else
-                                                         (t <= b.t_lo))
+    inner = ((t > a.t) if a.known else (t >= a.t_hi)) & ((t < b.t) if b.known else (t <= b.t_lo))
     ka, kb = [a] if a.known else [], [b] if b.known else []
-    return (np.concatenate([[c.t for c in ka], t[inner], [c.t for c in kb]]),
-            np.concatenate([[c.x for c in ka], x[inner], [c.x for c in kb]]),
-            np.concatenate([[c.y for c in ka], y[inner], [c.y for c in kb]]))
+    return (
+        np.concatenate([[c.t for c in ka], t[inner], [c.t for c in kb]]),
+        np.concatenate([[c.x for c in ka], x[inner], [c.x for c in kb]]),
+        np.concatenate([[c.y for c in ka], y[inner], [c.y for c in kb]]),
+    )
 
 
-def _leg_source(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArray,
-                where: str, strict: bool = True) -> int:
+def _leg_source(
+    sources: Sequence[WindSource],
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    where: str,
+    strict: bool = True,
+) -> int:
     """Index of the first source covering a leg; the last one's own error if none does
     (with ``strict`` False, a leg of unknown time: the last source)."""
     k = first_covering(sources, t, x, y)
@@ -324,16 +415,21 @@ def _leg_source(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArra
         try:
             sources[-1].field.sample(t, x, y)
         except OutOfCoverageError as exc:
-            raise OutOfCoverageError(f"{where}: no wind covers the leg "
-                                     f"({', '.join(s.label for s in sources)}): {exc}"
-                                     ) from None
+            raise OutOfCoverageError(
+                f"{where}: no wind covers the leg ({', '.join(s.label for s in sources)}): {exc}"
+            ) from None
         raise OutOfCoverageError(f"{where}: no wind covers the leg") from None
     return k
 
 
-def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind: WindField,
-                   boat: Any, choice: str = "auto") -> tuple[dict[str, list[WindSource]],
-                                                             list[str]]:
+def analysis_winds(
+    course: Course,
+    tracks: Sequence[Track],
+    scenario: str,
+    wind: WindField,
+    boat: Any,
+    choice: str = "auto",
+) -> tuple[dict[str, list[WindSource]], list[str]]:
     """The candidate winds each boat is judged in, best first, and what was found.
 
     * ``measured``: a boat's own log (:func:`sailroute.wind.measured.sensor_from_track`),
@@ -387,15 +483,19 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
                 notes.append(f"{tr.name}: no measured wind ({exc})")
                 continue
             own[tr.name] = WindSource(
-                "measured", boat_wind(series[tr.name], frame),
+                "measured",
+                boat_wind(series[tr.name], frame),
                 f"measured on board ({series[tr.name].source})",
-                route_field=boat_wind(series[tr.name], frame, max_gap_s=BRIDGE_S))
+                route_field=boat_wind(series[tr.name], frame, max_gap_s=BRIDGE_S),
+            )
         if len(series) >= 2:
             fw = fleet_wind(list(series.values()), frame)
-            fleet = WindSource("fleet", fw.field,
-                               f"measured by the fleet ({len(series)} boats, biases removed)",
-                               route_field=fleet_wind(list(series.values()), frame,
-                                                      max_gap_s=BRIDGE_S).field)
+            fleet = WindSource(
+                "fleet",
+                fw.field,
+                f"measured by the fleet ({len(series)} boats, biases removed)",
+                route_field=fleet_wind(list(series.values()), frame, max_gap_s=BRIDGE_S).field,
+            )
             notes.extend(fw.notes)
             t0, t1 = course.start_epoch, course.start_epoch + course.time_limit_s
             parts = []
@@ -404,8 +504,9 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
                 x, y = track_xy(tr, frame)
                 parts.append((tr.t_s[m], x[m], y[m]))
             t_all, x_all, y_all = (np.concatenate(c) for c in zip(*parts, strict=True))
-            notes.append(fw.extrapolation_note(t_all, x_all, y_all,
-                                               "the tracks in the race window"))
+            notes.append(
+                fw.extrapolation_note(t_all, x_all, y_all, "the tracks in the race window")
+            )
     inferred: WindSource | None = None
     if choice == "inferred" or (choice == "auto" and len(series) < len(tracks)):
         from sailroute.analysis.infer_wind import infer_wind, summary
@@ -416,20 +517,29 @@ def analysis_winds(course: Course, tracks: Sequence[Track], scenario: str, wind:
         cy = float(np.mean([m.y for m in course.marks.values()]))
         tws0, twd0 = _wind_at(wind, np.array([gun]), np.array([cx]), np.array([cy]))
         try:
-            inf = infer_wind(list(tracks), frame, prior_twd_deg=float(twd0[0]), boat=boat,
-                             t0=gun - 60.0, t1=_race_end(course, tracks))
+            inf = infer_wind(
+                list(tracks),
+                frame,
+                prior_twd_deg=float(twd0[0]),
+                boat=boat,
+                t0=gun - 60.0,
+                t1=_race_end(course, tracks),
+            )
         except InputError as exc:
             if choice == "inferred":
                 raise
             notes.append(f"wind not inferred from the tracks: {exc}")
         else:
             # held at its ends: an optimal route may run past the last tack of the fleet
-            field = SpeedDirectionWind(wind, inf.field(frame, tws_ms=float(tws0[0]),
-                                                       clamp=True), "inferred wind")
+            field = SpeedDirectionWind(
+                wind, inf.field(frame, tws_ms=float(tws0[0]), clamp=True), "inferred wind"
+            )
             sm = summary(inf)
-            inferred = WindSource("inferred", field,
-                                  f"TWD inferred from {len(tracks)} track(s), TWS of "
-                                  f"scenario {scenario!r}")
+            inferred = WindSource(
+                "inferred",
+                field,
+                f"TWD inferred from {len(tracks)} track(s), TWS of scenario {scenario!r}",
+            )
             notes.append(f"inferred wind: {_summary_text(sm)}")
     out: dict[str, list[WindSource]] = {}
     for tr in tracks:
@@ -459,18 +569,30 @@ def _summary_text(sm: Mapping[str, Any]) -> str:
     """``infer_wind``'s summary as one line."""
     if sm.get("twd_mean_deg") is None:
         return "no direction"
-    text = (f"TWD {sm['twd_mean_deg']:.0f}° (range {sm['twd_range_deg']:.0f}°, shifts RMS "
-            f"{sm['twd_shift_rms_deg']:.1f}°, median sd {sm['twd_sd_median_deg']:.1f}°)")
+    text = (
+        f"TWD {sm['twd_mean_deg']:.0f}° (range {sm['twd_range_deg']:.0f}°, shifts RMS "
+        f"{sm['twd_shift_rms_deg']:.1f}°, median sd {sm['twd_sd_median_deg']:.1f}°)"
+    )
     if sm.get("tws_mean_ms") is not None:
-        text += (f"; TWS from the polar {sm['tws_mean_ms'] / KNOT:.1f} kn (not used: the "
-                 "scenario's speed is)")
+        text += (
+            f"; TWS from the polar {sm['tws_mean_ms'] / KNOT:.1f} kn (not used: the "
+            "scenario's speed is)"
+        )
     return text + f", {sm['t_start']} .. {sm['t_end']}"
 
 
-def _optimal_leg(course: Course, i: int, bounds: Sequence[Crossing],
-                 sources: Sequence[WindSource], k: int, points: tuple[NDArray, NDArray, NDArray],
-                 boat: Any, settings: RoutingSettings, target: Any,
-                 progress: Progress | None) -> tuple[LegResult, WindSource]:
+def _optimal_leg(
+    course: Course,
+    i: int,
+    bounds: Sequence[Crossing],
+    sources: Sequence[WindSource],
+    k: int,
+    points: tuple[NDArray, NDArray, NDArray],
+    boat: Any,
+    settings: RoutingSettings,
+    target: Any,
+    progress: Progress | None,
+) -> tuple[LegResult, WindSource]:
     """The optimal route of leg ``i`` from the boat's own leg start point and time.
 
     Routed in ``sources[k]``; when that wind ends before the optimal route does, in the
@@ -480,17 +602,26 @@ def _optimal_leg(course: Course, i: int, bounds: Sequence[Crossing],
     barrier = None
     if i > 0 and np.isfinite(bounds[i - 1].x):
         prev_start = (bounds[i - 1].x, bounds[i - 1].y)
-        barrier = target_barrier(leg_target(course, i - 1),
-                                 Start(prev_start, None, course.legs[i - 1].from_name),
-                                 settings.zone_m)
+        barrier = target_barrier(
+            leg_target(course, i - 1),
+            Start(prev_start, None, course.legs[i - 1].from_name),
+            settings.zone_m,
+        )
     spec = course.legs[i]
     start = Start((a.x, a.y), None, spec.from_name, barrier)
     if progress is not None:
         progress.start_leg(i, spec.label)
     while True:
         try:
-            opt = route_leg(start, target, a.t, sources[k].for_routing, boat, settings,
-                            progress=progress.update if progress is not None else None)
+            opt = route_leg(
+                start,
+                target,
+                a.t,
+                sources[k].for_routing,
+                boat,
+                settings,
+                progress=progress.update if progress is not None else None,
+            )
             if sources[k].route_field is not None:  # raises if the route crosses a hole
                 sources[k].field.sample(opt.track.t, opt.track.x, opt.track.y)
             break
@@ -504,10 +635,18 @@ def _optimal_leg(course: Course, i: int, bounds: Sequence[Crossing],
     return opt, sources[k]
 
 
-def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing],
-                 sources: Sequence[WindSource], k: int, boat: Any, settings: RoutingSettings,
-                 target: Any, centre: tuple[float, float], progress: Progress | None
-                 ) -> LegAnalysis:
+def _unknown_leg(
+    course: Course,
+    i: int,
+    bounds: Sequence[Crossing],
+    sources: Sequence[WindSource],
+    k: int,
+    boat: Any,
+    settings: RoutingSettings,
+    target: Any,
+    centre: tuple[float, float],
+    progress: Progress | None,
+) -> LegAnalysis:
     """A leg whose start or end time is unknown: no sailed time, loss or split; the
     optimal route when the start is known."""
     nan = float("nan")
@@ -521,20 +660,47 @@ def _unknown_leg(course: Course, i: int, bounds: Sequence[Crossing],
         found = first_covering(sources, *start_pt, skip=k - 1)
         k = len(sources) - 1 if found is None else found
         mode = leg_wind_mode(sources[k].field, a.t, (a.x, a.y), centre)
-        opt, source = _optimal_leg(course, i, bounds, sources, k, start_pt, boat, settings,
-                                   target, progress)
-    note = (b.note if not b.known else f"leg {i + 1} ({spec.label}) starts at an unknown time "
-            f"(leg {i} ended in a data gap): sailed time unknown")
+        opt, source = _optimal_leg(
+            course, i, bounds, sources, k, start_pt, boat, settings, target, progress
+        )
+    note = (
+        b.note
+        if not b.known
+        else f"leg {i + 1} ({spec.label}) starts at an unknown time "
+        f"(leg {i} ended in a data gap): sailed time unknown"
+    )
     return LegAnalysis(
-        index=i, label=spec.label, mode=mode, t_start=a.t, t_end=b.t, start_xy=(a.x, a.y),
-        end_xy=(b.x, b.y), detected=b.detected, sailed_time_s=nan,
-        optimal_time_s=opt.time_s if opt is not None else nan, loss_s=nan,
-        sailed_distance_m=nan, optimal_distance_m=opt.distance_m if opt is not None else nan,
-        sailed_tacks=0, sailed_gybes=0, optimal_tacks=opt.n_tacks if opt is not None else 0,
-        optimal_gybes=opt.n_gybes if opt is not None else 0, manoeuvres=(), mean_vmg_ms=nan,
-        mean_sog_ms=nan, mean_polar_pct=nan, split=LossSplit(nan, nan, nan, nan),
-        side_sailed="", side_optimal="", lateral_sailed_m=nan, lateral_optimal_m=nan,
-        optimal=opt, note=note, wind_source=source.kind, wind_label=source.label)
+        index=i,
+        label=spec.label,
+        mode=mode,
+        t_start=a.t,
+        t_end=b.t,
+        start_xy=(a.x, a.y),
+        end_xy=(b.x, b.y),
+        detected=b.detected,
+        sailed_time_s=nan,
+        optimal_time_s=opt.time_s if opt is not None else nan,
+        loss_s=nan,
+        sailed_distance_m=nan,
+        optimal_distance_m=opt.distance_m if opt is not None else nan,
+        sailed_tacks=0,
+        sailed_gybes=0,
+        optimal_tacks=opt.n_tacks if opt is not None else 0,
+        optimal_gybes=opt.n_gybes if opt is not None else 0,
+        manoeuvres=(),
+        mean_vmg_ms=nan,
+        mean_sog_ms=nan,
+        mean_polar_pct=nan,
+        split=LossSplit(nan, nan, nan, nan),
+        side_sailed="",
+        side_optimal="",
+        lateral_sailed_m=nan,
+        lateral_optimal_m=nan,
+        optimal=opt,
+        note=note,
+        wind_source=source.kind,
+        wind_label=source.label,
+    )
 
 
 def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
@@ -561,10 +727,19 @@ def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
         leg_rank = _ranks(times)
         pos = _ranks(elapsed)
         for k, a in enumerate(analyses):
-            rows.append({"leg": i + 1, "label": a.legs[i].label, "boat": a.track.name,
-                         "leg_time_s": times[k], "leg_rank": leg_rank[k],
-                         "elapsed_s": elapsed[k], "position": pos[k],
-                         "loss_s": a.legs[i].loss_s, "note": a.legs[i].note})
+            rows.append(
+                {
+                    "leg": i + 1,
+                    "label": a.legs[i].label,
+                    "boat": a.track.name,
+                    "leg_time_s": times[k],
+                    "leg_rank": leg_rank[k],
+                    "elapsed_s": elapsed[k],
+                    "position": pos[k],
+                    "loss_s": a.legs[i].loss_s,
+                    "note": a.legs[i].note,
+                }
+            )
     return rows
 
 
@@ -573,9 +748,16 @@ def fleet_reference(analyses: Sequence[TrackAnalysis], reference: Polar) -> Flee
     tracks analysed against ``reference``: their straight-line points' TWA and SOG/polar."""
     from sailroute.analysis.fleetpolar import fleet_polar, straight_ratios
 
-    samples = [straight_ratios(a.points.t, a.points.twa_deg, a.points.sog_ms, a.points.polar_ms,
-                               np.array([m.t for leg in a.legs for m in leg.manoeuvres]))
-               for a in analyses]
+    samples = [
+        straight_ratios(
+            a.points.t,
+            a.points.twa_deg,
+            a.points.sog_ms,
+            a.points.polar_ms,
+            np.array([m.t for leg in a.legs for m in leg.manoeuvres]),
+        )
+        for a in analyses
+    ]
     return fleet_polar(samples, reference, [a.track.name for a in analyses])
 
 
@@ -611,8 +793,9 @@ def parse_leg_times(text: str | None, n_legs: int) -> list[float | None] | None:
     return [None if p in ("-", "") else to_epoch(parse_time(p, "--leg-times")) for p in parts]
 
 
-def parse_boat_leg_times(items: str | Sequence[str] | None, boats: Sequence[str], n_legs: int
-                         ) -> dict[str, list[float | None] | None]:
+def parse_boat_leg_times(
+    items: str | Sequence[str] | None, boats: Sequence[str], n_legs: int
+) -> dict[str, list[float | None] | None]:
     """``--leg-times`` for one track (``T0,T1,...``) or per boat (``BOAT=T0,T1,...``, repeated).
 
     Parameters
@@ -643,12 +826,15 @@ def parse_boat_leg_times(items: str | Sequence[str] | None, boats: Sequence[str]
             if len(boats) > 1:
                 raise InputError(
                     f"--leg-times {item!r}: with several tracks name the boat, "
-                    f"BOAT=T0,T1,... (boats: {', '.join(boats)})")
+                    f"BOAT=T0,T1,... (boats: {', '.join(boats)})"
+                )
             boat, text = boats[0], item
         boat = boat.strip()
         if boat not in out:
-            raise InputError(f"--leg-times {item!r}: no track named {boat!r}; boats are "
-                             f"the track file names without extension: {', '.join(boats)}")
+            raise InputError(
+                f"--leg-times {item!r}: no track named {boat!r}; boats are "
+                f"the track file names without extension: {', '.join(boats)}"
+            )
         if boat in seen:
             raise InputError(f"--leg-times: boat {boat!r} given twice")
         seen.add(boat)
@@ -659,8 +845,9 @@ def parse_boat_leg_times(items: str | Sequence[str] | None, boats: Sequence[str]
     return out
 
 
-def load_and_analyze(course_path: str | Path, track_path: str | Path, scenario: str | None = None,
-                     **read_kw: Any) -> TrackAnalysis:
+def load_and_analyze(
+    course_path: str | Path, track_path: str | Path, scenario: str | None = None, **read_kw: Any
+) -> TrackAnalysis:
     """Convenience: load a course, read a track, analyse (the Python API in one call)."""
     course = load_course(course_path)
     return analyze_track(course, read_track(track_path, **read_kw), scenario)

@@ -74,13 +74,17 @@ class FleetPolar:
         """One line: the factors and their support."""
         parts = ", ".join(
             f"{b} x{f:.2f} ({n} pts{'' if n >= MIN_COUNT else ', too few: the others mean'})"
-            for b, f, n in zip(BANDS, self.factor, self.count, strict=True))
-        return (f"fleet-relative polar: {self.polar.name} scaled to P{self.percentile:.0f} of "
-                f"SOG/polar of {len(self.boats)} track(s): {parts}")
+            for b, f, n in zip(BANDS, self.factor, self.count, strict=True)
+        )
+        return (
+            f"fleet-relative polar: {self.polar.name} scaled to P{self.percentile:.0f} of "
+            f"SOG/polar of {len(self.boats)} track(s): {parts}"
+        )
 
 
-def band_factors(twa_deg: NDArray, ratio: NDArray, *, percentile: float = PERCENTILE,
-                 min_count: int = MIN_COUNT) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+def band_factors(
+    twa_deg: NDArray, ratio: NDArray, *, percentile: float = PERCENTILE, min_count: int = MIN_COUNT
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Upwind, reach and downwind percentiles of speed ratios.
 
     Parameters
@@ -110,18 +114,24 @@ def band_factors(twa_deg: NDArray, ratio: NDArray, *, percentile: float = PERCEN
     ok = np.isfinite(a) & np.isfinite(r) & (r > 0)
     band = np.digitize(a[ok], BOUNDARIES_DEG)  # 0 upwind, 1 reach, 2 downwind
     count = np.bincount(band, minlength=3).astype(np.int64)
-    factor = np.array([float(np.percentile(r[ok][band == k], percentile))
-                       if count[k] >= min_count else np.nan for k in range(3)])
+    factor = np.array(
+        [
+            float(np.percentile(r[ok][band == k], percentile)) if count[k] >= min_count else np.nan
+            for k in range(3)
+        ]
+    )
     if not np.isfinite(factor).any():
         raise InputError(
             f"fleet polar: no point of sail has {min_count} straight-line points "
             f"(upwind {count[0]}, reach {count[1]}, downwind {count[2]}); analyse more or "
-            "longer tracks, or judge against the course's polar (--reference course)")
+            "longer tracks, or judge against the course's polar (--reference course)"
+        )
     return np.where(np.isfinite(factor), factor, np.nanmean(factor)), count
 
 
-def straight_ratios(t: NDArray, twa_deg: NDArray, sog_ms: NDArray, polar_ms: NDArray,
-                    man_t: NDArray) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def straight_ratios(
+    t: NDArray, twa_deg: NDArray, sog_ms: NDArray, polar_ms: NDArray, man_t: NDArray
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """One track's straight-line points: their TWA [°] and SOG / polar [-].
 
     Parameters
@@ -138,9 +148,14 @@ def straight_ratios(t: NDArray, twa_deg: NDArray, sog_ms: NDArray, polar_ms: NDA
     return twa_deg[good], sog_ms[good] / polar_ms[good]
 
 
-def fleet_polar(samples: Sequence[tuple[NDArray, NDArray]], reference: Polar,
-                boats: Sequence[str], *, percentile: float = PERCENTILE,
-                min_count: int = MIN_COUNT) -> FleetPolar:
+def fleet_polar(
+    samples: Sequence[tuple[NDArray, NDArray]],
+    reference: Polar,
+    boats: Sequence[str],
+    *,
+    percentile: float = PERCENTILE,
+    min_count: int = MIN_COUNT,
+) -> FleetPolar:
     """The fleet-relative reference from the fleet's straight-line speed ratios.
 
     Parameters
@@ -164,10 +179,18 @@ def fleet_polar(samples: Sequence[tuple[NDArray, NDArray]], reference: Polar,
     twa = np.concatenate([np.empty(0), *(a for a, _ in samples)])
     ratio = np.concatenate([np.empty(0), *(r for _, r in samples)])
     factor, count = band_factors(twa, ratio, percentile=percentile, min_count=min_count)
-    polar = scale_polar(reference, *factor, max_factor=MAX_FACTOR, key="fleet polar"
-                        ).with_name(f"{reference.name} x fleet")
+    polar = scale_polar(reference, *factor, max_factor=MAX_FACTOR, key="fleet polar").with_name(
+        f"{reference.name} x fleet"
+    )
     return FleetPolar(polar, factor, count, percentile, tuple(boats))
 
 
-__all__ = ["MAX_FACTOR", "MIN_COUNT", "PERCENTILE", "FleetPolar", "band_factors",
-           "fleet_polar", "straight_ratios"]
+__all__ = [
+    "MAX_FACTOR",
+    "MIN_COUNT",
+    "PERCENTILE",
+    "FleetPolar",
+    "band_factors",
+    "fleet_polar",
+    "straight_ratios",
+]

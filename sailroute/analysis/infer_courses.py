@@ -52,8 +52,9 @@ AXIS_TIE: Final = 0.1
 that ``prior_twd_deg`` breaks (:func:`axis_near_prior`) [-]."""
 
 
-def _window_course(t: NDArray, x: NDArray, y: NDArray, half: float, turn: float
-                   ) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def _window_course(
+    t: NDArray, x: NDArray, y: NDArray, half: float, turn: float
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Course and speed of the displacement over ``[t - half, t + half]``, and the courses
     over ``[t - turn, t]`` and ``[t, t + turn]`` [°, m s⁻¹, °, °]."""
     xa, ya = np.interp(t - half, t, x), np.interp(t - half, t, y)
@@ -86,8 +87,9 @@ class _Points:
     weight: NDArray[np.float64]  # 1 / correlation inflation: sampling interval / CORR_S
 
 
-def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: float,
-                   min_speed_ms: float) -> tuple[_Points, list[str]]:
+def _steady_points(
+    tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: float, min_speed_ms: float
+) -> tuple[_Points, list[str]]:
     ts, cs, ss, bs, ws, notes = [], [], [], [], [], []
     for k, tr in enumerate(tracks):
         m = (tr.t_s >= t0 - COG_WINDOW_S) & (tr.t_s <= t1 + COG_WINDOW_S)
@@ -102,12 +104,18 @@ def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: fl
         slow = sog < min_speed_ms
         dt = float(np.median(np.diff(t)))
         big_gap = np.concatenate([[False], np.diff(t) > max(MAX_GAP_S, 2.5 * dt)])
-        ok = (~_near_any(t, (turn > TURN_DEG) | slow, PAD_S)
-              & ~_near_any(t, turn > ROUNDING_DEG, ROUNDING_PAD_S)
-              & ~_near_any(t, big_gap, COG_WINDOW_S) & (t >= t0) & (t <= t1))
+        ok = (
+            ~_near_any(t, (turn > TURN_DEG) | slow, PAD_S)
+            & ~_near_any(t, turn > ROUNDING_DEG, ROUNDING_PAD_S)
+            & ~_near_any(t, big_gap, COG_WINDOW_S)
+            & (t >= t0)
+            & (t <= t1)
+        )
         n_ok = int(ok.sum())
-        notes.append(f"{tr.name or k}: {n_ok} of {int(((t >= t0) & (t <= t1)).sum())} points "
-                     "steady (not turning, slow or near a gap)")
+        notes.append(
+            f"{tr.name or k}: {n_ok} of {int(((t >= t0) & (t <= t1)).sum())} points "
+            "steady (not turning, slow or near a gap)"
+        )
         ts.append(t[ok])
         cs.append(cog[ok])
         ss.append(sog[ok])
@@ -117,8 +125,13 @@ def _steady_points(tracks: Sequence[Track], frame: LocalFrame, t0: float, t1: fl
         return _Points(*(np.zeros(0),) * 3, np.zeros(0, np.int64), np.zeros(0)), notes
     t_all = np.concatenate(ts)
     o = np.argsort(t_all, kind="stable")  # time order across boats
-    return _Points(t_all[o], np.concatenate(cs)[o], np.concatenate(ss)[o],
-                   np.concatenate(bs)[o], np.concatenate(ws)[o]), notes
+    return _Points(
+        t_all[o],
+        np.concatenate(cs)[o],
+        np.concatenate(ss)[o],
+        np.concatenate(bs)[o],
+        np.concatenate(ws)[o],
+    ), notes
 
 
 def wind_axis_deg(cog_deg: NDArray, weights: NDArray | None = None) -> tuple[float, float]:
@@ -160,8 +173,9 @@ def _axis_scores(cog_deg: NDArray, weights: NDArray | None = None) -> NDArray[np
     return np.asarray(s[:180] + s[180:], dtype=float)
 
 
-def axis_near_prior(cog_deg: NDArray, prior_twd_deg: float, weights: NDArray | None = None,
-                    tie: float = AXIS_TIE) -> float:
+def axis_near_prior(
+    cog_deg: NDArray, prior_twd_deg: float, weights: NDArray | None = None, tie: float = AXIS_TIE
+) -> float:
     """The wind axis [°, in ``[0, 180)``] when the courses leave several nearly tied.
 
     Among the local maxima of the symmetry score within ``tie`` of the best (a club
@@ -181,16 +195,17 @@ def axis_near_prior(cog_deg: NDArray, prior_twd_deg: float, weights: NDArray | N
 
 def _course_histogram(cog_deg: NDArray, weights: NDArray | None = None) -> NDArray[np.float64]:
     """Courses in 1° bins (bin i holds [i, i + 1)), smoothed with a 3° Gaussian."""
-    h = np.bincount(np.floor(wrap360(cog_deg)).astype(int) % 360, weights=weights,
-                    minlength=360).astype(float)
+    h = np.bincount(
+        np.floor(wrap360(cog_deg)).astype(int) % 360, weights=weights, minlength=360
+    ).astype(float)
     k = np.arange(-10, 11)
     g = np.exp(-0.5 * (k / 3.0) ** 2)
-    return np.asarray(np.sum([np.roll(h, s) * w for s, w in zip(k, g, strict=True)], axis=0),
-                      dtype=float)
+    return np.asarray(
+        np.sum([np.roll(h, s) * w for s, w in zip(k, g, strict=True)], axis=0), dtype=float
+    )
 
 
-def half_separation_deg(cog_deg: NDArray, end_deg: float,
-                        weights: NDArray | None = None) -> float:
+def half_separation_deg(cog_deg: NDArray, end_deg: float, weights: NDArray | None = None) -> float:
     """Mean half-separation [°] of the courses symmetric about the direction ``end_deg``.
 
     The score-weighted mean of ``d`` in 0..70° of ``sum H(end + d) H(end − d)``: about the

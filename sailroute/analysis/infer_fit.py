@@ -64,19 +64,19 @@ RUN_GAMMA_DEG: Final = 12.0
 @dataclass(frozen=True)
 class _Fit:
     knots: NDArray[np.float64]
-    twd: NDArray[np.float64]        # unwrapped TWD at the knots [°]
-    alpha: NDArray[np.float64]      # per boat [°]
-    gamma: NDArray[np.float64]      # per boat [°]
+    twd: NDArray[np.float64]  # unwrapped TWD at the knots [°]
+    alpha: NDArray[np.float64]  # per boat [°]
+    gamma: NDArray[np.float64]  # per boat [°]
     alpha_sd: NDArray[np.float64]
     gamma_sd: NDArray[np.float64]
-    up: NDArray[np.bool_]           # per point: on an upwind board
-    used: NDArray[np.bool_]         # per point: on a board (up or down)
-    boat: NDArray[np.int64]         # per point: boat index
-    side: NDArray[np.float64]       # per point: +1 starboard, -1 port
-    obs: NDArray[np.float64]        # per point: its own TWD observation (unwrapped) [°]
-    w: NDArray[np.float64]          # per point: fit weight (1/sd^2 x robust x correlation)
-    msd: NDArray[np.float64]        # per point: model sd (UP/RUN/DOWN_MODEL_SD) [°]
-    sigma: tuple[float, float]      # residual sd upwind, downwind [°]
+    up: NDArray[np.bool_]  # per point: on an upwind board
+    used: NDArray[np.bool_]  # per point: on a board (up or down)
+    boat: NDArray[np.int64]  # per point: boat index
+    side: NDArray[np.float64]  # per point: +1 starboard, -1 port
+    obs: NDArray[np.float64]  # per point: its own TWD observation (unwrapped) [°]
+    w: NDArray[np.float64]  # per point: fit weight (1/sd^2 x robust x correlation)
+    msd: NDArray[np.float64]  # per point: model sd (UP/RUN/DOWN_MODEL_SD) [°]
+    sigma: tuple[float, float]  # residual sd upwind, downwind [°]
 
 
 def _basis(t: NDArray, knots: NDArray) -> tuple[NDArray, NDArray, NDArray]:
@@ -86,11 +86,20 @@ def _basis(t: NDArray, knots: NDArray) -> tuple[NDArray, NDArray, NDArray]:
     return j, 1.0 - f, f
 
 
-def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
-               alpha0: NDArray, gamma0: NDArray, alpha_prior_sd: float,
-               window_s: float, *, use_down: bool = True,
-               alpha_sd_fixed: NDArray | None = None,
-               gamma_prior_sd: NDArray | None = None) -> _Fit:
+def _joint_fit(
+    p: _Points,
+    n_boats: int,
+    knots: NDArray,
+    twd0: NDArray,
+    alpha0: NDArray,
+    gamma0: NDArray,
+    alpha_prior_sd: float,
+    window_s: float,
+    *,
+    use_down: bool = True,
+    alpha_sd_fixed: NDArray | None = None,
+    gamma_prior_sd: NDArray | None = None,
+) -> _Fit:
     """Fit TWD(t) at the knots and the boats' half-angles (module notes, step 3).
 
     ``use_down=False`` fits the upwind boards alone; ``alpha_sd_fixed`` holds the tacking
@@ -125,8 +134,11 @@ def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
             dn = a >= 180.0 - DOWN_OFF_DEG
         else:
             up = np.abs(a - alpha[p.boat]) <= BAND_DEG
-            dn = (np.abs((180.0 - a) - gamma[p.boat]) <= BAND_DEG + 5.0) if it else (
-                a >= 180.0 - DOWN_OFF_DEG)
+            dn = (
+                (np.abs((180.0 - a) - gamma[p.boat]) <= BAND_DEG + 5.0)
+                if it
+                else (a >= 180.0 - DOWN_OFF_DEG)
+            )
         if not use_down:
             dn = np.zeros_like(up)
         used = up | dn
@@ -137,18 +149,24 @@ def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
         coef = np.where(up, -side, side)
         msd = _model_sd(up, gamma[p.boat])
         run = ~up & (np.abs(gamma[p.boat]) < RUN_GAMMA_DEG)
-        wt = (robust * p.weight * used * np.where(run, RUN_WEIGHT, 1.0)
-              / (np.where(up, sig_up, sig_dn) ** 2 + msd**2))
+        wt = (
+            robust
+            * p.weight
+            * used
+            * np.where(run, RUN_WEIGHT, 1.0)
+            / (np.where(up, sig_up, sig_dn) ** 2 + msd**2)
+        )
         # normal equations by accumulation: 3 non-zeros per row
         idx = np.stack([j, j + 1, col], axis=1)
         val = np.stack([w0, w1, coef], axis=1)
         rows = (idx[:, :, None] * P + idx[:, None, :]).reshape(-1)
         prods = (val[:, :, None] * val[:, None, :] * wt[:, None, None]).reshape(-1)
-        N: NDArray[np.float64] = np.bincount(rows, weights=prods,
-                                             minlength=P * P).reshape(P, P).astype(float)
+        N: NDArray[np.float64] = (
+            np.bincount(rows, weights=prods, minlength=P * P).reshape(P, P).astype(float)
+        )
         b: NDArray[np.float64] = np.bincount(
-            idx.reshape(-1), weights=(val * (wt * y)[:, None]).reshape(-1),
-            minlength=P).astype(float)
+            idx.reshape(-1), weights=(val * (wt * y)[:, None]).reshape(-1), minlength=P
+        ).astype(float)
         # curvature penalty on the increments (bridges gaps; resolution ~ window_s)
         per_knot = np.bincount(j, weights=wt, minlength=J)
         rho = float(np.median(per_knot[per_knot > 0])) if (per_knot > 0).any() else 1.0
@@ -177,19 +195,33 @@ def _joint_fit(p: _Points, n_boats: int, knots: NDArray, twd0: NDArray,
         sc = np.where(up, sig_up, sig_dn)
         robust = np.minimum(1.0, 1.5 * sc / np.maximum(np.abs(r), 1e-9))
     cur = twd[j] * w0 + twd[j + 1] * w1
-    obs = cur + wrap180(np.where(up, p.cog + side * alpha[p.boat],
-                                 p.cog + 180.0 - side * gamma[p.boat]) - cur)
+    obs = cur + wrap180(
+        np.where(up, p.cog + side * alpha[p.boat], p.cog + 180.0 - side * gamma[p.boat]) - cur
+    )
     ia, ig = J + np.arange(K), J + K + np.arange(K)
     # the covariance of a weighted fit with weights 1/sigma^2 is in deg^2 already
     a_out = np.sqrt(par_var[:K]) if alpha_sd_fixed is None else alpha_sd_fixed
-    return _Fit(knots, twd, alpha, gamma, a_out,
-                np.sqrt(par_var[K:]), up & used, used, p.boat, side, obs, wt,
-                _model_sd(up, gamma[p.boat]),
-                (sig_up, sig_dn))
+    return _Fit(
+        knots,
+        twd,
+        alpha,
+        gamma,
+        a_out,
+        np.sqrt(par_var[K:]),
+        up & used,
+        used,
+        p.boat,
+        side,
+        obs,
+        wt,
+        _model_sd(up, gamma[p.boat]),
+        (sig_up, sig_dn),
+    )
 
 
-def _solve_bordered(N: NDArray, b: NDArray, J: int
-                    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _solve_bordered(
+    N: NDArray, b: NDArray, J: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Solve the normal equations ``N x = b`` whose knot block ``N[:J, :J]`` is banded
     (pentadiagonal: linear basis plus the second-difference penalty) and bordered by a few
     dense parameter rows, by the Schur complement in O(J); also the variances of the
@@ -212,16 +244,18 @@ def _solve_bordered(N: NDArray, b: NDArray, J: int
 
 
 def _model_sd(up: NDArray, gamma: NDArray) -> NDArray[np.float64]:
-    return np.where(up, UP_MODEL_SD, np.where(np.abs(gamma) < RUN_GAMMA_DEG, RUN_MODEL_SD,
-                                              DOWN_MODEL_SD))
+    return np.where(
+        up, UP_MODEL_SD, np.where(np.abs(gamma) < RUN_GAMMA_DEG, RUN_MODEL_SD, DOWN_MODEL_SD)
+    )
 
 
 def _mad(r: NDArray) -> float:
     return float(1.4826 * np.median(np.abs(r - np.median(r))))
 
 
-def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float,
-                  infl: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def _local_linear(
+    tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float, infl: NDArray
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     """Local-linear kernel regression of ``v(t)`` at ``tg`` (tricube, half-width ``h``).
 
     Parameters
@@ -275,8 +309,9 @@ def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float,
     lin = both & (det > 1e-9 * np.maximum(s0 * s2, 1e-300))
     # equivalent kernel l_i = kern_i (s2 - s1 dt_i) / det (local linear); else local mean
     with np.errstate(invalid="ignore", divide="ignore"):
-        lw = np.where(lin[:, None], kern * (s2[:, None] - s1[:, None] * dt) / det[:, None],
-                      kern / s0[:, None])
+        lw = np.where(
+            lin[:, None], kern * (s2[:, None] - s1[:, None] * dt) / det[:, None], kern / s0[:, None]
+        )
     vv = v[k]
     e = (lw * vv).sum(1)
     r = vv - e[:, None]
@@ -289,8 +324,9 @@ def _local_linear(tg: NDArray, t: NDArray, v: NDArray, w: NDArray, h: float,
     return est, var, n, mu2
 
 
-def _group_var(tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDArray
-               ) -> NDArray[np.float64]:
+def _group_var(
+    tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDArray
+) -> NDArray[np.float64]:
     """Variance [°²] at the grid times from errors shared by a boat's board.
 
     Two terms per boat and board (upwind, downwind), with ``f_i`` the point's share of the
@@ -311,8 +347,10 @@ def _group_var(tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDAr
     k = lo[:, None] + np.arange(width)[None, :]
     inside = k < hi[:, None]
     k = np.minimum(k, t.size - 1)
-    kern = np.where(inside, (1.0 - np.clip(np.abs(t[k] - tg[:, None]) / h, 0, 1) ** 3) ** 3,
-                    0.0) * w[k]
+    kern = (
+        np.where(inside, (1.0 - np.clip(np.abs(t[k] - tg[:, None]) / h, 0, 1) ** 3) ** 3, 0.0)
+        * w[k]
+    )
     f = kern / np.maximum(kern.sum(1), 1e-300)[:, None]
     for is_up, sds in ((True, fit.alpha_sd), (False, fit.gamma_sd)):
         for b, sd in enumerate(sds):

@@ -213,23 +213,31 @@ class InferredWind:
     method: str
     notes: tuple[str, ...] = ()
     half_angles_deg: Mapping[str, tuple[float, float]] = field(
-        default_factory=lambda: MappingProxyType({}))
+        default_factory=lambda: MappingProxyType({})
+    )
 
     def __post_init__(self) -> None:
         n = np.shape(self.t)
-        bad = [k for k in ("twd_deg", "twd_sd_deg", "tws_ms", "tws_sd_ms", "n_obs")
-               if np.shape(getattr(self, k)) != n]
+        bad = [
+            k
+            for k in ("twd_deg", "twd_sd_deg", "tws_ms", "tws_sd_ms", "n_obs")
+            if np.shape(getattr(self, k)) != n
+        ]
         if len(n) != 1 or bad:
-            raise InputError(f"InferredWind: {', '.join(bad) or 't'} must be 1-D arrays of the "
-                             f"length of t ({n}); build it with infer_wind")
+            raise InputError(
+                f"InferredWind: {', '.join(bad) or 't'} must be 1-D arrays of the "
+                f"length of t ({n}); build it with infer_wind"
+            )
         if not isinstance(self.half_angles_deg, MappingProxyType):
             raise TypeError(
                 "InferredWind.half_angles_deg must be a read-only mapping "
                 f"(types.MappingProxyType), got {type(self.half_angles_deg).__name__}; "
-                "pass MappingProxyType(dict(half_angles))")
+                "pass MappingProxyType(dict(half_angles))"
+            )
 
-    def field(self, frame: LocalFrame | None = None, tws_ms: float | None = None,
-              *, clamp: bool = False) -> InferredWindField:
+    def field(
+        self, frame: LocalFrame | None = None, tws_ms: float | None = None, *, clamp: bool = False
+    ) -> InferredWindField:
         """The inferred wind as a :class:`~sailroute.wind.base.WindField`.
 
         Uniform in space; TWD and TWS linear in time between the grid times with a
@@ -260,7 +268,8 @@ class InferredWind:
                 raise InputError(
                     f"inferred wind: TWS is unknown at {int(np.isnan(s).sum())} of {s.size} "
                     "grid times (it is inferred only with a polar); pass a fallback "
-                    "tws_ms=... (m/s, >= 0)")
+                    "tws_ms=... (m/s, >= 0)"
+                )
             s = np.where(np.isnan(s), float(tws_ms), s)
         d = _unwrap_deg(self.twd_deg[ok])
         return InferredWindField(self.t[ok].copy(), d, s, frame, clamp)
@@ -294,14 +303,15 @@ class InferredWindField:
     def coverage(self) -> Coverage:
         """All space; the inferred time span."""
         inf = float("inf")
-        return Coverage(float(self.times[0]), float(self.times[-1]), -inf, inf, -inf, inf,
-                        frame=self.frame)
+        return Coverage(
+            float(self.times[0]), float(self.times[-1]), -inf, inf, -inf, inf, frame=self.frame
+        )
 
-    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
-               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def sample(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s] and ``x, y`` [m] (broadcast)."""
-        t, x, y = prepare_points(self.coverage, t, x, y, clamp=self.clamp,
-                                 name="inferred wind")
+        t, x, y = prepare_points(self.coverage, t, x, y, clamp=self.clamp, name="inferred wind")
         d = np.interp(t, self.times, self.twd_unwrapped_deg)
         s = np.interp(t, self.times, self.tws_ms)
         u, v = wind_components(s, d)
@@ -330,8 +340,9 @@ def _invert_polar(boat: BoatModel, twa_deg: NDArray, sog_ms: NDArray) -> NDArray
     return np.where(ok, grid[ci - 1] + f * (grid[ci] - grid[ci - 1]), np.nan)
 
 
-def _gamma_priors(p: _Points, n_boats: int, twd_axis: float, default: float
-                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _gamma_priors(
+    p: _Points, n_boats: int, twd_axis: float, default: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Prior angle off dead downwind [°] per boat, and its sd.
 
     From each boat's downwind courses: their half-separation about the downwind end of the
@@ -360,16 +371,20 @@ def _upwind_end(p: _Points, cands: tuple[float, float]) -> tuple[float, str]:
     sep = [half_separation_deg(p.cog, c, p.weight) for c in cands]
     if np.all(np.isfinite(sep)) and abs(sep[0] - sep[1]) >= SEPARATION_MARGIN_DEG:
         k = int(np.argmax(sep))
-        return cands[k], (f"up/down from the boards' separation (no prior): {sep[k]:.0f}° "
-                          f"either side upwind, {sep[1 - k]:.0f}° downwind")
+        return cands[k], (
+            f"up/down from the boards' separation (no prior): {sep[k]:.0f}° "
+            f"either side upwind, {sep[1 - k]:.0f}° downwind"
+        )
     speeds = []
     for c in cands:
         a = np.abs(wrap180(c - p.cog))
         speeds.append(float(np.median(p.sog[a < 70])) if (a < 70).any() else np.inf)
     k = int(np.argmin(speeds))  # upwind: the slower boards
-    return cands[k], (f"up/down from speeds (no prior; boards {sep[0]:.0f}° and {sep[1]:.0f}° "
-                      f"either side): upwind boards {speeds[k] / KNOT:.1f} kn, "
-                      f"downwind {speeds[1 - k] / KNOT:.1f} kn")
+    return cands[k], (
+        f"up/down from speeds (no prior; boards {sep[0]:.0f}° and {sep[1]:.0f}° "
+        f"either side): upwind boards {speeds[k] / KNOT:.1f} kn, "
+        f"downwind {speeds[1 - k] / KNOT:.1f} kn"
+    )
 
 
 def _check_same_place(trs: Sequence[Track], frame: LocalFrame, t0: float, t1: float) -> None:
@@ -387,20 +402,31 @@ def _check_same_place(trs: Sequence[Track], frame: LocalFrame, t0: float, t1: fl
             raise InputError(
                 f"infer_wind: {na!r} and {nb!r} sailed {d / 1000:.1f} km apart in the time "
                 f"span (more than {MAX_APART_M / 1000:.0f} km): one wind does not fit boats of "
-                "different places; infer each race on its own tracks")
+                "different places; infer each race on its own tracks"
+            )
 
 
-def _check_inputs(tracks: Sequence[Track] | Track, step_s: float, window_s: float,
-                  prior: float | None, min_speed_ms: float) -> list[Track]:
+def _check_inputs(
+    tracks: Sequence[Track] | Track,
+    step_s: float,
+    window_s: float,
+    prior: float | None,
+    min_speed_ms: float,
+) -> list[Track]:
     trs = [tracks] if isinstance(tracks, Track) else list(tracks)
     if not trs:
         raise InputError("infer_wind: no tracks given; pass one or more Track objects")
     for i, tr in enumerate(trs):
         if not isinstance(tr, Track):
-            raise InputError(f"infer_wind: item {i} is a {type(tr).__name__}, not a Track; "
-                             "read tracks with sailroute.track.read_track")
-    for name, v, unit in (("step_s", step_s, "s"), ("window_s", window_s, "s"),
-                          ("min_speed_ms", min_speed_ms, "m/s")):
+            raise InputError(
+                f"infer_wind: item {i} is a {type(tr).__name__}, not a Track; "
+                "read tracks with sailroute.track.read_track"
+            )
+    for name, v, unit in (
+        ("step_s", step_s, "s"),
+        ("window_s", window_s, "s"),
+        ("min_speed_ms", min_speed_ms, "m/s"),
+    ):
         if not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
             raise InputError(f"infer_wind: {name} must be a number > 0 {unit}, got {v!r}")
     if prior is not None and not np.isfinite(prior):
@@ -464,13 +490,16 @@ def infer_wind(
     t0 = ta if t0 is None else float(t0)
     t1 = tb if t1 is None else float(t1)
     if not t1 > t0:
-        raise InputError(f"infer_wind: empty time span {iso(t0)} .. {iso(t1)}; "
-                         "give t0 < t1 within the tracks' times")
+        raise InputError(
+            f"infer_wind: empty time span {iso(t0)} .. {iso(t1)}; "
+            "give t0 < t1 within the tracks' times"
+        )
     if t1 - t0 > MAX_SPAN_S:
         raise InputError(
             f"infer_wind: the time span {iso(t0)} .. {iso(t1)} is {(t1 - t0) / 3600:.1f} h, "
             f"more than {MAX_SPAN_S / 3600:.0f} h (tracks of different days?); infer one race "
-            "at a time: give t0 and t1, or the tracks of one race")
+            "at a time: give t0 and t1, or the tracks of one race"
+        )
     _check_same_place(trs, frame, t0, t1)
     names = [tr.name or f"track {i + 1}" for i, tr in enumerate(trs)]
     p, notes = _steady_points(trs, frame, t0, t1, min_speed_ms)
@@ -478,15 +507,18 @@ def infer_wind(
         raise InputError(
             f"infer_wind: only {p.t.size} steady points (faster than {min_speed_ms} m/s, "
             f"not turning) in {iso(t0)} .. {iso(t1)}; need at least 60: give longer tracks "
-            "or the race's time span")
+            "or the race's time span"
+        )
     # 1. the axis and which end is upwind
     axis, strength = wind_axis_deg(p.cog, p.weight)
     if prior_twd_deg is not None:
         tied = axis_near_prior(p.cog, float(prior_twd_deg), p.weight)
         if tied != axis:
-            notes.append(f"the tracks' courses are nearly as symmetric about {tied:.0f}° as "
-                         f"about {axis:.0f}° (within {100 * AXIS_TIE:.0f} %): the prior "
-                         "decides")
+            notes.append(
+                f"the tracks' courses are nearly as symmetric about {tied:.0f}° as "
+                f"about {axis:.0f}° (within {100 * AXIS_TIE:.0f} %): the prior "
+                "decides"
+            )
             axis = tied
     cands = (axis, axis + 180.0)
     if prior_twd_deg is not None:
@@ -495,8 +527,10 @@ def infer_wind(
         prior = float(wrap360(prior_twd_deg))
         how = f"up/down from the prior TWD {prior:.0f}° (tracks' axis {off:+.0f}° off it)"
         if abs(off) > 60.0:
-            notes.append(f"the tracks' wind axis lies {off:+.0f}° from the prior "
-                         f"{prior:.0f}°: check the prior")
+            notes.append(
+                f"the tracks' wind axis lies {off:+.0f}° from the prior "
+                f"{prior:.0f}°: check the prior"
+            )
     else:
         twd_axis, how = _upwind_end(p, cands)
     notes.append(f"wind axis {wrap360(twd_axis):.0f}° (symmetry contrast {strength:.2f}); {how}")
@@ -513,12 +547,30 @@ def infer_wind(
     # upwind boards alone give TWD and the tacking half-angles; the downwind boards are
     # then fitted with those held (a running boat steers for the mark within ~10° of dead
     # downwind, which would otherwise pull the half-angles and damp the shifts)
-    fit_up = _joint_fit(p, K, knots, np.full(knots.size, float(twd_axis)),
-                        np.full(K, a0), np.full(K, g0), a_sd, window_s, use_down=False)
+    fit_up = _joint_fit(
+        p,
+        K,
+        knots,
+        np.full(knots.size, float(twd_axis)),
+        np.full(K, a0),
+        np.full(K, g0),
+        a_sd,
+        window_s,
+        use_down=False,
+    )
     g0s, g_sd = _gamma_priors(p, K, float(twd_axis), g0)
-    fit = _joint_fit(p, K, knots, fit_up.twd, fit_up.alpha, g0s, a_sd, window_s,
-                     gamma_prior_sd=g_sd,
-                     alpha_sd_fixed=fit_up.alpha_sd)
+    fit = _joint_fit(
+        p,
+        K,
+        knots,
+        fit_up.twd,
+        fit_up.alpha,
+        g0s,
+        a_sd,
+        window_s,
+        gamma_prior_sd=g_sd,
+        alpha_sd_fixed=fit_up.alpha_sd,
+    )
     n_up, n_dn = int(fit.up.sum()), int((fit.used & ~fit.up).sum())
     n_stbd = int((fit_up.up & (fit_up.side > 0)).sum())
     n_port = int((fit_up.up & (fit_up.side < 0)).sum())
@@ -527,12 +579,14 @@ def infer_wind(
             f"infer_wind: no upwind boards with the wind from {wrap360(twd_axis):.0f}° "
             f"({how}), but {n_dn} points on downwind boards: the wind more likely comes from "
             f"the other end of the axis, {wrap360(twd_axis + 180.0):.0f}°; check "
-            "prior_twd_deg")
+            "prior_twd_deg"
+        )
     if n_up + n_dn < 60 or min(n_stbd, n_port) < MIN_BOARD_POINTS:
         raise InputError(
             f"infer_wind: {n_stbd} starboard and {n_port} port upwind points, {n_dn} downwind "
             f"(need {MIN_BOARD_POINTS} on each upwind board): the wind cannot be told from "
-            "one course; give a span with at least one beat sailed on both tacks")
+            "one course; give a span with at least one beat sailed on both tacks"
+        )
     # 3. the output grid
     tg = np.arange(t0, t1 + 1e-6, step_s)
     h = 0.5 * window_s
@@ -543,8 +597,7 @@ def infer_wind(
     # half-angle uncertainty: imbalance of boards within the window
     ang_var = _group_var(tg, p.t[m], wgt, h, fit, m)
     # smoothing bias from the fitted curvature
-    curv = np.interp(tg, fit.knots[1:-1],
-                     np.diff(fit.twd, 2) / (fit.knots[1] - fit.knots[0]) ** 2)
+    curv = np.interp(tg, fit.knots[1:-1], np.diff(fit.twd, 2) / (fit.knots[1] - fit.knots[0]) ** 2)
     bias = 0.5 * curv * np.nan_to_num(mu2)
     sd_all = np.sqrt(var + ang_var + bias**2)
     secs = _seconds_in_window(tg, p.t[m], h, p.weight[m])
@@ -560,48 +613,60 @@ def infer_wind(
         s_pt = _invert_polar(boat, twa, p.sog)
         ok = m & np.isfinite(s_pt)
         if ok.sum() >= 30:
-            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h,
-                                         1.0 / p.weight[ok])
+            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h, 1.0 / p.weight[ok])
             sec2 = _seconds_in_window(tg, p.t[ok], h, p.weight[ok])
             good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
             tws = np.where(good, np.maximum(e2, 0.0), np.nan)
             tws_sd = np.where(good, np.sqrt(v2), np.nan)
             s_med = float(np.nanmedian(tws)) if np.isfinite(tws).any() else float("nan")
             up_pol = boat.vmg_angles_deg(s_med)[0] if np.isfinite(s_med) else float("nan")
-            notes.append(f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which "
-                         f"it sails the observed speeds (median {s_med / KNOT:.1f} kn); check: "
-                         f"its best-VMG upwind angle there is {up_pol:.1f}°, the boats' "
-                         "tacking half-angles " + ", ".join(f"{a:.1f}°" for a in fit.alpha))
+            notes.append(
+                f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which "
+                f"it sails the observed speeds (median {s_med / KNOT:.1f} kn); check: "
+                f"its best-VMG upwind angle there is {up_pol:.1f}°, the boats' "
+                "tacking half-angles " + ", ".join(f"{a:.1f}°" for a in fit.alpha)
+            )
         else:
             notes.append("TWS not inferred: too few points within the polar's speed range")
     half = {names[k]: (float(fit.alpha[k]), float(180.0 - fit.gamma[k])) for k in range(K)}
     for k in range(K):
         nk_up = int((fit.up & (p.boat == k)).sum())
         nk_dn = int((fit.used & ~fit.up & (p.boat == k)).sum())
-        down = (f"runs (downwind held at 180°, {RUN_WEIGHT:g} weight)"
-                if abs(fit.gamma[k]) < RUN_GAMMA_DEG and fit.gamma_sd[k] < 0.01 else
-                f"gybing half-angle {180.0 - fit.gamma[k]:.1f} ± {fit.gamma_sd[k]:.1f}°")
-        weak = (f" (weakly determined by the track: leans on its prior {a0:.0f}° ± "
-                f"{a_sd:.0f}°{', the polar' if boat is not None else ''})"
-                if fit.alpha_sd[k] > 0.5 * a_sd else "")
-        notes.append(f"{names[k]}: tacking half-angle {fit.alpha[k]:.1f} ± "
-                     f"{fit.alpha_sd[k]:.1f}°{weak}, {down} ({nk_up} upwind, {nk_dn} downwind "
-                     "points)")
-    method = (f"inferred from {K} track(s): {n_up} upwind and {n_dn} downwind board points "
-              f"(course ± fitted half-angles), window {window_s:.0f} s, "
-              f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
-              + ("; TWS from the polar" if boat is not None else "; TWS not inferred (no polar)"))
-    return InferredWind(tg, twd, sd, tws, tws_sd, n.astype(np.int64), method, tuple(notes),
-                        MappingProxyType(half))
+        down = (
+            f"runs (downwind held at 180°, {RUN_WEIGHT:g} weight)"
+            if abs(fit.gamma[k]) < RUN_GAMMA_DEG and fit.gamma_sd[k] < 0.01
+            else f"gybing half-angle {180.0 - fit.gamma[k]:.1f} ± {fit.gamma_sd[k]:.1f}°"
+        )
+        weak = (
+            f" (weakly determined by the track: leans on its prior {a0:.0f}° ± "
+            f"{a_sd:.0f}°{', the polar' if boat is not None else ''})"
+            if fit.alpha_sd[k] > 0.5 * a_sd
+            else ""
+        )
+        notes.append(
+            f"{names[k]}: tacking half-angle {fit.alpha[k]:.1f} ± "
+            f"{fit.alpha_sd[k]:.1f}°{weak}, {down} ({nk_up} upwind, {nk_dn} downwind "
+            "points)"
+        )
+    method = (
+        f"inferred from {K} track(s): {n_up} upwind and {n_dn} downwind board points "
+        f"(course ± fitted half-angles), window {window_s:.0f} s, "
+        f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
+        + ("; TWS from the polar" if boat is not None else "; TWS not inferred (no polar)")
+    )
+    return InferredWind(
+        tg, twd, sd, tws, tws_sd, n.astype(np.int64), method, tuple(notes), MappingProxyType(half)
+    )
 
 
-def _seconds_in_window(tg: NDArray, t: NDArray, h: float, weight: NDArray
-                       ) -> NDArray[np.float64]:
+def _seconds_in_window(tg: NDArray, t: NDArray, h: float, weight: NDArray) -> NDArray[np.float64]:
     """Seconds of steady track within ``tg ± h``: each point stands for its sampling
     interval, up to ``CORR_S`` (``weight * CORR_S``); ``t`` sorted."""
     c = np.concatenate([[0.0], np.cumsum(weight * CORR_S)])
-    return np.asarray(c[np.searchsorted(t, tg + h, side="right")]
-                      - c[np.searchsorted(t, tg - h, side="left")], dtype=float)
+    return np.asarray(
+        c[np.searchsorted(t, tg + h, side="right")] - c[np.searchsorted(t, tg - h, side="left")],
+        dtype=float,
+    )
 
 
 def summary(inferred: InferredWind) -> dict[str, Any]:
@@ -624,10 +689,22 @@ def summary(inferred: InferredWind) -> dict[str, Any]:
     ok = np.isfinite(inferred.twd_deg)
     out: dict[str, Any] = {"n_grid": int(ok.sum()), "method": inferred.method}
     if not ok.any():
-        return out | {k: None for k in ("twd_mean_deg", "twd_min_deg", "twd_max_deg",
-                                          "twd_range_deg", "twd_shift_rms_deg",
-                                          "twd_sd_median_deg", "tws_mean_ms", "tws_min_ms",
-                                          "tws_max_ms", "t_start", "t_end")}
+        return out | {
+            k: None
+            for k in (
+                "twd_mean_deg",
+                "twd_min_deg",
+                "twd_max_deg",
+                "twd_range_deg",
+                "twd_shift_rms_deg",
+                "twd_sd_median_deg",
+                "tws_mean_ms",
+                "tws_min_ms",
+                "tws_max_ms",
+                "t_start",
+                "t_end",
+            )
+        }
     d = inferred.twd_deg[ok]
     mean = circular_mean_deg(d)
     dev = wrap180(d - mean)

@@ -63,16 +63,18 @@ class LossSplit:
     route: float
 
 
-def axis_progress(x: NDArray, y: NDArray, a: tuple[float, float], b: tuple[float, float]
-                  ) -> NDArray[np.float64]:
+def axis_progress(
+    x: NDArray, y: NDArray, a: tuple[float, float], b: tuple[float, float]
+) -> NDArray[np.float64]:
     """Progress [m] along the axis from ``a`` to ``b`` (projection of ``(x, y) − a``)."""
     ux, uy = b[0] - a[0], b[1] - a[1]
     n = float(np.hypot(ux, uy)) or 1.0
     return ((np.asarray(x) - a[0]) * ux + (np.asarray(y) - a[1]) * uy) / n
 
 
-def lateral_offset(x: NDArray, y: NDArray, a: tuple[float, float], b: tuple[float, float]
-                   ) -> NDArray[np.float64]:
+def lateral_offset(
+    x: NDArray, y: NDArray, a: tuple[float, float], b: tuple[float, float]
+) -> NDArray[np.float64]:
     """Signed distance [m] from the axis ``a → b``: + right of it looking from ``a`` to ``b``."""
     ux, uy = b[0] - a[0], b[1] - a[1]
     n = float(np.hypot(ux, uy)) or 1.0
@@ -111,7 +113,11 @@ def manoeuvre_mask(t: NDArray, man_t: NDArray) -> NDArray[np.bool_]:
 
 
 def split_loss(
-    t: NDArray, progress_m: NDArray, ratio: NDArray, man_t: NDArray, loss_s: float,
+    t: NDArray,
+    progress_m: NDArray,
+    ratio: NDArray,
+    man_t: NDArray,
+    loss_s: float,
     optimal_penalty_s: float,
 ) -> LossSplit:
     """Decompose one leg's loss (see the module notes).
@@ -152,8 +158,7 @@ def split_loss(
     return LossSplit(float(loss_s), float(lm), lv, float(loss_s) - float(lm) - lv)
 
 
-def window_costs(dt: NDArray, dprog: NDArray, win: NDArray, rate: float
-                 ) -> NDArray[np.float64]:
+def window_costs(dt: NDArray, dprog: NDArray, win: NDArray, rate: float) -> NDArray[np.float64]:
     """Cost [s] of each manoeuvre window: ``W − P / v̄``, at least 0.
 
     Parameters
@@ -186,8 +191,9 @@ def window_costs(dt: NDArray, dprog: NDArray, win: NDArray, rate: float
     return np.maximum(cost, 0.0)
 
 
-def progress_loss(t_rel: NDArray, progress_m: NDArray, t_rel_opt: NDArray,
-                  progress_opt_m: NDArray) -> NDArray[np.float64]:
+def progress_loss(
+    t_rel: NDArray, progress_m: NDArray, t_rel_opt: NDArray, progress_opt_m: NDArray
+) -> NDArray[np.float64]:
     """Loss [s] at each sailed point against the optimal route, by progress along the axis.
 
     ``t_rel − τ_o(p)``, with ``τ_o`` the first time the optimal route reached progress

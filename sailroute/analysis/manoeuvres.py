@@ -58,8 +58,9 @@ class SailedManoeuvre:
     index: int
 
 
-def smooth_cog(t: NDArray, vx: NDArray, vy: NDArray, window_s: float = SMOOTH_S
-               ) -> NDArray[np.float64]:
+def smooth_cog(
+    t: NDArray, vx: NDArray, vy: NDArray, window_s: float = SMOOTH_S
+) -> NDArray[np.float64]:
     """COG [°] of the velocity averaged over ``±window_s/2`` around each point."""
     t = np.asarray(t, float)
     if window_s <= 0 or t.size < 3:
@@ -71,8 +72,14 @@ def smooth_cog(t: NDArray, vx: NDArray, vy: NDArray, window_s: float = SMOOTH_S
     return bearing_deg(cx[hi] - cx[lo], cy[hi] - cy[lo])
 
 
-def sides(t: NDArray, twa_deg: NDArray, sog_ms: NDArray, *, hold_s: float = HOLD_S,
-          min_speed_ms: float = MIN_SPEED_MS) -> NDArray[np.int8]:
+def sides(
+    t: NDArray,
+    twa_deg: NDArray,
+    sog_ms: NDArray,
+    *,
+    hold_s: float = HOLD_S,
+    min_speed_ms: float = MIN_SPEED_MS,
+) -> NDArray[np.int8]:
     """Cleaned side (+1 starboard, −1 port) at each point (see the module notes)."""
     s = np.where(np.asarray(twa_deg) >= 0, 1, -1).astype(np.int8)
     slow = np.asarray(sog_ms) < min_speed_ms
@@ -106,10 +113,16 @@ def _mean_course(cog_deg: NDArray, sel: NDArray | slice) -> float:
     return float(np.degrees(np.arctan2(np.sin(r).sum(), np.cos(r).sum())))
 
 
-def find_sailed_manoeuvres(t: NDArray, twd_deg: NDArray, cog_deg: NDArray, sog_ms: NDArray,
-                           *, hold_s: float = HOLD_S, min_speed_ms: float = MIN_SPEED_MS,
-                           min_turn_deg: float = MIN_TURN_DEG
-                           ) -> tuple[tuple[SailedManoeuvre, ...], NDArray[np.float64]]:
+def find_sailed_manoeuvres(
+    t: NDArray,
+    twd_deg: NDArray,
+    cog_deg: NDArray,
+    sog_ms: NDArray,
+    *,
+    hold_s: float = HOLD_S,
+    min_speed_ms: float = MIN_SPEED_MS,
+    min_turn_deg: float = MIN_TURN_DEG,
+) -> tuple[tuple[SailedManoeuvre, ...], NDArray[np.float64]]:
     """Tacks and gybes of a track.
 
     Parameters

@@ -216,8 +216,15 @@ class Segmentation:
         return (*self.start.notes, *(c.note for c in self.ends if c.note))
 
 
-def _crossings(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_after: float,
-               gap_s: float = math.inf, t_before: float = math.inf) -> list[Crossing]:
+def _crossings(
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    geom: TargetGeometry,
+    t_after: float,
+    gap_s: float = math.inf,
+    t_before: float = math.inf,
+) -> list[Crossing]:
     """Every forward crossing of ``geom`` by the polyline after ``t_after`` (and before
     ``t_before``), in time order.
 
@@ -237,9 +244,18 @@ def _crossings(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_after
         t0, t1 = float(ts[k]), float(ts[k + 1])
         if t1 - t0 > gap_s:
             if t1 > t_after and t0 < t_before:
-                out.append(Crossing(math.nan, cx, cy, gap=(t0, t1), note=(
-                    f"{geom.name!r} crossed inside a data gap of {t1 - t0:.0f} s "
-                    f"({iso(t0)} .. {iso(t1)}, longer than {gap_s:.0f} s): time unknown")))
+                out.append(
+                    Crossing(
+                        math.nan,
+                        cx,
+                        cy,
+                        gap=(t0, t1),
+                        note=(
+                            f"{geom.name!r} crossed inside a data gap of {t1 - t0:.0f} s "
+                            f"({iso(t0)} .. {iso(t1)}, longer than {gap_s:.0f} s): time unknown"
+                        ),
+                    )
+                )
             continue
         tc = t0 + float(s[k]) * (t1 - t0)
         if t_after <= tc <= t_before:
@@ -251,9 +267,13 @@ def _extended(geom: TargetGeometry, margin: float) -> TargetGeometry:
     ex, ey = geom.b[0] - geom.a[0], geom.b[1] - geom.a[1]
     n = math.hypot(ex, ey)
     ux, uy = ex / n, ey / n
-    return TargetGeometry((geom.a[0] - margin * ux, geom.a[1] - margin * uy),
-                          (geom.b[0] + margin * ux, geom.b[1] + margin * uy),
-                          geom.normal, geom.kind, geom.name)
+    return TargetGeometry(
+        (geom.a[0] - margin * ux, geom.a[1] - margin * uy),
+        (geom.b[0] + margin * ux, geom.b[1] + margin * uy),
+        geom.normal,
+        geom.kind,
+        geom.name,
+    )
 
 
 def start_geometry(course: Course, detect_m: float = DETECT_M) -> TargetGeometry:
@@ -274,8 +294,9 @@ def start_geometry(course: Course, detect_m: float = DETECT_M) -> TargetGeometry
         return TargetGeometry(a, b, (math.sin(th), math.cos(th)), "line", start.name)
     # crossed from the side away from the first target: the "finish" geometry of a
     # leg that starts at the first target
-    g = target_geometry(Target("line", start.a, start.b, None, name=start.name),
-                        Start((tc[0], tc[1]), None))
+    g = target_geometry(
+        Target("line", start.a, start.b, None, name=start.name), Start((tc[0], tc[1]), None)
+    )
     return TargetGeometry(g.a, g.b, (-g.normal[0], -g.normal[1]), "line", start.name)
 
 
@@ -289,13 +310,16 @@ def leg_target(course: Course, i: int) -> Target:
     return target
 
 
-def detection_geometry(course: Course, i: int, from_xy: tuple[float, float],
-                       detect_m: float = DETECT_M, line_margin_m: float = LINE_MARGIN_M
-                       ) -> TargetGeometry:
+def detection_geometry(
+    course: Course,
+    i: int,
+    from_xy: tuple[float, float],
+    detect_m: float = DETECT_M,
+    line_margin_m: float = LINE_MARGIN_M,
+) -> TargetGeometry:
     """Crossing geometry of leg ``i``'s target for a leg that starts at ``from_xy`` [m]."""
     target = leg_target(course, i)
-    geom = target_geometry(target, Start(from_xy, None, course.legs[i].from_name),
-                           zone_m=detect_m)
+    geom = target_geometry(target, Start(from_xy, None, course.legs[i].from_name), zone_m=detect_m)
     if target.kind != "mark":
         return _extended(geom, line_margin_m)
     return _behind_mark(geom)
@@ -327,8 +351,16 @@ def turn_deg(x: NDArray, y: NDArray) -> float:
     return float(np.sum(wrap180(np.diff(h)))) if h.size > 1 else 0.0
 
 
-def _not_found(course: Course, i: int, t: NDArray, x: NDArray, y: NDArray, t_from: float,
-               where: str, detect_m: float) -> InputError:
+def _not_found(
+    course: Course,
+    i: int,
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    t_from: float,
+    where: str,
+    detect_m: float,
+) -> InputError:
     """The error for a leg whose target is never crossed (wrong side, or never reached)."""
     leg = course.legs[i]
     feat = course.feature(leg.to_name)
@@ -337,16 +369,19 @@ def _not_found(course: Course, i: int, t: NDArray, x: NDArray, y: NDArray, t_fro
     d = np.hypot(x[m] - cx, y[m] - cy)
     k = int(np.argmin(d)) if d.size else 0
     tq = t[m][k] if d.size else t_from
-    how = ("Check the mark positions and the leg order in the course file, or give the leg "
-           "times explicitly (--leg-times)")
+    how = (
+        "Check the mark positions and the leg order in the course file, or give the leg "
+        "times explicitly (--leg-times)"
+    )
     if isinstance(feat, Mark) and leg.rounding is not None and d.size and d[k] <= detect_m:
         # came close: which way did it go round?
         # the pass around the closest approach: the contiguous run within 2 detect_m
         far = d > 2.0 * detect_m
         before = np.flatnonzero(far[:k])
         after = np.flatnonzero(far[k:])
-        seg = slice(int(before[-1]) + 1 if before.size else 0,
-                    k + int(after[0]) if after.size else d.size)
+        seg = slice(
+            int(before[-1]) + 1 if before.size else 0, k + int(after[0]) if after.size else d.size
+        )
         turn = turn_deg(x[m][seg], y[m][seg])
         went = "port" if turn < 0 else "starboard"
         if went != leg.rounding and abs(turn) >= 90.0:
@@ -381,14 +416,21 @@ def _segment_offset(geom: TargetGeometry, px: float, py: float) -> tuple[float, 
 
 
 def _reversed(geom: TargetGeometry) -> TargetGeometry:
-    return TargetGeometry(geom.a, geom.b, (-geom.normal[0], -geom.normal[1]), geom.kind,
-                          geom.name)
+    return TargetGeometry(geom.a, geom.b, (-geom.normal[0], -geom.normal[1]), geom.kind, geom.name)
 
 
-def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
-               given: float | None = None, detect_m: float = DETECT_M,
-               line_margin_m: float = LINE_MARGIN_M, gap_s: float = math.inf,
-               where: str = "track") -> StartReport:
+def find_start(
+    course: Course,
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    *,
+    given: float | None = None,
+    detect_m: float = DETECT_M,
+    line_margin_m: float = LINE_MARGIN_M,
+    gap_s: float = math.inf,
+    where: str = "track",
+) -> StartReport:
     """The start: when and where the boat started, and how (late, over early, off the line).
 
     * On the pre-start side at the gun: the first crossing of the start line after the
@@ -416,8 +458,11 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
     abreast = 0.0 <= _segment_offset(wide, gx, gy)[0] <= 1.0
     over = t[0] <= gun <= t[-1] and abreast and _side(sg, gx, gy) > 0
     feat0 = course.feature(course.legs[0].from_name)
-    line = (sg if isinstance(feat0, Mark) else
-            TargetGeometry(feat0.a.xy, feat0.b.xy, sg.normal, "line", sg.name))
+    line = (
+        sg
+        if isinstance(feat0, Mark)
+        else TargetGeometry(feat0.a.xy, feat0.b.xy, sg.normal, "line", sg.name)
+    )
     notes: list[str] = []
     ocs: float | None = None
     returned = on_time = False
@@ -427,33 +472,45 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
         notes.append(f"start time given: {iso(given)}")
     else:
         if t[-1] < gun:
-            raise InputError(f"{where}: the track ends at {iso(t[-1])}, before the start "
-                             f"signal {iso(gun)}; is it the right track and day?")
+            raise InputError(
+                f"{where}: the track ends at {iso(t[-1])}, before the start "
+                f"signal {iso(gun)}; is it the right track and day?"
+            )
         after = gun
-        early = [c for c in _crossings(t, x, y, wide, t[0], gap_s, gun) if c.known] \
-            if over else []
+        early = [c for c in _crossings(t, x, y, wide, t[0], gap_s, gun) if c.known] if over else []
         on_time = bool(early) and gun - early[-1].t <= OCS_MIN_S
         if over and not on_time:
-            back = [c for c in _crossings(t, x, y, _reversed(wide), gun, gap_s,
-                                          gun + OCS_RETURN_S) if c.known]
+            back = [
+                c
+                for c in _crossings(t, x, y, _reversed(wide), gun, gap_s, gun + OCS_RETURN_S)
+                if c.known
+            ]
             if early:
                 ocs = gun - early[-1].t
             if back:
                 returned = True
                 after = back[0].t
                 notes.append(
-                    (f"over early: crossed the line {ocs:.0f} s before the gun, "
-                     if ocs is not None else "over the line at the gun, ")
-                    + f"came back at {iso(after)} and restarted")
+                    (
+                        f"over early: crossed the line {ocs:.0f} s before the gun, "
+                        if ocs is not None
+                        else "over the line at the gun, "
+                    )
+                    + f"came back at {iso(after)} and restarted"
+                )
         if on_time:
             start = early[-1]
         elif over and not returned:
             start = Crossing(gun, gx, gy)
             notes.append(
-                (f"OCS by {ocs:.0f} s: crossed the start line {ocs:.0f} s before the gun "
-                 if ocs is not None else "on the course side at the gun ")
+                (
+                    f"OCS by {ocs:.0f} s: crossed the start line {ocs:.0f} s before the gun "
+                    if ocs is not None
+                    else "on the course side at the gun "
+                )
                 + f"and did not come back; {dist:.0f} m over at the gun; legs timed from "
-                "the gun")
+                "the gun"
+            )
         else:
             found = [c for c in _crossings(t, x, y, wide, after, gap_s) if c.known]
             if not found:
@@ -463,7 +520,8 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
                     f"pre-start side after the gun at {iso(gun)} (closest approach "
                     f"{_closest_m(sg, x[t >= gun], y[t >= gun]):.0f} m). Check the course's "
                     "start_time and start line, or give the start time explicitly "
-                    "(--leg-times)")
+                    "(--leg-times)"
+                )
             start = found[0]
     f_line, off = _segment_offset(line, start.x, start.y)
     from_gun = over and not on_time and not returned
@@ -474,11 +532,23 @@ def find_start(course: Course, t: NDArray, x: NDArray, y: NDArray, *,
             end = f"the line through {feat0.name!r}"
         else:
             end = repr(feat0.a.name if f_line < 0.5 else feat0.b.name)
-        notes.append(f"crossed the start line's extension {off:.0f} m beyond {end}, not the "
-                     "surveyed line: is the line laid elsewhere?")
-    return StartReport(gun, start, start.t - gun, dist, "course" if over else "pre-start",
-                       float(f_line), ocs, returned, float(off), tuple(notes),
-                       speed_at(t, x, y, gun, gap_s))
+        notes.append(
+            f"crossed the start line's extension {off:.0f} m beyond {end}, not the "
+            "surveyed line: is the line laid elsewhere?"
+        )
+    return StartReport(
+        gun,
+        start,
+        start.t - gun,
+        dist,
+        "course" if over else "pre-start",
+        float(f_line),
+        ocs,
+        returned,
+        float(off),
+        tuple(notes),
+        speed_at(t, x, y, gun, gap_s),
+    )
 
 
 def speed_at(t: NDArray, x: NDArray, y: NDArray, tq: float, gap_s: float = math.inf) -> float:
@@ -491,12 +561,19 @@ def speed_at(t: NDArray, x: NDArray, y: NDArray, tq: float, gap_s: float = math.
     lo, hi = max(k - 2, 0), min(k + 2, t.size - 1)
     if t[hi] - t[lo] > 2.0 * gap_s:
         return math.nan
-    dist = float(np.sum(np.hypot(np.diff(x[lo:hi + 1]), np.diff(y[lo:hi + 1]))))
+    dist = float(np.sum(np.hypot(np.diff(x[lo : hi + 1]), np.diff(y[lo : hi + 1]))))
     return dist / float(t[hi] - t[lo])
 
 
-def _stop_near(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_from: float,
-               gap_s: float, reach_m: float) -> Crossing | None:
+def _stop_near(
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    geom: TargetGeometry,
+    t_from: float,
+    gap_s: float,
+    reach_m: float,
+) -> Crossing | None:
     """The first data gap after ``t_from`` whose last fix lies within ``reach_m`` of the
     target segment (a line or gate: on the near side of it; a mark: its rounding ray): the
     target is reached inside the gap, at an unknown time."""
@@ -510,15 +587,31 @@ def _stop_near(t: NDArray, x: NDArray, y: NDArray, geom: TargetGeometry, t_from:
         short = geom.kind == "mark" or _side(geom, px, py) <= 0
         if short and d <= reach_m:
             t0, t1 = float(t[k]), float(t[k + 1])
-            return Crossing(math.nan, px, py, gap=(t0, t1), note=(
-                f"the data stop {d:.0f} m short of {geom.name!r} at {iso(t0)} (a gap of "
-                f"{t1 - t0:.0f} s, longer than {gap_s:.0f} s): time unknown"))
+            return Crossing(
+                math.nan,
+                px,
+                py,
+                gap=(t0, t1),
+                note=(
+                    f"the data stop {d:.0f} m short of {geom.name!r} at {iso(t0)} (a gap of "
+                    f"{t1 - t0:.0f} s, longer than {gap_s:.0f} s): time unknown"
+                ),
+            )
     return None
 
 
-def gate_rounding(course: Course, i: int, passed: Crossing, from_xy: tuple[float, float],
-                  t: NDArray, x: NDArray, y: NDArray, *, gap_s: float = math.inf,
-                  detect_m: float = DETECT_M) -> Crossing | None:
+def gate_rounding(
+    course: Course,
+    i: int,
+    passed: Crossing,
+    from_xy: tuple[float, float],
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    *,
+    gap_s: float = math.inf,
+    detect_m: float = DETECT_M,
+) -> Crossing | None:
     """When the boat, having passed between the marks of leg ``i``'s gate, went round one.
 
     The mark is the one it comes closest to within :data:`GATE_ROUNDING_S` of ``passed``;
@@ -547,11 +640,13 @@ def gate_rounding(course: Course, i: int, passed: Crossing, from_xy: tuple[float
     nx, ny = line.normal  # the crossing direction
     left = nx * (mark.y - passed.y) - ny * (mark.x - passed.x) > 0
     exit_xy = leg_target(course, i + 1).centre if i + 1 < course.n_legs else None
-    target = Target("mark", mark.xy, None, "port" if left else "starboard", exit_xy=exit_xy,
-                    name=mark.name)
+    target = Target(
+        "mark", mark.xy, None, "port" if left else "starboard", exit_xy=exit_xy, name=mark.name
+    )
     geom = _behind_mark(target_geometry(target, Start(from_xy, None), zone_m=detect_m))
-    found = [c for c in _crossings(t, x, y, geom, passed.t, gap_s,
-                                   passed.t + GATE_ROUNDING_S) if c.known]
+    found = [
+        c for c in _crossings(t, x, y, geom, passed.t, gap_s, passed.t + GATE_ROUNDING_S) if c.known
+    ]
     return found[0] if found else None
 
 
@@ -630,15 +725,26 @@ def segment_track(
         )
     vals = [g for g in given if g is not None]
     if any(b <= a for a, b in itertools.pairwise(vals)):
-        raise InputError(f"{where}: leg times must increase; got "
-                         + ", ".join(iso(v) for v in vals))
+        raise InputError(
+            f"{where}: leg times must increase; got " + ", ".join(iso(v) for v in vals)
+        )
     for v in vals:
         if not t[0] <= v <= t[-1]:
-            raise InputError(f"{where}: leg time {iso(v)} is outside the track "
-                             f"({iso(t[0])} .. {iso(t[-1])})")
+            raise InputError(
+                f"{where}: leg time {iso(v)} is outside the track ({iso(t[0])} .. {iso(t[-1])})"
+            )
     gap_s = gap_limit_s(t)
-    report = find_start(course, t, x, y, given=given[0], detect_m=detect_m,
-                        line_margin_m=line_margin_m, gap_s=gap_s, where=where)
+    report = find_start(
+        course,
+        t,
+        x,
+        y,
+        given=given[0],
+        detect_m=detect_m,
+        line_margin_m=line_margin_m,
+        gap_s=gap_s,
+        where=where,
+    )
     ends: list[Crossing] = []
     prev = report.crossing
     lost = ""
@@ -651,9 +757,8 @@ def segment_track(
             end = Crossing(math.nan, math.nan, math.nan, note=lost)
         else:
             geom = detection_geometry(course, i, (prev.x, prev.y), detect_m, line_margin_m)
-            nxt = [v for v in given[i + 2:] if v is not None]
-            found = _crossings(t, x, y, geom, prev.t_hi + 1e-6, gap_s,
-                               nxt[0] if nxt else math.inf)
+            nxt = [v for v in given[i + 2 :] if v is not None]
+            found = _crossings(t, x, y, geom, prev.t_hi + 1e-6, gap_s, nxt[0] if nxt else math.inf)
             stop = _stop_near(t, x, y, geom, prev.t_hi, gap_s, detect_m)
             if stop is not None and (not found or stop.t_lo < found[0].t_lo):
                 found = [stop]
@@ -667,11 +772,29 @@ def segment_track(
             else:
                 end = found[0]
                 if gate_end == "rounding" and course.legs[i].kind == "gate":
-                    end = gate_rounding(course, i, end, (prev.x, prev.y), t, x, y,
-                                        gap_s=gap_s, detect_m=detect_m) or end
+                    end = (
+                        gate_rounding(
+                            course,
+                            i,
+                            end,
+                            (prev.x, prev.y),
+                            t,
+                            x,
+                            y,
+                            gap_s=gap_s,
+                            detect_m=detect_m,
+                        )
+                        or end
+                    )
                 if end.note:
-                    end = Crossing(end.t, end.x, end.y, end.detected, end.gap,
-                                   f"leg {i + 1} ({course.legs[i].label}): {end.note}")
+                    end = Crossing(
+                        end.t,
+                        end.x,
+                        end.y,
+                        end.detected,
+                        end.gap,
+                        f"leg {i + 1} ({course.legs[i].label}): {end.note}",
+                    )
         ends.append(end)
         prev = end
     return Segmentation(report, tuple(ends))
@@ -707,10 +830,12 @@ def fleet_start_notes(starts: Sequence[StartReport]) -> tuple[str, ...]:
             f"every boat was on the course side of the surveyed start line at the gun, "
             f"{d.min():.0f}-{d.max():.0f} m over (median {float(np.median(d)):.0f} m): the "
             "line used probably lay that far up the course from the surveyed marks (or the "
-            "start time is early); the over-early times are against the surveyed line")
+            "start time is early); the over-early times are against the surveyed line"
+        )
     off = np.array([s.line_offset_m for s in starts])
     if off.min() >= FLEET_OVER_M:
         notes.append(
             f"every boat crossed the start line's extension, {off.min():.0f}-{off.max():.0f} m "
-            "from the surveyed line: the line used probably lay elsewhere")
+            "from the surveyed line: the line used probably lay elsewhere"
+        )
     return tuple(notes)

@@ -95,15 +95,21 @@ def wind_order(choice: str, available: Sequence[WindSource]) -> list[WindSource]
     """
     if choice not in CHOICES:
         raise InputError(f"--wind: expected one of {', '.join(CHOICES)}; got {choice!r}")
-    wanted = {"auto": KINDS, "measured": ("measured", "fleet"), "inferred": ("inferred",),
-              "scenario": ("scenario",)}[choice]
+    wanted = {
+        "auto": KINDS,
+        "measured": ("measured", "fleet"),
+        "inferred": ("inferred",),
+        "scenario": ("scenario",),
+    }[choice]
     out = sorted((s for s in available if s.kind in wanted), key=lambda s: KINDS.index(s.kind))
     if not out:
-        why = {"measured": "no track has usable wind columns (tws/twd, twa with a heading, "
-                           "or aws/awa with a heading and boat speed)",
-               "inferred": "the wind could not be inferred from the tracks (too few tacks "
-                           "and steady boards)",
-               "scenario": "the course has no scenario"}.get(choice, "no wind source")
+        why = {
+            "measured": "no track has usable wind columns (tws/twd, twa with a heading, "
+            "or aws/awa with a heading and boat speed)",
+            "inferred": "the wind could not be inferred from the tracks (too few tacks "
+            "and steady boards)",
+            "scenario": "the course has no scenario",
+        }.get(choice, "no wind source")
         raise InputError(f"--wind {choice}: {why}; use --wind auto or --wind scenario")
     return out
 
@@ -117,8 +123,9 @@ def covers(field: WindField, t: NDArray, x: NDArray, y: NDArray) -> bool:
     return bool(np.all(np.isfinite(u)) and np.all(np.isfinite(v)))
 
 
-def first_covering(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArray,
-                   skip: int = -1) -> int | None:
+def first_covering(
+    sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDArray, skip: int = -1
+) -> int | None:
     """Index of the first source (after ``skip``) that covers all points, or None."""
     for k in range(skip + 1, len(sources)):
         if covers(sources[k].field, t, x, y):
@@ -126,5 +133,12 @@ def first_covering(sources: Sequence[WindSource], t: NDArray, x: NDArray, y: NDA
     return None
 
 
-__all__ = ["ABOVE_POLAR_PCT", "CHOICES", "KINDS", "WindSource", "covers", "first_covering",
-           "wind_order"]
+__all__ = [
+    "ABOVE_POLAR_PCT",
+    "CHOICES",
+    "KINDS",
+    "WindSource",
+    "covers",
+    "first_covering",
+    "wind_order",
+]

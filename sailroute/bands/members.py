@@ -39,8 +39,14 @@ from sailroute.wind.base import WindField
 from sailroute.wind.perturbed import PerturbedWind
 
 __all__ = [
-    "NOMINAL", "Member", "draw_members", "fit_shifts", "member_boat", "member_wind",
-    "one_at_a_time", "resolve_shifts",
+    "NOMINAL",
+    "Member",
+    "draw_members",
+    "fit_shifts",
+    "member_boat",
+    "member_wind",
+    "one_at_a_time",
+    "resolve_shifts",
 ]
 
 SHIFT_STEP_S: Final = 10.0
@@ -98,11 +104,14 @@ def fit_shifts(shifts: ShiftSpec) -> ShiftSpec:
 
     ou, _ = fit_station_file(shifts.fit, shifts.station, speed_unit=shifts.speed_unit)
     if not (np.isfinite(ou.sigma_deg) and np.isfinite(ou.timescale_s) and ou.timescale_s > 0):
-        raise InputError(f"uncertainty.shifts.fit: {shifts.fit}: the direction series gives no "
-                         f"usable shift model (sigma {ou.sigma_deg:g}°, timescale "
-                         f"{ou.timescale_s:g} s); give {{model: ou, sigma_deg, timescale_min}}")
-    return dataclasses.replace(shifts, sigma_deg=float(ou.sigma_deg),
-                               timescale_s=float(ou.timescale_s))
+        raise InputError(
+            f"uncertainty.shifts.fit: {shifts.fit}: the direction series gives no "
+            f"usable shift model (sigma {ou.sigma_deg:g}°, timescale "
+            f"{ou.timescale_s:g} s); give {{model: ou, sigma_deg, timescale_min}}"
+        )
+    return dataclasses.replace(
+        shifts, sigma_deg=float(ou.sigma_deg), timescale_s=float(ou.timescale_s)
+    )
 
 
 def resolve_shifts(spec: UncertaintySpec) -> UncertaintySpec:
@@ -134,8 +143,10 @@ def _shift_series(
         from sailroute.strategy.shiftmodel import OUShift
 
         if not shifts.sigma_deg > 0 or not shifts.timescale_s > 0:
-            raise InputError("uncertainty.shifts: an OU shift needs sigma_deg > 0 and "
-                             "timescale_min > 0 (or `fit:` a station file)")
+            raise InputError(
+                "uncertainty.shifts: an OU shift needs sigma_deg > 0 and "
+                "timescale_min > 0 (or `fit:` a station file)"
+            )
         model = OUShift(shifts.sigma_deg, shifts.timescale_s)
         eps = rng.standard_normal(t.size)
         s = np.empty(t.size)
@@ -147,14 +158,19 @@ def _shift_series(
 
 
 def _apply(
-    member: Member, source: str, u: float, spec: UncertaintySpec, duration_s: float,
+    member: Member,
+    source: str,
+    u: float,
+    spec: UncertaintySpec,
+    duration_s: float,
     rng: np.random.Generator,
 ) -> Member:
     """``member`` with ``source`` set from its stratum value ``u``."""
     z = float(ndtri(u))
     if source == "tws":
-        return dataclasses.replace(member, tws_add_ms=z * spec.tws_add_ms,
-                                   tws_scale=max(1.0 + z * spec.tws_rel, 0.0))
+        return dataclasses.replace(
+            member, tws_add_ms=z * spec.tws_add_ms, tws_scale=max(1.0 + z * spec.tws_rel, 0.0)
+        )
     if source == "twd":
         return dataclasses.replace(member, twd_offset_deg=z * spec.twd_deg)
     if source == "shifts":
@@ -219,8 +235,9 @@ def one_at_a_time(
         members = []
         for i, q in enumerate(quantiles):
             rng = np.random.default_rng([spec.seed, i])
-            members.append(_apply(Member(f"{source}@{q:g}"), source, float(q), spec,
-                                  duration_s, rng))
+            members.append(
+                _apply(Member(f"{source}@{q:g}"), source, float(q), spec, duration_s, rng)
+            )
         out[source] = tuple(members)
     return out
 
@@ -240,10 +257,14 @@ def member_wind(base: WindField, member: Member, t0: float) -> WindField:
     if member == dataclasses.replace(NOMINAL, name=member.name, boat=member.boat):
         return base
     return PerturbedWind(
-        base, speed_scale=member.tws_scale, speed_add_ms=member.tws_add_ms,
+        base,
+        speed_scale=member.tws_scale,
+        speed_add_ms=member.tws_add_ms,
         direction_offset_deg=member.twd_offset_deg,
         shift_times=t0 + np.asarray(member.shift_t_s, dtype=float),
-        shift_deg=np.asarray(member.shift_deg, dtype=float), name=f"wind of member {member.name}")
+        shift_deg=np.asarray(member.shift_deg, dtype=float),
+        name=f"wind of member {member.name}",
+    )
 
 
 def _race_form(boat_spec: Mapping[str, Any], where: str) -> dict[str, Any]:
@@ -261,13 +282,19 @@ def _race_form(boat_spec: Mapping[str, Any], where: str) -> dict[str, Any]:
     elif "vpp" in spec and spec.get("kinetics", "race") not in ("steady",):
         kin_raw = spec.get("kinetics", "race")
         return {**spec, "kinetics": {} if kin_raw == "race" else dict(kin_raw)}
-    raise InputError(f"{where}: uncertainty.boat: race-polar parameters need a race polar "
-                     "(boat: {builtin: ilca7} or {vpp: {class: ...}}); this course's boat is "
-                     f"{dict(boat_spec)}; remove uncertainty.boat or use a race polar")
+    raise InputError(
+        f"{where}: uncertainty.boat: race-polar parameters need a race polar "
+        "(boat: {builtin: ilca7} or {vpp: {class: ...}}); this course's boat is "
+        f"{dict(boat_spec)}; remove uncertainty.boat or use a race polar"
+    )
 
 
 def member_boat(
-    boat_spec: Mapping[str, Any], base_boat: Any, member: Member, *, base_dir: Path,
+    boat_spec: Mapping[str, Any],
+    base_boat: Any,
+    member: Member,
+    *,
+    base_dir: Path,
     where: str,
 ) -> Any:
     """The member's boat: the course's boat, or its race polar with parameters changed.

@@ -103,8 +103,12 @@ class BandSummary:
     def side_shares(self) -> NDArray[np.float64]:
         """Share of members per leg for each of :data:`SIDE_LABELS`, shape (n_legs, 4)."""
         n = max(len(self.sides), 1)
-        return np.array([[sum(s[k] == lab for s in self.sides) / n for lab in SIDE_LABELS]
-                         for k in range(len(self.leg_labels))])
+        return np.array(
+            [
+                [sum(s[k] == lab for s in self.sides) / n for lab in SIDE_LABELS]
+                for k in range(len(self.leg_labels))
+            ]
+        )
 
     def coverage(self, observed_s: np.ndarray) -> tuple[float, NDArray[np.bool_]]:
         """Share of legs whose observed time lies in [P10, P90], and which do.
@@ -124,30 +128,44 @@ class BandSummary:
         b, widths, dom = self.bands(), self.oat_widths(), self.dominant()
         sh = self.side_shares()
         u = self.uncertainty
-        shifts = None if u.shifts is None else {
-            "model": u.shifts.model, "amplitude_deg": u.shifts.amplitude_deg,
-            "period_s": u.shifts.period_s, "sigma_deg": u.shifts.sigma_deg,
-            "timescale_s": u.shifts.timescale_s, "rate_deg_per_s": u.shifts.rate_deg_per_s,
-            "fit": None if u.shifts.fit is None else str(u.shifts.fit)}
+        shifts = (
+            None
+            if u.shifts is None
+            else {
+                "model": u.shifts.model,
+                "amplitude_deg": u.shifts.amplitude_deg,
+                "period_s": u.shifts.period_s,
+                "sigma_deg": u.shifts.sigma_deg,
+                "timescale_s": u.shifts.timescale_s,
+                "rate_deg_per_s": u.shifts.rate_deg_per_s,
+                "fit": None if u.shifts.fit is None else str(u.shifts.fit),
+            }
+        )
         return {
             "scenario": self.scenario,
             "uncertainty": {
-                "tws_add_sd_ms": u.tws_add_ms, "tws_rel_sd": u.tws_rel, "twd_sd_deg": u.twd_deg,
+                "tws_add_sd_ms": u.tws_add_ms,
+                "tws_rel_sd": u.tws_rel,
+                "twd_sd_deg": u.twd_deg,
                 "shifts": shifts,
                 "boat": {name: [lo, hi] for name, lo, hi in u.boat},
-                "members": len(self.members), "seed": u.seed,
-                "side_margin_s": u.side_margin_s, "side_margin_pct": u.side_margin_pct,
+                "members": len(self.members),
+                "seed": u.seed,
+                "side_margin_s": u.side_margin_s,
+                "side_margin_pct": u.side_margin_pct,
             },
             "notes": list(self.notes),
             "legs": [
-                {"label": label,
-                 "nominal_s": float(self.nominal_s[k]),
-                 "time_s": {s: float(v) for s, v in zip(BAND_STATS, b[k], strict=True)},
-                 "width_by_source_s": {s: float(w[k]) for s, w in widths.items()},
-                 "widest_source": dom[k],
-                 "side_share": {s: float(v) for s, v in zip(SIDE_LABELS, sh[k], strict=True)},
-                 "member_time_s": [float(v) for v in self.times_s[:, k]],
-                 "member_side": [s[k] for s in self.sides]}
+                {
+                    "label": label,
+                    "nominal_s": float(self.nominal_s[k]),
+                    "time_s": {s: float(v) for s, v in zip(BAND_STATS, b[k], strict=True)},
+                    "width_by_source_s": {s: float(w[k]) for s, w in widths.items()},
+                    "widest_source": dom[k],
+                    "side_share": {s: float(v) for s, v in zip(SIDE_LABELS, sh[k], strict=True)},
+                    "member_time_s": [float(v) for v in self.times_s[:, k]],
+                    "member_side": [s[k] for s in self.sides],
+                }
                 for k, label in enumerate(self.leg_labels)
             ],
             "total": {

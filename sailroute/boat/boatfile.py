@@ -28,8 +28,11 @@ def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
     from sailroute.yamlfile import read_yaml
 
     p = Path(path)
-    ydoc = read_yaml(p, what="boat file", hint="check the path, or leave BOAT.yaml out to "
-                     "use the shipped ILCA 7 parameters")
+    ydoc = read_yaml(
+        p,
+        what="boat file",
+        hint="check the path, or leave BOAT.yaml out to use the shipped ILCA 7 parameters",
+    )
     doc = {} if ydoc.data is None else ydoc.data
     if not isinstance(doc, dict):
         raise InputError(
@@ -38,8 +41,10 @@ def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
         )
     if ydoc.duplicates:
         d = ydoc.duplicates[0]
-        raise InputError(f"{p}:{d.line}: {d.path}: the key appears twice (lines "
-                         f"{d.first_line} and {d.line}); keep one")
+        raise InputError(
+            f"{p}:{d.line}: {d.path}: the key appears twice (lines "
+            f"{d.first_line} and {d.line}); keep one"
+        )
     lines = {k: v for k, v in ydoc.lines.items() if "." not in k and "[" not in k}
     return params_from_mapping(doc, where=str(p), lines=lines), slug(p.stem)
 

@@ -55,7 +55,6 @@ STEADY_SUFFIX: Final = "-steady"
 """Suffix of the built-in names of the steady VPP polars (``ilca7-steady``)."""
 
 
-
 def builtin_names() -> tuple[str, ...]:
     """Names of the shipped polars: ``ilca4``, ``ilca6``, ``ilca7`` (race) and the
     same with ``-steady`` (steady VPP)."""
@@ -143,7 +142,11 @@ def vpp_polar(
 
 
 def boat_from_spec(
-    spec: Mapping[str, Any], *, base_dir: Path, where: str, key: str = "boat",
+    spec: Mapping[str, Any],
+    *,
+    base_dir: Path,
+    where: str,
+    key: str = "boat",
     lines: Mapping[str, int] | None = None,
 ) -> Polar:
     """Build the boat's polar from a course file's ``boat`` mapping.
@@ -187,8 +190,9 @@ def boat_from_spec(
         known.setdefault(path, line)
     probs = Problems(file, known, root=path, what="boat spec")
     c = Checker(probs, path)
-    if not c.is_mapping(spec, "a mapping such as {builtin: ilca7}, {polar: FILE} or "
-                              "{vpp: {class: ilca7}}"):
+    if not c.is_mapping(
+        spec, "a mapping such as {builtin: ilca7}, {polar: FILE} or {vpp: {class: ilca7}}"
+    ):
         probs.raise_if_any()
     form = _form(c, spec)
     if form is not None:
@@ -208,8 +212,12 @@ def boat_from_spec(
     if factors:
         from sailroute.boat.efficiency import scale_polar
 
-        polar = scale_polar(polar, factors.get("upwind", 1.0), factors.get("reach", 1.0),
-                            factors.get("downwind", 1.0))
+        polar = scale_polar(
+            polar,
+            factors.get("upwind", 1.0),
+            factors.get("reach", 1.0),
+            factors.get("downwind", 1.0),
+        )
     return polar
 
 
@@ -224,8 +232,11 @@ def _form(c: Checker, spec: Mapping[str, Any]) -> str | None:
     known = set().union(*_ALLOWED.values())
     hints = [suggest(str(k), _FORMS).strip() for k in spec if str(k) not in known]
     hint = next((h for h in hints if h), "")
-    c.add(None, f"give exactly one of 'builtin', 'polar' or 'vpp'; got keys "
-          f"{sorted(map(str, spec))}" + (f" ({hint})" if hint else ""))
+    c.add(
+        None,
+        f"give exactly one of 'builtin', 'polar' or 'vpp'; got keys "
+        f"{sorted(map(str, spec))}" + (f" ({hint})" if hint else ""),
+    )
     return None
 
 
@@ -237,8 +248,11 @@ def _check_builtin(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make
     name = spec["builtin"]
     if not isinstance(name, str) or name.lower() not in builtin_names():
         hint = suggest(name.lower(), builtin_names()).strip() if isinstance(name, str) else ""
-        c.add("builtin", f"expected one of {quoted(builtin_names())}; got {show(name)}"
-              + (f" ({hint})" if hint else ""))
+        c.add(
+            "builtin",
+            f"expected one of {quoted(builtin_names())}; got {show(name)}"
+            + (f" ({hint})" if hint else ""),
+        )
         return None
     return lambda interpolation: builtin_polar(name.lower(), interpolation)
 
@@ -253,8 +267,10 @@ def _check_polar(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make |
         u = spec.get(uk)
         if u is not None and (not isinstance(u, str) or u.strip().lower() not in SPEED_UNITS):
             hint = suggest(u.strip().lower(), SPEED_UNITS).strip() if isinstance(u, str) else ""
-            c.add(uk, f"expected one of {quoted(units)}; got {show(u)}"
-                  + (f" ({hint})" if hint else ""))
+            c.add(
+                uk,
+                f"expected one of {quoted(units)}; got {show(u)}" + (f" ({hint})" if hint else ""),
+            )
     fmt = spec.get("format")
     if fmt is not None:
         fmt = c.choice(spec, "format", ("pol", "csv", "json"))
@@ -264,8 +280,11 @@ def _check_polar(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make |
     if file is None:
         return None
     return lambda interpolation: read_polar(
-        file, speed_unit=spec.get("speed_unit"), wind_unit=spec.get("wind_unit"),
-        format=fmt, interpolation=interpolation,
+        file,
+        speed_unit=spec.get("speed_unit"),
+        wind_unit=spec.get("wind_unit"),
+        format=fmt,
+        interpolation=interpolation,
     )
 
 
@@ -275,5 +294,4 @@ def _check_vpp(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make | N
     params = check_params(c.child("vpp"), {} if vspec is None else vspec)
     if kinetics is None or params is None:
         return None
-    return lambda interpolation: vpp_polar(params, interpolation=interpolation,
-                                           kinetics=kinetics)
+    return lambda interpolation: vpp_polar(params, interpolation=interpolation, kinetics=kinetics)

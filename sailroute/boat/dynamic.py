@@ -284,15 +284,21 @@ class DynamicBoat:
             and the speed at its end [m s⁻¹].
         """
         ell, twa, vt, v0 = np.broadcast_arrays(
-            np.asarray(length_m, float), np.asarray(twa_deg, float),
-            np.asarray(tws_ms, float), np.asarray(v0_ms, float),
+            np.asarray(length_m, float),
+            np.asarray(twa_deg, float),
+            np.asarray(tws_ms, float),
+            np.asarray(v0_ms, float),
         )
         beta = np.radians(np.abs(wrap180(twa)))
         calm = vt <= _CALM
         vts = np.where(calm, 1.0, vt)
         tau, w1 = simulate_pieces(
-            self, beta[..., None], np.ones_like(beta)[..., None], ell[..., None],
-            v0 / vts, h_tau=dt_s * vts,
+            self,
+            beta[..., None],
+            np.ones_like(beta)[..., None],
+            ell[..., None],
+            v0 / vts,
+            h_tau=dt_s * vts,
         )
         t = np.where(calm, np.where(ell > 0, np.inf, 0.0), tau / vts)
         return t, np.where(calm, v0, w1 * vts)
@@ -310,13 +316,19 @@ class DynamicBoat:
         reference to ~1e-4 s for the default constants (see the design note).
         """
         ell, twa, vt, v0 = np.broadcast_arrays(
-            np.asarray(length_m, float), np.asarray(twa_deg, float),
-            np.asarray(tws_ms, float), np.asarray(v0_ms, float),
+            np.asarray(length_m, float),
+            np.asarray(twa_deg, float),
+            np.asarray(tws_ms, float),
+            np.asarray(v0_ms, float),
         )
         shape = ell.shape
         beta = np.radians(np.abs(wrap180(twa))).reshape(-1, 1)
         t, v1 = chain_time(
-            self, beta, vt.reshape(-1, 1), ell.reshape(-1, 1), np.ones_like(beta),
+            self,
+            beta,
+            vt.reshape(-1, 1),
+            ell.reshape(-1, 1),
+            np.ones_like(beta),
             v0.reshape(-1),
         )
         return t.reshape(shape), v1.reshape(shape)
@@ -407,8 +419,16 @@ class SegmentTable:
         key = xp.__name__
         if key not in self._xp_cache:
             self._xp_cache[key] = tuple(
-                xp.asarray(a) for a in (self.w_ss, self.loss, self.sconv, self.relax,
-                                        self.dloss0, self.dloss1, self.dist)
+                xp.asarray(a)
+                for a in (
+                    self.w_ss,
+                    self.loss,
+                    self.sconv,
+                    self.relax,
+                    self.dloss0,
+                    self.dloss1,
+                    self.dist,
+                )
             )
         return self._xp_cache[key]
 
@@ -473,8 +493,9 @@ class SegmentTable:
         key = ("poly", xp.__name__)
         if key not in self._xp_cache:
             y0, y1 = self.loss[:, :-1], self.loss[:, 1:]
-            c = np.stack(hermite_coefficients(y0, y1, self.dloss0, self.dloss1),
-                         axis=-1).reshape(-1, 4)
+            c = np.stack(hermite_coefficients(y0, y1, self.dloss0, self.dloss1), axis=-1).reshape(
+                -1, 4
+            )
             self._xp_cache[key] = xp.asarray(np.ascontiguousarray(c))
         return self._xp_cache[key]
 
@@ -584,6 +605,7 @@ def build_table(
     lam_dec, h_dec, s_dec, dist_dec = branch(w_dec)
     loss = np.concatenate([lam_acc[:, ::step][:, ::-1], lam_dec[:, ::step][:, 1:]], axis=1)
     sconv = np.maximum(s_acc, s_dec)
+
     # distance to come within 5 % of w_ss; the max over each node's two neighbouring
     # fine intervals keeps linear interpolation an upper bound
     def coarse(d: NDArray) -> NDArray:
@@ -610,9 +632,22 @@ def build_table(
     if not np.isfinite(stop_max):
         stop_max = np.inf
     return SegmentTable(
-        c1=c1, c2=c2, k=k, beta_min=beta_min, beta_lo=float(beta_lo), dbeta=dbeta, nq=nq,
-        w_max=w_max, w_ss=wss, loss=loss, dloss0=dloss0, dloss1=dloss1, relax=wss / gamma,
-        sconv=sconv, dist=dist, stop_max=stop_max,
+        c1=c1,
+        c2=c2,
+        k=k,
+        beta_min=beta_min,
+        beta_lo=float(beta_lo),
+        dbeta=dbeta,
+        nq=nq,
+        w_max=w_max,
+        w_ss=wss,
+        loss=loss,
+        dloss0=dloss0,
+        dloss1=dloss1,
+        relax=wss / gamma,
+        sconv=sconv,
+        dist=dist,
+        stop_max=stop_max,
     )
 
 
@@ -703,8 +738,9 @@ def chain_time(
     t_pieces = xp.stack(t_list, axis=-1) if pieces else None
     if bool(xp.any(exact)):
         idx = xp.nonzero(exact)
-        t_ex, v_ex, tp_ex = _exact_chain(boat, beta[idx], vt[idx], length[idx],
-                                         cos_turn[idx], v_start[idx], xp)
+        t_ex, v_ex, tp_ex = _exact_chain(
+            boat, beta[idx], vt[idx], length[idx], cos_turn[idx], v_start[idx], xp
+        )
         total[idx] = t_ex
         v[idx] = v_ex
         if t_pieces is not None:  # pieces
@@ -714,8 +750,9 @@ def chain_time(
     return total, v
 
 
-def _exact_chain(boat: DynamicBoat, beta: Any, vt: Any, length: Any, cos_turn: Any,
-                 v_in: Any, xp: ModuleType) -> tuple[Any, Any, Any]:
+def _exact_chain(
+    boat: DynamicBoat, beta: Any, vt: Any, length: Any, cos_turn: Any, v_in: Any, xp: ModuleType
+) -> tuple[Any, Any, Any]:
     """RK4 version of :func:`chain_time` for a flat batch ``(m, n)`` (runs on the host).
 
     Pieces in ``[beta_min, beta_lo)`` keep the table's steady-state treatment.
@@ -736,8 +773,12 @@ def _exact_chain(boat: DynamicBoat, beta: Any, vt: Any, length: Any, cos_turn: A
         ws = tab.steady(bj)
         w0 = v / us
         # pieces that hold their whole transient use the table, the others RK4
-        table = ~slow & (bj >= tab.beta_lo) & (w0 <= tab.w_max) & (
-            lj >= tab.transient_length(bj, w0, ws))
+        table = (
+            ~slow
+            & (bj >= tab.beta_lo)
+            & (w0 <= tab.w_max)
+            & (lj >= tab.transient_length(bj, w0, ws))
+        )
         sim = ~(slow | table) & (lj > 0)
         wsafe = np.where(ws > 0, ws, 1.0)
         tau = np.where(slow, lj / wsafe, lj / wsafe + tab.loss_at(bj, w0, ws))
@@ -745,18 +786,28 @@ def _exact_chain(boat: DynamicBoat, beta: Any, vt: Any, length: Any, cos_turn: A
         if sim.any():
             i = np.flatnonzero(sim)
 
-            def finish(k_: NDArray, s_: NDArray, w_: NDArray, _b: NDArray = bj[i],
-                       _w: NDArray = ws[i], _l: NDArray = lj[i]) -> tuple:
+            def finish(
+                k_: NDArray,
+                s_: NDArray,
+                w_: NDArray,
+                _b: NDArray = bj[i],
+                _w: NDArray = ws[i],
+                _l: NDArray = lj[i],
+            ) -> tuple:
                 bb, ww, rem = _b[k_], _w[k_], _l[k_] - s_
-                ok = (bb >= tab.beta_lo) & (w_ <= tab.w_max) & (
-                    rem >= tab.transient_length(bb, w_, ww))
+                ok = (
+                    (bb >= tab.beta_lo)
+                    & (w_ <= tab.w_max)
+                    & (rem >= tab.transient_length(bb, w_, ww))
+                )
                 return ok, rem / np.where(ww > 0, ww, 1.0) + tab.loss_at(bb, w_, ww), ww
 
             # step ≈ a quarter of the relaxation length in σ, at least _H_SIGMA
             gam = np.where(ws[i] > 0, ws[i] / tab.relax_at(bj[i]), np.inf)
             h_i = np.clip(0.25 * _OMEGA / gam, _H_SIGMA, 20.0 * _H_SIGMA)
-            tau_s, w_s = _rk4_piece_sigma(bj[i], lj[i], w0[i], h_i, _OMEGA,
-                                          boat.c1, boat.c2, boat.k, 200_000, finish)
+            tau_s, w_s = _rk4_piece_sigma(
+                bj[i], lj[i], w0[i], h_i, _OMEGA, boat.c1, boat.c2, boat.k, 200_000, finish
+            )
             tau[i] = tau_s
             w1[i] = w_s
         t = np.where(calm, np.where(ell[:, j] > 0, np.inf, 0.0), tau / us)
@@ -773,10 +824,18 @@ _A_RATE = 0.1  # adaptive RK4: largest relative change of (w + ω) per step
 _B_RELAX = 0.1  # adaptive RK4: largest step in local relaxation lengths
 
 
-def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, omega: float,
-                     c1: float, c2: float, k: float, max_steps: int,
-                     finish: Callable[[NDArray, NDArray, NDArray], tuple] | None = None,
-                     ) -> tuple[NDArray, NDArray]:
+def _rk4_piece_sigma(
+    beta: NDArray,
+    ell: NDArray,
+    w0: NDArray,
+    h: ArrayLike,
+    omega: float,
+    c1: float,
+    c2: float,
+    k: float,
+    max_steps: int,
+    finish: Callable[[NDArray, NDArray, NDArray], tuple] | None = None,
+) -> tuple[NDArray, NDArray]:
     """RK4 over one constant-wind piece in ``σ`` with ``dσ = (w + ω) dτ``.
 
     The state ``(s, w, τ)`` has ``ds/dσ = w/(w+ω)``, ``dw/dσ = g/(w+ω)``,
@@ -802,10 +861,16 @@ def _rk4_piece_sigma(beta: NDArray, ell: NDArray, w0: NDArray, h: ArrayLike, ome
         # adaptive: at most 10 % change of (w + ω) and a tenth of the local
         # relaxation length (w + ω)/|∂g/∂w| per step; never below the given step
         wp = np.maximum(yv[1], 0.0) + omega
-        gw = np.abs(drive(np.maximum(yv[1], 0.0) + 1e-6, bv, c1, c2, k)
-                    - drive(np.maximum(yv[1], 0.0), bv, c1, c2, k)) * 1e6
-        lim = np.minimum(_A_RATE * wp / np.maximum(np.abs(k1[1]), 1e-300),
-                         _B_RELAX * wp / np.maximum(gw, 1e-300))
+        gw = (
+            np.abs(
+                drive(np.maximum(yv[1], 0.0) + 1e-6, bv, c1, c2, k)
+                - drive(np.maximum(yv[1], 0.0), bv, c1, c2, k)
+            )
+            * 1e6
+        )
+        lim = np.minimum(
+            _A_RATE * wp / np.maximum(np.abs(k1[1]), 1e-300), _B_RELAX * wp / np.maximum(gw, 1e-300)
+        )
         hs = np.clip(lim, h_all[act], 40.0 * h_all[act])  # this step's h per item
         yn, _ = rk4_step(f, yv, hs, k1, args=(bv,))
         # stopped for good: (nearly) at rest and decelerating (a no-drive coast
@@ -901,8 +966,16 @@ def simulate_pieces(
     return tau_tot.reshape(shape), w_cur.reshape(shape)
 
 
-def _rk4_piece(beta: NDArray, ell: NDArray, w0: NDArray, h: NDArray, c1: float, c2: float,
-               k: float, max_steps: int) -> tuple[NDArray, NDArray]:
+def _rk4_piece(
+    beta: NDArray,
+    ell: NDArray,
+    w0: NDArray,
+    h: NDArray,
+    c1: float,
+    c2: float,
+    k: float,
+    max_steps: int,
+) -> tuple[NDArray, NDArray]:
     n = beta.size
     tau = np.zeros(n)
     y, out_tau, out_w, act = _piece_start(n, w0, ell, 2)  # s, w
@@ -945,8 +1018,9 @@ def _rk4_piece(beta: NDArray, ell: NDArray, w0: NDArray, h: NDArray, c1: float, 
     return out_tau, out_w
 
 
-def _piece_start(n: int, w0: ArrayLike, ell: NDArray, n_state: int
-                 ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.int64]]:
+def _piece_start(
+    n: int, w0: ArrayLike, ell: NDArray, n_state: int
+) -> tuple[NDArray, NDArray, NDArray, NDArray[np.int64]]:
     """Start of an RK4 piece of ``n`` items: the state ``(n_state, n)`` (``s = 0``, ``w``
     the entry speed clipped at 0, the rest 0), the scaled time and exit speed (0 and the
     entry speed for an empty piece, ``inf`` and 0 until known), the items to integrate."""
@@ -960,9 +1034,15 @@ def _piece_start(n: int, w0: ArrayLike, ell: NDArray, n_state: int
     return y, out_tau, out_w, np.flatnonzero(~done0)
 
 
-def _march_piece(step: Callable[[NDArray[np.int64]], NDArray[np.bool_]],
-                 act: NDArray[np.int64], max_steps: int, y: NDArray, tau: NDArray,
-                 ell: NDArray, out: tuple[NDArray, NDArray]) -> None:
+def _march_piece(
+    step: Callable[[NDArray[np.int64]], NDArray[np.bool_]],
+    act: NDArray[np.int64],
+    max_steps: int,
+    y: NDArray,
+    tau: NDArray,
+    ell: NDArray,
+    out: tuple[NDArray, NDArray],
+) -> None:
     """The RK4 loop over a constant-wind piece: ``step(items) -> done`` advances the active
     items one step (the state ``y`` = ``(s, w, ...)`` and scaled time ``tau`` [m]; the
     results ``out = (τ, w_end)`` of the items it ends) until none is left.  After

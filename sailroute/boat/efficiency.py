@@ -36,8 +36,9 @@ MAX_FACTOR: Final = 1.5
 """Largest accepted factor."""
 
 
-def efficiency_factor(twa_deg: ArrayLike, upwind: float = 1.0, reach: float = 1.0,
-                      downwind: float = 1.0) -> NDArray[np.float64]:
+def efficiency_factor(
+    twa_deg: ArrayLike, upwind: float = 1.0, reach: float = 1.0, downwind: float = 1.0
+) -> NDArray[np.float64]:
     """Speed factor at TWA [°] (sign ignored) for the given band factors."""
     a = np.abs(np.asarray(twa_deg, dtype=float))
     b1, b2 = BOUNDARIES_DEG
@@ -47,9 +48,15 @@ def efficiency_factor(twa_deg: ArrayLike, upwind: float = 1.0, reach: float = 1.
     return w_up * upwind + w_dn * downwind + (1.0 - w_up - w_dn) * reach
 
 
-def scale_polar(polar: Polar, upwind: float = 1.0, reach: float = 1.0,
-                downwind: float = 1.0, *, max_factor: float = MAX_FACTOR,
-                key: str = "efficiency") -> Polar:
+def scale_polar(
+    polar: Polar,
+    upwind: float = 1.0,
+    reach: float = 1.0,
+    downwind: float = 1.0,
+    *,
+    max_factor: float = MAX_FACTOR,
+    key: str = "efficiency",
+) -> Polar:
     """A new :class:`Polar` with speeds scaled by point of sail (module docstring).
 
     Parameters
@@ -86,8 +93,9 @@ def scale_polar(polar: Polar, upwind: float = 1.0, reach: float = 1.0,
         order = np.argsort(all_twa)
         twa, tab = all_twa[order], np.vstack([tab, rows])[order]
     f = efficiency_factor(twa, upwind, reach, downwind)
-    return Polar.from_arrays(twa, polar.tws_ms, tab * f[:, None], name=polar.name,
-                             interpolation=polar.interpolation)
+    return Polar.from_arrays(
+        twa, polar.tws_ms, tab * f[:, None], name=polar.name, interpolation=polar.interpolation
+    )
 
 
 def check_efficiency(c: Checker, value: Any) -> dict[str, float] | None:
@@ -114,15 +122,23 @@ def check_efficiency(c: Checker, value: Any) -> dict[str, float] | None:
     c.keys(value, BANDS)
     out = {}
     for k in BANDS:
-        v = c.number(value, k, None, lo=0.0, hi=MAX_FACTOR, lo_open=True,
-                     what=f"a speed factor in (0, {MAX_FACTOR:g}] (1.0 = the polar as is)")
+        v = c.number(
+            value,
+            k,
+            None,
+            lo=0.0,
+            hi=MAX_FACTOR,
+            lo_open=True,
+            what=f"a speed factor in (0, {MAX_FACTOR:g}] (1.0 = the polar as is)",
+        )
         if v is not None:
             out[k] = v
     return out if len(c.p) == before else None
 
 
-def efficiency_from_spec(value: Any, *, where: str, key: str = "boat.efficiency",
-                         lines: Mapping[str, int] | None = None) -> dict[str, float]:
+def efficiency_from_spec(
+    value: Any, *, where: str, key: str = "boat.efficiency", lines: Mapping[str, int] | None = None
+) -> dict[str, float]:
     """Check a course file's ``efficiency`` value and return the given factors.
 
     Parameters

@@ -69,8 +69,7 @@ from sailroute.errors import InputError
 from sailroute.numerics import pchip
 from sailroute.units import wrap180
 
-RULES: Final = ("non_finite", "low_wind", "manoeuvre", "acceleration", "outside_bins",
-                "outlier")
+RULES: Final = ("non_finite", "low_wind", "manoeuvre", "acceleration", "outside_bins", "outlier")
 """Names of the filter rules, in the order they are applied."""
 
 _MAD_TO_SIGMA: Final = 1.4826
@@ -107,8 +106,13 @@ class FitFilters:
     outlier_k: float = 3.0
 
     def __post_init__(self) -> None:
-        for name in ("min_tws_ms", "max_turn_rate_deg_s", "manoeuvre_window_s",
-                     "max_accel_per_s", "outlier_k"):
+        for name in (
+            "min_tws_ms",
+            "max_turn_rate_deg_s",
+            "manoeuvre_window_s",
+            "max_accel_per_s",
+            "outlier_k",
+        ):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and np.isfinite(v) and v >= 0):
                 raise InputError(f"fit filters: {name} must be a finite number >= 0; got {v!r}")
@@ -229,21 +233,22 @@ def fit_polar(
         arrays["heading_deg"] = hdg
     for nm, a in arrays.items():
         if a.size != k:
-            raise InputError(f"fit_polar: {nm} has {a.size} samples, tws_ms has {k}; "
-                             "give one value per sample")
+            raise InputError(
+                f"fit_polar: {nm} has {a.size} samples, tws_ms has {k}; give one value per sample"
+            )
     named = dict(options or {})
 
     def label(param: str) -> str:
         return named.get(param, f"fit_polar: {param}")
 
     tws_n = _check_nodes(tws_bins_ms, label("tws_bins_ms"), lo=0.0, hi=np.inf, strict_lo=True)
-    twa_n = _check_nodes(twa_bins_deg, label("twa_bins_deg"), lo=0.0, hi=180.0,
-                         strict_lo=False)
+    twa_n = _check_nodes(twa_bins_deg, label("twa_bins_deg"), lo=0.0, hi=180.0, strict_lo=False)
     if not 0.0 < percentile <= 100.0:
         raise InputError(f"{label('percentile')} must be in (0, 100], e.g. 90; got {percentile}")
     if not np.isfinite(min_count) or int(min_count) != min_count or min_count < 1:
-        raise InputError(f"{label('min_count')} must be a whole number >= 1, e.g. 5; "
-                         f"got {min_count}")
+        raise InputError(
+            f"{label('min_count')} must be a whole number >= 1, e.g. 5; got {min_count}"
+        )
     q = percentile / 100.0
     twa = fold_twa(twa_s)
 
@@ -300,15 +305,17 @@ def fit_polar(
     node_twa = twa_n[g // nj]
     v_final = v
     for _ in range(_CORRECTION_PASSES):
-        prov = _extended(*_finish(raw, counts, covered, tws_n, twa_n, q, v, g, name),
-                         tws_edges, twa_edges)
+        prov = _extended(
+            *_finish(raw, counts, covered, tws_n, twa_n, q, v, g, name), tws_edges, twa_edges
+        )
         at_node = prov.speed(node_tws, node_twa)
         at_sample = prov.speed(s_tws, s_twa)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = np.where(at_sample > 0, at_node / at_sample, 1.0)
         moved = v * np.clip(ratio, 0.5, 2.0)
-        raw = np.where(covered, _grouped_quantile(g, moved, n_cells, q)[1].reshape(counts.shape),
-                       np.nan)
+        raw = np.where(
+            covered, _grouped_quantile(g, moved, n_cells, q)[1].reshape(counts.shape), np.nan
+        )
         v_final = moved
     polar, rows, cols = _finish(raw, counts, covered, tws_n, twa_n, q, v_final, g, name)
     sub = np.ix_(rows, cols)
@@ -348,8 +355,9 @@ def _rate(t: NDArray, angle_deg: NDArray) -> NDArray:
     return np.where(np.isfinite(r), r, 0.0)
 
 
-def _manoeuvres(t: NDArray, twa_s: NDArray, hdg: NDArray | None,
-                filters: FitFilters) -> NDArray[np.bool_]:
+def _manoeuvres(
+    t: NDArray, twa_s: NDArray, hdg: NDArray | None, filters: FitFilters
+) -> NDArray[np.bool_]:
     """Samples turning fast or within the window of a tack/gybe."""
     rate = _rate(t, hdg if hdg is not None else twa_s)
     turning = rate > filters.max_turn_rate_deg_s
@@ -384,8 +392,9 @@ def _accelerating(t: NDArray, bsp: NDArray, filters: FitFilters) -> NDArray[np.b
 # --- envelope, monotonicity, fill ----------------------------------------------------
 
 
-def _grouped_quantile(g: NDArray, v: NDArray, n: int, q: float
-                      ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+def _grouped_quantile(
+    g: NDArray, v: NDArray, n: int, q: float
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Count and ``q``-quantile (linear, as ``np.quantile``) of ``v`` per group ``g``."""
     counts = np.bincount(g, minlength=n).astype(np.int64)
     res = np.full(n, np.nan)
@@ -445,8 +454,9 @@ def _monotone_in_tws(raw: NDArray, counts: NDArray, se: NDArray) -> NDArray:
         drop = y[:-1] - y[1:]
         tol = _SIGNIFICANT_Z * np.sqrt(np.nan_to_num(s[:-1]) ** 2 + np.nan_to_num(s[1:]) ** 2)
         cuts = np.flatnonzero(drop > tol) + 1
-        pieces = [_pava(yy, ww) for yy, ww in zip(np.split(y, cuts), np.split(w, cuts),
-                                                  strict=True)]
+        pieces = [
+            _pava(yy, ww) for yy, ww in zip(np.split(y, cuts), np.split(w, cuts), strict=True)
+        ]
         out[i, js] = np.concatenate(pieces)
     return out
 
@@ -494,8 +504,17 @@ def _fill(tab: NDArray, tws: NDArray, twa: NDArray) -> NDArray:
     return np.maximum(out, 0.0)
 
 
-def _finish(raw: NDArray, counts: NDArray, covered: NDArray, tws_n: NDArray, twa_n: NDArray,
-            q: float, v: NDArray, g: NDArray, name: str) -> tuple[Polar, NDArray, NDArray]:
+def _finish(
+    raw: NDArray,
+    counts: NDArray,
+    covered: NDArray,
+    tws_n: NDArray,
+    twa_n: NDArray,
+    q: float,
+    v: NDArray,
+    g: NDArray,
+    name: str,
+) -> tuple[Polar, NDArray, NDArray]:
     """Monotone rule, trim empty rows/columns, fill, build the polar."""
     se = _quantile_se(v, g, counts.size, counts, q)
     mono = _monotone_in_tws(raw, counts, se)
@@ -509,8 +528,9 @@ def _finish(raw: NDArray, counts: NDArray, covered: NDArray, tws_n: NDArray, twa
     return Polar.from_arrays(twa_n[rows], tws_n[cols], tab, name=name), rows, cols
 
 
-def _extended(polar: Polar, rows: NDArray, cols: NDArray, tws_edges: NDArray,
-              twa_edges: NDArray) -> Polar:
+def _extended(
+    polar: Polar, rows: NDArray, cols: NDArray, tws_edges: NDArray, twa_edges: NDArray
+) -> Polar:
     """``polar`` with one more row/column at each outer bin edge, extrapolated linearly.
 
     The provisional fit of the gradient correction must rate samples between the
@@ -542,14 +562,14 @@ def _extended(polar: Polar, rows: NDArray, cols: NDArray, tws_edges: NDArray,
 # --- helpers --------------------------------------------------------------------------
 
 
-def _check_nodes(nodes: ArrayLike, what: str, *, lo: float, hi: float,
-                 strict_lo: bool) -> NDArray[np.float64]:
+def _check_nodes(
+    nodes: ArrayLike, what: str, *, lo: float, hi: float, strict_lo: bool
+) -> NDArray[np.float64]:
     a = np.asarray(nodes, dtype=float).ravel()
     if a.size < 1 or not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0):
         raise InputError(f"{what} must be finite and strictly increasing; got {a}")
     if (a[0] <= lo if strict_lo else a[0] < lo) or a[-1] > hi:
-        raise InputError(f"{what} must lie in {'(' if strict_lo else '['}{lo:g}, "
-                         f"{hi:g}]; got {a}")
+        raise InputError(f"{what} must lie in {'(' if strict_lo else '['}{lo:g}, {hi:g}]; got {a}")
     return a
 
 
@@ -572,8 +592,9 @@ def _fmt_dropped(d: dict[str, int]) -> str:
     return ", ".join(f"{k} {v}" for k, v in d.items())
 
 
-def twa_sign_from(twd_deg: ArrayLike, heading_deg: ArrayLike,
-                  twa_deg: ArrayLike) -> NDArray[np.float64]:
+def twa_sign_from(
+    twd_deg: ArrayLike, heading_deg: ArrayLike, twa_deg: ArrayLike
+) -> NDArray[np.float64]:
     """Signed TWA from an unsigned one: the sign of ``wrap180(twd - heading)``.
 
     Logs often store ``|TWA|``; the tack (sign) is needed to find tacks and

@@ -23,8 +23,14 @@ from sailroute.errors import InputError
 from sailroute.track.model import Track
 from sailroute.units import wrap180
 
-__all__ = ["DEFAULT_TWS_STEP", "FitSamples", "PolarErrors", "auto_tws_bins", "compare_polars",
-           "samples_from_log"]
+__all__ = [
+    "DEFAULT_TWS_STEP",
+    "FitSamples",
+    "PolarErrors",
+    "auto_tws_bins",
+    "compare_polars",
+    "samples_from_log",
+]
 
 
 DEFAULT_TWS_STEP: Final = {"kn": 2.0, "m/s": 1.0}
@@ -133,18 +139,28 @@ def samples_from_log(track: Track) -> FitSamples:
         twa = twa_sign_from(twd, heading, twa)
         notes.append(f"TWA is unsigned in the log; tack (sign) from TWD - {hname}")
     elif np.nanmin(twa) >= 0:
-        notes.append("TWA is unsigned and the log has no TWD/heading: tacks and gybes are "
-                     "found by the turn-rate rule only")
+        notes.append(
+            "TWA is unsigned and the log has no TWD/heading: tacks and gybes are "
+            "found by the turn-rate rule only"
+        )
     bsp = finite_channel(ch, "bsp_ms")
     source = "bsp"
     if bsp is None:
         bsp, source = finite_channel(ch, "sog_ms"), "sog"
     if bsp is None:
-        raise InputError(f"{src}: no boat speed column (bsp, or sog); map it with "
-                         "--columns bsp=HEADER")
-    return FitSamples(t_s=np.asarray(track.t_s, float), tws_ms=tws, twa_deg=twa, bsp_ms=bsp,
-                      heading_deg=heading, speed_source=source, wind_source="log",
-                      notes=tuple(notes))
+        raise InputError(
+            f"{src}: no boat speed column (bsp, or sog); map it with --columns bsp=HEADER"
+        )
+    return FitSamples(
+        t_s=np.asarray(track.t_s, float),
+        tws_ms=tws,
+        twa_deg=twa,
+        bsp_ms=bsp,
+        heading_deg=heading,
+        speed_source=source,
+        wind_source="log",
+        notes=tuple(notes),
+    )
 
 
 def finite_channel(ch: Any, key: str) -> NDArray[np.float64] | None:
@@ -176,10 +192,12 @@ def compare_polars(fit: PolarFit, reference: Polar) -> PolarErrors:
     """
     p = fit.polar
     ref = reference.speed(p.tws_ms[None, :], p.twa_deg[:, None])
-    inside = ((p.twa_deg[:, None] >= reference.twa_deg[0])
-              & (p.twa_deg[:, None] <= reference.twa_deg[-1])
-              & (p.tws_ms[None, :] >= reference.tws_ms[0])
-              & (p.tws_ms[None, :] <= reference.tws_ms[-1]))
+    inside = (
+        (p.twa_deg[:, None] >= reference.twa_deg[0])
+        & (p.twa_deg[:, None] <= reference.twa_deg[-1])
+        & (p.tws_ms[None, :] >= reference.tws_ms[0])
+        & (p.tws_ms[None, :] <= reference.tws_ms[-1])
+    )
     cov = fit.covered & inside
     if not cov.any():
         raise InputError(
@@ -196,8 +214,13 @@ def compare_polars(fit: PolarFit, reference: Polar) -> PolarErrors:
     row_rms = np.array([np.sqrt(np.nanmean(rel[i, cov[i]] ** 2)) for i in rows])
     r = rel[cov]
     return PolarErrors(
-        rms_ms=float(np.sqrt(np.mean(d**2))), mean_ms=float(np.mean(d)),
-        rms_pct=float(np.sqrt(np.nanmean(r**2))), mean_pct=float(np.nanmean(r)),
-        twa_deg=p.twa_deg[rows], row_mean_pct=row_mean, row_rms_pct=row_rms,
-        row_cells=cov[rows].sum(axis=1).astype(np.int64), n_cells=int(cov.sum()),
+        rms_ms=float(np.sqrt(np.mean(d**2))),
+        mean_ms=float(np.mean(d)),
+        rms_pct=float(np.sqrt(np.nanmean(r**2))),
+        mean_pct=float(np.nanmean(r)),
+        twa_deg=p.twa_deg[rows],
+        row_mean_pct=row_mean,
+        row_rms_pct=row_rms,
+        row_cells=cov[rows].sum(axis=1).astype(np.int64),
+        n_cells=int(cov.sum()),
     )

@@ -131,10 +131,12 @@ def read_polar(
     if fmt == "json":
         return _read_json_text(text, p, speed_unit, wind_unit, interpolation)
     if fmt == "csv" and not _looks_wide(text):
-        return parse_long_csv(text, p, speed_unit=speed_unit, wind_unit=wind_unit,
-                              interpolation=interpolation)
-    return parse_pol(text, p, speed_unit=speed_unit, wind_unit=wind_unit,
-                     interpolation=interpolation)
+        return parse_long_csv(
+            text, p, speed_unit=speed_unit, wind_unit=wind_unit, interpolation=interpolation
+        )
+    return parse_pol(
+        text, p, speed_unit=speed_unit, wind_unit=wind_unit, interpolation=interpolation
+    )
 
 
 def write_pol(
@@ -200,8 +202,11 @@ def write_polar_csv(
     for j, tws in enumerate(polar.tws_ms):
         for i, twa in enumerate(polar.twa_deg):
             w.writerow(
-                [_fmt(tws / fw, decimals), _fmt(twa, decimals),
-                 _fmt(polar.speed_ms[i, j] / fs, decimals)]
+                [
+                    _fmt(tws / fw, decimals),
+                    _fmt(twa, decimals),
+                    _fmt(polar.speed_ms[i, j] / fs, decimals),
+                ]
             )
     out.write_text(buf.getvalue(), encoding="utf-8")
     return out

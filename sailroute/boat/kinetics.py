@@ -145,8 +145,7 @@ class Kinetics:
 RACE: Final = Kinetics()
 """The default race model (every value sourced in ``docs/vpp.md``)."""
 
-STEADY: Final = Kinetics(fetch_m=0.0, sea_age_h=0.0, pump_power_w_per_kg=0.0,
-                         upwind_efficiency=1.0)
+STEADY: Final = Kinetics(fetch_m=0.0, sea_age_h=0.0, pump_power_w_per_kg=0.0, upwind_efficiency=1.0)
 """No waves, no pumping: the race model reduces to the steady VPP."""
 
 
@@ -185,8 +184,7 @@ def check_kinetics(c: Checker, value: object) -> Kinetics | None:
             continue
         v = value[k]
         if isinstance(getattr(RACE, k), tuple):
-            if (not isinstance(v, list | tuple) or len(v) != 2
-                    or not all(_is_number(x) for x in v)):
+            if not isinstance(v, list | tuple) or len(v) != 2 or not all(_is_number(x) for x in v):
                 c.add(k, f"expected two numbers [from, to]; got {show(v)}")
             else:
                 given[k] = (float(v[0]), float(v[1]))
@@ -268,8 +266,9 @@ def wave_thrust(
     params: LaserParams, kin: Kinetics, tws_ms: ArrayLike, twa_deg: ArrayLike, v_ms: ArrayLike
 ) -> NDArray[np.float64]:
     """Mean forward force of riding wind-wave faces [N] (module docstring)."""
-    tws, twa, v = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in
-                                        (tws_ms, twa_deg, v_ms)))
+    tws, twa, v = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (tws_ms, twa_deg, v_ms))
+    )
     if kin.fetch_m <= 0 or kin.sea_age_h <= 0:
         return np.zeros(tws.shape)
     hs, _, lp, cp = wind_sea(_u10(tws, params, kin), kin.fetch_m, kin.sea_age_h * 3600.0)
@@ -285,8 +284,9 @@ def wave_thrust(
     slope = np.divide(2.0 * hs, lp, out=np.zeros_like(hs), where=lp > 0)
     # the hull feels the slope averaged over its waterline length: sinc(π L_wl / L_p); a hull
     # longer than the waves spans crest and trough and cannot ride one (0 past the first zero)
-    x = np.divide(np.pi * params.lwl_m * np.maximum(cos_phi, 0.0), lp, out=np.zeros_like(lp),
-                  where=lp > 0)
+    x = np.divide(
+        np.pi * params.lwl_m * np.maximum(cos_phi, 0.0), lp, out=np.zeros_like(lp), where=lp > 0
+    )
     hull = np.where(x < np.pi, np.sinc(x / np.pi), 0.0)
     mass = params.hull_mass_kg + params.crew_mass_kg
     return mass * G * slope * hull * share * np.maximum(cos_phi, 0.0)
@@ -308,8 +308,9 @@ def pump_thrust(
     params: LaserParams, kin: Kinetics, tws_ms: ArrayLike, twa_deg: ArrayLike, v_ms: ArrayLike
 ) -> NDArray[np.float64]:
     """Mean forward force of pumping [N]: ``η P / V`` where flag O allows it."""
-    tws, twa, v = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in
-                                        (tws_ms, twa_deg, v_ms)))
+    tws, twa, v = np.broadcast_arrays(
+        *(np.asarray(a, dtype=float) for a in (tws_ms, twa_deg, v_ms))
+    )
     power = kin.pump_efficiency * kin.pump_power_w_per_kg * params.crew_mass_kg
     allowed = _oscar(tws, kin)
     where = _ramp(np.abs(twa), *kin.pump_twa_deg)
@@ -361,17 +362,24 @@ def race_polar(
     from sailroute.boat.vpp import solve_polar
 
     thrust = None if kinetics == STEADY else race_thrust(params, kinetics)
-    polar = solve_polar(params, tws_ms, twa_deg, name=name, interpolation=interpolation,
-                        thrust=thrust)
+    polar = solve_polar(
+        params, tws_ms, twa_deg, name=name, interpolation=interpolation, thrust=thrust
+    )
     if kinetics.upwind_efficiency == 1.0:
         return polar
     scale = upwind_scale(kinetics, polar.twa_deg)
-    return Polar.from_arrays(polar.twa_deg, polar.tws_ms, polar.speed_ms * scale[:, None],
-                             name=polar.name, interpolation=polar.interpolation)
+    return Polar.from_arrays(
+        polar.twa_deg,
+        polar.tws_ms,
+        polar.speed_ms * scale[:, None],
+        name=polar.name,
+        interpolation=polar.interpolation,
+    )
 
 
 def upwind_scale(kin: Kinetics, twa_deg: ArrayLike) -> NDArray[np.float64]:
     """Speed factor per TWA [°]: ``upwind_efficiency`` on a beat, 1 off the wind."""
     lo, hi = kin.upwind_twa_deg
     return kin.upwind_efficiency + (1.0 - kin.upwind_efficiency) * _ramp(
-        np.abs(np.asarray(twa_deg, dtype=float)), lo, hi)
+        np.abs(np.asarray(twa_deg, dtype=float)), lo, hi
+    )

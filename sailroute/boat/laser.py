@@ -260,8 +260,9 @@ def _smaller_rig(
     """
     foot = base.sail_foot_height_m
     ce = foot + (base.ce_height_m - foot) * (sail_area_m2 / base.sail_area_m2) ** 0.5
-    return replace(base, name=name, sail_area_m2=sail_area_m2, ce_height_m=ce,
-                   crew_mass_kg=crew_mass_kg)
+    return replace(
+        base, name=name, sail_area_m2=sail_area_m2, ce_height_m=ce, crew_mass_kg=crew_mass_kg
+    )
 
 
 ILCA7: Final = LaserParams()
@@ -319,8 +320,9 @@ def params_from_mapping(
         known.setdefault("", line)
     probs = Problems(file, known, what="boat spec" if key else "boat file")
     if not isinstance(spec, dict):
-        raise InputError(f"{where}: {key or 'boat'}: expected a mapping of parameters; "
-                         f"got {show(spec)}")
+        raise InputError(
+            f"{where}: {key or 'boat'}: expected a mapping of parameters; got {show(spec)}"
+        )
     params = check_params(Checker(probs, key), spec)
     probs.raise_if_any()
     assert params is not None
@@ -355,8 +357,11 @@ def check_params(c: Checker, spec: Any) -> LaserParams | None:
     base = ILCA7
     if not isinstance(cls, str) or cls.lower() not in CLASSES:
         hint = suggest(cls.lower(), CLASSES).strip() if isinstance(cls, str) else ""
-        c.add("class", f"expected one of {quoted(sorted(CLASSES))}; got {show(cls)}"
-              + (f" ({hint})" if hint else ""))
+        c.add(
+            "class",
+            f"expected one of {quoted(sorted(CLASSES))}; got {show(cls)}"
+            + (f" ({hint})" if hint else ""),
+        )
     else:
         base = CLASSES[cls.lower()]
     names = [f.name for f in fields(LaserParams)]
@@ -367,9 +372,12 @@ def check_params(c: Checker, spec: Any) -> LaserParams | None:
         if k not in names:
             # "weight" is what sailors say for mass (crew_weight -> crew_mass_kg)
             word = str(k).lower().replace("weight", "mass")
-            c.add(str(k), f"unknown key; {suggest(word, [*_RESERVED, *names])}expected "
-                  "'class' or a parameter such as 'crew_mass_kg' (see docs/vpp.md for the "
-                  "full list)")
+            c.add(
+                str(k),
+                f"unknown key; {suggest(word, [*_RESERVED, *names])}expected "
+                "'class' or a parameter such as 'crew_mass_kg' (see docs/vpp.md for the "
+                "full list)",
+            )
             continue
         default = getattr(base, k)
         if isinstance(default, str):
@@ -404,10 +412,26 @@ def _number_problems(p: LaserParams) -> list[str]:
     centre of effort above its foot."""
     out: list[str] = []
     positive = (
-        "hull_mass_kg", "crew_mass_kg", "loa_m", "beam_m", "lwl_m", "bwl_m",
-        "prismatic_coefficient", "midship_coefficient", "waterplane_coefficient",
-        "lcb_fraction", "lcf_fraction", "board_area_m2", "appendage_chord_m", "max_draft_m",
-        "sail_area_m2", "ce_height_m", "rho_air", "rho_water", "nu_water", "gravity",
+        "hull_mass_kg",
+        "crew_mass_kg",
+        "loa_m",
+        "beam_m",
+        "lwl_m",
+        "bwl_m",
+        "prismatic_coefficient",
+        "midship_coefficient",
+        "waterplane_coefficient",
+        "lcb_fraction",
+        "lcf_fraction",
+        "board_area_m2",
+        "appendage_chord_m",
+        "max_draft_m",
+        "sail_area_m2",
+        "ce_height_m",
+        "rho_air",
+        "rho_water",
+        "nu_water",
+        "gravity",
         "hull_drag_area_m2",
     )
     for name in positive:
@@ -415,12 +439,34 @@ def _number_problems(p: LaserParams) -> list[str]:
         if not v > 0 or v != v or v == float("inf"):
             out.append(f"{name}: expected a finite number > 0; got {v!r}")
     nonneg = (
-        "wetted_area_m2", "form_factor", "rudder_area_m2", "appendage_form_factor",
-        "effective_draft_m", "clr_depth_m", "sail_foot_height_m", "effective_span_m",
-        "jib_area_m2", "jib_ce_height_m", "c_twist", "c_ds", "c_dp", "twist_ce_drop",
-        "flat_ce_drop", "flat_min", "ease_flat", "twist_max", "windage_cd_front", "windage_cd_side",
-        "windage_area_front_m2", "windage_area_side_m2", "windage_shielding",
-        "hiking_extension_m", "crew_arm_m", "kite_area_m2", "kite_ce_height_m", "max_heel_deg",
+        "wetted_area_m2",
+        "form_factor",
+        "rudder_area_m2",
+        "appendage_form_factor",
+        "effective_draft_m",
+        "clr_depth_m",
+        "sail_foot_height_m",
+        "effective_span_m",
+        "jib_area_m2",
+        "jib_ce_height_m",
+        "c_twist",
+        "c_ds",
+        "c_dp",
+        "twist_ce_drop",
+        "flat_ce_drop",
+        "flat_min",
+        "ease_flat",
+        "twist_max",
+        "windage_cd_front",
+        "windage_cd_side",
+        "windage_area_front_m2",
+        "windage_area_side_m2",
+        "windage_shielding",
+        "hiking_extension_m",
+        "crew_arm_m",
+        "kite_area_m2",
+        "kite_ce_height_m",
+        "max_heel_deg",
     )
     for name in nonneg:
         v = getattr(p, name)
@@ -446,11 +492,14 @@ def _model_problems(p: LaserParams) -> list[str]:
     """Hull and stability models known; a righting-arm curve of increasing heel."""
     out: list[str] = []
     if p.hull_model not in HULL_MODELS:
-        out.append(f"hull_model: expected one of {', '.join(map(repr, HULL_MODELS))}; "
-                   f"got {p.hull_model!r}")
+        out.append(
+            f"hull_model: expected one of {', '.join(map(repr, HULL_MODELS))}; got {p.hull_model!r}"
+        )
     if p.stability not in STABILITY_MODELS:
-        out.append(f"stability: expected one of {', '.join(map(repr, STABILITY_MODELS))}; "
-                   f"got {p.stability!r}")
+        out.append(
+            f"stability: expected one of {', '.join(map(repr, STABILITY_MODELS))}; "
+            f"got {p.stability!r}"
+        )
     if len(p.gz_heel_deg) != len(p.gz_m) or len(p.gz_m) < 2:
         out.append("gz_heel_deg, gz_m: need two lists of the same length (at least 2)")
     elif any(b <= a for a, b in zip(p.gz_heel_deg, p.gz_heel_deg[1:], strict=False)):
@@ -470,12 +519,16 @@ def _sail_crew_problems(p: LaserParams) -> list[str]:
         out.append(f"headsail_table: expected 'jib' or 'kite'; got {p.headsail_table!r}")
     lo, hi = CREW_MASS_RANGE_KG
     if p.stability == "hiking" and p.crew_mass_kg > 0 and not lo <= p.crew_mass_kg <= hi:
-        out.append(f"crew_mass_kg: expected a sailor mass in {lo:g}-{hi:g} kg for a hiking "
-                   f"dinghy; got {p.crew_mass_kg!r}")
+        out.append(
+            f"crew_mass_kg: expected a sailor mass in {lo:g}-{hi:g} kg for a hiking "
+            f"dinghy; got {p.crew_mass_kg!r}"
+        )
     if p.stability == "heel" and not (max(p.gz_m, default=0.0) > 0 or p.crew_arm_m > 0):
-        out.append("gz_m: stability 'heel' needs a righting-arm curve with a positive value "
-                   "(or crew_arm_m > 0); with none the boat cannot carry sail. Give gz_m "
-                   "(and gz_heel_deg) or use stability: hiking")
+        out.append(
+            "gz_m: stability 'heel' needs a righting-arm curve with a positive value "
+            "(or crew_arm_m > 0); with none the boat cannot carry sail. Give gz_m "
+            "(and gz_heel_deg) or use stability: hiking"
+        )
     return out
 
 

@@ -104,8 +104,11 @@ def axis_spacing_problem(values: ArrayLike, axis: str) -> str | None:
     if not close.size:
         return None
     a, b = float(ext[close[0]]), float(ext[close[0] + 1])
-    edges = "TWA 0 and 180 count: the polar adds zero-speed rows there" if axis == "TWA" \
+    edges = (
+        "TWA 0 and 180 count: the polar adds zero-speed rows there"
+        if axis == "TWA"
         else "TWS 0 counts: the polar adds a zero-speed column there"
+    )
     return (
         f"{axis} {a!r} and {b!r} {unit} are closer than {MIN_AXIS_STEP:g} {unit} ({edges}); "
         f"adjacent {axis} values must differ by at least {MIN_AXIS_STEP:g} {unit}: merge "
@@ -247,8 +250,13 @@ class Polar:
         InputError
             If the tables break a rule of :class:`Polar` (shape, order, range, spacing).
         """
-        return cls(_frozen_copy(twa_deg), _frozen_copy(tws_ms), _frozen_copy(speed_ms),
-                   name=name, interpolation=interpolation)
+        return cls(
+            _frozen_copy(twa_deg),
+            _frozen_copy(tws_ms),
+            _frozen_copy(speed_ms),
+            name=name,
+            interpolation=interpolation,
+        )
 
     def with_interpolation(self, interpolation: str) -> Polar:
         """Same table with another interpolation method (a new :class:`Polar`)."""

@@ -38,8 +38,14 @@ def parse_long_csv(
     """Parse a long ("tidy") polar CSV (see :mod:`sailroute.boat.io`)."""
     src = str(source)
     rows = csv_rows(list(enumerate(text.splitlines(), 1)), ",", src)
-    start = next((k for k, r in enumerate(rows) if r and any(c.strip() for c in r)
-                  and not r[0].lstrip().startswith("#")), None)
+    start = next(
+        (
+            k
+            for k, r in enumerate(rows)
+            if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")
+        ),
+        None,
+    )
     if start is None:
         raise InputError(f"{src}: the polar file is empty")
     header = [c.strip().lower() for c in rows[start]]
@@ -59,33 +65,49 @@ def parse_long_csv(
     def first_line(axis: int, value: float) -> int:  # (only on error)
         return min(ln for key, (_, ln) in values.items() if key[axis] == value)
 
-    _check_table(src, twa_ax, tws_ax, tab, s_unit, w_unit,
-                 at_twa=lambda i: f"{src}:{first_line(1, float(twa_ax[i]))}: "
-                                  f"cell {cols['twa'][0] + 1}",
-                 at_tws=lambda j: f"{src}:{first_line(0, float(tws_ax[j]))}: "
-                                  f"cell {cols['tws'][0] + 1}",
-                 at_cell=lambda i, j: f"{src}:{line_of[i, j]}: cell {cols['speed'][0] + 1}")
+    _check_table(
+        src,
+        twa_ax,
+        tws_ax,
+        tab,
+        s_unit,
+        w_unit,
+        at_twa=lambda i: f"{src}:{first_line(1, float(twa_ax[i]))}: cell {cols['twa'][0] + 1}",
+        at_tws=lambda j: f"{src}:{first_line(0, float(tws_ax[j]))}: cell {cols['tws'][0] + 1}",
+        at_cell=lambda i, j: f"{src}:{line_of[i, j]}: cell {cols['speed'][0] + 1}",
+    )
     tab = fill_empty_cells(twa_ax, tws_ax, tab)
-    return Polar.from_arrays(twa_ax, tws_ax * speed_factor(w_unit), tab * speed_factor(s_unit),
-                             name=clean_text(Path(src).stem), interpolation=interpolation)
+    return Polar.from_arrays(
+        twa_ax,
+        tws_ax * speed_factor(w_unit),
+        tab * speed_factor(s_unit),
+        name=clean_text(Path(src).stem),
+        interpolation=interpolation,
+    )
 
 
-def _long_columns(header: list[str], raw: list[str], src: str, lineno: int
-                  ) -> dict[str, tuple[int, str | None]]:
+def _long_columns(
+    header: list[str], raw: list[str], src: str, lineno: int
+) -> dict[str, tuple[int, str | None]]:
     """``role -> (index, unit suffix)`` of the ``tws``, ``twa`` and ``speed`` columns of the
     lower-case ``header`` (the file's cells ``raw``, on line ``lineno``)."""
     cols: dict[str, tuple[int, str | None]] = {}
     for k, name in enumerate(header):
         base, unit = _split_unit(name)
-        role = ("tws" if base == "tws" else "twa" if base == "twa"
-                else "speed" if base in _SPEED_NAMES else None)
+        role = (
+            "tws"
+            if base == "tws"
+            else "twa"
+            if base == "twa"
+            else "speed"
+            if base in _SPEED_NAMES
+            else None
+        )
         if role is None:
             continue
         if role in cols:
             first = header[cols[role][0]]
-            raise InputError(
-                f"{src}:{lineno}: two {role.upper()} columns ({first!r} and {name!r})"
-            )
+            raise InputError(f"{src}:{lineno}: two {role.upper()} columns ({first!r} and {name!r})")
         cols[role] = (k, unit)
     missing = [r for r in ("tws", "twa", "speed") if r not in cols]
     if missing:
@@ -95,33 +117,49 @@ def _long_columns(header: list[str], raw: list[str], src: str, lineno: int
             f"{', '.join(missing)} in the header ({quote_header(raw)})"
         )
     if cols["twa"][1] not in (None, "deg"):
-        raise InputError(f"{src}:{lineno}: TWA must be in degrees; got column "
-                         f"{header[cols['twa'][0]]!r}")
+        raise InputError(
+            f"{src}:{lineno}: TWA must be in degrees; got column {header[cols['twa'][0]]!r}"
+        )
     return cols
 
 
-def _long_units(header: list[str], cols: dict[str, tuple[int, str | None]],
-                speed_unit: str | None, wind_unit: str | None, src: str, lineno: int
-                ) -> tuple[str, str]:
+def _long_units(
+    header: list[str],
+    cols: dict[str, tuple[int, str | None]],
+    speed_unit: str | None,
+    wind_unit: str | None,
+    src: str,
+    lineno: int,
+) -> tuple[str, str]:
     """Boat-speed and wind-speed units: the column suffixes, the options and the file name
     must agree; knots when none says."""
     named = unit_from_name(src)
-    given_w = wind_unit or (speed_unit if cols["tws"][1] is None and cols["speed"][1] is None
-                            else None)
+    given_w = wind_unit or (
+        speed_unit if cols["tws"][1] is None and cols["speed"][1] is None else None
+    )
     if named is not None:  # the file name covers both columns
         name_claim = (f"the file name {Path(src).name!r}", named)
-        for what, role, given, opt in (("boat speed", "speed", speed_unit, "speed_unit"),
-                                       ("wind speed", "tws", given_w, "wind_unit")):
-            _agree(src, what, [(f"column {header[cols[role][0]]!r}", cols[role][1]),
-                               (f"{opt}={given!r}", given), name_claim])
-    s_unit = _merge_unit(src, lineno, "speed", cols["speed"][1], speed_unit,
-                         default=named or "kn")
+        for what, role, given, opt in (
+            ("boat speed", "speed", speed_unit, "speed_unit"),
+            ("wind speed", "tws", given_w, "wind_unit"),
+        ):
+            _agree(
+                src,
+                what,
+                [
+                    (f"column {header[cols[role][0]]!r}", cols[role][1]),
+                    (f"{opt}={given!r}", given),
+                    name_claim,
+                ],
+            )
+    s_unit = _merge_unit(src, lineno, "speed", cols["speed"][1], speed_unit, default=named or "kn")
     w_unit = _merge_unit(src, lineno, "wind", cols["tws"][1], given_w, default=named or "kn")
     return s_unit, w_unit
 
 
-def _long_values(rows: list[list[str]], start: int, cols: dict[str, tuple[int, str | None]],
-                 src: str) -> dict[tuple[float, float], tuple[float, int]]:
+def _long_values(
+    rows: list[list[str]], start: int, cols: dict[str, tuple[int, str | None]], src: str
+) -> dict[tuple[float, float], tuple[float, int]]:
     """``(TWS, TWA) -> (boat speed, line)`` of the data rows after the header row
     ``start`` (file units; each pair once)."""
     values: dict[tuple[float, float], tuple[float, int]] = {}
@@ -143,7 +181,9 @@ def _long_values(rows: list[list[str]], start: int, cols: dict[str, tuple[int, s
         if sp < 0:
             raise InputError(f"{src}:{lineno}: boat speed {sp:g} is negative")
         if (tws, twa) in values:
-            raise InputError(f"{src}:{lineno}: duplicate (TWS {tws:g}, TWA {twa:g}); first on "
-                             f"line {values[(tws, twa)][1]}")
+            raise InputError(
+                f"{src}:{lineno}: duplicate (TWS {tws:g}, TWA {twa:g}); first on "
+                f"line {values[(tws, twa)][1]}"
+            )
         values[(tws, twa)] = (sp, lineno)
     return values

@@ -44,8 +44,16 @@ _UNIT_SUFFIX: Final = {
 }
 
 _NAME_UNITS: Final = {
-    "kn": "kn", "kt": "kn", "kts": "kn", "knot": "kn", "knots": "kn",
-    "ms": "m/s", "mps": "m/s", "kmh": "km/h", "kph": "km/h", "mph": "mph",
+    "kn": "kn",
+    "kt": "kn",
+    "kts": "kn",
+    "knot": "kn",
+    "knots": "kn",
+    "ms": "m/s",
+    "mps": "m/s",
+    "kmh": "km/h",
+    "kph": "km/h",
+    "mph": "mph",
 }
 
 
@@ -92,8 +100,7 @@ def _header_unit(label: str) -> str | None:
     return _UNIT_SUFFIX.get(m.group(1))
 
 
-def _agree(src: str, what: str, claims: list[tuple[str, str | None]],
-           default: str = "kn") -> str:
+def _agree(src: str, what: str, claims: list[tuple[str, str | None]], default: str = "kn") -> str:
     """The one unit that every claim names (``default`` if none does), else an error.
 
     ``claims`` are ``(who, unit)`` pairs, e.g. ``("speed_unit='kn'", "kn")`` or
@@ -126,9 +133,11 @@ def _unit_hint(unit: str, option: str) -> str:
     smaller = [u for u in ("kn", "mph", "km/h") if speed_factor(u) < speed_factor(unit)]
     if not smaller:
         return f"it is read in {unit} already; check the file's values"
-    return (f"a unit mistake? It is read in {unit}; if the file is in {' or '.join(smaller)}, "
-            f"say so with {option}: {smaller[-1]} in the course's boat: block (or end the file "
-            "name with .kph, .kmh, .mph, ...)")
+    return (
+        f"a unit mistake? It is read in {unit}; if the file is in {' or '.join(smaller)}, "
+        f"say so with {option}: {smaller[-1]} in the course's boat: block (or end the file "
+        "name with .kph, .kmh, .mph, ...)"
+    )
 
 
 def _check_table(
@@ -183,8 +192,7 @@ def _check_table(
         raise InputError(
             f"{at_cell(i, j)}: boat speed {cell:g} {s_unit}{_in_kn(cell * fs, s_unit)} at TWA "
             f"{twa[i]:g}, TWS {tws[j]:g} {w_unit} is above {MAX_BOAT_SPEED_KN:g} kn, faster "
-            "than any sailing craft has gone (record 65.45 kn); "
-            + _unit_hint(s_unit, "speed_unit")
+            "than any sailing craft has gone (record 65.45 kn); " + _unit_hint(s_unit, "speed_unit")
         )
     if not np.nanmax(tab, initial=0.0) > 0:
         raise InputError(
@@ -198,10 +206,16 @@ def _well_formed(twa: NDArray, tws: NDArray, tab: NDArray) -> bool:
     """Axes 1-D, finite and increasing, table finite and of matching shape (else the
     :class:`Polar` constructor reports the problem)."""
     return bool(
-        twa.ndim == 1 and tws.ndim == 1 and tab.shape == (twa.size, tws.size)
-        and twa.size >= 2 and tws.size >= 1
-        and np.all(np.isfinite(twa)) and np.all(np.isfinite(tws)) and np.all(np.isfinite(tab))
-        and np.all(np.diff(twa) > 0) and np.all(np.diff(tws) > 0)
+        twa.ndim == 1
+        and tws.ndim == 1
+        and tab.shape == (twa.size, tws.size)
+        and twa.size >= 2
+        and tws.size >= 1
+        and np.all(np.isfinite(twa))
+        and np.all(np.isfinite(tws))
+        and np.all(np.isfinite(tab))
+        and np.all(np.diff(twa) > 0)
+        and np.all(np.diff(tws) > 0)
     )
 
 
@@ -244,8 +258,7 @@ def _number(cell: str, src: str, lineno: int, col: int, what: str) -> float:
             f"{src}:{lineno}: cell {col} ({excerpt(text)!r}): expected a number ({what})"
         ) from None
     if not math.isfinite(v):
-        raise InputError(f"{src}:{lineno}: cell {col} ({excerpt(text)!r}): {what} must be "
-                         "finite")
+        raise InputError(f"{src}:{lineno}: cell {col} ({excerpt(text)!r}): {what} must be finite")
     return v
 
 
@@ -266,12 +279,17 @@ def _split_unit(name: str) -> tuple[str, str | None]:
 def _suffix(unit: str) -> str:
     """Column-name suffix of a unit (``kn``, ``ms``, ``kmh``, ``mph``)."""
     f = speed_factor(unit)
-    return {speed_factor("kn"): "kn", 1.0: "ms", speed_factor("km/h"): "kmh",
-            speed_factor("mph"): "mph"}[f]
+    return {
+        speed_factor("kn"): "kn",
+        1.0: "ms",
+        speed_factor("km/h"): "kmh",
+        speed_factor("mph"): "mph",
+    }[f]
 
 
-def _file_units(src: str, speed_unit: str | None, wind_unit: str | None,
-                claims: list[tuple[str, str | None]]) -> tuple[str, str]:
+def _file_units(
+    src: str, speed_unit: str | None, wind_unit: str | None, claims: list[tuple[str, str | None]]
+) -> tuple[str, str]:
     """Speed and wind unit of a wide table: the options, what the file says, else knots.
 
     ``claims`` are the file's own statements (e.g. its label cell); the file name
@@ -281,14 +299,23 @@ def _file_units(src: str, speed_unit: str | None, wind_unit: str | None,
     named = unit_from_name(src)
     claims = [*claims, (f"the file name {Path(src).name!r}", named)]
     s_unit = _agree(src, "boat speed", [(f"speed_unit={speed_unit!r}", speed_unit), *claims])
-    given_w = (f"wind_unit={wind_unit!r}", wind_unit) if wind_unit else (
-        f"speed_unit={speed_unit!r}", speed_unit)
+    given_w = (
+        (f"wind_unit={wind_unit!r}", wind_unit)
+        if wind_unit
+        else (f"speed_unit={speed_unit!r}", speed_unit)
+    )
     w_unit = _agree(src, "wind speed", [given_w, *claims])
     return s_unit, w_unit
 
 
-def _merge_unit(src: str, lineno: int | None, what: str, declared: str | None,
-                given: str | None, default: str = "kn") -> str:
+def _merge_unit(
+    src: str,
+    lineno: int | None,
+    what: str,
+    declared: str | None,
+    given: str | None,
+    default: str = "kn",
+) -> str:
     where = f"{src}:{lineno}" if lineno else src
     try:
         if declared and given and speed_factor(declared) != speed_factor(given):

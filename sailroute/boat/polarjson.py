@@ -26,8 +26,9 @@ from sailroute.units import speed_factor
 JSON_FORMAT_TAG: Final = "sailroute-polar"
 
 
-_TOO_DEEP = ("not a polar: its JSON nests lists or objects too deeply to read (a polar file "
-             "has 3 levels)")
+_TOO_DEEP = (
+    "not a polar: its JSON nests lists or objects too deeply to read (a polar file has 3 levels)"
+)
 
 
 def read_orc_json(
@@ -81,11 +82,12 @@ def _read_json_text(
         return _orc_from_doc(doc, p, True, interpolation)
     if not isinstance(doc, dict) or doc.get("format") != JSON_FORMAT_TAG:
         raise InputError(
-            f"{p}: unknown JSON polar; expected sailroute's format (\"format\": "
-            f"\"{JSON_FORMAT_TAG}\") or an ORC certificate (with a \"vpp\" block)"
+            f'{p}: unknown JSON polar; expected sailroute\'s format ("format": '
+            f'"{JSON_FORMAT_TAG}") or an ORC certificate (with a "vpp" block)'
         )
-    problems = [f"missing key {k!r}" for k in ("twa_deg", "tws", "speed", "speed_unit")
-                if k not in doc]
+    problems = [
+        f"missing key {k!r}" for k in ("twa_deg", "tws", "speed", "speed_unit") if k not in doc
+    ]
     if problems:
         raise InputError(f"{p}: " + "; ".join(problems))
     file_speed = str(doc["speed_unit"])
@@ -102,13 +104,25 @@ def _read_json_text(
     except (TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: twa_deg, tws and speed must be numbers ({exc})") from None
     if _well_formed(twa, tws, tab):
-        _check_table(str(p), twa, tws, tab, s_unit, w_unit,
-                     at_twa=lambda i: f"{p}: twa_deg[{i}]", at_tws=lambda j: f"{p}: tws[{j}]",
-                     at_cell=lambda i, j: f"{p}: speed[{i}][{j}]")
+        _check_table(
+            str(p),
+            twa,
+            tws,
+            tab,
+            s_unit,
+            w_unit,
+            at_twa=lambda i: f"{p}: twa_deg[{i}]",
+            at_tws=lambda j: f"{p}: tws[{j}]",
+            at_cell=lambda i, j: f"{p}: speed[{i}][{j}]",
+        )
     try:
-        return Polar.from_arrays(twa, tws * speed_factor(w_unit), tab * speed_factor(s_unit),
-                                 name=clean_text(str(doc.get("name") or p.stem)),
-                                 interpolation=interpolation)
+        return Polar.from_arrays(
+            twa,
+            tws * speed_factor(w_unit),
+            tab * speed_factor(s_unit),
+            name=clean_text(str(doc.get("name") or p.stem)),
+            interpolation=interpolation,
+        )
     except InputError as exc:
         raise InputError(f"{p}: {exc}") from None
 
@@ -116,10 +130,14 @@ def _read_json_text(
 def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -> Polar:
     named = unit_from_name(p)
     if named not in (None, "kn"):
-        raise InputError(f"{p}: the file name says {named}, but ORC certificate polars are in "
-                         "knots; rename the file")
-    what = ("not an ORC certificate polar: need vpp.angles, vpp.speeds, one speed list per "
-            "angle and beat/run angle and VMG lists")
+        raise InputError(
+            f"{p}: the file name says {named}, but ORC certificate polars are in "
+            "knots; rename the file"
+        )
+    what = (
+        "not an ORC certificate polar: need vpp.angles, vpp.speeds, one speed list per "
+        "angle and beat/run angle and VMG lists"
+    )
     try:
         vpp = doc["vpp"]
         angles = [float(a) for a in vpp["angles"]]
@@ -130,27 +148,51 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
         tws = np.asarray([float(v) for v in vpp["speeds"]])
         keys = [_orc_key(vpp, a) for a in angles]
         tab = np.asarray([[float(v) for v in vpp[k]] for k in keys])
-        optima = {k: np.asarray(vpp[k], dtype=float)
-                  for k in ("beat_angle", "beat_vmg", "run_angle", "run_vmg")}
+        optima = {
+            k: np.asarray(vpp[k], dtype=float)
+            for k in ("beat_angle", "beat_vmg", "run_angle", "run_vmg")
+        }
     except (KeyError, TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{p}: {what} ({type(exc).__name__}: {exc})") from None
     if tab.shape != (len(angles), tws.size) or any(v.shape != tws.shape for v in optima.values()):
-        raise InputError(f"{p}: ORC vpp block: every list must have one value per wind speed "
-                         f"({tws.size})")
+        raise InputError(
+            f"{p}: ORC vpp block: every list must have one value per wind speed ({tws.size})"
+        )
     _orc_check(p, "vpp.speeds", tws, 0.0, math.inf, "a wind speed >= 0 kn")
     for i, k in enumerate(keys):
         _orc_check(p, f"vpp[{k!r}]", tab[i], 0.0, math.inf, "a boat speed >= 0 kn")
-    _orc_check(p, "vpp.beat_angle", optima["beat_angle"], 0.0, 90.0, "an angle in (0, 90) deg",
-               open_ends=True)
-    _orc_check(p, "vpp.run_angle", optima["run_angle"], 90.0, 180.0, "an angle in (90, 180] deg",
-               open_ends=(True, False))
+    _orc_check(
+        p,
+        "vpp.beat_angle",
+        optima["beat_angle"],
+        0.0,
+        90.0,
+        "an angle in (0, 90) deg",
+        open_ends=True,
+    )
+    _orc_check(
+        p,
+        "vpp.run_angle",
+        optima["run_angle"],
+        90.0,
+        180.0,
+        "an angle in (90, 180] deg",
+        open_ends=(True, False),
+    )
     for k in ("beat_vmg", "run_vmg"):
         _orc_check(p, f"vpp.{k}", optima[k], 0.0, math.inf, "a VMG >= 0 kn")
     if _well_formed(np.asarray(angles), tws, tab):
-        _check_table(str(p), np.asarray(angles), tws, tab, "kn", "kn",
-                     at_twa=lambda i: f"{p}: vpp.angles[{i}]",
-                     at_tws=lambda j: f"{p}: vpp.speeds[{j}]",
-                     at_cell=lambda i, j: f"{p}: vpp[{keys[i]!r}][{j}]")
+        _check_table(
+            str(p),
+            np.asarray(angles),
+            tws,
+            tab,
+            "kn",
+            "kn",
+            at_twa=lambda i: f"{p}: vpp.angles[{i}]",
+            at_tws=lambda j: f"{p}: vpp.speeds[{j}]",
+            at_cell=lambda i, j: f"{p}: vpp[{keys[i]!r}][{j}]",
+        )
     name = str(doc.get("boat", {}).get("type") or doc.get("name") or p.stem)
     if not include_optima:
         return _orc_polar(p, np.asarray(angles), tws, tab, name, interpolation)
@@ -180,17 +222,30 @@ def _orc_from_doc(doc: Any, p: Path, include_optima: bool, interpolation: str) -
     return _orc_polar(p, rows, tws, out, name, interpolation)
 
 
-def _orc_polar(p: Path, twa: NDArray, tws_kn: NDArray, tab_kn: NDArray, name: str,
-               interpolation: str) -> Polar:
+def _orc_polar(
+    p: Path, twa: NDArray, tws_kn: NDArray, tab_kn: NDArray, name: str, interpolation: str
+) -> Polar:
     try:
-        return Polar.from_arrays(twa, tws_kn * speed_factor("kn"), tab_kn * speed_factor("kn"),
-                                 name=name, interpolation=interpolation)
+        return Polar.from_arrays(
+            twa,
+            tws_kn * speed_factor("kn"),
+            tab_kn * speed_factor("kn"),
+            name=name,
+            interpolation=interpolation,
+        )
     except InputError as exc:
         raise InputError(f"{p}: {exc}") from None
 
 
-def _orc_check(p: Path, key: str, values: NDArray, lo: float, hi: float, expected: str,
-               open_ends: bool | tuple[bool, bool] = False) -> None:
+def _orc_check(
+    p: Path,
+    key: str,
+    values: NDArray,
+    lo: float,
+    hi: float,
+    expected: str,
+    open_ends: bool | tuple[bool, bool] = False,
+) -> None:
     """Every value of ``values`` finite and in ``[lo, hi]`` (open ends if asked), else an error."""
     lo_open, hi_open = (open_ends, open_ends) if isinstance(open_ends, bool) else open_ends
     v = np.asarray(values, dtype=float)

@@ -46,24 +46,43 @@ def parse_pol(
         head.pop()
     header_line = header_idx + 1
     if len(head) < 2:
-        raise InputError(f"{src}:{header_line}: header has no wind speeds after "
-                         f"{excerpt(head[0])!r}")
-    s_unit, w_unit = _file_units(src, speed_unit, wind_unit, [
-        (f"the label cell {excerpt(head[0].strip())!r} (line {header_line})",
-         _header_unit(head[0]))])
+        raise InputError(
+            f"{src}:{header_line}: header has no wind speeds after {excerpt(head[0])!r}"
+        )
+    s_unit, w_unit = _file_units(
+        src,
+        speed_unit,
+        wind_unit,
+        [
+            (
+                f"the label cell {excerpt(head[0].strip())!r} (line {header_line})",
+                _header_unit(head[0]),
+            )
+        ],
+    )
     tws = _header_speeds(head, src, header_line)
     twa, rows, row_lines = _table_rows(lines, header_idx, sep, tws, src)
     tws_arr = np.asarray(tws, dtype=float)
     raw_tab = np.asarray(rows, dtype=float)
-    _check_table(src, np.asarray(twa), tws_arr, raw_tab, s_unit, w_unit,
-                 at_twa=lambda i: f"{src}:{row_lines[i]}: cell 1",
-                 at_tws=lambda j: f"{src}:{header_line}: cell {j + 2}",
-                 at_cell=lambda i, j: f"{src}:{row_lines[i]}: cell {j + 2}")
+    _check_table(
+        src,
+        np.asarray(twa),
+        tws_arr,
+        raw_tab,
+        s_unit,
+        w_unit,
+        at_twa=lambda i: f"{src}:{row_lines[i]}: cell 1",
+        at_tws=lambda j: f"{src}:{header_line}: cell {j + 2}",
+        at_cell=lambda i, j: f"{src}:{row_lines[i]}: cell {j + 2}",
+    )
     tab = fill_empty_cells(np.asarray(twa), tws_arr, raw_tab)
-    return Polar.from_arrays(np.asarray(twa), tws_arr * speed_factor(w_unit),
-                             tab * speed_factor(s_unit),
-                             name=clean_text(Path(src).stem),
-                             interpolation=interpolation)
+    return Polar.from_arrays(
+        np.asarray(twa),
+        tws_arr * speed_factor(w_unit),
+        tab * speed_factor(s_unit),
+        name=clean_text(Path(src).stem),
+        interpolation=interpolation,
+    )
 
 
 def _header_index(lines: list[str], src: str) -> int:
@@ -102,8 +121,9 @@ def _header_speeds(head: list[str], src: str, lineno: int) -> list[float]:
     return tws
 
 
-def _table_rows(lines: list[str], header_idx: int, sep: str | None, tws: list[float],
-                src: str) -> tuple[list[float], list[list[float]], list[int]]:
+def _table_rows(
+    lines: list[str], header_idx: int, sep: str | None, tws: list[float], src: str
+) -> tuple[list[float], list[list[float]], list[int]]:
     """TWA [°], boat speeds (file units, NaN for an empty cell) and line number of every
     row after the header; at least 2 rows, TWA increasing, no blank line between rows."""
     twa: list[float] = []
@@ -133,16 +153,16 @@ def _table_rows(lines: list[str], header_idx: int, sep: str | None, tws: list[fl
     return twa, rows, row_lines
 
 
-def _table_row(cells: list[str], n_tws: int, src: str, lineno: int, previous: float | None
-               ) -> tuple[float, list[float]]:
+def _table_row(
+    cells: list[str], n_tws: int, src: str, lineno: int, previous: float | None
+) -> tuple[float, list[float]]:
     """TWA [°] in [0, 180] (above the ``previous`` row's) and the ``n_tws`` boat speeds
     (>= 0, NaN for an empty cell, not all empty) of one table row."""
     while len(cells) > n_tws + 1 and cells[-1].strip() == "":
         cells.pop()
     if len(cells) != n_tws + 1:
         raise InputError(
-            f"{src}:{lineno}: {len(cells) - 1} speed cells but the header has "
-            f"{n_tws} wind speeds"
+            f"{src}:{lineno}: {len(cells) - 1} speed cells but the header has {n_tws} wind speeds"
         )
     a = _number(cells[0], src, lineno, 1, "TWA")
     if not 0.0 <= a <= 180.0:
@@ -187,14 +207,14 @@ def fill_empty_cells(
         ok = ~np.isnan(tab[i])
         for j in np.flatnonzero(~ok):
             left = np.flatnonzero(ok[:j])
-            right = np.flatnonzero(ok[j + 1:]) + j + 1
+            right = np.flatnonzero(ok[j + 1 :]) + j + 1
             if left.size and right.size:
                 a, b = left[-1], right[0]
                 out[i, j] = np.interp(tws[j], [tws[a], tws[b]], [tab[i, a], tab[i, b]])
                 continue
             col_ok = ~np.isnan(tab[:, j])
             up = np.flatnonzero(col_ok[:i])
-            down = np.flatnonzero(col_ok[i + 1:]) + i + 1
+            down = np.flatnonzero(col_ok[i + 1 :]) + i + 1
             if up.size and down.size:
                 a, b = up[-1], down[0]
                 out[i, j] = np.interp(twa_deg[i], [twa_deg[a], twa_deg[b]], [tab[a, j], tab[b, j]])

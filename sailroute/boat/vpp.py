@@ -478,10 +478,13 @@ class _Ctx:
         r = np.minimum(x * self.inv_ease, 1.0) if self.inv_ease else np.ones_like(x)
         dr = np.where(x * self.inv_ease < 1.0, self.inv_ease, 0.0)
         cl2 = self.cl0 * self.cl0
-        ys = self.qa * (x * self.cl0 * self.cb
-                        + (self.cdl + (self.cd0 - self.cdl) * r + x * x * cl2 * k) * self.sb)
-        dys = self.qa * (self.cl0 * self.cb + ((self.cd0 - self.cdl) * dr + 2.0 * x * cl2 * k)
-                         * self.sb)
+        ys = self.qa * (
+            x * self.cl0 * self.cb
+            + (self.cdl + (self.cd0 - self.cdl) * r + x * x * cl2 * k) * self.sb
+        )
+        dys = self.qa * (
+            self.cl0 * self.cb + ((self.cd0 - self.cdl) * dr + 2.0 * x * cl2 * k) * self.sb
+        )
         arm = self.arm0 + self.arm_f * x - self.arm_t * t
         return ys * arm + self.wy * self.warm, dys * arm + ys * self.arm_f
 
@@ -537,8 +540,9 @@ def _best_controls(
 
     tmax = p.twist_max
     if tmax > 0:
-        t_opt = golden_max(lambda t: on_limit(t)[1], np.zeros(xu.shape),
-                            np.full(xu.shape, tmax), _N_GOLDEN_TWIST)
+        t_opt = golden_max(
+            lambda t: on_limit(t)[1], np.zeros(xu.shape), np.full(xu.shape, tmax), _N_GOLDEN_TWIST
+        )
     else:
         t_opt = np.zeros(xu.shape)
     candidates = [np.zeros(xu.shape), t_opt, np.full(xu.shape, tmax)]  # ties keep t = 0
@@ -671,8 +675,11 @@ def _solve_point(
     _, x, t, over, heel, ctx = _surplus_at(params, tws, twa, v)
     fx, fy, _, m = ctx.forces(x, t)
     nan = np.where(moving, 1.0, np.nan)
-    rm = params.max_righting_moment_nm if params.stability == "hiking" else float(
-        righting_moment(_max_heel(params), params))
+    rm = (
+        params.max_righting_moment_nm
+        if params.stability == "hiking"
+        else float(righting_moment(_max_heel(params), params))
+    )
     res = PointSolution(
         speed_ms=speed,
         flat=x * nan,
@@ -709,8 +716,7 @@ def _solve_speed(
         vmax = np.where(g_top >= 0, 2.0 * vmax, vmax)
     frac = (np.arange(1, _N_SCAN + 1) / _N_SCAN) ** 1.5
     grid = _V_MIN + (vmax[:, None] - _V_MIN) * frac[None, :]  # (n, K), increasing
-    g = surplus(np.repeat(tws, _N_SCAN), np.repeat(twa, _N_SCAN), grid.ravel()).reshape(
-        n, _N_SCAN)
+    g = surplus(np.repeat(tws, _N_SCAN), np.repeat(twa, _N_SCAN), grid.ravel()).reshape(n, _N_SCAN)
     pos = g >= 0
     has = np.asarray(pos.any(axis=1))  # (an array: numpy's stubs say "bool or array")
     # last grid point with g >= 0; the root lies between it and the next point
@@ -724,8 +730,10 @@ def _solve_speed(
         # skip points whose samples are too negative for any peak between them to reach 0
         k = np.argmax(g[miss], axis=1)
         gk = g[miss, k]
-        spread = np.maximum(np.abs(gk - g[miss, np.maximum(k - 1, 0)]),
-                            np.abs(gk - g[miss, np.minimum(k + 1, _N_SCAN - 1)]))
+        spread = np.maximum(
+            np.abs(gk - g[miss, np.maximum(k - 1, 0)]),
+            np.abs(gk - g[miss, np.minimum(k + 1, _N_SCAN - 1)]),
+        )
         miss = miss[gk + 2.0 * spread >= 0]
     if miss.size:
         k = np.argmax(g[miss], axis=1)
@@ -809,5 +817,6 @@ def solve_polar(
     tws = np.asarray(tws_ms, dtype=float)
     twa = np.asarray(twa_deg, dtype=float)
     sol = solve_point(params, tws[None, :], twa[:, None], thrust)
-    return Polar.from_arrays(twa, tws, sol.speed_ms, name=name or params.name,
-                             interpolation=interpolation)
+    return Polar.from_arrays(
+        twa, tws, sol.speed_ms, name=name or params.name, interpolation=interpolation
+    )

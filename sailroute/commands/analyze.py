@@ -78,23 +78,29 @@ def run_analyze_command(
     if not tracks:
         raise InputError("analyze: give at least one track file")
     if reference not in REFERENCES:
-        raise InputError(f"--reference: expected one of {', '.join(REFERENCES)}; "
-                         f"got {reference!r}")
+        raise InputError(f"--reference: expected one of {', '.join(REFERENCES)}; got {reference!r}")
     name = default_scenario(course) if scenario is None else scenario
     stems = _unique_stems(tracks)
     times = parse_boat_leg_times(leg_times, stems, course.n_legs)
     stem = Path(course.source).stem if course.source else "course"
-    default = (Path("out") / stem / (f"analysis-{Path(tracks[0]).stem}" if len(tracks) == 1
-                                     else "analysis-fleet"))
+    default = (
+        Path("out")
+        / stem
+        / (f"analysis-{Path(tracks[0]).stem}" if len(tracks) == 1 else "analysis-fleet")
+    )
     out = check_out_dir(Path(out_dir) if out_dir is not None else default)
-    read = [read_track(p, columns=columns, speed_unit=speed_unit, time_zone=time_zone,
-                       name=s) for p, s in zip(tracks, stems, strict=True)]
+    read = [
+        read_track(p, columns=columns, speed_unit=speed_unit, time_zone=time_zone, name=s)
+        for p, s in zip(tracks, stems, strict=True)
+    ]
     settings_for(course, router)
     boat, winds = build_specs(course, [name])
     polar = boat.routing_polar()
     if reference == "fleet" and polar is None:
-        raise InputError("--reference fleet scales a polar; the course's boat has none (a "
-                         "dynamic boat model): use --reference course")
+        raise InputError(
+            "--reference fleet scales a polar; the course's boat has none (a "
+            "dynamic boat model): use --reference course"
+        )
     sources, notes = analysis_winds(course, read, name, winds[name], boat, wind)
 
     def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
@@ -102,11 +108,19 @@ def run_analyze_command(
         for tr in read:
             if progress is not None:
                 progress.set_prefix(f"{tr.name}: ")
-            a = analyze_track(course, tr, name, leg_times=times[tr.name], router=router,
-                              detect_m=detect_m, built=(judged_by, winds[name]),
-                              winds=sources[tr.name], progress=progress,
-                              missing="error" if len(read) == 1 else "unknown",
-                              gate_end=gate_end)
+            a = analyze_track(
+                course,
+                tr,
+                name,
+                leg_times=times[tr.name],
+                router=router,
+                detect_m=detect_m,
+                built=(judged_by, winds[name]),
+                winds=sources[tr.name],
+                progress=progress,
+                missing="error" if len(read) == 1 else "unknown",
+                gate_end=gate_end,
+            )
             out_a.append(replace(a, reference=label))
         return out_a
 
@@ -117,9 +131,13 @@ def run_analyze_command(
         analyses = analyse_all(fp.polar, fp.describe())
     if len(analyses) == 1:
         files = write_output_set(out, lambda d: write_analysis(d, analyses[0], plots=plots))
-        return CommandResult("\n\n".join([analysis_table(analyses[0]), _notes_text(notes)]),
-                             files, data=tuple(analyses), notes=tuple(notes),
-                             main=("analysis_json",))
+        return CommandResult(
+            "\n\n".join([analysis_table(analyses[0]), _notes_text(notes)]),
+            files,
+            data=tuple(analyses),
+            notes=tuple(notes),
+            main=("analysis_json",),
+        )
     rows = fleet_ranking(analyses)
     # the page draws the fleet-wide wind: the first boat's first candidate not its own log
     shared = next((s for s in sources[read[0].name] if s.kind != "measured"), None)
@@ -130,14 +148,25 @@ def run_analyze_command(
         for s, a in zip(stems, analyses, strict=True):
             for kind, p in write_analysis(d / s, a, plots=plots).items():
                 files[f"{s}/{kind}"] = p
-        files.update(write_fleet(d, analyses, rows, plots=plots, notes=notes,
-                                 wind=fleet_wind_layer))
+        files.update(
+            write_fleet(d, analyses, rows, plots=plots, notes=notes, wind=fleet_wind_layer)
+        )
         return files
 
-    report = "\n\n".join([*(analysis_table(a) for a in analyses),
-                           fleet_table(rows, fleet_notes(analyses)), _notes_text(notes)])
-    return CommandResult(report, write_output_set(out, write), data=tuple(analyses),
-                         notes=tuple(notes), main=("fleet_json",))
+    report = "\n\n".join(
+        [
+            *(analysis_table(a) for a in analyses),
+            fleet_table(rows, fleet_notes(analyses)),
+            _notes_text(notes),
+        ]
+    )
+    return CommandResult(
+        report,
+        write_output_set(out, write),
+        data=tuple(analyses),
+        notes=tuple(notes),
+        main=("fleet_json",),
+    )
 
 
 def _notes_text(notes: Sequence[str]) -> str:
@@ -156,5 +185,3 @@ def _unique_stems(paths: Sequence[str | Path]) -> list[str]:
             k += 1
         out.append(s)
     return out
-
-

@@ -66,16 +66,25 @@ def spec_for(course: Course, n: int | None = None) -> tuple[UncertaintySpec, tup
     spec = course.uncertainty
     if spec is None:
         spec = DEFAULT_UNCERTAINTY
-        notes = ("the course has no `uncertainty:` section: default uncertainties (TWS 1 kn, "
-                 "TWD 5° 1 sigma, shifts ±5° every 6 min; docs/course-format.md)",)
+        notes = (
+            "the course has no `uncertainty:` section: default uncertainties (TWS 1 kn, "
+            "TWD 5° 1 sigma, shifts ±5° every 6 min; docs/course-format.md)",
+        )
     if n is not None:
         spec = spec.with_members(n)
     return resolve_shifts(spec), notes
 
 
 def route_members(
-    course: Course, scenario: str, members: Sequence[Member], *, wind: WindField, boat: Any,
-    settings: RoutingSettings, backend: str = "numpy", progress: Progress | None = None,
+    course: Course,
+    scenario: str,
+    members: Sequence[Member],
+    *,
+    wind: WindField,
+    boat: Any,
+    settings: RoutingSettings,
+    backend: str = "numpy",
+    progress: Progress | None = None,
 ) -> list[list[LegResult]]:
     """Route the course once per member, one after the other.
 
@@ -111,8 +120,11 @@ def route_members(
             progress.set_prefix(f"{scenario} {m.name}: ")
         w = member_wind(wind, m, course.start_epoch)
         b = member_boat(course.boat_spec, boat, m, base_dir=course.base_dir, where=where)
-        out.append(route_course(course, w, b, settings, backend=backend, progress=progress,
-                                current=current))
+        out.append(
+            route_course(
+                course, w, b, settings, backend=backend, progress=progress, current=current
+            )
+        )
     return out
 
 
@@ -121,9 +133,18 @@ def _times(results: Sequence[Sequence[LegResult]]) -> np.ndarray:
 
 
 def band_summary(
-    course: Course, scenario: str, spec: UncertaintySpec, *, wind: WindField, boat: Any,
-    settings: RoutingSettings, backend: str = "numpy", progress: Progress | None = None,
-    route: RouteMembers = route_members, notes: Sequence[str] = (), oat: bool = True,
+    course: Course,
+    scenario: str,
+    spec: UncertaintySpec,
+    *,
+    wind: WindField,
+    boat: Any,
+    settings: RoutingSettings,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+    route: RouteMembers = route_members,
+    notes: Sequence[str] = (),
+    oat: bool = True,
 ) -> BandSummary:
     """Route a scenario's members (main ensemble, nominal, one-at-a-time) and summarize.
 
@@ -153,8 +174,16 @@ def band_summary(
     for m in flat:
         unique.setdefault(key[m.name], m)
     todo = list(unique.values())
-    results = route(course, scenario, todo, wind=wind, boat=boat, settings=settings,
-                    backend=backend, progress=progress)
+    results = route(
+        course,
+        scenario,
+        todo,
+        wind=wind,
+        boat=boat,
+        settings=settings,
+        backend=backend,
+        progress=progress,
+    )
     by_key = {key[m.name]: r for m, r in zip(todo, results, strict=True)}
     res_of = {m.name: by_key[key[m.name]] for m in flat}
     where = course.boat_where or str(course.source or "<course>")
@@ -162,11 +191,20 @@ def band_summary(
     for m in main:
         w = member_wind(wind, m, course.start_epoch)
         b = member_boat(course.boat_spec, boat, m, base_dir=course.base_dir, where=where)
-        sides.append(tuple(
-            honest_side(r, w, b, tack_penalty_s=settings.tack_penalty_s,
-                        gybe_penalty_s=settings.gybe_penalty_s, margin_s=spec.side_margin_s,
-                        margin_pct=spec.side_margin_pct)
-            for r in res_of[m.name]))
+        sides.append(
+            tuple(
+                honest_side(
+                    r,
+                    w,
+                    b,
+                    tack_penalty_s=settings.tack_penalty_s,
+                    gybe_penalty_s=settings.gybe_penalty_s,
+                    margin_s=spec.side_margin_s,
+                    margin_pct=spec.side_margin_pct,
+                )
+                for r in res_of[m.name]
+            )
+        )
     return BandSummary(
         scenario=scenario,
         leg_labels=tuple(leg.label for leg in course.legs),
@@ -230,8 +268,10 @@ def run_bands_command(
     if members is not None and members < 3:
         raise InputError(f"--ensemble {members}: a band needs at least 3 members; give N >= 3")
     if scheduler not in (None, "serial"):
-        raise InputError(f"--scheduler {scheduler}: --ensemble routes its members here, one "
-                         "after the other; leave out --scheduler (or use serial)")
+        raise InputError(
+            f"--scheduler {scheduler}: --ensemble routes its members here, one "
+            "after the other; leave out --scheduler (or use serial)"
+        )
     course = course if isinstance(course, Course) else load_course(course)
     names = list(scenarios) if scenarios else [course.scenario_names[0]]
     for n in names:
@@ -240,10 +280,12 @@ def run_bands_command(
                 f"{course.where('scenarios.' + n)}: {n!r} is an ensemble of "
                 f"{len(course.ensembles[n])} members; --ensemble draws its own members "
                 f"around one scenario: give one of {', '.join(repr(s) for s in course.scenarios if s not in course.ensembles[n])} "  # noqa: E501
-                "or route the ensemble without --ensemble")
+                "or route the ensemble without --ensemble"
+            )
     folder = f"{names[0]}-bands" if len(names) == 1 else f"{what}-bands"
-    out = check_out_dir(Path(out_dir) if out_dir is not None
-                        else default_out_dir(course, folder, router))
+    out = check_out_dir(
+        Path(out_dir) if out_dir is not None else default_out_dir(course, folder, router)
+    )
     spec, notes = spec_for(course, members)
     settings = settings_for(course, router, backend)
     boat, winds = build_specs(course, names)
@@ -252,17 +294,33 @@ def run_bands_command(
         for line in warn.values():
             progress.warn(line)
     summaries = tuple(
-        band_summary(course, n, spec, wind=winds[n], boat=boat, settings=settings,
-                     backend=backend, progress=progress, notes=notes)
-        for n in names)
+        band_summary(
+            course,
+            n,
+            spec,
+            wind=winds[n],
+            boat=boat,
+            settings=settings,
+            backend=backend,
+            progress=progress,
+            notes=notes,
+        )
+        for n in names
+    )
 
     def write(d: Path) -> dict[str, Path]:
         files = write_bands(d, summaries, course_name=course.name, plot=plots)
         if plots:
-            files["html"] = write_report(d / "report.html", bands_page(
-                course, summaries, winds, router=settings.router))
+            files["html"] = write_report(
+                d / "report.html", bands_page(course, summaries, winds, router=settings.router)
+            )
         return files
 
     files = write_output_set(out, write)
-    return CommandResult("\n\n".join(bands_table(b) for b in summaries), files, summaries,
-                         notes=tuple(warn.values()), main=("bands_json",))
+    return CommandResult(
+        "\n\n".join(bands_table(b) for b in summaries),
+        files,
+        summaries,
+        notes=tuple(warn.values()),
+        main=("bands_json",),
+    )

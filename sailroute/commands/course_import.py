@@ -57,26 +57,31 @@ def boat_spec_of(text: str | None, out: Path) -> dict[str, Any] | None:
         try:
             spec = yaml.safe_load(t)
         except yaml.YAMLError as exc:
-            raise InputError(f"--boat {text!r}: not a YAML mapping ({exc.__class__.__name__});"
-                             " expected e.g. '{polar: f50.csv, speed_unit: km/h}'") from None
+            raise InputError(
+                f"--boat {text!r}: not a YAML mapping ({exc.__class__.__name__});"
+                " expected e.g. '{polar: f50.csv, speed_unit: km/h}'"
+            ) from None
         if not isinstance(spec, dict):
-            raise InputError(f"--boat {text!r}: expected a mapping such as "
-                             "'{builtin: ilca7}'")
+            raise InputError(f"--boat {text!r}: expected a mapping such as '{{builtin: ilca7}}'")
         return spec
     p = Path(t)
     if p.suffix.lower() in (".pol", ".csv", ".txt") or p.is_file():
         if not p.is_file():
-            raise InputError(f"--boat {text!r}: no such polar file; expected a built-in name "
-                             "(ilca7, ilca6, ...) or an existing .pol/.csv file")
+            raise InputError(
+                f"--boat {text!r}: no such polar file; expected a built-in name "
+                "(ilca7, ilca6, ...) or an existing .pol/.csv file"
+            )
         return {"polar": os.path.relpath(p.resolve(), out.resolve().parent)}
     return {"builtin": t}
 
 
 def _summary(ic: ImportedCourse, course: Course, out: Path, fmt: str) -> str:
     """The terminal report: what was read, leg by leg."""
-    rows = [f"course {course.name!r} from {fmt}: {len(ic.marks)} marks, "
-            f"{len(ic.lines)} lines, {len(ic.gates)} gates, {course.n_legs} legs; start "
-            f"{course.start_time.isoformat()}"]
+    rows = [
+        f"course {course.name!r} from {fmt}: {len(ic.marks)} marks, "
+        f"{len(ic.lines)} lines, {len(ic.gates)} gates, {course.n_legs} legs; start "
+        f"{course.start_time.isoformat()}"
+    ]
     for leg in course.legs:
         side = f" ({leg.rounding})" if leg.rounding else ""
         rows.append(f"  leg {leg.index + 1}: {leg.label} [{leg.kind}]{side}")
@@ -130,9 +135,11 @@ def run_course_import_command(
     """
     src = Path(source)
     if wind_twd_deg is None or wind_tws_kn is None:
-        raise InputError("--wind-twd and --wind-tws are required: the course file needs a "
-                         "wind scenario to plan in; give the forecast's direction [deg, from] "
-                         "and speed [kn] (replace the scenario in the file later if you like)")
+        raise InputError(
+            "--wind-twd and --wind-tws are required: the course file needs a "
+            "wind scenario to plan in; give the forecast's direction [deg, from] "
+            "and speed [kn] (replace the scenario in the file later if you like)"
+        )
     if not (math.isfinite(wind_twd_deg) and 0.0 <= wind_twd_deg <= 360.0):
         raise InputError(f"--wind-twd {wind_twd_deg:g}: expected degrees in [0, 360]")
     if not (math.isfinite(wind_tws_kn) and 0.0 <= wind_tws_kn <= 100.0):
@@ -143,14 +150,23 @@ def run_course_import_command(
     ic, chosen = read_course_source(src, fmt)
     if dest.exists() and dest.resolve() == src.resolve():
         raise InputError(f"-o {dest}: the same file as the input; choose another name")
-    t0: datetime | None = (parse_time(start_time, where="--start-time")
-                           if start_time is not None else ic.start_time)
+    t0: datetime | None = (
+        parse_time(start_time, where="--start-time") if start_time is not None else ic.start_time
+    )
     if t0 is None:
-        raise InputError(f"{src}: the file gives no start time; give --start-time "
-                         "'2025-01-19T16:08:00+13:00' (ISO 8601 with a UTC offset)")
-    text = course_yaml(ic, source=src.name, fmt=chosen, twd_deg=float(wind_twd_deg),
-                       tws_kn=float(wind_tws_kn), start_time=t0,
-                       boat=boat_spec_of(boat, dest))
+        raise InputError(
+            f"{src}: the file gives no start time; give --start-time "
+            "'2025-01-19T16:08:00+13:00' (ISO 8601 with a UTC offset)"
+        )
+    text = course_yaml(
+        ic,
+        source=src.name,
+        fmt=chosen,
+        twd_deg=float(wind_twd_deg),
+        tws_kn=float(wind_tws_kn),
+        start_time=t0,
+        boat=boat_spec_of(boat, dest),
+    )
     if not dest.parent.is_dir():
         raise InputError(f"-o {dest}: the folder {dest.parent} does not exist; create it first")
     tmp = dest.with_name(f".{dest.name}.sailroute-tmp")
@@ -166,8 +182,10 @@ def run_course_import_command(
     course = load_course(dest)
     notes = list(ic.notes)
     if boat is None:
-        notes.append(f"no boat given (--boat): add a `boat:` section to {dest} for the boat "
-                     "you race; until then `sailroute plan` routes the default ILCA 7 polar")
+        notes.append(
+            f"no boat given (--boat): add a `boat:` section to {dest} for the boat "
+            "you race; until then `sailroute plan` routes the default ILCA 7 polar"
+        )
     files: Mapping[str, Path] = {"course": dest}
     report = "\n".join([_summary(ic, course, dest, chosen), *(f"note: {n}" for n in notes)])
     return CommandResult(report, files, course, tuple(notes), main=())

@@ -22,10 +22,19 @@ __all__ = ["live_report", "run_live_command", "run_live_convert_command", "start
 
 
 def start_live(
-    course: Course | str | Path, *, source: str, scenario: str | None = None,
-    every_s: float = 10.0, speed: float = 1.0, port: int | None = 8080,
-    nmea_port: int | None = 10110, log: str | Path | None = None, router: str | None = None,
-    leg: int = 1, settings: LiveSettings | None = None, worker: bool = True,
+    course: Course | str | Path,
+    *,
+    source: str,
+    scenario: str | None = None,
+    every_s: float = 10.0,
+    speed: float = 1.0,
+    port: int | None = 8080,
+    nmea_port: int | None = 10110,
+    log: str | Path | None = None,
+    router: str | None = None,
+    leg: int = 1,
+    settings: LiveSettings | None = None,
+    worker: bool = True,
 ) -> LiveEngine:
     """Load the course and its forecast, open the ports and start the live threads.
 
@@ -40,8 +49,10 @@ def start_live(
     loaded = course if isinstance(course, Course) else load_course(course)
     name = default_scenario(loaded) if scenario is None else scenario
     if name in loaded.ensembles:
-        raise InputError(f"--scenario {name}: an ensemble; give one member "
-                         f"({', '.join(loaded.ensembles[name])}) as the forecast")
+        raise InputError(
+            f"--scenario {name}: an ensemble; give one member "
+            f"({', '.join(loaded.ensembles[name])}) as the forecast"
+        )
     if not every_s > 0:
         raise InputError(f"--every {every_s:g}: must be > 0 seconds between re-plans")
     if not 1 <= leg <= loaded.n_legs:
@@ -50,42 +61,75 @@ def start_live(
     routing = settings_for(loaded, router)
     boat, winds = build_specs(loaded, [name])
     base = settings or LiveSettings()
-    live = LiveSettings(every_s, base.shift_deg, base.change_ms, base.fade_s, base.window_s,
-                        base.stale_s, base.reach_m, base.side)
+    live = LiveSettings(
+        every_s,
+        base.shift_deg,
+        base.change_ms,
+        base.fade_s,
+        base.window_s,
+        base.stale_s,
+        base.reach_m,
+        base.side,
+    )
     planner = ProcessPlanner(loaded, name, router) if worker else None
-    return LiveEngine(loaded, winds[name], boat, routing, src, live, port=port,
-                      nmea_port=nmea_port, log=None if log is None else Path(log),
-                      leg=leg - 1, planner=planner).start()
+    return LiveEngine(
+        loaded,
+        winds[name],
+        boat,
+        routing,
+        src,
+        live,
+        port=port,
+        nmea_port=nmea_port,
+        log=None if log is None else Path(log),
+        leg=leg - 1,
+        planner=planner,
+    ).start()
 
 
 def live_report(engine: LiveEngine) -> str:
     """The terminal summary of a live run: inputs, re-plans, the last plan."""
     st = engine.state()
     c = st["counts"]
-    lines = [f"source {engine.source.label}: {engine.n_readings} readings, "
-             f"{c['used']} messages used, {c.get('bad_checksum', 0)} with a bad checksum, "
-             f"{c.get('malformed', 0)} malformed, {engine.n_drops} connection drops",
-             f"re-plans: {engine.n_plans}"]
+    lines = [
+        f"source {engine.source.label}: {engine.n_readings} readings, "
+        f"{c['used']} messages used, {c.get('bad_checksum', 0)} with a bad checksum, "
+        f"{c.get('malformed', 0)} malformed, {engine.n_drops} connection drops",
+        f"re-plans: {engine.n_plans}",
+    ]
     p = engine.plan
     if p is not None:
-        lines.append(f"last re-plan #{p.number} at {iso(p.t)} ({p.reason}), leg {p.leg + 1}: "
-                     f"next mark in {p.time_to_mark_s:.0f} s, finish in "
-                     f"{p.time_to_finish_s:.0f} s, wind {p.wind_tws_ms * 1.9438:.1f} kn "
-                     f"from {p.wind_twd_deg:.0f}°")
+        lines.append(
+            f"last re-plan #{p.number} at {iso(p.t)} ({p.reason}), leg {p.leg + 1}: "
+            f"next mark in {p.time_to_mark_s:.0f} s, finish in "
+            f"{p.time_to_finish_s:.0f} s, wind {p.wind_tws_ms * 1.9438:.1f} kn "
+            f"from {p.wind_twd_deg:.0f}°"
+        )
         if p.side is not None:
-            lines.append(f"side that pays: {p.side.side}" + (
-                "" if p.side.side == "none" else f" by {p.side.gain_s:.0f} s"))
+            lines.append(
+                f"side that pays: {p.side.side}"
+                + ("" if p.side.side == "none" else f" by {p.side.gain_s:.0f} s")
+            )
     if engine.error:
         lines.append(f"last routing problem: {engine.error}")
     return "\n".join(lines)
 
 
 def run_live_command(
-    course: Course | str | Path, *, source: str, scenario: str | None = None,
-    every_s: float = 10.0, speed: float = 1.0, port: int | None = 8080,
-    nmea_port: int | None = 10110, log: str | Path | None = None,
-    duration_s: float | None = None, router: str | None = None, leg: int = 1,
-    announce: Callable[[str], None] | None = None, settings: LiveSettings | None = None,
+    course: Course | str | Path,
+    *,
+    source: str,
+    scenario: str | None = None,
+    every_s: float = 10.0,
+    speed: float = 1.0,
+    port: int | None = 8080,
+    nmea_port: int | None = 10110,
+    log: str | Path | None = None,
+    duration_s: float | None = None,
+    router: str | None = None,
+    leg: int = 1,
+    announce: Callable[[str], None] | None = None,
+    settings: LiveSettings | None = None,
     worker: bool = True,
 ) -> CommandResult:
     """Everything ``sailroute live`` does, minus printing.
@@ -133,16 +177,26 @@ def run_live_command(
         ``data`` is the last :class:`~sailroute.live.replan.LivePlan` (None if none);
         ``files`` the log.
     """
-    engine = start_live(course, source=source, scenario=scenario, every_s=every_s,
-                        speed=speed, port=port, nmea_port=nmea_port, log=log, router=router,
-                        leg=leg, settings=settings, worker=worker)
+    engine = start_live(
+        course,
+        source=source,
+        scenario=scenario,
+        every_s=every_s,
+        speed=speed,
+        port=port,
+        nmea_port=nmea_port,
+        log=log,
+        router=router,
+        leg=leg,
+        settings=settings,
+        worker=worker,
+    )
     try:
         if announce is not None:
             if engine.page is not None:
                 announce(f"page: http://127.0.0.1:{engine.page.port}/")
             if engine.nmea is not None:
-                announce(f"NMEA 0183 out (RMB, APB, WPL, RTE): tcp://127.0.0.1:"
-                         f"{engine.nmea.port}")
+                announce(f"NMEA 0183 out (RMB, APB, WPL, RTE): tcp://127.0.0.1:{engine.nmea.port}")
         with contextlib.suppress(KeyboardInterrupt):
             engine.wait(duration_s)
     finally:
@@ -152,8 +206,13 @@ def run_live_command(
 
 
 def run_live_convert_command(
-    log: str | Path, *, fmt: str, out: str | Path, utc_offset: str = "+01:00",
-    start: str | None = None, end: str | None = None,
+    log: str | Path,
+    *,
+    fmt: str,
+    out: str | Path,
+    utc_offset: str = "+01:00",
+    start: str | None = None,
+    end: str | None = None,
 ) -> CommandResult:
     """Everything ``sailroute live-convert`` does: an instrument log to a ``.nmea`` replay.
 
@@ -179,5 +238,6 @@ def run_live_convert_command(
     t0 = None if start is None else to_epoch(parse_time(start, "--from"))
     t1 = None if end is None else to_epoch(parse_time(end, "--to"))
     n = convert_log(Path(log), fmt, Path(out), utc_offset_s=offset, t0=t0, t1=t1)
-    return CommandResult(f"{n} seconds of {fmt} log written as NMEA 0183", {"nmea": Path(out)},
-                         n, main=())
+    return CommandResult(
+        f"{n} seconds of {fmt} log written as NMEA 0183", {"nmea": Path(out)}, n, main=()
+    )

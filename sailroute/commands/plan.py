@@ -72,8 +72,9 @@ def run_plan_command(
 
     course = _loaded(course)
     name = default_scenario(course) if scenario is None else scenario
-    out = check_out_dir(Path(out_dir) if out_dir is not None
-                        else default_out_dir(course, name, options.router))
+    out = check_out_dir(
+        Path(out_dir) if out_dir is not None else default_out_dir(course, name, options.router)
+    )
     if name in course.ensembles:
         return _run_ensemble(course, name, out_dir=out, options=options, plots=plots)
     with png_worker.start(plots) as png:  # loads matplotlib on another core meanwhile
@@ -93,12 +94,17 @@ def run_plan_command(
             return files
 
         files = write_output_set(out, write)
-    return CommandResult(plan_table(run.plan), files, data=run.plan, notes=run.notes,
-                         main=("plan",))
+    return CommandResult(
+        plan_table(run.plan), files, data=run.plan, notes=run.notes, main=("plan",)
+    )
 
 
 def _run_ensemble(
-    course: Course, name: str, *, out_dir: str | Path | None, options: RunOptions,
+    course: Course,
+    name: str,
+    *,
+    out_dir: str | Path | None,
+    options: RunOptions,
     plots: bool = True,
 ) -> CommandResult:
     """``sailroute plan`` on an ensemble scenario: every member, then the spread."""
@@ -115,16 +121,19 @@ def _run_ensemble(
             from sailroute.report.html import comparison_report
             from sailroute.report.page_render import write_report
 
-            files["html"] = write_report(d / "report.html",
-                                         comparison_report(cmp, plans, winds))
+            files["html"] = write_report(d / "report.html", comparison_report(cmp, plans, winds))
         for p in plans:
             sub = d / safe_part(p.scenario, "scenario")
             for kind, path in write_plan_outputs(sub, p, plot=False).items():
                 files[f"{p.scenario}/{kind}"] = path
         return files
 
-    return CommandResult(ensemble_table(summary), write_output_set(out, write), data=tuple(plans),
-                         main=("ensemble_json",))
+    return CommandResult(
+        ensemble_table(summary),
+        write_output_set(out, write),
+        data=tuple(plans),
+        main=("ensemble_json",),
+    )
 
 
 def run_compare_command(
@@ -149,14 +158,19 @@ def run_compare_command(
     from sailroute.report.tables import comparison_table
 
     course = _loaded(course)
-    out = check_out_dir(Path(out_dir) if out_dir is not None
-                        else default_out_dir(course, "comparison", options.router))
+    out = check_out_dir(
+        Path(out_dir)
+        if out_dir is not None
+        else default_out_dir(course, "comparison", options.router)
+    )
     cmp, plans, winds = route_scenarios(course, scenarios, options)
     report = [comparison_table(cmp)]
     by_name = {p.scenario: p for p in plans}
-    summaries = [summarize_ensemble(ens, [by_name[m] for m in members], winds)
-                 for ens, members in course.ensembles.items()
-                 if all(m in by_name for m in members)]
+    summaries = [
+        summarize_ensemble(ens, [by_name[m] for m in members], winds)
+        for ens, members in course.ensembles.items()
+        if all(m in by_name for m in members)
+    ]
     report += [ensemble_table(summary) for summary in summaries]
 
     def write(d: Path) -> dict[str, Path]:
@@ -180,5 +194,9 @@ def run_compare_command(
                 files[f"{summary.name}/{kind}"] = path
         return files
 
-    return CommandResult("\n\n".join(report), write_output_set(out, write),
-                         data=(cmp, tuple(plans)), main=("comparison_json",))
+    return CommandResult(
+        "\n\n".join(report),
+        write_output_set(out, write),
+        data=(cmp, tuple(plans)),
+        main=("comparison_json",),
+    )

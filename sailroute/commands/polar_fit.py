@@ -44,12 +44,9 @@ class FitRun:
     errors: PolarErrors | None = None
 
 
-
-
-
-
-def samples_from_course_wind(track: Track, course_path: str | Path,
-                             scenario: str | None = None) -> FitSamples:
+def samples_from_course_wind(
+    track: Track, course_path: str | Path, scenario: str | None = None
+) -> FitSamples:
     """Samples from a GPS track and a course scenario's wind.
 
     The scenario's wind field (uniform, stations, WRF, blended; built as for
@@ -73,17 +70,23 @@ def samples_from_course_wind(track: Track, course_path: str | Path,
     course = load_course(course_path)
     names = list(course.scenarios)
     if not names:
-        raise InputError(f"{course_path}: the course has no wind scenarios; add one under "
-                         "'scenarios:' to fit a GPS track")
+        raise InputError(
+            f"{course_path}: the course has no wind scenarios; add one under "
+            "'scenarios:' to fit a GPS track"
+        )
     name = names[0] if scenario is None else scenario
     if name not in course.scenarios:
-        raise InputError(f"--scenario: the course {str(course_path)!r} has no scenario "
-                         f"{name!r}; its scenarios are: {', '.join(names)}")
+        raise InputError(
+            f"--scenario: the course {str(course_path)!r} has no scenario "
+            f"{name!r}; its scenarios are: {', '.join(names)}"
+        )
     frame = course.frame
     x, y = track_xy(track, frame)
     sc = course.scenarios[name]
     wind = wind_from_spec(
-        dict(sc.wind), frame=frame, base_dir=course.base_dir,
+        dict(sc.wind),
+        frame=frame,
+        base_dir=course.base_dir,
         where=sc.where or course.where(f"scenarios.{name}"),
         crop_bbox=(float(x.min()), float(x.max()), float(y.min()), float(y.max())),
         lines=course.key_lines,
@@ -98,8 +101,7 @@ def samples_from_course_wind(track: Track, course_path: str | Path,
             f"({cov.describe()}); use a scenario whose wind covers the track's time"
         )
     if not inside.all():
-        notes.append(f"{int((~inside).sum())} track points outside the wind's time span "
-                     "left out")
+        notes.append(f"{int((~inside).sum())} track points outside the wind's time span left out")
     ch = track.channels
     sog, cog = finite_channel(ch, "sog_ms"), finite_channel(ch, "cog_deg")
     source = "sog"
@@ -111,29 +113,22 @@ def samples_from_course_wind(track: Track, course_path: str | Path,
     # local +y is rotated from true north by the meridian convergence
     twd = twd_local - frame.grid_north_deg(track.lat_deg[inside], track.lon_deg[inside])
     twa = wrap180(twd - cog[inside])
-    return FitSamples(t_s=t[inside], tws_ms=tws, twa_deg=twa, bsp_ms=sog[inside],
-                      heading_deg=cog[inside], speed_source=source,
-                      wind_source=f"course {course_path}, scenario {name}", notes=tuple(notes))
-
-
+    return FitSamples(
+        t_s=t[inside],
+        tws_ms=tws,
+        twa_deg=twa,
+        bsp_ms=sog[inside],
+        heading_deg=cog[inside],
+        speed_source=source,
+        wind_source=f"course {course_path}, scenario {name}",
+        notes=tuple(notes),
+    )
 
 
 # --- fit, compare ----------------------------------------------------------------------
 
 
-
-
-
-
 # --- report, plot, files -----------------------------------------------------------------
-
-
-
-
-
-
-
-
 
 
 # --- the command -----------------------------------------------------------------------
@@ -155,8 +150,12 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
     return out
 
 
-FIT_OPTIONS: Final = {"percentile": "--percentile", "min_count": "--min-count",
-                      "tws_bins_ms": "--tws-bins", "twa_bins_deg": "--twa-step"}
+FIT_OPTIONS: Final = {
+    "percentile": "--percentile",
+    "min_count": "--min-count",
+    "tws_bins_ms": "--tws-bins",
+    "twa_bins_deg": "--twa-step",
+}
 """The ``polar fit`` options that give :func:`~sailroute.boat.fit.fit_polar`'s parameters
 (named in its messages)."""
 
@@ -224,27 +223,48 @@ def run_fit_command(
     if unit not in UNITS:
         raise InputError(f"--unit: expected one of 'kn', 'm/s'; got {unit!r}")
     if scenario is not None and course is None:
-        raise InputError("--scenario needs --course: the scenario's wind comes from a course "
-                         "file")
+        raise InputError("--scenario needs --course: the scenario's wind comes from a course file")
     check_out_dir(out_dir)
     ref = None
     if reference is not None:
         ref = read_polar(reference, speed_unit=reference_unit, wind_unit=reference_unit)
-    track = read_track(log, columns=parse_columns(columns), speed_unit=speed_unit,
-                       time_zone=time_zone)
-    samples = (samples_from_log(track) if course is None
-               else samples_from_course_wind(track, course, scenario))
-    tws_n = (np.asarray(parse_speed_list(tws_bins, unit, option="--tws-bins"))
-             if tws_bins is not None else auto_tws_bins(samples.tws_ms, DEFAULT_TWS_STEP[unit]
-                                                         * speed_factor(unit)))
+    track = read_track(
+        log, columns=parse_columns(columns), speed_unit=speed_unit, time_zone=time_zone
+    )
+    samples = (
+        samples_from_log(track)
+        if course is None
+        else samples_from_course_wind(track, course, scenario)
+    )
+    tws_n = (
+        np.asarray(parse_speed_list(tws_bins, unit, option="--tws-bins"))
+        if tws_bins is not None
+        else auto_tws_bins(samples.tws_ms, DEFAULT_TWS_STEP[unit] * speed_factor(unit))
+    )
     stem = slug(name) if name else slug(Path(log).stem) + "-fit"
-    fit = fit_polar(samples.tws_ms, samples.twa_deg, samples.bsp_ms, samples.t_s,
-                    tws_bins_ms=tws_n, twa_bins_deg=twa_grid(twa_step_deg),
-                    heading_deg=samples.heading_deg, percentile=percentile,
-                    min_count=min_count, filters=filters, name=stem, options=FIT_OPTIONS)
+    fit = fit_polar(
+        samples.tws_ms,
+        samples.twa_deg,
+        samples.bsp_ms,
+        samples.t_s,
+        tws_bins_ms=tws_n,
+        twa_bins_deg=twa_grid(twa_step_deg),
+        heading_deg=samples.heading_deg,
+        percentile=percentile,
+        min_count=min_count,
+        filters=filters,
+        name=stem,
+        options=FIT_OPTIONS,
+    )
     errors = compare_polars(fit, ref) if ref is not None else None
     report = fit_report(fit, samples, unit, errors, ref.name if ref is not None else "")
     files = write_output_set(
-        out_dir, lambda d: write_fit_outputs(fit, samples, d, stem, unit, ref, errors))
-    return CommandResult(report, files, data=FitRun(fit=fit, samples=samples, errors=errors),
-                         main=("json",), labels=POLAR_FILE_LABELS)
+        out_dir, lambda d: write_fit_outputs(fit, samples, d, stem, unit, ref, errors)
+    )
+    return CommandResult(
+        report,
+        files,
+        data=FitRun(fit=fit, samples=samples, errors=errors),
+        main=("json",),
+        labels=POLAR_FILE_LABELS,
+    )

@@ -19,8 +19,7 @@ from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.timeutil import parse_time, to_epoch
 
-__all__ = ["MAX_OFFSET_M", "parse_position", "parse_start_time", "position_xy",
-           "run_start_command"]
+__all__ = ["MAX_OFFSET_M", "parse_position", "parse_start_time", "position_xy", "run_start_command"]
 
 MAX_OFFSET_M = 20_000.0
 """A position further than this from the course area (the marks' box) is refused [m]."""
@@ -43,8 +42,9 @@ def parse_position(text: str, option: str = "--at") -> tuple[float, float]:
             raise ValueError
         a, b = float(parts[0]), float(parts[1])
     except ValueError:
-        example = ("43.0645,6.2295 (LAT,LON in degrees)" if option == "--at"
-                   else "-150,80 (X,Y in metres)")
+        example = (
+            "43.0645,6.2295 (LAT,LON in degrees)" if option == "--at" else "-150,80 (X,Y in metres)"
+        )
         raise InputError(
             f"{option} {text!r}: expected two comma-separated numbers, e.g. {example}"
         ) from None
@@ -85,7 +85,8 @@ def parse_start_time(text: str, gun: float) -> float:
     except InputError:
         raise InputError(
             f"--time {text!r}: expected an ISO 8601 time with a UTC offset "
-            "(e.g. 2018-04-24T12:08:30+02:00) or seconds from the gun (e.g. -90)") from None
+            "(e.g. 2018-04-24T12:08:30+02:00) or seconds from the gun (e.g. -90)"
+        ) from None
 
 
 def position_xy(course: Course, at: str | None, xy: str | None) -> tuple[float, float]:
@@ -98,13 +99,17 @@ def position_xy(course: Course, at: str | None, xy: str | None) -> tuple[float, 
         course area.
     """
     if (at is None) == (xy is None):
-        raise InputError("give the boat's position with --at LAT,LON (degrees) or --xy X,Y "
-                         "(metres east and north of the course origin), one of the two")
+        raise InputError(
+            "give the boat's position with --at LAT,LON (degrees) or --xy X,Y "
+            "(metres east and north of the course origin), one of the two"
+        )
     if at is not None:
         lat, lon = parse_position(at, "--at")
         if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 360.0):
-            raise InputError(f"--at {at!r}: latitude must be within -90..90 and longitude "
-                             "within -180..360 degrees; the order is LAT,LON")
+            raise InputError(
+                f"--at {at!r}: latitude must be within -90..90 and longitude "
+                "within -180..360 degrees; the order is LAT,LON"
+            )
         x, y = (float(v) for v in course.frame.to_xy(lat, lon))
         given = f"--at {at}"
     else:
@@ -116,7 +121,8 @@ def position_xy(course: Course, at: str | None, xy: str | None) -> tuple[float, 
         raise InputError(
             f"{given}: the position is {gap / 1000:.0f} km from the course area (the marks "
             f"of {course.source or course.name}); it must be within {MAX_OFFSET_M / 1000:.0f} km"
-            " (check the order LAT,LON and the signs)")
+            " (check the order LAT,LON and the signs)"
+        )
     return x, y
 
 
@@ -181,9 +187,12 @@ def run_start_command(
     names = (line.a.name, line.b.name)
     numbers = start_line_numbers(line.a.xy, line.b.xy, wind, boat, gun, names=names)
     ap = line_approach(p, t, line.a.xy, line.b.xy, wind, boat, gun, names=names)
-    doc = {"schema_version": SCHEMA_VERSION, "sailroute_version": __version__,
-           "scenario": name,
-           **approach_to_dict(ap, course.frame, course=course.name, line=numbers)}
+    doc = {
+        "schema_version": SCHEMA_VERSION,
+        "sailroute_version": __version__,
+        "scenario": name,
+        **approach_to_dict(ap, course.frame, course=course.name, line=numbers),
+    }
     notes = tuple(n for n in (ap.wind_note,) if n)
     if ap.course_side:
         notes += ("the boat is on the course side of the line: it must come back below it",)
@@ -195,5 +204,11 @@ def run_start_command(
         return {"json": path}
 
     files = write_output_set(out, write)
-    return CommandResult(approach_table(ap, course.name, names), files, ap, notes, ("json",),
-                         labels={"json": "start (JSON)"})
+    return CommandResult(
+        approach_table(ap, course.name, names),
+        files,
+        ap,
+        notes,
+        ("json",),
+        labels={"json": "start (JSON)"},
+    )

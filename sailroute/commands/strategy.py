@@ -30,8 +30,13 @@ from sailroute.strategy.study import (
 )
 from sailroute.units import KNOT
 
-__all__ = ["SHIFT_KINDS", "check_command_options", "parse_objective", "parse_shift",
-           "run_strategy_command"]
+__all__ = [
+    "SHIFT_KINDS",
+    "check_command_options",
+    "parse_objective",
+    "parse_shift",
+    "run_strategy_command",
+]
 
 
 def parse_objective(text: str) -> tuple[float, ...]:
@@ -134,8 +139,9 @@ def run_strategy_command(
 
     deadlines = parse_objective(objective)
     check_out_dir(out_dir)
-    check_command_options(settings, n_workers=n_workers, sigma_deg=sigma_deg,
-                          drift_deg_per_min=drift_deg_per_min)
+    check_command_options(
+        settings, n_workers=n_workers, sigma_deg=sigma_deg, drift_deg_per_min=drift_deg_per_min
+    )
     scheduler = check_scheduler(scheduler)
     kind = parse_shift(shift)
     name = str(start_tack).strip().lower()
@@ -146,19 +152,22 @@ def run_strategy_command(
         raise InputError(f"--tws-kn {tws_kn}: must be > 0")
     seed = settings.get("seed", 0)
     if not isinstance(seed, int) or seed < 0:
-        raise InputError(f"--seed {seed}: expected an integer >= 0 (NumPy's generators take "
-                         "no negative seeds)")
+        raise InputError(
+            f"--seed {seed}: expected an integer >= 0 (NumPy's generators take no negative seeds)"
+        )
     polar = load_polar(polar_spec)
     check_wind_in_polar(tws_kn, polar, polar_spec)
     fit = None
     if fit_from is not None:
-        ou, dd = fit_station_file(fit_from, station=fit_station, timezone=fit_timezone,
-                                  speed_unit=fit_speed_unit)
+        ou, dd = fit_station_file(
+            fit_from, station=fit_station, timezone=fit_timezone, speed_unit=fit_speed_unit
+        )
         model: ShiftModel = ou.model() if kind == "ou" else dd.model()
         fit = fit_summary(ou, dd, str(fit_from))
     else:
-        model = shift_model(kind, sigma_deg, timescale_min, drift_deg_per_min,
-                            diffusion_deg_per_sqrt_min)
+        model = shift_model(
+            kind, sigma_deg, timescale_min, drift_deg_per_min, diffusion_deg_per_sqrt_min
+        )
     try:
         st = StrategySettings(
             tws_ms=tws_kn * KNOT,
@@ -194,7 +203,10 @@ def _option(name: str) -> str:
 
 
 def check_command_options(
-    settings: Mapping[str, Any], *, n_workers: int | None, sigma_deg: float,
+    settings: Mapping[str, Any],
+    *,
+    n_workers: int | None,
+    sigma_deg: float,
     drift_deg_per_min: float,
 ) -> None:
     """Refuse bad ``strategy`` options by their command-line names, before any work.
@@ -222,12 +234,14 @@ def check_command_options(
     defaults = StrategySettings()
     runs = settings.get("runs", defaults.runs)
     if isinstance(runs, bool) or not isinstance(runs, int) or not 1 <= runs <= MAX_RUNS:
-        raise InputError(f"--runs {runs}: expected a whole number of Monte Carlo runs in "
-                         f"1..{MAX_RUNS:,} (default {defaults.runs})")
-    if n_workers is not None and (isinstance(n_workers, bool) or not isinstance(n_workers, int)
-                                  or n_workers < 1):
-        raise InputError(f"--workers {n_workers}: expected a whole number >= 1 of worker "
-                         "processes")
+        raise InputError(
+            f"--runs {runs}: expected a whole number of Monte Carlo runs in "
+            f"1..{MAX_RUNS:,} (default {defaults.runs})"
+        )
+    if n_workers is not None and (
+        isinstance(n_workers, bool) or not isinstance(n_workers, int) or n_workers < 1
+    ):
+        raise InputError(f"--workers {n_workers}: expected a whole number >= 1 of worker processes")
     for name, lo in (("tack_penalty_s", 0.0), ("sigma_deg", 0.0)):
         v = sigma_deg if name == "sigma_deg" else settings.get(name, getattr(defaults, name))
         if not (math.isfinite(v) and v >= lo):
@@ -243,8 +257,10 @@ def check_command_options(
             raise InputError(f"{_option(name)} {v:g}: must be finite and > 0 m")
         k = v / step
         if abs(k - round(k)) > 1e-9 or round(k) < 1:
-            raise InputError(f"{_option(name)} {v:g}: expected a whole number (>= 1) of "
-                             f"{step:g} m {what}, e.g. {max(1, round(k)) * step:g}")
+            raise InputError(
+                f"{_option(name)} {v:g}: expected a whole number (>= 1) of "
+                f"{step:g} m {what}, e.g. {max(1, round(k)) * step:g}"
+            )
         n[name] = round(k)
     grid = StrategySettings(**{**asdict(defaults), **settings}).beat_grid()
     n_shift = grid.theta_deg.size
@@ -257,12 +273,14 @@ def check_command_options(
             f"expected-time lattice would have {nodes:.2g} nodes (about "
             f"{nodes * 8 * 2.5 / 2**30:.3g} GiB), more than {MAX_LATTICE_NODES:.0e} (minutes "
             f"and gigabytes); give a beat of at most {max(longest, 0.0):g} m at this width "
-            "(a dinghy beat is 0.5-3 km), or a smaller --half-width-m")
+            "(a dinghy beat is 0.5-3 km), or a smaller --half-width-m"
+        )
     if runs * n["length_m"] > MAX_RUN_STEPS:
         raise InputError(
             f"--runs {runs} over {n['length_m']} rows of --length-m {grid.length_m:g}: "
             f"{runs * n['length_m']:.2g} Monte Carlo boat-steps per policy, more than "
-            f"{MAX_RUN_STEPS:.0e}; use --runs <= {MAX_RUN_STEPS // n['length_m']}")
+            f"{MAX_RUN_STEPS:.0e}; use --runs <= {MAX_RUN_STEPS // n['length_m']}"
+        )
 
 
 def check_wind_in_polar(tws_kn: float, polar: Polar, polar_spec: str) -> None:
@@ -286,7 +304,8 @@ def check_wind_in_polar(tws_kn: float, polar: Polar, polar_spec: str) -> None:
             f"--tws-kn {tws_kn:g}: above the highest TWS column of --polar {polar_spec} "
             f"(TWS {lo / KNOT:.1f} .. {top / KNOT:.1f} kn); the boat speed would be clamped "
             f"to that column without notice. Give --tws-kn up to {top / KNOT:.1f}, or a "
-            "--polar with higher TWS columns")
+            "--polar with higher TWS columns"
+        )
 
 
 SHIFT_KINDS = ("ou", "drift-diffusion")
@@ -302,5 +321,3 @@ def parse_shift(text: str) -> str:
             "(persistent shift)"
         )
     return kind
-
-

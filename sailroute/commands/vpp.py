@@ -55,13 +55,11 @@ class VppRun:
     polar: Polar
 
 
-
-
 KINETICS_LINES: Final = {
     "race": "race polar (the VPP with wave riding and pumping, as the built-in ilca7 that "
-            "plan routes with; --kinetics steady for the VPP alone)",
+    "plan routes with; --kinetics steady for the VPP alone)",
     "steady": "steady VPP (no wave riding or pumping, as the built-in ilca7-steady; "
-              "--kinetics race for the race polar)",
+    "--kinetics race for the race polar)",
 }
 """First line of the ``vpp`` report: which polar was written."""
 
@@ -82,21 +80,25 @@ def parse_speed_list(text: str, unit: str, *, option: str = "--tws") -> tuple[fl
             v = float(cell)
         except ValueError:
             raise InputError(
-                f"{option}: item {k + 1} ({cell!r}) is not a number; {example}") from None
+                f"{option}: item {k + 1} ({cell!r}) is not a number; {example}"
+            ) from None
         if not v > 0 or not np.isfinite(v):
             raise InputError(
-                f"{option}: item {k + 1} ({cell!r}) must be a positive, finite speed; {example}")
+                f"{option}: item {k + 1} ({cell!r}) must be a positive, finite speed; {example}"
+            )
         if v * f > MAX_TWS_MS * (1 + 1e-12):
             raise InputError(
                 f"{option}: item {k + 1} ({cell} {unit}) is above {top}, stronger than any "
                 f"wind a polar is made for (sailroute's polar readers refuse such a column); "
-                f"give wind speeds up to {top}")
+                f"give wind speeds up to {top}"
+            )
         vals.append(v * f)
     if not vals:
         raise InputError(f"{option}: no wind speed given; {example}")
     if any(b <= a for a, b in pairwise(vals)):
         raise InputError(
-            f"{option}: wind speeds must increase from item to item; got {text!r}, e.g. '4,6,8'")
+            f"{option}: wind speeds must increase from item to item; got {text!r}, e.g. '4,6,8'"
+        )
     return tuple(vals)
 
 
@@ -106,14 +108,6 @@ def twa_grid(step_deg: float) -> tuple[float, ...]:
         raise InputError(f"--twa-step: expected a step between 0.1 and 90 degrees; got {step_deg}")
     grid = np.arange(0.0, 180.0, step_deg)
     return tuple(float(a) for a in np.append(grid, 180.0))
-
-
-
-
-
-
-
-
 
 
 def run_vpp_command(
@@ -164,8 +158,11 @@ def run_vpp_command(
                 f"--crew-mass: expected a sailor mass in {lo:g}-{hi:g} kg; got {crew_mass_kg}"
             )
         params = replace(params, crew_mass_kg=float(crew_mass_kg))
-    tws_ms = (parse_speed_list(tws, unit) if tws is not None
-              else tuple(v * speed_factor(unit) for v in DEFAULT_TWS[unit]))
+    tws_ms = (
+        parse_speed_list(tws, unit)
+        if tws is not None
+        else tuple(v * speed_factor(unit) for v in DEFAULT_TWS[unit])
+    )
     kin = kinetics_from_spec(kinetics)[0]
     polar = vpp_polar(params, tws_ms, twa_grid(twa_step_deg), kinetics=kin)
     fastest = float(np.nanmax(polar.speed_ms, initial=0.0))
@@ -173,13 +170,15 @@ def run_vpp_command(
         raise InputError(
             f"--tws: the VPP gives boat speeds up to {fastest / speed_factor('kn'):.1f} kn, "
             f"above {MAX_BOAT_SPEED_KN:g} kn (faster than any sailing craft has gone); "
-            "give lower wind speeds")
+            "give lower wind speeds"
+        )
     files = write_output_set(
-        out_dir, lambda d: write_vpp_outputs(polar, params, d, stem, unit, kin))
-    return CommandResult(KINETICS_LINES[kinetics] + "\n" + polar_report(polar, unit), files,
-                         data=VppRun(params=params, polar=polar), main=("json",),
-                         labels=POLAR_FILE_LABELS)
-
-
-
-
+        out_dir, lambda d: write_vpp_outputs(polar, params, d, stem, unit, kin)
+    )
+    return CommandResult(
+        KINETICS_LINES[kinetics] + "\n" + polar_report(polar, unit),
+        files,
+        data=VppRun(params=params, polar=polar),
+        main=("json",),
+        labels=POLAR_FILE_LABELS,
+    )

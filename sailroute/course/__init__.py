@@ -10,6 +10,17 @@ from sailroute.course.load import build_boat, build_wind, load_course, validate_
 from sailroute.course.model import Course, Gate, LegSpec, Line, Mark, ScenarioSpec
 
 __all__ = [
-    "Course", "Gate", "LegSpec", "Line", "Mark", "ScenarioSpec", "build_boat", "build_wind",
-    "leg_endpoints", "load_course", "start_of", "target_of", "validate_specs",
+    "Course",
+    "Gate",
+    "LegSpec",
+    "Line",
+    "Mark",
+    "ScenarioSpec",
+    "build_boat",
+    "build_wind",
+    "leg_endpoints",
+    "load_course",
+    "start_of",
+    "target_of",
+    "validate_specs",
 ]

@@ -95,7 +95,8 @@ def _kml_ring(text: str, path: Path) -> list[tuple[float, float]]:
             out.append((float(parts[0]), float(parts[1])))
         except (ValueError, IndexError):
             raise ValueError(
-                f"{path}: bad KML coordinate {token!r}; expected lon,lat[,alt]") from None
+                f"{path}: bad KML coordinate {token!r}; expected lon,lat[,alt]"
+            ) from None
     return out
 
 
@@ -105,19 +106,31 @@ def _open_ring(pts: list[tuple[float, float]]) -> list[tuple[float, float]]:
 
 
 def _polygon(
-    c: Checker, raw: Any, path: str, name: str, frame: LocalFrame, has_origin: bool,
-    base: Path, position: PositionReader,
+    c: Checker,
+    raw: Any,
+    path: str,
+    name: str,
+    frame: LocalFrame,
+    has_origin: bool,
+    base: Path,
+    position: PositionReader,
 ) -> AreaPolygon | None:
     """One polygon spec (``points`` or ``file``, ``clearance_m``) in the course frame."""
     keys = OBSTACLE_KEYS if path.startswith("obstacles") else POLYGON_KEYS
-    if not c.at(path).is_mapping(raw, "a mapping with `points` (a list of {lat, lon} or "
-                                 "{x, y}) or `file` (GeoJSON or KML), and `clearance_m`"):
+    if not c.at(path).is_mapping(
+        raw,
+        "a mapping with `points` (a list of {lat, lon} or "
+        "{x, y}) or `file` (GeoJSON or KML), and `clearance_m`",
+    ):
         return None
     c.at(path).keys(raw, keys)
     clearance = c.at(path).number(raw, "clearance_m", 0.0, lo=0.0)
     if ("points" in raw) == ("file" in raw):
-        c.p.add(path, "give either `points` (a list of {lat, lon} or {x, y}) or `file` "
-                "(a GeoJSON or KML polygon), one of them")
+        c.p.add(
+            path,
+            "give either `points` (a list of {lat, lon} or {x, y}) or `file` "
+            "(a GeoJSON or KML polygon), one of them",
+        )
         return None
     xy: list[tuple[float, float]] = []
     if "file" in raw:
@@ -128,14 +141,17 @@ def _polygon(
         try:
             lonlat = _open_ring(read_polygon_file(base / raw["file"]))
         except ValueError as exc:
-            c.p.add(fpath, f"{exc}; expected a GeoJSON Polygon/Feature or a KML Polygon "
-                    "in lon/lat degrees")
+            c.p.add(
+                fpath,
+                f"{exc}; expected a GeoJSON Polygon/Feature or a KML Polygon in lon/lat degrees",
+            )
             return None
         if lonlat:
             lon, lat = np.array(lonlat).T
             px, py = frame.to_xy(lat, lon)
-            xy = list(zip(np.asarray(px, float).tolist(), np.asarray(py, float).tolist(),
-                          strict=True))
+            xy = list(
+                zip(np.asarray(px, float).tolist(), np.asarray(py, float).tolist(), strict=True)
+            )
     else:
         ppath = join_path(path, "points")
         pts = raw["points"]
@@ -151,8 +167,11 @@ def _polygon(
                 x, y = frame.to_xy(*pos[1])
                 xy.append((float(x), float(y)))
             elif not has_origin:
-                c.p.add(join_path(ppath, i), "points in {x, y} metres need `origin: {lat, "
-                        "lon}` at the top level of the course file (the point x = y = 0)")
+                c.p.add(
+                    join_path(ppath, i),
+                    "points in {x, y} metres need `origin: {lat, "
+                    "lon}` at the top level of the course file (the point x = y = 0)",
+                )
                 bad = True
             else:
                 xy.append(pos[1])
@@ -170,8 +189,11 @@ def _polygon(
 
 
 def check_area(
-    c: Checker, data: Mapping[str, Any], frame: LocalFrame | None,
-    marks: Mapping[str, tuple[float, float]], position: PositionReader,
+    c: Checker,
+    data: Mapping[str, Any],
+    frame: LocalFrame | None,
+    marks: Mapping[str, tuple[float, float]],
+    position: PositionReader,
 ) -> RaceArea:
     """The race area of a course file (an empty one when it names none).
 
@@ -199,21 +221,26 @@ def check_area(
     has_origin = "origin" in data
     boundary = None
     if "boundary" in data:
-        boundary = _polygon(c, data["boundary"], "boundary", "boundary", frame, has_origin,
-                            base, position)
+        boundary = _polygon(
+            c, data["boundary"], "boundary", "boundary", frame, has_origin, base, position
+        )
     obstacles: list[AreaPolygon] = []
     raw = data.get("obstacles", [])
     if not isinstance(raw, list):
-        c.p.add("obstacles", "expected a list of {name, points or file, clearance_m}; got "
-                f"{show(raw)}")
+        c.p.add(
+            "obstacles",
+            f"expected a list of {{name, points or file, clearance_m}}; got {show(raw)}",
+        )
         raw = []
     seen: set[str] = set()
     for i, item in enumerate(raw):
         path = join_path("obstacles", i)
         name = str(item.get("name", f"obstacle {i + 1}")) if isinstance(item, Mapping) else ""
         if name in seen:
-            c.p.add(join_path(path, "name"), f"obstacle name {name!r} is used twice; give "
-                    "each obstacle its own name")
+            c.p.add(
+                join_path(path, "name"),
+                f"obstacle name {name!r} is used twice; give each obstacle its own name",
+            )
         seen.add(name)
         ob = _polygon(c, item, path, name, frame, has_origin, base, position)
         if ob is not None:
@@ -223,7 +250,9 @@ def check_area(
 
 
 def _marks_clear(
-    c: Checker, boundary: AreaPolygon | None, obstacles: list[AreaPolygon],
+    c: Checker,
+    boundary: AreaPolygon | None,
+    obstacles: list[AreaPolygon],
     marks: Mapping[str, tuple[float, float]],
 ) -> None:
     """A problem for each mark inside a grown obstacle or outside the shrunk boundary."""
@@ -238,9 +267,12 @@ def _marks_clear(
             g = shapely.buffer(g, ob.clearance_m, quad_segs=QUAD_SEGS)
         for k in np.flatnonzero(shapely.intersects_xy(g, mx, my)):
             kept = f" with its clearance_m = {ob.clearance_m:g} m" if ob.clearance_m else ""
-            c.p.add(ob.where, f"mark {names[k]!r} ({mx[k]:.0f}, {my[k]:.0f} m) lies inside "
-                    f"obstacle {ob.name!r}{kept}; move the mark or the obstacle's points"
-                    + (", or lower clearance_m" if ob.clearance_m else ""))
+            c.p.add(
+                ob.where,
+                f"mark {names[k]!r} ({mx[k]:.0f}, {my[k]:.0f} m) lies inside "
+                f"obstacle {ob.name!r}{kept}; move the mark or the obstacle's points"
+                + (", or lower clearance_m" if ob.clearance_m else ""),
+            )
     if boundary is not None:
         g = boundary.polygon()
         if boundary.clearance_m > 0:
@@ -248,8 +280,14 @@ def _marks_clear(
         out = np.flatnonzero(~shapely.contains_xy(g, mx, my))
         if out.size:
             listed = ", ".join(f"{names[k]!r} ({mx[k]:.0f}, {my[k]:.0f} m)" for k in out)
-            kept = (f" shrunk by its clearance_m = {boundary.clearance_m:g} m"
-                    if boundary.clearance_m else "")
-            c.p.add("boundary", f"the boundary{kept} does not contain every mark: {listed} "
-                    "lie outside; the boundary must enclose the whole course (check its "
-                    "points, their order and the marks)")
+            kept = (
+                f" shrunk by its clearance_m = {boundary.clearance_m:g} m"
+                if boundary.clearance_m
+                else ""
+            )
+            c.p.add(
+                "boundary",
+                f"the boundary{kept} does not contain every mark: {listed} "
+                "lie outside; the boundary must enclose the whole course (check its "
+                "points, their order and the marks)",
+            )

@@ -19,7 +19,9 @@ __all__ = ["build_course"]
 
 
 def build_course(
-    checked: CheckedCourse, *, source: Path | None = None,
+    checked: CheckedCourse,
+    *,
+    source: Path | None = None,
     key_lines: Mapping[str, int] | None = None,
 ) -> Course:
     """The :class:`Course` of a checked course file.
@@ -44,10 +46,12 @@ def build_course(
         start_time=checked.start_time,
         frame=checked.frame,
         marks=frozen_mapping(marks),
-        lines=frozen_mapping({k: Line(k, marks[a], marks[b])
-                              for k, (a, b) in checked.lines.items()}),
-        gates=frozen_mapping({k: Gate(k, marks[a], marks[b])
-                              for k, (a, b) in checked.gates.items()}),
+        lines=frozen_mapping(
+            {k: Line(k, marks[a], marks[b]) for k, (a, b) in checked.lines.items()}
+        ),
+        gates=frozen_mapping(
+            {k: Gate(k, marks[a], marks[b]) for k, (a, b) in checked.gates.items()}
+        ),
         legs=tuple(LegSpec(*leg) for leg in checked.legs),
         boat_spec=frozen_mapping(checked.boat),
         routing=checked.routing,
@@ -68,9 +72,11 @@ def build_course(
 def _scenario(kw: Mapping[str, Any]) -> ScenarioSpec:
     """The :class:`ScenarioSpec` of one checked scenario, its mappings made read-only."""
     current = kw.get("current")
-    return ScenarioSpec(**{
-        **kw,
-        "wind": frozen_mapping(kw["wind"]),
-        "references": frozen_mapping(kw.get("references")),
-        "current": None if current is None else frozen_mapping(current),
-    })
+    return ScenarioSpec(
+        **{
+            **kw,
+            "wind": frozen_mapping(kw["wind"]),
+            "references": frozen_mapping(kw.get("references")),
+            "current": None if current is None else frozen_mapping(current),
+        }
+    )

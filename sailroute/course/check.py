@@ -58,8 +58,21 @@ from sailroute.wind.build import CURRENT_BUILDERS, WIND_TYPES
 __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
 TOP_KEYS = (
-    "name", "description", "start_time", "time_limit_min", "origin", "marks", "lines", "gates",
-    "legs", "template", "boat", "routing", "scenarios", "references", "uncertainty",
+    "name",
+    "description",
+    "start_time",
+    "time_limit_min",
+    "origin",
+    "marks",
+    "lines",
+    "gates",
+    "legs",
+    "template",
+    "boat",
+    "routing",
+    "scenarios",
+    "references",
+    "uncertainty",
     *AREA_KEYS,
 )
 """Keys allowed at the top level of a course file."""
@@ -149,13 +162,19 @@ class CheckedCourse:
 # ----------------------------------------------------------------------------- sections
 def _start_time(c: Checker, data: Mapping[str, Any]) -> datetime | None:
     if "start_time" not in data:
-        c.p.add("start_time", "missing required key; expected an ISO 8601 time with a UTC "
-                "offset, e.g. '2018-04-24T12:10:00+02:00'")
+        c.p.add(
+            "start_time",
+            "missing required key; expected an ISO 8601 time with a UTC "
+            "offset, e.g. '2018-04-24T12:10:00+02:00'",
+        )
         return None
     v = data["start_time"]
     if isinstance(v, date) and not isinstance(v, datetime):
-        c.p.add("start_time", f"expected a date and time with a UTC offset, e.g. "
-                f"'{v.isoformat()}T12:00:00+02:00'; got the date {v.isoformat()}")
+        c.p.add(
+            "start_time",
+            f"expected a date and time with a UTC offset, e.g. "
+            f"'{v.isoformat()}T12:00:00+02:00'; got the date {v.isoformat()}",
+        )
         return None
     if not isinstance(v, str | datetime):
         c.p.add("start_time", f"expected an ISO 8601 time with a UTC offset; got {show(v)}")
@@ -169,15 +188,14 @@ def _start_time(c: Checker, data: Mapping[str, Any]) -> datetime | None:
 
 def _latlon(c: Checker, d: Mapping[str, Any], path: str) -> tuple[float, float] | None:
     lat = c.at(path).number(d, "lat", lo=-90.0, hi=90.0, what="a latitude in [-90, 90] degrees")
-    lon = c.at(path).number(d, "lon", lo=-180.0, hi=360.0,
-                            what="a longitude in [-180, 360] degrees")
+    lon = c.at(path).number(
+        d, "lon", lo=-180.0, hi=360.0, what="a longitude in [-180, 360] degrees"
+    )
     # 0..360 longitudes are accepted and wrapped to [-180, 180), as GPX and plan.json use
     return None if lat is None or lon is None else (lat, float(wrap_lon(lon)))
 
 
-def _position(
-    c: Checker, value: Any, path: str, what: str
-) -> Position | None:
+def _position(c: Checker, value: Any, path: str, what: str) -> Position | None:
     """``("ll", (lat, lon))`` or ``("xy", (x, y))`` from ``{lat, lon}`` / ``{x, y}``."""
     if not c.at(path).is_mapping(value, f"{what} as {{lat, lon}} (degrees) or {{x, y}} (metres)"):
         return None
@@ -188,17 +206,22 @@ def _position(
         c.p.add(path, "give either {lat, lon} or {x, y}, not both")
         return None
     if not has_ll and not has_xy:
-        c.p.add(path, f"expected {what} as {{lat, lon}} (degrees) or {{x, y}} (metres east/"
-                "north of the origin); got neither")
+        c.p.add(
+            path,
+            f"expected {what} as {{lat, lon}} (degrees) or {{x, y}} (metres east/"
+            "north of the origin); got neither",
+        )
         return None
     if has_ll:
         ll = _latlon(c, value, path)
         return None if ll is None else ("ll", ll)
     span = f"in [{-MAX_OFFSET_M:.0f}, {MAX_OFFSET_M:.0f}]"
-    x = c.at(path).number(value, "x", lo=-MAX_OFFSET_M, hi=MAX_OFFSET_M,
-                          what=f"metres east of the origin, {span}")
-    y = c.at(path).number(value, "y", lo=-MAX_OFFSET_M, hi=MAX_OFFSET_M,
-                          what=f"metres north of the origin, {span}")
+    x = c.at(path).number(
+        value, "x", lo=-MAX_OFFSET_M, hi=MAX_OFFSET_M, what=f"metres east of the origin, {span}"
+    )
+    y = c.at(path).number(
+        value, "y", lo=-MAX_OFFSET_M, hi=MAX_OFFSET_M, what=f"metres north of the origin, {span}"
+    )
     return None if x is None or y is None else ("xy", (x, y))
 
 
@@ -217,8 +240,11 @@ def _frame(
         ll = _latlon(c, data["origin"], "origin")
         return None if ll is None else LocalFrame(*ll)
     if needs:
-        c.p.add(needs[0], "positions in {x, y} metres need `origin: {lat, lon}` at the top "
-                "level of the course file (the point x = y = 0)")
+        c.p.add(
+            needs[0],
+            "positions in {x, y} metres need `origin: {lat, lon}` at the top "
+            "level of the course file (the point x = y = 0)",
+        )
         return None
     if latlons:
         a = np.array(latlons)
@@ -244,7 +270,11 @@ def _marks(c: Checker, raw: Any) -> dict[str, Position]:
 
 
 def _pairs(
-    c: Checker, raw: Any, section: str, marks: XY, taken: set[str],
+    c: Checker,
+    raw: Any,
+    section: str,
+    marks: XY,
+    taken: set[str],
 ) -> dict[str, tuple[str, str]]:
     """``lines``/``gates``: name → two mark names, checked against the marks."""
     out: dict[str, tuple[str, str]] = {}
@@ -256,12 +286,16 @@ def _pairs(
         if name not in taken:
             c.declared.add(name)
         if name in taken:
-            c.p.add(path, f"the name {name!r} is already used by a mark, line or gate; "
-                    "names must be unique")
+            c.p.add(
+                path,
+                f"the name {name!r} is already used by a mark, line or gate; names must be unique",
+            )
             continue
         if not isinstance(value, list) or len(value) != 2:
-            c.p.add(path, f"expected a list of two mark names, e.g. [{what}_a, {what}_b]; "
-                    f"got {show(value)}")
+            c.p.add(
+                path,
+                f"expected a list of two mark names, e.g. [{what}_a, {what}_b]; got {show(value)}",
+            )
             continue
         e0, e1 = (c.at(join_path(path, i)).name(v, "a mark name") for i, v in enumerate(value))
         if e0 is None or e1 is None:
@@ -271,8 +305,11 @@ def _pairs(
         for i, m in enumerate(ends):
             if m not in marks:
                 if m not in c.declared:
-                    c.p.add(join_path(path, i), f"unknown mark {m!r}; {suggest(m, marks)}"
-                            f"marks are: {', '.join(marks) or '(none)'}")
+                    c.p.add(
+                        join_path(path, i),
+                        f"unknown mark {m!r}; {suggest(m, marks)}"
+                        f"marks are: {', '.join(marks) or '(none)'}",
+                    )
                 ok = False
         if not ok:
             continue
@@ -282,17 +319,18 @@ def _pairs(
             continue
         d = math.hypot(bx - ax, by - ay)
         if d < MIN_SEPARATION_M:
-            c.p.add(path, f"marks {ends[0]!r} and {ends[1]!r} are {d:.2f} m apart; a {what} "
-                    f"needs its two marks at least {MIN_SEPARATION_M:g} m apart")
+            c.p.add(
+                path,
+                f"marks {ends[0]!r} and {ends[1]!r} are {d:.2f} m apart; a {what} "
+                f"needs its two marks at least {MIN_SEPARATION_M:g} m apart",
+            )
             continue
         out[name] = (ends[0], ends[1])
         taken.add(name)
     return out
 
 
-def _centre(
-    table: Mapping[str, Any], marks: XY, name: str
-) -> tuple[float, float]:
+def _centre(table: Mapping[str, Any], marks: XY, name: str) -> tuple[float, float]:
     if name in marks:
         return marks[name]
     (ax, ay), (bx, by) = marks[table[name][0]], marks[table[name][1]]
@@ -308,14 +346,20 @@ def _legs(
 ) -> list[Leg]:
     out: list[Leg] = []
     if not isinstance(raw, list):
-        c.p.add("legs", f"expected a list of legs, e.g. [{{to: '1', rounding: port}}, "
-                f"{{to: finish}}]; got {show(raw)}")
+        c.p.add(
+            "legs",
+            f"expected a list of legs, e.g. [{{to: '1', rounding: port}}, "
+            f"{{to: finish}}]; got {show(raw)}",
+        )
         return out
     if not raw:
         c.p.add("legs", "expected at least one leg; got an empty list")
         return out
-    features: dict[str, LegKind] = {**{m: "mark" for m in marks}, **{g: "gate" for g in gates},
-                                    **{n: "line" for n in lines}}
+    features: dict[str, LegKind] = {
+        **{m: "mark" for m in marks},
+        **{g: "gate" for g in gates},
+        **{n: "line" for n in lines},
+    }
     centres = {**gates, **lines}
     prev: str | None = None
     for i, item in enumerate(raw):
@@ -326,81 +370,111 @@ def _legs(
             prev = None
             continue
         c.at(path).keys(item, ("from", "to", "rounding"), ("to",))
-        frm = _leg_from(c, item, path, features, lines) if i == 0 else _later_from(c, item, path,
-                                                                                    prev)
+        frm = (
+            _leg_from(c, item, path, features, lines)
+            if i == 0
+            else _later_from(c, item, path, prev)
+        )
         to = _feature(c, item, "to", path, features, "mark, gate or line")
         kind = features.get(to) if to is not None else None
         rounding = _rounding(c, item, path, to, kind)
         if to is not None and frm is not None:
-            _check_leg_length(c, path, i, frm, to, _centre(centres, marks, frm),
-                              _centre(centres, marks, to))
+            _check_leg_length(
+                c, path, i, frm, to, _centre(centres, marks, frm), _centre(centres, marks, to)
+            )
         if to is not None and kind is not None and frm is not None:
             out.append((i, frm, to, kind, rounding))
         prev = to
     return out
 
 
-def _feature(c: Checker, item: Mapping[str, Any], key: str, path: str,
-             features: Mapping[str, LegKind], what: str) -> str | None:
+def _feature(
+    c: Checker,
+    item: Mapping[str, Any],
+    key: str,
+    path: str,
+    features: Mapping[str, LegKind],
+    what: str,
+) -> str | None:
     """The mark, gate or line named by ``item[key]``, or None (a problem recorded)."""
     if key not in item:
         return None
     name = c.at(join_path(path, key)).name(item[key], f"a {what} name")
     if name is not None and name not in features:
         if name not in c.declared:
-            c.p.add(join_path(path, key), f"unknown {what} {name!r}; "
-                    f"{suggest(name, features)}known: {', '.join(features)}")
+            c.p.add(
+                join_path(path, key),
+                f"unknown {what} {name!r}; {suggest(name, features)}known: {', '.join(features)}",
+            )
         return None
     return name
 
 
-def _leg_from(c: Checker, item: Mapping[str, Any], path: str,
-              features: Mapping[str, LegKind], lines: Mapping[str, tuple[str, str]]
-              ) -> str | None:
+def _leg_from(
+    c: Checker,
+    item: Mapping[str, Any],
+    path: str,
+    features: Mapping[str, LegKind],
+    lines: Mapping[str, tuple[str, str]],
+) -> str | None:
     """Where the first leg starts: its ``from``, else the line named ``start``."""
     if "from" in item:
         return _feature(c, item, "from", path, features, "line or mark")
     if "start" in lines:
         return "start"
     if "start" not in c.declared:  # (an invalid start line is reported there)
-        c.p.add(path, "the first leg needs `from: LINE_OR_MARK`, or define a line "
-                "named 'start' under `lines`")
+        c.p.add(
+            path,
+            "the first leg needs `from: LINE_OR_MARK`, or define a line "
+            "named 'start' under `lines`",
+        )
     return None
 
 
-def _later_from(c: Checker, item: Mapping[str, Any], path: str, prev: str | None
-                ) -> str | None:
+def _later_from(c: Checker, item: Mapping[str, Any], path: str, prev: str | None) -> str | None:
     """Where a later leg starts: where the previous one ended (``from`` is refused)."""
     if "from" in item:
-        c.p.add(join_path(path, "from"), "only the first leg may give `from`; later legs "
-                "start where the previous leg ended")
+        c.p.add(
+            join_path(path, "from"),
+            "only the first leg may give `from`; later legs start where the previous leg ended",
+        )
     return prev
 
 
-def _rounding(c: Checker, item: Mapping[str, Any], path: str, to: str | None,
-              kind: LegKind | None) -> Side | None:
+def _rounding(
+    c: Checker, item: Mapping[str, Any], path: str, to: str | None, kind: LegKind | None
+) -> Side | None:
     """The side a mark is rounded on (default port); gates and lines take none."""
     if kind == "mark" or (kind is None and "rounding" in item):
         side: Side | None = c.at(path).choice(item, "rounding", SIDES, "port")
         return side
     if kind is not None and "rounding" in item:
-        c.p.add(join_path(path, "rounding"), f"{to!r} is a {kind}; boats pass through a "
-                f"{kind}, so `rounding` applies to marks only (remove it)")
+        c.p.add(
+            join_path(path, "rounding"),
+            f"{to!r} is a {kind}; boats pass through a "
+            f"{kind}, so `rounding` applies to marks only (remove it)",
+        )
     return None
 
 
-def _check_leg_length(c: Checker, path: str, i: int, frm: str, to: str,
-                      a: tuple[float, float], b: tuple[float, float]) -> None:
+def _check_leg_length(
+    c: Checker, path: str, i: int, frm: str, to: str, a: tuple[float, float], b: tuple[float, float]
+) -> None:
     """A leg goes somewhere else, at least :data:`MIN_SEPARATION_M` away."""
     if to == frm:
         what = "the previous leg ends" if i > 0 else "the leg starts"
-        c.p.add(join_path(path, "to"), f"{to!r} is where {what}; a leg must go to a "
-                "different mark, gate or line")
+        c.p.add(
+            join_path(path, "to"),
+            f"{to!r} is where {what}; a leg must go to a different mark, gate or line",
+        )
         return
     d = math.hypot(b[0] - a[0], b[1] - a[1])
     if d < MIN_SEPARATION_M:
-        c.p.add(path, f"the leg {frm!r} -> {to!r} is {d:.2f} m long; "
-                f"expected at least {MIN_SEPARATION_M:g} m")
+        c.p.add(
+            path,
+            f"the leg {frm!r} -> {to!r} is {d:.2f} m long; "
+            f"expected at least {MIN_SEPARATION_M:g} m",
+        )
 
 
 def _routing(c: Checker, raw: Any) -> RoutingSettings:
@@ -415,13 +489,25 @@ def _routing(c: Checker, raw: Any) -> RoutingSettings:
     r = c.at("routing")
     special: dict[str, Callable[[], Any]] = {
         "router": lambda: r.choice(raw, "router", typing.get_args(RouterName)),
-        "dt_s": lambda: r.number(raw, "dt_s", lo=MIN_DT_S, what=(
-            f"a time step >= {MIN_DT_S:g} s (default 10; finer steps hardly change the "
-            "route and make it slow)")),
-        "heading_step_deg": lambda: r.number(raw, "heading_step_deg", lo=MIN_HEADING_STEP_DEG,
-                                             hi=45.0, what=(
-            f"a number in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer steps only slow "
-            "the router)")),
+        "dt_s": lambda: r.number(
+            raw,
+            "dt_s",
+            lo=MIN_DT_S,
+            what=(
+                f"a time step >= {MIN_DT_S:g} s (default 10; finer steps hardly change the "
+                "route and make it slow)"
+            ),
+        ),
+        "heading_step_deg": lambda: r.number(
+            raw,
+            "heading_step_deg",
+            lo=MIN_HEADING_STEP_DEG,
+            hi=45.0,
+            what=(
+                f"a number in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer steps only slow "
+                "the router)"
+            ),
+        ),
         "tack_penalty_s": lambda: r.number(raw, "tack_penalty_s", lo=0.0),
         "gybe_penalty_s": lambda: r.number(raw, "gybe_penalty_s", lo=0.0),
         "initial_side": lambda: r.choice(raw, "initial_side", (*SIDES, None)),
@@ -506,16 +592,21 @@ def _references(
 
 
 def _wind_spec(c: Checker, value: Any, path: str) -> bool:
-    if not c.at(path).is_mapping(value, "a wind spec {type: " + "|".join(WIND_TYPES)
-                                 + ", ...}"):
+    if not c.at(path).is_mapping(value, "a wind spec {type: " + "|".join(WIND_TYPES) + ", ...}"):
         return False
     if "type" not in value:
-        c.p.add(path, "the wind spec has no `type`; expected one of "
-                + ", ".join(repr(t) for t in WIND_TYPES) + " (see docs/design/wind.md)")
+        c.p.add(
+            path,
+            "the wind spec has no `type`; expected one of "
+            + ", ".join(repr(t) for t in WIND_TYPES)
+            + " (see docs/design/wind.md)",
+        )
         return False
     if not isinstance(value["type"], str):
-        c.p.add(join_path(path, "type"), f"expected text such as 'uniform' or 'wrf'; "
-                f"got {show(value['type'])}")
+        c.p.add(
+            join_path(path, "type"),
+            f"expected text such as 'uniform' or 'wrf'; got {show(value['type'])}",
+        )
         return False
     return True
 
@@ -525,8 +616,11 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
     one scenario ``NAME#k`` per member)."""
     out: dict[str, dict[str, Any]] = {}
     if raw is None:
-        c.p.add("scenarios", "missing required key; add at least one wind scenario, e.g. "
-                "`scenarios: {steady: {type: uniform, tws_kn: 10, twd_deg: 270}}`")
+        c.p.add(
+            "scenarios",
+            "missing required key; add at least one wind scenario, e.g. "
+            "`scenarios: {steady: {type: uniform, tws_kn: 10, twd_deg: 270}}`",
+        )
         return out
     if not c.at("scenarios").is_mapping(raw, "a mapping of scenario name to a wind spec"):
         return out
@@ -536,11 +630,16 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
         path = join_path("scenarios", name)
         why = path_part_problem(name)
         if why is not None:  # it names a folder of the output (out/<course>/<scenario>)
-            c.p.add(path, f"the scenario name {name!r} cannot name an output folder: {why}; "
-                    "use letters, digits, '-', '_' or '#'")
+            c.p.add(
+                path,
+                f"the scenario name {name!r} cannot name an output folder: {why}; "
+                "use letters, digits, '-', '_' or '#'",
+            )
             continue
-        if not c.at(path).is_mapping(value, "a wind spec {type: ...} or {wind: {type: ...}, "
-                                     "references: ..., description: ...}"):
+        if not c.at(path).is_mapping(
+            value,
+            "a wind spec {type: ...} or {wind: {type: ...}, references: ..., description: ...}",
+        ):
             continue
         keys = ("wind", "members", "references", "description", "current")
         cur, cwhere = None, ""  # surface current spec (sailroute.wind.current), key path
@@ -550,21 +649,25 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
         else:
             c.at(path).keys(value, keys)
             if ("wind" in value) == ("members" in value):
-                c.p.add(path, "give exactly one of `wind: {type: ...}` (one wind) or "
-                        "`members: [...]` (an ensemble of winds)")
+                c.p.add(
+                    path,
+                    "give exactly one of `wind: {type: ...}` (one wind) or "
+                    "`members: [...]` (an ensemble of winds)",
+                )
                 continue
             refs = _references(c, value.get("references"), join_path(path, "references"), n_legs)
             desc = c.at(path).string(value, "description", "") or ""
             cchk = c.at(join_path(path, "current"))
             if value.get("current") is not None and cchk.is_mapping(
-                    value["current"], "a current spec {type: "
-                    + "|".join(CURRENT_BUILDERS) + ", ...}"):
+                value["current"], "a current spec {type: " + "|".join(CURRENT_BUILDERS) + ", ...}"
+            ):
                 cur, cwhere = dict(value["current"]), cchk.where()
             if "members" in value:
                 mpath = join_path(path, "members")
                 for k, (spec, where) in enumerate(_members(c, value["members"], mpath), 1):
-                    out[f"{name}#{k}"] = _scenario(f"{name}#{k}", spec, refs, desc,
-                                                   c.p.prefix(where), str(name), cur, cwhere)
+                    out[f"{name}#{k}"] = _scenario(
+                        f"{name}#{k}", spec, refs, desc, c.p.prefix(where), str(name), cur, cwhere
+                    )
                 continue
             wind, wpath = value["wind"], join_path(path, "wind")
         if _wind_spec(c, wind, wpath):
@@ -573,13 +676,26 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
 
 
 def _scenario(
-    name: str, wind: Mapping[str, Any], refs: dict[str, tuple[float, ...]], desc: str,
-    where: str, ensemble: str, current: dict[str, Any] | None, current_where: str,
+    name: str,
+    wind: Mapping[str, Any],
+    refs: dict[str, tuple[float, ...]],
+    desc: str,
+    where: str,
+    ensemble: str,
+    current: dict[str, Any] | None,
+    current_where: str,
 ) -> dict[str, Any]:
     """The keyword arguments of one ``ScenarioSpec`` (its field names)."""
-    return {"name": name, "wind": dict(wind), "references": refs, "description": desc,
-            "where": where, "ensemble": ensemble, "current": current,
-            "current_where": current_where}
+    return {
+        "name": name,
+        "wind": dict(wind),
+        "references": refs,
+        "description": desc,
+        "where": where,
+        "ensemble": ensemble,
+        "current": current,
+        "current_where": current_where,
+    }
 
 
 def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], str]]:
@@ -594,8 +710,11 @@ def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], s
             return []
         items = [(spec, f"{path}[{k}]") for k, spec in enumerate(raw)]
         return [(s, w) for s, w in items if _wind_spec(c, s, w)]
-    if not c.at(path).is_mapping(raw, "a list of wind specs, or {dim: NAME, wind: {type: "
-                                 "netcdf, path: FILE}} (one member per index of that dimension)"):
+    if not c.at(path).is_mapping(
+        raw,
+        "a list of wind specs, or {dim: NAME, wind: {type: "
+        "netcdf, path: FILE}} (one member per index of that dimension)",
+    ):
         return []
     c.at(path).keys(raw, ("dim", "wind"), ("dim", "wind"))
     dim, wpath = raw.get("dim"), join_path(path, "wind")
@@ -611,8 +730,9 @@ def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], s
     n = _dimension_size(c, resolve_path(base, wind["path"]), base, dim, wpath)
     if n is None:
         return []
-    return [({**wind, "select": {**dict(wind.get("select") or {}), dim: k}}, wpath)
-            for k in range(n)]
+    return [
+        ({**wind, "select": {**dict(wind.get("select") or {}), dim: k}}, wpath) for k in range(n)
+    ]
 
 
 def _dimension_size(c: Checker, file: Path, base: Path, dim: str, path: str) -> int | None:
@@ -628,8 +748,11 @@ def _dimension_size(c: Checker, file: Path, base: Path, dim: str, path: str) -> 
         c.p.add(join_path(path, "path"), f"{file.name} cannot be read as NetCDF ({exc})")
         return None
     if dim not in dims:
-        c.p.add(path, f"{file.name} has no dimension {dim!r}; it has "
-                + ", ".join(f"{k} ({v})" for k, v in dims.items()))
+        c.p.add(
+            path,
+            f"{file.name} has no dimension {dim!r}; it has "
+            + ", ".join(f"{k} ({v})" for k, v in dims.items()),
+        )
         return None
     return dims[dim]
 
@@ -640,15 +763,27 @@ _POS = "positive"
 _NONNEG = "nonnegative"
 _TEMPLATE_KEYS: dict[str, dict[str, Any]] = {
     "windward-leeward": {
-        "twd_deg": _DIR, "leg_length_m": _POS, "laps": "int", "gate_width_m": _POS,
-        "start_line_length_m": _POS, "start_offset_m": _NONNEG,
-        "finish": ("leeward", "windward"), "finish_line_length_m": _POS,
+        "twd_deg": _DIR,
+        "leg_length_m": _POS,
+        "laps": "int",
+        "gate_width_m": _POS,
+        "start_line_length_m": _POS,
+        "start_offset_m": _NONNEG,
+        "finish": ("leeward", "windward"),
+        "finish_line_length_m": _POS,
         "finish_offset_m": _NONNEG,
     },
     "trapezoid": {
-        "twd_deg": _DIR, "leg_length_m": _POS, "laps": "int", "loop": ("inner", "outer"),
-        "reach_angle_deg": _POS, "reach_length_m": _POS, "gate_width_m": _POS,
-        "start_line_length_m": _POS, "start_offset_m": _NONNEG, "finish_line_length_m": _POS,
+        "twd_deg": _DIR,
+        "leg_length_m": _POS,
+        "laps": "int",
+        "loop": ("inner", "outer"),
+        "reach_angle_deg": _POS,
+        "reach_length_m": _POS,
+        "gate_width_m": _POS,
+        "start_line_length_m": _POS,
+        "start_offset_m": _NONNEG,
+        "finish_line_length_m": _POS,
         "finish_reach_m": _POS,
     },
 }
@@ -669,16 +804,20 @@ def _template(
 ) -> tuple[CourseLayout | None, Position | None]:
     """Validate ``template`` and build its layout around ``centre`` (in a provisional frame)."""
     t = c.at("template")
-    if not t.is_mapping(raw, "{type: windward-leeward|trapezoid, twd_deg, leg_length_m, "
-                        "centre, ...}"):
+    if not t.is_mapping(
+        raw, "{type: windward-leeward|trapezoid, twd_deg, leg_length_m, centre, ...}"
+    ):
         return None, None
     kind = t.choice(raw, "type", list(_TEMPLATE_KEYS))
     if kind is None:
         return None, None
     spec = _TEMPLATE_KEYS[kind]
     t.keys(raw, ("type", "centre", *spec), ("twd_deg", "leg_length_m", "centre"))
-    centre = _position(c, raw["centre"], "template.centre", "the course centre") if (
-        "centre" in raw) else None
+    centre = (
+        _position(c, raw["centre"], "template.centre", "the course centre")
+        if ("centre" in raw)
+        else None
+    )
     kw: dict[str, Any] = {}
     for key, rule in spec.items():
         if key not in raw:
@@ -694,25 +833,32 @@ def _template(
         else:
             v = t.choice(raw, key, rule)
         if v is not None and key.endswith("_m") and v > MAX_OFFSET_M:
-            t.add(key, f"expected at most {MAX_OFFSET_M:.0f} m (a buoy course spans a few km); "
-                  f"got {v:g}")
+            t.add(
+                key,
+                f"expected at most {MAX_OFFSET_M:.0f} m (a buoy course spans a few km); got {v:g}",
+            )
             v = None
         elif v is not None and rule == _POS and key.endswith("_m") and v < MIN_SEPARATION_M:
             t.add(key, f"expected at least {MIN_SEPARATION_M:g} m; got {v:g}")
             v = None
         if v is not None:
             kw[key] = v
-    if centre is None or any(k not in kw for k in ("twd_deg", "leg_length_m")) or any(
-        k in raw and k not in kw for k in spec
+    if (
+        centre is None
+        or any(k not in kw for k in ("twd_deg", "leg_length_m"))
+        or any(k in raw and k not in kw for k in spec)
     ):
         return None, centre
     twd, length = kw.pop("twd_deg"), kw.pop("leg_length_m")
     laps = kw.pop("laps", 2)
     most = _max_laps(length, time_limit_min)
     if laps > most:
-        c.p.add("template.laps", f"{laps} laps of 2 × {length:g} m cannot be sailed within "
-                f"time_limit_min {time_limit_min or DEFAULT_TIME_LIMIT_MIN:g} even at 70 kn; "
-                f"expected an integer in [1, {most}] (or raise time_limit_min)")
+        c.p.add(
+            "template.laps",
+            f"{laps} laps of 2 × {length:g} m cannot be sailed within "
+            f"time_limit_min {time_limit_min or DEFAULT_TIME_LIMIT_MIN:g} even at 70 kn; "
+            f"expected an integer in [1, {most}] (or raise time_limit_min)",
+        )
         return None, centre
     try:
         layout = TEMPLATES[kind]((0.0, 0.0), twd, length, laps, **kw)
@@ -736,8 +882,6 @@ def _layout_mapping(layout: CourseLayout) -> dict[str, Any]:
         "gates": {k: list(v) for k, v in layout.gates.items()},
         "legs": legs,
     }
-
-
 
 
 # ----------------------------------------------------------------------------- the walk
@@ -766,8 +910,11 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     c = Checker(probs)
     if not isinstance(data, Mapping):
         what = "an empty file" if data is None else show(data)
-        probs.add("", "expected a course mapping with keys name, start_time, marks, legs, "
-                  f"scenarios, ...; got {what}")
+        probs.add(
+            "",
+            "expected a course mapping with keys name, start_time, marks, legs, "
+            f"scenarios, ...; got {what}",
+        )
         probs.raise_if_any()
     c.keys(data, TOP_KEYS, ("name", "start_time"))
     name = c.string(data, "name", "") or ""
@@ -786,8 +933,11 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     if template is not None:
         clash = [k for k in LAYOUT_KEYS if k in data]
         if clash:
-            probs.add(clash[0], "a course with `template` gets its marks, lines, gates and "
-                      f"legs from the template; remove {', '.join(clash)} or the template")
+            probs.add(
+                clash[0],
+                "a course with `template` gets its marks, lines, gates and "
+                f"legs from the template; remove {', '.join(clash)} or the template",
+            )
         layout, centre = _template(c, template, time_limit)
         if layout is not None:
             layout_raw = _layout_mapping(layout)
@@ -817,17 +967,22 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     legs: list[Leg] = []
     if "legs" in layout_raw and frame is not None:
         legs = _legs(c, layout_raw["legs"], xy, lines, gates)
-    n_legs = len(legs) if legs and "legs" in layout_raw and len(legs) == len(
-        layout_raw["legs"]) else None
+    n_legs = (
+        len(legs)
+        if legs and "legs" in layout_raw and len(legs) == len(layout_raw["legs"])
+        else None
+    )
 
     boat = _boat(c, data.get("boat"))
     routing = _routing(c, data.get("routing"))
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
     area = check_area(c, data, frame, xy, _position)
-    uncertainty = check_uncertainty(
-        c.at("uncertainty"), data["uncertainty"],
-        Path(probs.file).parent) if data.get("uncertainty") is not None else None
+    uncertainty = (
+        check_uncertainty(c.at("uncertainty"), data["uncertainty"], Path(probs.file).parent)
+        if data.get("uncertainty") is not None
+        else None
+    )
     probs.raise_if_any()
 
     assert frame is not None and start_time is not None  # guaranteed when no problems
@@ -854,24 +1009,33 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
 
 
 def _near_origin(
-    c: Checker, marks: Mapping[str, tuple[float, float, float, float]], frame: LocalFrame,
-    given: bool, template: bool,
+    c: Checker,
+    marks: Mapping[str, tuple[float, float, float, float]],
+    frame: LocalFrame,
+    given: bool,
+    template: bool,
 ) -> None:
     """A problem for each mark farther than :data:`MAX_OFFSET_M` from the frame's origin
     (``given``: the file has ``origin``, else the origin is the mean of the marks; a
     ``template`` course gets one problem, at ``template.centre``)."""
-    origin = (f"the origin ({frame.lat0:.6f}, {frame.lon0:.6f})" if given else
-              f"the course's centre ({frame.lat0:.6f}, {frame.lon0:.6f}, the mean of the "
-              "marks' lat/lon)")
+    origin = (
+        f"the origin ({frame.lat0:.6f}, {frame.lon0:.6f})"
+        if given
+        else f"the course's centre ({frame.lat0:.6f}, {frame.lon0:.6f}, the mean of the "
+        "marks' lat/lon)"
+    )
     for k, m in marks.items():
         d = math.hypot(m[0], m[1])
         if d <= MAX_OFFSET_M:  # False for NaN
             continue
         far = f"{d / 1000.0:.0f} km" if d < 1e7 else "more than 10000 km"
         where = "template.centre" if template else join_path("marks", k)
-        c.p.add(where, f"mark {k!r} ({m[2]:.6f}, {m[3]:.6f}) lies {far} from {origin}; "
-                f"expected every mark within {MAX_OFFSET_M / 1000.0:.0f} km of it (check the "
-                "marks for a typing error)")
+        c.p.add(
+            where,
+            f"mark {k!r} ({m[2]:.6f}, {m[3]:.6f}) lies {far} from {origin}; "
+            f"expected every mark within {MAX_OFFSET_M / 1000.0:.0f} km of it (check the "
+            "marks for a typing error)",
+        )
         if template:
             return
 
@@ -884,8 +1048,8 @@ def _place(
     A template's layout is built around (0, 0) and moved to its ``centre`` here.
     """
     if centre is not None:
-        cx, cy = centre[1] if centre[0] == "xy" else tuple(
-            float(v) for v in frame.to_xy(*centre[1])
+        cx, cy = (
+            centre[1] if centre[0] == "xy" else tuple(float(v) for v in frame.to_xy(*centre[1]))
         )
         positions = {k: ("xy", (x + cx, y + cy)) for k, (_, (x, y)) in positions.items()}
     out: dict[str, tuple[float, float, float, float]] = {}

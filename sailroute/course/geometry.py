@@ -175,8 +175,13 @@ def nominal_legs(course: Course) -> tuple[NominalLeg, ...]:
         b = feature_centre(course.feature(leg.to_name))
         out.append(
             NominalLeg(
-                leg.index, leg.from_name, leg.to_name, a, b,
-                float(math.hypot(b[0] - a[0], b[1] - a[1])), xy_bearing_deg(a, b),
+                leg.index,
+                leg.from_name,
+                leg.to_name,
+                a,
+                b,
+                float(math.hypot(b[0] - a[0], b[1] - a[1])),
+                xy_bearing_deg(a, b),
             )
         )
     return tuple(out)
@@ -196,8 +201,10 @@ def course_bbox(course: Course, margin_m: float = 0.0) -> tuple[float, float, fl
     x = np.array([m.x for m in course.marks.values()])
     y = np.array([m.y for m in course.marks.values()])
     return (
-        float(x.min()) - margin_m, float(x.max()) + margin_m,
-        float(y.min()) - margin_m, float(y.max()) + margin_m,
+        float(x.min()) - margin_m,
+        float(x.max()) + margin_m,
+        float(y.min()) - margin_m,
+        float(y.max()) + margin_m,
     )
 
 

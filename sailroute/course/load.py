@@ -34,8 +34,14 @@ from sailroute.course.specs import (
 )
 
 __all__ = [
-    "TOP_KEYS", "build_boat", "build_current", "build_specs", "build_wind",
-    "course_from_mapping", "load_course", "validate_specs",
+    "TOP_KEYS",
+    "build_boat",
+    "build_current",
+    "build_specs",
+    "build_wind",
+    "course_from_mapping",
+    "load_course",
+    "validate_specs",
 ]
 
 
@@ -97,5 +103,6 @@ def load_course(path: str | Path) -> Course:
     """
     p = Path(path)
     text = read_course_file(p)
-    return course_from_mapping(text.data, source=p, key_lines=text.lines,
-                               extra_problems=text.duplicates)
+    return course_from_mapping(
+        text.data, source=p, key_lines=text.lines, extra_problems=text.duplicates
+    )

@@ -57,6 +57,9 @@ def read_course_file(path: str | Path) -> CourseText:
         column).
     """
     doc = read_yaml(Path(path), what="course file")
-    dup = tuple(f"{d.path}: the key {d.key!r} appears twice in the same mapping "
-                f"(lines {d.first_line} and {d.line}); keep one" for d in doc.duplicates)
+    dup = tuple(
+        f"{d.path}: the key {d.key!r} appears twice in the same mapping "
+        f"(lines {d.first_line} and {d.line}); keep one"
+        for d in doc.duplicates
+    )
     return CourseText(doc.data, doc.lines, dup)

@@ -28,8 +28,13 @@ def build_boat(course: Course) -> Any:
     from sailroute.boat.build import boat_from_spec
 
     where = course.boat_where or (str(course.source) if course.source else "<course>")
-    return boat_from_spec(dict(course.boat_spec), base_dir=course.base_dir, where=where,
-                          key="boat", lines=course.key_lines)
+    return boat_from_spec(
+        dict(course.boat_spec),
+        base_dir=course.base_dir,
+        where=where,
+        key="boat",
+        lines=course.key_lines,
+    )
 
 
 def build_wind(course: Course, scenario: str) -> Any:
@@ -57,9 +62,12 @@ def build_wind(course: Course, scenario: str) -> Any:
         )
     sc = course.scenarios[scenario]
     return wind_from_spec(
-        dict(sc.wind), frame=course.frame, base_dir=course.base_dir,
+        dict(sc.wind),
+        frame=course.frame,
+        base_dir=course.base_dir,
         where=sc.where or course.where(f"scenarios.{scenario}"),
-        crop_bbox=course_bbox(course), time_window=race_time_window(course),
+        crop_bbox=course_bbox(course),
+        time_window=race_time_window(course),
         lines=course.key_lines,
     )
 
@@ -77,9 +85,12 @@ def build_current(course: Course, scenario: str) -> Any:
     if sc is None or sc.current is None:  # (an unknown name is build_wind's error)
         return None
     return current_from_spec(
-        dict(sc.current), frame=course.frame, base_dir=course.base_dir,
+        dict(sc.current),
+        frame=course.frame,
+        base_dir=course.base_dir,
         where=sc.current_where or course.where(f"scenarios.{scenario}.current"),
-        crop_bbox=course_bbox(course), time_window=race_time_window(course),
+        crop_bbox=course_bbox(course),
+        time_window=race_time_window(course),
         lines=course.key_lines,
     )
 
@@ -128,10 +139,12 @@ def build_specs(
         raise errors[0]
     problems = [p for exc in errors for p in _flatten(str(exc))]
     if problems:
-        raise InputError(format_problems(
-            f"{course.source or '<course>'}: {len(problems)} problems in boat/wind specs",
-            problems,
-        ))
+        raise InputError(
+            format_problems(
+                f"{course.source or '<course>'}: {len(problems)} problems in boat/wind specs",
+                problems,
+            )
+        )
     return boat, winds
 
 

@@ -97,8 +97,13 @@ def _at(p: XY, *terms: tuple[float, XY]) -> XY:
 
 
 def _pair(
-    into: dict[str, tuple[str, str]], layout: CourseLayout, name: str, ends: tuple[str, str],
-    centre: XY, length_m: float, axis: XY,
+    into: dict[str, tuple[str, str]],
+    layout: CourseLayout,
+    name: str,
+    ends: tuple[str, str],
+    centre: XY,
+    length_m: float,
+    axis: XY,
 ) -> None:
     """Put marks ``ends`` at ``centre ± length_m / 2 · axis`` and register them as ``name``."""
     layout.marks[ends[0]] = _at(centre, (length_m / 2, axis))
@@ -128,8 +133,7 @@ def _leeward_end(
     layout.marks["1"] = m1
     _pair(layout.gates, layout, "4", ("4s", "4p"), g4, gate_width_m, left)
     st = _at(g4, (-start_offset_m, up))
-    _pair(layout.lines, layout, "start", ("start_pin", "start_boat"), st, start_line_length_m,
-          left)
+    _pair(layout.lines, layout, "start", ("start_pin", "start_boat"), st, start_line_length_m, left)
 
 
 def windward_leeward(
@@ -174,8 +178,10 @@ def windward_leeward(
     CourseLayout
     """
     _check_positive(
-        leg_length_m=leg_length_m, gate_width_m=gate_width_m,
-        start_line_length_m=start_line_length_m, finish_line_length_m=finish_line_length_m,
+        leg_length_m=leg_length_m,
+        gate_width_m=gate_width_m,
+        start_line_length_m=start_line_length_m,
+        finish_line_length_m=finish_line_length_m,
     )
     if finish not in ("leeward", "windward"):
         raise InputError(f"course template: finish must be 'leeward' or 'windward', got {finish!r}")
@@ -188,15 +194,28 @@ def windward_leeward(
     up, left = _axes(twd_deg)
     layout = CourseLayout()
     _leeward_end(
-        layout, centre_xy, up, left, leg_length_m, gate_width_m, start_line_length_m,
+        layout,
+        centre_xy,
+        up,
+        left,
+        leg_length_m,
+        gate_width_m,
+        start_line_length_m,
         start_offset_m,
     )
     if finish == "leeward":
         fc = _at(centre_xy, (-leg_length_m / 2 - start_offset_m, up))
     else:
         fc = _at(centre_xy, (leg_length_m / 2 + finish_offset_m, up))
-    _pair(layout.lines, layout, "finish", ("finish_pin", "finish_boat"), fc,
-          finish_line_length_m, left)
+    _pair(
+        layout.lines,
+        layout,
+        "finish",
+        ("finish_pin", "finish_boat"),
+        fc,
+        finish_line_length_m,
+        left,
+    )
     legs = [LayoutLeg("1", "port")]
     n_gate_to_1 = laps - 1 if finish == "leeward" else laps - 2
     for _ in range(n_gate_to_1):
@@ -255,8 +274,11 @@ def trapezoid(
     reach_length_m = 2.0 * leg_length_m / 3.0 if reach_length_m is None else reach_length_m
     finish_reach_m = leg_length_m / 4.0 if finish_reach_m is None else finish_reach_m
     _check_positive(
-        leg_length_m=leg_length_m, gate_width_m=gate_width_m, reach_length_m=reach_length_m,
-        start_line_length_m=start_line_length_m, finish_line_length_m=finish_line_length_m,
+        leg_length_m=leg_length_m,
+        gate_width_m=gate_width_m,
+        reach_length_m=reach_length_m,
+        start_line_length_m=start_line_length_m,
+        finish_line_length_m=finish_line_length_m,
         finish_reach_m=finish_reach_m,
     )
     if loop not in ("inner", "outer"):
@@ -270,7 +292,13 @@ def trapezoid(
     up, left = _axes(twd_deg)
     layout = CourseLayout()
     _leeward_end(
-        layout, centre_xy, up, left, leg_length_m, gate_width_m, start_line_length_m,
+        layout,
+        centre_xy,
+        up,
+        left,
+        leg_length_m,
+        gate_width_m,
+        start_line_length_m,
         start_offset_m,
     )
     a = math.radians(reach_angle_deg)
@@ -288,8 +316,9 @@ def trapezoid(
     g3 = _at(m2, (-drop, up))
     _pair(layout.gates, layout, "3", ("3s", "3p"), g3, gate_width_m, left)
     fc = _at(g3, (-finish_reach_m, left))
-    _pair(layout.lines, layout, "finish", ("finish_pin", "finish_boat"), fc,
-          finish_line_length_m, up)
+    _pair(
+        layout.lines, layout, "finish", ("finish_pin", "finish_boat"), fc, finish_line_length_m, up
+    )
     legs = [LayoutLeg("1", "port")]
     if loop == "inner":
         for _ in range(laps - 1):
@@ -304,5 +333,7 @@ def trapezoid(
 
 
 TEMPLATES: dict[str, Callable[..., CourseLayout]] = {
-    "windward-leeward": windward_leeward, "trapezoid": trapezoid}
+    "windward-leeward": windward_leeward,
+    "trapezoid": trapezoid,
+}
 """Template name (the ``template.type`` key) → builder."""

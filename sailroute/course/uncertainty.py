@@ -29,12 +29,27 @@ from sailroute.checks import Checker, Problems, show
 from sailroute.units import KNOT
 
 __all__ = [
-    "DEFAULT_UNCERTAINTY", "SHIFT_MODELS", "UNCERTAINTY_KEYS", "ShiftSpec", "UncertaintySpec",
-    "check_uncertainty", "uncertainty_from_mapping",
+    "DEFAULT_UNCERTAINTY",
+    "SHIFT_MODELS",
+    "UNCERTAINTY_KEYS",
+    "ShiftSpec",
+    "UncertaintySpec",
+    "check_uncertainty",
+    "uncertainty_from_mapping",
 ]
 
-UNCERTAINTY_KEYS: Final = ("tws_kn", "tws_ms", "tws_pct", "twd_deg", "shifts", "boat",
-                           "members", "seed", "side_margin_s", "side_margin_pct")
+UNCERTAINTY_KEYS: Final = (
+    "tws_kn",
+    "tws_ms",
+    "tws_pct",
+    "twd_deg",
+    "shifts",
+    "boat",
+    "members",
+    "seed",
+    "side_margin_s",
+    "side_margin_pct",
+)
 """Keys of the ``uncertainty`` section."""
 SHIFT_MODELS: Final = ("oscillating", "ou", "persistent")
 """Shift models of ``uncertainty.shifts.model``."""
@@ -43,8 +58,14 @@ _SHIFT_KEYS: Final = {
     "ou": ("model", "sigma_deg", "timescale_min"),
     "persistent": ("model", "rate_deg_per_min"),
 }
-BOAT_PARAMETERS: Final = ("fetch_m", "sea_age_h", "pump_power_w_per_kg", "pump_efficiency",
-                          "oscar_tws_kn", "upwind_efficiency")
+BOAT_PARAMETERS: Final = (
+    "fetch_m",
+    "sea_age_h",
+    "pump_power_w_per_kg",
+    "pump_efficiency",
+    "oscar_tws_kn",
+    "upwind_efficiency",
+)
 """Race-polar parameters (:class:`sailroute.boat.kinetics.Kinetics`) a band may vary."""
 
 
@@ -147,7 +168,8 @@ class UncertaintySpec:
 
 
 DEFAULT_UNCERTAINTY: Final = UncertaintySpec(
-    tws_add_ms=1.0 * KNOT, twd_deg=5.0,
+    tws_add_ms=1.0 * KNOT,
+    twd_deg=5.0,
     shifts=ShiftSpec("oscillating", amplitude_deg=5.0, period_s=360.0),
 )
 """Used when a course has no ``uncertainty`` section: 1 kn and 5° (1 sigma), a 5° shift
@@ -156,8 +178,11 @@ oscillating every 6 min; no boat parameters (``docs/course-format.md``)."""
 
 def _range(c: Checker, d: Mapping[str, Any], key: str) -> tuple[float, float] | None:
     v = d[key]
-    ok = (isinstance(v, list) and len(v) == 2
-          and all(isinstance(x, int | float) and not isinstance(x, bool) for x in v))
+    ok = (
+        isinstance(v, list)
+        and len(v) == 2
+        and all(isinstance(x, int | float) and not isinstance(x, bool) for x in v)
+    )
     if not ok or not (float(v[0]) <= float(v[1])):
         c.add(key, f"expected a range [low, high] of two numbers, low <= high; got {show(v)}")
         return None
@@ -178,8 +203,11 @@ def _shifts(c: Checker, raw: Any, base_dir: Path | None) -> ShiftSpec | None:
         if not p.is_absolute() and base_dir is not None:
             p = base_dir / p
         if not p.is_file():
-            c.add("fit", f"no station CSV at {p}; give a file of measured wind "
-                  "(docs/measured-wind.md) relative to the course file")
+            c.add(
+                "fit",
+                f"no station CSV at {p}; give a file of measured wind "
+                "(docs/measured-wind.md) relative to the course file",
+            )
             return None
         return ShiftSpec("ou", fit=p, station=station, speed_unit=unit)
     model = c.choice(raw, "model", SHIFT_MODELS)
@@ -189,13 +217,19 @@ def _shifts(c: Checker, raw: Any, base_dir: Path | None) -> ShiftSpec | None:
     if model == "oscillating":
         a = c.number(raw, "amplitude_deg", None, lo=0.0, hi=90.0)
         per = c.number(raw, "period_min", None, lo=0.0, lo_open=True)
-        return None if a is None or per is None else ShiftSpec(model, amplitude_deg=a,
-                                                                period_s=60.0 * per)
+        return (
+            None
+            if a is None or per is None
+            else ShiftSpec(model, amplitude_deg=a, period_s=60.0 * per)
+        )
     if model == "ou":
         s = c.number(raw, "sigma_deg", None, lo=0.0, hi=90.0)
         ts = c.number(raw, "timescale_min", None, lo=0.0, lo_open=True)
-        return None if s is None or ts is None else ShiftSpec(model, sigma_deg=s,
-                                                               timescale_s=60.0 * ts)
+        return (
+            None
+            if s is None or ts is None
+            else ShiftSpec(model, sigma_deg=s, timescale_s=60.0 * ts)
+        )
     r = c.number(raw, "rate_deg_per_min", None, lo=0.0, hi=30.0)
     return None if r is None else ShiftSpec(model, rate_deg_per_s=r / 60.0)
 
@@ -213,9 +247,7 @@ def _boat(c: Checker, raw: Any) -> tuple[tuple[str, float, float], ...]:
     return tuple(out)
 
 
-def check_uncertainty(
-    c: Checker, raw: Any, base_dir: Path | None = None
-) -> UncertaintySpec | None:
+def check_uncertainty(c: Checker, raw: Any, base_dir: Path | None = None) -> UncertaintySpec | None:
     """Check the ``uncertainty`` mapping at ``c.path``; every problem goes to ``c``.
 
     Parameters
@@ -247,19 +279,30 @@ def check_uncertainty(
     elif "tws_pct" in raw:
         rel = (c.number(raw, "tws_pct", None, lo=0.0, hi=100.0) or 0.0) / 100.0
     twd = c.number(raw, "twd_deg", 0.0, lo=0.0, hi=90.0)
-    shifts = _shifts(c.child("shifts"), raw["shifts"], base_dir) if raw.get(
-        "shifts") is not None else None
+    shifts = (
+        _shifts(c.child("shifts"), raw["shifts"], base_dir)
+        if raw.get("shifts") is not None
+        else None
+    )
     boat = _boat(c.child("boat"), raw["boat"]) if raw.get("boat") is not None else ()
     members = c.integer(raw, "members", DEFAULT_UNCERTAINTY.members, lo=3)
     seed = c.integer(raw, "seed", DEFAULT_UNCERTAINTY.seed, lo=0)
     m_s = c.number(raw, "side_margin_s", DEFAULT_UNCERTAINTY.side_margin_s, lo=0.0)
-    m_pct = c.number(raw, "side_margin_pct", DEFAULT_UNCERTAINTY.side_margin_pct, lo=0.0,
-                     hi=100.0)
+    m_pct = c.number(raw, "side_margin_pct", DEFAULT_UNCERTAINTY.side_margin_pct, lo=0.0, hi=100.0)
     if len(c.p) > n0:
         return None
-    return UncertaintySpec(tws_add_ms=add, tws_rel=rel, twd_deg=twd or 0.0, shifts=shifts,
-                           boat=boat, members=members, seed=seed, side_margin_s=m_s,
-                           side_margin_pct=m_pct, where=c.where())
+    return UncertaintySpec(
+        tws_add_ms=add,
+        tws_rel=rel,
+        twd_deg=twd or 0.0,
+        shifts=shifts,
+        boat=boat,
+        members=members,
+        seed=seed,
+        side_margin_s=m_s,
+        side_margin_pct=m_pct,
+        where=c.where(),
+    )
 
 
 def uncertainty_from_mapping(

@@ -64,18 +64,23 @@ def nmea_lines(row: Row, talker: str = "II") -> Iterator[str]:
     la, lo = lat_field(row.lat), lon_field(row.lon)
     sog = "" if row.sog_kn is None else f"{row.sog_kn:.2f}"
     cog = "" if row.cog_deg is None else f"{row.cog_deg % 360:.1f}"
-    yield sentence(f"GPRMC,{hms},A,{la[0]},{la[1]},{lo[0]},{lo[1]},{sog},{cog},"
-                   f"{dt:%d%m%y},,,A").rstrip()
+    yield sentence(
+        f"GPRMC,{hms},A,{la[0]},{la[1]},{lo[0]},{lo[1]},{sog},{cog},{dt:%d%m%y},,,A"
+    ).rstrip()
     if row.hdg_deg is not None:
         yield sentence(f"{talker}HDT,{row.hdg_deg % 360:.1f},T").rstrip()
         if row.stw_kn is not None:
-            yield sentence(f"{talker}VHW,{row.hdg_deg % 360:.1f},T,,M,{row.stw_kn:.2f},N,"
-                           f"{row.stw_kn * 1.852:.2f},K").rstrip()
+            yield sentence(
+                f"{talker}VHW,{row.hdg_deg % 360:.1f},T,,M,{row.stw_kn:.2f},N,"
+                f"{row.stw_kn * 1.852:.2f},K"
+            ).rstrip()
     if row.aws_kn is not None and row.awa_deg is not None:
         yield sentence(f"{talker}MWV,{row.awa_deg % 360:.1f},R,{row.aws_kn:.2f},N,A").rstrip()
     if row.tws_kn is not None and row.twd_deg is not None:
-        yield sentence(f"{talker}MWD,{row.twd_deg % 360:.1f},T,,M,{row.tws_kn:.2f},N,"
-                       f"{row.tws_kn * 1852 / 3600:.2f},M").rstrip()
+        yield sentence(
+            f"{talker}MWD,{row.twd_deg % 360:.1f},T,,M,{row.tws_kn:.2f},N,"
+            f"{row.tws_kn * 1852 / 3600:.2f},M"
+        ).rstrip()
 
 
 def read_trieste(path: Path, utc_offset_s: float = 3600.0) -> list[Row]:
@@ -89,14 +94,28 @@ def read_trieste(path: Path, utc_offset_s: float = 3600.0) -> list[Row]:
                 lat, lon = _num(r, "lat"), _num(r, "lon")
                 if lat is None or lon is None:
                     continue
-                out.append(Row(t, lat, lon, _num(r, "sog_kn"), _num(r, "cog_deg"),
-                               _num(r, "hdg_deg"), _num(r, "bs_kn"), _num(r, "aws_kn"),
-                               _num(r, "awa_deg"), _num(r, "tws_kn"), _num(r, "twd_deg")))
+                out.append(
+                    Row(
+                        t,
+                        lat,
+                        lon,
+                        _num(r, "sog_kn"),
+                        _num(r, "cog_deg"),
+                        _num(r, "hdg_deg"),
+                        _num(r, "bs_kn"),
+                        _num(r, "aws_kn"),
+                        _num(r, "awa_deg"),
+                        _num(r, "tws_kn"),
+                        _num(r, "twd_deg"),
+                    )
+                )
             except (KeyError, ValueError) as exc:
-                raise InputError(f"{path}:{n}: not a row of the Trieste coach-boat CSV "
-                                 f"({exc}); expected the columns datetime_local, bs_kn, "
-                                 "awa_deg, aws_kn, hdg_deg, tws_kn, twd_deg, sog_kn, "
-                                 "cog_deg, lat, lon") from None
+                raise InputError(
+                    f"{path}:{n}: not a row of the Trieste coach-boat CSV "
+                    f"({exc}); expected the columns datetime_local, bs_kn, "
+                    "awa_deg, aws_kn, hdg_deg, tws_kn, twd_deg, sog_kn, "
+                    "cog_deg, lat, lon"
+                ) from None
     return out
 
 
@@ -112,18 +131,36 @@ def read_tallinn(path: Path) -> list[Row]:
                     continue
                 awa, tack = _num(r, "awa"), _num(r, "tack")
                 signed = None if awa is None or tack is None else awa * (1 if tack >= 0 else -1)
-                out.append(Row(t, lat, lon, _num(r, "sog"), _num(r, "cog"), _num(r, "hdg"),
-                               None, _num(r, "aws"), signed))
+                out.append(
+                    Row(
+                        t,
+                        lat,
+                        lon,
+                        _num(r, "sog"),
+                        _num(r, "cog"),
+                        _num(r, "hdg"),
+                        None,
+                        _num(r, "aws"),
+                        signed,
+                    )
+                )
             except (KeyError, ValueError) as exc:
-                raise InputError(f"{path}:{n}: not a row of the Tallinn race log ({exc}); "
-                                 "expected the columns time, lat, lng, sog, cog, hdg, awa, "
-                                 "aws, tack") from None
+                raise InputError(
+                    f"{path}:{n}: not a row of the Tallinn race log ({exc}); "
+                    "expected the columns time, lat, lng, sog, cog, hdg, awa, "
+                    "aws, tack"
+                ) from None
     return out
 
 
 def convert_log(
-    path: Path, fmt: str, out: Path, *, utc_offset_s: float = 3600.0,
-    t0: float | None = None, t1: float | None = None,
+    path: Path,
+    fmt: str,
+    out: Path,
+    *,
+    utc_offset_s: float = 3600.0,
+    t0: float | None = None,
+    t1: float | None = None,
 ) -> int:
     """Write the NMEA 0183 replay file of a log; returns the number of rows written.
 

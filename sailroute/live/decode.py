@@ -88,8 +88,17 @@ class Reading:
             v = getattr(self, name)
             if v is not None:
                 out[name] = round(v, 7)
-        for name in ("sog_ms", "cog_deg", "hdg_deg", "stw_ms", "tws_ms", "twd_deg",
-                     "twa_deg", "aws_ms", "awa_deg"):
+        for name in (
+            "sog_ms",
+            "cog_deg",
+            "hdg_deg",
+            "stw_ms",
+            "tws_ms",
+            "twd_deg",
+            "twa_deg",
+            "aws_ms",
+            "awa_deg",
+        ):
             v = getattr(self, name)
             if v is not None:
                 out[name] = round(v, 3)
@@ -208,8 +217,14 @@ class NmeaDecoder:
         if self._t is None:
             self.counts.by_kind["untimed"] += 1
             return None
-        untimed = {"VTG": self._vtg, "HDT": self._hdt, "HDG": self._hdg, "VHW": self._vhw,
-                   "MWV": self._mwv, "MWD": self._mwd}
+        untimed = {
+            "VTG": self._vtg,
+            "HDT": self._hdt,
+            "HDG": self._hdg,
+            "VHW": self._vhw,
+            "MWV": self._mwv,
+            "MWD": self._mwd,
+        }
         if kind in untimed:
             return untimed[kind](msg, self._t)
         self.counts.by_kind["ignored"] += 1
@@ -226,9 +241,14 @@ class NmeaDecoder:
         if var is not None:
             self._variation = -var if msg.mag_var_dir == "W" else var
         sog = _f(msg.spd_over_grnd)
-        return Reading(self._t, lat=float(msg.latitude), lon=float(msg.longitude),
-                       sog_ms=None if sog is None else sog * KN,
-                       cog_deg=_f(msg.true_course), timed=True)
+        return Reading(
+            self._t,
+            lat=float(msg.latitude),
+            lon=float(msg.longitude),
+            sog_ms=None if sog is None else sog * KN,
+            cog_deg=_f(msg.true_course),
+            timed=True,
+        )
 
     def _fix(self, msg: Any) -> Reading | None:
         """GGA or GLL: a position at a time of day (dated by the last RMC or ZDA)."""

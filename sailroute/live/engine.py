@@ -97,8 +97,10 @@ class JsonLog:
             try:
                 self._fh = open(path, "w", encoding="utf-8")  # noqa: SIM115 (closed in close)
             except OSError as exc:
-                raise InputError(f"--log {path}: cannot write ({exc.strerror}); give a path "
-                                 "in a folder that exists and is writable") from None
+                raise InputError(
+                    f"--log {path}: cannot write ({exc.strerror}); give a path "
+                    "in a folder that exists and is writable"
+                ) from None
         self._lock = threading.Lock()
         self._flushed = time.monotonic()
         self.lines = 0
@@ -154,21 +156,30 @@ class LiveEngine:
     """
 
     def __init__(
-        self, course: Course, forecast: WindField, boat: BoatModel, routing: RoutingSettings,
-        source: Source, settings: LiveSettings = LiveSettings(), *, port: int | None = 0,
-        nmea_port: int | None = 0, log: Path | None = None, leg: int = 0,
+        self,
+        course: Course,
+        forecast: WindField,
+        boat: BoatModel,
+        routing: RoutingSettings,
+        source: Source,
+        settings: LiveSettings = LiveSettings(),
+        *,
+        port: int | None = 0,
+        nmea_port: int | None = 0,
+        log: Path | None = None,
+        leg: int = 0,
         planner: Planner | None = None,
     ) -> None:
         self.course, self.forecast, self.boat, self.routing = course, forecast, boat, routing
-        self.planner: Planner = planner or ThreadPlanner(PlanCore(course, forecast, boat,
-                                                                   routing))
+        self.planner: Planner = planner or ThreadPlanner(PlanCore(course, forecast, boat, routing))
         self.source, self.settings = source, settings
         self._lock = threading.Lock()
         self._planning = threading.Lock()  # one re-plan at a time
         self._wake = threading.Event()
         self.done = threading.Event()
         self._decoder: NmeaDecoder | SignalKDecoder = (
-            SignalKDecoder() if source.kind == "signalk" else NmeaDecoder())
+            SignalKDecoder() if source.kind == "signalk" else NmeaDecoder()
+        )
         self._wind = RollingWind(settings.window_s)
         self._pos: tuple[float, float, float] | None = None  # t, lat, lon
         self._sog: float | None = None
@@ -195,15 +206,17 @@ class LiveEngine:
             self.page = PageServer(self.state, port) if port is not None else None
         except OSError as exc:
             self.planner.close()
-            raise InputError(f"--port {port}: cannot serve the page ({exc.strerror}); pick "
-                             "a free port") from None
+            raise InputError(
+                f"--port {port}: cannot serve the page ({exc.strerror}); pick a free port"
+            ) from None
         try:
             self.nmea = NmeaServer(nmea_port) if nmea_port is not None else None
         except OSError as exc:
             self._close_servers()
             self.planner.close()
-            raise InputError(f"--nmea-port {nmea_port}: cannot listen ({exc.strerror}); "
-                             "pick a free port") from None
+            raise InputError(
+                f"--nmea-port {nmea_port}: cannot listen ({exc.strerror}); pick a free port"
+            ) from None
         self._threads: list[threading.Thread] = []
         self.source_ended = threading.Event()
 
@@ -253,8 +266,13 @@ class LiveEngine:
         elif r.tws_ms is not None and r.twa_deg is not None and self._hdg is not None:
             self._true_t = r.t
             self._wind.add(r.t, r.tws_ms, (self._hdg + r.twa_deg) % 360.0)
-        elif (r.aws_ms is not None and r.awa_deg is not None and self._sog is not None
-              and self._cog is not None and r.t - self._true_t > TRUE_WIND_HOLD_S):
+        elif (
+            r.aws_ms is not None
+            and r.awa_deg is not None
+            and self._sog is not None
+            and self._cog is not None
+            and r.t - self._true_t > TRUE_WIND_HOLD_S
+        ):
             tws, twd = apparent_to_true(r.aws_ms, r.awa_deg, self._sog, self._cog, self._hdg)
             self._wind.add(r.t, tws, twd)
             r = replace(r, tws_ms=tws, twd_deg=twd)
@@ -285,7 +303,8 @@ class LiveEngine:
 
     def _stale(self) -> bool:
         return (not self._linked and not self.source_ended.is_set()) or (
-            time.monotonic() - self._wall > self.settings.stale_s)
+            time.monotonic() - self._wall > self.settings.stale_s
+        )
 
     def state(self) -> dict[str, Any]:
         """What ``/state.json`` serves."""
@@ -303,19 +322,39 @@ class LiveEngine:
                 la, lo = self.course.frame.to_latlon(*m.xy)
                 marks.append([name, round(float(la), 7), round(float(lo), 7)])
             return {
-                "t": self._clock, "source": self.source.label, "stale": self._stale(),
-                "link": self._link_note, "leg": self.leg, "n_legs": self.course.n_legs,
-                "position": None if pos is None else {
-                    "t": pos[0], "lat": pos[1], "lon": pos[2], "sog_ms": self._sog,
-                    "cog_deg": self._cog, "hdg_deg": self._hdg},
+                "t": self._clock,
+                "source": self.source.label,
+                "stale": self._stale(),
+                "link": self._link_note,
+                "leg": self.leg,
+                "n_legs": self.course.n_legs,
+                "position": None
+                if pos is None
+                else {
+                    "t": pos[0],
+                    "lat": pos[1],
+                    "lon": pos[2],
+                    "sog_ms": self._sog,
+                    "cog_deg": self._cog,
+                    "hdg_deg": self._hdg,
+                },
                 "wind": None if wind is None else {"tws_ms": wind[0], "twd_deg": wind[1]},
-                "wind_trend": [[round(a, 1), round(b, 3), round(c, 1)]
-                               for a, b, c in self._wind.trend()],
+                "wind_trend": [
+                    [round(a, 1), round(b, 3), round(c, 1)] for a, b, c in self._wind.trend()
+                ],
                 "plan": None if self.plan is None else self.plan.as_dict(),
-                "next_mark": tg, "marks": marks, "error": self.error,
-                "counts": {"used": sum(v for k, v in counts.by_kind.items() if k not in (
-                    "bad_checksum", "malformed", "untimed", "ignored", "empty")),
-                    "bad": counts.bad, **dict(counts.by_kind)},
+                "next_mark": tg,
+                "marks": marks,
+                "error": self.error,
+                "counts": {
+                    "used": sum(
+                        v
+                        for k, v in counts.by_kind.items()
+                        if k not in ("bad_checksum", "malformed", "untimed", "ignored", "empty")
+                    ),
+                    "bad": counts.bad,
+                    **dict(counts.by_kind),
+                },
             }
 
     # ------------------------------------------------------------------------- planning
@@ -328,8 +367,7 @@ class LiveEngine:
             return None
         if self.plan is None:
             reason = "first"
-        elif wind_changed(self._plan_wind, wind, self.settings.shift_deg,
-                          self.settings.change_ms):
+        elif wind_changed(self._plan_wind, wind, self.settings.shift_deg, self.settings.change_ms):
             reason = "wind"
         elif self._clock - self._plan_t >= self.settings.every_s:
             reason = "interval"
@@ -337,14 +375,16 @@ class LiveEngine:
             return None
         return reason, self._clock, self._pos[1], self._pos[2], wind[0], wind[1]
 
-    def replan(self, reason: str, t: float, lat: float, lon: float, tws: float,
-               twd: float) -> LivePlan | None:
+    def replan(
+        self, reason: str, t: float, lat: float, lon: float, tws: float, twd: float
+    ) -> LivePlan | None:
         """Route the rest of the course from ``lat, lon`` at ``t`` in the measured wind."""
         with self._planning:
             return self._replan(reason, t, lat, lon, tws, twd)
 
-    def _replan(self, reason: str, t: float, lat: float, lon: float, tws: float,
-                twd: float) -> LivePlan | None:
+    def _replan(
+        self, reason: str, t: float, lat: float, lon: float, tws: float, twd: float
+    ) -> LivePlan | None:
         frame = self.course.frame
         x, y = (float(v) for v in frame.to_xy(lat, lon))
         with self._lock:
@@ -352,8 +392,7 @@ class LiveEngine:
             self._plan_wind, self._plan_t = (tws, twd), t
         if leg >= self.course.n_legs:
             return None
-        req = PlanRequest(self.n_plans + 1, reason, t, x, y, leg, tws, twd,
-                          self.settings.fade_s)
+        req = PlanRequest(self.n_plans + 1, reason, t, x, y, leg, tws, twd, self.settings.fade_s)
         w0 = time.perf_counter()
         try:
             plan = self.planner.route(req)
@@ -442,6 +481,13 @@ class LiveEngine:
             self.nmea.close()
         with self._lock:
             counts = dict(self._decoder.counts.by_kind)
-        self.log.write({"kind": "end", "readings": self.n_readings, "plans": self.n_plans,
-                        "drops": self.n_drops, "counts": counts})
+        self.log.write(
+            {
+                "kind": "end",
+                "readings": self.n_readings,
+                "plans": self.n_plans,
+                "drops": self.n_drops,
+                "counts": counts,
+            }
+        )
         self.log.close()

@@ -110,8 +110,10 @@ class RollingWind:
 
 
 def wind_changed(
-    old: tuple[float, float] | None, new: tuple[float, float],
-    dir_deg: float = 5.0, speed_ms: float = 0.5144,
+    old: tuple[float, float] | None,
+    new: tuple[float, float],
+    dir_deg: float = 5.0,
+    speed_ms: float = 0.5144,
 ) -> bool:
     """True when ``new`` differs from ``old`` by at least ``dir_deg`` or ``speed_ms``.
 
@@ -124,8 +126,7 @@ def wind_changed(
     """
     if old is None:
         return True
-    return bool(abs(float(wrap180(new[1] - old[1]))) >= dir_deg
-                or abs(new[0] - old[0]) >= speed_ms)
+    return bool(abs(float(wrap180(new[1] - old[1]))) >= dir_deg or abs(new[0] - old[0]) >= speed_ms)
 
 
 @dataclass(frozen=True, eq=False)

@@ -59,7 +59,9 @@ def route_sentences(number: int, waypoints: Sequence[tuple[str, float, float]]) 
     out = []
     ids = [_name(n) for n, _, _ in waypoints]
     for wid, (_, la, lo) in zip(ids, waypoints, strict=True):
-        out.append(sentence(f"{_TALKER}WPL,{','.join(lat_field(la))},{','.join(lon_field(lo))},{wid}"))
+        out.append(
+            sentence(f"{_TALKER}WPL,{','.join(lat_field(la))},{','.join(lon_field(lo))},{wid}")
+        )
     groups: list[list[str]] = [[]]
     for wid in ids:  # an NMEA sentence holds at most 82 characters
         if len(",".join([*groups[-1], wid])) > 50:
@@ -76,14 +78,18 @@ def _bearing_range(lat: float, lon: float, lat2: float, lon2: float) -> tuple[fl
     dl = math.radians(lon2 - lon)
     y = math.sin(dl) * math.cos(p2)
     x = math.cos(p1) * math.sin(p2) - math.sin(p1) * math.cos(p2) * math.cos(dl)
-    h = (math.sin((p2 - p1) / 2) ** 2
-         + math.cos(p1) * math.cos(p2) * math.sin(dl / 2) ** 2)
+    h = math.sin((p2 - p1) / 2) ** 2 + math.cos(p1) * math.cos(p2) * math.sin(dl / 2) ** 2
     return math.degrees(math.atan2(y, x)) % 360.0, 2 * 6371008.8 * math.asin(math.sqrt(h))
 
 
 def steer_sentences(
-    lat: float, lon: float, sog_ms: float, cog_deg: float,
-    origin: tuple[str, float, float], dest: tuple[str, float, float], arrived: bool = False,
+    lat: float,
+    lon: float,
+    sog_ms: float,
+    cog_deg: float,
+    origin: tuple[str, float, float],
+    dest: tuple[str, float, float],
+    arrived: bool = False,
 ) -> list[str]:
     """``RMB`` and ``APB`` from the boat to the next waypoint ``dest``.
 
@@ -107,10 +113,14 @@ def steer_sentences(
     a = "A" if arrived else "V"
     o, d = _name(origin[0]), _name(dest[0])
     la, lo = lat_field(dest[1]), lon_field(dest[2])
-    rmb = (f"{_TALKER}RMB,A,{min(abs(xte), 9.99):.2f},{steer},{o},{d},{la[0]},{la[1]},"
-           f"{lo[0]},{lo[1]},{min(rng / NM, 999.9):.3f},{brg:.1f},{vmc:.1f},{a},A")
-    apb = (f"{_TALKER}APB,A,A,{min(abs(xte), 9.99):.2f},{steer},N,{a},V,{brg_od:.1f},T,{d},"
-           f"{brg:.1f},T,{brg:.1f},T,A")
+    rmb = (
+        f"{_TALKER}RMB,A,{min(abs(xte), 9.99):.2f},{steer},{o},{d},{la[0]},{la[1]},"
+        f"{lo[0]},{lo[1]},{min(rng / NM, 999.9):.3f},{brg:.1f},{vmc:.1f},{a},A"
+    )
+    apb = (
+        f"{_TALKER}APB,A,A,{min(abs(xte), 9.99):.2f},{steer},N,{a},V,{brg_od:.1f},T,{d},"
+        f"{brg:.1f},T,{brg:.1f},T,A"
+    )
     return [sentence(rmb), sentence(apb)]
 
 

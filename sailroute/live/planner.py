@@ -70,31 +70,51 @@ class PlanRequest:
 class PlanCore:
     """Route a :class:`PlanRequest`, then (on demand) the side that pays of its first leg."""
 
-    def __init__(self, course: Course, forecast: WindField, boat: BoatModel,
-                 routing: RoutingSettings) -> None:
+    def __init__(
+        self, course: Course, forecast: WindField, boat: BoatModel, routing: RoutingSettings
+    ) -> None:
         self.course, self.forecast, self.boat, self.routing = course, forecast, boat, routing
         self._last: tuple[PlanRequest, LiveWind, LegResult] | None = None
 
     def route(self, req: PlanRequest) -> LivePlan:
         """The remaining course for ``req`` (raises the routers' errors)."""
         w0, c0 = time.perf_counter(), time.thread_time()
-        wind = LiveWind(self.forecast, req.t, req.x, req.y, req.tws_ms, req.twd_deg,
-                        self.course.frame, req.fade_s)
-        results = route_remaining(self.course, wind, self.boat, self.routing, req.leg,
-                                  (req.x, req.y), req.t)
+        wind = LiveWind(
+            self.forecast,
+            req.t,
+            req.x,
+            req.y,
+            req.tws_ms,
+            req.twd_deg,
+            self.course.frame,
+            req.fade_s,
+        )
+        results = route_remaining(
+            self.course, wind, self.boat, self.routing, req.leg, (req.x, req.y), req.t
+        )
         self._last = (req, wind, results[0])
-        return summarise(self.course, results, number=req.number, t=req.t, leg=req.leg,
-                         wind=wind, boat=self.boat, measured=(req.tws_ms, req.twd_deg),
-                         reason=req.reason, compute_s=time.perf_counter() - w0,
-                         compute_cpu_s=time.thread_time() - c0)
+        return summarise(
+            self.course,
+            results,
+            number=req.number,
+            t=req.t,
+            leg=req.leg,
+            wind=wind,
+            boat=self.boat,
+            measured=(req.tws_ms, req.twd_deg),
+            reason=req.reason,
+            compute_s=time.perf_counter() - w0,
+            compute_cpu_s=time.thread_time() - c0,
+        )
 
     def side(self, number: int) -> SidePays | None:
         """The side that pays on the first leg of re-plan ``number`` (None if not the last)."""
         if self._last is None or self._last[0].number != number:
             return None
         req, wind, first = self._last
-        return side_that_pays(first, leg_target(self.course, req.leg), wind, self.boat,
-                              self.routing)
+        return side_that_pays(
+            first, leg_target(self.course, req.leg), wind, self.boat, self.routing
+        )
 
 
 class Planner(Protocol):
@@ -174,8 +194,11 @@ class ProcessPlanner:
 
     def __init__(self, course: Course, scenario: str, router: str | None = None) -> None:
         self._pool = ProcessPoolExecutor(
-            max_workers=1, mp_context=multiprocessing.get_context("spawn"),
-            initializer=_init_worker, initargs=(course, scenario, router))
+            max_workers=1,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_init_worker,
+            initargs=(course, scenario, router),
+        )
         self._warm = self._pool.submit(_ready)  # start it now, not at the first re-plan
 
     def route(self, req: PlanRequest) -> LivePlan:

@@ -85,8 +85,13 @@ def leg_target(course: Course, leg: int) -> Target:
 
 
 def route_remaining(
-    course: Course, wind: WindField, boat: BoatModel, settings: RoutingSettings,
-    leg: int, xy: XY, t: float,
+    course: Course,
+    wind: WindField,
+    boat: BoatModel,
+    settings: RoutingSettings,
+    leg: int,
+    xy: XY,
+    t: float,
 ) -> list[LegResult]:
     """Route legs ``leg`` .. last from the boat at ``xy`` [m] at epoch ``t`` [s].
 
@@ -144,7 +149,10 @@ def _cross_track(route: LegResult, a: XY, b: XY) -> tuple[float, float, float]:
 
 
 def side_that_pays(
-    route: LegResult, target: Target, wind: WindField, boat: BoatModel,
+    route: LegResult,
+    target: Target,
+    wind: WindField,
+    boat: BoatModel,
     settings: RoutingSettings,
 ) -> SidePays:
     """The side of the rhumb line the best route of a leg takes, and what it gains.
@@ -177,10 +185,17 @@ def side_that_pays(
     ex, ey = dx / n, dy / n
     # mirror point: same distance along the rhumb line, same offset on the other side
     mx, my = a[0] + along * ex - off * ey, a[1] + along * ey + off * ex
-    via = route_leg(Start(a, None, name="boat"), Target("mark", (mx, my), name="mirror"),
-                    route.t_start, wind, boat, settings)
-    rest = route_leg(Start(via.end_xy, None, name="mirror"), target, via.t_end, wind, boat,
-                     settings)
+    via = route_leg(
+        Start(a, None, name="boat"),
+        Target("mark", (mx, my), name="mirror"),
+        route.t_start,
+        wind,
+        boat,
+        settings,
+    )
+    rest = route_leg(
+        Start(via.end_xy, None, name="mirror"), target, via.t_end, wind, boat, settings
+    )
     # the router resolves times to about its time step: a mirror route found a little
     # faster than the best one means that both sides are worth the same
     gain = max(float(rest.t_end - route.t_end), 0.0)
@@ -226,8 +241,10 @@ def laylines(boat: BoatModel, tws_ms: float, twd_deg: float, upwind: bool) -> tu
     up, down = boat.vmg_angles_deg(tws_ms)
     twa = up if upwind else down
     # on starboard the wind comes over the right side: course = twd - twa
-    return (Layline("starboard", float(wrap360(twd_deg - twa))),
-            Layline("port", float(wrap360(twd_deg + twa))))
+    return (
+        Layline("starboard", float(wrap360(twd_deg - twa))),
+        Layline("port", float(wrap360(twd_deg + twa))),
+    )
 
 
 @dataclass(frozen=True)
@@ -291,31 +308,51 @@ class LivePlan:
     def as_dict(self) -> dict[str, object]:
         """JSON-ready form (for the page, the log)."""
         return {
-            "number": self.number, "t": self.t, "leg": self.leg,
+            "number": self.number,
+            "t": self.t,
+            "leg": self.leg,
             "leg_labels": list(self.leg_labels),
             "leg_times_s": [round(v, 1) for v in self.leg_times_s],
             "mark_eta": [round(v, 1) for v in self.mark_eta],
             "time_to_mark_s": round(self.time_to_mark_s, 1),
             "time_to_finish_s": round(self.time_to_finish_s, 1),
-            "route": [[round(a, 7), round(b, 7)] for a, b in zip(self.route_lat,
-                                                                  self.route_lon, strict=True)],
+            "route": [
+                [round(a, 7), round(b, 7)]
+                for a, b in zip(self.route_lat, self.route_lon, strict=True)
+            ],
             "waypoints": [[n, round(a, 7), round(b, 7)] for n, a, b in self.waypoints],
             "wind_tws_ms": round(self.wind_tws_ms, 3),
             "wind_twd_deg": round(self.wind_twd_deg, 2),
-            "side": None if self.side is None else {
-                "side": self.side.side, "gain_s": round(self.side.gain_s, 1),
-                "offset_m": round(self.side.offset_m, 1)},
-            "laylines": [{"tack": ll.tack, "bearing_deg": round(ll.bearing_deg, 1)}
-                         for ll in self.laylines],
-            "reason": self.reason, "compute_s": round(self.compute_s, 3),
+            "side": None
+            if self.side is None
+            else {
+                "side": self.side.side,
+                "gain_s": round(self.side.gain_s, 1),
+                "offset_m": round(self.side.offset_m, 1),
+            },
+            "laylines": [
+                {"tack": ll.tack, "bearing_deg": round(ll.bearing_deg, 1)} for ll in self.laylines
+            ],
+            "reason": self.reason,
+            "compute_s": round(self.compute_s, 3),
             "compute_cpu_s": round(self.compute_cpu_s, 3),
         }
 
 
 def summarise(
-    course: Course, results: Sequence[LegResult], *, number: int, t: float, leg: int,
-    wind: WindField, boat: BoatModel, measured: tuple[float, float], reason: str,
-    compute_s: float, side: SidePays | None = None, compute_cpu_s: float = 0.0,
+    course: Course,
+    results: Sequence[LegResult],
+    *,
+    number: int,
+    t: float,
+    leg: int,
+    wind: WindField,
+    boat: BoatModel,
+    measured: tuple[float, float],
+    reason: str,
+    compute_s: float,
+    side: SidePays | None = None,
+    compute_cpu_s: float = 0.0,
 ) -> LivePlan:
     """Assemble the :class:`LivePlan` of routed remaining legs ``results`` (from ``leg``)."""
     frame = course.frame
@@ -326,8 +363,9 @@ def summarise(
     for i, r in enumerate(results):
         for m in r.manoeuvres:
             la, lo = frame.to_latlon(m.x, m.y)
-            points.append((f"{m.kind[0].upper()}{i + leg + 1}{len(points) + 1:02d}",
-                           float(la), float(lo)))
+            points.append(
+                (f"{m.kind[0].upper()}{i + leg + 1}{len(points) + 1:02d}", float(la), float(lo))
+            )
         tg = target_of(course, leg + i)
         la, lo = frame.to_latlon(*tg.centre)
         points.append((tg.name or f"M{leg + i + 1}", float(la), float(lo)))
@@ -343,11 +381,22 @@ def summarise(
             lls = laylines(boat, float(tws), float(twd), upwind=off < 60.0)
     etas = tuple(float(r.t_end) for r in results)
     return LivePlan(
-        number=number, t=t, leg=leg,
+        number=number,
+        t=t,
+        leg=leg,
         leg_labels=tuple(course.legs[leg + i].label for i in range(len(results))),
-        leg_times_s=tuple(float(r.time_s) for r in results), mark_eta=etas,
-        time_to_mark_s=etas[0] - t, time_to_finish_s=etas[-1] - t,
-        route_lat=tuple(map(float, lat)), route_lon=tuple(map(float, lon)),
-        waypoints=tuple(points), wind_tws_ms=measured[0], wind_twd_deg=measured[1],
-        side=side, laylines=lls, reason=reason, compute_s=compute_s,
-        compute_cpu_s=compute_cpu_s)
+        leg_times_s=tuple(float(r.time_s) for r in results),
+        mark_eta=etas,
+        time_to_mark_s=etas[0] - t,
+        time_to_finish_s=etas[-1] - t,
+        route_lat=tuple(map(float, lat)),
+        route_lon=tuple(map(float, lon)),
+        waypoints=tuple(points),
+        wind_tws_ms=measured[0],
+        wind_twd_deg=measured[1],
+        side=side,
+        laylines=lls,
+        reason=reason,
+        compute_s=compute_s,
+        compute_cpu_s=compute_cpu_s,
+    )

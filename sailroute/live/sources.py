@@ -117,7 +117,8 @@ class NmeaUdpSource:
             except OSError as exc:
                 raise InputError(
                     f"--source {self.label}: cannot listen on UDP port {self.port} "
-                    f"({exc.strerror or exc}); pick a free port") from None
+                    f"({exc.strerror or exc}); pick a free port"
+                ) from None
             sock.settimeout(0.5)
             link(True, f"listening on {self.label}")
             while not done.is_set():
@@ -217,15 +218,18 @@ def parse_source(text: str, speed: float = 1.0) -> Source:
     InputError
         An unknown scheme, a missing port, a file that does not exist.
     """
-    how = ("give signalk://HOST:PORT, nmea+tcp://HOST:PORT, nmea+udp://:PORT or the path "
-           "of a recorded .nmea file")
+    how = (
+        "give signalk://HOST:PORT, nmea+tcp://HOST:PORT, nmea+udp://:PORT or the path "
+        "of a recorded .nmea file"
+    )
     if "://" not in text:
         path = Path(text)
         if not path.is_file():
             raise InputError(f"--source {text}: no such file; {how}")
         if not speed > 0:
-            raise InputError(f"--speed {speed:g}: must be > 0 (1 = real time, 10 = ten "
-                             "times faster)")
+            raise InputError(
+                f"--speed {speed:g}: must be > 0 (1 = real time, 10 = ten times faster)"
+            )
         return NmeaFileSource(path, speed)
     parts = urlsplit(text)
     try:

@@ -139,13 +139,18 @@ def _handler(state: Callable[[], dict[str, Any]]) -> type[BaseHTTPRequestHandler
 class PageServer:
     """The page and ``/state.json`` on ``host:port`` (0: a free port, see :attr:`port`)."""
 
-    def __init__(self, state: Callable[[], dict[str, Any]], port: int,
-                 host: str = "127.0.0.1") -> None:
+    def __init__(
+        self, state: Callable[[], dict[str, Any]], port: int, host: str = "127.0.0.1"
+    ) -> None:
         self._httpd = ThreadingHTTPServer((host, port), _handler(state))
         self._httpd.daemon_threads = True
         self.port: int = self._httpd.server_address[1]
-        self._thread = threading.Thread(target=self._httpd.serve_forever, name="live-page",
-                                        kwargs={"poll_interval": 0.2}, daemon=True)
+        self._thread = threading.Thread(
+            target=self._httpd.serve_forever,
+            name="live-page",
+            kwargs={"poll_interval": 0.2},
+            daemon=True,
+        )
         self._thread.start()
 
     def close(self) -> None:

@@ -235,13 +235,17 @@ def compare(plans: Sequence[Plan]) -> Comparison:
     times = np.array([[leg.time_s for leg in p.legs] for p in plans], dtype=float)
     first = {k: np.asarray(v, dtype=float) for k, v in plans[0].references.items()}
     shared = {
-        k: v for k, v in first.items()
-        if all(k in p.references and np.array_equal(np.asarray(p.references[k], float), v)
-               for p in plans)
+        k: v
+        for k, v in first.items()
+        if all(
+            k in p.references and np.array_equal(np.asarray(p.references[k], float), v)
+            for p in plans
+        )
     }
     own = {
-        p.scenario: {k: np.asarray(v, dtype=float) for k, v in p.references.items()
-                     if k not in shared}
+        p.scenario: {
+            k: np.asarray(v, dtype=float) for k, v in p.references.items() if k not in shared
+        }
         for p in plans
     }
     return Comparison(

@@ -97,8 +97,11 @@ def settings_for(
     InputError
         Unknown router or backend name (checked here, before any work is done).
     """
-    settings = course.routing if router is None else dataclasses.replace(
-        course.routing, router=cast(RouterName, router))  # the name is checked just below
+    settings = (
+        course.routing
+        if router is None
+        else dataclasses.replace(course.routing, router=cast(RouterName, router))
+    )  # the name is checked just below
     get_router(settings.router)
     get_xp(backend)
     return settings
@@ -145,8 +148,9 @@ def check_boat_and_winds(
         sc = course.scenarios[name]
         where = sc.where or course.where(f"scenarios.{name}")
         try:
-            note = check_wind_range(boat, peak_wind(wind, bbox, window),
-                                    allow_extrapolation=allow, where=where)
+            note = check_wind_range(
+                boat, peak_wind(wind, bbox, window), allow_extrapolation=allow, where=where
+            )
         except InputError as exc:
             problems.append(str(exc))
             continue
@@ -155,9 +159,13 @@ def check_boat_and_winds(
     if len(problems) == 1:
         raise InputError(problems[0])
     if problems:
-        raise InputError(format_problems(
-            f"{course.source or '<course>'}: the wind exceeds the polar in {len(problems)} "
-            "scenarios", problems))
+        raise InputError(
+            format_problems(
+                f"{course.source or '<course>'}: the wind exceeds the polar in {len(problems)} "
+                "scenarios",
+                problems,
+            )
+        )
     return notes
 
 
@@ -235,10 +243,18 @@ def route_course(
         t0 = previous.t_end if previous is not None else course.start_epoch
         if progress is not None:
             progress.start_leg(i, spec.label)
-        res = route_leg(start, target, t0, wind, boat, settings, backend=backend,
-                        progress=progress.update if progress is not None else None,
-                        **({} if current is None else {"current": current}),
-                        obstacles=obstacles)
+        res = route_leg(
+            start,
+            target,
+            t0,
+            wind,
+            boat,
+            settings,
+            backend=backend,
+            progress=progress.update if progress is not None else None,
+            **({} if current is None else {"current": current}),
+            obstacles=obstacles,
+        )
         if progress is not None:
             progress.end_leg(res.time_s, f"{res.n_tacks} tacks, {res.n_gybes} gybes")
         results.append(res)
@@ -282,23 +298,32 @@ def route_course_batch(
         following = target_of(course, i + 1) if i + 1 < course.n_legs else None
         ends = leg_endpoints(course, i)
         target = chain_leg(*ends, None, following)[1]
-        starts = [chain_leg(*ends, legs[-1] if legs else None, following)[0]
-                  for legs in results]
+        starts = [chain_leg(*ends, legs[-1] if legs else None, following)[0] for legs in results]
         t0s = [legs[-1].t_end if legs else course.start_epoch for legs in results]
         if progress is not None:
             progress.start_leg(i, spec.label)
-        done = route_leg_batch(starts, target, t0s, winds, boat, settings,
-                               progress=progress.update if progress is not None else None)
+        done = route_leg_batch(
+            starts,
+            target,
+            t0s,
+            winds,
+            boat,
+            settings,
+            progress=progress.update if progress is not None else None,
+        )
         if progress is not None:
-            progress.end_leg(float(np.median([r.time_s for r in done])),
-                             f"median of {len(done)} members")
+            progress.end_leg(
+                float(np.median([r.time_s for r in done])), f"median of {len(done)} members"
+            )
         for legs, res in zip(results, done, strict=True):
             legs.append(res)
     return results
 
 
 def plan_course(
-    course: Course, scenario: str | None = None, options: RunOptions = DEFAULT_RUN,
+    course: Course,
+    scenario: str | None = None,
+    options: RunOptions = DEFAULT_RUN,
 ) -> PlannedCourse:
     """Route ``course`` in one of its wind scenarios.
 
@@ -331,7 +356,8 @@ def plan_course(
             f"{course.where('scenarios.' + name)}: {name!r} is an ensemble of "
             f"{len(course.ensembles[name])} members; route them all with "
             "`sailroute plan --scenario NAME` (run_plan_command) or compare_scenarios, or "
-            f"one member by its name ({course.ensembles[name][0]!r}, ...)")
+            f"one member by its name ({course.ensembles[name][0]!r}, ...)"
+        )
     settings = settings_for(course, options.router, options.backend)
     boat, winds = build_specs(course, [name])
     notes = check_boat_and_winds(course, boat, winds)
@@ -341,7 +367,11 @@ def plan_course(
 
 
 def _routed(
-    course: Course, name: str, wind: WindField, boat: BoatModel, settings: RoutingSettings,
+    course: Course,
+    name: str,
+    wind: WindField,
+    boat: BoatModel,
+    settings: RoutingSettings,
     options: RunOptions,
 ) -> PlannedCourse:
     """Route the course in one built scenario and assemble its :class:`Plan`."""
@@ -352,21 +382,30 @@ def _routed(
     current = build_current(course, name)
     if current is not None:
         check_current_router(settings.router)
-    results = route_course(course, wind, boat, settings, backend=options.backend,
-                           progress=progress, current=current)
+    results = route_course(
+        course, wind, boat, settings, backend=options.backend, progress=progress, current=current
+    )
     return PlannedCourse(_plan_of(course, name, results, wind, boat, settings), wind)
 
 
-def _plan_of(course: Course, name: str, results: Sequence[LegResult], wind: WindField,
-             boat: BoatModel, settings: RoutingSettings) -> Plan:
+def _plan_of(
+    course: Course,
+    name: str,
+    results: Sequence[LegResult],
+    wind: WindField,
+    boat: BoatModel,
+    settings: RoutingSettings,
+) -> Plan:
     """The :class:`Plan` of routed legs, with the start line's numbers and the laylines
     (:mod:`sailroute.planning.startline`)."""
     from sailroute.planning.startline import course_laylines, course_start_line_numbers
 
     plan = make_plan(course, name, list(results), wind, router=settings.router)
     return dataclasses.replace(
-        plan, start_line=course_start_line_numbers(course, wind, boat),
-        laylines=course_laylines(course, [(pl.mode, pl.result) for pl in plan.legs], wind, boat))
+        plan,
+        start_line=course_start_line_numbers(course, wind, boat),
+        laylines=course_laylines(course, [(pl.mode, pl.result) for pl in plan.legs], wind, boat),
+    )
 
 
 def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:
@@ -376,7 +415,9 @@ def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:
 
 
 def compare_scenarios(
-    course: Course, scenarios: Sequence[str] | None = None, options: RunOptions = DEFAULT_RUN,
+    course: Course,
+    scenarios: Sequence[str] | None = None,
+    options: RunOptions = DEFAULT_RUN,
 ) -> tuple[Comparison, list[Plan]]:
     """Route ``course`` in several scenarios and put the leg times side by side.
 
@@ -402,8 +443,11 @@ def compare_scenarios(
 
 
 def route_scenarios(
-    course: Course, scenarios: Sequence[str] | None = None, options: RunOptions = DEFAULT_RUN,
-    *, batch: bool = False,
+    course: Course,
+    scenarios: Sequence[str] | None = None,
+    options: RunOptions = DEFAULT_RUN,
+    *,
+    batch: bool = False,
 ) -> tuple[Comparison, list[Plan], dict[str, WindField]]:
     """:func:`compare_scenarios`, plus the scenarios' built winds (for ``report.html``);
     ``batch``: route the scenarios together (:func:`~sailroute.routing.batch.batchable`)."""
@@ -415,13 +459,20 @@ def route_scenarios(
     boat, winds = build_specs(course, names)
     _warn(progress, check_boat_and_winds(course, boat, winds))
     open_water = course.area == RaceArea()  # the batch routes without a race area
-    if where == SERIAL and batch and open_water and batchable(
-            settings, backend, [build_current(course, n) for n in names]):
+    if (
+        where == SERIAL
+        and batch
+        and open_water
+        and batchable(settings, backend, [build_current(course, n) for n in names])
+    ):
         # the members as one front per leg (routing/batch.py)
-        results = route_course_batch(course, [winds[n] for n in names], boat, settings,
-                                     progress=progress)
-        plans = [_plan_of(course, n, r, winds[n], boat, settings)
-                 for n, r in zip(names, results, strict=True)]
+        results = route_course_batch(
+            course, [winds[n] for n in names], boat, settings, progress=progress
+        )
+        plans = [
+            _plan_of(course, n, r, winds[n], boat, settings)
+            for n, r in zip(names, results, strict=True)
+        ]
     elif where == SERIAL:
         plans = []
         for n in names:
@@ -430,6 +481,7 @@ def route_scenarios(
             plans.append(_routed(course, n, winds[n], boat, settings, options).plan)
     else:
         # workers build their own scenario (a wind field is not worth shipping)
-        plans = map_tasks(_plan_task, [(course, n, router, backend) for n in names],
-                          scheduler=where)
+        plans = map_tasks(
+            _plan_task, [(course, n, router, backend) for n in names], scheduler=where
+        )
     return compare(plans), plans, winds

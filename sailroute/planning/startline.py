@@ -25,8 +25,7 @@ from sailroute.routing.startline import StartLineNumbers, start_line_numbers
 from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
-__all__ = ["course_laylines", "course_start_line_numbers", "require_start_line",
-           "start_line_of"]
+__all__ = ["course_laylines", "course_start_line_numbers", "require_start_line", "start_line_of"]
 
 
 def course_laylines(
@@ -78,7 +77,7 @@ def course_laylines(
         counts.append(2 * len(ends))
     lines = trace_many(specs, kinds, wind, boat, n_steps) if specs else ()
     bounds = np.cumsum([0, *counts])
-    return tuple(tuple(lines[bounds[i]:bounds[i + 1]]) for i in range(len(counts)))
+    return tuple(tuple(lines[bounds[i] : bounds[i + 1]]) for i in range(len(counts)))
 
 
 def start_line_of(course: Course) -> Line | None:
@@ -103,7 +102,8 @@ def require_start_line(course: Course) -> Line:
         raise InputError(
             f"{course.where('legs[0].from')}: the first leg starts from {first!r}, which is "
             "not a line; the start numbers need a start line: add one under `lines` "
-            "(e.g. start: [pin, committee]) and start the first leg from it")
+            "(e.g. start: [pin, committee]) and start the first leg from it"
+        )
     return line
 
 
@@ -115,5 +115,6 @@ def course_start_line_numbers(
     line = start_line_of(course)
     if line is None:
         return None
-    return start_line_numbers(line.a.xy, line.b.xy, wind, boat, course.start_epoch,
-                              names=(line.a.name, line.b.name))
+    return start_line_numbers(
+        line.a.xy, line.b.xy, wind, boat, course.start_epoch, names=(line.a.name, line.b.name)
+    )

@@ -32,18 +32,55 @@ if TYPE_CHECKING:  # pragma: no cover
 SCHEMA_VERSION = 1
 
 LEG_COLUMNS = (
-    "leg", "from", "to", "mode", "start_time", "end_time", "detected", "sailed_time_s",
-    "optimal_time_s", "loss_s", "loss_manoeuvres_s", "loss_speed_s", "loss_route_s",
-    "sailed_distance_m", "optimal_distance_m", "sailed_tacks", "optimal_tacks", "sailed_gybes",
-    "optimal_gybes", "mean_vmg_ms", "mean_sog_ms", "mean_polar_pct", "side_sailed",
-    "side_optimal", "lateral_sailed_m", "lateral_optimal_m", "note", "wind_source",
+    "leg",
+    "from",
+    "to",
+    "mode",
+    "start_time",
+    "end_time",
+    "detected",
+    "sailed_time_s",
+    "optimal_time_s",
+    "loss_s",
+    "loss_manoeuvres_s",
+    "loss_speed_s",
+    "loss_route_s",
+    "sailed_distance_m",
+    "optimal_distance_m",
+    "sailed_tacks",
+    "optimal_tacks",
+    "sailed_gybes",
+    "optimal_gybes",
+    "mean_vmg_ms",
+    "mean_sog_ms",
+    "mean_polar_pct",
+    "side_sailed",
+    "side_optimal",
+    "lateral_sailed_m",
+    "lateral_optimal_m",
+    "note",
+    "wind_source",
     "above_polar",
 )
 """Columns of ``analysis.csv``."""
 
 POINT_COLUMNS = (
-    "leg", "time", "x_m", "y_m", "lat", "lon", "sog_ms", "sog_kn", "cog_deg", "tws_ms",
-    "twd_deg", "twa_deg", "polar_ms", "polar_pct", "vmg_ms", "loss_s",
+    "leg",
+    "time",
+    "x_m",
+    "y_m",
+    "lat",
+    "lon",
+    "sog_ms",
+    "sog_kn",
+    "cog_deg",
+    "tws_ms",
+    "twd_deg",
+    "twa_deg",
+    "polar_ms",
+    "polar_pct",
+    "vmg_ms",
+    "loss_s",
 )
 """Columns of ``points.csv``."""
 
@@ -54,37 +91,62 @@ def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
     legs = []
     for leg in a.legs:
         spec = c.legs[leg.index]
-        legs.append({
-            "index": leg.index + 1, "from": spec.from_name, "to": spec.to_name,
-            "target_kind": spec.kind, "rounding": spec.rounding, "mode": leg.mode,
-            "start_time": _iso(leg.t_start), "end_time": _iso(leg.t_end),
-            "end_detected": leg.detected, "known": leg.known, "note": leg.note or None,
-            "start_point": _point(c, leg.start_xy), "end_point": _point(c, leg.end_xy),
-            "sailed_time_s": _num(leg.sailed_time_s), "optimal_time_s": _num(leg.optimal_time_s),
-            "loss_s": _num(leg.loss_s),
-            "loss_split_s": {"manoeuvres": _num(leg.split.manoeuvres),
-                             "speed": _num(leg.split.speed), "route": _num(leg.split.route)},
-            "sailed_distance_m": _num(leg.sailed_distance_m, 1),
-            "optimal_distance_m": _num(leg.optimal_distance_m, 1),
-            "sailed_tacks": leg.sailed_tacks, "sailed_gybes": leg.sailed_gybes,
-            "optimal_tacks": leg.optimal_tacks, "optimal_gybes": leg.optimal_gybes,
-            "manoeuvres": [{"kind": m.kind, "time": iso(m.t)} for m in leg.manoeuvres],
-            "mean_vmg_ms": _num(leg.mean_vmg_ms), "mean_sog_ms": _num(leg.mean_sog_ms),
-            "mean_polar_pct": _num(leg.mean_polar_pct, 1),
-            "side": {"sailed": leg.side_sailed, "optimal": leg.side_optimal,
-                     "lateral_sailed_m": _num(leg.lateral_sailed_m, 1),
-                     "lateral_optimal_m": _num(leg.lateral_optimal_m, 1)},
-            "wind": {"source": leg.wind_source, "label": leg.wind_label},
-            "above_polar": leg.above_polar,
-        })
+        legs.append(
+            {
+                "index": leg.index + 1,
+                "from": spec.from_name,
+                "to": spec.to_name,
+                "target_kind": spec.kind,
+                "rounding": spec.rounding,
+                "mode": leg.mode,
+                "start_time": _iso(leg.t_start),
+                "end_time": _iso(leg.t_end),
+                "end_detected": leg.detected,
+                "known": leg.known,
+                "note": leg.note or None,
+                "start_point": _point(c, leg.start_xy),
+                "end_point": _point(c, leg.end_xy),
+                "sailed_time_s": _num(leg.sailed_time_s),
+                "optimal_time_s": _num(leg.optimal_time_s),
+                "loss_s": _num(leg.loss_s),
+                "loss_split_s": {
+                    "manoeuvres": _num(leg.split.manoeuvres),
+                    "speed": _num(leg.split.speed),
+                    "route": _num(leg.split.route),
+                },
+                "sailed_distance_m": _num(leg.sailed_distance_m, 1),
+                "optimal_distance_m": _num(leg.optimal_distance_m, 1),
+                "sailed_tacks": leg.sailed_tacks,
+                "sailed_gybes": leg.sailed_gybes,
+                "optimal_tacks": leg.optimal_tacks,
+                "optimal_gybes": leg.optimal_gybes,
+                "manoeuvres": [{"kind": m.kind, "time": iso(m.t)} for m in leg.manoeuvres],
+                "mean_vmg_ms": _num(leg.mean_vmg_ms),
+                "mean_sog_ms": _num(leg.mean_sog_ms),
+                "mean_polar_pct": _num(leg.mean_polar_pct, 1),
+                "side": {
+                    "sailed": leg.side_sailed,
+                    "optimal": leg.side_optimal,
+                    "lateral_sailed_m": _num(leg.lateral_sailed_m, 1),
+                    "lateral_optimal_m": _num(leg.lateral_optimal_m, 1),
+                },
+                "wind": {"source": leg.wind_source, "label": leg.wind_label},
+                "above_polar": leg.above_polar,
+            }
+        )
     return {
         "schema_version": SCHEMA_VERSION,
         "sailroute_version": __version__,
         "course": c.name,
         "source": str(c.source) if c.source else None,
-        "track": {"name": a.track.name, "source": a.track.source, "points": len(a.track),
-                  "first_time": iso(a.track.t_start), "last_time": iso(a.track.t_end),
-                  "notes": list(a.track.notes)},
+        "track": {
+            "name": a.track.name,
+            "source": a.track.source,
+            "points": len(a.track),
+            "first_time": iso(a.track.t_start),
+            "last_time": iso(a.track.t_end),
+            "notes": list(a.track.notes),
+        },
         "scenario": a.scenario,
         "router": a.router,
         "reference": a.reference,
@@ -97,8 +159,10 @@ def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
         "sailed_time_s": _num(a.sailed_time_s),
         "optimal_time_s": _num(a.optimal_time_s),
         "loss_s": _num(a.loss_s),
-        "loss_split_s": {k: _num(sum(getattr(leg.split, k) for leg in a.known_legs))
-                         for k in ("manoeuvres", "speed", "route")},
+        "loss_split_s": {
+            k: _num(sum(getattr(leg.split, k) for leg in a.known_legs))
+            for k in ("manoeuvres", "speed", "route")
+        },
         "legs": legs,
     }
 
@@ -106,14 +170,21 @@ def analysis_to_dict(a: TrackAnalysis) -> dict[str, Any]:
 def start_to_dict(a: TrackAnalysis) -> dict[str, Any]:
     """The ``start`` object of ``analysis.json`` (and of each boat in ``fleet.json``)."""
     st = a.segmentation.start
-    return {"gun_time": iso(st.gun_t), "start_time": iso(st.crossing.t),
-            "detected": st.crossing.detected, "late_s": _num(st.late_s),
-            "distance_at_gun_m": _num(st.distance_at_gun_m, 1),
-            "side_at_gun": st.side_at_gun, "speed_at_gun_kn": _num(speed_at_gun_kn(a), 2),
-            "line_fraction": _num(st.line_fraction),
-            "ocs_s": None if st.ocs_s is None else _num(st.ocs_s, 1),
-            "ocs_returned": st.ocs_returned, "line_offset_m": _num(st.line_offset_m, 1),
-            "notes": list(st.notes), "point": _point(a.course, (st.crossing.x, st.crossing.y))}
+    return {
+        "gun_time": iso(st.gun_t),
+        "start_time": iso(st.crossing.t),
+        "detected": st.crossing.detected,
+        "late_s": _num(st.late_s),
+        "distance_at_gun_m": _num(st.distance_at_gun_m, 1),
+        "side_at_gun": st.side_at_gun,
+        "speed_at_gun_kn": _num(speed_at_gun_kn(a), 2),
+        "line_fraction": _num(st.line_fraction),
+        "ocs_s": None if st.ocs_s is None else _num(st.ocs_s, 1),
+        "ocs_returned": st.ocs_returned,
+        "line_offset_m": _num(st.line_offset_m, 1),
+        "notes": list(st.notes),
+        "point": _point(a.course, (st.crossing.x, st.crossing.y)),
+    }
 
 
 def speed_at_gun_kn(a: TrackAnalysis) -> float:
@@ -152,16 +223,16 @@ def _fmt(v: Any) -> Any:
     return v
 
 
-def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
-                   ) -> dict[str, Path]:
+def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True) -> dict[str, Path]:
     """Write ``analysis.json``, ``analysis.csv``, ``points.csv`` and (with ``plots``)
     ``legs.png``, ``loss.png`` and ``report.html`` into ``out_dir`` (created)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files: dict[str, Path] = {}
     jp = out / "analysis.json"
-    jp.write_text(json.dumps(analysis_to_dict(a), indent=2, ensure_ascii=False) + "\n",
-                  encoding="utf-8")
+    jp.write_text(
+        json.dumps(analysis_to_dict(a), indent=2, ensure_ascii=False) + "\n", encoding="utf-8"
+    )
     files["analysis_json"] = jp
     cp = out / "analysis.csv"
     with cp.open("w", newline="", encoding="utf-8") as fh:
@@ -169,24 +240,71 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
         w.writerow(LEG_COLUMNS)
         for leg in a.legs:
             spec = a.course.legs[leg.index]
-            w.writerow([_fmt(v) for v in (
-                leg.index + 1, spec.from_name, spec.to_name, leg.mode, _iso(leg.t_start) or "",
-                _iso(leg.t_end) or "", leg.detected, leg.sailed_time_s, leg.optimal_time_s,
-                leg.loss_s, leg.split.manoeuvres, leg.split.speed, leg.split.route,
-                leg.sailed_distance_m, leg.optimal_distance_m, leg.sailed_tacks,
-                leg.optimal_tacks, leg.sailed_gybes, leg.optimal_gybes, leg.mean_vmg_ms,
-                leg.mean_sog_ms, leg.mean_polar_pct, leg.side_sailed, leg.side_optimal,
-                leg.lateral_sailed_m, leg.lateral_optimal_m, leg.note, leg.wind_source,
-                leg.above_polar)])
+            w.writerow(
+                [
+                    _fmt(v)
+                    for v in (
+                        leg.index + 1,
+                        spec.from_name,
+                        spec.to_name,
+                        leg.mode,
+                        _iso(leg.t_start) or "",
+                        _iso(leg.t_end) or "",
+                        leg.detected,
+                        leg.sailed_time_s,
+                        leg.optimal_time_s,
+                        leg.loss_s,
+                        leg.split.manoeuvres,
+                        leg.split.speed,
+                        leg.split.route,
+                        leg.sailed_distance_m,
+                        leg.optimal_distance_m,
+                        leg.sailed_tacks,
+                        leg.optimal_tacks,
+                        leg.sailed_gybes,
+                        leg.optimal_gybes,
+                        leg.mean_vmg_ms,
+                        leg.mean_sog_ms,
+                        leg.mean_polar_pct,
+                        leg.side_sailed,
+                        leg.side_optimal,
+                        leg.lateral_sailed_m,
+                        leg.lateral_optimal_m,
+                        leg.note,
+                        leg.wind_source,
+                        leg.above_polar,
+                    )
+                ]
+            )
     files["analysis_csv"] = cp
     pp = out / "points.csv"
     p = a.points
     # one %-format per row (not per value): 220 000 rows in about a second; then the
     # non-finite values (nan, inf) become empty cells, as _fmt writes them
     row = "%d,%s,%.2f,%.2f,%.8f,%.8f" + ",%.3f" * 10 + "\r\n"
-    cols = (p.leg.tolist(), iso_column(p.t), *(np.asarray(v, float).tolist() for v in (
-        p.x, p.y, p.lat, p.lon, p.sog_ms, p.sog_ms / KNOT, p.cog_deg, p.tws_ms, p.twd_deg,
-        p.twa_deg, p.polar_ms, p.polar_pct, p.vmg_ms, p.loss_s)))
+    cols = (
+        p.leg.tolist(),
+        iso_column(p.t),
+        *(
+            np.asarray(v, float).tolist()
+            for v in (
+                p.x,
+                p.y,
+                p.lat,
+                p.lon,
+                p.sog_ms,
+                p.sog_ms / KNOT,
+                p.cog_deg,
+                p.tws_ms,
+                p.twd_deg,
+                p.twa_deg,
+                p.polar_ms,
+                p.polar_pct,
+                p.vmg_ms,
+                p.loss_s,
+            )
+        ),
+    )
     body = "".join(row % r for r in zip(*cols, strict=True))
     body = body.replace("-inf", "").replace("inf", "").replace("nan", "")
     pp.write_text(",".join(POINT_COLUMNS) + "\r\n" + body, encoding="utf-8", newline="")
@@ -203,10 +321,15 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True
     return files
 
 
-def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
-                rows: Sequence[Mapping[str, Any]], *, plots: bool = True,
-                notes: Sequence[str] = (), wind: tuple[str, WindField] | None = None
-                ) -> dict[str, Path]:
+def write_fleet(
+    out_dir: str | Path,
+    analyses: Sequence[TrackAnalysis],
+    rows: Sequence[Mapping[str, Any]],
+    *,
+    plots: bool = True,
+    notes: Sequence[str] = (),
+    wind: tuple[str, WindField] | None = None,
+) -> dict[str, Path]:
     """Write ``fleet.csv`` (one row per leg and boat), ``fleet.json`` and (with ``plots``)
     the fleet's ``report.html`` (:func:`sailroute.report.html.fleet_report`).
 
@@ -214,30 +337,49 @@ def write_fleet(out_dir: str | Path, analyses: Sequence[TrackAnalysis],
     and the page; ``wind`` is the fleet-wide wind drawn on the page (name, field)."""
     out = Path(out_dir)
     cp = out / "fleet.csv"
-    cols = ("leg", "label", "boat", "leg_time_s", "leg_rank", "elapsed_s", "position", "loss_s",
-            "note")
+    cols = (
+        "leg",
+        "label",
+        "boat",
+        "leg_time_s",
+        "leg_rank",
+        "elapsed_s",
+        "position",
+        "loss_s",
+        "note",
+    )
     with cp.open("w", newline="", encoding="utf-8") as fh:
         w = CleanCsvWriter(fh)
         w.writerow(cols)
         for r in rows:
             w.writerow([_fmt(r[c]) if r[c] is not None else "" for c in cols])
     jp = out / "fleet.json"
-    doc = {"schema_version": SCHEMA_VERSION, "sailroute_version": __version__,
-           "course": analyses[0].course.name if analyses else None,
-           "boats": [{"name": a.track.name, "complete": a.complete, "notes": list(a.notes),
-                      "start": start_to_dict(a)} for a in analyses],
-           "notes": [*fleet_notes(analyses), *notes],
-           "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()}
-                    for r in rows]}
+    doc = {
+        "schema_version": SCHEMA_VERSION,
+        "sailroute_version": __version__,
+        "course": analyses[0].course.name if analyses else None,
+        "boats": [
+            {
+                "name": a.track.name,
+                "complete": a.complete,
+                "notes": list(a.notes),
+                "start": start_to_dict(a),
+            }
+            for a in analyses
+        ],
+        "notes": [*fleet_notes(analyses), *notes],
+        "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()} for r in rows],
+    }
     jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     files = {"fleet_csv": cp, "fleet_json": jp}
     if plots:
         from sailroute.report.html import fleet_report
         from sailroute.report.page_render import write_report
 
-        files["html"] = write_report(out / "report.html",
-                                     fleet_report(analyses, rows,
-                                                  [*fleet_notes(analyses), *notes], wind))
+        files["html"] = write_report(
+            out / "report.html",
+            fleet_report(analyses, rows, [*fleet_notes(analyses), *notes], wind),
+        )
     return files
 
 
@@ -252,23 +394,28 @@ def _mss(s: float) -> str:
 def analysis_table(a: TrackAnalysis) -> str:
     """Terminal report: start, then one row per leg and a total."""
     st = a.segmentation.start
-    head = (f"{a.track.name} on {a.course.name} ({a.scenario}, {a.router})\n"
-            f"start: {'detected' if st.crossing.detected else 'given'} "
-            f"{iso(st.crossing.t)}, {st.late_s:+.1f} s after the gun, "
-            f"{st.distance_at_gun_m:.0f} m from the line at the gun "
-            f"({st.side_at_gun} side), {100 * st.line_fraction:.0f}% along it, "
-            f"{speed_at_gun_kn(a):.1f} kn at the gun"
-            + "".join(f"\n  start: {n}" for n in st.notes))
+    head = (
+        f"{a.track.name} on {a.course.name} ({a.scenario}, {a.router})\n"
+        f"start: {'detected' if st.crossing.detected else 'given'} "
+        f"{iso(st.crossing.t)}, {st.late_s:+.1f} s after the gun, "
+        f"{st.distance_at_gun_m:.0f} m from the line at the gun "
+        f"({st.side_at_gun} side), {100 * st.line_fraction:.0f}% along it, "
+        f"{speed_at_gun_kn(a):.1f} kn at the gun" + "".join(f"\n  start: {n}" for n in st.notes)
+    )
     if a.reference:
         head += f"\njudged against: {a.reference}"
-    cols = f"{'leg':<14}{'mode':<9}{'sailed':>9}{'optimal':>9}{'lost':>8}{'man':>7}" \
-           f"{'speed':>7}{'route':>7}{'dist m':>13}{'tk/gb':>11}{'polar%':>7}{'side s/o':>15}" \
-           f"  {'wind':<9}"
+    cols = (
+        f"{'leg':<14}{'mode':<9}{'sailed':>9}{'optimal':>9}{'lost':>8}{'man':>7}"
+        f"{'speed':>7}{'route':>7}{'dist m':>13}{'tk/gb':>11}{'polar%':>7}{'side s/o':>15}"
+        f"  {'wind':<9}"
+    )
     rows = [head, "", cols]
     for leg in a.legs:
         if not leg.known:
-            rows.append(f"{leg.label:<14}{leg.mode:<9}{'unknown':>9}"
-                        f"{_mss(leg.optimal_time_s):>9}{'?':>8}  ({leg.note})")
+            rows.append(
+                f"{leg.label:<14}{leg.mode:<9}{'unknown':>9}"
+                f"{_mss(leg.optimal_time_s):>9}{'?':>8}  ({leg.note})"
+            )
             continue
         rows.append(
             f"{leg.label:<14}{leg.mode:<9}{_mss(leg.sailed_time_s):>9}"
@@ -277,21 +424,31 @@ def analysis_table(a: TrackAnalysis) -> str:
             f"{leg.sailed_distance_m:>6.0f}/{leg.optimal_distance_m:<6.0f}"
             f"{leg.sailed_tacks:>3}/{leg.sailed_gybes}:{leg.optimal_tacks}/{leg.optimal_gybes:<3}"
             f"{leg.mean_polar_pct:>6.0f}{'*' if leg.above_polar else ' '}"
-            f"{leg.side_sailed:>8}/{leg.side_optimal:<6}  {leg.wind_source:<9}")
-    tot = [sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed",
-                                                                         "route")]
+            f"{leg.side_sailed:>8}/{leg.side_optimal:<6}  {leg.wind_source:<9}"
+        )
+    tot = [
+        sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed", "route")
+    ]
     label = "total" if a.complete else f"{len(a.known_legs)} of {len(a.legs)}"
-    rows.append(f"{label:<14}{'':<9}{_mss(a.sailed_time_s):>9}{_mss(a.optimal_time_s):>9}"
-                f"{a.loss_s:>+8.1f}{tot[0]:>+7.1f}{tot[1]:>+7.1f}{tot[2]:>+7.1f}")
-    rows.append("(lost = sailed - optimal from the same point and time, split into "
-                "manoeuvres + speed + route; tk/gb sailed:optimal"
-                + ("" if a.complete else "; totals over the legs of known time") + ")")
+    rows.append(
+        f"{label:<14}{'':<9}{_mss(a.sailed_time_s):>9}{_mss(a.optimal_time_s):>9}"
+        f"{a.loss_s:>+8.1f}{tot[0]:>+7.1f}{tot[1]:>+7.1f}{tot[2]:>+7.1f}"
+    )
+    rows.append(
+        "(lost = sailed - optimal from the same point and time, split into "
+        "manoeuvres + speed + route; tk/gb sailed:optimal"
+        + ("" if a.complete else "; totals over the legs of known time")
+        + ")"
+    )
     if any(leg.above_polar for leg in a.legs):
-        rows.append(f"* sailed above {ABOVE_POLAR_PCT:.0f} % of the polar: the polar stands in "
-                    "for another class, or the wind is wrong (too light); these losses are not "
-                    "a debrief (try --reference fleet)")
-    winds = dict.fromkeys(f"{leg.wind_source}: {leg.wind_label}" for leg in a.legs
-                          if leg.wind_label)
+        rows.append(
+            f"* sailed above {ABOVE_POLAR_PCT:.0f} % of the polar: the polar stands in "
+            "for another class, or the wind is wrong (too light); these losses are not "
+            "a debrief (try --reference fleet)"
+        )
+    winds = dict.fromkeys(
+        f"{leg.wind_source}: {leg.wind_label}" for leg in a.legs if leg.wind_label
+    )
     if winds:
         rows.append("wind: " + "; ".join(winds))
     if a.track.notes:
@@ -311,9 +468,11 @@ def fleet_table(rows: Sequence[Mapping[str, Any]], notes: Sequence[str] = ()) ->
         rank = f"{r['leg_rank']}." if r["leg_rank"] is not None else "-"
         pos = r["position"] if r["position"] is not None else "-"
         lost = f"{r['loss_s']:+.1f} s" if math.isfinite(r["loss_s"]) else "unknown"
-        out.append(f"  {rank:>3} {r['boat']:<28}{_mss(r['leg_time_s']):>9}  "
-                   f"pos {pos} {_mss(r['elapsed_s']):>9}  {lost}"
-                   + (f"  ({r['note']})" if r.get("note") else ""))
+        out.append(
+            f"  {rank:>3} {r['boat']:<28}{_mss(r['leg_time_s']):>9}  "
+            f"pos {pos} {_mss(r['elapsed_s']):>9}  {lost}"
+            + (f"  ({r['note']})" if r.get("note") else "")
+        )
     return "\n".join(out)
 
 
@@ -333,16 +492,37 @@ def plot_legs(a: TrackAnalysis) -> Figure:
         ax = fig.add_subplot(nrow, ncol, i + 1)
         draw_course(ax, a.course)
         m = p.leg == i + 1
-        ax.plot(p.x[m], p.y[m], "-", color="tab:blue", lw=1.4, gid=f"sailed:{i + 1}",
-                label=f"sailed {_mss(leg.sailed_time_s)}")
+        ax.plot(
+            p.x[m],
+            p.y[m],
+            "-",
+            color="tab:blue",
+            lw=1.4,
+            gid=f"sailed:{i + 1}",
+            label=f"sailed {_mss(leg.sailed_time_s)}",
+        )
         o = leg.optimal.track if leg.optimal is not None else None
         if o is not None:
-            ax.plot(o.x, o.y, "--", color="tab:red", lw=1.4, gid=f"optimal:{i + 1}",
-                    label=f"optimal {_mss(leg.optimal_time_s)}")
+            ax.plot(
+                o.x,
+                o.y,
+                "--",
+                color="tab:red",
+                lw=1.4,
+                gid=f"optimal:{i + 1}",
+                label=f"optimal {_mss(leg.optimal_time_s)}",
+            )
         if leg.manoeuvres:
             idx = [int(np.argmin(np.abs(p.t[m] - mm.t))) for mm in leg.manoeuvres]
-            ax.plot(p.x[m][idx], p.y[m][idx], "^", color="black", ms=4, linestyle="none",
-                    label="sailed tacks/gybes")
+            ax.plot(
+                p.x[m][idx],
+                p.y[m][idx],
+                "^",
+                color="black",
+                ms=4,
+                linestyle="none",
+                label="sailed tacks/gybes",
+            )
         xs = np.concatenate([p.x[m], o.x if o is not None else [], [leg.start_xy[0]]])
         ys = np.concatenate([p.y[m], o.y if o is not None else [], [leg.start_xy[1]]])
         xs, ys = xs[np.isfinite(xs)], ys[np.isfinite(ys)]
@@ -375,10 +555,20 @@ def plot_loss(a: TrackAnalysis) -> Figure:
     for i, leg in enumerate(a.legs):
         if not leg.known:
             continue
-        ax.axvspan((leg.t_start - t0) / 60, (leg.t_end - t0) / 60, alpha=0.08 if i % 2 else 0.0,
-                   color="grey")
-        ax.annotate(f"{i + 1}", ((0.5 * (leg.t_start + leg.t_end) - t0) / 60, 0.98),
-                    xycoords=("data", "axes fraction"), ha="center", va="top", fontsize=8)
+        ax.axvspan(
+            (leg.t_start - t0) / 60,
+            (leg.t_end - t0) / 60,
+            alpha=0.08 if i % 2 else 0.0,
+            color="grey",
+        )
+        ax.annotate(
+            f"{i + 1}",
+            ((0.5 * (leg.t_start + leg.t_end) - t0) / 60, 0.98),
+            xycoords=("data", "axes fraction"),
+            ha="center",
+            va="top",
+            fontsize=8,
+        )
     ax.axhline(0, color="black", lw=0.6)
     ax.set_xlabel("minutes since the start crossing")
     ax.set_ylabel("time lost vs optimal [s]")

@@ -18,8 +18,14 @@ import numpy as np
 from sailroute.bands.summary import BAND_STATS, SIDE_LABELS, BandSummary
 from sailroute.textin import CleanCsvWriter
 
-__all__ = ["bands_dict", "bands_html_table", "bands_page", "bands_table", "plot_bands",
-           "write_bands"]
+__all__ = [
+    "bands_dict",
+    "bands_html_table",
+    "bands_page",
+    "bands_table",
+    "plot_bands",
+    "write_bands",
+]
 
 
 def _mmss(seconds: float) -> str:
@@ -54,37 +60,64 @@ def bands_table(b: BandSummary) -> str:
     bd, dom, sh = b.bands(), b.dominant(), b.side_shares()
     widths = b.oat_widths()
     refs = {k: v for k, v in b.references.items() if len(v) == len(b.leg_labels)}
-    head = (f"bands {b.scenario}: {len(b.members)} members; {_describe(b)}\n"
-            "leg times P10 / P50 / P90, the nominal wind's time, the source widening the band "
-            "most (its P10-P90 width, the others nominal), the side verdicts")
+    head = (
+        f"bands {b.scenario}: {len(b.members)} members; {_describe(b)}\n"
+        "leg times P10 / P50 / P90, the nominal wind's time, the source widening the band "
+        "most (its P10-P90 width, the others nominal), the side verdicts"
+    )
     ref_cols = list(refs)
-    rows: list[tuple[str, ...]] = [("leg", *(s.upper() for s in BAND_STATS), "nominal",
-                                    "widest source", *ref_cols, "sides")]
+    rows: list[tuple[str, ...]] = [
+        ("leg", *(s.upper() for s in BAND_STATS), "nominal", "widest source", *ref_cols, "sides")
+    ]
     for k, label in enumerate(b.leg_labels):
         src = f"{dom[k]} {widths[dom[k]][k]:.0f} s" if dom[k] else ""
-        shares = " ".join(f"{lab} {100 * v:.0f}%" for lab, v in zip(SIDE_LABELS, sh[k],
-                                                                    strict=True) if v > 0)
-        rows.append((f"{k + 1} {label}", *(_mmss(v) for v in bd[k]), _mmss(b.nominal_s[k]),
-                     src, *(_mmss(refs[r][k]) for r in ref_cols), shares))
+        shares = " ".join(
+            f"{lab} {100 * v:.0f}%" for lab, v in zip(SIDE_LABELS, sh[k], strict=True) if v > 0
+        )
+        rows.append(
+            (
+                f"{k + 1} {label}",
+                *(_mmss(v) for v in bd[k]),
+                _mmss(b.nominal_s[k]),
+                src,
+                *(_mmss(refs[r][k]) for r in ref_cols),
+                shares,
+            )
+        )
     src = f"{dom[-1]} {widths[dom[-1]][-1]:.0f} s" if dom[-1] else ""
-    rows.append(("total", *(_mmss(v) for v in bd[-1]), _mmss(float(np.sum(b.nominal_s))), src,
-                 *(_mmss(sum(refs[r])) for r in ref_cols), ""))
+    rows.append(
+        (
+            "total",
+            *(_mmss(v) for v in bd[-1]),
+            _mmss(float(np.sum(b.nominal_s))),
+            src,
+            *(_mmss(sum(refs[r])) for r in ref_cols),
+            "",
+        )
+    )
     w = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines = [head]
     for j, r in enumerate(rows):
-        lines.append("  ".join(c.ljust(x) if i in (0, len(r) - 1) else c.rjust(x)
-                               for i, (c, x) in enumerate(zip(r, w, strict=True))).rstrip())
+        lines.append(
+            "  ".join(
+                c.ljust(x) if i in (0, len(r) - 1) else c.rjust(x)
+                for i, (c, x) in enumerate(zip(r, w, strict=True))
+            ).rstrip()
+        )
         if j == 0:
             lines.append("  ".join("-" * x for x in w))
     if widths:
-        lines += ["", "width by source [s] (one source at its P10 / P50 / P90, the others "
-                  "nominal)"]
+        lines += ["", "width by source [s] (one source at its P10 / P50 / P90, the others nominal)"]
         wrows = [("source", *(str(k + 1) for k in range(len(b.leg_labels))), "total")]
         wrows += [(src, *(f"{v:.0f}" for v in w)) for src, w in widths.items()]
         ww = [max(len(r[i]) for r in wrows) for i in range(len(wrows[0]))]
         for j, r in enumerate(wrows):
-            lines.append("  ".join(c.ljust(x) if i == 0 else c.rjust(x)
-                                   for i, (c, x) in enumerate(zip(r, ww, strict=True))))
+            lines.append(
+                "  ".join(
+                    c.ljust(x) if i == 0 else c.rjust(x)
+                    for i, (c, x) in enumerate(zip(r, ww, strict=True))
+                )
+            )
             if j == 0:
                 lines.append("  ".join("-" * x for x in ww))
     lines += [f"note: {n}" for n in b.notes]
@@ -98,19 +131,41 @@ def bands_html_table(b: BandSummary) -> Any:
     bd, dom, sh, widths = b.bands(), b.dominant(), b.side_shares(), b.oat_widths()
     rows = []
     for k, label in enumerate(b.leg_labels):
-        rows.append((f"{k + 1} {label}", *(_mmss(v) for v in bd[k]), _mmss(b.nominal_s[k]),
-                     f"{dom[k]} {widths[dom[k]][k]:.0f} s" if dom[k] else "",
-                     " ".join(f"{lab} {100 * v:.0f}%" for lab, v in zip(SIDE_LABELS, sh[k],
-                                                                       strict=True) if v > 0)))
-    foot = (("total", *(_mmss(v) for v in bd[-1]), _mmss(float(np.sum(b.nominal_s))),
-             f"{dom[-1]} {widths[dom[-1]][-1]:.0f} s" if dom[-1] else "", ""),)
-    return Table(f"Leg-time bands, {b.scenario}: {len(b.members)} members; {_describe(b)}",
-                 ("leg", "P10", "P50", "P90", "nominal", "widest source", "sides"),
-                 tuple(rows), foot)
+        rows.append(
+            (
+                f"{k + 1} {label}",
+                *(_mmss(v) for v in bd[k]),
+                _mmss(b.nominal_s[k]),
+                f"{dom[k]} {widths[dom[k]][k]:.0f} s" if dom[k] else "",
+                " ".join(
+                    f"{lab} {100 * v:.0f}%"
+                    for lab, v in zip(SIDE_LABELS, sh[k], strict=True)
+                    if v > 0
+                ),
+            )
+        )
+    foot = (
+        (
+            "total",
+            *(_mmss(v) for v in bd[-1]),
+            _mmss(float(np.sum(b.nominal_s))),
+            f"{dom[-1]} {widths[dom[-1]][-1]:.0f} s" if dom[-1] else "",
+            "",
+        ),
+    )
+    return Table(
+        f"Leg-time bands, {b.scenario}: {len(b.members)} members; {_describe(b)}",
+        ("leg", "P10", "P50", "P90", "nominal", "widest source", "sides"),
+        tuple(rows),
+        foot,
+    )
 
 
 def bands_page(
-    course: Any, summaries: Sequence[BandSummary], winds: Mapping[str, Any], *,
+    course: Any,
+    summaries: Sequence[BandSummary],
+    winds: Mapping[str, Any],
+    *,
     router: str = "",
 ) -> Any:
     """``report.html`` of a bands run: the nominal route(s) on the map and the band tables."""
@@ -119,19 +174,27 @@ def bands_page(
     from sailroute.planning.result import compare, make_plan
     from sailroute.report.html import comparison_report, plan_report
 
-    plans = [make_plan(course, b.scenario, b.nominal_legs, winds.get(b.scenario),
-                       router=router) for b in summaries]
+    plans = [
+        make_plan(course, b.scenario, b.nominal_legs, winds.get(b.scenario), router=router)
+        for b in summaries
+    ]
     if len(plans) == 1:
         page = plan_report(plans[0], winds.get(plans[0].scenario))
     else:
-        page = comparison_report(compare(plans), plans, {p.scenario: winds[p.scenario]
-                                                         for p in plans})
-    notes = ("Leg-time bands: P10/P50/P90 of the members' leg times; the nominal time is the "
-             "scenario as given; the widest source is the one whose one-at-a-time band "
-             "(P10-P90, the other sources nominal) is widest; a side counts only when it beats "
-             "the other side's layline extreme by more than the margin, else tie.",)
-    return dataclasses.replace(page, tables=(*(bands_html_table(b) for b in summaries),
-                                             *page.tables), notes=(*notes, *page.notes))
+        page = comparison_report(
+            compare(plans), plans, {p.scenario: winds[p.scenario] for p in plans}
+        )
+    notes = (
+        "Leg-time bands: P10/P50/P90 of the members' leg times; the nominal time is the "
+        "scenario as given; the widest source is the one whose one-at-a-time band "
+        "(P10-P90, the other sources nominal) is widest; a side counts only when it beats "
+        "the other side's layline extreme by more than the margin, else tie.",
+    )
+    return dataclasses.replace(
+        page,
+        tables=(*(bands_html_table(b) for b in summaries), *page.tables),
+        notes=(*notes, *page.notes),
+    )
 
 
 def bands_dict(summaries: Sequence[BandSummary], course_name: str = "") -> dict[str, Any]:
@@ -160,8 +223,9 @@ def plot_bands(summaries: Sequence[BandSummary]) -> Any:
         for r, v in b.references.items():
             if len(v) == len(b.leg_labels):
                 rv = np.append(np.asarray(v, float), np.sum(v))
-                ax.plot(x, 100 * (rv / nom - 1), "o", markersize=4,
-                        label=f"{r}" if i == 0 else None)
+                ax.plot(
+                    x, 100 * (rv / nom - 1), "o", markersize=4, label=f"{r}" if i == 0 else None
+                )
     ax.axhline(0.0, color="grey", lw=0.8)
     ax.margins(y=0.08)
     ax.set_xticks(np.arange(n_legs))
@@ -175,21 +239,32 @@ def plot_bands(summaries: Sequence[BandSummary]) -> Any:
 
 
 def write_bands(
-    out_dir: Path, summaries: Sequence[BandSummary], *, course_name: str = "",
+    out_dir: Path,
+    summaries: Sequence[BandSummary],
+    *,
+    course_name: str = "",
     plot: bool = True,
 ) -> dict[str, Path]:
     """Write ``bands.json``, ``bands.csv`` and (``plot``) ``bands.png`` into ``out_dir``."""
     out_dir.mkdir(parents=True, exist_ok=True)
     js = out_dir / "bands.json"
-    js.write_text(json.dumps(bands_dict(summaries, course_name), indent=2) + "\n",
-                  encoding="utf-8")
+    js.write_text(json.dumps(bands_dict(summaries, course_name), indent=2) + "\n", encoding="utf-8")
     cs = out_dir / "bands.csv"
     sources = list(dict.fromkeys(src for b in summaries for src in b.oat_s))
     with cs.open("w", newline="", encoding="utf-8") as f:
         w = CleanCsvWriter(f)
-        w.writerow(["scenario", "leg", "label", *(f"{s}_s" for s in BAND_STATS), "nominal_s",
-                    "widest_source", *(f"width_{s}_s" for s in sources),
-                    *(f"share_{s}" for s in SIDE_LABELS)])
+        w.writerow(
+            [
+                "scenario",
+                "leg",
+                "label",
+                *(f"{s}_s" for s in BAND_STATS),
+                "nominal_s",
+                "widest_source",
+                *(f"width_{s}_s" for s in sources),
+                *(f"share_{s}" for s in SIDE_LABELS),
+            ]
+        )
         for b in summaries:
             bd, dom, sh, wid = b.bands(), b.dominant(), b.side_shares(), b.oat_widths()
 
@@ -197,12 +272,30 @@ def write_bands(
                 return [f"{wid[s][k]:.3f}" if s in wid else "" for s in sources]
 
             for k, label in enumerate(b.leg_labels):
-                w.writerow([b.scenario, k + 1, label, *(f"{v:.3f}" for v in bd[k]),
-                            f"{b.nominal_s[k]:.3f}", dom[k], *widths_at(k),
-                            *(f"{v:.4f}" for v in sh[k])])
-            w.writerow([b.scenario, "total", "", *(f"{v:.3f}" for v in bd[-1]),
-                        f"{np.sum(b.nominal_s):.3f}", dom[-1], *widths_at(-1),
-                        *("" for _ in SIDE_LABELS)])
+                w.writerow(
+                    [
+                        b.scenario,
+                        k + 1,
+                        label,
+                        *(f"{v:.3f}" for v in bd[k]),
+                        f"{b.nominal_s[k]:.3f}",
+                        dom[k],
+                        *widths_at(k),
+                        *(f"{v:.4f}" for v in sh[k]),
+                    ]
+                )
+            w.writerow(
+                [
+                    b.scenario,
+                    "total",
+                    "",
+                    *(f"{v:.3f}" for v in bd[-1]),
+                    f"{np.sum(b.nominal_s):.3f}",
+                    dom[-1],
+                    *widths_at(-1),
+                    *("" for _ in SIDE_LABELS),
+                ]
+            )
     files = {"bands_json": js, "bands_csv": cs}
     if plot:
         import matplotlib.pyplot as plt

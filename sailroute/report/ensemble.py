@@ -83,8 +83,12 @@ class EnsembleSummary:
     def side_shares(self) -> NDArray[np.float64]:
         """Share of members per leg going left, up the middle, right, shape (n_legs, 3)."""
         n = len(self.members)
-        return np.array([[sum(s[k] == side for s in self.sides) / n for side in SIDES]
-                         for k in range(len(self.leg_labels))])
+        return np.array(
+            [
+                [sum(s[k] == side for s in self.sides) / n for side in SIDES]
+                for k in range(len(self.leg_labels))
+            ]
+        )
 
 
 def leg_side(res: LegResult) -> str:
@@ -97,8 +101,14 @@ def leg_side(res: LegResult) -> str:
 
 
 def honest_side(
-    res: LegResult, wind: WindField, boat: BoatModel, *, tack_penalty_s: float = 0.0,
-    gybe_penalty_s: float = 0.0, margin_s: float = 2.0, margin_pct: float = 0.5,
+    res: LegResult,
+    wind: WindField,
+    boat: BoatModel,
+    *,
+    tack_penalty_s: float = 0.0,
+    gybe_penalty_s: float = 0.0,
+    margin_s: float = 2.0,
+    margin_pct: float = 0.5,
 ) -> str:
     """The side a routed leg used if it beat the other side by more than the margin, else "tie".
 
@@ -117,14 +127,23 @@ def honest_side(
         (:func:`sailroute.routing.sides.side_verdict`).
     """
     t_left, t_right = layline_times(
-        res.start_xy, res.end_xy, res.t_start, wind, boat, tack_penalty_s=tack_penalty_s,
-        gybe_penalty_s=gybe_penalty_s, max_time_s=max(4.0 * res.time_s, 600.0))
-    return side_verdict(leg_side(res), res.time_s, t_left, t_right, margin_s=margin_s,
-                        margin_pct=margin_pct)
+        res.start_xy,
+        res.end_xy,
+        res.t_start,
+        wind,
+        boat,
+        tack_penalty_s=tack_penalty_s,
+        gybe_penalty_s=gybe_penalty_s,
+        max_time_s=max(4.0 * res.time_s, 600.0),
+    )
+    return side_verdict(
+        leg_side(res), res.time_s, t_left, t_right, margin_s=margin_s, margin_pct=margin_pct
+    )
 
 
-def route_side(plan: Plan, k: int, wind: WindField | None = None,
-               boat: BoatModel | None = None) -> str:
+def route_side(
+    plan: Plan, k: int, wind: WindField | None = None, boat: BoatModel | None = None
+) -> str:
     """Side of the course (:data:`SIDES`) that leg ``k`` of ``plan`` used.
 
     With the plan's ``wind`` and ``boat`` the side counts only when it beats the other
@@ -135,14 +154,23 @@ def route_side(plan: Plan, k: int, wind: WindField | None = None,
     if wind is None or boat is None:
         return leg_side(res)
     st, unc = plan.course.routing, plan.course.uncertainty
-    margins = {} if unc is None else {"margin_s": unc.side_margin_s,
-                                      "margin_pct": unc.side_margin_pct}
-    return honest_side(res, wind, boat, tack_penalty_s=st.tack_penalty_s,
-                       gybe_penalty_s=st.gybe_penalty_s, **margins)
+    margins = (
+        {} if unc is None else {"margin_s": unc.side_margin_s, "margin_pct": unc.side_margin_pct}
+    )
+    return honest_side(
+        res,
+        wind,
+        boat,
+        tack_penalty_s=st.tack_penalty_s,
+        gybe_penalty_s=st.gybe_penalty_s,
+        **margins,
+    )
 
 
 def summarize_ensemble(
-    name: str, plans: Sequence[Plan], winds: Mapping[str, WindField] | None = None,
+    name: str,
+    plans: Sequence[Plan],
+    winds: Mapping[str, WindField] | None = None,
     boat: BoatModel | None = None,
 ) -> EnsembleSummary:
     """The :class:`EnsembleSummary` of an ensemble's member plans (same course).
@@ -160,8 +188,7 @@ def summarize_ensemble(
         The boat; default: built from the course.
     """
     if len(plans) < 2:
-        raise InputError(f"ensemble {name!r}: needs at least 2 routed members; got "
-                         f"{len(plans)}")
+        raise InputError(f"ensemble {name!r}: needs at least 2 routed members; got {len(plans)}")
     n = len(plans[0].legs)
     if any(len(p.legs) != n for p in plans):
         raise InputError(f"ensemble {name!r}: the members have different numbers of legs")
@@ -170,8 +197,10 @@ def summarize_ensemble(
         members=tuple(p.scenario for p in plans),
         leg_labels=tuple(leg.spec.label for leg in plans[0].legs),
         times_s=np.array([[leg.time_s for leg in p.legs] for p in plans], dtype=float),
-        sides=tuple(tuple(route_side(p, k, _wind_of(p, winds), _boat_of(p, boat))
-                          for k in range(n)) for p in plans),
+        sides=tuple(
+            tuple(route_side(p, k, _wind_of(p, winds), _boat_of(p, boat)) for k in range(n))
+            for p in plans
+        ),
     )
 
 
@@ -199,19 +228,26 @@ def _mmss(seconds: float) -> str:
 def ensemble_table(summary: EnsembleSummary) -> str:
     """Terminal table: per leg the spread of times and the side shares."""
     sp, sh = summary.spread(), summary.side_shares()
-    head = (f"ensemble {summary.name}: {len(summary.members)} members; leg times over the "
-            "members (min / P10 / median / P90 / max) and the side of the course routes took "
-            "(tie: neither side beat the other by more than max(2 s, 0.5 %))")
+    head = (
+        f"ensemble {summary.name}: {len(summary.members)} members; leg times over the "
+        "members (min / P10 / median / P90 / max) and the side of the course routes took "
+        "(tie: neither side beat the other by more than max(2 s, 0.5 %))"
+    )
     rows: list[tuple[str, ...]] = [("leg", *STATS, *SIDES)]
     for k, label in enumerate(summary.leg_labels):
-        rows.append((f"{k + 1} {label}", *(_mmss(v) for v in sp[k]),
-                     *(f"{100 * v:.0f}%" for v in sh[k])))
+        rows.append(
+            (f"{k + 1} {label}", *(_mmss(v) for v in sp[k]), *(f"{100 * v:.0f}%" for v in sh[k]))
+        )
     rows.append(("total", *(_mmss(v) for v in sp[-1]), *("" for _ in SIDES)))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines = [head]
     for j, r in enumerate(rows):
-        lines.append("  ".join(c.ljust(w) if i == 0 else c.rjust(w)
-                               for i, (c, w) in enumerate(zip(r, widths, strict=True))))
+        lines.append(
+            "  ".join(
+                c.ljust(w) if i == 0 else c.rjust(w)
+                for i, (c, w) in enumerate(zip(r, widths, strict=True))
+            )
+        )
         if j == 0:
             lines.append("  ".join("-" * w for w in widths))
     return "\n".join(lines)
@@ -224,11 +260,13 @@ def ensemble_dict(summary: EnsembleSummary) -> dict[str, Any]:
         "ensemble": summary.name,
         "members": list(summary.members),
         "legs": [
-            {"label": label,
-             "time_s": {s: float(v) for s, v in zip(STATS, sp[k], strict=True)},
-             "side_share": {s: float(v) for s, v in zip(SIDES, sh[k], strict=True)},
-             "member_time_s": [float(v) for v in summary.times_s[:, k]],
-             "member_side": [s[k] for s in summary.sides]}
+            {
+                "label": label,
+                "time_s": {s: float(v) for s, v in zip(STATS, sp[k], strict=True)},
+                "side_share": {s: float(v) for s, v in zip(SIDES, sh[k], strict=True)},
+                "member_time_s": [float(v) for v in summary.times_s[:, k]],
+                "member_side": [s[k] for s in summary.sides],
+            }
             for k, label in enumerate(summary.leg_labels)
         ],
         "total_s": {s: float(v) for s, v in zip(STATS, sp[-1], strict=True)},
@@ -245,10 +283,8 @@ def write_ensemble(out_dir: Path, summary: EnsembleSummary) -> dict[str, Path]:
     sp, sh = summary.spread(), summary.side_shares()
     with cs.open("w", newline="", encoding="utf-8") as f:
         w = CleanCsvWriter(f)
-        w.writerow(["leg", "label", *(f"{s}_s" for s in STATS),
-                    *(f"share_{s}" for s in SIDES)])
+        w.writerow(["leg", "label", *(f"{s}_s" for s in STATS), *(f"share_{s}" for s in SIDES)])
         for k, label in enumerate(summary.leg_labels):
-            w.writerow([k + 1, label, *(f"{v:.3f}" for v in sp[k]),
-                        *(f"{v:.4f}" for v in sh[k])])
+            w.writerow([k + 1, label, *(f"{v:.3f}" for v in sp[k]), *(f"{v:.4f}" for v in sh[k])])
         w.writerow(["total", "", *(f"{v:.3f}" for v in sp[-1]), *("" for _ in SIDES)])
     return {"ensemble_json": js, "ensemble_csv": cs}

@@ -48,9 +48,28 @@ SR_NS = "urn:x-sailroute:gpx:1"
 """Namespace of the per-point extensions (boat speed, wind) in ``route.gpx``."""
 
 TRACK_COLUMNS = (
-    "leg", "from", "to", "time", "t_race_s", "t_leg_s", "x_m", "y_m", "lat", "lon",
-    "heading_deg", "tws_ms", "tws_kn", "twd_deg", "twa_deg", "bsp_ms", "bsp_kn", "tack", "event",
-    "sog_ms", "sog_kn", "cog_deg",
+    "leg",
+    "from",
+    "to",
+    "time",
+    "t_race_s",
+    "t_leg_s",
+    "x_m",
+    "y_m",
+    "lat",
+    "lon",
+    "heading_deg",
+    "tws_ms",
+    "tws_kn",
+    "twd_deg",
+    "twa_deg",
+    "bsp_ms",
+    "bsp_kn",
+    "tack",
+    "event",
+    "sog_ms",
+    "sog_kn",
+    "cog_deg",
 )
 """Columns of ``track.csv`` (see ``docs/output-format.md``)."""
 
@@ -62,8 +81,12 @@ def _num(x: float, nd: int = 3) -> float | None:
 
 def _point(course: Course, xy: tuple[float, float]) -> dict[str, float | None]:
     lat, lon = course.frame.to_latlon(xy[0], xy[1])
-    return {"x": _num(xy[0]), "y": _num(xy[1]), "lat": _num(float(lat), 7),
-            "lon": _num(float(lon), 7)}
+    return {
+        "x": _num(xy[0]),
+        "y": _num(xy[1]),
+        "lat": _num(float(lat), 7),
+        "lon": _num(float(lon), 7),
+    }
 
 
 def plan_to_dict(plan: Plan) -> dict[str, Any]:
@@ -87,34 +110,38 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
     legs = []
     for k, pl in enumerate(plan.legs):
         r = pl.result
-        legs.append({
-            "index": pl.spec.index + 1,
-            "from": pl.spec.from_name,
-            "to": pl.spec.to_name,
-            "target_kind": pl.spec.kind,
-            "rounding": pl.spec.rounding,
-            "mode": pl.mode,
-            "time_s": _num(r.time_s),
-            "tacks": int(r.n_tacks),
-            "gybes": int(r.n_gybes),
-            "distance_m": _num(r.distance_m, 2),
-            **_speeds(r),
-            "start_time": iso(r.t_start),
-            "end_time": iso(r.t_end),
-            "start_point": _point(c, r.start_xy),
-            "start_line_fraction": (None if pl.start_line_fraction is None
-                                    else _num(pl.start_line_fraction, 4)),
-            "end_point": _point(c, r.end_xy),
-            "manoeuvres": [
-                {"kind": m.kind, "time": iso(m.t), **_point(c, (m.x, m.y))} for m in r.manoeuvres
-            ],
-            "reference": {name: _num(times[k]) for name, times in plan.references.items()},
-            "reference_error_pct": {
-                name: _num(percent_error(r.time_s, times[k]), 3)
-                for name, times in plan.references.items()
-            },
-            "laylines": laylines_to_dicts(plan.laylines[k] if plan.laylines else (), c.frame),
-        })
+        legs.append(
+            {
+                "index": pl.spec.index + 1,
+                "from": pl.spec.from_name,
+                "to": pl.spec.to_name,
+                "target_kind": pl.spec.kind,
+                "rounding": pl.spec.rounding,
+                "mode": pl.mode,
+                "time_s": _num(r.time_s),
+                "tacks": int(r.n_tacks),
+                "gybes": int(r.n_gybes),
+                "distance_m": _num(r.distance_m, 2),
+                **_speeds(r),
+                "start_time": iso(r.t_start),
+                "end_time": iso(r.t_end),
+                "start_point": _point(c, r.start_xy),
+                "start_line_fraction": (
+                    None if pl.start_line_fraction is None else _num(pl.start_line_fraction, 4)
+                ),
+                "end_point": _point(c, r.end_xy),
+                "manoeuvres": [
+                    {"kind": m.kind, "time": iso(m.t), **_point(c, (m.x, m.y))}
+                    for m in r.manoeuvres
+                ],
+                "reference": {name: _num(times[k]) for name, times in plan.references.items()},
+                "reference_error_pct": {
+                    name: _num(percent_error(r.time_s, times[k]), 3)
+                    for name, times in plan.references.items()
+                },
+                "laylines": laylines_to_dicts(plan.laylines[k] if plan.laylines else (), c.frame),
+            }
+        )
     total = plan.total_time_s
     return {
         "schema_version": SCHEMA_VERSION,
@@ -134,9 +161,11 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
         "start_line": start_line_to_dict(plan.start_line, c.frame),
         "legs": legs,
         "references": {
-            name: {"total_time_s": _num(sum(times)),
-                   "error_pct": _num(percent_error(total, sum(times)), 3),
-                   "legs_s": [_num(t) for t in times]}
+            name: {
+                "total_time_s": _num(sum(times)),
+                "error_pct": _num(percent_error(total, sum(times)), 3),
+                "legs_s": [_num(t) for t in times],
+            }
             for name, times in plan.references.items()
         },
     }
@@ -162,8 +191,9 @@ def _current_of(plan: Plan) -> dict[str, Any] | None:
 def write_plan_json(path: str | Path, plan: Plan) -> Path:
     """Write ``plan.json`` (see :func:`plan_to_dict`); returns the path."""
     p = Path(path)
-    p.write_text(json.dumps(plan_to_dict(plan), indent=2, ensure_ascii=False) + "\n",
-                 encoding="utf-8")
+    p.write_text(
+        json.dumps(plan_to_dict(plan), indent=2, ensure_ascii=False) + "\n", encoding="utf-8"
+    )
     return p
 
 
@@ -192,16 +222,32 @@ def write_track_csv(path: str | Path, plan: Plan) -> Path:
             events = _events(tr.t, pl.result.manoeuvres)
             sog, cog = tr.ground_speed_ms, tr.ground_course_deg
             for i in range(len(tr)):
-                w.writerow([
-                    pl.spec.index + 1, pl.spec.from_name, pl.spec.to_name, iso(tr.t[i]),
-                    f"{tr.t[i] - t0:.3f}", f"{tr.t[i] - tr.t[0]:.3f}",
-                    f"{tr.x[i]:.3f}", f"{tr.y[i]:.3f}", f"{lat[i]:.8f}", f"{lon[i]:.8f}",
-                    f"{tr.heading_deg[i]:.2f}", f"{tr.tws_ms[i]:.3f}",
-                    f"{tr.tws_ms[i] / KNOT:.3f}", f"{tr.twd_deg[i]:.2f}",
-                    f"{tr.twa_deg[i]:.2f}", f"{tr.bsp_ms[i]:.3f}", f"{tr.bsp_ms[i] / KNOT:.3f}",
-                    side_name(int(tr.side[i])), events[i],
-                    f"{sog[i]:.3f}", f"{sog[i] / KNOT:.3f}", f"{cog[i]:.2f}",
-                ])
+                w.writerow(
+                    [
+                        pl.spec.index + 1,
+                        pl.spec.from_name,
+                        pl.spec.to_name,
+                        iso(tr.t[i]),
+                        f"{tr.t[i] - t0:.3f}",
+                        f"{tr.t[i] - tr.t[0]:.3f}",
+                        f"{tr.x[i]:.3f}",
+                        f"{tr.y[i]:.3f}",
+                        f"{lat[i]:.8f}",
+                        f"{lon[i]:.8f}",
+                        f"{tr.heading_deg[i]:.2f}",
+                        f"{tr.tws_ms[i]:.3f}",
+                        f"{tr.tws_ms[i] / KNOT:.3f}",
+                        f"{tr.twd_deg[i]:.2f}",
+                        f"{tr.twa_deg[i]:.2f}",
+                        f"{tr.bsp_ms[i]:.3f}",
+                        f"{tr.bsp_ms[i] / KNOT:.3f}",
+                        side_name(int(tr.side[i])),
+                        events[i],
+                        f"{sog[i]:.3f}",
+                        f"{sog[i] / KNOT:.3f}",
+                        f"{cog[i]:.2f}",
+                    ]
+                )
     return p
 
 
@@ -252,9 +298,13 @@ def write_gpx(path: str | Path, plan: Plan) -> Path:
             pt = _sub(seg, "trkpt", lat=f"{lat[i]:.8f}", lon=f"{lon[i]:.8f}")
             _sub(pt, "time", iso(tr.t[i]))
             ext = _sub(pt, "extensions")
-            for tag, val in (("bsp_ms", tr.bsp_ms[i]), ("tws_ms", tr.tws_ms[i]),
-                             ("twd_deg", tr.twd_deg[i]), ("twa_deg", tr.twa_deg[i]),
-                             ("heading_deg", tr.heading_deg[i])):
+            for tag, val in (
+                ("bsp_ms", tr.bsp_ms[i]),
+                ("tws_ms", tr.tws_ms[i]),
+                ("twd_deg", tr.twd_deg[i]),
+                ("twa_deg", tr.twa_deg[i]),
+                ("heading_deg", tr.heading_deg[i]),
+            ):
                 ET.SubElement(ext, f"{{{SR_NS}}}{tag}").text = f"{val:.3f}"
     tree = ET.ElementTree(root)
     ET.indent(tree, space=" ")
@@ -267,16 +317,18 @@ def comparison_to_dict(cmp: Comparison) -> dict[str, Any]:
     """The ``comparison.json`` document (see ``docs/output-format.md``)."""
     legs = []
     for k, label in enumerate(cmp.leg_labels):
-        legs.append({
-            "index": k + 1,
-            "label": label,
-            "time_s": {s: _num(cmp.times[i, k]) for i, s in enumerate(cmp.scenarios)},
-            "reference_s": {r: _num(v[k]) for r, v in cmp.references.items()},
-            "error_pct": {
-                r: {s: _num(cmp.percent(r)[i, k], 3) for i, s in enumerate(cmp.scenarios)}
-                for r in cmp.references
-            },
-        })
+        legs.append(
+            {
+                "index": k + 1,
+                "label": label,
+                "time_s": {s: _num(cmp.times[i, k]) for i, s in enumerate(cmp.scenarios)},
+                "reference_s": {r: _num(v[k]) for r, v in cmp.references.items()},
+                "error_pct": {
+                    r: {s: _num(cmp.percent(r)[i, k], 3) for i, s in enumerate(cmp.scenarios)}
+                    for r in cmp.references
+                },
+            }
+        )
     return {
         "schema_version": SCHEMA_VERSION,
         "sailroute_version": __version__,
@@ -288,18 +340,23 @@ def comparison_to_dict(cmp: Comparison) -> dict[str, Any]:
             "time_s": {s: _num(t) for s, t in zip(cmp.scenarios, cmp.totals, strict=True)},
             "reference_s": {r: _num(v.sum()) for r, v in cmp.references.items()},
             "error_pct": {
-                r: {s: _num(e, 3) for s, e in zip(cmp.scenarios, cmp.total_percent(r),
-                                                  strict=True)}
+                r: {s: _num(e, 3) for s, e in zip(cmp.scenarios, cmp.total_percent(r), strict=True)}
                 for r in cmp.references
             },
         },
         "scenario_references": {
             s: {
-                r: {"legs_s": [_num(x) for x in v], "total_s": _num(v.sum()),
-                    "error_pct": [_num(percent_error(cmp.times[cmp.scenarios.index(s), k], v[k]),
-                                       3) for k in range(v.size)],
-                    "total_error_pct": _num(percent_error(
-                        float(cmp.totals[cmp.scenarios.index(s)]), float(v.sum())), 3)}
+                r: {
+                    "legs_s": [_num(x) for x in v],
+                    "total_s": _num(v.sum()),
+                    "error_pct": [
+                        _num(percent_error(cmp.times[cmp.scenarios.index(s), k], v[k]), 3)
+                        for k in range(v.size)
+                    ],
+                    "total_error_pct": _num(
+                        percent_error(float(cmp.totals[cmp.scenarios.index(s)]), float(v.sum())), 3
+                    ),
+                }
                 for r, v in refs.items()
             }
             for s, refs in cmp.scenario_references.items()
@@ -316,14 +373,22 @@ def write_comparison(out_dir: str | Path, cmp: Comparison) -> tuple[Path, Path]:
     """
     d = make_out_dir(out_dir)
     jp = d / "comparison.json"
-    jp.write_text(json.dumps(comparison_to_dict(cmp), indent=2, ensure_ascii=False) + "\n",
-                  encoding="utf-8")
+    jp.write_text(
+        json.dumps(comparison_to_dict(cmp), indent=2, ensure_ascii=False) + "\n", encoding="utf-8"
+    )
     cp = d / "comparison.csv"
     refs = list(cmp.references)
     with cp.open("w", newline="", encoding="utf-8") as fh:
         w = CleanCsvWriter(fh)
-        w.writerow(["leg", "label", "scenario", "time_s",
-                    *[c for r in refs for c in (f"{r}_s", f"{r}_error_pct")]])
+        w.writerow(
+            [
+                "leg",
+                "label",
+                "scenario",
+                "time_s",
+                *[c for r in refs for c in (f"{r}_s", f"{r}_error_pct")],
+            ]
+        )
         for k, label in enumerate(cmp.leg_labels):
             for i, s in enumerate(cmp.scenarios):
                 row: list[Any] = [k + 1, label, s, f"{cmp.times[i, k]:.3f}"]
@@ -366,20 +431,24 @@ FILE_LABELS: dict[str, str] = {
 """Human names of the output kinds (the keys of the commands' ``files`` mappings)."""
 
 POLAR_FILE_LABELS: dict[str, str] = {
-    "pol": "polar (.pol table)", "csv": "polar (CSV)", "json": "polar (JSON)",
+    "pol": "polar (.pol table)",
+    "csv": "polar (CSV)",
+    "json": "polar (JSON)",
     "png": "polar plot (PNG)",
 }
 """Names of the files of ``sailroute vpp`` and ``sailroute polar fit``."""
 
 _STEM_LABELS = {
-    "summary": "summary", "policy_map": "policy map", "spaghetti": "simulated tracks",
-    "leg_times": "leg-time distributions", "deadline_policy": "deadline policy map",
+    "summary": "summary",
+    "policy_map": "policy map",
+    "spaghetti": "simulated tracks",
+    "leg_times": "leg-time distributions",
+    "deadline_policy": "deadline policy map",
     "deadline_tracks": "deadline tracks",
 }
 
 
-def file_label(kind: str | None, path: str | Path,
-               labels: Mapping[str, str] = FILE_LABELS) -> str:
+def file_label(kind: str | None, path: str | Path, labels: Mapping[str, str] = FILE_LABELS) -> str:
     """A human name for an output file, e.g. ``"plan (JSON)"`` or ``"wrf10: track (CSV)"``.
 
     Parameters

@@ -79,54 +79,92 @@ def _plan_table(plan: Plan, caption: str, collapsed: bool = False) -> Table:
     """The leg table of a plan: times in local time, durations, distances, references."""
     off = plan.course.utc_offset_s
     refs = list(plan.references.items())
-    headers = ["leg", "from → to", "mode", "start", "arrival", "time", "distance m",
-               "tacks", "gybes", "mean boat speed kn", "start point"]
+    headers = [
+        "leg",
+        "from → to",
+        "mode",
+        "start",
+        "arrival",
+        "time",
+        "distance m",
+        "tacks",
+        "gybes",
+        "mean boat speed kn",
+        "start point",
+    ]
     for name, _ in refs:
         headers += [name, f"vs {name}"]
     rows = []
     for k, pl in enumerate(plan.legs):
         r = pl.result
         dt = np.diff(r.track.t)
-        stw = float(np.sum(r.track.bsp_ms[:-1] * dt) / r.time_s) / KNOT if r.time_s > 0 \
+        stw = (
+            float(np.sum(r.track.bsp_ms[:-1] * dt) / r.time_s) / KNOT
+            if r.time_s > 0
             else float("nan")
-        row = [str(pl.spec.index + 1), pl.spec.label.replace("->", "→"), pl.mode or "-",
-               clock(r.t_start, off), clock(r.t_end, off), format_duration(r.time_s),
-               f"{r.distance_m:.0f}", str(r.n_tacks), str(r.n_gybes), f"{stw:.2f}",
-               start_point_text(pl)]
+        )
+        row = [
+            str(pl.spec.index + 1),
+            pl.spec.label.replace("->", "→"),
+            pl.mode or "-",
+            clock(r.t_start, off),
+            clock(r.t_end, off),
+            format_duration(r.time_s),
+            f"{r.distance_m:.0f}",
+            str(r.n_tacks),
+            str(r.n_gybes),
+            f"{stw:.2f}",
+            start_point_text(pl),
+        ]
         for _, times in refs:
             row += [format_duration(times[k]), f"{percent_error(r.time_s, times[k]):+.1f}%"]
         rows.append(tuple(row))
-    total = ["", "total", "", clock(plan.t_start, off), clock(plan.t_end, off),
-             format_duration(plan.total_time_s),
-             f"{sum(pl.result.distance_m for pl in plan.legs):.0f}",
-             str(sum(pl.result.n_tacks for pl in plan.legs)),
-             str(sum(pl.result.n_gybes for pl in plan.legs)), "", ""]
+    total = [
+        "",
+        "total",
+        "",
+        clock(plan.t_start, off),
+        clock(plan.t_end, off),
+        format_duration(plan.total_time_s),
+        f"{sum(pl.result.distance_m for pl in plan.legs):.0f}",
+        str(sum(pl.result.n_tacks for pl in plan.legs)),
+        str(sum(pl.result.n_gybes for pl in plan.legs)),
+        "",
+        "",
+    ]
     for _, times in refs:
-        total += [format_duration(sum(times)),
-                  f"{percent_error(plan.total_time_s, sum(times)):+.1f}%"]
+        total += [
+            format_duration(sum(times)),
+            f"{percent_error(plan.total_time_s, sum(times)):+.1f}%",
+        ]
     return Table(caption, tuple(headers), tuple(rows), (tuple(total),), collapsed)
 
 
 def _times_note(course: Course) -> str:
-    return (f"Times: local time of the course ({offset_text(course.utc_offset_s)}, the offset "
-            "its start_time is written with) and UTC.")
+    return (
+        f"Times: local time of the course ({offset_text(course.utc_offset_s)}, the offset "
+        "its start_time is written with) and UTC."
+    )
 
 
 def _wind_note(layers: Sequence[WindLayer]) -> str:
     if not layers:
         return "No wind drawn: the wind data do not cover the course area."
     steady = all(w.steady for w in layers)
-    return (f"Wind: arrows point where the air goes, their length in proportion to the "
-            f"speed (hover over an arrowhead for its speed and direction); the field sampled on "
-            f"{WIND_GRID} × {WIND_GRID} points over the course area"
-            + (", the same all race." if steady else
-               f" at each of the slider's {N_STEPS} times."))
+    return (
+        f"Wind: arrows point where the air goes, their length in proportion to the "
+        f"speed (hover over an arrowhead for its speed and direction); the field sampled on "
+        f"{WIND_GRID} × {WIND_GRID} points over the course area"
+        + (", the same all race." if steady else f" at each of the slider's {N_STEPS} times.")
+    )
 
 
-HELP = ("Drag the time slider (or press ▶) to move the boat and the wind; click a legend "
-        "entry to hide or show it; hover over a route for its time, wind and speed; scroll "
-        "to zoom, drag to pan, double-click to reset the view. Background: plain water "
-        "(no chart or coastline); positions WGS-84.")
+HELP = (
+    "Drag the time slider (or press ▶) to move the boat and the wind; click a legend "
+    "entry to hide or show it; hover over a route for its time, wind and speed; scroll "
+    "to zoom, drag to pan, double-click to reset the view. Background: plain water "
+    "(no chart or coastline); positions WGS-84."
+)
 
 
 def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
@@ -148,16 +186,28 @@ def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
     from sailroute.report.startline import plotly_traces
     from sailroute.report.tables import start_line_rows
 
-    start = () if plan.start_line is None else (
-        Table("Start line", ("", "at the gun"), tuple(start_line_rows(plan.start_line))),)
-    return Report(f"{c.name} — {plan.scenario}", summary, c, (route,), tuple(layers), times,
-                  (_plan_table(plan, "Legs"), *start),
-                  (HELP, _times_note(c), _wind_note(layers)), colour_by_speed=True,
-                  overlays=tuple(plotly_traces(plan.start_line, plan.laylines, c.frame)))
+    start = (
+        ()
+        if plan.start_line is None
+        else (Table("Start line", ("", "at the gun"), tuple(start_line_rows(plan.start_line))),)
+    )
+    return Report(
+        f"{c.name} — {plan.scenario}",
+        summary,
+        c,
+        (route,),
+        tuple(layers),
+        times,
+        (_plan_table(plan, "Legs"), *start),
+        (HELP, _times_note(c), _wind_note(layers)),
+        colour_by_speed=True,
+        overlays=tuple(plotly_traces(plan.start_line, plan.laylines, c.frame)),
+    )
 
 
-def _layers(winds: Mapping[str, WindField], course: Course, routes: Sequence[Route],
-            times: NDArray) -> list[WindLayer]:
+def _layers(
+    winds: Mapping[str, WindField], course: Course, routes: Sequence[Route], times: NDArray
+) -> list[WindLayer]:
     area = course_area(course, routes)
     out = []
     for name, w in list(winds.items())[:MAX_WIND_LAYERS]:
@@ -167,8 +217,9 @@ def _layers(winds: Mapping[str, WindField], course: Course, routes: Sequence[Rou
     return out
 
 
-def comparison_report(cmp: Comparison, plans: Sequence[Plan],
-                      winds: Mapping[str, WindField] | None = None) -> Report:
+def comparison_report(
+    cmp: Comparison, plans: Sequence[Plan], winds: Mapping[str, WindField] | None = None
+) -> Report:
     """The page of ``compare-scenarios``: every scenario's route (legend toggles them),
     each scenario's wind (the first shown), the legs × scenarios times and each
     scenario's leg table (folded)."""
@@ -180,29 +231,59 @@ def comparison_report(cmp: Comparison, plans: Sequence[Plan],
     refs = list(cmp.references)
     rows = []
     for k, label in enumerate(cmp.leg_labels):
-        rows.append((f"{k + 1}", label.replace("->", "→"),
-                     *(format_duration(cmp.times[i, k]) for i in range(len(cmp.scenarios))),
-                     *(format_duration(cmp.references[r][k]) for r in refs)))
-    footer = (("", "total", *(format_duration(t) for t in cmp.totals),
-               *(format_duration(float(cmp.references[r].sum())) for r in refs)),)
-    tables = [Table("Leg times by scenario", ("leg", "from → to", *cmp.scenarios, *refs),
-                    tuple(rows), footer)]
+        rows.append(
+            (
+                f"{k + 1}",
+                label.replace("->", "→"),
+                *(format_duration(cmp.times[i, k]) for i in range(len(cmp.scenarios))),
+                *(format_duration(cmp.references[r][k]) for r in refs),
+            )
+        )
+    footer = (
+        (
+            "",
+            "total",
+            *(format_duration(t) for t in cmp.totals),
+            *(format_duration(float(cmp.references[r].sum())) for r in refs),
+        ),
+    )
+    tables = [
+        Table(
+            "Leg times by scenario",
+            ("leg", "from → to", *cmp.scenarios, *refs),
+            tuple(rows),
+            footer,
+        )
+    ]
     tables += [_plan_table(p, f"Legs: {p.scenario}", collapsed=True) for p in plans]
     best = int(np.argmin(cmp.totals))
     summary = (
         f"{len(plans)} scenarios, start {time_label(plans[0].t_start, off)} on "
         f"{iso(plans[0].t_start + off)[:10]}",
-        "Race times: " + ", ".join(f"{s} {format_duration(t)}"
-                                   for s, t in zip(cmp.scenarios, cmp.totals, strict=True))
+        "Race times: "
+        + ", ".join(
+            f"{s} {format_duration(t)}" for s, t in zip(cmp.scenarios, cmp.totals, strict=True)
+        )
         + f"; fastest {cmp.scenarios[best]}",
     )
     notes = [HELP, _times_note(course), _wind_note(layers)]
     if winds and len(winds) > len(layers):
-        notes.append(f"The wind of {len(winds) - len(layers)} scenarios is not drawn (at most "
-                     f"{MAX_WIND_LAYERS} are; or their data miss the course area).")
-    return Report(f"{cmp.course_name} — scenario comparison", summary, course, routes,
-                  tuple(layers), times, tuple(tables), tuple(notes), leg_numbers=False,
-                  legend_beside=True)
+        notes.append(
+            f"The wind of {len(winds) - len(layers)} scenarios is not drawn (at most "
+            f"{MAX_WIND_LAYERS} are; or their data miss the course area)."
+        )
+    return Report(
+        f"{cmp.course_name} — scenario comparison",
+        summary,
+        course,
+        routes,
+        tuple(layers),
+        times,
+        tuple(tables),
+        tuple(notes),
+        leg_numbers=False,
+        legend_beside=True,
+    )
 
 
 def analysis_report(a: TrackAnalysis) -> Report:
@@ -215,39 +296,100 @@ def analysis_report(a: TrackAnalysis) -> Report:
     rows = []
     for leg in a.legs:
         if not leg.known:
-            rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
-                         clock(leg.t_start, off) if np.isfinite(leg.t_start) else "unknown",
-                         "unknown", format_duration(leg.optimal_time_s), "-", "-", "-", "-",
-                         "-", "-", leg.note, leg.wind_source))
+            rows.append(
+                (
+                    str(leg.index + 1),
+                    leg.label.replace("->", "→"),
+                    leg.mode,
+                    clock(leg.t_start, off) if np.isfinite(leg.t_start) else "unknown",
+                    "unknown",
+                    format_duration(leg.optimal_time_s),
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    "-",
+                    leg.note,
+                    leg.wind_source,
+                )
+            )
             continue
-        rows.append((str(leg.index + 1), leg.label.replace("->", "→"), leg.mode,
-                     clock(leg.t_start, off), format_duration(leg.sailed_time_s),
-                     format_duration(leg.optimal_time_s), f"{leg.loss_s:+.1f}",
-                     f"{leg.split.manoeuvres:+.1f}", f"{leg.split.speed:+.1f}",
-                     f"{leg.split.route:+.1f}",
-                     f"{leg.sailed_tacks}/{leg.sailed_gybes} : "
-                     f"{leg.optimal_tacks}/{leg.optimal_gybes}",
-                     _polar_pct(leg), f"{leg.side_sailed} / {leg.side_optimal}",
-                     leg.wind_source))
-    tot = [sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed",
-                                                                         "route")]
-    footer = (("", "total" if a.complete else f"{len(a.known_legs)} legs of known time", "",
-               "", format_duration(a.sailed_time_s),
-               format_duration(a.optimal_time_s), f"{a.loss_s:+.1f}",
-               *(f"{v:+.1f}" for v in tot), "", "", "", ""),)
-    table = Table("Legs: sailed against optimal from the same point and time",
-                  ("leg", "from → to", "mode", "start", "sailed", "optimal", "lost s",
-                   "manoeuvres s", "speed s", "route s", "tacks/gybes sailed : optimal",
-                   "polar %", "side sailed / optimal", "wind"), tuple(rows), footer)
+        rows.append(
+            (
+                str(leg.index + 1),
+                leg.label.replace("->", "→"),
+                leg.mode,
+                clock(leg.t_start, off),
+                format_duration(leg.sailed_time_s),
+                format_duration(leg.optimal_time_s),
+                f"{leg.loss_s:+.1f}",
+                f"{leg.split.manoeuvres:+.1f}",
+                f"{leg.split.speed:+.1f}",
+                f"{leg.split.route:+.1f}",
+                f"{leg.sailed_tacks}/{leg.sailed_gybes} : {leg.optimal_tacks}/{leg.optimal_gybes}",
+                _polar_pct(leg),
+                f"{leg.side_sailed} / {leg.side_optimal}",
+                leg.wind_source,
+            )
+        )
+    tot = [
+        sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed", "route")
+    ]
+    footer = (
+        (
+            "",
+            "total" if a.complete else f"{len(a.known_legs)} legs of known time",
+            "",
+            "",
+            format_duration(a.sailed_time_s),
+            format_duration(a.optimal_time_s),
+            f"{a.loss_s:+.1f}",
+            *(f"{v:+.1f}" for v in tot),
+            "",
+            "",
+            "",
+            "",
+        ),
+    )
+    table = Table(
+        "Legs: sailed against optimal from the same point and time",
+        (
+            "leg",
+            "from → to",
+            "mode",
+            "start",
+            "sailed",
+            "optimal",
+            "lost s",
+            "manoeuvres s",
+            "speed s",
+            "route s",
+            "tacks/gybes sailed : optimal",
+            "polar %",
+            "side sailed / optimal",
+            "wind",
+        ),
+        tuple(rows),
+        footer,
+    )
     t0 = a.legs[0].t_start if a.legs else course.start_epoch
-    summary = (f"Track {a.track.name} · scenario {a.scenario} · router {a.router} · start "
-               f"{time_label(t0, off)} on {iso(t0 + off)[:10]}",
-               f"Sailed {format_duration(a.sailed_time_s)}, optimal "
-               f"{format_duration(a.optimal_time_s)}, lost {a.loss_s:+.1f} s")
-    return Report(f"{course.name} — {a.track.name}", summary, course, (sailed, optimal),
-                  tuple(layers), times, (table,),
-                  (HELP, *_judged_notes([a]), *a.notes, _times_note(course),
-                   _wind_note(layers)))
+    summary = (
+        f"Track {a.track.name} · scenario {a.scenario} · router {a.router} · start "
+        f"{time_label(t0, off)} on {iso(t0 + off)[:10]}",
+        f"Sailed {format_duration(a.sailed_time_s)}, optimal "
+        f"{format_duration(a.optimal_time_s)}, lost {a.loss_s:+.1f} s",
+    )
+    return Report(
+        f"{course.name} — {a.track.name}",
+        summary,
+        course,
+        (sailed, optimal),
+        tuple(layers),
+        times,
+        (table,),
+        (HELP, *_judged_notes([a]), *a.notes, _times_note(course), _wind_note(layers)),
+    )
 
 
 def _wind_name(a: TrackAnalysis) -> str:
@@ -266,19 +408,28 @@ def _judged_notes(analyses: Sequence[TrackAnalysis]) -> list[str]:
     """What the boats are judged against and in which wind, and the above-polar warning."""
     out = []
     refs = dict.fromkeys(a.reference for a in analyses if a.reference)
-    out += [f"Judged against the {r}." if r.startswith("course") else f"Judged against a {r}."
-            for r in refs]
-    winds = dict.fromkeys(f"{leg.wind_source} ({leg.wind_label})" for a in analyses
-                          for leg in a.legs if leg.wind_label)
+    out += [
+        f"Judged against the {r}." if r.startswith("course") else f"Judged against a {r}."
+        for r in refs
+    ]
+    winds = dict.fromkeys(
+        f"{leg.wind_source} ({leg.wind_label})"
+        for a in analyses
+        for leg in a.legs
+        if leg.wind_label
+    )
     if winds:
         out.append("Wind of the legs: " + "; ".join(winds) + ".")
-    above = [f"{a.track.name} leg {leg.index + 1}" for a in analyses for leg in a.legs
-             if leg.above_polar]
+    above = [
+        f"{a.track.name} leg {leg.index + 1}" for a in analyses for leg in a.legs if leg.above_polar
+    ]
     if above:
-        out.append(f"* Sailed above {ABOVE_POLAR_PCT:.0f} % of the polar ({', '.join(above)}): "
-                   "the polar stands in for another class, or the wind is wrong (too light); "
-                   "those losses are not a debrief (analyze --reference fleet judges the boats "
-                   "against what the fleet sails).")
+        out.append(
+            f"* Sailed above {ABOVE_POLAR_PCT:.0f} % of the polar ({', '.join(above)}): "
+            "the polar stands in for another class, or the wind is wrong (too light); "
+            "those losses are not a debrief (analyze --reference fleet judges the boats "
+            "against what the fleet sails)."
+        )
     return out
 
 
@@ -295,9 +446,12 @@ def _signed(v: float, nd: int = 1) -> str:
     return f"{v:+.{nd}f}" if math.isfinite(v) else "-"
 
 
-def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, Any]],
-                 notes: Sequence[str] = (), wind: tuple[str, WindField] | None = None
-                 ) -> Report:
+def fleet_report(
+    analyses: Sequence[TrackAnalysis],
+    rows: Sequence[Mapping[str, Any]],
+    notes: Sequence[str] = (),
+    wind: tuple[str, WindField] | None = None,
+) -> Report:
     """The page of ``sailroute analyze`` with several tracks.
 
     Every boat's sailed track on one map with one time slider (a marker per boat), the
@@ -312,8 +466,10 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
     course, off = analyses[0].course, analyses[0].course.utc_offset_s
     sailed = [replace(routes_from_analysis(a)[0], name=a.track.name) for a in analyses]
     lead = _leader(analyses)
-    opt = replace(routes_from_analysis(analyses[lead])[1],
-                  name=f"optimal from {analyses[lead].track.name}'s leg starts")
+    opt = replace(
+        routes_from_analysis(analyses[lead])[1],
+        name=f"optimal from {analyses[lead].track.name}'s leg starts",
+    )
     routes = (*sailed, opt)
     times = slider_times(sailed, FLEET_STEPS)
     name, field = wind if wind is not None else (_wind_name(analyses[0]), analyses[0].wind)
@@ -329,51 +485,117 @@ def fleet_report(analyses: Sequence[TrackAnalysis], rows: Sequence[Mapping[str, 
                 cells.append("unknown")
             else:
                 pos = f", pos {row['position']}" if row["position"] is not None else ""
-                cells.append(f"{format_duration(row['leg_time_s'])} ({row['leg_rank']}{pos}) "
-                             f"{_signed(row['loss_s'])} s")
+                cells.append(
+                    f"{format_duration(row['leg_time_s'])} ({row['leg_rank']}{pos}) "
+                    f"{_signed(row['loss_s'])} s"
+                )
         rank_rows.append((str(i + 1), spec.label.replace("->", "→"), *cells))
-    ranking = Table("Leg ranking: leg time (rank, position at the leg's end) and time lost "
-                    "against the optimal leg", ("leg", "from → to", *names),
-                    tuple(rank_rows))
+    ranking = Table(
+        "Leg ranking: leg time (rank, position at the leg's end) and time lost "
+        "against the optimal leg",
+        ("leg", "from → to", *names),
+        tuple(rank_rows),
+    )
     start_rows = []
     for a in analyses:
         st = a.segmentation.start
-        start_rows.append((
-            a.track.name, clock(st.crossing.t, off), f"{st.late_s:+.1f}",
-            f"{st.distance_at_gun_m:.0f} ({st.side_at_gun})",
-            f"{st.speed_at_gun_ms / KNOT:.1f}" if math.isfinite(st.speed_at_gun_ms) else "-",
-            (f"{st.ocs_s:.0f} s" + (", returned" if st.ocs_returned else "")
-             if st.ocs_s is not None else ("returned" if st.ocs_returned else "no")),
-            f"{st.line_offset_m:.0f}", "; ".join(st.notes)))
-    start = Table("Start", ("boat", "start (local)", "late s", "to the line at the gun m",
-                            "speed at the gun kn", "over early", "line offset m", "notes"),
-                  tuple(start_rows))
+        start_rows.append(
+            (
+                a.track.name,
+                clock(st.crossing.t, off),
+                f"{st.late_s:+.1f}",
+                f"{st.distance_at_gun_m:.0f} ({st.side_at_gun})",
+                f"{st.speed_at_gun_ms / KNOT:.1f}" if math.isfinite(st.speed_at_gun_ms) else "-",
+                (
+                    f"{st.ocs_s:.0f} s" + (", returned" if st.ocs_returned else "")
+                    if st.ocs_s is not None
+                    else ("returned" if st.ocs_returned else "no")
+                ),
+                f"{st.line_offset_m:.0f}",
+                "; ".join(st.notes),
+            )
+        )
+    start = Table(
+        "Start",
+        (
+            "boat",
+            "start (local)",
+            "late s",
+            "to the line at the gun m",
+            "speed at the gun kn",
+            "over early",
+            "line offset m",
+            "notes",
+        ),
+        tuple(start_rows),
+    )
     split_rows = []
     for a in analyses:
         for leg in a.legs:
-            split_rows.append((a.track.name, str(leg.index + 1), leg.label.replace("->", "→"),
-                               _signed(leg.loss_s), _signed(leg.split.manoeuvres),
-                               _signed(leg.split.speed), _signed(leg.split.route),
-                               _polar_pct(leg), leg.wind_source, leg.note))
-    split = Table("Time lost per boat and leg, split into manoeuvres, speed and route",
-                  ("boat", "leg", "from → to", "lost s", "manoeuvres s", "speed s", "route s",
-                   "polar %", "wind", "note"), tuple(split_rows),
-                  collapsed=len(split_rows) > 40)
+            split_rows.append(
+                (
+                    a.track.name,
+                    str(leg.index + 1),
+                    leg.label.replace("->", "→"),
+                    _signed(leg.loss_s),
+                    _signed(leg.split.manoeuvres),
+                    _signed(leg.split.speed),
+                    _signed(leg.split.route),
+                    _polar_pct(leg),
+                    leg.wind_source,
+                    leg.note,
+                )
+            )
+    split = Table(
+        "Time lost per boat and leg, split into manoeuvres, speed and route",
+        (
+            "boat",
+            "leg",
+            "from → to",
+            "lost s",
+            "manoeuvres s",
+            "speed s",
+            "route s",
+            "polar %",
+            "wind",
+            "note",
+        ),
+        tuple(split_rows),
+        collapsed=len(split_rows) > 40,
+    )
     t0 = course.start_epoch
     summary = (
         f"{len(analyses)} boats · scenario {analyses[0].scenario} · router "
         f"{analyses[0].router} · gun {time_label(t0, off)} on {iso(t0 + off)[:10]}",
-        "Sailed (legs of known time): " + ", ".join(
+        "Sailed (legs of known time): "
+        + ", ".join(
             f"{a.track.name} {format_duration(a.sailed_time_s)}"
             + ("" if a.complete else f" ({len(a.known_legs)} of {len(a.legs)} legs)")
-            for a in analyses))
-    page_notes = [HELP, *_judged_notes(analyses), *notes,
-                  *(f"{a.track.name}: {n}" for a in analyses for n in a.notes),
-                  "The dashed line is the optimal route of each leg from the leader's own leg "
-                  "start point and time.", _times_note(course), _wind_note(layers)]
-    return Report(f"{course.name} — fleet of {len(analyses)}", summary, course, routes,
-                  tuple(layers), times, (ranking, start, split), tuple(page_notes),
-                  leg_numbers=False, legend_beside=True)
+            for a in analyses
+        ),
+    )
+    page_notes = [
+        HELP,
+        *_judged_notes(analyses),
+        *notes,
+        *(f"{a.track.name}: {n}" for a in analyses for n in a.notes),
+        "The dashed line is the optimal route of each leg from the leader's own leg "
+        "start point and time.",
+        _times_note(course),
+        _wind_note(layers),
+    ]
+    return Report(
+        f"{course.name} — fleet of {len(analyses)}",
+        summary,
+        course,
+        routes,
+        tuple(layers),
+        times,
+        (ranking, start, split),
+        tuple(page_notes),
+        leg_numbers=False,
+        legend_beside=True,
+    )
 
 
 # ---------------------------------------------------------------------------------------------

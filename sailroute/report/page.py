@@ -45,8 +45,18 @@ SEA = "#dcebf5"
 """Map background colour (plain water)."""
 BOAT_COLOUR = "#e41a1c"
 """The boat marker of a single route (a comparison's boats take their route's colour)."""
-ROUTE_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
-                 "#e377c2", "#17becf", "#bcbd22", "#7f7f7f")
+ROUTE_COLOURS = (
+    "#1f77b4",
+    "#d62728",
+    "#2ca02c",
+    "#9467bd",
+    "#ff7f0e",
+    "#8c564b",
+    "#e377c2",
+    "#17becf",
+    "#bcbd22",
+    "#7f7f7f",
+)
 """Route colours in scenario order (plotly's default palette)."""
 WIND_COLOUR = "#41607d"
 """Colour of the wind arrows (a comparison's layers take their scenario's route colour)."""
@@ -245,8 +255,9 @@ def clocks(t: NDArray, utc_offset_s: float = 0.0) -> list[str]:
     """:func:`clock` of every element of ``t`` (``""`` where ``t`` is not finite)."""
     us = np.round((np.asarray(t, dtype=float) + utc_offset_s) * 1e6)
     ok = np.isfinite(us)
-    text = np.datetime_as_string(np.where(ok, us, 0.0).astype(np.int64).astype("datetime64[us]"),
-                                 unit="s")
+    text = np.datetime_as_string(
+        np.where(ok, us, 0.0).astype(np.int64).astype("datetime64[us]"), unit="s"
+    )
     return [str(s)[11:19] if good else "" for s, good in zip(text, ok.tolist(), strict=True)]
 
 
@@ -255,8 +266,16 @@ def time_label(t: float, utc_offset_s: float) -> str:
     return f"{clock(t, utc_offset_s)} local ({offset_text(utc_offset_s)}) · {clock(t)} UTC"
 
 
-def leg_vmg(mode: str, speed: NDArray, twa_deg: NDArray, sog: NDArray, cog_deg: NDArray,
-            x: NDArray, y: NDArray, centre: tuple[float, float]) -> NDArray[np.float64]:
+def leg_vmg(
+    mode: str,
+    speed: NDArray,
+    twa_deg: NDArray,
+    sog: NDArray,
+    cog_deg: NDArray,
+    x: NDArray,
+    y: NDArray,
+    centre: tuple[float, float],
+) -> NDArray[np.float64]:
     """Velocity made good [same unit as the speeds], as ``sailroute analyze`` defines it.
 
     Upwind: ``speed·cos(TWA)`` (towards the wind); downwind: ``−speed·cos(TWA)``; on a
@@ -275,11 +294,19 @@ def _leg_columns(course: Course, k: int, r: LegResult, mode: str) -> dict[str, N
     """Per-point arrays of one routed leg (``k`` 0-based)."""
     tr = r.track
     centre = feature_centre(course.feature(course.legs[k].to_name))
-    vmg = leg_vmg(mode, tr.bsp_ms, tr.twa_deg, tr.ground_speed_ms, tr.ground_course_deg,
-                  tr.x, tr.y, centre)
-    return {"t": tr.t, "x": tr.x, "y": tr.y, "leg": np.full(tr.t.size, k + 1),
-            "tws": tr.tws_ms / KNOT, "twa": tr.twa_deg, "speed": tr.bsp_ms / KNOT,
-            "vmg": vmg / KNOT}
+    vmg = leg_vmg(
+        mode, tr.bsp_ms, tr.twa_deg, tr.ground_speed_ms, tr.ground_course_deg, tr.x, tr.y, centre
+    )
+    return {
+        "t": tr.t,
+        "x": tr.x,
+        "y": tr.y,
+        "leg": np.full(tr.t.size, k + 1),
+        "tws": tr.tws_ms / KNOT,
+        "twa": tr.twa_deg,
+        "speed": tr.bsp_ms / KNOT,
+        "vmg": vmg / KNOT,
+    }
 
 
 def _repeat_shifts(parts: Sequence[Mapping[str, NDArray]]) -> list[tuple[float, float]]:
@@ -290,8 +317,11 @@ def _repeat_shifts(parts: Sequence[Mapping[str, NDArray]]) -> list[tuple[float, 
     for p in parts:
         ok = np.isfinite(p["x"]) & np.isfinite(p["y"])
         xs, ys = np.asarray(p["x"])[ok], np.asarray(p["y"])[ok]
-        ends.append(((float(xs[0]), float(ys[0])), (float(xs[-1]), float(ys[-1])))
-                    if xs.size else ((math.nan, math.nan), (math.nan, math.nan)))
+        ends.append(
+            ((float(xs[0]), float(ys[0])), (float(xs[-1]), float(ys[-1])))
+            if xs.size
+            else ((math.nan, math.nan), (math.nan, math.nan))
+        )
     chords = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in ends]
     step = REPEAT_SHIFT * max((c for c in chords if math.isfinite(c)), default=0.0)
     out = []
@@ -303,13 +333,22 @@ def _repeat_shifts(parts: Sequence[Mapping[str, NDArray]]) -> list[tuple[float, 
     return out
 
 
-def _route(name: str, course: Course, parts: Sequence[Mapping[str, NDArray]],
-           modes: Sequence[str], manoeuvres: Sequence[tuple[str, float, float, float]],
-           *, gaps: bool = False, side_by_side: bool = False, **kw: Any) -> Route:
+def _route(
+    name: str,
+    course: Course,
+    parts: Sequence[Mapping[str, NDArray]],
+    modes: Sequence[str],
+    manoeuvres: Sequence[tuple[str, float, float, float]],
+    *,
+    gaps: bool = False,
+    side_by_side: bool = False,
+    **kw: Any,
+) -> Route:
     """Join per-leg columns into a :class:`Route` (a NaN row between legs with ``gaps``;
     legs over the same water drawn beside each other with ``side_by_side``)."""
-    cols: dict[str, list[NDArray]] = {k: [] for k in ("t", "x", "y", "leg", "tws", "twa",
-                                                      "speed", "vmg")}
+    cols: dict[str, list[NDArray]] = {
+        k: [] for k in ("t", "x", "y", "leg", "tws", "twa", "speed", "vmg")
+    }
     for i, p in enumerate(parts):
         if gaps and i:
             for k in cols:
@@ -327,8 +366,11 @@ def _route(name: str, course: Course, parts: Sequence[Mapping[str, NDArray]],
             sx[c["leg"] == i + 1] = dx
             sy[c["leg"] == i + 1] = dy
         dlat, dlon = course.frame.to_latlon(c["x"] + sx, c["y"] + sy)
-        kw = {**kw, "lat_shift": np.asarray(dlat, float) - lat,
-              "lon_shift": np.asarray(dlon, float) - lon}
+        kw = {
+            **kw,
+            "lat_shift": np.asarray(dlat, float) - lat,
+            "lon_shift": np.asarray(dlon, float) - lon,
+        }
     man = []
     for kind, t, x, y in manoeuvres:
         # drawn on its leg's line: the leg whose time span holds it
@@ -336,16 +378,31 @@ def _route(name: str, course: Course, parts: Sequence[Mapping[str, NDArray]],
         dx, dy = shifts[j] if shifts and j is not None else (0.0, 0.0)
         mlat, mlon = course.frame.to_latlon(x + dx, y + dy)
         man.append((kind, float(t), float(mlat), float(mlon)))
-    return Route(name, c["t"].astype(float), c["x"], c["y"], lat, lon,
-                 c["leg"].astype(np.int64), c["tws"], c["twa"], c["speed"], c["vmg"],
-                 tuple(modes), tuple(man), **kw)
+    return Route(
+        name,
+        c["t"].astype(float),
+        c["x"],
+        c["y"],
+        lat,
+        lon,
+        c["leg"].astype(np.int64),
+        c["tws"],
+        c["twa"],
+        c["speed"],
+        c["vmg"],
+        tuple(modes),
+        tuple(man),
+        **kw,
+    )
 
 
 def route_from_plan(plan: Plan, name: str | None = None) -> Route:
     """The :class:`Route` of a routed course (boat speed through the water)."""
     modes = [pl.mode or "reach" for pl in plan.legs]
-    parts = [_leg_columns(plan.course, pl.spec.index, pl.result, modes[k])
-             for k, pl in enumerate(plan.legs)]
+    parts = [
+        _leg_columns(plan.course, pl.spec.index, pl.result, modes[k])
+        for k, pl in enumerate(plan.legs)
+    ]
     man = [(m.kind, m.t, m.x, m.y) for pl in plan.legs for m in pl.result.manoeuvres]
     return _route(name or plan.scenario, plan.course, parts, modes, man, side_by_side=True)
 
@@ -359,8 +416,10 @@ def decimated(r: Route, max_points: int = MAX_ROUTE_POINTS) -> Route:
     step = math.ceil(n / max_points)
     change = np.flatnonzero(np.diff(r.leg) != 0)
     keep = np.unique(np.concatenate([np.arange(0, n, step), change, change + 1, [n - 1]]))
-    cut = {f: getattr(r, f)[keep] for f in ("t", "x", "y", "lat", "lon", "leg", "tws_kn",
-                                             "twa_deg", "speed_kn", "vmg_kn")}
+    cut = {
+        f: getattr(r, f)[keep]
+        for f in ("t", "x", "y", "lat", "lon", "leg", "tws_kn", "twa_deg", "speed_kn", "vmg_kn")
+    }
     if r.lat_shift is not None and r.lon_shift is not None:
         cut["lat_shift"], cut["lon_shift"] = r.lat_shift[keep], r.lon_shift[keep]
     return replace(r, **cut)
@@ -371,25 +430,51 @@ def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
     and the optimal legs from its leg starts (legs of unknown start left out)."""
     p, course = a.points, a.course
     modes = [leg.mode for leg in a.legs]
-    sailed_parts = [{"t": p.t, "x": p.x, "y": p.y, "leg": p.leg, "tws": p.tws_ms / KNOT,
-                     "twa": p.twa_deg, "speed": p.sog_ms / KNOT, "vmg": p.vmg_ms / KNOT}]
+    sailed_parts = [
+        {
+            "t": p.t,
+            "x": p.x,
+            "y": p.y,
+            "leg": p.leg,
+            "tws": p.tws_ms / KNOT,
+            "twa": p.twa_deg,
+            "speed": p.sog_ms / KNOT,
+            "vmg": p.vmg_ms / KNOT,
+        }
+    ]
     man = []
     for m in (m for leg in a.legs for m in leg.manoeuvres):
-        man.append((m.kind, m.t, float(np.interp(m.t, p.t, p.x)),
-                    float(np.interp(m.t, p.t, p.y))))
-    sailed = decimated(_route(f"sailed: {a.track.name}", course, sailed_parts, modes, man,
-                              speed_name="SOG"))
-    opt_parts = [_leg_columns(course, leg.index, leg.optimal, leg.mode) for leg in a.legs
-                 if leg.optimal is not None]
-    opt_man = [(m.kind, m.t, m.x, m.y) for leg in a.legs if leg.optimal is not None
-               for m in leg.optimal.manoeuvres]
-    optimal = _route("optimal from the boat's leg starts", course, opt_parts, modes,
-                     opt_man, gaps=True, dash="dash", boat=False)
+        man.append((m.kind, m.t, float(np.interp(m.t, p.t, p.x)), float(np.interp(m.t, p.t, p.y))))
+    sailed = decimated(
+        _route(f"sailed: {a.track.name}", course, sailed_parts, modes, man, speed_name="SOG")
+    )
+    opt_parts = [
+        _leg_columns(course, leg.index, leg.optimal, leg.mode)
+        for leg in a.legs
+        if leg.optimal is not None
+    ]
+    opt_man = [
+        (m.kind, m.t, m.x, m.y)
+        for leg in a.legs
+        if leg.optimal is not None
+        for m in leg.optimal.manoeuvres
+    ]
+    optimal = _route(
+        "optimal from the boat's leg starts",
+        course,
+        opt_parts,
+        modes,
+        opt_man,
+        gaps=True,
+        dash="dash",
+        boat=False,
+    )
     return sailed, optimal
 
 
-def course_area(course: Course, routes: Sequence[Route], pad: float = 0.08
-                ) -> tuple[float, float, float, float]:
+def course_area(
+    course: Course, routes: Sequence[Route], pad: float = 0.08
+) -> tuple[float, float, float, float]:
     """``(x0, x1, y0, y1)`` [m]: the marks and routes, padded by ``pad`` of the larger side."""
     xs = [m.x for m in course.marks.values()]
     ys = [m.y for m in course.marks.values()]
@@ -402,9 +487,14 @@ def course_area(course: Course, routes: Sequence[Route], pad: float = 0.08
     return x0 - pad * span, x1 + pad * span, y0 - pad * span, y1 + pad * span
 
 
-def wind_layer(name: str, wind: WindField, course: Course,
-               area: tuple[float, float, float, float], times: NDArray,
-               grid: int = WIND_GRID) -> WindLayer | None:
+def wind_layer(
+    name: str,
+    wind: WindField,
+    course: Course,
+    area: tuple[float, float, float, float],
+    times: NDArray,
+    grid: int = WIND_GRID,
+) -> WindLayer | None:
     """Sample ``wind`` at the centres of ``grid × grid`` cells over ``area`` (clipped to the
     field's coverage) at each of ``times`` [epoch s].
 
@@ -436,13 +526,15 @@ def wind_layer(name: str, wind: WindField, course: Course,
         spd[k], twd[k] = wind_speed_direction(u, v)
     if not np.isfinite(spd).any():
         return None
-    if np.allclose(spd, spd[:1], atol=1e-9, equal_nan=True) and \
-            np.allclose(twd, twd[:1], atol=1e-9, equal_nan=True):
+    if np.allclose(spd, spd[:1], atol=1e-9, equal_nan=True) and np.allclose(
+        twd, twd[:1], atol=1e-9, equal_nan=True
+    ):
         spd, twd = spd[:1], twd[:1]
     lat, lon = course.frame.to_latlon(gx, gy)
     spacing = min(x1 - x0, y1 - y0) / grid
-    return WindLayer(name, gx, gy, np.asarray(lat, float), np.asarray(lon, float), spacing,
-                     spd / KNOT, twd)
+    return WindLayer(
+        name, gx, gy, np.asarray(lat, float), np.asarray(lon, float), spacing, spd / KNOT, twd
+    )
 
 
 def slider_times(routes: Sequence[Route], n: int = N_STEPS) -> NDArray[np.float64]:

@@ -70,20 +70,32 @@ def _customdata(r: Route, off: float) -> list[list[Any] | None]:
     """Hover data per point: leg, mode, local time, UTC time, TWS, |TWA|, tack, speed, VMG,
     latitude, longitude (the true position, also where the line is drawn shifted)."""
     modes = [r.modes[k - 1] if 0 < k <= len(r.modes) else "" for k in r.leg.tolist()]
-    cols = zip(r.leg.tolist(), modes, clocks(r.t, off), clocks(r.t), _r(r.tws_kn, 2),
-               _r(np.abs(r.twa_deg), 1),
-               np.where(r.twa_deg >= 0, "stbd", "port").tolist(), _r(r.speed_kn, 3),
-               _r(r.vmg_kn, 3), _r(r.lat, 6), _r(r.lon, 6), strict=True)
+    cols = zip(
+        r.leg.tolist(),
+        modes,
+        clocks(r.t, off),
+        clocks(r.t),
+        _r(r.tws_kn, 2),
+        _r(np.abs(r.twa_deg), 1),
+        np.where(r.twa_deg >= 0, "stbd", "port").tolist(),
+        _r(r.speed_kn, 3),
+        _r(r.vmg_kn, 3),
+        _r(r.lat, 6),
+        _r(r.lon, 6),
+        strict=True,
+    )
     ok = np.isfinite(r.t).tolist()
     return [list(row) if good else None for row, good in zip(cols, ok, strict=True)]
 
 
 def _hover(r: Route, off: float) -> str:
-    return ("<b>%{fullData.name}</b> · leg %{customdata[0]} (%{customdata[1]})<br>"
-            f"%{{customdata[2]}} local ({offset_text(off)}) · %{{customdata[3]}} UTC<br>"
-            "TWS %{customdata[4]:.1f} kn · TWA %{customdata[5]:.0f}° %{customdata[6]}<br>"
-            f"{r.speed_name} %{{customdata[7]:.2f}} kn · VMG %{{customdata[8]:.2f}} kn"
-            "<br>%{customdata[9]:.5f}° N %{customdata[10]:.5f}° E<extra></extra>")
+    return (
+        "<b>%{fullData.name}</b> · leg %{customdata[0]} (%{customdata[1]})<br>"
+        f"%{{customdata[2]}} local ({offset_text(off)}) · %{{customdata[3]}} UTC<br>"
+        "TWS %{customdata[4]:.1f} kn · TWA %{customdata[5]:.0f}° %{customdata[6]}<br>"
+        f"{r.speed_name} %{{customdata[7]:.2f}} kn · VMG %{{customdata[8]:.2f}} kn"
+        "<br>%{customdata[9]:.5f}° N %{customdata[10]:.5f}° E<extra></extra>"
+    )
 
 
 def boat_at(r: Route, times: NDArray) -> NDArray[np.int64]:
@@ -94,8 +106,9 @@ def boat_at(r: Route, times: NDArray) -> NDArray[np.int64]:
     return np.clip(k, 0, r.t.size - 1)
 
 
-def _boat_states(r: Route, times: NDArray, off: float, custom: Sequence[Any]
-                 ) -> list[dict[str, Any]]:
+def _boat_states(
+    r: Route, times: NDArray, off: float, custom: Sequence[Any]
+) -> list[dict[str, Any]]:
     """Boat marker of ``r`` at each of ``times``: the position interpolated in time, the
     hover data of the point before with the time itself."""
     drawn_lat, drawn_lon = r.drawn()
@@ -104,8 +117,9 @@ def _boat_states(r: Route, times: NDArray, off: float, custom: Sequence[Any]
     true_lat = _r(np.interp(times, r.t, r.lat), 6)
     true_lon = _r(np.interp(times, r.t, r.lon), 6)
     out = []
-    for k, (i, local, utc) in enumerate(zip(boat_at(r, times).tolist(), clocks(times, off),
-                                            clocks(times), strict=True)):
+    for k, (i, local, utc) in enumerate(
+        zip(boat_at(r, times).tolist(), clocks(times, off), clocks(times), strict=True)
+    ):
         row = list(custom[i] or [])
         if row:
             row[2], row[3] = local, utc
@@ -114,8 +128,9 @@ def _boat_states(r: Route, times: NDArray, off: float, custom: Sequence[Any]
     return out
 
 
-def wind_arrows(w: WindLayer, course: Course, m_per_kn: float
-                ) -> list[tuple[dict[str, Any], dict[str, Any]]]:
+def wind_arrows(
+    w: WindLayer, course: Course, m_per_kn: float
+) -> list[tuple[dict[str, Any], dict[str, Any]]]:
     """Every row of ``w`` as arrows centred on the grid points, ``m_per_kn`` metres long per
     knot.
 
@@ -139,10 +154,12 @@ def wind_arrows(w: WindLayer, course: Course, m_per_kn: float
         xs = np.column_stack([tail_lon[k], tip_lon[k], nan]).ravel()
         ys = np.column_stack([tail_lat[k], tip_lat[k], nan]).ravel()
         shafts = {"x": _r(xs, 6), "y": _r(ys, 6)}
-        heads = {"x": _r(tip_lon[k], 6), "y": _r(tip_lat[k], 6),
-                 "marker": {"angle": _r(angle[k], 1)},
-                 "customdata": [[a, b] for a, b in zip(_r(spd[k], 1), _r(twd[k], 0),
-                                                       strict=True)]}
+        heads = {
+            "x": _r(tip_lon[k], 6),
+            "y": _r(tip_lat[k], 6),
+            "marker": {"angle": _r(angle[k], 1)},
+            "customdata": [[a, b] for a, b in zip(_r(spd[k], 1), _r(twd[k], 0), strict=True)],
+        }
         out.append((shafts, heads))
     return out
 
@@ -164,24 +181,40 @@ def label_positions(course: Course) -> list[str]:
 def _course_traces(course: Course) -> list[dict[str, Any]]:
     out: list[dict[str, Any]] = []
     first = True
-    for ln, dash in [*((ln, "solid") for ln in course.lines.values()),
-                     *((g, "dot") for g in course.gates.values())]:
-        out.append({"type": "scatter", "mode": "lines", "name": "lines and gates",
-                    "legendgroup": "course", "showlegend": first,
-                    "x": _r([ln.a.lon, ln.b.lon], 7), "y": _r([ln.a.lat, ln.b.lat], 7),
-                    "line": {"color": "black", "width": 2, "dash": dash},
-                    "hovertemplate": f"{plotly_label(ln.name)}<extra></extra>"})
+    for ln, dash in [
+        *((ln, "solid") for ln in course.lines.values()),
+        *((g, "dot") for g in course.gates.values()),
+    ]:
+        out.append(
+            {
+                "type": "scatter",
+                "mode": "lines",
+                "name": "lines and gates",
+                "legendgroup": "course",
+                "showlegend": first,
+                "x": _r([ln.a.lon, ln.b.lon], 7),
+                "y": _r([ln.a.lat, ln.b.lat], 7),
+                "line": {"color": "black", "width": 2, "dash": dash},
+                "hovertemplate": f"{plotly_label(ln.name)}<extra></extra>",
+            }
+        )
         first = False
     marks = list(course.marks.values())
-    out.append({"type": "scatter", "mode": "markers+text", "name": "marks",
-                "legendgroup": "course",
-                "x": _r([m.lon for m in marks], 7), "y": _r([m.lat for m in marks], 7),
-                "text": [plotly_label(m.name) for m in marks],
-                "textposition": label_positions(course),
-                "textfont": {"size": 12, "color": "#222"},
-                "marker": {"color": "darkorange", "size": 11,
-                           "line": {"color": "black", "width": 1}},
-                "hovertemplate": "mark %{text}<br>%{y:.6f}° N %{x:.6f}° E<extra></extra>"})
+    out.append(
+        {
+            "type": "scatter",
+            "mode": "markers+text",
+            "name": "marks",
+            "legendgroup": "course",
+            "x": _r([m.lon for m in marks], 7),
+            "y": _r([m.lat for m in marks], 7),
+            "text": [plotly_label(m.name) for m in marks],
+            "textposition": label_positions(course),
+            "textfont": {"size": 12, "color": "#222"},
+            "marker": {"color": "darkorange", "size": 11, "line": {"color": "black", "width": 1}},
+            "hovertemplate": "mark %{text}<br>%{y:.6f}° N %{x:.6f}° E<extra></extra>",
+        }
+    )
     return out
 
 
@@ -198,11 +231,19 @@ def _leg_number_trace(r: Route, group: str) -> dict[str, Any]:
         xs.append(lon[i])
         ys.append(lat[i])
         text.append(str(k + 1))
-    return {"type": "scatter", "mode": "markers+text", "name": "leg numbers",
-            "legendgroup": group, "showlegend": False, "x": _r(xs, 7), "y": _r(ys, 7),
-            "text": text, "textfont": {"size": 10, "color": "#222"},
-            "marker": {"color": "white", "size": 17, "line": {"color": "#555", "width": 1}},
-            "hovertemplate": "leg %{text}<extra></extra>"}
+    return {
+        "type": "scatter",
+        "mode": "markers+text",
+        "name": "leg numbers",
+        "legendgroup": group,
+        "showlegend": False,
+        "x": _r(xs, 7),
+        "y": _r(ys, 7),
+        "text": text,
+        "textfont": {"size": 10, "color": "#222"},
+        "marker": {"color": "white", "size": 17, "line": {"color": "#555", "width": 1}},
+        "hovertemplate": "leg %{text}<extra></extra>",
+    }
 
 
 def figure(report: Report) -> dict[str, Any]:
@@ -217,30 +258,59 @@ def figure(report: Report) -> dict[str, Any]:
     data: list[dict[str, Any]] = []
     moving: list[tuple[int, list[dict[str, Any]]]] = []  # (trace, its state per frame)
 
-    top = max((float(np.nanmax(w.tws_kn)) for w in report.winds
-               if np.isfinite(w.tws_kn).any()), default=0.0)
+    top = max(
+        (float(np.nanmax(w.tws_kn)) for w in report.winds if np.isfinite(w.tws_kn).any()),
+        default=0.0,
+    )
     m_per_kn = ARROW_FILL * min(w.spacing_m for w in report.winds) / top if top > 0 else 0.0
     route_names = [r.name for r in report.routes]
     for i, w in enumerate(report.winds):
-        colour = _colour(route_names.index(w.name)) \
-            if len(report.winds) > 1 and w.name in route_names else WIND_COLOUR
+        colour = (
+            _colour(route_names.index(w.name))
+            if len(report.winds) > 1 and w.name in route_names
+            else WIND_COLOUR
+        )
         name = "wind" if len(report.winds) == 1 else f"wind: {w.name}"
         if w.uniform:
             name += f" {w.tws_kn.flat[0]:.1f} kn from {w.twd_deg.flat[0]:.0f}°"
         rows = wind_arrows(w, course, m_per_kn)
         shafts, heads = rows[0]
         group = f"wind{i}"
-        common = {"type": "scatter", "legendgroup": group, "name": plotly_label(name),
-                  **({} if i == 0 else {"visible": "legendonly"})}
-        data.append({**common, "mode": "lines", **shafts, "hoverinfo": "skip",
-                     "line": {"color": colour, "width": 1.3}, "opacity": 0.75})
-        data.append({**common, "mode": "markers", "showlegend": False, **heads,
-                     "marker": {"symbol": "arrow", "size": 9, "color": colour,
-                                "angle": heads["marker"]["angle"], "line": {"width": 0}},
-                     "opacity": 0.75,
-                     "hovertemplate": "wind %{customdata[0]:.1f} kn from "
-                                      f"%{{customdata[1]:.0f}}°<extra>{plotly_label(w.name)}"
-                                      "</extra>"})
+        common = {
+            "type": "scatter",
+            "legendgroup": group,
+            "name": plotly_label(name),
+            **({} if i == 0 else {"visible": "legendonly"}),
+        }
+        data.append(
+            {
+                **common,
+                "mode": "lines",
+                **shafts,
+                "hoverinfo": "skip",
+                "line": {"color": colour, "width": 1.3},
+                "opacity": 0.75,
+            }
+        )
+        data.append(
+            {
+                **common,
+                "mode": "markers",
+                "showlegend": False,
+                **heads,
+                "marker": {
+                    "symbol": "arrow",
+                    "size": 9,
+                    "color": colour,
+                    "angle": heads["marker"]["angle"],
+                    "line": {"width": 0},
+                },
+                "opacity": 0.75,
+                "hovertemplate": "wind %{customdata[0]:.1f} kn from "
+                f"%{{customdata[1]:.0f}}°<extra>{plotly_label(w.name)}"
+                "</extra>",
+            }
+        )
         if not w.steady:
             moving.append((len(data) - 2, [sh for sh, _ in rows]))
             moving.append((len(data) - 1, [hd for _, hd in rows]))
@@ -249,57 +319,108 @@ def figure(report: Report) -> dict[str, Any]:
     data += list(report.overlays)
 
     single = report.colour_by_speed and len(report.routes) == 1
-    slo, shi = speed_limits(np.concatenate([r.speed_kn for r in report.routes]), decimals=2) \
-        if report.routes else (0.0, SPEED_SPAN_KN)
+    slo, shi = (
+        speed_limits(np.concatenate([r.speed_kn for r in report.routes]), decimals=2)
+        if report.routes
+        else (0.0, SPEED_SPAN_KN)
+    )
     for i, r in enumerate(report.routes):
         group = f"route{i}"
         colour = "#333333" if single else _colour(i)
         custom = _customdata(r, off)
         drawn_lat, drawn_lon = r.drawn()
-        tr = {"type": "scatter", "mode": "lines+markers" if single else "lines",
-              "name": plotly_label(r.name), "legendgroup": group,
-              "x": _r(drawn_lon, 7), "y": _r(drawn_lat, 7),
-              "line": {"color": colour, "width": 2.5, "dash": r.dash},
-              "customdata": custom, "hovertemplate": _hover(r, off)}
+        tr = {
+            "type": "scatter",
+            "mode": "lines+markers" if single else "lines",
+            "name": plotly_label(r.name),
+            "legendgroup": group,
+            "x": _r(drawn_lon, 7),
+            "y": _r(drawn_lat, 7),
+            "line": {"color": colour, "width": 2.5, "dash": r.dash},
+            "customdata": custom,
+            "hovertemplate": _hover(r, off),
+        }
         if single:
-            tr["marker"] = {"color": _r(r.speed_kn, 3), "colorscale": "Viridis",
-                            "cmin": slo, "cmax": shi, "size": 5,
-                            "colorbar": {"title": {"text": "boat speed [kn]"}, "x": 1.02,
-                                         "y": 1.0, "yanchor": "top", "len": 0.45,
-                                         "thickness": 14}}
+            tr["marker"] = {
+                "color": _r(r.speed_kn, 3),
+                "colorscale": "Viridis",
+                "cmin": slo,
+                "cmax": shi,
+                "size": 5,
+                "colorbar": {
+                    "title": {"text": "boat speed [kn]"},
+                    "x": 1.02,
+                    "y": 1.0,
+                    "yanchor": "top",
+                    "len": 0.45,
+                    "thickness": 14,
+                },
+            }
         data.append(tr)
-        for kind, symbol, mc in (("tack", "triangle-up", "crimson"),
-                                 ("gybe", "square", "royalblue")):
+        for kind, symbol, mc in (
+            ("tack", "triangle-up", "crimson"),
+            ("gybe", "square", "royalblue"),
+        ):
             pts = [m for m in r.manoeuvres if m[0] == kind]
-            data.append({"type": "scatter", "mode": "markers", "name": f"{kind}s",
-                         "legendgroup": group, "showlegend": False,
-                         "x": _r([m[3] for m in pts], 7), "y": _r([m[2] for m in pts], 7),
-                         "text": [f"{kind} {clock(m[1], off)} local · {clock(m[1])} UTC"
-                                  for m in pts],
-                         "marker": {"symbol": symbol, "color": mc, "size": 10,
-                                    "line": {"color": "white", "width": 1}},
-                         "hovertemplate": f"%{{text}}<extra>{plotly_label(r.name)}</extra>"})
+            data.append(
+                {
+                    "type": "scatter",
+                    "mode": "markers",
+                    "name": f"{kind}s",
+                    "legendgroup": group,
+                    "showlegend": False,
+                    "x": _r([m[3] for m in pts], 7),
+                    "y": _r([m[2] for m in pts], 7),
+                    "text": [f"{kind} {clock(m[1], off)} local · {clock(m[1])} UTC" for m in pts],
+                    "marker": {
+                        "symbol": symbol,
+                        "color": mc,
+                        "size": 10,
+                        "line": {"color": "white", "width": 1},
+                    },
+                    "hovertemplate": f"%{{text}}<extra>{plotly_label(r.name)}</extra>",
+                }
+            )
         if i == 0 and report.leg_numbers:
             data.append(_leg_number_trace(r, group))
         if r.boat:
             states = _boat_states(r, report.times, off, custom)
             st = states[0]
-            data.append({"type": "scatter", "mode": "markers",
-                         "name": plotly_label(f"boat: {r.name}"),
-                         "legendgroup": group, "showlegend": False, **st,
-                         "marker": {"symbol": "circle", "size": 15,
-                                    "color": BOAT_COLOUR if single else colour,
-                                    "line": {"color": "white", "width": 2.5}},
-                         "hovertemplate": "boat · " + _hover(r, off)})
+            data.append(
+                {
+                    "type": "scatter",
+                    "mode": "markers",
+                    "name": plotly_label(f"boat: {r.name}"),
+                    "legendgroup": group,
+                    "showlegend": False,
+                    **st,
+                    "marker": {
+                        "symbol": "circle",
+                        "size": 15,
+                        "color": BOAT_COLOUR if single else colour,
+                        "line": {"color": "white", "width": 2.5},
+                    },
+                    "hovertemplate": "boat · " + _hover(r, off),
+                }
+            )
             moving.append((len(data) - 1, states))
 
     frames = []
     if len(report.times) > 1 and moving:
         for k in range(len(report.times)):
-            frames.append({"name": str(k), "data": [states[k] for _, states in moving],
-                           "traces": [i for i, _ in moving]})
-    return {"data": data, "layout": _layout(report, frames), "frames": frames,
-            "config": {"responsive": True, "displaylogo": False, "scrollZoom": True}}
+            frames.append(
+                {
+                    "name": str(k),
+                    "data": [states[k] for _, states in moving],
+                    "traces": [i for i, _ in moving],
+                }
+            )
+    return {
+        "data": data,
+        "layout": _layout(report, frames),
+        "frames": frames,
+        "config": {"responsive": True, "displaylogo": False, "scrollZoom": True},
+    }
 
 
 def _layout(report: Report, frames: Sequence[Any]) -> dict[str, Any]:
@@ -308,44 +429,95 @@ def _layout(report: Report, frames: Sequence[Any]) -> dict[str, Any]:
     x0, x1, y0, y1 = course_area(course, report.routes)
     lats, lons = course.frame.to_latlon(np.array([x0, x1, x0, x1]), np.array([y0, y0, y1, y1]))
     layout: dict[str, Any] = {
-        "xaxis": {"title": {"text": "longitude [° E]"}, "tickformat": ".3f",
-                  "range": _r([np.min(lons), np.max(lons)], 6), "gridcolor": "white",
-                  "zeroline": False, "constrain": "domain"},
-        "yaxis": {"title": {"text": "latitude [° N]"}, "tickformat": ".3f",
-                  "range": _r([np.min(lats), np.max(lats)], 6), "gridcolor": "white",
-                  "zeroline": False, "scaleanchor": "x",
-                  "scaleratio": round(1.0 / math.cos(math.radians(lat0)), 6)},
-        "plot_bgcolor": SEA, "paper_bgcolor": "white", "hovermode": "closest",
-        "dragmode": "pan", "margin": {"l": 70, "r": 30, "t": 40, "b": 40},
-        "legend": ({"orientation": "v", "x": 1.02, "y": 1.0, "yanchor": "top"}
-                   if report.legend_beside else
-                   {"orientation": "h", "x": 0.0, "y": 1.02, "yanchor": "bottom"}),
+        "xaxis": {
+            "title": {"text": "longitude [° E]"},
+            "tickformat": ".3f",
+            "range": _r([np.min(lons), np.max(lons)], 6),
+            "gridcolor": "white",
+            "zeroline": False,
+            "constrain": "domain",
+        },
+        "yaxis": {
+            "title": {"text": "latitude [° N]"},
+            "tickformat": ".3f",
+            "range": _r([np.min(lats), np.max(lats)], 6),
+            "gridcolor": "white",
+            "zeroline": False,
+            "scaleanchor": "x",
+            "scaleratio": round(1.0 / math.cos(math.radians(lat0)), 6),
+        },
+        "plot_bgcolor": SEA,
+        "paper_bgcolor": "white",
+        "hovermode": "closest",
+        "dragmode": "pan",
+        "margin": {"l": 70, "r": 30, "t": 40, "b": 40},
+        "legend": (
+            {"orientation": "v", "x": 1.02, "y": 1.0, "yanchor": "top"}
+            if report.legend_beside
+            else {"orientation": "h", "x": 0.0, "y": 1.02, "yanchor": "bottom"}
+        ),
         "font": {"family": "Helvetica, Arial, sans-serif", "size": 12},
         "uirevision": "sailroute",
     }
     if frames:
-        step_args = {"mode": "immediate", "frame": {"duration": 0, "redraw": True},
-                     "transition": {"duration": 0}}
+        step_args = {
+            "mode": "immediate",
+            "frame": {"duration": 0, "redraw": True},
+            "transition": {"duration": 0},
+        }
         t0 = float(report.times[0])
-        layout["sliders"] = [{
-            "active": 0, "pad": {"t": 50, "b": 10, "l": 110}, "x": 0.0, "len": 1.0,
-            "currentvalue": {"prefix": "time: ", "font": {"size": 13, "color": "#222"}},
-            "font": {"color": "rgba(0,0,0,0)", "size": 1},
-            "steps": [{"label": f"{time_label(t, off)} · race +{format_duration(t - t0)}",
-                       "method": "animate", "args": [[str(k)], step_args]}
-                      for k, t in enumerate(report.times)],
-        }]
-        layout["updatemenus"] = [{
-            "type": "buttons", "direction": "left", "x": 0.0, "y": 0.0, "xanchor": "left",
-            "yanchor": "top", "pad": {"t": 60, "r": 10}, "showactive": False,
-            "buttons": [
-                {"label": "▶", "method": "animate",
-                 "args": [None, {"mode": "immediate", "fromcurrent": True,
-                                 "frame": {"duration": 400, "redraw": True},
-                                 "transition": {"duration": 0}}]},
-                {"label": "❚❚", "method": "animate",
-                 "args": [[None], {"mode": "immediate", "frame": {"duration": 0,
-                                                                   "redraw": False}}]},
-            ]}]
+        layout["sliders"] = [
+            {
+                "active": 0,
+                "pad": {"t": 50, "b": 10, "l": 110},
+                "x": 0.0,
+                "len": 1.0,
+                "currentvalue": {"prefix": "time: ", "font": {"size": 13, "color": "#222"}},
+                "font": {"color": "rgba(0,0,0,0)", "size": 1},
+                "steps": [
+                    {
+                        "label": f"{time_label(t, off)} · race +{format_duration(t - t0)}",
+                        "method": "animate",
+                        "args": [[str(k)], step_args],
+                    }
+                    for k, t in enumerate(report.times)
+                ],
+            }
+        ]
+        layout["updatemenus"] = [
+            {
+                "type": "buttons",
+                "direction": "left",
+                "x": 0.0,
+                "y": 0.0,
+                "xanchor": "left",
+                "yanchor": "top",
+                "pad": {"t": 60, "r": 10},
+                "showactive": False,
+                "buttons": [
+                    {
+                        "label": "▶",
+                        "method": "animate",
+                        "args": [
+                            None,
+                            {
+                                "mode": "immediate",
+                                "fromcurrent": True,
+                                "frame": {"duration": 400, "redraw": True},
+                                "transition": {"duration": 0},
+                            },
+                        ],
+                    },
+                    {
+                        "label": "❚❚",
+                        "method": "animate",
+                        "args": [
+                            [None],
+                            {"mode": "immediate", "frame": {"duration": 0, "redraw": False}},
+                        ],
+                    },
+                ],
+            }
+        ]
         layout["margin"]["b"] = 100
     return layout

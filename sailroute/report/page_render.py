@@ -76,8 +76,6 @@ def _h(text: str) -> str:
     return html.escape(clean_text(text))
 
 
-
-
 def _json_for_script(obj: Any) -> str:
     """JSON safe inside a ``<script>`` element (no ``<``, ``>`` or ``&`` characters)."""
     text = json.dumps(obj, ensure_ascii=False, separators=(",", ":"), allow_nan=False)
@@ -87,8 +85,16 @@ def _json_for_script(obj: Any) -> str:
 _LEFT = ' class="l"'
 
 
-_TEXT_COLUMNS = ("from → to", "mode", "start point", "tacks/gybes sailed : optimal",
-                 "side sailed / optimal", "boat", "note", "notes")
+_TEXT_COLUMNS = (
+    "from → to",
+    "mode",
+    "start point",
+    "tacks/gybes sailed : optimal",
+    "side sailed / optimal",
+    "boat",
+    "note",
+    "notes",
+)
 """Table columns aligned left (text); the others are numbers, aligned right."""
 
 
@@ -96,13 +102,16 @@ def _table_html(t: Table) -> str:
     left = {i for i, h in enumerate(t.headers) if h in _TEXT_COLUMNS}
 
     def cells(row: Sequence[str], tag: str) -> str:
-        return "".join(f"<{tag}{_LEFT if i in left else ''}>{_h(c)}</{tag}>"
-                       for i, c in enumerate(row))
+        return "".join(
+            f"<{tag}{_LEFT if i in left else ''}>{_h(c)}</{tag}>" for i, c in enumerate(row)
+        )
 
     body = "\n".join(f"<tr>{cells(r, 'td')}</tr>" for r in t.rows)
     foot = "\n".join(f"<tr>{cells(r, 'td')}</tr>" for r in t.footer)
-    table = (f"<table>\n<thead><tr>{cells(t.headers, 'th')}</tr></thead>\n<tbody>\n{body}\n"
-             f"</tbody>\n" + (f"<tfoot>\n{foot}\n</tfoot>\n" if foot else "") + "</table>")
+    table = (
+        f"<table>\n<thead><tr>{cells(t.headers, 'th')}</tr></thead>\n<tbody>\n{body}\n"
+        f"</tbody>\n" + (f"<tfoot>\n{foot}\n</tfoot>\n" if foot else "") + "</table>"
+    )
     table = f'<div class="table">\n{table}\n</div>'
     if t.collapsed:
         return f"<details><summary>{_h(t.caption)}</summary>\n{table}\n</details>"
@@ -163,8 +172,9 @@ inlined.</footer>
 
 def read_figure(page: str) -> dict[str, Any]:
     """The figure JSON embedded in a page written by :func:`render_html`."""
-    m = re.search(rf'<script type="application/json" id="{FIGURE_ID}">(.*?)</script>', page,
-                  flags=re.S)
+    m = re.search(
+        rf'<script type="application/json" id="{FIGURE_ID}">(.*?)</script>', page, flags=re.S
+    )
     if m is None:
         raise ValueError(f"no <script id={FIGURE_ID!r}> in the page")
     return json.loads(m.group(1))

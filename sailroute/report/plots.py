@@ -85,25 +85,63 @@ def draw_course(ax: Axes, course: Course) -> None:
     """Draw marks (with names), start/finish lines (solid) and gates (dotted) on ``ax``."""
     mx = [m.x for m in course.marks.values()]
     my = [m.y for m in course.marks.values()]
-    ax.plot(mx, my, "o", color="darkorange", mec="black", ms=7, zorder=5, gid="marks",
-            label="marks", linestyle="none")
+    ax.plot(
+        mx,
+        my,
+        "o",
+        color="darkorange",
+        mec="black",
+        ms=7,
+        zorder=5,
+        gid="marks",
+        label="marks",
+        linestyle="none",
+    )
     dirs = _label_directions(course)
     for m in course.marks.values():
         dx, dy = dirs[m.name]
         ha = "left" if dx > 0.3 else ("right" if dx < -0.3 else "center")
         va = "bottom" if dy > 0.3 else ("top" if dy < -0.3 else "center")
-        ax.annotate(m.name, (m.x, m.y), xytext=(9 * dx, 9 * dy), textcoords="offset points",
-                    fontsize=8, zorder=6, ha=ha, va=va)
+        ax.annotate(
+            m.name,
+            (m.x, m.y),
+            xytext=(9 * dx, 9 * dy),
+            textcoords="offset points",
+            fontsize=8,
+            zorder=6,
+            ha=ha,
+            va=va,
+        )
     for ln in course.lines.values():
-        ax.plot([ln.a.x, ln.b.x], [ln.a.y, ln.b.y], "-", color="black", lw=1.5, zorder=4,
-                gid=f"line:{ln.name}")
+        ax.plot(
+            [ln.a.x, ln.b.x],
+            [ln.a.y, ln.b.y],
+            "-",
+            color="black",
+            lw=1.5,
+            zorder=4,
+            gid=f"line:{ln.name}",
+        )
     for g in course.gates.values():
-        ax.plot([g.a.x, g.b.x], [g.a.y, g.b.y], ":", color="black", lw=1.2, zorder=4,
-                gid=f"gate:{g.name}")
+        ax.plot(
+            [g.a.x, g.b.x],
+            [g.a.y, g.b.y],
+            ":",
+            color="black",
+            lw=1.2,
+            zorder=4,
+            gid=f"gate:{g.name}",
+        )
 
 
-def _draw_wind(ax: Axes, fig: Figure, wind: WindField, t: float,
-               extent: tuple[float, ...], utc_offset_s: float = 0.0) -> str | None:
+def _draw_wind(
+    ax: Axes,
+    fig: Figure,
+    wind: WindField,
+    t: float,
+    extent: tuple[float, ...],
+    utc_offset_s: float = 0.0,
+) -> str | None:
     """Quiver (and speed background if the field varies) at time ``t``; returns a label."""
     x0, x1, y0, y1 = extent
     c = wind.coverage
@@ -119,17 +157,29 @@ def _draw_wind(ax: Axes, fig: Figure, wind: WindField, t: float,
     spd, twd = wind_speed_direction(u, v)
     if float(np.ptp(spd)) > 1e-6 or float(np.ptp(np.cos(np.radians(twd)))) > 1e-6:
         lo, hi = speed_limits(np.ravel(spd) / KNOT)  # >= 2 kn wide: noise stays pale
-        mesh = ax.imshow(spd / KNOT, extent=(gx0, gx1, gy0, gy1), origin="lower",
-                         cmap="Blues", alpha=0.35, interpolation="bilinear", zorder=0,
-                         aspect="auto", vmin=lo, vmax=hi)
+        mesh = ax.imshow(
+            spd / KNOT,
+            extent=(gx0, gx1, gy0, gy1),
+            origin="lower",
+            cmap="Blues",
+            alpha=0.35,
+            interpolation="bilinear",
+            zorder=0,
+            aspect="auto",
+            vmin=lo,
+            vmax=hi,
+        )
         mesh.set_gid("wind-field")
-        fig.colorbar(mesh, ax=ax, orientation="horizontal", fraction=0.04, pad=0.08,
-                     label="wind speed [kn]")
+        fig.colorbar(
+            mesh, ax=ax, orientation="horizontal", fraction=0.04, pad=0.08, label="wind speed [kn]"
+        )
     q = ax.quiver(gx, gy, u, v, color="0.35", alpha=0.7, zorder=1, angles="xy", pivot="middle")
     q.set_gid("wind")
     mean_dir = circular_mean_deg(twd, weights=spd) if float(spd.sum()) > 0 else 0.0
-    return (f"grey arrows: wind at {local_time(t, utc_offset_s)}, "
-            f"{float(spd.mean()) / KNOT:.1f} kn from {mean_dir:.0f}°")
+    return (
+        f"grey arrows: wind at {local_time(t, utc_offset_s)}, "
+        f"{float(spd.mean()) / KNOT:.1f} kn from {mean_dir:.0f}°"
+    )
 
 
 SPEED_SPAN_KN = 2.0
@@ -138,8 +188,9 @@ OFFSET_PT = 4.0
 """Sideways shift of a leg that repeats an earlier one [points]."""
 
 
-def speed_limits(values: NDArray, span: float = SPEED_SPAN_KN, decimals: int | None = None
-                 ) -> tuple[float, float]:
+def speed_limits(
+    values: NDArray, span: float = SPEED_SPAN_KN, decimals: int | None = None
+) -> tuple[float, float]:
     """Colour-scale limits [kn] of boat speeds ``values`` [kn].
 
     The 2nd-98th percentile of the finite speeds above 0.05 kn (moving), widened about its
@@ -172,9 +223,11 @@ def repeat_index_of_ends(
     """:func:`repeat_index` of legs given as ``(start_xy, end_xy)`` pairs [m]."""
     out = []
     for k, (a, b) in enumerate(ends):
-        same = sum(1 for qa, qb in ends[:k]
-                   if np.hypot(*np.subtract(qa, a)) < tol_m
-                   and np.hypot(*np.subtract(qb, b)) < tol_m)
+        same = sum(
+            1
+            for qa, qb in ends[:k]
+            if np.hypot(*np.subtract(qa, a)) < tol_m and np.hypot(*np.subtract(qb, b)) < tol_m
+        )
         out.append(same)
     return out
 
@@ -190,10 +243,20 @@ def _latlon_axes(ax: Axes, course: Course) -> None:
     lat0, lon0 = frame.lat0, frame.lon0
     m_lat = 111_132.0  # metres per degree of latitude (WGS-84, mid-latitudes; ±0.5 %)
     m_lon = m_lat * float(np.cos(np.radians(lat0)))
-    top = ax.secondary_xaxis("top", functions=(lambda x: lon0 + np.asarray(x) / m_lon,
-                                               lambda lon: (np.asarray(lon) - lon0) * m_lon))
-    right = ax.secondary_yaxis("right", functions=(lambda y: lat0 + np.asarray(y) / m_lat,
-                                                   lambda lat: (np.asarray(lat) - lat0) * m_lat))
+    top = ax.secondary_xaxis(
+        "top",
+        functions=(
+            lambda x: lon0 + np.asarray(x) / m_lon,
+            lambda lon: (np.asarray(lon) - lon0) * m_lon,
+        ),
+    )
+    right = ax.secondary_yaxis(
+        "right",
+        functions=(
+            lambda y: lat0 + np.asarray(y) / m_lat,
+            lambda lat: (np.asarray(lat) - lat0) * m_lat,
+        ),
+    )
     top.set_xlabel("longitude [°E]", fontsize=8)
     right.set_ylabel("latitude [°N]", fontsize=8)
     for a in (top, right):
@@ -210,8 +273,9 @@ def label_point(r: LegResult, k: int) -> int:
     return min(int(frac * r.track.t.size), r.track.t.size - 1)
 
 
-def _leg_wind(ax: Axes, wind: WindField, legs: Sequence[LegResult],
-              extent: tuple[float, ...]) -> str | None:
+def _leg_wind(
+    ax: Axes, wind: WindField, legs: Sequence[LegResult], extent: tuple[float, ...]
+) -> str | None:
     """One arrow per leg where its number is (at that point's time); nothing when the wind
     is the same on every leg.  Returns the legend text ("1: 6.3 kn 149°, ...") or None."""
     size = 0.06 * max(extent[1] - extent[0], extent[3] - extent[2])
@@ -235,12 +299,16 @@ def _leg_wind(ax: Axes, wind: WindField, legs: Sequence[LegResult],
         if spd <= 0:
             continue
         ux, uy = u / spd, v / spd
-        ax.annotate("", xy=(x + 0.5 * size * ux, y + 0.5 * size * uy),
-                    xytext=(x - 0.5 * size * ux, y - 0.5 * size * uy),
-                    arrowprops={"arrowstyle": "-|>", "color": "steelblue", "lw": 1.6},
-                    zorder=8, gid=f"wind-leg:{k + 1}")
+        ax.annotate(
+            "",
+            xy=(x + 0.5 * size * ux, y + 0.5 * size * uy),
+            xytext=(x - 0.5 * size * ux, y - 0.5 * size * uy),
+            arrowprops={"arrowstyle": "-|>", "color": "steelblue", "lw": 1.6},
+            zorder=8,
+            gid=f"wind-leg:{k + 1}",
+        )
         parts.append(f"{k + 1}: {spd / KNOT:.1f} kn {twd:.0f}°")
-    rows = [", ".join(parts[i:i + 3]) for i in range(0, len(parts), 3)]
+    rows = [", ".join(parts[i : i + 3]) for i in range(0, len(parts), 3)]
     return "blue arrows, wind at each leg's number:\n" + "\n".join(rows)
 
 
@@ -288,13 +356,13 @@ def plot_route(
     # a fixed layout in inches (constrained layout cost 0.2-0.45 s of a 1.8 s plan):
     # room for the metre ticks (left, bottom), the title and longitude axis (top), and
     # the latitude axis and colour bar (right)
-    fig.subplots_adjust(left=0.75 / 10.0, right=1.0 - 1.2 / 10.0, bottom=0.55 / height,
-                        top=1.0 - 0.85 / height)
+    fig.subplots_adjust(
+        left=0.75 / 10.0, right=1.0 - 1.2 / 10.0, bottom=0.55 / height, top=1.0 - 0.85 / height
+    )
     ax = fig.add_subplot()
     if t is None:
         t = legs[0].t_start if legs else course.start_epoch
-    wind_label = (_draw_wind(ax, fig, wind, t, extent, utc_offset_s)
-                  if wind is not None else None)
+    wind_label = _draw_wind(ax, fig, wind, t, extent, utc_offset_s) if wind is not None else None
     draw_course(ax, course)
     bsp_all = np.concatenate([r.track.bsp_ms for r in legs]) / KNOT if legs else np.zeros(1)
     norm = Normalize(*speed_limits(bsp_all))
@@ -304,23 +372,36 @@ def plot_route(
         pts = np.column_stack([r.track.x, r.track.y])
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
         # an (n, 2, 2) array is the segment list matplotlib documents; its stubs want a Sequence
-        lc = LineCollection(segs, cmap="viridis", norm=norm, linewidths=2.2,  # type: ignore[arg-type]
-                            zorder=3)
+        lc = LineCollection(
+            segs,
+            cmap="viridis",
+            norm=norm,
+            linewidths=2.2,  # type: ignore[arg-type]
+            zorder=3,
+        )
         lc.set_array(r.track.bsp_ms[:-1] / KNOT)
         lc.set_gid(f"leg:{k + 1}")
         if repeats[k]:  # the same water as an earlier leg: shift it sideways on screen
             dx, dy = np.subtract(r.end_xy, r.start_xy)
             n = float(np.hypot(dx, dy)) or 1.0
             off = OFFSET_PT * repeats[k]
-            lc.set_transform(offset_copy(ax.transData, fig=fig, x=off * dy / n,
-                                         y=-off * dx / n, units="points"))
+            lc.set_transform(
+                offset_copy(ax.transData, fig=fig, x=off * dy / n, y=-off * dx / n, units="points")
+            )
         ax.add_collection(lc)
         i = label_point(r, k)
-        ax.annotate(str(k + 1), (float(r.track.x[i]), float(r.track.y[i])),
-                    xytext=(0, 0), textcoords="offset points", fontsize=7, ha="center",
-                    va="center", zorder=9, gid=f"legno:{k + 1}",
-                    bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.3",
-                          "lw": 0.6})
+        ax.annotate(
+            str(k + 1),
+            (float(r.track.x[i]), float(r.track.y[i])),
+            xytext=(0, 0),
+            textcoords="offset points",
+            fontsize=7,
+            ha="center",
+            va="center",
+            zorder=9,
+            gid=f"legno:{k + 1}",
+            bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.3", "lw": 0.6},
+        )
     legs_wind = _leg_wind(ax, wind, legs, extent) if wind is not None else None
     if legs_wind:
         wind_label = f"{wind_label}\n{legs_wind}" if wind_label else legs_wind
@@ -328,10 +409,28 @@ def plot_route(
         fig.colorbar(lc, ax=ax, label="boat speed [kn]", shrink=0.8, pad=0.09, fraction=0.04)
     tacks = [(m.x, m.y) for r in legs for m in r.manoeuvres if m.kind == "tack"]
     gybes = [(m.x, m.y) for r in legs for m in r.manoeuvres if m.kind == "gybe"]
-    ax.plot([p[0] for p in tacks], [p[1] for p in tacks], "^", color="crimson", ms=6,
-            linestyle="none", zorder=7, gid="tacks", label=f"tacks ({len(tacks)})")
-    ax.plot([p[0] for p in gybes], [p[1] for p in gybes], "s", color="royalblue", ms=5,
-            linestyle="none", zorder=7, gid="gybes", label=f"gybes ({len(gybes)})")
+    ax.plot(
+        [p[0] for p in tacks],
+        [p[1] for p in tacks],
+        "^",
+        color="crimson",
+        ms=6,
+        linestyle="none",
+        zorder=7,
+        gid="tacks",
+        label=f"tacks ({len(tacks)})",
+    )
+    ax.plot(
+        [p[0] for p in gybes],
+        [p[1] for p in gybes],
+        "s",
+        color="royalblue",
+        ms=5,
+        linestyle="none",
+        zorder=7,
+        gid="gybes",
+        label=f"gybes ({len(gybes)})",
+    )
     _map_frame(ax, extent)
     _latlon_axes(ax, course)
     ax.legend(loc="best", fontsize=8, title=wind_label, title_fontsize=8)
@@ -345,10 +444,11 @@ def plot_plan(plan: Plan, wind: WindField | None = None) -> Figure:
     from sailroute.report.tables import format_duration
 
     off = plan.course.utc_offset_s
-    title = (f"{plan.course.name} - {plan.scenario}: {format_duration(plan.total_time_s)} "
-             f"({plan.total_time_s:.0f} s), start {local_time(plan.t_start, off)}")
-    fig = plot_route(plan.course, plan.results, wind, plan.t_start, title=title,
-                     utc_offset_s=off)
+    title = (
+        f"{plan.course.name} - {plan.scenario}: {format_duration(plan.total_time_s)} "
+        f"({plan.total_time_s:.0f} s), start {local_time(plan.t_start, off)}"
+    )
+    fig = plot_route(plan.course, plan.results, wind, plan.t_start, title=title, utc_offset_s=off)
     from sailroute.report.startline import draw_start_and_laylines
 
     draw_start_and_laylines(fig.axes[0], plan.start_line, plan.laylines)
@@ -381,15 +481,31 @@ def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:
     x = np.arange(nl)
     colours = [f"C{i % 10}" for i in range(ns)]
     for i, s in enumerate(cmp.scenarios):
-        bars = ax.bar(x - 0.4 + width * (i + 0.5), cmp.times[i], width, color=colours[i],
-                      label=f"{s} ({cmp.totals[i]:.0f} s)")
+        bars = ax.bar(
+            x - 0.4 + width * (i + 0.5),
+            cmp.times[i],
+            width,
+            color=colours[i],
+            label=f"{s} ({cmp.totals[i]:.0f} s)",
+        )
         for patch in bars.patches:
             patch.set_gid(f"bars:{s}")
     styles = [("_", 24, "black"), ("o", 8, "none"), ("D", 7, "none"), ("s", 7, "none")]
     for j, (r, vals) in enumerate(cmp.references.items()):
         mk, ms, mfc = styles[j % len(styles)]
-        ax.plot(x, vals, mk, color="black", mfc=mfc, ms=ms, mew=2, linestyle="none",
-                label=f"{r} ({vals.sum():.0f} s)", gid=f"reference:{r}", zorder=4)
+        ax.plot(
+            x,
+            vals,
+            mk,
+            color="black",
+            mfc=mfc,
+            ms=ms,
+            mew=2,
+            linestyle="none",
+            label=f"{r} ({vals.sum():.0f} s)",
+            gid=f"reference:{r}",
+            zorder=4,
+        )
     ax.set_xticks(x, [f"{k + 1}\n{lab}" for k, lab in enumerate(cmp.leg_labels)], fontsize=8)
     ax.set_ylabel("leg time [s]")
     ax.set_title(f"{cmp.course_name}: leg times by scenario", fontsize=10)
@@ -402,8 +518,15 @@ def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:
         for i, p in enumerate(plans):
             xs = np.concatenate([r.track.x for r in p.results])
             ys = np.concatenate([r.track.y for r in p.results])
-            mx.plot(xs, ys, "-", color=colours[i % len(colours)], lw=1.6, gid=f"route:{p.scenario}",
-                    label=p.scenario)
+            mx.plot(
+                xs,
+                ys,
+                "-",
+                color=colours[i % len(colours)],
+                lw=1.6,
+                gid=f"route:{p.scenario}",
+                label=p.scenario,
+            )
         _map_frame(mx, _extent(course, [r for p in plans for r in p.results]))
         mx.legend(fontsize=8)
         mx.set_title("routes", fontsize=10)

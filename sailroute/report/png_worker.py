@@ -123,8 +123,12 @@ class PngWorker:
     def __enter__(self) -> PngWorker:
         return self
 
-    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None,
-                 tb: TracebackType | None) -> None:
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
         self.close()
 
 
@@ -143,7 +147,9 @@ def start(enabled: bool = True) -> PngWorker:
     try:
         proc = subprocess.Popen(
             [sys.executable, "-m", "sailroute.report.png_worker"],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
         )
     except OSError:  # pragma: no cover - no interpreter to start
         return PngWorker(None)

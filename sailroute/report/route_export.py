@@ -36,8 +36,15 @@ from sailroute.textin import clean_text
 from sailroute.timeutil import iso
 
 __all__ = [
-    "KML_NS", "NMEA_MAX_LEN", "RoutePoint", "nmea_checksum", "nmea_ids", "nmea_sentences",
-    "route_points", "write_kml", "write_nmea",
+    "KML_NS",
+    "NMEA_MAX_LEN",
+    "RoutePoint",
+    "nmea_checksum",
+    "nmea_ids",
+    "nmea_sentences",
+    "route_points",
+    "write_kml",
+    "write_nmea",
 ]
 
 KML_NS = "http://www.opengis.net/kml/2.2"
@@ -96,19 +103,24 @@ def route_points(plan: Plan) -> tuple[RoutePoint, ...]:
         return ()
     first = plan.legs[0]
     lat, lon = c.frame.to_latlon(*first.result.start_xy)
-    out.append(RoutePoint(first.spec.from_name, "start", float(lat), float(lon),
-                          first.result.t_start, 1))
+    out.append(
+        RoutePoint(first.spec.from_name, "start", float(lat), float(lon), first.result.t_start, 1)
+    )
     count = {"tack": 0, "gybe": 0}
     for pl in plan.legs:
         leg = pl.spec.index + 1
         for m in sorted(pl.result.manoeuvres, key=lambda m: m.t):
             count[m.kind] += 1
             lat, lon = c.frame.to_latlon(m.x, m.y)
-            out.append(RoutePoint(f"{m.kind[0].upper()}{count[m.kind]}", m.kind, float(lat),
-                                  float(lon), m.t, leg))
+            out.append(
+                RoutePoint(
+                    f"{m.kind[0].upper()}{count[m.kind]}", m.kind, float(lat), float(lon), m.t, leg
+                )
+            )
         lat, lon = c.frame.to_latlon(*pl.result.end_xy)
-        out.append(RoutePoint(pl.spec.to_name, pl.spec.kind, float(lat), float(lon),
-                              pl.result.t_end, leg))
+        out.append(
+            RoutePoint(pl.spec.to_name, pl.spec.kind, float(lat), float(lon), pl.result.t_end, leg)
+        )
     return tuple(out)
 
 
@@ -120,8 +132,14 @@ def _kml(parent: ET.Element, tag: str, text: str | None = None) -> ET.Element:
     return el
 
 
-def _placemark(folder: ET.Element, name: str, description: str, coords: str,
-               when: str | None = None, geometry: str = "Point") -> ET.Element:
+def _placemark(
+    folder: ET.Element,
+    name: str,
+    description: str,
+    coords: str,
+    when: str | None = None,
+    geometry: str = "Point",
+) -> ET.Element:
     pm = _kml(folder, "Placemark")
     _kml(pm, "name", name)
     _kml(pm, "description", description)
@@ -151,8 +169,12 @@ def write_kml(path: str | Path, plan: Plan) -> Path:
     root = ET.Element(f"{{{KML_NS}}}kml")
     doc = _kml(root, "Document")
     _kml(doc, "name", f"{c.name} ({plan.scenario})")
-    _kml(doc, "description", f"sailroute {__version__}: route planned with the "
-         f"{plan.router or 'default'} router, start {iso(plan.t_start)}")
+    _kml(
+        doc,
+        "description",
+        f"sailroute {__version__}: route planned with the "
+        f"{plan.router or 'default'} router, start {iso(plan.t_start)}",
+    )
     marks = _kml(doc, "Folder")
     _kml(marks, "name", "marks")
     for m in c.marks.values():
@@ -164,14 +186,23 @@ def write_kml(path: str | Path, plan: Plan) -> Path:
         tr = pl.result.track
         lat, lon = c.frame.to_latlon(tr.x, tr.y)
         coords += [f"{b:.8f},{a:.8f}" for a, b in zip(lat, lon, strict=True)]
-    _placemark(route, f"{c.name} ({plan.scenario})",
-               f"{len(plan.legs)} legs, {plan.total_time_s:.0f} s", " ".join(coords),
-               geometry="LineString")
+    _placemark(
+        route,
+        f"{c.name} ({plan.scenario})",
+        f"{len(plan.legs)} legs, {plan.total_time_s:.0f} s",
+        " ".join(coords),
+        geometry="LineString",
+    )
     wps = _kml(doc, "Folder")
     _kml(wps, "name", "waypoints")
     for p in route_points(plan):
-        _placemark(wps, p.name, f"{p.kind}, leg {p.leg}, {iso(p.t)}",
-                   f"{p.lon:.8f},{p.lat:.8f}", when=iso(p.t))
+        _placemark(
+            wps,
+            p.name,
+            f"{p.kind}, leg {p.leg}, {iso(p.t)}",
+            f"{p.lon:.8f},{p.lat:.8f}",
+            when=iso(p.t),
+        )
     tree = ET.ElementTree(root)
     ET.indent(tree, space=" ")
     out = Path(path)
@@ -207,8 +238,10 @@ def nmea_ids(names: Sequence[str]) -> tuple[str, ...]:
     tuple of str
     """
     width = max(2, len(str(len(names) - 1)))
-    return tuple(f"{k:0{width}d}{re.sub(r'[^A-Z0-9]', '', n.upper())}"[:NMEA_ID_LEN]
-                 for k, n in enumerate(names))
+    return tuple(
+        f"{k:0{width}d}{re.sub(r'[^A-Z0-9]', '', n.upper())}"[:NMEA_ID_LEN]
+        for k, n in enumerate(names)
+    )
 
 
 def _lat(lat: float) -> str:
@@ -246,8 +279,10 @@ def nmea_sentences(points: Sequence[RoutePoint], route_id: str = "1") -> list[st
         :data:`NMEA_MAX_LEN` characters with its line end.
     """
     ids = nmea_ids([p.name for p in points])
-    out = [_sentence(f"{TALKER}WPL,{_lat(p.lat)},{_lon(p.lon)},{i}")
-           for p, i in zip(points, ids, strict=True)]
+    out = [
+        _sentence(f"{TALKER}WPL,{_lat(p.lat)},{_lon(p.lon)},{i}")
+        for p, i in zip(points, ids, strict=True)
+    ]
     # "$" + body + "*hh" + CR LF <= 82; the header's counts are at most 2 digits each
     room = NMEA_MAX_LEN - len("$") - len("*hh") - len("\r\n")
     head = len(f"{TALKER}RTE,99,99,c,{route_id}")
@@ -257,8 +292,10 @@ def nmea_sentences(points: Sequence[RoutePoint], route_id: str = "1") -> list[st
             groups.append([])
         groups[-1].append(i)
     n = len(groups)
-    out += [_sentence(f"{TALKER}RTE,{n},{k + 1},c,{route_id},{','.join(g)}")
-            for k, g in enumerate(groups)]
+    out += [
+        _sentence(f"{TALKER}RTE,{n},{k + 1},c,{route_id},{','.join(g)}")
+        for k, g in enumerate(groups)
+    ]
     return out
 
 

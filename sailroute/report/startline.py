@@ -35,8 +35,12 @@ def _num(x: float, nd: int = 3) -> float | None:
 
 def _point(frame: LocalFrame, xy: tuple[float, float]) -> dict[str, float | None]:
     lat, lon = frame.to_latlon(xy[0], xy[1])
-    return {"x": _num(xy[0]), "y": _num(xy[1]), "lat": _num(float(lat), 7),
-            "lon": _num(float(lon), 7)}
+    return {
+        "x": _num(xy[0]),
+        "y": _num(xy[1]),
+        "lat": _num(float(lat), 7),
+        "lon": _num(float(lon), 7),
+    }
 
 
 # --- plan: the start line -------------------------------------------------------------
@@ -52,15 +56,20 @@ def start_line_to_dict(sl: StartLineNumbers | None, frame: LocalFrame) -> dict[s
         "b": {"name": sl.b_name, **_point(frame, sl.b_xy)},
         "time": iso(sl.t_gun),
         "length_m": _num(sl.length_m, 2),
-        "tws_ms": _num(sl.tws_ms), "tws_kn": _num(sl.tws_ms / KNOT),
+        "tws_ms": _num(sl.tws_ms),
+        "tws_kn": _num(sl.tws_ms / KNOT),
         "twd_deg": _num(sl.twd_deg, 2),
         "bias_deg": _num(sl.bias_deg, 2),
-        "starboard_end": sl.starboard_end, "port_end": sl.port_end,
-        "favoured_end": sl.favoured_end, "favoured_side": sl.favoured_side,
+        "starboard_end": sl.starboard_end,
+        "port_end": sl.port_end,
+        "favoured_end": sl.favoured_end,
+        "favoured_side": sl.favoured_side,
         "favoured_point": None if fav is None else _point(frame, fav),
-        "gain_m": _num(sl.gain_m, 2), "gain_s": _num(sl.gain_s, 2),
+        "gain_m": _num(sl.gain_m, 2),
+        "gain_s": _num(sl.gain_s, 2),
         "vmg_ms": _num(sl.vmg_ms),
-        "bias_min_deg": _num(sl.bias_min_deg, 2), "bias_max_deg": _num(sl.bias_max_deg, 2),
+        "bias_min_deg": _num(sl.bias_min_deg, 2),
+        "bias_max_deg": _num(sl.bias_max_deg, 2),
         "window_s": _num(sl.window_s, 1),
     }
 
@@ -70,21 +79,29 @@ def laylines_to_dicts(laylines: Sequence[Layline], frame: LocalFrame) -> list[di
     out = []
     for ll in laylines:
         lat, lon = frame.to_latlon(ll.x, ll.y)
-        out.append({
-            "mark": ll.mark, "kind": ll.kind, "tack": ll.tack,
-            "length_m": _num(ll.length_m, 1),
-            "points": [{"x": _num(x, 2), "y": _num(y, 2), "lat": _num(a, 7), "lon": _num(o, 7)}
-                       for x, y, a, o in zip(ll.x, ll.y, np.atleast_1d(lat),
-                                             np.atleast_1d(lon), strict=True)],
-        })
+        out.append(
+            {
+                "mark": ll.mark,
+                "kind": ll.kind,
+                "tack": ll.tack,
+                "length_m": _num(ll.length_m, 1),
+                "points": [
+                    {"x": _num(x, 2), "y": _num(y, 2), "lat": _num(a, 7), "lon": _num(o, 7)}
+                    for x, y, a, o in zip(
+                        ll.x, ll.y, np.atleast_1d(lat), np.atleast_1d(lon), strict=True
+                    )
+                ],
+            }
+        )
     return out
 
 
 # --- drawings --------------------------------------------------------------------------
 
 
-def draw_start_and_laylines(ax: Any, sl: StartLineNumbers | None,
-                            laylines: Sequence[Sequence[Layline]]) -> None:
+def draw_start_and_laylines(
+    ax: Any, sl: StartLineNumbers | None, laylines: Sequence[Sequence[Layline]]
+) -> None:
     """Laylines (dashed grey) and the favoured end (green star) on a matplotlib map.
 
     Artists carry gids ``layline:<leg>:<mark>:<tack>`` and ``favoured-end``; an existing
@@ -93,46 +110,92 @@ def draw_start_and_laylines(ax: Any, sl: StartLineNumbers | None,
     first = True
     for k, leg in enumerate(laylines):
         for ll in leg:
-            ax.plot(ll.x, ll.y, linestyle=(0, (4, 3)), color=LAYLINE_COLOUR, lw=0.9,
-                    zorder=2, gid=f"layline:{k + 1}:{ll.mark}:{ll.tack}",
-                    label="laylines" if first else None)
+            ax.plot(
+                ll.x,
+                ll.y,
+                linestyle=(0, (4, 3)),
+                color=LAYLINE_COLOUR,
+                lw=0.9,
+                zorder=2,
+                gid=f"layline:{k + 1}:{ll.mark}:{ll.tack}",
+                label="laylines" if first else None,
+            )
             first = False
     if sl is not None and sl.favoured_xy is not None:
         fx, fy = sl.favoured_xy
-        ax.plot([fx], [fy], marker="*", ms=15, color=FAVOURED_COLOUR, mec="black", mew=0.6,
-                linestyle="none", zorder=8, gid="favoured-end", label="favoured start end")
-        ax.annotate(f"favoured +{sl.gain_m:.0f} m", (fx, fy), xytext=(8, -12),
-                    textcoords="offset points", fontsize=7, color="#1b5e20", zorder=9)
+        ax.plot(
+            [fx],
+            [fy],
+            marker="*",
+            ms=15,
+            color=FAVOURED_COLOUR,
+            mec="black",
+            mew=0.6,
+            linestyle="none",
+            zorder=8,
+            gid="favoured-end",
+            label="favoured start end",
+        )
+        ax.annotate(
+            f"favoured +{sl.gain_m:.0f} m",
+            (fx, fy),
+            xytext=(8, -12),
+            textcoords="offset points",
+            fontsize=7,
+            color="#1b5e20",
+            zorder=9,
+        )
     old = ax.get_legend()
     if old is not None and (not first or (sl is not None and sl.favoured_xy is not None)):
         ax.legend(loc="best", fontsize=8, title=old.get_title().get_text(), title_fontsize=8)
 
 
-def plotly_traces(sl: StartLineNumbers | None, laylines: Sequence[Sequence[Layline]],
-                  frame: LocalFrame) -> list[dict[str, Any]]:
+def plotly_traces(
+    sl: StartLineNumbers | None, laylines: Sequence[Sequence[Layline]], frame: LocalFrame
+) -> list[dict[str, Any]]:
     """Plotly traces (lon/lat) of the laylines and the favoured end for ``report.html``."""
     out: list[dict[str, Any]] = []
     first = True
     for k, leg in enumerate(laylines):
         for ll in leg:
             lat, lon = frame.to_latlon(ll.x, ll.y)
-            out.append({"type": "scatter", "mode": "lines", "name": "laylines",
-                        "legendgroup": "laylines", "showlegend": first,
-                        "x": [round(float(v), 7) for v in np.atleast_1d(lon)],
-                        "y": [round(float(v), 7) for v in np.atleast_1d(lat)],
-                        "line": {"color": LAYLINE_COLOUR, "width": 1.2, "dash": "dash"},
-                        "hovertemplate": f"leg {k + 1}: {ll.tack} {ll.kind} layline to "
-                                         f"{ll.mark}<extra></extra>"})
+            out.append(
+                {
+                    "type": "scatter",
+                    "mode": "lines",
+                    "name": "laylines",
+                    "legendgroup": "laylines",
+                    "showlegend": first,
+                    "x": [round(float(v), 7) for v in np.atleast_1d(lon)],
+                    "y": [round(float(v), 7) for v in np.atleast_1d(lat)],
+                    "line": {"color": LAYLINE_COLOUR, "width": 1.2, "dash": "dash"},
+                    "hovertemplate": f"leg {k + 1}: {ll.tack} {ll.kind} layline to "
+                    f"{ll.mark}<extra></extra>",
+                }
+            )
             first = False
     if sl is not None and sl.favoured_xy is not None:
         lat, lon = frame.to_latlon(*sl.favoured_xy)
-        out.append({"type": "scatter", "mode": "markers", "name": "favoured end",
-                    "x": [round(float(lon), 7)], "y": [round(float(lat), 7)],
-                    "marker": {"symbol": "star", "size": 16, "color": FAVOURED_COLOUR,
-                               "line": {"color": "black", "width": 1}},
-                    "hovertemplate": (f"favoured end {sl.favoured_end}: bias "
-                                      f"{sl.bias_deg:+.1f}°, {sl.gain_m:.0f} m, "
-                                      f"{sl.gain_s:.0f} s<extra></extra>")})
+        out.append(
+            {
+                "type": "scatter",
+                "mode": "markers",
+                "name": "favoured end",
+                "x": [round(float(lon), 7)],
+                "y": [round(float(lat), 7)],
+                "marker": {
+                    "symbol": "star",
+                    "size": 16,
+                    "color": FAVOURED_COLOUR,
+                    "line": {"color": "black", "width": 1},
+                },
+                "hovertemplate": (
+                    f"favoured end {sl.favoured_end}: bias "
+                    f"{sl.bias_deg:+.1f}°, {sl.gain_m:.0f} m, "
+                    f"{sl.gain_s:.0f} s<extra></extra>"
+                ),
+            }
+        )
     return out
 
 
@@ -141,17 +204,23 @@ def plotly_traces(sl: StartLineNumbers | None, laylines: Sequence[Sequence[Layli
 
 def _approach_dict(ap: Approach, frame: LocalFrame) -> dict[str, Any]:
     return {
-        "label": ap.label, "tack": ap.tack, "heading_deg": _num(ap.heading_deg, 2),
-        "twa_deg": _num(ap.twa_deg, 2), "speed_ms": _num(ap.speed_ms),
-        "speed_kn": _num(ap.speed_ms / KNOT), "reaches_line": ap.reaches,
-        "distance_m": _num(ap.distance_m, 2), "time_s": _num(ap.time_s, 2),
+        "label": ap.label,
+        "tack": ap.tack,
+        "heading_deg": _num(ap.heading_deg, 2),
+        "twa_deg": _num(ap.twa_deg, 2),
+        "speed_ms": _num(ap.speed_ms),
+        "speed_kn": _num(ap.speed_ms / KNOT),
+        "reaches_line": ap.reaches,
+        "distance_m": _num(ap.distance_m, 2),
+        "time_s": _num(ap.time_s, 2),
         "line_fraction": _num(ap.fraction, 4),
         "point": _point(frame, ap.point_xy) if ap.reaches else None,
     }
 
 
-def approach_to_dict(ap: LineApproach, frame: LocalFrame, *, course: str,
-                     line: StartLineNumbers) -> dict[str, Any]:
+def approach_to_dict(
+    ap: LineApproach, frame: LocalFrame, *, course: str, line: StartLineNumbers
+) -> dict[str, Any]:
     """The ``start.json`` document (without the version keys)."""
     return {
         "course": course,
@@ -159,13 +228,18 @@ def approach_to_dict(ap: LineApproach, frame: LocalFrame, *, course: str,
         "time": iso(ap.t),
         "gun": iso(ap.t_gun),
         "time_to_gun_s": _num(ap.time_to_gun_s, 2),
-        "wind": {"tws_ms": _num(ap.tws_ms), "tws_kn": _num(ap.tws_ms / KNOT),
-                 "twd_deg": _num(ap.twd_deg, 2)},
+        "wind": {
+            "tws_ms": _num(ap.tws_ms),
+            "tws_kn": _num(ap.tws_ms / KNOT),
+            "twd_deg": _num(ap.twd_deg, 2),
+        },
         "distance_to_line_m": _num(ap.distance_m, 2),
         "course_side": ap.course_side,
         "close_hauled": {a.tack: _approach_dict(a, frame) for a in ap.close_hauled},
-        "to_ends": {name: _approach_dict(a, frame)
-                    for name, a in zip((line.a_name, line.b_name), ap.to_ends, strict=True)},
+        "to_ends": {
+            name: _approach_dict(a, frame)
+            for name, a in zip((line.a_name, line.b_name), ap.to_ends, strict=True)
+        },
         "tacks": {a.tack: _approach_dict(a, frame) for a in ap.tacks},
         "fastest": _approach_dict(ap.fastest, frame),
         "time_to_burn_s": _num(ap.time_to_burn_s, 2),

@@ -173,7 +173,7 @@ def plot_leg_times(
     fig = _figure(11.0, 4.5)
     ax1, ax2 = fig.subplots(1, 2)
     fin_all = np.concatenate([np.asarray(v)[np.isfinite(v)] for v in samples.values()])
-    lo, hi = (np.percentile(fin_all, [0.5, 99.5]) if fin_all.size else (0.0, 1.0))
+    lo, hi = np.percentile(fin_all, [0.5, 99.5]) if fin_all.size else (0.0, 1.0)
     bins = np.linspace(lo, hi, 50)
     for label, t in samples.items():
         xs, fs = ecdf(t)
@@ -238,8 +238,9 @@ def plot_deadline_policy(
     ax1.set_facecolor("#bdbdbd")
     im1 = ax1.imshow(u, origin="lower", extent=box, cmap="viridis", vmin=0, vmax=180)
     hopeless = np.where(w <= 0.0, 1.0, np.nan)
-    ax1.imshow(hopeless, origin="lower", extent=box, cmap=ListedColormap(["#404040"]),
-               vmin=0, vmax=1)
+    ax1.imshow(
+        hopeless, origin="lower", extent=box, cmap=ListedColormap(["#404040"]), vmin=0, vmax=1
+    )
     fig.colorbar(
         im1,
         ax=ax1,
@@ -309,8 +310,9 @@ def write_json(summary: Mapping[str, Any], path: str | Path) -> Path:
     return p
 
 
-def write_strategy_outputs(result: StrategyResult, out_dir: str | Path, plots: bool = True
-                           ) -> dict[str, Path]:
+def write_strategy_outputs(
+    result: StrategyResult, out_dir: str | Path, plots: bool = True
+) -> dict[str, Path]:
     """Write ``summary.json`` and (unless ``plots=False``) the PNG figures into ``out_dir``.
 
     Returns
@@ -324,8 +326,7 @@ def write_strategy_outputs(result: StrategyResult, out_dir: str | Path, plots: b
         return {p.stem: p for p in written}
     pol = result.policy
     written.append(
-        save_figure(plot_policy_map(pol, tack=result.settings.start_tack),
-                           out / "policy_map.png")
+        save_figure(plot_policy_map(pol, tack=result.settings.start_tack), out / "policy_map.png")
     )
     written.append(save_figure(plot_spaghetti(result.sim), out / "spaghetti.png"))
     samples = {"expected-time SDP (lattice, OU/chain wind)": result.sim.leg_time_s}
@@ -334,8 +335,9 @@ def write_strategy_outputs(result: StrategyResult, out_dir: str | Path, plots: b
     if study is not None:
         samples = {"risk-neutral μ*": study.sim_rn.leg_time_s}
         r0, th0, q0 = study.start
-        curves = {"w(s): best possible P(T ≤ s)": (study.ra.s_s,
-                                                     study.ra.success_curve(r0, th0, q0))}
+        curves = {
+            "w(s): best possible P(T ≤ s)": (study.ra.s_s, study.ra.success_curve(r0, th0, q0))
+        }
         for d, sim in study.sims_ra.items():
             samples[f"risk-aware α^{d:g}"] = sim.leg_time_s
     written.append(
@@ -348,8 +350,12 @@ def write_strategy_outputs(result: StrategyResult, out_dir: str | Path, plots: b
         d0 = float(result.settings.deadlines_s[0])
         written.append(
             save_figure(
-                plot_deadline_policy(study.ra, d0, result.settings.start_tack,
-                                            extent_m=result.settings.length_m * 1.1),
+                plot_deadline_policy(
+                    study.ra,
+                    d0,
+                    result.settings.start_tack,
+                    extent_m=result.settings.length_m * 1.1,
+                ),
                 out / "deadline_policy.png",
             )
         )
@@ -370,12 +376,15 @@ def shift_model_text(model: ShiftModel) -> str:
     d = model.describe()
     if d["kind"] == "ou":
         tl = float(d["timescale_s"])
-        text = (f"oscillating (OU): sd {float(d['sigma_deg']):.1f}°, time scale "
-                + ("infinite (frozen wind)" if math.isinf(tl) else f"{tl / 60:.1f} min"))
+        text = f"oscillating (OU): sd {float(d['sigma_deg']):.1f}°, time scale " + (
+            "infinite (frozen wind)" if math.isinf(tl) else f"{tl / 60:.1f} min"
+        )
         mean = float(d["mean_deg"])
         return text + (f", mean {mean:+.1f}°" if mean else "")
-    return (f"persistent (drift-diffusion): drift {60 * float(d['drift_deg_per_s']):+.2f}°/min, "
-            f"diffusion {math.sqrt(60) * float(d['sigma_deg_per_sqrt_s']):.2f}°/√min")
+    return (
+        f"persistent (drift-diffusion): drift {60 * float(d['drift_deg_per_s']):+.2f}°/min, "
+        f"diffusion {math.sqrt(60) * float(d['sigma_deg_per_sqrt_s']):.2f}°/√min"
+    )
 
 
 def format_report(result: StrategyResult) -> str:

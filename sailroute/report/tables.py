@@ -49,15 +49,19 @@ def rich_tables(console: Any) -> Iterator[None]:
         _RICH_CONSOLE.reset(token)
 
 
-def _rich_table(console: Any, headers: Sequence[str], rows: Sequence[Sequence[str]],
-                align: str, footer: Sequence[Sequence[str]]) -> str:
+def _rich_table(
+    console: Any,
+    headers: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    align: str,
+    footer: Sequence[Sequence[str]],
+) -> str:
     from rich.box import Box
     from rich.console import Console
     from rich.table import Table
 
     rules = Box("    \n    \n ── \n    \n ── \n ── \n    \n    \n")  # under head, above total
-    t = Table(box=rules, show_edge=False, header_style="bold", pad_edge=False,
-              padding=(0, 1, 0, 0))
+    t = Table(box=rules, show_edge=False, header_style="bold", pad_edge=False, padding=(0, 1, 0, 0))
     for h, a in zip(headers, align, strict=True):
         t.add_column(h, justify="left" if a == "l" else "right")
     for r in rows:
@@ -68,14 +72,22 @@ def _rich_table(console: Any, headers: Sequence[str], rows: Sequence[Sequence[st
             t.add_row(*r, style="bold")
     # drawn at its natural width, never squeezed to the terminal's: numbers stay whole
     buf = io.StringIO()
-    wide = Console(file=buf, width=100_000, color_system=console.color_system,
-                   force_terminal=console.is_terminal, no_color=console.no_color)
+    wide = Console(
+        file=buf,
+        width=100_000,
+        color_system=console.color_system,
+        force_terminal=console.is_terminal,
+        no_color=console.no_color,
+    )
     wide.print(t)
     return "\n".join(line.rstrip() for line in buf.getvalue().rstrip("\n").split("\n"))
 
 
 def render_table(
-    headers: Sequence[str], rows: Sequence[Sequence[str]], *, align: str | None = None,
+    headers: Sequence[str],
+    rows: Sequence[Sequence[str]],
+    *,
+    align: str | None = None,
     footer: Sequence[Sequence[str]] = (),
 ) -> str:
     """Align columns of text.
@@ -140,26 +152,46 @@ def plan_table(plan: Plan) -> str:
     (:func:`start_line_text`) when the plan has one.
     """
     refs = list(plan.references.items())
-    headers = ["leg", "from -> to", "mode", "time", "time s", "tacks", "gybes", "dist m",
-               "start point"]
+    headers = [
+        "leg",
+        "from -> to",
+        "mode",
+        "time",
+        "time s",
+        "tacks",
+        "gybes",
+        "dist m",
+        "start point",
+    ]
     for name, _ in refs:
         headers += [name, "err"]
     rows = []
     for k, leg in enumerate(plan.legs):
         r = leg.result
         row = [
-            str(leg.spec.index + 1), leg.spec.label, leg.mode or "-", format_duration(r.time_s),
-            f"{r.time_s:.1f}", str(r.n_tacks), str(r.n_gybes), f"{r.distance_m:.0f}",
+            str(leg.spec.index + 1),
+            leg.spec.label,
+            leg.mode or "-",
+            format_duration(r.time_s),
+            f"{r.time_s:.1f}",
+            str(r.n_tacks),
+            str(r.n_gybes),
+            f"{r.distance_m:.0f}",
             start_point_text(leg),
         ]
         for _, times in refs:
             row += [format_duration(times[k]), _pct(r.time_s, times[k])]
         rows.append(row)
     total = [
-        "", "total", "", format_duration(plan.total_time_s), f"{plan.total_time_s:.1f}",
+        "",
+        "total",
+        "",
+        format_duration(plan.total_time_s),
+        f"{plan.total_time_s:.1f}",
         str(sum(leg.result.n_tacks for leg in plan.legs)),
         str(sum(leg.result.n_gybes for leg in plan.legs)),
-        f"{sum(leg.result.distance_m for leg in plan.legs):.0f}", "",
+        f"{sum(leg.result.distance_m for leg in plan.legs):.0f}",
+        "",
     ]
     for _, times in refs:
         total += [format_duration(sum(times)), _pct(plan.total_time_s, sum(times))]
@@ -169,8 +201,12 @@ def plan_table(plan: Plan) -> str:
     )
     align = "rllrrrrrl" + "rr" * len(refs)
     start = start_line_text(plan.start_line)
-    return (title + "\n" + render_table(headers, rows, align=align, footer=[total])
-            + (f"\n\n{start}" if start else ""))
+    return (
+        title
+        + "\n"
+        + render_table(headers, rows, align=align, footer=[total])
+        + (f"\n\n{start}" if start else "")
+    )
 
 
 def comparison_table(cmp: Comparison) -> str:
@@ -207,8 +243,11 @@ def comparison_table(cmp: Comparison) -> str:
         tot = cmp.totals - cmp.references[r].sum()
         tp = cmp.total_percent(r)
         footer = [["total"] + [f"{tot[s]:+.1f} s {tp[s]:+.1f}%" for s in range(len(cmp.scenarios))]]
-        blocks += ["", f"error vs {r}: model - {r}, (model - {r})/{r}",
-                   render_table(["leg", *cmp.scenarios], rows, footer=footer)]
+        blocks += [
+            "",
+            f"error vs {r}: model - {r}, (model - {r})/{r}",
+            render_table(["leg", *cmp.scenarios], rows, footer=footer),
+        ]
     if cmp.scenario_references:
         lines = []
         for s, refs in cmp.scenario_references.items():
@@ -218,9 +257,11 @@ def comparison_table(cmp: Comparison) -> str:
                     f"{percent_error(cmp.times[i, k], vals[k]):+.1f}%" for k in range(n)
                 )
                 lines.append([s, r, legs, _pct(float(cmp.totals[i]), float(vals.sum()))])
-        blocks += ["", "error vs scenario-specific references, (model - ref)/ref",
-                   render_table(["scenario", "reference", "legs", "total"], lines,
-                                align="lllr")]
+        blocks += [
+            "",
+            "error vs scenario-specific references, (model - ref)/ref",
+            render_table(["scenario", "reference", "legs", "total"], lines, align="lllr"),
+        ]
     return "\n".join(blocks)
 
 
@@ -247,14 +288,22 @@ def start_line_rows(sl: StartLineNumbers) -> list[tuple[str, str]]:
         ("ends", f"starboard end {sl.starboard_end}, port end {sl.port_end}"),
     ]
     if sl.favoured_end is not None:
-        rows.append(("gain at the favoured end",
-                     f"{sl.gain_m:.1f} m upwind, {sl.gain_s:.1f} s at "
-                     f"{sl.vmg_ms / KNOT:.2f} kn VMG"))
+        rows.append(
+            (
+                "gain at the favoured end",
+                f"{sl.gain_m:.1f} m upwind, {sl.gain_s:.1f} s at {sl.vmg_ms / KNOT:.2f} kn VMG",
+            )
+        )
     if sl.window_s > 0:
         steady = sl.bias_min_deg == sl.bias_max_deg
-        rows.append((f"bias range, {sl.window_s / 60:.0f} min before",
-                     f"{_signed(sl.bias_min_deg)}° (steady)" if steady else
-                     f"{_signed(sl.bias_min_deg)}° .. {_signed(sl.bias_max_deg)}°"))
+        rows.append(
+            (
+                f"bias range, {sl.window_s / 60:.0f} min before",
+                f"{_signed(sl.bias_min_deg)}° (steady)"
+                if steady
+                else f"{_signed(sl.bias_min_deg)}° .. {_signed(sl.bias_max_deg)}°",
+            )
+        )
     return rows
 
 
@@ -267,15 +316,28 @@ def start_line_text(sl: StartLineNumbers | None) -> str:
     return "start line\n" + "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
 
 
-
-
 def _approach_row(ap: Approach) -> list[str]:
     if not ap.reaches:
-        return [ap.label, ap.tack, f"{ap.heading_deg:.0f}", f"{ap.twa_deg:.0f}",
-                f"{ap.speed_ms / KNOT:.2f}", "misses", "-", "-"]
-    return [ap.label, ap.tack, f"{ap.heading_deg:.0f}", f"{ap.twa_deg:.0f}",
-            f"{ap.speed_ms / KNOT:.2f}", f"{ap.distance_m:.0f}", f"{ap.time_s:.1f}",
-            f"{100 * ap.fraction:.0f}%"]
+        return [
+            ap.label,
+            ap.tack,
+            f"{ap.heading_deg:.0f}",
+            f"{ap.twa_deg:.0f}",
+            f"{ap.speed_ms / KNOT:.2f}",
+            "misses",
+            "-",
+            "-",
+        ]
+    return [
+        ap.label,
+        ap.tack,
+        f"{ap.heading_deg:.0f}",
+        f"{ap.twa_deg:.0f}",
+        f"{ap.speed_ms / KNOT:.2f}",
+        f"{ap.distance_m:.0f}",
+        f"{ap.time_s:.1f}",
+        f"{100 * ap.fraction:.0f}%",
+    ]
 
 
 def approach_table(ap: LineApproach, course_name: str, line_names: tuple[str, str]) -> str:
@@ -287,13 +349,17 @@ def approach_table(ap: LineApproach, course_name: str, line_names: tuple[str, st
         f"{ap.distance_m:.0f} m{' (on the course side)' if ap.course_side else ''}",
     ]
     rows = [_approach_row(a) for a in (*ap.close_hauled, *ap.to_ends, *ap.tacks)]
-    table = render_table(["approach", "tack", "heading °", "TWA °", "speed kn", "path m",
-                          "time s", "on line"], rows, align="llrrrrrr")
+    table = render_table(
+        ["approach", "tack", "heading °", "TWA °", "speed kn", "path m", "time s", "on line"],
+        rows,
+        align="llrrrrrr",
+    )
     f = ap.fastest
     tail = [
         f"fastest: {f.tack} tack, heading {f.heading_deg:.0f}°, "
-        f"{f.time_s:.1f} s to {100 * f.fraction:.0f}% along the line" if f.reaches else
-        "fastest: none, the boat has no speed in this wind",
+        f"{f.time_s:.1f} s to {100 * f.fraction:.0f}% along the line"
+        if f.reaches
+        else "fastest: none, the boat has no speed in this wind",
         f"time to the gun {format_duration(ap.time_to_gun_s)}, time to burn "
         f"{format_duration(ap.time_to_burn_s)}"
         + (" (late: the line cannot be reached by the gun)" if ap.time_to_burn_s < 0 else ""),

@@ -82,8 +82,10 @@ class LegFrame:
 
     def point(self, along: Any, across: Any) -> tuple[Any, Any]:
         """Local ``(x, y)`` [m] of along/across coordinates [m] (across: positive to the left)."""
-        return (self.ox + along * self.ex - across * self.ey,
-                self.oy + along * self.ey + across * self.ex)
+        return (
+            self.ox + along * self.ex - across * self.ey,
+            self.oy + along * self.ey + across * self.ex,
+        )
 
     def coords(self, x: Any, y: Any) -> tuple[Any, Any]:
         """Along/across coordinates [m] of local points."""
@@ -122,8 +124,10 @@ class Row:
         if self.kind == "free":
             return frame.point(self.along, p)
         if self.kind == "line":
-            return (self.a[0] + p * (self.b[0] - self.a[0]),
-                    self.a[1] + p * (self.b[1] - self.a[1]))
+            return (
+                self.a[0] + p * (self.b[0] - self.a[0]),
+                self.a[1] + p * (self.b[1] - self.a[1]),
+            )
         return np.full(p.shape, self.a[0]), np.full(p.shape, self.a[1])
 
     def initial(self, n: int, half_width: float) -> NDArray:
@@ -178,8 +182,7 @@ class PathLimits:
     barriers: tuple[tuple[Barrier, float], ...] = ()
     obstacles: Obstacles | None = None
 
-    def allowed(self, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, last: bool
-                ) -> NDArray:
+    def allowed(self, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, last: bool) -> NDArray:
         """Straight moves ``(x0, y0) → (x1, y1)`` (broadcast) that respect the limits;
         ``last``: the moves end on the target segment."""
         ok = np.ones(np.broadcast_shapes(np.shape(x0), np.shape(x1)), dtype=bool)
@@ -221,8 +224,11 @@ def make_grid(start: Start, target: Target, n_rows: int, zone_m: float) -> LegGr
     if start.b is None:
         first = Row("point", a=(float(start.a[0]), float(start.a[1])))
     else:
-        first = Row("line", a=(float(start.a[0]), float(start.a[1])),
-                    b=(float(start.b[0]), float(start.b[1])))
+        first = Row(
+            "line",
+            a=(float(start.a[0]), float(start.a[1])),
+            b=(float(start.b[0]), float(start.b[1])),
+        )
     seg_len = math.hypot(geom.b[0] - geom.a[0], geom.b[1] - geom.a[1])
     m = min(AIM_MARGIN_M, 0.5 * seg_len) / seg_len
     last = Row("line", a=geom.a, b=geom.b, lo=m, hi=1.0 - m)
@@ -308,16 +314,16 @@ class ChainWind:
     valid: NDArray
 
 
-def sample_wind(wind: WindField, t: NDArray, x: NDArray, y: NDArray
-                ) -> tuple[NDArray, NDArray, NDArray]:
+def sample_wind(
+    wind: WindField, t: NDArray, x: NDArray, y: NDArray
+) -> tuple[NDArray, NDArray, NDArray]:
     """Sample ``wind`` without raising: ``(u, v, inside)``.
 
     Points outside a non-clamping field's coverage are sampled at the nearest
     covered point and flagged ``inside = False`` (routers treat them as
     unusable); non-finite times count as outside.
     """
-    t, x, y = np.broadcast_arrays(np.asarray(t, float), np.asarray(x, float),
-                                  np.asarray(y, float))
+    t, x, y = np.broadcast_arrays(np.asarray(t, float), np.asarray(x, float), np.asarray(y, float))
     cov = wind.coverage
     finite = np.isfinite(t)
     tt = np.where(finite, t, 0.0)
@@ -333,8 +339,9 @@ def sample_wind(wind: WindField, t: NDArray, x: NDArray, y: NDArray
     return u, v, inside
 
 
-def _pieces_wind(wind: WindField, t: NDArray, mx: NDArray, my: NDArray, ux: NDArray,
-                 uy: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def _pieces_wind(
+    wind: WindField, t: NDArray, mx: NDArray, my: NDArray, ux: NDArray, uy: NDArray
+) -> tuple[NDArray, NDArray, NDArray, NDArray]:
     u, v, ok = sample_wind(wind, t, mx, my)
     tws = np.hypot(u, v)
     safe = np.where(tws > 0, tws, 1.0)
@@ -345,9 +352,14 @@ def _pieces_wind(wind: WindField, t: NDArray, mx: NDArray, my: NDArray, ux: NDAr
     return tws, np.abs(twa), np.where(twa >= 0, 1, -1).astype(np.int8), ok
 
 
-def sample_chains(wind: WindField, px: NDArray, py: NDArray, t_dep: NDArray,
-                  model: GridBoat,
-                  speed: Callable[[NDArray, NDArray], NDArray] | None = None) -> ChainWind:
+def sample_chains(
+    wind: WindField,
+    px: NDArray,
+    py: NDArray,
+    t_dep: NDArray,
+    model: GridBoat,
+    speed: Callable[[NDArray, NDArray], NDArray] | None = None,
+) -> ChainWind:
     """Wind along chains of pieces at the time the boat sails each piece.
 
     Parameters
@@ -386,8 +398,7 @@ def sample_chains(wind: WindField, px: NDArray, py: NDArray, t_dep: NDArray,
     my = 0.5 * (py[..., 1:] + py[..., :-1])
     t1 = np.asarray(t_dep, float)[..., None]
     shape = np.broadcast_shapes(mx.shape, t1.shape)
-    t1, mx, my, ux, uy, length = (np.broadcast_to(a, shape)
-                                  for a in (t1, mx, my, ux, uy, length))
+    t1, mx, my, ux, uy, length = (np.broadcast_to(a, shape) for a in (t1, mx, my, ux, uy, length))
     tws, beta, _, _ = _pieces_wind(wind, t1, mx, my, ux, uy)
     spd = (model.steady_speed if speed is None else speed)(tws, beta)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -444,8 +455,9 @@ def default_half_width(frame: LegFrame, wind: WindField, t0: float, model: GridB
     return max(LAYLINE_TOLERANCE * exc, floor)
 
 
-def penalty_of(beta_new: NDArray, beta_old: NDArray | None, tack_s: float,
-               gybe_s: float) -> NDArray:
+def penalty_of(
+    beta_new: NDArray, beta_old: NDArray | None, tack_s: float, gybe_s: float
+) -> NDArray:
     """Penalty [s] of a side change: tack if the mean |TWA| is below 90°, else gybe."""
     b = beta_new if beta_old is None else 0.5 * (beta_new + beta_old)
     return np.where(b < 0.5 * np.pi, tack_s, gybe_s)

@@ -67,10 +67,12 @@ class RouterEntry:
 
 
 ROUTERS: dict[str, RouterEntry] = {
-    "isochrone": RouterEntry("sailroute.routing.isochrone", "route_isochrone",
-                             current=True, obstacles=True),
-    "griddp": RouterEntry("sailroute.routing.griddp", "route_griddp",
-                          obstacles=True, dynamic_boat=True),
+    "isochrone": RouterEntry(
+        "sailroute.routing.isochrone", "route_isochrone", current=True, obstacles=True
+    ),
+    "griddp": RouterEntry(
+        "sailroute.routing.griddp", "route_griddp", obstacles=True, dynamic_boat=True
+    ),
     "spline": RouterEntry("sailroute.routing.multispline", "route_spline", dynamic_boat=True),
 }
 """Router name -> :class:`RouterEntry`."""
@@ -112,7 +114,10 @@ def get_router(name: str) -> Router:
 
 
 def check_router_supports(
-    router: str, *, current: bool = False, obstacles: bool = False,
+    router: str,
+    *,
+    current: bool = False,
+    obstacles: bool = False,
     dynamic_boat: bool = False,
 ) -> None:
     """Refuse what a course asks of a router that the router does not support.
@@ -135,22 +140,38 @@ def check_router_supports(
         get_router(router)  # raises the unknown-router message
         return
     wants = (
-        (current, entry.current, "current",
-         "a current is supported by the {who} router{s} only; set routing.router: {first} "
-         "(or remove the scenario's `current:`)"),
-        (obstacles, entry.obstacles, "obstacles",
-         "a race-area boundary or obstacles are honoured by the {who} router{s} only; set "
-         "routing.router: {first} (or remove the course's `boundary:`/`obstacles:`)"),
-        (dynamic_boat, entry.dynamic_boat, "dynamic_boat",
-         "a boat without a steady polar is routed by the {who} router{s} only; set "
-         "routing.router: {first} (or give the boat a polar)"),
+        (
+            current,
+            entry.current,
+            "current",
+            "a current is supported by the {who} router{s} only; set routing.router: {first} "
+            "(or remove the scenario's `current:`)",
+        ),
+        (
+            obstacles,
+            entry.obstacles,
+            "obstacles",
+            "a race-area boundary or obstacles are honoured by the {who} router{s} only; set "
+            "routing.router: {first} (or remove the course's `boundary:`/`obstacles:`)",
+        ),
+        (
+            dynamic_boat,
+            entry.dynamic_boat,
+            "dynamic_boat",
+            "a boat without a steady polar is routed by the {who} router{s} only; set "
+            "routing.router: {first} (or give the boat a polar)",
+        ),
     )
     for asked, has, attr, text in wants:
         if asked and not has:
             able = [k for k, e in ROUTERS.items() if getattr(e, attr)]
             who = " and ".join(repr(k).strip("'") for k in able)
-            raise InputError(f"routing.router: {router!r}: " + text.format(
-                who=who, s="s" if len(able) > 1 else "", first=able[0] if able else "isochrone"))
+            raise InputError(
+                f"routing.router: {router!r}: "
+                + text.format(
+                    who=who, s="s" if len(able) > 1 else "", first=able[0] if able else "isochrone"
+                )
+            )
 
 
 def check_current_router(router: str) -> None:
@@ -168,8 +189,9 @@ def check_current_router(router: str) -> None:
 def _is_dynamic(boat: object) -> bool:
     """A boat model without a steady polar but with segment dynamics (the dynamic boat);
     anything else is left to the router's own check."""
-    return (isinstance(boat, BoatModel) and boat.routing_polar() is None
-            and boat.dynamics() is not None)
+    return (
+        isinstance(boat, BoatModel) and boat.routing_polar() is None and boat.dynamics() is not None
+    )
 
 
 def _check_passage(obstacles: Obstacles, start: Start, target: Target) -> None:
@@ -181,7 +203,8 @@ def _check_passage(obstacles: Obstacles, start: Start, target: Target) -> None:
             f"leg {leg_label(start, target)}: no route round {what}: the start and the "
             f"target lie in separate parts of free water ({obstacles.describe()}).\n  Try: "
             "leave a passage between the obstacles and the boundary wider than their "
-            "clearances, or move the marks.")
+            "clearances, or move the marks."
+        )
 
 
 def route_leg(
@@ -245,9 +268,12 @@ def route_leg(
     func = get_router(settings.router)
     xp = get_xp(backend)
     extra: dict[str, Any] = {} if xp is np else {"xp": xp}  # NumPy is every router's default
-    check_router_supports(settings.router, current=current is not None,
-                          obstacles=obstacles is not None,
-                          dynamic_boat=_is_dynamic(boat))
+    check_router_supports(
+        settings.router,
+        current=current is not None,
+        obstacles=obstacles is not None,
+        dynamic_boat=_is_dynamic(boat),
+    )
     if current is not None:
         extra["current"] = current
     if obstacles is not None:

@@ -92,10 +92,9 @@ def batchable(settings: RoutingSettings, backend: str, currents: Sequence[object
     """Whether :func:`~sailroute.planning.route.route_course_batch` can route these
     members: the isochrone router on NumPy, every member in still water (``currents`` all
     None)."""
-    return (settings.router == "isochrone" and backend == "numpy"
-            and all(c is None for c in currents))
-
-
+    return (
+        settings.router == "isochrone" and backend == "numpy" and all(c is None for c in currents)
+    )
 
 
 def route_leg_batch(
@@ -150,7 +149,8 @@ def route_leg_batch(
         raise InputError(
             f"leg {label}: route_leg_batch needs one start time, one wind and (unless a "
             f"single start is given) one start per member; got {n} start times, "
-            f"{len(winds)} winds and {len(starts)} starts")
+            f"{len(winds)} winds and {len(starts)} starts"
+        )
     check_settings(settings, label)
     polar = _routing_polar(boat, label)
     tab = polar_tables(polar, settings.heading_step_deg)
@@ -159,24 +159,39 @@ def route_leg_batch(
     barriers = leg_barriers(starts[0], target)
     clearances = None
     if starts[0].barrier is not None:  # each member keeps its own clearance from the mark
-        clearances = [barrier_clearance(dataclasses.replace(st, barrier=starts[0].barrier))
-                      for st in starts]
+        clearances = [
+            barrier_clearance(dataclasses.replace(st, barrier=starts[0].barrier)) for st in starts
+        ]
     ctxs = []
     for k, (t0, wind) in enumerate(zip(t0s, winds, strict=True)):
         _check_start_time(t0, label)
-        own = barriers if clearances is None \
-            else ((barriers[0][0], clearances[k]), *barriers[1:])
+        own = barriers if clearances is None else ((barriers[0][0], clearances[k]), *barriers[1:])
         ctx = _context(label, float(t0), frame, geom, wind, settings, own)
         if ctx.box is not None:
             _check_target_covered(geom, ctx.box, wind, label)
         ctxs.append(ctx)
-    leg = _Leg(target, settings, polar, frame, _device_tables(tab, np),
-               int(tab.twa_deg.size), progress, n,
-               target_barrier(target, starts[0], settings.zone_m))
-    members = [_Member(k, starts[k], winds[k], ctxs[k],
-                       start_points(starts[k], settings.start_line_spacing_m),
-                       None if clearances is None else clearances[k])
-               for k in range(n)]
+    leg = _Leg(
+        target,
+        settings,
+        polar,
+        frame,
+        _device_tables(tab, np),
+        int(tab.twa_deg.size),
+        progress,
+        n,
+        target_barrier(target, starts[0], settings.zone_m),
+    )
+    members = [
+        _Member(
+            k,
+            starts[k],
+            winds[k],
+            ctxs[k],
+            start_points(starts[k], settings.start_line_spacing_m),
+            None if clearances is None else clearances[k],
+        )
+        for k in range(n)
+    ]
     results: dict[int, LegResult] = {}
     by_box: dict[Any, list[_Member]] = {}
     for m in members:  # one front per coverage box (the moves must stay in it)
@@ -266,9 +281,11 @@ class _MemberWinds:
         for m in f.members:
             lo, hi = f.block(m)
             cov = m.wind.coverage
-            uu, vv = m.wind.sample(clip(t[:, lo:hi].ravel(), cov.t0, cov.t1),
-                                   clip(x[:, lo:hi].ravel(), cov.xmin, cov.xmax),
-                                   clip(y[:, lo:hi].ravel(), cov.ymin, cov.ymax))
+            uu, vv = m.wind.sample(
+                clip(t[:, lo:hi].ravel(), cov.t0, cov.t1),
+                clip(x[:, lo:hi].ravel(), cov.xmin, cov.xmax),
+                clip(y[:, lo:hi].ravel(), cov.ymin, cov.ymax),
+            )
             u[:, lo:hi] = np.asarray(uu, dtype=float).reshape(-1, hi - lo)
             v[:, lo:hi] = np.asarray(vv, dtype=float).reshape(-1, hi - lo)
         return u.ravel(), v.ravel()
@@ -296,13 +313,14 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
             _finish_alone(short, history, leg, results)
             continue
         ctx = front.members[0].ctx
-        pre, tau_min, dist_min = _prepare(front.layer, _MemberWinds(front),
-                                          leg.polar, leg.dev, ctx, s, math.inf, np,
-                                          front.groups)
+        pre, tau_min, dist_min = _prepare(
+            front.layer, _MemberWinds(front), leg.polar, leg.dev, ctx, s, math.inf, np, front.groups
+        )
         near = np.logical_or.reduceat(pre.near_target, front.groups.starts)
         if near.any():  # the arrival is tested member by member
-            _finish_alone([m for m, k in zip(front.members, near, strict=True) if k],
-                          history, leg, results)
+            _finish_alone(
+                [m for m, k in zip(front.members, near, strict=True) if k], history, leg, results
+            )
             continue
         out = _common_step(pre, front, ctx, leg)
         if isinstance(out, list):  # members without a survivor: their own error
@@ -315,8 +333,7 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
 def _groups(members: Sequence[_Member], sizes: Any) -> Groups:
     """The :class:`Groups` of ``members`` with ``sizes`` points each, with their
     clearances from the start's mark (if the leg starts at a rounded mark)."""
-    clear = None if members[0].clearance is None \
-        else np.array([m.clearance for m in members])
+    clear = None if members[0].clearance is None else np.array([m.clearance for m in members])
     return Groups.of_sizes(sizes, clear)
 
 
@@ -352,8 +369,7 @@ def _common_step(pre: Any, front: _Front, ctx: _Context, leg: _Leg) -> _Front | 
                 local = mine - k * per_member
                 merge = -(-int(mine.shape[0]) // ctx.max_points)
                 coarse = (local // 2 // merge) * 2 + local % 2
-                mine = np.sort(mine[_group_argmin(coarse, best[mine], int(coarse.max()) + 1,
-                                                  np)])
+                mine = np.sort(mine[_group_argmin(coarse, best[mine], int(coarse.max()) + 1, np)])
             parts.append(mine)
         won = np.concatenate(parts)
         counts = np.bincount(won // per_member, minlength=len(front.members))
@@ -365,9 +381,7 @@ def _common_step(pre: Any, front: _Front, ctx: _Context, leg: _Leg) -> _Front | 
     return _Front(layer, front.members, _groups(front.members, counts), moved)
 
 
-def _after_step(
-    front: _Front, new: _Front, tau_min: Any, dist_min: Any, leg: _Leg
-) -> None:
+def _after_step(front: _Front, new: _Front, tau_min: Any, dist_min: Any, leg: _Leg) -> None:
     """Each member's calm clock, time to go, work check and time limit after a step."""
     s = leg.settings
     first_step = bool(np.all(front.layer.parent < 0))
@@ -384,8 +398,7 @@ def _after_step(
             check_leg_work(m.ctx.label, s, m.ctx, leg.n_angles, m.tau_hint)
         elapsed = t_new - m.ctx.t0
         if elapsed >= s.max_leg_time_s:
-            raise _timeout_error(m.ctx.label, s, elapsed, float(dist_min[k]), m.calm_since,
-                                 t_new)
+            raise _timeout_error(m.ctx.label, s, elapsed, float(dist_min[k]), m.calm_since, t_new)
 
 
 def _finish_alone(
@@ -395,20 +408,39 @@ def _finish_alone(
     out of the common front (``history[-1]``)."""
     for m in leaving:
         layers = _own_layers(m, history)
-        arrival = _route_on(layers, m.wind, leg.dev, m.ctx, leg.settings, leg.n_angles, np,
-                            polar=leg.polar, calm_since=m.calm_since, tau_hint=m.tau_hint)
+        arrival = _route_on(
+            layers,
+            m.wind,
+            leg.dev,
+            m.ctx,
+            leg.settings,
+            leg.n_angles,
+            np,
+            polar=leg.polar,
+            calm_since=m.calm_since,
+            tau_hint=m.tau_hint,
+        )
         results[m.index] = _result(m, layers, arrival, leg)
         if leg.progress is not None:
             leg.progress(len(results) / leg.n_members)
     front = history[-1]
     stay = tuple(m for m in front.members if m not in leaving)
-    rows = np.concatenate([np.arange(*front.block(m)) for m in stay]) if stay \
+    rows = (
+        np.concatenate([np.arange(*front.block(m)) for m in stay])
+        if stay
         else np.zeros(0, dtype=np.int64)
+    )
     sizes = [front.block(m)[1] - front.block(m)[0] for m in stay]
-    layer = _Layer(**{f.name: getattr(front.layer, f.name)[rows]
-                      for f in dataclasses.fields(_Layer)})
-    history[-1] = _Front(layer, stay, _groups(stay, sizes) if stay
-                         else Groups(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)))
+    layer = _Layer(
+        **{f.name: getattr(front.layer, f.name)[rows] for f in dataclasses.fields(_Layer)}
+    )
+    history[-1] = _Front(
+        layer,
+        stay,
+        _groups(stay, sizes)
+        if stay
+        else Groups(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)),
+    )
 
 
 def _own_layers(m: _Member, history: list[_Front]) -> list[_Layer]:
@@ -420,12 +452,23 @@ def _own_layers(m: _Member, history: list[_Front]) -> list[_Layer]:
         lo, hi = front.block(m)
         lay = front.layer
         parent = lay.parent[lo:hi] - prev_lo if out else lay.parent[lo:hi]
-        out.append(_Layer(
-            t=float(lay.t[lo]), x=lay.x[lo:hi], y=lay.y[lo:hi], side=lay.side[lo:hi],
-            debt=lay.debt[lo:hi], abs_twa=lay.abs_twa[lo:hi], pend_old=lay.pend_old[lo:hi],
-            pend_pen=lay.pend_pen[lo:hi], parent=parent, heading=lay.heading[lo:hi],
-            bsp=lay.bsp[lo:hi], delay=lay.delay[lo:hi], tau_est=lay.tau_est[lo:hi],
-        ))
+        out.append(
+            _Layer(
+                t=float(lay.t[lo]),
+                x=lay.x[lo:hi],
+                y=lay.y[lo:hi],
+                side=lay.side[lo:hi],
+                debt=lay.debt[lo:hi],
+                abs_twa=lay.abs_twa[lo:hi],
+                pend_old=lay.pend_old[lo:hi],
+                pend_pen=lay.pend_pen[lo:hi],
+                parent=parent,
+                heading=lay.heading[lo:hi],
+                bsp=lay.bsp[lo:hi],
+                delay=lay.delay[lo:hi],
+                tau_est=lay.tau_est[lo:hi],
+            )
+        )
         prev_lo = lo
     return out
 

@@ -216,9 +216,7 @@ def rounding_segment(
     raise InputError(f"mark rounding {rounding!r}: expected 'port', 'starboard' or None")
 
 
-def target_geometry(
-    target: Target, start: Start, zone_m: float = DEFAULT_ZONE_M
-) -> TargetGeometry:
+def target_geometry(target: Target, start: Start, zone_m: float = DEFAULT_ZONE_M) -> TargetGeometry:
     """The directed crossing segment of ``target`` for a leg from ``start``.
 
     Parameters
@@ -256,8 +254,7 @@ def target_geometry(
                     f"({target.a[0]:.1f}, {target.a[1]:.1f}) m, so the rounding has no "
                     "direction; give the next target's centre, or exit_xy=None"
                 )
-            th = rounding_apex_deg(th, math.degrees(math.atan2(ox, oy)) % 360.0,
-                                   target.rounding)
+            th = rounding_apex_deg(th, math.degrees(math.atan2(ox, oy)) % 360.0, target.rounding)
         a, b = rounding_segment(target.a, th, target.rounding, zone_m)
         n = (math.sin(math.radians(th)), math.cos(math.radians(th)))
         return TargetGeometry(a, b, n, "mark", target.name)
@@ -287,8 +284,13 @@ def target_geometry(
 
 
 def segment_crossing(
-    px: NDArray, py: NDArray, qx: NDArray, qy: NDArray, geom: TargetGeometry,
-    *, xp: ModuleType = np,
+    px: NDArray,
+    py: NDArray,
+    qx: NDArray,
+    qy: NDArray,
+    geom: TargetGeometry,
+    *,
+    xp: ModuleType = np,
 ) -> tuple[NDArray, NDArray, NDArray]:
     """Which straight moves ``P → Q`` cross the target segment forwards, and where.
 
@@ -336,8 +338,12 @@ def segment_crossing(
 
 
 def aim_points(
-    px: NDArray, py: NDArray, geom: TargetGeometry, margin_m: float = AIM_MARGIN_M,
-    *, xp: ModuleType = np,
+    px: NDArray,
+    py: NDArray,
+    geom: TargetGeometry,
+    margin_m: float = AIM_MARGIN_M,
+    *,
+    xp: ModuleType = np,
 ) -> tuple[NDArray, NDArray]:
     """Nearest point of the target segment, kept ``margin_m`` from its ends [m].
 
@@ -393,8 +399,7 @@ def start_points(
 # roundings across legs
 
 
-def target_barrier(target: Target, start: Start, zone_m: float = DEFAULT_ZONE_M
-                   ) -> Barrier | None:
+def target_barrier(target: Target, start: Start, zone_m: float = DEFAULT_ZONE_M) -> Barrier | None:
     """The barrier a leg to ``target`` leaves for the next leg (None unless a mark
     with a rounding side): the ray from the mark along its rounding segment."""
     if target.kind != "mark" or target.rounding is None:
@@ -446,8 +451,14 @@ def barrier_clearance(start: Start) -> float:
 
 
 def barrier_blocks(
-    px: NDArray, py: NDArray, qx: NDArray, qy: NDArray, barrier: Barrier,
-    clearance_m: float | NDArray = 0.0, *, xp: ModuleType = np,
+    px: NDArray,
+    py: NDArray,
+    qx: NDArray,
+    qy: NDArray,
+    barrier: Barrier,
+    clearance_m: float | NDArray = 0.0,
+    *,
+    xp: ModuleType = np,
 ) -> NDArray:
     """Which straight moves ``P → Q`` a barrier forbids.
 
@@ -474,8 +485,13 @@ def barrier_blocks(
     rx, ry = barrier.ray
     nx, ny = barrier.normal
     ax, ay = mx - BARRIER_SLACK_M * nx, my - BARRIER_SLACK_M * ny
-    back = TargetGeometry((ax, ay), (ax + BARRIER_LENGTH_M * rx, ay + BARRIER_LENGTH_M * ry),
-                          (-nx, -ny), "barrier", barrier.name)
+    back = TargetGeometry(
+        (ax, ay),
+        (ax + BARRIER_LENGTH_M * rx, ay + BARRIER_LENGTH_M * ry),
+        (-nx, -ny),
+        "barrier",
+        barrier.name,
+    )
     blocked, _, _ = segment_crossing(px, py, qx, qy, back, xp=xp)
     if isinstance(clearance_m, np.ndarray) or clearance_m > 0:  # an array: one per move
         dx, dy = qx - px, qy - py
@@ -488,7 +504,9 @@ def barrier_blocks(
 
 
 def chain_leg(
-    start: Start, target: Target, previous: LegResult | None = None,
+    start: Start,
+    target: Target,
+    previous: LegResult | None = None,
     following: Target | None = None,
 ) -> tuple[Start, Target]:
     """Link a leg to its neighbours so that mark roundings hold across legs.

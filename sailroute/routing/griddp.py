@@ -91,8 +91,14 @@ class GridDPOptions:
         """The ``dp_*`` fields of settings validated by
         :func:`~sailroute.routing.types.check_settings`."""
         hw = s.dp_half_width_m
-        return cls(int(s.dp_rows), int(s.dp_cols), int(s.dp_refinements),
-                   None if hw is None else float(hw), float(s.dp_shrink), int(s.dp_samples))
+        return cls(
+            int(s.dp_rows),
+            int(s.dp_cols),
+            int(s.dp_refinements),
+            None if hw is None else float(hw),
+            float(s.dp_shrink),
+            int(s.dp_samples),
+        )
 
 
 @dataclass(frozen=True)
@@ -211,10 +217,13 @@ def route_griddp(
         The race outlasts the wind's time span (from the track builder).
     """
     if current is not None:
-        raise InputError(f"leg {leg_label(start, target)}: the griddp router routes still water "
-                         "only; set routing.router: isochrone to route a current")
-    return solve_griddp(start, target, t0, wind, boat, settings, progress=progress, xp=xp,
-                        obstacles=obstacles).result
+        raise InputError(
+            f"leg {leg_label(start, target)}: the griddp router routes still water "
+            "only; set routing.router: isochrone to route a current"
+        )
+    return solve_griddp(
+        start, target, t0, wind, boat, settings, progress=progress, xp=xp, obstacles=obstacles
+    ).result
 
 
 def solve_griddp(
@@ -246,9 +255,11 @@ def solve_griddp(
     for k in range(n_pass):
         tic = _time.perf_counter()
         if k > 0:
-            scale = opts.shrink ** k
-            params = [row.refined(opts.cols, c, scale, half)
-                      for row, c in zip(grid.rows, best_params, strict=True)]
+            scale = opts.shrink**k
+            params = [
+                row.refined(opts.cols, c, scale, half)
+                for row, c in zip(grid.rows, best_params, strict=True)
+            ]
         xy = [row.points(grid.frame, p) for row, p in zip(grid.rows, params, strict=True)]
 
         def rowprog(frac: float, k: int = k) -> None:
@@ -257,22 +268,35 @@ def solve_griddp(
 
         lim = grid.limits if obstacles is None else replace(grid.limits, obstacles=obstacles)
         if model.dynamic is not None:
-            path, dp_time, evals = _dp_dynamic(model.dynamic, wind, xy, t0, opts, lim, xp,
-                                               rowprog)
+            path, dp_time, evals = _dp_dynamic(model.dynamic, wind, xy, t0, opts, lim, xp, rowprog)
         else:
-            path, dp_time, evals = _dp_polar(model, wind, xy, t0, opts, settings, lim, xp,
-                                             rowprog)
+            path, dp_time, evals = _dp_polar(model, wind, xy, t0, opts, settings, lim, xp, rowprog)
         if path is None:
-            raise _no_route(grid, half * opts.shrink ** k, k)
-        ev = evaluate_path(model, wind, np.array([xy[r][0][c] for r, c in enumerate(path)]),
-                           np.array([xy[r][1][c] for r, c in enumerate(path)]), t0,
-                           opts.samples, settings, limits=lim)
+            raise _no_route(grid, half * opts.shrink**k, k)
+        ev = evaluate_path(
+            model,
+            wind,
+            np.array([xy[r][0][c] for r, c in enumerate(path)]),
+            np.array([xy[r][1][c] for r, c in enumerate(path)]),
+            t0,
+            opts.samples,
+            settings,
+            limits=lim,
+        )
         if best is None or ev.time_s < best.time_s:
             best = ev
             best_params = [float(params[r][c]) for r, c in enumerate(path)]
-        band = half * opts.shrink ** k
-        passes.append(GridDPPass(band, 2 * band / (opts.cols - 1), dp_time, ev.time_s, evals,
-                                 _time.perf_counter() - tic))
+        band = half * opts.shrink**k
+        passes.append(
+            GridDPPass(
+                band,
+                2 * band / (opts.cols - 1),
+                dp_time,
+                ev.time_s,
+                evals,
+                _time.perf_counter() - tic,
+            )
+        )
     assert best is not None
     if not math.isfinite(best.time_s):
         raise _no_route(grid, half, 0)
@@ -282,13 +306,11 @@ def solve_griddp(
             f"max_leg_time_s = {settings.max_leg_time_s:.0f} s; check the wind (calm?) or "
             "raise max_leg_time_s"
         )
-    track = build_track(best.t, best.x, best.y, wind, model.polar,
-                        bsp_ms=best.bsp, side=best.side)
+    track = build_track(best.t, best.x, best.y, wind, model.polar, bsp_ms=best.bsp, side=best.side)
     if progress is not None:
         progress(1.0)
     result = make_leg_result(track, "griddp", target_barrier(target, start, settings.zone_m))
-    return GridDPSolution(result, tuple(passes), half,
-                          np.stack([best.node_x, best.node_y], axis=1))
+    return GridDPSolution(result, tuple(passes), half, np.stack([best.node_x, best.node_y], axis=1))
 
 
 def _no_route(grid: LegGrid, band: float, k: int) -> RoutingError:
@@ -306,8 +328,7 @@ def _no_route(grid: LegGrid, band: float, k: int) -> RoutingError:
 # geometry helpers
 
 
-def _chains(x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, n: int
-            ) -> tuple[NDArray, NDArray]:
+def _chains(x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, n: int) -> tuple[NDArray, NDArray]:
     """Vertices ``(C0, C1, n + 1)`` of straight segments from every node to every node."""
     f = np.linspace(0.0, 1.0, n + 1)
     px = x0[:, None, None] + (x1[None, :, None] - x0[:, None, None]) * f
@@ -315,8 +336,9 @@ def _chains(x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, n: int
     return px, py
 
 
-def _inside_pairs(wind: WindField, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray,
-                  lim: PathLimits, last: bool) -> NDArray:
+def _inside_pairs(
+    wind: WindField, x0: NDArray, y0: NDArray, x1: NDArray, y1: NDArray, lim: PathLimits, last: bool
+) -> NDArray:
     """Segments (every node of a row to every node of the next) that may be sailed:
     both ends inside the wind coverage, and the rounding limits respected."""
     ok = node_inside(wind, x0, y0)[:, None] & node_inside(wind, x1, y1)[None, :]
@@ -327,9 +349,17 @@ def _inside_pairs(wind: WindField, x0: NDArray, y0: NDArray, x1: NDArray, y1: ND
 # polar model: state (node, side of the last piece)
 
 
-def _dp_polar(model: GridBoat, wind: WindField, xy: list, t0: float, opts: GridDPOptions,
-              s: RoutingSettings, lim: PathLimits, xp: ModuleType,
-              progress: Callable[[float], None]) -> tuple[list[int] | None, float, int]:
+def _dp_polar(
+    model: GridBoat,
+    wind: WindField,
+    xy: list,
+    t0: float,
+    opts: GridDPOptions,
+    s: RoutingSettings,
+    lim: PathLimits,
+    xp: ModuleType,
+    progress: Callable[[float], None],
+) -> tuple[list[int] | None, float, int]:
     n_rows = len(xy)
     c0 = xy[0][0].size
     T = np.full((c0, 2), np.inf)
@@ -353,16 +383,22 @@ def _dp_polar(model: GridBoat, wind: WindField, xy: list, t0: float, opts: GridD
         with np.errstate(divide="ignore", invalid="ignore"):
             tp = np.where(cw.length > 0, cw.length / spd, 0.0)
         tp = np.where(np.isnan(tp), np.inf, tp)
-        ok = np.all(cw.valid, axis=-1) & _inside_pairs(
-            wind, x0, y0, x1, y1, lim, r == n_rows - 2)[:, None, :]
+        ok = (
+            np.all(cw.valid, axis=-1)
+            & _inside_pairs(wind, x0, y0, x1, y1, lim, r == n_rows - 2)[:, None, :]
+        )
         side = cw.side
         ch = side[..., 1:] != side[..., :-1]
-        pen_int = np.sum(ch * penalty_of(cw.beta[..., 1:], cw.beta[..., :-1],
-                                         s.tack_penalty_s, s.gybe_penalty_s), axis=-1)
+        pen_int = np.sum(
+            ch
+            * penalty_of(cw.beta[..., 1:], cw.beta[..., :-1], s.tack_penalty_s, s.gybe_penalty_s),
+            axis=-1,
+        )
         first_b = cw.beta[..., 0]
         old_b = np.broadcast_to(B[:, :, None], first_b.shape)
-        join_pen = penalty_of(first_b, np.where(np.isnan(old_b), first_b, old_b),
-                              s.tack_penalty_s, s.gybe_penalty_s)
+        join_pen = penalty_of(
+            first_b, np.where(np.isnan(old_b), first_b, old_b), s.tack_penalty_s, s.gybe_penalty_s
+        )
         state_side = _SIDE_VALUE[None, :, None]
         join = np.where(side[..., 0] != state_side, join_pen, 0.0)
         if r == 0 and free_start:
@@ -400,9 +436,16 @@ def _dp_polar(model: GridBoat, wind: WindField, xy: list, t0: float, opts: GridD
 # dynamic model: state = segment (start node, end node), carrying arrival time and speed
 
 
-def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: GridDPOptions,
-                lim: PathLimits, xp: ModuleType, progress: Callable[[float], None]
-                ) -> tuple[list[int] | None, float, int]:
+def _dp_dynamic(
+    boat: DynamicBoat,
+    wind: WindField,
+    xy: list,
+    t0: float,
+    opts: GridDPOptions,
+    lim: PathLimits,
+    xp: ModuleType,
+    progress: Callable[[float], None],
+) -> tuple[list[int] | None, float, int]:
     model = GridBoat(boat, None, boat)
     tab = boat.table()
     n_rows = len(xy)
@@ -412,8 +455,15 @@ def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: G
     px, py = _chains(x0, y0, x1, y1, n)
     cw = sample_chains(wind, px, py, np.full(x0.size, t0)[:, None], model)
     ok = np.all(cw.valid, axis=-1) & _inside_pairs(wind, x0, y0, x1, y1, lim, n_rows == 2)
-    t, v_end = chain_time(boat, xp.asarray(cw.beta), xp.asarray(cw.tws), xp.asarray(cw.length),
-                          xp.ones(cw.beta.shape), xp.zeros(cw.beta.shape[:-1]), xp)
+    t, v_end = chain_time(
+        boat,
+        xp.asarray(cw.beta),
+        xp.asarray(cw.tws),
+        xp.asarray(cw.length),
+        xp.ones(cw.beta.shape),
+        xp.zeros(cw.beta.shape[:-1]),
+        xp,
+    )
     T = xp.where(xp.asarray(ok), t0 + t, xp.inf)
     V = v_end
     U = (xp.asarray(cw.ux[..., 0]), xp.asarray(cw.uy[..., 0]))
@@ -428,8 +478,11 @@ def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: G
         reach = np.isfinite(t_est)
         px, py = _chains(x0, y0, x1, y1, n)
         cw = sample_chains(wind, px, py, np.where(reach, t_est, t0)[:, None], model)
-        ok = (np.all(cw.valid, axis=-1) & reach[:, None]
-              & _inside_pairs(wind, x0, y0, x1, y1, lim, r == n_rows - 2))
+        ok = (
+            np.all(cw.valid, axis=-1)
+            & reach[:, None]
+            & _inside_pairs(wind, x0, y0, x1, y1, lim, r == n_rows - 2)
+        )
         beta, tws, length = (xp.asarray(a) for a in (cw.beta, cw.tws, cw.length))
         b1, vt1, l1 = beta[..., 0], tws[..., 0], length[..., 0]
         ws1 = tab.steady(b1, xp)
@@ -440,15 +493,23 @@ def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: G
         wss = xp.where(ws1 > 0, ws1, 1.0)
         v_exit1 = ws1 * vt1
         if n > 1:
-            t_tail, v_seg = chain_time(boat, beta[..., 1:], tws[..., 1:], length[..., 1:],
-                                       xp.ones(beta[..., 1:].shape), v_exit1, xp)
+            t_tail, v_seg = chain_time(
+                boat,
+                beta[..., 1:],
+                tws[..., 1:],
+                length[..., 1:],
+                xp.ones(beta[..., 1:].shape),
+                v_exit1,
+                xp,
+            )
         else:
             t_tail, v_seg = xp.zeros(b1.shape), v_exit1
         base = l1 / (wss * vts) + t_tail
         base = xp.where(nogo1 | calm1 | ~xp.asarray(ok), xp.inf, base)
         seg_len = xp.sum(length, axis=-1)
         fallback = ((seg_len < tab.sconv_at(b1, xp)) & ~nogo1 & ~slow1) | (
-            nogo1 & (l1 < tab.stop_max))
+            nogo1 & (l1 < tab.stop_max)
+        )
         fallback = fallback & xp.asarray(ok) & ~calm1
         ux1, uy1 = xp.asarray(cw.ux[..., 0]), xp.asarray(cw.uy[..., 0])
         seg = _SegData.build(tab, ux1, uy1, b1, ws1, vt1, vts, base, slow1, fallback, xp)
@@ -466,14 +527,16 @@ def _dp_dynamic(boat: DynamicBoat, wind: WindField, xy: list, t0: float, opts: G
         if k_i.size:
             cos_t = xp.ones((k_i.size, n))
             cos_t[:, 0] = U[0][k_i, c_i] * ux1[c_i, e_i] + U[1][k_i, c_i] * uy1[c_i, e_i]
-            t_ex, v_ex = chain_time(boat, beta[c_i, e_i], tws[c_i, e_i], length[c_i, e_i],
-                                    cos_t, V[k_i, c_i], xp)
+            t_ex, v_ex = chain_time(
+                boat, beta[c_i, e_i], tws[c_i, e_i], length[c_i, e_i], cos_t, V[k_i, c_i], xp
+            )
             a_ex = T[k_i, c_i] + t_ex
             # sequential merge keeps the lowest k on ties, like argmin
             for q in range(int(k_i.size)):
                 ci, ei = int(c_i[q]), int(e_i[q])
                 if float(a_ex[q]) < float(T_new[ci, ei]) or (
-                        float(a_ex[q]) == float(T_new[ci, ei]) and int(k_i[q]) < int(bp[ci, ei])):
+                    float(a_ex[q]) == float(T_new[ci, ei]) and int(k_i[q]) < int(bp[ci, ei])
+                ):
                     T_new[ci, ei] = a_ex[q]
                     bp[ci, ei] = k_i[q]
                     V_new[ci, ei] = v_ex[q]
@@ -509,23 +572,52 @@ class _SegData:
     coef: Any  # 1 / v_t for the loss [s/m], 0 where the loss is ignored
 
     @classmethod
-    def build(cls, tab: SegmentTable, ux: Any, uy: Any, b1: Any, ws1: Any, vt1: Any, vts: Any,
-              base: Any, slow: Any, fallback: Any, xp: ModuleType) -> _SegData:
+    def build(
+        cls,
+        tab: SegmentTable,
+        ux: Any,
+        uy: Any,
+        b1: Any,
+        ws1: Any,
+        vt1: Any,
+        vts: Any,
+        base: Any,
+        slow: Any,
+        fallback: Any,
+        xp: ModuleType,
+    ) -> _SegData:
         m = tab.nq - 1
         j0, fb = tab.column(b1, xp)
         thr = ws1 * vt1
         acc = m / xp.where(thr > 0, thr, 1.0)
         dec = m / ((tab.w_max - ws1) * vts)
         dec0 = m - thr * dec
-        return cls(ux, uy, thr, acc, dec, dec0, j0 * (2 * m), fb,
-                   xp.where(fallback, xp.inf, base), xp.where(slow, 0.0, 1.0 / vts))
+        return cls(
+            ux,
+            uy,
+            thr,
+            acc,
+            dec,
+            dec0,
+            j0 * (2 * m),
+            fb,
+            xp.where(fallback, xp.inf, base),
+            xp.where(slow, 0.0, 1.0 / vts),
+        )
 
 
 _CHUNK = 1 << 17  # triples per numpy batch (keeps the temporaries in cache)
 
 
-def _relax(T: Any, V: Any, U: tuple[Any, Any], seg: _SegData, boat: DynamicBoat,
-           tab: SegmentTable, xp: ModuleType) -> tuple[Any, Any, tuple[Any, Any, Any] | None]:
+def _relax(
+    T: Any,
+    V: Any,
+    U: tuple[Any, Any],
+    seg: _SegData,
+    boat: DynamicBoat,
+    tab: SegmentTable,
+    xp: ModuleType,
+) -> tuple[Any, Any, tuple[Any, Any, Any] | None]:
     """Best predecessor of every segment: ``min_k T[k, cs] + t(k, cs, ce)``.
 
     All ``(k, cs, ce)`` triples are evaluated as array batches (the whole row
@@ -545,8 +637,7 @@ def _relax(T: Any, V: Any, U: tuple[Any, Any], seg: _SegData, boat: DynamicBoat,
         ks = slice(k0, min(K, k0 + step))
         cosd = U[0][ks, :, None] * seg.ux[None] + U[1][ks, :, None] * seg.uy[None]
         c2 = cosd * cosd
-        v0 = V[ks, :, None] * xp.where(cosd >= boat.um, 1.0,
-                                       xp.where(cosd > boat.lm, c2 * c2, 0.0))
+        v0 = V[ks, :, None] * xp.where(cosd >= boat.um, 1.0, xp.where(cosd > boat.lm, c2 * c2, 0.0))
         xq = xp.where(v0 <= seg.thr, v0 * seg.acc, v0 * seg.dec + seg.dec0)
         over = xq > xmax
         xq = xp.clip(xq, 0.0, xmax)
@@ -600,9 +691,17 @@ class _PathEval:
     node_y: NDArray
 
 
-def evaluate_path(model: GridBoat, wind: WindField, xs: NDArray, ys: NDArray, t0: float,
-                  samples: int, settings: RoutingSettings, *,
-                  limits: PathLimits | None = None) -> _PathEval:
+def evaluate_path(
+    model: GridBoat,
+    wind: WindField,
+    xs: NDArray,
+    ys: NDArray,
+    t0: float,
+    samples: int,
+    settings: RoutingSettings,
+    *,
+    limits: PathLimits | None = None,
+) -> _PathEval:
     """Sail a polyline exactly as the DP costs it, segment by segment in time order.
 
     Returns the leg time and the track vertices: the nodes, the piece
@@ -621,8 +720,10 @@ def evaluate_path(model: GridBoat, wind: WindField, xs: NDArray, ys: NDArray, t0
     prev_dir: tuple[float, float] | None = None
     if limits is not None:
         last = np.arange(xs.size - 1) == xs.size - 2
-        if not np.all(limits.allowed(xs[:-1], ys[:-1], xs[1:], ys[1:], False)
-                      & (limits.allowed(xs[:-1], ys[:-1], xs[1:], ys[1:], True) | ~last)):
+        if not np.all(
+            limits.allowed(xs[:-1], ys[:-1], xs[1:], ys[1:], False)
+            & (limits.allowed(xs[:-1], ys[:-1], xs[1:], ys[1:], True) | ~last)
+        ):
             return _PathEval(math.inf, *(np.zeros(0),) * 3, None, np.zeros(0, np.int8), xs, ys)
     for r in range(xs.size - 1):
         px = xs[r] + (xs[r + 1] - xs[r]) * f
@@ -637,8 +738,9 @@ def evaluate_path(model: GridBoat, wind: WindField, xs: NDArray, ys: NDArray, t0
             cos0 = 1.0 if prev_dir is None else d[0] * prev_dir[0] + d[1] * prev_dir[1]
             cos_t = np.ones((1, n))
             cos_t[0, 0] = cos0
-            _, v_end, tp, v_in = chain_time(model.dynamic, cw.beta, cw.tws, cw.length, cos_t,
-                                            np.array([v]), pieces=True)
+            _, v_end, tp, v_in = chain_time(
+                model.dynamic, cw.beta, cw.tws, cw.length, cos_t, np.array([v]), pieces=True
+            )
             for j in range(n):
                 out_t.append(t)
                 out_x.append(px[j])
@@ -653,8 +755,14 @@ def evaluate_path(model: GridBoat, wind: WindField, xs: NDArray, ys: NDArray, t0
             for j in range(n):
                 if cur_side != 0 and side[j] != cur_side:
                     old = beta[j] if math.isnan(cur_beta) else cur_beta
-                    pen = float(penalty_of(np.array(beta[j]), np.array(old),
-                                           settings.tack_penalty_s, settings.gybe_penalty_s))
+                    pen = float(
+                        penalty_of(
+                            np.array(beta[j]),
+                            np.array(old),
+                            settings.tack_penalty_s,
+                            settings.gybe_penalty_s,
+                        )
+                    )
                     out_t.append(t)
                     out_x.append(px[j])
                     out_y.append(py[j])
@@ -677,8 +785,16 @@ def evaluate_path(model: GridBoat, wind: WindField, xs: NDArray, ys: NDArray, t0
     out_s.append(out_s[-1] if out_s else 1)
     out_v.append(v)
     bsp = np.array(out_v) if model.dynamic is not None else None
-    return _PathEval(t - t0, np.array(out_t), np.array(out_x), np.array(out_y), bsp,
-                     np.array(out_s, dtype=np.int8), xs, ys)
+    return _PathEval(
+        t - t0,
+        np.array(out_t),
+        np.array(out_x),
+        np.array(out_y),
+        bsp,
+        np.array(out_s, dtype=np.int8),
+        xs,
+        ys,
+    )
 
 
 _ROUTER: Router = route_griddp  # mypy checks the shared router signature

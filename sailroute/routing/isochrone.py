@@ -91,8 +91,15 @@ from sailroute.wind.base import WindField
 from sailroute.wind.current import CurrentField, RelativeWind, current_rate_set
 
 __all__ = [
-    "MAX_LEG_WORK", "NEAR_TARGET_STEPS", "PATH_SAMPLES", "TABLE_TWS_STEP_MS", "PolarTables",
-    "check_leg_work", "leg_work", "polar_tables", "route_isochrone",
+    "MAX_LEG_WORK",
+    "NEAR_TARGET_STEPS",
+    "PATH_SAMPLES",
+    "TABLE_TWS_STEP_MS",
+    "PolarTables",
+    "check_leg_work",
+    "leg_work",
+    "polar_tables",
+    "route_isochrone",
 ]
 
 # --------------------------------------------------------------------------------------
@@ -177,8 +184,18 @@ def route_isochrone(
     geom = target_geometry(target, start, settings.zone_m)
     tab = polar_tables(polar, settings.heading_step_deg)
     frame = _LegFrame.for_leg(geom.centre, start_centre(start))
-    ctx = _context(label, float(t0), frame, geom, wind, settings,
-                   leg_barriers(start, target), current, obstacles, start_centre(start))
+    ctx = _context(
+        label,
+        float(t0),
+        frame,
+        geom,
+        wind,
+        settings,
+        leg_barriers(start, target),
+        current,
+        obstacles,
+        start_centre(start),
+    )
     if ctx.box is not None:
         _check_target_covered(geom, ctx.box, wind, label)
     dev = _device_tables(tab, xp)
@@ -186,32 +203,49 @@ def route_isochrone(
     wx0, wy0 = start_points(start, settings.start_line_spacing_m)
     x0, y0 = frame.to_leg(xp.asarray(wx0), xp.asarray(wy0))
     layers = [_root_layer(float(t0), x0, y0, settings, xp)]
-    arrival = _route_on(layers, wind, dev, ctx, settings, tab.twa_deg.size, xp,
-                        polar=polar, progress=progress)
+    arrival = _route_on(
+        layers, wind, dev, ctx, settings, tab.twa_deg.size, xp, polar=polar, progress=progress
+    )
     track = _backtrack(layers, arrival, frame, wind, polar, (wx0, wy0), current)
     if progress is not None:
         progress(1.0)
     return make_leg_result(track, "isochrone", target_barrier(target, start, settings.zone_m))
 
 
-def _root_layer(t0: Any, x0: Any, y0: Any, settings: RoutingSettings, xp: ModuleType
-                ) -> _Layer:
+def _root_layer(t0: Any, x0: Any, y0: Any, settings: RoutingSettings, xp: ModuleType) -> _Layer:
     """The front at the leg start: the start points ``(x0, y0)`` (leg frame) at time
     ``t0`` [epoch s] (a float, or one per point), on ``settings.initial_side``."""
     n0 = int(x0.shape[0])
     nan = xp.full(n0, np.nan)
     return _Layer(
-        t=t0, x=x0, y=y0, side=xp.full(n0, float(side_sign(settings.initial_side))),
-        debt=xp.zeros(n0), abs_twa=nan, pend_old=nan, pend_pen=xp.zeros(n0),
-        parent=xp.full(n0, -1, dtype=xp.int64), heading=xp.zeros(n0), bsp=xp.zeros(n0),
-        delay=xp.zeros(n0), tau_est=nan,
+        t=t0,
+        x=x0,
+        y=y0,
+        side=xp.full(n0, float(side_sign(settings.initial_side))),
+        debt=xp.zeros(n0),
+        abs_twa=nan,
+        pend_old=nan,
+        pend_pen=xp.zeros(n0),
+        parent=xp.full(n0, -1, dtype=xp.int64),
+        heading=xp.zeros(n0),
+        bsp=xp.zeros(n0),
+        delay=xp.zeros(n0),
+        tau_est=nan,
     )
 
 
 def _route_on(
-    layers: list[_Layer], wind: WindField, dev: _DeviceTables, ctx: _Context,
-    settings: RoutingSettings, n_angles: int, xp: ModuleType, *, polar: Polar,
-    progress: Callable[[float], None] | None = None, calm_since: float | None = None,
+    layers: list[_Layer],
+    wind: WindField,
+    dev: _DeviceTables,
+    ctx: _Context,
+    settings: RoutingSettings,
+    n_angles: int,
+    xp: ModuleType,
+    *,
+    polar: Polar,
+    progress: Callable[[float], None] | None = None,
+    calm_since: float | None = None,
     tau_hint: float = np.inf,
 ) -> _Arrival:
     """Step the front ``layers[-1]`` until it arrives; the new fronts are appended to
@@ -258,8 +292,9 @@ may need [-]: about 20 ns each on one core, so a few minutes.  The defaults need
 ~1e7 on a 1 km beat; ``dt_s`` 0.5 s with ``heading_step_deg`` 0.1 about 2e9."""
 
 
-def leg_work(settings: RoutingSettings, n_points: int, n_angles: int,
-             time_to_go_s: float) -> tuple[float, float]:
+def leg_work(
+    settings: RoutingSettings, n_points: int, n_angles: int, time_to_go_s: float
+) -> tuple[float, float]:
     """Upper bound of the work of an isochrone leg: ``(steps, candidates per step)``.
 
     Parameters
@@ -282,8 +317,9 @@ def leg_work(settings: RoutingSettings, n_points: int, n_angles: int,
     return time_to_go_s / float(settings.dt_s), float(n_points) * 2.0 * (n_angles + 4)
 
 
-def check_leg_work(label: str, settings: RoutingSettings, ctx: _Context, n_angles: int,
-                   time_to_go_s: float) -> None:
+def check_leg_work(
+    label: str, settings: RoutingSettings, ctx: _Context, n_angles: int, time_to_go_s: float
+) -> None:
     """Refuse a leg whose estimated work (:func:`leg_work`) exceeds :data:`MAX_LEG_WORK`.
 
     Raises
@@ -306,14 +342,13 @@ def check_leg_work(label: str, settings: RoutingSettings, ctx: _Context, n_angle
         f"({steps:.0f} steps to go of up to {per_step:.1e}), more than {MAX_LEG_WORK:.0e} "
         f"(minutes of work per leg); use routing.dt_s >= {dt_fit:.2g} s, a coarser "
         "heading_step_deg or fewer max_front_points (the defaults, 10 s and 2, are accurate "
-        "to 3e-4 of the leg time)")
+        "to 3e-4 of the leg time)"
+    )
 
 
 def _check_start_time(t0: float, label: str) -> None:
     if not (isinstance(t0, int | float) and math.isfinite(t0)):
-        raise InputError(
-            f"leg {label}: the start time must be finite epoch seconds, got {t0!r}"
-        )
+        raise InputError(f"leg {label}: the start time must be finite epoch seconds, got {t0!r}")
 
 
 def _routing_polar(boat: BoatModel, label: str) -> Polar:
@@ -323,8 +358,10 @@ def _routing_polar(boat: BoatModel, label: str) -> Polar:
         return polar
     hint = ""
     if isinstance(boat, BoatModel) and boat.dynamics() is not None:
-        hint = (" For the dynamic boat model use router 'griddp' or 'spline', or route "
-                "its steady polar (boat.steady_polar(tws_ms)) with the isochrone router.")
+        hint = (
+            " For the dynamic boat model use router 'griddp' or 'spline', or route "
+            "its steady polar (boat.steady_polar(tws_ms)) with the isochrone router."
+        )
     raise InputError(
         f"leg {label}: the isochrone router needs a Polar (with .speed(tws, twa)), got "
         f"{type(boat).__name__}.{hint}"
@@ -346,9 +383,15 @@ def _check_target_covered(
 
 
 def _context(
-    label: str, t0: float, frame: _LegFrame, geom: TargetGeometry, wind: WindField,
-    s: RoutingSettings, barriers: tuple[tuple[Barrier, float], ...] = (),
-    current: CurrentField | None = None, obstacles: Obstacles | None = None,
+    label: str,
+    t0: float,
+    frame: _LegFrame,
+    geom: TargetGeometry,
+    wind: WindField,
+    s: RoutingSettings,
+    barriers: tuple[tuple[Barrier, float], ...] = (),
+    current: CurrentField | None = None,
+    obstacles: Obstacles | None = None,
     start_xy: tuple[float, float] = (0.0, 0.0),
 ) -> _Context:
     cov = wind.coverage
@@ -357,19 +400,30 @@ def _context(
     if bounded and not wind.clamp:
         box = (cov.xmin, cov.xmax, cov.ymin, cov.ymax)
     return _Context(
-        label=label, t0=t0, frame=frame, geom=frame.geometry(geom),
-        tack_s=float(s.tack_penalty_s), gybe_s=float(s.gybe_penalty_s),
+        label=label,
+        t0=t0,
+        frame=frame,
+        geom=frame.geometry(geom),
+        tack_s=float(s.tack_penalty_s),
+        gybe_s=float(s.gybe_penalty_s),
         sector_rad=math.radians(s.prune_sector_deg),
         n_bins=math.ceil(2.0 * math.pi / math.radians(s.prune_sector_deg)) + 3,
         max_points=int(s.max_front_points),
-        fan_hull=s.heading_fan == "hull", box=box,
-        barriers=tuple((frame.barrier(b), c) for b, c in barriers), current=current,
-        obstacles=obstacles, bin_origin=_detour_origin(frame, geom, obstacles, start_xy),
+        fan_hull=s.heading_fan == "hull",
+        box=box,
+        barriers=tuple((frame.barrier(b), c) for b, c in barriers),
+        current=current,
+        obstacles=obstacles,
+        bin_origin=_detour_origin(frame, geom, obstacles, start_xy),
     )
 
 
-def _detour_origin(frame: _LegFrame, geom: TargetGeometry, obstacles: Obstacles | None,
-                   start_xy: tuple[float, float]) -> tuple[float, float] | None:
+def _detour_origin(
+    frame: _LegFrame,
+    geom: TargetGeometry,
+    obstacles: Obstacles | None,
+    start_xy: tuple[float, float],
+) -> tuple[float, float] | None:
     """The start centre in the leg frame if the way round the obstacles that block the
     straight line from it to the target centre is more than :data:`DETOUR_FRACTION`
     longer (then the pruning sectors are seen from it), else None.  Sectors seen from
@@ -390,14 +444,18 @@ fraction of the straight start-target distance, above which the pruning sectors 
 from the start."""
 
 
-
 # --------------------------------------------------------------------------------------
 # backtracking
 
 
 def _backtrack(
-    layers: list[_Layer], arr: _Arrival, frame: _LegFrame, wind: WindField, polar: Polar,
-    world_start: tuple[NDArray, NDArray], current: CurrentField | None = None,
+    layers: list[_Layer],
+    arr: _Arrival,
+    frame: _LegFrame,
+    wind: WindField,
+    polar: Polar,
+    world_start: tuple[NDArray, NDArray],
+    current: CurrentField | None = None,
 ) -> RouteTrack:
     """Polyline of the chosen route: step starts, penalty stops, exact arrival (world frame).
 
@@ -412,8 +470,17 @@ def _backtrack(
     for k in range(len(layers) - 1, 0, -1):
         lay = layers[k]
         pidx = int(lay.parent[idx])
-        moves.append((layers[k - 1].t, lay.t, pidx, float(lay.heading[idx]),
-                      float(lay.bsp[idx]), float(lay.delay[idx]), int(lay.side[idx])))
+        moves.append(
+            (
+                layers[k - 1].t,
+                lay.t,
+                pidx,
+                float(lay.heading[idx]),
+                float(lay.bsp[idx]),
+                float(lay.delay[idx]),
+                int(lay.side[idx]),
+            )
+        )
         idx = pidx
     moves.reverse()
     root_side = int(layers[0].side[idx])
@@ -448,7 +515,13 @@ def _backtrack(
         twd = math.degrees(math.atan2(-float(u), -float(v)))
         heading[0] = (2.0 * twd - heading[1]) % 360.0
     track = build_track(
-        a[:, 0], wx, wy, wind, polar, heading_deg=heading, bsp_ms=a[:, 4],
+        a[:, 0],
+        wx,
+        wy,
+        wind,
+        polar,
+        heading_deg=heading,
+        bsp_ms=a[:, 4],
         side=a[:, 5].astype(np.int8),
     )
     if current is None:
@@ -460,8 +533,12 @@ def _backtrack(
 
 
 def _timeout_error(
-    label: str, s: RoutingSettings, elapsed: float, dist_min: float,
-    calm_since: float | None, t: float,
+    label: str,
+    s: RoutingSettings,
+    elapsed: float,
+    dist_min: float,
+    calm_since: float | None,
+    t: float,
 ) -> RoutingError:
     msg = (
         f"leg {label}: no route reached the target within {elapsed:.0f} s of race time "

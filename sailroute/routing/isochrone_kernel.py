@@ -120,9 +120,7 @@ class PolarTables:
     sup_deg: NDArray[np.float64]
 
 
-_TABLE_CACHE: weakref.WeakKeyDictionary[Any, dict[int, PolarTables]] = (
-    weakref.WeakKeyDictionary()
-)
+_TABLE_CACHE: weakref.WeakKeyDictionary[Any, dict[int, PolarTables]] = weakref.WeakKeyDictionary()
 
 
 def _vmg_angles(polar: Polar, tws: NDArray, upwind: bool) -> tuple[NDArray, NDArray]:
@@ -155,10 +153,14 @@ def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
     a = np.linspace(180.0 / n_a, 180.0, n_a)
     own = np.asarray(polar.tws_ms, dtype=float).ravel()
     top = float(own.max()) if own.size and own.max() > 0 else 30.0
-    nodes = np.sort(np.concatenate([
-        np.linspace(0.0, top, math.ceil(top / TABLE_TWS_STEP_MS) + 1),
-        own[(own >= 0) & (own <= top)],
-    ]))
+    nodes = np.sort(
+        np.concatenate(
+            [
+                np.linspace(0.0, top, math.ceil(top / TABLE_TWS_STEP_MS) + 1),
+                own[(own >= 0) & (own <= top)],
+            ]
+        )
+    )
     # distinct values (np.unique's result without NaNs; np.unique imports numpy.ma, 22 ms
     # of a plan's start-up)
     nodes = nodes[np.concatenate([[True], nodes[1:] != nodes[:-1]])]
@@ -168,19 +170,26 @@ def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
     up = _backfill_calm(up, vu)
     down = _backfill_calm(down, vd)
     rad = np.radians(a)
-    vmax = np.maximum(speed.max(axis=1), np.asarray(polar.speed(nodes, np.stack([up, down], 1).T)
-                                                    ).max(axis=0))
+    vmax = np.maximum(
+        speed.max(axis=1), np.asarray(polar.speed(nodes, np.stack([up, down], 1).T)).max(axis=0)
+    )
     vu, vd = np.maximum(vu, 0.0), np.maximum(vd, 0.0)
     beta = np.linspace(-180.0, 180.0, 361)
     sup_ms, sup_deg = _support_table(a, speed, up, down, vu, vd, beta)
-    tables = PolarTables(a, np.cos(rad), np.sin(rad), nodes, speed, up, down, vu, vd, vmax,
-                         beta, sup_ms, sup_deg)
+    tables = PolarTables(
+        a, np.cos(rad), np.sin(rad), nodes, speed, up, down, vu, vd, vmax, beta, sup_ms, sup_deg
+    )
     per_polar[n_a] = tables
     return tables
 
 
 def _support_table(
-    a: NDArray, speed: NDArray, up: NDArray, down: NDArray, vu: NDArray, vd: NDArray,
+    a: NDArray,
+    speed: NDArray,
+    up: NDArray,
+    down: NDArray,
+    vu: NDArray,
+    vd: NDArray,
     beta: NDArray,
 ) -> tuple[NDArray, NDArray]:
     """Largest speed component towards ``beta`` and its |TWA|, per TWS node (see
@@ -365,7 +374,6 @@ def _group_argmin(key: Any, score: Any, n_keys: int, xp: ModuleType) -> Any:
     return keep[score[keep] < np.inf]
 
 
-
 @dataclass(frozen=True, eq=False)
 class _DeviceTables:
     """The :class:`PolarTables` arrays in the kernel's array module ``xp`` (same units).
@@ -389,10 +397,18 @@ class _DeviceTables:
 
 def _device_tables(tab: PolarTables, xp: ModuleType) -> _DeviceTables:
     return _DeviceTables(
-        xp.asarray(tab.twa_deg), xp.asarray(tab.cos_a), xp.asarray(tab.sin_a),
-        xp.asarray(tab.tws_ms), xp.asarray(tab.speed_ms), xp.asarray(tab.up_deg),
-        xp.asarray(tab.down_deg), xp.asarray(tab.up_vmg_ms), xp.asarray(tab.down_vmg_ms),
-        xp.asarray(tab.vmax_ms), xp.asarray(tab.sup_ms), xp.asarray(tab.sup_deg),
+        xp.asarray(tab.twa_deg),
+        xp.asarray(tab.cos_a),
+        xp.asarray(tab.sin_a),
+        xp.asarray(tab.tws_ms),
+        xp.asarray(tab.speed_ms),
+        xp.asarray(tab.up_deg),
+        xp.asarray(tab.down_deg),
+        xp.asarray(tab.up_vmg_ms),
+        xp.asarray(tab.down_vmg_ms),
+        xp.asarray(tab.vmax_ms),
+        xp.asarray(tab.sup_ms),
+        xp.asarray(tab.sup_deg),
     )
 
 
@@ -442,8 +458,15 @@ class _PointWind(NamedTuple):
 
     def rows(self, sl: slice) -> _PointWind:
         """The points ``sl`` only."""
-        return _PointWind(self.tws_ms[sl], self.up_x[sl], self.up_y[sl], self.row[sl],
-                          self.weight[sl], self.up_deg[sl], self.down_deg[sl])
+        return _PointWind(
+            self.tws_ms[sl],
+            self.up_x[sl],
+            self.up_y[sl],
+            self.row[sl],
+            self.weight[sl],
+            self.up_deg[sl],
+            self.down_deg[sl],
+        )
 
 
 class _ExactColumns(NamedTuple):
@@ -473,9 +496,14 @@ class _ExactColumns(NamedTuple):
 
     def rows(self, sl: slice) -> _ExactColumns:
         """The points ``sl`` only."""
-        return _ExactColumns(self.twa_deg[sl], self.bsp_ms[sl], self.cos_twa[sl],
-                             self.sin_twa[sl], self.direct_sin_keep[sl],
-                             self.direct_sin_switch[sl])
+        return _ExactColumns(
+            self.twa_deg[sl],
+            self.bsp_ms[sl],
+            self.cos_twa[sl],
+            self.sin_twa[sl],
+            self.direct_sin_keep[sl],
+            self.direct_sin_switch[sl],
+        )
 
 
 class _TimeToGo(NamedTuple):
@@ -537,9 +565,15 @@ class _ManoeuvreState(NamedTuple):
         """The points ``sl`` only."""
         pending = self.pending[sl]
         return _ManoeuvreState(
-            self.side[sl], self.free[sl], pending, self.base_twa_deg[sl],
-            self.penalty_up_s[sl], self.penalty_down_s[sl], self.debt_s[sl],
-            self.charged_s[sl], self.any_pending and bool(xp.any(pending)),
+            self.side[sl],
+            self.free[sl],
+            pending,
+            self.base_twa_deg[sl],
+            self.penalty_up_s[sl],
+            self.penalty_down_s[sl],
+            self.debt_s[sl],
+            self.charged_s[sl],
+            self.any_pending and bool(xp.any(pending)),
         )
 
 
@@ -647,14 +681,23 @@ class _StepInputs(NamedTuple):
         sl = slice(r0, r1)
         still = self.current_x is None
         return _StepInputs(
-            t=self.t, dt=self.dt, first=self.first, stop=self.stop, x=self.x[sl],
-            y=self.y[sl], wind=self.wind.rows(sl), exact=self.exact.rows(sl),
-            keep=self.keep.rows(sl), switch=self.switch.rows(sl),
-            manoeuvre=self.manoeuvre.rows(sl, xp), near_target=self.near_target[sl],
+            t=self.t,
+            dt=self.dt,
+            first=self.first,
+            stop=self.stop,
+            x=self.x[sl],
+            y=self.y[sl],
+            wind=self.wind.rows(sl),
+            exact=self.exact.rows(sl),
+            keep=self.keep.rows(sl),
+            switch=self.switch.rows(sl),
+            manoeuvre=self.manoeuvre.rows(sl, xp),
+            near_target=self.near_target[sl],
             near_barrier=tuple(None if c is None else c[sl] for c in self.near_barrier),
             current_x=None if still else self.current_x[sl],
             current_y=None if still else self.current_y[sl],
-            group=None if self.group is None else self.group[sl], n_groups=self.n_groups,
+            group=None if self.group is None else self.group[sl],
+            n_groups=self.n_groups,
             fan_lo=None if self.fan_lo is None else self.fan_lo[sl],
             fan_hi=None if self.fan_hi is None else self.fan_hi[sl],
             box_clear=self.box_clear,
@@ -667,8 +710,14 @@ class _StepInputs(NamedTuple):
 
 
 def _step(
-    f: _Layer, wind: WindField, polar: Polar, dev: _DeviceTables, ctx: _Context,
-    s: RoutingSettings, tau_hint: float, xp: ModuleType,
+    f: _Layer,
+    wind: WindField,
+    polar: Polar,
+    dev: _DeviceTables,
+    ctx: _Context,
+    s: RoutingSettings,
+    tau_hint: float,
+    xp: ModuleType,
 ) -> _Arrival | tuple[_Layer, bool, float, float]:
     """One isochrone step from the front ``f``.
 
@@ -755,8 +804,9 @@ def _winner_columns(
     node, weight = pre.wind.row[row], pre.wind.weight[row]
     ex = pre.exact
     s_lo = dev.speed_ms[node, grid_col]
-    bsp = xp.where(grid, s_lo + weight * (dev.speed_ms[node + 1, grid_col] - s_lo),
-                   ex.bsp_ms[row, exact_col])
+    bsp = xp.where(
+        grid, s_lo + weight * (dev.speed_ms[node + 1, grid_col] - s_lo), ex.bsp_ms[row, exact_col]
+    )
     twa = xp.where(grid, dev.twa_deg[grid_col], ex.twa_deg[row, exact_col])
     sx = bsp * xp.where(grid, dev.cos_a[grid_col], ex.cos_twa[row, exact_col])
     sy = bsp * xp.where(grid, dev.sin_a[grid_col], ex.sin_twa[row, exact_col])
@@ -764,7 +814,12 @@ def _winner_columns(
 
 
 def _survivors(
-    pre: _StepInputs, row: Any, block: Any, column: Any, score: Any, dev: _DeviceTables,
+    pre: _StepInputs,
+    row: Any,
+    block: Any,
+    column: Any,
+    score: Any,
+    dev: _DeviceTables,
     xp: ModuleType,
 ) -> tuple[_Layer, Any]:
     """The new front from the winning ``(row, block, column)`` triples (shape (m,)) and
@@ -779,9 +834,11 @@ def _survivors(
     pen = _penalty(twa, m.penalty_up_s[row], m.penalty_down_s[row], xp)
     free = m.free[row]
     pending = m.pending[row]
-    debt = xp.where(switch, xp.where(free, 0.0, pen),
-                    xp.where(pending, xp.maximum(m.debt_s[row] + pen - m.charged_s[row], 0.0),
-                             0.0))
+    debt = xp.where(
+        switch,
+        xp.where(free, 0.0, pen),
+        xp.where(pending, xp.maximum(m.debt_s[row] + pen - m.charged_s[row], 0.0), 0.0),
+    )
     delay = xp.minimum(debt, dt)
     move = dt - delay
     in_manoeuvre = xp.where(switch, ~free, pending) & ~(move > 0)
@@ -790,11 +847,19 @@ def _survivors(
         x, y = x + dt * pre.current_x[row], y + dt * pre.current_y[row]
     t_new = pre.t + dt if isinstance(pre.t, float) else pre.t[row] + dt  # per point: members
     layer = _Layer(
-        t=t_new, x=x, y=y, side=sigma, debt=debt - delay, abs_twa=twa,
+        t=t_new,
+        x=x,
+        y=y,
+        side=sigma,
+        debt=debt - delay,
+        abs_twa=twa,
         pend_old=xp.where(in_manoeuvre, m.base_twa_deg[row], np.nan),
         pend_pen=xp.where(in_manoeuvre, pen, 0.0),
-        parent=row, heading=xp.mod(xp.degrees(xp.arctan2(vx, vy)), 360.0), bsp=bsp,
-        delay=delay, tau_est=score,
+        parent=row,
+        heading=xp.mod(xp.degrees(xp.arctan2(vx, vy)), 360.0),
+        bsp=bsp,
+        delay=delay,
+        tau_est=score,
     )
     return layer, (move > 0) & (bsp > 0)
 
@@ -803,8 +868,7 @@ def _survivors(
 # one step: the inputs (wind, aim, exact columns, time to go, manoeuvres)
 
 
-def _wind_state(u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleType
-                ) -> _PointWind:
+def _wind_state(u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleType) -> _PointWind:
     """The wind ``(u, v)`` [m s⁻¹] (world frame, towards; any shape) for the kernel."""
     tws = xp.sqrt(u * u + v * v)
     windy = tws > _CALM_MS
@@ -819,8 +883,16 @@ def _wind_state(u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleTyp
 
 
 def _time_to_go(
-    wind: _PointWind, ex: Any, ey: Any, dist: Any, sides: Any, free: Any, tack_s: float,
-    gybe_s: float, dev: _DeviceTables, xp: ModuleType,
+    wind: _PointWind,
+    ex: Any,
+    ey: Any,
+    dist: Any,
+    sides: Any,
+    free: Any,
+    tack_s: float,
+    gybe_s: float,
+    dev: _DeviceTables,
+    xp: ModuleType,
 ) -> tuple[Any, Any, Any]:
     """Time to go over ``dist`` [m] along the unit vector ``(ex, ey)``, and its gradient.
 
@@ -845,8 +917,7 @@ def _time_to_go(
     sin_b = up_x * ey - up_y * ex
     beta_deg = xp.degrees(xp.arccos(cos_b))
     vmg_up = dev.up_vmg_ms[node] + weight * (dev.up_vmg_ms[node + 1] - dev.up_vmg_ms[node])
-    vmg_dn = (dev.down_vmg_ms[node]
-              + weight * (dev.down_vmg_ms[node + 1] - dev.down_vmg_ms[node]))
+    vmg_dn = dev.down_vmg_ms[node] + weight * (dev.down_vmg_ms[node + 1] - dev.down_vmg_ms[node])
     # polar speed and slope dS/dbeta at the direct angle, from the grid table
     na = dev.twa_deg.shape[0]
     step = 180.0 / na
@@ -862,14 +933,14 @@ def _time_to_go(
     cone_dn = (beta_deg >= wind.down_deg) & (vmg_dn > 0) & ~cone_up
     cone = cone_up | cone_dn
     inv_s = 1.0 / xp.where(spd > 0, spd, 1.0)
-    inv_v = xp.where(cone_up, 1.0 / xp.where(cone_up, vmg_up, 1.0),
-                     -1.0 / xp.where(cone_dn, vmg_dn, 1.0))
+    inv_v = xp.where(
+        cone_up, 1.0 / xp.where(cone_up, vmg_up, 1.0), -1.0 / xp.where(cone_dn, vmg_dn, 1.0)
+    )
     t_straight = xp.where(spd > 0, dist * inv_s, np.inf)
     t_cone = xp.where(cone, dist * cos_b * inv_v, np.inf)
     own = free | (sides * sin_b >= 0)
     paid = ~free
-    t_straight = t_straight + xp.where(own | ~paid, 0.0,
-                                       xp.where(beta_deg < 90.0, tack_s, gybe_s))
+    t_straight = t_straight + xp.where(own | ~paid, 0.0, xp.where(beta_deg < 90.0, tack_s, gybe_s))
     t_cone = t_cone + xp.where(paid, xp.where(cone_up, tack_s, gybe_s), 0.0)
     use_cone = t_cone < t_straight
     tau = xp.minimum(t_cone, t_straight)
@@ -884,8 +955,9 @@ def _time_to_go(
     return tau, along_up * up_x + along_way * ex, along_up * up_y + along_way * ey
 
 
-def _support(node: Any, weight: Any, beta_deg: Any, dev: _DeviceTables, xp: ModuleType
-             ) -> tuple[Any, Any]:
+def _support(
+    node: Any, weight: Any, beta_deg: Any, dev: _DeviceTables, xp: ModuleType
+) -> tuple[Any, Any]:
     """Polar support towards ``beta_deg`` (from the upwind direction, towards the side)
     at the table rows ``node, weight``: the best speed component [m s⁻¹] and its |TWA|
     [°], interpolated bilinearly in (TWS, beta) from :attr:`PolarTables.sup_ms`."""
@@ -901,8 +973,16 @@ def _support(node: Any, weight: Any, beta_deg: Any, dev: _DeviceTables, xp: Modu
 
 
 def _fastest_aim(
-    x: Any, y: Any, ex: Any, ey: Any, dist: Any, side: Any, wind: _PointWind,
-    g: TargetGeometry, dev: _DeviceTables, xp: ModuleType,
+    x: Any,
+    y: Any,
+    ex: Any,
+    ey: Any,
+    dist: Any,
+    side: Any,
+    wind: _PointWind,
+    g: TargetGeometry,
+    dev: _DeviceTables,
+    xp: ModuleType,
     cur: tuple[Any, Any] | None = None,
 ) -> tuple[Any, Any, Any]:
     """Aim points on the target segment that the local wind reaches soonest, per side.
@@ -964,7 +1044,13 @@ _TTG_ITERATIONS = 4
 
 
 def _crab(
-    ex: Any, ey: Any, cx: Any, cy: Any, wind: _PointWind, polar: Polar, xp: ModuleType,
+    ex: Any,
+    ey: Any,
+    cx: Any,
+    cy: Any,
+    wind: _PointWind,
+    polar: Polar,
+    xp: ModuleType,
 ) -> tuple[Any, Any, Any, Any]:
     """The direct column in a current: the heading through the water whose velocity
     over the ground, ``S(TWA(h))·w(h) + C``, points along the unit vectors ``(ex, ey)``.
@@ -995,8 +1081,20 @@ def _crab(
 
 
 def _time_to_go_current(
-    tau: Any, gx: Any, gy: Any, wind: _PointWind, ex: Any, ey: Any, dist: Any, cx: Any,
-    cy: Any, sides: Any, free: Any, ctx: _Context, dev: _DeviceTables, xp: ModuleType,
+    tau: Any,
+    gx: Any,
+    gy: Any,
+    wind: _PointWind,
+    ex: Any,
+    ey: Any,
+    dist: Any,
+    cx: Any,
+    cy: Any,
+    sides: Any,
+    free: Any,
+    ctx: _Context,
+    dev: _DeviceTables,
+    xp: ModuleType,
 ) -> tuple[Any, Any, Any]:
     """Time to go in a current ``C`` (averaged along the way, leg frame) and its gradient.
 
@@ -1014,9 +1112,18 @@ def _time_to_go_current(
         dw = xp.sqrt(wx * wx + wy * wy)
         pos = dw > 0
         inv = 1.0 / xp.where(pos, dw, 1.0)
-        t_w, gx, gy = _time_to_go(wind, xp.where(pos, wx * inv, ex),
-                                  xp.where(pos, wy * inv, ey), dw, sides, free, ctx.tack_s,
-                                  ctx.gybe_s, dev, xp)
+        t_w, gx, gy = _time_to_go(
+            wind,
+            xp.where(pos, wx * inv, ex),
+            xp.where(pos, wy * inv, ey),
+            dw,
+            sides,
+            free,
+            ctx.tack_s,
+            ctx.gybe_s,
+            dev,
+            xp,
+        )
         der = 1.0 + gx * cx + gy * cy
         newton = der > 0.25
         tau = xp.where(ok, tt - (tt - t_w) / xp.where(newton, der, 1.0), t_w)
@@ -1044,8 +1151,15 @@ def _direction(dx: Any, dy: Any, xp: ModuleType) -> tuple[Any, Any, Any]:
 
 
 def _sample_step(
-    f: _Layer, dt: float, aim_x: Any, aim_y: Any, dist: Any, wind: WindField, ctx: _Context,
-    s: RoutingSettings, xp: ModuleType,
+    f: _Layer,
+    dt: float,
+    aim_x: Any,
+    aim_y: Any,
+    dist: Any,
+    wind: WindField,
+    ctx: _Context,
+    s: RoutingSettings,
+    xp: ModuleType,
 ) -> tuple[Any, Any, _Current | None]:
     """The wind ``(u, v)`` [m s⁻¹] (world frame) of the step, shape
     (``PATH_SAMPLES + 1``, n), and the current (None: still or slack water).
@@ -1061,24 +1175,31 @@ def _sample_step(
     t_mid = f.t + 0.5 * dt
     hr = xp.radians(f.heading)
     half = xp.where(f.debt > 0, 0.0, 0.5 * dt * f.bsp)
-    horizon = xp.where(xp.isnan(f.tau_est), dist * (1.0 / _ROOT_SPEED_MS),
-                       xp.minimum(f.tau_est, float(s.max_leg_time_s)))
+    horizon = xp.where(
+        xp.isnan(f.tau_est),
+        dist * (1.0 / _ROOT_SPEED_MS),
+        xp.minimum(f.tau_est, float(s.max_leg_time_s)),
+    )
     fk = (xp.arange(PATH_SAMPLES, dtype=float) + 0.5) / PATH_SAMPLES
     px = xp.concatenate([x + half * xp.sin(hr), (x + fk[:, None] * (aim_x - x)).reshape(-1)])
     py = xp.concatenate([y + half * xp.cos(hr), (y + fk[:, None] * (aim_y - y)).reshape(-1)])
     pt = xp.concatenate([xp.full(n, t_mid), (t_mid + fk[:, None] * horizon).reshape(-1)])
     wx, wy = ctx.frame.to_world(px, py)
-    pts = (to_numpy(clip(pt, cov.t0, cov.t1, xp=xp)),
-           to_numpy(clip(wx, cov.xmin, cov.xmax, xp=xp)),
-           to_numpy(clip(wy, cov.ymin, cov.ymax, xp=xp)))
+    pts = (
+        to_numpy(clip(pt, cov.t0, cov.t1, xp=xp)),
+        to_numpy(clip(wx, cov.xmin, cov.xmax, xp=xp)),
+        to_numpy(clip(wy, cov.ymin, cov.ymax, xp=xp)),
+    )
     u, v = wind.sample(*pts)
     u = xp.asarray(u, dtype=float).reshape(PATH_SAMPLES + 1, n)
     v = xp.asarray(v, dtype=float).reshape(PATH_SAMPLES + 1, n)
     if ctx.current is None:
         return u, v, None
     cu, cv = ctx.current.sample(*pts)
-    cu, cv = ctx.frame.vec_to_leg(xp.asarray(cu, dtype=float).reshape(PATH_SAMPLES + 1, n),
-                                  xp.asarray(cv, dtype=float).reshape(PATH_SAMPLES + 1, n))
+    cu, cv = ctx.frame.vec_to_leg(
+        xp.asarray(cu, dtype=float).reshape(PATH_SAMPLES + 1, n),
+        xp.asarray(cv, dtype=float).reshape(PATH_SAMPLES + 1, n),
+    )
     if not (bool(xp.any(cu != 0.0)) or bool(xp.any(cv != 0.0))):  # slack water: still water
         return u, v, None
     return u, v, _Current(cu[0], cv[0], xp.mean(cu, axis=0), xp.mean(cv, axis=0))
@@ -1146,17 +1267,23 @@ def _group_fans(
     lo = np.zeros(groups.n_members, dtype=np.int64)
     hi = np.full(groups.n_members, n_a, dtype=np.int64)
     if hull:
-        lo_h = np.searchsorted(dev.twa_deg, np.minimum.reduceat(wind.up_deg, groups.starts),
-                               side="right")
-        hi_h = np.searchsorted(dev.twa_deg,
-                               np.maximum.reduceat(wind.down_deg, groups.starts), side="left")
+        lo_h = np.searchsorted(
+            dev.twa_deg, np.minimum.reduceat(wind.up_deg, groups.starts), side="right"
+        )
+        hi_h = np.searchsorted(
+            dev.twa_deg, np.maximum.reduceat(wind.down_deg, groups.starts), side="left"
+        )
         ok = hi_h > lo_h
         lo, hi = np.where(ok, lo_h, lo), np.where(ok, hi_h, hi)
     return int(lo.min()), int(hi.max()), lo[groups.member], hi[groups.member]
 
 
 def _exact_columns(
-    wind: _PointWind, aim_x: Any, aim_y: Any, cur: _Current | None, polar: Polar,
+    wind: _PointWind,
+    aim_x: Any,
+    aim_y: Any,
+    cur: _Current | None,
+    polar: Polar,
     xp: ModuleType,
 ) -> _ExactColumns:
     """VMG up, VMG down and the direct columns to the aim points ``(aim_x, aim_y)`` (unit
@@ -1164,9 +1291,10 @@ def _exact_columns(
     In a current the direct heading is the one whose ground track goes to the aim
     (:func:`_crab`)."""
     tws_h = to_numpy(wind.tws_ms)
-    v_vmg = xp.asarray(polar.speed(tws_h[:, None],
-                                   to_numpy(xp.stack([wind.up_deg, wind.down_deg], 1))),
-                       dtype=float)
+    v_vmg = xp.asarray(
+        polar.speed(tws_h[:, None], to_numpy(xp.stack([wind.up_deg, wind.down_deg], 1))),
+        dtype=float,
+    )
     if cur is None:
         cos_d = clip(wind.up_y * aim_y + wind.up_x * aim_x, -1.0, 1.0, xp=xp)  # (2, n)
         sin_d = wind.up_x * aim_y - wind.up_y * aim_x
@@ -1177,10 +1305,12 @@ def _exact_columns(
     twa = xp.concatenate([wind.up_deg[:, None], wind.down_deg[:, None], a_d.T], axis=1)
     rad = xp.radians(twa[:, :2])
     return _ExactColumns(
-        twa_deg=twa, bsp_ms=xp.concatenate([v_vmg, v_d.T], axis=1),
+        twa_deg=twa,
+        bsp_ms=xp.concatenate([v_vmg, v_d.T], axis=1),
         cos_twa=xp.concatenate([xp.cos(rad), cos_d.T], axis=1),
         sin_twa=xp.concatenate([xp.sin(rad), xp.abs(sin_d).T], axis=1),
-        direct_sin_keep=sin_d[0], direct_sin_switch=sin_d[1],
+        direct_sin_keep=sin_d[0],
+        direct_sin_switch=sin_d[1],
     )
 
 
@@ -1198,16 +1328,25 @@ def _manoeuvre_state(f: _Layer, ctx: _Context, xp: ModuleType) -> _ManoeuvreStat
     mixed = max(ctx.tack_s, ctx.gybe_s)
     unknown = xp.isnan(base)
     return _ManoeuvreState(
-        side=xp.where(f.side < 0, -1.0, 1.0), free=f.side == 0, pending=pending,
+        side=xp.where(f.side < 0, -1.0, 1.0),
+        free=f.side == 0,
+        pending=pending,
         base_twa_deg=base,
         penalty_up_s=xp.where(unknown | (base < 90.0), ctx.tack_s, mixed),
         penalty_down_s=xp.where(unknown | (base >= 90.0), ctx.gybe_s, mixed),
-        debt_s=f.debt, charged_s=f.pend_pen, any_pending=bool(xp.any(pending)),
+        debt_s=f.debt,
+        charged_s=f.pend_pen,
+        any_pending=bool(xp.any(pending)),
     )
 
 
 def _within_reach(
-    x: Any, y: Any, step_m: Any, ctx: _Context, xp: ModuleType, first_clear: Any = None,
+    x: Any,
+    y: Any,
+    step_m: Any,
+    ctx: _Context,
+    xp: ModuleType,
+    first_clear: Any = None,
 ) -> tuple[Any, tuple[Any, ...]]:
     """Points whose move (at most ``step_m`` [m], shape (n,)) can reach the target segment,
     and per barrier of the leg those that can reach its ray (None where no point can);
@@ -1217,16 +1356,27 @@ def _within_reach(
     for i, (b, clear) in enumerate(ctx.barriers):
         if i == 0 and first_clear is not None:
             clear = first_clear
-        ray = TargetGeometry(b.mark, (b.mark[0] + BARRIER_LENGTH_M * b.ray[0],
-                                      b.mark[1] + BARRIER_LENGTH_M * b.ray[1]), b.normal, "ray")
+        ray = TargetGeometry(
+            b.mark,
+            (b.mark[0] + BARRIER_LENGTH_M * b.ray[0], b.mark[1] + BARRIER_LENGTH_M * b.ray[1]),
+            b.normal,
+            "ray",
+        )
         close = _segment_distance(x, y, ray, xp) <= step_m + clear + 1e-3
         near_barrier.append(close if bool(xp.any(close)) else None)
     return near, tuple(near_barrier)
 
 
 def _prepare(
-    f: _Layer, wind: WindField, polar: Polar, dev: _DeviceTables, ctx: _Context,
-    s: RoutingSettings, tau_hint: float, xp: ModuleType, groups: Groups | None = None,
+    f: _Layer,
+    wind: WindField,
+    polar: Polar,
+    dev: _DeviceTables,
+    ctx: _Context,
+    s: RoutingSettings,
+    tau_hint: float,
+    xp: ModuleType,
+    groups: Groups | None = None,
 ) -> tuple[_StepInputs, Any, Any]:
     """Step length, wind, VMG angles, direct bearing and time to go of the front points.
 
@@ -1259,41 +1409,83 @@ def _prepare(
     # aim, per side, at the point of the target segment reached fastest in this wind
     man = _manoeuvre_state(f, ctx, xp)
     sides = xp.stack([man.side, -man.side])
-    aex, aey, adist = _fastest_aim(x, y, ex, ey, dist, man.side, move_wind, ctx.geom, dev, xp,
-                                   None if cur is None else (cur.move_x, cur.move_y))
+    aex, aey, adist = _fastest_aim(
+        x,
+        y,
+        ex,
+        ey,
+        dist,
+        man.side,
+        move_wind,
+        ctx.geom,
+        dev,
+        xp,
+        None if cur is None else (cur.move_x, cur.move_y),
+    )
     exact = _exact_columns(move_wind, aex, aey, cur, polar, xp)
 
     # time to go on either side, in the wind averaged along the way
     mean_wind = _wind_state(xp.mean(u, axis=0), xp.mean(v, axis=0), dev, ctx.frame, xp)
-    tau, gx, gy = _time_to_go(mean_wind, aex, aey, adist, sides, man.free, ctx.tack_s,
-                              ctx.gybe_s, dev, xp)
+    tau, gx, gy = _time_to_go(
+        mean_wind, aex, aey, adist, sides, man.free, ctx.tack_s, ctx.gybe_s, dev, xp
+    )
     if cur is not None:
-        tau, gx, gy = _time_to_go_current(tau, gx, gy, mean_wind, aex, aey, adist, cur.mean_x,
-                                          cur.mean_y, sides, man.free, ctx, dev, xp)
+        tau, gx, gy = _time_to_go_current(
+            tau,
+            gx,
+            gy,
+            mean_wind,
+            aex,
+            aey,
+            adist,
+            cur.mean_x,
+            cur.mean_y,
+            sides,
+            man.free,
+            ctx,
+            dev,
+            xp,
+        )
     tau_min = _least(f.debt + tau[0], groups, xp)
     if cur is not None:  # the drift of the step is common to all candidates of a point
         tau = tau - dt * (gx * cur.move_x + gy * cur.move_y)
     dist_min = _least(adist, groups, xp)
 
     # the points a move can take to the target or a barrier
-    top_ms = xp.maximum(xp.maximum(dev.vmax_ms[move_wind.row], dev.vmax_ms[move_wind.row + 1]),
-                        xp.max(exact.bsp_ms, axis=1))
+    top_ms = xp.maximum(
+        xp.maximum(dev.vmax_ms[move_wind.row], dev.vmax_ms[move_wind.row + 1]),
+        xp.max(exact.bsp_ms, axis=1),
+    )
     if cur is not None:
         top_ms = top_ms + xp.sqrt(cur.move_x * cur.move_x + cur.move_y * cur.move_y)
-    first_clear = None if groups is None or groups.clearance is None \
-        else groups.clearance[groups.member]
+    first_clear = (
+        None if groups is None or groups.clearance is None else groups.clearance[groups.member]
+    )
     near, near_barrier = _within_reach(x, y, top_ms * dt * 1.0001, ctx, xp, first_clear)
     box_clear = ctx.box is None or _box_holds(x, y, top_ms * dt * 1.0001, ctx, xp)
 
     pre = _StepInputs(
-        t=f.t, dt=dt, first=first, stop=stop, x=x, y=y, wind=move_wind, exact=exact,
-        keep=_TimeToGo(tau[0], gx[0], gy[0]), switch=_TimeToGo(tau[1], gx[1], gy[1]),
-        manoeuvre=man, near_target=near, near_barrier=near_barrier,
+        t=f.t,
+        dt=dt,
+        first=first,
+        stop=stop,
+        x=x,
+        y=y,
+        wind=move_wind,
+        exact=exact,
+        keep=_TimeToGo(tau[0], gx[0], gy[0]),
+        switch=_TimeToGo(tau[1], gx[1], gy[1]),
+        manoeuvre=man,
+        near_target=near,
+        near_barrier=near_barrier,
         current_x=None if cur is None else cur.move_x,
         current_y=None if cur is None else cur.move_y,
         group=None if groups is None else groups.member,
-        n_groups=1 if groups is None else groups.n_members, fan_lo=fan_lo, fan_hi=fan_hi,
-        box_clear=box_clear, first_clear=first_clear,
+        n_groups=1 if groups is None else groups.n_members,
+        fan_lo=fan_lo,
+        fan_hi=fan_hi,
+        box_clear=box_clear,
+        first_clear=first_clear,
     )
     return pre, tau_min, dist_min
 
@@ -1346,8 +1538,8 @@ class _Timing(NamedTuple):
 def _grid_speeds(c: _StepInputs, dev: _DeviceTables) -> Any:
     """Boat speed [m s⁻¹] of the grid columns, shape (rows, n_grid)."""
     node, weight = c.wind.row, c.wind.weight
-    s_lo = dev.speed_ms[node, c.first:c.stop]
-    return s_lo + weight[:, None] * (dev.speed_ms[node + 1, c.first:c.stop] - s_lo)
+    s_lo = dev.speed_ms[node, c.first : c.stop]
+    return s_lo + weight[:, None] * (dev.speed_ms[node + 1, c.first : c.stop] - s_lo)
 
 
 def _block(
@@ -1360,12 +1552,16 @@ def _block(
     lo, n_grid = c.first + first, c.n_grid - first
     exact = _EXACT_OF_BLOCK[block]
     bsp = xp.concatenate([grid_bsp[:, first:], c.exact.bsp_ms[:, exact]], axis=1)
-    twa = xp.concatenate([xp.broadcast_to(dev.twa_deg[lo:c.stop], (rows, n_grid)),
-                          c.exact.twa_deg[:, exact]], axis=1)
-    sx = bsp * xp.concatenate([xp.broadcast_to(dev.cos_a[lo:c.stop], (rows, n_grid)),
-                               c.exact.cos_twa[:, exact]], axis=1)
-    sy = bsp * xp.concatenate([xp.broadcast_to(dev.sin_a[lo:c.stop], (rows, n_grid)),
-                               c.exact.sin_twa[:, exact]], axis=1)
+    twa = xp.concatenate(
+        [xp.broadcast_to(dev.twa_deg[lo : c.stop], (rows, n_grid)), c.exact.twa_deg[:, exact]],
+        axis=1,
+    )
+    sx = bsp * xp.concatenate(
+        [xp.broadcast_to(dev.cos_a[lo : c.stop], (rows, n_grid)), c.exact.cos_twa[:, exact]], axis=1
+    )
+    sy = bsp * xp.concatenate(
+        [xp.broadcast_to(dev.sin_a[lo : c.stop], (rows, n_grid)), c.exact.sin_twa[:, exact]], axis=1
+    )
     side = c.manoeuvre.side
     sigma = side if block == _KEEP else -side
     vx, vy = _velocity(c.wind.up_x[:, None], c.wind.up_y[:, None], sigma[:, None], sx, sy)
@@ -1397,8 +1593,7 @@ def _keep_timing(c: _StepInputs, keep: _Block, sub: Any, xp: ModuleType) -> _Tim
     if m.any_pending and bool(xp.any(m.pending[sub])):
         pr = sub[m.pending[sub]]
         pos = xp.flatnonzero(m.pending[sub])
-        price = _penalty(keep.twa_deg[pr], m.penalty_up_s[pr, None],
-                         m.penalty_down_s[pr, None], xp)
+        price = _penalty(keep.twa_deg[pr], m.penalty_up_s[pr, None], m.penalty_down_s[pr, None], xp)
         owed[pos] = xp.maximum(m.debt_s[pr, None] + price - m.charged_s[pr, None], 0.0)
     delay = xp.minimum(owed, c.dt)
     return _Timing(delay, c.dt - delay, owed - delay)
@@ -1426,8 +1621,9 @@ def _keep_ends(
 
 def _switch_ends(c: _StepInputs, switch: _Block, timing: _Timing) -> tuple[Any, Any]:
     """End points [m] of the moves of block ``_SWITCH``, after the penalty stop."""
-    return _drifted(c, c.x[:, None] + timing.move * switch.vx,
-                    c.y[:, None] + timing.move * switch.vy)
+    return _drifted(
+        c, c.x[:, None] + timing.move * switch.vx, c.y[:, None] + timing.move * switch.vy
+    )
 
 
 def _barrier_blocked(
@@ -1452,8 +1648,12 @@ def _barrier_blocked(
 
 
 def _obstacle_blocked(
-    c: _StepInputs, ends: tuple[tuple[Any, Any], ...], blocked: list[Any] | None,
-    frame: _LegFrame, obstacles: Obstacles, xp: ModuleType,
+    c: _StepInputs,
+    ends: tuple[tuple[Any, Any], ...],
+    blocked: list[Any] | None,
+    frame: _LegFrame,
+    obstacles: Obstacles,
+    xp: ModuleType,
 ) -> list[Any]:
     """``blocked`` (:func:`_barrier_blocked`) with the moves that leave free water added:
     each move from its row's point to its end, in the world frame
@@ -1483,9 +1683,15 @@ def _blocked_error(f: _Layer, ctx: _Context, t: float) -> RoutingError:
 
 
 def _arrival(
-    c: _StepInputs, r0: int, blocks: tuple[_Block, _Block],
-    ends: tuple[tuple[Any, Any], ...], timings: tuple[_Timing, _Timing],
-    direct_ok: tuple[Any, Any], blocked: list[Any] | None, ctx: _Context, xp: ModuleType,
+    c: _StepInputs,
+    r0: int,
+    blocks: tuple[_Block, _Block],
+    ends: tuple[tuple[Any, Any], ...],
+    timings: tuple[_Timing, _Timing],
+    direct_ok: tuple[Any, Any],
+    blocked: list[Any] | None,
+    ctx: _Context,
+    xp: ModuleType,
 ) -> _Arrival | None:
     """The earliest forward crossing of the target segment (rows within reach only).
 
@@ -1525,26 +1731,35 @@ def _arrival(
         ds = float(frac[rr, col])
         x0, y0 = float(px[rr, 0]), float(py[rr, 0])
         end_x, end_y = float(qx[p, col]), float(qy[p, col])
-        hd = (_heading_deg(end_x - x0, end_y - y0) if c.current_x is None  # through the water:
-              else _heading_deg(float(blk.vx[p, col]), float(blk.vy[p, col])))
+        hd = (
+            _heading_deg(end_x - x0, end_y - y0)
+            if c.current_x is None  # through the water:
+            else _heading_deg(float(blk.vx[p, col]), float(blk.vy[p, col]))
+        )
         arrival = _Arrival(
-            parent=r0 + p, t_start=c.t, t=c.t + best_t,
-            x=x0 + ds * (end_x - x0), y=y0 + ds * (end_y - y0),
-            heading=hd, bsp=float(blk.bsp_ms[p, col]),
-            delay=float(timing.delay[rr, col]), side=int(blk.sigma[p]),
+            parent=r0 + p,
+            t_start=c.t,
+            t=c.t + best_t,
+            x=x0 + ds * (end_x - x0),
+            y=y0 + ds * (end_y - y0),
+            heading=hd,
+            bsp=float(blk.bsp_ms[p, col]),
+            delay=float(timing.delay[rr, col]),
+            side=int(blk.sigma[p]),
         )
     return arrival
 
 
-def _keep_scores(
-    c: _StepInputs, keep: _Block, pending: Any, pending_timing: _Timing | None
-) -> Any:
+def _keep_scores(c: _StepInputs, keep: _Block, pending: Any, pending_timing: _Timing | None) -> Any:
     """Estimated time to go after the moves of block ``_KEEP`` [s], ``τ - dt G·v`` (the
     pending rows: ``τ + debt - move G·v``)."""
     score = c.keep.tau_s[:, None] - c.dt * keep.rate
     if pending_timing is not None:
-        score[pending] = (c.keep.tau_s[pending, None] + pending_timing.debt
-                          - pending_timing.move * keep.rate[pending])
+        score[pending] = (
+            c.keep.tau_s[pending, None]
+            + pending_timing.debt
+            - pending_timing.move * keep.rate[pending]
+        )
     return score
 
 
@@ -1555,8 +1770,13 @@ def _switch_scores(c: _StepInputs, switch: _Block, timing: _Timing) -> Any:
 
 
 def _drop_forbidden(
-    c: _StepInputs, scores: list[Any], ends: tuple[tuple[Any, Any], ...],
-    direct_ok: tuple[Any, Any], blocked: list[Any] | None, ctx: _Context, xp: ModuleType,
+    c: _StepInputs,
+    scores: list[Any],
+    ends: tuple[tuple[Any, Any], ...],
+    direct_ok: tuple[Any, Any],
+    blocked: list[Any] | None,
+    ctx: _Context,
+    xp: ModuleType,
 ) -> list[Any]:
     """Scores with the forbidden candidates at infinity: a direct column on the wrong
     side, a side change during a pending manoeuvre, a move past a rounded mark on the
@@ -1570,19 +1790,27 @@ def _drop_forbidden(
         outside = (col < c.fan_lo[:, None]) | (col >= c.fan_hi[:, None])
         for score in scores:
             if score.shape[1] == c.n_columns:  # the block has the grid columns
-                score[:, :c.n_grid][outside] = np.inf
+                score[:, : c.n_grid][outside] = np.inf
     if blocked is not None:
-        scores = [xp.where(mask, np.inf, score) for score, mask in zip(scores, blocked,
-                                                                        strict=True)]
+        scores = [
+            xp.where(mask, np.inf, score) for score, mask in zip(scores, blocked, strict=True)
+        ]
     if ctx.box is not None and not c.box_clear:
-        scores = [xp.where(_in_box(qx, qy, ctx.frame, ctx.box), score, np.inf)
-                  for score, (qx, qy) in zip(scores, ends, strict=True)]
+        scores = [
+            xp.where(_in_box(qx, qy, ctx.frame, ctx.box), score, np.inf)
+            for score, (qx, qy) in zip(scores, ends, strict=True)
+        ]
     return scores
 
 
 def _sector_winners(
-    c: _StepInputs, r0: int, blocks: tuple[_Block, _Block], ends: tuple[tuple[Any, Any], ...],
-    scores: list[Any], ctx: _Context, xp: ModuleType,
+    c: _StepInputs,
+    r0: int,
+    blocks: tuple[_Block, _Block],
+    ends: tuple[tuple[Any, Any], ...],
+    scores: list[Any],
+    ctx: _Context,
+    xp: ModuleType,
 ) -> tuple[Any, Any, Any] | None:
     """The best candidate per bin: sector of the bearing seen from the target and side.
 
@@ -1615,13 +1843,21 @@ def _sector_winners(
     f1 = flat - n_keep
     first = blocks[_SWITCH].first
     h1 = h - first
-    wid = xp.where(in_keep, ((r0 + flat // h) * 2 + _KEEP) * h + flat % h,
-                   ((r0 + f1 // h1) * 2 + _SWITCH) * h + first + f1 % h1)
+    wid = xp.where(
+        in_keep,
+        ((r0 + flat // h) * 2 + _KEEP) * h + flat % h,
+        ((r0 + f1 // h1) * 2 + _SWITCH) * h + first + f1 % h1,
+    )
     return key[flat], score[flat], wid
 
 
 def _expand(
-    pre: _StepInputs, r0: int, r1: int, dev: _DeviceTables, ctx: _Context, xp: ModuleType,
+    pre: _StepInputs,
+    r0: int,
+    r1: int,
+    dev: _DeviceTables,
+    ctx: _Context,
+    xp: ModuleType,
     want_winners: bool,
 ) -> tuple[_Arrival | None, tuple[Any, Any, Any] | None]:
     """Candidates of front points ``r0:r1``: arrival check and per-sector winners.
@@ -1662,15 +1898,18 @@ def _expand(
     arrival = None
     near = xp.flatnonzero(c.near_target)
     if near.shape[0] > 0:
-        near_timing = (_keep_timing(c, keep, near, xp),
-                       _Timing(switch_timing.delay[near], switch_timing.move[near], None))
-        arrival = _arrival(c, r0, (keep, switch), ends, near_timing, direct_ok, blocked, ctx,
-                           xp)
+        near_timing = (
+            _keep_timing(c, keep, near, xp),
+            _Timing(switch_timing.delay[near], switch_timing.move[near], None),
+        )
+        arrival = _arrival(c, r0, (keep, switch), ends, near_timing, direct_ok, blocked, ctx, xp)
     if not want_winners or arrival is not None:
         return arrival, None
 
-    scores = [_keep_scores(c, keep, pending, pending_timing),
-              _switch_scores(c, switch, switch_timing)]
+    scores = [
+        _keep_scores(c, keep, pending, pending_timing),
+        _switch_scores(c, switch, switch_timing),
+    ]
     scores = _drop_forbidden(c, scores, ends, direct_ok, blocked, ctx, xp)
     if ctx.bin_origin is not None:  # sectors seen from the start: see _Context.bin_origin
         ox, oy = ctx.bin_origin
@@ -1678,9 +1917,7 @@ def _expand(
     return None, _sector_winners(c, r0, (keep, switch), ends, scores, ctx, xp)
 
 
-def _in_box(
-    qx: Any, qy: Any, fr: _LegFrame, box: tuple[float, float, float, float]
-) -> Any:
+def _in_box(qx: Any, qy: Any, fr: _LegFrame, box: tuple[float, float, float, float]) -> Any:
     """Candidates (leg frame) whose world position lies inside the coverage box."""
     wx, wy = fr.to_world(qx, qy)
     return (wx >= box[0]) & (wx <= box[1]) & (wy >= box[2]) & (wy <= box[3])
@@ -1692,8 +1929,14 @@ def _box_holds(x: Any, y: Any, reach_m: Any, ctx: _Context, xp: ModuleType) -> b
     assert ctx.box is not None
     wx, wy = ctx.frame.to_world(x, y)
     xmin, xmax, ymin, ymax = ctx.box
-    return bool(xp.all((wx - reach_m >= xmin) & (wx + reach_m <= xmax)
-                       & (wy - reach_m >= ymin) & (wy + reach_m <= ymax)))
+    return bool(
+        xp.all(
+            (wx - reach_m >= xmin)
+            & (wx + reach_m <= xmax)
+            & (wy - reach_m >= ymin)
+            & (wy + reach_m <= ymax)
+        )
+    )
 
 
 def _segment_distance(x: Any, y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
@@ -1709,4 +1952,3 @@ def _segment_distance(x: Any, y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
 
 def _heading_deg(ux: float, uy: float) -> float:
     return math.degrees(math.atan2(ux, uy)) % 360.0
-

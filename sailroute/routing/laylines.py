@@ -88,11 +88,11 @@ class _VmgTable:
     def __call__(self, tws_ms: NDArray) -> NDArray[np.float64]:
         pos = np.asarray(tws_ms, dtype=float) * TWS_NODES_PER_MS
         lo = np.floor(pos).astype(np.int64)
-        need = sorted({*lo.reshape(-1).tolist(), *(lo + 1).reshape(-1).tolist()}
-                      - self.nodes.keys())
+        need = sorted(
+            {*lo.reshape(-1).tolist(), *(lo + 1).reshape(-1).tolist()} - self.nodes.keys()
+        )
         if need:
-            vals = vmg_angles(self.boat, np.array(need, dtype=float) / TWS_NODES_PER_MS,
-                              self.kind)
+            vals = vmg_angles(self.boat, np.array(need, dtype=float) / TWS_NODES_PER_MS, self.kind)
             self.nodes.update(zip(need, vals.tolist(), strict=True))
         a0 = np.vectorize(self.nodes.__getitem__, otypes=[float])(lo)
         a1 = np.vectorize(self.nodes.__getitem__, otypes=[float])(lo + 1)
@@ -101,8 +101,14 @@ class _VmgTable:
 
 
 def _state(
-    wind: WindField, tables: tuple[_VmgTable, _VmgTable], boat: BoatModel, sign: NDArray,
-    tack: NDArray, t: NDArray, x: NDArray, y: NDArray,
+    wind: WindField,
+    tables: tuple[_VmgTable, _VmgTable],
+    boat: BoatModel,
+    sign: NDArray,
+    tack: NDArray,
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
 ) -> tuple[NDArray, NDArray]:
     """Heading sailed [°] and boat speed [m s⁻¹] at the given points (vectorised);
     ``tack`` marks the points of tack laylines (the others are gybe laylines)."""
@@ -123,8 +129,7 @@ def vmg_angles(boat: BoatModel, tws_ms: NDArray, kind: LaylineKind) -> NDArray[n
     if polar is not None:
         return (polar.vmg_upwind(tws) if kind == "tack" else polar.vmg_downwind(tws))[0]
     k = 0 if kind == "tack" else 1
-    return np.array([boat.vmg_angles_deg(float(s))[k] for s in tws.reshape(-1)]
-                    ).reshape(tws.shape)
+    return np.array([boat.vmg_angles_deg(float(s))[k] for s in tws.reshape(-1)]).reshape(tws.shape)
 
 
 def _inside(wind: WindField, t: NDArray, x: NDArray, y: NDArray) -> NDArray[np.bool_]:
@@ -171,8 +176,7 @@ def trace_laylines(
         coverage ends at its last point inside it.
     """
     specs = [(name, xy, float(t_mark), float(length_m)) for name, xy in marks]
-    return trace_many(specs, kind_of=[kind] * len(specs), wind=wind, boat=boat,
-                   n_steps=n_steps)
+    return trace_many(specs, kind_of=[kind] * len(specs), wind=wind, boat=boat, n_steps=n_steps)
 
 
 def trace_many(
@@ -209,8 +213,9 @@ def trace_many(
         ok = _inside(wind, tm, xm, ym)
         h2, v2 = h1.copy(), v1.copy()
         if ok.any():
-            h2[ok], v2[ok] = _state(wind, tables, boat, sign[a][ok], tack[a][ok], tm[ok],
-                                    xm[ok], ym[ok])
+            h2[ok], v2[ok] = _state(
+                wind, tables, boat, sign[a][ok], tack[a][ok], tm[ok], xm[ok], ym[ok]
+            )
         ex2, ey2 = heading_unit(h2)
         with np.errstate(divide="ignore", invalid="ignore"):
             dt2 = np.where(v2 > 0, ds / v2, 0.0)
@@ -231,15 +236,20 @@ def trace_many(
         m = int(good.sum())  # a prefix: a trace that stops stays stopped
         heads = ph_all[: max(m - 1, 0), k]
         last = heads[-1] if heads.size else float("nan")
-        out.append(Layline(
-            specs[k // 2][0], kind_of[k // 2], "starboard" if sign[k] > 0 else "port",
-            px_all[:m, k], py_all[:m, k], pt_all[:m, k], np.append(heads, last)[:m],
-        ))
+        out.append(
+            Layline(
+                specs[k // 2][0],
+                kind_of[k // 2],
+                "starboard" if sign[k] > 0 else "port",
+                px_all[:m, k],
+                py_all[:m, k],
+                pt_all[:m, k],
+                np.append(heads, last)[:m],
+            )
+        )
     return tuple(out)
 
 
 def leg_layline_kind(mode: str | None) -> LaylineKind | None:
     """``tack`` for an upwind leg, ``gybe`` for a downwind one, None otherwise."""
     return {"upwind": "tack", "downwind": "gybe"}.get(mode or "")  # type: ignore[return-value]
-
-

@@ -129,8 +129,9 @@ class Edges:
         t = np.asarray(t, float)
         dx = (self.x1 - self.x0)[..., None]
         x = self.x0[..., None] + t * dx
-        y = hermite_y(self.y0[..., None], self.m0[..., None], self.y1[..., None],
-                      self.m1[..., None], dx, t)
+        y = hermite_y(
+            self.y0[..., None], self.m0[..., None], self.y1[..., None], self.m1[..., None], dx, t
+        )
         x, y = np.broadcast_arrays(x, y)
         return x, y
 
@@ -202,8 +203,11 @@ class SplineFit:
         for r in range(self.along.size - 1):
             dx = self.along[r + 1] - self.along[r]
             xs.append(self.along[r] + t * dx)
-            ys.append(hermite_y(self.across[r], self.slopes[r], self.across[r + 1],
-                                self.slopes[r + 1], dx, t))
+            ys.append(
+                hermite_y(
+                    self.across[r], self.slopes[r], self.across[r + 1], self.slopes[r + 1], dx, t
+                )
+            )
         xs.append(self.along[-1:])
         ys.append(self.across[-1:])
         return np.concatenate(xs), np.concatenate(ys)
@@ -235,10 +239,16 @@ def multispline_pass(
     edges = 0
     for r in range(n_rows - 1):
         (xa, ya), (xb, yb) = xy[r], xy[r + 1]
-        e = Edges(xa[:, None, None, None], ya[:, None, None, None],
-                  slopes[r][None, :, None, None], xb[None, None, :, None],
-                  yb[None, None, :, None], slopes[r + 1][None, None, None, :],
-                  A[:, :, None, None], None if carry is None else carry[:, :, None, None])
+        e = Edges(
+            xa[:, None, None, None],
+            ya[:, None, None, None],
+            slopes[r][None, :, None, None],
+            xb[None, None, :, None],
+            yb[None, None, :, None],
+            slopes[r + 1][None, None, None, :],
+            A[:, :, None, None],
+            None if carry is None else carry[:, :, None, None],
+        )
         out = edge_cost(r, e)
         cost, c_out = out if isinstance(out, tuple) else (out, None)
         cost = np.broadcast_to(np.asarray(cost, float), e.shape)
@@ -269,8 +279,11 @@ def multispline_pass(
 def _slope_set(ref: float, half: float, n: int, keep: float | None) -> NDArray:
     """``n`` slopes at angles ``atan(ref) ± half``; ``keep`` replaces the nearest one."""
     a0 = math.atan(ref)
-    ang = np.clip(a0 + np.linspace(-half, half, n) if n > 1 else np.array([a0]),
-                  -_MAX_SLOPE_ANGLE, _MAX_SLOPE_ANGLE)
+    ang = np.clip(
+        a0 + np.linspace(-half, half, n) if n > 1 else np.array([a0]),
+        -_MAX_SLOPE_ANGLE,
+        _MAX_SLOPE_ANGLE,
+    )
     m = np.tan(ang)
     if keep is not None:
         m[int(np.argmin(np.abs(ang - math.atan(keep))))] = keep
@@ -348,8 +361,9 @@ def fit_multispline(
             f"{n_cols}, {n_slopes}, {n_refine}"
         )
     n_pass = n_refine + 1
-    params = [row.initial(n_cols, half_width) + (centre if row.kind == "free" else 0.0)
-              for row in rows]
+    params = [
+        row.initial(n_cols, half_width) + (centre if row.kind == "free" else 0.0) for row in rows
+    ]
     slopes = [_slope_set(0.0, slope_half, n_slopes, None) for _ in rows]
     best: SplineFit | None = None
     passes = []
@@ -357,38 +371,49 @@ def fit_multispline(
         tic = _time.perf_counter()
         if k > 0:
             assert best is not None
-            scale = k_y ** k
-            params = [row.refined(n_cols, c, scale, half_width)
-                      for row, c in zip(rows, best.params, strict=True)]
+            scale = k_y**k
+            params = [
+                row.refined(n_cols, c, scale, half_width)
+                for row, c in zip(rows, best.params, strict=True)
+            ]
             ref = _reference_slopes(best.along, best.across)
-            half = slope_half * k_alpha ** k
-            slopes = [_slope_set(float(ref[r]), half, n_slopes, float(best.slopes[r]))
-                      for r in range(len(rows))]
+            half = slope_half * k_alpha**k
+            slopes = [
+                _slope_set(float(ref[r]), half, n_slopes, float(best.slopes[r]))
+                for r in range(len(rows))
+            ]
 
         def prog(f: float, k: int = k) -> None:
             if progress is not None:
                 progress((k + f) / n_pass)
 
         path, cost, n_edges = multispline_pass(frame, rows, params, slopes, edge_cost, xp, prog)
-        passes.append(SplinePass(cost, k_y ** k, math.degrees(slope_half * k_alpha ** k),
-                                 n_edges, _time.perf_counter() - tic))
+        passes.append(
+            SplinePass(
+                cost,
+                k_y**k,
+                math.degrees(slope_half * k_alpha**k),
+                n_edges,
+                _time.perf_counter() - tic,
+            )
+        )
         if path is None:
             continue
         if best is None or cost < best.cost:
             p = np.array([params[r][c] for r, (c, _) in enumerate(path)])
             xs, ys = [], []
             for r, (c, _) in enumerate(path):
-                px, py = rows[r].points(frame, params[r][c:c + 1])
+                px, py = rows[r].points(frame, params[r][c : c + 1])
                 a, b = frame.coords(px, py)
                 xs.append(float(a[0]))
                 ys.append(float(b[0]))
             m = np.array([slopes[r][s] for r, (_, s) in enumerate(path)])
             best = SplineFit(np.array(xs), np.array(ys), m, p, cost, ())
     if best is None:
-        return SplineFit(np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), math.inf,
-                         tuple(passes))
-    return SplineFit(best.along, best.across, best.slopes, best.params, best.cost,
-                     tuple(passes))
+        return SplineFit(
+            np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0), math.inf, tuple(passes)
+        )
+    return SplineFit(best.along, best.across, best.slopes, best.params, best.cost, tuple(passes))
 
 
 # --------------------------------------------------------------------------------------
@@ -465,9 +490,16 @@ def fit_function(
     rows = [Row("point", a=(0.0, 0.0))]
     rows += [Row("free", along=float(x)) for x in xs[1:-1]]
     rows += [Row("point", a=(x_end, 0.0))]
-    return fit_multispline(l2_edge_cost(target), frame, rows, n_cols=n_cols,
-                           n_slopes=n_slopes, n_refine=n_refine, half_width=0.5 * (hi - lo),
-                           centre=0.5 * (hi + lo))
+    return fit_multispline(
+        l2_edge_cost(target),
+        frame,
+        rows,
+        n_cols=n_cols,
+        n_slopes=n_slopes,
+        n_refine=n_refine,
+        half_width=0.5 * (hi - lo),
+        centre=0.5 * (hi + lo),
+    )
 
 
 # --------------------------------------------------------------------------------------
@@ -517,7 +549,8 @@ def route_spline(
         if given is not None:
             raise InputError(
                 f"leg {leg_label(start, target)}: the spline router cannot honour {what}; "
-                "set routing.router: isochrone (or griddp for obstacles)")
+                "set routing.router: isochrone (or griddp for obstacles)"
+            )
     sol = solve_spline(start, target, t0, wind, boat, settings, progress=progress, xp=xp)
     return sol[0]
 
@@ -540,9 +573,17 @@ def solve_spline(
     model = GridBoat.of(boat, grid.label)
     half = settings.dp_half_width_m or default_half_width(grid.frame, wind, t0, model)
     cost = _route_cost(grid.frame, wind, model, t0, settings, grid.limits, len(grid.rows))
-    fit = fit_multispline(cost, grid.frame, grid.rows, n_cols=settings.spline_cols,
-                          n_slopes=settings.spline_slopes, n_refine=settings.spline_refinements,
-                          half_width=half, xp=xp, progress=progress)
+    fit = fit_multispline(
+        cost,
+        grid.frame,
+        grid.rows,
+        n_cols=settings.spline_cols,
+        n_slopes=settings.spline_slopes,
+        n_refine=settings.spline_refinements,
+        half_width=half,
+        xp=xp,
+        progress=progress,
+    )
     if not math.isfinite(fit.cost):
         raise RoutingError(
             f"leg {grid.label}: the multi-spline router found no feasible smooth route "
@@ -574,8 +615,9 @@ class _EdgeSail:
     v_end: NDArray | None = None  # (...,) dynamic: speed at the end node [m/s]
 
 
-def _tangent_side(frame: LegFrame, wind: WindField, t: NDArray, px: NDArray, py: NDArray,
-                  m: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
+def _tangent_side(
+    frame: LegFrame, wind: WindField, t: NDArray, px: NDArray, py: NDArray, m: NDArray
+) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
     """Unit tangent ``(hx, hy)`` of slope ``m`` at points, and TWS, signed TWA [rad] there."""
     hx, hy = frame.ex - m * frame.ey, frame.ey + m * frame.ex
     hn = np.hypot(hx, hy)
@@ -588,8 +630,9 @@ def _tangent_side(frame: LegFrame, wind: WindField, t: NDArray, px: NDArray, py:
     return hx, hy, tws, twa, np.where(twa >= 0, 1, -1)
 
 
-def _chain_limits(cw: ChainWind, px: NDArray, py: NDArray, limits: PathLimits | None,
-                  last: bool) -> NDArray:
+def _chain_limits(
+    cw: ChainWind, px: NDArray, py: NDArray, limits: PathLimits | None, last: bool
+) -> NDArray:
     """Chains inside the wind data that respect ``limits`` (``last``: ending on the target)."""
     ok = np.all(cw.valid, axis=-1)
     if limits is not None:
@@ -608,10 +651,20 @@ def _turn_cosines(cw: ChainWind, hx: NDArray, hy: NDArray) -> NDArray:
     return cos_t
 
 
-def _sail_edges(frame: LegFrame, wind: WindField, model: GridBoat, t_dep: NDArray,
-                x: NDArray, y: NDArray, m0: NDArray, m1: NDArray,
-                settings: RoutingSettings, limits: PathLimits | None = None,
-                last: bool = False, v_in: NDArray | None = None) -> _EdgeSail:
+def _sail_edges(
+    frame: LegFrame,
+    wind: WindField,
+    model: GridBoat,
+    t_dep: NDArray,
+    x: NDArray,
+    y: NDArray,
+    m0: NDArray,
+    m1: NDArray,
+    settings: RoutingSettings,
+    limits: PathLimits | None = None,
+    last: bool = False,
+    v_in: NDArray | None = None,
+) -> _EdgeSail:
     """Sail chord chains ``(x, y)`` of shape ``(..., CHORDS + 1)`` from ``t_dep``.
 
     The tack side at a node is that of the curve's tangent there (the same for
@@ -632,8 +685,9 @@ def _sail_edges(frame: LegFrame, wind: WindField, model: GridBoat, t_dep: NDArra
         boat = model.dynamic
         v_start = tws0 * boat.table().steady(np.abs(twa0)) if v_in is None else v_in
         cos_t = _turn_cosines(cw, hx, hy)
-        total, v_end, tp, v_pc = chain_time(boat, cw.beta, cw.tws, cw.length, cos_t,
-                                            np.broadcast_to(v_start, lead), pieces=True)
+        total, v_end, tp, v_pc = chain_time(
+            boat, cw.beta, cw.tws, cw.length, cos_t, np.broadcast_to(v_start, lead), pieces=True
+        )
         total = np.where(ok, total, np.inf)
         return _EdgeSail(total, tp, np.zeros(tp.shape), np.zeros(lead), cw.side, v_pc, v_end)
     spd = model.steady_speed(cw.tws, cw.beta)
@@ -644,15 +698,21 @@ def _sail_edges(frame: LegFrame, wind: WindField, model: GridBoat, t_dep: NDArra
     beta0 = np.broadcast_to(np.abs(twa0), lead)
     prev_side = np.concatenate([side0[..., None], cw.side[..., :-1]], axis=-1)
     prev_beta = np.concatenate([beta0[..., None], cw.beta[..., :-1]], axis=-1)
-    pen = np.where(cw.side != prev_side,
-                   penalty_of(cw.beta, prev_beta, settings.tack_penalty_s,
-                              settings.gybe_penalty_s), 0.0)
+    pen = np.where(
+        cw.side != prev_side,
+        penalty_of(cw.beta, prev_beta, settings.tack_penalty_s, settings.gybe_penalty_s),
+        0.0,
+    )
     run = np.sum(tp + pen, axis=-1)
     t_arr = t_dep + np.where(np.isfinite(run), run, 0.0)
     _, _, _, twa1, side1 = _tangent_side(frame, wind, t_arr, px[..., -1], py[..., -1], m1)
-    pen_end = np.where(side1 != cw.side[..., -1],
-                       penalty_of(np.abs(twa1), cw.beta[..., -1], settings.tack_penalty_s,
-                                  settings.gybe_penalty_s), 0.0)
+    pen_end = np.where(
+        side1 != cw.side[..., -1],
+        penalty_of(
+            np.abs(twa1), cw.beta[..., -1], settings.tack_penalty_s, settings.gybe_penalty_s
+        ),
+        0.0,
+    )
     total = np.where(ok, run + pen_end, np.inf)
     return _EdgeSail(total, tp, pen, pen_end, cw.side, None, None)
 
@@ -692,8 +752,9 @@ def _speed_cap(boat: DynamicBoat) -> NDArray[np.float64]:
     return np.maximum(ws[:-1], ws[1:]) * (1.0 + 1e-4)
 
 
-def edge_time_bound(boat: DynamicBoat, cw: ChainWind, v_in: NDArray,
-                    cap: NDArray | None = None) -> NDArray:
+def edge_time_bound(
+    boat: DynamicBoat, cw: ChainWind, v_in: NDArray, cap: NDArray | None = None
+) -> NDArray:
     """Lower bound [s] of the time to sail chord chains entered at ``v_in`` [m s⁻¹].
 
     Driving, the boat approaches the steady speed ``w_ss v_t`` from either side;
@@ -714,8 +775,9 @@ def edge_time_bound(boat: DynamicBoat, cw: ChainWind, v_in: NDArray,
     v_enter = np.empty_like(vss)
     v_enter[..., 0] = v_in
     if vss.shape[-1] > 1:
-        v_enter[..., 1:] = np.maximum(np.maximum.accumulate(vss[..., :-1], axis=-1),
-                                      np.asarray(v_in, float)[..., None])
+        v_enter[..., 1:] = np.maximum(
+            np.maximum.accumulate(vss[..., :-1], axis=-1), np.asarray(v_in, float)[..., None]
+        )
     with np.errstate(divide="ignore", invalid="ignore"):
         t = np.where(cw.length > 0, cw.length / np.maximum(v_enter, vss), 0.0)
         drive = (cw.beta >= tab.beta_lo) & (cw.length > 0) & (cw.tws > 0)
@@ -743,10 +805,19 @@ def edge_time_bound(boat: DynamicBoat, cw: ChainWind, v_in: NDArray,
     return np.sum(t, axis=-1)
 
 
-def _dynamic_row(frame: LegFrame, wind: WindField, model: GridBoat, e: Edges,
-                 px: NDArray, py: NDArray, t_start: NDArray, v_start: NDArray | None,
-                 limits: PathLimits | None, last: bool, cap: NDArray
-                 ) -> tuple[NDArray, NDArray]:
+def _dynamic_row(
+    frame: LegFrame,
+    wind: WindField,
+    model: GridBoat,
+    e: Edges,
+    px: NDArray,
+    py: NDArray,
+    t_start: NDArray,
+    v_start: NDArray | None,
+    limits: PathLimits | None,
+    last: bool,
+    cap: NDArray,
+) -> tuple[NDArray, NDArray]:
     """Edge times [s] and end speeds [m s⁻¹] of one row of the dynamic model.
 
     ``px, py``: chord vertices, shape ``(N, CHORDS + 1)`` with ``N = M0 M1`` edges
@@ -765,10 +836,12 @@ def _dynamic_row(frame: LegFrame, wind: WindField, model: GridBoat, e: Edges,
     t_dep = np.repeat(t_start.reshape(-1), m1n)
     cw = sample_chains(wind, px, py, t_dep, model, _predictor_speed(boat))
     ok = _chain_limits(cw, px, py, limits, last)
-    sx, sy = frame.point(np.broadcast_to(e.x0[:, :, 0, 0], (c0, s0)),
-                         np.broadcast_to(e.y0[:, :, 0, 0], (c0, s0)))
-    hx, hy, tws0, twa0, _ = _tangent_side(frame, wind, t_start, sx, sy,
-                                          np.broadcast_to(e.m0[:, :, 0, 0], (c0, s0)))
+    sx, sy = frame.point(
+        np.broadcast_to(e.x0[:, :, 0, 0], (c0, s0)), np.broadcast_to(e.y0[:, :, 0, 0], (c0, s0))
+    )
+    hx, hy, tws0, twa0, _ = _tangent_side(
+        frame, wind, t_start, sx, sy, np.broadcast_to(e.m0[:, :, 0, 0], (c0, s0))
+    )
     if v_start is None:
         v_start = tws0 * boat.table().steady(np.abs(twa0))
     v_e = np.repeat(np.broadcast_to(v_start, (c0, s0)).reshape(-1), m1n)
@@ -781,8 +854,7 @@ def _dynamic_row(frame: LegFrame, wind: WindField, model: GridBoat, e: Edges,
 
     def sail(idx: NDArray) -> None:
         if idx.size:
-            t, v = chain_time(boat, cw.beta[idx], cw.tws[idx], cw.length[idx], cos_t[idx],
-                              v_e[idx])
+            t, v = chain_time(boat, cw.beta[idx], cw.tws[idx], cw.length[idx], cos_t[idx], v_e[idx])
             cost[idx] = t
             v_end[idx] = v
 
@@ -801,8 +873,15 @@ def _dynamic_row(frame: LegFrame, wind: WindField, model: GridBoat, e: Edges,
     return cost.reshape(e.shape), v_end.reshape(e.shape)
 
 
-def _route_cost(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
-                settings: RoutingSettings, limits: PathLimits, n_rows: int) -> EdgeCost:
+def _route_cost(
+    frame: LegFrame,
+    wind: WindField,
+    model: GridBoat,
+    t0: float,
+    settings: RoutingSettings,
+    limits: PathLimits,
+    n_rows: int,
+) -> EdgeCost:
     t = np.linspace(0.0, 1.0, CHORDS + 1)
     boat = model.dynamic
     carry = bool(settings.spline_carry_speed) and boat is not None
@@ -816,8 +895,7 @@ def _route_cost(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
             t_dep = np.broadcast_to(t0 + e.acc, e.shape)
             m0 = np.broadcast_to(e.m0, e.shape)
             m1 = np.broadcast_to(e.m1, e.shape)
-            return _sail_edges(frame, wind, model, t_dep, x, y, m0, m1, settings, limits,
-                               last).time
+            return _sail_edges(frame, wind, model, t_dep, x, y, m0, m1, settings, limits, last).time
         assert cap is not None
         px, py = frame.point(x.reshape(-1, CHORDS + 1), y.reshape(-1, CHORDS + 1))
         c0, s0 = e.shape[:2]
@@ -828,16 +906,23 @@ def _route_cost(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
             v_start = np.broadcast_to(e.carry[:, :, 0, 0], (c0, s0))
         else:
             v_start = None
-        times, v_end = _dynamic_row(frame, wind, model, e, px, py, t_start, v_start, limits,
-                                    last, cap)
+        times, v_end = _dynamic_row(
+            frame, wind, model, e, px, py, t_start, v_start, limits, last, cap
+        )
         return (times, v_end) if carry else times
 
     return cost
 
 
-def _sail_curve(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
-                settings: RoutingSettings, fit: SplineFit, limits: PathLimits | None = None
-                ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray | None]:
+def _sail_curve(
+    frame: LegFrame,
+    wind: WindField,
+    model: GridBoat,
+    t0: float,
+    settings: RoutingSettings,
+    fit: SplineFit,
+    limits: PathLimits | None = None,
+) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray | None]:
     """Sail the best curve edge by edge: track vertices at the chord ends."""
     tt = np.linspace(0.0, 1.0, CHORDS + 1)
     t = t0
@@ -850,11 +935,27 @@ def _sail_curve(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
         dx = fit.along[r + 1] - fit.along[r]
         X = fit.along[r] + tt * dx
         Y = hermite_y(fit.across[r], fit.slopes[r], fit.across[r + 1], fit.slopes[r + 1], dx, tt)
-        v_in = (np.zeros(1) if r == 0 and rest
-                else np.array([v_prev]) if carry and v_prev is not None else None)
-        es = _sail_edges(frame, wind, model, np.array([t]), X[None], Y[None],
-                         np.array([fit.slopes[r]]), np.array([fit.slopes[r + 1]]), settings,
-                         limits, r == fit.along.size - 2, v_in)
+        v_in = (
+            np.zeros(1)
+            if r == 0 and rest
+            else np.array([v_prev])
+            if carry and v_prev is not None
+            else None
+        )
+        es = _sail_edges(
+            frame,
+            wind,
+            model,
+            np.array([t]),
+            X[None],
+            Y[None],
+            np.array([fit.slopes[r]]),
+            np.array([fit.slopes[r + 1]]),
+            settings,
+            limits,
+            r == fit.along.size - 2,
+            v_in,
+        )
         if es.v_end is not None:
             v_prev = float(es.v_end[0])
         px, py = frame.point(X, Y)
@@ -886,8 +987,7 @@ def _sail_curve(frame: LegFrame, wind: WindField, model: GridBoat, t0: float,
     out_s.append(out_s[-1])
     out_v.append(out_v[-1])
     bsp = np.array(out_v) if model.dynamic is not None else None
-    return (np.array(out_t), np.array(out_x), np.array(out_y), np.array(out_s, dtype=np.int8),
-            bsp)
+    return (np.array(out_t), np.array(out_x), np.array(out_y), np.array(out_s, dtype=np.int8), bsp)
 
 
 _ROUTER: Router = route_spline  # mypy checks the shared router signature

@@ -38,8 +38,14 @@ from sailroute.routing.rings import ring_problem
 from sailroute.wind.grid import GridWind
 
 __all__ = [
-    "BOUNDARY_NAME", "AreaPolygon", "Obstacles", "RaceArea", "land_filled", "land_obstacle",
-    "obstacles_for", "polygon_problem",
+    "BOUNDARY_NAME",
+    "AreaPolygon",
+    "Obstacles",
+    "RaceArea",
+    "land_filled",
+    "land_obstacle",
+    "obstacles_for",
+    "polygon_problem",
 ]
 
 BOUNDARY_NAME: Final = "the race-area boundary"
@@ -103,8 +109,9 @@ class RaceArea:
         return self.boundary is None and not self.obstacles and not self.wind_land_is_obstacle
 
 
-def polygon_problem(x: Sequence[float], y: Sequence[float], clearance_m: float = 0.0,
-                    *, boundary: bool = False) -> str | None:
+def polygon_problem(
+    x: Sequence[float], y: Sequence[float], clearance_m: float = 0.0, *, boundary: bool = False
+) -> str | None:
     """What is wrong with a ring, or None: fewer than 3 vertices, a zero area,
     self-intersection (shapely's ``explain_validity``), a boundary that a clearance
     leaves empty; the ring checks and wording of :func:`sailroute.routing.rings.ring_problem`
@@ -114,13 +121,17 @@ def polygon_problem(x: Sequence[float], y: Sequence[float], clearance_m: float =
         return ring
     poly = shapely.Polygon(np.column_stack([x, y]))
     if not shapely.is_valid(poly):
-        return (f"the polygon is not valid ({shapely.is_valid_reason(poly)}): "
-                "its edges must not cross; list the points in order round the ring")
+        return (
+            f"the polygon is not valid ({shapely.is_valid_reason(poly)}): "
+            "its edges must not cross; list the points in order round the ring"
+        )
     if poly.area <= 0.0:
         return "the polygon has no area (its points are on one line)"
     if boundary and clearance_m > 0 and poly.buffer(-clearance_m).is_empty:
-        return (f"clearance_m = {clearance_m:g} leaves no water inside the boundary; "
-                "use a smaller clearance")
+        return (
+            f"clearance_m = {clearance_m:g} leaves no water inside the boundary; "
+            "use a smaller clearance"
+        )
     return None
 
 
@@ -223,14 +234,23 @@ class Obstacles:
         edges = _edges(rings)
         own = np.asarray(owners, dtype=np.int64)
         run = [BOUNDARY_RUN if n == BOUNDARY_NAME else OBSTACLE_RUN for n in names]
-        starts = [0] + [i for i in range(1, own.size) if own[i] != own[i - 1]
-                        or (i - _first(own, i)) % run[own[i]] == 0]
+        starts = [0] + [
+            i
+            for i in range(1, own.size)
+            if own[i] != own[i - 1] or (i - _first(own, i)) % run[own[i]] == 0
+        ]
         bounds = np.asarray([*starts, own.size], dtype=np.int64)
-        box = np.array([[min(edges[a:b, 0].min(), edges[a:b, 2].min()),
-                         min(edges[a:b, 1].min(), edges[a:b, 3].min()),
-                         max(edges[a:b, 0].max(), edges[a:b, 2].max()),
-                         max(edges[a:b, 1].max(), edges[a:b, 3].max())]
-                        for a, b in itertools.pairwise(bounds)]).reshape(-1, 4)
+        box = np.array(
+            [
+                [
+                    min(edges[a:b, 0].min(), edges[a:b, 2].min()),
+                    min(edges[a:b, 1].min(), edges[a:b, 3].min()),
+                    max(edges[a:b, 0].max(), edges[a:b, 2].max()),
+                    max(edges[a:b, 1].max(), edges[a:b, 3].max()),
+                ]
+                for a, b in itertools.pairwise(bounds)
+            ]
+        ).reshape(-1, 4)
         return cls(tuple(names), inside, blocked, edges, own, box, bounds)
 
     # ------------------------------------------------------------------ predicates
@@ -245,8 +265,9 @@ class Obstacles:
             ok &= ~shapely.intersects_xy(self.blocked, xa, ya)
         return ok
 
-    def segments_cross(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
-                       ) -> NDArray[np.bool_]:
+    def segments_cross(
+        self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
+    ) -> NDArray[np.bool_]:
         """True where the segment touches or crosses any ring edge (orientation test,
         touching included, so a move through a vertex counts).  Each group of edges is
         tested only against the segments whose bounding box meets the group's."""
@@ -262,26 +283,33 @@ class Obstacles:
             b = self.group_box[g]
             idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
             if idx.size:
-                e = self.edges[self.group_start[g]:self.group_start[g + 1]]
+                e = self.edges[self.group_start[g] : self.group_start[g + 1]]
                 hit[idx] |= _cross(sx0[idx], sy0[idx], sx1[idx], sy1[idx], e)
         return hit.reshape(shape)
 
-    def segments_free(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
-                      ) -> NDArray[np.bool_]:
+    def segments_free(
+        self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
+    ) -> NDArray[np.bool_]:
         """True where the straight move ``(x0, y0) -> (x1, y1)`` [m] stays in free
         water: its start is free and no ring edge is touched or crossed (so its end is
         free too)."""
         a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
         return self.points_free(a[0], a[1]) & ~self.segments_cross(*a)
 
-    def segments_free_shapely(self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike,
-                              y1: ArrayLike) -> NDArray[np.bool_]:
+    def segments_free_shapely(
+        self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
+    ) -> NDArray[np.bool_]:
         """:meth:`segments_free` through ``shapely.intersects`` on linestrings (the same
         answer up to touching; slower per segment, see ``benchmarks/bench_obstacles.py``)."""
         a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
         shape = a[0].shape
-        coords = np.stack([np.column_stack([a[0].ravel(), a[1].ravel()]),
-                           np.column_stack([a[2].ravel(), a[3].ravel()])], axis=1)
+        coords = np.stack(
+            [
+                np.column_stack([a[0].ravel(), a[1].ravel()]),
+                np.column_stack([a[2].ravel(), a[3].ravel()]),
+            ],
+            axis=1,
+        )
         lines = np.asarray(shapely.linestrings(coords))
         ok = np.ones(lines.shape, dtype=bool)
         if self.inside is not None:
@@ -314,18 +342,26 @@ class Obstacles:
         reach = np.max(np.hypot(qx - px[:, None], qy - py[:, None]), axis=1, initial=0.0)
         r = reach[:, None]
         b = self.group_box
-        near = ((px[:, None] + r >= b[:, 0]) & (px[:, None] - r <= b[:, 2])
-                & (py[:, None] + r >= b[:, 1]) & (py[:, None] - r <= b[:, 3]))
+        near = (
+            (px[:, None] + r >= b[:, 0])
+            & (px[:, None] - r <= b[:, 2])
+            & (py[:, None] + r >= b[:, 1])
+            & (py[:, None] - r <= b[:, 3])
+        )
         for g in np.flatnonzero(near.any(axis=0)):
             rows = np.flatnonzero(near[:, g])
             sx1, sy1 = qx[rows], qy[rows]
             sx0 = np.broadcast_to(px[rows, None], sx1.shape)
             sy0 = np.broadcast_to(py[rows, None], sx1.shape)
-            box = ((np.maximum(sx0, sx1) >= b[g, 0]) & (np.minimum(sx0, sx1) <= b[g, 2])
-                   & (np.maximum(sy0, sy1) >= b[g, 1]) & (np.minimum(sy0, sy1) <= b[g, 3]))
+            box = (
+                (np.maximum(sx0, sx1) >= b[g, 0])
+                & (np.minimum(sx0, sx1) <= b[g, 2])
+                & (np.maximum(sy0, sy1) >= b[g, 1])
+                & (np.minimum(sy0, sy1) <= b[g, 3])
+            )
             ri, ci = np.nonzero(box)
             if ri.size:
-                e = self.edges[self.group_start[g]:self.group_start[g + 1]]
+                e = self.edges[self.group_start[g] : self.group_start[g + 1]]
                 hit = _cross(sx0[ri, ci], sy0[ri, ci], sx1[ri, ci], sy1[ri, ci], e)
                 out[rows[ri[hit]], ci[hit]] = False
         return out
@@ -341,10 +377,10 @@ class Obstacles:
         den = np.maximum(dx * dx + dy * dy, 1e-300)
         step = max(1, _CHUNK // e.shape[0])
         for i in range(0, xa.size, step):
-            ux = xa[i:i + step, None] - e[:, 0]
-            uy = ya[i:i + step, None] - e[:, 1]
+            ux = xa[i : i + step, None] - e[:, 0]
+            uy = ya[i : i + step, None] - e[:, 1]
             f = np.clip((ux * dx + uy * dy) / den, 0.0, 1.0)
-            best[i:i + step] = np.min(np.hypot(ux - f * dx, uy - f * dy), axis=1)
+            best[i : i + step] = np.min(np.hypot(ux - f * dx, uy - f * dy), axis=1)
         return best
 
     def nearest_name(self, x: ArrayLike, y: ArrayLike) -> str:
@@ -419,8 +455,7 @@ class Obstacles:
     def describe(self) -> str:
         """``"obstacles 'a', 'b' and the race-area boundary"`` for messages."""
         named = [repr(n) for n in self.names if n != BOUNDARY_NAME]
-        parts = ([f"obstacle{'s' if len(named) > 1 else ''} " + ", ".join(named)]
-                 if named else [])
+        parts = [f"obstacle{'s' if len(named) > 1 else ''} " + ", ".join(named)] if named else []
         if BOUNDARY_NAME in self.names:
             parts.append(BOUNDARY_NAME)
         return " and ".join(parts)
@@ -445,8 +480,8 @@ def _cross(sx0: Any, sy0: Any, sx1: Any, sy1: Any, e: NDArray[np.float64]) -> An
     ex0, ey0, ex1, ey1 = (e[:, k] for k in range(4))
     step = max(1, _CHUNK // max(1, e.shape[0]))
     for i in range(0, sx0.size, step):
-        a0, b0 = sx0[i:i + step, None], sy0[i:i + step, None]
-        a1, b1 = sx1[i:i + step, None], sy1[i:i + step, None]
+        a0, b0 = sx0[i : i + step, None], sy0[i : i + step, None]
+        a1, b1 = sx1[i : i + step, None], sy1[i : i + step, None]
         o1 = _orient(a0, b0, a1, b1, ex0, ey0)
         o2 = _orient(a0, b0, a1, b1, ex1, ey1)
         o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
@@ -456,12 +491,14 @@ def _cross(sx0: Any, sy0: Any, sx1: Any, sy1: Any, e: NDArray[np.float64]) -> An
         # overlap
         line = (o1 == 0.0) & (o2 == 0.0) & (o3 == 0.0) & (o4 == 0.0)
         if line.any():
-            over = ((np.minimum(a0, a1) <= np.maximum(ex0, ex1))
-                    & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
-                    & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
-                    & (np.maximum(b0, b1) >= np.minimum(ey0, ey1)))
+            over = (
+                (np.minimum(a0, a1) <= np.maximum(ex0, ex1))
+                & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
+                & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
+                & (np.maximum(b0, b1) >= np.minimum(ey0, ey1))
+            )
             both = np.where(line, over, both)
-        hit[i:i + step] = both.any(axis=1)
+        hit[i : i + step] = both.any(axis=1)
     return hit
 
 
@@ -470,8 +507,9 @@ def _orient(ax: Any, ay: Any, bx: Any, by: Any, cx: Any, cy: Any) -> Any:
     return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
 
-def land_obstacle(x: ArrayLike, y: ArrayLike, nan: ArrayLike, name: str = "land"
-                  ) -> tuple[str, Any] | None:
+def land_obstacle(
+    x: ArrayLike, y: ArrayLike, nan: ArrayLike, name: str = "land"
+) -> tuple[str, Any] | None:
     """The NaN cells of a wind grid as one obstacle.
 
     Parameters

@@ -80,12 +80,16 @@ def ring_problem(xy: NDArray) -> str | None:
     step = np.hypot(*(np.roll(p, -1, axis=0) - p).T)
     if np.any(step < 0.01):
         k = int(np.argmax(step < 0.01))
-        return (f"expected distinct consecutive points; points {k + 1} and {(k + 1) % n + 1} "
-                "are the same place (a ring does not repeat its first point at the end)")
+        return (
+            f"expected distinct consecutive points; points {k + 1} and {(k + 1) % n + 1} "
+            "are the same place (a ring does not repeat its first point at the end)"
+        )
     hit = ring_crossing(p)
     if hit is not None:
         i, j = hit
-        return (f"expected a simple polygon; its edge from point {i + 1} to {(i + 1) % n + 1} "
-                f"crosses the edge from point {j + 1} to {(j + 1) % n + 1} (a self-"
-                "intersecting ring: reorder the points along the edge)")
+        return (
+            f"expected a simple polygon; its edge from point {i + 1} to {(i + 1) % n + 1} "
+            f"crosses the edge from point {j + 1} to {(j + 1) % n + 1} (a self-"
+            "intersecting ring: reorder the points along the edge)"
+        )
     return None

@@ -36,9 +36,17 @@ def _wrap(a: float) -> float:
 
 
 def _sail_extreme(
-    start: tuple[float, float], target: tuple[float, float], t0: float, wind: WindField,
-    boat: BoatModel, first: int, *, tack_penalty_s: float, gybe_penalty_s: float,
-    dt_s: float, max_time_s: float,
+    start: tuple[float, float],
+    target: tuple[float, float],
+    t0: float,
+    wind: WindField,
+    boat: BoatModel,
+    first: int,
+    *,
+    tack_penalty_s: float,
+    gybe_penalty_s: float,
+    dt_s: float,
+    max_time_s: float,
 ) -> float:
     """Time [s] of the extreme path that goes first to the side ``first`` (+1 left, -1 right)."""
     x, y = float(start[0]), float(start[1])
@@ -68,8 +76,9 @@ def _sail_extreme(
             cand = [twd + angle, twd - angle]
             lefts = [_wrap(h - bearing) < 0 for h in cand]
             want_left = (first > 0) != reached
-            heading = next((h for h, lf in zip(cand, lefts, strict=True) if lf == want_left),
-                           cand[0])
+            heading = next(
+                (h for h, lf in zip(cand, lefts, strict=True) if lf == want_left), cand[0]
+            )
         else:
             reached = True
             upwind = abs(off) < 90.0
@@ -93,9 +102,16 @@ def _sail_extreme(
 
 
 def layline_times(
-    start: tuple[float, float], target: tuple[float, float], t0: float, wind: WindField,
-    boat: BoatModel, *, tack_penalty_s: float = 0.0, gybe_penalty_s: float = 0.0,
-    dt_s: float = 2.0, max_time_s: float = 7200.0,
+    start: tuple[float, float],
+    target: tuple[float, float],
+    t0: float,
+    wind: WindField,
+    boat: BoatModel,
+    *,
+    tack_penalty_s: float = 0.0,
+    gybe_penalty_s: float = 0.0,
+    dt_s: float = 2.0,
+    max_time_s: float = 7200.0,
 ) -> tuple[float, float]:
     """Times of a leg's left and right extremes (layline to layline), sailed in ``wind``.
 
@@ -127,17 +143,32 @@ def layline_times(
     out = []
     for first in (1, -1):
         try:
-            out.append(_sail_extreme(start, target, t0, wind, boat, first,
-                                     tack_penalty_s=tack_penalty_s,
-                                     gybe_penalty_s=gybe_penalty_s, dt_s=dt_s,
-                                     max_time_s=max_time_s))
+            out.append(
+                _sail_extreme(
+                    start,
+                    target,
+                    t0,
+                    wind,
+                    boat,
+                    first,
+                    tack_penalty_s=tack_penalty_s,
+                    gybe_penalty_s=gybe_penalty_s,
+                    dt_s=dt_s,
+                    max_time_s=max_time_s,
+                )
+            )
         except SailrouteError:  # the extreme leaves the wind data: no verdict from it
             out.append(math.inf)
     return out[0], out[1]
 
 
 def side_verdict(
-    side: str, t_route: float, t_left: float, t_right: float, *, margin_s: float = 2.0,
+    side: str,
+    t_route: float,
+    t_left: float,
+    t_right: float,
+    *,
+    margin_s: float = 2.0,
     margin_pct: float = 0.5,
 ) -> str:
     """The side a route took, if it beat the other side by more than the margin, else ``"tie"``.

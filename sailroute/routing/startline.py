@@ -206,8 +206,10 @@ def start_line_numbers(
     tws, twd = (float(v) for v in _wind_at(wind, t_gun, mid))
     length = float(np.hypot(b_xy[0] - a_xy[0], b_xy[1] - a_xy[1]))
     if not length > 0:
-        raise InputError(f"start line {names[0]} - {names[1]}: both ends are at the same "
-                         "place; a line needs two distinct marks")
+        raise InputError(
+            f"start line {names[0]} - {names[1]}: both ends are at the same "
+            "place; a line needs two distinct marks"
+        )
     bias_arr, b_star = line_bias_deg(a_xy, b_xy, twd)
     bias = float(bias_arr)
     starboard, port = (names[1], names[0]) if b_star else (names[0], names[1])
@@ -226,10 +228,24 @@ def start_line_numbers(
     # the bias relative to the gun's, so a range across ±180° stays contiguous
     rel = wrap180(window - bias)
     return StartLineNumbers(
-        names[0], names[1], (float(a_xy[0]), float(a_xy[1])),
-        (float(b_xy[0]), float(b_xy[1])), float(t_gun), length, tws, twd, bias,
-        starboard, port, favoured, gain_m, vmg, gain_s,
-        bias + float(rel.min()), bias + float(rel.max()), float(t_gun - t0),
+        names[0],
+        names[1],
+        (float(a_xy[0]), float(a_xy[1])),
+        (float(b_xy[0]), float(b_xy[1])),
+        float(t_gun),
+        length,
+        tws,
+        twd,
+        bias,
+        starboard,
+        port,
+        favoured,
+        gain_m,
+        vmg,
+        gain_s,
+        bias + float(rel.min()),
+        bias + float(rel.max()),
+        float(t_gun - t0),
     )
 
 
@@ -267,8 +283,10 @@ def ray_segment_distance(
         frac = (qx * ey - qy * ex) / den  # cross(q, e) / cross(e, s)
     tol = 1e-9
     hit = (np.abs(den) > 1e-12) & (dist >= -tol) & (frac >= -tol) & (frac <= 1.0 + tol)
-    return (np.where(hit, np.maximum(dist, 0.0), np.inf),
-            np.where(hit, np.clip(frac, 0.0, 1.0), np.nan))
+    return (
+        np.where(hit, np.maximum(dist, 0.0), np.inf),
+        np.where(hit, np.clip(frac, 0.0, 1.0), np.nan),
+    )
 
 
 def distance_to_segment(p_xy: XY, a_xy: XY, b_xy: XY) -> tuple[float, float]:
@@ -380,8 +398,14 @@ class LineApproach:
 
 
 def _approaches(
-    label: str | list[str], p_xy: XY, headings: NDArray, twd: float, tws: float,
-    boat: BoatModel, a_xy: XY, b_xy: XY,
+    label: str | list[str],
+    p_xy: XY,
+    headings: NDArray,
+    twd: float,
+    tws: float,
+    boat: BoatModel,
+    a_xy: XY,
+    b_xy: XY,
 ) -> list[Approach]:
     """Straight approaches along ``headings`` (vectorised), one :class:`Approach` each."""
     dist, frac = ray_segment_distance(p_xy, headings, a_xy, b_xy)
@@ -397,9 +421,19 @@ def _approaches(
     for k in range(headings.size):
         f = float(frac[k])
         tack: Side = "starboard" if stwa[k] >= 0 else "port"
-        out.append(Approach(labels[k], tack, float(headings[k] % 360.0), float(twa[k]),
-                            float(speed[k]), float(dist[k]), float(time[k]), f,
-                            (a_xy[0] + f * sx, a_xy[1] + f * sy)))
+        out.append(
+            Approach(
+                labels[k],
+                tack,
+                float(headings[k] % 360.0),
+                float(twa[k]),
+                float(speed[k]),
+                float(dist[k]),
+                float(time[k]),
+                f,
+                (a_xy[0] + f * sx, a_xy[1] + f * sy),
+            )
+        )
     return out
 
 
@@ -457,18 +491,36 @@ def line_approach(
         nx, ny = -nx, -ny
     course_side = bool((p_xy[0] - mid[0]) * nx + (p_xy[1] - mid[1]) * ny > 1e-9 and dist > 0)
     twa_up, _ = boat.vmg_angles_deg(tws)
-    close = _approaches(["close-hauled", "close-hauled"], p_xy,
-                        np.array([twd - twa_up, twd + twa_up]), twd, tws, boat, a_xy, b_xy)
-    end_headings = np.array([float(bearing_deg(e[0] - p_xy[0], e[1] - p_xy[1]))
-                             for e in (a_xy, b_xy)])
-    ends = _approaches([f"to {names[0]}", f"to {names[1]}"], p_xy, end_headings, twd, tws,
-                       boat, a_xy, b_xy)
+    close = _approaches(
+        ["close-hauled", "close-hauled"],
+        p_xy,
+        np.array([twd - twa_up, twd + twa_up]),
+        twd,
+        tws,
+        boat,
+        a_xy,
+        b_xy,
+    )
+    end_headings = np.array(
+        [float(bearing_deg(e[0] - p_xy[0], e[1] - p_xy[1])) for e in (a_xy, b_xy)]
+    )
+    ends = _approaches(
+        [f"to {names[0]}", f"to {names[1]}"], p_xy, end_headings, twd, tws, boat, a_xy, b_xy
+    )
     for k, e in enumerate((a_xy, b_xy)):  # straight at an end: exactly its distance
         d = float(np.hypot(e[0] - p_xy[0], e[1] - p_xy[1]))
         sp = ends[k].speed_ms
-        ends[k] = Approach(ends[k].label, ends[k].tack, ends[k].heading_deg, ends[k].twa_deg,
-                           sp, d, d / sp if sp > 0 else (0.0 if d == 0 else float("inf")),
-                           float(k), e)
+        ends[k] = Approach(
+            ends[k].label,
+            ends[k].tack,
+            ends[k].heading_deg,
+            ends[k].twa_deg,
+            sp,
+            d,
+            d / sp if sp > 0 else (0.0 if d == 0 else float("inf")),
+            float(k),
+            e,
+        )
     grid = np.arange(0.0, 360.0, heading_step_deg)
     scan = _approaches("fastest", p_xy, grid, twd, tws, boat, a_xy, b_xy)
     candidates = [*close, *ends, *scan]
@@ -476,13 +528,34 @@ def line_approach(
     for side in ("starboard", "port"):
         on = [c for c in candidates if c.tack == side]
         best = min(on, key=lambda c: c.time_s)
-        tacks.append(Approach("fastest", best.tack, best.heading_deg, best.twa_deg,
-                              best.speed_ms, best.distance_m, best.time_s, best.fraction,
-                              best.point_xy))
+        tacks.append(
+            Approach(
+                "fastest",
+                best.tack,
+                best.heading_deg,
+                best.twa_deg,
+                best.speed_ms,
+                best.distance_m,
+                best.time_s,
+                best.fraction,
+                best.point_xy,
+            )
+        )
     fastest = min(tacks, key=lambda c: c.time_s)
-    return LineApproach((float(p_xy[0]), float(p_xy[1])), float(t), float(t_gun), tws, twd,
-                        dist, course_side, tuple(close), tuple(ends), tuple(tacks), fastest,
-                        note)
+    return LineApproach(
+        (float(p_xy[0]), float(p_xy[1])),
+        float(t),
+        float(t_gun),
+        tws,
+        twd,
+        dist,
+        course_side,
+        tuple(close),
+        tuple(ends),
+        tuple(tacks),
+        fastest,
+        note,
+    )
 
 
 def wind_near(wind: WindField, t: float, xy: XY) -> tuple[float, float, str]:
@@ -494,20 +567,17 @@ def wind_near(wind: WindField, t: float, xy: XY) -> tuple[float, float, str]:
     yc = min(max(float(xy[1]), cov.ymin), cov.ymax)
     notes = []
     if tc != t:
-        notes.append(f"the wind data cover {iso(cov.t0)} .. {iso(cov.t1)}; the wind at "
-                     f"{iso(tc)} is used")
+        notes.append(
+            f"the wind data cover {iso(cov.t0)} .. {iso(cov.t1)}; the wind at {iso(tc)} is used"
+        )
     if (xc, yc) != (float(xy[0]), float(xy[1])):
         gap = float(np.hypot(xc - xy[0], yc - xy[1]))
-        notes.append(f"the position is {gap:.0f} m outside the wind data's area; the wind at "
-                     "its nearest edge is used")
+        notes.append(
+            f"the position is {gap:.0f} m outside the wind data's area; the wind at "
+            "its nearest edge is used"
+        )
     tws, twd = wind_speed_direction(*wind.sample(tc, xc, yc))
     return float(tws), float(twd), "; ".join(notes)
 
 
 # --- a course's start line -------------------------------------------------------------
-
-
-
-
-
-

@@ -90,8 +90,15 @@ def build_track(
         bsp = np.asarray(bsp_ms, dtype=float)
     sd = np.where(twa >= 0, 1, -1) if side is None else np.asarray(side)
     return RouteTrack(
-        t=t, x=x, y=y, heading_deg=h, tws_ms=tws, twd_deg=twd, twa_deg=twa,
-        bsp_ms=bsp, side=sd.astype(np.int8),
+        t=t,
+        x=x,
+        y=y,
+        heading_deg=h,
+        tws_ms=tws,
+        twd_deg=twd,
+        twa_deg=twa,
+        bsp_ms=bsp,
+        side=sd.astype(np.int8),
     )
 
 

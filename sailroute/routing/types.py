@@ -291,7 +291,8 @@ def _work_problems(s: RoutingSettings) -> list[str]:
             f"dp_cols = {cols} with dp_rows = {s.dp_rows}, dp_samples = {smp} and "
             f"dp_refinements = {ref - 1} needs about {dp:.1e} wind samples per leg (rows x "
             f"cols^2 x samples x passes), more than {MAX_DP_SEGMENT_SAMPLES:.0e} (minutes of "
-            "work); lower them (defaults 64 columns, 13 rows, 4 samples, 2 refinements)")
+            "work); lower them (defaults 64 columns, 13 rows, 4 samples, 2 refinements)"
+        )
     per_row = float(s.spline_cols * s.spline_slopes) ** 2
     total = per_row * rows * (s.spline_refinements + 1)
     if per_row > MAX_SPLINE_ROW_EDGES or total > MAX_SPLINE_EDGES:
@@ -299,14 +300,18 @@ def _work_problems(s: RoutingSettings) -> list[str]:
             f"spline_cols = {s.spline_cols} with spline_slopes = {s.spline_slopes} needs "
             f"{per_row:.1e} edges between two rows and {total:.1e} per leg, more than "
             f"{MAX_SPLINE_ROW_EDGES:.0e} and {MAX_SPLINE_EDGES:.0e} (memory and minutes of "
-            "work); lower spline_cols, spline_slopes or spline_refinements (defaults 25, 7, 3)")
+            "work); lower spline_cols, spline_slopes or spline_refinements (defaults 25, 7, 3)"
+        )
     return problems
 
 
 def _is_number(v: object) -> bool:
     """A finite real number (not a bool)."""
-    return isinstance(v, int | float | np.integer | np.floating) and not isinstance(
-        v, bool) and math.isfinite(v)
+    return (
+        isinstance(v, int | float | np.integer | np.floating)
+        and not isinstance(v, bool)
+        and math.isfinite(v)
+    )
 
 
 class _Problems(list[str]):
@@ -331,10 +336,20 @@ def _common_problems(p: _Problems) -> None:
     """The router name, the time limit, the penalties and the start-line spacing."""
     s = p.s
     if s.router not in get_args(RouterName):
-        p.append("router must be one of " + ", ".join(
-            repr(r) for r in get_args(RouterName)) + f", got {s.router!r}")
-    for name in ("dt_s", "heading_step_deg", "min_dt_s", "prune_sector_deg",
-                 "max_leg_time_s", "start_line_spacing_m", "zone_m"):
+        p.append(
+            "router must be one of "
+            + ", ".join(repr(r) for r in get_args(RouterName))
+            + f", got {s.router!r}"
+        )
+    for name in (
+        "dt_s",
+        "heading_step_deg",
+        "min_dt_s",
+        "prune_sector_deg",
+        "max_leg_time_s",
+        "start_line_spacing_m",
+        "zone_m",
+    ):
         p.number(name)
     for name in ("tack_penalty_s", "gybe_penalty_s"):
         p.number(name, strict=False)
@@ -348,11 +363,15 @@ def _isochrone_problems(p: _Problems) -> None:
     if _is_number(s.heading_step_deg) and s.heading_step_deg > 45:
         p.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
     if _is_number(s.heading_step_deg) and 0 < s.heading_step_deg < MIN_HEADING_STEP_DEG:
-        p.append(f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer "
-                 f"steps only slow the router), got {s.heading_step_deg!r}")
+        p.append(
+            f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer "
+            f"steps only slow the router), got {s.heading_step_deg!r}"
+        )
     if _is_number(s.dt_s) and 0 < s.dt_s < MIN_DT_S:
-        p.append(f"dt_s must be >= {MIN_DT_S:g} s (default 10; finer steps hardly "
-                 f"change the route and make it slow), got {s.dt_s!r}")
+        p.append(
+            f"dt_s must be >= {MIN_DT_S:g} s (default 10; finer steps hardly "
+            f"change the route and make it slow), got {s.dt_s!r}"
+        )
     if _is_number(s.min_dt_s) and 0 < s.min_dt_s < MIN_MIN_DT_S:
         p.append(f"min_dt_s must be >= {MIN_MIN_DT_S:g} s (default 1), got {s.min_dt_s!r}")
     p.integer("max_front_points", 8, MAX_FRONT_POINTS, f"in [8, {MAX_FRONT_POINTS}]")

@@ -55,16 +55,41 @@ def _inline(fn: Any) -> Any:
 
 
 @_jit
-def count_runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, nt: int,
-               ring0: int, ptr: Any) -> None:
+def count_runs(
+    g: Any,
+    b: Any,
+    inv_r: Any,
+    ca: Any,
+    cs: Any,
+    fr_in: float,
+    nr: int,
+    nt: int,
+    ring0: int,
+    ptr: Any,
+) -> None:
     """Number of runs of every ``(q, i, n)`` (see :func:`fill_runs`), as offsets ``ptr``."""
     _runs(g, b, inv_r, ca, cs, fr_in, nr, nt, ring0, ptr, False, ptr, ptr, ptr, ptr, ptr, ptr)
 
 
 @_jit
-def fill_runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, nt: int,
-              ring0: int, ptr: Any, j0: Any, j1: Any, kind: Any, di: Any, op: Any,
-              om: Any) -> None:
+def fill_runs(
+    g: Any,
+    b: Any,
+    inv_r: Any,
+    ca: Any,
+    cs: Any,
+    fr_in: float,
+    nr: int,
+    nt: int,
+    ring0: int,
+    ptr: Any,
+    j0: Any,
+    j1: Any,
+    kind: Any,
+    di: Any,
+    op: Any,
+    om: Any,
+) -> None:
     """The runs of the ring-relative bilinear rows (``deadline_rows._RingRows``).
 
     Along ``j`` (fixed tack ``q``, ring ``i >= ring0``, control ``n``) a row is one of: a
@@ -79,9 +104,25 @@ def fill_runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: in
 
 
 @_jit
-def _runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, nt: int,
-          ring0: int, ptr: Any, fill: bool, j0: Any, j1: Any, kind: Any, di: Any, op: Any,
-          om: Any) -> None:
+def _runs(
+    g: Any,
+    b: Any,
+    inv_r: Any,
+    ca: Any,
+    cs: Any,
+    fr_in: float,
+    nr: int,
+    nt: int,
+    ring0: int,
+    ptr: Any,
+    fill: bool,
+    j0: Any,
+    j1: Any,
+    kind: Any,
+    di: Any,
+    op: Any,
+    om: Any,
+) -> None:
     n_u = g.shape[1]
     m = 0
     for q in range(2):
@@ -118,8 +159,7 @@ def _runs(g: Any, b: Any, inv_r: Any, ca: Any, cs: Any, fr_in: float, nr: int, n
 
 
 @_jit
-def pad_rings(prev: Any, nr: int, nt: int, pad: int, ring_lo: int, ring_hi: int,
-              out: Any) -> None:
+def pad_rings(prev: Any, nr: int, nt: int, pad: int, ring_lo: int, ring_hi: int, out: Any) -> None:
     """Copy rings ``ring_lo - 1 .. ring_hi`` of ``prev`` into the padded slice of
     ``deadline_rows._RingRows`` (``pad`` periodic columns on each side of every ring)."""
     stride = nt + 2 * pad
@@ -140,9 +180,24 @@ scalar remainder per run cost more; the tables and scratch have ``LANES`` spare 
 
 
 @_inline
-def run_values(j_lo: int, j_hi: int, b: Any, h0: Any, h1: Any, ir: Any, ca: Any, cs: Any,
-               fop: Any, fom: Any, xpad: Any, ring: int, stride: int, n: Any, best_val: Any,
-               best_n: Any) -> None:
+def run_values(
+    j_lo: int,
+    j_hi: int,
+    b: Any,
+    h0: Any,
+    h1: Any,
+    ir: Any,
+    ca: Any,
+    cs: Any,
+    fop: Any,
+    fom: Any,
+    xpad: Any,
+    ring: int,
+    stride: int,
+    n: Any,
+    best_val: Any,
+    best_n: Any,
+) -> None:
     """Rows ``j_lo .. j_hi - 1`` of one run (``kind`` 0) of control ``n``; keeps the best
     so far per node.  A row is the weighted sum of ``deadline_rows._RingRows`` in the order of
     its CSR entries (the NumPy path's mat-vec adds them in that order).
@@ -204,11 +259,38 @@ def unsure_arc(prev: Any, base: int, nt: int, sure: Any) -> tuple[int, int]:
 
 @_jit
 def ring_slice(
-    ptr: Any, j0: Any, j1: Any, kind: Any, di: Any, op: Any, om: Any, b: Any, h0: Any,
-    h1: Any, inv_r: Any, ca: Any, cs: Any, nr: int, nt: int, pad: int, xpad: Any,
-    prev: Any, sw_data: Any, sw_indices: Any, prev_c: Any, use_switch: bool, ring_lo: int,
-    ring_hi: int, switch_eps: Any, zero_clip: Any, sure: Any, prev_action: Any,
-    w_out: Any, action_out: Any, best_val: Any, best_n: Any,
+    ptr: Any,
+    j0: Any,
+    j1: Any,
+    kind: Any,
+    di: Any,
+    op: Any,
+    om: Any,
+    b: Any,
+    h0: Any,
+    h1: Any,
+    inv_r: Any,
+    ca: Any,
+    cs: Any,
+    nr: int,
+    nt: int,
+    pad: int,
+    xpad: Any,
+    prev: Any,
+    sw_data: Any,
+    sw_indices: Any,
+    prev_c: Any,
+    use_switch: bool,
+    ring_lo: int,
+    ring_hi: int,
+    switch_eps: Any,
+    zero_clip: Any,
+    sure: Any,
+    prev_action: Any,
+    w_out: Any,
+    action_out: Any,
+    best_val: Any,
+    best_n: Any,
 ) -> None:
     """One budget slice of the bilinear solve for rings ``ring_lo .. ring_hi - 1``.
 
@@ -248,19 +330,59 @@ def ring_slice(
                                     best_n[j] = nn
                             continue
                         ring = (q * (nr + 2) + i + di[r]) * stride + pad
-                        run_values(r0, r1, b_qn, h0_qn, h1_qn, ir, ca, cs,
-                                   prev.dtype.type(op[r]), prev.dtype.type(om[r]), xpad,
-                                   ring, stride, nn, best_val, best_n)
-            finish_nodes(q * per_tack + i * nt, best_val[:nt], best_n[:nt], prev, sw_data,
-                         sw_indices, prev_c, use_switch, switch_eps, zero_clip, sure,
-                         prev_action, w_out, action_out)
+                        run_values(
+                            r0,
+                            r1,
+                            b_qn,
+                            h0_qn,
+                            h1_qn,
+                            ir,
+                            ca,
+                            cs,
+                            prev.dtype.type(op[r]),
+                            prev.dtype.type(om[r]),
+                            xpad,
+                            ring,
+                            stride,
+                            nn,
+                            best_val,
+                            best_n,
+                        )
+            finish_nodes(
+                q * per_tack + i * nt,
+                best_val[:nt],
+                best_n[:nt],
+                prev,
+                sw_data,
+                sw_indices,
+                prev_c,
+                use_switch,
+                switch_eps,
+                zero_clip,
+                sure,
+                prev_action,
+                w_out,
+                action_out,
+            )
 
 
 @_jit
-def finish_nodes(p0: int, best_val: Any, best_n: Any, prev: Any, sw_data: Any,
-                 sw_indices: Any, prev_c: Any, use_switch: bool, switch_eps: Any,
-                 zero_clip: Any, sure: Any, prev_action: Any, w_out: Any,
-                 action_out: Any) -> None:
+def finish_nodes(
+    p0: int,
+    best_val: Any,
+    best_n: Any,
+    prev: Any,
+    sw_data: Any,
+    sw_indices: Any,
+    prev_c: Any,
+    use_switch: bool,
+    switch_eps: Any,
+    zero_clip: Any,
+    sure: Any,
+    prev_action: Any,
+    w_out: Any,
+    action_out: Any,
+) -> None:
     """Nodes ``p0 .. p0 + len(best_val) - 1`` given their best steering value and
     control: the switch update, the clip to ``[0, 1]`` and the "more budget never hurts"
     keep (a node already sure keeps its value and action).  The action is the control
@@ -317,10 +439,23 @@ def _best_csr(p: int, data: Any, indices: Any, n_u: int, per_row: int, prev: Any
 
 @_jit
 def slice_update(
-    cols: Any, vals: Any, n_u: int, per_row: int, prev: Any,
-    sw_data: Any, sw_indices: Any, prev_c: Any, use_switch: bool,
-    node_lo: int, node_hi: int, switch_eps: Any, zero_clip: Any, sure: Any,
-    prev_action: Any, w_out: Any, action_out: Any,
+    cols: Any,
+    vals: Any,
+    n_u: int,
+    per_row: int,
+    prev: Any,
+    sw_data: Any,
+    sw_indices: Any,
+    prev_c: Any,
+    use_switch: bool,
+    node_lo: int,
+    node_hi: int,
+    switch_eps: Any,
+    zero_clip: Any,
+    sure: Any,
+    prev_action: Any,
+    w_out: Any,
+    action_out: Any,
 ) -> None:
     """One budget slice for nodes ``node_lo .. node_hi - 1`` with CSR steering rows
     (bicubic; see ``solve_deadline``).
@@ -351,7 +486,22 @@ def slice_update(
     best_n = np.zeros(node_hi - node_lo, dtype=np.int8)
     for p in range(node_lo, node_hi):
         if prev[p] < sure:  # a sure node keeps its value: skip its rows
-            best_val[p - node_lo], best_n[p - node_lo] = _best_csr(p, vals, cols, n_u,
-                                                                   per_row, prev)
-    finish_nodes(node_lo, best_val, best_n, prev, sw_data, sw_indices, prev_c, use_switch,
-                 switch_eps, zero_clip, sure, prev_action, w_out, action_out)
+            best_val[p - node_lo], best_n[p - node_lo] = _best_csr(
+                p, vals, cols, n_u, per_row, prev
+            )
+    finish_nodes(
+        node_lo,
+        best_val,
+        best_n,
+        prev,
+        sw_data,
+        sw_indices,
+        prev_c,
+        use_switch,
+        switch_eps,
+        zero_clip,
+        sure,
+        prev_action,
+        w_out,
+        action_out,
+    )

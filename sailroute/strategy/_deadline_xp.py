@@ -44,8 +44,10 @@ extern "C" __global__ void {name}(const {t}* __restrict__ data,
     out[r] = s;
 }}
 """
-_OPS = {"float32": ("float", "__fadd_rn", "__fmul_rn"),
-        "float64": ("double", "__dadd_rn", "__dmul_rn")}
+_OPS = {
+    "float32": ("float", "__fadd_rn", "__fmul_rn"),
+    "float64": ("double", "__dadd_rn", "__dmul_rn"),
+}
 
 
 @lru_cache(maxsize=2)
@@ -78,15 +80,18 @@ class DeviceRows:
         """From ``cols`` and ``vals`` of shape ``(n_nodes, rows_per_node, per_row)``
         (NumPy or ``xp`` arrays; copied to ``xp``)."""
         _, rows_per_node, per_row = cols.shape
-        return cls(xp.ascontiguousarray(xp.asarray(vals).reshape(-1)),
-                   xp.ascontiguousarray(xp.asarray(cols).reshape(-1).astype(np.int32, copy=False)),
-                   int(rows_per_node), int(per_row), xp)
+        return cls(
+            xp.ascontiguousarray(xp.asarray(vals).reshape(-1)),
+            xp.ascontiguousarray(xp.asarray(cols).reshape(-1).astype(np.int32, copy=False)),
+            int(rows_per_node),
+            int(per_row),
+            xp,
+        )
 
     @classmethod
     def from_host(cls, op: Any, xp: ModuleType) -> DeviceRows:
         """A copy on ``xp`` of a ``deadline_rows._RowOperator`` (the same layout)."""
-        return cls(xp.asarray(op.data), xp.asarray(op.indices), op.rows_per_node,
-                   op.per_row, xp)
+        return cls(xp.asarray(op.data), xp.asarray(op.indices), op.rows_per_node, op.per_row, xp)
 
     def apply(self, x: Any, node_lo: int, node_hi: int) -> Any:
         """Rows of nodes ``node_lo .. node_hi - 1`` times ``x`` (an ``xp`` array of the
@@ -99,12 +104,21 @@ class DeviceRows:
             if n_rows > 0:
                 blocks = (n_rows + THREADS - 1) // THREADS
                 _kernel(self.data.dtype.name)(
-                    (blocks,), (THREADS,),
-                    (self.data, self.cols, x, np.int64(e0), np.int64(n_rows),
-                     np.int32(per_row), out))
+                    (blocks,),
+                    (THREADS,),
+                    (
+                        self.data,
+                        self.cols,
+                        x,
+                        np.int64(e0),
+                        np.int64(n_rows),
+                        np.int32(per_row),
+                        out,
+                    ),
+                )
         else:
-            d = self.data[e0:e0 + n_rows * per_row].reshape(n_rows, per_row)
-            c = self.cols[e0:e0 + n_rows * per_row].reshape(n_rows, per_row)
+            d = self.data[e0 : e0 + n_rows * per_row].reshape(n_rows, per_row)
+            c = self.cols[e0 : e0 + n_rows * per_row].reshape(n_rows, per_row)
             out = d[:, 0] * x[c[:, 0]]
             for k in range(1, per_row):
                 out = out + d[:, k] * x[c[:, k]]

@@ -145,8 +145,8 @@ def _rings_all_sure(w_prev: NDArray, grid: DeadlineGrid, lo: int, hi: int) -> in
     nt = grid.n_theta
     sure = w_prev.dtype.type(SURE)  # as NumPy compares (on any array module)
     while lo < hi:
-        if (w_prev[lo * nt:(lo + 1) * nt] < sure).any() or (
-            w_prev[per_tack + lo * nt:per_tack + (lo + 1) * nt] < sure
+        if (w_prev[lo * nt : (lo + 1) * nt] < sure).any() or (
+            w_prev[per_tack + lo * nt : per_tack + (lo + 1) * nt] < sure
         ).any():
             return lo
         lo += 1
@@ -168,17 +168,28 @@ def resolve_engine(engine: str) -> tuple[bool, ModuleType]:
         try:
             return False, get_xp("cupy")
         except InputError:
-            raise InputError("engine 'cupy' needs CuPy and an NVIDIA GPU: pip install "
-                             "'sailroute[gpu]' on a machine with one, or use engine 'auto' "
-                             "(numba where installed, else NumPy)") from None
+            raise InputError(
+                "engine 'cupy' needs CuPy and an NVIDIA GPU: pip install "
+                "'sailroute[gpu]' on a machine with one, or use engine 'auto' "
+                "(numba where installed, else NumPy)"
+            ) from None
     return engine == "numba" or (engine == "auto" and _jit.AVAILABLE), np
 
 
-def _update_block(n0: int, n1: int, vals: NDArray, prev: NDArray, prev_c: NDArray | None,
-                  w_out: NDArray, actions: tuple[NDArray, NDArray],
-                  offsets: tuple[NDArray, NDArray] | None, refine: _SteerRefiner | None,
-                  switch_op: _RowOperator | DeviceRows, consts: tuple[Any, Any, Any],
-                  xp: ModuleType = np) -> None:
+def _update_block(
+    n0: int,
+    n1: int,
+    vals: NDArray,
+    prev: NDArray,
+    prev_c: NDArray | None,
+    w_out: NDArray,
+    actions: tuple[NDArray, NDArray],
+    offsets: tuple[NDArray, NDArray] | None,
+    refine: _SteerRefiner | None,
+    switch_op: _RowOperator | DeviceRows,
+    consts: tuple[Any, Any, Any],
+    xp: ModuleType = np,
+) -> None:
     """Nodes ``n0 .. n1 - 1`` of a slice from their steering rows ``vals`` (NumPy path,
     or any array module ``xp``; ``_deadline_jit.finish_nodes`` is the compiled twin):
     ``prev`` is the previous slice, ``prev_c`` the slice ``C`` back (None before a switch
@@ -206,8 +217,9 @@ def _update_block(n0: int, n1: int, vals: NDArray, prev: NDArray, prev_c: NDArra
     keep = (p >= sure) | (p > wk)
     w_out[n0:n1] = xp.where(keep, p, wk)
     a_prev, a_out = actions
-    a_out[n0:n1] = xp.where(keep, a_prev[n0:n1],
-                            (best | xp.where(sw, SWITCH_BIT, 0)).astype(np.uint8))
+    a_out[n0:n1] = xp.where(
+        keep, a_prev[n0:n1], (best | xp.where(sw, SWITCH_BIT, 0)).astype(np.uint8)
+    )
     if offsets is not None and off is not None:
         offsets[1][n0:n1] = xp.where(keep, offsets[0][n0:n1], off)
 
@@ -234,44 +246,61 @@ class _SliceOperators:
     n_controls: int
 
 
-def _slice_operators(grid: DeadlineGrid, f: NDArray[np.float64],
-                     rates: tuple[float, float, float], ftype: type, jit: bool,
-                     refine: _SteerRefiner | None, xp: ModuleType) -> _SliceOperators:
+def _slice_operators(
+    grid: DeadlineGrid,
+    f: NDArray[np.float64],
+    rates: tuple[float, float, float],
+    ftype: type,
+    jit: bool,
+    refine: _SteerRefiner | None,
+    xp: ModuleType,
+) -> _SliceOperators:
     """Steering and switch rows of ``grid`` for polar speeds ``f`` [m s⁻¹] and ``rates``
     ``(a, σ, C)`` (drift [rad s⁻¹], diffusion [rad s⁻½], tack penalty [s])."""
     a, sigma, penalty = rates
     cubic = grid.interpolation == "cubic"
     rows = None if cubic else _RingRows.build(grid, f, a, sigma, grid.ds_s, ftype, jit)
     if cubic:
-        steer_op: _RowOperator | None = _steer_operator(grid, f, a, sigma, grid.ds_s, "fail",
-                                                        "cubic", ftype)
+        steer_op: _RowOperator | None = _steer_operator(
+            grid, f, a, sigma, grid.ds_s, "fail", "cubic", ftype
+        )
     else:  # the compiled slice computes the bilinear rows; NumPy multiplies them
         assert rows is not None
         steer_op = None if jit or xp is not np else rows.operator()
     switch_op = _switch_operator(grid, a, sigma, penalty, ftype)
     if xp is np:
-        return _SliceOperators(rows, steer_op, switch_op, steer_op, switch_op, BLOCK_NODES,
-                               jit, refine, f.size)
+        return _SliceOperators(
+            rows, steer_op, switch_op, steer_op, switch_op, BLOCK_NODES, jit, refine, f.size
+        )
     # on the array module: one block per tack band
     if steer_op is not None:
         steer_x: _RowOperator | DeviceRows = DeviceRows.from_host(steer_op, xp)
     else:
         assert rows is not None
         steer_x = DeviceRows.of(*rows.entries(xp, 1 << 17), xp)
-    return _SliceOperators(rows, steer_op, switch_op, steer_x,
-                           DeviceRows.from_host(switch_op, xp), grid.n_nodes, jit, refine,
-                           f.size)
+    return _SliceOperators(
+        rows,
+        steer_op,
+        switch_op,
+        steer_x,
+        DeviceRows.from_host(switch_op, xp),
+        grid.n_nodes,
+        jit,
+        refine,
+        f.size,
+    )
 
 
-def _working_slices(grid: DeadlineGrid, kc: int, n_in: int, ftype: type, refined: bool,
-                    xp: ModuleType) -> tuple[NDArray, NDArray, NDArray | None]:
+def _working_slices(
+    grid: DeadlineGrid, kc: int, n_in: int, ftype: type, refined: bool, xp: ModuleType
+) -> tuple[NDArray, NDArray, NDArray | None]:
     """``w`` of the last ``kc + 1`` budgets (the switch reads ``C`` back), the action (and
     the refined offsets) of the last two: 1 inside the mark and on the ghost in the mark,
     0 elsewhere."""
     per_tack = (grid.n_r + 1) * grid.n_theta
     ws = xp.zeros((kc + 1, grid.n_nodes + 2), dtype=ftype)
     for q in (0, 1):
-        ws[:, q * per_tack:q * per_tack + n_in * grid.n_theta] = 1.0
+        ws[:, q * per_tack : q * per_tack + n_in * grid.n_theta] = 1.0
     ws[:, grid.n_nodes] = 1.0
     acts = xp.zeros((2, grid.n_nodes), dtype=np.uint8)
     offs = np.zeros((2, grid.n_nodes), dtype=np.int8) if refined else None
@@ -283,12 +312,18 @@ def _slice_scratch(ops: _SliceOperators, nt: int, ftype: type) -> tuple[NDArray,
     control per node of a ring."""
     size = ops.rows.padded_size() if ops.rows is not None and ops.jit else 0
     xpad: NDArray[Any] = np.zeros(size, dtype=ftype)
-    return (xpad, np.zeros(nt + _jit.LANES, dtype=ftype),
-            np.zeros(nt + _jit.LANES, dtype=np.int8))
+    return (xpad, np.zeros(nt + _jit.LANES, dtype=ftype), np.zeros(nt + _jit.LANES, dtype=np.int8))
 
 
-def _carry_sure_rings(grid: DeadlineGrid, k: int, kc: int, rings: tuple[int, int, int],
-                      ws: NDArray, acts: NDArray, offs: NDArray | None) -> None:
+def _carry_sure_rings(
+    grid: DeadlineGrid,
+    k: int,
+    kc: int,
+    rings: tuple[int, int, int],
+    ws: NDArray,
+    acts: NDArray,
+    offs: NDArray | None,
+) -> None:
     """Rings below ``lo`` are sure and keep their value and action: bring the reused slots
     of slice ``k`` up to date (they hold budget ``k - kc - 1``, resp. ``k - 2``; rings
     frozen before agree).  ``rings``: ``(lo_w, lo_a, lo)``, the first ring those slots
@@ -299,17 +334,27 @@ def _carry_sure_rings(grid: DeadlineGrid, k: int, kc: int, rings: tuple[int, int
     a_prev, a_cur = acts[(k - 1) % 2], acts[k % 2]
     for q in (0, 1):
         base = q * per_tack
-        cur[base + lo_w * nt:base + lo * nt] = prev[base + lo_w * nt:base + lo * nt]
-        a_cur[base + lo_a * nt:base + lo * nt] = a_prev[base + lo_a * nt:base + lo * nt]
+        cur[base + lo_w * nt : base + lo * nt] = prev[base + lo_w * nt : base + lo * nt]
+        a_cur[base + lo_a * nt : base + lo * nt] = a_prev[base + lo_a * nt : base + lo * nt]
         if offs is not None:
-            offs[k % 2, base + lo_a * nt:base + lo * nt] = \
-                offs[(k - 1) % 2, base + lo_a * nt:base + lo * nt]
+            offs[k % 2, base + lo_a * nt : base + lo * nt] = offs[
+                (k - 1) % 2, base + lo_a * nt : base + lo * nt
+            ]
 
 
-def _march_slice(ops: _SliceOperators, grid: DeadlineGrid, k: int, kc: int,
-                 rings: tuple[int, int], ws: NDArray, acts: NDArray, offs: NDArray | None,
-                 consts: tuple[Any, ...], scratch: tuple[NDArray, ...],
-                 xp: ModuleType) -> None:
+def _march_slice(
+    ops: _SliceOperators,
+    grid: DeadlineGrid,
+    k: int,
+    kc: int,
+    rings: tuple[int, int],
+    ws: NDArray,
+    acts: NDArray,
+    offs: NDArray | None,
+    consts: tuple[Any, ...],
+    scratch: tuple[NDArray, ...],
+    xp: ModuleType,
+) -> None:
     """Rings ``rings = (lo, hi)`` (``lo .. hi - 1``) of budget slice ``k`` from slice
     ``k - 1`` (and ``k - kc`` for the switch), into the working slices."""
     lo, hi = rings
@@ -323,17 +368,47 @@ def _march_slice(ops: _SliceOperators, grid: DeadlineGrid, k: int, kc: int,
         assert rows.runs is not None
         xpad, best_val, best_n = scratch
         rows.pad_slice(prev, lo, hi, xpad)
-        _jit.ring_slice(*rows.runs, rows.b, rows.h0, rows.h1, rows.inv_r, rows.ca,
-                        rows.cs, grid.n_r, nt, rows.pad, xpad, prev, *switch_args, lo, hi,
-                        *consts, a_prev, cur, a_cur, best_val, best_n)
+        _jit.ring_slice(
+            *rows.runs,
+            rows.b,
+            rows.h0,
+            rows.h1,
+            rows.inv_r,
+            rows.ca,
+            rows.cs,
+            grid.n_r,
+            nt,
+            rows.pad,
+            xpad,
+            prev,
+            *switch_args,
+            lo,
+            hi,
+            *consts,
+            a_prev,
+            cur,
+            a_cur,
+            best_val,
+            best_n,
+        )
     elif ops.jit:
         steer_op = ops.steer_op
         assert steer_op is not None
         for q in (0, 1):
             _jit.slice_update(
-                steer_op.indices.view(np.uint32), steer_op.data, ops.n_controls,
-                steer_op.per_row, prev, *switch_args, q * per_tack + lo * nt,
-                q * per_tack + hi * nt, *consts, a_prev, cur, a_cur)
+                steer_op.indices.view(np.uint32),
+                steer_op.data,
+                ops.n_controls,
+                steer_op.per_row,
+                prev,
+                *switch_args,
+                q * per_tack + lo * nt,
+                q * per_tack + hi * nt,
+                *consts,
+                a_prev,
+                cur,
+                a_cur,
+            )
     else:
         steer_x = ops.steer_x
         assert steer_x is not None
@@ -341,15 +416,29 @@ def _march_slice(ops: _SliceOperators, grid: DeadlineGrid, k: int, kc: int,
             for n0 in range(q * per_tack + lo * nt, q * per_tack + hi * nt, ops.block):
                 n1 = min(n0 + ops.block, q * per_tack + hi * nt)
                 vals = steer_x.apply(prev, n0, n1)
-                _update_block(n0, n1, vals, prev, prev_c if k >= kc else None, cur,
-                              (a_prev, a_cur), None if offs is None else
-                              (offs[(k - 1) % 2], offs[k % 2]), ops.refine, ops.switch_x,
-                              consts, xp)
+                _update_block(
+                    n0,
+                    n1,
+                    vals,
+                    prev,
+                    prev_c if k >= kc else None,
+                    cur,
+                    (a_prev, a_cur),
+                    None if offs is None else (offs[(k - 1) % 2], offs[k % 2]),
+                    ops.refine,
+                    ops.switch_x,
+                    consts,
+                    xp,
+                )
 
 
-def _store_band(grid: DeadlineGrid, start: int, rings: tuple[int, int],
-                slices: tuple[NDArray, NDArray, NDArray | None],
-                bands: tuple[NDArray, NDArray, NDArray | None]) -> None:
+def _store_band(
+    grid: DeadlineGrid,
+    start: int,
+    rings: tuple[int, int],
+    slices: tuple[NDArray, NDArray, NDArray | None],
+    bands: tuple[NDArray, NDArray, NDArray | None],
+) -> None:
     """Rings ``lo .. hi - 1`` of both tacks (tack 0, then tack 1) of the slice's ``w``,
     action and offsets into the flat band arrays from ``start``."""
     lo, hi = rings
@@ -428,18 +517,22 @@ def solve_deadline(
     ftype = np.dtype(dtype).type
     compiled, xp = resolve_engine(engine)
     if xp is not np and grid.refine_controls != "none":
-        raise InputError("engine 'cupy' does not refine the steering angle: use "
-                         "refine_controls='none', or engine 'numpy' or 'numba'")
+        raise InputError(
+            "engine 'cupy' does not refine the steering angle: use "
+            "refine_controls='none', or engine 'numpy' or 'numba'"
+        )
     kc = grid.penalty_steps(tack_penalty_s)
     a, sigma = _model_rates(model)
     f = _controls_speed(grid, polar, tws_ms)
     refine = (
         _SteerRefiner(grid, polar, tws_ms, a, sigma, grid.ds_s)
-        if grid.refine_controls != "none" else None
+        if grid.refine_controls != "none"
+        else None
     )
     # golden refinement runs on the NumPy path
-    ops = _slice_operators(grid, f, (a, sigma, tack_penalty_s), ftype, compiled and refine is None,
-                           refine, xp)
+    ops = _slice_operators(
+        grid, f, (a, sigma, tack_penalty_s), ftype, compiled and refine is None, refine, xp
+    )
     n_s, nt = grid.n_s, grid.n_theta
     n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))  # rings inside the mark
     reach_time = (grid.r_m - grid.target_radius_m) / float(np.max(f))  # per ring
@@ -458,22 +551,40 @@ def solve_deadline(
     for k in range(1, n_s + 1):
         hi = int(his[k])
         lo = _rings_all_sure(ws[(k - 1) % (kc + 1)], grid, lo, hi)
-        _carry_sure_rings(grid, k, kc, (int(los[k - kc - 1]) if k > kc else n_in,
-                                        int(los[k - 2]) if k > 1 else n_in, lo),
-                          ws, acts, offs)
+        _carry_sure_rings(
+            grid,
+            k,
+            kc,
+            (int(los[k - kc - 1]) if k > kc else n_in, int(los[k - 2]) if k > 1 else n_in, lo),
+            ws,
+            acts,
+            offs,
+        )
         _march_slice(ops, grid, k, kc, (lo, hi), ws, acts, offs, consts, scratch, xp)
         # store the band of rings lo .. hi - 1 (tack 0, then tack 1)
         los[k] = lo
         starts[k + 1] = starts[k] + 2 * (hi - lo) * nt
-        _store_band(grid, int(starts[k]), (lo, hi), (ws[k % (kc + 1)], acts[k % 2],
-                    None if offs is None else offs[k % 2]), (band_w, band_a, band_o))
+        _store_band(
+            grid,
+            int(starts[k]),
+            (lo, hi),
+            (ws[k % (kc + 1)], acts[k % 2], None if offs is None else offs[k % 2]),
+            (band_w, band_a, band_o),
+        )
         if progress is not None:
             progress(k, n_s)
     used = int(starts[-1])
     last = np.searchsorted(los, np.arange(grid.n_r + 1), side="right") - 1
-    bands = SliceBands(los, his.astype(np.int64), starts, to_numpy(band_w[:used]),
-                       to_numpy(band_a[:used]),
-                       None if band_o is None else band_o[:used], n_in, last)
+    bands = SliceBands(
+        los,
+        his.astype(np.int64),
+        starts,
+        to_numpy(band_w[:used]),
+        to_numpy(band_a[:used]),
+        None if band_o is None else band_o[:used],
+        n_in,
+        last,
+    )
     return DeadlinePolicy(
         grid=grid,
         tack_penalty_s=float(tack_penalty_s),
@@ -537,8 +648,11 @@ def solve_risk_neutral(
     s_op = _steer_operator(grid, f, a, sigma, tau, "fail", "linear")
     c_op = _switch_operator(grid, a, sigma, tack_penalty_s)
     blocks = [
-        [(q * per_tack + i * nt + b0, q * per_tack + i * nt + min(b0 + BLOCK_NODES, nt))
-         for q in (0, 1) for b0 in range(0, nt, BLOCK_NODES)]
+        [
+            (q * per_tack + i * nt + b0, q * per_tack + i * nt + min(b0 + BLOCK_NODES, nt))
+            for q in (0, 1)
+            for b0 in range(0, nt, BLOCK_NODES)
+        ]
         for i in range(n_in, grid.n_r + 1)
     ]
     # start from a plausible upper estimate (beat to the mark at the worst VMG, two switches)

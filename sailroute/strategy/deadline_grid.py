@@ -86,8 +86,7 @@ class DeadlineGrid:
         if not (self.r_max_m > 0 and math.isfinite(self.r_max_m)):
             raise InputError(f"deadline grid: r_max_m = {self.r_max_m} must be finite and > 0")
         if self.n_r < 2 or self.n_theta < 4 or not 2 <= self.n_controls <= 128:
-            raise InputError(
-                "deadline grid: need n_r >= 2, n_theta >= 4, 2 <= n_controls <= 128")
+            raise InputError("deadline grid: need n_r >= 2, n_theta >= 4, 2 <= n_controls <= 128")
         if not 0 < self.target_radius_m < self.r_max_m:
             raise InputError(
                 f"deadline grid: target radius {self.target_radius_m} m must be in (0, r_max)"
@@ -173,9 +172,7 @@ def _node_coords(
     return nodes // per_tack, (nodes % per_tack) // grid.n_theta, nodes % grid.n_theta
 
 
-def _nearest_nodes(
-    grid: DeadlineGrid, r: NDArray, theta: NDArray, q: NDArray
-) -> NDArray[np.int64]:
+def _nearest_nodes(grid: DeadlineGrid, r: NDArray, theta: NDArray, q: NDArray) -> NDArray[np.int64]:
     """Nearest node; points outside the mark never map to a node inside it."""
     first = math.floor(grid.target_radius_m / grid.dr + 1e-9) + 1
     i = np.rint(r / grid.dr).astype(np.int64)
@@ -186,8 +183,11 @@ def _nearest_nodes(
 
 def _nearest_node(grid: DeadlineGrid, r_m: float, theta_rad: float, tack: int) -> int:
     """Flat index of the node nearest to one point ``(r [m], θ [rad])`` on ``tack`` (+1/-1)."""
-    return int(_nearest_nodes(grid, np.array([r_m]), np.array([theta_rad]),
-                              np.array([0 if tack == 1 else 1]))[0])
+    return int(
+        _nearest_nodes(
+            grid, np.array([r_m]), np.array([theta_rad]), np.array([0 if tack == 1 else 1])
+        )[0]
+    )
 
 
 def _controls_speed(grid: DeadlineGrid, polar: Polar, tws_ms: float) -> NDArray[np.float64]:

@@ -55,12 +55,14 @@ class SliceBands:
     n_in: int
     last: NDArray[np.int64]
 
-    def locate(self, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int
-               ) -> tuple[NDArray[np.int64], NDArray[np.int8]]:
+    def locate(
+        self, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int
+    ) -> tuple[NDArray[np.int64], NDArray[np.int8]]:
         """Flat index of ``(k, node)`` (broadcast), and where it is not stored: ``-1``
         inside the mark (``w = 1``), ``-2`` beyond reach (``w = 0``), else 0."""
-        k, node = np.broadcast_arrays(np.asarray(k, dtype=np.int64),
-                                      np.asarray(node, dtype=np.int64))
+        k, node = np.broadcast_arrays(
+            np.asarray(k, dtype=np.int64), np.asarray(node, dtype=np.int64)
+        )
         q, i, j = _node_coords(grid, node)
         kk = np.where(i >= self.lo[k], k, self.last[i])
         lo_s, hi_s = self.lo[kk], self.hi[kk]
@@ -83,8 +85,9 @@ class SliceBands:
         """``w`` of slice(s) ``k`` at ``node``."""
         return self.w_at(*self.locate(grid, k, node))
 
-    def gather(self, table: NDArray, grid: DeadlineGrid, k: NDArray | int,
-               node: NDArray | int) -> NDArray:
+    def gather(
+        self, table: NDArray, grid: DeadlineGrid, k: NDArray | int, node: NDArray | int
+    ) -> NDArray:
         """``table`` (``action`` or ``offset``) at ``(k, node)``; 0 where not stored."""
         return self.table_at(table, *self.locate(grid, k, node))
 
@@ -131,8 +134,9 @@ class DeadlinePolicy:
         """Steering angle [rad] and boat speed [m s⁻¹] of slice(s) ``k`` at ``node``."""
         return self.decide(k, node)[1:3]
 
-    def decide(self, k: NDArray | int, node: NDArray | int
-               ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
+    def decide(
+        self, k: NDArray | int, node: NDArray | int
+    ) -> tuple[NDArray, NDArray, NDArray, NDArray[np.bool_]]:
         """``w``, steering angle [rad], boat speed [m s⁻¹] and switch of slice(s) ``k``
         at ``node`` (one look-up, for the Monte Carlo steps)."""
         b = self.bands

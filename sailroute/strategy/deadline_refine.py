@@ -36,8 +36,9 @@ class _SteerRefiner:
     where it beats the best coarse control.
     """
 
-    def __init__(self, grid: DeadlineGrid, polar: Polar, tws_ms: float, a: float,
-                 sigma: float, tau: float) -> None:
+    def __init__(
+        self, grid: DeadlineGrid, polar: Polar, tws_ms: float, a: float, sigma: float, tau: float
+    ) -> None:
         self.grid, self.a, self.sigma, self.tau = grid, a, sigma, tau
         self.cubic = grid.interpolation == "cubic"
         self.u_tab, self.f_tab = _fine_speed_table(polar, tws_ms)
@@ -46,12 +47,14 @@ class _SteerRefiner:
 
     def _value(self, x: NDArray, q: NDArray, i: NDArray, j: NDArray, u: NDArray) -> NDArray:
         f = np.interp(u, self.u_tab, self.f_tab)
-        cols, wts = _feet_stencil(self.grid, q, i, j, u, f, self.a, self.sigma, self.tau,
-                                  "fail", self.cubic)
+        cols, wts = _feet_stencil(
+            self.grid, q, i, j, u, f, self.a, self.sigma, self.tau, "fail", self.cubic
+        )
         return np.einsum("mk,mk->m", wts, x[cols])
 
-    def refine(self, x: NDArray, n0: int, n1: int, best: NDArray, wk: NDArray
-               ) -> tuple[NDArray, NDArray]:
+    def refine(
+        self, x: NDArray, n0: int, n1: int, best: NDArray, wk: NDArray
+    ) -> tuple[NDArray, NDArray]:
         """Values and int8 offsets after refining nodes ``n0 .. n1 - 1`` (``x``: previous
         slice with ghosts; ``best``, ``wk``: the best coarse control and its value)."""
         offset = np.zeros(n1 - n0, dtype=np.int8)
@@ -63,8 +66,7 @@ class _SteerRefiner:
         lo = np.maximum(ub - self.du, 0.0)
         hi = np.minimum(ub + self.du, math.pi)
         u_star = golden_max(lambda u: self._value(x, q, i, j, u), lo, hi, self.n_iter)
-        off = np.clip(np.rint((u_star - ub) / self.du * OFFSET_STEPS), -OFFSET_STEPS,
-                      OFFSET_STEPS)
+        off = np.clip(np.rint((u_star - ub) / self.du * OFFSET_STEPS), -OFFSET_STEPS, OFFSET_STEPS)
         u_q = np.clip(ub + off * self.du / OFFSET_STEPS, 0.0, math.pi)
         v_q = self._value(x, q, i, j, u_q).astype(wk.dtype)
         better = v_q > wk[todo]

@@ -136,8 +136,9 @@ class _RowOperator:
     indptr: NDArray[np.int32]
 
     @classmethod
-    def build(cls, cols: NDArray, vals: NDArray, n_cols: int,
-              block_nodes: int = BLOCK_NODES) -> _RowOperator:
+    def build(
+        cls, cols: NDArray, vals: NDArray, n_cols: int, block_nodes: int = BLOCK_NODES
+    ) -> _RowOperator:
         """From ``cols`` and ``vals`` of shape ``(n_nodes, rows_per_node, per_row)``."""
         _, rows_per_node, per_row = cols.shape
         if n_cols >= 2**31 or per_row * rows_per_node * block_nodes >= 2**31:
@@ -148,8 +149,7 @@ class _RowOperator:
             rows_per_node=rows_per_node,
             n_cols=n_cols,
             block_nodes=block_nodes,
-            indptr=np.arange(0, per_row * rows_per_node * block_nodes + 1, per_row,
-                             dtype=np.int32),
+            indptr=np.arange(0, per_row * rows_per_node * block_nodes + 1, per_row, dtype=np.int32),
         )
 
     @property
@@ -203,8 +203,9 @@ def _steer_operator(
     for n0 in range(0, grid.n_nodes, step):
         n1 = min(n0 + step, grid.n_nodes)
         q, i, j = _node_coords(grid, np.arange(n0, n1)[:, None])
-        cols[n0:n1], vals[n0:n1] = _feet_stencil(grid, q, i, j, u, speeds, a, sigma, tau,
-                                                 outer, cubic)
+        cols[n0:n1], vals[n0:n1] = _feet_stencil(
+            grid, q, i, j, u, speeds, a, sigma, tau, outer, cubic
+        )
     return _RowOperator.build(cols, vals, grid.n_nodes + 2)
 
 
@@ -256,8 +257,16 @@ class _RingRows:
     """``(ptr, j0, j1, kind, di, op, om)`` of ``_deadline_jit.fill_runs`` (numba only)."""
 
     @classmethod
-    def build(cls, grid: DeadlineGrid, speeds: NDArray[np.float64], a: float, sigma: float,
-              tau: float, dtype: type, compiled: bool) -> _RingRows:
+    def build(
+        cls,
+        grid: DeadlineGrid,
+        speeds: NDArray[np.float64],
+        a: float,
+        sigma: float,
+        tau: float,
+        dtype: type,
+        compiled: bool,
+    ) -> _RingRows:
         """Tables of ``grid`` (and the runs when ``compiled``)."""
         u = grid.controls_rad
         q = np.arange(2)[:, None, None]
@@ -274,19 +283,27 @@ class _RingRows:
         ca, cs = dtype(tau * a / grid.dtheta), dtype(sigma * math.sqrt(tau) / grid.dtheta)
         n_in = int(np.count_nonzero(grid.r_m <= grid.target_radius_m))
         # the largest |x ± c_σ| over the rings outside the mark, + 2 for ⌊⌋ and the +1 column
-        pad = math.ceil(float(np.max(np.abs(b))) * float(inv_r[n_in]) + abs(float(ca))
-                        + float(cs)) + 2
+        pad = (
+            math.ceil(float(np.max(np.abs(b))) * float(inv_r[n_in]) + abs(float(ca)) + float(cs))
+            + 2
+        )
         fr_in = grid.target_radius_m / grid.dr
         runs = None
         if compiled:
             ptr = np.zeros(2 * (grid.n_r + 1) * u.size + 1, dtype=np.int64)
             _jit.count_runs(g, b, inv_r, ca, cs, fr_in, grid.n_r, grid.n_theta, n_in, ptr)
             m = int(ptr[-1])
-            runs = (ptr, np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int8),
-                    np.empty(m, np.int64), np.empty(m, np.int64), np.empty(m, np.int64))
+            runs = (
+                ptr,
+                np.empty(m, np.int64),
+                np.empty(m, np.int64),
+                np.empty(m, np.int8),
+                np.empty(m, np.int64),
+                np.empty(m, np.int64),
+                np.empty(m, np.int64),
+            )
             _jit.fill_runs(g, b, inv_r, ca, cs, fr_in, grid.n_r, grid.n_theta, n_in, *runs)
-        return cls(g, _spare(b), di, _spare(h0), _spare(h1), inv_r, ca, cs, fr_in, pad, grid,
-                   runs)
+        return cls(g, _spare(b), di, _spare(h0), _spare(h1), inv_r, ca, cs, fr_in, pad, grid, runs)
 
     @property
     def stride(self) -> int:
@@ -310,8 +327,9 @@ class _RingRows:
         cols, vals = self.entries(np, max(1, block_nodes // 8))
         return _RowOperator.build(cols, vals, self.grid.n_nodes + 2, block_nodes)
 
-    def entries(self, xp: ModuleType = np, step: int = BLOCK_NODES // 8
-                ) -> tuple[NDArray[np.int32], NDArray]:
+    def entries(
+        self, xp: ModuleType = np, step: int = BLOCK_NODES // 8
+    ) -> tuple[NDArray[np.int32], NDArray]:
         """Columns and weights ``(n_nodes, n_u, 8)`` of every row, computed on the array
         module ``xp`` (the same operations on CuPy, so the same bits), ``step`` nodes at
         a time."""

@@ -46,8 +46,9 @@ class DeadlineSimulation:
     seed: int
 
 
-def start_budget(policy: DeadlinePolicy, r_m: float, theta_rad: float, tack: int,
-                 deadline_s: float) -> float:
+def start_budget(
+    policy: DeadlinePolicy, r_m: float, theta_rad: float, tack: int, deadline_s: float
+) -> float:
     """Budget after the deadline upgrade: the least ``s_k <= ŝ`` with ``w = 1`` if any."""
     g = policy.grid
     k_hat = int(min(round(deadline_s / g.ds_s), g.n_s))
@@ -154,9 +155,15 @@ def simulate_deadline_chunk(
         lost = ~done & ~arrive & (((rn_new > g.r_max_m) & steering) | (t > t_max))
         done |= arrive | lost
         if n_tr:
-            tracks.append(np.stack([np.where(done[:n_tr] & ~arrive[:n_tr], np.nan, x[:n_tr]),
-                                    np.where(done[:n_tr] & ~arrive[:n_tr], np.nan, y[:n_tr])],
-                                   axis=-1).astype(np.float32))
+            tracks.append(
+                np.stack(
+                    [
+                        np.where(done[:n_tr] & ~arrive[:n_tr], np.nan, x[:n_tr]),
+                        np.where(done[:n_tr] & ~arrive[:n_tr], np.nan, y[:n_tr]),
+                    ],
+                    axis=-1,
+                ).astype(np.float32)
+            )
     tr = np.stack(tracks, axis=1) if tracks else np.zeros((0, 0, 2), dtype=np.float32)
     return DeadlineSimulation(
         leg_time_s=result,
@@ -248,6 +255,15 @@ def _deadline_chunk_task(
 ) -> DeadlineSimulation:
     """One chunk of :func:`simulate_deadline` (top level, so Dask can pickle it)."""
     return simulate_deadline_chunk(
-        rn, chunk_index, seed, start, ra, deadline_s, dt_s, t_max_s,
-        n_tracks if chunk_index == 0 else 0, CHUNK_SIZE, give_up_below,
+        rn,
+        chunk_index,
+        seed,
+        start,
+        ra,
+        deadline_s,
+        dt_s,
+        t_max_s,
+        n_tracks if chunk_index == 0 else 0,
+        CHUNK_SIZE,
+        give_up_below,
     )

@@ -350,9 +350,7 @@ def fit_station_file(
     """
     from sailroute.wind.stations import read_stations
 
-    data = read_stations(
-        path, resample_s=dt_s, timezone=timezone, speed_unit=speed_unit
-    )
+    data = read_stations(path, resample_s=dt_s, timezone=timezone, speed_unit=speed_unit)
     names = data.stations
     if station is None:
         if len(names) != 1:

@@ -318,8 +318,7 @@ def _run_deadline(
         f"solving the deadline problem ({grid.n_r + 1} x {grid.n_theta} x 2 nodes, "
         f"{grid.n_s} budget steps of {grid.ds_s:g} s)"
     )
-    ra = solve_deadline(polar, st.tws_ms, dd, grid, st.tack_penalty_s,
-                        engine=st.deadline_engine)
+    ra = solve_deadline(polar, st.tws_ms, dd, grid, st.tack_penalty_s, engine=st.deadline_engine)
     say(f"  solved in {ra.solve_time_s:.1f} s; solving the risk-neutral problem")
     rn = solve_risk_neutral(polar, st.tws_ms, dd, grid, st.tack_penalty_s, tol_s=1e-3)
     say(f"  solved in {rn.solve_time_s:.1f} s ({rn.iterations} sweeps); simulating")
@@ -330,8 +329,15 @@ def _run_deadline(
     )
     sims = {
         float(d): simulate_deadline(
-            rn, st.runs, st.seed, start, ra=ra, deadline_s=float(d), t_max_s=t_max,
-            n_tracks=100, scheduler=runner,
+            rn,
+            st.runs,
+            st.seed,
+            start,
+            ra=ra,
+            deadline_s=float(d),
+            t_max_s=t_max,
+            n_tracks=100,
+            scheduler=runner,
         )
         for d in st.deadlines_s
     }

@@ -57,7 +57,8 @@ class Track:
     name: str = ""
     source: str = ""
     channels: Mapping[str, NDArray[np.float64]] = field(
-        default_factory=lambda: MappingProxyType({}))
+        default_factory=lambda: MappingProxyType({})
+    )
     notes: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
@@ -88,5 +89,12 @@ class Track:
     def between(self, t0: float, t1: float) -> Track:
         """The points with ``t0 <= t <= t1`` [epoch s] (same name, source and notes)."""
         m = (self.t_s >= t0) & (self.t_s <= t1)
-        return Track(self.t_s[m], self.lat_deg[m], self.lon_deg[m], self.name, self.source,
-                     MappingProxyType({k: v[m] for k, v in self.channels.items()}), self.notes)
+        return Track(
+            self.t_s[m],
+            self.lat_deg[m],
+            self.lon_deg[m],
+            self.name,
+            self.source,
+            MappingProxyType({k: v[m] for k, v in self.channels.items()}),
+            self.notes,
+        )

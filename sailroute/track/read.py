@@ -68,8 +68,17 @@ from sailroute.track.model import Track
 from sailroute.units import speed_factor, wrap180, wrap360
 
 TRACK_ALIASES: Final[dict[str, tuple[str, ...]]] = {
-    "time": ("time", "datetime", "timestamp", "date_time", "time_utc", "datetime_utc", "utc",
-             "gps_time", "time_iso"),
+    "time": (
+        "time",
+        "datetime",
+        "timestamp",
+        "date_time",
+        "time_utc",
+        "datetime_utc",
+        "utc",
+        "gps_time",
+        "time_iso",
+    ),
     "lat": ("lat", "latitude", "latitude_gps", "lat_gps", "gps_lat"),
     "lon": ("lon", "lng", "long", "longitude", "longitude_gps", "lon_gps", "gps_lon"),
     "sog": ("sog", "gps_sog", "speed", "speed_over_ground", "gps_speed"),
@@ -89,8 +98,7 @@ ANGLE_COLUMNS: Final = ("cog", "hdg", "twa", "twd", "awa")
 _SIGNED: Final = ("twa", "awa")
 
 _STRIP: Final = re.compile(r"(_\d+)?$")
-_UNIT_PART: Final = re.compile(
-    r"_(km_h|kmh|kph|kn|kt|kts|knots|m_s|ms|mps|mph|deg|degrees|unk)$")
+_UNIT_PART: Final = re.compile(r"_(km_h|kmh|kph|kn|kt|kts|knots|m_s|ms|mps|mph|deg|degrees|unk)$")
 _PHONE_MS: Final = re.compile(r"^(.*\d{2}:\d{2}:\d{2}):(\d{1,3})$")
 
 GAP_MIN_S: Final = 30.0
@@ -156,11 +164,12 @@ def read_track(
         raise InputError(f"{src}: track file not found; check the path")
     text = p.read_text(encoding="utf-8-sig", errors="replace")
     if looks_binary(text):
-        raise InputError(f"{src}: not a text file (binary content); expected a GPX or CSV "
-                         "track with time, lat, lon")
+        raise InputError(
+            f"{src}: not a text file (binary content); expected a GPX or CSV "
+            "track with time, lat, lon"
+        )
     if not text.strip():
-        raise InputError(f"{src}: the track file is empty; expected GPX or CSV with "
-                         "time, lat, lon")
+        raise InputError(f"{src}: the track file is empty; expected GPX or CSV with time, lat, lon")
     tz = _zone(time_zone, src) if time_zone is not None else None
     if text.lstrip().startswith("<"):
         if columns:
@@ -170,8 +179,9 @@ def read_track(
     else:
         t, lat, lon, lines, channels = _read_csv(text, src, columns, speed_unit, tz)
         default_name = p.stem
-    return clean_track(t, lat, lon, lines, channels, src,
-                       clean_text(name if name is not None else default_name))
+    return clean_track(
+        t, lat, lon, lines, channels, src, clean_text(name if name is not None else default_name)
+    )
 
 
 # ------------------------------------------------------------------------------ times
@@ -229,24 +239,27 @@ _ISO_UTC: Final = re.compile(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d(\.\d{1,9})?Z")
 """The common GPX time (UTC, ``Z``): parsed in bulk by numpy."""
 
 
-def parse_epochs(cells: list[str], tz: tzinfo | None, where: Callable[[int], str]
-                 ) -> NDArray[np.float64]:
+def parse_epochs(
+    cells: list[str], tz: tzinfo | None, where: Callable[[int], str]
+) -> NDArray[np.float64]:
     """Epoch seconds of many timestamp cells: :func:`parse_epoch` of each, with the usual
     ``YYYY-MM-DDTHH:MM:SS[.f]Z`` form parsed by numpy at once (a 10 Hz log of three hours
     in tens of milliseconds).  ``where(k)`` names cell ``k`` in messages."""
     out = np.full(len(cells), np.nan)
     fast = np.array([_ISO_UTC.fullmatch(c) is not None for c in cells], dtype=bool)
     if fast.any():
-        arr = np.array([c[:-1] for c, f in zip(cells, fast, strict=True) if f],
-                       dtype="datetime64[ns]")
+        arr = np.array(
+            [c[:-1] for c, f in zip(cells, fast, strict=True) if f], dtype="datetime64[ns]"
+        )
         out[fast] = (arr - np.datetime64(0, "ns")).astype(np.int64) / 1e9
     for k in np.flatnonzero(~fast):
         out[k] = parse_epoch(cells[k], tz, where(int(k)), utc_column=False)
     return out
 
 
-def _read_gpx(text: str, src: str, tz: tzinfo | None
-              ) -> tuple[NDArray, NDArray, NDArray, NDArray, str, dict[str, NDArray]]:
+def _read_gpx(
+    text: str, src: str, tz: tzinfo | None
+) -> tuple[NDArray, NDArray, NDArray, NDArray, str, dict[str, NDArray]]:
     """Every ``<trkpt>`` with its ``<time>``, by the expat parser's callbacks (no element
     tree: 300 000 points in about a second)."""
     from xml.parsers import expat
@@ -260,22 +273,31 @@ def _read_gpx(text: str, src: str, tz: tzinfo | None
     try:
         parser.Parse(text, True)
     except expat.ExpatError as exc:
-        raise InputError(f"{src}:{exc.lineno}:{exc.offset + 1}: not well-formed XML "
-                         f"({expat.errors.messages[exc.code]}: line {exc.lineno}, column "
-                         f"{exc.offset}); is the file a complete GPX export?") from None
+        raise InputError(
+            f"{src}:{exc.lineno}:{exc.offset + 1}: not well-formed XML "
+            f"({expat.errors.messages[exc.code]}: line {exc.lineno}, column "
+            f"{exc.offset}); is the file a complete GPX export?"
+        ) from None
     if not gpx.root:
         raise InputError(f"{src}: no XML element found; expected a GPX file")
     if not gpx.times:
-        raise InputError(f"{src}: the GPX file has no track points (<trk><trkseg><trkpt>); "
-                         "export the activity as a track with times")
+        raise InputError(
+            f"{src}: the GPX file has no track points (<trk><trkseg><trkpt>); "
+            "export the activity as a track with times"
+        )
     lines = gpx.lines
     try:
         lat, lon = np.array(gpx.lat_s, dtype=float), np.array(gpx.lon_s, dtype=float)
     except ValueError:
-        k = next(i for i, (a, b) in enumerate(zip(gpx.lat_s, gpx.lon_s, strict=True))
-                 if not _is_float(a) or not _is_float(b))
-        raise InputError(f"{src}: line {lines[k]}: <trkpt lat={gpx.lat_s[k]!r} "
-                         f"lon={gpx.lon_s[k]!r}>: expected decimal degrees") from None
+        k = next(
+            i
+            for i, (a, b) in enumerate(zip(gpx.lat_s, gpx.lon_s, strict=True))
+            if not _is_float(a) or not _is_float(b)
+        )
+        raise InputError(
+            f"{src}: line {lines[k]}: <trkpt lat={gpx.lat_s[k]!r} "
+            f"lon={gpx.lon_s[k]!r}>: expected decimal degrees"
+        ) from None
     t = parse_epochs(gpx.times, tz, lambda k: f"{src}: line {lines[k]}")
     return t, lat, lon, np.array(lines), gpx.names[0] if gpx.names else "", {}
 
@@ -302,8 +324,10 @@ class _GpxPoints:
         if not self.root:
             self.root = True
             if tag != "gpx":
-                raise InputError(f"{self.src}: line {self.parser.CurrentLineNumber}: root "
-                                 f"element <{tag}>; expected <gpx> (a GPX 1.0/1.1 file)")
+                raise InputError(
+                    f"{self.src}: line {self.parser.CurrentLineNumber}: root "
+                    f"element <{tag}>; expected <gpx> (a GPX 1.0/1.1 file)"
+                )
         self.stack.append(tag)
         if tag == "trkpt":
             self.pt, self.has_time = True, False
@@ -320,9 +344,11 @@ class _GpxPoints:
         parent = self.stack[-1] if self.stack else None
         if tag == "time" and self.pt and parent == "trkpt":
             if self.has_time:
-                raise InputError(f"{self.src}: line {self.parser.CurrentLineNumber}: a "
-                                 "<trkpt> with a second <time> (GPX gives each point one); "
-                                 "is the file damaged?")
+                raise InputError(
+                    f"{self.src}: line {self.parser.CurrentLineNumber}: a "
+                    "<trkpt> with a second <time> (GPX gives each point one); "
+                    "is the file damaged?"
+                )
             self.times.append("".join(self.text_buf).strip())
             self.has_time = True
         elif tag == "name" and parent == "trk":
@@ -330,8 +356,10 @@ class _GpxPoints:
         elif tag == "trkpt" and self.pt:
             self.pt = False
             if not self.has_time or not self.times[-1]:
-                raise InputError(f"{self.src}: line {self.lines[-1]}: <trkpt> has no <time>; "
-                                 "a track for analysis needs a time on every point")
+                raise InputError(
+                    f"{self.src}: line {self.lines[-1]}: <trkpt> has no <time>; "
+                    "a track for analysis needs a time on every point"
+                )
 
     def data(self, chunk: str) -> None:
         """Text inside a ``<time>`` or ``<name>``."""
@@ -348,14 +376,22 @@ def _is_float(text: str) -> bool:
 
 
 # ------------------------------------------------------------------------------ CSV
-def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit: str | None,
-              tz: tzinfo | None
-              ) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray]]:
-    lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
-             if ln.strip() and not ln.lstrip().startswith("#")]
+def _read_csv(
+    text: str,
+    src: str,
+    columns: Mapping[str, str] | None,
+    speed_unit: str | None,
+    tz: tzinfo | None,
+) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray]]:
+    lines = [
+        (k + 1, ln)
+        for k, ln in enumerate(text.splitlines())
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if not lines:
-        raise InputError(f"{src}: the track file holds only comments; expected GPX or CSV "
-                         "with time, lat, lon")
+        raise InputError(
+            f"{src}: the track file holds only comments; expected GPX or CSV with time, lat, lon"
+        )
     delim = max((",", ";", "\t"), key=lines[0][1].count)
     rows = csv_rows(lines, delim, src)
     header, body = rows[0], rows[1:]
@@ -374,7 +410,8 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
         raise InputError(
             f"{src}: not a track: line {lines[0][0]} is not a header of column names; expected "
             "GPX, or CSV with a header row such as time,lat,lon,sog_kn (names and aliases: "
-            "docs/usage.md, 'sailroute analyze')")
+            "docs/usage.md, 'sailroute analyze')"
+        )
     if absent:
         raise InputError(
             f"{src}: no column for {', '.join(absent)}; header is "
@@ -383,22 +420,32 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
         )
     if not body:
         raise InputError(f"{src}: the file has a header but no data rows")
-    units: dict[str, str] = {c: column_speed_unit(header[cmap[c]], speed_unit, src,
-                                                  header_unit(header[cmap[c]]))
-                             for c in SPEED_COLUMNS if c in cmap}
+    units: dict[str, str] = {
+        c: column_speed_unit(header[cmap[c]], speed_unit, src, header_unit(header[cmap[c]]))
+        for c in SPEED_COLUMNS
+        if c in cmap
+    }
     ncol = len(header)
     for r, lineno in zip(body, linenos, strict=True):
         if len(r) != ncol:
-            raise InputError(f"{src}, line {lineno}: {len(r)} fields but the header has {ncol}; "
-                             f"check the separator ({delim!r}) and quoting")
+            raise InputError(
+                f"{src}, line {lineno}: {len(r)} fields but the header has {ncol}; "
+                f"check the separator ({delim!r}) and quoting"
+            )
     miss = set(DEFAULT_MISSING)
     tcol = header[cmap["time"]]
     utc_col = "utc" in tcol.strip().lower()
-    t = np.array([np.nan if r[cmap["time"]].strip() in miss else
-                  parse_epoch(r[cmap["time"]], tz, f"{src}, line {ln}, column {tcol!r}", utc_col)
-                  for r, ln in zip(body, linenos, strict=True)])
-    vals = {c: _numbers(body, linenos, cmap[c], header[cmap[c]], miss, src)
-            for c in cmap if c != "time"}
+    t = np.array(
+        [
+            np.nan
+            if r[cmap["time"]].strip() in miss
+            else parse_epoch(r[cmap["time"]], tz, f"{src}, line {ln}, column {tcol!r}", utc_col)
+            for r, ln in zip(body, linenos, strict=True)
+        ]
+    )
+    vals = {
+        c: _numbers(body, linenos, cmap[c], header[cmap[c]], miss, src) for c in cmap if c != "time"
+    }
     lat, lon = vals.pop("lat"), vals.pop("lon")
     channels: dict[str, NDArray] = {}
     for c, v in vals.items():
@@ -411,8 +458,9 @@ def _read_csv(text: str, src: str, columns: Mapping[str, str] | None, speed_unit
     return t, lat, lon, np.array(linenos), channels
 
 
-def _numbers(body: list[list[str]], linenos: list[int], k: int, column: str, miss: set[str],
-             src: str) -> NDArray:
+def _numbers(
+    body: list[list[str]], linenos: list[int], k: int, column: str, miss: set[str], src: str
+) -> NDArray:
     out = np.empty(len(body))
     for i, r in enumerate(body):
         c = r[k].strip()
@@ -422,17 +470,28 @@ def _numbers(body: list[list[str]], linenos: list[int], k: int, column: str, mis
         try:
             out[i] = float(c)
         except ValueError:
-            raise InputError(f"{src}, line {linenos[i]}, column {column!r}: cannot read "
-                             f"{excerpt(c)!r} as a number") from None
+            raise InputError(
+                f"{src}, line {linenos[i]}, column {column!r}: cannot read "
+                f"{excerpt(c)!r} as a number"
+            ) from None
         if math.isinf(out[i]):
-            raise InputError(f"{src}, line {linenos[i]}, column {column!r}: {excerpt(c)!r} is "
-                             "not a finite number; replace it with a value or a missing marker")
+            raise InputError(
+                f"{src}, line {linenos[i]}, column {column!r}: {excerpt(c)!r} is "
+                "not a finite number; replace it with a value or a missing marker"
+            )
     return out
 
 
 # ------------------------------------------------------------------------------ cleaning
-def clean_track(t: NDArray, lat: NDArray, lon: NDArray, lines: NDArray,
-                channels: Mapping[str, NDArray], src: str, name: str) -> Track:
+def clean_track(
+    t: NDArray,
+    lat: NDArray,
+    lon: NDArray,
+    lines: NDArray,
+    channels: Mapping[str, NDArray],
+    src: str,
+    name: str,
+) -> Track:
     """Drop unusable rows, sort, remove repeated times, note gaps; build the :class:`Track`.
 
     Parameters
@@ -462,8 +521,10 @@ def clean_track(t: NDArray, lat: NDArray, lon: NDArray, lines: NDArray,
         bad = np.nonzero((a < lo) | (a > hi))[0]
         if bad.size:
             k = int(bad[0])
-            raise InputError(f"{src}, line {int(lines[k])}: {what} {a[k]:g} is out of range "
-                             f"[{lo:g}, {hi:g}] ({bad.size} point(s))")
+            raise InputError(
+                f"{src}, line {int(lines[k])}: {what} {a[k]:g} is out of range "
+                f"[{lo:g}, {hi:g}] ({bad.size} point(s))"
+            )
     ok = np.isfinite(t) & np.isfinite(lat) & np.isfinite(lon) & ~((lat == 0) & (lon == 0))
     if (~ok).any():
         notes.append(f"dropped {int((~ok).sum())} row(s) without a time or position")
@@ -491,6 +552,12 @@ def clean_track(t: NDArray, lat: NDArray, lon: NDArray, lines: NDArray,
     if gaps.size > 5:
         notes.append(f"... and {gaps.size - 5} more gap(s) longer than {limit:.0f} s")
     lon_w = np.asarray(wrap_lon(lon[order]), dtype=float)
-    return Track(ts, lat[order].astype(float), lon_w, name, src,
-                 MappingProxyType({k: np.asarray(v, float)[order] for k, v in channels.items()}),
-                 tuple(notes))
+    return Track(
+        ts,
+        lat[order].astype(float),
+        lon_w,
+        name,
+        src,
+        MappingProxyType({k: np.asarray(v, float)[order] for k, v in channels.items()}),
+        tuple(notes),
+    )

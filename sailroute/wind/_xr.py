@@ -97,8 +97,9 @@ class XarrayAsNetCDF:
     def __init__(self, ds: Any, label: str = "xarray.Dataset") -> None:
         self._ds = ds
         self.label = label
-        self.variables: Mapping[str, _Var] = {str(k): _Var(str(k), v)
-                                              for k, v in ds.variables.items()}
+        self.variables: Mapping[str, _Var] = {
+            str(k): _Var(str(k), v) for k, v in ds.variables.items()
+        }
         self.dimensions: Mapping[str, int] = {str(k): int(n) for k, n in ds.sizes.items()}
         self._attrs = dict(ds.attrs)
 
@@ -157,8 +158,9 @@ def open_dataset(source: Any, kind: str, expected: str) -> tuple[Any, str]:
 
     p = Path(source)
     if not p.is_file():
-        raise InputError(f"{p}: {kind} file not found; check the `path` (relative to the "
-                         "course file's folder)")
+        raise InputError(
+            f"{p}: {kind} file not found; check the `path` (relative to the course file's folder)"
+        )
     if p.stat().st_size == 0:
         raise WindDataError(f"{p}: the file is empty (0 bytes); expected {expected}")
     from sailroute.wind.ncheader import check_classic_header
@@ -167,16 +169,21 @@ def open_dataset(source: Any, kind: str, expected: str) -> tuple[Any, str]:
     try:
         ds = netCDF4.Dataset(str(p), "r")
     except UnicodeDecodeError:  # a damaged file: the names of its variables are not text
-        raise WindDataError(f"{p}: cannot be read as NetCDF (variable or attribute names that "
-                            f"are not UTF-8: the file is damaged); expected {expected}.") from None
+        raise WindDataError(
+            f"{p}: cannot be read as NetCDF (variable or attribute names that "
+            f"are not UTF-8: the file is damaged); expected {expected}."
+        ) from None
     except RuntimeError as exc:  # the library found the file damaged after opening it
-        raise WindDataError(f"{p}: cannot be read as NetCDF ({exc}: the file is damaged); "
-                            f"expected {expected}.") from None
+        raise WindDataError(
+            f"{p}: cannot be read as NetCDF ({exc}: the file is damaged); expected {expected}."
+        ) from None
     except OSError as exc:
-        hint = (" GRIB files are read with `type: grib`." if p.suffix.lower() in _GRIB_SUFFIXES
-                else "")
-        raise WindDataError(f"{p}: cannot be read as NetCDF ({exc}); expected {expected}."
-                            f"{hint}") from None
+        hint = (
+            " GRIB files are read with `type: grib`." if p.suffix.lower() in _GRIB_SUFFIXES else ""
+        )
+        raise WindDataError(
+            f"{p}: cannot be read as NetCDF ({exc}); expected {expected}.{hint}"
+        ) from None
     ds.set_auto_mask(True)
     return ds, str(p)
 
@@ -193,7 +200,9 @@ def damaged_as_wind_error(fn: Callable[P, R]) -> Callable[P, R]:
         except RuntimeError as exc:
             src = args[0] if args else "the file"
             label = "xarray.Dataset" if is_xarray_dataset(src) else str(src)
-            raise WindDataError(f"{label}: cannot read the NetCDF data ({exc}: the file is "
-                                "damaged); copy or download it again") from None
+            raise WindDataError(
+                f"{label}: cannot read the NetCDF data ({exc}: the file is "
+                "damaged); copy or download it again"
+            ) from None
 
     return read

@@ -78,12 +78,16 @@ class Coverage:
         )
         ll = self.latlon_box()
         if ll is not None:
-            text += (f" (lat {_fmt_lat(ll[0])} .. {_fmt_lat(ll[1])}, "
-                     f"lon {_fmt_lon(ll[2])} .. {_fmt_lon(ll[3])})")
-        if self.source_span is not None and (self.source_span[0] != self.t0
-                                             or self.source_span[1] != self.t1):
-            text += (f"; the source holds {_fmt_t(self.source_span[0])} .. "
-                     f"{_fmt_t(self.source_span[1])}")
+            text += (
+                f" (lat {_fmt_lat(ll[0])} .. {_fmt_lat(ll[1])}, "
+                f"lon {_fmt_lon(ll[2])} .. {_fmt_lon(ll[3])})"
+            )
+        if self.source_span is not None and (
+            self.source_span[0] != self.t0 or self.source_span[1] != self.t1
+        ):
+            text += (
+                f"; the source holds {_fmt_t(self.source_span[0])} .. {_fmt_t(self.source_span[1])}"
+            )
         return text
 
     def latlon_box(self) -> tuple[float, float, float, float] | None:
@@ -92,8 +96,7 @@ class Coverage:
         None without a :attr:`frame` or for an unbounded box.  Computed from the
         box's corners and edge midpoints, so good to a few metres for course-sized boxes.
         """
-        if self.frame is None or not all(np.isfinite(
-                (self.xmin, self.xmax, self.ymin, self.ymax))):
+        if self.frame is None or not all(np.isfinite((self.xmin, self.xmax, self.ymin, self.ymax))):
             return None
         xs = np.array([self.xmin, 0.5 * (self.xmin + self.xmax), self.xmax])
         ys = np.array([self.ymin, 0.5 * (self.ymin + self.ymax), self.ymax])
@@ -214,7 +217,12 @@ def prepare_points(
     ):
         bad = ~c.contains(t, x, y)
         requested = Coverage(
-            float(tmin), float(tmax), float(xmin), float(xmax), float(ymin), float(ymax),
+            float(tmin),
+            float(tmax),
+            float(xmin),
+            float(xmax),
+            float(ymin),
+            float(ymax),
             frame=c.frame,
         )
         raise OutOfCoverageError(

@@ -149,11 +149,13 @@ class BlendedWind:
             raise InputError(f"{self.name}: length_scale_m must be > 0 and time_scale_s >= 0")
         lo, hi = self.ratio_range
         if not (0 < lo <= 1 <= hi):
-            raise InputError(f"{self.name}: ratio_range must satisfy 0 < min <= 1 <= max, "
-                             f"got {self.ratio_range}")
+            raise InputError(
+                f"{self.name}: ratio_range must satisfy 0 < min <= 1 <= max, got {self.ratio_range}"
+            )
         d = self.stations
-        x, y, uo, vo = local_records(d, self.frame, self.height_m, self.name,
-                                     exponent=self.exponent)
+        x, y, uo, vo = local_records(
+            d, self.frame, self.height_m, self.name, exponent=self.exponent
+        )
         inside = self.base.coverage.contains(d.t, x, y)
         if not inside.any():
             raise WindDataError(
@@ -179,9 +181,16 @@ class BlendedWind:
             dd = np.degrees(np.arctan2(sn, cs))
             good = np.isfinite(lr) & np.isfinite(dd)
             if good.any():
-                corr.append(StationCorrection(
-                    str(s), tv[good], x[m][good], y[m][good], lr[good],
-                    np.clip(dd[good], -self.max_offset_deg, self.max_offset_deg)))
+                corr.append(
+                    StationCorrection(
+                        str(s),
+                        tv[good],
+                        x[m][good],
+                        y[m][good],
+                        lr[good],
+                        np.clip(dd[good], -self.max_offset_deg, self.max_offset_deg),
+                    )
+                )
         return tuple(corr)
 
     @property
@@ -194,11 +203,13 @@ class BlendedWind:
         """Per-station smoothed corrections (stations without usable records are absent)."""
         return self._corr
 
-    def correction(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
-                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def correction(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Spread corrections ``(ln r, δ [°])`` at points (broadcast, no coverage check)."""
-        t, x, y = np.broadcast_arrays(np.asarray(t, float), np.asarray(x, float),
-                                      np.asarray(y, float))
+        t, x, y = np.broadcast_arrays(
+            np.asarray(t, float), np.asarray(x, float), np.asarray(y, float)
+        )
         shape = t.shape
         t, x, y = t.ravel(), x.ravel(), y.ravel()
         num_r = np.zeros(t.size)

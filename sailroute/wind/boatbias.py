@@ -57,10 +57,11 @@ class BoatBias:
 
     def describe(self) -> str:
         """One line: ``NZL: speed x1.031, direction +2.4°, time +12.0 s (1612 samples)``."""
-        clock = (f"time {self.time_offset_s:+.1f} s" if self.clock_samples else
-                 "time not identified")
-        return (f"{self.boat}: speed x{self.speed_factor:.3f}, direction "
-                f"{self.direction_offset_deg:+.1f}°, {clock} ({self.n_samples} samples)")
+        clock = f"time {self.time_offset_s:+.1f} s" if self.clock_samples else "time not identified"
+        return (
+            f"{self.boat}: speed x{self.speed_factor:.3f}, direction "
+            f"{self.direction_offset_deg:+.1f}°, {clock} ({self.n_samples} samples)"
+        )
 
 
 def _sample_series(s: MeasuredSeries, t: NDArray) -> tuple[NDArray, NDArray, NDArray]:
@@ -71,8 +72,9 @@ def _sample_series(s: MeasuredSeries, t: NDArray) -> tuple[NDArray, NDArray, NDA
     return np.interp(t, s.t, s.u), np.interp(t, s.t, s.v), ok
 
 
-def _pair_offsets(a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_overlap: int
-                  ) -> tuple[float, float, float, int, bool] | None:
+def _pair_offsets(
+    a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_overlap: int
+) -> tuple[float, float, float, int, bool] | None:
     """``(log speed ratio, direction offset [°], time offset [s], n, time identified)`` of
     ``a`` against ``b``; a best lag at the edge of the search is not identified (lag 0)."""
     t0, t1 = max(a.t[0], b.t[0]), min(a.t[-1], b.t[-1])
@@ -97,8 +99,9 @@ def _pair_offsets(a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_ov
         return None
     score = score - 1e-9 * np.abs(lags)  # a flat score (steady wind) gives lag 0
     k = int(np.argmax(score))
-    identified = bool(0 < k < lags.size - 1 and np.isfinite(score[k - 1])
-                      and np.isfinite(score[k + 1]))
+    identified = bool(
+        0 < k < lags.size - 1 and np.isfinite(score[k - 1]) and np.isfinite(score[k + 1])
+    )
     lag = float(lags[k]) if identified else 0.0
     if identified:
         den = score[k - 1] - 2 * score[k] + score[k + 1]
@@ -108,8 +111,13 @@ def _pair_offsets(a: MeasuredSeries, b: MeasuredSeries, max_lag_s: float, min_ov
     m = oka & okb
     sa, da = wind_speed_direction(ua[m], va[m])
     ddir = _circmean(wrap180(da - db[m]))
-    return (float(np.log(np.mean(sa) / np.mean(sb[m]))), float(wrap180(ddir)), lag,
-            int(m.sum()), identified)
+    return (
+        float(np.log(np.mean(sa) / np.mean(sb[m]))),
+        float(wrap180(ddir)),
+        lag,
+        int(m.sum()),
+        identified,
+    )
 
 
 def _circmean(a: NDArray) -> float:
@@ -190,8 +198,17 @@ def estimate_biases(
             x[used > 0] -= np.median(x[used > 0])
         x[used == 0] = 0.0
         sol.append(x)
-    return tuple(BoatBias(s.boat, float(np.exp(sol[0][k])), float(sol[1][k]), float(sol[2][k]),
-                          int(count[k]), int(clock[k])) for k, s in enumerate(series))
+    return tuple(
+        BoatBias(
+            s.boat,
+            float(np.exp(sol[0][k])),
+            float(sol[1][k]),
+            float(sol[2][k]),
+            int(count[k]),
+            int(clock[k]),
+        )
+        for k, s in enumerate(series)
+    )
 
 
 def apply_bias(series: MeasuredSeries, bias: BoatBias) -> MeasuredSeries:
@@ -199,6 +216,16 @@ def apply_bias(series: MeasuredSeries, bias: BoatBias) -> MeasuredSeries:
     s, d = wind_speed_direction(series.u, series.v)
     u, v = wind_components(s / bias.speed_factor, d - bias.direction_offset_deg)
     dt = bias.time_offset_s
-    return MeasuredSeries(series.boat, series.file, series.t - dt, series.lat, series.lon, u, v,
-                          series.source, (*series.notes, f"bias corrected: {bias.describe()}"),
-                          tuple((a - dt, b - dt) for a, b in series.gaps), series.max_gap_s)
+    return MeasuredSeries(
+        series.boat,
+        series.file,
+        series.t - dt,
+        series.lat,
+        series.lon,
+        u,
+        v,
+        series.source,
+        (*series.notes, f"bias corrected: {bias.describe()}"),
+        tuple((a - dt, b - dt) for a, b in series.gaps),
+        series.max_gap_s,
+    )

@@ -106,11 +106,13 @@ def wind_from_spec(
     if crop_bbox is not None and not (
         crop_bbox[0] <= crop_bbox[1] and crop_bbox[2] <= crop_bbox[3]
     ):
-        raise InputError(f"{where}: crop_bbox must be (xmin, xmax, ymin, ymax) in metres; got "
-                         f"{tuple(crop_bbox)}")
+        raise InputError(
+            f"{where}: crop_bbox must be (xmin, xmax, ymin, ymax) in metres; got {tuple(crop_bbox)}"
+        )
     if time_window is not None and not time_window[0] <= time_window[1]:
-        raise InputError(f"{where}: time_window must be (t0, t1) with t0 <= t1; got "
-                         f"{tuple(time_window)}")
+        raise InputError(
+            f"{where}: time_window must be (t0, t1) with t0 <= t1; got {tuple(time_window)}"
+        )
     ctx = _Context(frame, Path(base_dir), crop_bbox, time_window)
     field = _BUILDERS[kind](spec, chk, ctx)
     if not spec.get("clamp", False):
@@ -145,23 +147,33 @@ def check_covers(
     c = field.coverage
     t0, t1 = time_window if time_window is not None else (c.t0, c.t1)
     x0, x1, y0, y1 = bbox if bbox is not None else (c.xmin, c.xmax, c.ymin, c.ymax)
-    if t0 >= c.t0 and t1 <= c.t1 and x0 >= c.xmin and x1 <= c.xmax and y0 >= c.ymin and (
-        y1 <= c.ymax
+    if (
+        t0 >= c.t0
+        and t1 <= c.t1
+        and x0 >= c.xmin
+        and x1 <= c.xmax
+        and y0 >= c.ymin
+        and (y1 <= c.ymax)
     ):
         return
     frame = frame if frame is not None else c.frame
     need = Coverage(t0, t1, x0, x1, y0, y1, frame=frame)
     if c.frame is None and frame is not None:
-        c = Coverage(c.t0, c.t1, c.xmin, c.xmax, c.ymin, c.ymax, frame=frame,
-                     source_span=c.source_span)
+        c = Coverage(
+            c.t0, c.t1, c.xmin, c.xmax, c.ymin, c.ymax, frame=frame, source_span=c.source_span
+        )
     span = c.source_span or (c.t0, c.t1)
     single = span[0] == span[1] and not (t0 >= c.t0 and t1 <= c.t1)
     raise OutOfCoverageError(
         f"{name} does not cover the course and race time.\n"
         f"  needed:  {need.describe()}\n"
         f"  covered: {c.describe()}\n"
-        + ("  The source holds a single time: to use it as a steady wind for the whole race, "
-           "set `steady: true`.\n" if single else "")
+        + (
+            "  The source holds a single time: to use it as a steady wind for the whole race, "
+            "set `steady: true`.\n"
+            if single
+            else ""
+        )
         + "  Use wind data that covers the course (the thesis's main failure was extrapolating "
         "outside the data), or opt in to clamping at the edges with `clamp: true`."
     )
@@ -189,8 +201,11 @@ def wind_notes(field: WindField) -> list[str]:
     if isinstance(data, StationData):
         text = f"{name}: {data.n_raw} rows read"
         if data.n_missing:
-            per = ", ".join(f"{k} {v}" for k, v in data.missing_by_column.items()
-                            if k not in ("gust", "height_m"))  # optional: no row dropped
+            per = ", ".join(
+                f"{k} {v}"
+                for k, v in data.missing_by_column.items()
+                if k not in ("gust", "height_m")
+            )  # optional: no row dropped
             text += f", {data.n_missing} dropped for missing values ({per})"
         return [text + f", {len(data)} records used"]
     return []
@@ -246,8 +261,10 @@ def _build_uniform(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Wind
         if key in spec:
             chk.add(key, "not allowed together with `table`; put speeds and directions in the rows")
     if not isinstance(table, list) or not table:
-        chk.add("table", f"expected a non-empty list of rows {{time, tws_kn, twd_deg}}; "
-                f"got {show(table)}")
+        chk.add(
+            "table",
+            f"expected a non-empty list of rows {{time, tws_kn, twd_deg}}; got {show(table)}",
+        )
         chk.p.raise_if_any()
     times: list[float] = []
     speeds: list[float] = []
@@ -280,8 +297,20 @@ def _build_uniform(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Wind
 
 
 # ---------------------------------------------------------------------------- wrf
-_WRF_KEYS = ("type", "path", "height_m", "time_step_min", "interpolation", "levels", "shear",
-             "fallback_exponent", "exponent_range", "roughness_m", "margin_m", "clamp")
+_WRF_KEYS = (
+    "type",
+    "path",
+    "height_m",
+    "time_step_min",
+    "interpolation",
+    "levels",
+    "shear",
+    "fallback_exponent",
+    "exponent_range",
+    "roughness_m",
+    "margin_m",
+    "clamp",
+)
 
 
 def _path(chk: Checker, spec: Mapping[str, Any], ctx: _Context) -> Path | None:
@@ -298,8 +327,9 @@ def _wrf_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[s
         "interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
         "levels": chk.choice(spec, "levels", ["auto", "u10", "model"], "auto"),
         "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
-        "fallback_exponent": chk.number(spec, "fallback_exponent", DEFAULT_EXPONENT, lo=-1.0,
-                                        hi=1.0),
+        "fallback_exponent": chk.number(
+            spec, "fallback_exponent", DEFAULT_EXPONENT, lo=-1.0, hi=1.0
+        ),
         "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, lo=0.0, lo_open=True),
         "margin_m": chk.number(spec, "margin_m", None, lo=0.0),
         "clamp": chk.boolean(spec, "clamp", False),
@@ -307,23 +337,31 @@ def _wrf_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[s
     }
     if "exponent_range" in spec:
         er = spec["exponent_range"]
-        if (not isinstance(er, list | tuple) or len(er) != 2
-                or not all(isinstance(a, int | float) and not isinstance(a, bool) for a in er)
-                or not er[0] < er[1]):
-            chk.add("exponent_range", f"expected [min, max] with min < max, e.g. [0.0, 0.6]; "
-                    f"got {er!r}")
+        if (
+            not isinstance(er, list | tuple)
+            or len(er) != 2
+            or not all(isinstance(a, int | float) and not isinstance(a, bool) for a in er)
+            or not er[0] < er[1]
+        ):
+            chk.add(
+                "exponent_range", f"expected [min, max] with min < max, e.g. [0.0, 0.6]; got {er!r}"
+            )
         else:
             opts["exponent_range"] = (float(er[0]), float(er[1]))
     if opts["levels"] == "model" and "height_m" not in spec:
-        chk.add("levels", "'model' levels are only used for a height correction; set height_m "
-                "(e.g. 2.68 for a Laser's centre of effort) or use levels: auto")
+        chk.add(
+            "levels",
+            "'model' levels are only used for a height correction; set height_m "
+            "(e.g. 2.68 for a Laser's centre of effort) or use levels: auto",
+        )
     return opts
 
 
 def _open_wrf_checked(opts: dict[str, Any], where: str, ctx: _Context) -> WindField:
     try:
-        return open_wrf(opts.pop("path"), ctx.frame, bbox=ctx.crop_bbox,
-                        time_window=ctx.time_window, **opts)
+        return open_wrf(
+            opts.pop("path"), ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window, **opts
+        )
     except InputError as exc:
         raise type(exc)(f"{where}: {exc}") from None
 
@@ -335,14 +373,30 @@ def _build_wrf(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindFiel
 
 
 # ---------------------------------------------------------------------------- netcdf / grib
-_GRID_KEYS = ("type", "path", "variables", "time", "data_height_m", "speed_unit", "height_m",
-              "shear", "exponent", "roughness_m", "time_step_min", "interpolation", "steady",
-              "margin_m", "clamp", "select")
+_GRID_KEYS = (
+    "type",
+    "path",
+    "variables",
+    "time",
+    "data_height_m",
+    "speed_unit",
+    "height_m",
+    "shear",
+    "exponent",
+    "roughness_m",
+    "time_step_min",
+    "interpolation",
+    "steady",
+    "margin_m",
+    "clamp",
+    "select",
+)
 _CF_ONLY = ("variables", "time", "data_height_m", "speed_unit", "steady", "select")
 
 
-def _grid_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context,
-                  extra: tuple[str, ...] = ()) -> dict[str, Any]:
+def _grid_options(
+    spec: Mapping[str, Any], chk: Checker, ctx: _Context, extra: tuple[str, ...] = ()
+) -> dict[str, Any]:
     """Validate a ``type: netcdf`` / ``type: grib`` spec into :func:`open_netcdf` keywords."""
     chk.keys(spec, (*_GRID_KEYS, *extra))  # a missing path is reported by _path
     opts: dict[str, Any] = {
@@ -364,11 +418,15 @@ def _grid_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context,
     }
     sel = chk.mapping(spec, "select", None)
     if sel is not None:
-        bad = {k: v for k, v in sel.items()
-               if not isinstance(v, int) or isinstance(v, bool) or v < 0}
+        bad = {
+            k: v for k, v in sel.items() if not isinstance(v, int) or isinstance(v, bool) or v < 0
+        }
         if bad:
-            chk.add("select", "expected a mapping of dimension name to an index >= 0, e.g. "
-                    f"{{number: 3}}; got {dict(sel)!r}")
+            chk.add(
+                "select",
+                "expected a mapping of dimension name to an index >= 0, e.g. "
+                f"{{number: 3}}; got {dict(sel)!r}",
+            )
         else:
             opts["select"] = {str(k): int(v) for k, v in sel.items()}
     unit = chk.string(spec, "speed_unit", None)
@@ -385,10 +443,14 @@ def _grid_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context,
         for k, v in var.items():
             if k in DATA_KEYS and (not isinstance(v, str) or not v.strip()):
                 vchk.add(str(k), f"expected a variable name; got {show(v)}")
-        if not ({"u", "v"} <= set(var) or {"speed", "direction"} <= set(var)
-                or not set(var) & {"u", "v", "speed", "direction"}):
-            chk.add("variables", "give both u and v, or both speed and direction, e.g. "
-                    "{u: u10, v: v10}")
+        if not (
+            {"u", "v"} <= set(var)
+            or {"speed", "direction"} <= set(var)
+            or not set(var) & {"u", "v", "speed", "direction"}
+        ):
+            chk.add(
+                "variables", "give both u and v, or both speed and direction, e.g. {u: u10, v: v10}"
+            )
         opts["variables"] = dict(var)
     if "time" in spec:
         try:
@@ -408,15 +470,17 @@ def _build_netcdf(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindF
         if is_wrfout(path):
             used = [k for k in _CF_ONLY if k in spec]
             if used:
-                raise InputError(f"{path.name} is a WRF wrfout file; {', '.join(used)} only "
-                                 "apply to latitude/longitude files (use the `type: wrf` keys)")
+                raise InputError(
+                    f"{path.name} is a WRF wrfout file; {', '.join(used)} only "
+                    "apply to latitude/longitude files (use the `type: wrf` keys)"
+                )
             for k in _CF_ONLY:
                 opts.pop(k)
             opts["fallback_exponent"] = opts.pop("exponent")
-            return open_wrf(path, ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window,
-                            **opts)
-        return open_netcdf(path, ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window,
-                           **opts)
+            return open_wrf(
+                path, ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window, **opts
+            )
+        return open_netcdf(path, ctx.frame, bbox=ctx.crop_bbox, time_window=ctx.time_window, **opts)
     except InputError as exc:
         raise type(exc)(f"{chk.where()}: {exc}") from None
 
@@ -429,23 +493,50 @@ def _build_grib(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindFie
     chk.p.raise_if_any()
     path = opts.pop("path")
     try:
-        return open_grib(path, ctx.frame, filter_by_keys=filt, bbox=ctx.crop_bbox,
-                         time_window=ctx.time_window, **opts)
+        return open_grib(
+            path,
+            ctx.frame,
+            filter_by_keys=filt,
+            bbox=ctx.crop_bbox,
+            time_window=ctx.time_window,
+            **opts,
+        )
     except InputError as exc:
         raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
 # ---------------------------------------------------------------------------- stations
-_READ_KEYS = ("path", "format", "speed_unit", "columns", "timezone", "resample_s", "station",
-              "position", "measurement_height_m", "missing")
-_STATION_FIELD_KEYS = ("method", "power", "radius_m", "max_gap_s", "height_m", "shear",
-                       "exponent", "roughness_m", "clamp")
+_READ_KEYS = (
+    "path",
+    "format",
+    "speed_unit",
+    "columns",
+    "timezone",
+    "resample_s",
+    "station",
+    "position",
+    "measurement_height_m",
+    "missing",
+)
+_STATION_FIELD_KEYS = (
+    "method",
+    "power",
+    "radius_m",
+    "max_gap_s",
+    "height_m",
+    "shear",
+    "exponent",
+    "roughness_m",
+    "clamp",
+)
 
 
 def _read_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[str, Any]:
     """Validate the station-file keys into keyword arguments of :func:`read_stations`."""
-    opts: dict[str, Any] = {"path": _path(chk, spec, ctx),
-                            "format": chk.choice(spec, "format", ["auto", "csv", "ndbc"], "auto")}
+    opts: dict[str, Any] = {
+        "path": _path(chk, spec, ctx),
+        "format": chk.choice(spec, "format", ["auto", "csv", "ndbc"], "auto"),
+    }
     unit = chk.string(spec, "speed_unit", None)
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
         chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
@@ -455,8 +546,11 @@ def _read_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[
     if cols is not None:
         for k, v in cols.items():
             if k not in CANONICAL_COLUMNS and k not in TIME_PARTS:
-                chk.child("columns").add(str(k), "unknown canonical column; expected one of "
-                                         + ", ".join((*CANONICAL_COLUMNS, *TIME_PARTS)))
+                chk.child("columns").add(
+                    str(k),
+                    "unknown canonical column; expected one of "
+                    + ", ".join((*CANONICAL_COLUMNS, *TIME_PARTS)),
+                )
             elif not isinstance(v, str):
                 chk.child("columns").add(str(k), f"expected a column name; got {show(v)}")
     opts["columns"] = cols
@@ -484,8 +578,9 @@ def _read_options(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> dict[
     miss = spec.get("missing")
     if miss is not None:
         if not isinstance(miss, list) or not all(isinstance(m, str | int | float) for m in miss):
-            chk.add("missing", f"expected a list of markers such as ['', 'MM', '999'], "
-                    f"got {miss!r}")
+            chk.add(
+                "missing", f"expected a list of markers such as ['', 'MM', '999'], got {miss!r}"
+            )
         else:
             opts["missing"] = tuple(DEFAULT_MISSING) + tuple(str(m) for m in miss)
     return opts
@@ -505,15 +600,20 @@ def _read_checked(opts: dict[str, Any], where: str) -> StationData:
 def _read_ndbc_checked(path: Path, opts: dict[str, Any], where: str) -> StationData:
     """NDBC realtime text: only position, station, height and resample_s apply."""
     if opts.get("position") is None:
-        raise InputError(f"{path.name} is NDBC text, which does not carry the buoy's position; "
-                         "add `position: {lat: ..., lon: ...}` (from the station's NDBC page, "
-                         "e.g. 41008: {lat: 31.400, lon: -80.866})")
+        raise InputError(
+            f"{path.name} is NDBC text, which does not carry the buoy's position; "
+            "add `position: {lat: ..., lon: ...}` (from the station's NDBC page, "
+            "e.g. 41008: {lat: 31.400, lon: -80.866})"
+        )
     bad = [k for k in ("columns", "speed_unit", "timezone") if opts.get(k) is not None]
     if bad:
-        raise InputError(f"{', '.join(bad)}: not used for NDBC text (its columns, m/s and UTC "
-                         "are fixed by the format); remove them")
-    data = read_ndbc(path, position=opts["position"], station=opts.get("station"),
-                     height_m=opts.get("height_m"))
+        raise InputError(
+            f"{', '.join(bad)}: not used for NDBC text (its columns, m/s and UTC "
+            "are fixed by the format); remove them"
+        )
+    data = read_ndbc(
+        path, position=opts["position"], station=opts.get("station"), height_m=opts.get("height_m")
+    )
     if opts.get("resample_s") is not None:
         data = resample_stations(data, opts["resample_s"])
     return data
@@ -536,15 +636,29 @@ def _build_stations(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Win
     chk.p.raise_if_any()
     data = _read_checked(ropts, chk.where())
     try:
-        return StationWind(data, ctx.frame, name=f"station wind {data.source}",
-                           time_window=ctx.time_window, **fopts)
+        return StationWind(
+            data,
+            ctx.frame,
+            name=f"station wind {data.source}",
+            time_window=ctx.time_window,
+            **fopts,
+        )
     except InputError as exc:
         raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
 # ---------------------------------------------------------------------------- blended
-_BLEND_KEYS = ("type", "wrf", "stations", "length_scale_m", "time_scale_s", "min_speed_ms",
-               "ratio_range", "max_offset_deg", "clamp")
+_BLEND_KEYS = (
+    "type",
+    "wrf",
+    "stations",
+    "length_scale_m",
+    "time_scale_s",
+    "min_speed_ms",
+    "ratio_range",
+    "max_offset_deg",
+    "clamp",
+)
 
 
 def _build_blended(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> WindField:
@@ -557,8 +671,9 @@ def _build_blended(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Wind
         wchk = chk.child("wrf")
         if wspec.get("type", "wrf") != "wrf":
             wchk.add("type", f"expected 'wrf' (or leave it out); got {show(wspec.get('type'))}")
-        wopts = _wrf_options({k: v for k, v in wspec.items() if k != "type"} | {"type": "wrf"},
-                             wchk, ctx)
+        wopts = _wrf_options(
+            {k: v for k, v in wspec.items() if k != "type"} | {"type": "wrf"}, wchk, ctx
+        )
     if sspec is not None:
         schk = chk.child("stations")
         schk.keys(sspec, ("type", *_READ_KEYS), ("path",))
@@ -572,28 +687,49 @@ def _build_blended(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Wind
     }
     if "ratio_range" in spec:
         rr = spec["ratio_range"]
-        if (not isinstance(rr, list | tuple) or len(rr) != 2
-                or not all(isinstance(a, int | float) and not isinstance(a, bool) for a in rr)
-                or not 0 < rr[0] <= 1 <= rr[1]):
-            chk.add("ratio_range", f"expected [min, max] with 0 < min <= 1 <= max, e.g. "
-                    f"[0.5, 2.0]; got {rr!r}")
+        if (
+            not isinstance(rr, list | tuple)
+            or len(rr) != 2
+            or not all(isinstance(a, int | float) and not isinstance(a, bool) for a in rr)
+            or not 0 < rr[0] <= 1 <= rr[1]
+        ):
+            chk.add(
+                "ratio_range",
+                f"expected [min, max] with 0 < min <= 1 <= max, e.g. [0.5, 2.0]; got {rr!r}",
+            )
         else:
             bopts["ratio_range"] = (float(rr[0]), float(rr[1]))
     chk.p.raise_if_any()
     base = _open_wrf_checked(dict(wopts), chk.where("wrf"), ctx)
     data = _read_checked(ropts, chk.where("stations"))
     try:
-        return BlendedWind(base, data, ctx.frame, height_m=wopts.get("height_m"),
-                           exponent=wopts.get("fallback_exponent", DEFAULT_EXPONENT),
-                           name=f"blended wind ({Path(str(wopts['path'])).name} + "
-                           f"{Path(data.source).name})", **bopts)
+        return BlendedWind(
+            base,
+            data,
+            ctx.frame,
+            height_m=wopts.get("height_m"),
+            exponent=wopts.get("fallback_exponent", DEFAULT_EXPONENT),
+            name=f"blended wind ({Path(str(wopts['path'])).name} + {Path(data.source).name})",
+            **bopts,
+        )
     except InputError as exc:
         raise type(exc)(f"{chk.where()}: {exc}") from None
 
 
 # ---------------------------------------------------------------------------- measured
-_MEASURED_KEYS = ("type", "tracks", "speed_unit", "time_zone", "method", "estimate_bias",
-                  "resample_s", "smooth_s", "max_gap_s", "radius_m", "clamp")
+_MEASURED_KEYS = (
+    "type",
+    "tracks",
+    "speed_unit",
+    "time_zone",
+    "method",
+    "estimate_bias",
+    "resample_s",
+    "smooth_s",
+    "max_gap_s",
+    "radius_m",
+    "clamp",
+)
 MEASURED_MARGIN_S = 600.0
 """Records within this of the race window [s] are used by ``type: measured``."""
 
@@ -638,24 +774,33 @@ def _build_measured(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> Win
     for k, p in enumerate(paths):
         where = chk.where(f"tracks[{k}]")
         try:
-            s = sensor_from_track(read_track(p, speed_unit=unit, time_zone=tz),
-                                  smooth_s=smooth_s, max_gap_s=max_gap_s)
+            s = sensor_from_track(
+                read_track(p, speed_unit=unit, time_zone=tz), smooth_s=smooth_s, max_gap_s=max_gap_s
+            )
         except InputError as exc:
             raise type(exc)(f"{where}: {exc}") from None
         if ctx.time_window is not None:
             w0, w1 = ctx.time_window
             cut = s.between(w0 - MEASURED_MARGIN_S, w1 + MEASURED_MARGIN_S)
             if len(cut) < 2:
-                raise InputError(f"{where}: {p.name} has no wind records within "
-                                 f"{MEASURED_MARGIN_S:g} s of the race window; use the logs of "
-                                 "this race")
+                raise InputError(
+                    f"{where}: {p.name} has no wind records within "
+                    f"{MEASURED_MARGIN_S:g} s of the race window; use the logs of "
+                    "this race"
+                )
             s = cut
         series.append(s)
     try:
-        fw = fleet_wind(series, ctx.frame, method=method, estimate_bias=bias,
-                        resample_s=resample_s, radius_m=radius_m, clamp=clamp,
-                        options={"name": "measured wind (" + ", ".join(s.boat for s in series)
-                                 + ")"})
+        fw = fleet_wind(
+            series,
+            ctx.frame,
+            method=method,
+            estimate_bias=bias,
+            resample_s=resample_s,
+            radius_m=radius_m,
+            clamp=clamp,
+            options={"name": "measured wind (" + ", ".join(s.boat for s in series) + ")"},
+        )
     except InputError as exc:
         raise type(exc)(f"{chk.where()}: {exc}") from None
     return fw.field
@@ -678,8 +823,16 @@ WIND_TYPES: tuple[str, ...] = tuple(_BUILDERS)
 # ---------------------------------------------------------------------------- currents
 _CURRENT_UNIFORM_KEYS = ("type", "speed_kn", "speed_ms", "set_deg")
 _CURRENT_DIAMOND_KEYS = ("type", "high_water", "table", "rate_unit", "clamp")
-_CURRENT_NETCDF_KEYS = ("type", "path", "variables", "speed_unit", "select", "interpolation",
-                        "steady", "clamp")
+_CURRENT_NETCDF_KEYS = (
+    "type",
+    "path",
+    "variables",
+    "speed_unit",
+    "select",
+    "interpolation",
+    "steady",
+    "clamp",
+)
 
 
 def current_from_spec(
@@ -724,16 +877,18 @@ def current_from_spec(
     probs = Problems.below(where, lines, what="current spec")
     chk = Checker(probs, probs.root)
     if not isinstance(spec, Mapping):
-        raise InputError(f"{where}: expected a current spec mapping, e.g. {{type: uniform, "
-                         f"speed_kn: 1.5, set_deg: 90}}; got {show(spec)}")
+        raise InputError(
+            f"{where}: expected a current spec mapping, e.g. {{type: uniform, "
+            f"speed_kn: 1.5, set_deg: 90}}; got {show(spec)}"
+        )
     kind = chk.choice(spec, "type", list(CURRENT_BUILDERS))
     chk.p.raise_if_any()
     assert kind is not None  # an unknown or missing type was raised just above
-    field = CURRENT_BUILDERS[kind](spec, chk, _Context(frame, Path(base_dir), crop_bbox,
-                                                       time_window, where))
+    field = CURRENT_BUILDERS[kind](
+        spec, chk, _Context(frame, Path(base_dir), crop_bbox, time_window, where)
+    )
     if not spec.get("clamp", False):
-        check_covers(field, crop_bbox, time_window, name=f"{where}: {kind} current",
-                     frame=frame)
+        check_covers(field, crop_bbox, time_window, name=f"{where}: {kind} current", frame=frame)
     return field
 
 
@@ -751,8 +906,7 @@ def _current_rate(chk: Checker, spec: Mapping[str, Any]) -> float | None:
     return None
 
 
-def _build_uniform_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
-                           ) -> CurrentField:
+def _build_uniform_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> CurrentField:
     """``type: uniform``: one rate and set everywhere, all the time."""
     chk.keys(spec, _CURRENT_UNIFORM_KEYS, ("set_deg",))
     rate = _current_rate(chk, spec)
@@ -767,24 +921,34 @@ def _diamond_rows(chk: Checker, table: Any, scale: float) -> list[tuple[float, f
     rows: list[tuple[float, float, float]] = []
     tchk = chk.child("table")
     for k, row in enumerate(table):
-        ok = (isinstance(row, list | tuple) and len(row) == 3 and all(
-            isinstance(a, int | float) and not isinstance(a, bool) and np.isfinite(a)
-            for a in row))
+        ok = (
+            isinstance(row, list | tuple)
+            and len(row) == 3
+            and all(
+                isinstance(a, int | float) and not isinstance(a, bool) and np.isfinite(a)
+                for a in row
+            )
+        )
         if not ok:
-            tchk.add(k, f"expected [hour, set_deg, rate_{'kn' if scale != 1 else 'ms'}]"
-                     f" (three numbers); got {row!r}")
+            tchk.add(
+                k,
+                f"expected [hour, set_deg, rate_{'kn' if scale != 1 else 'ms'}]"
+                f" (three numbers); got {row!r}",
+            )
         elif not (0.0 <= row[1] <= 360.0 and row[2] >= 0):
             tchk.add(k, f"expected a set in [0, 360] and a rate >= 0; got {row!r}")
         elif rows and row[0] <= rows[-1][0]:
-            tchk.add(k, f"the hours must increase strictly from row to row "
-                     f"({row[0]:g} after {rows[-1][0]:g})")
+            tchk.add(
+                k,
+                f"the hours must increase strictly from row to row "
+                f"({row[0]:g} after {rows[-1][0]:g})",
+            )
         else:
             rows.append((float(row[0]), float(row[1]), float(row[2]) * scale))
     return rows
 
 
-def _build_diamond_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
-                           ) -> CurrentField:
+def _build_diamond_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> CurrentField:
     """``type: diamonds``: a tidal-diamond table of set and rate by hour from high water."""
     chk.keys(spec, _CURRENT_DIAMOND_KEYS, ("high_water", "table"))
     unit = chk.choice(spec, "rate_unit", ["kn", "m/s"], "kn")
@@ -799,8 +963,11 @@ def _build_diamond_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
     rows: list[tuple[float, float, float]] = []
     table = spec.get("table")
     if "table" in spec and (not isinstance(table, list) or not table):
-        chk.add("table", "expected a non-empty list of rows [hour, set_deg, rate_kn], "
-                f"e.g. [[-6, 250, 0.4], [0, 70, 1.2]]; got {show(table)}")
+        chk.add(
+            "table",
+            "expected a non-empty list of rows [hour, set_deg, rate_kn], "
+            f"e.g. [[-6, 250, 0.4], [0, 70, 1.2]]; got {show(table)}",
+        )
     elif isinstance(table, list):
         rows = _diamond_rows(chk, table, scale)
     chk.p.raise_if_any()
@@ -809,28 +976,39 @@ def _build_diamond_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
     return DiamondCurrent(hw, h, s, r, clamp=clamp)
 
 
-def _build_netcdf_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context
-                          ) -> CurrentField:
+def _build_netcdf_current(spec: Mapping[str, Any], chk: Checker, ctx: _Context) -> CurrentField:
     """``type: netcdf``: a gridded current (u, v) from a NetCDF file."""
     chk.keys(spec, _CURRENT_NETCDF_KEYS, ("path",))
     path = _path(chk, spec, ctx)
     var = chk.mapping(spec, "variables", None)
-    if var is not None and not ({"u", "v"} == set(var) and all(
-            isinstance(v, str) and v for v in var.values())):
-        chk.add("variables", f"expected {{u: NAME, v: NAME}}, e.g. {{u: uo, v: vo}}; "
-                f"got {dict(var)!r}")
+    if var is not None and not (
+        {"u", "v"} == set(var) and all(isinstance(v, str) and v for v in var.values())
+    ):
+        chk.add(
+            "variables", f"expected {{u: NAME, v: NAME}}, e.g. {{u: uo, v: vo}}; got {dict(var)!r}"
+        )
     unit = chk.string(spec, "speed_unit", None)
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
         chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
     sel = chk.mapping(spec, "select", None)
-    opts = {"interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
-            "steady": chk.boolean(spec, "steady", False),
-            "clamp": chk.boolean(spec, "clamp", False)}
+    opts = {
+        "interpolation": chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
+        "steady": chk.boolean(spec, "steady", False),
+        "clamp": chk.boolean(spec, "clamp", False),
+    }
     chk.p.raise_if_any()
     assert path is not None  # required key: reported above when missing
     try:
-        return open_netcdf_current(path, ctx.frame, variables=var, speed_unit=unit, select=sel,
-                                   bbox=ctx.crop_bbox, time_window=ctx.time_window, **opts)
+        return open_netcdf_current(
+            path,
+            ctx.frame,
+            variables=var,
+            speed_unit=unit,
+            select=sel,
+            bbox=ctx.crop_bbox,
+            time_window=ctx.time_window,
+            **opts,
+        )
     except InputError as exc:
         raise type(exc)(f"{ctx.where}: {exc}") from None
 

@@ -70,14 +70,29 @@ STANDARD_UV = (("eastward_wind", "northward_wind"),)
 STANDARD_SD = (("wind_speed", "wind_from_direction"), ("wind_speed", "wind_to_direction"))
 """CF standard names of wind speed and direction."""
 
-NAMES_UV = (("u10", "v10"), ("U10", "V10"), ("u10m", "v10m"), ("U10M", "V10M"), ("uas", "vas"),
-            ("10u", "10v"), ("UGRD_10maboveground", "VGRD_10maboveground"),
-            ("ugrd10m", "vgrd10m"), ("u_10m", "v_10m"), ("u100", "v100"), ("u", "v"),
-            ("U", "V"))
+NAMES_UV = (
+    ("u10", "v10"),
+    ("U10", "V10"),
+    ("u10m", "v10m"),
+    ("U10M", "V10M"),
+    ("uas", "vas"),
+    ("10u", "10v"),
+    ("UGRD_10maboveground", "VGRD_10maboveground"),
+    ("ugrd10m", "vgrd10m"),
+    ("u_10m", "v_10m"),
+    ("u100", "v100"),
+    ("u", "v"),
+    ("U", "V"),
+)
 """Variable names tried, in order, when no standard_name says which are the winds."""
 
-NAMES_SD = (("wind_speed", "wind_direction"), ("ws10", "wd10"), ("si10", "wdir10"),
-            ("wspd", "wdir"), ("wind_speed_10m", "wind_direction_10m"))
+NAMES_SD = (
+    ("wind_speed", "wind_direction"),
+    ("ws10", "wd10"),
+    ("si10", "wdir10"),
+    ("wspd", "wdir"),
+    ("wind_speed_10m", "wind_direction_10m"),
+)
 """Speed/direction variable names tried after :data:`NAMES_UV`."""
 
 LAT_NAMES = ("lat", "latitude", "nav_lat", "lats", "XLAT", "LAT", "Latitude", "gridlat_0")
@@ -86,15 +101,44 @@ TIME_NAMES = ("valid_time", "time", "Time", "times", "t")
 TIME_ATTRS = ("valid_time", "time", "ref_time", "forecast_time", "reference_time", "date")
 """Global attributes read as the time of a file without a time coordinate."""
 
-HEIGHT_NAMES = ("height", "heightAboveGround", "height_above_ground", "height_above_ground1",
-                "z", "level")
+HEIGHT_NAMES = (
+    "height",
+    "heightAboveGround",
+    "height_above_ground",
+    "height_above_ground1",
+    "z",
+    "level",
+)
 
-DIRECTION_UNITS = frozenset({"degree", "degrees", "deg", "degrees_true", "degree_true", "°",
-                             "degrees true", "degT", "degree_north", "degrees_north"})
-_SPEED_UNIT_ALIASES = {"m s-1": "m/s", "m s**-1": "m/s", "m.s-1": "m/s", "ms-1": "m/s",
-                       "m s^-1": "m/s", "m sec-1": "m/s", "meter second-1": "m/s",
-                       "meters/second": "m/s", "metre second-1": "m/s", "m s{-1}": "m/s",
-                       "knot": "kn", "km h-1": "km/h", "km/hr": "km/h"}
+DIRECTION_UNITS = frozenset(
+    {
+        "degree",
+        "degrees",
+        "deg",
+        "degrees_true",
+        "degree_true",
+        "°",
+        "degrees true",
+        "degT",
+        "degree_north",
+        "degrees_north",
+    }
+)
+_SPEED_UNIT_ALIASES = {
+    "m s-1": "m/s",
+    "m s**-1": "m/s",
+    "m.s-1": "m/s",
+    "ms-1": "m/s",
+    "m s^-1": "m/s",
+    "m sec-1": "m/s",
+    "meter second-1": "m/s",
+    "meters/second": "m/s",
+    "metre second-1": "m/s",
+    "m s{-1}": "m/s",
+    "knot": "kn",
+    "km h-1": "km/h",
+    "km/hr": "km/h",
+}
 DATA_KEYS = ("u", "v", "speed", "direction", "lat", "lon", "time")
 """Keys of the ``variables`` mapping."""
 
@@ -199,8 +243,9 @@ def _std(var: Any) -> str:
     return str(_attr(var, "standard_name", "") or "").strip()
 
 
-def _find_winds(ds: Any, variables: Mapping[str, str] | None, label: str
-                ) -> tuple[str, tuple[str, str], str, bool]:
+def _find_winds(
+    ds: Any, variables: Mapping[str, str] | None, label: str
+) -> tuple[str, tuple[str, str], str, bool]:
     """``(kind, names, how, to_direction)`` of the wind variables: ``"uv"`` or ``"sd"``,
     found through ``variables``, a CF ``standard_name`` or a conventional name."""
     names = list(ds.variables)
@@ -210,9 +255,12 @@ def _find_winds(ds: Any, variables: Mapping[str, str] | None, label: str
     if found is not None:
         return found
     by_std = {_std(ds.variables[n]) for n in names}
-    hint = (" The file has grid-relative x_wind/y_wind: rotate them to eastward/northward "
-            "first (or name them with `variables:` if the grid axes point east and north)."
-            if "x_wind" in by_std or "grid_eastward_wind" in by_std else "")
+    hint = (
+        " The file has grid-relative x_wind/y_wind: rotate them to eastward/northward "
+        "first (or name them with `variables:` if the grid axes point east and north)."
+        if "x_wind" in by_std or "grid_eastward_wind" in by_std
+        else ""
+    )
     raise WindDataError(
         f"{label}: no wind variables found; expected CF standard_name eastward_wind and "
         "northward_wind (or wind_speed and wind_from_direction), or variables named u10/v10, "
@@ -221,22 +269,26 @@ def _find_winds(ds: Any, variables: Mapping[str, str] | None, label: str
     )
 
 
-def _given_winds(ds: Any, variables: Mapping[str, str], label: str
-                 ) -> tuple[str, tuple[str, str], str, bool] | None:
+def _given_winds(
+    ds: Any, variables: Mapping[str, str], label: str
+) -> tuple[str, tuple[str, str], str, bool] | None:
     """The wind variables that ``variables`` names (None when it names none of u, v,
     speed, direction); unknown keys, absent variables and half pairs are errors."""
     unknown = [k for k in variables if k not in DATA_KEYS]
     if unknown:
-        raise InputError(f"{label}: variables: unknown key(s) {', '.join(unknown)}; "
-                         f"expected some of {', '.join(DATA_KEYS)}")
+        raise InputError(
+            f"{label}: variables: unknown key(s) {', '.join(unknown)}; "
+            f"expected some of {', '.join(DATA_KEYS)}"
+        )
     missing = [f"{k}: {v!r}" for k, v in variables.items() if v not in ds.variables]
     if missing:
-        raise InputError(f"{label}: variables: {', '.join(missing)} not in the file "
-                         f"(variables: {', '.join(ds.variables)})")
+        raise InputError(
+            f"{label}: variables: {', '.join(missing)} not in the file "
+            f"(variables: {', '.join(ds.variables)})"
+        )
     if "u" in variables or "v" in variables:
         if not ("u" in variables and "v" in variables):
-            raise InputError(f"{label}: variables: give both u and v (or speed and "
-                             "direction)")
+            raise InputError(f"{label}: variables: give both u and v (or speed and direction)")
         return "uv", (variables["u"], variables["v"]), "variables", False
     if "speed" in variables and "direction" in variables:
         to_dir = _std(ds.variables[variables["direction"]]) == "wind_to_direction"
@@ -246,8 +298,7 @@ def _given_winds(ds: Any, variables: Mapping[str, str], label: str
     return None
 
 
-def _standard_winds(ds: Any, names: list[str]
-                    ) -> tuple[str, tuple[str, str], str, bool] | None:
+def _standard_winds(ds: Any, names: list[str]) -> tuple[str, tuple[str, str], str, bool] | None:
     """The first wind pair by CF ``standard_name`` (:data:`STANDARD_UV`, then
     :data:`STANDARD_SD`), else by name (:data:`NAMES_UV`, :data:`NAMES_SD`; at least 2-D)."""
     by_std: dict[str, str] = {}
@@ -270,25 +321,43 @@ def _standard_winds(ds: Any, names: list[str]
 
 def _is_lat(ds: Any, n: str) -> bool:
     v = ds.variables[n]
-    return (_std(v) == "latitude" or str(_attr(v, "units", "")).strip() in
-            ("degrees_north", "degree_north", "degree_N", "degrees_N") or n in LAT_NAMES)
+    return (
+        _std(v) == "latitude"
+        or str(_attr(v, "units", "")).strip()
+        in ("degrees_north", "degree_north", "degree_N", "degrees_N")
+        or n in LAT_NAMES
+    )
 
 
 def _is_lon(ds: Any, n: str) -> bool:
     v = ds.variables[n]
-    return (_std(v) == "longitude" or str(_attr(v, "units", "")).strip() in
-            ("degrees_east", "degree_east", "degree_E", "degrees_E") or n in LON_NAMES)
+    return (
+        _std(v) == "longitude"
+        or str(_attr(v, "units", "")).strip()
+        in ("degrees_east", "degree_east", "degree_E", "degrees_E")
+        or n in LON_NAMES
+    )
 
 
-def _find_coord(ds: Any, wind_dims: tuple[str, ...], wind_var: Any, test: Any, given: str | None,
-                what: str, label: str) -> str:
+def _find_coord(
+    ds: Any,
+    wind_dims: tuple[str, ...],
+    wind_var: Any,
+    test: Any,
+    given: str | None,
+    what: str,
+    label: str,
+) -> str:
     if given is not None:
         return given
     # CF order of preference: the wind's `coordinates` attribute, coordinate variables
     # (name == dimension), then any variable whose dimensions are among the wind's.
     listed = str(_attr(wind_var, "coordinates", "") or "").split()
-    cands = [n for n in listed if n in ds.variables] + [
-        n for n in ds.variables if n in wind_dims] + list(ds.variables)
+    cands = (
+        [n for n in listed if n in ds.variables]
+        + [n for n in ds.variables if n in wind_dims]
+        + list(ds.variables)
+    )
     for n in cands:
         v = ds.variables[n]
         if v.ndim in (1, 2, 3) and set(v.dimensions) <= set(wind_dims) and test(ds, n):
@@ -311,8 +380,9 @@ def _read_all(var: Any) -> NDArray[np.float64]:
     return np.asarray(a, dtype=float)
 
 
-def _coords_2d(ds: Any, latn: str, lonn: str, dims: tuple[str, ...], label: str
-               ) -> tuple[NDArray, NDArray, str, str, bool]:
+def _coords_2d(
+    ds: Any, latn: str, lonn: str, dims: tuple[str, ...], label: str
+) -> tuple[NDArray, NDArray, str, str, bool]:
     lv, ov = ds.variables[latn], ds.variables[lonn]
     lat = _read_all(lv if lv.ndim < 3 else _First(lv))
     lon = _read_all(ov if ov.ndim < 3 else _First(ov))
@@ -320,8 +390,10 @@ def _coords_2d(ds: Any, latn: str, lonn: str, dims: tuple[str, ...], label: str
     odims = ov.dimensions[-2:] if ov.ndim >= 2 else ov.dimensions
     if lat.ndim == 1 and lon.ndim == 1:
         if ldims[0] == odims[0]:
-            raise WindDataError(f"{label}: {latn} and {lonn} are 1-D on the same dimension "
-                                f"{ldims[0]!r} (a list of points, not a grid); expected a grid")
+            raise WindDataError(
+                f"{label}: {latn} and {lonn} are 1-D on the same dimension "
+                f"{ldims[0]!r} (a list of points, not a grid); expected a grid"
+            )
         row_dim, col_dim = ldims[0], odims[0]
         lat2, lon2 = np.meshgrid(lat, lon, indexing="ij")
         regular = True
@@ -336,22 +408,32 @@ def _coords_2d(ds: Any, latn: str, lonn: str, dims: tuple[str, ...], label: str
             row_dim, col_dim, lat2, lon2 = d1, d0, lat.T, lon.T
         regular = False
     else:
-        raise WindDataError(f"{label}: {latn} {lat.shape} {tuple(ldims)} and {lonn} {lon.shape} "
-                            f"{tuple(odims)} are neither two 1-D axes nor two 2-D arrays on the "
-                            "same dimensions")
+        raise WindDataError(
+            f"{label}: {latn} {lat.shape} {tuple(ldims)} and {lonn} {lon.shape} "
+            f"{tuple(odims)} are neither two 1-D axes nor two 2-D arrays on the "
+            "same dimensions"
+        )
     missing = [d for d in (row_dim, col_dim) if d not in dims]
     if missing:
-        raise WindDataError(f"{label}: the wind variables (dimensions {', '.join(dims)}) do not "
-                            f"have the coordinate dimension(s) {', '.join(missing)}")
+        raise WindDataError(
+            f"{label}: the wind variables (dimensions {', '.join(dims)}) do not "
+            f"have the coordinate dimension(s) {', '.join(missing)}"
+        )
     if not (np.all(np.isfinite(lat2)) and np.all(np.isfinite(lon2))):
-        raise WindDataError(f"{label}: {latn}/{lonn} contain missing or NaN values; expected "
-                            "a complete coordinate grid")
+        raise WindDataError(
+            f"{label}: {latn}/{lonn} contain missing or NaN values; expected "
+            "a complete coordinate grid"
+        )
     if np.any(np.abs(lat2) > 90.0):
-        raise WindDataError(f"{label}: {latn} has values outside [-90, 90] degrees "
-                            f"(max |lat| {float(np.max(np.abs(lat2))):g})")
+        raise WindDataError(
+            f"{label}: {latn} has values outside [-90, 90] degrees "
+            f"(max |lat| {float(np.max(np.abs(lat2))):g})"
+        )
     if np.any(lon2 < -180.0) or np.any(lon2 > 360.0):
-        raise WindDataError(f"{label}: {lonn} has values outside [-180, 360] degrees "
-                            f"({float(np.min(lon2)):g} .. {float(np.max(lon2)):g})")
+        raise WindDataError(
+            f"{label}: {lonn} has values outside [-180, 360] degrees "
+            f"({float(np.min(lon2)):g} .. {float(np.max(lon2)):g})"
+        )
     return lat2, lon2, row_dim, col_dim, regular
 
 
@@ -372,33 +454,44 @@ def _epoch_from_values(vals: NDArray, var: Any, name: str, label: str) -> NDArra
         return a.astype("datetime64[ns]").astype("int64").astype(float) / 1e9
     units = str(_attr(var, "units", "") or "")
     if "since" not in units:
-        raise WindDataError(f"{label}: time variable {name} has units {units!r}; expected CF "
-                            "time units such as 'hours since 2014-10-07 00:00:00'")
+        raise WindDataError(
+            f"{label}: time variable {name} has units {units!r}; expected CF "
+            "time units such as 'hours since 2014-10-07 00:00:00'"
+        )
     calendar = str(_attr(var, "calendar", "standard") or "standard").lower()
     if calendar not in ("standard", "gregorian", "proleptic_gregorian", "julian"):
-        raise WindDataError(f"{label}: time variable {name} uses calendar {calendar!r}; only "
-                            "real-world calendars (standard, gregorian, proleptic_gregorian) "
-                            "can be matched with a race time")
+        raise WindDataError(
+            f"{label}: time variable {name} uses calendar {calendar!r}; only "
+            "real-world calendars (standard, gregorian, proleptic_gregorian) "
+            "can be matched with a race time"
+        )
     import cftime
 
     try:
         values: NDArray[np.float64] = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan).ravel()
     except (ValueError, TypeError) as exc:
-        raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
-                            f"{exc}") from None
+        raise WindDataError(
+            f"{label}: cannot decode time variable {name} ({units!r}): {exc}"
+        ) from None
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
-        raise WindDataError(f"{label}: time variable {name} has {bad.size} missing or "
-                            f"non-finite value(s) (the first at index {int(bad[0])}); every "
-                            "time step needs its time")
+        raise WindDataError(
+            f"{label}: time variable {name} has {bad.size} missing or "
+            f"non-finite value(s) (the first at index {int(bad[0])}); every "
+            "time step needs its time"
+        )
     try:
-        dts = cftime.num2date(values, units, calendar, only_use_cftime_datetimes=False,
-                              only_use_python_datetimes=True)
+        dts = cftime.num2date(
+            values, units, calendar, only_use_cftime_datetimes=False, only_use_python_datetimes=True
+        )
     except (ValueError, TypeError, OverflowError) as exc:
-        raise WindDataError(f"{label}: cannot decode time variable {name} ({units!r}): "
-                            f"{exc}") from None
-    return np.array([(d if d.tzinfo else d.replace(tzinfo=UTC)).timestamp()
-                     for d in np.atleast_1d(dts)], dtype=float)
+        raise WindDataError(
+            f"{label}: cannot decode time variable {name} ({units!r}): {exc}"
+        ) from None
+    return np.array(
+        [(d if d.tzinfo else d.replace(tzinfo=UTC)).timestamp() for d in np.atleast_1d(dts)],
+        dtype=float,
+    )
 
 
 def _size(dim: Any) -> int:
@@ -408,14 +501,22 @@ def _size(dim: Any) -> int:
 
 def _is_time(ds: Any, n: str) -> bool:
     v = ds.variables[n]
-    return (getattr(v, "dtype", None) is not None and np.dtype(v.dtype).kind == "M") or (
-        "since" in str(_attr(v, "units", "") or "")) or _std(v) == "time" or (
-        str(_attr(v, "axis", "")).upper() == "T")
+    return (
+        (getattr(v, "dtype", None) is not None and np.dtype(v.dtype).kind == "M")
+        or ("since" in str(_attr(v, "units", "") or ""))
+        or _std(v) == "time"
+        or (str(_attr(v, "axis", "")).upper() == "T")
+    )
 
 
-def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
-                given: str | None, time: str | float | None, label: str
-                ) -> tuple[str | None, NDArray[np.float64], str]:
+def _find_times(
+    ds: Any,
+    dims: tuple[str, ...],
+    grid_dims: tuple[str, str],
+    given: str | None,
+    time: str | float | None,
+    label: str,
+) -> tuple[str | None, NDArray[np.float64], str]:
     """``(time dimension or None, epoch seconds [s], source)`` of the wind variables: the
     ``given`` variable, a time coordinate on one of their dimensions, the ``time``
     argument, a scalar time variable, or a global attribute (UTC)."""
@@ -440,22 +541,25 @@ def _find_times(ds: Any, dims: tuple[str, ...], grid_dims: tuple[str, str],
     )
 
 
-def _given_time(ds: Any, given: str, extra: list[str], label: str
-                ) -> tuple[str | None, NDArray[np.float64], str]:
+def _given_time(
+    ds: Any, given: str, extra: list[str], label: str
+) -> tuple[str | None, NDArray[np.float64], str]:
     """The time variable named by ``variables: {time: ...}``: 1-D on one of the wind's
     ``extra`` dimensions, or a scalar."""
     v = ds.variables[given]
     if v.ndim == 1 and v.dimensions[0] in extra:
         return v.dimensions[0], _epoch_from_values(v[:], v, given, label), f"variable {given}"
     if v.ndim == 0:
-        return None, _epoch_from_values(np.atleast_1d(v[()]), v, given, label), \
-            f"variable {given}"
-    raise WindDataError(f"{label}: time variable {given} has dimensions {v.dimensions}; "
-                        f"expected one of the wind's dimensions ({', '.join(extra)}) or none")
+        return None, _epoch_from_values(np.atleast_1d(v[()]), v, given, label), f"variable {given}"
+    raise WindDataError(
+        f"{label}: time variable {given} has dimensions {v.dimensions}; "
+        f"expected one of the wind's dimensions ({', '.join(extra)}) or none"
+    )
 
 
-def _dimension_time(ds: Any, extra: list[str], label: str
-                    ) -> tuple[str | None, NDArray[np.float64], str] | None:
+def _dimension_time(
+    ds: Any, extra: list[str], label: str
+) -> tuple[str | None, NDArray[np.float64], str] | None:
     """A time dimension among ``extra``: its coordinate variable, or a time-like 1-D
     variable on it (not a duration); None if there is none."""
     for d in extra:
@@ -463,23 +567,27 @@ def _dimension_time(ds: Any, extra: list[str], label: str
         cands += [n for n in ds.variables if n not in cands]
         for n in cands:
             v = ds.variables[n]
-            if v.ndim == 1 and v.dimensions[0] == d and _is_time(ds, n) and (
-                    np.dtype(v.dtype).kind != "m"):
+            if (
+                v.ndim == 1
+                and v.dimensions[0] == d
+                and _is_time(ds, n)
+                and (np.dtype(v.dtype).kind != "m")
+            ):
                 return d, _epoch_from_values(v[:], v, n, label), f"variable {n}"
     return None
 
 
 def _refuse_extra_dims(ds: Any, extra: list[str], label: str) -> None:
     """An error when a dimension other than the grid's, of size > 1, is not a time."""
-    sizes = {d: _size(ds.dimensions.get(d, 1)) for d in extra} if hasattr(
-        ds, "dimensions") else {}
+    sizes = {d: _size(ds.dimensions.get(d, 1)) for d in extra} if hasattr(ds, "dimensions") else {}
     big = [d for d, n in sizes.items() if n > 1]
     if big:
         raise WindDataError(
             f"{label}: dimension {big[0]!r} (size {sizes[big[0]]}) of the wind "
             "variables is not a time with CF units; expected a time coordinate such as "
             "time(time) with units 'hours since ...'. Select one level/member first, or "
-            "name the time variable with `variables: {time: NAME}`.")
+            "name the time variable with `variables: {time: NAME}`."
+        )
 
 
 def _scalar_time(ds: Any, label: str) -> tuple[str | None, NDArray[np.float64], str] | None:
@@ -535,8 +643,11 @@ def _data_height(ds: Any, var: Any, name: str, dims: tuple[str, ...]) -> tuple[f
             v = ds.variables[n]
             size = int(np.prod(v.shape)) if v.ndim else 1
             std = _std(v)
-            if size == 1 and (std == "height" or n in HEIGHT_NAMES) and (
-                    n in listed or n in dims or v.ndim == 0 or std == "height"):
+            if (
+                size == 1
+                and (std == "height" or n in HEIGHT_NAMES)
+                and (n in listed or n in dims or v.ndim == 0 or std == "height")
+            ):
                 units = str(_attr(v, "units", "") or "").strip()
                 if units in ("m", "meters", "metre", "metres", "meter"):
                     val = float(_read_all(v).ravel()[0])
@@ -552,12 +663,19 @@ def _data_height(ds: Any, var: Any, name: str, dims: tuple[str, ...]) -> tuple[f
     return None, "unknown"
 
 
-def _check_times(times: NDArray[np.float64], time_dim: str | None, dims: tuple[str, ...],
-                 shape: tuple[int, ...], label: str) -> None:
+def _check_times(
+    times: NDArray[np.float64],
+    time_dim: str | None,
+    dims: tuple[str, ...],
+    shape: tuple[int, ...],
+    label: str,
+) -> None:
     """One finite time per slice of ``time_dim`` (if any), strictly increasing."""
     if time_dim is not None and times.size != dict(zip(dims, shape, strict=True))[time_dim]:
-        raise WindDataError(f"{label}: the time coordinate has {times.size} values but "
-                            f"dimension {time_dim!r} has {shape[dims.index(time_dim)]}")
+        raise WindDataError(
+            f"{label}: the time coordinate has {times.size} values but "
+            f"dimension {time_dim!r} has {shape[dims.index(time_dim)]}"
+        )
     if not np.all(np.isfinite(times)):
         raise WindDataError(f"{label}: the time coordinate has missing values")
     bad = np.nonzero(np.diff(times) <= 0)[0]
@@ -565,31 +683,42 @@ def _check_times(times: NDArray[np.float64], time_dim: str | None, dims: tuple[s
         k = int(bad[0])
         raise WindDataError(
             f"{label}: times must increase strictly, but time[{k}] = {iso(times[k])} and "
-            f"time[{k + 1}] = {iso(times[k + 1])}; remove duplicated or out-of-order slices")
+            f"time[{k + 1}] = {iso(times[k + 1])}; remove duplicated or out-of-order slices"
+        )
 
 
-def _fixed_indices(dims: tuple[str, ...], shape: tuple[int, ...],
-                   field_dims: tuple[str, str, str | None], select: Mapping[str, int] | None,
-                   label: str) -> dict[str, int]:
+def _fixed_indices(
+    dims: tuple[str, ...],
+    shape: tuple[int, ...],
+    field_dims: tuple[str, str, str | None],
+    select: Mapping[str, int] | None,
+    label: str,
+) -> dict[str, int]:
     """Index taken along each dimension other than the grid's and the time's
     (``field_dims``): the one ``select`` names, else 0 for a dimension of size 1."""
     fixed: dict[str, int] = {}
     chosen = dict(select or {})
     unknown = sorted(set(chosen) - set(dims))
     if unknown:
-        raise InputError(f"{label}: select names {', '.join(map(repr, unknown))}, which "
-                         f"the wind variables do not have (dimensions: {', '.join(dims)})")
+        raise InputError(
+            f"{label}: select names {', '.join(map(repr, unknown))}, which "
+            f"the wind variables do not have (dimensions: {', '.join(dims)})"
+        )
     for d, n in zip(dims, shape, strict=True):
         if d in field_dims:
             if d in chosen:
-                raise InputError(f"{label}: select {d!r}: that is a time or grid "
-                                 "dimension; select only members or levels")
+                raise InputError(
+                    f"{label}: select {d!r}: that is a time or grid "
+                    "dimension; select only members or levels"
+                )
             continue
         if d in chosen:
             k = chosen[d]
             if not 0 <= k < n:
-                raise InputError(f"{label}: select {d}: {k} is out of range; that "
-                                 f"dimension has indices 0 .. {n - 1}")
+                raise InputError(
+                    f"{label}: select {d}: {k} is out of range; that "
+                    f"dimension has indices 0 .. {n - 1}"
+                )
             fixed[d] = int(k)
             continue
         if n != 1:
@@ -597,7 +726,8 @@ def _fixed_indices(dims: tuple[str, ...], shape: tuple[int, ...],
                 f"{label}: the wind variables have an extra dimension {d!r} of size {n} "
                 "(levels or ensemble members); pick one with `select: {"
                 f"{d}: 0}}` in the wind spec (an ensemble scenario's `members: {{dim: "
-                f"{d}, ...}}` takes them all), or with xarray `ds.isel({{{d!r}: 0}})`")
+                f"{d}, ...}}` takes them all), or with xarray `ds.isel({{{d!r}: 0}})`"
+            )
         fixed[d] = 0
     return fixed
 
@@ -646,36 +776,60 @@ def read_cf_header(
         kind, names, how, to_dir = _find_winds(ds, variables, label)
         va, vb = ds.variables[names[0]], ds.variables[names[1]]
         if tuple(va.dimensions) != tuple(vb.dimensions) or tuple(va.shape) != tuple(vb.shape):
-            raise WindDataError(f"{label}: {names[0]} {va.dimensions} and {names[1]} "
-                                f"{vb.dimensions} must have the same dimensions and shape")
+            raise WindDataError(
+                f"{label}: {names[0]} {va.dimensions} and {names[1]} "
+                f"{vb.dimensions} must have the same dimensions and shape"
+            )
         dims = tuple(va.dimensions)
         vmap = dict(variables or {})
         latn = _find_coord(ds, dims, va, _is_lat, vmap.get("lat"), "latitude", label)
         lonn = _find_coord(ds, dims, va, _is_lon, vmap.get("lon"), "longitude", label)
         lat, lon, row_dim, col_dim, regular = _coords_2d(ds, latn, lonn, dims, label)
-        time_dim, times, tsrc = _find_times(ds, dims, (row_dim, col_dim), vmap.get("time"),
-                                            time, label)
+        time_dim, times, tsrc = _find_times(
+            ds, dims, (row_dim, col_dim), vmap.get("time"), time, label
+        )
         _check_times(times, time_dim, dims, tuple(va.shape), label)
-        fixed = _fixed_indices(dims, tuple(va.shape), (row_dim, col_dim, time_dim), select,
-                               label)
+        fixed = _fixed_indices(dims, tuple(va.shape), (row_dim, col_dim, time_dim), select, label)
         if str(_attr(va, "GRIB_uvRelativeToGrid", 0)) == "1":
             raise WindDataError(
                 f"{label}: {names[0]}/{names[1]} are relative to the GRIB grid's axes "
                 "(uvRelativeToGrid = 1), not to true east/north; rotate them to earth-relative "
-                "first (e.g. with the grid's rotation angles) and pass the dataset")
+                "first (e.g. with the grid's rotation angles) and pass the dataset"
+            )
         factor, units = _speed_units(va, names[0], label, speed_unit)
         if kind == "sd":
             du = str(_attr(vb, "units", "degree") or "degree").strip()
             if du not in DIRECTION_UNITS:
-                raise WindDataError(f"{label}: direction variable {names[1]} has units {du!r}; "
-                                    "expected degrees (clockwise from true north)")
+                raise WindDataError(
+                    f"{label}: direction variable {names[1]} has units {du!r}; "
+                    "expected degrees (clockwise from true north)"
+                )
         h: float | None
         if data_height_m is not None:
             h, hsrc = float(data_height_m), "argument"
         else:
             h, hsrc = _data_height(ds, va, names[0], dims)
-    return CFHeader(label, kind, names, how, dims, time_dim, row_dim, col_dim, times, tsrc,
-                    lat, lon, regular, factor, units, to_dir, h, hsrc, fixed)
+    return CFHeader(
+        label,
+        kind,
+        names,
+        how,
+        dims,
+        time_dim,
+        row_dim,
+        col_dim,
+        times,
+        tsrc,
+        lat,
+        lon,
+        regular,
+        factor,
+        units,
+        to_dir,
+        h,
+        hsrc,
+        fixed,
+    )
 
 
 # ----------------------------------------------------------------------------- window
@@ -797,22 +951,35 @@ def open_netcdf(
 
     if shear not in ("power", "log"):
         raise InputError(f"shear {shear!r}; expected 'power' or 'log'")
-    hdr = read_cf_header(source, variables=variables, time=time, data_height_m=data_height_m,
-                         speed_unit=speed_unit, select=select)
+    hdr = read_cf_header(
+        source,
+        variables=variables,
+        time=time,
+        data_height_m=data_height_m,
+        speed_unit=speed_unit,
+        select=select,
+    )
     name = hdr.label
     if height_m is not None and hdr.data_height_m is None:
         raise InputError(
             f"{name}: a height correction to height_m {height_m:g} m needs the height of the "
             f"winds, which the file does not give ({hdr.names[0]} has no height coordinate or "
-            "attribute); set `data_height_m` (10 for 10 m winds)")
+            "attribute); set `data_height_m` (10 for 10 m winds)"
+        )
     rows, cols = _orient(hdr, frame)
     lat_o = hdr.lat[np.ix_(rows, cols)]
     lon_o = hdr.lon[np.ix_(rows, cols)]
     oriented = WrfHeader(name, hdr.times, lat_o, lon_o, {}, frozenset())
     step_s = None if time_step_min is None else float(time_step_min) * 60.0
-    w = crop_window(oriented, frame, bbox=bbox, margin_m=margin_m, time_window=time_window,
-                    time_pad_s=step_s or 0.0)
-    r_file, c_file = rows[w.j0:w.j1], cols[w.i0:w.i1]
+    w = crop_window(
+        oriented,
+        frame,
+        bbox=bbox,
+        margin_m=margin_m,
+        time_window=time_window,
+        time_pad_s=step_s or 0.0,
+    )
+    r_file, c_file = rows[w.j0 : w.j1], cols[w.i0 : w.i1]
     r_sorted, c_sorted = np.sort(r_file), np.sort(c_file)
     ds, _ = _open_source(source)
     arrays = []
@@ -832,15 +999,17 @@ def open_netcdf(
                     index.append(slice(k, k + 1))
             a = var[tuple(index)]
             a = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan)
-            order = [hdr.dims.index(d) for d in (hdr.time_dim, hdr.row_dim, hdr.col_dim)
-                     if d is not None]
+            order = [
+                hdr.dims.index(d) for d in (hdr.time_dim, hdr.row_dim, hdr.col_dim) if d is not None
+            ]
             order += [k for k in range(a.ndim) if k not in order]
             shape = (w.k1 - w.k0 if hdr.time_dim is not None else 1, r_file.size, c_file.size)
             if a.size != shape[0] * shape[1] * shape[2]:  # a damaged or unusual header
                 raise WindDataError(
                     f"{name}: {vname} holds {a.size} values where its dimensions "
                     f"{tuple(hdr.dims)} give {shape[0]} x {shape[1]} x {shape[2]}; the file's "
-                    "header does not describe its data (a damaged file?)")
+                    "header does not describe its data (a damaged file?)"
+                )
             a = np.transpose(a, order).reshape(shape)
             # back from sorted file order to south-north / west-east order
             a = a[:, np.searchsorted(r_sorted, r_file)][:, :, np.searchsorted(c_sorted, c_file)]
@@ -864,23 +1033,29 @@ def open_netcdf(
         raise WindDataError(
             f"{name}: {' and '.join(hdr.names)} give a wind of {fast:g} m/s; expected at most "
             f"{MAX_WIND_MS:g} m/s (check speed_unit; a value that marks missing data needs "
-            "the variable's _FillValue or missing_value attribute)")
+            "the variable's _FillValue or missing_value attribute)"
+        )
     if both.all():
-        raise WindDataError(f"{name}: every cell in the window around the course has no wind "
-                            "(NaN: land or masked); check the course position and the file")
+        raise WindDataError(
+            f"{name}: every cell in the window around the course has no wind "
+            "(NaN: land or masked); check the course position and the file"
+        )
     z_out = hdr.data_height_m
     if height_m is not None:
         z_in = hdr.data_height_m
         assert z_in is not None  # a height correction without the data's height is refused above
         z_out = float(height_m)
-        f = (power_law_factor(z_in, z_out, exponent) if shear == "power"
-             else log_law_factor(z_in, z_out, roughness_m))
+        f = (
+            power_law_factor(z_in, z_out, exponent)
+            if shear == "power"
+            else log_law_factor(z_in, z_out, roughness_m)
+        )
         ue, ve = ue * f, ve * f
-    lat_w = lat_o[w.j0:w.j1, w.i0:w.i1]
-    lon_w = lon_o[w.j0:w.j1, w.i0:w.i1]
+    lat_w = lat_o[w.j0 : w.j1, w.i0 : w.i1]
+    lon_w = lon_o[w.j0 : w.j1, w.i0 : w.i1]
     x, y = frame.to_xy(lat_w, lon_w)
     ul, vl = earth_to_local(ue, ve, frame.grid_north_deg(lat_w, lon_w))
-    times = hdr.times[w.k0:w.k1]
+    times = hdr.times[w.k0 : w.k1]
     span = (float(hdr.times[0]), float(hdr.times[-1]))
     nan_cells = int(both[0].sum()) if both.ndim == 3 else 0
     info: dict[str, Any] = {
@@ -893,20 +1068,36 @@ def open_netcdf(
         "data_height_m": hdr.data_height_m,
         "height_source": hdr.height_source,
         "height_m": z_out,
-        "window": {"rows": (int(r_sorted[0]), int(r_sorted[-1]) + 1),
-                   "cols": (int(c_sorted[0]), int(c_sorted[-1]) + 1), "times": (w.k0, w.k1)},
+        "window": {
+            "rows": (int(r_sorted[0]), int(r_sorted[-1]) + 1),
+            "cols": (int(c_sorted[0]), int(c_sorted[-1]) + 1),
+            "times": (w.k0, w.k1),
+        },
         "cells": int(both[0].size),
         "nan_cells": nan_cells,
-        "times": f"{iso(times[0])} .. {iso(times[-1])} ({times.size} of {hdr.times.size} "
-                 "slices)",
+        "times": f"{iso(times[0])} .. {iso(times[-1])} ({times.size} of {hdr.times.size} slices)",
         "map_degree": None,  # filled in below, from the field's index map
         "map_residual_cells": None,
     }
-    field = GridWind(times, x, y, ul, vl, interpolation=interpolation, time_step_s=step_s,
-                     clamp=clamp, name=label or f"gridded wind {_short(name)}", info=info,
-                     frame=frame, source_span=span, allow_nan=True, steady=steady)
-    info.update(map_degree=field.index_map.degree,
-                map_residual_cells=field.index_map.residual_cells)
+    field = GridWind(
+        times,
+        x,
+        y,
+        ul,
+        vl,
+        interpolation=interpolation,
+        time_step_s=step_s,
+        clamp=clamp,
+        name=label or f"gridded wind {_short(name)}",
+        info=info,
+        frame=frame,
+        source_span=span,
+        allow_nan=True,
+        steady=steady,
+    )
+    info.update(
+        map_degree=field.index_map.degree, map_residual_cells=field.index_map.residual_cells
+    )
     return field
 
 
@@ -915,8 +1106,7 @@ def _short(name: str) -> str:
 
 
 # ----------------------------------------------------------------------------- GRIB
-def open_grib_dataset(path: str | Path, *, filter_by_keys: Mapping[str, Any] | None = None
-                      ) -> Any:
+def open_grib_dataset(path: str | Path, *, filter_by_keys: Mapping[str, Any] | None = None) -> Any:
     """Read a GRIB file into an :class:`xarray.Dataset` with cfgrib (extra ``grib``).
 
     Parameters
@@ -935,15 +1125,17 @@ def open_grib_dataset(path: str | Path, *, filter_by_keys: Mapping[str, Any] | N
     """
     p = Path(path)
     if not p.is_file():
-        raise InputError(f"{p}: GRIB file not found; check the `path` (relative to the course "
-                         "file's folder)")
+        raise InputError(
+            f"{p}: GRIB file not found; check the `path` (relative to the course file's folder)"
+        )
     xr = require_xarray("reading GRIB")
     try:
         import cfgrib  # noqa: F401
     except (ImportError, RuntimeError) as exc:
         raise InputError(
             f"{p}: reading GRIB needs the optional packages cfgrib and eccodes ({exc}); install "
-            "them with `pip install 'sailroute[grib]'`") from None
+            "them with `pip install 'sailroute[grib]'`"
+        ) from None
     kw: dict[str, Any] = {"indexpath": ""}  # no .idx files next to the data
     if filter_by_keys:
         kw["filter_by_keys"] = dict(filter_by_keys)
@@ -955,13 +1147,19 @@ def open_grib_dataset(path: str | Path, *, filter_by_keys: Mapping[str, Any] | N
         raise WindDataError(
             f"{p}: cannot be read as GRIB by cfgrib ({text}). A file that mixes levels or "
             "forecast types needs a filter, e.g. `filter: {typeOfLevel: heightAboveGround, "
-            "level: 10}`") from None
+            "level: 10}`"
+        ) from None
     ds.attrs[SOURCE_ATTR] = str(p)
     return ds
 
 
-def open_grib(path: str | Path, frame: LocalFrame, *,
-              filter_by_keys: Mapping[str, Any] | None = None, **kwargs: Any) -> GridWind:
+def open_grib(
+    path: str | Path,
+    frame: LocalFrame,
+    *,
+    filter_by_keys: Mapping[str, Any] | None = None,
+    **kwargs: Any,
+) -> GridWind:
     """Open GRIB wind (via cfgrib) as a wind field; keywords as :func:`open_netcdf`."""
     ds = open_grib_dataset(path, filter_by_keys=filter_by_keys)
     kwargs.setdefault("label", f"GRIB wind {Path(path).name}")

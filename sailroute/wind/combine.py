@@ -39,22 +39,32 @@ class SpeedDirectionWind:
     @property
     def coverage(self) -> Coverage:
         """The intersection of the coverages of the parts that do not clamp."""
-        parts = [f.coverage for f in (self.speed_from, self.direction_from)
-                 if not getattr(f, "clamp", False)] or [self.speed_from.coverage]
-        return Coverage(max(c.t0 for c in parts), min(c.t1 for c in parts),
-                        max(c.xmin for c in parts), min(c.xmax for c in parts),
-                        max(c.ymin for c in parts), min(c.ymax for c in parts),
-                        frame=self.speed_from.coverage.frame
-                        or self.direction_from.coverage.frame)
+        parts = [
+            f.coverage
+            for f in (self.speed_from, self.direction_from)
+            if not getattr(f, "clamp", False)
+        ] or [self.speed_from.coverage]
+        return Coverage(
+            max(c.t0 for c in parts),
+            min(c.t1 for c in parts),
+            max(c.xmin for c in parts),
+            min(c.xmax for c in parts),
+            max(c.ymin for c in parts),
+            min(c.ymax for c in parts),
+            frame=self.speed_from.coverage.frame or self.direction_from.coverage.frame,
+        )
 
     @property
     def clamp(self) -> bool:
         """Clamps only when both parts do."""
-        return bool(getattr(self.speed_from, "clamp", False)
-                    and getattr(self.direction_from, "clamp", False))
+        return bool(
+            getattr(self.speed_from, "clamp", False)
+            and getattr(self.direction_from, "clamp", False)
+        )
 
-    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
-               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def sample(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s], local ``x, y`` [m] (broadcast).
 
         Raises

@@ -88,8 +88,10 @@ class UniformCurrent:
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.speed_ms) and self.speed_ms >= 0 and np.isfinite(self.set_deg)):
-            raise InputError(f"uniform current: the rate must be finite and >= 0 and the set "
-                             f"finite; got {self.speed_ms!r} m/s towards {self.set_deg!r}°")
+            raise InputError(
+                f"uniform current: the rate must be finite and >= 0 and the set "
+                f"finite; got {self.speed_ms!r} m/s towards {self.set_deg!r}°"
+            )
 
     @cached_property
     def _uv(self) -> tuple[float, float]:
@@ -148,10 +150,16 @@ class DiamondCurrent:
         s = np.asarray(self.set_deg, dtype=float)
         r = np.asarray(self.rate_ms, dtype=float)
         if not (h.ndim == 1 and h.shape == s.shape == r.shape and h.size >= 1):
-            raise InputError("tidal diamond: give one hour, set and rate per row "
-                             f"(got {h.size} hours, {s.size} sets, {r.size} rates)")
-        if not (np.all(np.isfinite(h)) and np.all(np.isfinite(s)) and np.all(np.isfinite(r))
-                and np.all(r >= 0)):
+            raise InputError(
+                "tidal diamond: give one hour, set and rate per row "
+                f"(got {h.size} hours, {s.size} sets, {r.size} rates)"
+            )
+        if not (
+            np.all(np.isfinite(h))
+            and np.all(np.isfinite(s))
+            and np.all(np.isfinite(r))
+            and np.all(r >= 0)
+        ):
             raise InputError("tidal diamond: hours, sets and rates must be finite, rates >= 0")
         if np.any(np.diff(h) <= 0):
             raise InputError("tidal diamond: the hours must increase strictly from row to row")
@@ -167,8 +175,9 @@ class DiamondCurrent:
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Current ``(u, v)`` [m s⁻¹], linear in time between rows."""
-        t, x, y = prepare_points(self.coverage, t, x, y, clamp=self.clamp,
-                                 name="tidal-diamond current")
+        t, x, y = prepare_points(
+            self.coverage, t, x, y, clamp=self.clamp, name="tidal-diamond current"
+        )
         tt, u, v = self._table
         if tt.size == 1:
             return np.full(t.shape, u[0]), np.full(t.shape, v[0])
@@ -201,9 +210,15 @@ class RelativeWind:
     def coverage(self) -> Coverage:
         """Where both the wind and the current are defined."""
         a, b = self.wind.coverage, self.current.coverage
-        return Coverage(max(a.t0, b.t0), min(a.t1, b.t1), max(a.xmin, b.xmin),
-                        min(a.xmax, b.xmax), max(a.ymin, b.ymin), min(a.ymax, b.ymax),
-                        frame=a.frame if a.frame is not None else b.frame)
+        return Coverage(
+            max(a.t0, b.t0),
+            min(a.t1, b.t1),
+            max(a.xmin, b.xmin),
+            min(a.xmax, b.xmax),
+            max(a.ymin, b.ymin),
+            min(a.ymax, b.ymax),
+            frame=a.frame if a.frame is not None else b.frame,
+        )
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Water-relative wind ``(u, v)`` [m s⁻¹]."""
@@ -259,13 +274,21 @@ def open_netcdf_current(
     var = dict(variables) if variables else _current_variables(p)
     if var is None:
         tried = ", ".join(f"{a}/{b}" for a, b in CURRENT_NAMES)
-        raise InputError(f"{p.name}: no surface-current variables found (tried {tried}, as "
-                         "names and CF standard names); name them with `variables: {u: ..., "
-                         "v: ...}`")
-    return open_netcdf(p, frame, bbox=bbox, time_window=time_window, variables=var,
-                       speed_unit=speed_unit, select=select, interpolation=interpolation,
-                       steady=steady, clamp=clamp, label=f"NetCDF current {p.name}")
-
-
-
-
+        raise InputError(
+            f"{p.name}: no surface-current variables found (tried {tried}, as "
+            "names and CF standard names); name them with `variables: {u: ..., "
+            "v: ...}`"
+        )
+    return open_netcdf(
+        p,
+        frame,
+        bbox=bbox,
+        time_window=time_window,
+        variables=var,
+        speed_unit=speed_unit,
+        select=select,
+        interpolation=interpolation,
+        steady=steady,
+        clamp=clamp,
+        label=f"NetCDF current {p.name}",
+    )

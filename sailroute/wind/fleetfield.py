@@ -107,15 +107,22 @@ class FleetField:
     @cached_property
     def _state(self) -> tuple[tuple[_Sensor, ...], Coverage, str]:
         if self.method not in FLEET_METHODS:
-            raise InputError(f"{self.name}: method {self.method!r}; expected one of "
-                             f"{', '.join(FLEET_METHODS)}")
+            raise InputError(
+                f"{self.name}: method {self.method!r}; expected one of {', '.join(FLEET_METHODS)}"
+            )
         if not self.sensors:
             raise InputError(f"{self.name}: no sensors")
-        if not (self.power > 0 and self.speed_scale_ms >= 0 and self.window_s >= 0
-                and self.radius_m >= 0):
-            raise InputError(f"{self.name}: power must be > 0 and speed_scale_ms, window_s, "
-                             f"radius_m >= 0 (got {self.power}, {self.speed_scale_ms}, "
-                             f"{self.window_s}, {self.radius_m})")
+        if not (
+            self.power > 0
+            and self.speed_scale_ms >= 0
+            and self.window_s >= 0
+            and self.radius_m >= 0
+        ):
+            raise InputError(
+                f"{self.name}: power must be > 0 and speed_scale_ms, window_s, "
+                f"radius_m >= 0 (got {self.power}, {self.speed_scale_ms}, "
+                f"{self.window_s}, {self.radius_m})"
+            )
         sens = []
         for s in self.sensors:
             if len(s) < 1:
@@ -127,17 +134,27 @@ class FleetField:
         t0, t1 = max(starts), min(ends)
         first = sens[int(np.argmax(starts))].series
         last = sens[int(np.argmin(ends))].series
-        limit = (f"the time span is limited by the log of {first.label} (starts "
-                 f"{iso(t0)}) and the log of {last.label} (ends {iso(t1)})")
+        limit = (
+            f"the time span is limited by the log of {first.label} (starts "
+            f"{iso(t0)}) and the log of {last.label} (ends {iso(t1)})"
+        )
         if t0 > t1:
-            raise InputError(f"{self.name}: the logs never overlap in time: {limit}; use "
-                             "logs of the same race")
+            raise InputError(
+                f"{self.name}: the logs never overlap in time: {limit}; use logs of the same race"
+            )
         xs = np.concatenate([s.x for s in sens])
         ys = np.concatenate([s.y for s in sens])
         r = self.radius_m
-        cov = Coverage(t0, t1, float(xs.min()) - r, float(xs.max()) + r, float(ys.min()) - r,
-                       float(ys.max()) + r, frame=self.frame,
-                       source_span=(min(starts), max(ends)))
+        cov = Coverage(
+            t0,
+            t1,
+            float(xs.min()) - r,
+            float(xs.max()) + r,
+            float(ys.min()) - r,
+            float(ys.max()) + r,
+            frame=self.frame,
+            source_span=(min(starts), max(ends)),
+        )
         return tuple(sens), cov, limit
 
     @cached_property
@@ -200,8 +217,11 @@ class FleetField:
             raise OutOfCoverageError(
                 f"{self.name}: {int((tot <= 0).sum())} of {tot.size} sample points fall where "
                 f"every log has a gap (first at {iso(float(t[k]))}; gaps: "
-                + "; ".join(f"{s.series.label} {iso(a)} .. {iso(b)}" for s in self._state[0]
-                            for a, b in s.series.gaps)
+                + "; ".join(
+                    f"{s.series.label} {iso(a)} .. {iso(b)}"
+                    for s in self._state[0]
+                    for a, b in s.series.gaps
+                )
                 + "); the wind there is unknown. Use another wind for that time."
             )
         return (w * u).sum(axis=-1) / tot, (w * v).sum(axis=-1) / tot
@@ -271,7 +291,7 @@ class FleetField:
 
     def _st_idw(self, t: NDArray, x: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
         """Inverse space-time distance over every record within ``±window_s``."""
-        c2 = self.speed_scale_ms ** 2
+        c2 = self.speed_scale_ms**2
         wsum = np.zeros(t.size)
         usum = np.zeros(t.size)
         vsum = np.zeros(t.size)
@@ -291,14 +311,15 @@ class FleetField:
                 k = np.minimum(lo + m, ts.size - 1)
                 dt = ts[k] - t
                 d2 = np.maximum((x - s.x[k]) ** 2 + (y - s.y[k]) ** 2 + c2 * dt * dt, 1e-24)
-                w = (1.0 / d2 if self.power == 2.0 else d2 ** (-0.5 * self.power))
+                w = 1.0 / d2 if self.power == 2.0 else d2 ** (-0.5 * self.power)
                 w *= (lo + m < hi) & ok
                 wsum += w
                 usum += w * s.u[k]
                 vsum += w * s.v[k]
         if not any_ok.all():
-            self._combine(any_ok[:, None].astype(float), np.zeros((t.size, 1)),
-                          np.zeros((t.size, 1)), t)
+            self._combine(
+                any_ok[:, None].astype(float), np.zeros((t.size, 1)), np.zeros((t.size, 1)), t
+            )
         return usum / wsum, vsum / wsum
 
     def _oi(self, t: NDArray, x: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
@@ -315,11 +336,21 @@ class FleetField:
         return u, v
 
 
-def _kernel(t1: NDArray, x1: NDArray, y1: NDArray, t2: NDArray, x2: NDArray, y2: NDArray,
-            sigma2: float, length_m: float, time_s: float) -> NDArray:
+def _kernel(
+    t1: NDArray,
+    x1: NDArray,
+    y1: NDArray,
+    t2: NDArray,
+    x2: NDArray,
+    y2: NDArray,
+    sigma2: float,
+    length_m: float,
+    time_s: float,
+) -> NDArray:
     """Squared-exponential covariance in space and time, ``(n1, n2)``."""
-    q = (((x1[:, None] - x2) ** 2 + (y1[:, None] - y2) ** 2) / (length_m * length_m)
-         + (t1[:, None] - t2) ** 2 / (time_s * time_s))
+    q = ((x1[:, None] - x2) ** 2 + (y1[:, None] - y2) ** 2) / (length_m * length_m) + (
+        t1[:, None] - t2
+    ) ** 2 / (time_s * time_s)
     return sigma2 * np.exp(-0.5 * q)
 
 
@@ -328,8 +359,9 @@ NOISE_FLOOR_MS: Final = 0.05
 keeps the covariance matrix well conditioned when the boats agree to the last digit."""
 
 
-def _fit_gp(t: NDArray, x: NDArray, y: NDArray, res: NDArray, max_points: int = 400
-            ) -> tuple[float, float, float, float]:
+def _fit_gp(
+    t: NDArray, x: NDArray, y: NDArray, res: NDArray, max_points: int = 400
+) -> tuple[float, float, float, float]:
     """Maximum-likelihood ``(sigma², length, time, noise²)`` for residuals ``(n, 2)``.
 
     Both components share the scales; at most ``max_points`` evenly spaced records
@@ -340,7 +372,7 @@ def _fit_gp(t: NDArray, x: NDArray, y: NDArray, res: NDArray, max_points: int = 
     if t.size > max_points:
         k = np.linspace(0, t.size - 1, max_points).astype(int)
         t, x, y, res = t[k], x[k], y[k], res[k]
-    var = max(float(np.mean(res * res)), NOISE_FLOOR_MS ** 2)
+    var = max(float(np.mean(res * res)), NOISE_FLOOR_MS**2)
     n = t.size
 
     def nll(p: NDArray) -> float:
@@ -355,9 +387,12 @@ def _fit_gp(t: NDArray, x: NDArray, y: NDArray, res: NDArray, max_points: int = 
         return float(0.5 * np.sum(z * z) + 2 * np.sum(np.log(np.diag(c))) + n * np.log(2 * np.pi))
 
     p0 = np.log([0.5 * var, 500.0, 120.0, 0.5 * var])
-    bounds = [(np.log(var * 1e-3), np.log(var * 10)), (np.log(50.0), np.log(2e4)),
-              (np.log(10.0), np.log(3600.0)),
-              (np.log(max(var * 1e-3, NOISE_FLOOR_MS ** 2)), np.log(var * 10))]
+    bounds = [
+        (np.log(var * 1e-3), np.log(var * 10)),
+        (np.log(50.0), np.log(2e4)),
+        (np.log(10.0), np.log(3600.0)),
+        (np.log(max(var * 1e-3, NOISE_FLOOR_MS**2)), np.log(var * 10)),
+    ]
     r = minimize(nll, p0, method="L-BFGS-B", bounds=bounds)
     s2, lm, ts, n2 = (float(a) for a in np.exp(r.x))
     return s2, lm, ts, n2

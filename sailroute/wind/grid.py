@@ -239,17 +239,23 @@ class GridWind:
         for label, a in (("x", x), ("y", y), ("u", u), ("v", v)):
             ok = np.isfinite(a) | (np.isnan(a) if self.allow_nan and label in "uv" else False)
             if not np.all(ok):
-                hint = "" if label in "xy" else (
-                    "; pass allow_nan=True to keep NaN (land) cells as holes that routing "
-                    "must not cross")
+                hint = (
+                    ""
+                    if label in "xy"
+                    else (
+                        "; pass allow_nan=True to keep NaN (land) cells as holes that routing "
+                        "must not cross"
+                    )
+                )
                 raise InputError(f"{self.name}: {label} contains NaN or infinite values{hint}")
         if self.steady and t.size != 1:
-            raise InputError(f"{self.name}: steady=True holds a single time slice at all "
-                             f"times, but there are {t.size} slices")
+            raise InputError(
+                f"{self.name}: steady=True holds a single time slice at all "
+                f"times, but there are {t.size} slices"
+            )
         if self.interpolation not in ("linear", "nearest"):
             raise InputError(
-                f"{self.name}: interpolation {self.interpolation!r}; "
-                "expected 'linear' or 'nearest'"
+                f"{self.name}: interpolation {self.interpolation!r}; expected 'linear' or 'nearest'"
             )
         if self.time_step_s is not None and not (self.time_step_s > 0):
             raise InputError(
@@ -268,8 +274,9 @@ class GridWind:
         imap = fit_index_map(x, y, tolerance_cells=self.map_tolerance_cells, name=self.name)
         uv = np.ascontiguousarray((u + 1j * v).reshape(t.size, -1))
         t0, t1 = (-np.inf, np.inf) if self.steady else (float(t[0]), float(t[-1]))
-        cov = Coverage(t0, t1, xmin, xmax, ymin, ymax, frame=self.frame,
-                       source_span=self.source_span)
+        cov = Coverage(
+            t0, t1, xmin, xmax, ymin, ymax, frame=self.frame, source_span=self.source_span
+        )
         return _GridState(t, uv, imap, cov, bool(np.isnan(uv).any()))
 
     @property
@@ -303,13 +310,15 @@ class GridWind:
         """
         return self._sample(t, x, y, refuse_nan=True)
 
-    def sample_with_holes(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
-                          ) -> tuple[NDArray, NDArray]:
+    def sample_with_holes(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+    ) -> tuple[NDArray, NDArray]:
         """As :meth:`sample`, but NaN where the data hold no wind (for statistics over an area)."""
         return self._sample(t, x, y, refuse_nan=False)
 
-    def _sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike, *, refuse_nan: bool
-                ) -> tuple[NDArray, NDArray]:
+    def _sample(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike, *, refuse_nan: bool
+    ) -> tuple[NDArray, NDArray]:
         t, x, y = prepare_points(self._state.cov, t, x, y, clamp=self.clamp, name=self.name)
         shape = t.shape
         t, x, y = t.ravel(), x.ravel(), y.ravel()
@@ -399,8 +408,11 @@ class GridWind:
             "x": (("j", "i"), x, {"units": "m", "long_name": "metres east of the origin"}),
             "y": (("j", "i"), y, {"units": "m", "long_name": "metres north of the origin"}),
         }
-        attrs: dict[str, Any] = {"title": self.name, "interpolation": self.interpolation,
-                                 "source": "sailroute GridWind"}
+        attrs: dict[str, Any] = {
+            "title": self.name,
+            "interpolation": self.interpolation,
+            "source": "sailroute GridWind",
+        }
         if self.time_step_s is not None:
             attrs["time_step_s"] = float(self.time_step_s)
         if self.frame is not None:
@@ -409,10 +421,16 @@ class GridWind:
             lat, lon = self.frame.to_latlon(x, y)
             gn = self.frame.grid_north_deg(lat, lon)
             ue, ve = rotate_clockwise(uv.real, uv.imag, -gn)
-            coords["lat"] = (("j", "i"), lat, {"standard_name": "latitude",
-                                               "units": "degrees_north"})
-            coords["lon"] = (("j", "i"), lon, {"standard_name": "longitude",
-                                               "units": "degrees_east"})
+            coords["lat"] = (
+                ("j", "i"),
+                lat,
+                {"standard_name": "latitude", "units": "degrees_north"},
+            )
+            coords["lon"] = (
+                ("j", "i"),
+                lon,
+                {"standard_name": "longitude", "units": "degrees_east"},
+            )
             data["eastward_wind"] = (dims, ue, {**ms, "standard_name": "eastward_wind"})
             data["northward_wind"] = (dims, ve, {**ms, "standard_name": "northward_wind"})
             attrs["frame_lat0"] = float(self.frame.lat0)

@@ -119,8 +119,15 @@ class BoatWind:
     def coverage(self) -> Coverage:
         """The log's time span; unbounded in space."""
         inf = float("inf")
-        return Coverage(float(self.series.t[0]), float(self.series.t[-1]), -inf, inf, -inf,
-                        inf, frame=self.frame)
+        return Coverage(
+            float(self.series.t[0]),
+            float(self.series.t[-1]),
+            -inf,
+            inf,
+            -inf,
+            inf,
+            frame=self.frame,
+        )
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s], position ``x, y`` [m] (broadcast).
@@ -170,8 +177,14 @@ def boat_wind(
     return BoatWind(_as_series(series_or_track, max_gap_s), frame, clamp=clamp)
 
 
-def hull_fraction(sensors: Sequence[MeasuredSeries], frame: LocalFrame, t: ArrayLike,
-                  x: ArrayLike, y: ArrayLike, window_s: float = 60.0) -> float:
+def hull_fraction(
+    sensors: Sequence[MeasuredSeries],
+    frame: LocalFrame,
+    t: ArrayLike,
+    x: ArrayLike,
+    y: ArrayLike,
+    window_s: float = 60.0,
+) -> float:
     """Fraction of points inside the sensors' convex hull in space and time.
 
     A point counts as inside when its time lies within the sensors' common span
@@ -196,14 +209,18 @@ def hull_fraction(sensors: Sequence[MeasuredSeries], frame: LocalFrame, t: Array
     """
     from scipy.spatial import Delaunay, QhullError
 
-    t, x, y = (a.ravel() for a in np.broadcast_arrays(np.asarray(t, float),
-                                                      np.asarray(x, float),
-                                                      np.asarray(y, float)))
+    t, x, y = (
+        a.ravel()
+        for a in np.broadcast_arrays(
+            np.asarray(t, float), np.asarray(x, float), np.asarray(y, float)
+        )
+    )
     if not t.size:
         return float("nan")
     st = np.concatenate([s.t for s in sensors])
-    sx, sy = frame.to_xy(np.concatenate([s.lat for s in sensors]),
-                         np.concatenate([s.lon for s in sensors]))
+    sx, sy = frame.to_xy(
+        np.concatenate([s.lat for s in sensors]), np.concatenate([s.lon for s in sensors])
+    )
     t0 = max(float(s.t[0]) for s in sensors)
     t1 = min(float(s.t[-1]) for s in sensors)
     half = 0.5 * window_s
@@ -259,16 +276,19 @@ class FleetWind:
         """
         return hull_fraction(self.sensors, self.frame, t, x, y, self.hull_window_s)
 
-    def extrapolation_note(self, t: ArrayLike, x: ArrayLike, y: ArrayLike,
-                           what: str = "the requested points") -> str:
+    def extrapolation_note(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike, what: str = "the requested points"
+    ) -> str:
         """One line saying how much of ``what`` lies outside the sensors' hull."""
         n = int(np.broadcast(np.asarray(t), np.asarray(x), np.asarray(y)).size)
         f = self.coverage_report(t, x, y)
         if not np.isfinite(f):
             return f"{self.field.name}: no points to check"
-        return (f"{self.field.name}: {100 * (1 - f):.0f} % of {what} ({n} points) lie outside "
-                f"the sensors' hull (±{self.hull_window_s / 2:g} s): the wind there is "
-                "extrapolated")
+        return (
+            f"{self.field.name}: {100 * (1 - f):.0f} % of {what} ({n} points) lie outside "
+            f"the sensors' hull (±{self.hull_window_s / 2:g} s): the wind there is "
+            "extrapolated"
+        )
 
 
 DEFAULT_METHOD: Final = "st-idw"
@@ -331,22 +351,34 @@ def fleet_wind(
     series = [_as_series(s, max_gap_s) for s in tracks_or_series]
     if not series:
         raise InputError("fleet wind: no boats given")
-    biases = (estimate_biases(series, max_lag_s=max_lag_s) if estimate_bias and len(series) > 1
-              else tuple(BoatBias(s.boat) for s in series))
-    used = [apply_bias(s, b) if estimate_bias else s
-            for s, b in zip(series, biases, strict=True)]
+    biases = (
+        estimate_biases(series, max_lag_s=max_lag_s)
+        if estimate_bias and len(series) > 1
+        else tuple(BoatBias(s.boat) for s in series)
+    )
+    used = [apply_bias(s, b) if estimate_bias else s for s, b in zip(series, biases, strict=True)]
     opts = dict(options or {})
-    f = FleetField(tuple(resample_series(s, resample_s) for s in used), frame, method=method,
-                   radius_m=radius_m, clamp=clamp, **opts)  # type: ignore[arg-type]
-    notes = [f"{f.name}: method {method}, {len(used)} boat(s)"
-             + (f", resampled to {resample_s:g} s" if resample_s > 0 else "")]
+    f = FleetField(
+        tuple(resample_series(s, resample_s) for s in used),
+        frame,
+        method=method,
+        radius_m=radius_m,
+        clamp=clamp,
+        **opts,
+    )  # type: ignore[arg-type]
+    notes = [
+        f"{f.name}: method {method}, {len(used)} boat(s)"
+        + (f", resampled to {resample_s:g} s" if resample_s > 0 else "")
+    ]
     if estimate_bias:
         notes += [f"bias {b.describe()}" for b in biases]
     notes.append(f.limit_note)
     sc = f.oi_scales_fitted
     if sc is not None:
-        notes.append(f"optimal interpolation: sigma {sc[0]:.2f} m/s, length {sc[1]:.0f} m, "
-                     f"time {sc[2]:.0f} s, noise {sc[3]:.2f} m/s")
+        notes.append(
+            f"optimal interpolation: sigma {sc[0]:.2f} m/s, length {sc[1]:.0f} m, "
+            f"time {sc[2]:.0f} s, noise {sc[3]:.2f} m/s"
+        )
     return FleetWind(f, biases, tuple(used), frame, tuple(notes), hull_window_s)
 
 
@@ -412,8 +444,10 @@ def leave_one_out(
     per: dict[str, list[tuple[LooRow, NDArray, NDArray]]] = {k: [] for k in methods}
     for k, tgt in enumerate(targets):
         others = [s for j, s in enumerate(series_list) if j != k]
-        fields = {label: fleet_wind(others, frame, clamp=True, **kw)  # type: ignore[arg-type]
-                  for label, kw in methods.items()}
+        fields = {
+            label: fleet_wind(others, frame, clamp=True, **kw)  # type: ignore[arg-type]
+            for label, kw in methods.items()
+        }
         m = np.ones(tgt.t.size, bool)
         for fw in fields.values():
             m &= fw.field.available(tgt.t)
@@ -426,9 +460,20 @@ def leave_one_out(
             ps, pd = wind_speed_direction(*fw.field.sample(tt, x, y))
             ds, dd = (ps - ms) / KNOT, np.abs(wrap180(pd - md))
             ins = fw.coverage_report(tt, x, y)
-            per[label].append((LooRow(label, tgt.boat, int(tt.size),
-                                      float(np.sqrt(np.mean(ds ** 2))), float(np.mean(dd)), ins),
-                               ds, dd))
+            per[label].append(
+                (
+                    LooRow(
+                        label,
+                        tgt.boat,
+                        int(tt.size),
+                        float(np.sqrt(np.mean(ds**2))),
+                        float(np.mean(dd)),
+                        ins,
+                    ),
+                    ds,
+                    dd,
+                )
+            )
     rows: list[LooRow] = []
     for label, got in per.items():
         if not got:
@@ -436,6 +481,14 @@ def leave_one_out(
         rows += [g[0] for g in got]
         ds, dd = np.concatenate([g[1] for g in got]), np.concatenate([g[2] for g in got])
         n = sum(g[0].n for g in got)
-        rows.append(LooRow(label, "pooled", n, float(np.sqrt(np.mean(ds ** 2))),
-                           float(np.mean(dd)), sum(g[0].n * g[0].inside_hull for g in got) / n))
+        rows.append(
+            LooRow(
+                label,
+                "pooled",
+                n,
+                float(np.sqrt(np.mean(ds**2))),
+                float(np.mean(dd)),
+                sum(g[0].n * g[0].inside_hull for g in got) / n,
+            )
+        )
     return rows

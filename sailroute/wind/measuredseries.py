@@ -159,9 +159,19 @@ class MeasuredSeries:
         """The records with ``t0 <= t <= t1`` [epoch s]; gaps clipped to that span."""
         m = (self.t >= t0) & (self.t <= t1)
         gaps = tuple((a, b) for a, b in self.gaps if b > t0 and a < t1)
-        return MeasuredSeries(self.boat, self.file, self.t[m], self.lat[m], self.lon[m],
-                              self.u[m], self.v[m], self.source, self.notes, gaps,
-                              self.max_gap_s)
+        return MeasuredSeries(
+            self.boat,
+            self.file,
+            self.t[m],
+            self.lat[m],
+            self.lon[m],
+            self.u[m],
+            self.v[m],
+            self.source,
+            self.notes,
+            gaps,
+            self.max_gap_s,
+        )
 
     def local(self, frame: LocalFrame) -> tuple[NDArray, NDArray, NDArray, NDArray]:
         """Positions ``x, y`` [m] and wind ``u, v`` [m s⁻¹] in the local frame."""
@@ -176,8 +186,9 @@ def find_gaps(t: NDArray, max_gap_s: float) -> tuple[tuple[float, float], ...]:
     return tuple((float(t[i]), float(t[i + 1])) for i in k)
 
 
-def smooth_vector(t: NDArray, u: NDArray, v: NDArray, window_s: float, max_gap_s: float
-                  ) -> tuple[NDArray, NDArray]:
+def smooth_vector(
+    t: NDArray, u: NDArray, v: NDArray, window_s: float, max_gap_s: float
+) -> tuple[NDArray, NDArray]:
     """Centred vector mean of ``(u, v)`` over ``window_s`` [s], never across a gap.
 
     Each record becomes the mean of the records within ``±window_s / 2`` of it in
@@ -244,8 +255,10 @@ def sensor_from_track(
         channels found), or fewer than two usable rows.
     """
     if not (max_gap_s > 0) or not (smooth_s >= 0):
-        raise InputError(f"{track.source or track.name}: max_gap_s must be > 0 and smooth_s "
-                         f">= 0 (got {max_gap_s}, {smooth_s})")
+        raise InputError(
+            f"{track.source or track.name}: max_gap_s must be > 0 and smooth_s "
+            f">= 0 (got {max_gap_s}, {smooth_s})"
+        )
     ch = dict(track.channels)
     if _has(ch, "tws_ms", "twd_deg"):
         source = "tws/twd"
@@ -256,10 +269,12 @@ def sensor_from_track(
         tws, twd = ch["tws_ms"], wrap360(ch[ref] + ch["twa_deg"])
     elif _has(ch, "aws_ms", "awa_deg") and _has(ch, "sog_ms", "cog_deg"):
         hdg = ch["hdg_deg"] if _has(ch, "hdg_deg") else None
-        source = ("aws/awa + sog/cog (over the ground" + (", awa from hdg)" if hdg is not None
-                                                          else ", awa from cog)"))
-        tws, twd = true_wind(ch["aws_ms"], ch["awa_deg"], ch["sog_ms"], ch["cog_deg"],
-                             heading_deg=hdg)
+        source = "aws/awa + sog/cog (over the ground" + (
+            ", awa from hdg)" if hdg is not None else ", awa from cog)"
+        )
+        tws, twd = true_wind(
+            ch["aws_ms"], ch["awa_deg"], ch["sog_ms"], ch["cog_deg"], heading_deg=hdg
+        )
     elif _has(ch, "aws_ms", "awa_deg", "bsp_ms", "hdg_deg"):
         source = "aws/awa + bsp/hdg (over the water)"
         tws, twd = true_wind(ch["aws_ms"], ch["awa_deg"], ch["bsp_ms"], ch["hdg_deg"])
@@ -272,22 +287,38 @@ def sensor_from_track(
         )
     tws = np.asarray(tws, float)
     twd = np.asarray(twd, float)
-    ok = np.isfinite(tws) & np.isfinite(twd) & np.isfinite(track.lat_deg) & np.isfinite(
-        track.lon_deg)
+    ok = (
+        np.isfinite(tws)
+        & np.isfinite(twd)
+        & np.isfinite(track.lat_deg)
+        & np.isfinite(track.lon_deg)
+    )
     notes = []
     if (~ok).any():
         notes.append(f"dropped {int((~ok).sum())} of {ok.size} row(s) without a wind value")
     if ok.sum() < 2:
-        raise InputError(f"{track.source or track.name}: only {int(ok.sum())} row(s) with a "
-                         f"wind value ({source}); a wind sensor needs at least two")
+        raise InputError(
+            f"{track.source or track.name}: only {int(ok.sum())} row(s) with a "
+            f"wind value ({source}); a wind sensor needs at least two"
+        )
     t = np.asarray(track.t_s[ok], float)
     u, v = wind_components(tws[ok], twd[ok])
     if smooth_s > 0:
         u, v = smooth_vector(t, u, v, smooth_s, max_gap_s)
         notes.append(f"smoothed: centred vector mean over {smooth_s:g} s")
-    return MeasuredSeries(track.name, track.source, t, track.lat_deg[ok].astype(float),
-                          track.lon_deg[ok].astype(float), u, v, source, tuple(notes),
-                          find_gaps(t, max_gap_s), float(max_gap_s))
+    return MeasuredSeries(
+        track.name,
+        track.source,
+        t,
+        track.lat_deg[ok].astype(float),
+        track.lon_deg[ok].astype(float),
+        u,
+        v,
+        source,
+        tuple(notes),
+        find_gaps(t, max_gap_s),
+        float(max_gap_s),
+    )
 
 
 def _as_series(obj: MeasuredSeries | Track, max_gap_s: float | None) -> MeasuredSeries:
@@ -298,8 +329,19 @@ def _as_series(obj: MeasuredSeries | Track, max_gap_s: float | None) -> Measured
     if max_gap_s is not None and max_gap_s != s.max_gap_s:
         if not (max_gap_s > 0):
             raise InputError(f"{s.label}: max_gap_s must be > 0 (got {max_gap_s})")
-        s = MeasuredSeries(s.boat, s.file, s.t, s.lat, s.lon, s.u, s.v, s.source, s.notes,
-                           find_gaps(s.t, max_gap_s), float(max_gap_s))
+        s = MeasuredSeries(
+            s.boat,
+            s.file,
+            s.t,
+            s.lat,
+            s.lon,
+            s.u,
+            s.v,
+            s.source,
+            s.notes,
+            find_gaps(s.t, max_gap_s),
+            float(max_gap_s),
+        )
     return s
 
 
@@ -339,7 +381,16 @@ def resample_series(series: MeasuredSeries, interval_s: float) -> MeasuredSeries
 
     t = (uniq + 0.5) * interval_s
     t = np.clip(t, series.t[0], series.t[-1])  # first/last bins stay inside the log
-    return MeasuredSeries(series.boat, series.file, t.astype(float), mean(series.lat),
-                          mean(series.lon), mean(series.u), mean(series.v), series.source,
-                          (*series.notes, f"resampled to {interval_s:g} s means"), series.gaps,
-                          series.max_gap_s)
+    return MeasuredSeries(
+        series.boat,
+        series.file,
+        t.astype(float),
+        mean(series.lat),
+        mean(series.lon),
+        mean(series.u),
+        mean(series.v),
+        series.source,
+        (*series.notes, f"resampled to {interval_s:g} s means"),
+        series.gaps,
+        series.max_gap_s,
+    )

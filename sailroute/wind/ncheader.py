@@ -128,11 +128,16 @@ def check_classic_header(path: str | Path) -> None:
                     raise _Damaged(f"unknown variable type at offset {r.pos - 4}")
                 r.count()  # vsize (rounded, may wrap for large variables: not used)
                 r.skip(4 if magic[3] == 1 else 8)  # begin
-                lengths = [numrecs if dims[i] == 0 and numrecs != _STREAMING else dims[i]
-                           for i in ids]
+                lengths = [
+                    numrecs if dims[i] == 0 and numrecs != _STREAMING else dims[i] for i in ids
+                ]
                 if math.prod(lengths) * value > size:
-                    raise _Damaged(f"a variable of {' x '.join(map(str, lengths))} values "
-                                   f"({value} bytes each) in a file of {size} bytes")
+                    raise _Damaged(
+                        f"a variable of {' x '.join(map(str, lengths))} values "
+                        f"({value} bytes each) in a file of {size} bytes"
+                    )
         except _Damaged as exc:
-            raise WindDataError(f"{p}: damaged NetCDF file: {exc}; expected a complete classic "
-                                "NetCDF file (download or copy it again)") from None
+            raise WindDataError(
+                f"{p}: damaged NetCDF file: {exc}; expected a complete classic "
+                "NetCDF file (download or copy it again)"
+            ) from None

@@ -26,8 +26,11 @@ def is_ndbc_text(path: str | Path) -> bool:
             first = f.readline()
     except OSError:
         return False
-    return first.startswith(("#YY", "#yy")) and len(first.split()) >= 6 and (
-        "WDIR" in first.split() or "WSPD" in first.split())
+    return (
+        first.startswith(("#YY", "#yy"))
+        and len(first.split()) >= 6
+        and ("WDIR" in first.split() or "WSPD" in first.split())
+    )
 
 
 def read_ndbc(
@@ -63,14 +66,16 @@ def read_ndbc(
     lines = p.read_text(errors="replace").splitlines()
     if not lines or not lines[0].startswith("#"):
         raise WindDataError(
-            f"{name}: expected an NDBC header line starting with '#YY  MM DD hh mm'")
+            f"{name}: expected an NDBC header line starting with '#YY  MM DD hh mm'"
+        )
     names = lines[0].lstrip("#").split()
     for need in ("YY", "MM", "DD", "hh", "mm", "WDIR", "WSPD"):
         if need not in names:
             raise WindDataError(f"{name}: NDBC header lacks column {need!r} (found {names})")
     col = {n: k for k, n in enumerate(names)}
-    rows = [(k + 1, ln.split()) for k, ln in enumerate(lines) if ln.strip()
-            and not ln.startswith("#")]
+    rows = [
+        (k + 1, ln.split()) for k, ln in enumerate(lines) if ln.strip() and not ln.startswith("#")
+    ]
     if not rows:
         raise WindDataError(f"{name}: no data rows")
     n = len(rows)
@@ -81,16 +86,25 @@ def read_ndbc(
     miss = {"speed": 0, "direction": 0, "gust": 0}
     for k, (lineno, f) in enumerate(rows):
         if len(f) != len(names):
-            raise WindDataError(f"{name}, line {lineno}: {len(f)} fields, header has "
-                                f"{len(names)}")
+            raise WindDataError(f"{name}, line {lineno}: {len(f)} fields, header has {len(names)}")
         try:
-            t[k] = datetime(int(f[col["YY"]]), int(f[col["MM"]]), int(f[col["DD"]]),
-                            int(f[col["hh"]]), int(f[col["mm"]]), tzinfo=UTC).timestamp()
+            t[k] = datetime(
+                int(f[col["YY"]]),
+                int(f[col["MM"]]),
+                int(f[col["DD"]]),
+                int(f[col["hh"]]),
+                int(f[col["mm"]]),
+                tzinfo=UTC,
+            ).timestamp()
         except (ValueError, OverflowError):
-            raise WindDataError(f"{name}, line {lineno}: cannot read the date/time columns "
-                                f"{' '.join(f[:5])!r}") from None
-        for key, arr, c in (("speed", spd, "WSPD"), ("direction", dirn, "WDIR"),
-                            ("gust", gust, "GST")):
+            raise WindDataError(
+                f"{name}, line {lineno}: cannot read the date/time columns {' '.join(f[:5])!r}"
+            ) from None
+        for key, arr, c in (
+            ("speed", spd, "WSPD"),
+            ("direction", dirn, "WDIR"),
+            ("gust", gust, "GST"),
+        ):
             if c not in col:
                 continue
             cell = f[col[c]]
@@ -101,10 +115,14 @@ def read_ndbc(
                 try:
                     arr[k] = float(cell)
                 except ValueError:
-                    raise WindDataError(f"{name}, line {lineno}, column {c}: cannot read "
-                                        f"{cell!r} as a number") from None
-                hi, want = ((360.0, "0..360 degrees") if key == "direction"
-                            else (np.inf, "a finite speed >= 0 m/s"))
+                    raise WindDataError(
+                        f"{name}, line {lineno}, column {c}: cannot read {cell!r} as a number"
+                    ) from None
+                hi, want = (
+                    (360.0, "0..360 degrees")
+                    if key == "direction"
+                    else (np.inf, "a finite speed >= 0 m/s")
+                )
                 if not 0.0 <= arr[k] <= hi or np.isinf(arr[k]):
                     raise WindDataError(
                         f"{name}, line {lineno}, column {c}: value {cell!r} is out of range "
@@ -117,12 +135,17 @@ def read_ndbc(
     keep = ~bad
     sid = station if station is not None else p.name.split(".")[0]
     data = StationData(
-        station=np.full(int(keep.sum()), sid), t=t[keep],
+        station=np.full(int(keep.sum()), sid),
+        t=t[keep],
         lat=np.full(int(keep.sum()), float(position[0])),
-        lon=np.full(int(keep.sum()), float(position[1])), speed_ms=spd[keep],
+        lon=np.full(int(keep.sum()), float(position[1])),
+        speed_ms=spd[keep],
         direction_deg=np.mod(dirn[keep], 360.0),
         height_m=np.full(int(keep.sum()), np.nan if height_m is None else float(height_m)),
-        gust_ms=gust[keep], source=name, n_raw=n, n_missing=int(bad.sum()),
+        gust_ms=gust[keep],
+        source=name,
+        n_raw=n,
+        n_missing=int(bad.sum()),
         missing_by_column={k: v for k, v in miss.items() if v},
     )
     return _sorted_checked(data, linenos[keep], name)

@@ -64,21 +64,26 @@ class PerturbedWind:
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.speed_scale) and self.speed_scale >= 0):
-            raise InputError(f"{self.name}: speed_scale must be finite and >= 0; got "
-                             f"{self.speed_scale}")
+            raise InputError(
+                f"{self.name}: speed_scale must be finite and >= 0; got {self.speed_scale}"
+            )
         if not np.isfinite(self.speed_add_ms):
             raise InputError(f"{self.name}: speed_add_ms must be finite; got {self.speed_add_ms}")
         if not np.isfinite(self.direction_offset_deg):
-            raise InputError(f"{self.name}: direction_offset_deg must be finite; got "
-                             f"{self.direction_offset_deg}")
+            raise InputError(
+                f"{self.name}: direction_offset_deg must be finite; got {self.direction_offset_deg}"
+            )
         t, s = self._series
         if t.shape != s.shape:
-            raise InputError(f"{self.name}: {t.size} shift times but {s.size} shifts; give one "
-                             "shift per time")
-        if t.size and (np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t))
-                       or not np.all(np.isfinite(s))):
-            raise InputError(f"{self.name}: shift times must be finite and increase strictly, "
-                             "shifts finite")
+            raise InputError(
+                f"{self.name}: {t.size} shift times but {s.size} shifts; give one shift per time"
+            )
+        if t.size and (
+            np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)) or not np.all(np.isfinite(s))
+        ):
+            raise InputError(
+                f"{self.name}: shift times must be finite and increase strictly, shifts finite"
+            )
 
     @cached_property
     def _series(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -103,8 +108,9 @@ class PerturbedWind:
             return np.full(tt.shape, float(self.direction_offset_deg))
         return self.direction_offset_deg + np.interp(tt, times, shifts)
 
-    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike
-               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    def sample(
+        self, t: ArrayLike, x: ArrayLike, y: ArrayLike
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Wind ``(u, v)`` [m s⁻¹] at epoch ``t`` [s], local ``x, y`` [m] (broadcast).
 
         Raises

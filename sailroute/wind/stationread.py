@@ -99,8 +99,16 @@ class StationData:
         return wind_components(self.speed_ms, self.direction_deg)[1]
 
 
-_ARRAY_FIELDS: Final = ("station", "t", "lat", "lon", "speed_ms", "direction_deg", "height_m",
-                        "gust_ms")
+_ARRAY_FIELDS: Final = (
+    "station",
+    "t",
+    "lat",
+    "lon",
+    "speed_ms",
+    "direction_deg",
+    "height_m",
+    "gust_ms",
+)
 
 
 def _table_text(source: Any) -> tuple[str, str]:
@@ -117,8 +125,10 @@ def _table_text(source: Any) -> tuple[str, str]:
         raise InputError(f"{p}: station file not found; check the `path`")
     text = p.read_text(encoding="utf-8-sig", errors="replace")
     if looks_binary(text):
-        raise WindDataError(f"{p}: not a text file (binary content); expected a station CSV "
-                            "with a header row such as time,station,lat,lon,speed,direction")
+        raise WindDataError(
+            f"{p}: not a text file (binary content); expected a station CSV "
+            "with a header row such as time,station,lat,lon,speed,direction"
+        )
     return text, str(p)
 
 
@@ -193,8 +203,14 @@ def read_stations(
     rows, delim = split_fields(lines, name)
     header, body = rows[0], rows[1:]
     linenos = [k for k, _ in lines[1:]]
-    cmap, parts, timezone = station_columns(header, columns, position=position is not None,
-                                            timezone=timezone, name=name, lineno=lines[0][0])
+    cmap, parts, timezone = station_columns(
+        header,
+        columns,
+        position=position is not None,
+        timezone=timezone,
+        name=name,
+        lineno=lines[0][0],
+    )
     if not body:
         raise WindDataError(f"{name}: the file has a header but no data rows")
     unit, gust_unit = speed_units(header, cmap, speed_unit, name)
@@ -202,18 +218,28 @@ def read_stations(
     miss = {m.strip() for m in missing}
 
     n = len(body)
-    cols = _column_cells(body, linenos, {**cmap, **{f"_{q}": k for q, k in parts.items()}},
-                         len(header), delim, name)
+    cols = _column_cells(
+        body, linenos, {**cmap, **{f"_{q}": k for q, k in parts.items()}}, len(header), delim, name
+    )
     values, missing_by = _column_values(cols, header, cmap, linenos, miss, name)
     if parts:
-        t, missing_by["time"] = _part_times({q: cols[f"_{q}"] for q in parts},
-                                            {q: header[k].strip() for q, k in parts.items()},
-                                            linenos, miss, tz, name)
+        t, missing_by["time"] = _part_times(
+            {q: cols[f"_{q}"] for q in parts},
+            {q: header[k].strip() for q, k in parts.items()},
+            linenos,
+            miss,
+            tz,
+            name,
+        )
     else:
-        t, missing_by["time"] = _times(cols["time"], linenos, miss, tz, name,
-                                       header[cmap["time"]])
-    st, st_missing = _station_ids(cols.get("station"), miss, missing_by, n,
-                                  station if station is not None else Path(name).stem)
+        t, missing_by["time"] = _times(cols["time"], linenos, miss, tz, name, header[cmap["time"]])
+    st, st_missing = _station_ids(
+        cols.get("station"),
+        miss,
+        missing_by,
+        n,
+        station if station is not None else Path(name).stem,
+    )
     if position is not None and "lat" not in values:
         values["lat"] = np.full(n, float(position[0]))
         values["lon"] = np.full(n, float(position[1]))
@@ -221,8 +247,11 @@ def read_stations(
     lat, lon = values["lat"], values["lon"]
     spd = values["speed"] * speed_factor(unit)
     dirn = values["direction"]
-    h = values["height_m"] if "height_m" in values else np.full(
-        n, np.nan if height_m is None else float(height_m))
+    h = (
+        values["height_m"]
+        if "height_m" in values
+        else np.full(n, np.nan if height_m is None else float(height_m))
+    )
     gust = values["gust"] * speed_factor(gust_unit) if "gust" in values else np.full(n, np.nan)
     _check_ranges(name, linenos, header, cmap, (spd, dirn, lat, lon))
 
@@ -236,20 +265,35 @@ def read_stations(
         )
     ids = np.array([str(s) for s in st[keep]])
     data = StationData(
-        station=ids, t=t[keep], lat=lat[keep], lon=lon[keep], speed_ms=spd[keep],
-        direction_deg=np.mod(dirn[keep], 360.0), height_m=h[keep], gust_ms=gust[keep],
-        source=name, n_raw=n, n_missing=int(bad.sum()),
+        station=ids,
+        t=t[keep],
+        lat=lat[keep],
+        lon=lon[keep],
+        speed_ms=spd[keep],
+        direction_deg=np.mod(dirn[keep], 360.0),
+        height_m=h[keep],
+        gust_ms=gust[keep],
+        source=name,
+        n_raw=n,
+        n_missing=int(bad.sum()),
         missing_by_column={k: v for k, v in missing_by.items() if v},
     )
-    data = _sorted_checked(data, np.asarray(linenos)[keep], name,
-                           allow_repeats=resample_s is not None)
+    data = _sorted_checked(
+        data, np.asarray(linenos)[keep], name, allow_repeats=resample_s is not None
+    )
     if resample_s is not None:
         data = resample_stations(data, resample_s, min_fill=min_fill)
     return data
 
 
-def _column_cells(body: list[list[str]], linenos: list[int], every: Mapping[str, int],
-                  ncol: int, delim: str, name: str) -> dict[str, list[str]]:
+def _column_cells(
+    body: list[list[str]],
+    linenos: list[int],
+    every: Mapping[str, int],
+    ncol: int,
+    delim: str,
+    name: str,
+) -> dict[str, list[str]]:
     """The stripped cells of the columns ``every`` (``key -> index``) of the data rows;
     a row without the header's ``ncol`` fields is an error naming its line."""
     cols: dict[str, list[str]] = {c: [] for c in every}
@@ -264,9 +308,14 @@ def _column_cells(body: list[list[str]], linenos: list[int], every: Mapping[str,
     return cols
 
 
-def _column_values(cols: Mapping[str, list[str]], header: Sequence[str],
-                   cmap: Mapping[str, int], linenos: list[int], miss: set[str], name: str
-                   ) -> tuple[dict[str, NDArray], dict[str, int]]:
+def _column_values(
+    cols: Mapping[str, list[str]],
+    header: Sequence[str],
+    cmap: Mapping[str, int],
+    linenos: list[int],
+    miss: set[str],
+    name: str,
+) -> tuple[dict[str, NDArray], dict[str, int]]:
     """The numeric columns present (lat, lon, speed, direction, height_m, gust) and their
     missing cells per column."""
     missing_by: dict[str, int] = {}
@@ -277,8 +326,9 @@ def _column_values(cols: Mapping[str, list[str]], header: Sequence[str],
     return values, missing_by
 
 
-def _station_ids(cells: list[str] | None, miss: set[str], missing_by: dict[str, int], n: int,
-                 default: str) -> tuple[NDArray, NDArray[np.bool_]]:
+def _station_ids(
+    cells: list[str] | None, miss: set[str], missing_by: dict[str, int], n: int, default: str
+) -> tuple[NDArray, NDArray[np.bool_]]:
     """Station id of each row and where it is missing (counted into ``missing_by``); the
     ``default`` id for every row without a ``station`` column."""
     if cells is None:
@@ -289,33 +339,46 @@ def _station_ids(cells: list[str] | None, miss: set[str], missing_by: dict[str, 
     return st, st_missing
 
 
-def _check_ranges(name: str, linenos: list[int], header: Sequence[str],
-                  cmap: Mapping[str, int], values: tuple[NDArray, NDArray, NDArray, NDArray]
-                  ) -> None:
+def _check_ranges(
+    name: str,
+    linenos: list[int],
+    header: Sequence[str],
+    cmap: Mapping[str, int],
+    values: tuple[NDArray, NDArray, NDArray, NDArray],
+) -> None:
     """Speed [m s⁻¹] >= 0, direction in [0, 360] and, from the file, lat and lon [°]."""
     spd, dirn, lat, lon = values
     _check_range(name, linenos, header[cmap["speed"]], spd, 0.0, np.inf, "speeds must be >= 0")
-    _check_range(name, linenos, header[cmap["direction"]], dirn, 0.0, 360.0,
-                 "directions must lie in [0, 360] degrees (wind FROM, true)")
+    _check_range(
+        name,
+        linenos,
+        header[cmap["direction"]],
+        dirn,
+        0.0,
+        360.0,
+        "directions must lie in [0, 360] degrees (wind FROM, true)",
+    )
     if "lat" in cmap:
         _check_range(name, linenos, header[cmap["lat"]], lat, -90.0, 90.0, "latitude in [-90, 90]")
-        _check_range(name, linenos, header[cmap["lon"]], lon, -180.0, 360.0,
-                     "longitude in [-180, 360]")
+        _check_range(
+            name, linenos, header[cmap["lon"]], lon, -180.0, 360.0, "longitude in [-180, 360]"
+        )
 
 
-def _parse_cells(cells: list[str], miss: set[str], parse: Callable[[int, str], float]
-                 ) -> tuple[NDArray, int]:
+def _parse_cells(
+    cells: list[str], miss: set[str], parse: Callable[[int, str], float]
+) -> tuple[NDArray, int]:
     """Parse a column cell by cell: ``parse(k, cell)``, or NaN for a missing marker.
 
     Returns the values and how many are missing (markers, and cells read as NaN).
     """
-    out = np.array([np.nan if c in miss else parse(k, c) for k, c in enumerate(cells)],
-                   dtype=float)
+    out = np.array([np.nan if c in miss else parse(k, c) for k, c in enumerate(cells)], dtype=float)
     return out, int(np.count_nonzero(np.isnan(out)))
 
 
-def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss: set[str],
-             name: str) -> tuple[NDArray, int]:
+def _numbers(
+    cells: list[str], canon: str, column: str, linenos: list[int], miss: set[str], name: str
+) -> tuple[NDArray, int]:
     def number(k: int, c: str) -> float:
         try:
             v = float(c)
@@ -334,8 +397,14 @@ def _numbers(cells: list[str], canon: str, column: str, linenos: list[int], miss
     return _parse_cells(cells, miss, number)
 
 
-def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | None, name: str,
-           column: str) -> tuple[NDArray, int]:
+def _times(
+    cells: list[str],
+    linenos: list[int],
+    miss: set[str],
+    tz: timezone | None,
+    name: str,
+    column: str,
+) -> tuple[NDArray, int]:
     def epoch(k: int, c: str) -> float:
         try:
             dt = iso_datetime(c)
@@ -357,8 +426,14 @@ def _times(cells: list[str], linenos: list[int], miss: set[str], tz: timezone | 
     return _parse_cells(cells, miss, epoch)
 
 
-def _part_times(cells: Mapping[str, list[str]], headers: Mapping[str, str], linenos: list[int],
-                miss: set[str], tz: timezone | None, name: str) -> tuple[NDArray, int]:
+def _part_times(
+    cells: Mapping[str, list[str]],
+    headers: Mapping[str, str],
+    linenos: list[int],
+    miss: set[str],
+    tz: timezone | None,
+    name: str,
+) -> tuple[NDArray, int]:
     """Epoch seconds from split year/month/day/hour[/minute/second] columns."""
     if tz is None:
         cols = "/".join(headers.values())
@@ -377,8 +452,15 @@ def _part_times(cells: Mapping[str, list[str]], headers: Mapping[str, str], line
             year = num["year"]
             if year < 100:  # two-digit years (old NDBC files): 50..99 -> 19xx
                 year += 1900 if year >= 50 else 2000
-            out[k] = datetime(year, num["month"], num["day"], num["hour"], num.get("minute", 0),
-                              num.get("second", 0), tzinfo=tz).timestamp()
+            out[k] = datetime(
+                year,
+                num["month"],
+                num["day"],
+                num["hour"],
+                num.get("minute", 0),
+                num.get("second", 0),
+                tzinfo=tz,
+            ).timestamp()
         except ValueError:
             shown = excerpt(" ".join(f"{headers[q]}={v}" for q, v in vals.items()))
             raise WindDataError(
@@ -388,8 +470,9 @@ def _part_times(cells: Mapping[str, list[str]], headers: Mapping[str, str], line
     return out, int(np.count_nonzero(np.isnan(out)))
 
 
-def _check_range(name: str, linenos: list[int], column: str, a: NDArray, lo: float, hi: float,
-                 what: str) -> None:
+def _check_range(
+    name: str, linenos: list[int], column: str, a: NDArray, lo: float, hi: float, what: str
+) -> None:
     bad = np.nonzero((a < lo) | (a > hi))[0]
     if bad.size:
         k = int(bad[0])
@@ -403,8 +486,9 @@ def _fmt_counts(d: Mapping[str, int]) -> str:
     return ", ".join(f"{k} {v}" for k, v in d.items() if v) or "none"
 
 
-def _sorted_checked(data: StationData, linenos: NDArray, name: str, *,
-                    allow_repeats: bool = False) -> StationData:
+def _sorted_checked(
+    data: StationData, linenos: NDArray, name: str, *, allow_repeats: bool = False
+) -> StationData:
     """Group by station (first appearance) and check times increase within each station.
 
     Repeated timestamps (1 Hz loggers with a 1 s clock jitter) are accepted only
@@ -423,8 +507,11 @@ def _sorted_checked(data: StationData, linenos: NDArray, name: str, *,
         k = int(bad[0])
         repeat = data.t[k + 1] == data.t[k]
         kind = "repeats the time of" if repeat else "goes back in time from"
-        fix = ("Remove the duplicated rows, or average them away with `resample_s` (e.g. 10)."
-               if repeat else "Sort the file by time.")
+        fix = (
+            "Remove the duplicated rows, or average them away with `resample_s` (e.g. 10)."
+            if repeat
+            else "Sort the file by time."
+        )
         raise WindDataError(
             f"{name}, line {linenos[k + 1]}: time {iso(data.t[k + 1])} of station "
             f"{str(data.station[k + 1])!r} {kind} line {linenos[k]} ({iso(data.t[k])}); times "
@@ -433,8 +520,9 @@ def _sorted_checked(data: StationData, linenos: NDArray, name: str, *,
     return data
 
 
-def resample_stations(data: StationData, interval_s: float, *, min_fill: float = 0.5
-                      ) -> StationData:
+def resample_stations(
+    data: StationData, interval_s: float, *, min_fill: float = 0.5
+) -> StationData:
     """Average records into fixed intervals per station.
 
     Bins are aligned to multiples of ``interval_s`` since the epoch (UTC clock),
@@ -469,8 +557,9 @@ def resample_stations(data: StationData, interval_s: float, *, min_fill: float =
     sidx = np.array([lookup[s] for s in data.station], dtype=np.int64)
     b = np.floor(data.t / interval_s).astype(np.int64)
     key = sidx.astype(np.int64) * (1 << 40) + (b - b.min())
-    uniq, first, inv, counts = np.unique(key, return_index=True, return_inverse=True,
-                                         return_counts=True)
+    uniq, first, inv, counts = np.unique(
+        key, return_index=True, return_inverse=True, return_counts=True
+    )
     u, v = data.u, data.v
 
     def mean(a: NDArray) -> NDArray:
@@ -488,9 +577,17 @@ def resample_stations(data: StationData, interval_s: float, *, min_fill: float =
     np.maximum.at(gust, inv, np.where(np.isnan(data.gust_ms), -np.inf, data.gust_ms))
     gust[~np.isfinite(gust)] = np.nan
     out = StationData(
-        station=data.station[first], t=(b[first] + 0.5).astype(np.float64) * interval_s,
-        lat=mean(data.lat), lon=mean(data.lon), speed_ms=mean(data.speed_ms), direction_deg=dirn,
-        height_m=mean(data.height_m), gust_ms=gust, source=data.source, n_raw=data.n_raw,
-        n_missing=data.n_missing, missing_by_column=data.missing_by_column,
+        station=data.station[first],
+        t=(b[first] + 0.5).astype(np.float64) * interval_s,
+        lat=mean(data.lat),
+        lon=mean(data.lon),
+        speed_ms=mean(data.speed_ms),
+        direction_deg=dirn,
+        height_m=mean(data.height_m),
+        gust_ms=gust,
+        source=data.source,
+        n_raw=data.n_raw,
+        n_missing=data.n_missing,
+        missing_by_column=data.missing_by_column,
     )
     return replace(out, **{k: getattr(out, k)[keep] for k in _ARRAY_FIELDS})

@@ -121,15 +121,26 @@ def local_records(
                 f"for {data.source or 'the stations'}; add a height_m column or give the "
                 "stations' height (`measurement_height_m`)"
             )
-        f = (power_law_factor(data.height_m, height_m, exponent) if shear == "power" else
-             log_law_factor(data.height_m, height_m, roughness_m))
+        f = (
+            power_law_factor(data.height_m, height_m, exponent)
+            if shear == "power"
+            else log_law_factor(data.height_m, height_m, roughness_m)
+        )
         ue, ve = ue * f, ve * f
     u, v = earth_to_local(ue, ve, frame.grid_north_deg(data.lat, data.lon))
     return x, y, u, v
 
 
-RbfKernel = Literal["thin_plate_spline", "linear", "cubic", "quintic", "multiquadric",
-                    "inverse_multiquadric", "inverse_quadratic", "gaussian"]
+RbfKernel = Literal[
+    "thin_plate_spline",
+    "linear",
+    "cubic",
+    "quintic",
+    "multiquadric",
+    "inverse_multiquadric",
+    "inverse_quadratic",
+    "gaussian",
+]
 """Kernel names of :class:`scipy.interpolate.RBFInterpolator`."""
 
 
@@ -225,8 +236,15 @@ class StationWind:
             raise InputError(f"{self.name}: shear {self.shear!r}; expected 'power' or 'log'")
         if not (self.radius_m >= 0) or not (self.power > 0) or not (self.max_gap_s > 0):
             raise InputError(f"{self.name}: radius_m must be >= 0, power and max_gap_s > 0")
-        x, y, ul, vl = local_records(d, self.frame, self.height_m, self.name, shear=self.shear,
-                                     exponent=self.exponent, roughness_m=self.roughness_m)
+        x, y, ul, vl = local_records(
+            d,
+            self.frame,
+            self.height_m,
+            self.name,
+            shear=self.shear,
+            exponent=self.exponent,
+            roughness_m=self.roughness_m,
+        )
         series = []
         moving = False
         for s in d.stations:
@@ -234,20 +252,27 @@ class StationWind:
             ts = d.t[m]
             moving |= bool(np.ptp(x[m]) > 1e-6 or np.ptp(y[m]) > 1e-6)
             series.append((s, ts, x[m], y[m], ul[m], vl[m]))
-        spans = [_gap_free_span(ts, self.time_window, self.max_gap_s) if
-                 self.time_window is not None else (float(ts[0]), float(ts[-1]))
-                 for _, ts, *_ in series]
+        spans = [
+            _gap_free_span(ts, self.time_window, self.max_gap_s)
+            if self.time_window is not None
+            else (float(ts[0]), float(ts[-1]))
+            for _, ts, *_ in series
+        ]
         t0 = max(a for a, _ in spans)
         t1 = min(b for _, b in spans)
         if t0 > t1:
-            spans_txt = "; ".join(f"{s[0]}: {iso(a)} .. {iso(b)}"
-                                  for s, (a, b) in zip(series, spans, strict=True))
+            spans_txt = "; ".join(
+                f"{s[0]}: {iso(a)} .. {iso(b)}" for s, (a, b) in zip(series, spans, strict=True)
+            )
             raise WindDataError(
                 f"{self.name}: the stations never report at the same time ({spans_txt}); "
                 "use stations with overlapping records"
             )
-        lo, hi = (t0, t1) if self.time_window is None else (
-            max(t0, self.time_window[0]), min(t1, self.time_window[1]))
+        lo, hi = (
+            (t0, t1)
+            if self.time_window is None
+            else (max(t0, self.time_window[0]), min(t1, self.time_window[1]))
+        )
         for s, ts, *_ in series:
             if lo > hi:
                 break
@@ -270,8 +295,10 @@ class StationWind:
         rbf = None
         if self.method == "rbf":
             if moving:
-                raise InputError(f"{self.name}: method 'rbf' needs fixed stations; a station "
-                                 "moves (coach boat?) -- use method 'idw'")
+                raise InputError(
+                    f"{self.name}: method 'rbf' needs fixed stations; a station "
+                    "moves (coach boat?) -- use method 'idw'"
+                )
             from scipy.interpolate import RBFInterpolator
 
             pts = np.array([[s[2][0], s[3][0]] for s in series])
@@ -282,19 +309,30 @@ class StationWind:
             try:
                 rbf = RBFInterpolator(pts, np.eye(len(series)), kernel=kernel, degree=deg)
             except (ValueError, np.linalg.LinAlgError) as exc:
-                raise InputError(f"{self.name}: RBF interpolation failed for these stations "
-                                 f"({exc}); use method 'idw'") from None
-        cov = Coverage(t0, t1, float(x.min()) - self.radius_m, float(x.max()) + self.radius_m,
-                       float(y.min()) - self.radius_m, float(y.max()) + self.radius_m,
-                       frame=self.frame, source_span=(float(d.t.min()), float(d.t.max())))
+                raise InputError(
+                    f"{self.name}: RBF interpolation failed for these stations "
+                    f"({exc}); use method 'idw'"
+                ) from None
+        cov = Coverage(
+            t0,
+            t1,
+            float(x.min()) - self.radius_m,
+            float(x.max()) + self.radius_m,
+            float(y.min()) - self.radius_m,
+            float(y.max()) + self.radius_m,
+            frame=self.frame,
+            source_span=(float(d.t.min()), float(d.t.max())),
+        )
         limit = ""
         if len(series) > 1:
             k0 = max(range(len(spans)), key=lambda k: spans[k][0])
             k1 = min(range(len(spans)), key=lambda k: spans[k][1])
             src = f" of {d.source}" if d.source else ""
-            limit = (f"the time span is limited by station {series[k0][0]!r}{src} (first record "
-                     f"{iso(spans[k0][0])}) and station {series[k1][0]!r} (last record "
-                     f"{iso(spans[k1][1])})")
+            limit = (
+                f"the time span is limited by station {series[k0][0]!r}{src} (first record "
+                f"{iso(spans[k0][0])}) and station {series[k1][0]!r} (last record "
+                f"{iso(spans[k1][1])})"
+            )
         return _StationState(tuple(series), cov, moving, rbf, limit)
 
     @property
@@ -307,8 +345,9 @@ class StationWind:
         cols: list[list[NDArray]] = [[], [], [], []]
         moving = self._state.moving
         for _, ts, xs, ys, us, vs in self._state.series:
-            for c, a, moves in zip(cols, (xs, ys, us, vs), (moving, moving, True, True),
-                                   strict=True):
+            for c, a, moves in zip(
+                cols, (xs, ys, us, vs), (moving, moving, True, True), strict=True
+            ):
                 if not moves or a.size == 1:
                     c.append(np.full(t.shape, a[0]))
                 else:
@@ -327,8 +366,12 @@ class StationWind:
         Points are flattened; no coverage check (used by :class:`BlendedWind`-style
         diagnostics).
         """
-        t, x, y = (a.ravel() for a in np.broadcast_arrays(
-            np.asarray(t, float), np.asarray(x, float), np.asarray(y, float)))
+        t, x, y = (
+            a.ravel()
+            for a in np.broadcast_arrays(
+                np.asarray(t, float), np.asarray(x, float), np.asarray(y, float)
+            )
+        )
         if self._state.rbf is not None:
             return self._state.rbf(np.column_stack([x, y]))
         sx, sy, _, _ = self.station_values(t)
@@ -341,8 +384,7 @@ class StationWind:
         the stations (logs) whose first and last records limit the common time span.
         """
         try:
-            t, x, y = prepare_points(self._state.cov, t, x, y, clamp=self.clamp,
-                                     name=self.name)
+            t, x, y = prepare_points(self._state.cov, t, x, y, clamp=self.clamp, name=self.name)
         except OutOfCoverageError as e:
             if not self._state.limit:
                 raise
@@ -361,8 +403,9 @@ class StationWind:
         return u.reshape(shape), v.reshape(shape)
 
 
-def _gap_free_span(ts: NDArray, window: tuple[float, float], max_gap_s: float
-                   ) -> tuple[float, float]:
+def _gap_free_span(
+    ts: NDArray, window: tuple[float, float], max_gap_s: float
+) -> tuple[float, float]:
     """The stretch of records around ``window`` without a gap longer than ``max_gap_s``.
 
     Gaps that overlap the window itself are left in (the caller reports them);
@@ -380,8 +423,9 @@ def _gap_free_span(ts: NDArray, window: tuple[float, float], max_gap_s: float
     return float(ts[starts[first]]), float(ts[ends[last]])
 
 
-def idw_weights(x: NDArray, y: NDArray, sx: NDArray, sy: NDArray, power: float = 2.0
-                ) -> NDArray[np.float64]:
+def idw_weights(
+    x: NDArray, y: NDArray, sx: NDArray, sy: NDArray, power: float = 2.0
+) -> NDArray[np.float64]:
     """Inverse-distance weights ``(n, S)`` normalised to sum 1 per point.
 
     Parameters

@@ -63,10 +63,12 @@ class LambertGrid:
             f"+lat_0={self.center_lat} +lon_0={self.stand_lon} "
             f"+a={WRF_EARTH_RADIUS_M} +b={WRF_EARTH_RADIUS_M} +units=m +no_defs"
         )
-        fwd = Transformer.from_crs("+proj=longlat +a=6370000 +b=6370000 +no_defs", proj,
-                                   always_xy=True)
-        inv = Transformer.from_crs(proj, "+proj=longlat +a=6370000 +b=6370000 +no_defs",
-                                   always_xy=True)
+        fwd = Transformer.from_crs(
+            "+proj=longlat +a=6370000 +b=6370000 +no_defs", proj, always_xy=True
+        )
+        inv = Transformer.from_crs(
+            proj, "+proj=longlat +a=6370000 +b=6370000 +no_defs", always_xy=True
+        )
         return fwd, inv
 
     def latlon(self, i: NDArray | float, j: NDArray | float) -> tuple[NDArray, NDArray]:
@@ -189,8 +191,9 @@ def write_wrfout(
         attrs.update(extra_attrs or {})
         ds.setncatts(attrs)
 
-        def var(name: str, dims: tuple[str, ...], desc: str, units: str, stagger: str = ""
-                ) -> netCDF4.Variable:
+        def var(
+            name: str, dims: tuple[str, ...], desc: str, units: str, stagger: str = ""
+        ) -> netCDF4.Variable:
             v = ds.createVariable(name, "f4", dims, zlib=True, complevel=4)
             v.FieldType = np.int32(104)
             v.MemoryOrder = "XYZ" if len(dims) == 4 else "XY "
@@ -203,17 +206,21 @@ def write_wrfout(
         tv[:] = np.array([list(s) for s in strings], dtype="S1")
         d3 = ("Time", "south_north", "west_east")
         var("XLAT", d3, "LATITUDE, SOUTH IS NEGATIVE", "degree_north")[:] = np.broadcast_to(
-            lat, (nt, ny, nx))
+            lat, (nt, ny, nx)
+        )
         var("XLONG", d3, "LONGITUDE, WEST IS NEGATIVE", "degree_east")[:] = np.broadcast_to(
-            lon, (nt, ny, nx))
+            lon, (nt, ny, nx)
+        )
         xt = ds.createVariable("XTIME", "f4", ("Time",))
         xt.units = f"minutes since {strings[0].replace('_', ' ')}"
         xt[:] = (t - t[0]) / 60.0
         if write_alpha:
             var("COSALPHA", d3, "Local cosine of map rotation", "")[:] = np.broadcast_to(
-                ca, (nt, ny, nx))
+                ca, (nt, ny, nx)
+            )
             var("SINALPHA", d3, "Local sine of map rotation", "")[:] = np.broadcast_to(
-                sa, (nt, ny, nx))
+                sa, (nt, ny, nx)
+            )
         var("HGT", d3, "Terrain Height", "m")[:] = np.zeros((nt, ny, nx))
         u10 = np.empty((nt, ny, nx))
         v10 = np.empty((nt, ny, nx))
@@ -230,10 +237,20 @@ def write_wrfout(
             ds.createDimension("bottom_top_stag", nz + 1)
             zw = full_levels_from_mass(level_heights_m)
             ph_full = G_WRF * zw[None, :, None, None] * np.ones((nt, 1, ny, nx))
-            var("PHB", ("Time", "bottom_top_stag", "south_north", "west_east"),
-                "base-state geopotential", "m2 s-2", "Z")[:] = 0.9 * ph_full
-            var("PH", ("Time", "bottom_top_stag", "south_north", "west_east"),
-                "perturbation geopotential", "m2 s-2", "Z")[:] = 0.1 * ph_full
+            var(
+                "PHB",
+                ("Time", "bottom_top_stag", "south_north", "west_east"),
+                "base-state geopotential",
+                "m2 s-2",
+                "Z",
+            )[:] = 0.9 * ph_full
+            var(
+                "PH",
+                ("Time", "bottom_top_stag", "south_north", "west_east"),
+                "perturbation geopotential",
+                "m2 s-2",
+                "Z",
+            )[:] = 0.1 * ph_full
             U = np.empty((nt, nz, ny, nx + 1))
             V = np.empty((nt, nz, ny + 1, nx))
             for k, tk in enumerate(t):
@@ -242,8 +259,18 @@ def write_wrfout(
                     U[k, m] = earth_to_grid(ue, ve, ca_u, sa_u)[0]
                     ue, ve = wind_at(float(tk), lat_v, lon_v, float(z))
                     V[k, m] = earth_to_grid(ue, ve, ca_v, sa_v)[1]
-            var("U", ("Time", "bottom_top", "south_north", "west_east_stag"),
-                "x-wind component", "m s-1", "X")[:] = U
-            var("V", ("Time", "bottom_top", "south_north_stag", "west_east"),
-                "y-wind component", "m s-1", "Y")[:] = V
+            var(
+                "U",
+                ("Time", "bottom_top", "south_north", "west_east_stag"),
+                "x-wind component",
+                "m s-1",
+                "X",
+            )[:] = U
+            var(
+                "V",
+                ("Time", "bottom_top", "south_north_stag", "west_east"),
+                "y-wind component",
+                "m s-1",
+                "Y",
+            )[:] = V
     return path

@@ -54,11 +54,34 @@ REQUIRED_VARIABLES = ("Times", "XLAT", "XLONG", "U10", "V10")
 MODEL_LEVEL_VARIABLES = ("U", "V", "PH", "PHB", "HGT")
 """Variables needed for a height correction from the lowest model levels."""
 
-PROJECTION_ATTRIBUTES = ("MAP_PROJ", "TRUELAT1", "TRUELAT2", "STAND_LON", "DX", "DY",
-                         "POLE_LAT", "POLE_LON", "CEN_LAT", "CEN_LON", "TITLE")
+PROJECTION_ATTRIBUTES = (
+    "MAP_PROJ",
+    "TRUELAT1",
+    "TRUELAT2",
+    "STAND_LON",
+    "DX",
+    "DY",
+    "POLE_LAT",
+    "POLE_LON",
+    "CEN_LAT",
+    "CEN_LON",
+    "TITLE",
+)
 
-SPEED_UNITS_MS = frozenset({"m s-1", "m/s", "m s**-1", "ms-1", "m.s-1", "m s^-1", "m sec-1",
-                            "meter second-1", "meters/second", "m s{-1}"})
+SPEED_UNITS_MS = frozenset(
+    {
+        "m s-1",
+        "m/s",
+        "m s**-1",
+        "ms-1",
+        "m.s-1",
+        "m s^-1",
+        "m sec-1",
+        "meter second-1",
+        "meters/second",
+        "m s{-1}",
+    }
+)
 
 U10_HEIGHT_M = 10.0
 """Height of WRF's diagnostic ``U10``/``V10`` [m]."""
@@ -130,11 +153,16 @@ def parse_wrf_times(chars: NDArray, *, path: str = "WRF file") -> NDArray[np.flo
     """
     a = np.asarray(chars)
     if a.ndim == 2:
-        strings = [b"".join(row.tolist()).decode("ascii", "replace") if a.dtype.kind == "S"
-                   else "".join(row.tolist()) for row in a]
+        strings = [
+            b"".join(row.tolist()).decode("ascii", "replace")
+            if a.dtype.kind == "S"
+            else "".join(row.tolist())
+            for row in a
+        ]
     else:
-        strings = [s.decode("ascii", "replace") if isinstance(s, bytes) else str(s)
-                   for s in a.ravel()]
+        strings = [
+            s.decode("ascii", "replace") if isinstance(s, bytes) else str(s) for s in a.ravel()
+        ]
     out = np.empty(len(strings))
     for k, s in enumerate(strings):
         s = s.strip().strip("\x00")
@@ -212,8 +240,9 @@ def _coords(ds: Any, var: str, name: str) -> NDArray[np.float64]:
         )
     a = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan)
     if not np.all(np.isfinite(a)):
-        raise WindDataError(f"{name}: {var} contains missing or NaN values; expected a "
-                            "complete coordinate grid")
+        raise WindDataError(
+            f"{name}: {var} contains missing or NaN values; expected a complete coordinate grid"
+        )
     return a
 
 
@@ -274,8 +303,13 @@ def crop_window(
         raise WindDataError(
             f"{header.path}: the wind grid has {ny} x {nx} points (rows x columns); a gridded "
             "wind field needs at least 2 x 2 to interpolate between them"
-            + ("; for one point (a station, a buoy) use `type: stations`, for a steady wind "
-               "`type: uniform`" if ny * nx == 1 else ""))
+            + (
+                "; for one point (a station, a buoy) use `type: stations`, for a steady wind "
+                "`type: uniform`"
+                if ny * nx == 1
+                else ""
+            )
+        )
     j0, j1, i0, i1 = 0, ny, 0, nx
     if bbox is not None:
         dx = float(header.attrs.get("DX", 0.0)) or _spacing(header, frame)
@@ -419,20 +453,48 @@ def read_wrf(
         if model_levels:
             nz = ds.variables["U"].shape[1] if ds.variables["U"].ndim == 4 else 0
             if nz < N_MODEL_LEVELS:
-                raise WindDataError(f"{name}: U needs at least {N_MODEL_LEVELS} vertical levels "
-                                    f"with dimensions (Time, bottom_top, south_north, "
-                                    f"west_east_stag); got shape {ds.variables['U'].shape}")
+                raise WindDataError(
+                    f"{name}: U needs at least {N_MODEL_LEVELS} vertical levels "
+                    f"with dimensions (Time, bottom_top, south_north, "
+                    f"west_east_stag); got shape {ds.variables['U'].shape}"
+                )
             lev = slice(0, N_MODEL_LEVELS)
-            u = _read(ds, "U", name, (nt, nz, ny, nx + 1),
-                      (tsl, lev, js, slice(w.i0, w.i1 + 1)), speed=True)
-            v = _read(ds, "V", name, (nt, nz, ny + 1, nx),
-                      (tsl, lev, slice(w.j0, w.j1 + 1), is_), speed=True)
+            u = _read(
+                ds,
+                "U",
+                name,
+                (nt, nz, ny, nx + 1),
+                (tsl, lev, js, slice(w.i0, w.i1 + 1)),
+                speed=True,
+            )
+            v = _read(
+                ds,
+                "V",
+                name,
+                (nt, nz, ny + 1, nx),
+                (tsl, lev, slice(w.j0, w.j1 + 1), is_),
+                speed=True,
+            )
             levw = slice(0, N_MODEL_LEVELS + 1)
             ph = _read(ds, "PH", name, (nt, nz + 1, ny, nx), (tsl, levw, js, is_))
             phb = _read(ds, "PHB", name, (nt, nz + 1, ny, nx), (tsl, levw, js, is_))
             hgt = _read_2d(ds, "HGT", name, (ny, nx), (js, is_))
-    return WrfRaw(hdr, w, hdr.times[w.k0:w.k1], hdr.lat[w.j0:w.j1, w.i0:w.i1],
-                  hdr.lon[w.j0:w.j1, w.i0:w.i1], u10, v10, ca, sa, u, v, ph, phb, hgt)
+    return WrfRaw(
+        hdr,
+        w,
+        hdr.times[w.k0 : w.k1],
+        hdr.lat[w.j0 : w.j1, w.i0 : w.i1],
+        hdr.lon[w.j0 : w.j1, w.i0 : w.i1],
+        u10,
+        v10,
+        ca,
+        sa,
+        u,
+        v,
+        ph,
+        phb,
+        hgt,
+    )
 
 
 def _check_units(var: Any, vname: str, name: str) -> None:
@@ -446,8 +508,15 @@ def _check_units(var: Any, vname: str, name: str) -> None:
         )
 
 
-def _read(ds: Any, vname: str, name: str, shape: tuple[int, ...], index: tuple[slice, ...],
-          *, speed: bool = False) -> NDArray[np.float64]:
+def _read(
+    ds: Any,
+    vname: str,
+    name: str,
+    shape: tuple[int, ...],
+    index: tuple[slice, ...],
+    *,
+    speed: bool = False,
+) -> NDArray[np.float64]:
     var = ds.variables[vname]
     if tuple(var.shape) != tuple(shape):
         raise WindDataError(
@@ -461,12 +530,15 @@ def _read(ds: Any, vname: str, name: str, shape: tuple[int, ...], index: tuple[s
     return a
 
 
-def _read_2d(ds: Any, vname: str, name: str, shape: tuple[int, int],
-             index: tuple[slice, slice]) -> NDArray[np.float64]:
+def _read_2d(
+    ds: Any, vname: str, name: str, shape: tuple[int, int], index: tuple[slice, slice]
+) -> NDArray[np.float64]:
     var = ds.variables[vname]
     if tuple(var.shape[-2:]) != shape or var.ndim not in (2, 3):
-        raise WindDataError(f"{name}: {vname} has shape {var.shape}; expected {shape} or "
-                            f"(Time, {shape[0]}, {shape[1]})")
+        raise WindDataError(
+            f"{name}: {vname} has shape {var.shape}; expected {shape} or "
+            f"(Time, {shape[0]}, {shape[1]})"
+        )
     a = var[(0, *index)] if var.ndim == 3 else var[index]
     a = np.ma.filled(np.ma.asarray(a, dtype=float), np.nan)
     _check_finite(a, vname, name, index)
@@ -547,8 +619,9 @@ def wrf_rotation(raw: WrfRaw) -> tuple[NDArray, NDArray, str]:
             "them) or convert the winds to earth-relative first."
         )
     proj = int(a["MAP_PROJ"])
-    if proj == 6 and (float(a.get("POLE_LAT", 90.0)) != 90.0 or float(a.get("POLE_LON", 0.0))
-                      != 0.0):
+    if proj == 6 and (
+        float(a.get("POLE_LAT", 90.0)) != 90.0 or float(a.get("POLE_LON", 0.0)) != 0.0
+    ):
         raise WindDataError(
             f"{raw.header.path}: rotated-pole lat-lon grid (MAP_PROJ 6, POLE_LAT "
             f"{a.get('POLE_LAT')}) without COSALPHA/SINALPHA; the rotation is unknown"
@@ -557,8 +630,10 @@ def wrf_rotation(raw: WrfRaw) -> tuple[NDArray, NDArray, str]:
         need = ["TRUELAT1", "STAND_LON"] + (["TRUELAT2"] if proj == 1 else [])
         miss = [k for k in need if k not in a]
         if miss:
-            raise WindDataError(f"{raw.header.path}: MAP_PROJ {proj} needs global attribute(s) "
-                                f"{', '.join(miss)} to rotate the winds")
+            raise WindDataError(
+                f"{raw.header.path}: MAP_PROJ {proj} needs global attribute(s) "
+                f"{', '.join(miss)} to rotate the winds"
+            )
     cone = cone_factor(proj, float(a.get("TRUELAT1", 0.0)), float(a.get("TRUELAT2", 0.0)))
     if cone == 0.0:
         one = np.ones_like(raw.lat)
@@ -628,26 +703,61 @@ def decode_wrf(
     if height_m is not None:
         z_out = float(height_m)
         if use == "u10":
-            f = (power_law_factor(U10_HEIGHT_M, z_out, fallback_exponent) if shear == "power"
-                 else log_law_factor(U10_HEIGHT_M, z_out, roughness_m))
+            f = (
+                power_law_factor(U10_HEIGHT_M, z_out, fallback_exponent)
+                if shear == "power"
+                else log_law_factor(U10_HEIGHT_M, z_out, roughness_m)
+            )
             ue, ve = ue * f, ve * f
             if shear == "power":
                 exponent = np.full(ue.shape, float(fallback_exponent))
                 fallback_fraction = 1.0
         else:
             ue, ve, exponent, fallback_fraction = _from_model_levels(
-                raw, ca, sa, ue, ve, z_out, shear, fallback_exponent, exponent_range,
-                roughness_m, min_fit_speed_ms)
+                raw,
+                ca,
+                sa,
+                ue,
+                ve,
+                z_out,
+                shear,
+                fallback_exponent,
+                exponent_range,
+                roughness_m,
+                min_fit_speed_ms,
+            )
     x, y = frame.to_xy(raw.lat, raw.lon)
     gn = frame.grid_north_deg(raw.lat, raw.lon)
     ul, vl = earth_to_local(ue, ve, gn)
-    return WrfDecoded(raw.times, raw.lat, raw.lon, x, y, ul, vl, z_out, use, exponent,
-                      fallback_fraction, how, ue, ve)
+    return WrfDecoded(
+        raw.times,
+        raw.lat,
+        raw.lon,
+        x,
+        y,
+        ul,
+        vl,
+        z_out,
+        use,
+        exponent,
+        fallback_fraction,
+        how,
+        ue,
+        ve,
+    )
 
 
 def _from_model_levels(
-    raw: WrfRaw, ca: NDArray, sa: NDArray, ue10: NDArray, ve10: NDArray, z_out: float,
-    shear: str, fallback: float, exponent_range: tuple[float, float], roughness_m: float,
+    raw: WrfRaw,
+    ca: NDArray,
+    sa: NDArray,
+    ue10: NDArray,
+    ve10: NDArray,
+    z_out: float,
+    shear: str,
+    fallback: float,
+    exponent_range: tuple[float, float],
+    roughness_m: float,
     min_speed: float,
 ) -> tuple[NDArray, NDArray, NDArray | None, float]:
     name = raw.header.path
@@ -669,8 +779,9 @@ def _from_model_levels(
     if shear == "log":
         f = log_law_factor(z1, z_out, roughness_m)
         return ue1 * f, ve1 * f, None, 0.0
-    alpha, usable = fit_power_exponent(s1, z1, s2, z2, exponent_range=exponent_range,
-                                       min_speed_ms=min_speed)
+    alpha, usable = fit_power_exponent(
+        s1, z1, s2, z2, exponent_range=exponent_range, min_speed_ms=min_speed
+    )
     f_fit = power_law_factor(z1, z_out, np.where(usable, alpha, 0.0))
     f_fb = power_law_factor(U10_HEIGHT_M, z_out, fallback)
     ue = np.where(usable, ue1 * f_fit, ue10 * f_fb)
@@ -742,15 +853,29 @@ def open_wrf(
     """
     header = read_wrf_header(path)
     step_s = None if time_step_min is None else float(time_step_min) * 60.0
-    window = crop_window(header, frame, bbox=bbox, margin_m=margin_m, time_window=time_window,
-                         time_pad_s=step_s or 0.0)
+    window = crop_window(
+        header,
+        frame,
+        bbox=bbox,
+        margin_m=margin_m,
+        time_window=time_window,
+        time_pad_s=step_s or 0.0,
+    )
     want_model = height_m is not None and (
-        levels == "model" or (levels == "auto" and all(
-            v in header.variables for v in MODEL_LEVEL_VARIABLES)))
+        levels == "model"
+        or (levels == "auto" and all(v in header.variables for v in MODEL_LEVEL_VARIABLES))
+    )
     raw = read_wrf(path, window, model_levels=want_model, header=header)
-    dec = decode_wrf(raw, frame, height_m=height_m, levels=levels if want_model else "u10",
-                     shear=shear, fallback_exponent=fallback_exponent,
-                     exponent_range=exponent_range, roughness_m=roughness_m)
+    dec = decode_wrf(
+        raw,
+        frame,
+        height_m=height_m,
+        levels=levels if want_model else "u10",
+        shear=shear,
+        fallback_exponent=fallback_exponent,
+        exponent_range=exponent_range,
+        roughness_m=roughness_m,
+    )
     label = f"WRF wind {Path(header.path).name}"
     info: dict[str, Any] = {
         "path": header.path,
@@ -764,9 +889,21 @@ def open_wrf(
         "map_residual_cells": None,
         "exponent_mean": None if dec.exponent is None else float(np.mean(dec.exponent)),
     }
-    field = GridWind(dec.times, dec.x, dec.y, dec.u, dec.v, interpolation=interpolation,
-                     time_step_s=step_s, clamp=clamp, name=label, info=info, frame=frame,
-                     source_span=(float(header.times[0]), float(header.times[-1])))
-    info.update(map_degree=field.index_map.degree,
-                map_residual_cells=field.index_map.residual_cells)
+    field = GridWind(
+        dec.times,
+        dec.x,
+        dec.y,
+        dec.u,
+        dec.v,
+        interpolation=interpolation,
+        time_step_s=step_s,
+        clamp=clamp,
+        name=label,
+        info=info,
+        frame=frame,
+        source_span=(float(header.times[0]), float(header.times[-1])),
+    )
+    info.update(
+        map_degree=field.index_map.degree, map_residual_cells=field.index_map.residual_cells
+    )
     return field

@@ -63,8 +63,13 @@ def routed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Course, list[LegRe
     return course, route_course(course, winds["steady"], boat, settings_for(course))
 
 
-def _sailed(course: Course, legs: list[LegResult], turn_at_s: float | None = None,
-            turn_s: float = 20.0, radius_m: float = 4.0) -> Track:
+def _sailed(
+    course: Course,
+    legs: list[LegResult],
+    turn_at_s: float | None = None,
+    turn_s: float = 20.0,
+    radius_m: float = 4.0,
+) -> Track:
     """The routed legs as a 1 Hz track with a 20 s lead-in to the line; optionally a
     360° turn (anticlockwise circle of ``radius_m`` taking ``turn_s``) ``turn_at_s``
     after the start."""
@@ -98,8 +103,7 @@ def _sailed(course: Course, legs: list[LegResult], turn_at_s: float | None = Non
     return Track(tq, lat, lon, "synthetic", "synthetic.gpx")
 
 
-def test_sailing_the_optimal_route_loses_nothing(routed: tuple[Course, list[LegResult]]
-                                                 ) -> None:
+def test_sailing_the_optimal_route_loses_nothing(routed: tuple[Course, list[LegResult]]) -> None:
     course, legs = routed
     a = analyze_track(course, _sailed(course, legs))
     assert abs(a.segmentation.start.late_s) < 0.5  # crossed the line at the gun
@@ -124,8 +128,10 @@ def test_a_360_turn_shows_as_manoeuvre_loss(routed: tuple[Course, list[LegResult
     extra = turned.legs[0].loss_s - base.legs[0].loss_s
     assert extra == pytest.approx(20.0, abs=4.0)
     # a full circle is one tack and one gybe more
-    assert turned.legs[0].sailed_tacks + turned.legs[0].sailed_gybes == \
-        base.legs[0].sailed_tacks + base.legs[0].sailed_gybes + 2
+    assert (
+        turned.legs[0].sailed_tacks + turned.legs[0].sailed_gybes
+        == base.legs[0].sailed_tacks + base.legs[0].sailed_gybes + 2
+    )
     dm = turned.legs[0].split.manoeuvres - base.legs[0].split.manoeuvres
     assert dm > 0.6 * extra  # most of it is booked as manoeuvres
     for b, t in zip(base.legs[1:], turned.legs[1:], strict=True):
@@ -167,8 +173,17 @@ def test_cli_bad_input_exit_2_and_nothing_written(tmp_path: Path) -> None:
     empty = tmp_path / "empty.gpx"
     empty.write_text("", encoding="utf-8")
     out = tmp_path / "out"
-    res = CliRunner().invoke(app, ["analyze", str(ROOT / "courses" / "snipe-valencia-p01.yaml"),
-                                   str(empty), "--out", str(out), "-q"])
+    res = CliRunner().invoke(
+        app,
+        [
+            "analyze",
+            str(ROOT / "courses" / "snipe-valencia-p01.yaml"),
+            str(empty),
+            "--out",
+            str(out),
+            "-q",
+        ],
+    )
     assert res.exit_code == 2
     assert "empty.gpx: the track file is empty" in res.output
     assert "Traceback" not in res.output
@@ -177,11 +192,19 @@ def test_cli_bad_input_exit_2_and_nothing_written(tmp_path: Path) -> None:
 
 def test_shipped_example_runs_and_writes_every_file(tmp_path: Path) -> None:
     out = tmp_path / "ex"
-    res = run_analyze_command(ROOT / "courses" / "snipe-valencia-p01.yaml",
-                              [ROOT / "data" / "snipe-valencia-2025-06-21-ESP30782-P01.gpx"],
-                              out_dir=out)
-    assert set(res.files) == {"analysis_json", "analysis_csv", "points_csv", "legs_png",
-                              "loss_png", "html"}
+    res = run_analyze_command(
+        ROOT / "courses" / "snipe-valencia-p01.yaml",
+        [ROOT / "data" / "snipe-valencia-2025-06-21-ESP30782-P01.gpx"],
+        out_dir=out,
+    )
+    assert set(res.files) == {
+        "analysis_json",
+        "analysis_csv",
+        "points_csv",
+        "legs_png",
+        "loss_png",
+        "html",
+    }
     doc = json.loads((out / "analysis.json").read_text())
     assert doc["schema_version"] == 1 and len(doc["legs"]) == 4
     ends = [leg["end_time"][11:19] for leg in doc["legs"]]
@@ -193,17 +216,18 @@ def test_shipped_example_runs_and_writes_every_file(tmp_path: Path) -> None:
     from sailroute.report.page_render import read_figure
 
     fig = read_figure((out / "report.html").read_text(encoding="utf-8"))
-    (sailed,) = [t for t in fig["data"] if t["name"].startswith("sailed: ")
-                 and t["mode"] == "lines"]
+    (sailed,) = [
+        t for t in fig["data"] if t["name"].startswith("sailed: ") and t["mode"] == "lines"
+    ]
     assert len(sailed["x"]) == len(rows) - 1
-    assert [c[3] for c in sailed["customdata"][:3]] == [r.split(",")[1][11:19]
-                                                        for r in rows[1:4]]
+    assert [c[3] for c in sailed["customdata"][:3]] == [r.split(",")[1][11:19] for r in rows[1:4]]
     (optimal,) = [t for t in fig["data"] if t["name"].startswith("optimal")]
     assert optimal["x"].count(None) == 3 and optimal["line"]["dash"] == "dash"
     leg1 = doc["legs"][0]
     split = leg1["loss_split_s"]
-    assert split["manoeuvres"] + split["speed"] + split["route"] == \
-        pytest.approx(leg1["loss_s"], abs=0.01)
+    assert split["manoeuvres"] + split["speed"] + split["route"] == pytest.approx(
+        leg1["loss_s"], abs=0.01
+    )
 
 
 # README of the shared data: closest approach within 40 m of the metadata marks
@@ -219,9 +243,11 @@ def snipe_course(tmp_path: Path, race: str) -> Course:
     """The shipped P01 course, or the P02 one (B1 moved, 8 kn, start 12:06:30)."""
     text = (ROOT / "courses" / "snipe-valencia-p01.yaml").read_text(encoding="utf-8")
     if race == "P02":
-        text = (text.replace("11:23:30Z", "12:06:30Z").replace("tws_kn: 6", "tws_kn: 8")
-                .replace("B1: {lat: 39.40691, lon: -0.31500}",
-                         "B1: {lat: 39.40615, lon: -0.31310}"))
+        text = (
+            text.replace("11:23:30Z", "12:06:30Z")
+            .replace("tws_kn: 6", "tws_kn: 8")
+            .replace("B1: {lat: 39.40691, lon: -0.31500}", "B1: {lat: 39.40615, lon: -0.31310}")
+        )
     p = tmp_path / f"snipe-{race}.yaml"
     p.write_text(text, encoding="utf-8")
     return load_course(p)

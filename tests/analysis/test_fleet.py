@@ -32,8 +32,9 @@ def routed(tmp_path_factory: pytest.TempPathFactory) -> tuple[Course, list[LegRe
     return course, route_course(course, winds["steady"], boat, settings_for(course))
 
 
-def _piecewise(course: Course, knots_t: list[float], knots_x: list[float],
-               knots_y: list[float]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _piecewise(
+    course: Course, knots_t: list[float], knots_x: list[float], knots_y: list[float]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A 1 Hz track through the knots (relative to the gun [s], course frame [m])."""
     gun = course.start_epoch
     t = np.arange(knots_t[0], knots_t[-1] + 0.5, 1.0)
@@ -51,15 +52,16 @@ def test_over_early_and_not_back_is_timed_from_the_gun(routed) -> None:
     assert st.ocs_s == pytest.approx(8.0, abs=1e-6) and not st.ocs_returned
     assert st.crossing.t == st.gun_t and st.late_s == 0.0
     assert st.side_at_gun == "course" and st.distance_at_gun_m == pytest.approx(40.0)
-    assert st.notes[0].startswith("OCS by 8 s: crossed the start line 8 s before the gun "
-                                  "and did not come back; 40 m over at the gun")
+    assert st.notes[0].startswith(
+        "OCS by 8 s: crossed the start line 8 s before the gun "
+        "and did not come back; 40 m over at the gun"
+    )
 
 
 def test_over_early_and_back_restarts(routed) -> None:
     course, _ = routed
     # over at -8 s, back across at +12 s, restarts at +20 s (5 m/s throughout)
-    t, x, y = _piecewise(course, [-60.0, 2.0, 16.0, 60.0], [0.0] * 4,
-                         [-260.0, 50.0, -20.0, 200.0])
+    t, x, y = _piecewise(course, [-60.0, 2.0, 16.0, 60.0], [0.0] * 4, [-260.0, 50.0, -20.0, 200.0])
     st = find_start(course, t, x, y)
     assert st.ocs_s == pytest.approx(8.0, abs=1e-6) and st.ocs_returned
     assert st.late_s == pytest.approx(20.0, abs=1e-6)
@@ -74,15 +76,20 @@ def test_a_start_on_the_lines_extension_reports_the_offset(routed) -> None:
     assert st.late_s == pytest.approx(10.0, abs=1e-6) and st.ocs_s is None
     assert st.line_offset_m == pytest.approx(140.0, abs=1e-6)
     assert st.line_fraction == pytest.approx(260.0 / 120.0)
-    assert st.notes == ("crossed the start line's extension 140 m beyond 'boat', not the "
-                        "surveyed line: is the line laid elsewhere?",)
+    assert st.notes == (
+        "crossed the start line's extension 140 m beyond 'boat', not the "
+        "surveyed line: is the line laid elsewhere?",
+    )
 
 
 def test_no_start_anywhere_near_gives_the_closest_approach(routed) -> None:
     course, _ = routed
     t, x, y = _piecewise(course, [-10.0, 30.0], [900.0, 900.0], [-100.0, 100.0])
-    with pytest.raises(InputError, match=r"never crosses the start line \(start\) nor its "
-                       r"extension \(500 m beyond each end\).*closest approach 840 m"):
+    with pytest.raises(
+        InputError,
+        match=r"never crosses the start line \(start\) nor its "
+        r"extension \(500 m beyond each end\).*closest approach 840 m",
+    ):
         find_start(course, t, x, y)
 
 
@@ -105,8 +112,11 @@ def test_a_leg_end_inside_a_data_gap_is_unknown(routed) -> None:
     mid = a.legs[1]
     assert np.isnan(mid.t_end) and np.isnan(mid.sailed_time_s) and np.isnan(mid.loss_s)
     assert mid.note.startswith("leg 2 (top -> bottom): ")
-    assert re.search(r"the data stop \d+ m short of 'bottom' at .* \(a gap of 4[01] s, longer "
-                     r"than 10 s\): time unknown$", mid.note), mid.note
+    assert re.search(
+        r"the data stop \d+ m short of 'bottom' at .* \(a gap of 4[01] s, longer "
+        r"than 10 s\): time unknown$",
+        mid.note,
+    ), mid.note
     assert mid.optimal_time_s == pytest.approx(legs[1].time_s, rel=0.1)  # from a known start
     assert a.legs[2].note.startswith("leg 3 (bottom -> top) starts at an unknown time")
     assert a.legs[2].optimal is None and np.isnan(a.legs[2].optimal_time_s)
@@ -148,11 +158,16 @@ def _with_tail(tr: Track, seconds: int = 10) -> Track:
     """``tr`` sailed on for ``seconds`` at its last velocity (past the finish: the written
     file rounds the last fix, which lies on the finish itself)."""
     dt = np.arange(1, seconds + 1, dtype=float)
-    k = (tr.t_s[-1] - tr.t_s[-2])
+    k = tr.t_s[-1] - tr.t_s[-2]
     lat = tr.lat_deg[-1] + (tr.lat_deg[-1] - tr.lat_deg[-2]) / k * dt
     lon = tr.lon_deg[-1] + (tr.lon_deg[-1] - tr.lon_deg[-2]) / k * dt
-    return Track(np.concatenate([tr.t_s, tr.t_s[-1] + dt]), np.concatenate([tr.lat_deg, lat]),
-                 np.concatenate([tr.lon_deg, lon]), tr.name, tr.source)
+    return Track(
+        np.concatenate([tr.t_s, tr.t_s[-1] + dt]),
+        np.concatenate([tr.lat_deg, lat]),
+        np.concatenate([tr.lon_deg, lon]),
+        tr.name,
+        tr.source,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -161,14 +176,17 @@ def fleet_files(routed, tmp_path_factory: pytest.TempPathFactory) -> dict[str, P
     d = tmp_path_factory.mktemp("tracks")
     tr = _with_tail(_sailed(course, legs))
     cut = tr.between(tr.t_start, legs[0].t_end - 60.0)
-    return {"course": Path(course.source), "fast": _write_csv(d / "fast.csv", tr),
-            "slow": _write_csv(d / "slow.csv",
-                               _with_tail(_sailed(course, legs, turn_at_s=60.0))),
-            "short": _write_csv(d / "short.csv", cut),
-            "odd": _write_csv(d / "<b>odd.csv", tr, dt=4.0),
-            "day": _write_csv(d / "other-day.csv", tr, dt=86400.0),
-            "far": _write_csv(d / "far.csv", Track(tr.t_s, tr.lat_deg + 0.45, tr.lon_deg,
-                                                   "far", "far"))}
+    return {
+        "course": Path(course.source),
+        "fast": _write_csv(d / "fast.csv", tr),
+        "slow": _write_csv(d / "slow.csv", _with_tail(_sailed(course, legs, turn_at_s=60.0))),
+        "short": _write_csv(d / "short.csv", cut),
+        "odd": _write_csv(d / "<b>odd.csv", tr, dt=4.0),
+        "day": _write_csv(d / "other-day.csv", tr, dt=86400.0),
+        "far": _write_csv(
+            d / "far.csv", Track(tr.t_s, tr.lat_deg + 0.45, tr.lon_deg, "far", "far")
+        ),
+    }
 
 
 def _run(*args: str):
@@ -178,8 +196,7 @@ def _run(*args: str):
 def test_fleet_with_a_track_that_stops_early(fleet_files, tmp_path: Path) -> None:
     f = fleet_files
     out = tmp_path / "out"
-    res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), str(f["short"]), "-o",
-               str(out))
+    res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), str(f["short"]), "-o", str(out))
     assert res.exit_code == 0, res.output
     rows = list(csv.DictReader((out / "fleet.csv").open()))
     short = [r for r in rows if r["boat"] == "short"]
@@ -199,8 +216,9 @@ def test_fleet_with_a_track_that_stops_early(fleet_files, tmp_path: Path) -> Non
     assert "Traceback" not in res.output and not out2.exists()
 
 
-def test_fleet_with_a_boat_from_another_day_or_place_is_refused(fleet_files,
-                                                                tmp_path: Path) -> None:
+def test_fleet_with_a_boat_from_another_day_or_place_is_refused(
+    fleet_files, tmp_path: Path
+) -> None:
     f = fleet_files
     out = tmp_path / "out"
     res = _run(str(f["course"]), str(f["fast"]), str(f["day"]), "-o", str(out))
@@ -219,23 +237,46 @@ def test_per_boat_leg_times(fleet_files, routed, tmp_path: Path) -> None:
     course, _ = routed
     t0 = iso(course.start_epoch + 5.0)
     out = tmp_path / "out"
-    res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), "-o", str(out),
-               "--leg-times", f"slow={t0},-,-,-", "--no-plots")
+    res = _run(
+        str(f["course"]),
+        str(f["fast"]),
+        str(f["slow"]),
+        "-o",
+        str(out),
+        "--leg-times",
+        f"slow={t0},-,-,-",
+        "--no-plots",
+    )
     assert res.exit_code == 0, res.output
     doc = {b["name"]: b for b in json.loads((out / "fleet.json").read_text())["boats"]}
     assert doc["slow"]["start"]["start_time"] == t0 and not doc["slow"]["start"]["detected"]
     assert doc["fast"]["start"]["detected"]
-    for bad, msg in ((f"{t0},-,-,-", "with several tracks name the boat"),
-                     (f"nobody={t0},-,-,-", "no track named 'nobody'; boats are the track "
-                                            "file names without extension: fast, slow")):
-        res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), "-o",
-                   str(tmp_path / "bad"), "--leg-times", bad)
+    for bad, msg in (
+        (f"{t0},-,-,-", "with several tracks name the boat"),
+        (
+            f"nobody={t0},-,-,-",
+            "no track named 'nobody'; boats are the track file names without extension: fast, slow",
+        ),
+    ):
+        res = _run(
+            str(f["course"]),
+            str(f["fast"]),
+            str(f["slow"]),
+            "-o",
+            str(tmp_path / "bad"),
+            "--leg-times",
+            bad,
+        )
         assert res.exit_code == 2 and msg in res.output, res.output
         assert not (tmp_path / "bad").exists()
     with pytest.raises(InputError, match="boat 'a' given twice"):
         parse_boat_leg_times([f"a={t0},-,-,-", f"a={t0},-,-,-"], ["a", "b"], 3)
     assert parse_boat_leg_times(f"{t0},-,-,-", ["a"], 3)["a"] == [
-        course.start_epoch + 5.0, None, None, None]
+        course.start_epoch + 5.0,
+        None,
+        None,
+        None,
+    ]
 
 
 def test_fleet_page_escapes_names_and_draws_every_boat(fleet_files, tmp_path: Path) -> None:
@@ -243,8 +284,7 @@ def test_fleet_page_escapes_names_and_draws_every_boat(fleet_files, tmp_path: Pa
 
     f = fleet_files
     out = tmp_path / "out"
-    res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), str(f["odd"]), "-o",
-               str(out))
+    res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), str(f["odd"]), "-o", str(out))
     assert res.exit_code == 0, res.output
     page = (out / "report.html").read_text(encoding="utf-8")
     assert "<b>odd" not in page and "&lt;b&gt;odd" in page
@@ -268,8 +308,7 @@ def test_fleet_page_in_chromium(fleet_files, tmp_path: Path) -> None:
         pytest.skip("no Chromium installed")
     f = fleet_files
     out = tmp_path / "out"
-    res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), str(f["short"]), "-o",
-               str(out))
+    res = _run(str(f["course"]), str(f["fast"]), str(f["slow"]), str(f["short"]), "-o", str(out))
     assert res.exit_code == 0, res.output
     html = dom(out / "report.html", step=30)  # asserts a silent console
     assert 'data-map="drawn"' in html and 'id="sailroute-error"></div>' in html

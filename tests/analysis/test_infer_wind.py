@@ -70,18 +70,23 @@ def route_boat(twd, offset_m: float, dt0: float, side):
     th = np.radians(BASE)
     ux, uy, px, py = np.sin(th), np.cos(th), -np.cos(th), np.sin(th)
     W, L = (800.0 * ux + 0.3 * offset_m * px, 800.0 * uy + 0.3 * offset_m * py), (0.0, 0.0)
-    targets = [Target("mark", W, rounding="port", name="W"),
-               Target("mark", L, rounding="port", name="L")] * 2
+    targets = [
+        Target("mark", W, rounding="port", name="W"),
+        Target("mark", L, rounding="port", name="L"),
+    ] * 2
     prev = None
     parts = []
     for i, tg in enumerate(targets):
-        st = Start((L[0] - 60 * ux + offset_m * px, L[1] - 60 * uy + offset_m * py)
-                   if i == 0 else L, None, "start")
+        st = Start(
+            (L[0] - 60 * ux + offset_m * px, L[1] - 60 * uy + offset_m * py) if i == 0 else L,
+            None,
+            "start",
+        )
         st, tg2 = chain_leg(st, tg, prev, targets[i + 1] if i + 1 < len(targets) else None)
-        settings = RoutingSettings(tack_penalty_s=5.0, gybe_penalty_s=3.0,
-                                   initial_side=side if i == 0 else None)
-        prev = route_leg(st, tg2, T0 + dt0 if prev is None else prev.t_end, wind, BOAT,
-                         settings)
+        settings = RoutingSettings(
+            tack_penalty_s=5.0, gybe_penalty_s=3.0, initial_side=side if i == 0 else None
+        )
+        prev = route_leg(st, tg2, T0 + dt0 if prev is None else prev.t_end, wind, BOAT, settings)
         parts.append(prev.track)
     t = np.concatenate([p.t for p in parts])
     x = np.concatenate([p.x for p in parts])
@@ -188,15 +193,24 @@ def logged(route, name: str, every: int, sigma_m: float, rng) -> Track:
     return Track(t1[::every], lat, lon, name, "route", MappingProxyType({}), ())
 
 
-@pytest.mark.parametrize(("wind", "every", "sigma", "rms_max", "rms_beating_max", "within_min"), [
-    ("shift", 5, 0.0, 4.8, 1.5, 0.95),  # a 0.2 Hz logger
-    pytest.param("shift", 1, 3.0, 5.1, 2.3, 0.95, marks=pytest.mark.slow),
-    pytest.param("osc", 5, 0.0, 5.4, 3.5, 0.9, marks=pytest.mark.slow),
-    pytest.param("osc", 1, 3.0, 6.9, 5.6, 0.85, marks=pytest.mark.slow),
-])
-def test_slow_logs_and_correlated_gps_error(routes, wind: str, every: int, sigma: float,
-                                            rms_max: float, rms_beating_max: float,
-                                            within_min: float) -> None:
+@pytest.mark.parametrize(
+    ("wind", "every", "sigma", "rms_max", "rms_beating_max", "within_min"),
+    [
+        ("shift", 5, 0.0, 4.8, 1.5, 0.95),  # a 0.2 Hz logger
+        pytest.param("shift", 1, 3.0, 5.1, 2.3, 0.95, marks=pytest.mark.slow),
+        pytest.param("osc", 5, 0.0, 5.4, 3.5, 0.9, marks=pytest.mark.slow),
+        pytest.param("osc", 1, 3.0, 6.9, 5.6, 0.85, marks=pytest.mark.slow),
+    ],
+)
+def test_slow_logs_and_correlated_gps_error(
+    routes,
+    wind: str,
+    every: int,
+    sigma: float,
+    rms_max: float,
+    rms_beating_max: float,
+    within_min: float,
+) -> None:
     # 3 boats; 3 m of GPS error correlated over 30 s (a consumer receiver's wander), or a
     # log of one point in 5 s.  Measured: shift 0.2 Hz 4.32 / 1.20°, 100 %; shift 3 m
     # 4.62 / 2.03°, 98 %; osc 0.2 Hz 4.87 / 3.08°, 95 %; osc 3 m 6.27 / 5.05°, 88 %.
@@ -225,15 +239,22 @@ def test_without_a_prior_the_wider_boards_are_upwind(routes) -> None:
     np.testing.assert_allclose(iw.twd_deg, infer_wind(trs, FRAME, prior_twd_deg=BASE).twd_deg)
     assert any("up/down from the boards' separation" in n for n in iw.notes)
     # a prior on the wrong end finds no beats, and says where the wind more likely is
-    with pytest.raises(InputError, match=r"no upwind boards with the wind from 20° "
-                       r"\(up/down from the prior TWD 20°.*other end of the axis, 200°"):
+    with pytest.raises(
+        InputError,
+        match=r"no upwind boards with the wind from 20° "
+        r"\(up/down from the prior TWD 20°.*other end of the axis, 200°",
+    ):
         infer_wind(trs, FRAME, prior_twd_deg=BASE + 180.0)
 
 
 def test_half_separation_tells_beats_from_runs() -> None:
     rng = np.random.default_rng(5)
-    c = np.concatenate([rng.normal(70 - 42, 2, 500), rng.normal(70 + 42, 2, 500),
-                        rng.normal(250, 4, 600)]) % 360.0
+    c = (
+        np.concatenate(
+            [rng.normal(70 - 42, 2, 500), rng.normal(70 + 42, 2, 500), rng.normal(250, 4, 600)]
+        )
+        % 360.0
+    )
     assert half_separation_deg(c, 70.0) == pytest.approx(42.0, abs=3.0)
     assert half_separation_deg(c, 250.0) < 8.0
 
@@ -280,7 +301,8 @@ def test_field_is_linear_in_time_and_honours_coverage(routes) -> None:
     mid = 0.5 * (iw.t[k] + iw.t[k + 1])
     _, dm = wind_speed_direction(*f.sample(mid, 1e5, -1e5))
     assert float(dm) == pytest.approx(
-        iw.twd_deg[k] + 0.5 * float(wrap180(iw.twd_deg[k + 1] - iw.twd_deg[k])), abs=1e-9)
+        iw.twd_deg[k] + 0.5 * float(wrap180(iw.twd_deg[k + 1] - iw.twd_deg[k])), abs=1e-9
+    )
     with pytest.raises(OutOfCoverageError, match="requested"):
         f.sample(iw.t[ok][-1] + 60.0, 0.0, 0.0)
 
@@ -288,22 +310,39 @@ def test_field_is_linear_in_time_and_honours_coverage(routes) -> None:
 def test_summary_numbers() -> None:
     t = T0 + 30.0 * np.arange(5)
     d = np.array([355.0, 0.0, 5.0, np.nan, 0.0])
-    iw = InferredWind(t, d, np.full(5, 1.0), np.array([4.0, 5.0, 6.0, np.nan, 5.0]),
-                      np.full(5, 0.2), np.full(5, 30), "test")
+    iw = InferredWind(
+        t,
+        d,
+        np.full(5, 1.0),
+        np.array([4.0, 5.0, 6.0, np.nan, 5.0]),
+        np.full(5, 0.2),
+        np.full(5, 30),
+        "test",
+    )
     s = summary(iw)
     assert s["twd_mean_deg"] == pytest.approx(0.0, abs=1e-9)
     assert (s["twd_min_deg"], s["twd_max_deg"], s["twd_range_deg"]) == (355.0, 5.0, 10.0)
     assert s["twd_shift_rms_deg"] == pytest.approx(np.sqrt(50.0 / 4.0), abs=0.005)
     assert s["tws_mean_ms"] == 5.0 and s["n_grid"] == 4
-    empty = summary(InferredWind(t, np.full(5, np.nan), np.full(5, np.nan), np.full(5, np.nan),
-                                 np.full(5, np.nan), np.zeros(5, np.int64), "none"))
+    empty = summary(
+        InferredWind(
+            t,
+            np.full(5, np.nan),
+            np.full(5, np.nan),
+            np.full(5, np.nan),
+            np.full(5, np.nan),
+            np.zeros(5, np.int64),
+            "none",
+        )
+    )
     assert empty["twd_mean_deg"] is None and empty["n_grid"] == 0
 
 
 def test_wind_axis_of_symmetric_boards() -> None:
     rng = np.random.default_rng(3)
-    c = np.concatenate([rng.normal(70 - 42, 3, 400), rng.normal(70 + 42, 3, 400),
-                        rng.normal(250, 8, 300)])
+    c = np.concatenate(
+        [rng.normal(70 - 42, 3, 400), rng.normal(70 + 42, 3, 400), rng.normal(250, 8, 300)]
+    )
     axis, strength = wind_axis_deg(c % 360.0)
     assert axis == pytest.approx(70.0, abs=1.5)
     assert 0.0 < strength <= 1.0
@@ -326,8 +365,10 @@ def test_bad_input_is_refused(routes) -> None:
         infer_wind(tr, FRAME, t0=T0, t1=T0 + 160.0)
     with pytest.raises(InputError, match=r"is 30\.0 h, more than 6 h \(tracks of different days"):
         infer_wind(tr, FRAME, t0=T0, t1=T0 + 30 * 3600.0)
-    far = as_track(tuple(np.asarray(a) + (0.0, 3e4, 0.0)[i] for i, a in enumerate(
-        routes["shift"][1])), "far boat")
+    far = as_track(
+        tuple(np.asarray(a) + (0.0, 3e4, 0.0)[i] for i, a in enumerate(routes["shift"][1])),
+        "far boat",
+    )
     with pytest.raises(InputError, match=r"'boat 1' and 'far boat' sailed 30\.\d km apart"):
         infer_wind([tr[0], far], FRAME)
 
@@ -354,7 +395,7 @@ def test_snipe_p01_mean_direction_is_the_sailors_estimate() -> None:
         s = summary(iw)
         assert s["twd_mean_deg"] == pytest.approx(110.0, abs=5.0)
         assert s["n_grid"] >= 0.7 * iw.t.size
-        (alpha, _), = iw.half_angles_deg.values()
+        ((alpha, _),) = iw.half_angles_deg.values()
         assert 38.0 < alpha < 47.0  # a Snipe tacks through about 85° over the ground
         # the ILCA 7 stand-in polar sails the Snipe's speeds in 8-10 kn, not the noted 6 kn
         assert 8.0 * 0.5144 < s["tws_mean_ms"] < 10.0 * 0.5144
@@ -372,8 +413,13 @@ def test_j24_wind_is_the_course_axis_not_the_bridge_station() -> None:
     from sailroute.track import read_track
     from sailroute.units import circular_mean_deg
 
-    tr = read_track(SHARED_REAL / "races" / "j24-lake-washington-2015" /
-                    "Sensor_record_20150728_211517_AndroSensor.csv", time_zone="-07:00")
+    tr = read_track(
+        SHARED_REAL
+        / "races"
+        / "j24-lake-washington-2015"
+        / "Sensor_record_20150728_211517_AndroSensor.csv",
+        time_zone="-07:00",
+    )
     with open(SHARED_REAL / "wind" / "lake-washington-sr520" / "tuesday-july-28-2015.csv") as f:
         rows = list(csv.DictReader(f))
     day = datetime(2015, 7, 28, tzinfo=timezone(timedelta(hours=-7))).timestamp()
@@ -388,7 +434,7 @@ def test_j24_wind_is_the_course_axis_not_the_bridge_station() -> None:
     s = summary(iw)
     assert s["twd_mean_deg"] == pytest.approx(346.0, abs=5.0)
     assert 15.0 < float(wrap180(s["twd_mean_deg"] - station)) < 35.0
-    (alpha, gybe), = iw.half_angles_deg.values()
+    ((alpha, gybe),) = iw.half_angles_deg.values()
     assert 44.0 < alpha < 56.0  # over the ground: tacking angle plus leeway
     assert 145.0 < gybe < 172.0  # boards off dead downwind: not a run (held at 180°)
     np.testing.assert_allclose(infer_wind(tr, frame, t0=t0, t1=t1).twd_deg, iw.twd_deg)
@@ -404,16 +450,19 @@ def test_a_prior_breaks_a_tie_between_two_wind_axes() -> None:
     from sailroute.analysis.infer_wind import axis_near_prior
 
     # boards symmetric about 0° (courses ±45°) and, as many, about 90° (courses 90 ± 40°)
-    cog = np.concatenate([np.full(100, 45.0), np.full(100, 315.0), np.full(100, 50.0),
-                          np.full(100, 130.0)])
+    cog = np.concatenate(
+        [np.full(100, 45.0), np.full(100, 315.0), np.full(100, 50.0), np.full(100, 130.0)]
+    )
     cog = cog + np.random.default_rng(1).normal(0.0, 1.0, cog.size)
     assert axis_near_prior(cog, 80.0) == pytest.approx(90.0, abs=3.0)
-    assert axis_near_prior(cog, 350.0) == pytest.approx(0.0, abs=3.0) or \
-        axis_near_prior(cog, 350.0) == pytest.approx(180.0, abs=3.0)
+    assert axis_near_prior(cog, 350.0) == pytest.approx(0.0, abs=3.0) or axis_near_prior(
+        cog, 350.0
+    ) == pytest.approx(180.0, abs=3.0)
     # one clear axis: the prior does not move it
     one = cog[:200]
-    assert axis_near_prior(one, 80.0) % 180.0 == pytest.approx(0.0, abs=3.0) or \
-        axis_near_prior(one, 80.0) == pytest.approx(180.0, abs=3.0)
+    assert axis_near_prior(one, 80.0) % 180.0 == pytest.approx(0.0, abs=3.0) or axis_near_prior(
+        one, 80.0
+    ) == pytest.approx(180.0, abs=3.0)
 
 
 @requires_shared
@@ -423,11 +472,17 @@ def test_j24_direction_does_not_hang_on_the_window_end() -> None:
     # more, past the race, and 276° wins outright: infer over the race, not the evening)
     from sailroute.track import read_track
 
-    tr = read_track(SHARED_REAL / "races" / "j24-lake-washington-2015" /
-                    "Sensor_record_20150728_211517_AndroSensor.csv", time_zone="-07:00")
+    tr = read_track(
+        SHARED_REAL
+        / "races"
+        / "j24-lake-washington-2015"
+        / "Sensor_record_20150728_211517_AndroSensor.csv",
+        time_zone="-07:00",
+    )
     frame = LocalFrame(float(np.mean(tr.lat_deg)), float(np.mean(tr.lon_deg)))
     t0 = tr.t_s[0] + 0.5 * 3600.0
     for extra in (0.0, 300.0):
-        s = summary(infer_wind(tr, frame, prior_twd_deg=320.0, t0=t0 - 300.0,
-                               t1=t0 + 7200.0 + extra))
+        s = summary(
+            infer_wind(tr, frame, prior_twd_deg=320.0, t0=t0 - 300.0, t1=t0 + 7200.0 + extra)
+        )
         assert s["twd_mean_deg"] == pytest.approx(346.0, abs=5.0), extra

@@ -42,7 +42,8 @@ def test_a_60000_point_10hz_log_gives_the_same_race(tmp_path: Path) -> None:
         assert leg.sailed_distance_m == pytest.approx(ref.sailed_distance_m, rel=0.01)
         assert leg.sailed_tacks + leg.sailed_gybes == ref.sailed_tacks + ref.sailed_gybes
     assert a.segmentation.start.crossing.t == pytest.approx(
-        base.segmentation.start.crossing.t, abs=0.05)
+        base.segmentation.start.crossing.t, abs=0.05
+    )
     n_race = int(np.sum((tr.t_s > a.legs[0].t_start) & (tr.t_s < a.legs[-1].t_end)))
     assert a.points.t.size == n_race + 2 * len(a.legs)  # boundaries twice
     # the page: the sailed track decimated, leg changes where they are

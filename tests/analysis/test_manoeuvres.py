@@ -28,6 +28,7 @@ def test_a_gybe_and_a_tack_are_found() -> None:
     (m,) = _run(tack)
     assert m.kind == "tack" and m.index == 60
     # a change of side with a turn just under the threshold is not counted
-    small = np.r_[np.full(60, 180.0 - MIN_TURN_DEG / 2 + 1), np.full(60, 180.0 + MIN_TURN_DEG / 2
-                                                                      - 1)]
+    small = np.r_[
+        np.full(60, 180.0 - MIN_TURN_DEG / 2 + 1), np.full(60, 180.0 + MIN_TURN_DEG / 2 - 1)
+    ]
     assert _run(small) == ()

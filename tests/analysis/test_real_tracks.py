@@ -62,21 +62,29 @@ def _check(a) -> None:
         assert np.isfinite(leg.optimal_time_s) and leg.optimal_time_s > 0
         sp = leg.split
         assert sp.manoeuvres + sp.speed + sp.route == pytest.approx(
-            leg.sailed_time_s - leg.optimal_time_s, abs=1e-6)
+            leg.sailed_time_s - leg.optimal_time_s, abs=1e-6
+        )
         assert leg.loss_s == pytest.approx(leg.sailed_time_s - leg.optimal_time_s, abs=1e-9)
 
 
 @requires_shared
 def test_tallinn_instrument_log_analyses(tmp_path: Path) -> None:
-    tr = read_track(SHARED_REAL / "races" / "tallinn-wednesday-races-2023" /
-                    "kolmak_2023_09_27.csv", speed_unit="kn")
+    tr = read_track(
+        SHARED_REAL / "races" / "tallinn-wednesday-races-2023" / "kolmak_2023_09_27.csv",
+        speed_unit="kn",
+    )
     twd = tr.channels["twd_deg"]
     d = float(circular_mean_deg(twd[np.isfinite(twd)]))
     s = float(np.nanmedian(tr.channels["tws_ms"]))
     assert 12.0 < s / KNOT < 16.0  # the log's median TWS, 14.1 kn
-    c = course_on_track(tr, tr.t_s[0], tr.t_s[-1], d,
-                        f"{{type: uniform, tws_ms: {s:.2f}, twd_deg: {d:.0f}}}",
-                        tmp_path / "tallinn.yaml")
+    c = course_on_track(
+        tr,
+        tr.t_s[0],
+        tr.t_s[-1],
+        d,
+        f"{{type: uniform, tws_ms: {s:.2f}, twd_deg: {d:.0f}}}",
+        tmp_path / "tallinn.yaml",
+    )
     _check(analyze_track(c, tr))
 
 
@@ -98,12 +106,24 @@ def test_j24_phone_track_with_the_bridge_station_analyses(tmp_path: Path) -> Non
             hh, mm = int(h), round((h - int(h)) * 60)
             if mm == 60:
                 hh, mm = hh + 1, 0
-            f.write(f"2015-07-28T{hh:02d}:{mm:02d}:00-07:00,47.641,-122.262,{r['speed']},"
-                    f"{r['direction']}\n")
-    tr = read_track(SHARED_REAL / "races" / "j24-lake-washington-2015" /
-                    "Sensor_record_20150728_211517_AndroSensor.csv", time_zone="-07:00")
+            f.write(
+                f"2015-07-28T{hh:02d}:{mm:02d}:00-07:00,47.641,-122.262,{r['speed']},"
+                f"{r['direction']}\n"
+            )
+    tr = read_track(
+        SHARED_REAL
+        / "races"
+        / "j24-lake-washington-2015"
+        / "Sensor_record_20150728_211517_AndroSensor.csv",
+        time_zone="-07:00",
+    )
     t0 = tr.t_s[0] + 0.5 * 3600
-    c = course_on_track(tr, t0, t0 + 2.0 * 3600, 300.0,
-                        f"{{type: stations, path: {station}, radius_m: 8000}}",
-                        tmp_path / "j24.yaml")
+    c = course_on_track(
+        tr,
+        t0,
+        t0 + 2.0 * 3600,
+        300.0,
+        f"{{type: stations, path: {station}, radius_m: 8000}}",
+        tmp_path / "j24.yaml",
+    )
     _check(analyze_track(c, tr))

@@ -59,8 +59,10 @@ def course_from_xml(xml: Path, tws_kn: float, twd_deg: float, out: Path) -> Path
             names.append(m.get("Name", ""))
             marks[m.get("Name", "")] = (m.get("TargetLat", ""), m.get("TargetLng", ""))
         compound[cm.get("CompoundMarkID", "")] = names
-    corners = [(c.get("CompoundMarkID", ""), c.get("Rounding", ""))
-               for c in root.iterfind("CompoundMarkSequence/Corner")]
+    corners = [
+        (c.get("CompoundMarkID", ""), c.get("Rounding", ""))
+        for c in root.iterfind("CompoundMarkSequence/Corner")
+    ]
     lines, gates, legs = {}, {}, []
     for k, (cid, rounding) in enumerate(corners):
         names = compound[cid]
@@ -75,14 +77,21 @@ def course_from_xml(xml: Path, tws_kn: float, twd_deg: float, out: Path) -> Path
         else:  # LG1/LG2 -> gate LG
             gates[names[0][:-1]] = names
             legs.append(f"{{to: {names[0][:-1]}}}")
-    text = [f"name: SailGP race {root.findtext('RaceID')}",
-            f'start_time: "{start.get("Start")}"', "time_limit_min: 30", "marks:"]
+    text = [
+        f"name: SailGP race {root.findtext('RaceID')}",
+        f'start_time: "{start.get("Start")}"',
+        "time_limit_min: 30",
+        "marks:",
+    ]
     text += [f"  {n}: {{lat: {la}, lon: {lo}}}" for n, (la, lo) in marks.items()]
     text += ["lines:", *(f"  {k}: [{a}, {b}]" for k, (a, b) in lines.items())]
     text += ["gates:", *(f"  {k}: [{a}, {b}]" for k, (a, b) in gates.items())]
     text += ["legs:", *(f"  - {leg}" for leg in legs)]
-    text += [f"boat: {{polar: {POLAR}}}", "scenarios:",
-             f"  race-mean: {{type: uniform, tws_kn: {tws_kn:.2f}, twd_deg: {twd_deg:.1f}}}"]
+    text += [
+        f"boat: {{polar: {POLAR}}}",
+        "scenarios:",
+        f"  race-mean: {{type: uniform, tws_kn: {tws_kn:.2f}, twd_deg: {twd_deg:.1f}}}",
+    ]
     out.write_text("\n".join(text) + "\n", encoding="utf-8")
     return out
 
@@ -116,10 +125,20 @@ def fleet(tmp_path_factory: pytest.TempPathFactory) -> CommandResult:
         tws.append(tr.channels["tws_ms"][m])
         twd.append(tr.channels["twd_deg"][m])
     s, d = np.concatenate(tws), np.concatenate(twd)
-    course = course_from_xml(XML, float(np.nanmean(s)) / KNOT,
-                             float(circular_mean_deg(d[np.isfinite(d)])), tmp / "race.yaml")
-    return run_analyze_command(load_course(course), tracks, time_zone="UTC",
-                               out_dir=tmp / "out", plots=False, gate_end="rounding")
+    course = course_from_xml(
+        XML,
+        float(np.nanmean(s)) / KNOT,
+        float(circular_mean_deg(d[np.isfinite(d)])),
+        tmp / "race.yaml",
+    )
+    return run_analyze_command(
+        load_course(course),
+        tracks,
+        time_zone="UTC",
+        out_dir=tmp / "out",
+        plots=False,
+        gate_end="rounding",
+    )
 
 
 @requires_shared

@@ -37,8 +37,9 @@ SCENARIO = UniformWind(10 * KNOT, 0.0)
 def _faster(track: Track, factor: float, gun: float) -> Track:
     """The same path sailed ``factor`` times faster (time compressed about the gun)."""
     t0 = gun
-    return Track(t0 + (track.t_s - t0) / factor, track.lat_deg, track.lon_deg, track.name,
-                 track.source)
+    return Track(
+        t0 + (track.t_s - t0) / factor, track.lat_deg, track.lon_deg, track.name, track.source
+    )
 
 
 def test_speed_from_one_field_direction_from_another() -> None:
@@ -58,7 +59,10 @@ def test_wind_order_best_first_and_a_missing_kind_is_a_clear_error() -> None:
     inf = WindSource("inferred", SCENARIO, "inferred")
     own = WindSource("measured", SCENARIO, "measured on board")
     assert [s.kind for s in wind_order("auto", [scen, inf, own])] == [
-        "measured", "inferred", "scenario"]
+        "measured",
+        "inferred",
+        "scenario",
+    ]
     assert [s.kind for s in wind_order("scenario", [scen, inf, own])] == ["scenario"]
     with pytest.raises(InputError, match="wind columns"):
         wind_order("measured", [scen, inf])
@@ -78,15 +82,18 @@ def test_first_covering_skips_a_field_with_a_hole() -> None:
 
 
 def test_each_leg_is_judged_in_the_first_wind_that_covers_it(
-        routed: tuple[Course, list[LegResult]]) -> None:
+    routed: tuple[Course, list[LegResult]],
+) -> None:
     course, legs = routed
     track = _sailed(course, legs)
     base = analyze_track(course, track)
     # "measured" = the scenario's wind, but its log ends during leg 2
     t_end = 0.5 * (legs[1].t_start + legs[1].t_end)
     measured = UniformWind([10 * KNOT] * 2, [0.0, 0.0], times=[track.t_s[0], t_end])
-    srcs = [WindSource("measured", measured, "measured on board"),
-            WindSource("scenario", SCENARIO, "scenario 'steady'")]
+    srcs = [
+        WindSource("measured", measured, "measured on board"),
+        WindSource("scenario", SCENARIO, "scenario 'steady'"),
+    ]
     a = analyze_track(course, track, winds=srcs)
     assert [leg.wind_source for leg in a.legs] == ["measured", "scenario", "scenario"]
     assert a.legs[0].wind_label == "measured on board"
@@ -121,7 +128,8 @@ def test_band_factors_take_the_percentile_per_point_of_sail() -> None:
 
 
 def test_a_fleet_relative_polar_judges_a_fast_boat_against_itself(
-        routed: tuple[Course, list[LegResult]]) -> None:
+    routed: tuple[Course, list[LegResult]],
+) -> None:
     course, legs = routed
     fast = _faster(_sailed(course, legs), 1.25, course.start_epoch)
     boat, winds = build_specs(course, ["steady"])
@@ -168,7 +176,8 @@ SNIPE_TRACK = ROOT / "data" / "snipe-valencia-2025-06-21-ESP30782-P01.gpx"
 
 
 def test_the_snipe_example_is_judged_in_the_inferred_wind_and_its_polar_called_out(
-        tmp_path: Path) -> None:
+    tmp_path: Path,
+) -> None:
     # a GPS watch track: no wind in the log, so the direction is inferred from the track;
     # the ILCA polar stands in for the faster Snipe: every leg is flagged
     r = run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "abs")
@@ -178,14 +187,14 @@ def test_the_snipe_example_is_judged_in_the_inferred_wind_and_its_polar_called_o
     assert "sailed above 110 % of the polar" in r.report
     assert any(n.startswith("inferred wind: TWD 1") for n in r.notes)
     doc = json.loads(r.files["analysis_json"].read_text())
-    assert all(leg["above_polar"] and leg["wind"]["source"] == "inferred"
-               for leg in doc["legs"])
+    assert all(leg["above_polar"] and leg["wind"]["source"] == "inferred" for leg in doc["legs"])
     assert doc["reference"].startswith("course polar")
     page = r.files["html"].read_text()
     assert "Sailed above 110 % of the polar" in page and "inferred" in page
     # against what this fleet (one boat) sails: no leg is a big "gain" any more
-    f = run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "fleet",
-                            reference="fleet", plots=False)
+    f = run_analyze_command(
+        SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "fleet", reference="fleet", plots=False
+    )
     b = f.data[0]
     assert b.reference.startswith("fleet-relative polar")
     for leg in b.legs:
@@ -195,9 +204,11 @@ def test_the_snipe_example_is_judged_in_the_inferred_wind_and_its_polar_called_o
 
 def test_asking_for_a_wind_the_data_do_not_hold_is_a_clear_error(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="--wind measured: no track has usable wind columns"):
-        run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "o",
-                            wind="measured", plots=False)
+        run_analyze_command(
+            SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "o", wind="measured", plots=False
+        )
     assert not (tmp_path / "o").exists()
     with pytest.raises(InputError, match="--reference: expected one of course, fleet"):
-        run_analyze_command(SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "p",
-                            reference="peers", plots=False)
+        run_analyze_command(
+            SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "p", reference="peers", plots=False
+        )

@@ -11,9 +11,11 @@ from sailroute.boat.polar import Polar
 
 TWA = np.array([0, 40, 60, 90, 120, 150, 180.0])
 POLAR = Polar.from_arrays(
-    TWA, np.array([2, 4, 6, 8.0]),
+    TWA,
+    np.array([2, 4, 6, 8.0]),
     np.outer([0, 0.7, 0.85, 0.97, 0.97, 0.8, 0.6], 0.5 * np.array([2, 4, 6, 8.0])),
-    name="small")
+    name="small",
+)
 BOAT = DynamicBoat()
 
 

@@ -58,8 +58,9 @@ def test_vpp_default_boat_writes_readable_files(tmp_path: Path) -> None:
         np.testing.assert_allclose(speeds, api.speed_ms[i] / KNOT, atol=0.005 + 1e-9)
     # best VMG lines agree with the API
     beat = next(ln for ln in res.output.splitlines() if ln.strip().startswith("beat TWA"))
-    np.testing.assert_allclose([float(v) for v in beat.split()[3:]],
-                               api.vmg_upwind(api.tws_ms)[0], atol=0.05 + 1e-9)
+    np.testing.assert_allclose(
+        [float(v) for v in beat.split()[3:]], api.vmg_upwind(api.tws_ms)[0], atol=0.05 + 1e-9
+    )
     doc = json.loads((out / "ilca7.json").read_text())
     assert doc["vpp_params"]["crew_mass_kg"] == 80.0 and doc["speed_unit"] == "kn"
 
@@ -67,15 +68,34 @@ def test_vpp_default_boat_writes_readable_files(tmp_path: Path) -> None:
 def test_vpp_boat_file_options_and_units(tmp_path: Path) -> None:
     boat = tmp_path / "radial.yaml"
     boat.write_text("class: ilca6\nname: My radial\ncrew_mass_kg: 60\n")
-    res = runner.invoke(app, ["vpp", str(boat), "--crew-mass", "64", "--tws", "3,6",
-                              "--twa-step", "30", "--unit", "m/s", "--kinetics", "steady",
-                              "--out", str(tmp_path)])
+    res = runner.invoke(
+        app,
+        [
+            "vpp",
+            str(boat),
+            "--crew-mass",
+            "64",
+            "--tws",
+            "3,6",
+            "--twa-step",
+            "30",
+            "--unit",
+            "m/s",
+            "--kinetics",
+            "steady",
+            "--out",
+            str(tmp_path),
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert res.output.startswith("steady VPP (no wave riding or pumping")
     assert "My radial: boat speed [m/s]" in res.output
     back = read_polar(tmp_path / "radial.csv")  # units in the CSV header: m/s
-    api = vpp_polar(replace(ILCA6, name="My radial", crew_mass_kg=64.0), (3.0, 6.0),
-                    tuple(float(a) for a in range(0, 181, 30)))
+    api = vpp_polar(
+        replace(ILCA6, name="My radial", crew_mass_kg=64.0),
+        (3.0, 6.0),
+        tuple(float(a) for a in range(0, 181, 30)),
+    )
     np.testing.assert_allclose(back.speed_ms, api.speed_ms, atol=1e-6)
 
 
@@ -104,23 +124,30 @@ def test_vpp_bad_input_exits_2_and_names_the_key(tmp_path: Path) -> None:
         (None, ["--tws", "8,4"], "--tws: wind speeds must increase"),
         (None, ["--tws", "4,-6"], "--tws: item 2 ('-6') must be a positive, finite speed"),
         # the readers' TWS limit (80 kn) at the writer's input: every file written reads back
-        (None, ["--tws", "4,1000"], "--tws: item 2 (1000 kn) is above 80 kn, stronger than any "
-         "wind a polar is made for"),
+        (
+            None,
+            ["--tws", "4,1000"],
+            "--tws: item 2 (1000 kn) is above 80 kn, stronger than any wind a polar is made for",
+        ),
         (None, ["--tws", "2,50", "--unit", "m/s"], "--tws: item 2 (50 m/s) is above 41.2 m/s"),
         (None, ["--crew-mass", "-70"], "--crew-mass: expected a sailor mass in 20-200 kg"),
         (None, ["--twa-step", "0"], "--twa-step: expected a step between 0.1 and 90 degrees"),
         (b"crew_mass_kg: -70\n", [], "b.yaml:1: crew_mass_kg: expected a finite number > 0"),
         (b"crew_mass_kg: 5\n", [], "b.yaml:1: crew_mass_kg: expected a sailor mass in 20-200 kg"),
         (b"class: ilca7\nname: \xff\n", [], "b.yaml: not a UTF-8 text file"),
-        (b"crew_mass_kg: 80\nclass: ilca6\ncrew_mass_kg: 90\n", [],
-         "b.yaml:3: crew_mass_kg: the key appears twice (lines 1 and 3)"),
+        (
+            b"crew_mass_kg: 80\nclass: ilca6\ncrew_mass_kg: 90\n",
+            [],
+            "b.yaml:3: crew_mass_kg: the key appears twice (lines 1 and 3)",
+        ),
         (b"- ilca7\n", [], "b.yaml: a boat file is a mapping like 'class: ilca7'"),
         (b"stability: heel\n", [], "b.yaml: gz_m: stability 'heel' needs a righting-arm curve"),
         (b"sail_area_m2: 1e6\nbeam_m: wide\n", [], "b.yaml:2: beam_m: expected a number"),
     ],
 )
-def test_vpp_bad_input_table(tmp_path: Path, content: bytes | None, args: list[str],
-                             message: str) -> None:
+def test_vpp_bad_input_table(
+    tmp_path: Path, content: bytes | None, args: list[str], message: str
+) -> None:
     """Every bad input: exit code 2, one message naming the file/line/key or option."""
     cmd = ["vpp", "--out", str(tmp_path / "out")]
     if content is not None:

@@ -133,8 +133,9 @@ def test_no_drive_zone_coast_and_stop() -> None:
 def test_chain_of_pieces_in_uniform_wind_equals_one_segment() -> None:
     # splitting a straight segment in uniform wind must not change its time
     beta = np.full((1, 5), np.radians(45.0))
-    t_chain, v_chain = chain_time(BOAT, beta, np.full((1, 5), 10.0), np.full((1, 5), 8.0),
-                                  np.ones((1, 5)), np.array([0.3]))
+    t_chain, v_chain = chain_time(
+        BOAT, beta, np.full((1, 5), 10.0), np.full((1, 5), 8.0), np.ones((1, 5)), np.array([0.3])
+    )
     t_one, v_one = BOAT.segment(40.0, 45.0, 10.0, 0.3)
     assert t_chain[0] == pytest.approx(float(t_one), abs=2e-4)
     assert v_chain[0] == pytest.approx(float(v_one), rel=1e-6)
@@ -150,8 +151,9 @@ def test_turn_between_pieces_costs_time() -> None:
     mild, _ = chain_time(BOAT, beta, vt, ell, np.array([[1.0, np.cos(np.radians(30))]]), v)
     assert straight[0] < mild[0] < tack[0]
     # the tack restarts from rest: same as a chain entered at zero speed
-    from_rest, _ = chain_time(BOAT, beta[:, 1:], vt[:, 1:], ell[:, 1:], np.ones((1, 1)),
-                              np.array([0.0]))
+    from_rest, _ = chain_time(
+        BOAT, beta[:, 1:], vt[:, 1:], ell[:, 1:], np.ones((1, 1)), np.array([0.0])
+    )
     first, _ = chain_time(BOAT, beta[:, :1], vt[:, :1], ell[:, :1], np.ones((1, 1)), v)
     assert tack[0] == pytest.approx(first[0] + from_rest[0], abs=1e-9)
 

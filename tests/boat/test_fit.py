@@ -62,10 +62,10 @@ def synthetic_log(target, n_s=50_000, seed=1):
             tacking[j] = True
             factor[j] = 0.5
             rec = np.arange(min(30, n_s - j.stop))
-            factor[j.stop:j.stop + rec.size] = 1 - 0.5 * np.exp(-rec / 3.0)
+            factor[j.stop : j.stop + rec.size] = 1 - 0.5 * np.exp(-rec / 3.0)
         i = j.stop
         m = min(seg, n_s - i)
-        twa[i:i + m] = new_sign * (ang + 2.0 * np.sin(2 * np.pi * np.arange(m) / 71))
+        twa[i : i + m] = new_sign * (ang + 2.0 * np.sin(2 * np.pi * np.arange(m) / 71))
         i, sign, prev = i + m, new_sign, ang
     tri = 2 * np.abs(((t / 31.0 + rng.uniform()) % 1) - 0.5)
     u = U_LO + (U_HI - U_LO) * tri
@@ -86,8 +86,7 @@ def target():
 def synthetic(target):
     log = synthetic_log(target)
     t, tws, twa, bsp = log[:4]
-    fit = fit_polar(tws, twa, bsp, t, tws_bins_ms=TWS_BINS, twa_bins_deg=TWA_BINS,
-                    min_count=30)
+    fit = fit_polar(tws, twa, bsp, t, tws_bins_ms=TWS_BINS, twa_bins_deg=TWA_BINS, min_count=30)
     return log, fit
 
 
@@ -125,8 +124,7 @@ def test_without_the_within_cell_correction_the_upper_corner_biases_the_fit(targ
     saved = fitmod._CORRECTION_PASSES
     try:
         fitmod._CORRECTION_PASSES = 0
-        raw = fit_polar(tws, twa, bsp, tws_bins_ms=TWS_BINS, twa_bins_deg=TWA_BINS,
-                        min_count=30)
+        raw = fit_polar(tws, twa, bsp, tws_bins_ms=TWS_BINS, twa_bins_deg=TWA_BINS, min_count=30)
     finally:
         fitmod._CORRECTION_PASSES = saved
     rms_raw = np.sqrt(np.mean((raw.polar.speed_ms / ref - 1)[raw.covered] ** 2))
@@ -150,8 +148,16 @@ def test_filter_rules_one_by_one() -> None:
     bsp[80] = 3.0  # +50 % in one second: acceleration
     tws = np.full(100, 4.0)
     tws[5] = 0.5  # below the floor
-    fit = fit_polar(tws, twa, bsp, t, tws_bins_ms=[4.0], twa_bins_deg=[40.0, 50.0],
-                    min_count=1, filters=FitFilters(manoeuvre_window_s=5.0))
+    fit = fit_polar(
+        tws,
+        twa,
+        bsp,
+        t,
+        tws_bins_ms=[4.0],
+        twa_bins_deg=[40.0, 50.0],
+        min_count=1,
+        filters=FitFilters(manoeuvre_window_s=5.0),
+    )
     # the tack's heading change (90 deg in 1 s) also trips the turn rate at 49, 50
     assert fit.dropped["low_wind"] == 1
     assert fit.dropped["manoeuvre"] == 10  # 45..54: |t - 49.5| <= 5
@@ -170,8 +176,9 @@ def test_monotone_in_tws_unless_the_data_say_otherwise() -> None:
     # a small dip at 4 m/s (within noise) is smoothed; a large drop at 5 m/s is kept
     base = np.repeat([2.0, 1.98, 1.5], n)
     bsp = base * rng.uniform(0.8, 1.0, 3 * n)
-    fit = fit_polar(tws, twa, bsp, tws_bins_ms=[3.0, 4.0, 5.0], twa_bins_deg=[80.0, 90.0],
-                    min_count=10)
+    fit = fit_polar(
+        tws, twa, bsp, tws_bins_ms=[3.0, 4.0, 5.0], twa_bins_deg=[80.0, 90.0], min_count=10
+    )
     row = fit.polar.speed_ms[list(fit.polar.twa_deg).index(90.0)]
     assert row[1] >= row[0] - 1e-12  # pooled: non-decreasing 3 -> 4
     assert row[2] < 0.8 * row[1]  # the significant drop survives
@@ -184,8 +191,14 @@ def test_empty_cells_are_filled_and_marked() -> None:
     keep = ~((twa == 90.0) & (tws > 4.5))  # no data at (90, 5)
     tws, twa = tws[keep], twa[keep]
     bsp = np.where(twa == 90.0, 2.5, 2.0) * np.ones_like(tws)
-    fit = fit_polar(tws, twa, bsp, tws_bins_ms=[3.0, 4.0, 5.0],
-                    twa_bins_deg=[0.0, 45.0, 90.0, 150.0, 180.0], min_count=5)
+    fit = fit_polar(
+        tws,
+        twa,
+        bsp,
+        tws_bins_ms=[3.0, 4.0, 5.0],
+        twa_bins_deg=[0.0, 45.0, 90.0, 150.0, 180.0],
+        min_count=5,
+    )
     np.testing.assert_array_equal(fit.polar.twa_deg, [45.0, 90.0, 150.0])  # empty rows out
     np.testing.assert_array_equal(fit.empty_twa_deg, [0.0, 180.0])
     i = 1
@@ -200,8 +213,7 @@ def test_bad_input_raises_with_a_hint() -> None:
     with pytest.raises(InputError, match="twa_deg has 2 samples"):
         fit_polar([4.0], [45.0, 50.0], [2.0], tws_bins_ms=[4.0], twa_bins_deg=[40.0, 50.0])
     with pytest.raises(InputError, match="percentile"):
-        fit_polar([4.0], [45.0], [2.0], tws_bins_ms=[4.0], twa_bins_deg=[40, 50],
-                  percentile=0)
+        fit_polar([4.0], [45.0], [2.0], tws_bins_ms=[4.0], twa_bins_deg=[40, 50], percentile=0)
     with pytest.raises(InputError, match="strictly increasing"):
         fit_polar([4.0], [45.0], [2.0], tws_bins_ms=[4.0, 3.0], twa_bins_deg=[40, 50])
 
@@ -222,16 +234,21 @@ def test_efficiency_bands_and_blend() -> None:
 
 def test_efficiency_in_the_course_boat_block(tmp_path: Path) -> None:
     base = boat_from_spec({"builtin": "ilca7"}, base_dir=tmp_path, where="c.yaml")
-    up = boat_from_spec({"builtin": "ilca7", "efficiency": {"upwind": 0.9, "downwind": 1.05}},
-                        base_dir=tmp_path, where="c.yaml")
+    up = boat_from_spec(
+        {"builtin": "ilca7", "efficiency": {"upwind": 0.9, "downwind": 1.05}},
+        base_dir=tmp_path,
+        where="c.yaml",
+    )
     assert up.speed(4.0, 40.0) == pytest.approx(0.9 * base.speed(4.0, 40.0), rel=2e-3)
     assert up.speed(4.0, 160.0) == pytest.approx(1.05 * base.speed(4.0, 160.0), rel=2e-3)
     with pytest.raises(InputError, match=r"c.yaml: boat.efficiency.upwnd: unknown key"):
-        boat_from_spec({"builtin": "ilca7", "efficiency": {"upwnd": 0.9}}, base_dir=tmp_path,
-                       where="c.yaml")
+        boat_from_spec(
+            {"builtin": "ilca7", "efficiency": {"upwnd": 0.9}}, base_dir=tmp_path, where="c.yaml"
+        )
     with pytest.raises(InputError, match=r"boat.efficiency.reach: expected a speed factor"):
-        boat_from_spec({"builtin": "ilca7", "efficiency": {"reach": 1.6}}, base_dir=tmp_path,
-                       where="c.yaml")
+        boat_from_spec(
+            {"builtin": "ilca7", "efficiency": {"reach": 1.6}}, base_dir=tmp_path, where="c.yaml"
+        )
 
 
 # --- files, CLI ------------------------------------------------------------------------
@@ -248,8 +265,7 @@ def write_log(path: Path, target, n_s: int = 20_000) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-def test_cli_fit_writes_files_that_read_back_and_a_course_can_use(tmp_path: Path,
-                                                                   target) -> None:
+def test_cli_fit_writes_files_that_read_back_and_a_course_can_use(tmp_path: Path, target) -> None:
     log = tmp_path / "synthetic.csv"
     write_log(log, target)
     ref = tmp_path / "target.pol"
@@ -257,8 +273,22 @@ def test_cli_fit_writes_files_that_read_back_and_a_course_can_use(tmp_path: Path
 
     write_pol(target, ref)
     out = tmp_path / "out"
-    res = runner.invoke(app, ["polar", "fit", str(log), "--tws-bins", "6,8,10,12",
-                              "--out", str(out), "--reference", str(ref), "--min-count", "30"])
+    res = runner.invoke(
+        app,
+        [
+            "polar",
+            "fit",
+            str(log),
+            "--tws-bins",
+            "6,8,10,12",
+            "--out",
+            str(out),
+            "--reference",
+            str(ref),
+            "--min-count",
+            "30",
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert "boat speed: bsp" in res.output and "coverage:" in res.output
     assert "vs reference target: RMS" in res.output
@@ -268,8 +298,9 @@ def test_cli_fit_writes_files_that_read_back_and_a_course_can_use(tmp_path: Path
     doc = json.loads((out / "synthetic-fit.json").read_text())
     assert doc["fit"]["reference"]["rms_pct"] < 3.0
     assert np.array(doc["fit"]["counts"]).shape == fitted.speed_ms.shape
-    course_boat = boat_from_spec({"polar": "out/synthetic-fit.pol"}, base_dir=tmp_path,
-                                 where="c.yaml")
+    course_boat = boat_from_spec(
+        {"polar": "out/synthetic-fit.pol"}, base_dir=tmp_path, where="c.yaml"
+    )
     np.testing.assert_allclose(course_boat.speed_ms, fitted.speed_ms)
 
 
@@ -278,8 +309,9 @@ def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path: Path) -> None:
     res = runner.invoke(app, ["polar", "fit", str(tmp_path / "none.csv"), "--out", str(out)])
     assert res.exit_code == 2 and "track file not found" in res.output
     log = tmp_path / "gps.csv"
-    log.write_text("time,lat,lon\n2023-01-01T00:00:00Z,59.5,24.8\n"
-                   "2023-01-01T00:00:01Z,59.5,24.81\n")
+    log.write_text(
+        "time,lat,lon\n2023-01-01T00:00:00Z,59.5,24.8\n2023-01-01T00:00:01Z,59.5,24.81\n"
+    )
     res = runner.invoke(app, ["polar", "fit", str(log), "--out", str(out)])
     assert res.exit_code == 2 and "no true wind speed column" in res.output
     assert "--course" in res.output
@@ -302,7 +334,9 @@ def test_gps_track_with_a_course_wind(tmp_path: Path, target) -> None:
     lon = 24.8 + x / (111_320.0 * np.cos(np.radians(59.5)))
     lines = ["time,lat,lon"] + [
         f"{np.datetime_as_string(np.datetime64(1_700_000_000 + int(t[k]), 's'))}Z,"
-        f"{lat[k]:.8f},{lon[k]:.8f}" for k in range(t.size)]
+        f"{lat[k]:.8f},{lon[k]:.8f}"
+        for k in range(t.size)
+    ]
     (tmp_path / "track.csv").write_text("\n".join(lines) + "\n")
     (tmp_path / "course.yaml").write_text(
         "name: fit test\nstart_time: 2023-11-14T22:00:00Z\ntime_limit_min: 600\n"
@@ -311,9 +345,15 @@ def test_gps_track_with_a_course_wind(tmp_path: Path, target) -> None:
         "W: {lat: 59.52, lon: 24.8}}\n"
         "lines: {start: [A, B]}\nlegs: [{from: start, to: W, rounding: port}]\n"
         "boat: {builtin: ilca7}\n"
-        "scenarios: {north: {wind: {type: uniform, tws_kn: 10, twd_deg: 0}}}\n")
-    run = run_fit_command(tmp_path / "track.csv", course=tmp_path / "course.yaml",
-                          tws_bins="10", out_dir=tmp_path / "out", min_count=30)
+        "scenarios: {north: {wind: {type: uniform, tws_kn: 10, twd_deg: 0}}}\n"
+    )
+    run = run_fit_command(
+        tmp_path / "track.csv",
+        course=tmp_path / "course.yaml",
+        tws_bins="10",
+        out_dir=tmp_path / "out",
+        min_count=30,
+    )
     assert run.data.samples.speed_source == "sog (from positions)"
     assert "scenario north" in run.data.samples.wind_source
     err = compare_polars(run.data.fit, target)
@@ -330,7 +370,8 @@ def test_orc_speed_guide_reads_as_published() -> None:
 
     guide = read_polar(ORC_GUIDE)
     assert guide.tws_ms[0] == pytest.approx(6 * KNOT) and guide.tws_ms[-1] == pytest.approx(
-        20 * KNOT)
+        20 * KNOT
+    )
     for twa, kn in ((52.0, 5.11), (144.2, 4.11), (180.0, 3.03)):
         i = int(np.flatnonzero(guide.twa_deg == twa)[0])
         assert guide.speed_ms[i, 0] == pytest.approx(kn * KNOT, abs=1e-12)
@@ -342,8 +383,13 @@ def test_tallinn_log_against_its_orc_speed_guide(tmp_path: Path) -> None:
     # the log has no bsp, so SOG is fitted (no current in Tallinn Bay).  Measured
     # (min_count 10, default filters): RMS 6.6 %, mean -4.5 % over 14 covered cells
     # (docs/polar-fit.md).
-    run = run_fit_command(TALLINN / "kolmak_2023_09_27.csv", speed_unit="kn",
-                          out_dir=tmp_path / "out", reference=ORC_GUIDE, min_count=10)
+    run = run_fit_command(
+        TALLINN / "kolmak_2023_09_27.csv",
+        speed_unit="kn",
+        out_dir=tmp_path / "out",
+        reference=ORC_GUIDE,
+        min_count=10,
+    )
     assert run.data.samples.speed_source == "sog"
     assert run.data.errors is not None and run.data.errors.n_cells >= 10
     assert run.data.errors.rms_pct < 8.0
@@ -355,8 +401,14 @@ def test_sailgp_nzl_log_against_the_f50_polar(tmp_path: Path) -> None:
     # F50 at 1 Hz, TWS 16-24 kn; measured (min_count 20): RMS 19.4 %, mean +8.3 % over 21
     # cells; the largest errors are at 40-60 deg, where the polar's speed doubles within
     # one 10-deg bin (foiling take-off) and the log's TWA is noisy.
-    run = run_fit_command(NZL_LOG, time_zone="UTC", out_dir=tmp_path / "out", reference=F50,
-                          reference_unit="km/h", min_count=20)
+    run = run_fit_command(
+        NZL_LOG,
+        time_zone="UTC",
+        out_dir=tmp_path / "out",
+        reference=F50,
+        reference_unit="km/h",
+        min_count=20,
+    )
     assert run.data.samples.speed_source == "bsp"
     assert run.data.errors is not None and run.data.errors.n_cells >= 15
     assert run.data.errors.rms_pct < 25.0

@@ -94,8 +94,10 @@ def test_empty_cells_are_filled_by_documented_rules() -> None:
         ("TWA\\TWS\t6\t8\n45\t4\t5\n\n90\t5\t6\n", r":3: empty line inside the table"),
         ("TWA\\TWS\t6\t8\n45\t4\t5\t6\n90\t5\t6\n", r":2: 3 speed cells but the header has 2"),
         ("TWA\\TWS\t6\t8\n45\t4\t5\n181\t5\t6\n", r":3: cell 1: TWA 181 is outside"),
-        ("TWA\\TWS\t6\t8\n4x5\t4\t5\n90\t5\t6\n",
-         r":2: cell 1 \('4x5'\): expected a number \(TWA\)"),
+        (
+            "TWA\\TWS\t6\t8\n4x5\t4\t5\n90\t5\t6\n",
+            r":2: cell 1 \('4x5'\): expected a number \(TWA\)",
+        ),
         ("TWA\\TWS\t6\t8\n45\t4\t-5\n90\t5\t6\n", r":2: cell 3: boat speed -5 is negative"),
         ("TWA\\TWS\t6\t8\n90\t4\t5\n45\t5\t6\n", r":3: cell 1: TWA 45 does not increase"),
         ("TWA\\TWS\t6\t8\n45\t\t\n90\t5\t6\n", r":2: TWA 45 has no boat speeds"),

@@ -66,8 +66,9 @@ def test_wave_thrust_pushes_only_with_the_waves_and_grows_with_the_wind() -> Non
     run = wave_thrust(ILCA7, RACE, np.array([3.0, 4.0, 5.0]), 180.0, v)
     assert np.all(run > 0) and np.all(np.diff(run) > 0)
     # never more than the whole boat's weight on the mean front-face slope 2 Hs / Lp
-    hs, _, lp, _ = wind_sea(5.0 * (10 / ILCA7.ce_height_m) ** (1 / 7), RACE.fetch_m,
-                            RACE.sea_age_h * 3600)
+    hs, _, lp, _ = wind_sea(
+        5.0 * (10 / ILCA7.ce_height_m) ** (1 / 7), RACE.fetch_m, RACE.sea_age_h * 3600
+    )
     cap = (ILCA7.hull_mass_kg + ILCA7.crew_mass_kg) * G * 2 * hs / lp
     assert float(wave_thrust(ILCA7, RACE, 5.0, 180.0, v)) < float(cap)
     off = dataclasses.replace(RACE, fetch_m=0.0)
@@ -112,7 +113,8 @@ def test_race_speed_balances_the_surge_equation_with_the_thrust() -> None:
     tws, twa = np.meshgrid(TWS, TWA[2:])
     v = solve_point(ILCA7, tws, twa, thrust).speed_ms
     residual = _surplus_at(ILCA7, tws.ravel(), twa.ravel(), v.ravel())[0] + thrust(
-        tws.ravel(), twa.ravel(), v.ravel())
+        tws.ravel(), twa.ravel(), v.ravel()
+    )
     assert np.max(np.abs(residual)) < 1e-6  # [N]; Illinois tolerance 1e-9 N / 1e-10 m/s
     steady = solve_point(ILCA7, tws, twa).speed_ms
     assert np.all(v >= steady - 1e-12)  # extra forward force never slows the boat
@@ -122,10 +124,12 @@ def test_race_polar_is_steady_times_efficiency_on_a_beat_and_faster_downwind() -
     race = race_polar(ILCA7, TWS, TWA, RACE)
     steady = race_polar(ILCA7, TWS, TWA, STEADY)
     # beats (TWA <= 60): no waves, no pumping, the Tallinn-derived upwind efficiency
-    np.testing.assert_allclose(race.speed_ms[:2], RACE.upwind_efficiency * steady.speed_ms[:2],
-                               rtol=1e-12)
-    np.testing.assert_allclose(upwind_scale(RACE, [0, 60, 75, 90, 180]),
-                               [0.94, 0.94, 0.97, 1.0, 1.0], rtol=1e-12)
+    np.testing.assert_allclose(
+        race.speed_ms[:2], RACE.upwind_efficiency * steady.speed_ms[:2], rtol=1e-12
+    )
+    np.testing.assert_allclose(
+        upwind_scale(RACE, [0, 60, 75, 90, 180]), [0.94, 0.94, 0.97, 1.0, 1.0], rtol=1e-12
+    )
     # broad reach and run: waves (and pumping above 10 kn) add 25-40 % (measured 27-37 %);
     # flag O (5.61 m/s = 10.9 kn) adds pumping on top of the bigger waves
     gain = race.speed_ms[-2:] / steady.speed_ms[-2:]
@@ -140,8 +144,12 @@ def test_builtin_race_polar_never_below_steady_off_the_wind() -> None:
     race, steady = builtin_polar("ilca7"), builtin_polar("ilca7-steady")
     off = race.twa_deg >= 90.0
     assert np.all(race.speed_ms[off] >= steady.speed_ms[off] - 1e-4)  # file rounding
-    assert np.all(wave_thrust(ILCA7, RACE, np.linspace(0.1, 3.0, 30)[:, None],
-                              np.linspace(90, 180, 19)[None, :], 1.0) >= 0.0)
+    assert np.all(
+        wave_thrust(
+            ILCA7, RACE, np.linspace(0.1, 3.0, 30)[:, None], np.linspace(90, 180, 19)[None, :], 1.0
+        )
+        >= 0.0
+    )
 
 
 def test_builtin_race_polar_vmg_ratio_and_steady_name() -> None:
@@ -183,15 +191,20 @@ SNIPE = {
 @pytest.mark.parametrize("race", sorted(SNIPE))
 def test_snipe_valencia_downwind_upwind_ratio_with_the_ilca_stand_in(race: str) -> None:
     tws_kn, b1, run_obs, beat_obs = SNIPE[race]
-    course = course_from_mapping({
-        "name": f"Snipe {race}", "start_time": "2025-06-21T12:00:00+00:00",
-        "marks": {"S1": {"lat": 39.40921, "lon": -0.32253}, "B1": {"lat": b1[0], "lon": b1[1]}},
-        "legs": [{"from": "S1", "to": "B1"}, {"to": "S1"}, {"to": "B1"}, {"to": "S1"}],
-        "boat": {"builtin": "ilca7"},
-        "routing": {"tack_penalty_s": 5.0, "gybe_penalty_s": 5.0},
-        "scenarios": {"reported": {"wind": {"type": "uniform", "tws_kn": tws_kn,
-                                            "twd_deg": 110}}},
-    }, source=f"<snipe {race}>")
+    course = course_from_mapping(
+        {
+            "name": f"Snipe {race}",
+            "start_time": "2025-06-21T12:00:00+00:00",
+            "marks": {"S1": {"lat": 39.40921, "lon": -0.32253}, "B1": {"lat": b1[0], "lon": b1[1]}},
+            "legs": [{"from": "S1", "to": "B1"}, {"to": "S1"}, {"to": "B1"}, {"to": "S1"}],
+            "boat": {"builtin": "ilca7"},
+            "routing": {"tack_penalty_s": 5.0, "gybe_penalty_s": 5.0},
+            "scenarios": {
+                "reported": {"wind": {"type": "uniform", "tws_kn": tws_kn, "twd_deg": 110}}
+            },
+        },
+        source=f"<snipe {race}>",
+    )
     legs = [leg.time_s for leg in plan_course(course).plan.legs]
     model = _dn_up(legs, [1, 3], [2])
     # measured +1.8 % (P01) and +8.7 % (P02); the steady VPP gave +48 % on both
@@ -218,27 +231,32 @@ def test_vpp_boat_kinetics_key_race_steady_and_overrides(tmp_path) -> None:
     # no waves (sea_age_h 0): a slower run, the same beat; an older sea (6 h) has higher but
     # less steep waves (JONSWAP: H/L ∝ F^-1/6), so in this model a slightly slower run
     calm, older, base = boat({"sea_age_h": 0}), boat({"sea_age_h": 6}), boat("race")
-    assert float(calm.speed(w, 180.0)) < float(older.speed(w, 180.0)) < float(
-        base.speed(w, 180.0))
-    assert float(calm.speed(w, 45.0)) == float(older.speed(w, 45.0)) == float(
-        base.speed(w, 45.0))
+    assert float(calm.speed(w, 180.0)) < float(older.speed(w, 180.0)) < float(base.speed(w, 180.0))
+    assert float(calm.speed(w, 45.0)) == float(older.speed(w, 45.0)) == float(base.speed(w, 45.0))
 
 
-@pytest.mark.parametrize(("value", "message"), [
-    ("fast", "c.yaml: boat.kinetics: expected 'race', 'steady' or a mapping"),
-    ({"sea_age": 3}, "boat.kinetics.sea_age: unknown key; did you mean 'sea_age_h'? valid keys: "
-     "fetch_m, sea_age_h"),
-    ({"fetch_m": "far"}, "boat.kinetics.fetch_m: expected a number; got 'far'"),
-    ({"pump_twa_deg": [60]}, "boat.kinetics.pump_twa_deg: expected two numbers"),
-    ({"pump_efficiency": 2}, "boat.kinetics: pump_efficiency is a share, at most 1"),
-    ({"fetch_m": True}, "boat.kinetics.fetch_m: expected a number; got True"),
-])
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        ("fast", "c.yaml: boat.kinetics: expected 'race', 'steady' or a mapping"),
+        (
+            {"sea_age": 3},
+            "boat.kinetics.sea_age: unknown key; did you mean 'sea_age_h'? valid keys: "
+            "fetch_m, sea_age_h",
+        ),
+        ({"fetch_m": "far"}, "boat.kinetics.fetch_m: expected a number; got 'far'"),
+        ({"pump_twa_deg": [60]}, "boat.kinetics.pump_twa_deg: expected two numbers"),
+        ({"pump_efficiency": 2}, "boat.kinetics: pump_efficiency is a share, at most 1"),
+        ({"fetch_m": True}, "boat.kinetics.fetch_m: expected a number; got True"),
+    ],
+)
 def test_vpp_boat_kinetics_key_errors(tmp_path, value: object, message: str) -> None:
     from sailroute.boat.build import boat_from_spec
 
     with pytest.raises(InputError) as exc:
-        boat_from_spec({"vpp": {"class": "ilca7"}, "kinetics": value}, base_dir=tmp_path,
-                       where="c.yaml")
+        boat_from_spec(
+            {"vpp": {"class": "ilca7"}, "kinetics": value}, base_dir=tmp_path, where="c.yaml"
+        )
     assert message in str(exc.value)
 
 
@@ -250,8 +268,22 @@ def test_cli_vpp_kinetics_race_writes_the_race_polar(tmp_path) -> None:
     from sailroute.boat.build import vpp_polar
     from sailroute.cli import app
 
-    res = CliRunner().invoke(app, ["vpp", "--kinetics", "race", "--tws", "2,6", "--unit", "m/s",
-                                   "--twa-step", "30", "--out", str(tmp_path)])
+    res = CliRunner().invoke(
+        app,
+        [
+            "vpp",
+            "--kinetics",
+            "race",
+            "--tws",
+            "2,6",
+            "--unit",
+            "m/s",
+            "--twa-step",
+            "30",
+            "--out",
+            str(tmp_path),
+        ],
+    )
     assert res.exit_code == 0, res.output
     doc = json.loads((tmp_path / "ilca7.json").read_text())
     assert doc["kinetics"]["pump_efficiency"] == RACE.pump_efficiency

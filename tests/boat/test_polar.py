@@ -45,8 +45,9 @@ def test_invalid_tables_are_rejected_with_reason() -> None:
     with pytest.raises(InputError, match=">= 0"):
         Polar.from_arrays(np.array([0.0, 90.0]), np.array([1.0]), -np.ones((2, 1)))
     with pytest.raises(InputError, match="interpolation"):
-        Polar.from_arrays(np.array([0.0, 90.0]), np.array([1.0]), np.ones((2, 1)),
-                          interpolation="cubic")
+        Polar.from_arrays(
+            np.array([0.0, 90.0]), np.array([1.0]), np.ones((2, 1)), interpolation="cubic"
+        )
 
 
 def test_caller_arrays_are_copied_not_frozen() -> None:
@@ -165,8 +166,9 @@ def test_vmg_is_consistent_with_speed(method: str) -> None:
         ang, vmg = fn(tws)
         sign = 1.0 if upwind else -1.0
         # the returned VMG is speed(twa*) cos(twa*) to rounding, so leg time L / VMG* is exact
-        np.testing.assert_allclose(vmg, sign * p.speed(tws, ang) * np.cos(np.radians(ang)),
-                                   rtol=1e-12)
+        np.testing.assert_allclose(
+            vmg, sign * p.speed(tws, ang) * np.cos(np.radians(ang)), rtol=1e-12
+        )
         # and no other angle does better (dense check, 0.01 deg)
         grid = np.linspace(0, 90, 9001) if upwind else np.linspace(90, 180, 9001)
         dense = sign * p.speed(tws[:, None], grid[None, :]) * np.cos(np.radians(grid))[None, :]
@@ -177,9 +179,12 @@ def test_vmg_matches_scipy_bounded_optimum() -> None:
     p = small_polar()
     for w in (2.0, 3.7, 8.0):
         ang, vmg = p.vmg_upwind(w)
-        res = minimize_scalar(lambda a, w=w: -p.speed(w, a) * math.cos(math.radians(a)),
-                              bounds=(float(ang) - 2, float(ang) + 2), method="bounded",
-                              options={"xatol": 1e-9})
+        res = minimize_scalar(
+            lambda a, w=w: -p.speed(w, a) * math.cos(math.radians(a)),
+            bounds=(float(ang) - 2, float(ang) + 2),
+            method="bounded",
+            options={"xatol": 1e-9},
+        )
         # same optimum to the bounded optimiser's tolerance
         assert float(vmg) == pytest.approx(-res.fun, abs=1e-9)
         assert float(ang) == pytest.approx(res.x, abs=1e-3)

@@ -60,10 +60,15 @@ def test_dsyhs_residuary_at_a_table_node() -> None:
     a = [-0.0064, -0.4034, -0.1250, 0.0273, -0.1341, 0.3578, 0.0045, 0.1115]
     p = ILCA7
     vol = p.volume_m3
-    x = (a[1] * p.lcb_fraction + a[2] * p.prismatic_coefficient
-         + a[3] * vol ** (2 / 3) / p.waterplane_area_m2 + a[4] * p.bwl_m / p.lwl_m
-         + a[5] * p.lcb_fraction / p.lcf_fraction + a[6] * p.bwl_m / p.canoe_draft_m
-         + a[7] * p.midship_coefficient)
+    x = (
+        a[1] * p.lcb_fraction
+        + a[2] * p.prismatic_coefficient
+        + a[3] * vol ** (2 / 3) / p.waterplane_area_m2
+        + a[4] * p.bwl_m / p.lwl_m
+        + a[5] * p.lcb_fraction / p.lcf_fraction
+        + a[6] * p.bwl_m / p.canoe_draft_m
+        + a[7] * p.midship_coefficient
+    )
     want = p.rho_water * p.gravity * vol * (a[0] + x * vol ** (1 / 3) / p.lwl_m)
     v = 0.40 * math.sqrt(p.gravity * p.lwl_m)
     assert float(vpp.residuary_resistance(v, p)) == pytest.approx(want, rel=1e-12)
@@ -89,7 +94,8 @@ def test_crew_righting_moment_and_ce() -> None:
 def test_induced_resistance() -> None:
     p = ILCA7
     assert float(vpp.induced_resistance(200.0, 2.0, p)) == pytest.approx(
-        200.0**2 / (0.5 * 1025 * 4.0 * math.pi * 0.787**2))
+        200.0**2 / (0.5 * 1025 * 4.0 * math.pi * 0.787**2)
+    )
 
 
 # --- the solver ------------------------------------------------------------------------------
@@ -115,8 +121,9 @@ def test_equilibrium_and_constraints_hold_at_the_solution() -> None:
     assert np.all(s.heel_deg == 0.0)  # the hiking model sails flat
 
 
-@pytest.mark.parametrize(("tws", "twa"), [(3.0, 45.0), (5.61, 40.0), (8.0, 60.0), (12.0, 90.0),
-                                          (10.0, 150.0)])
+@pytest.mark.parametrize(
+    ("tws", "twa"), [(3.0, 45.0), (5.61, 40.0), (8.0, 60.0), (12.0, 90.0), (10.0, 150.0)]
+)
 def test_speed_is_optimal_against_a_brute_force_control_grid(tws: float, twa: float) -> None:
     # independent of the solver's searches: at V* + 1 mm/s no (flat, twist) on a fine grid
     # balances the resistance within the moment limit; at V* - 1 cm/s one does (the grid's
@@ -216,7 +223,8 @@ def test_thesis_run_speed_is_not_a_steady_state() -> None:
     aws, awa = vpp.apparent_wind(5.61, 180.0, 3.26)
     _, cd = vpp.sail_coefficients(awa, 1.0, 0.0, p)
     drive = 0.5 * p.rho_air * aws**2 * p.sail_area_m2 * float(cd) + float(
-        vpp.windage_drag(aws, awa, p))
+        vpp.windage_drag(aws, awa, p)
+    )
     assert drive < 40.0 < 100.0 < float(vpp.hull_resistance(3.26, p))
     # docs/vpp.md quotes 34 N of drive against 144 N (this VPP's hull) and 136 N with the
     # thesis's own drag area (eq 4.19): the conclusion does not depend on the hull model
@@ -281,13 +289,17 @@ def test_params_from_mapping_reports_every_problem() -> None:
     with pytest.raises(InputError) as exc:
         params_from_mapping(
             {"class": "ilca9", "crew_mass": 70, "beam_m": "wide", "gz_m": [1, "x"]},
-            where="b.yaml", key="boat.vpp",
+            where="b.yaml",
+            key="boat.vpp",
         )
     msg = str(exc.value)
     assert msg.startswith("b.yaml: 4 problems")
-    for part in ("boat.vpp.class: expected one of 'ilca4', 'ilca6', 'ilca7'; got 'ilca9'",
-                 "boat.vpp.crew_mass: unknown key", "boat.vpp.beam_m: expected a number",
-                 "boat.vpp.gz_m: expected a list of numbers"):
+    for part in (
+        "boat.vpp.class: expected one of 'ilca4', 'ilca6', 'ilca7'; got 'ilca9'",
+        "boat.vpp.crew_mass: unknown key",
+        "boat.vpp.beam_m: expected a number",
+        "boat.vpp.gz_m: expected a list of numbers",
+    ):
         assert part in msg
     with pytest.raises(InputError, match=r"b\.yaml: hull_model: expected one of 'dsyhs', 'thesis'"):
         params_from_mapping({"hull_model": "planing"}, where="b.yaml")
@@ -301,8 +313,12 @@ def test_docs_vpp_results_table_matches_the_shipped_polar() -> None:
     from sailroute.boat.build import builtin_polar
 
     text = (Path(__file__).resolve().parents[2] / "docs" / "vpp.md").read_text()
-    rows = re.findall(r"^\| (\d+) \| ([\d.]+)° \| ([\d.]+) \| ([\d.]+) \(([\d.]+)°\) \| "
-                      r"([\d.]+)(?: m/s)? at ([\d.]+)° \|$", text, flags=re.M)
+    rows = re.findall(
+        r"^\| (\d+) \| ([\d.]+)° \| ([\d.]+) \| ([\d.]+) \(([\d.]+)°\) \| "
+        r"([\d.]+)(?: m/s)? at ([\d.]+)° \|$",
+        text,
+        flags=re.M,
+    )
     assert [int(r[0]) for r in rows] == [2, 4, 6, 8, 10, 12]
     p = builtin_polar("ilca7-steady")
     for tws, beat_a, beat_v, run_v, run_a, fast_v, fast_a in rows:

@@ -85,9 +85,7 @@ def reference() -> list[tuple[float, np.ndarray, np.ndarray]]:
 
 
 def relative_errors(blocks: list[tuple[float, np.ndarray, np.ndarray]]) -> list[np.ndarray]:
-    return [
-        vpp.solve_point(YD41, tws, twa).speed_ms / KNOT / ref - 1.0 for tws, twa, ref in blocks
-    ]
+    return [vpp.solve_point(YD41, tws, twa).speed_ms / KNOT / ref - 1.0 for tws, twa, ref in blocks]
 
 
 def test_yd41_polar_moderate_winds() -> None:

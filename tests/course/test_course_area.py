@@ -66,41 +66,71 @@ def test_lat_lon_points_and_files_give_the_same_polygon(tmp_path):
     ob = course.area.obstacles[0]
     lat, lon = course.frame.to_latlon(np.array(ob.x), np.array(ob.y))
     ring = [[float(b), float(a)] for a, b in zip(lat, lon, strict=True)]
-    (tmp_path / "bw.geojson").write_text(json.dumps({
-        "type": "Feature", "properties": {},
-        "geometry": {"type": "Polygon", "coordinates": [ring + ring[:1]]}}))
+    (tmp_path / "bw.geojson").write_text(
+        json.dumps(
+            {
+                "type": "Feature",
+                "properties": {},
+                "geometry": {"type": "Polygon", "coordinates": [ring + ring[:1]]},
+            }
+        )
+    )
     kml = ET.Element("kml")
-    coords = ET.SubElement(ET.SubElement(ET.SubElement(ET.SubElement(
-        kml, "Polygon"), "outerBoundaryIs"), "LinearRing"), "coordinates")
+    coords = ET.SubElement(
+        ET.SubElement(
+            ET.SubElement(ET.SubElement(kml, "Polygon"), "outerBoundaryIs"), "LinearRing"
+        ),
+        "coordinates",
+    )
     coords.text = " ".join(f"{x},{y},0" for x, y in ring + ring[:1])
     (tmp_path / "bw.kml").write_bytes(ET.tostring(kml))
     points = ", ".join(f"{{lat: {a!r}, lon: {b!r}}}" for b, a in ring)
     for spec in ("file: bw.geojson", "file: bw.kml", f"points: [{points}]"):
         area = AREA.replace(
             "points: [{x: -250, y: 600}, {x: 350, y: 600}, {x: 350, y: 750}, {x: -250, y: 750}]",
-            spec)
+            spec,
+        )
         got = load_course(write(tmp_path, area)).area.obstacles[0]
         assert np.allclose(got.x, ob.x, atol=1e-6) and np.allclose(got.y, ob.y, atol=1e-6)
 
 
-@pytest.mark.parametrize(("area", "message"), [
-    (AREA.replace("{x: 350, y: 750}, {x: -250, y: 750}", "{x: -250, y: 750}, {x: 350, y: 750}"),
-     r"c.yaml:\d+: obstacles\[0\]: expected a simple polygon; its edge from point \d to \d "
-     r"crosses the edge"),
-    (AREA.replace(", {x: 350, y: 750}, {x: -250, y: 750}", ""),
-     r"obstacles\[0\]: expected a ring of at least 3 points; got 2"),
-    (AREA.replace("y: 600}, {x: 350, y: 600}", "y: -20}, {x: 350, y: -20}"),
-     r"obstacles\[0\]: mark 'pin' \(-50, 0 m\) lies inside obstacle 'breakwater' with its "
-     r"clearance_m = 10 m; move the mark"),
-    (AREA.replace("{x: 600, y: 1800}, {x: -600, y: 1800}", "{x: 600, y: 1490}, {x: -600, y: 1490}"),
-     r"c.yaml:\d+: boundary: the boundary shrunk by its clearance_m = 20 m does not contain "
-     r"every mark: 'top' \(0, 1500 m\) lie outside"),
-    ("boundary: {file: missing.geojson}",
-     r"boundary.file: cannot read .*missing.geojson.*; expected a GeoJSON"),
-    ("obstacles: [{name: x, points: [], file: a.kml}]",
-     r"obstacles\[0\]: give either `points`"),
-    ("wind_land_is_obstacle: 1", r"wind_land_is_obstacle: expected true or false"),
-])
+@pytest.mark.parametrize(
+    ("area", "message"),
+    [
+        (
+            AREA.replace(
+                "{x: 350, y: 750}, {x: -250, y: 750}", "{x: -250, y: 750}, {x: 350, y: 750}"
+            ),
+            r"c.yaml:\d+: obstacles\[0\]: expected a simple polygon; its edge from point \d to \d "
+            r"crosses the edge",
+        ),
+        (
+            AREA.replace(", {x: 350, y: 750}, {x: -250, y: 750}", ""),
+            r"obstacles\[0\]: expected a ring of at least 3 points; got 2",
+        ),
+        (
+            AREA.replace("y: 600}, {x: 350, y: 600}", "y: -20}, {x: 350, y: -20}"),
+            r"obstacles\[0\]: mark 'pin' \(-50, 0 m\) lies inside obstacle 'breakwater' with its "
+            r"clearance_m = 10 m; move the mark",
+        ),
+        (
+            AREA.replace(
+                "{x: 600, y: 1800}, {x: -600, y: 1800}", "{x: 600, y: 1490}, {x: -600, y: 1490}"
+            ),
+            r"c.yaml:\d+: boundary: the boundary shrunk by its clearance_m = 20 m does not contain "
+            r"every mark: 'top' \(0, 1500 m\) lie outside",
+        ),
+        (
+            "boundary: {file: missing.geojson}",
+            r"boundary.file: cannot read .*missing.geojson.*; expected a GeoJSON",
+        ),
+        (
+            "obstacles: [{name: x, points: [], file: a.kml}]",
+            r"obstacles\[0\]: give either `points`",
+        ),
+        ("wind_land_is_obstacle: 1", r"wind_land_is_obstacle: expected true or false"),
+    ],
+)
 def test_bad_area_is_a_one_line_error_naming_file_and_key(tmp_path, area, message):
     with pytest.raises(InputError, match=message) as err:
         load_course(write(tmp_path, area))
@@ -129,27 +159,44 @@ def test_plan_stays_inside_the_boundary_and_round_the_obstacle(tmp_path):
 def test_spline_router_refuses_an_area(tmp_path):
     from sailroute.planning.route import plan_course
 
-    with pytest.raises(InputError, match="'spline': a race-area boundary or obstacles are "
-                       "honoured by the isochrone and griddp routers only"):
+    with pytest.raises(
+        InputError,
+        match="'spline': a race-area boundary or obstacles are "
+        "honoured by the isochrone and griddp routers only",
+    ):
         plan_course(load_course(write(tmp_path, router="spline")), "reach")
 
 
-@pytest.mark.parametrize(("area", "router", "code", "message"), [
-    (AREA.replace("y: 600}, {x: 350, y: 600}", "y: -20}, {x: 350, y: -20}"), "isochrone", 2,
-     "mark 'pin' (-50, 0 m) lies inside obstacle 'breakwater'"),
-    (AREA, "spline", 2, "honoured by the isochrone and griddp routers only"),
-    (AREA.replace("{x: -250, y: 600}, {x: 350, y: 600}, {x: 350, y: 750}, {x: -250, y: 750}",
-                  "{x: -700, y: 600}, {x: 700, y: 600}, {x: 700, y: 750}, {x: -700, y: 750}"),
-     "isochrone", 3, "no route round obstacle 'breakwater'"),
-])
+@pytest.mark.parametrize(
+    ("area", "router", "code", "message"),
+    [
+        (
+            AREA.replace("y: 600}, {x: 350, y: 600}", "y: -20}, {x: 350, y: -20}"),
+            "isochrone",
+            2,
+            "mark 'pin' (-50, 0 m) lies inside obstacle 'breakwater'",
+        ),
+        (AREA, "spline", 2, "honoured by the isochrone and griddp routers only"),
+        (
+            AREA.replace(
+                "{x: -250, y: 600}, {x: 350, y: 600}, {x: 350, y: 750}, {x: -250, y: 750}",
+                "{x: -700, y: 600}, {x: 700, y: 600}, {x: 700, y: 750}, {x: -700, y: 750}",
+            ),
+            "isochrone",
+            3,
+            "no route round obstacle 'breakwater'",
+        ),
+    ],
+)
 def test_cli_exit_codes_and_nothing_written(tmp_path, area, router, code, message):
     from typer.testing import CliRunner
 
     from sailroute.cli import app
 
     out = tmp_path / "out"
-    res = CliRunner().invoke(app, ["plan", str(write(tmp_path, area, router)), "-o", str(out),
-                                   "-q", "--no-plots"])
+    res = CliRunner().invoke(
+        app, ["plan", str(write(tmp_path, area, router)), "-o", str(out), "-q", "--no-plots"]
+    )
     assert res.exit_code == code, res.output
     assert message in " ".join(res.output.split())
     assert "Traceback" not in res.output
@@ -190,9 +237,10 @@ RACE = SHARED_REAL / "races" / "sailgp-auckland-2025"
 def course_limits(xml) -> dict[str, list[tuple[str, str]]]:
     """``CourseLimit`` name -> its points ``(lat, lon)`` as written in the race XML."""
     root = ET.parse(xml).getroot()
-    return {cl.get("name", ""): [(p.get("Lat", ""), p.get("Lon", ""))
-                                 for p in cl.iterfind("Limit")]
-            for cl in root.iterfind("CourseLimit")}
+    return {
+        cl.get("name", ""): [(p.get("Lat", ""), p.get("Lon", "")) for p in cl.iterfind("Limit")]
+        for cl in root.iterfind("CourseLimit")
+    }
 
 
 @requires_shared
@@ -217,12 +265,17 @@ def test_sailgp_auckland_race_stays_in_its_course_limits(tmp_path):
     text = path.read_text(encoding="utf-8")
     bad = text + f"boundary: {{points: {ring('Boundary')}}}\n"
     path.write_text(bad, encoding="utf-8")
-    with pytest.raises(InputError, match=r"boundary: the boundary does not contain every "
-                       r"mark: 'SL1' \(\d+, -\d+ m\), 'SL2' .* lie outside"):
+    with pytest.raises(
+        InputError,
+        match=r"boundary: the boundary does not contain every "
+        r"mark: 'SL1' \(\d+, -\d+ m\), 'SL2' .* lie outside",
+    ):
         load_course(path)
-    area = (f"boundary: {{points: {ring('Exclusion Zone')}, clearance_m: 10}}\n"
-            f"obstacles:\n  - {{name: AY, points: {ring('AY')}, clearance_m: 10}}\n"
-            f"  - {{name: BYOB, points: {ring('BYOB')}, clearance_m: 10}}\n")
+    area = (
+        f"boundary: {{points: {ring('Exclusion Zone')}, clearance_m: 10}}\n"
+        f"obstacles:\n  - {{name: AY, points: {ring('AY')}, clearance_m: 10}}\n"
+        f"  - {{name: BYOB, points: {ring('BYOB')}, clearance_m: 10}}\n"
+    )
     path.write_text(text + area, encoding="utf-8")
     course = load_course(path)
     assert len(course.legs) == 7 and len(course.area.obstacles) == 2

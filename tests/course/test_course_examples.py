@@ -18,8 +18,12 @@ COURSES = sorted((ROOT / "courses").glob("*.yaml"))
 
 def test_expected_examples_are_shipped():
     names = {p.name for p in COURSES}
-    assert {"hyeres-r1.yaml", "trieste-coach-wl.yaml", "windward-leeward-template.yaml",
-            "trapezoid-outer-template.yaml"} <= names
+    assert {
+        "hyeres-r1.yaml",
+        "trieste-coach-wl.yaml",
+        "windward-leeward-template.yaml",
+        "trapezoid-outer-template.yaml",
+    } <= names
 
 
 @pytest.mark.parametrize("path", COURSES, ids=lambda p: p.stem)

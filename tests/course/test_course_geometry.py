@@ -35,13 +35,13 @@ def test_leg_bearing_is_compass(dx, dy, bearing):
     ("bearing", "twd", "mode"),
     [
         (108.0, 108.0, "upwind"),
-        (153.0, 108.0, "upwind"),       # Ω = 45 exactly: upwind (≤ 45)
+        (153.0, 108.0, "upwind"),  # Ω = 45 exactly: upwind (≤ 45)
         (63.0, 108.0, "upwind"),
         (153.1, 108.0, "reach"),
-        (243.0, 108.0, "downwind"),     # Ω = 135 exactly: downwind (≥ 135)
+        (243.0, 108.0, "downwind"),  # Ω = 135 exactly: downwind (≥ 135)
         (242.9, 108.0, "reach"),
         (288.0, 108.0, "downwind"),
-        (350.0, 10.0, "upwind"),        # across north
+        (350.0, 10.0, "upwind"),  # across north
         (190.0, 10.0, "downwind"),
         (100.0, 10.0, "reach"),
     ],
@@ -67,11 +67,17 @@ def test_leg_wind_mode_samples_the_wind_at_start():
     ("start", "lo", "hi"),
     [
         # thesis eqs 4.68-4.70: a 13:25 start gives [11:00, 18:00]
-        (datetime(2018, 4, 24, 13, 25, tzinfo=CEST), datetime(2018, 4, 24, 11, 0, tzinfo=CEST),
-         datetime(2018, 4, 24, 18, 0, tzinfo=CEST)),
+        (
+            datetime(2018, 4, 24, 13, 25, tzinfo=CEST),
+            datetime(2018, 4, 24, 11, 0, tzinfo=CEST),
+            datetime(2018, 4, 24, 18, 0, tzinfo=CEST),
+        ),
         # eq 5.1: a 12:00 start gives [10:00, 16:00]
-        (datetime(2018, 4, 24, 12, 0, tzinfo=CEST), datetime(2018, 4, 24, 10, 0, tzinfo=CEST),
-         datetime(2018, 4, 24, 16, 0, tzinfo=CEST)),
+        (
+            datetime(2018, 4, 24, 12, 0, tzinfo=CEST),
+            datetime(2018, 4, 24, 10, 0, tzinfo=CEST),
+            datetime(2018, 4, 24, 16, 0, tzinfo=CEST),
+        ),
     ],
 )
 def test_thesis_time_window(start, lo, hi):

@@ -36,10 +36,15 @@ RACES = {  # file -> local start time (README of the data folder)
 }
 R05 = XML_DIR / "25011905_03-13-55.xml"
 # Start -> M1 -> LG -> WG -> LG -> WG -> LG1 -> Finish (the README's 8 corners)
-LEGS = [("start", "M1", "mark", "port"), ("M1", "LG1-LG2", "gate", None),
-        ("LG1-LG2", "WG1-WG2", "gate", None), ("WG1-WG2", "LG1-LG2", "gate", None),
-        ("LG1-LG2", "WG1-WG2", "gate", None), ("WG1-WG2", "LG1", "mark", "port"),
-        ("LG1", "finish", "line", None)]
+LEGS = [
+    ("start", "M1", "mark", "port"),
+    ("M1", "LG1-LG2", "gate", None),
+    ("LG1-LG2", "WG1-WG2", "gate", None),
+    ("WG1-WG2", "LG1-LG2", "gate", None),
+    ("LG1-LG2", "WG1-WG2", "gate", None),
+    ("WG1-WG2", "LG1", "mark", "port"),
+    ("LG1", "finish", "line", None),
+]
 WIND = {"wind_twd_deg": 225.0, "wind_tws_kn": 12.0}
 runner = CliRunner()
 
@@ -47,13 +52,17 @@ runner = CliRunner()
 def xml_marks(path: Path) -> dict[str, tuple[float, float]]:
     """Every <Mark>'s position, read with ElementTree."""
     root = ET.parse(path).getroot()
-    return {m.get("Name"): (float(m.get("TargetLat")), float(m.get("TargetLng")))
-            for m in root.iter("Mark")}
+    return {
+        m.get("Name"): (float(m.get("TargetLat")), float(m.get("TargetLng")))
+        for m in root.iter("Mark")
+    }
 
 
 def xml_limits(path: Path) -> dict[str, int]:
-    return {cl.get("name"): len(cl.findall("Limit")) for cl in ET.parse(path).getroot()
-            .iter("CourseLimit")}
+    return {
+        cl.get("name"): len(cl.findall("Limit"))
+        for cl in ET.parse(path).getroot().iter("CourseLimit")
+    }
 
 
 def distance_m(course, a: tuple[float, float], b: tuple[float, float]) -> float:
@@ -115,21 +124,37 @@ def test_imported_race_plans_with_the_f50_polar(tmp_path):
 
 
 # ------------------------------------------------------------------ GPX / CSV / KML
-SEQUENCE = [("SL1", "start"), ("SL2", "start"), ("M1", "port"), ("LG1", "gate"), ("LG2", "gate"),
-            ("WG1", "gate"), ("WG2", "gate"), ("LG1", "gate"), ("LG2", "gate"),
-            ("WG1", "gate"), ("WG2", "gate"), ("LG1", "port"), ("FL1", "finish"),
-            ("FL2", "finish")]
+SEQUENCE = [
+    ("SL1", "start"),
+    ("SL2", "start"),
+    ("M1", "port"),
+    ("LG1", "gate"),
+    ("LG2", "gate"),
+    ("WG1", "gate"),
+    ("WG2", "gate"),
+    ("LG1", "gate"),
+    ("LG2", "gate"),
+    ("WG1", "gate"),
+    ("WG2", "gate"),
+    ("LG1", "port"),
+    ("FL1", "finish"),
+    ("FL2", "finish"),
+]
 """Race 25011905 as a list of points in sailing order, with their types."""
 T0 = "2025-01-19T16:08:00+13:00"
 
 
 def write_gpx(path: Path, marks: dict[str, tuple[float, float]], *, route: bool) -> Path:
     pts = "".join(
-        f'<{tag} lat="{marks[n][0]}" lon="{marks[n][1]}"><name>{n}</name><type>{t}</type>'
-        f"</{tag}>\n" for n, t in SEQUENCE for tag in (["rtept"] if route else ["wpt"]))
+        f'<{tag} lat="{marks[n][0]}" lon="{marks[n][1]}"><name>{n}</name><type>{t}</type></{tag}>\n'
+        for n, t in SEQUENCE
+        for tag in (["rtept"] if route else ["wpt"])
+    )
     body = f"<rte><name>race 05</name>\n{pts}</rte>" if route else pts
-    path.write_text('<?xml version="1.0"?>\n<gpx version="1.1" creator="test" '
-                    f'xmlns="http://www.topografix.com/GPX/1/1">\n{body}\n</gpx>\n')
+    path.write_text(
+        '<?xml version="1.0"?>\n<gpx version="1.1" creator="test" '
+        f'xmlns="http://www.topografix.com/GPX/1/1">\n{body}\n</gpx>\n'
+    )
     return path
 
 
@@ -142,31 +167,41 @@ def write_csv(path: Path, marks: dict[str, tuple[float, float]]) -> Path:
     return path
 
 
-def write_kml(path: Path, marks: dict[str, tuple[float, float]],
-              rings: dict[str, list[tuple[float, float]]]) -> Path:
+def write_kml(
+    path: Path, marks: dict[str, tuple[float, float]], rings: dict[str, list[tuple[float, float]]]
+) -> Path:
     pms = []
     for n, t in SEQUENCE:
-        data = ('<Data name="rounding"><value>port</value></Data>' if t == "port"
-                else f'<Data name="type"><value>{t}</value></Data>')
-        pms.append(f"<Placemark><name>{n}</name><ExtendedData>{data}</ExtendedData>"
-                   f"<Point><coordinates>{marks[n][1]},{marks[n][0]},0</coordinates></Point>"
-                   "</Placemark>")
+        data = (
+            '<Data name="rounding"><value>port</value></Data>'
+            if t == "port"
+            else f'<Data name="type"><value>{t}</value></Data>'
+        )
+        pms.append(
+            f"<Placemark><name>{n}</name><ExtendedData>{data}</ExtendedData>"
+            f"<Point><coordinates>{marks[n][1]},{marks[n][0]},0</coordinates></Point>"
+            "</Placemark>"
+        )
     for name, ring in rings.items():
         closed = [*ring, ring[0]]  # KML repeats the first point
         coords = " ".join(f"{lon},{lat},0" for lat, lon in closed)
-        pms.append(f"<Placemark><name>{name}</name><Polygon><outerBoundaryIs><LinearRing>"
-                   f"<coordinates>{coords}</coordinates></LinearRing></outerBoundaryIs>"
-                   "</Polygon></Placemark>")
-    path.write_text('<?xml version="1.0"?>\n<kml xmlns="http://www.opengis.net/kml/2.2">'
-                    "<Document><name>race 05</name>\n" + "\n".join(pms)
-                    + "\n</Document></kml>\n")
+        pms.append(
+            f"<Placemark><name>{name}</name><Polygon><outerBoundaryIs><LinearRing>"
+            f"<coordinates>{coords}</coordinates></LinearRing></outerBoundaryIs>"
+            "</Polygon></Placemark>"
+        )
+    path.write_text(
+        '<?xml version="1.0"?>\n<kml xmlns="http://www.opengis.net/kml/2.2">'
+        "<Document><name>race 05</name>\n" + "\n".join(pms) + "\n</Document></kml>\n"
+    )
     return path
 
 
 def xml_rings(path: Path) -> dict[str, list[tuple[float, float]]]:
-    return {cl.get("name"): [(float(p.get("Lat")), float(p.get("Lon")))
-                             for p in cl.findall("Limit")]
-            for cl in ET.parse(path).getroot().iter("CourseLimit")}
+    return {
+        cl.get("name"): [(float(p.get("Lat")), float(p.get("Lon"))) for p in cl.findall("Limit")]
+        for cl in ET.parse(path).getroot().iter("CourseLimit")
+    }
 
 
 @requires_shared
@@ -179,10 +214,10 @@ def test_point_files_give_the_race_xml_course(tmp_path, kind):
     elif kind == "csv":
         src = write_csv(tmp_path / "course.csv", marks)
     else:
-        src = write_kml(tmp_path / "course.kml", marks,
-                        {"Boundary": rings["Boundary"], "AY": rings["AY"]})
-    run_course_import_command(src, out=tmp_path / "c.yaml", start_time=T0, boat="ilca7",
-                              **WIND)
+        src = write_kml(
+            tmp_path / "course.kml", marks, {"Boundary": rings["Boundary"], "AY": rings["AY"]}
+        )
+    run_course_import_command(src, out=tmp_path / "c.yaml", start_time=T0, boat="ilca7", **WIND)
     course = load_course(tmp_path / "c.yaml")
     assert legs_of(course) == LEGS
     for n, ll in marks.items():
@@ -209,7 +244,8 @@ def test_kml_linestring_is_a_line_and_gpx_waypoints_keep_file_order(tmp_path):
         "<Placemark><name>top</name><Point><coordinates>13.001,45.009</coordinates></Point>"
         "</Placemark>"
         "<Placemark><name>Finish</name><LineString><coordinates>13.0,45.0005 13.002,45.0005"
-        "</coordinates></LineString></Placemark></Document></kml>")
+        "</coordinates></LineString></Placemark></Document></kml>"
+    )
     ic, fmt = read_course_source(kml)
     assert fmt == "kml"
     assert ic.lines == (("start", "Start_1", "Start_2"), ("finish", "Finish_1", "Finish_2"))
@@ -230,8 +266,10 @@ def assert_one_line(exc: pytest.ExceptionInfo, *parts: str) -> None:
 
 def test_gpx_without_waypoints(tmp_path):
     src = tmp_path / "empty.gpx"
-    src.write_text('<?xml version="1.0"?>\n<gpx version="1.1" creator="x" '
-                   'xmlns="http://www.topografix.com/GPX/1/1">\n<trk/></gpx>\n')
+    src.write_text(
+        '<?xml version="1.0"?>\n<gpx version="1.1" creator="x" '
+        'xmlns="http://www.topografix.com/GPX/1/1">\n<trk/></gpx>\n'
+    )
     with pytest.raises(InputError) as exc:
         run_course_import_command(src, out=tmp_path / "c.yaml", start_time=T0, **WIND)
     assert_one_line(exc, str(src), "line 2", "no waypoints (<wpt>)")
@@ -242,7 +280,9 @@ def test_gpx_without_waypoints(tmp_path):
 def test_unknown_element_in_a_compound_mark(tmp_path):
     text = R05.read_text().replace(
         '<CompoundMark CompoundMarkID="2" Name="M1">',
-        '<CompoundMark CompoundMarkID="2" Name="M1">\n      <Buoy Name="M1" />', 1)
+        '<CompoundMark CompoundMarkID="2" Name="M1">\n      <Buoy Name="M1" />',
+        1,
+    )
     src = tmp_path / "race.xml"
     src.write_text(text)
     line = next(k + 1 for k, ln in enumerate(text.splitlines()) if "<Buoy" in ln)
@@ -273,8 +313,11 @@ def test_self_intersecting_polygon(tmp_path):
     # swap two vertices of the boundary: its ring crosses itself
     a = '<Limit SeqID="2" Lat="-36.8272030" Lon="174.7620790" />'
     b = '<Limit SeqID="3" Lat="-36.8279690" Lon="174.7677170" />'
-    text = text.replace(a, "@A@").replace(b, a.replace('"2"', '"3"')).replace(
-        "@A@", b.replace('"3"', '"2"'))
+    text = (
+        text.replace(a, "@A@")
+        .replace(b, a.replace('"2"', '"3"'))
+        .replace("@A@", b.replace('"3"', '"2"'))
+    )
     src = tmp_path / "race.xml"
     src.write_text(text)
     line = next(k + 1 for k, ln in enumerate(text.splitlines()) if 'name="Boundary"' in ln)
@@ -301,14 +344,16 @@ def test_course_file_areas_are_checked_at_their_line(tmp_path):
         "boundary:\n  points: [{lat: 44.99, lon: 12.99}, {lat: 45.02, lon: 13.01},\n"
         "           {lat: 45.02, lon: 12.99}, {lat: 44.99, lon: 13.01}]\n"
         "obstacles:\n  - {name: rock, points: [{lat: 45.005, lon: 13.001}, "
-        "{lat: 45.005, lon: 13.002}], clearance_m: 5}\n")
+        "{lat: 45.005, lon: 13.002}], clearance_m: 5}\n"
+    )
     with pytest.raises(InputError) as exc:
         load_course(course)
     msg = str(exc.value)
-    assert f"{course}:10: boundary: expected a simple polygon; its edge from point 1 " \
-           "to 2 crosses the edge from point 3 to 4" in msg
-    assert f"{course}:14: obstacles[0]: expected a ring of at least 3 points; got 2" \
-        in msg
+    assert (
+        f"{course}:10: boundary: expected a simple polygon; its edge from point 1 "
+        "to 2 crosses the edge from point 3 to 4" in msg
+    )
+    assert f"{course}:14: obstacles[0]: expected a ring of at least 3 points; got 2" in msg
 
 
 # ------------------------------------------------------------------ command line
@@ -316,8 +361,22 @@ def test_cli_writes_the_course_and_reports_it(tmp_path):
     src = tmp_path / "m.csv"
     src.write_text("name,lat,lon,rounding\npin,45.0,13.0,\ntop,45.009,13.001,starboard\n")
     out = tmp_path / "c.yaml"
-    res = runner.invoke(app, ["course", "import", str(src), "-o", str(out), "--wind-twd", "0",
-                              "--wind-tws", "10", "--start-time", T0])
+    res = runner.invoke(
+        app,
+        [
+            "course",
+            "import",
+            str(src),
+            "-o",
+            str(out),
+            "--wind-twd",
+            "0",
+            "--wind-tws",
+            "10",
+            "--start-time",
+            T0,
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert "leg 1: pin -> top [mark] (starboard)" in res.output
     assert f"wrote course (YAML): {out}" in res.output
@@ -329,8 +388,24 @@ def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path):
     src = tmp_path / "m.csv"
     src.write_text("name,lat,lon\npin,45.0,13.0\ntop,45.009,13.001\n")
     out = tmp_path / "c.yaml"
-    res = runner.invoke(app, ["course", "import", str(src), "-o", str(out), "--wind-twd", "0",
-                              "--wind-tws", "10", "--start-time", T0, "--boat", "ilca99"])
+    res = runner.invoke(
+        app,
+        [
+            "course",
+            "import",
+            str(src),
+            "-o",
+            str(out),
+            "--wind-twd",
+            "0",
+            "--wind-tws",
+            "10",
+            "--start-time",
+            T0,
+            "--boat",
+            "ilca99",
+        ],
+    )
     assert res.exit_code == 2
     assert res.output.startswith("error: ") and "ilca99" in res.output
     assert "Traceback" not in res.output
@@ -349,7 +424,9 @@ def test_boat_option_forms(tmp_path):
     assert boat_spec_of(str(polar), out) == {"polar": os.path.join("..", "polars", "mine.pol")}
     assert boat_spec_of("ilca6", out) == {"builtin": "ilca6"}
     assert boat_spec_of("{polar: f.csv, speed_unit: km/h}", out) == {
-        "polar": "f.csv", "speed_unit": "km/h"}
+        "polar": "f.csv",
+        "speed_unit": "km/h",
+    }
     assert boat_spec_of(None, out) is None
     with pytest.raises(InputError, match="no such polar file"):
         boat_spec_of(str(tmp_path / "missing.pol"), out)

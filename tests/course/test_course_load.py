@@ -86,7 +86,7 @@ def test_xy_and_latlon_marks_are_the_same_course(tmp_path):
     for name, m in ll.marks.items():
         lines.append(f"  {name}: {{x: {m.x!r}, y: {m.y!r}}}")
     xy_text = BASE.replace(
-        BASE[BASE.index("marks:"):BASE.index("lines:")],
+        BASE[BASE.index("marks:") : BASE.index("lines:")],
         "origin: {{lat: {!r}, lon: {!r}}}\nmarks:\n{}\n".format(f.lat0, f.lon0, "\n".join(lines)),
     )
     xy = load_course(write(tmp_path, xy_text, "xy.yaml"))
@@ -107,8 +107,14 @@ def test_routing_section_maps_to_settings(tmp_path):
           initial_side: starboard
         """)
     r = load_course(write(tmp_path, text)).routing
-    assert (r.router, r.dt_s, r.heading_step_deg, r.tack_penalty_s, r.gybe_penalty_s,
-            r.initial_side) == ("griddp", 2.5, 1.0, 10.0, 4.0, "starboard")
+    assert (
+        r.router,
+        r.dt_s,
+        r.heading_step_deg,
+        r.tack_penalty_s,
+        r.gybe_penalty_s,
+        r.initial_side,
+    ) == ("griddp", 2.5, 1.0, 10.0, 4.0, "starboard")
 
 
 def test_scenario_forms_and_references(tmp_path):
@@ -131,16 +137,21 @@ def test_scenario_forms_and_references(tmp_path):
     assert c.scenarios["full"].wind["type"] == "wrf"
     assert c.scenarios["full"].description == "with its own reference"
     assert c.references == {"winner": (100.0, 200.0, 300.0, 40.5)}
-    assert c.references_for("full") == {"winner": (100.0, 200.0, 300.0, 40.5),
-                                        "model": (1.0, 2.0, 3.0, 4.0)}
+    assert c.references_for("full") == {
+        "winner": (100.0, 200.0, 300.0, 40.5),
+        "model": (1.0, 2.0, 3.0, 4.0),
+    }
     # where = file:line: key path, for the wind factory's messages
     assert c.scenarios["full"].where.endswith("c.yaml:24: scenarios.full.wind")
 
 
 def test_yaml_12_scalars_keep_mark_names(tmp_path):
     # YAML 1.1 would read 4_2 as 42 and 12:10 as 730; course files use YAML 1.2 scalars.
-    text = BASE.replace("g2:", "4_2:").replace("[g1, g2]", "[g1, 4_2]").replace(
-        "name: test", "name: 12:10")
+    text = (
+        BASE.replace("g2:", "4_2:")
+        .replace("[g1, g2]", "[g1, 4_2]")
+        .replace("name: test", "name: 12:10")
+    )
     c = load_course(write(tmp_path, text))
     assert "4_2" in c.marks and c.gates["gate"].b.name == "4_2"
     assert c.name == "12:10"
@@ -154,7 +165,8 @@ def test_integer_mark_names_are_text(tmp_path):
 
 def test_course_from_mapping_without_file():
     data = {
-        "name": "m", "start_time": "2024-05-01T10:00:00Z",
+        "name": "m",
+        "start_time": "2024-05-01T10:00:00Z",
         "origin": {"lat": 45.0, "lon": 13.0},
         "marks": {"a": {"x": 0, "y": 0}, "b": {"x": 0, "y": 500}},
         "legs": [{"from": "a", "to": "b"}],
@@ -192,8 +204,10 @@ def test_yaml_syntax_error_names_line_and_column():
 
 
 def test_duplicate_keys(tmp_path):
-    text = BASE.replace("  top: {lat: 45.009, lon: 13.001}\n",
-                        "  top: {lat: 45.009, lon: 13.001}\n  top: {lat: 45.01, lon: 13.0}\n")
+    text = BASE.replace(
+        "  top: {lat: 45.009, lon: 13.001}\n",
+        "  top: {lat: 45.009, lon: 13.001}\n  top: {lat: 45.01, lon: 13.0}\n",
+    )
     msg = problems(write(tmp_path, text))
     assert "marks.top: the key 'top' appears twice in the same mapping (lines 6 and 7)" in msg
 
@@ -201,30 +215,59 @@ def test_duplicate_keys(tmp_path):
 @pytest.mark.parametrize(
     ("old", "new", "expected"),
     [
-        ("  - {to: gate}\n", "  - {to: top}\n",
-         "legs[1].to: 'top' is where the previous leg ends"),
+        ("  - {to: gate}\n", "  - {to: top}\n", "legs[1].to: 'top' is where the previous leg ends"),
         ("[g1, g2]", "[g1, g1]", "gates.gate: a gate needs two different marks; got 'g1' twice"),
-        ("g2: {lat: 45.001, lon: 13.0015}", "g2: {lat: 45.001, lon: 13.0005}",
-         "marks 'g1' and 'g2' are 0.00 m apart"),
-        ("  - {to: gate}\n", "  - {to: gate, rounding: port}\n",
-         "legs[1].rounding: 'gate' is a gate"),
-        ("  - {to: gate}\n", "  - {from: top, to: gate}\n",
-         "legs[1].from: only the first leg may give `from`"),
-        ("  - {to: gate}\n", "  - {to: gaet}\n",
-         "legs[1].to: unknown mark, gate or line 'gaet'; did you mean 'gate'?"),
-        ('"2024-05-01T12:00:00+02:00"', "2024-05-01",
-         "start_time: expected a date and time with a UTC offset"),
+        (
+            "g2: {lat: 45.001, lon: 13.0015}",
+            "g2: {lat: 45.001, lon: 13.0005}",
+            "marks 'g1' and 'g2' are 0.00 m apart",
+        ),
+        (
+            "  - {to: gate}\n",
+            "  - {to: gate, rounding: port}\n",
+            "legs[1].rounding: 'gate' is a gate",
+        ),
+        (
+            "  - {to: gate}\n",
+            "  - {from: top, to: gate}\n",
+            "legs[1].from: only the first leg may give `from`",
+        ),
+        (
+            "  - {to: gate}\n",
+            "  - {to: gaet}\n",
+            "legs[1].to: unknown mark, gate or line 'gaet'; did you mean 'gate'?",
+        ),
+        (
+            '"2024-05-01T12:00:00+02:00"',
+            "2024-05-01",
+            "start_time: expected a date and time with a UTC offset",
+        ),
         ('"2024-05-01T12:00:00+02:00"', "noon", "start_time: cannot read 'noon'"),
-        ("lines:\n  start: [pin, boat]\n", "lines:\n  begin: [pin, boat]\n",
-         "legs[0]: the first leg needs `from: LINE_OR_MARK`"),
-        ("  top: {lat: 45.009, lon: 13.001}", "  top: {lat: 45.009, lon: 13.001, x: 3}",
-         "marks.top: give either {lat, lon} or {x, y}, not both"),
-        ("  top: {lat: 45.009, lon: 13.001}", "  top: {x: 0, y: 1000}",
-         "marks.top: positions in {x, y} metres need `origin: {lat, lon}`"),
-        ("  top: {lat: 45.009, lon: 13.001}", "  top: {lat: 45.009}",
-         "marks.top.lon: missing required key"),
-        ("gates:\n  gate: [g1, g2]", "gates:\n  pin: [g1, g2]",
-         "gates.pin: the name 'pin' is already used"),
+        (
+            "lines:\n  start: [pin, boat]\n",
+            "lines:\n  begin: [pin, boat]\n",
+            "legs[0]: the first leg needs `from: LINE_OR_MARK`",
+        ),
+        (
+            "  top: {lat: 45.009, lon: 13.001}",
+            "  top: {lat: 45.009, lon: 13.001, x: 3}",
+            "marks.top: give either {lat, lon} or {x, y}, not both",
+        ),
+        (
+            "  top: {lat: 45.009, lon: 13.001}",
+            "  top: {x: 0, y: 1000}",
+            "marks.top: positions in {x, y} metres need `origin: {lat, lon}`",
+        ),
+        (
+            "  top: {lat: 45.009, lon: 13.001}",
+            "  top: {lat: 45.009}",
+            "marks.top.lon: missing required key",
+        ),
+        (
+            "gates:\n  gate: [g1, g2]",
+            "gates:\n  pin: [g1, g2]",
+            "gates.pin: the name 'pin' is already used",
+        ),
         ("legs:\n", "legz:\n", "legz: unknown key; did you mean 'legs'?"),
     ],
 )
@@ -235,7 +278,7 @@ def test_single_problem(tmp_path, old, new, expected):
 
 
 def test_empty_legs_and_leg_to_start(tmp_path):
-    text = BASE[: BASE.index("legs:")] + "legs: []\n" + BASE[BASE.index("scenarios:"):]
+    text = BASE[: BASE.index("legs:")] + "legs: []\n" + BASE[BASE.index("scenarios:") :]
     assert "legs: expected at least one leg; got an empty list" in problems(write(tmp_path, text))
     text = BASE.replace("  - {to: top, rounding: port}\n", "  - {from: top, to: top}\n")
     assert "legs[0].to: 'top' is where the leg starts" in problems(write(tmp_path, text))
@@ -245,8 +288,11 @@ def test_empty_legs_and_leg_to_start(tmp_path):
     ("routing", "expected"),
     [
         ("router: dijkstra", "routing.router: expected one of 'isochrone', 'griddp', 'spline'"),
-        ("dt_s: 0", "routing.dt_s: expected a time step >= 0.5 s (default 10; finer steps "
-                    "hardly change the route and make it slow); got 0"),
+        (
+            "dt_s: 0",
+            "routing.dt_s: expected a time step >= 0.5 s (default 10; finer steps "
+            "hardly change the route and make it slow); got 0",
+        ),
         ("tack_penalty_s: -1", "routing.tack_penalty_s: expected a number >= 0; got -1"),
         ("tack_penalty_s: ten", "routing.tack_penalty_s: expected a number >= 0; got 'ten'"),
         ("heading_step_deg: 90", "routing.heading_step_deg: expected a number in [0.1, 45]"),
@@ -257,42 +303,53 @@ def test_routing_problems(tmp_path, routing, expected):
     assert expected in problems(write(tmp_path, BASE + f"routing:\n  {routing}\n"))
 
 
-@pytest.mark.parametrize(("routing", "expected"), [
-    ("dp_cols: 1", "routing.dp_cols: dp_cols must be an integer in [2, 1024], got 1"),
-    ("dp_shrink: 2", "routing.dp_shrink: dp_shrink must be in (0, 1], got 2.0"),
-    ("spline_slopes: 0", "routing.spline_slopes: spline_slopes must be an integer >= 1, got 0"),
-])
+@pytest.mark.parametrize(
+    ("routing", "expected"),
+    [
+        ("dp_cols: 1", "routing.dp_cols: dp_cols must be an integer in [2, 1024], got 1"),
+        ("dp_shrink: 2", "routing.dp_shrink: dp_shrink must be in (0, 1], got 2.0"),
+        ("spline_slopes: 0", "routing.spline_slopes: spline_slopes must be an integer >= 1, got 0"),
+    ],
+)
 def test_router_rules_are_checked_when_the_course_loads(tmp_path, routing, expected):
     # the routers' rules (routing.types.settings_problems) at load time, with the line:
     # before, such a file loaded and the plan stopped at its first leg
     n_lines = BASE.count("\n") + 2  # the key below "routing:"
     assert f"c.yaml:{n_lines}: {expected}" in problems(
-        write(tmp_path, BASE + f"routing:\n  {routing}\n"))
+        write(tmp_path, BASE + f"routing:\n  {routing}\n")
+    )
 
 
 def test_references_must_have_one_time_per_leg(tmp_path):
     text = BASE + "references:\n  winner: [100, 200, 300]\n"
     assert "references.winner: expected 4 leg times (one per leg); got 3" in problems(
-        write(tmp_path, text))
+        write(tmp_path, text)
+    )
     text = BASE + "references:\n  winner: [100, -2, 300, 4]\n"
     assert "references.winner[1]: expected a leg time in seconds > 0; got -2" in problems(
-        write(tmp_path, text))
+        write(tmp_path, text)
+    )
 
 
 def test_boat_needs_exactly_one_source(tmp_path):
     text = BASE + "boat: {builtin: ilca7, polar: x.pol}\n"
     assert "boat: expected exactly one of 'builtin', 'polar', 'vpp'; got builtin, polar" in (
-        problems(write(tmp_path, text)))
+        problems(write(tmp_path, text))
+    )
 
 
 def test_scenarios_required_and_typed(tmp_path):
     text = BASE[: BASE.index("scenarios:")]
     assert "scenarios: missing required key; add at least one wind scenario" in problems(
-        write(tmp_path, text))
-    text = BASE.replace("north: {type: uniform, tws_kn: 10, twd_deg: 0}",
-                        "north: {wind: {type: uniform}, referenses: {}}")
+        write(tmp_path, text)
+    )
+    text = BASE.replace(
+        "north: {type: uniform, tws_kn: 10, twd_deg: 0}",
+        "north: {wind: {type: uniform}, referenses: {}}",
+    )
     assert "scenarios.north.referenses: unknown key; did you mean 'references'?" in problems(
-        write(tmp_path, text))
+        write(tmp_path, text)
+    )
 
 
 def test_template_and_explicit_marks_are_exclusive(tmp_path):
@@ -309,34 +366,49 @@ def test_template_and_explicit_marks_are_exclusive(tmp_path):
 def test_template_problems(tmp_path):
     head = 'name: t\nstart_time: "2024-05-01T12:00:00Z"\n'
     tail = "scenarios:\n  s: {type: uniform, tws_kn: 10, twd_deg: 0}\n"
-    text = head + textwrap.dedent("""\
+    text = (
+        head
+        + textwrap.dedent("""\
         template:
           type: windward-leward
           centre: {lat: 45.0, lon: 13.0}
-        """) + tail
-    assert "template.type: expected one of 'windward-leeward', 'trapezoid'; got " \
-           "'windward-leward' (did you mean 'windward-leeward'?)" in problems(write(tmp_path, text))
-    text = head + textwrap.dedent("""\
+        """)
+        + tail
+    )
+    assert (
+        "template.type: expected one of 'windward-leeward', 'trapezoid'; got "
+        "'windward-leward' (did you mean 'windward-leeward'?)" in problems(write(tmp_path, text))
+    )
+    text = (
+        head
+        + textwrap.dedent("""\
         template:
           type: trapezoid
           centre: {x: 0, y: 0}
           twd_deg: 0
           leg_length_m: -5
           loop: middle
-        """) + tail
+        """)
+        + tail
+    )
     msg = problems(write(tmp_path, text))
     assert "template.leg_length_m: expected a number > 0; got -5" in msg
     assert "template.loop: expected one of 'inner', 'outer'; got 'middle'" in msg
     assert "template.centre: positions in {x, y} metres need `origin: {lat, lon}`" in msg
-    text = head + textwrap.dedent("""\
+    text = (
+        head
+        + textwrap.dedent("""\
         template:
           type: windward-leeward
           centre: {lat: 45.0, lon: 13.0}
           twd_deg: 2700
           leg_length_m: 800
-        """) + tail  # a typo for 270 must not become a 180 deg course axis
+        """)
+        + tail
+    )  # a typo for 270 must not become a 180 deg course axis
     assert "template.twd_deg: expected a number in [0, 360]; got 2700" in problems(
-        write(tmp_path, text))
+        write(tmp_path, text)
+    )
 
 
 def test_template_course_loads(tmp_path):
@@ -377,11 +449,14 @@ def test_validate_specs_reports_boat_and_wind_problems_together(tmp_path):
     pytest.importorskip("sailroute.wind.build")
     from sailroute.course.load import validate_specs
 
-    text = BASE.replace(
-        "  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n",
-        "  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n"
-        "  bad: {type: uniform, tws_kn: 10, twd_degs: 0}\n",
-    ) + "boat: {builtin: ilca9}\n"
+    text = (
+        BASE.replace(
+            "  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n",
+            "  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n"
+            "  bad: {type: uniform, tws_kn: 10, twd_degs: 0}\n",
+        )
+        + "boat: {builtin: ilca9}\n"
+    )
     path = write(tmp_path, text)
     c = load_course(path)  # structurally fine: specs are checked by their factories
     with pytest.raises(InputError) as ei:
@@ -402,16 +477,27 @@ def test_legs_may_be_bare_names(tmp_path):
     )
     c = load_course(write(tmp_path, text))
     assert [(leg.to_name, leg.rounding) for leg in c.legs] == [
-        ("top", "port"), ("gate", None), ("top", "port"), ("start", None)]
+        ("top", "port"),
+        ("gate", None),
+        ("top", "port"),
+        ("start", None),
+    ]
 
 
-@pytest.mark.parametrize(("laps", "limit", "expected"), [
-    # 90 min at 70 kn (36.0 m/s) covers 194 km: at most 121 laps of 2 x 800 m
-    ("10000000", None, "template.laps: 10000000 laps of 2 × 800 m cannot be sailed within "
-     "time_limit_min 90 even at 70 kn; expected an integer in [1, 121]"),
-    ("1e30", None, "template.laps:"),
-    ("50", "10", "expected an integer in [1, 13] (or raise time_limit_min)"),
-])
+@pytest.mark.parametrize(
+    ("laps", "limit", "expected"),
+    [
+        # 90 min at 70 kn (36.0 m/s) covers 194 km: at most 121 laps of 2 x 800 m
+        (
+            "10000000",
+            None,
+            "template.laps: 10000000 laps of 2 × 800 m cannot be sailed within "
+            "time_limit_min 90 even at 70 kn; expected an integer in [1, 121]",
+        ),
+        ("1e30", None, "template.laps:"),
+        ("50", "10", "expected an integer in [1, 13] (or raise time_limit_min)"),
+    ],
+)
 def test_template_laps_bounded_by_the_time_limit(tmp_path, laps, limit, expected):
     # laps: 10000000 took 5.4 GB in 60 s and 1e30 never finished; both now fail at once
     import time

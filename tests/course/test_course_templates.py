@@ -36,8 +36,16 @@ def seq(layout):
 @pytest.mark.parametrize("twd", TWDS)
 def test_windward_leeward_geometry(twd):
     centre = (120.0, -40.0)
-    lay = windward_leeward(centre, twd, 900.0, 2, gate_width_m=50.0, start_line_length_m=200.0,
-                           start_offset_m=60.0, finish_line_length_m=70.0)
+    lay = windward_leeward(
+        centre,
+        twd,
+        900.0,
+        2,
+        gate_width_m=50.0,
+        start_line_length_m=200.0,
+        start_offset_m=60.0,
+        finish_line_length_m=70.0,
+    )
     m1 = lay.marks["1"]
     g4 = mid(lay, "4s", "4p")
     # the windward leg goes straight into the wind, with the requested length, about the centre
@@ -50,7 +58,8 @@ def test_windward_leeward_geometry(twd):
     to_4p = (lay.marks["4p"][0] - g4[0], lay.marks["4p"][1] - g4[1])
     assert cross(up, to_4p) < 0  # clockwise from upwind = right
     assert abs(wrap180(xy_bearing_deg(lay.marks["4s"], lay.marks["4p"]) - twd)) == pytest.approx(
-        90.0, abs=1e-9)
+        90.0, abs=1e-9
+    )
     # start line: length, square to the wind, start_offset below the gate, boat at the right end
     st = mid(lay, "start_pin", "start_boat")
     assert math.dist(lay.marks["start_pin"], lay.marks["start_boat"]) == pytest.approx(200.0)
@@ -61,8 +70,10 @@ def test_windward_leeward_geometry(twd):
     # leeward finish: shortened line on the start line's centre
     np.testing.assert_allclose(mid(lay, "finish_pin", "finish_boat"), st, atol=1e-9)
     assert math.dist(lay.marks["finish_pin"], lay.marks["finish_boat"]) == pytest.approx(70.0)
-    assert lay.lines == {"start": ("start_pin", "start_boat"),
-                         "finish": ("finish_pin", "finish_boat")}
+    assert lay.lines == {
+        "start": ("start_pin", "start_boat"),
+        "finish": ("finish_pin", "finish_boat"),
+    }
     assert lay.gates == {"4": ("4s", "4p")}
 
 
@@ -79,8 +90,11 @@ def test_windward_leeward_geometry(twd):
 def test_windward_leeward_sequences(laps, finish, expected):
     lay = windward_leeward((0.0, 0.0), 0.0, 1000.0, laps, finish=finish)
     assert seq(lay) == expected
-    beats = sum(1 for a, b in zip(["start", *expected], expected, strict=False)
-                if b in ("1", "finish") and a in ("start", "4"))
+    beats = sum(
+        1
+        for a, b in zip(["start", *expected], expected, strict=False)
+        if b in ("1", "finish") and a in ("start", "4")
+    )
     assert beats == laps  # laps counts the beats, as in course codes L2, L3
     assert all(leg.rounding == "port" for leg in lay.legs if leg.to == "1")
     assert all(leg.rounding is None for leg in lay.legs if leg.to in ("4", "finish"))
@@ -95,8 +109,17 @@ def test_windward_finish_line_beyond_mark_1():
 @pytest.mark.parametrize("angle", [60.0, 70.0, 110.0])
 def test_trapezoid_geometry(twd, angle):
     L = 1200.0
-    lay = trapezoid((0.0, 0.0), twd, L, 2, loop="outer", reach_angle_deg=angle,
-                    gate_width_m=40.0, finish_reach_m=250.0, finish_line_length_m=60.0)
+    lay = trapezoid(
+        (0.0, 0.0),
+        twd,
+        L,
+        2,
+        loop="outer",
+        reach_angle_deg=angle,
+        gate_width_m=40.0,
+        finish_reach_m=250.0,
+        finish_line_length_m=60.0,
+    )
     m1, m2 = lay.marks["1"], lay.marks["2"]
     g3, g4 = mid(lay, "3s", "3p"), mid(lay, "4s", "4p")
     # reach 1 -> 2: length 2/3 L, at TWA 180 - angle on starboard tack (after a port rounding)
@@ -112,8 +135,9 @@ def test_trapezoid_geometry(twd, angle):
     fin = mid(lay, "finish_pin", "finish_boat")
     assert math.dist(g3, fin) == pytest.approx(250.0, abs=1e-9)
     assert xy_bearing_deg(g3, fin) == pytest.approx((twd + 90.0) % 360.0, abs=1e-9)
-    assert abs(wrap180(xy_bearing_deg(lay.marks["finish_boat"], lay.marks["finish_pin"]) - twd)
-               ) == pytest.approx(0.0, abs=1e-9)
+    assert abs(
+        wrap180(xy_bearing_deg(lay.marks["finish_boat"], lay.marks["finish_pin"]) - twd)
+    ) == pytest.approx(0.0, abs=1e-9)
 
 
 @pytest.mark.parametrize(
@@ -141,8 +165,7 @@ def test_trapezoid_outer_wind_modes():
     pts["3"] = mid(lay, "3s", "3p")
     pts["finish"] = mid(lay, "finish_pin", "finish_boat")
     names = ["start", *seq(lay)]
-    modes = [wind_mode(xy_bearing_deg(pts[a], pts[b]), twd)
-             for a, b in itertools.pairwise(names)]
+    modes = [wind_mode(xy_bearing_deg(pts[a], pts[b]), twd) for a, b in itertools.pairwise(names)]
     assert modes == ["upwind", "reach", "downwind", "upwind", "downwind", "reach"]
 
 
@@ -154,8 +177,10 @@ def test_rotation_invariance(twd):
     # compass rotation by twd: (x, y) -> (x cos t + y sin t, -x sin t + y cos t)
     for k, (x, y) in base.marks.items():
         np.testing.assert_allclose(
-            rot.marks[k], (x * math.cos(t) + y * math.sin(t), -x * math.sin(t) + y * math.cos(t)),
-            atol=1e-9)
+            rot.marks[k],
+            (x * math.cos(t) + y * math.sin(t), -x * math.sin(t) + y * math.cos(t)),
+            atol=1e-9,
+        )
 
 
 @pytest.mark.parametrize(
@@ -163,12 +188,16 @@ def test_rotation_invariance(twd):
     [
         (lambda: windward_leeward((0, 0), 0, -1.0), "leg_length_m must be > 0"),
         (lambda: windward_leeward((0, 0), 0, 500.0, 0), "laps must be an integer >= 1"),
-        (lambda: windward_leeward((0, 0), 0, 500.0, 1, finish="windward"),
-         "laps must be an integer >= 2 with a windward finish"),
+        (
+            lambda: windward_leeward((0, 0), 0, 500.0, 1, finish="windward"),
+            "laps must be an integer >= 2 with a windward finish",
+        ),
         (lambda: trapezoid((0, 0), 0, 500.0, loop="middle"), "loop must be 'inner' or 'outer'"),
         (lambda: trapezoid((0, 0), 0, 500.0, reach_angle_deg=180.0), "reach_angle_deg"),
-        (lambda: trapezoid((0, 0), 0, 500.0, reach_angle_deg=10.0, reach_length_m=600.0),
-         "mark 2 lies too close to the leeward gates"),
+        (
+            lambda: trapezoid((0, 0), 0, 500.0, reach_angle_deg=10.0, reach_length_m=600.0),
+            "mark 2 lies too close to the leeward gates",
+        ),
     ],
 )
 def test_invalid_parameters(call, match):

@@ -32,9 +32,15 @@ def trieste(coarse: bool = True) -> Course:
 
 
 def approach(
-    course: Course, seconds: int, *, speed_ms: float = 2.0,
-    twd: Callable[[float], float] = lambda s: 65.0, tws_kn: float = 5.0,
-    start_back_m: float = 150.0, t0: float | None = None, to: str = "1",
+    course: Course,
+    seconds: int,
+    *,
+    speed_ms: float = 2.0,
+    twd: Callable[[float], float] = lambda s: 65.0,
+    tws_kn: float = 5.0,
+    start_back_m: float = 150.0,
+    t0: float | None = None,
+    to: str = "1",
 ) -> list[Row]:
     """A boat motoring straight at mark ``to`` from ``start_back_m`` behind the start line.
 
@@ -52,8 +58,21 @@ def approach(
     for s in range(seconds):
         go = min(speed_ms * s, math.hypot(mx - x0, my - y0))
         lat, lon = course.frame.to_latlon(x0 + ux * go, y0 + uy * go)
-        rows.append(Row(t0 + s, float(lat), float(lon), speed_ms / 0.514444, cog, cog,
-                        speed_ms / 0.514444, None, None, tws_kn, twd(s) % 360.0))
+        rows.append(
+            Row(
+                t0 + s,
+                float(lat),
+                float(lon),
+                speed_ms / 0.514444,
+                cog,
+                cog,
+                speed_ms / 0.514444,
+                None,
+                None,
+                tws_kn,
+                twd(s) % 360.0,
+            )
+        )
     return rows
 
 
@@ -85,8 +104,13 @@ class FeedServer:
         How long the server accepts no connection after the drop [s].
     """
 
-    def __init__(self, lines: Sequence[str], rate: float = 20.0, drop_after: int | None = None,
-                 down_s: float = 1.0) -> None:
+    def __init__(
+        self,
+        lines: Sequence[str],
+        rate: float = 20.0,
+        drop_after: int | None = None,
+        down_s: float = 1.0,
+    ) -> None:
         self.lines = list(lines)
         self.rate = rate
         self.drop_after = drop_after
@@ -126,8 +150,11 @@ class FeedServer:
             line = self.lines[self._pos]
             if line[3:6] == "RMC":
                 n_rmc += 1
-                if self.drop_after is not None and self.connections == 1 \
-                        and n_rmc > self.drop_after:
+                if (
+                    self.drop_after is not None
+                    and self.connections == 1
+                    and n_rmc > self.drop_after
+                ):
                     return True
                 time.sleep(1.0 / self.rate)
             try:

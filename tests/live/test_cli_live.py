@@ -20,9 +20,25 @@ def test_live_replays_a_file_to_its_end(tmp_path: Path) -> None:
     the file's end with a summary, the log is written (Tallinn is far from Trieste: every
     re-plan fails with an error that names the wind file, and the run goes on)."""
     log = tmp_path / "live.jsonl"
-    res = CliRunner().invoke(app, ["live", COURSE, "--source", str(TALLINN), "--scenario",
-                                   "measured", "--speed", "2000", "--port", "0",
-                                   "--nmea-port", "0", "--log", str(log)])
+    res = CliRunner().invoke(
+        app,
+        [
+            "live",
+            COURSE,
+            "--source",
+            str(TALLINN),
+            "--scenario",
+            "measured",
+            "--speed",
+            "2000",
+            "--port",
+            "0",
+            "--nmea-port",
+            "0",
+            "--log",
+            str(log),
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert "page: http://127.0.0.1:" in res.output and "NMEA 0183 out" in res.output
     assert "0 with a bad checksum, 0 malformed" in res.output
@@ -48,11 +64,12 @@ def test_live_bad_source_is_exit_2(tmp_path: Path) -> None:
 
 def test_live_convert(tmp_path: Path) -> None:
     csv = tmp_path / "log.csv"
-    csv.write_text("time,lat,lng,sog,cog,hdg,awa,aws,tack\n"
-                   "2023-09-27 14:31:57+00:00,59.5,24.8,7.1,123.8,288.0,55.0,18.9,-1.0\n")
+    csv.write_text(
+        "time,lat,lng,sog,cog,hdg,awa,aws,tack\n"
+        "2023-09-27 14:31:57+00:00,59.5,24.8,7.1,123.8,288.0,55.0,18.9,-1.0\n"
+    )
     out = tmp_path / "log.nmea"
-    res = CliRunner().invoke(app, ["live-convert", str(csv), "--format", "tallinn",
-                                   "-o", str(out)])
+    res = CliRunner().invoke(app, ["live-convert", str(csv), "--format", "tallinn", "-o", str(out)])
     assert res.exit_code == 0, res.output
     lines = out.read_text().splitlines()
     for line in lines:
@@ -63,16 +80,23 @@ def test_live_convert(tmp_path: Path) -> None:
         "$IIMWV,305.0,R,18.90,N,A*3B",  # port tack: 55° over port = 305° clockwise
     ]
     csv.write_text("time,lat\nyesterday,59.5\n")
-    res = CliRunner().invoke(app, ["live-convert", str(csv), "--format", "tallinn",
-                                   "-o", str(out)])
+    res = CliRunner().invoke(app, ["live-convert", str(csv), "--format", "tallinn", "-o", str(out)])
     assert res.exit_code == 2 and f"{csv}:2: not a row of the Tallinn race log" in res.output
 
 
 def test_help_lists_the_options() -> None:
     res = CliRunner().invoke(app, ["live", "--help"])
     assert res.exit_code == 0
-    for text in ("--source SOURCE", "--every S", "--speed X", "--nmea-port", "--log FILE",
-                 "--duration S", "--router [isochrone|griddp|spline]", "-h, --help"):
+    for text in (
+        "--source SOURCE",
+        "--every S",
+        "--speed X",
+        "--nmea-port",
+        "--log FILE",
+        "--duration S",
+        "--router [isochrone|griddp|spline]",
+        "-h, --help",
+    ):
         assert text in res.output, text
     assert "<float>" not in res.output and "<int>" not in res.output
     conv = CliRunner().invoke(app, ["live-convert", "-h"])

@@ -47,20 +47,33 @@ def test_bad_input_is_counted_not_raised() -> None:
     assert d.feed("$IIMWV,abc,R") is None
     assert d.feed("not nmea at all") is None
     assert d.feed(sentence("GPRMC,094430.00,V,,,,,,,150218,,,N").strip()) is None  # void fix
-    assert d.counts.by_kind == {"untimed": 1, "bad_checksum": 1, "RMC": 1, "malformed": 2,
-                                "ignored": 1}
+    assert d.counts.by_kind == {
+        "untimed": 1,
+        "bad_checksum": 1,
+        "RMC": 1,
+        "malformed": 2,
+        "ignored": 1,
+    }
     assert d.counts.bad == 3
 
 
 def test_signalk_delta() -> None:
     d = SignalKDecoder()
     assert d.feed(json.dumps({"name": "signalk-server", "self": "vessels.urn:x"})) == []
-    delta = {"context": "vessels.urn:x", "updates": [{
-        "timestamp": "2018-02-15T09:44:30.000Z",
-        "values": [{"path": "navigation.position", "value": {"latitude": 45.5, "longitude": 13.6}},
-                   {"path": "navigation.courseOverGroundTrue", "value": math.radians(370.0)},
-                   {"path": "environment.wind.angleApparent", "value": -math.pi / 3},
-                   {"path": "environment.wind.speedApparent", "value": 3.5}]}]}
+    delta = {
+        "context": "vessels.urn:x",
+        "updates": [
+            {
+                "timestamp": "2018-02-15T09:44:30.000Z",
+                "values": [
+                    {"path": "navigation.position", "value": {"latitude": 45.5, "longitude": 13.6}},
+                    {"path": "navigation.courseOverGroundTrue", "value": math.radians(370.0)},
+                    {"path": "environment.wind.angleApparent", "value": -math.pi / 3},
+                    {"path": "environment.wind.speedApparent", "value": 3.5},
+                ],
+            }
+        ],
+    }
     (r,) = d.feed(json.dumps(delta))
     assert r.t == datetime.fromisoformat("2018-02-15T09:44:30+00:00").timestamp()
     assert (r.lat, r.lon, r.aws_ms) == (45.5, 13.6, 3.5)
@@ -114,8 +127,10 @@ def test_trieste_replay_round_trip() -> None:
     """The committed Trieste replay decodes, row by row, to the source CSV's position, TWS
     and TWD (the CSV's local clock is CET, UTC+01:00)."""
     with open(TRIESTE_CSV, newline="") as fh:
-        src = [(datetime.fromisoformat(row["datetime_local"] + "+01:00").timestamp(), row)
-               for row in csv.DictReader(fh)]
+        src = [
+            (datetime.fromisoformat(row["datetime_local"] + "+01:00").timestamp(), row)
+            for row in csv.DictReader(fh)
+        ]
     d = NmeaDecoder()
     fixes, winds = [], []
     for line in (LIVE / "trieste-coach-2018-02-15.nmea").read_text().splitlines():

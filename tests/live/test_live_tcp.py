@@ -34,9 +34,18 @@ def test_tcp_feed_replans_page_and_nmea_out(tmp_path: Path) -> None:
     course = trieste()
     feed = FeedServer(lines_of(approach(course, 100, speed_ms=2.5)), rate=20.0)
     log = tmp_path / "live.jsonl"
-    engine = start_live(course, source=f"nmea+tcp://127.0.0.1:{feed.port}", scenario="mean",
-                        every_s=20, port=0, nmea_port=0, log=log, leg=3,
-                        worker=False, settings=LiveSettings(side=False))
+    engine = start_live(
+        course,
+        source=f"nmea+tcp://127.0.0.1:{feed.port}",
+        scenario="mean",
+        every_s=20,
+        port=0,
+        nmea_port=0,
+        log=log,
+        leg=3,
+        worker=False,
+        settings=LiveSettings(side=False),
+    )
     assert engine.nmea is not None and engine.page is not None
     plotter = socket.create_connection(("127.0.0.1", engine.nmea.port), timeout=5)
     try:
@@ -88,10 +97,20 @@ def test_wind_shift_changes_the_side_that_pays(tmp_path: Path) -> None:
     course = trieste()
     rows = approach(course, 80, speed_ms=0.5, twd=lambda s: 50.0 if s < 40 else 80.0)
     log = tmp_path / "live.jsonl"
-    res = run_live_command(course, source=str(write_feed(tmp_path / "f.nmea", rows)),
-                           scenario="mean", every_s=1000, speed=15, port=None,
-                           nmea_port=None, log=log, duration_s=30, leg=3,
-                           worker=False, settings=LiveSettings(fade_s=300, window_s=10))
+    res = run_live_command(
+        course,
+        source=str(write_feed(tmp_path / "f.nmea", rows)),
+        scenario="mean",
+        every_s=1000,
+        speed=15,
+        port=None,
+        nmea_port=None,
+        log=log,
+        duration_s=30,
+        leg=3,
+        worker=False,
+        settings=LiveSettings(fade_s=300, window_s=10),
+    )
     plans = _plans(log)
     assert [p["reason"] for p in plans][:1] == ["first"]
     assert any(p["reason"] == "wind" for p in plans[1:])
@@ -108,9 +127,18 @@ def test_dropped_connection_reconnects_and_marks_stale(tmp_path: Path) -> None:
     rows = approach(course, 60)
     feed = FeedServer(lines_of(rows), rate=20.0, drop_after=20, down_s=1.5)
     log = tmp_path / "live.jsonl"
-    engine = start_live(course, source=f"nmea+tcp://127.0.0.1:{feed.port}", scenario="mean",
-                        port=None, nmea_port=None, log=log, leg=4, every_s=1000,
-                        worker=False, settings=LiveSettings(side=False, stale_s=0.5))
+    engine = start_live(
+        course,
+        source=f"nmea+tcp://127.0.0.1:{feed.port}",
+        scenario="mean",
+        port=None,
+        nmea_port=None,
+        log=log,
+        leg=4,
+        every_s=1000,
+        worker=False,
+        settings=LiveSettings(side=False, stale_s=0.5),
+    )
     stale_seen = False
     try:
         end = time.monotonic() + 20
@@ -126,8 +154,7 @@ def test_dropped_connection_reconnects_and_marks_stale(tmp_path: Path) -> None:
     links = [r for r in _records(log) if r["kind"] == "link"]
     ups = [r["up"] for r in links]
     # up, down (then refused tries, with back-off), up again, down at the feed's end
-    assert [u for i, u in enumerate(ups) if i == 0 or u != ups[i - 1]] == [
-        True, False, True, False]
+    assert [u for i, u in enumerate(ups) if i == 0 or u != ups[i - 1]] == [True, False, True, False]
     tries = [r["wall"] for r in links if not r["up"]][:-1]
     assert len(tries) >= 2 and all(b - a >= 0.4 for a, b in itertools.pairwise(tries))
     inputs = [r for r in _records(log) if r["kind"] == "input" and "lat" in r]
@@ -149,9 +176,20 @@ def test_bad_sentences_are_counted_and_skipped(tmp_path: Path) -> None:
     path = tmp_path / "bad.nmea"
     path.write_text("\n".join(bad) + "\n", encoding="ascii")
     log = tmp_path / "live.jsonl"
-    run_live_command(course, source=str(path), scenario="mean", speed=100, port=None,
-                     nmea_port=None, log=log, duration_s=10, leg=4, every_s=1000,
-                     worker=False, settings=LiveSettings(side=False))
+    run_live_command(
+        course,
+        source=str(path),
+        scenario="mean",
+        speed=100,
+        port=None,
+        nmea_port=None,
+        log=log,
+        duration_s=10,
+        leg=4,
+        every_s=1000,
+        worker=False,
+        settings=LiveSettings(side=False),
+    )
     end = _records(log)[-1]
     n = len(lines)
     assert end["counts"]["bad_checksum"] == len(range(3, n, 10))
@@ -165,9 +203,18 @@ def test_udp_source(tmp_path: Path) -> None:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
     log = tmp_path / "live.jsonl"
-    engine = start_live(course, source=f"nmea+udp://127.0.0.1:{port}", scenario="mean",
-                        port=None, nmea_port=None, log=log, leg=4, every_s=1000,
-                        worker=False, settings=LiveSettings(side=False))
+    engine = start_live(
+        course,
+        source=f"nmea+udp://127.0.0.1:{port}",
+        scenario="mean",
+        port=None,
+        nmea_port=None,
+        log=log,
+        leg=4,
+        every_s=1000,
+        worker=False,
+        settings=LiveSettings(side=False),
+    )
     try:
         time.sleep(0.3)
         with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as tx:
@@ -193,9 +240,19 @@ def test_ctrl_c_ends_cleanly_with_the_log_flushed(tmp_path: Path) -> None:
         if line.startswith("page:"):
             timer.start()
 
-    res = run_live_command(course, source=str(feed), scenario="mean", speed=20, port=0,
-                           nmea_port=0, log=log, leg=4, worker=False, announce=announce,
-                           settings=LiveSettings(side=False))
+    res = run_live_command(
+        course,
+        source=str(feed),
+        scenario="mean",
+        speed=20,
+        port=0,
+        nmea_port=0,
+        log=log,
+        leg=4,
+        worker=False,
+        announce=announce,
+        settings=LiveSettings(side=False),
+    )
     timer.join()
     records = _records(log)
     assert records[-1]["kind"] == "end"

@@ -60,11 +60,11 @@ def test_remaining_course_from_a_mark_matches_the_full_plan() -> None:
     course = trieste()
     boat, winds = build_specs(course, ["mean"])
     full = route_course(course, winds["mean"], boat, course.routing)
-    rest = route_remaining(course, winds["mean"], boat, course.routing, 1, full[0].end_xy,
-                           full[0].t_end)
+    rest = route_remaining(
+        course, winds["mean"], boat, course.routing, 1, full[0].end_xy, full[0].t_end
+    )
     assert len(rest) == 3
-    np.testing.assert_allclose([r.time_s for r in rest], [r.time_s for r in full[1:]],
-                               rtol=0.03)
+    np.testing.assert_allclose([r.time_s for r in rest], [r.time_s for r in full[1:]], rtol=0.03)
     assert rest[-1].t_end == pytest.approx(full[-1].t_end, rel=0, abs=30.0)
 
 
@@ -93,8 +93,11 @@ def test_laylines_are_the_polars_vmg_angles() -> None:
 
 
 def test_nmea_out_sentences_parse_and_measure() -> None:
-    wps = [("T301", 45.5633, 13.6751), ("1", 45.566951, 13.676702),
-           ("finish", 45.564859, 13.6703175)]
+    wps = [
+        ("T301", 45.5633, 13.6751),
+        ("1", 45.566951, 13.676702),
+        ("finish", 45.564859, 13.6703175),
+    ]
     out = route_sentences(7, wps)
     msgs = [pynmea2.parse(s.strip()) for s in out]  # checksums verified by pynmea2
     wpl = [m for m in msgs if m.sentence_type == "WPL"]
@@ -104,8 +107,10 @@ def test_nmea_out_sentences_parse_and_measure() -> None:
     assert rte[0].data[3] == "live7" and rte[0].data[4:] == ["T301", "1", "FINISH"]
     # 1 nm due north of the waypoint, steering to it: range 1 nm, bearing 180°
     lat = 45.566951 + 1852.0 / 111_132.0
-    rmb, apb = (pynmea2.parse(s.strip()) for s in steer_sentences(
-        lat, 13.676702, 2.0, 180.0, ("BOAT", lat, 13.676702), wps[1]))
+    rmb, apb = (
+        pynmea2.parse(s.strip())
+        for s in steer_sentences(lat, 13.676702, 2.0, 180.0, ("BOAT", lat, 13.676702), wps[1])
+    )
     assert float(rmb.data[9]) == pytest.approx(1.0, abs=0.01)
     assert float(rmb.data[10]) == pytest.approx(180.0, abs=0.1)
     assert float(rmb.data[11]) == pytest.approx(2.0 * 3600 / 1852, abs=0.05)  # closing speed

@@ -48,27 +48,56 @@ def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
     """A signalk-server on a free port replaying a boat closing on mark 1 (120 s at 10x)."""
     exe = _server_bin()
     if exe is None:
-        pytest.skip(f"signalk-server is not installed (npm install --prefix {CACHE} "
-                    f"signalk-server@{SIGNALK_VERSION}, as .ci/run does)")
+        pytest.skip(
+            f"signalk-server is not installed (npm install --prefix {CACHE} "
+            f"signalk-server@{SIGNALK_VERSION}, as .ci/run does)"
+        )
     course = trieste()
     rows = approach(course, 120, speed_ms=2.0)
     feed = write_feed(tmp_path / "replay.nmea", rows)
     per_s = len(feed.read_bytes()) / len(rows)
     conf = tmp_path / "signalk"
     conf.mkdir()
-    (conf / "settings.json").write_text(json.dumps({
-        "interfaces": {}, "ssl": False,
-        "pipedProviders": [{"id": "replay", "enabled": True, "pipeElements": [{
-            "type": "providers/simple",
-            "options": {"logging": False, "type": "FileStream", "subOptions": {
-                "dataType": "NMEA0183", "filename": str(feed), "keepRunning": False,
-                "throttleRate": int(per_s * 10)}}}]}]}))
+    (conf / "settings.json").write_text(
+        json.dumps(
+            {
+                "interfaces": {},
+                "ssl": False,
+                "pipedProviders": [
+                    {
+                        "id": "replay",
+                        "enabled": True,
+                        "pipeElements": [
+                            {
+                                "type": "providers/simple",
+                                "options": {
+                                    "logging": False,
+                                    "type": "FileStream",
+                                    "subOptions": {
+                                        "dataType": "NMEA0183",
+                                        "filename": str(feed),
+                                        "keepRunning": False,
+                                        "throttleRate": int(per_s * 10),
+                                    },
+                                },
+                            }
+                        ],
+                    }
+                ],
+            }
+        )
+    )
     port = _free_port()
     env = {**os.environ, "PORT": str(port), "SIGNALK_NODE_CONFIG_DIR": str(conf)}
     with open(tmp_path / "server.log", "w") as out:
-        proc = subprocess.Popen([str(exe), "-c", str(conf), "-s", "settings.json"], env=env,
-                                cwd=conf, stdout=out, stderr=subprocess.STDOUT,
-                                process_group=0)
+        proc = subprocess.Popen(
+            [str(exe), "-c", str(conf), "-s", "settings.json"],
+            env=env,
+            cwd=conf,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            process_group=0,
+        )
     try:
         end = time.monotonic() + 60
         while True:
@@ -77,8 +106,10 @@ def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
                     break
             except OSError:
                 if proc.poll() is not None or time.monotonic() > end:
-                    pytest.fail("signalk-server did not start: "
-                                + (tmp_path / "server.log").read_text()[-2000:])
+                    pytest.fail(
+                        "signalk-server did not start: "
+                        + (tmp_path / "server.log").read_text()[-2000:]
+                    )
                 time.sleep(0.3)
         yield port, rows
     finally:
@@ -99,9 +130,17 @@ def test_live_from_a_real_signalk_server(signalk: tuple[int, list], tmp_path: Pa
 
     port, rows = signalk
     log = tmp_path / "live.jsonl"
-    engine = start_live(trieste(), source=f"signalk://127.0.0.1:{port}", scenario="mean",
-                        every_s=15, port=None, nmea_port=None, log=log, leg=3,
-                        settings=LiveSettings(side=False))  # re-plans in a worker process
+    engine = start_live(
+        trieste(),
+        source=f"signalk://127.0.0.1:{port}",
+        scenario="mean",
+        every_s=15,
+        port=None,
+        nmea_port=None,
+        log=log,
+        leg=3,
+        settings=LiveSettings(side=False),
+    )  # re-plans in a worker process
     try:
         end = time.monotonic() + 40
         while time.monotonic() < end and (engine.n_plans < 3 or engine.stale()):

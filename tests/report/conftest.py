@@ -24,23 +24,39 @@ COURSE = {
     "start_time": "2024-05-01T12:00:00+02:00",
     "origin": {"lat": 45.0, "lon": 13.0},
     "marks": {
-        "pin": {"x": -100, "y": 0}, "boat": {"x": 100, "y": 0}, "top": {"x": 0, "y": 1000},
-        "g1": {"x": -25, "y": 200}, "g2": {"x": 25, "y": 200},
-        "f1": {"x": 300, "y": 100}, "f2": {"x": 340, "y": 100},
+        "pin": {"x": -100, "y": 0},
+        "boat": {"x": 100, "y": 0},
+        "top": {"x": 0, "y": 1000},
+        "g1": {"x": -25, "y": 200},
+        "g2": {"x": 25, "y": 200},
+        "f1": {"x": 300, "y": 100},
+        "f2": {"x": 340, "y": 100},
     },
     "lines": {"start": ["pin", "boat"], "finish": ["f1", "f2"]},
     "gates": {"gate": ["g1", "g2"]},
     "legs": [{"to": "top"}, {"to": "gate"}, {"to": "finish"}],
     "references": {"winner": [700.0, 300.0, 100.0]},
-    "scenarios": {"north": {"wind": {"type": "uniform", "tws_ms": 5.0, "twd_deg": 0.0},
-                            "references": {"model": [650.0, 320.0, 110.0]}}},
+    "scenarios": {
+        "north": {
+            "wind": {"type": "uniform", "tws_ms": 5.0, "twd_deg": 0.0},
+            "references": {"model": [650.0, 320.0, 110.0]},
+        }
+    },
 }
 
 POLAR = Polar.from_arrays(
     np.array([0.0, 40.0, 45.0, 90.0, 135.0, 180.0]),
     np.array([2.0, 5.0, 8.0]),
-    np.array([[0, 0, 0], [1.0, 1.6, 1.9], [1.1, 1.8, 2.1], [1.6, 2.6, 3.0],
-                          [1.5, 2.4, 2.9], [1.2, 2.0, 2.5]]),
+    np.array(
+        [
+            [0, 0, 0],
+            [1.0, 1.6, 1.9],
+            [1.1, 1.8, 2.1],
+            [1.6, 2.6, 3.0],
+            [1.5, 2.4, 2.9],
+            [1.2, 2.0, 2.5],
+        ]
+    ),
     name="synthetic",
 )
 
@@ -79,8 +95,7 @@ def results(course, wind):
     # leg 1: from 25% along the start line (x = -50), starboard tack to the left, one tack, fetch
     r1 = make_leg_result(timed_track([(-50, 0), (-550, 500), (0, 1000)], t0, wind), "test")
     # leg 2: broad reach one way, gybe, the other way through the gate at x = 10
-    r2 = make_leg_result(
-        timed_track([(0, 1000), (200, 600), (10, 200)], r1.t_end, wind), "test")
+    r2 = make_leg_result(timed_track([(0, 1000), (200, 600), (10, 200)], r1.t_end, wind), "test")
     # leg 3: straight reach to the finish line centre
     r3 = make_leg_result(timed_track([(10, 200), (320, 100)], r2.t_end, wind), "test")
     return [r1, r2, r3]

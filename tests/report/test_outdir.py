@@ -32,8 +32,7 @@ def writer(files: dict[str, str]):
 
 
 def snapshot(d: Path) -> dict[str, str]:
-    return {p.relative_to(d).as_posix(): p.read_text() for p in sorted(d.rglob("*"))
-            if p.is_file()}
+    return {p.relative_to(d).as_posix(): p.read_text() for p in sorted(d.rglob("*")) if p.is_file()}
 
 
 def leftovers(*dirs: Path) -> list[str]:
@@ -44,8 +43,11 @@ def test_new_folder_gets_the_files_and_a_manifest(tmp_path):
     out = tmp_path / "a" / "b"
     files = write_output_set(out, writer({"plan.json": "1", "s/track.csv": "2"}))
     assert files == {"plan.json": out / "plan.json", "s/track.csv": out / "s" / "track.csv"}
-    assert snapshot(out) == {"plan.json": "1", "s/track.csv": "2",
-                             MANIFEST_NAME: (out / MANIFEST_NAME).read_text()}
+    assert snapshot(out) == {
+        "plan.json": "1",
+        "s/track.csv": "2",
+        MANIFEST_NAME: (out / MANIFEST_NAME).read_text(),
+    }
     assert read_manifest(out) == {"plan.json", "s/track.csv"}
     assert leftovers(out, out.parent) == []
 
@@ -56,8 +58,12 @@ def test_rerun_replaces_the_set_and_keeps_the_users_files(tmp_path):
     (out / "notes.txt").write_text("mine")
     (out / "s" / "mine.csv").write_text("mine")
     write_output_set(out, writer({"plan.json": "new"}))  # e.g. a --no-plots rerun
-    assert snapshot(out) == {"plan.json": "new", "notes.txt": "mine", "s/mine.csv": "mine",
-                             MANIFEST_NAME: (out / MANIFEST_NAME).read_text()}
+    assert snapshot(out) == {
+        "plan.json": "new",
+        "notes.txt": "mine",
+        "s/mine.csv": "mine",
+        MANIFEST_NAME: (out / MANIFEST_NAME).read_text(),
+    }
     assert read_manifest(out) == {"plan.json"}
     # a folder emptied of the old run's files goes too; one with a user's file stays
     write_output_set(out, writer({"t/y.csv": "1"}))
@@ -100,8 +106,9 @@ def test_a_manifest_cannot_delete_outside_the_folder(tmp_path):
     out.mkdir()
     victim = tmp_path / "victim.txt"
     victim.write_text("keep")
-    (out / MANIFEST_NAME).write_text(json.dumps({"files": ["../victim.txt", "/etc/hosts",
-                                                           "ok.txt"]}))
+    (out / MANIFEST_NAME).write_text(
+        json.dumps({"files": ["../victim.txt", "/etc/hosts", "ok.txt"]})
+    )
     (out / "ok.txt").write_text("old output")
     assert read_manifest(out) == {"ok.txt"}
     write_output_set(out, writer({"plan.json": "1"}))

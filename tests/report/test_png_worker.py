@@ -33,8 +33,11 @@ def test_child_draws_the_same_bytes_as_in_process(planned, tmp_path, monkeypatch
 
 
 def test_a_failing_child_falls_back_to_drawing_here(planned, tmp_path) -> None:
-    broken = subprocess.Popen([sys.executable, "-c", "import sys; sys.exit(3)"],
-                              stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+    broken = subprocess.Popen(
+        [sys.executable, "-c", "import sys; sys.exit(3)"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+    )
     got = png_worker.PngWorker(broken).draw(planned.plan, planned.wind, tmp_path / "r.png", 60)
     ref = png_worker.draw_in_process(planned.plan, planned.wind, tmp_path / "ref.png", 60)
     assert got.read_bytes() == ref.read_bytes()

@@ -46,23 +46,39 @@ REQUIRED = os.environ.get("SAILROUTE_REQUIRE_BROWSER") == "1"
 
 pytestmark = [
     pytest.mark.browser,
-    pytest.mark.skipif(CHROMIUM is None and not REQUIRED,
-                       reason="no Chromium installed (apt-get install chromium; "
-                              ".ci/run installs it and requires this test)"),
+    pytest.mark.skipif(
+        CHROMIUM is None and not REQUIRED,
+        reason="no Chromium installed (apt-get install chromium; "
+        ".ci/run installs it and requires this test)",
+    ),
 ]
 
-FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-         "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--host-resolver-rules=MAP * ~NOTFOUND", "--enable-logging=stderr", "--v=0",
-         "--virtual-time-budget=10000"]
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--host-resolver-rules=MAP * ~NOTFOUND",
+    "--enable-logging=stderr",
+    "--v=0",
+    "--virtual-time-budget=10000",
+]
 
 
 def chromium(url: str, *args: str) -> subprocess.CompletedProcess[str]:
     """Run headless Chromium on ``url`` with a fresh profile; the console must stay silent."""
     assert CHROMIUM is not None, "SAILROUTE_REQUIRE_BROWSER=1 but no Chromium found"
     with tempfile.TemporaryDirectory(prefix="sailroute-chromium-") as profile:
-        proc = subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", *args, url],
-                              capture_output=True, text=True, timeout=90)
+        proc = subprocess.run(
+            [CHROMIUM, *FLAGS, f"--user-data-dir={profile}", *args, url],
+            capture_output=True,
+            text=True,
+            timeout=90,
+        )
     assert proc.returncode == 0, proc.stderr[-2000:]
     console = [ln for ln in proc.stderr.splitlines() if "CONSOLE" in ln or "Uncaught" in ln]
     assert console == [], "\n".join(console)
@@ -83,7 +99,7 @@ def screenshot(page: Path, out: Path, step: int = 0) -> np.ndarray:
 
 
 def colour_mask(img: np.ndarray, hex_colour: str, tol: int = 12) -> np.ndarray:
-    rgb = np.array([int(hex_colour[i:i + 2], 16) for i in (1, 3, 5)])
+    rgb = np.array([int(hex_colour[i : i + 2], 16) for i in (1, 3, 5)])
     return np.all(np.abs(img - rgb) <= tol, axis=-1)
 
 
@@ -116,8 +132,9 @@ def test_plan_page_draws_offline_with_slider_legend_and_boat(plan, wind, tmp_pat
 def test_comparison_page_lists_every_scenario(plan, wind, tmp_path):
     other = dataclasses.replace(plan, scenario="second")
     plans = [plan, other]
-    page = write_report(tmp_path / "report.html",
-                        comparison_report(compare(plans), plans, {"north": wind}))
+    page = write_report(
+        tmp_path / "report.html", comparison_report(compare(plans), plans, {"north": wind})
+    )
     html = dom(page, step=3)
     assert 'data-map="drawn"' in html
     for entry in ("north", "second", "wind 9.7 kn from 0°"):

@@ -30,9 +30,20 @@ NS = {"g": GPX_NS, "sr": SR_NS}
 def test_plan_json(tmp_path, plan):
     doc = json.loads(write_plan_json(tmp_path / "plan.json", plan).read_text())
     assert doc["schema_version"] == SCHEMA_VERSION
-    for key in ("course", "scenario", "router", "start_time", "end_time", "total_time_s",
-                "total_distance_m", "total_tacks", "total_gybes", "origin", "legs",
-                "references"):
+    for key in (
+        "course",
+        "scenario",
+        "router",
+        "start_time",
+        "end_time",
+        "total_time_s",
+        "total_distance_m",
+        "total_tacks",
+        "total_gybes",
+        "origin",
+        "legs",
+        "references",
+    ):
         assert key in doc, key
     assert (doc["course"], doc["scenario"], doc["router"]) == ("report test", "north", "test")
     assert doc["start_time"] == "2024-05-01T10:00:00.000Z"
@@ -56,7 +67,8 @@ def test_plan_json(tmp_path, plan):
         assert leg["end_point"]["x"] == pytest.approx(r.end_xy[0], abs=1e-3)
         assert leg["reference"]["winner"] == [700.0, 300.0, 100.0][k]
         assert leg["reference_error_pct"]["winner"] == pytest.approx(
-            100 * (r.time_s - [700.0, 300.0, 100.0][k]) / [700.0, 300.0, 100.0][k], abs=1e-3)
+            100 * (r.time_s - [700.0, 300.0, 100.0][k]) / [700.0, 300.0, 100.0][k], abs=1e-3
+        )
         assert len(leg["manoeuvres"]) == r.n_tacks + r.n_gybes
     assert [leg["mode"] for leg in doc["legs"]] == ["upwind", "downwind", "reach"]
     assert doc["legs"][0]["start_line_fraction"] == pytest.approx(0.25)
@@ -71,8 +83,9 @@ def test_track_csv(tmp_path, plan):
     with path.open() as fh:
         assert tuple(next(csv.reader(fh))) == TRACK_COLUMNS
     assert len(rows) == sum(len(leg.result.track) for leg in plan.legs)
-    assert [r["leg"] for r in rows] == [str(k + 1) for k, leg in enumerate(plan.legs)
-                                        for _ in range(len(leg.result.track))]
+    assert [r["leg"] for r in rows] == [
+        str(k + 1) for k, leg in enumerate(plan.legs) for _ in range(len(leg.result.track))
+    ]
     t_race = np.array([float(r["t_race_s"]) for r in rows])
     assert t_race[0] == 0.0 and np.all(np.diff(t_race) >= 0)
     assert t_race[-1] == pytest.approx(plan.total_time_s, abs=1e-3)
@@ -95,10 +108,22 @@ def test_gpx(tmp_path, plan):
     assert sorted(w.find("g:name", NS).text for w in wpts) == sorted(plan.course.marks)
     rtepts = root.findall("g:rte/g:rtept", NS)
     # the start, each leg's end and, between, the plan's one tack (leg 1) and one gybe (leg 2)
-    assert [p.find("g:name", NS).text for p in rtepts] == ["start", "T1", "top", "G1", "gate",
-                                                           "finish"]
-    assert [p.find("g:type", NS).text for p in rtepts] == ["start", "tack", "mark", "gybe",
-                                                           "gate", "line"]
+    assert [p.find("g:name", NS).text for p in rtepts] == [
+        "start",
+        "T1",
+        "top",
+        "G1",
+        "gate",
+        "finish",
+    ]
+    assert [p.find("g:type", NS).text for p in rtepts] == [
+        "start",
+        "tack",
+        "mark",
+        "gybe",
+        "gate",
+        "line",
+    ]
     # GPX 1.1 rteptType order: time before name before type
     assert [c.tag.split("}")[1] for c in rtepts[0]] == ["time", "name", "type"]
     segs = root.findall("g:trk/g:trkseg", NS)
@@ -125,8 +150,9 @@ def test_gpx(tmp_path, plan):
 
 
 def test_comparison_files(tmp_path, plan):
-    other = plan.__class__(plan.course, "copy", plan.legs, {"winner": (700.0, 300.0, 100.0)},
-                           plan.router)
+    other = plan.__class__(
+        plan.course, "copy", plan.legs, {"winner": (700.0, 300.0, 100.0)}, plan.router
+    )
     cmp = compare([plan, other])
     jp, cp = write_comparison(tmp_path / "out", cmp)
     doc = json.loads(jp.read_text())
@@ -142,8 +168,7 @@ def test_comparison_files(tmp_path, plan):
     with cp.open() as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == 3 * 2 + 2  # legs x scenarios + one total per scenario
-    assert list(rows[0]) == ["leg", "label", "scenario", "time_s", "winner_s",
-                             "winner_error_pct"]
+    assert list(rows[0]) == ["leg", "label", "scenario", "time_s", "winner_s", "winner_error_pct"]
     assert rows[-1]["leg"] == "total"
     assert float(rows[-1]["time_s"]) == pytest.approx(plan.total_time_s, abs=1e-3)
 

@@ -47,16 +47,21 @@ def page_of(report) -> tuple[str, dict]:
 
 
 def route_trace(fig: dict, name: str) -> dict:
-    (tr,) = [t for t in fig["data"] if t.get("name") == name and "customdata" in t
-             and t["mode"].startswith("lines")]
+    (tr,) = [
+        t
+        for t in fig["data"]
+        if t.get("name") == name and "customdata" in t and t["mode"].startswith("lines")
+    ]
     return tr
 
 
 def rotating_wind(t0: float, duration_s: float, speed_ms: float = 5.0) -> AnalyticWind:
     """Wind of constant speed whose FROM-direction turns from 0° to 90° over ``duration_s``."""
+
     def uv(t, x, y):
         frm = np.radians(90.0 * (t - t0) / duration_s) + 0.0 * x + 0.0 * y
         return -speed_ms * np.sin(frm), -speed_ms * np.cos(frm)
+
     return AnalyticWind(uv, name="rotating")
 
 
@@ -81,14 +86,16 @@ def test_plan_page_embeds_the_plan(plan, wind):
     rt = route_trace(fig, "route: north")
     tracks = [pl.result.track for pl in plan.legs]
     assert len(rt["x"]) == sum(len(tr) for tr in tracks)
-    lat, lon = course.frame.to_latlon(np.concatenate([tr.x for tr in tracks]),
-                                      np.concatenate([tr.y for tr in tracks]))
+    lat, lon = course.frame.to_latlon(
+        np.concatenate([tr.x for tr in tracks]), np.concatenate([tr.y for tr in tracks])
+    )
     np.testing.assert_allclose(rt["y"], lat, atol=1e-6, rtol=0)
     np.testing.assert_allclose(rt["x"], lon, atol=1e-6, rtol=0)
     cd = rt["customdata"]
     assert sorted({row[0] for row in cd}) == [1, 2, 3]  # leg numbers
     assert {k: row[1] for row in cd for k in [row[0]]} == {
-        k + 1: pl.mode for k, pl in enumerate(plan.legs)}  # the wind mode of each leg
+        k + 1: pl.mode for k, pl in enumerate(plan.legs)
+    }  # the wind mode of each leg
     # times: the course's start_time is 12:00:00+02:00
     assert cd[0][2:4] == ["12:00:00", "10:00:00"]
     assert cd[-1][2:4] == [clock(plan.t_end, 7200), clock(plan.t_end)]
@@ -99,14 +106,14 @@ def test_plan_page_embeds_the_plan(plan, wind):
     assert cd[0][5] == pytest.approx(abs(tr0.twa_deg[0]), abs=0.06)
     assert cd[0][6] == ("stbd" if tr0.twa_deg[0] >= 0 else "port")
     assert cd[0][7] == pytest.approx(tr0.bsp_ms[0] / KNOT, abs=6e-4)
-    assert cd[0][8] == pytest.approx(tr0.bsp_ms[0] * math.cos(math.radians(tr0.twa_deg[0]))
-                                     / KNOT, abs=6e-4)
+    assert cd[0][8] == pytest.approx(
+        tr0.bsp_ms[0] * math.cos(math.radians(tr0.twa_deg[0])) / KNOT, abs=6e-4
+    )
     # the marks, within 1e-6 degrees
     (marks,) = [t for t in fig["data"] if t.get("name") == "marks"]
     assert marks["text"] == list(course.marks)
     for name, x, y in zip(marks["text"], marks["x"], marks["y"], strict=True):
-        assert (y, x) == pytest.approx((course.marks[name].lat, course.marks[name].lon),
-                                       abs=1e-6)
+        assert (y, x) == pytest.approx((course.marks[name].lat, course.marks[name].lon), abs=1e-6)
     # tacks and gybes where the router put them
     man = [m for pl in plan.legs for m in pl.result.manoeuvres]
     (tacks,) = [t for t in fig["data"] if t.get("name") == "tacks"]
@@ -134,10 +141,12 @@ def test_slider_moves_the_boat_along_the_route(plan, wind):
         assert fr["traces"] == [boat_idx]  # uniform wind: only the boat moves
         (st,) = fr["data"]
         ok = np.isfinite(rt.t)
-        assert st["y"][0] == pytest.approx(np.interp(report.times[k], rt.t[ok], rt.lat[ok]),
-                                           abs=1e-6)
-        assert st["x"][0] == pytest.approx(np.interp(report.times[k], rt.t[ok], rt.lon[ok]),
-                                           abs=1e-6)
+        assert st["y"][0] == pytest.approx(
+            np.interp(report.times[k], rt.t[ok], rt.lat[ok]), abs=1e-6
+        )
+        assert st["x"][0] == pytest.approx(
+            np.interp(report.times[k], rt.t[ok], rt.lon[ok]), abs=1e-6
+        )
         assert st["customdata"][0][2] == clock(report.times[k], 7200)
     steps = fig["layout"]["sliders"][0]["steps"]
     assert [s["args"][0] for s in steps] == [[str(k)] for k in range(N_STEPS)]
@@ -151,7 +160,7 @@ def test_uniform_wind_arrows_point_downwind(plan, wind):
     fig = figure(plan_report(plan, wind))  # 5 m/s from the north
     shafts, heads = (t for t in fig["data"] if t.get("legendgroup") == "wind0")
     assert shafts["name"] == f"wind {5 / KNOT:.1f} kn from 0°"
-    assert len(heads["x"]) == WIND_GRID ** 2 and len(shafts["x"]) == 3 * WIND_GRID ** 2
+    assert len(heads["x"]) == WIND_GRID**2 and len(shafts["x"]) == 3 * WIND_GRID**2
     assert set(heads["marker"]["angle"]) == {180.0}  # the air goes south
     assert {tuple(c) for c in heads["customdata"]} == {(round(5 / KNOT, 1), 0.0)}
     # each shaft runs north to south, ARROW_FILL of a grid cell long (the only speed)
@@ -162,8 +171,7 @@ def test_uniform_wind_arrows_point_downwind(plan, wind):
     x1, y1 = frame.to_xy(lat1, shafts["x"][1])
     a = course_area(plan.course, [route_from_plan(plan)])
     cell = min(a[1] - a[0], a[3] - a[2]) / WIND_GRID
-    assert math.hypot(float(x1 - x0), float(y1 - y0)) == pytest.approx(ARROW_FILL * cell,
-                                                                        rel=1e-3)
+    assert math.hypot(float(x1 - x0), float(y1 - y0)) == pytest.approx(ARROW_FILL * cell, rel=1e-3)
 
 
 def test_time_varying_wind_is_in_the_frames(plan):
@@ -171,10 +179,13 @@ def test_time_varying_wind_is_in_the_frames(plan):
     rot = rotating_wind(plan.t_start, duration)
     report = plan_report(plan, rot)
     (layer,) = report.winds
-    assert not layer.steady and layer.tws_kn.shape == (N_STEPS, WIND_GRID ** 2)
+    assert not layer.steady and layer.tws_kn.shape == (N_STEPS, WIND_GRID**2)
     fig = figure(report)
-    heads_idx = next(i for i, t in enumerate(fig["data"])
-                     if t.get("legendgroup") == "wind0" and t["mode"] == "markers")
+    heads_idx = next(
+        i
+        for i, t in enumerate(fig["data"])
+        if t.get("legendgroup") == "wind0" and t["mode"] == "markers"
+    )
     for k in (0, N_STEPS // 2, N_STEPS - 1):
         fr = fig["frames"][k]
         st = fr["data"][fr["traces"].index(heads_idx)]
@@ -194,10 +205,15 @@ def test_comparison_page_has_every_scenario(plan, wind):
         assert rt["legendgroup"] == f"route{i}" and rt.get("visible", True) is True
         boat = next(t for t in fig["data"] if t["name"] == f"boat: {name}")
         assert boat["legendgroup"] == f"route{i}"  # toggled with its route
-    shafts = [t for t in fig["data"] if t.get("legendgroup", "").startswith("wind")
-              and t["mode"] == "lines"]
-    assert [t["name"] for t in shafts] == ["wind: north 9.7 kn from 0°",
-                                           "wind: veer 9.7 kn from 90°"]
+    shafts = [
+        t
+        for t in fig["data"]
+        if t.get("legendgroup", "").startswith("wind") and t["mode"] == "lines"
+    ]
+    assert [t["name"] for t in shafts] == [
+        "wind: north 9.7 kn from 0°",
+        "wind: veer 9.7 kn from 90°",
+    ]
     assert "visible" not in shafts[0] and shafts[1]["visible"] == "legendonly"
     # both boats move in every frame
     boats = [i for i, t in enumerate(fig["data"]) if t["name"].startswith("boat:")]
@@ -225,9 +241,10 @@ def test_figure_is_valid_for_plotly(plan, wind):
     go = pytest.importorskip("plotly.graph_objects")
     rot = rotating_wind(plan.t_start, plan.t_end - plan.t_start)
     other = dataclasses.replace(plan, scenario="veer")
-    for report in (plan_report(plan, rot),
-                   comparison_report(compare([plan, other]), [plan, other],
-                                     {"north": wind, "veer": rot})):
+    for report in (
+        plan_report(plan, rot),
+        comparison_report(compare([plan, other]), [plan, other], {"north": wind, "veer": rot}),
+    ):
         fig = figure(report)
         go.Figure(data=fig["data"], layout=fig["layout"], frames=fig["frames"])
 
@@ -238,9 +255,14 @@ def test_wind_layer_clips_to_the_coverage_and_marks_missing_times(plan):
     t0 = plan.t_start
     cover = Coverage(t0, t0 + 100.0, -500.0, 500.0, -200.0, 800.0)
     w = AnalyticWind(lambda t, x, y: (0.0 * x, -3.0 + 0.0 * y), cover=cover, name="boxed")
-    layer = wind_layer("boxed", w, plan.course, (-1000.0, 1000.0, -1000.0, 1000.0),
-                       np.array([t0, t0 + 50.0, t0 + 500.0]))
-    assert layer is not None and layer.tws_kn.shape == (3, WIND_GRID ** 2)
+    layer = wind_layer(
+        "boxed",
+        w,
+        plan.course,
+        (-1000.0, 1000.0, -1000.0, 1000.0),
+        np.array([t0, t0 + 50.0, t0 + 500.0]),
+    )
+    assert layer is not None and layer.tws_kn.shape == (3, WIND_GRID**2)
     assert layer.x.min() > -500.0 and layer.x.max() < 500.0  # cell centres inside the box
     assert layer.y.min() > -200.0 and layer.y.max() < 800.0
     assert layer.spacing_m == pytest.approx(1000.0 / WIND_GRID)
@@ -258,8 +280,12 @@ def test_legs_over_the_same_water_are_drawn_side_by_side(wind):
     del data["references"], data["scenarios"]["north"]["references"]
     course = course_from_mapping(data)
     legs, t = [], course.start_epoch
-    for pts in ([(-50, 0), (-550, 500), (0, 1000)], [(0, 1000), (200, 600), (10, 200)],
-                [(10, 200), (-480, 690), (0, 1000)], [(0, 1000), (200, 600), (10, 200)]):
+    for pts in (
+        [(-50, 0), (-550, 500), (0, 1000)],
+        [(0, 1000), (200, 600), (10, 200)],
+        [(10, 200), (-480, 690), (0, 1000)],
+        [(0, 1000), (200, 600), (10, 200)],
+    ):
         legs.append(make_leg_result(timed_track(pts, t, wind), "test"))
         t = legs[-1].t_end
     plan = make_plan(course, "north", legs, wind)

@@ -15,8 +15,11 @@ from sailroute.wind.uniform import UniformWind
 
 def test_plan_chaining_modes_and_start_points(plan, course):
     assert [leg.mode for leg in plan.legs] == ["upwind", "downwind", "reach"]
-    assert [(leg.result.n_tacks, leg.result.n_gybes) for leg in plan.legs] == [(1, 0), (0, 1),
-                                                                              (0, 0)]
+    assert [(leg.result.n_tacks, leg.result.n_gybes) for leg in plan.legs] == [
+        (1, 0),
+        (0, 1),
+        (0, 0),
+    ]
     # started at x = -50 on a line from x = -100 (pin) to 100 (boat): 25 % along
     assert plan.legs[0].start_line_fraction == pytest.approx(0.25)
     # leg 2 starts at mark "top": no line position; leg 3 starts at the gate, x = 10 of -25..25
@@ -59,15 +62,16 @@ def test_compare_thesis_numbers(course, wind, polar):
     # the thesis's WRF-10-min and constant leg times on a 3-leg stand-in (legs 1-3 of R1)
     a = _plan_with_times(course, "north", [1035.11, 537.38, 834.00], wind, polar)
     b = dataclasses.replace(
-        _plan_with_times(course, "north", [1054.24, 518.01, 979.12], wind, polar),
-        scenario="const")
+        _plan_with_times(course, "north", [1054.24, 518.01, 979.12], wind, polar), scenario="const"
+    )
     cmp = compare([a, b])
     assert cmp.scenarios == ("north", "const")
     np.testing.assert_allclose(cmp.totals, [2406.49, 2551.37])
     assert set(cmp.references) == {"winner", "model"}  # shared by both plans
     np.testing.assert_allclose(cmp.delta_s("winner")[0], [335.11, 237.38, 734.0])
-    np.testing.assert_allclose(cmp.percent("winner")[1],
-                               100 * (np.array([1054.24, 518.01, 979.12]) / [700, 300, 100] - 1))
+    np.testing.assert_allclose(
+        cmp.percent("winner")[1], 100 * (np.array([1054.24, 518.01, 979.12]) / [700, 300, 100] - 1)
+    )
     assert cmp.total_percent("winner")[0] == pytest.approx(100 * (2406.49 / 1100 - 1))
 
 

@@ -22,8 +22,7 @@ def test_plot_route_artists(plan, wind, tmp_path):
     for a, pl in zip(sorted(legs, key=lambda a: a.get_gid()), plan.legs, strict=True):
         assert len(a.get_segments()) == len(pl.result.track) - 1
         # coloured by boat speed in knots
-        np.testing.assert_allclose(a.get_array(), pl.result.track.bsp_ms[:-1] / 0.514444,
-                                   rtol=1e-5)
+        np.testing.assert_allclose(a.get_array(), pl.result.track.bsp_ms[:-1] / 0.514444, rtol=1e-5)
     (tacks,) = by_gid(fig, "tacks")
     (gybes,) = by_gid(fig, "gybes")
     assert len(tacks.get_xdata()) == 1 and len(gybes.get_xdata()) == 1
@@ -84,7 +83,8 @@ def test_speed_scale_ignores_stops_and_is_at_least_2_kn_wide():
     wide = np.linspace(3.0, 9.0, 101)
     lo, hi = speed_limits(wide)
     assert lo == pytest.approx(np.percentile(wide, 2)) and hi == pytest.approx(
-        np.percentile(wide, 98))
+        np.percentile(wide, 98)
+    )
 
 
 def test_speed_scale_skips_non_finite_speeds_and_rounds_for_the_web_page():
@@ -93,8 +93,10 @@ def test_speed_scale_skips_non_finite_speeds_and_rounds_for_the_web_page():
     bsp = np.r_[np.linspace(3.0, 9.0, 101), np.nan, np.inf, -np.inf]
     assert speed_limits(bsp) == speed_limits(np.linspace(3.0, 9.0, 101))
     lo, hi = speed_limits(bsp, decimals=2)
-    assert (lo, hi) == (round(np.percentile(np.linspace(3.0, 9.0, 101), 2), 2),
-                        round(np.percentile(np.linspace(3.0, 9.0, 101), 98), 2))
+    assert (lo, hi) == (
+        round(np.percentile(np.linspace(3.0, 9.0, 101), 2), 2),
+        round(np.percentile(np.linspace(3.0, 9.0, 101), 98), 2),
+    )
     assert speed_limits(np.zeros(5)) == (0.0, 2.0)
     assert speed_limits(np.full(3, np.nan), span=3.0) == (0.0, 3.0)
 
@@ -120,8 +122,9 @@ def test_leg_numbers_lat_lon_axes_and_repeated_legs_offset(plan, wind):
     assert repeat_index(legs) == [0, 0, 0, 1]
     fig2 = plot_route(plan.course, legs)
     ax = fig2.axes[0]
-    first, again = (next(a for a in by_gid(fig2, "leg:") if a.get_gid() == g)
-                    for g in ("leg:2", "leg:4"))
+    first, again = (
+        next(a for a in by_gid(fig2, "leg:") if a.get_gid() == g) for g in ("leg:2", "leg:4")
+    )
     fig2.canvas.draw()
     p1 = first.get_transform().transform(first.get_segments()[0][0])
     p2 = again.get_transform().transform(again.get_segments()[0][0])
@@ -134,6 +137,9 @@ def test_varying_wind_draws_one_arrow_per_leg(plan):
     wind = AnalyticWind(lambda t, x, y: wind_components(5.0 + 0.002 * y, 0.0 * x))
     fig = plot_plan(plan, wind)
     assert sorted(a.get_gid() for a in by_gid(fig, "wind-leg:")) == [
-        "wind-leg:1", "wind-leg:2", "wind-leg:3"]
+        "wind-leg:1",
+        "wind-leg:2",
+        "wind-leg:3",
+    ]
     title = fig.axes[0].get_legend().get_title().get_text()
     assert "wind at each leg's number" in title and "1: " in title

@@ -37,8 +37,13 @@ def _degrees(value: str, hemisphere: str) -> float:
 def test_route_points_are_the_start_the_manoeuvres_and_each_leg_end(plan):
     pts = route_points(plan)
     assert [(p.name, p.kind, p.leg) for p in pts] == [
-        ("start", "start", 1), ("T1", "tack", 1), ("top", "mark", 1), ("G1", "gybe", 2),
-        ("gate", "gate", 2), ("finish", "line", 3)]
+        ("start", "start", 1),
+        ("T1", "tack", 1),
+        ("top", "mark", 1),
+        ("G1", "gybe", 2),
+        ("gate", "gate", 2),
+        ("finish", "line", 3),
+    ]
     t = [p.t for p in pts]
     assert np.all(np.diff(t) > 0)
     frame = plan.course.frame
@@ -62,8 +67,7 @@ def test_gpxpy_reads_the_route_beside_the_track(tmp_path, plan):
     assert [p.type for p in rpts] == [p.kind for p in pts]
     np.testing.assert_allclose([p.latitude for p in rpts], [p.lat for p in pts], atol=1e-8)
     np.testing.assert_allclose([p.longitude for p in rpts], [p.lon for p in pts], atol=1e-8)
-    np.testing.assert_allclose([p.time.timestamp() for p in rpts], [p.t for p in pts],
-                               atol=1e-3)
+    np.testing.assert_allclose([p.time.timestamp() for p in rpts], [p.t for p in pts], atol=1e-3)
     assert sorted(w.name for w in gpx.waypoints) == sorted(plan.course.marks)
     # GPX 1.1 order of the root's children: metadata, wpt*, rte*, trk*
     root = ET.parse(path).getroot()
@@ -122,8 +126,10 @@ def test_nmea_checksum_of_a_published_sentence():
 
 
 def test_a_long_route_is_split_over_several_rte_sentences():
-    pts = [RoutePoint(f"mark{k}", "mark", -36.8 - k * 1e-3, 174.7 + k * 1e-3, 1e9 + k, k)
-           for k in range(40)]
+    pts = [
+        RoutePoint(f"mark{k}", "mark", -36.8 - k * 1e-3, 174.7 + k * 1e-3, 1e9 + k, k)
+        for k in range(40)
+    ]
     lines = nmea_sentences(pts)
     msgs = [pynmea2.parse(s, check=True) for s in lines]
     rte = [m for m in msgs if m.sentence_type == "RTE"]

@@ -41,8 +41,9 @@ def test_isochrone_dispatch_is_the_isochrone_router():
 
 def test_progress_is_passed_through():
     seen: list[float] = []
-    route_leg(*LEG, T0, UniformWind(4.0, 90.0), small_polar(), RoutingSettings(),
-              progress=seen.append)
+    route_leg(
+        *LEG, T0, UniformWind(4.0, 90.0), small_polar(), RoutingSettings(), progress=seen.append
+    )
     assert seen and seen[-1] == 1.0
 
 
@@ -53,8 +54,9 @@ def test_unknown_router_is_an_input_error_listing_the_choices():
 
 
 def test_missing_router_module_is_a_routing_error(monkeypatch):
-    monkeypatch.setitem(api.ROUTERS, "griddp",
-                        api.RouterEntry("sailroute.routing._no_such_module", "f"))
+    monkeypatch.setitem(
+        api.ROUTERS, "griddp", api.RouterEntry("sailroute.routing._no_such_module", "f")
+    )
     with pytest.raises(RoutingError, match=r"'griddp' is not available.*_no_such_module"):
         get_router("griddp")
 
@@ -62,8 +64,9 @@ def test_missing_router_module_is_a_routing_error(monkeypatch):
 def test_module_without_the_function_is_a_routing_error(monkeypatch):
     mod = types.ModuleType("sailroute_fake_router")
     monkeypatch.setitem(sys.modules, "sailroute_fake_router", mod)
-    monkeypatch.setitem(api.ROUTERS, "spline",
-                        api.RouterEntry("sailroute_fake_router", "route_spline"))
+    monkeypatch.setitem(
+        api.ROUTERS, "spline", api.RouterEntry("sailroute_fake_router", "route_spline")
+    )
     with pytest.raises(RoutingError, match="has no function route_spline"):
         get_router("spline")
 
@@ -78,8 +81,9 @@ def test_other_routers_are_called_lazily_with_the_shared_signature(monkeypatch):
 
     mod.route_griddp = route_griddp  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "sailroute_fake_griddp", mod)
-    monkeypatch.setitem(api.ROUTERS, "griddp",
-                        api.RouterEntry("sailroute_fake_griddp", "route_griddp"))
+    monkeypatch.setitem(
+        api.ROUTERS, "griddp", api.RouterEntry("sailroute_fake_griddp", "route_griddp")
+    )
     st = replace(RoutingSettings(), router="griddp")
     # a router's RoutingError without the leg gets the leg label prepended
     with pytest.raises(RoutingError, match=r"^leg start -> 1 \(griddp router\): no feasible"):

@@ -28,15 +28,22 @@ def same_result(a, b):
     assert (a.n_tacks, a.n_gybes) == (b.n_tacks, b.n_gybes)
 
 
-@pytest.mark.parametrize("target", [
-    Target("mark", (40.0, 700.0), rounding="port", name="1"),
-    Target("line", (-60.0, 650.0), (60.0, 650.0), name="finish"),
-])
+@pytest.mark.parametrize(
+    "target",
+    [
+        Target("mark", (40.0, 700.0), rounding="port", name="1"),
+        Target("line", (-60.0, 650.0), (60.0, 650.0), name="finish"),
+    ],
+)
 def test_a_batch_gives_each_member_its_own_route_bit_for_bit(target):
     # beats and reaches in different winds and at different start times, from one start
     # line: every member steps exactly as it would alone
-    winds = [UniformWind(4.4, 0.0), UniformWind(3.0, 20.0), UniformWind(6.0, 80.0),
-             UniformWind([3.0, 6.0], [350.0, 10.0], times=[T0, T0 + 600.0], clamp=True)]
+    winds = [
+        UniformWind(4.4, 0.0),
+        UniformWind(3.0, 20.0),
+        UniformWind(6.0, 80.0),
+        UniformWind([3.0, 6.0], [350.0, 10.0], times=[T0, T0 + 600.0], clamp=True),
+    ]
     t0s = [T0, T0 + 50.0, T0, T0 + 120.0]
     batch = route_leg_batch(LINE, target, t0s, winds, POLAR, SET)
     assert len(batch) == len(winds)
@@ -51,11 +58,13 @@ def test_members_in_a_stronger_wind_finish_in_the_closed_form_order():
     L = 500.0
     finish = Target("line", (-300.0, L), (300.0, L), name="finish")
     tws = [2.5, 3.5, 4.5, 5.5, 6.5]
-    batch = route_leg_batch(Start((0.0, 0.0)), finish, [T0] * len(tws),
-                            [UniformWind(w, 90.0) for w in tws], POLAR, SET)
+    batch = route_leg_batch(
+        Start((0.0, 0.0)), finish, [T0] * len(tws), [UniformWind(w, 90.0) for w in tws], POLAR, SET
+    )
     twa = np.arange(30.0, 150.0, 0.01)
-    closed = np.array([L / np.max(POLAR.speed(np.full_like(twa, w), twa) * np.sin(np.radians(twa)))
-                       for w in tws])
+    closed = np.array(
+        [L / np.max(POLAR.speed(np.full_like(twa, w), twa) * np.sin(np.radians(twa))) for w in tws]
+    )
     times = np.array([r.time_s for r in batch])
     np.testing.assert_allclose(times, closed, rtol=1e-5)
     assert np.all(np.diff(times) < 0)  # the speed towards the line rises with the wind
@@ -89,8 +98,7 @@ def test_a_member_that_cannot_arrive_raises_its_own_error():
 def test_members_given_in_different_numbers_are_refused():
     finish = Target("line", (-100.0, 400.0), (100.0, 400.0), name="finish")
     with pytest.raises(InputError, match=r"got 2 start times, 1 winds and 2 starts"):
-        route_leg_batch(Start((0.0, 0.0)), finish, [T0, T0], [UniformWind(4.0, 90.0)],
-                        POLAR, SET)
+        route_leg_batch(Start((0.0, 0.0)), finish, [T0, T0], [UniformWind(4.0, 90.0)], POLAR, SET)
 
 
 def test_only_the_isochrone_router_on_numpy_in_still_water_is_batched():

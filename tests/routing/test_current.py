@@ -71,8 +71,9 @@ def reach_bounds(wind, current, L):
     return float(t.min()), float(t[inner].min())
 
 
-@pytest.mark.parametrize(("twd", "rate", "set_deg"), [(90.0, 0.5, 200.0), (90.0, 0.8, 90.0),
-                                                      (270.0, 0.6, 0.0)])
+@pytest.mark.parametrize(
+    ("twd", "rate", "set_deg"), [(90.0, 0.5, 200.0), (90.0, 0.8, 90.0), (270.0, 0.6, 0.0)]
+)
 def test_reach_in_uniform_current_is_the_vector_solution(twd, rate, set_deg):
     L = 800.0
     wind, cur = UniformWind(TWS, twd), UniformCurrent(rate, set_deg)
@@ -95,8 +96,12 @@ def laylines_time(wind, current, target, pen):
     a_up, vmg = (float(v) for v in POLAR.vmg_upwind(tws))
     s = vmg / math.cos(math.radians(a_up))
     c = np.array([float(a) for a in current.sample(T0, 0.0, 0.0)])
-    g = [s * np.array([math.sin(math.radians(twd + k * a_up)),
-                       math.cos(math.radians(twd + k * a_up))]) + c for k in (-1, 1)]
+    g = [
+        s
+        * np.array([math.sin(math.radians(twd + k * a_up)), math.cos(math.radians(twd + k * a_up))])
+        + c
+        for k in (-1, 1)
+    ]
     a, b = np.linalg.solve(np.stack(g, axis=1), np.asarray(target) - pen * c)
     assert a > 0 and b > 0
     return a + b + pen
@@ -110,8 +115,7 @@ def test_beat_in_uniform_current_is_the_layline_solution(rate, set_deg):
     r = route_isochrone(Start((0.0, 0.0)), mark(L), T0, wind, POLAR, st, current=cur)
     # the leg ends on the mark's 13 m rounding segment (pointing east); the closed form
     # is linear along it, so its best point is an end
-    expected = min(laylines_time(wind, cur, (x, L), st.tack_penalty_s)
-                   for x in (0.0, st.zone_m))
+    expected = min(laylines_time(wind, cur, (x, L), st.tack_penalty_s) for x in (0.0, st.zone_m))
     assert r.time_s == pytest.approx(expected, rel=1e-3)  # measured: 1.0e-4 .. 2.4e-4
     assert (r.n_tacks, r.n_gybes) == (1, 0)
 
@@ -120,8 +124,9 @@ def test_beat_in_uniform_current_is_the_layline_solution(rate, set_deg):
 def test_zero_current_changes_nothing(twd):
     wind = UniformWind(TWS, twd)
     a = route_isochrone(Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET)
-    b = route_isochrone(Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET,
-                        current=UniformCurrent(0.0, 0.0))
+    b = route_isochrone(
+        Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET, current=UniformCurrent(0.0, 0.0)
+    )
     assert abs(a.time_s - b.time_s) <= 1e-9
     assert a.track.sog_ms is None and a.track.cog_deg is None
     assert np.array_equal(a.track.ground_speed_ms, a.track.bsp_ms)
@@ -149,31 +154,48 @@ FRAME = LocalFrame(43.0, 6.2)
 
 
 def spec(s, **kw):
-    return current_from_spec(s, frame=FRAME, base_dir=Path("."),
-                             where="c.yaml:3: scenarios.spring.current", **kw)
+    return current_from_spec(
+        s, frame=FRAME, base_dir=Path("."), where="c.yaml:3: scenarios.spring.current", **kw
+    )
 
 
 def test_current_spec_builds_each_kind():
     u = spec({"type": "uniform", "speed_kn": 2.0, "set_deg": 90})
     assert np.allclose(u.sample(T0, 0.0, 0.0), (2.0 * KNOT, 0.0), atol=1e-12)
-    d = spec({"type": "diamonds", "high_water": "2018-04-24T11:00:00Z",
-              "table": [[-6, 250, 0.4], [0, 70, 1.2], [6, 250, 0.5]]},
-             time_window=(T0, T0 + 3600.0))
+    d = spec(
+        {
+            "type": "diamonds",
+            "high_water": "2018-04-24T11:00:00Z",
+            "table": [[-6, 250, 0.4], [0, 70, 1.2], [6, 250, 0.5]],
+        },
+        time_window=(T0, T0 + 3600.0),
+    )
     assert float(np.hypot(*d.sample(T0, 0.0, 0.0))) == pytest.approx(1.2 * KNOT)
 
 
-@pytest.mark.parametrize(("s", "needle"), [
-    ({"type": "tidal"}, "type: expected one of 'uniform', 'diamonds', 'netcdf'"),
-    ({"type": "uniform", "set_deg": 90}, "speed_kn: missing required key"),
-    ({"type": "uniform", "speed_kn": -1, "set_deg": 90}, "speed_kn: expected a number >= 0"),
-    ({"type": "uniform", "speed_kn": 1, "set_deg": 90, "drift": 2}, "drift: unknown key"),
-    ({"type": "diamonds", "high_water": "2018-04-24T11:00:00Z", "table": [[0, 70]]},
-     "table[0]: expected [hour, set_deg, rate_kn]"),
-    ({"type": "diamonds", "high_water": "2018-04-24T11:00:00Z",
-      "table": [[1, 70, 1], [0, 80, 1]]}, "table[1]: the hours must increase"),
-    ({"type": "diamonds", "table": [[0, 70, 1]]}, "high_water: missing required key"),
-    ({"type": "netcdf", "path": "nowhere.nc"}, "path: file not found"),
-])
+@pytest.mark.parametrize(
+    ("s", "needle"),
+    [
+        ({"type": "tidal"}, "type: expected one of 'uniform', 'diamonds', 'netcdf'"),
+        ({"type": "uniform", "set_deg": 90}, "speed_kn: missing required key"),
+        ({"type": "uniform", "speed_kn": -1, "set_deg": 90}, "speed_kn: expected a number >= 0"),
+        ({"type": "uniform", "speed_kn": 1, "set_deg": 90, "drift": 2}, "drift: unknown key"),
+        (
+            {"type": "diamonds", "high_water": "2018-04-24T11:00:00Z", "table": [[0, 70]]},
+            "table[0]: expected [hour, set_deg, rate_kn]",
+        ),
+        (
+            {
+                "type": "diamonds",
+                "high_water": "2018-04-24T11:00:00Z",
+                "table": [[1, 70, 1], [0, 80, 1]],
+            },
+            "table[1]: the hours must increase",
+        ),
+        ({"type": "diamonds", "table": [[0, 70, 1]]}, "high_water: missing required key"),
+        ({"type": "netcdf", "path": "nowhere.nc"}, "path: file not found"),
+    ],
+)
 def test_current_spec_errors_name_the_key(s, needle):
     with pytest.raises(InputError) as exc:
         spec(s)
@@ -183,16 +205,28 @@ def test_current_spec_errors_name_the_key(s, needle):
 
 def test_diamonds_must_cover_the_race():
     with pytest.raises(InputError, match="does not cover"):
-        spec({"type": "diamonds", "high_water": "2018-04-24T11:00:00Z",
-              "table": [[-1, 70, 1], [1, 80, 1]]}, time_window=(T0, T0 + 3 * 3600.0))
+        spec(
+            {
+                "type": "diamonds",
+                "high_water": "2018-04-24T11:00:00Z",
+                "table": [[-1, 70, 1], [1, 80, 1]],
+            },
+            time_window=(T0, T0 + 3 * 3600.0),
+        )
 
 
 @pytest.mark.parametrize("router", ["griddp", "spline"])
 def test_other_routers_refuse_a_current(router):
     with pytest.raises(InputError, match=r"set routing.router: isochrone"):
-        route_leg(Start((0.0, 0.0)), mark(500.0), T0, UniformWind(TWS, 90.0), POLAR,
-                  replace(SET, router=router), current=UniformCurrent(0.5, 0.0))
-
+        route_leg(
+            Start((0.0, 0.0)),
+            mark(500.0),
+            T0,
+            UniformWind(TWS, 90.0),
+            POLAR,
+            replace(SET, router=router),
+            current=UniformCurrent(0.5, 0.0),
+        )
 
 
 def test_gridded_netcdf_current_equals_the_uniform_one_it_holds(tmp_path):
@@ -215,17 +249,24 @@ def test_gridded_netcdf_current_equals_the_uniform_one_it_holds(tmp_path):
         la.standard_name, la.units, la[:] = "latitude", "degrees_north", lats
         lo = ds.createVariable("longitude", "f8", ("longitude",))
         lo.standard_name, lo.units, lo[:] = "longitude", "degrees_east", lons
-        for name, std, val in (("uo", "eastward_sea_water_velocity", cu),
-                               ("vo", "northward_sea_water_velocity", cv)):
+        for name, std, val in (
+            ("uo", "eastward_sea_water_velocity", cu),
+            ("vo", "northward_sea_water_velocity", cv),
+        ):
             v = ds.createVariable(name, "f4", ("time", "latitude", "longitude"))
             v.standard_name, v.units = std, "m s-1"
             v[:] = np.full((2, lats.size, lons.size), val, dtype=np.float32)
-    grid = current_from_spec({"type": "netcdf", "path": "cur.nc"}, frame=frame,
-                             base_dir=tmp_path, where="c.yaml: scenarios.s.current")
+    grid = current_from_spec(
+        {"type": "netcdf", "path": "cur.nc"},
+        frame=frame,
+        base_dir=tmp_path,
+        where="c.yaml: scenarios.s.current",
+    )
     u, v = grid.sample(T0, 100.0, 200.0)
     assert math.hypot(float(u), float(v)) == pytest.approx(0.6, rel=1e-6)
     wind = UniformWind(TWS, 90.0)
     a = route_isochrone(Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET, current=grid)
-    b = route_isochrone(Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET,
-                        current=UniformCurrent(0.6, 200.0))
+    b = route_isochrone(
+        Start((0.0, 0.0)), mark(700.0), T0, wind, POLAR, SET, current=UniformCurrent(0.6, 200.0)
+    )
     assert a.time_s == pytest.approx(b.time_s, rel=1e-4)

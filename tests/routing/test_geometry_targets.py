@@ -29,7 +29,8 @@ EPS = 1e-12  # float64 round-off on metre-scale coordinates
 
 def crossing(geom: TargetGeometry, p, q):
     hit, s, r = segment_crossing(
-        np.array([p[0]]), np.array([p[1]]), np.array([q[0]]), np.array([q[1]]), geom)
+        np.array([p[0]]), np.array([p[1]]), np.array([q[0]]), np.array([q[1]]), geom
+    )
     return bool(hit[0]), float(s[0]), float(r[0])
 
 
@@ -52,7 +53,8 @@ def test_rounding_segment_is_perpendicular_and_on_the_passing_side(bearing):
     a2, b2 = rounding_segment(mark, bearing, "starboard", 13.0)
     assert a2 == mark
     assert (b2[0] - mark[0]) * right[0] + (b2[1] - mark[1]) * right[1] == pytest.approx(
-        -13.0, abs=1e-9)
+        -13.0, abs=1e-9
+    )
     # no side given: 2 zone_m centred on the mark
     a3, b3 = rounding_segment(mark, bearing, None, 13.0)
     assert ((a3[0] + b3[0]) / 2, (a3[1] + b3[1]) / 2) == pytest.approx(mark, abs=1e-9)

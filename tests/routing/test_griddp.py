@@ -21,8 +21,12 @@ from sailroute.wind.uniform import UniformWind
 BOAT = DynamicBoat()
 TOY_POLAR = BOAT.steady_polar(np.arange(0.0, 61.0, 2.0), twa_step=1.0)
 # 0.3 TWS for every TWA >= 40°: the straight line is the unique optimum of any reach
-ISO = Polar.from_arrays(np.array([0.0, 40.0, 180.0]), np.array([0.0, 20.0]),
-                        np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]), interpolation="linear")
+ISO = Polar.from_arrays(
+    np.array([0.0, 40.0, 180.0]),
+    np.array([0.0, 20.0]),
+    np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]),
+    interpolation="linear",
+)
 A = Start((0.0, 0.0), name="A")
 
 
@@ -35,8 +39,9 @@ def settings(**kw: object) -> RoutingSettings:
 def test_reach_in_uniform_wind_is_straight_and_exact() -> None:
     # wind from the west, leg north: TWA 90 on port; odd C puts a node on the axis
     wind = UniformWind(8.0, 270.0)
-    r = route_griddp(A, Target("line", (-20.0, 400.0), (20.0, 400.0)), 0.0, wind, ISO,
-                     settings(dp_cols=33))
+    r = route_griddp(
+        A, Target("line", (-20.0, 400.0), (20.0, 400.0)), 0.0, wind, ISO, settings(dp_cols=33)
+    )
     assert r.router == "griddp"
     assert r.time_s == pytest.approx(400.0 / 2.4, rel=1e-12)
     assert np.allclose(r.track.x, 0.0, atol=1e-9)
@@ -61,8 +66,9 @@ def test_upwind_leg_tends_to_vmg_bound(boat: Polar | DynamicBoat) -> None:
         bound = 500.0 / (12.0 * vmg) + 2.0 * loss
     errs = []
     for cols, ref in [(33, 0), (33, 3), (65, 3)]:
-        r = route_griddp(A, tgt, 0.0, wind, boat,
-                         settings(dp_cols=cols, dp_rows=13, dp_refinements=ref))
+        r = route_griddp(
+            A, tgt, 0.0, wind, boat, settings(dp_cols=cols, dp_rows=13, dp_refinements=ref)
+        )
         assert r.n_tacks == 1
         errs.append(r.time_s - bound)
     # the polar bound is a true lower bound (any grid path is a feasible route); the
@@ -80,9 +86,24 @@ def test_mesh_convergence_reproduces_the_paper() -> None:
     # towards the bound L cos5°/VMG* (plus the momentum lost at the start and tack)
     wind = UniformWind(12.0, 5.0)
     tgt = Target("mark", (0.0, 500.0))
-    times = [solve_griddp(A, tgt, 0.0, wind, BOAT, settings(
-        dp_cols=c, dp_rows=30, dp_refinements=0, dp_half_width_m=400.0, dp_samples=1,
-        zone_m=0.01)).result.time_s for c in (16, 32, 64)]
+    times = [
+        solve_griddp(
+            A,
+            tgt,
+            0.0,
+            wind,
+            BOAT,
+            settings(
+                dp_cols=c,
+                dp_rows=30,
+                dp_refinements=0,
+                dp_half_width_m=400.0,
+                dp_samples=1,
+                zone_m=0.01,
+            ),
+        ).result.time_s
+        for c in (16, 32, 64)
+    ]
     assert times == pytest.approx([655.36, 411.25, 357.85], rel=0.02)
     bound = 500.0 * math.cos(math.radians(5.0)) / (12.0 * BOAT.best_vmg()[1])
     assert bound < times[2] < times[1] < times[0]
@@ -97,8 +118,10 @@ def _brute_force(boat: Polar | DynamicBoat, wind, tgt: Target, s: RoutingSetting
     for path in itertools.product(*[range(p[0].size) for p in xy]):
         xs = np.array([xy[r][0][c] for r, c in enumerate(path)])
         ys = np.array([xy[r][1][c] for r, c in enumerate(path)])
-        best = min(best, evaluate_path(model, wind, xs, ys, 0.0, s.dp_samples, s,
-                                      limits=grid.limits).time_s)
+        best = min(
+            best,
+            evaluate_path(model, wind, xs, ys, 0.0, s.dp_samples, s, limits=grid.limits).time_s,
+        )
     return best
 
 
@@ -111,8 +134,14 @@ def test_dp_equals_brute_force_on_a_small_grid(boat: Polar | DynamicBoat, case: 
         wind, tgt = UniformWind(8.0, 10.0), Target("mark", (30.0, 300.0))
     else:
         wind, tgt = debski_test_wind(), Target("mark", (500.0, 0.0))
-    s = settings(dp_cols=4, dp_rows=5, dp_refinements=0, dp_half_width_m=150.0,
-                 tack_penalty_s=4.0, gybe_penalty_s=2.0)
+    s = settings(
+        dp_cols=4,
+        dp_rows=5,
+        dp_refinements=0,
+        dp_half_width_m=150.0,
+        tack_penalty_s=4.0,
+        gybe_penalty_s=2.0,
+    )
     sol = solve_griddp(A, tgt, 0.0, wind, boat, s)
     brute = _brute_force(boat, wind, tgt, s)
     assert sol.passes[0].dp_time_s == pytest.approx(brute, rel=1e-12)
@@ -141,8 +170,9 @@ def test_runs_are_deterministic() -> None:
 
 
 def test_later_start_sees_later_wind() -> None:
-    wind = UniformWind([8.0, 4.0], [270.0, 270.0], times=[0.0, 100.0],
-                       interpolation="previous", clamp=True)
+    wind = UniformWind(
+        [8.0, 4.0], [270.0, 270.0], times=[0.0, 100.0], interpolation="previous", clamp=True
+    )
     tgt = Target("line", (-20.0, 400.0), (20.0, 400.0))
     early = route_griddp(A, tgt, -1000.0, wind, ISO, settings())
     late = route_griddp(A, tgt, 200.0, wind, ISO, settings())
@@ -159,8 +189,14 @@ def test_start_line_reports_best_start_point() -> None:
     # isotropic reach: any path straight north between the lines is optimal
     wind = UniformWind(8.0, 270.0)
     line = Start((-50.0, 0.0), (150.0, 0.0))
-    r = route_griddp(line, Target("line", (-20.0, 300.0), (20.0, 300.0)), 0.0, wind, ISO,
-                     settings(dp_cols=33, dp_refinements=3))
+    r = route_griddp(
+        line,
+        Target("line", (-20.0, 300.0), (20.0, 300.0)),
+        0.0,
+        wind,
+        ISO,
+        settings(dp_cols=33, dp_refinements=3),
+    )
     assert r.time_s == pytest.approx(300.0 / 2.4, rel=1e-4)
     assert r.start_xy[1] == 0.0 and -20.0 <= r.start_xy[0] <= 20.0
     assert abs(r.start_xy[0] - r.end_xy[0]) < 2.0
@@ -214,32 +250,44 @@ def test_track_is_consistent() -> None:
 
 def test_calm_wind_gives_routing_error() -> None:
     with pytest.raises(RoutingError, match="no feasible path"):
-        route_griddp(A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(0.0, 0.0), ISO,
-                     settings())
+        route_griddp(A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(0.0, 0.0), ISO, settings())
 
 
 @pytest.mark.parametrize(
     ("kw", "key"),
-    [(dict(dp_cols=1), "dp_cols"), (dict(dp_shrink=0.0), "dp_shrink"),
-     (dict(dp_half_width_m=-5.0), "dp_half_width_m"), (dict(dp_samples=0), "dp_samples"),
-     (dict(tack_penalty_s=-1.0), "tack_penalty_s")],
+    [
+        (dict(dp_cols=1), "dp_cols"),
+        (dict(dp_shrink=0.0), "dp_shrink"),
+        (dict(dp_half_width_m=-5.0), "dp_half_width_m"),
+        (dict(dp_samples=0), "dp_samples"),
+        (dict(tack_penalty_s=-1.0), "tack_penalty_s"),
+    ],
 )
 def test_invalid_settings(kw: dict, key: str) -> None:
     with pytest.raises(InputError, match=key):
-        route_griddp(A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO,
-                     settings(**kw))
+        route_griddp(
+            A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO, settings(**kw)
+        )
 
 
 def test_wrong_boat_type() -> None:
     with pytest.raises(InputError, match="Polar or a DynamicBoat"):
-        route_griddp(A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0),
-                     "laser", settings())  # type: ignore[arg-type]
+        route_griddp(
+            A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), "laser", settings()
+        )  # type: ignore[arg-type]
 
 
 def test_progress_is_reported_up_to_one() -> None:
     seen: list[float] = []
-    route_griddp(A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO,
-                 settings(), progress=seen.append)
+    route_griddp(
+        A,
+        Target("mark", (0.0, 300.0)),
+        0.0,
+        UniformWind(8.0, 270.0),
+        ISO,
+        settings(),
+        progress=seen.append,
+    )
     assert seen[-1] == 1.0 and all(0.0 <= f <= 1.0 for f in seen)
     assert all(b >= a for a, b in itertools.pairwise(seen))
 
@@ -277,5 +325,11 @@ def test_gpu_code_path_matches_numpy() -> None:
 
 def test_max_leg_time_is_enforced() -> None:
     with pytest.raises(RoutingError, match="max_leg_time_s"):
-        route_griddp(A, Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO,
-                     settings(max_leg_time_s=60.0))
+        route_griddp(
+            A,
+            Target("mark", (0.0, 300.0)),
+            0.0,
+            UniformWind(8.0, 270.0),
+            ISO,
+            settings(max_leg_time_s=60.0),
+        )

@@ -49,13 +49,13 @@ def test_every_router_has_the_router_call_shape(name: str) -> None:
     params = list(sig.parameters.values())
     # six positional arguments, in the Router order, then keyword-only options
     assert [p.kind for p in params[:6]] == [inspect.Parameter.POSITIONAL_OR_KEYWORD] * 6
-    assert [p.name for p in params[:6]] == ["start", "target", "t0", "wind", "boat",
-                                            "settings"]
+    assert [p.name for p in params[:6]] == ["start", "target", "t0", "wind", "boat", "settings"]
     assert sig.parameters["progress"].kind is inspect.Parameter.KEYWORD_ONLY
     assert sig.parameters["progress"].default is None
     assert sig.parameters["xp"].default is np
-    sig.bind(*LEG, T0, UniformWind(4.0, 0.0), small_polar(), RoutingSettings(),
-             progress=None, xp=np)
+    sig.bind(
+        *LEG, T0, UniformWind(4.0, 0.0), small_polar(), RoutingSettings(), progress=None, xp=np
+    )
     assert sig.return_annotation == "LegResult"
 
 
@@ -63,14 +63,21 @@ def test_every_router_has_the_router_call_shape(name: str) -> None:
 
 
 BAD = [
-    ("router", "dijkstra",
-     "router must be one of 'isochrone', 'griddp', 'spline', got 'dijkstra'"),
+    ("router", "dijkstra", "router must be one of 'isochrone', 'griddp', 'spline', got 'dijkstra'"),
     ("dt_s", 0.0, "dt_s must be a number > 0, got 0.0"),
     ("heading_step_deg", 60.0, "heading_step_deg must be <= 45, got 60.0"),
-    ("heading_step_deg", 0.01, "heading_step_deg must be in [0.1, 45] (default 2; finer steps "
-     "only slow the router), got 0.01"),
-    ("dt_s", 0.1, "dt_s must be >= 0.5 s (default 10; finer steps hardly change the route "
-     "and make it slow), got 0.1"),
+    (
+        "heading_step_deg",
+        0.01,
+        "heading_step_deg must be in [0.1, 45] (default 2; finer steps "
+        "only slow the router), got 0.01",
+    ),
+    (
+        "dt_s",
+        0.1,
+        "dt_s must be >= 0.5 s (default 10; finer steps hardly change the route "
+        "and make it slow), got 0.1",
+    ),
     ("min_dt_s", -1.0, "min_dt_s must be a number > 0, got -1.0"),
     ("prune_sector_deg", float("nan"), "prune_sector_deg must be a number > 0, got nan"),
     ("max_leg_time_s", "1h", "max_leg_time_s must be a number > 0, got '1h'"),
@@ -86,21 +93,20 @@ BAD = [
     ("dp_refinements", 1.5, "dp_refinements must be an integer in [0, 20], got 1.5"),
     ("dp_samples", 0, "dp_samples must be an integer in [1, 64], got 0"),
     ("dp_shrink", 0.0, "dp_shrink must be in (0, 1], got 0.0"),
-    ("dp_half_width_m", -5.0,
-     "dp_half_width_m must be > 0 m or None (automatic), got -5.0"),
+    ("dp_half_width_m", -5.0, "dp_half_width_m must be > 0 m or None (automatic), got -5.0"),
     ("spline_cols", 1, "spline_cols must be an integer >= 2, got 1"),
     ("spline_slopes", 0, "spline_slopes must be an integer >= 1, got 0"),
     ("spline_refinements", -1, "spline_refinements must be an integer >= 0, got -1"),
     ("spline_carry_speed", "yes", "spline_carry_speed must be true or false, got 'yes'"),
-    ("spline_start_from_rest", 1,
-     "spline_start_from_rest must be true or false, got 1"),
+    ("spline_start_from_rest", 1, "spline_start_from_rest must be true or false, got 1"),
 ]
 
 
 def test_default_settings_are_valid() -> None:
     assert settings_problems(RoutingSettings()) == []
-    check_settings(RoutingSettings(router="spline", initial_side="port",
-                                   dp_half_width_m=400.0), "x")
+    check_settings(
+        RoutingSettings(router="spline", initial_side="port", dp_half_width_m=400.0), "x"
+    )
 
 
 def test_every_field_is_checked() -> None:
@@ -109,8 +115,7 @@ def test_every_field_is_checked() -> None:
 
 
 @pytest.mark.parametrize(("field", "value", "line"), BAD, ids=[b[0] for b in BAD])
-def test_each_bad_field_is_refused_with_its_message(field: str, value: object,
-                                                    line: str) -> None:
+def test_each_bad_field_is_refused_with_its_message(field: str, value: object, line: str) -> None:
     s = replace(RoutingSettings(), **{field: value})
     assert settings_problems(s) == [line]
     with pytest.raises(InputError) as err:
@@ -118,10 +123,11 @@ def test_each_bad_field_is_refused_with_its_message(field: str, value: object,
     assert str(err.value) == f"leg start -> 1: invalid routing settings:\n  - {line}"
 
 
-@pytest.mark.parametrize(("field", "value"), [("dp_cols", 1), ("tack_penalty_s", -1.0),
-                                               ("spline_slopes", 0), ("heading_fan", "wide")])
-def test_every_router_refuses_bad_settings_with_the_same_message(field: str,
-                                                                 value: object) -> None:
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("dp_cols", 1), ("tack_penalty_s", -1.0), ("spline_slopes", 0), ("heading_fan", "wide")],
+)
+def test_every_router_refuses_bad_settings_with_the_same_message(field: str, value: object) -> None:
     # before: each router checked only "its" fields, with its own wording
     messages = set()
     for name in ROUTERS:
@@ -135,8 +141,10 @@ def test_every_router_refuses_bad_settings_with_the_same_message(field: str,
 
 def test_several_bad_fields_are_listed_together() -> None:
     s = RoutingSettings(dt_s=-1.0, dp_cols=1)
-    assert settings_problems(s) == ["dt_s must be a number > 0, got -1.0",
-                                    "dp_cols must be an integer in [2, 1024], got 1"]
+    assert settings_problems(s) == [
+        "dt_s must be a number > 0, got -1.0",
+        "dp_cols must be an integer in [2, 1024], got 1",
+    ]
 
 
 # --- tack / side encoding ----------------------------------------------------------------
@@ -169,7 +177,6 @@ def test_side_name_has_no_name_for_no_side(bad: float) -> None:
 @pytest.mark.parametrize("side", SIDE_NAMES)
 def test_initial_side_name_starts_the_track_on_that_sign(router: Any, side: Any) -> None:
     # a beat: the route starts on the tack the settings name (side_sign in the arrays)
-    s = RoutingSettings(router=router, dp_rows=5, dp_cols=9, dp_refinements=0,
-                        initial_side=side)
+    s = RoutingSettings(router=router, dp_rows=5, dp_cols=9, dp_refinements=0, initial_side=side)
     res = get_router(router)(*LEG, T0, UniformWind(6.0, 0.0), small_polar(), s)
     assert side_name(int(res.track.side[0])) == side

@@ -153,8 +153,10 @@ def vmg_loss_bound(board_m, miss_m, board_s):
     """Extra time of a board bent by ``miss_m`` over ``board_m`` away from the VMG angle
     (the worse of bearing away and heading up), sailed for about ``board_s``."""
     d = math.degrees(miss_m / board_m)
-    worst = min(float(POLAR.speed(TWS, A_UP + k * d)) * math.cos(math.radians(A_UP + k * d))
-                for k in (-1.0, 1.0))
+    worst = min(
+        float(POLAR.speed(TWS, A_UP + k * d)) * math.cos(math.radians(A_UP + k * d))
+        for k in (-1.0, 1.0)
+    )
     return board_s * (VMG_UP / worst - 1.0)
 
 
@@ -192,8 +194,12 @@ def test_forced_wrong_start_side_pays_one_manoeuvre_at_the_start():
 
 def test_both_start_sides_give_the_same_time():
     L = 1000.0
-    times = [route(Start((0.0, 0.0)), north_mark(L), UniformWind(TWS, 0.0),
-                   replace(FINE, initial_side=s)).time_s for s in ("port", "starboard")]
+    times = [
+        route(
+            Start((0.0, 0.0)), north_mark(L), UniformWind(TWS, 0.0), replace(FINE, initial_side=s)
+        ).time_s
+        for s in ("port", "starboard")
+    ]
     assert times[0] == pytest.approx(times[1], rel=1e-9)
 
 
@@ -241,8 +247,9 @@ def test_ilca7_runs_dead_downwind_without_gybing():
     ilca = builtin_polar("ilca7-steady")
     tws, L = 5.61, 1000.0
     assert float(ilca.vmg_downwind(tws)[0]) == 180.0
-    r = route_isochrone(Start((0.0, 0.0)), north_mark(-L, "port"), T0, UniformWind(tws, 0.0),
-                        ilca, SET)
+    r = route_isochrone(
+        Start((0.0, 0.0)), north_mark(-L, "port"), T0, UniformWind(tws, 0.0), ilca, SET
+    )
     rr = np.linspace(0.0, SET.zone_m, 1301)
     t = np.hypot(rr, L) / ilca.speed(tws, 180.0 - np.degrees(np.arctan2(rr, L)))
     assert t.min() == pytest.approx(L / float(ilca.speed(tws, 180.0)), rel=1e-12)
@@ -270,8 +277,7 @@ def test_thesis_validation_beat_closed_form():
     # the thesis (Pardo 2018, §5.7): 8.5 kn from 0°, a 1809 m beat, 10 s per manoeuvre, dt 5 s, 1°
     # headings.  The thesis's optimum (1100-1225 s) used its own Laser VPP, which is
     # not available; with this polar the closed form L / VMG* + 10 s must hold.
-    st = replace(SET, tack_penalty_s=10.0, gybe_penalty_s=10.0, heading_step_deg=1.0,
-                 dt_s=5.0)
+    st = replace(SET, tack_penalty_s=10.0, gybe_penalty_s=10.0, heading_step_deg=1.0, dt_s=5.0)
     r = route(Start((0.0, 0.0)), north_mark(1809.0), UniformWind(TWS, 0.0), st)
     expected = 1809.0 / VMG_UP + 10.0
     assert r.time_s >= expected * (1 - ROUNDOFF)
@@ -314,11 +320,12 @@ def _rotate(p, deg):
 def test_rotating_course_and_wind_together_leaves_the_time_unchanged(angle):
     # an off-axis beat to a port-rounding mark, then the same rotated by `angle`
     start, mark = (30.0, -20.0), (250.0, 700.0)
-    base = route(Start(start), Target("mark", mark, rounding="port"),
-                 UniformWind(TWS, 10.0))
-    r = route(Start(_rotate(start, angle)), Target("mark", _rotate(mark, angle),
-                                                   rounding="port"),
-              UniformWind(TWS, (10.0 + angle) % 360.0))
+    base = route(Start(start), Target("mark", mark, rounding="port"), UniformWind(TWS, 10.0))
+    r = route(
+        Start(_rotate(start, angle)),
+        Target("mark", _rotate(mark, angle), rounding="port"),
+        UniformWind(TWS, (10.0 + angle) % 360.0),
+    )
     # the router works in a leg-aligned frame, so only round-off differs (1e-9)
     assert r.time_s == pytest.approx(base.time_s, rel=1e-9)
     assert (r.n_tacks, r.n_gybes) == (base.n_tacks, base.n_gybes) == (1, 0)
@@ -329,10 +336,18 @@ def test_rotating_course_and_wind_together_leaves_the_time_unchanged(angle):
 def test_mirror_image_gives_the_same_time_and_a_mirrored_track():
     # mirror about the y axis: x -> -x, TWD -> -TWD, port <-> starboard everywhere
     st = replace(SET, initial_side="starboard")
-    a = route(Start((40.0, 0.0)), Target("mark", (-150.0, 800.0), rounding="port"),
-              UniformWind(TWS, 15.0), st)
-    b = route(Start((-40.0, 0.0)), Target("mark", (150.0, 800.0), rounding="starboard"),
-              UniformWind(TWS, 345.0), replace(st, initial_side="port"))
+    a = route(
+        Start((40.0, 0.0)),
+        Target("mark", (-150.0, 800.0), rounding="port"),
+        UniformWind(TWS, 15.0),
+        st,
+    )
+    b = route(
+        Start((-40.0, 0.0)),
+        Target("mark", (150.0, 800.0), rounding="starboard"),
+        UniformWind(TWS, 345.0),
+        replace(st, initial_side="port"),
+    )
     assert b.time_s == pytest.approx(a.time_s, rel=1e-9)
     assert b.track.x == pytest.approx(-a.track.x, abs=1e-6)
     assert b.track.y == pytest.approx(a.track.y, abs=1e-6)
@@ -344,8 +359,13 @@ def test_mirror_image_gives_the_same_time_and_a_mirrored_track():
 
 def switching_wind(t_switch, before, after):
     """Wind from the east (a reach for a leg north), switching speed at t_switch."""
-    return UniformWind([before, after], [90.0, 90.0], times=[T0 - 86400.0, t_switch],
-                       interpolation="previous", clamp=True)
+    return UniformWind(
+        [before, after],
+        [90.0, 90.0],
+        times=[T0 - 86400.0, t_switch],
+        interpolation="previous",
+        clamp=True,
+    )
 
 
 def test_a_leg_started_later_sees_the_later_wind():
@@ -382,8 +402,13 @@ def test_direction_switch_mid_leg_is_sailed_on_the_new_wind():
     # a 600 m beat; at T0 + 200 s the wind veers from 0° to 20°: the rest of the leg
     # is a beat in the new wind, from wherever the boat is
     L = 600.0
-    w = UniformWind([TWS, TWS], [0.0, 20.0], times=[T0 - 86400.0, T0 + 200.0],
-                    interpolation="previous", clamp=True)
+    w = UniformWind(
+        [TWS, TWS],
+        [0.0, 20.0],
+        times=[T0 - 86400.0, T0 + 200.0],
+        interpolation="previous",
+        clamp=True,
+    )
     r = route(Start((0.0, 0.0)), north_mark(L), w)
     i = np.searchsorted(r.track.t, T0 + 200.0)
     assert np.allclose(r.track.twd_deg[:i], 0.0) and np.allclose(r.track.twd_deg[i:], 20.0)
@@ -432,8 +457,7 @@ def test_mark_is_rounded_on_the_requested_side(rounding, sign):
     # start 20 m east of the mark's meridian, wind from the east: the straight line
     # passes just east of the mark, so a starboard rounding must cross over to the west
     mark = (0.0, 500.0)
-    r = route(Start((20.0, 0.0)), Target("mark", mark, rounding=rounding),
-              UniformWind(TWS, 90.0))
+    r = route(Start((20.0, 0.0)), Target("mark", mark, rounding=rounding), UniformWind(TWS, 90.0))
     # signed offset of the arrival from the mark, to the right of the leg direction
     th = math.atan2(mark[0] - 20.0, mark[1])
     offset = (r.end_xy[0] - mark[0]) * math.cos(th) - (r.end_xy[1] - mark[1]) * math.sin(th)
@@ -556,8 +580,15 @@ def test_wrf_beat_routes_well_under_a_second():
 
 def test_progress_is_reported_up_to_one():
     seen = []
-    route_isochrone(Start((0.0, 0.0)), north_mark(400.0), T0, UniformWind(TWS, 0.0), POLAR,
-                    SET, progress=seen.append)
+    route_isochrone(
+        Start((0.0, 0.0)),
+        north_mark(400.0),
+        T0,
+        UniformWind(TWS, 0.0),
+        POLAR,
+        SET,
+        progress=seen.append,
+    )
     assert len(seen) > 10 and seen[-1] == 1.0
     assert all(0.0 <= v <= 1.0 for v in seen)
     assert seen[len(seen) // 2] > 0.2
@@ -586,8 +617,14 @@ def test_calm_wind_fails_with_a_routing_error_that_says_why():
 
 def test_dynamic_boat_is_refused_with_a_pointer_to_the_grid_routers():
     with pytest.raises(InputError, match=r"start -> 1.*needs a Polar.*'griddp'"):
-        route_isochrone(Start((0.0, 0.0), name="start"), north_mark(500.0), T0,
-                        UniformWind(TWS, 0.0), DynamicBoat(), SET)
+        route_isochrone(
+            Start((0.0, 0.0), name="start"),
+            north_mark(500.0),
+            T0,
+            UniformWind(TWS, 0.0),
+            DynamicBoat(),
+            SET,
+        )
 
 
 def test_target_outside_the_wind_coverage_is_refused_up_front():
@@ -616,12 +653,23 @@ def test_wind_that_ends_before_the_finish_raises_out_of_coverage():
         route(Start((0.0, 0.0)), north_mark(500.0), w)
 
 
-@pytest.mark.parametrize("field,value", [
-    ("dt_s", 0.0), ("heading_step_deg", 60.0), ("tack_penalty_s", -1.0),
-    ("prune_sector_deg", float("nan")), ("max_front_points", 2), ("heading_fan", "wide"),
-    ("initial_side", "left"),
-])
+@pytest.mark.parametrize(
+    "field,value",
+    [
+        ("dt_s", 0.0),
+        ("heading_step_deg", 60.0),
+        ("tack_penalty_s", -1.0),
+        ("prune_sector_deg", float("nan")),
+        ("max_front_points", 2),
+        ("heading_fan", "wide"),
+        ("initial_side", "left"),
+    ],
+)
 def test_invalid_settings_are_input_errors_naming_the_field(field, value):
     with pytest.raises(InputError, match=field):
-        route(Start((0.0, 0.0)), north_mark(500.0), UniformWind(TWS, 0.0),
-              replace(SET, **{field: value}))
+        route(
+            Start((0.0, 0.0)),
+            north_mark(500.0),
+            UniformWind(TWS, 0.0),
+            replace(SET, **{field: value}),
+        )

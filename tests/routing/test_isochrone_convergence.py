@@ -55,8 +55,9 @@ def wind() -> AnalyticWind:
 
 def leg_time(dt, heading, sector):
     st = RoutingSettings(dt_s=dt, heading_step_deg=heading, prune_sector_deg=sector)
-    r = route_isochrone(Start((0.0, 0.0)), Target("mark", (0.0, L), rounding="port"), 0.0,
-                        wind(), POLAR, st)
+    r = route_isochrone(
+        Start((0.0, 0.0)), Target("mark", (0.0, L), rounding="port"), 0.0, wind(), POLAR, st
+    )
     assert r.n_gybes == 0 and 2 <= r.n_tacks <= 3  # play the shifts: two or three tacks
     return r.time_s
 

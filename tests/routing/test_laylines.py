@@ -49,8 +49,10 @@ def test_uniform_wind_laylines_are_straight_at_the_vmg_angle(kind, twd):
 
 def veering_wind(k_deg_per_m: float) -> AnalyticWind:
     """Wind of constant speed whose direction is ``k x`` degrees (veers eastwards)."""
+
     def f(t, x, y):
         return wind_components(np.full(np.shape(x), TWS), k_deg_per_m * np.asarray(x))
+
     return AnalyticWind(f, name="veering")
 
 
@@ -62,8 +64,7 @@ def test_laylines_curve_with_a_linearly_veering_wind():
     direction is the local heading + 180°."""
     k = 0.01
     up, _ = POLAR.vmg_angles_deg(TWS)
-    star, port = trace_laylines([("1", (0.0, 0.0))], T, veering_wind(k), POLAR, "tack",
-                                1000.0)
+    star, port = trace_laylines([("1", (0.0, 0.0))], T, veering_wind(k), POLAR, "tack", 1000.0)
     for ll, sign in ((star, 1.0), (port, -1.0)):
         seg = bearing_deg(np.diff(ll.x), np.diff(ll.y))
         turn = wrap180(np.diff(seg))
@@ -77,8 +78,10 @@ def test_laylines_curve_with_a_linearly_veering_wind():
         assert ll.length_m == pytest.approx(1000.0, rel=1e-9)
     assert star.x[-1] > 0 > port.x[-1]
     # straight laylines of the wind at the mark would end elsewhere: the curve is real
-    straight = (1000.0 * math.sin(math.radians(180.0 - up)),
-                1000.0 * math.cos(math.radians(180.0 - up)))
+    straight = (
+        1000.0 * math.sin(math.radians(180.0 - up)),
+        1000.0 * math.cos(math.radians(180.0 - up)),
+    )
     assert math.hypot(star.x[-1] - straight[0], star.y[-1] - straight[1]) > 20.0
 
 
@@ -91,10 +94,15 @@ def test_gate_laylines_and_coverage_edge():
         return wind_components(np.full(np.shape(x), TWS), np.zeros(np.shape(x)))
 
     wind = AnalyticWind(f, cover)
-    lls = trace_laylines([("4p", (-50.0, 0.0)), ("4s", (50.0, 0.0))], T, wind, POLAR,
-                         "gybe", 1000.0)
+    lls = trace_laylines(
+        [("4p", (-50.0, 0.0)), ("4s", (50.0, 0.0))], T, wind, POLAR, "gybe", 1000.0
+    )
     assert [(ll.mark, ll.tack) for ll in lls] == [
-        ("4p", "starboard"), ("4p", "port"), ("4s", "starboard"), ("4s", "port")]
+        ("4p", "starboard"),
+        ("4p", "port"),
+        ("4s", "starboard"),
+        ("4s", "port"),
+    ]
     for ll in lls:
         assert 0 < ll.length_m < 1000.0
         assert np.all(np.abs(ll.x) <= 400.0) and np.all(np.abs(ll.y) <= 400.0)

@@ -23,8 +23,14 @@ def test_uniform_light_air_run_has_at_most_one_gybe(boat: str, twd_off: float) -
     polar = builtin_polar(boat)
     settings = RoutingSettings(dt_s=5.0)
     for tws in WINDS_MS:
-        r = route_isochrone(Start((0.0, 0.0)), Target("mark", (0.0, -600.0), rounding="port"),
-                            T0, UniformWind(float(tws), twd_off), polar, settings)
+        r = route_isochrone(
+            Start((0.0, 0.0)),
+            Target("mark", (0.0, -600.0), rounding="port"),
+            T0,
+            UniformWind(float(tws), twd_off),
+            polar,
+            settings,
+        )
         assert r.n_gybes <= 1 and r.n_tacks == 0, (boat, tws, r.n_gybes, r.n_tacks)
         tr = r.track
         moving = tr.bsp_ms > 0

@@ -21,8 +21,12 @@ from sailroute.routing.multispline import (
 from sailroute.routing.types import RoutingSettings, Start, Target
 from sailroute.wind.uniform import UniformWind
 
-ISO = Polar.from_arrays(np.array([0.0, 40.0, 180.0]), np.array([0.0, 20.0]),
-                        np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]), interpolation="linear")
+ISO = Polar.from_arrays(
+    np.array([0.0, 40.0, 180.0]),
+    np.array([0.0, 20.0]),
+    np.array([[0.0, 0.0], [0.0, 6.0], [0.0, 6.0]]),
+    interpolation="linear",
+)
 
 
 def test_hermite_edge_matches_end_values_and_slopes() -> None:
@@ -49,7 +53,7 @@ def _continuous_optimum(n_rows: int = 10) -> float:
 
     def obj(p: np.ndarray) -> float:
         yv = np.concatenate([[0.0], p[: n_rows - 2], [0.0]])
-        m = p[n_rows - 2:]
+        m = p[n_rows - 2 :]
         tot = 0.0
         for r in range(n_rows - 1):
             dx = xs[r + 1] - xs[r]
@@ -82,10 +86,12 @@ def test_function_fitting_problem_converges() -> None:
 
 def test_spline_reach_is_straight_and_exact() -> None:
     wind = UniformWind(8.0, 270.0)
-    s = RoutingSettings(router="spline", dp_rows=7, spline_cols=11, spline_slopes=5,
-                        spline_refinements=1)
-    r = route_spline(Start((0.0, 0.0)), Target("line", (-20.0, 400.0), (20.0, 400.0)), 0.0,
-                     wind, ISO, s)
+    s = RoutingSettings(
+        router="spline", dp_rows=7, spline_cols=11, spline_slopes=5, spline_refinements=1
+    )
+    r = route_spline(
+        Start((0.0, 0.0)), Target("line", (-20.0, 400.0), (20.0, 400.0)), 0.0, wind, ISO, s
+    )
     assert r.router == "spline"
     assert r.time_s == pytest.approx(400.0 / 2.4, rel=1e-12)
     assert np.allclose(r.track.x, 0.0, atol=1e-9)
@@ -93,8 +99,14 @@ def test_spline_reach_is_straight_and_exact() -> None:
 
 def test_spline_refinement_costs_never_increase() -> None:
     wind = UniformWind([8.0, 9.0], [260.0, 300.0], times=[0.0, 300.0])
-    s = RoutingSettings(router="spline", dp_rows=7, spline_cols=11, spline_slopes=5,
-                        spline_refinements=3, dp_half_width_m=150.0)
+    s = RoutingSettings(
+        router="spline",
+        dp_rows=7,
+        spline_cols=11,
+        spline_slopes=5,
+        spline_refinements=3,
+        dp_half_width_m=150.0,
+    )
     res, fit = solve_spline(Start((0.0, 0.0)), Target("mark", (50.0, 400.0)), 0.0, wind, ISO, s)
     costs = [p.cost for p in fit.passes]
     assert all(b <= a + 1e-9 for a, b in itertools.pairwise(costs))
@@ -105,23 +117,35 @@ def test_spline_refinement_costs_never_increase() -> None:
 def test_invalid_spline_settings() -> None:
     s = RoutingSettings(router="spline", spline_slopes=0)
     with pytest.raises(InputError, match="spline_slopes"):
-        route_spline(Start((0.0, 0.0)), Target("mark", (0.0, 300.0)), 0.0,
-                     UniformWind(8.0, 270.0), ISO, s)
+        route_spline(
+            Start((0.0, 0.0)), Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO, s
+        )
 
 
 # ---------------------------------------------------------------------------------------
 # pruned dynamic rows, the separable fitting cost, carried speed, start from rest
 
+
 def _debski_small(carry: bool = False, rest: bool = False) -> tuple:
     from sailroute.boat.dynamic import DynamicBoat
     from sailroute.wind.analytic import debski_test_wind
 
-    s = RoutingSettings(router="spline", dp_rows=6, spline_cols=9, spline_slopes=5,
-                        spline_refinements=1, dp_half_width_m=400.0, tack_penalty_s=0.0,
-                        gybe_penalty_s=0.0, zone_m=0.01, spline_carry_speed=carry,
-                        spline_start_from_rest=rest)
-    return solve_spline(Start((0.0, 0.0)), Target("mark", (500.0, 0.0)), 0.0,
-                        debski_test_wind(), DynamicBoat(), s)
+    s = RoutingSettings(
+        router="spline",
+        dp_rows=6,
+        spline_cols=9,
+        spline_slopes=5,
+        spline_refinements=1,
+        dp_half_width_m=400.0,
+        tack_penalty_s=0.0,
+        gybe_penalty_s=0.0,
+        zone_m=0.01,
+        spline_carry_speed=carry,
+        spline_start_from_rest=rest,
+    )
+    return solve_spline(
+        Start((0.0, 0.0)), Target("mark", (500.0, 0.0)), 0.0, debski_test_wind(), DynamicBoat(), s
+    )
 
 
 def test_edge_time_bound_is_a_lower_bound_of_the_sailed_time() -> None:
@@ -191,10 +215,17 @@ def test_reach_from_rest_costs_the_acceleration_loss_and_carrying_changes_nothin
     beta = np.radians(90.0)
 
     def route(**kw: bool) -> float:
-        s = RoutingSettings(router="spline", dp_rows=5, spline_cols=7, spline_slopes=3,
-                            spline_refinements=1, **kw)
-        return route_spline(Start((0.0, 0.0)), Target("line", (-0.01, length), (0.01, length)),
-                            0.0, UniformWind(vt, 270.0), boat, s).time_s
+        s = RoutingSettings(
+            router="spline", dp_rows=5, spline_cols=7, spline_slopes=3, spline_refinements=1, **kw
+        )
+        return route_spline(
+            Start((0.0, 0.0)),
+            Target("line", (-0.01, length), (0.01, length)),
+            0.0,
+            UniformWind(vt, 270.0),
+            boat,
+            s,
+        ).time_s
 
     ws = float(tab.steady(beta))
     fly = length / (ws * vt)
@@ -213,10 +244,15 @@ def test_separable_fitting_cost_equals_quadrature_per_edge() -> None:
 
     rng = np.random.default_rng(3)
     c0, s0, c1, s1 = 4, 3, 5, 2
-    e = Edges(np.full((c0, 1, 1, 1), 0.4), rng.normal(size=(c0, 1, 1, 1)),
-              rng.normal(size=(1, s0, 1, 1)), np.full((1, 1, c1, 1), 0.9),
-              rng.normal(size=(1, 1, c1, 1)), rng.normal(size=(1, 1, 1, s1)),
-              np.zeros((c0, s0, 1, 1)))
+    e = Edges(
+        np.full((c0, 1, 1, 1), 0.4),
+        rng.normal(size=(c0, 1, 1, 1)),
+        rng.normal(size=(1, s0, 1, 1)),
+        np.full((1, 1, c1, 1), 0.9),
+        rng.normal(size=(1, 1, c1, 1)),
+        rng.normal(size=(1, 1, 1, s1)),
+        np.zeros((c0, s0, 1, 1)),
+    )
     fast = l2_edge_cost(fitting_target)(0, e)
     # the same edges with per-edge X (not all equal) take the quadrature path
     g, w = np.polynomial.legendre.leggauss(8)
@@ -230,5 +266,6 @@ def test_separable_fitting_cost_equals_quadrature_per_edge() -> None:
 def test_invalid_spline_options_are_named() -> None:
     s = RoutingSettings(router="spline", spline_carry_speed="yes")  # type: ignore[arg-type]
     with pytest.raises(InputError, match="spline_carry_speed"):
-        route_spline(Start((0.0, 0.0)), Target("mark", (0.0, 300.0)), 0.0,
-                     UniformWind(8.0, 270.0), ISO, s)
+        route_spline(
+            Start((0.0, 0.0)), Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO, s
+        )

@@ -44,25 +44,36 @@ def constant_polar() -> Polar:
     return Polar.from_arrays(twa, tws, np.outer(g, np.full(3, SPEED)), name="constant")
 
 
-def rect(name: str, x0: float, x1: float, y0: float, y1: float, clearance: float = 0.0
-         ) -> AreaPolygon:
+def rect(
+    name: str, x0: float, x1: float, y0: float, y1: float, clearance: float = 0.0
+) -> AreaPolygon:
     return AreaPolygon(name, (x0, x1, x1, x0), (y0, y0, y1, y1), clearance)
 
 
 # the blocked reach: wind from the west, course north from (0, 0) to a short line at
 # y = 2000; a 800 m x 600 m block across the direct path, nearer its left (west) corners
 BLOCK = rect("block", -300.0, 500.0, 700.0, 1300.0)
-REACH = (Start((0.0, 0.0), name="start"),
-         Target("line", (-50.0, 2000.0), (50.0, 2000.0), name="finish"))
+REACH = (
+    Start((0.0, 0.0), name="start"),
+    Target("line", (-50.0, 2000.0), (50.0, 2000.0), name="finish"),
+)
 REACH_WIND = UniformWind(6.0, 270.0)
 # shortest path: start -> (-300, 700) -> (-300, 1300) -> line end (-50, 2000)
 REACH_LENGTH = math.hypot(300, 700) + 600 + math.hypot(250, 700)
 
 
 def reach_settings(router: str = "isochrone") -> RoutingSettings:
-    return RoutingSettings(router=router, dt_s=5.0, tack_penalty_s=0.0, gybe_penalty_s=0.0,
-                           heading_step_deg=1.0, dp_half_width_m=600.0, dp_cols=96,
-                           dp_rows=17, dp_refinements=3)
+    return RoutingSettings(
+        router=router,
+        dt_s=5.0,
+        tack_penalty_s=0.0,
+        gybe_penalty_s=0.0,
+        heading_step_deg=1.0,
+        dp_half_width_m=600.0,
+        dp_cols=96,
+        dp_rows=17,
+        dp_refinements=3,
+    )
 
 
 def track_free(res: LegResult, obs: Obstacles) -> bool:
@@ -72,20 +83,25 @@ def track_free(res: LegResult, obs: Obstacles) -> bool:
 
 # ---------------------------------------------------------------------- predicates
 def test_points_and_segments_free_by_hand() -> None:
-    obs = Obstacles.build(RaceArea(rect("bound", -100, 100, -100, 100),
-                                   (rect("b", -10, 10, -10, 10),)))
+    obs = Obstacles.build(
+        RaceArea(rect("bound", -100, 100, -100, 100), (rect("b", -10, 10, -10, 10),))
+    )
     assert obs is not None
     assert obs.points_free([0, 50, 150, 10], [0, 50, 0, 0]).tolist() == [False, True, False, False]
     # through the block, round it, out of the boundary, through a corner exactly
-    free = obs.segments_free([-50, -50, 0, -50], [0, 20, 50, 50],
-                             [50, 50, 0, 50], [0, 20, 150, -50])
+    free = obs.segments_free(
+        [-50, -50, 0, -50], [0, 20, 50, 50], [50, 50, 0, 50], [0, 20, 150, -50]
+    )
     assert free.tolist() == [False, True, False, False]
 
 
 def test_edge_test_agrees_with_shapely_linestrings() -> None:
-    area = RaceArea(rect("bound", -500, 500, -500, 500, clearance=20.0),
-                    tuple(rect(f"o{k}", -400 + 80 * k, -350 + 80 * k, -100, 60 + 10 * k, 5.0)
-                          for k in range(10)))
+    area = RaceArea(
+        rect("bound", -500, 500, -500, 500, clearance=20.0),
+        tuple(
+            rect(f"o{k}", -400 + 80 * k, -350 + 80 * k, -100, 60 + 10 * k, 5.0) for k in range(10)
+        ),
+    )
     obs = Obstacles.build(area)
     assert obs is not None
     rng = np.random.default_rng(1)
@@ -98,15 +114,22 @@ def test_edge_test_agrees_with_shapely_linestrings() -> None:
     assert np.array_equal(ours, theirs)
     # the fan form (rows decided by their start when no edge is within reach) agrees too
     px, py = x0[:200], y0[:200]
-    qx, qy = x1[:200 * 100].reshape(200, 100) - x0[:200 * 100].reshape(200, 100) + px[:, None], \
-        y1[:200 * 100].reshape(200, 100) - y0[:200 * 100].reshape(200, 100) + py[:, None]
-    assert np.array_equal(obs.moves_free(px, py, qx, qy),
-                          obs.segments_free(px[:, None], py[:, None], qx, qy))
+    qx, qy = (
+        x1[: 200 * 100].reshape(200, 100) - x0[: 200 * 100].reshape(200, 100) + px[:, None],
+        y1[: 200 * 100].reshape(200, 100) - y0[: 200 * 100].reshape(200, 100) + py[:, None],
+    )
+    assert np.array_equal(
+        obs.moves_free(px, py, qx, qy), obs.segments_free(px[:, None], py[:, None], qx, qy)
+    )
 
 
 def test_clearance_grows_obstacles_and_shrinks_the_boundary() -> None:
-    obs = Obstacles.build(RaceArea(rect("bound", 0, 100, 0, 100, clearance=10.0),
-                                   (rect("b", 40, 60, 40, 60, clearance=5.0),)))
+    obs = Obstacles.build(
+        RaceArea(
+            rect("bound", 0, 100, 0, 100, clearance=10.0),
+            (rect("b", 40, 60, 40, 60, clearance=5.0),),
+        )
+    )
     assert obs is not None
     assert obs.points_free([5, 15, 36, 34], [50, 50, 50, 50]).tolist() == [False, True, False, True]
     assert obs.nearest_name([5.0], [50.0]) == BOUNDARY_NAME
@@ -131,13 +154,13 @@ def test_land_cells_of_a_wind_grid_become_one_obstacle() -> None:
 def blocked_reach() -> tuple[LegResult, Obstacles]:
     obs = Obstacles.build(RaceArea(obstacles=(BLOCK,)))
     assert obs is not None
-    res = route_isochrone(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(),
-                          obstacles=obs)
+    res = route_isochrone(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(), obstacles=obs)
     return res, obs
 
 
-def test_blocked_reach_goes_round_the_near_corners(blocked_reach: tuple[LegResult, Obstacles]
-                                                   ) -> None:
+def test_blocked_reach_goes_round_the_near_corners(
+    blocked_reach: tuple[LegResult, Obstacles],
+) -> None:
     res, obs = blocked_reach
     assert track_free(res, obs)
     # constant speed: time = shortest length / speed, within 0.5 %
@@ -154,10 +177,12 @@ def test_open_reach_is_straight() -> None:
 
 
 def test_griddp_agrees_with_isochrone_round_the_block(
-        blocked_reach: tuple[LegResult, Obstacles]) -> None:
+    blocked_reach: tuple[LegResult, Obstacles],
+) -> None:
     iso, obs = blocked_reach
-    dp = route_griddp(*REACH, T0, REACH_WIND, constant_polar(), reach_settings("griddp"),
-                      obstacles=obs)
+    dp = route_griddp(
+        *REACH, T0, REACH_WIND, constant_polar(), reach_settings("griddp"), obstacles=obs
+    )
     assert track_free(dp, obs)
     # the grid's corner nodes lie off the corners: within 1 % of the isochrone and of
     # the closed form
@@ -197,8 +222,7 @@ def test_beat_up_a_channel_tacks_at_its_edges() -> None:
 def test_a_start_inside_an_obstacle_is_a_clear_error() -> None:
     obs = Obstacles.build(RaceArea(obstacles=(rect("pier", -20, 20, -20, 20),)))
     with pytest.raises(RoutingError, match="no route round obstacle 'pier'"):
-        route_isochrone(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(),
-                        obstacles=obs)
+        route_isochrone(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(), obstacles=obs)
 
 
 def test_a_walled_off_target_is_refused_before_routing() -> None:
@@ -206,23 +230,29 @@ def test_a_walled_off_target_is_refused_before_routing() -> None:
     obs = Obstacles.build(RaceArea(rect("bound", -800, 800, -200, 2200), (wall,)))
     for router in ("isochrone", "griddp"):
         with pytest.raises(RoutingError, match="no route round obstacle 'reef'"):
-            route_leg(*REACH, T0, REACH_WIND, constant_polar(), reach_settings(router),
-                      obstacles=obs)
+            route_leg(
+                *REACH, T0, REACH_WIND, constant_polar(), reach_settings(router), obstacles=obs
+            )
 
 
 # ---------------------------------------------------------------------- registry
 def test_registry_says_what_each_router_supports() -> None:
     assert {k: (e.current, e.obstacles) for k, e in ROUTERS.items()} == {
-        "isochrone": (True, True), "griddp": (False, True), "spline": (False, False)}
-    with pytest.raises(InputError, match="'spline': a race-area boundary or obstacles are "
-                       "honoured by the isochrone and griddp routers only"):
+        "isochrone": (True, True),
+        "griddp": (False, True),
+        "spline": (False, False),
+    }
+    with pytest.raises(
+        InputError,
+        match="'spline': a race-area boundary or obstacles are "
+        "honoured by the isochrone and griddp routers only",
+    ):
         check_router_supports("spline", obstacles=True)
     with pytest.raises(InputError, match="supported by the isochrone router only"):
         check_router_supports("griddp", current=True)
     obs = Obstacles.build(RaceArea(obstacles=(BLOCK,)))
     with pytest.raises(InputError, match=r"set routing\.router: isochrone"):
-        route_leg(*REACH, T0, REACH_WIND, constant_polar(), reach_settings("spline"),
-                  obstacles=obs)
+        route_leg(*REACH, T0, REACH_WIND, constant_polar(), reach_settings("spline"), obstacles=obs)
 
 
 def test_a_point_move_crosses_nothing_in_an_edges_box() -> None:
@@ -231,8 +261,9 @@ def test_a_point_move_crosses_nothing_in_an_edges_box() -> None:
     tri = AreaPolygon("bound", (0.0, 1000.0, 0.0), (0.0, 1000.0, 1000.0))
     obs = Obstacles.build(RaceArea(tri))
     assert obs is not None
-    assert obs.segments_free([100.0, 500.0], [700.0, 500.0], [100.0, 500.0],
-                             [700.0, 500.0]).tolist() == [True, False]
+    assert obs.segments_free(
+        [100.0, 500.0], [700.0, 500.0], [100.0, 500.0], [700.0, 500.0]
+    ).tolist() == [True, False]
 
 
 def test_generic_array_module_path_goes_round_the_same_way() -> None:
@@ -246,7 +277,6 @@ def test_generic_array_module_path_goes_round_the_same_way() -> None:
     start, target = Start((0.0, 0.0)), Target("line", (-20.0, 800.0), (20.0, 800.0))
     s = replace(reach_settings(), dt_s=10.0)
     a = route_isochrone(start, target, T0, REACH_WIND, constant_polar(), s, obstacles=obs)
-    b = route_isochrone(start, target, T0, REACH_WIND, constant_polar(), s, obstacles=obs,
-                        xp=fake)
+    b = route_isochrone(start, target, T0, REACH_WIND, constant_polar(), s, obstacles=obs, xp=fake)
     assert b.time_s == pytest.approx(a.time_s, rel=1e-12)
     assert np.min(a.track.x) < -140.0

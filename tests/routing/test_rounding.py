@@ -93,26 +93,29 @@ def two_legs(router, twd, nxt, rounding, chained=True, settings=None):
 
 
 def joined(r1, r2):
-    return (np.concatenate([r1.track.x, r2.track.x]),
-            np.concatenate([r1.track.y, r2.track.y]))
+    return (np.concatenate([r1.track.x, r2.track.x]), np.concatenate([r1.track.y, r2.track.y]))
 
 
 # --- geometry ------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(("out", "port", "starboard"), [
-    (0.0, 0.0, 0.0),  # straight on: the mark is passed, h = θ
-    (270.0, 315.0, 135.0),  # left turn of 90° (a right turn of 270° to starboard)
-    (180.0, 270.0, 90.0),  # windward-leeward
-    (90.0, 225.0, 45.0),  # right turn of 90°
-])
+@pytest.mark.parametrize(
+    ("out", "port", "starboard"),
+    [
+        (0.0, 0.0, 0.0),  # straight on: the mark is passed, h = θ
+        (270.0, 315.0, 135.0),  # left turn of 90° (a right turn of 270° to starboard)
+        (180.0, 270.0, 90.0),  # windward-leeward
+        (90.0, 225.0, 45.0),  # right turn of 90°
+    ],
+)
 def test_apex_heading_bisects_the_turn_in_the_rounding_sense(out, port, starboard):
     # leg north (θ = 0); exact values by hand, float round-off only
     assert rounding_apex_deg(0.0, out, "port") == pytest.approx(port, abs=1e-12)
     assert rounding_apex_deg(0.0, out, "starboard") == pytest.approx(starboard, abs=1e-12)
     # rotating both bearings rotates the apex
     assert rounding_apex_deg(33.0, (out + 33.0) % 360, "port") == pytest.approx(
-        (port + 33.0) % 360, abs=1e-9)
+        (port + 33.0) % 360, abs=1e-9
+    )
     with pytest.raises(InputError, match="'prot'"):
         rounding_apex_deg(0.0, out, "prot")
 
@@ -149,18 +152,22 @@ def test_barriers_of_a_port_rounding():
 def test_barrier_blocks_backward_crossings_of_its_ray_and_touching_the_mark():
     # ray east from the origin, crossed northwards: moving south across it is forbidden
     bar = Barrier((0.0, 0.0), (1.0, 0.0), (0.0, 1.0))
-    p = np.array([[5.0, 3.0], [5.0, -3.0], [-5.0, 1.0], [1000.0, 1.0], [5.0, -1e-12],
-                  [5.0, 0.0]])
-    q = np.array([[5.0, -3.0], [5.0, 3.0], [-5.0, -1.0], [1000.0, -1.0], [5.0, -3.0],
-                  [-5.0, 0.0]])
+    p = np.array([[5.0, 3.0], [5.0, -3.0], [-5.0, 1.0], [1000.0, 1.0], [5.0, -1e-12], [5.0, 0.0]])
+    q = np.array([[5.0, -3.0], [5.0, 3.0], [-5.0, -1.0], [1000.0, -1.0], [5.0, -3.0], [-5.0, 0.0]])
     got = barrier_blocks(p[:, 0], p[:, 1], q[:, 0], q[:, 1], bar)
     # backwards; forwards; west of the mark (not the ray); far along the (unbounded) ray;
     # from the ray itself up to round-off (tested BARRIER_SLACK_M behind it); along it
     assert got.tolist() == [True, False, False, True, True, False]
     assert BARRIER_SLACK_M < 1e-3
     # passing the mark closer than the clearance (0.05 m < 0.1 m) is forbidden too
-    near = barrier_blocks(np.array([-5.0, -5.0]), np.array([0.05, 0.2]), np.array([5.0, 5.0]),
-                          np.array([0.05, 0.2]), bar, MARK_CLEARANCE_M)
+    near = barrier_blocks(
+        np.array([-5.0, -5.0]),
+        np.array([0.05, 0.2]),
+        np.array([5.0, 5.0]),
+        np.array([0.05, 0.2]),
+        bar,
+        MARK_CLEARANCE_M,
+    )
     assert near.tolist() == [True, False]
 
 
@@ -187,9 +194,14 @@ CASES = [  # (wind from, next mark): the course turns left, back, right, ...
 ]
 
 
-@pytest.mark.parametrize(("router", "rounding"), [
-    ("isochrone", "port"), ("isochrone", "starboard"), ("griddp", "port"),
-])  # the grid DP's starboard roundings: test_mirrored_course_...
+@pytest.mark.parametrize(
+    ("router", "rounding"),
+    [
+        ("isochrone", "port"),
+        ("isochrone", "starboard"),
+        ("griddp", "port"),
+    ],
+)  # the grid DP's starboard roundings: test_mirrored_course_...
 @pytest.mark.parametrize(("twd", "nxt"), CASES)
 def test_two_legs_leave_the_mark_on_the_required_side(router, twd, nxt, rounding):
     r1, r2 = two_legs(router, twd, nxt, rounding)
@@ -206,8 +218,9 @@ def test_a_turn_against_the_rounding_side_loops_round_the_mark():
     r1, r2 = two_legs("isochrone", 45.0, (600.0, L - 100.0), "port")
     x, y = joined(r1, r2)
     w = winding_deg(x, y, MARK)
-    assert w == pytest.approx(string_winding_deg((x[0], y[0]), (x[-1], y[-1]), MARK, "port"),
-                              abs=1e-6)
+    assert w == pytest.approx(
+        string_winding_deg((x[0], y[0]), (x[-1], y[-1]), MARK, "port"), abs=1e-6
+    )
     assert w > 360.0  # observed 439.3°: one turn more than passing the mark
 
 
@@ -246,8 +259,7 @@ def test_mirrored_course_rounded_the_other_way_takes_the_same_time(router):
 
 def test_spline_router_respects_the_rounding():
     # a smooth case (no manoeuvre): close reach north, broad reach west-south-west
-    st = RoutingSettings(router="spline", spline_cols=15, spline_slopes=5,
-                         spline_refinements=2)
+    st = RoutingSettings(router="spline", spline_cols=15, spline_slopes=5, spline_refinements=2)
     r1, r2 = two_legs("spline", 45.0, (-600.0, L - 100.0), "port", settings=st)
     x, y = joined(r1, r2)
     expected = string_winding_deg((x[0], y[0]), (x[-1], y[-1]), MARK, "port")

@@ -37,8 +37,7 @@ def rotated_line(length: float, rot_deg: float) -> tuple[tuple[float, float], tu
 
 def test_square_line_has_no_bias_and_no_favoured_end():
     west, east = rotated_line(300.0, 0.0)
-    sl = start_line_numbers(west, east, UniformWind(TWS, 0.0), POLAR, T_GUN,
-                            names=("pin", "boat"))
+    sl = start_line_numbers(west, east, UniformWind(TWS, 0.0), POLAR, T_GUN, names=("pin", "boat"))
     assert sl.length_m == pytest.approx(300.0, abs=1e-9)
     assert sl.bias_deg == pytest.approx(0.0, abs=1e-9)
     assert sl.favoured_end is None and sl.favoured_xy is None
@@ -54,8 +53,7 @@ def test_rotated_line_bias_favoured_end_and_gain(b):
     favoured by L sin|b| metres, L sin|b| / VMG* seconds."""
     length = 400.0
     west, east = rotated_line(length, b)
-    sl = start_line_numbers(west, east, UniformWind(TWS, 0.0), POLAR, T_GUN,
-                            names=("pin", "boat"))
+    sl = start_line_numbers(west, east, UniformWind(TWS, 0.0), POLAR, T_GUN, names=("pin", "boat"))
     assert sl.bias_deg == pytest.approx(b, abs=1e-9)
     upwind_end = "boat" if east[1] > west[1] else "pin"
     assert sl.favoured_end == upwind_end
@@ -77,8 +75,10 @@ def test_bias_is_independent_of_end_order_and_wind_direction():
         rot = np.radians(-twd)  # turn the picture clockwise by twd (compass)
 
         def turn(p, rot=rot):
-            return (p[0] * math.cos(rot) - p[1] * math.sin(rot),
-                    p[0] * math.sin(rot) + p[1] * math.cos(rot))
+            return (
+                p[0] * math.cos(rot) - p[1] * math.sin(rot),
+                p[0] * math.sin(rot) + p[1] * math.cos(rot),
+            )
 
         w, e = turn(west), turn(east)
         wind = UniformWind(TWS, twd)
@@ -91,8 +91,7 @@ def test_bias_is_independent_of_end_order_and_wind_direction():
 
 def test_nearly_square_line_is_square():
     west, east = rotated_line(300.0, 0.5 * SQUARE_TOL_DEG)
-    assert start_line_numbers(west, east, UniformWind(TWS, 0.0), POLAR,
-                              T_GUN).favoured_end is None
+    assert start_line_numbers(west, east, UniformWind(TWS, 0.0), POLAR, T_GUN).favoured_end is None
 
 
 def test_bias_range_over_the_five_minutes_before_the_gun():
@@ -139,8 +138,16 @@ def test_time_to_line_close_hauled_from_straight_downwind(d):
     """From a point d below the middle of a long square line, close-hauled on either tack
     the path is d / cos(TWA*) long and takes that over the polar speed at TWA*."""
     west, east = rotated_line(2000.0, 0.0)
-    ap = line_approach((0.0, -d), T_GUN - 120.0, west, east, UniformWind(TWS, 0.0), POLAR,
-                       T_GUN, names=("pin", "boat"))
+    ap = line_approach(
+        (0.0, -d),
+        T_GUN - 120.0,
+        west,
+        east,
+        UniformWind(TWS, 0.0),
+        POLAR,
+        T_GUN,
+        names=("pin", "boat"),
+    )
     twa, _ = POLAR.vmg_upwind(TWS)
     twa = float(twa)
     path = d / math.cos(math.radians(twa))
@@ -165,8 +172,7 @@ def test_fastest_approach_and_time_to_burn():
     the time to burn is the time to the gun minus it."""
     d = 100.0
     west, east = rotated_line(4000.0, 0.0)
-    ap = line_approach((0.0, -d), T_GUN - 90.0, west, east, UniformWind(TWS, 0.0), POLAR,
-                       T_GUN)
+    ap = line_approach((0.0, -d), T_GUN - 90.0, west, east, UniformWind(TWS, 0.0), POLAR, T_GUN)
     theta = np.linspace(1.0, 89.0, 88_001)
     expected = float(np.min(d / (POLAR.speed(TWS, theta) * np.cos(np.radians(theta)))))
     assert ap.fastest.time_s == pytest.approx(expected, rel=2e-4)  # 0.5° heading scan
@@ -180,8 +186,9 @@ def test_straight_to_each_end():
     """Straight to an end: its distance over the polar speed at that heading's TWA."""
     west, east = (-100.0, 0.0), (100.0, 0.0)
     p = (0.0, -100.0)
-    ap = line_approach(p, T_GUN - 60.0, west, east, UniformWind(TWS, 0.0), POLAR, T_GUN,
-                       names=("pin", "boat"))
+    ap = line_approach(
+        p, T_GUN - 60.0, west, east, UniformWind(TWS, 0.0), POLAR, T_GUN, names=("pin", "boat")
+    )
     to_pin, to_boat = ap.to_ends
     assert to_pin.label == "to pin" and to_boat.label == "to boat"
     assert to_pin.heading_deg == pytest.approx(315.0) and to_pin.tack == "starboard"
@@ -193,8 +200,7 @@ def test_straight_to_each_end():
 
 def test_boat_above_the_line_is_on_the_course_side():
     west, east = rotated_line(300.0, 0.0)
-    ap = line_approach((0.0, 50.0), T_GUN - 60.0, west, east, UniformWind(TWS, 0.0), POLAR,
-                       T_GUN)
+    ap = line_approach((0.0, 50.0), T_GUN - 60.0, west, east, UniformWind(TWS, 0.0), POLAR, T_GUN)
     assert ap.course_side
     assert ap.distance_m == pytest.approx(50.0)
     assert all(not a.reaches for a in ap.close_hauled)  # close-hauled leads away from it
@@ -216,5 +222,6 @@ def test_a_line_of_zero_length_is_refused():
     from sailroute.errors import InputError
 
     with pytest.raises(InputError, match="both ends are at the same place"):
-        start_line_numbers((1.0, 2.0), (1.0, 2.0), UniformWind(TWS, 0.0), POLAR, T_GUN,
-                           names=("p", "q"))
+        start_line_numbers(
+            (1.0, 2.0), (1.0, 2.0), UniformWind(TWS, 0.0), POLAR, T_GUN, names=("p", "q")
+        )

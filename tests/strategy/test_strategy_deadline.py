@@ -28,12 +28,70 @@ from sailroute.strategy.deadline import (
 from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
 
 # Sun Odyssey 40, TWS 8 kn column (Wang et al. 2024, Table 1), scaled to f_max = 0.05
-SO40_TWA = np.array([0, 5, 10, 15, 20, 25, 32, 36, 40, 45, 52, 60, 70, 80, 90, 100, 110, 120,
-                     130, 140, 150, 160, 170, 180], dtype=float)
-SO40_KN = np.array([0.0, 0.6, 1.2, 1.8, 2.1, 2.5, 4.1, 4.6, 5.0, 5.4, 5.8, 6.2, 6.4, 6.5, 6.5,
-                    6.5, 6.4, 6.2, 5.7, 5.2, 4.7, 4.2, 3.9, 3.6])
-SO40 = Polar.from_arrays(SO40_TWA, np.array([1.0]), (SO40_KN * 0.05 / 6.5)[:, None],
-                         name="SO40 8kn", interpolation="linear")
+SO40_TWA = np.array(
+    [
+        0,
+        5,
+        10,
+        15,
+        20,
+        25,
+        32,
+        36,
+        40,
+        45,
+        52,
+        60,
+        70,
+        80,
+        90,
+        100,
+        110,
+        120,
+        130,
+        140,
+        150,
+        160,
+        170,
+        180,
+    ],
+    dtype=float,
+)
+SO40_KN = np.array(
+    [
+        0.0,
+        0.6,
+        1.2,
+        1.8,
+        2.1,
+        2.5,
+        4.1,
+        4.6,
+        5.0,
+        5.4,
+        5.8,
+        6.2,
+        6.4,
+        6.5,
+        6.5,
+        6.5,
+        6.4,
+        6.2,
+        5.7,
+        5.2,
+        4.7,
+        4.2,
+        3.9,
+        3.6,
+    ]
+)
+SO40 = Polar.from_arrays(
+    SO40_TWA,
+    np.array([1.0]),
+    (SO40_KN * 0.05 / 6.5)[:, None],
+    name="SO40 8kn",
+    interpolation="linear",
+)
 C = 2.0
 SIGMA = 0.05  # rad per sqrt(time unit)
 
@@ -70,8 +128,14 @@ def test_three_node_gauss_hermite_is_exact_to_degree_five() -> None:
     m, v = 0.3, 0.02
     nodes = m + np.array(GH3_OFFSETS) * math.sqrt(3 * v)
     w = np.array(GH3_WEIGHTS)
-    exact = [1, m, m**2 + v, m**3 + 3 * m * v, m**4 + 6 * m**2 * v + 3 * v**2,
-             m**5 + 10 * m**3 * v + 15 * m * v**2]
+    exact = [
+        1,
+        m,
+        m**2 + v,
+        m**3 + 3 * m * v,
+        m**4 + 6 * m**2 * v + 3 * v**2,
+        m**5 + 10 * m**3 * v + 15 * m * v**2,
+    ]
     for k, e in enumerate(exact):
         assert float(w @ nodes**k) == pytest.approx(e, rel=1e-12)
 
@@ -82,7 +146,8 @@ def test_brownian_equivalent_matches_ou_change_over_horizon() -> None:
     assert s**2 * 800.0 == pytest.approx(2 * 100 * (1 - math.exp(-800 / 600)), rel=1e-12)
     # short horizon: the OU's own short-term diffusion sqrt(2σ²/l)
     assert brownian_equivalent(10.0, 600.0, 1e-3) == pytest.approx(
-        math.sqrt(2 * 100 / 600), rel=1e-5)
+        math.sqrt(2 * 100 / 600), rel=1e-5
+    )
     assert brownian_equivalent(10.0, math.inf, 800.0) == 0.0
 
 
@@ -304,8 +369,11 @@ def test_bilinear_is_the_default() -> None:
     st = StrategySettings(deadlines_s=(800.0,))
     g = deadline_grid_for(st, 2.0, 800.0)
     assert (g.interpolation, g.refine_controls) == ("linear", "none")
-    g = deadline_grid_for(StrategySettings(deadlines_s=(800.0,), interpolation="cubic",
-                                           refine_controls="golden"), 2.0, 800.0)
+    g = deadline_grid_for(
+        StrategySettings(deadlines_s=(800.0,), interpolation="cubic", refine_controls="golden"),
+        2.0,
+        800.0,
+    )
     assert (g.interpolation, g.refine_controls) == ("cubic", "golden")
     with pytest.raises(InputError, match="refine_controls"):
         DeadlineGrid(2.0, 10, 16, 0.1, 0.4, 10.0, refine_controls="brent")
@@ -374,8 +442,7 @@ ENGINE_CASES = [
 
 
 @pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), ENGINE_CASES)
-def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype,
-                                                       shape) -> None:
+def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype, shape) -> None:
     # the numba kernels do the NumPy arithmetic in the same order: the same w and actions
     pytest.importorskip("numba")
     a, s_max, sigma = fig
@@ -384,8 +451,14 @@ def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype
     if shape[1] == 4:
         from sailroute.strategy.deadline import _model_rates, _RingRows
 
-        rows = _RingRows.build(g, SO40.speed(1.0, np.degrees(g.controls_rad)),
-                               *_model_rates(m), g.ds_s, np.float32, compiled=False)
+        rows = _RingRows.build(
+            g,
+            SO40.speed(1.0, np.degrees(g.controls_rad)),
+            *_model_rates(m),
+            g.ds_s,
+            np.float32,
+            compiled=False,
+        )
         assert rows.pad > g.n_theta
     ref = solve_deadline(SO40, 1.0, m, g, C, engine="numpy", dtype=dtype)
     jit = solve_deadline(SO40, 1.0, m, g, C, engine="numba", dtype=dtype)
@@ -397,8 +470,9 @@ def test_compiled_engine_is_bit_for_bit_the_numpy_path(interpolation, fig, dtype
 
 
 @pytest.mark.parametrize(("interpolation", "fig", "dtype", "shape"), ENGINE_CASES)
-def test_array_module_engine_is_bit_for_bit_the_numpy_path(monkeypatch, interpolation, fig,
-                                                           dtype, shape) -> None:
+def test_array_module_engine_is_bit_for_bit_the_numpy_path(
+    monkeypatch, interpolation, fig, dtype, shape
+) -> None:
     # engine "cupy" runs the NumPy path's operations on another array module, with its own
     # row sums (_deadline_xp.DeviceRows) and one block per tack band; a stand-in for NumPy
     # takes that code path without a GPU (tests/test_gpu.py runs it on CuPy) and must give
@@ -439,12 +513,12 @@ def test_ring_rows_agree_with_the_sparse_bilinear_rows() -> None:
     csr = _steer_operator(g, f, a, sigma, g.ds_s, "fail", "linear", np.float64)
     for q in (0, 1):
         n0, n1 = q * per_tack + lo, (q + 1) * per_tack
-        np.testing.assert_allclose(ring.apply(x, n0, n1), csr.apply(x, n0, n1),
-                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(ring.apply(x, n0, n1), csr.apply(x, n0, n1), rtol=0, atol=1e-12)
 
 
-@pytest.mark.parametrize("sure", [[], [0, 1, 2], [5, 6, 7, 0, 1], [3], list(range(8)),
-                                  [0, 2, 3, 4, 7], [7]])
+@pytest.mark.parametrize(
+    "sure", [[], [0, 1, 2], [5, 6, 7, 0, 1], [3], list(range(8)), [0, 2, 3, 4, 7], [7]]
+)
 def test_unsure_arc_covers_every_unsure_node(sure: list[int]) -> None:
     pytest.importorskip("numba")
     from sailroute.strategy._deadline_jit import unsure_arc
@@ -457,8 +531,15 @@ def test_unsure_arc_covers_every_unsure_node(sure: list[int]) -> None:
     unsure = set(range(nt)) - set(sure)
     assert unsure <= covered
     # the complement of the longest circular run of sure nodes
-    longest = max((n for s0 in range(nt) for n in range(nt + 1)
-                   if all((s0 + k) % nt in sure for k in range(n))), default=0)
+    longest = max(
+        (
+            n
+            for s0 in range(nt)
+            for n in range(nt + 1)
+            if all((s0 + k) % nt in sure for k in range(n))
+        ),
+        default=0,
+    )
     assert length == nt - min(longest, nt)
 
 

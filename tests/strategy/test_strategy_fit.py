@@ -68,8 +68,10 @@ def test_ou_standard_errors_are_calibrated(method) -> None:
     fits = [fit_ou(t, s, timescale_method=method) for s in series]
     sig = np.array([f.sigma_deg for f in fits])
     lt = np.array([f.timescale_s for f in fits])
-    for est, se in ((sig, np.mean([f.sigma_se_deg for f in fits])),
-                    (lt, np.mean([f.timescale_se_s for f in fits]))):
+    for est, se in (
+        (sig, np.mean([f.sigma_se_deg for f in fits])),
+        (lt, np.mean([f.timescale_se_s for f in fits])),
+    ):
         ratio = np.std(est, ddof=1) / se
         assert 1 / 1.35 < ratio < 1.35
     # and no large bias: means within 3 standard errors of the replicate mean

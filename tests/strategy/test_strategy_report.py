@@ -74,8 +74,9 @@ def test_ecdf_counts_failures_as_late() -> None:
 
 
 def test_write_json_maps_non_finite_to_null(tmp_path) -> None:
-    p = report.write_json({"a": math.inf, "b": [np.float64(1.5), np.nan], "c": np.int64(3)},
-                          tmp_path / "s.json")
+    p = report.write_json(
+        {"a": math.inf, "b": [np.float64(1.5), np.nan], "c": np.int64(3)}, tmp_path / "s.json"
+    )
     assert json.loads(p.read_text()) == {"a": None, "b": [1.5, None], "c": 3}
 
 
@@ -89,8 +90,7 @@ def test_parse_objective() -> None:
 
 
 def test_run_strategy_with_deadline_writes_everything(tmp_path) -> None:
-    st = StrategySettings(deadlines_s=(190.0,), n_r=40, n_theta=48, interpolation="linear",
-                          **SMALL)
+    st = StrategySettings(deadlines_s=(190.0,), n_r=40, n_theta=48, interpolation="linear", **SMALL)
     res = run_strategy(ILCA7, OUShift(10.0, 600.0), st)
     s = res.summary
     e = s["expected_time_policy"]
@@ -104,14 +104,21 @@ def test_run_strategy_with_deadline_writes_everything(tmp_path) -> None:
     assert d["grid"]["ds_s"] * round(5.0 / d["grid"]["ds_s"]) == pytest.approx(5.0)
     files = write_strategy_outputs(res, tmp_path / "out")
     names = sorted(p.name for p in files.values())
-    assert names == ["deadline_policy.png", "deadline_tracks.png", "leg_times.png",
-                     "policy_map.png", "spaghetti.png", "summary.json"]
+    assert names == [
+        "deadline_policy.png",
+        "deadline_tracks.png",
+        "leg_times.png",
+        "policy_map.png",
+        "spaghetti.png",
+        "summary.json",
+    ]
     saved = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert saved["seed"] == 1 and saved["runs"] == 300
     assert saved["deadline"]["engine"] == "auto"
     # the NumPy engine gives the same policy, so the same simulated probabilities
-    d_np = run_strategy(ILCA7, OUShift(10.0, 600.0), replace(st, deadline_engine="numpy")
-                        ).summary["deadline"]
+    d_np = run_strategy(ILCA7, OUShift(10.0, 600.0), replace(st, deadline_engine="numpy")).summary[
+        "deadline"
+    ]
     assert d_np["engine"] == "numpy"
     assert d_np["risk_aware"] == d["risk_aware"]
 
@@ -120,8 +127,14 @@ def test_drift_diffusion_shift_given_directly_in_minutes(tmp_path) -> None:
     # 0.6 °/min drift and 3 °/√min diffusion are 0.01 °/s and 3/√60 °/√s; the study's
     # SDP runs on that model (the chain diagnostics have no stationary target for it)
     res = run_strategy_command(
-        shift="Drift_Diffusion", drift_deg_per_min=0.6, diffusion_deg_per_sqrt_min=3.0,
-        out_dir=tmp_path, plots=False, length_m=200.0, half_width_m=100.0, runs=50,
+        shift="Drift_Diffusion",
+        drift_deg_per_min=0.6,
+        diffusion_deg_per_sqrt_min=3.0,
+        out_dir=tmp_path,
+        plots=False,
+        length_m=200.0,
+        half_width_m=100.0,
+        runs=50,
     ).data
     assert res.model == DriftDiffusionShift(0.01, 3.0 / math.sqrt(60.0))
     assert res.policy.model == res.model
@@ -151,14 +164,34 @@ def test_deadline_objective_needs_a_tack_penalty() -> None:
 
 def test_cli_strategy_expected(tmp_path) -> None:
     out = tmp_path / "o"
-    res = CliRunner().invoke(app, [
-        "strategy", "--length-m", "400", "--half-width-m", "200", "--runs", "200",
-        "--sigma-deg", "8", "--timescale-min", "5", "--out", str(out), "--no-plots"])
+    res = CliRunner().invoke(
+        app,
+        [
+            "strategy",
+            "--length-m",
+            "400",
+            "--half-width-m",
+            "200",
+            "--runs",
+            "200",
+            "--sigma-deg",
+            "8",
+            "--timescale-min",
+            "5",
+            "--out",
+            str(out),
+            "--no-plots",
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert "expected-time policy" in res.stdout
     s = json.loads((out / "summary.json").read_text())
-    assert s["shift_model"] == {"kind": "ou", "sigma_deg": 8.0, "timescale_s": 300.0,
-                                "mean_deg": 0.0}
+    assert s["shift_model"] == {
+        "kind": "ou",
+        "sigma_deg": 8.0,
+        "timescale_s": 300.0,
+        "mean_deg": 0.0,
+    }
     assert s["settings"]["length_m"] == 400.0
 
 
@@ -172,10 +205,11 @@ def test_cli_strategy_expected(tmp_path) -> None:
         (["--fit-from", "nowhere.csv"], "not found"),
         (["--seed", "-1"], "--seed -1: expected an integer >= 0"),
         (["--fit-from", str(ROOT / "data" / "trieste-coach-2018-02-15.csv")], "speed_unit"),
-        pytest.param(["--objective", "deadline=300", "--deadline-engine", "cupy"],
-                     "engine 'cupy' needs CuPy and an NVIDIA GPU",
-                     marks=pytest.mark.skipif(_cupy_or_none() is not None,
-                                              reason="a GPU is here")),
+        pytest.param(
+            ["--objective", "deadline=300", "--deadline-engine", "cupy"],
+            "engine 'cupy' needs CuPy and an NVIDIA GPU",
+            marks=pytest.mark.skipif(_cupy_or_none() is not None, reason="a GPU is here"),
+        ),
         (["--deadline-engine", "gpu"], "--deadline-engine"),
     ],
 )
@@ -188,19 +222,48 @@ def test_cli_strategy_errors_exit_2_without_traceback(args, message, tmp_path) -
 
 def test_cli_notes_a_chain_too_coarse_for_sigma(tmp_path) -> None:
     # σ = 3° on 5° bins: the chain's stationary sd is 3.8° (+27 %), which the report says
-    res = CliRunner().invoke(app, [
-        "strategy", "--length-m", "200", "--half-width-m", "100", "--runs", "50",
-        "--sigma-deg", "3", "--out", str(tmp_path), "--no-plots"])
+    res = CliRunner().invoke(
+        app,
+        [
+            "strategy",
+            "--length-m",
+            "200",
+            "--half-width-m",
+            "100",
+            "--runs",
+            "50",
+            "--sigma-deg",
+            "3",
+            "--out",
+            str(tmp_path),
+            "--no-plots",
+        ],
+    )
     assert res.exit_code == 0, res.output
     assert "note: the shift chain's sd is 3.8°" in res.stdout
 
 
 @requires_shared
 def test_cli_fits_the_shift_from_a_station_file(tmp_path) -> None:
-    res = CliRunner().invoke(app, [
-        "strategy", "--length-m", "200", "--half-width-m", "100", "--runs", "50",
-        "--fit-from", str(COACH), "--fit-timezone", "+01:00", "--out", str(tmp_path),
-        "--no-plots"])
+    res = CliRunner().invoke(
+        app,
+        [
+            "strategy",
+            "--length-m",
+            "200",
+            "--half-width-m",
+            "100",
+            "--runs",
+            "50",
+            "--fit-from",
+            str(COACH),
+            "--fit-timezone",
+            "+01:00",
+            "--out",
+            str(tmp_path),
+            "--no-plots",
+        ],
+    )
     assert res.exit_code == 0, res.output
     s = json.loads((tmp_path / "summary.json").read_text())
     assert s["shift_model"]["sigma_deg"] == pytest.approx(s["fit"]["ou"]["sigma_deg"])
@@ -212,22 +275,42 @@ def test_drift_diffusion_fitted_from_a_station_file(tmp_path) -> None:
     # the committed 15 min excerpt of the coach-boat log: the fitted Brownian model, not the
     # OU one, drives the study
     res = run_strategy_command(
-        shift="drift-diffusion", fit_from=str(COACH_EXCERPT), fit_timezone="+01:00",
-        out_dir=tmp_path, plots=False, length_m=200.0, half_width_m=100.0, runs=50,
+        shift="drift-diffusion",
+        fit_from=str(COACH_EXCERPT),
+        fit_timezone="+01:00",
+        out_dir=tmp_path,
+        plots=False,
+        length_m=200.0,
+        half_width_m=100.0,
+        runs=50,
     )
     dd = res.data.summary["fit"]["drift_diffusion"]
-    assert res.data.model == DriftDiffusionShift(dd["drift_deg_per_s"],
-                                                   dd["sigma_deg_per_sqrt_s"])
+    assert res.data.model == DriftDiffusionShift(dd["drift_deg_per_s"], dd["sigma_deg_per_sqrt_s"])
     assert "diffusion" in res.report and "°/√min" in res.report
 
 
 def test_cli_fits_the_shipped_coach_log_given_its_speed_unit(tmp_path) -> None:
     # the shipped log's speed column is in knots with no unit in its header: the CLI can now
     # say so (it failed with "declare it with speed_unit:" and had no option to)
-    res = CliRunner().invoke(app, [
-        "strategy", "--length-m", "200", "--half-width-m", "100", "--runs", "50",
-        "--fit-from", str(ROOT / "data" / "trieste-coach-2018-02-15.csv"),
-        "--fit-speed-unit", "kn", "--out", str(tmp_path), "--no-plots"])
+    res = CliRunner().invoke(
+        app,
+        [
+            "strategy",
+            "--length-m",
+            "200",
+            "--half-width-m",
+            "100",
+            "--runs",
+            "50",
+            "--fit-from",
+            str(ROOT / "data" / "trieste-coach-2018-02-15.csv"),
+            "--fit-speed-unit",
+            "kn",
+            "--out",
+            str(tmp_path),
+            "--no-plots",
+        ],
+    )
     assert res.exit_code == 0, res.output
     s = json.loads((tmp_path / "summary.json").read_text())
     assert s["fit"]["ou"]["sigma_deg"] == pytest.approx(28.4, abs=0.05)  # docs/strategy.md

@@ -19,8 +19,9 @@ from sailroute.strategy.shiftmodel import OUShift
 from sailroute.units import KNOT
 
 TWA = np.arange(0.0, 181.0)
-SIN_POLAR = Polar.from_arrays(TWA, np.array([1.0]), np.sin(np.radians(TWA))[:, None], name="sin",
-                              interpolation="linear")
+SIN_POLAR = Polar.from_arrays(
+    TWA, np.array([1.0]), np.sin(np.radians(TWA))[:, None], name="sin", interpolation="linear"
+)
 ILCA7 = builtin_polar("ilca7")
 TWS = 10 * KNOT
 COARSE = BeatGrid(lateral_m=8.0, row_m=20.0)
@@ -159,8 +160,9 @@ def test_expected_time_monotone_in_tack_penalty() -> None:
 def test_stage_clock_and_integrate_chain_agree_in_steady_wind() -> None:
     # Without shifts the wind clock and the chain discretisation cannot matter.
     base = solve_expected_time(ILCA7, TWS, OUShift(0.0, 600.0), COARSE, 5.0)
-    other = solve_expected_time(ILCA7, TWS, OUShift(0.0, 600.0), COARSE, 5.0,
-                                clock="stage", chain_method="integrate")
+    other = solve_expected_time(
+        ILCA7, TWS, OUShift(0.0, 600.0), COARSE, 5.0, clock="stage", chain_method="integrate"
+    )
     assert other.expected_time() == pytest.approx(base.expected_time(), rel=1e-12)
     shifty = solve_expected_time(ILCA7, TWS, OUShift(10.0, 600.0), COARSE, 5.0, clock="stage")
     assert np.isfinite(shifty.expected_time())

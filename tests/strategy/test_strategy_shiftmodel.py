@@ -76,8 +76,12 @@ def test_integrate_uses_corrected_bin_limits_and_lumps_tails() -> None:
     ("timescale_min", "sigma", "sd", "lag", "stay"),
     # the "discretisation trap" table (an earlier hand computation):
     # chain by exact bin integration, corrected eq 13, edge lumping, δθ = 5°, 20 s steps
-    [(10, 10, 11.5, 31, 0.65), (10, 5, 6.5, 65, 0.89), (40, 10, 12.9, 254, 0.95),
-     (120, 10, 13.6, None, 0.999)],
+    [
+        (10, 10, 11.5, 31, 0.65),
+        (10, 5, 6.5, 65, 0.89),
+        (40, 10, 12.9, 254, 0.95),
+        (120, 10, 13.6, None, 0.999),
+    ],
 )
 def test_integrate_reproduces_trap_table(timescale_min, sigma, sd, lag, stay) -> None:
     model = OUShift(sigma, timescale_min * 60.0)

@@ -71,28 +71,43 @@ def test_gpx10_and_name_override(tmp_path: Path) -> None:
     assert tr.name == "X" and len(tr) == 2 and tr.notes == ()
 
 
-@pytest.mark.parametrize(("text", "match"), [
-    ("", "empty"),
-    ('<?xml version="1.0"?><gpx version="1.1" xmlns="http://www.topografix.com/GPX/1/1">'
-     "<metadata/></gpx>", "no track points"),
-    ('<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2"></trkpt>\n</trkseg></trk></gpx>',
-     "line 3: <trkpt> has no <time>"),
-    ('<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2">\n</trk></gpx>',
-     r"e\.gpx:4:\d+: not well-formed XML"),
-    # found by the fuzz test: two times in one point gave one time more than points
-    ('<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2"><time>2025-06-21T11:18:31Z'
-     '</time>\n<time>2025-06-21T11:18:30Z</time></trkpt>\n</trkseg></trk></gpx>',
-     "line 4: a <trkpt> with a second <time>"),
-])
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("", "empty"),
+        (
+            '<?xml version="1.0"?><gpx version="1.1" xmlns="http://www.topografix.com/GPX/1/1">'
+            "<metadata/></gpx>",
+            "no track points",
+        ),
+        (
+            '<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2"></trkpt>\n'
+            "</trkseg></trk></gpx>",
+            "line 3: <trkpt> has no <time>",
+        ),
+        (
+            '<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2">\n</trk></gpx>',
+            r"e\.gpx:4:\d+: not well-formed XML",
+        ),
+        # found by the fuzz test: two times in one point gave one time more than points
+        (
+            '<gpx version="1.1">\n<trk><trkseg>\n<trkpt lat="1" lon="2"><time>2025-06-21T11:18:31Z'
+            "</time>\n<time>2025-06-21T11:18:30Z</time></trkpt>\n</trkseg></trk></gpx>",
+            "line 4: a <trkpt> with a second <time>",
+        ),
+    ],
+)
 def test_bad_gpx(tmp_path: Path, text: str, match: str) -> None:
     with pytest.raises(InputError, match=match):
         read_track(_write(tmp_path, "e.gpx", text))
 
 
 def test_csv_units_time_zones_and_channels(tmp_path: Path) -> None:
-    csv_text = ("time;lat;lon;sog_kn;cog;TWA_SGP_deg;BOAT_SPEED_km_h_1\n"
-                "2025-01-19 10:00:00;45.0;13.0;10;90;-40;36\n"
-                "2025-01-19 10:00:01;45.0;13.0001;;90;-40;36\n")
+    csv_text = (
+        "time;lat;lon;sog_kn;cog;TWA_SGP_deg;BOAT_SPEED_km_h_1\n"
+        "2025-01-19 10:00:00;45.0;13.0;10;90;-40;36\n"
+        "2025-01-19 10:00:01;45.0;13.0001;;90;-40;36\n"
+    )
     p = _write(tmp_path, "c.csv", csv_text)
     with pytest.raises(InputError, match=r"c\.csv, line 2, column 'time'.*no UTC offset"):
         read_track(p)
@@ -106,8 +121,12 @@ def test_csv_units_time_zones_and_channels(tmp_path: Path) -> None:
 
 
 def test_csv_unsuffixed_speed_needs_a_unit(tmp_path: Path) -> None:
-    p = _write(tmp_path, "d.csv", "time,lat,lng,sog\n2023-09-27 14:31:56+00:00,59.4,24.8,5\n"
-               "2023-09-27 14:31:57+00:00,59.4,24.8001,6\n")
+    p = _write(
+        tmp_path,
+        "d.csv",
+        "time,lat,lng,sog\n2023-09-27 14:31:56+00:00,59.4,24.8,5\n"
+        "2023-09-27 14:31:57+00:00,59.4,24.8001,6\n",
+    )
     with pytest.raises(InputError, match=r"unit of column 'sog' is not known.*speed_unit"):
         read_track(p)
     assert read_track(p, speed_unit="kn").channels["sog_ms"][1] == pytest.approx(6 * KNOT)
@@ -116,24 +135,32 @@ def test_csv_unsuffixed_speed_needs_a_unit(tmp_path: Path) -> None:
 
 
 def test_csv_phone_time_format_epoch_and_column_mapping(tmp_path: Path) -> None:
-    p = _write(tmp_path, "e.csv", "when,y,x\n2015-07-28 17:29:21:798,47.6,-122.28\n"
-               "2015-07-28 17:29:22:799,47.6001,-122.28\n")
+    p = _write(
+        tmp_path,
+        "e.csv",
+        "when,y,x\n2015-07-28 17:29:21:798,47.6,-122.28\n2015-07-28 17:29:22:799,47.6001,-122.28\n",
+    )
     with pytest.raises(InputError, match="no column for time, lat, lon"):
         read_track(p)
     tr = read_track(p, columns={"time": "when", "lat": "y", "lon": "x"}, time_zone="-07:00")
     assert tr.t_s[0] == pytest.approx(1438129761.798)
-    q = _write(tmp_path, "f.csv", "timestamp,lat,lon\n1438129761798,47.6,-122.28\n"
-               "1438129762.5,47.6001,-122.28\n")
+    q = _write(
+        tmp_path,
+        "f.csv",
+        "timestamp,lat,lon\n1438129761798,47.6,-122.28\n1438129762.5,47.6001,-122.28\n",
+    )
     assert read_track(q).t_s.tolist() == pytest.approx([1438129761.798, 1438129762.5])
 
 
 def test_csv_errors_name_line_and_column(tmp_path: Path) -> None:
-    p = _write(tmp_path, "g.csv", "time,lat,lon\n2024-01-01T00:00:00Z,45,13\n"
-               "2024-01-01T00:00:01Z,abc,13\n")
+    p = _write(
+        tmp_path, "g.csv", "time,lat,lon\n2024-01-01T00:00:00Z,45,13\n2024-01-01T00:00:01Z,abc,13\n"
+    )
     with pytest.raises(InputError, match=r"g\.csv, line 3, column 'lat': cannot read 'abc'"):
         read_track(p)
-    q = _write(tmp_path, "h.csv", "time,lat,lon\n2024-01-01T00:00:00Z,95,13\n"
-               "2024-01-01T00:00:01Z,45,13\n")
+    q = _write(
+        tmp_path, "h.csv", "time,lat,lon\n2024-01-01T00:00:00Z,95,13\n2024-01-01T00:00:01Z,45,13\n"
+    )
     with pytest.raises(InputError, match=r"line 2: latitude 95 is out of range"):
         read_track(q)
     r = _write(tmp_path, "i.csv", "time,lat,lon\n2024-01-01T00:00:00Z,45,13\n")
@@ -165,10 +192,11 @@ def test_real_tracks_read() -> None:
         read_track(tallinn)
     tl = read_track(tallinn, speed_unit="kn")
     assert len(tl) == 942 and {"sog_ms", "tws_ms", "twd_deg", "hdg_deg"} <= set(tl.channels)
-    j24 = read_track(races / "j24-lake-washington-2015"
-                     / "Sensor_record_20150728_211517_AndroSensor.csv", time_zone="-07:00")
+    j24 = read_track(
+        races / "j24-lake-washington-2015" / "Sensor_record_20150728_211517_AndroSensor.csv",
+        time_zone="-07:00",
+    )
     assert j24.t_s[0] == pytest.approx(1438129763.799)  # 17:29:23.799 PDT, 3rd row
     assert "dropped 2 row(s)" in j24.notes[0]
-    gp = read_track(races / "sailgp-auckland-2025" / "Boat_logs" / "data_AUS.csv",
-                    time_zone="UTC")
+    gp = read_track(races / "sailgp-auckland-2025" / "Boat_logs" / "data_AUS.csv", time_zone="UTC")
     assert np.nanmedian(gp.channels["tws_ms"]) == pytest.approx(36.0 / 3.6, rel=0.2)

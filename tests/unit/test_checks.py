@@ -61,28 +61,38 @@ def test_one_did_you_mean_for_course_wind_and_boat_files(tmp_path: Path) -> None
     # wind spec inside it: an unknown key of the scenario's spec, at its own line
     course = _write(tmp_path, "w.yaml", COURSE.replace("twd_deg: 0", "twd: 0"))
     msg = _error(validate_specs, load_course(course))
-    assert f"{course}:15: scenarios.steady.twd: unknown key; did you mean 'twd_deg'? " \
+    assert (
+        f"{course}:15: scenarios.steady.twd: unknown key; did you mean 'twd_deg'? "
         "valid keys: type, tws_kn" in msg
+    )
     # boat file: an unknown parameter ("weight" is read as "mass")
     boat = _write(tmp_path, "b.yaml", "class: ilca7\ncrew_weight: 80\n")
     msg = _error(load_boat_file, boat)
     assert msg.startswith(f"{boat}:2: crew_weight: unknown key; did you mean 'crew_mass_kg'? ")
     # the same words around the same hint in all three
-    for word, choices in [("referencez", ["references"]), ("twd", ["twd_deg"]),
-                          ("crew_mass", ["crew_mass_kg"])]:
+    for word, choices in [
+        ("referencez", ["references"]),
+        ("twd", ["twd_deg"]),
+        ("crew_mass", ["crew_mass_kg"]),
+    ]:
         assert suggest(word, choices) == f"did you mean {choices[0]!r}? "
 
 
 def test_a_bad_choice_gets_the_same_hint_in_a_course_and_a_wind_spec(tmp_path: Path) -> None:
     course = _write(tmp_path, "c.yaml", COURSE.replace("rounding: port", "rounding: prot"))
     msg = _error(load_course, course)
-    assert msg == (f"{course}:10: legs[0].rounding: expected one of 'port', 'starboard'; "
-                   "got 'prot' (did you mean 'port'?)")
-    course = _write(tmp_path, "w.yaml", COURSE.replace("type: uniform",
-                                                       "type: uniform\n    interpolation: lin"))
+    assert msg == (
+        f"{course}:10: legs[0].rounding: expected one of 'port', 'starboard'; "
+        "got 'prot' (did you mean 'port'?)"
+    )
+    course = _write(
+        tmp_path, "w.yaml", COURSE.replace("type: uniform", "type: uniform\n    interpolation: lin")
+    )
     msg = _error(validate_specs, load_course(course))
-    assert msg == (f"{course}:14: scenarios.steady.interpolation: expected one of 'linear', "
-                   "'previous'; got 'lin' (did you mean 'linear'?)")
+    assert msg == (
+        f"{course}:14: scenarios.steady.interpolation: expected one of 'linear', "
+        "'previous'; got 'lin' (did you mean 'linear'?)"
+    )
 
 
 # ----------------------------------------------------------------------------- lines
@@ -94,21 +104,25 @@ def test_a_wind_spec_problem_is_reported_at_its_own_line(tmp_path: Path) -> None
 
 
 def test_a_wind_spec_with_a_wind_key_reports_lines_below_it(tmp_path: Path) -> None:
-    text = COURSE.replace("""  steady:
+    text = COURSE.replace(
+        """  steady:
     type: uniform
     tws_kn: 10
     twd_deg: 0
-""", """  steady:
+""",
+        """  steady:
     description: a steady breeze
     wind:
       type: uniform
       tws_kn: 10
       twd_deg: 400
-""")
+""",
+    )
     course = _write(tmp_path, "c.yaml", text)
     msg = _error(validate_specs, load_course(course))
-    assert msg == f"{course}:17: scenarios.steady.wind.twd_deg: expected a number in [0, 360]; " \
-        "got 400"
+    assert (
+        msg == f"{course}:17: scenarios.steady.wind.twd_deg: expected a number in [0, 360]; got 400"
+    )
 
 
 def test_a_boat_file_problem_is_reported_at_its_line(tmp_path: Path) -> None:
@@ -118,8 +132,9 @@ def test_a_boat_file_problem_is_reported_at_its_line(tmp_path: Path) -> None:
 
 def test_a_course_boat_vpp_problem_is_reported_at_its_own_line(tmp_path: Path) -> None:
     # before sailroute.checks, the line was the `boat:` key's (16), not the parameter's (19)
-    course = _write(tmp_path, "c.yaml", COURSE + "boat:\n  vpp:\n    class: ilca7\n"
-                    "    beam_m: -1\n")
+    course = _write(
+        tmp_path, "c.yaml", COURSE + "boat:\n  vpp:\n    class: ilca7\n    beam_m: -1\n"
+    )
     msg = _error(build_boat, load_course(course))
     assert msg == f"{course}:19: boat.vpp.beam_m: expected a finite number > 0; got -1.0"
 
@@ -138,7 +153,8 @@ def test_every_problem_is_listed_once_under_one_title() -> None:
         "  - x.yaml:4: a.b: expected a number; got 'x'\n"
         "  - x.yaml:3: a.z: unknown key\n"
         "  - x.yaml:9: c[1].d: missing required key\n"
-        "  - x.yaml: e: expected text; got 1")
+        "  - x.yaml: e: expected text; got 1"
+    )
     p = Problems("x.yaml")
     p.raise_if_any()  # nothing recorded: no error
     p.add("k", "expected true or false; got 'yes'")
@@ -146,10 +162,14 @@ def test_every_problem_is_listed_once_under_one_title() -> None:
 
 
 def test_a_wind_spec_lists_every_problem_under_its_key_path() -> None:
-    msg = _error(wind_from_spec, {"type": "uniform", "tws_kn": -3, "twd_deg": "north",
-                                  "clamp": "yes", "table2": []},
-                 frame=LocalFrame(45.0, 13.0), base_dir=Path("."),
-                 where="c.yaml:12: scenarios.a", lines={"scenarios.a.tws_kn": 14})
+    msg = _error(
+        wind_from_spec,
+        {"type": "uniform", "tws_kn": -3, "twd_deg": "north", "clamp": "yes", "table2": []},
+        frame=LocalFrame(45.0, 13.0),
+        base_dir=Path("."),
+        where="c.yaml:12: scenarios.a",
+        lines={"scenarios.a.tws_kn": 14},
+    )
     assert msg.splitlines() == [
         "c.yaml:12: scenarios.a: 4 problems in the wind spec",
         "  - c.yaml:12: scenarios.a.table2: unknown key; did you mean 'table'? valid keys: "
@@ -167,26 +187,28 @@ def test_a_course_lists_every_problem_at_once(tmp_path: Path) -> None:
     assert msg.splitlines() == [
         f"{course}: 3 problems in the course file",
         f"  - {course}:16: time_limit_min: expected a number > 0; got 0",
-        f"  - {course}:5: marks.boat.lon: expected a longitude in [-180, 360] degrees; "
-        "got 'east'",
+        f"  - {course}:5: marks.boat.lon: expected a longitude in [-180, 360] degrees; got 'east'",
         f"  - {course}:10: legs[0].rounding: expected one of 'port', 'starboard'; got 'up'",
     ]
 
 
 # ----------------------------------------------------------------------------- getters
-@pytest.mark.parametrize(("value", "bounds", "message"), [
-    (400, {"lo": 0.0, "hi": 360.0}, "expected a number in [0, 360]; got 400"),
-    (0, {"lo": 0.0, "lo_open": True}, "expected a number > 0; got 0"),
-    (-1, {"lo": 0.0}, "expected a number >= 0; got -1"),
-    (6, {"hi": 5.0}, "expected a number <= 5; got 6"),
-    (0, {"lo": 0.0, "hi": 1.0, "lo_open": True}, "expected a number in (0, 1]; got 0"),
-    ("ten", {"lo": 0.0}, "expected a number >= 0; got 'ten'"),
-    (True, {}, "expected a number; got True"),
-    (float("nan"), {}, "expected a number; got nan"),
-    (float("inf"), {"lo": 0.0}, "expected a number >= 0; got inf"),
-    ([1], {}, "expected a number; got a list"),
-    (2, {"lo": 0.0, "hi": 1.0, "what": "a fraction"}, "expected a fraction; got 2"),
-])
+@pytest.mark.parametrize(
+    ("value", "bounds", "message"),
+    [
+        (400, {"lo": 0.0, "hi": 360.0}, "expected a number in [0, 360]; got 400"),
+        (0, {"lo": 0.0, "lo_open": True}, "expected a number > 0; got 0"),
+        (-1, {"lo": 0.0}, "expected a number >= 0; got -1"),
+        (6, {"hi": 5.0}, "expected a number <= 5; got 6"),
+        (0, {"lo": 0.0, "hi": 1.0, "lo_open": True}, "expected a number in (0, 1]; got 0"),
+        ("ten", {"lo": 0.0}, "expected a number >= 0; got 'ten'"),
+        (True, {}, "expected a number; got True"),
+        (float("nan"), {}, "expected a number; got nan"),
+        (float("inf"), {"lo": 0.0}, "expected a number >= 0; got inf"),
+        ([1], {}, "expected a number; got a list"),
+        (2, {"lo": 0.0, "hi": 1.0, "what": "a fraction"}, "expected a fraction; got 2"),
+    ],
+)
 def test_number_bounds_messages(value, bounds, message) -> None:
     p = Problems("f.yaml", {"s.k": 7})
     assert Checker(p, "s").number({"k": value}, "k", **bounds) is None

@@ -30,8 +30,9 @@ from tests.conftest import ROOT
 T0 = 1_524_567_600.0
 
 
-@pytest.mark.parametrize("cls", [Polar, UniformCurrent, DiamondCurrent, UniformWind, GridWind,
-                                 StationWind, BlendedWind])
+@pytest.mark.parametrize(
+    "cls", [Polar, UniformCurrent, DiamondCurrent, UniformWind, GridWind, StationWind, BlendedWind]
+)
 def test_every_field_is_an_input(cls: type) -> None:
     # no derived state as init=False fields patched in by __post_init__
     assert [f.name for f in dataclasses.fields(cls) if not f.init] == []
@@ -45,8 +46,9 @@ def grid_wind(**kw: object) -> GridWind:
 
 def test_grid_wind_state_is_built_when_made_and_rebuilt_by_replace() -> None:
     with pytest.raises(InputError, match="times must be finite and strictly increasing"):
-        GridWind([T0, T0], *np.meshgrid([0.0, 1.0], [0.0, 1.0]), np.zeros((2, 2, 2)),
-                 np.zeros((2, 2, 2)))
+        GridWind(
+            [T0, T0], *np.meshgrid([0.0, 1.0], [0.0, 1.0]), np.zeros((2, 2, 2)), np.zeros((2, 2, 2))
+        )
     w = grid_wind()
     assert "_state" in vars(w)  # built by __post_init__, not on first sample
     with pytest.raises(OutOfCoverageError):
@@ -88,10 +90,15 @@ def test_cached_package_tables_are_read_only() -> None:
 
 def _object_setattr_calls(tree: ast.AST) -> list[int]:
     """Lines of ``object.__setattr__(...)`` calls in ``tree``."""
-    return [n.lineno for n in ast.walk(tree)
-            if isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)
-            and n.func.attr == "__setattr__" and isinstance(n.func.value, ast.Name)
-            and n.func.value.id == "object"]
+    return [
+        n.lineno
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Call)
+        and isinstance(n.func, ast.Attribute)
+        and n.func.attr == "__setattr__"
+        and isinstance(n.func.value, ast.Name)
+        and n.func.value.id == "object"
+    ]
 
 
 def test_the_scan_finds_object_setattr() -> None:
@@ -102,8 +109,11 @@ def test_the_scan_finds_object_setattr() -> None:
 def test_no_frozen_dataclass_is_patched_with_object_setattr() -> None:
     package = ROOT / "sailroute"
     assert sailroute.__file__ is not None and package.samefile(Path(sailroute.__file__).parent)
-    found = [f"{path.relative_to(ROOT)}:{line}" for path in sorted(package.rglob("*.py"))
-             for line in _object_setattr_calls(ast.parse(path.read_text(encoding="utf-8")))]
+    found = [
+        f"{path.relative_to(ROOT)}:{line}"
+        for path in sorted(package.rglob("*.py"))
+        for line in _object_setattr_calls(ast.parse(path.read_text(encoding="utf-8")))
+    ]
     assert found == []
 
 
@@ -127,20 +137,34 @@ def test_polar_from_arrays_copies_lists_to_read_only_float_arrays() -> None:
     assert (p.name, p.interpolation, float(p.speed(5.0, 90.0))) == ("p", "linear", 2.0)
 
 
-@pytest.mark.parametrize(("args", "field", "got"), [
-    ((TWA3, np.array(TWS1), np.array(SPD31)), "twa_deg", "got a list"),
-    ((_read_only(TWA3), np.array([5]), np.array(SPD31)), "tws_ms",
-     "got an ndarray of dtype int64"),
-    ((np.array(TWA3), np.array(TWS1), np.array(SPD31)), "twa_deg",
-     r"got a writable ndarray \(the polar would change if the caller's array did\)"),
-])
+@pytest.mark.parametrize(
+    ("args", "field", "got"),
+    [
+        ((TWA3, np.array(TWS1), np.array(SPD31)), "twa_deg", "got a list"),
+        (
+            (_read_only(TWA3), np.array([5]), np.array(SPD31)),
+            "tws_ms",
+            "got an ndarray of dtype int64",
+        ),
+        (
+            (np.array(TWA3), np.array(TWS1), np.array(SPD31)),
+            "twa_deg",
+            r"got a writable ndarray \(the polar would change if the caller's array did\)",
+        ),
+    ],
+)
 def test_polar_constructor_refuses_unfrozen_tables_and_names_the_factory(
-        args: tuple[object, object, object], field: str, got: str) -> None:
-    with pytest.raises(InputError, match=(
+    args: tuple[object, object, object], field: str, got: str
+) -> None:
+    with pytest.raises(
+        InputError,
+        match=(
             rf"^polar 'x': {field} must be a read-only float64 ndarray, {got}; build the "
             r"polar with Polar\.from_arrays\(twa_deg, tws_ms, speed_ms, name=\.\.\., "
             r"interpolation=\.\.\.\), which copies lists and arrays to read-only float64 "
-            r"arrays$")):
+            r"arrays$"
+        ),
+    ):
         Polar(*args, name="x")  # type: ignore[arg-type]
 
 
@@ -151,6 +175,7 @@ def test_polar_constructor_takes_another_polars_tables_unchanged() -> None:
 
 
 # --- Track, ScenarioSpec, Course: built with read-only mappings and tuples -----------------
+
 
 def _track(**kw: object) -> Track:
     t = np.array([0.0, 1.0])
@@ -166,18 +191,27 @@ def test_track_defaults_and_slices_are_read_only() -> None:
 
 
 def test_track_refuses_plain_dict_and_list() -> None:
-    with pytest.raises(TypeError, match=(
+    with pytest.raises(
+        TypeError,
+        match=(
             r"^Track\.channels must be a read-only mapping \(types\.MappingProxyType\), got "
-            r"dict; pass MappingProxyType\(dict\(channels\)\)$")):
+            r"dict; pass MappingProxyType\(dict\(channels\)\)$"
+        ),
+    ):
         _track(channels={})
-    with pytest.raises(TypeError, match=r"^Track\.notes must be a tuple of str, got list; "
-                                        r"pass tuple\(notes\)$"):
+    with pytest.raises(
+        TypeError,
+        match=r"^Track\.notes must be a tuple of str, got list; "
+        r"pass tuple\(notes\)$",
+    ):
         _track(notes=["gap"])
 
 
-FROZEN_HINT = (r"must be a read-only mapping \(types\.MappingProxyType\), got dict; wrap it "
-               r"with sailroute\.course\.model\.frozen_mapping\(\.\.\.\), or load the course "
-               r"with sailroute\.course\.load\.load_course, whose builder does$")
+FROZEN_HINT = (
+    r"must be a read-only mapping \(types\.MappingProxyType\), got dict; wrap it "
+    r"with sailroute\.course\.model\.frozen_mapping\(\.\.\.\), or load the course "
+    r"with sailroute\.course\.load\.load_course, whose builder does$"
+)
 
 
 def test_scenario_spec_refuses_plain_mappings() -> None:
@@ -201,6 +235,9 @@ def test_loaded_course_is_read_only_and_replace_refuses_plain_values() -> None:
     assert isinstance(again.marks, MappingProxyType) and list(again.marks) == list(course.marks)
     with pytest.raises(TypeError, match=r"^Course\.marks " + FROZEN_HINT):
         dataclasses.replace(course, marks=dict(course.marks))
-    with pytest.raises(TypeError, match=r"^Course\.legs must be a tuple of LegSpec, got list; "
-                                        r"pass tuple\(legs\)$"):
+    with pytest.raises(
+        TypeError,
+        match=r"^Course\.legs must be a tuple of LegSpec, got list; "
+        r"pass tuple\(legs\)$",
+    ):
         dataclasses.replace(course, legs=list(course.legs))

@@ -59,15 +59,14 @@ PLAN_LIMIT_S = 90.0
 
 _COMMON = {"database": None, "suppress_health_check": list(HealthCheck)}
 FAST = settings(max_examples=40, deadline=timedelta(seconds=10), derandomize=True, **_COMMON)
-FAST_PLAN = settings(max_examples=6, deadline=timedelta(seconds=60), derandomize=True,
-                     **_COMMON)
+FAST_PLAN = settings(max_examples=6, deadline=timedelta(seconds=60), derandomize=True, **_COMMON)
 # CI runs the slow tests: the same examples every run there (a red CI must be
 # reproducible); SAILROUTE_FUZZ_RANDOM=1 draws fresh ones, to explore by hand
 _FIXED = os.environ.get("SAILROUTE_FUZZ_RANDOM", "") != "1"
-LONG = settings(max_examples=2000, deadline=timedelta(seconds=10), derandomize=_FIXED,
-                **_COMMON)
-LONG_PLAN = settings(max_examples=150, deadline=timedelta(seconds=60), derandomize=_FIXED,
-                     **_COMMON)
+LONG = settings(max_examples=2000, deadline=timedelta(seconds=10), derandomize=_FIXED, **_COMMON)
+LONG_PLAN = settings(
+    max_examples=150, deadline=timedelta(seconds=60), derandomize=_FIXED, **_COMMON
+)
 
 
 class Hang(BaseException):
@@ -77,6 +76,7 @@ class Hang(BaseException):
 @contextmanager
 def time_limit(seconds: float) -> Iterator[None]:
     """Raise :class:`Hang` in the main thread after ``seconds``."""
+
     def alarm(signum: int, frame: Any) -> None:
         raise Hang(f"no answer within {seconds:g} s")
 
@@ -105,12 +105,60 @@ def outcome(read: Callable[[], Any], limit_s: float = READER_LIMIT_S) -> str:
 
 # ------------------------------------------------------------------------- mutations
 NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
-ODD_NUMBERS = ("0", "-0", "1", "-1", "0.5", "1e20", "-1e20", "1e308", "1e309", "-1e309",
-               "1e-320", "nan", "NaN", "inf", "-inf", ".inf", "9" * 400, "", ".", "1e",
-               "--1", "0x1A", "1_0", "1,5", "\u0663")
-STRUCTURE = (b'"', b"'", b",", b";", b"\t", b"\n", b"\r", b" ", b"#", b":", b"{", b"}", b"[",
-             b"]", b"&a", b"*a", b"<", b">", b"\x00", b"\xff", b"\xef\xbb\xbf", b"\\",
-             b"- ", b"!!", b"%")
+ODD_NUMBERS = (
+    "0",
+    "-0",
+    "1",
+    "-1",
+    "0.5",
+    "1e20",
+    "-1e20",
+    "1e308",
+    "1e309",
+    "-1e309",
+    "1e-320",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    ".inf",
+    "9" * 400,
+    "",
+    ".",
+    "1e",
+    "--1",
+    "0x1A",
+    "1_0",
+    "1,5",
+    "\u0663",
+)
+STRUCTURE = (
+    b'"',
+    b"'",
+    b",",
+    b";",
+    b"\t",
+    b"\n",
+    b"\r",
+    b" ",
+    b"#",
+    b":",
+    b"{",
+    b"}",
+    b"[",
+    b"]",
+    b"&a",
+    b"*a",
+    b"<",
+    b">",
+    b"\x00",
+    b"\xff",
+    b"\xef\xbb\xbf",
+    b"\\",
+    b"- ",
+    b"!!",
+    b"%",
+)
 
 
 VALUE = re.compile(r"(?<![\w.:-])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.:-])")
@@ -118,9 +166,12 @@ VALUE = re.compile(r"(?<![\w.:-])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w
 
 
 @st.composite
-def number_mutations(draw: st.DrawFn, text: str, pattern: re.Pattern[str] = NUMBER,
-                     kinds: tuple[str, ...] = ("odd", "float", "int", "twice", "scaled",
-                                               "nudged", "nudged")) -> str:
+def number_mutations(
+    draw: st.DrawFn,
+    text: str,
+    pattern: re.Pattern[str] = NUMBER,
+    kinds: tuple[str, ...] = ("odd", "float", "int", "twice", "scaled", "nudged", "nudged"),
+) -> str:
     """``text`` with one to four of its numbers replaced: by an odd value, any float or
     integer, the number written twice, or the number scaled by 0.5 .. 2 or nudged by up
     to 1e-4 of itself (a mark moves by up to some 500 m): plausible values, so that
@@ -128,8 +179,7 @@ def number_mutations(draw: st.DrawFn, text: str, pattern: re.Pattern[str] = NUMB
     spans = [m.span() for m in pattern.finditer(text)]
     if not spans:
         return text
-    picks = draw(st.lists(st.integers(0, len(spans) - 1), min_size=1, max_size=4,
-                          unique=True))
+    picks = draw(st.lists(st.integers(0, len(spans) - 1), min_size=1, max_size=4, unique=True))
     for k in sorted(picks, reverse=True):
         a, b = spans[k]
         old = text[a:b]
@@ -139,7 +189,7 @@ def number_mutations(draw: st.DrawFn, text: str, pattern: re.Pattern[str] = NUMB
         elif kind == "float":
             new = repr(draw(st.floats(allow_nan=False)))
         elif kind == "int":
-            new = str(draw(st.integers(-10**6, 10**6)))
+            new = str(draw(st.integers(-(10**6), 10**6)))
         elif kind == "twice":
             new = old * 2
         elif kind == "scaled":
@@ -159,14 +209,13 @@ def byte_mutations(draw: st.DrawFn, data: bytes) -> bytes:
         i = draw(st.integers(0, max(len(b) - 1, 0)))
         n = draw(st.integers(1, 16))
         if op == "replace" and b:
-            b[i:i + n] = draw(st.binary(min_size=n, max_size=n))
+            b[i : i + n] = draw(st.binary(min_size=n, max_size=n))
         elif op == "delete":
-            del b[i:i + n]
+            del b[i : i + n]
         elif op == "insert":
-            b[i:i] = draw(st.one_of(st.sampled_from(STRUCTURE), st.binary(min_size=1,
-                                                                           max_size=8)))
+            b[i:i] = draw(st.one_of(st.sampled_from(STRUCTURE), st.binary(min_size=1, max_size=8)))
         elif op == "duplicate":
-            b[i:i] = b[i:i + draw(st.integers(1, 400))]
+            b[i:i] = b[i : i + draw(st.integers(1, 400))]
         else:
             b = b[:i]
     return bytes(b)
@@ -174,11 +223,13 @@ def byte_mutations(draw: st.DrawFn, data: bytes) -> bytes:
 
 def mutated(files: dict[str, bytes]) -> st.SearchStrategy[tuple[str, bytes]]:
     """``(file name, mutated content)``: numbers or bytes of one of ``files``."""
+
     def one(name: str) -> st.SearchStrategy[tuple[str, bytes]]:
         data = files[name]
         text = data.decode("utf-8", errors="surrogateescape")
         by_number = number_mutations(text).map(
-            lambda t: t.encode("utf-8", errors="surrogateescape"))
+            lambda t: t.encode("utf-8", errors="surrogateescape")
+        )
         return st.tuples(st.just(name), st.one_of(by_number, byte_mutations(data)))
 
     return st.sampled_from(sorted(files)).flatmap(one)
@@ -207,13 +258,18 @@ COURSE_FILES = {
 def _polar_files() -> dict[str, bytes]:
     builtin = ROOT / "sailroute" / "boat" / "data" / "ilca7.pol"
     polar = read_polar(builtin)
-    small = Polar.from_arrays(polar.twa_deg[::4], polar.tws_ms[::3], polar.speed_ms[::4, ::3],
-                              name="ilca7")
+    small = Polar.from_arrays(
+        polar.twa_deg[::4], polar.tws_ms[::3], polar.speed_ms[::4, ::3], name="ilca7"
+    )
     with tempfile.TemporaryDirectory() as d:
         csv_text = write_polar_csv(small, Path(d) / "p_kn.csv", "kn").read_bytes()
         json_text = write_polar_json(small, Path(d) / "p.json", "kn").read_bytes()
-    return {"ilca7.pol": builtin.read_bytes(), "p_kn.csv": csv_text, "p.json": json_text,
-            "orc.json": (TESTS_DATA / "boat" / "BUL_BUL7888.json").read_bytes()}
+    return {
+        "ilca7.pol": builtin.read_bytes(),
+        "p_kn.csv": csv_text,
+        "p.json": json_text,
+        "orc.json": (TESTS_DATA / "boat" / "BUL_BUL7888.json").read_bytes(),
+    }
 
 
 POLAR_FILES = _polar_files()
@@ -238,8 +294,9 @@ TRACK_FILES = {
 }
 
 
-def write_grid(path: Path, fmt: str, lat: Any, lon: Any, hours: Any, u: Any, v: Any,
-               units: str = "m s-1") -> None:
+def write_grid(
+    path: Path, fmt: str, lat: Any, lon: Any, hours: Any, u: Any, v: Any, units: str = "m s-1"
+) -> None:
     """A CF NetCDF file of 10 m wind on a lat/lon grid."""
     import netCDF4
 
@@ -248,8 +305,11 @@ def write_grid(path: Path, fmt: str, lat: Any, lon: Any, hours: Any, u: Any, v: 
             ds.createDimension(name, len(values))
             var = ds.createVariable(name, "f8", (name,))
             var.standard_name = name
-            var.units = {"time": "hours since 2024-05-01 09:00:00",
-                         "latitude": "degrees_north", "longitude": "degrees_east"}[name]
+            var.units = {
+                "time": "hours since 2024-05-01 09:00:00",
+                "latitude": "degrees_north",
+                "longitude": "degrees_east",
+            }[name]
             var[:] = values
         for name, std, values in (("u10", "eastward_wind", u), ("v10", "northward_wind", v)):
             var = ds.createVariable(name, "f4", ("time", "latitude", "longitude"))
@@ -262,8 +322,15 @@ def _grid_files() -> dict[str, bytes]:
     with tempfile.TemporaryDirectory() as d:
         for fmt in ("NETCDF3_CLASSIC", "NETCDF4"):
             p = Path(d) / f"{fmt}.nc"
-            write_grid(p, fmt, 45.0 + 0.01 * np.arange(3), 13.0 + 0.01 * np.arange(3),
-                       [0.0, 1.0, 2.0], np.full((3, 3, 3), 1.0), np.full((3, 3, 3), -5.0))
+            write_grid(
+                p,
+                fmt,
+                45.0 + 0.01 * np.arange(3),
+                13.0 + 0.01 * np.arange(3),
+                [0.0, 1.0, 2.0],
+                np.full((3, 3, 3), 1.0),
+                np.full((3, 3, 3), -5.0),
+            )
             out[f"{fmt}.nc"] = p.read_bytes()
     return out
 
@@ -315,8 +382,9 @@ def _grid_bytes(case: tuple[str, bytes]) -> str:
         return outcome(lambda: _read_grid(p))
 
 
-FLOATS = st.one_of(st.floats(-1e3, 1e3), st.sampled_from([np.nan, np.inf, -np.inf, 1e20,
-                                                          -1e20, 0.0]))
+FLOATS = st.one_of(
+    st.floats(-1e3, 1e3), st.sampled_from([np.nan, np.inf, -np.inf, 1e20, -1e20, 0.0])
+)
 
 
 @st.composite
@@ -330,10 +398,17 @@ def grid_numbers(draw: st.DrawFn) -> dict[str, Any]:
 
     return {
         "fmt": draw(st.sampled_from(["NETCDF3_CLASSIC", "NETCDF4"])),
-        "lat": axis(ny, 45.0, 0.01), "lon": axis(nx, 13.0, 0.01), "hours": axis(nt, 0.0, 1.0),
-        "u": draw(st.one_of(st.just(np.full((nt, ny, nx), 2.0)),
-                            st.lists(FLOATS, min_size=nt * ny * nx, max_size=nt * ny * nx)
-                            .map(lambda a: np.reshape(a, (nt, ny, nx))))),
+        "lat": axis(ny, 45.0, 0.01),
+        "lon": axis(nx, 13.0, 0.01),
+        "hours": axis(nt, 0.0, 1.0),
+        "u": draw(
+            st.one_of(
+                st.just(np.full((nt, ny, nx), 2.0)),
+                st.lists(FLOATS, min_size=nt * ny * nx, max_size=nt * ny * nx).map(
+                    lambda a: np.reshape(a, (nt, ny, nx))
+                ),
+            )
+        ),
         "v": np.full((nt, ny, nx), -5.0),
         "units": draw(st.sampled_from(["m s-1", "knots", "km/h", "furlongs", ""])),
     }
@@ -356,8 +431,7 @@ def _plan(text: str) -> str:
         course, out = Path(d) / "course.yaml", Path(d) / "out"
         course.write_text(text, encoding="utf-8", errors="surrogateescape")
         with time_limit(PLAN_LIMIT_S):
-            res = runner.invoke(app, ["plan", str(course), "-q", "--no-plots", "--out",
-                                      str(out)])
+            res = runner.invoke(app, ["plan", str(course), "-q", "--no-plots", "--out", str(out)])
         assert "Traceback" not in res.output and "internal error" not in res.output, res.output
         assert res.exit_code in (0, 2, 3), (res.exit_code, res.output, res.exception)
         if res.exit_code:
@@ -377,21 +451,31 @@ CASES = {
     # bytes of the classic file only: a damaged NetCDF-4 (HDF5) file can hang inside the
     # HDF5 library at open, where no Python signal reaches (a 107-byte shorter file with a
     # few bytes of its superblock replaced did); its numbers are mutated below
-    "netcdf_bytes": (_grid_bytes, byte_mutations(GRID_FILES["NETCDF3_CLASSIC.nc"]).map(
-        lambda b: ("NETCDF3_CLASSIC.nc", b))),
+    "netcdf_bytes": (
+        _grid_bytes,
+        byte_mutations(GRID_FILES["NETCDF3_CLASSIC.nc"]).map(lambda b: ("NETCDF3_CLASSIC.nc", b)),
+    ),
     "netcdf_numbers": (_grid_numbers, grid_numbers()),
     # plan: mostly plausible values, so that many examples are routed
-    "plan": (_plan, number_mutations(PLAN_COURSE, VALUE, ("odd", "float", "scaled", "nudged",
-                                                         "nudged", "nudged", "nudged"))),
+    "plan": (
+        _plan,
+        number_mutations(
+            PLAN_COURSE, VALUE, ("odd", "float", "scaled", "nudged", "nudged", "nudged", "nudged")
+        ),
+    ),
 }
 
 
 def test_unmutated_files_are_valid():
     """Unmutated, every starting file reads (mutations start from a valid file), and plan
     routes."""
-    for case, files in (("course", COURSE_FILES), ("polar", POLAR_FILES),
-                        ("stations", STATION_FILES), ("track", TRACK_FILES),
-                        ("netcdf_bytes", GRID_FILES)):
+    for case, files in (
+        ("course", COURSE_FILES),
+        ("polar", POLAR_FILES),
+        ("stations", STATION_FILES),
+        ("track", TRACK_FILES),
+        ("netcdf_bytes", GRID_FILES),
+    ):
         for name, data in files.items():
             if name != "hyeres-r1.yaml":  # names wind files beside it, absent in a tmp folder
                 assert CASES[case][0]((name, data)) == "ok", (case, name)

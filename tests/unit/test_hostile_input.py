@@ -70,25 +70,32 @@ def billion_laughs(levels: int = 9) -> str:
 # ------------------------------------------------------------------ YAML structure (1, 2, 3)
 def test_recursive_alias_is_refused_with_its_line(tmp_path):
     msg = plan_error(tmp_path, MINIMAL + "x: &r [*r]\n")
-    assert msg == (f"{tmp_path / 'course.yaml'}:{N_MINIMAL + 1}:8: the alias *r is inside the "
-                   "node &r it refers to (a value that contains itself); refer to a finished node")
+    assert msg == (
+        f"{tmp_path / 'course.yaml'}:{N_MINIMAL + 1}:8: the alias *r is inside the "
+        "node &r it refers to (a value that contains itself); refer to a finished node"
+    )
 
 
-@pytest.mark.parametrize("nested", [
-    "{a: " * 2000 + "1" + "}" * 2000,
-    "[" * 5000 + "]" * 5000,
-    "\n".join("  " * k + "a:" for k in range(200)) + " 1",
-])
+@pytest.mark.parametrize(
+    "nested",
+    [
+        "{a: " * 2000 + "1" + "}" * 2000,
+        "[" * 5000 + "]" * 5000,
+        "\n".join("  " * k + "a:" for k in range(200)) + " 1",
+    ],
+)
 def test_deep_nesting_is_refused(tmp_path, nested):
     msg = plan_error(tmp_path, MINIMAL + "x:\n  " + nested.replace("\n", "\n  ") + "\n")
-    assert f"nested more than {MAX_DEPTH} levels deep; a course or boat file needs a few " \
-           "levels" in msg
+    assert (
+        f"nested more than {MAX_DEPTH} levels deep; a course or boat file needs a few levels" in msg
+    )
 
 
 def test_nesting_through_aliases_counts(tmp_path):
     # 10 anchors of depth 6 chained: 60 levels once expanded, although no line is deep
     text = "a0: &a0 [[[[[1]]]]]\n" + "".join(
-        f"a{k}: &a{k} [[[[[*a{k - 1}]]]]]\n" for k in range(1, 10))
+        f"a{k}: &a{k} [[[[[*a{k - 1}]]]]]\n" for k in range(1, 10)
+    )
     msg = plan_error(tmp_path, MINIMAL + text)
     assert "levels deep through the alias *a" in msg
 
@@ -102,21 +109,25 @@ def test_billion_laughs_is_refused_at_once(tmp_path):
 
 
 def test_ordinary_anchors_still_work(tmp_path):
-    text = MINIMAL.replace("scenarios:\n  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n",
-                           "") + (
+    text = MINIMAL.replace("scenarios:\n  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n", "") + (
         "scenarios:\n"
         "  north: &wind {type: uniform, tws_kn: 10, twd_deg: 0}\n"
         "  again: *wind\n"
         "  west: {type: uniform, tws_kn: &tws 10, twd_deg: 270}\n"
-        "  east: {type: uniform, tws_kn: *tws, twd_deg: 90}\n")
+        "  east: {type: uniform, tws_kn: *tws, twd_deg: 90}\n"
+    )
     p = tmp_path / "course.yaml"
     p.write_text(text)
     course = load_course(p)
     assert set(course.scenarios) == {"north", "again", "west", "east"}
     # a file of some 29 000 values once its aliases are expanded reads (4**7 / 3 + keys)
     doc = tmp_path / "wide.yaml"
-    doc.write_text("l0: &l0 [1, 2, 3, 4]\n" + "".join(
-        f"l{k}: &l{k} [*l{k - 1}, *l{k - 1}, *l{k - 1}, *l{k - 1}]\n" for k in range(1, 7)))
+    doc.write_text(
+        "l0: &l0 [1, 2, 3, 4]\n"
+        + "".join(
+            f"l{k}: &l{k} [*l{k - 1}, *l{k - 1}, *l{k - 1}, *l{k - 1}]\n" for k in range(1, 7)
+        )
+    )
     assert np.asarray(read_yaml(doc).data["l6"]).size == 4**7
 
 
@@ -124,28 +135,39 @@ def test_polar_json_nested_100000_deep(tmp_path):
     for text in ("[" * 100_000 + "]" * 100_000, '{"a":' * 100_000 + "1" + "}" * 100_000):
         p = tmp_path / "deep.json"
         p.write_text(text)
-        with pytest.raises(InputError, match=r"deep.json: not a polar: its JSON nests lists or "
-                           r"objects too deeply to read \(a polar file has 3 levels\)$"):
+        with pytest.raises(
+            InputError,
+            match=r"deep.json: not a polar: its JSON nests lists or "
+            r"objects too deeply to read \(a polar file has 3 levels\)$",
+        ):
             read_polar(p)
     msg = plan_error(tmp_path, MINIMAL + "boat: {polar: deep.json}\n")
-    assert msg.endswith("deep.json: not a polar: its JSON nests lists or objects too deeply "
-                        "to read (a polar file has 3 levels)")
+    assert msg.endswith(
+        "deep.json: not a polar: its JSON nests lists or objects too deeply "
+        "to read (a polar file has 3 levels)"
+    )
 
 
 # ------------------------------------------------------------------ text in YAML (4, 11)
-@pytest.mark.parametrize(("escape", "what"), [
-    ("\\ud800", "U+D800 (a lone surrogate)"),
-    ("\\0", "U+0000 (a control character)"),
-    ("\\x1b", "U+001B (a control character)"),
-    ("\\uffff", "U+FFFF (a non-character)"),
-])
+@pytest.mark.parametrize(
+    ("escape", "what"),
+    [
+        ("\\ud800", "U+D800 (a lone surrogate)"),
+        ("\\0", "U+0000 (a control character)"),
+        ("\\x1b", "U+001B (a control character)"),
+        ("\\uffff", "U+FFFF (a non-character)"),
+    ],
+)
 def test_bad_characters_in_names_are_refused(tmp_path, escape, what):
     msg = plan_error(tmp_path, MINIMAL.replace("name: minimal", f'name: "a{escape}b"'))
     assert msg.startswith(f"{tmp_path / 'course.yaml'}:1:7: the text ")
-    assert msg.endswith(f" holds {what}, which no output file can carry; remove it (or the "
-                        "escape that writes it)")
-    msg = plan_error(tmp_path, MINIMAL.replace("  top:", f'  "t{escape}p":').replace(
-        "{to: top}", f'{{to: "t{escape}p"}}'))
+    assert msg.endswith(
+        f" holds {what}, which no output file can carry; remove it (or the escape that writes it)"
+    )
+    msg = plan_error(
+        tmp_path,
+        MINIMAL.replace("  top:", f'  "t{escape}p":').replace("{to: top}", f'{{to: "t{escape}p"}}'),
+    )
     assert f"holds {what}" in msg
 
 
@@ -158,10 +180,13 @@ def test_tab_and_line_breaks_in_text_are_fine(tmp_path):
 # ------------------------------------------------------------------ coordinates (5)
 def test_mark_at_1e20_is_refused_with_its_key(tmp_path):
     text = "origin: {lat: 45, lon: 13}\n" + MINIMAL.replace(
-        "top: {lat: 45.0090, lon: 13.0010}", "top: {x: 1e20, y: 0}")
+        "top: {lat: 45.0090, lon: 13.0010}", "top: {x: 1e20, y: 0}"
+    )
     msg = plan_error(tmp_path, text)
-    assert msg == (f"{tmp_path / 'course.yaml'}:7: marks.top.x: expected metres east of the "
-                   "origin, in [-100000, 100000]; got 1e+20")
+    assert msg == (
+        f"{tmp_path / 'course.yaml'}:7: marks.top.x: expected metres east of the "
+        "origin, in [-100000, 100000]; got 1e+20"
+    )
 
 
 def test_marks_far_apart_in_degrees_are_refused(tmp_path):
@@ -170,29 +195,36 @@ def test_marks_far_apart_in_degrees_are_refused(tmp_path):
     p.write_text(text)
     with pytest.raises(InputError) as exc:
         load_course(p)
-    assert ("marks.top: mark 'top' (48.009000, 13.001000) lies 223 km from the course's "
-            "centre (46.003000, 13.001000, the mean of the marks' lat/lon); expected every "
-            "mark within 100 km of it") in str(exc.value)
+    assert (
+        "marks.top: mark 'top' (48.009000, 13.001000) lies 223 km from the course's "
+        "centre (46.003000, 13.001000, the mean of the marks' lat/lon); expected every "
+        "mark within 100 km of it"
+    ) in str(exc.value)
 
 
 def test_template_lengths_are_bounded(tmp_path):
-    text = ("name: t\nstart_time: 2024-05-01T10:00:00Z\ntemplate: {type: windward-leeward, "
-            "twd_deg: 0, leg_length_m: 1e300, centre: {lat: 45, lon: 13}}\n"
-            "scenarios:\n  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n")
+    text = (
+        "name: t\nstart_time: 2024-05-01T10:00:00Z\ntemplate: {type: windward-leeward, "
+        "twd_deg: 0, leg_length_m: 1e300, centre: {lat: 45, lon: 13}}\n"
+        "scenarios:\n  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n"
+    )
     msg = plan_error(tmp_path, text)
-    assert msg.endswith(":3: template.leg_length_m: expected at most 100000 m (a buoy course "
-                        "spans a few km); got 1e+300")
+    assert msg.endswith(
+        ":3: template.leg_length_m: expected at most 100000 m (a buoy course "
+        "spans a few km); got 1e+300"
+    )
 
 
 # ------------------------------------------------------------------ timestamps (7)
-@pytest.mark.parametrize("stamp", ["2024-02-30T10:00:00Z", "2024-05-01T10:00:60Z",
-                                   "2024-02-30"])
+@pytest.mark.parametrize("stamp", ["2024-02-30T10:00:00Z", "2024-05-01T10:00:60Z", "2024-02-30"])
 def test_unquoted_impossible_time_gets_the_quoted_message(tmp_path, stamp):
     bare = plan_error(tmp_path, MINIMAL.replace("2024-05-01T10:00:00Z", stamp))
     quoted = plan_error(tmp_path, MINIMAL.replace("2024-05-01T10:00:00Z", f'"{stamp}"'))
     assert bare == quoted
-    assert bare.endswith(f":2: start_time: cannot read {stamp!r} as an ISO 8601 time; "
-                         "expected e.g. '2018-04-24T12:10:00+02:00'")
+    assert bare.endswith(
+        f":2: start_time: cannot read {stamp!r} as an ISO 8601 time; "
+        "expected e.g. '2018-04-24T12:10:00+02:00'"
+    )
 
 
 # ------------------------------------------------------------------ CSV quoting (8)
@@ -202,32 +234,41 @@ ROW = "2024-05-01T10:{m:02d}:00Z,A,45.004,13.001,8.0,0\n"
 
 def station_course(tmp_path: Path, csv_text: str) -> str:
     (tmp_path / "st.csv").write_text(csv_text)
-    return MINIMAL.replace("north: {type: uniform, tws_kn: 10, twd_deg: 0}",
-                           "st: {type: stations, path: st.csv}")
+    return MINIMAL.replace(
+        "north: {type: uniform, tws_kn: 10, twd_deg: 0}", "st: {type: stations, path: st.csv}"
+    )
 
 
 def test_station_csv_with_a_stray_quote(tmp_path):
     text = STATIONS_HEAD + ROW.format(m=0) + '2024-05-01T10:01:00Z,A,45.004,13.001,4.10,"61\n'
     msg = plan_error(tmp_path, station_course(tmp_path, text + ROW.format(m=2)))
-    assert msg.endswith("st.csv, line 3: cannot split the line into fields (unexpected end of "
-                        "data); check its quotes: a field that starts with \" must end with \" "
-                        "before the next ','")
+    assert msg.endswith(
+        "st.csv, line 3: cannot split the line into fields (unexpected end of "
+        'data); check its quotes: a field that starts with " must end with " '
+        "before the next ','"
+    )
 
 
 def test_large_station_csv_with_a_stray_quote(tmp_path):
     # was "_csv.Error: field larger than field limit": the quote swallowed the file
-    text = (STATIONS_HEAD + '2024-05-01T09:59:00Z,A,45.004,13.001,4.10,"61\n'
-            + "".join(ROW.format(m=m % 60) for m in range(20_000)))
+    text = (
+        STATIONS_HEAD
+        + '2024-05-01T09:59:00Z,A,45.004,13.001,4.10,"61\n'
+        + "".join(ROW.format(m=m % 60) for m in range(20_000))
+    )
     msg = plan_error(tmp_path, station_course(tmp_path, text))
-    assert msg.endswith("st.csv, line 2: cannot split the line into fields (unexpected end of "
-                        "data); check its quotes: a field that starts with \" must end with \" "
-                        "before the next ','")
+    assert msg.endswith(
+        "st.csv, line 2: cannot split the line into fields (unexpected end of "
+        'data); check its quotes: a field that starts with " must end with " '
+        "before the next ','"
+    )
 
 
 def test_track_and_polar_csv_with_a_stray_quote(tmp_path):
     track = tmp_path / "t.csv"
-    track.write_text("time,lat,lon\n2024-05-01T10:00:00Z,45.0,13.0\n"
-                     '2024-05-01T10:00:01Z,45.0,"13.0001\n' * 2000)
+    track.write_text(
+        'time,lat,lon\n2024-05-01T10:00:00Z,45.0,13.0\n2024-05-01T10:00:01Z,45.0,"13.0001\n' * 2000
+    )
     with pytest.raises(InputError, match=r"t.csv, line 3: cannot split the line into fields"):
         read_track(track)
     polar = tmp_path / "p.csv"
@@ -242,15 +283,19 @@ def test_quoted_fields_still_read():
 
 
 # ------------------------------------------------------------------ file contents (16)
-PASSWD = ("root:x:0:0:root:/root:/bin/bash\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n"
-          "secret:x:1000:1000:Secret Person,,,:/home/secret:/bin/bash\n")
+PASSWD = (
+    "root:x:0:0:root:/root:/bin/bash\ndaemon:x:1:1:daemon:/usr/sbin:/usr/sbin/nologin\n"
+    "secret:x:1000:1000:Secret Person,,,:/home/secret:/bin/bash\n"
+)
 
 
 def test_a_file_of_another_kind_is_not_printed(tmp_path):
     msg = plan_error(tmp_path, station_course(tmp_path, PASSWD))
-    assert msg.endswith("st.csv: not a station CSV: line 1 is not a header of column names; "
-                        "expected a header row such as time,station,lat,lon,speed_kn,direction "
-                        "(names and aliases: docs/course-format.md)")
+    assert msg.endswith(
+        "st.csv: not a station CSV: line 1 is not a header of column names; "
+        "expected a header row such as time,station,lat,lon,speed_kn,direction "
+        "(names and aliases: docs/course-format.md)"
+    )
     for word in ("root:x", "daemon", "Secret Person", "/bin/bash"):
         assert word not in msg
     track = tmp_path / "passwd"
@@ -264,8 +309,11 @@ def test_a_file_of_another_kind_is_not_printed(tmp_path):
 def test_a_binary_file_is_not_printed(tmp_path):
     blob = tmp_path / "st.csv"
     blob.write_bytes(b"\x7fELF\x02\x01\x01\x00" + bytes(range(256)) * 8)
-    with pytest.raises(InputError, match=r"st.csv: not a text file \(binary content\)$|"
-                       r"st.csv: not a text file \(binary content\); expected a station CSV"):
+    with pytest.raises(
+        InputError,
+        match=r"st.csv: not a text file \(binary content\)$|"
+        r"st.csv: not a text file \(binary content\); expected a station CSV",
+    ):
         read_stations(blob)
     with pytest.raises(InputError, match=r"not a text file \(binary content\); expected a GPX"):
         read_track(blob)
@@ -273,8 +321,10 @@ def test_a_binary_file_is_not_printed(tmp_path):
 
 def test_a_csv_header_is_quoted_short_and_clean(tmp_path):
     p = tmp_path / "st.csv"
-    p.write_text("time,station,lat,lon,spd,dir" + ",x" * 200 + "\n"
-                 "2024-05-01T10:00:00Z,A,45,13,8,0" + ",1" * 200 + "\n")
+    p.write_text(
+        "time,station,lat,lon,spd,dir" + ",x" * 200 + "\n"
+        "2024-05-01T10:00:00Z,A,45,13,8,0" + ",1" * 200 + "\n"
+    )
     with pytest.raises(InputError) as exc:
         read_stations(p)
     msg = str(exc.value)
@@ -357,8 +407,7 @@ def write_grid(path: Path, ny: int, nx: int) -> None:
             v = ds.createVariable(name, "f8", (dim,))
             v.units, v.standard_name = units, name
             v[:] = values
-        for name, std, value in (("u10", "eastward_wind", 0.0),
-                                 ("v10", "northward_wind", -5.0)):
+        for name, std, value in (("u10", "eastward_wind", 0.0), ("v10", "northward_wind", -5.0)):
             v = ds.createVariable(name, "f4", ("time", "latitude", "longitude"))
             v.units, v.standard_name = "m s-1", std
             v[:] = value
@@ -368,11 +417,14 @@ def write_grid(path: Path, ny: int, nx: int) -> None:
 @pytest.mark.parametrize(("ny", "nx"), [(1, 1), (1, 4)])
 def test_one_point_grid_is_refused_before_any_arithmetic(tmp_path, ny, nx):
     write_grid(tmp_path / "g.nc", ny, nx)
-    text = MINIMAL.replace("north: {type: uniform, tws_kn: 10, twd_deg: 0}",
-                           "grid: {type: netcdf, path: g.nc}")
+    text = MINIMAL.replace(
+        "north: {type: uniform, tws_kn: 10, twd_deg: 0}", "grid: {type: netcdf, path: g.nc}"
+    )
     msg = plan_error(tmp_path, text)
-    assert f"g.nc: the wind grid has {ny} x {nx} points (rows x columns); a gridded wind " \
-           "field needs at least 2 x 2 to interpolate between them" in msg
+    assert (
+        f"g.nc: the wind grid has {ny} x {nx} points (rows x columns); a gridded wind "
+        "field needs at least 2 x 2 to interpolate between them" in msg
+    )
     assert "nan" not in msg
 
 
@@ -385,37 +437,58 @@ def test_integer_too_long_for_a_float(tmp_path, digits):
 
 
 def test_template_length_below_a_metre(tmp_path):
-    text = ("name: t\nstart_time: 2024-05-01T10:00:00Z\ntemplate: {type: windward-leeward, "
-            "twd_deg: 0, leg_length_m: 2.2e-313, centre: {lat: 45, lon: 13}}\n"
-            "scenarios:\n  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n")
+    text = (
+        "name: t\nstart_time: 2024-05-01T10:00:00Z\ntemplate: {type: windward-leeward, "
+        "twd_deg: 0, leg_length_m: 2.2e-313, centre: {lat: 45, lon: 13}}\n"
+        "scenarios:\n  north: {type: uniform, tws_kn: 10, twd_deg: 0}\n"
+    )
     assert plan_error(tmp_path, text).endswith(
-        ":3: template.leg_length_m: expected at least 1 m; got 2.2e-313")
+        ":3: template.leg_length_m: expected at least 1 m; got 2.2e-313"
+    )
 
 
 def grid_course(tmp_path: Path, **overrides: object) -> str:
-    kw: dict[str, object] = {"lat": 45.004 + 0.01 * np.arange(2),
-                             "lon": 13.001 + 0.01 * np.arange(2), "hours": [0.0, 1.0, 2.0],
-                             "u": np.zeros((3, 2, 2)), "v": np.full((3, 2, 2), -5.0)}
+    kw: dict[str, object] = {
+        "lat": 45.004 + 0.01 * np.arange(2),
+        "lon": 13.001 + 0.01 * np.arange(2),
+        "hours": [0.0, 1.0, 2.0],
+        "u": np.zeros((3, 2, 2)),
+        "v": np.full((3, 2, 2), -5.0),
+    }
     kw.update(overrides)
     from tests.unit.test_fuzz_inputs import write_grid as write_cf_grid
 
-    write_cf_grid(tmp_path / "g.nc", "NETCDF3_CLASSIC", kw["lat"], kw["lon"], kw["hours"],
-               kw["u"], kw["v"])
-    return MINIMAL.replace("north: {type: uniform, tws_kn: 10, twd_deg: 0}",
-                           "grid: {type: netcdf, path: g.nc, clamp: true}")
+    write_cf_grid(
+        tmp_path / "g.nc", "NETCDF3_CLASSIC", kw["lat"], kw["lon"], kw["hours"], kw["u"], kw["v"]
+    )
+    return MINIMAL.replace(
+        "north: {type: uniform, tws_kn: 10, twd_deg: 0}",
+        "grid: {type: netcdf, path: g.nc, clamp: true}",
+    )
 
 
 @pytest.mark.filterwarnings("error")
-@pytest.mark.parametrize(("overrides", "expected"), [
-    ({"hours": [0.0, np.nan, 2.0]}, "time variable time has 1 missing or non-finite value(s) "
-                                    "(the first at index 1); every time step needs its time"),
-    ({"u": np.full((3, 2, 2), np.inf)}, "u10 and v10 give a wind of inf m/s; expected at most "
-                                        "500 m/s"),
-    ({"u": np.full((3, 2, 2), 9999.0)}, "give a wind of 9999 m/s; expected at most 500 m/s "
-                                        "(check speed_unit; a value that marks missing data "
-                                        "needs the variable's _FillValue"),
-    ({"lon": [13.0, 573.0]}, "longitude has values outside [-180, 360] degrees (13 .. 573)"),
-])
+@pytest.mark.parametrize(
+    ("overrides", "expected"),
+    [
+        (
+            {"hours": [0.0, np.nan, 2.0]},
+            "time variable time has 1 missing or non-finite value(s) "
+            "(the first at index 1); every time step needs its time",
+        ),
+        (
+            {"u": np.full((3, 2, 2), np.inf)},
+            "u10 and v10 give a wind of inf m/s; expected at most 500 m/s",
+        ),
+        (
+            {"u": np.full((3, 2, 2), 9999.0)},
+            "give a wind of 9999 m/s; expected at most 500 m/s "
+            "(check speed_unit; a value that marks missing data "
+            "needs the variable's _FillValue",
+        ),
+        ({"lon": [13.0, 573.0]}, "longitude has values outside [-180, 360] degrees (13 .. 573)"),
+    ],
+)
 def test_grid_numbers_that_cannot_be_wind(tmp_path, overrides, expected):
     assert expected in plan_error(tmp_path, grid_course(tmp_path, **overrides))
 
@@ -427,8 +500,10 @@ def test_damaged_classic_netcdf_header(tmp_path):
     data[12:16] = b"\x7f\xff\xff\xff"  # ... claims 2**31 - 1 dimensions
     (tmp_path / "g.nc").write_bytes(bytes(data))
     msg = plan_error(tmp_path, text)
-    assert "g.nc: damaged NetCDF file: it lists 2147483647 items at offset 16, more than the " \
-           "file holds; expected a complete classic NetCDF file" in msg
+    assert (
+        "g.nc: damaged NetCDF file: it lists 2147483647 items at offset 16, more than the "
+        "file holds; expected a complete classic NetCDF file" in msg
+    )
 
 
 def test_polar_and_track_numbers_past_a_float(tmp_path):
@@ -439,8 +514,12 @@ def test_polar_and_track_numbers_past_a_float(tmp_path):
     with pytest.raises(InputError, match=r"orc.json: not an ORC certificate polar.*OverflowError"):
         read_polar(p)
     t = tmp_path / "t.csv"
-    t.write_text("time,lat,lon,cog\n2024-05-01T10:00:00Z,45,13,1e309\n"
-                 "2024-05-01T10:00:01Z,45,13.0001,10\n")
-    with pytest.raises(InputError, match=r"t.csv, line 2, column 'cog': '1e309' is not a finite "
-                       r"number; replace it with a value or a missing marker"):
+    t.write_text(
+        "time,lat,lon,cog\n2024-05-01T10:00:00Z,45,13,1e309\n2024-05-01T10:00:01Z,45,13.0001,10\n"
+    )
+    with pytest.raises(
+        InputError,
+        match=r"t.csv, line 2, column 'cog': '1e309' is not a finite "
+        r"number; replace it with a value or a missing marker",
+    ):
         read_track(t)

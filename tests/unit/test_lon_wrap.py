@@ -29,8 +29,11 @@ scenarios:
 
 
 def test_wrap_lon_range() -> None:
-    np.testing.assert_allclose(wrap_lon([288.67, 180.0, -180.0, 360.0, 179.5]),
-                               [-71.33, -180.0, -180.0, 0.0, 179.5], atol=1e-9)
+    np.testing.assert_allclose(
+        wrap_lon([288.67, 180.0, -180.0, 360.0, 179.5]),
+        [-71.33, -180.0, -180.0, 0.0, 179.5],
+        atol=1e-9,
+    )
     assert wrap_lon(288.67) == pytest.approx(-71.33)
 
 
@@ -43,12 +46,15 @@ def test_local_frame_latlon_stays_in_gpx_range() -> None:
 
 def test_0_360_course_gives_the_same_files_as_minus_180_180(tmp_path) -> None:
     out = {}
-    for tag, (pin, boat, top) in {"east": (288.670, 288.672, 288.674),
-                                  "west": (-71.330, -71.328, -71.326)}.items():
+    for tag, (pin, boat, top) in {
+        "east": (288.670, 288.672, 288.674),
+        "west": (-71.330, -71.328, -71.326),
+    }.items():
         course = tmp_path / f"{tag}.yaml"
         course.write_text(COURSE.format(pin=pin, boat=boat, top=top))
-        res = CliRunner().invoke(app, ["plan", str(course), "-q", "--no-plots",
-                                       "--out", str(tmp_path / tag)])
+        res = CliRunner().invoke(
+            app, ["plan", str(course), "-q", "--no-plots", "--out", str(tmp_path / tag)]
+        )
         assert res.exit_code == 0, res.output
         out[tag] = tmp_path / tag
     # GPX 1.1 longitudeType is [-180, 180): every point of both files is in range

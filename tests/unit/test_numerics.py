@@ -116,8 +116,14 @@ def test_hermite_crossing_inverts_a_monotone_step() -> None:
     t_true = np.linspace(0.0, 1.0, 9)
     n = t_true.size
     one = np.ones(n)
-    th = hermite_crossing(s(x0) * one, s(x0 + h) * one, s.deriv()(x0) * one,
-                          s.deriv()(x0 + h) * one, h * one, s(x0 + t_true * h))
+    th = hermite_crossing(
+        s(x0) * one,
+        s(x0 + h) * one,
+        s.deriv()(x0) * one,
+        s.deriv()(x0 + h) * one,
+        h * one,
+        s(x0 + t_true * h),
+    )
     np.testing.assert_allclose(th, t_true, rtol=0, atol=1e-13)
 
 

@@ -28,8 +28,13 @@ from sailroute.units import speed_factor
 from sailroute.wind.stations import read_stations
 
 # few examples, the same ones every run: together these tests take about a second
-FAST = settings(max_examples=50, derandomize=True, database=None, deadline=None,
-                suppress_health_check=[HealthCheck.too_slow])
+FAST = settings(
+    max_examples=50,
+    derandomize=True,
+    database=None,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
 
 WRITERS = {
     "pol": (write_pol, ".pol"),
@@ -38,8 +43,9 @@ WRITERS = {
 }
 
 
-def _increasing(draw: st.DrawFn, n: int, first: st.SearchStrategy[float],
-                gap: st.SearchStrategy[float]) -> np.ndarray:
+def _increasing(
+    draw: st.DrawFn, n: int, first: st.SearchStrategy[float], gap: st.SearchStrategy[float]
+) -> np.ndarray:
     steps = draw(st.lists(gap, min_size=n - 1, max_size=n - 1))
     return draw(first) + np.concatenate([[0.0], np.cumsum(steps)])
 
@@ -48,11 +54,17 @@ def _increasing(draw: st.DrawFn, n: int, first: st.SearchStrategy[float],
 def polars(draw: st.DrawFn) -> Polar:
     """Polars the readers accept: TWA in [0, 170], TWS up to 25 m/s, speeds up to 30 m/s."""
     n_twa, n_tws = draw(st.integers(2, 7)), draw(st.integers(1, 5))
-    twa = _increasing(draw, n_twa, st.one_of(st.just(0.0), st.floats(0.01, 15.0)),
-                      st.floats(0.01, 25.0))
+    twa = _increasing(
+        draw, n_twa, st.one_of(st.just(0.0), st.floats(0.01, 15.0)), st.floats(0.01, 25.0)
+    )
     tws = _increasing(draw, n_tws, st.floats(0.1, 5.0), st.floats(0.05, 5.0))
-    cells = draw(st.lists(st.floats(0.0, 30.0, allow_subnormal=False),
-                          min_size=n_twa * n_tws, max_size=n_twa * n_tws))
+    cells = draw(
+        st.lists(
+            st.floats(0.0, 30.0, allow_subnormal=False),
+            min_size=n_twa * n_tws,
+            max_size=n_twa * n_tws,
+        )
+    )
     # the readers refuse a polar without speed: one cell (any) is positive
     cells[draw(st.integers(0, len(cells) - 1))] = draw(st.floats(0.1, 30.0))
     return Polar.from_arrays(twa, tws, np.reshape(cells, (n_twa, n_tws)), name="p")
@@ -81,18 +93,22 @@ UTC_OFFSETS_MIN = st.integers(-14 * 4, 14 * 4).map(lambda q: 15 * q)
 @st.composite
 def station_rows(draw: st.DrawFn) -> list[dict]:
     """Rows of up to 3 stations at distinct whole-second times, some with a missing speed."""
-    times = draw(st.lists(st.integers(1_500_000_000, 1_900_000_000), min_size=1, max_size=12,
-                          unique=True))
-    rows = [{
-        "t": t,
-        "offset_min": draw(UTC_OFFSETS_MIN),
-        "station": draw(st.sampled_from(["A", "B", "S-3"])),
-        "lat": draw(st.floats(-90.0, 90.0)),
-        "lon": draw(st.floats(-180.0, 360.0)),
-        "speed": draw(st.floats(0.0, 60.0)),
-        "direction": draw(st.floats(0.0, 360.0)),
-        "missing": draw(st.booleans()),
-    } for t in sorted(times)]
+    times = draw(
+        st.lists(st.integers(1_500_000_000, 1_900_000_000), min_size=1, max_size=12, unique=True)
+    )
+    rows = [
+        {
+            "t": t,
+            "offset_min": draw(UTC_OFFSETS_MIN),
+            "station": draw(st.sampled_from(["A", "B", "S-3"])),
+            "lat": draw(st.floats(-90.0, 90.0)),
+            "lon": draw(st.floats(-180.0, 360.0)),
+            "speed": draw(st.floats(0.0, 60.0)),
+            "direction": draw(st.floats(0.0, 360.0)),
+            "missing": draw(st.booleans()),
+        }
+        for t in sorted(times)
+    ]
     assume(not all(r["missing"] for r in rows))
     return rows
 
@@ -105,8 +121,7 @@ def test_station_csv_rows_read_back(rows: list[dict], unit: str) -> None:
         tz = timezone(timedelta(minutes=r["offset_min"]))
         stamp = datetime.fromtimestamp(r["t"], tz).isoformat()
         speed = "NA" if r["missing"] else repr(r["speed"])
-        lines.append(f"{stamp},{r['station']},{r['lat']!r},{r['lon']!r},{speed},"
-                     f"{r['direction']!r}")
+        lines.append(f"{stamp},{r['station']},{r['lat']!r},{r['lon']!r},{speed},{r['direction']!r}")
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "stations.csv"
         path.write_text("\n".join(lines) + "\n")
@@ -122,9 +137,9 @@ def test_station_csv_rows_read_back(rows: list[dict], unit: str) -> None:
     np.testing.assert_array_equal(data.lat, [r["lat"] for r in kept])
     np.testing.assert_array_equal(data.lon, [r["lon"] for r in kept])
     np.testing.assert_array_equal(
-        data.speed_ms, np.array([r["speed"] for r in kept]) * speed_factor(unit))
-    np.testing.assert_array_equal(data.direction_deg,
-                                  np.mod([r["direction"] for r in kept], 360.0))
+        data.speed_ms, np.array([r["speed"] for r in kept]) * speed_factor(unit)
+    )
+    np.testing.assert_array_equal(data.direction_deg, np.mod([r["direction"] for r in kept], 360.0))
 
 
 COURSE = """\
@@ -147,18 +162,30 @@ WGS84 = Geod(ellps="WGS84")
 
 
 @FAST
-@given(lat0=st.floats(-80.0, 80.0), lon0=st.floats(-180.0, 359.98),
-       d_boat=st.floats(0.001, 0.01), d_top=st.tuples(st.floats(0.001, 0.01),
-                                                      st.floats(-0.01, 0.01)))
+@given(
+    lat0=st.floats(-80.0, 80.0),
+    lon0=st.floats(-180.0, 359.98),
+    d_boat=st.floats(0.001, 0.01),
+    d_top=st.tuples(st.floats(0.001, 0.01), st.floats(-0.01, 0.01)),
+)
 @example(lat0=45.0, lon0=179.9995, d_boat=0.002, d_top=(0.009, 0.001))  # across 180
 @example(lat0=-17.8, lon0=-180.0, d_boat=0.003, d_top=(0.01, -0.002))  # -180 itself
-def test_course_marks_wrap_and_keep_distances(lat0: float, lon0: float, d_boat: float,
-                                              d_top: tuple[float, float]) -> None:
-    given_ll = {"pin": (lat0, lon0), "boat": (lat0, lon0 + d_boat),
-                "top": (lat0 + d_top[0], lon0 + d_top[1])}
+def test_course_marks_wrap_and_keep_distances(
+    lat0: float, lon0: float, d_boat: float, d_top: tuple[float, float]
+) -> None:
+    given_ll = {
+        "pin": (lat0, lon0),
+        "boat": (lat0, lon0 + d_boat),
+        "top": (lat0 + d_top[0], lon0 + d_top[1]),
+    }
     assume(given_ll["top"][1] >= -180.0)
-    text = COURSE.format(lat0=lat0, lon0=lon0, lon1=given_ll["boat"][1],
-                         lat2=given_ll["top"][0], lon2=given_ll["top"][1])
+    text = COURSE.format(
+        lat0=lat0,
+        lon0=lon0,
+        lon1=given_ll["boat"][1],
+        lat2=given_ll["top"][0],
+        lon2=given_ll["top"][1],
+    )
     with tempfile.TemporaryDirectory() as d:
         path = Path(d) / "course.yaml"
         path.write_text(text)
@@ -178,7 +205,7 @@ def test_course_marks_wrap_and_keep_distances(lat0: float, lon0: float, d_boat: 
     # distances in the local frame are the geodesic ones (to 1 mm)
     names = list(given_ll)
     for i, a in enumerate(names):
-        for b in names[i + 1:]:
+        for b in names[i + 1 :]:
             ma, mb = course.marks[a], course.marks[b]
             _, _, dist = WGS84.inv(ma.lon, ma.lat, mb.lon, mb.lat)
             assert abs(np.hypot(mb.x - ma.x, mb.y - ma.y) - dist) < 1e-3

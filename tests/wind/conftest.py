@@ -75,10 +75,15 @@ def tiny_wrf(tmp_path: Path) -> Callable[..., Path]:
         t = T0 + 600.0 * np.arange(4) if times is None else np.asarray(times, float)
         w10 = wind10 or constant_wind(5.0, 150.0)
         wat = wind_at or power_profile(5.0, 150.0, 0.15)
-        return write_wrfout(tmp_path / name, grid, t, w10,
-                            level_heights_m=level_heights_m,
-                            wind_at=wat if level_heights_m is not None else None,
-                            write_alpha=write_alpha)
+        return write_wrfout(
+            tmp_path / name,
+            grid,
+            t,
+            w10,
+            level_heights_m=level_heights_m,
+            wind_at=wat if level_heights_m is not None else None,
+            write_alpha=write_alpha,
+        )
 
     return make
 
@@ -87,9 +92,12 @@ def tiny_wrf(tmp_path: Path) -> Callable[..., Path]:
 def station_csv(tmp_path: Path) -> Callable[..., Path]:
     """Factory writing a station CSV from a header and rows (lists of cells)."""
 
-    def make(rows: Sequence[Sequence[object]], header: Sequence[str] = (
-            "time", "station", "lat", "lon", "speed", "direction"), name: str = "st.csv",
-            sep: str = ",") -> Path:
+    def make(
+        rows: Sequence[Sequence[object]],
+        header: Sequence[str] = ("time", "station", "lat", "lon", "speed", "direction"),
+        name: str = "st.csv",
+        sep: str = ",",
+    ) -> Path:
         p = tmp_path / name
         lines = [sep.join(header)] + [sep.join(str(c) for c in r) for r in rows]
         p.write_text("\n".join(lines) + "\n")

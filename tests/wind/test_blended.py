@@ -36,8 +36,16 @@ def obs(xy, speeds, dirs, times=None, height=np.nan) -> StationData:
         s += list(sp)
         d += list((di - gn) % 360.0)
     n = len(tt)
-    return StationData(np.array(ids), np.array(tt), np.array(la), np.array(lo), np.array(s),
-                       np.array(d), np.full(n, height), np.full(n, np.nan))
+    return StationData(
+        np.array(ids),
+        np.array(tt),
+        np.array(la),
+        np.array(lo),
+        np.array(s),
+        np.array(d),
+        np.full(n, height),
+        np.full(n, np.nan),
+    )
 
 
 def speed_dir(f, t, x, y):
@@ -59,8 +67,12 @@ def test_full_correction_at_station_and_decay_with_distance() -> None:
 
 
 def test_nearby_stations_are_averaged_not_added() -> None:
-    b = BlendedWind(BASE, obs([(-100.0, 0.0), (100.0, 0.0)], [6.0, 6.0], [160.0, 160.0]),
-                    FRAME, length_scale_m=1000.0)
+    b = BlendedWind(
+        BASE,
+        obs([(-100.0, 0.0), (100.0, 0.0)], [6.0, 6.0], [160.0, 160.0]),
+        FRAME,
+        length_scale_m=1000.0,
+    )
     s, d = speed_dir(b, T0 + 900.0, 0.0, 0.0)  # sum of weights ~2: normalised, not doubled
     assert s == pytest.approx(6.0, rel=1e-6) and d == pytest.approx(160.0, abs=1e-3)
 
@@ -83,8 +95,9 @@ def test_time_smoothing_and_taper() -> None:
 
 def test_window_mean_ignores_invalid() -> None:
     t = np.arange(5.0)
-    out = window_mean(t, np.array([1.0, 100.0, 3.0, 5.0, 7.0]),
-                      np.array([True, False, True, True, True]), 2.0)
+    out = window_mean(
+        t, np.array([1.0, 100.0, 3.0, 5.0, 7.0]), np.array([True, False, True, True, True]), 2.0
+    )
     np.testing.assert_allclose(out, [1.0, 2.0, 4.0, 5.0, 6.0])
 
 
@@ -99,8 +112,7 @@ def test_calm_and_extreme_observations_are_guarded() -> None:
 
 
 def test_with_wrf_base_and_height(tiny_wrf, frame) -> None:
-    wrf = open_wrf(tiny_wrf(wind10=constant_wind(5.0, 150.0)), frame, height_m=2.68,
-                   levels="u10")
+    wrf = open_wrf(tiny_wrf(wind10=constant_wind(5.0, 150.0)), frame, height_m=2.68, levels="u10")
     s_wrf = 5.0 * 0.268 ** (1 / 7)
     # Observed 6 m/s at 7.5 m -> at 2.68 m with 1/7: 6 (2.68/7.5)^(1/7)
     b = BlendedWind(wrf, obs([(0.0, 0.0)], [6.0], [150.0], height=7.5), frame, height_m=2.68)

@@ -40,10 +40,22 @@ def expected_local(frame, x, y, k=1.0):
     return earth_to_local(ue_f(lat, lon, k), ve_f(lat, lon, k), frame.grid_north_deg(lat, lon))
 
 
-def write_cf(path: Path, *, lats=None, lons=None, times=(0.0, 3600.0, 7200.0), factors=None,
-             names=("u10", "v10"), std=("eastward_wind", "northward_wind"), units="m s-1",
-             kind="uv", land=None, height=10.0, time_units="seconds since 2014-10-07 12:00:00",
-             extra_dim=0) -> Path:
+def write_cf(
+    path: Path,
+    *,
+    lats=None,
+    lons=None,
+    times=(0.0, 3600.0, 7200.0),
+    factors=None,
+    names=("u10", "v10"),
+    std=("eastward_wind", "northward_wind"),
+    units="m s-1",
+    kind="uv",
+    land=None,
+    height=10.0,
+    time_units="seconds since 2014-10-07 12:00:00",
+    extra_dim=0,
+) -> Path:
     """A CF file with 1-D lat/lon axes (descending latitude by default)."""
     lats = np.arange(43.3, 42.69, -0.05) if lats is None else np.asarray(lats)
     lons = np.arange(6.6, 7.41, 0.05) if lons is None else np.asarray(lons)
@@ -93,8 +105,10 @@ def write_cf(path: Path, *, lats=None, lons=None, times=(0.0, 3600.0, 7200.0), f
         if extra_dim:
             a = np.broadcast_to(a, (extra_dim, *a.shape))
             b = np.broadcast_to(b, (extra_dim, *b.shape))
-        for name, s, arr, un in ((names[0], std[0], a, units),
-                                 (names[1], std[1], b, "degree" if kind == "sd" else units)):
+        for name, s, arr, un in (
+            (names[0], std[0], a, units),
+            (names[1], std[1], b, "degree" if kind == "sd" else units),
+        ):
             var = ds.createVariable(name, "f4", dims, fill_value=np.float32(1e20))
             if s:
                 var.standard_name = s
@@ -134,8 +148,13 @@ def test_longitudes_0_to_360_across_the_seam(tmp_path) -> None:
     # of 0 deg are at the far end of the file
     lons = np.arange(0.0, 360.0, 0.5)
     # (half the test field: at the seam it reaches 160 m/s, which the reader refuses)
-    p = write_cf(tmp_path / "g.nc", lats=np.arange(44.0, 42.0, -0.25), lons=lons,
-                 times=(0.0,), factors=(0.5,))
+    p = write_cf(
+        tmp_path / "g.nc",
+        lats=np.arange(44.0, 42.0, -0.25),
+        lons=lons,
+        times=(0.0,),
+        factors=(0.5,),
+    )
     frame = LocalFrame(43.0, 0.0)
     f = open_netcdf(p, frame, bbox=(-20000.0, 20000.0, -20000.0, 20000.0), steady=True)
     assert f.shape[2] < 20  # cropped around the seam, not the whole globe
@@ -143,15 +162,15 @@ def test_longitudes_0_to_360_across_the_seam(tmp_path) -> None:
     lat, lon = frame.to_latlon(x, y)
     assert lon.min() < 0 < lon.max()
     u, v = f.sample(T0 + 1e6, x, y)  # steady: any time
-    eu, ev = earth_to_local(ue_f(lat, lon, 0.5), ve_f(lat, lon, 0.5),
-                            frame.grid_north_deg(lat, lon))
+    eu, ev = earth_to_local(
+        ue_f(lat, lon, 0.5), ve_f(lat, lon, 0.5), frame.grid_north_deg(lat, lon)
+    )
     np.testing.assert_allclose(u, eu, atol=2e-2)  # 0.5 deg cells: index map misfit ~0.01 cell
     np.testing.assert_allclose(v, ev, atol=2e-2)
 
 
 def test_speed_direction_in_knots_and_explicit_names(tmp_path) -> None:
-    p = write_cf(tmp_path / "sd.nc", names=("WS", "WD"), std=("", ""), units="knots",
-                 kind="sd")
+    p = write_cf(tmp_path / "sd.nc", names=("WS", "WD"), std=("", ""), units="knots", kind="sd")
     with pytest.raises(WindDataError, match=r"no wind variables found.*found: .*WS, WD"):
         read_cf_header(p)
     f = open_netcdf(p, FRAME, bbox=BOX, variables={"speed": "WS", "direction": "WD"})
@@ -173,8 +192,12 @@ def test_curvilinear_x_y_order_and_height_correction(tmp_path) -> None:
         ds.ref_time = "2014-10-07T12:00:00"
         ds.createDimension("x", 30)
         ds.createDimension("y", 25)
-        for name, arr in (("lat", lat), ("lon", lon), ("u10", ue_f(lat, lon)),
-                          ("v10", ve_f(lat, lon))):
+        for name, arr in (
+            ("lat", lat),
+            ("lon", lon),
+            ("u10", ue_f(lat, lon)),
+            ("v10", ve_f(lat, lon)),
+        ):
             v = ds.createVariable(name, "f8", ("x", "y"))
             v[:] = arr
     hdr = read_cf_header(p)
@@ -222,8 +245,14 @@ def test_routing_into_nan_cells_raises(tmp_path) -> None:
     f = open_netcdf(write_cf(tmp_path / "bridge.nc", land=land), FRAME, bbox=BOX)
     boat = boat_from_spec({"builtin": "ilca7"}, base_dir=tmp_path, where="boat")
     with pytest.raises(OutOfCoverageError, match="the data hold no wind"):
-        route_leg(Start((0.0, -2500.0)), Target("mark", (0.0, 2500.0), rounding="port",
-                                                name="1"), T0, f, boat, RoutingSettings())
+        route_leg(
+            Start((0.0, -2500.0)),
+            Target("mark", (0.0, 2500.0), rounding="port", name="1"),
+            T0,
+            f,
+            boat,
+            RoutingSettings(),
+        )
 
 
 def test_plan_near_land_cells_routes_and_checks_the_polar_over_the_sea(tmp_path) -> None:
@@ -238,13 +267,18 @@ def test_plan_near_land_cells_routes_and_checks_the_polar_over_the_sea(tmp_path)
     LAT, LON = np.meshgrid(lats, lons, indexing="ij")
     land = np.broadcast_to((LAT > 43.012) & (LON > 7.015), (3, *LAT.shape))
     write_cf(tmp_path / "coast.nc", land=land)
-    course = course_from_mapping({
-        "name": "coast", "start_time": "2014-10-07T12:00:00Z", "time_limit_min": 60,
-        "origin": {"lat": 43.0, "lon": 7.0},
-        "marks": {"a": {"x": -300.0, "y": -1800.0}, "b": {"x": -300.0, "y": -200.0}},
-        "legs": [{"from": "a", "to": "b"}],
-        "scenarios": {"cf": {"wind": {"type": "netcdf", "path": "coast.nc"}}},
-    }, source=tmp_path / "coast.yaml")
+    course = course_from_mapping(
+        {
+            "name": "coast",
+            "start_time": "2014-10-07T12:00:00Z",
+            "time_limit_min": 60,
+            "origin": {"lat": 43.0, "lon": 7.0},
+            "marks": {"a": {"x": -300.0, "y": -1800.0}, "b": {"x": -300.0, "y": -200.0}},
+            "legs": [{"from": "a", "to": "b"}],
+            "scenarios": {"cf": {"wind": {"type": "netcdf", "path": "coast.nc"}}},
+        },
+        source=tmp_path / "coast.yaml",
+    )
     run = plan_course(course)
     assert run.plan.total_time_s > 0 and run.notes == ()
 
@@ -285,48 +319,81 @@ def test_time_window_reads_only_the_bracketing_slices(tmp_path) -> None:
     f = open_netcdf(p, FRAME, bbox=BOX, time_window=(T0 + 5 * 3600 + 600, T0 + 6 * 3600))
     assert f.shape[0] == 2 and f.info["window"]["times"] == (5, 7)
     u, _ = f.sample(T0 + 5.5 * 3600, 0.0, 0.0)
-    assert float(u) == pytest.approx(float(expected_local(FRAME, 0.0, 0.0,
-                                                         1.0 + 5.5 / 24)[0]), abs=2e-3)
+    assert float(u) == pytest.approx(
+        float(expected_local(FRAME, 0.0, 0.0, 1.0 + 5.5 / 24)[0]), abs=2e-3
+    )
 
 
 # --------------------------------------------------------------------------- errors
 def test_errors_teach(tmp_path) -> None:
     p = write_cf(tmp_path / "nt.nc", times=None)
-    with pytest.raises(WindDataError, match=r"no time found.*give the time the field is valid "
-                                            r"at with `time: '2014-10-07T12:00:00Z'`"):
+    with pytest.raises(
+        WindDataError,
+        match=r"no time found.*give the time the field is valid "
+        r"at with `time: '2014-10-07T12:00:00Z'`",
+    ):
         read_cf_header(p)
     assert read_cf_header(p, time="2014-10-07T14:00:00+02:00").times.tolist() == [T0]
     p = write_cf(tmp_path / "nh.nc", height=None, names=("eu", "ev"))
     with pytest.raises(InputError, match=r"needs the height of the winds.*set `data_height_m`"):
         open_netcdf(p, FRAME, bbox=BOX, height_m=2.68)
-    assert open_netcdf(p, FRAME, bbox=BOX, height_m=2.68, data_height_m=10.0).info[
-        "height_source"] == "argument"
+    assert (
+        open_netcdf(p, FRAME, bbox=BOX, height_m=2.68, data_height_m=10.0).info["height_source"]
+        == "argument"
+    )
     p = write_cf(tmp_path / "ens.nc", extra_dim=3)
-    with pytest.raises(WindDataError, match=r"extra dimension 'member' of size 3 .*"
-                                            r"`ds.isel\(\{'member': 0\}\)`"):
+    with pytest.raises(
+        WindDataError,
+        match=r"extra dimension 'member' of size 3 .*"
+        r"`ds.isel\(\{'member': 0\}\)`",
+    ):
         read_cf_header(p)
     p = write_cf(tmp_path / "k.nc", units="furlongs per fortnight")
     with pytest.raises(WindDataError, match=r"units 'furlongs per fortnight'; expected a speed"):
         read_cf_header(p)
-    with pytest.raises(OutOfCoverageError, match=r"the grid does not contain the course.\n"
-                                                 r"  course box: lat 44\.9"):
+    with pytest.raises(
+        OutOfCoverageError,
+        match=r"the grid does not contain the course.\n"
+        r"  course box: lat 44\.9",
+    ):
         open_netcdf(write_cf(tmp_path / "far.nc"), LocalFrame(45.0, 7.0), bbox=BOX)
 
 
 def test_course_spec_netcdf(tmp_path, tiny_wrf, frame) -> None:
     p = write_cf(tmp_path / "spec.nc", names=("UU", "VV"), std=("", ""))
     where = "x.yaml: scenarios.cf.wind"
-    spec = {"type": "netcdf", "path": p.name, "variables": {"u": "UU", "v": "VV"},
-            "height_m": 2.68, "time_step_min": 30}
-    f = wind_from_spec(spec, frame=FRAME, base_dir=tmp_path, where=where, crop_bbox=BOX,
-                       time_window=(T0, T0 + 3600.0))
+    spec = {
+        "type": "netcdf",
+        "path": p.name,
+        "variables": {"u": "UU", "v": "VV"},
+        "height_m": 2.68,
+        "time_step_min": 30,
+    }
+    f = wind_from_spec(
+        spec,
+        frame=FRAME,
+        base_dir=tmp_path,
+        where=where,
+        crop_bbox=BOX,
+        time_window=(T0, T0 + 3600.0),
+    )
     u, _ = f.sample(T0 + 1700.0, 0.0, 0.0)  # frozen at the 12:00 block
     assert float(u) == pytest.approx(
-        float(expected_local(FRAME, 0.0, 0.0, (2.68 / 10) ** (1 / 7))[0]), abs=2e-3)
+        float(expected_local(FRAME, 0.0, 0.0, (2.68 / 10) ** (1 / 7))[0]), abs=2e-3
+    )
     with pytest.raises(InputError) as e:
-        wind_from_spec({"type": "netcdf", "path": p.name, "variables": {"u": "UU", "w": 3},
-                        "steady": "yes", "tme": "x"}, frame=FRAME, base_dir=tmp_path,
-                       where=where)
+        wind_from_spec(
+            {
+                "type": "netcdf",
+                "path": p.name,
+                "variables": {"u": "UU", "w": 3},
+                "steady": "yes",
+                "tme": "x",
+            },
+            frame=FRAME,
+            base_dir=tmp_path,
+            where=where,
+        )
     msg = str(e.value)
     assert f"{where}.variables.w: unknown key" in msg
     assert f"{where}.steady: expected true or false; got 'yes'" in msg
@@ -334,15 +401,23 @@ def test_course_spec_netcdf(tmp_path, tiny_wrf, frame) -> None:
     assert f"{where}.variables: give both u and v" in msg
     # a wrfout file named as netcdf is detected and read as WRF
     w = tiny_wrf("auto.nc")
-    a = wind_from_spec({"type": "netcdf", "path": str(w), "height_m": 2.68}, frame=frame,
-                       base_dir=tmp_path, where=where)
-    b = wind_from_spec({"type": "wrf", "path": str(w), "height_m": 2.68}, frame=frame,
-                       base_dir=tmp_path, where=where)
-    np.testing.assert_array_equal(a.sample(1524556800.0, 10.0, 20.0),
-                                  b.sample(1524556800.0, 10.0, 20.0))
+    a = wind_from_spec(
+        {"type": "netcdf", "path": str(w), "height_m": 2.68},
+        frame=frame,
+        base_dir=tmp_path,
+        where=where,
+    )
+    b = wind_from_spec(
+        {"type": "wrf", "path": str(w), "height_m": 2.68},
+        frame=frame,
+        base_dir=tmp_path,
+        where=where,
+    )
+    np.testing.assert_array_equal(
+        a.sample(1524556800.0, 10.0, 20.0), b.sample(1524556800.0, 10.0, 20.0)
+    )
     with pytest.raises(InputError, match=r"not a WRF wrfout file.*use `type: netcdf`"):
-        wind_from_spec({"type": "wrf", "path": str(p)}, frame=FRAME, base_dir=tmp_path,
-                       where=where)
+        wind_from_spec({"type": "wrf", "path": str(p)}, frame=FRAME, base_dir=tmp_path, where=where)
 
 
 # --------------------------------------------------------------------------- xarray
@@ -353,8 +428,7 @@ def test_xarray_dataset_in_and_to_xarray_round_trip(tmp_path, tiny_wrf, frame) -
         a = open_netcdf(ds, FRAME, bbox=BOX)
     b = open_netcdf(p, FRAME, bbox=BOX)
     x, y = probe()
-    np.testing.assert_allclose(a.sample(T0 + 900.0, x, y), b.sample(T0 + 900.0, x, y),
-                               atol=1e-12)
+    np.testing.assert_allclose(a.sample(T0 + 900.0, x, y), b.sample(T0 + 900.0, x, y), atol=1e-12)
     assert a.info["path"] == "xarray.Dataset" and a.info["time_source"] == "variable time"
     out = b.to_xarray()
     assert out["eastward_wind"].attrs["standard_name"] == "eastward_wind"
@@ -362,15 +436,15 @@ def test_xarray_dataset_in_and_to_xarray_round_trip(tmp_path, tiny_wrf, frame) -
     c = open_netcdf(out, FRAME)  # our own output is CF
     inner = (-2000.0, 2000.0, -2000.0, 2000.0)
     x, y = probe(box=inner)
-    np.testing.assert_allclose(c.sample(T0 + 900.0, x, y), b.sample(T0 + 900.0, x, y),
-                               atol=1e-3)
+    np.testing.assert_allclose(c.sample(T0 + 900.0, x, y), b.sample(T0 + 900.0, x, y), atol=1e-3)
     # open_wrf takes a dataset too
     w = tiny_wrf("xw.nc")
     with xr.open_dataset(w) as ds:
         d = open_wrf(ds, frame, height_m=2.68)
     e = open_wrf(w, frame, height_m=2.68)
-    np.testing.assert_allclose(d.sample(1524556800.0, 50.0, 80.0),
-                               e.sample(1524556800.0, 50.0, 80.0), atol=1e-12)
+    np.testing.assert_allclose(
+        d.sample(1524556800.0, 50.0, 80.0), e.sample(1524556800.0, 50.0, 80.0), atol=1e-12
+    )
 
 
 def test_missing_xarray_is_a_clear_error(monkeypatch) -> None:
@@ -385,8 +459,13 @@ def test_missing_xarray_is_a_clear_error(monkeypatch) -> None:
             raise ImportError("No module named 'xarray'")
         return real(name, *a, **k)
 
-    g = GridWind([T0], np.array([[0.0, 1.0], [0.0, 1.0]]), np.array([[0.0, 0.0], [1.0, 1.0]]),
-                 np.zeros((1, 2, 2)), np.zeros((1, 2, 2)))
+    g = GridWind(
+        [T0],
+        np.array([[0.0, 1.0], [0.0, 1.0]]),
+        np.array([[0.0, 0.0], [1.0, 1.0]]),
+        np.zeros((1, 2, 2)),
+        np.zeros((1, 2, 2)),
+    )
     monkeypatch.setattr(builtins, "__import__", no_xarray)
     with pytest.raises(InputError, match=r"install it with `pip install 'sailroute\[xarray\]'`"):
         g.to_xarray()
@@ -414,8 +493,11 @@ def test_ligurian_sea_fields() -> None:
     g = open_netcdf(domain, nice, bbox=(-3000.0, 3000.0, -3000.0, 3000.0), steady=True)
     assert g.info["nan_cells"] > 0
     np.testing.assert_array_equal(np.isfinite(g.sample(T0, 0.0, -2000.0)), True)
-    with pytest.raises(OutOfCoverageError, match=r"no wind \(NaN: land or masked cells\).*"
-                                                 r"first at lat 43\.6"):
+    with pytest.raises(
+        OutOfCoverageError,
+        match=r"no wind \(NaN: land or masked cells\).*"
+        r"first at lat 43\.6",
+    ):
         g.sample(T0, 0.0, np.linspace(-2000.0, 3000.0, 11))
 
 
@@ -428,7 +510,8 @@ def test_grib_file_values_and_course_spec() -> None:
     f = open_grib(GRIB, FRAME, bbox=BOX)
     assert f.info["format"] == "grib" and f.info["variables"] == ("u10", "v10")
     assert f.info["data_height_m"] == 10.0 and f.info["height_source"] == (
-        "coordinate heightAboveGround")
+        "coordinate heightAboveGround"
+    )
     assert f.coverage.t0 == T0 and f.coverage.t1 == T0 + 3600.0  # valid_time of the 2 steps
     x, y = probe()
     lat, lon = FRAME.to_latlon(x, y)
@@ -438,12 +521,16 @@ def test_grib_file_values_and_course_spec() -> None:
         u, v = f.sample(t, x, y)
         np.testing.assert_allclose(u, eu, atol=3e-3)  # 16-bit packing: ~3e-4 m/s steps
         np.testing.assert_allclose(v, ev, atol=3e-3)
-    g = wind_from_spec({"type": "grib", "path": GRIB.name, "height_m": 2.68}, frame=FRAME,
-                       base_dir=WIND_DATA, where="x.yaml: scenarios.grib.wind", crop_bbox=BOX,
-                       time_window=(T0, T0 + 3600.0))
+    g = wind_from_spec(
+        {"type": "grib", "path": GRIB.name, "height_m": 2.68},
+        frame=FRAME,
+        base_dir=WIND_DATA,
+        where="x.yaml: scenarios.grib.wind",
+        crop_bbox=BOX,
+        time_window=(T0, T0 + 3600.0),
+    )
     k = (2.68 / 10.0) ** (1.0 / 7.0)
-    np.testing.assert_allclose(g.sample(T0, x, y), np.multiply(f.sample(T0, x, y), k),
-                               atol=1e-12)
+    np.testing.assert_allclose(g.sample(T0, x, y), np.multiply(f.sample(T0, x, y), k), atol=1e-12)
 
 
 def test_grib_without_cfgrib_says_how_to_install(monkeypatch) -> None:
@@ -458,8 +545,11 @@ def test_grib_without_cfgrib_says_how_to_install(monkeypatch) -> None:
 
     pytest.importorskip("xarray")
     monkeypatch.setattr(builtins, "__import__", no_cfgrib)
-    with pytest.raises(InputError, match=r"reading GRIB needs the optional packages cfgrib and "
-                                         r"eccodes .*`pip install 'sailroute\[grib\]'`"):
+    with pytest.raises(
+        InputError,
+        match=r"reading GRIB needs the optional packages cfgrib and "
+        r"eccodes .*`pip install 'sailroute\[grib\]'`",
+    ):
         open_grib(GRIB, FRAME)
 
 
@@ -468,8 +558,9 @@ def test_a_dimension_with_an_empty_name_is_still_the_time_axis() -> None:
     # the reader treated "" as no time axis and failed reshaping 3 x 3 x 3 values as 1 x 3 x 3
     from tests.unit.test_fuzz_inputs import FRAME
 
-    w = open_netcdf(Path(__file__).parents[1] / "data" / "wind" / "damaged_dims.nc", FRAME,
-                    clamp=True)
+    w = open_netcdf(
+        Path(__file__).parents[1] / "data" / "wind" / "damaged_dims.nc", FRAME, clamp=True
+    )
     assert w.info["times"].endswith("(3 of 3 slices)")
     u, v = w.sample(w.times[1], 0.0, 0.0)
     assert float(u) == pytest.approx(1.0, abs=1e-3) and float(v) == pytest.approx(-5.0, abs=1e-3)

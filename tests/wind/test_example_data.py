@@ -60,8 +60,10 @@ def test_synthetic_wrf_matches_its_design() -> None:
     assert 2.7 < float(s_c0) < 3.5 and float(s_c1) > float(s_c0)  # ~3 m/s at 2.68 m, rising
 
 
-@pytest.mark.skipif(not (ROOT.parent / "shared" / "data" / "real").is_dir(),
-                    reason="../shared/data/real not present")
+@pytest.mark.skipif(
+    not (ROOT.parent / "shared" / "data" / "real").is_dir(),
+    reason="../shared/data/real not present",
+)
 @pytest.mark.shared
 def test_coach_csv_is_reproduced_by_its_script(tmp_path) -> None:
     out = _load("make_trieste_coach").main(out=tmp_path / "coach.csv")
@@ -74,4 +76,3 @@ def test_coach_csv_schema() -> None:
     assert list(rows[0]) == ["time", "station", "lat", "lon", "speed", "direction"]
     assert len(rows) == 4300
     assert all(r["time"].endswith("+01:00") and r["station"] == "coach" for r in rows)
-

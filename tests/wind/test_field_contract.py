@@ -35,8 +35,9 @@ def local_constant_wind(frame: LocalFrame) -> Callable:
     """``wind10`` whose local-frame components are (U0, V0) everywhere."""
 
     def f(t, lat, lon):
-        return rotate_clockwise(np.full(lat.shape, U0), np.full(lat.shape, V0),
-                                -frame.grid_north_deg(lat, lon))
+        return rotate_clockwise(
+            np.full(lat.shape, U0), np.full(lat.shape, V0), -frame.grid_north_deg(lat, lon)
+        )
 
     return f
 
@@ -52,8 +53,9 @@ def local_constant_profile(frame: LocalFrame) -> Callable:
     return f
 
 
-def stations_constant(frame: LocalFrame, xy=((-1500.0, -1000.0), (1200.0, -800.0),
-                                             (0.0, 1500.0))) -> StationData:
+def stations_constant(
+    frame: LocalFrame, xy=((-1500.0, -1000.0), (1200.0, -800.0), (0.0, 1500.0))
+) -> StationData:
     """Stations reading the local constant wind every 5 min from T0 to T0 + 30 min."""
     t = T0 + 300.0 * np.arange(7)
     ids, tt, la, lo, d = [], [], [], [], []
@@ -66,8 +68,16 @@ def stations_constant(frame: LocalFrame, xy=((-1500.0, -1000.0), (1200.0, -800.0
         lo += [float(lon)] * t.size
         d += [twd_true] * t.size
     n = len(tt)
-    return StationData(np.array(ids), np.array(tt), np.array(la), np.array(lo),
-                       np.full(n, TWS), np.array(d), np.full(n, 10.0), np.full(n, np.nan))
+    return StationData(
+        np.array(ids),
+        np.array(tt),
+        np.array(la),
+        np.array(lo),
+        np.full(n, TWS),
+        np.array(d),
+        np.full(n, 10.0),
+        np.full(n, np.nan),
+    )
 
 
 def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
@@ -78,14 +88,21 @@ def build(kind: str, tiny_wrf, frame: LocalFrame, clamp: bool) -> WindField:
     if kind == "inferred":  # wind inferred from tracks, 30 s grid over 30 min
         t = T0 + 30.0 * np.arange(61)
         n = t.size
-        return InferredWind(t, np.full(n, TWD), np.full(n, 1.0), np.full(n, np.nan),
-                            np.full(n, np.nan), np.full(n, 50), "contract").field(
-                                frame, tws_ms=TWS, clamp=clamp)
+        return InferredWind(
+            t,
+            np.full(n, TWD),
+            np.full(n, 1.0),
+            np.full(n, np.nan),
+            np.full(n, np.nan),
+            np.full(n, 50),
+            "contract",
+        ).field(frame, tws_ms=TWS, clamp=clamp)
     if kind == "analytic":
         cover = Coverage(T0, T0 + 1800.0, -2000.0, 2000.0, -1500.0, 1500.0)
         return AnalyticWind(lambda t, x, y: (U0, V0), cover, clamp=clamp)
-    path = tiny_wrf("contract.nc", wind10=local_constant_wind(frame),
-                    wind_at=local_constant_profile(frame))
+    path = tiny_wrf(
+        "contract.nc", wind10=local_constant_wind(frame), wind_at=local_constant_profile(frame)
+    )
     if kind == "wrf-linear":
         return open_wrf(path, frame, clamp=clamp)
     if kind == "wrf-nearest":
@@ -132,8 +149,10 @@ def cf_constant(tiny_wrf, frame: LocalFrame):
         tv = ds.createVariable("time", "f8", ("time",))
         tv.units = "minutes since 2018-04-24 08:00:00"
         tv[:] = [0.0, 10.0, 20.0, 30.0]
-        for name, vals, units in (("latitude", lat, "degrees_north"),
-                                  ("longitude", lon, "degrees_east")):
+        for name, vals, units in (
+            ("latitude", lat, "degrees_north"),
+            ("longitude", lon, "degrees_east"),
+        ):
             v = ds.createVariable(name, "f8", (name,))
             v.units = units
             v[:] = vals
@@ -144,30 +163,57 @@ def cf_constant(tiny_wrf, frame: LocalFrame):
     return path
 
 
-KINDS = ["uniform", "uniform-table", "inferred", "analytic", "wrf-linear", "wrf-nearest",
-         "wrf-frozen-10min", "wrf-2.68m", "netcdf-cf", "stations-idw", "stations-rbf",
-         "blended", "boat-measured", "fleet-measured"]
+KINDS = [
+    "uniform",
+    "uniform-table",
+    "inferred",
+    "analytic",
+    "wrf-linear",
+    "wrf-nearest",
+    "wrf-frozen-10min",
+    "wrf-2.68m",
+    "netcdf-cf",
+    "stations-idw",
+    "stations-rbf",
+    "blended",
+    "boat-measured",
+    "fleet-measured",
+]
 # Exact for the analytic sources; float32 storage in WRF files limits those to ~1e-6 m/s.
-TOL = {"uniform": 1e-12, "uniform-table": 1e-12, "inferred": 1e-12, "analytic": 1e-12,
-       "stations-idw": 1e-12, "stations-rbf": 1e-9, "boat-measured": 1e-12,
-       "fleet-measured": 1e-12}
+TOL = {
+    "uniform": 1e-12,
+    "uniform-table": 1e-12,
+    "inferred": 1e-12,
+    "analytic": 1e-12,
+    "stations-idw": 1e-12,
+    "stations-rbf": 1e-9,
+    "boat-measured": 1e-12,
+    "fleet-measured": 1e-12,
+}
 
 
 @pytest.fixture(params=KINDS)
 def field_and_tol(request, tiny_wrf, frame):
-    return (build(request.param, tiny_wrf, frame, clamp=False),
-            build(request.param, tiny_wrf, frame, clamp=True),
-            TOL.get(request.param, 2e-5))
+    return (
+        build(request.param, tiny_wrf, frame, clamp=False),
+        build(request.param, tiny_wrf, frame, clamp=True),
+        TOL.get(request.param, 2e-5),
+    )
 
 
 def _inside(c, n=5):
     """n points inside the coverage (finite stand-ins for unbounded axes)."""
+
     def span(lo, hi, d):
         lo = lo if np.isfinite(lo) else d[0]
         hi = hi if np.isfinite(hi) else d[1]
         return np.linspace(lo, hi, n)
-    return (span(c.t0, c.t1, (T0, T0 + 1800.0)), span(c.xmin, c.xmax, (-1e4, 1e4)),
-            span(c.ymin, c.ymax, (-1e4, 1e4)))
+
+    return (
+        span(c.t0, c.t1, (T0, T0 + 1800.0)),
+        span(c.xmin, c.xmax, (-1e4, 1e4)),
+        span(c.ymin, c.ymax, (-1e4, 1e4)),
+    )
 
 
 def test_protocol_and_values(field_and_tol) -> None:

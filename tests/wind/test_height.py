@@ -53,9 +53,10 @@ def test_exponent_fit_recovers_alpha_and_flags_unusable() -> None:
 
 def test_destagger_and_heights_match_wrf_python_ci_results() -> None:
     """Known answers from wrf-python's CI (ua = destaggered U; z = height of mass levels)."""
-    with netCDF4.Dataset(WIND_DATA / "wrfpython_ci_crop.nc") as ds, netCDF4.Dataset(
-        WIND_DATA / "wrfpython_ci_result_crop.nc"
-    ) as ref:
+    with (
+        netCDF4.Dataset(WIND_DATA / "wrfpython_ci_crop.nc") as ds,
+        netCDF4.Dataset(WIND_DATA / "wrfpython_ci_result_crop.nc") as ref,
+    ):
         ua = destagger(ds["U"][0], axis=-1)
         va = destagger(ds["V"][0], axis=-2)
         z = mass_level_heights(ds["PH"][0], ds["PHB"][0], ds["HGT"][0])

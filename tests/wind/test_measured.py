@@ -62,8 +62,7 @@ def test_true_wind_reproduces_tallinn_log() -> None:
     def col(k: str) -> np.ndarray:
         return np.array([float(r[k]) if r[k] else np.nan for r in rows])
 
-    tws, twd = true_wind(col("aws") * KNOT, col("awa") * col("tack"), col("sog") * KNOT,
-                         col("cog"))
+    tws, twd = true_wind(col("aws") * KNOT, col("awa") * col("tack"), col("sog") * KNOT, col("cog"))
     ok = np.isfinite(col("tws"))
     assert ok.sum() > 900
     assert np.median(np.abs(tws[ok] / KNOT - col("tws")[ok])) < 0.05
@@ -88,16 +87,22 @@ def test_sensor_channel_priority_and_source() -> None:
     assert s.source == "tws/twd"
     np.testing.assert_allclose(s.tws_ms, 8.0)
     np.testing.assert_allclose(s.twd_deg, 40.0)
-    s = sensor_from_track(_track(t, {"tws_ms": tws, "twa_deg": wrap180(twd - hdg),
-                                     "hdg_deg": hdg}), smooth_s=0)
+    s = sensor_from_track(
+        _track(t, {"tws_ms": tws, "twa_deg": wrap180(twd - hdg), "hdg_deg": hdg}), smooth_s=0
+    )
     assert s.source == "tws + twa + hdg"
     np.testing.assert_allclose(s.twd_deg, 40.0, atol=1e-9)
     # apparent wind of a boat sailing at 4 m/s through a true 8 m/s from 40 deg
     uw, vw = wind_components(tws, twd)
     bu, bv = 4.0 * np.sin(np.radians(hdg)), 4.0 * np.cos(np.radians(hdg))
     aws, afrom = wind_speed_direction(uw - bu, vw - bv)
-    ch = {"aws_ms": aws, "awa_deg": wrap180(afrom - hdg), "sog_ms": np.full(n, 4.0),
-          "cog_deg": hdg, "hdg_deg": hdg}
+    ch = {
+        "aws_ms": aws,
+        "awa_deg": wrap180(afrom - hdg),
+        "sog_ms": np.full(n, 4.0),
+        "cog_deg": hdg,
+        "hdg_deg": hdg,
+    }
     s = sensor_from_track(_track(t, ch), smooth_s=0)
     assert s.source.startswith("aws/awa + sog/cog (over the ground")
     np.testing.assert_allclose(s.tws_ms, 8.0, atol=1e-9)
@@ -132,26 +137,37 @@ def test_smoothing_is_a_centred_vector_mean_within_stretches() -> None:
 
 def test_log_without_wind_columns_names_file_and_channels(tmp_path: Path) -> None:
     p = tmp_path / "dinghy.csv"
-    p.write_text("time,lat,lon,sog_kn\n2025-01-19T03:00:00Z,-36.83,174.76,5\n"
-                 "2025-01-19T03:00:01Z,-36.83,174.7601,5.1\n")
+    p.write_text(
+        "time,lat,lon,sog_kn\n2025-01-19T03:00:00Z,-36.83,174.76,5\n"
+        "2025-01-19T03:00:01Z,-36.83,174.7601,5.1\n"
+    )
     tr = read_track(p)
-    with pytest.raises(InputError, match=r"dinghy\.csv: no usable wind columns \(channels "
-                                         r"found: sog_ms\)"):
+    with pytest.raises(
+        InputError,
+        match=r"dinghy\.csv: no usable wind columns \(channels "
+        r"found: sog_ms\)",
+    ):
         sensor_from_track(tr)
 
 
 # ------------------------------------------------------------------------------ one boat
 def test_boat_wind_hole_raises_naming_boat_and_gap() -> None:
     t = np.concatenate([T0 + np.arange(100.0), T0 + 400.0 + np.arange(100.0)])
-    tr = _track(t, {"tws_ms": np.full(t.size, 8.0), "twd_deg": np.full(t.size, 40.0)},
-                name="NZL", source="data_NZL.csv")
+    tr = _track(
+        t,
+        {"tws_ms": np.full(t.size, 8.0), "twd_deg": np.full(t.size, 40.0)},
+        name="NZL",
+        source="data_NZL.csv",
+    )
     f = boat_wind(tr, FRAME)
     u, v = f.sample(np.array([T0, T0 + 99.0, T0 + 400.0]), 0.0, 0.0)
     np.testing.assert_allclose(wind_speed_direction(u, v)[0], 8.0)
-    with pytest.raises(OutOfCoverageError,
-                       match=r"1 of 2 sample points fall in a gap of the log of NZL "
-                             r"\(data_NZL\.csv\): no record from 2025-01-19T03:08:19.*"
-                             r"\(301 s > max_gap_s 30 s\)"):
+    with pytest.raises(
+        OutOfCoverageError,
+        match=r"1 of 2 sample points fall in a gap of the log of NZL "
+        r"\(data_NZL\.csv\): no record from 2025-01-19T03:08:19.*"
+        r"\(301 s > max_gap_s 30 s\)",
+    ):
         f.sample(np.array([T0 + 50.0, T0 + 250.0]), 0.0, 0.0)
     # a larger limit bridges it
     f = boat_wind(tr, FRAME, max_gap_s=400.0)
@@ -161,8 +177,14 @@ def test_boat_wind_hole_raises_naming_boat_and_gap() -> None:
 
 def test_boat_wind_is_linear_in_time_in_components() -> None:
     t = T0 + np.array([0.0, 10.0])
-    s = MeasuredSeries("B", "", t, *FRAME.to_latlon(np.zeros(2), np.zeros(2)),
-                       np.array([2.0, 4.0]), np.array([0.0, -6.0]))
+    s = MeasuredSeries(
+        "B",
+        "",
+        t,
+        *FRAME.to_latlon(np.zeros(2), np.zeros(2)),
+        np.array([2.0, 4.0]),
+        np.array([0.0, -6.0]),
+    )
     u, v = boat_wind(s, FRAME).sample(T0 + 2.5, 1e4, -1e4)
     assert (float(u), float(v)) == pytest.approx((2.5, -1.5), abs=1e-9)
 
@@ -213,8 +235,11 @@ def test_fleet_reproduces_a_uniform_wind(method: str) -> None:
         tw = (150.0 - FRAME.grid_north_deg(lat, lon)) % 360  # constant in the local frame
         uni.append(MeasuredSeries(s.boat, s.file, s.t, lat, lon, *wind_components(7.0, tw)))
     rng = np.random.default_rng(3)
-    pts = (rng.uniform(T0 + 30, T0 + 1100, 500), rng.uniform(-700, 700, 500),
-           rng.uniform(-500, 500, 500))
+    pts = (
+        rng.uniform(T0 + 30, T0 + 1100, 500),
+        rng.uniform(-700, 700, 500),
+        rng.uniform(-500, 500, 500),
+    )
     u0, v0 = wind_components(7.0, 150.0)
     u, v = fleet_wind(uni, FRAME, method=method, estimate_bias=False).field.sample(*pts)
     np.testing.assert_allclose(u, u0, atol=1e-9)
@@ -222,8 +247,12 @@ def test_fleet_reproduces_a_uniform_wind(method: str) -> None:
     # a steady wind has no bias to find (in true directions the boats differ by the
     # meridian convergence across 1.6 km, 0.006 deg)
     fw = fleet_wind(uni, FRAME, method=method)
-    assert all(b.speed_factor == pytest.approx(1.0, abs=1e-9) and b.time_offset_s == 0.0
-               and abs(b.direction_offset_deg) < 0.01 for b in fw.biases)
+    assert all(
+        b.speed_factor == pytest.approx(1.0, abs=1e-9)
+        and b.time_offset_s == 0.0
+        and abs(b.direction_offset_deg) < 0.01
+        for b in fw.biases
+    )
     u, v = fw.field.sample(*pts)
     np.testing.assert_allclose(u, u0, atol=1e-3)
 
@@ -241,7 +270,8 @@ def test_hull_fraction_on_a_known_triangle() -> None:
     fw = fleet_wind(sens, FRAME, method="mean", estimate_bias=False)
     assert fw.coverage_report(pt, px, py) == pytest.approx(0.4)
     assert fw.extrapolation_note(pt, px, py, "the course").startswith(
-        "fleet wind: 60 % of the course (5 points) lie outside the sensors' hull")
+        "fleet wind: 60 % of the course (5 points) lie outside the sensors' hull"
+    )
 
 
 def test_fleet_names_the_log_that_limits_the_span_and_refuses_common_holes() -> None:
@@ -249,18 +279,33 @@ def test_fleet_names_the_log_that_limits_the_span_and_refuses_common_holes() -> 
     short = boats[2].between(T0 + 100, T0 + 900)
     fw = fleet_wind([boats[0], boats[1], short], FRAME, estimate_bias=False)
     assert "limited by the log of B2 (b2.csv) (starts" in fw.notes[-1]
-    with pytest.raises(OutOfCoverageError, match=r"(?s)requested.*the time span is limited by "
-                                                 r"the log of B2 \(b2\.csv\)"):
+    with pytest.raises(
+        OutOfCoverageError,
+        match=r"(?s)requested.*the time span is limited by "
+        r"the log of B2 \(b2\.csv\)",
+    ):
         fw.field.sample(T0 + 50, 0.0, 0.0)
     cut = [b.between(T0, T0 + 400) for b in boats]
     later = [b.between(T0 + 500, T0 + 1199) for b in boats]
-    holed = [MeasuredSeries(a.boat, a.file, np.concatenate([a.t, b.t]),
-                            np.concatenate([a.lat, b.lat]), np.concatenate([a.lon, b.lon]),
-                            np.concatenate([a.u, b.u]), np.concatenate([a.v, b.v]),
-                            gaps=((T0 + 400, T0 + 500),)) for a, b in zip(cut, later, strict=True)]
+    holed = [
+        MeasuredSeries(
+            a.boat,
+            a.file,
+            np.concatenate([a.t, b.t]),
+            np.concatenate([a.lat, b.lat]),
+            np.concatenate([a.lon, b.lon]),
+            np.concatenate([a.u, b.u]),
+            np.concatenate([a.v, b.v]),
+            gaps=((T0 + 400, T0 + 500),),
+        )
+        for a, b in zip(cut, later, strict=True)
+    ]
     fw = fleet_wind(holed, FRAME, estimate_bias=False, method="mean")
-    with pytest.raises(OutOfCoverageError, match=r"every log has a gap .* B0 \(b0\.csv\) "
-                                                 r"2025-01-19T03:13:20"):
+    with pytest.raises(
+        OutOfCoverageError,
+        match=r"every log has a gap .* B0 \(b0\.csv\) "
+        r"2025-01-19T03:13:20",
+    ):
         fw.field.sample(T0 + 450, 0.0, 0.0)
     u, _ = fw.field.sample(T0 + 399, 0.0, 0.0)
     assert np.isfinite(u)
@@ -298,10 +343,15 @@ def test_sailgp_default_beats_the_sensor_mean_leaving_one_boat_out() -> None:
     sens = [sensor_from_track(t) for t in tracks]
     assert sens[0].source == "tws/twd" and sens[0].gaps == ()
     raw = [sensor_from_track(t, smooth_s=0.0) for t in tracks]
-    rows = leave_one_out(sens, FRAME, {
-        "default": {},
-        "mean": {"method": "mean", "resample_s": 0.0, "estimate_bias": False},
-    }, targets=raw)
+    rows = leave_one_out(
+        sens,
+        FRAME,
+        {
+            "default": {},
+            "mean": {"method": "mean", "resample_s": 0.0, "estimate_bias": False},
+        },
+        targets=raw,
+    )
     pooled = {r.label: r for r in rows if r.boat == "pooled"}
     d, m = pooled["default"], pooled["mean"]
     assert d.n == m.n > 1800
@@ -328,22 +378,42 @@ def test_course_wind_type_measured(tmp_path: Path) -> None:
 
     for k in range(3):
         _write_log(tmp_path / f"boat{k}.csv", 300.0 * k, 200.0)
-    spec = {"type": "measured", "tracks": [f"boat{k}.csv" for k in range(3)],
-            "method": "mean"}
-    f = wind_from_spec(spec, frame=FRAME, base_dir=tmp_path, where="c.yaml: scenarios.m",
-                       time_window=(T0 + 100, T0 + 800))
+    spec = {"type": "measured", "tracks": [f"boat{k}.csv" for k in range(3)], "method": "mean"}
+    f = wind_from_spec(
+        spec,
+        frame=FRAME,
+        base_dir=tmp_path,
+        where="c.yaml: scenarios.m",
+        time_window=(T0 + 100, T0 + 800),
+    )
     s, d = wind_speed_direction(*f.sample(T0 + 400.0, 0.0, 300.0))
     assert float(s) == pytest.approx(12.0 * KNOT, rel=1e-9)
-    assert float(d) == pytest.approx(200.0 + float(FRAME.grid_north_deg(*FRAME.to_latlon(
-        0.0, 300.0))), abs=0.01)
+    assert float(d) == pytest.approx(
+        200.0 + float(FRAME.grid_north_deg(*FRAME.to_latlon(0.0, 300.0))), abs=0.01
+    )
     with pytest.raises(InputError, match=r"c\.yaml: scenarios\.m\.tracks\[1\]: file not found"):
-        wind_from_spec({"type": "measured", "tracks": ["boat0.csv", "nope.csv"]}, frame=FRAME,
-                       base_dir=tmp_path, where="c.yaml: scenarios.m")
+        wind_from_spec(
+            {"type": "measured", "tracks": ["boat0.csv", "nope.csv"]},
+            frame=FRAME,
+            base_dir=tmp_path,
+            where="c.yaml: scenarios.m",
+        )
     with pytest.raises(InputError, match=r"scenarios\.m\.method: expected one of 'mean'"):
-        wind_from_spec({"type": "measured", "tracks": ["boat0.csv"], "method": "krige"},
-                       frame=FRAME, base_dir=tmp_path, where="c.yaml: scenarios.m")
-    with pytest.raises(InputError, match=r"scenarios\.m\.tracks\[0\]: boat0\.csv has no wind "
-                                         r"records within 600 s of the race window"):
-        wind_from_spec({"type": "measured", "tracks": ["boat0.csv"]}, frame=FRAME,
-                       base_dir=tmp_path, where="c.yaml: scenarios.m",
-                       time_window=(T0 + 1e5, T0 + 2e5))
+        wind_from_spec(
+            {"type": "measured", "tracks": ["boat0.csv"], "method": "krige"},
+            frame=FRAME,
+            base_dir=tmp_path,
+            where="c.yaml: scenarios.m",
+        )
+    with pytest.raises(
+        InputError,
+        match=r"scenarios\.m\.tracks\[0\]: boat0\.csv has no wind "
+        r"records within 600 s of the race window",
+    ):
+        wind_from_spec(
+            {"type": "measured", "tracks": ["boat0.csv"]},
+            frame=FRAME,
+            base_dir=tmp_path,
+            where="c.yaml: scenarios.m",
+            time_window=(T0 + 1e5, T0 + 2e5),
+        )

@@ -48,7 +48,8 @@ def test_grid_to_earth_matches_wrf_python_formula_and_inverts() -> None:
 def test_cone_factor_known_values() -> None:
     # Lambert 30/60: n = ln(cos30/cos60) / ln(tan(30)/tan(15)) = 0.715566... (textbook value).
     expected = math.log(math.cos(math.radians(30)) / math.cos(math.radians(60))) / math.log(
-        math.tan(math.radians(30)) / math.tan(math.radians(15)))
+        math.tan(math.radians(30)) / math.tan(math.radians(15))
+    )
     assert cone_factor(1, 30.0, 60.0) == pytest.approx(expected, rel=1e-12)
     assert cone_factor(1, 30.0, 60.0) == pytest.approx(0.7155668, abs=1e-7)
     assert cone_factor(1, 45.0, 45.0) == pytest.approx(math.sin(math.radians(45.0)))

@@ -36,8 +36,11 @@ def rows(*specs):
 
 # --------------------------------------------------------------------------- reading
 def test_canonical_csv_units_times_and_ids(station_csv) -> None:
-    p = station_csv(rows((0, "A", 43.0, 6.0, 10, 90), (1, "A", 43.0, 6.0, 12, 95),
-                         (0, "B", 43.01, 6.01, 8, 359)))
+    p = station_csv(
+        rows(
+            (0, "A", 43.0, 6.0, 10, 90), (1, "A", 43.0, 6.0, 12, 95), (0, "B", 43.01, 6.01, 8, 359)
+        )
+    )
     d = read_stations(p, speed_unit="kn")
     assert d.stations == ("A", "B")
     assert d.station.tolist() == ["A", "A", "B"]  # grouped by station, time order kept
@@ -59,11 +62,18 @@ def test_aliases_timezone_and_unit_from_header() -> None:
 
 
 def test_explicit_column_mapping_and_position(station_csv) -> None:
-    p = station_csv([["2018-04-24T10:00:00Z", "3.0", "200"], ["2018-04-24T10:10:00Z", "4.0",
-                                                                "210"]],
-                    header=("when", "vel", "from_deg"))
-    d = read_stations(p, columns={"time": "when", "speed": "vel", "direction": "from_deg"},
-                      speed_unit="m/s", position=(43.0, 6.0), station="buoy", height_m=3.5)
+    p = station_csv(
+        [["2018-04-24T10:00:00Z", "3.0", "200"], ["2018-04-24T10:10:00Z", "4.0", "210"]],
+        header=("when", "vel", "from_deg"),
+    )
+    d = read_stations(
+        p,
+        columns={"time": "when", "speed": "vel", "direction": "from_deg"},
+        speed_unit="m/s",
+        position=(43.0, 6.0),
+        station="buoy",
+        height_m=3.5,
+    )
     assert d.stations == ("buoy",)
     np.testing.assert_array_equal(d.lat, [43.0, 43.0])
     np.testing.assert_array_equal(d.height_m, [3.5, 3.5])
@@ -76,8 +86,11 @@ def test_speed_unit_must_be_known_and_consistent(station_csv) -> None:
     p = station_csv(rows((0, "A", 43.0, 6.0, 10, 90)))
     with pytest.raises(InputError, match="unit of column 'speed' is not known; declare it"):
         read_stations(p)
-    q = station_csv([[T.format(0), "A", 43, 6, 10, 90]], name="kn.csv",
-                    header=("time", "station", "lat", "lon", "tws_kn", "twd_deg"))
+    q = station_csv(
+        [[T.format(0), "A", 43, 6, 10, 90]],
+        name="kn.csv",
+        header=("time", "station", "lat", "lon", "tws_kn", "twd_deg"),
+    )
     with pytest.raises(InputError, match="speed_unit 'm/s' contradicts the column name 'tws_kn'"):
         read_stations(q, speed_unit="m/s")
     with pytest.raises(InputError, match="unknown speed unit 'knts'"):
@@ -86,8 +99,11 @@ def test_speed_unit_must_be_known_and_consistent(station_csv) -> None:
 
 def test_naive_time_needs_timezone(station_csv) -> None:
     p = station_csv([["2018-02-15T10:00:00", "A", 45.5, 13.6, 5, 60]])
-    with pytest.raises(InputError, match=r"line 2, column 'time': time '2018-02-15T10:00:00' has "
-                                         r"no UTC offset.*timezone: '\+01:00'"):
+    with pytest.raises(
+        InputError,
+        match=r"line 2, column 'time': time '2018-02-15T10:00:00' has "
+        r"no UTC offset.*timezone: '\+01:00'",
+    ):
         read_stations(p, speed_unit="kn")
     d = read_stations(p, speed_unit="kn", timezone="+01:00")
     assert d.t[0] == datetime.fromisoformat("2018-02-15T09:00:00+00:00").timestamp()
@@ -96,9 +112,16 @@ def test_naive_time_needs_timezone(station_csv) -> None:
 
 
 def test_missing_markers_counted_and_dropped(station_csv) -> None:
-    p = station_csv(rows((0, "A", 43, 6, 10, 90), (1, "A", 43, 6, "", 90),
-                         (2, "A", 43, 6, "MM", 90), (3, "A", 43, 6, 11, "999"),
-                         (4, "A", 43, 6, "nan", 91), (5, "A", 43, 6, 12, 92)))
+    p = station_csv(
+        rows(
+            (0, "A", 43, 6, 10, 90),
+            (1, "A", 43, 6, "", 90),
+            (2, "A", 43, 6, "MM", 90),
+            (3, "A", 43, 6, 11, "999"),
+            (4, "A", 43, 6, "nan", 91),
+            (5, "A", 43, 6, 12, 92),
+        )
+    )
     d = read_stations(p, speed_unit="kn", missing=("", "MM", "999", "nan"))
     assert len(d) == 2 and d.n_raw == 6 and d.n_missing == 4
     assert dict(d.missing_by_column) == {"speed": 3, "direction": 1}
@@ -116,8 +139,9 @@ def test_bad_rows_are_named(station_csv) -> None:
     short = station_csv([[T.format(0), "A", 43, 6, 10]], name="s.csv")
     with pytest.raises(WindDataError, match="line 2: 5 fields but the header has 6"):
         read_stations(short, speed_unit="kn")
-    badtime = station_csv([*rows((0, "A", 43, 6, 10, 90)), ["yesterday", "A", 43, 6, 1, 2]],
-                          name="t.csv")
+    badtime = station_csv(
+        [*rows((0, "A", 43, 6, 10, 90)), ["yesterday", "A", 43, 6, 1, 2]], name="t.csv"
+    )
     with pytest.raises(WindDataError, match="line 3, column 'time': cannot read 'yesterday'"):
         read_stations(badtime, speed_unit="kn")
 
@@ -147,10 +171,16 @@ def test_repeated_timestamps_need_resampling() -> None:
 # --------------------------------------------------------------------------- resampling
 def _data(t, speed, direction, station="S", lat=43.0, lon=6.0, gust=None):
     n = len(t)
-    return StationData(np.full(n, station), np.asarray(t, float), np.full(n, lat),
-                       np.full(n, lon), np.asarray(speed, float), np.asarray(direction, float),
-                       np.full(n, np.nan), np.full(n, np.nan) if gust is None else
-                       np.asarray(gust, float))
+    return StationData(
+        np.full(n, station),
+        np.asarray(t, float),
+        np.full(n, lat),
+        np.full(n, lon),
+        np.asarray(speed, float),
+        np.asarray(direction, float),
+        np.full(n, np.nan),
+        np.full(n, np.nan) if gust is None else np.asarray(gust, float),
+    )
 
 
 def test_resample_vector_direction_scalar_speed_and_bins() -> None:
@@ -175,15 +205,20 @@ def test_resample_vector_direction_scalar_speed_and_bins() -> None:
 def test_coach_resampling_matches_hand_computation() -> None:
     r = read_stations(COACH, timezone="+01:00", resample_s=60)
     with open(COACH, newline="") as f:
-        raw = [row for row in csv.DictReader(f) if row["datetime_local"].startswith(
-            "2018-02-15T10:40:")]
+        raw = [
+            row
+            for row in csv.DictReader(f)
+            if row["datetime_local"].startswith("2018-02-15T10:40:")
+        ]
     spd = np.array([float(x["tws_kn"]) for x in raw]) * KNOT
     u, v = wind_components(spd, [float(x["twd_deg"]) for x in raw])
-    k = int(np.argmin(np.abs(r.t - datetime.fromisoformat(
-        "2018-02-15T09:40:30+00:00").timestamp())))
+    k = int(
+        np.argmin(np.abs(r.t - datetime.fromisoformat("2018-02-15T09:40:30+00:00").timestamp()))
+    )
     assert r.speed_ms[k] == pytest.approx(spd.mean(), rel=1e-12)
-    assert r.direction_deg[k] == pytest.approx(wind_speed_direction(u.mean(), v.mean())[1],
-                                               abs=1e-9)
+    assert r.direction_deg[k] == pytest.approx(
+        wind_speed_direction(u.mean(), v.mean())[1], abs=1e-9
+    )
     assert r.lat[k] == pytest.approx(np.mean([float(x["lat"]) for x in raw]), abs=1e-12)
     r10 = read_stations(COACH, timezone="+01:00", resample_s=10)
     with open(COACH, newline="") as f:
@@ -207,15 +242,17 @@ def test_ndbc_raw_text_and_csv_agree() -> None:
 def test_ndbc_circular_mean_across_north() -> None:
     d = read_stations(NDBC_CSV, position=GRAYS_REEF)
     hour = (d.t >= datetime.fromisoformat("2018-06-17T18:10:00+00:00").timestamp()) & (
-        d.t <= datetime.fromisoformat("2018-06-17T19:30:00+00:00").timestamp())
+        d.t <= datetime.fromisoformat("2018-06-17T19:30:00+00:00").timestamp()
+    )
     dirs = d.direction_deg[hour]
     assert dirs.min() < 10 and dirs.max() > 350  # the hour straddles north
     assert 100 < np.mean(dirs) < 200  # the naive arithmetic mean points south: the trap
     m = circular_mean_deg(dirs)
     assert m < 10 or m > 355
     r = resample_stations(d.select(d.stations[0]), 3600.0, min_fill=0.5)
-    k = int(np.argmin(np.abs(r.t - datetime.fromisoformat(
-        "2018-06-17T18:30:00+00:00").timestamp())))
+    k = int(
+        np.argmin(np.abs(r.t - datetime.fromisoformat("2018-06-17T18:30:00+00:00").timestamp()))
+    )
     assert r.direction_deg[k] < 15 or r.direction_deg[k] > 345
 
 
@@ -224,10 +261,16 @@ def _two_stations(t0: float = 0.0) -> StationData:
     frame = LocalFrame(43.0, 6.0)
     la, lo = frame.to_latlon(np.array([-1000.0, 1000.0]), np.array([0.0, 0.0]))
     t = np.array([t0, t0 + 600.0])
-    return StationData(np.array(["W", "W", "E", "E"]), np.tile(t, 2), np.repeat(la, 2),
-                       np.repeat(lo, 2), np.array([4.0, 6.0, 8.0, 8.0]),
-                       np.array([270.0, 270.0, 270.0, 270.0]), np.full(4, 7.5),
-                       np.full(4, np.nan))
+    return StationData(
+        np.array(["W", "W", "E", "E"]),
+        np.tile(t, 2),
+        np.repeat(la, 2),
+        np.repeat(lo, 2),
+        np.array([4.0, 6.0, 8.0, 8.0]),
+        np.array([270.0, 270.0, 270.0, 270.0]),
+        np.full(4, 7.5),
+        np.full(4, np.nan),
+    )
 
 
 def test_idw_exact_at_stations_average_between_linear_in_time() -> None:
@@ -244,8 +287,9 @@ def test_idw_exact_at_stations_average_between_linear_in_time() -> None:
     s, _ = wind_speed_direction(*f.sample(300.0, 0.0, 0.0))  # equidistant: mean of 5 and 8
     assert float(s) == pytest.approx(6.5, abs=1e-6)
     s, _ = wind_speed_direction(*f.sample(0.0, 500.0, 0.0))  # d_W = 1500 m, d_E = 500 m
-    assert float(s) == pytest.approx((4 / 1500**2 + 8 / 500**2) / (1 / 1500**2 + 1 / 500**2),
-                                     abs=1e-6)
+    assert float(s) == pytest.approx(
+        (4 / 1500**2 + 8 / 500**2) / (1 / 1500**2 + 1 / 500**2), abs=1e-6
+    )
 
 
 def test_rbf_exact_at_stations_and_constant() -> None:
@@ -269,8 +313,16 @@ def test_station_coverage_height_and_gaps() -> None:
     with pytest.raises(WindDataError, match=r"station 'W' has no record .* max_gap_s"):
         StationWind(_two_stations(), frame, max_gap_s=300.0)
     late = _two_stations()
-    late = StationData(late.station, late.t + np.array([0, 0, 1e4, 1e4]), late.lat, late.lon,
-                       late.speed_ms, late.direction_deg, late.height_m, late.gust_ms)
+    late = StationData(
+        late.station,
+        late.t + np.array([0, 0, 1e4, 1e4]),
+        late.lat,
+        late.lon,
+        late.speed_ms,
+        late.direction_deg,
+        late.height_m,
+        late.gust_ms,
+    )
     with pytest.raises(WindDataError, match="never report at the same time"):
         StationWind(late, frame)
 
@@ -278,13 +330,25 @@ def test_station_coverage_height_and_gaps() -> None:
 def test_coverage_error_names_the_station_that_cuts_the_span() -> None:
     d = _two_stations()
     # station E starts 120 s later than W and ends with it: E limits the start
-    d = StationData(d.station, d.t + np.array([0.0, 0.0, 120.0, 0.0]), d.lat, d.lon, d.speed_ms,
-                    d.direction_deg, d.height_m, d.gust_ms, source="coach.csv")
+    d = StationData(
+        d.station,
+        d.t + np.array([0.0, 0.0, 120.0, 0.0]),
+        d.lat,
+        d.lon,
+        d.speed_ms,
+        d.direction_deg,
+        d.height_m,
+        d.gust_ms,
+        source="coach.csv",
+    )
     f = StationWind(d, LocalFrame(43.0, 6.0))
     assert f.coverage.t0 == 120.0
-    with pytest.raises(OutOfCoverageError, match=r"(?s)requested.*the time span is limited by "
-                                                 r"station 'E' of coach\.csv \(first record "
-                                                 r"1970-01-01T00:02:00"):
+    with pytest.raises(
+        OutOfCoverageError,
+        match=r"(?s)requested.*the time span is limited by "
+        r"station 'E' of coach\.csv \(first record "
+        r"1970-01-01T00:02:00",
+    ):
         f.sample(60.0, 0.0, 0.0)
 
 
@@ -300,20 +364,30 @@ def test_moving_station_coverage_follows_track() -> None:
     u, v = f.sample(d.t[k], x[k] + 300.0, y[k] - 200.0)
     s, dd = wind_speed_direction(u, v)
     assert float(s) == pytest.approx(d.speed_ms[k], rel=1e-9)
-    assert float(dd) == pytest.approx(d.direction_deg[k] + frame.grid_north_deg(
-        d.lat[k], d.lon[k]), abs=1e-6)
+    assert float(dd) == pytest.approx(
+        d.direction_deg[k] + frame.grid_north_deg(d.lat[k], d.lon[k]), abs=1e-6
+    )
     with pytest.raises(InputError, match="'rbf' needs fixed stations"):
         StationWind(d, frame, method="rbf")
 
 
 # --------------------------------------------------------------------------- additions
-@pytest.mark.parametrize(("header", "declared", "factor"), [
-    ("speed_kmh", None, 1000.0 / 3600.0), ("wind_speed_mph", None, 1609.344 / 3600.0),
-    ("speed", "km/h", 1000.0 / 3600.0), ("speed", "mph", 1609.344 / 3600.0),
-    ("speed", "m/s", 1.0), ("tws_kn", None, 1852.0 / 3600.0)])
+@pytest.mark.parametrize(
+    ("header", "declared", "factor"),
+    [
+        ("speed_kmh", None, 1000.0 / 3600.0),
+        ("wind_speed_mph", None, 1609.344 / 3600.0),
+        ("speed", "km/h", 1000.0 / 3600.0),
+        ("speed", "mph", 1609.344 / 3600.0),
+        ("speed", "m/s", 1.0),
+        ("tws_kn", None, 1852.0 / 3600.0),
+    ],
+)
 def test_all_four_speed_units(station_csv, header: str, declared, factor: float) -> None:
-    p = station_csv(rows((0, "A", 43.0, 6.0, 18, 90), (1, "A", 43.0, 6.0, 36, 95)),
-                    header=("time", "station", "lat", "lon", header, "direction"))
+    p = station_csv(
+        rows((0, "A", 43.0, 6.0, 18, 90), (1, "A", 43.0, 6.0, 36, 95)),
+        header=("time", "station", "lat", "lon", header, "direction"),
+    )
     d = read_stations(p, speed_unit=declared)
     np.testing.assert_allclose(d.speed_ms, np.array([18.0, 36.0]) * factor, rtol=1e-15)
 
@@ -333,8 +407,9 @@ def test_resampling_high_rate_logs(hz: int) -> None:
     for k, b in enumerate(np.unique(starts)[:3]):
         m = starts == b
         u, v = wind_components(5.0, direction[m])
-        assert r.direction_deg[k] == pytest.approx(wind_speed_direction(u.mean(), v.mean())[1],
-                                                   abs=1e-9)
+        assert r.direction_deg[k] == pytest.approx(
+            wind_speed_direction(u.mean(), v.mean())[1], abs=1e-9
+        )
         assert r.t[k] == b + 30.0
     assert r.direction_deg[1] > 355.0 or r.direction_deg[1] < 5.0  # across north, not south
 

@@ -36,8 +36,11 @@ SALEM = WIND_DATA / "salem_lambert_crop.nc"
 def test_ci_times_and_xy_to_ll_known_answer() -> None:
     h = read_wrf_header(CI)
     assert [iso(t) for t in h.times] == [
-        "2005-08-28T12:00:00.000Z", "2005-08-28T15:00:00.000Z",
-        "2005-08-28T18:00:00.000Z", "2005-08-28T21:00:00.000Z"]
+        "2005-08-28T12:00:00.000Z",
+        "2005-08-28T15:00:00.000Z",
+        "2005-08-28T18:00:00.000Z",
+        "2005-08-28T21:00:00.000Z",
+    ]
     # wrf-python xy_to_ll(x=10, y=10) = (22.63660539, -90.75394145); XLAT is float32
     # (7 digits), so 2e-5 deg (~2 m) is the achievable agreement.
     with netCDF4.Dataset(CI_REF) as ref:
@@ -101,8 +104,10 @@ def test_salem_model_level_height_correction_is_sane() -> None:
 
 @pytest.mark.parametrize(
     "name",
-    ["ligurian_sea_2014-10-07T12-00-00_area_strong_wind_conv.nc",
-     "ligurian_sea_2014-10-07T12-00-00_area_domain.nc"],
+    [
+        "ligurian_sea_2014-10-07T12-00-00_area_strong_wind_conv.nc",
+        "ligurian_sea_2014-10-07T12-00-00_area_domain.nc",
+    ],
 )
 @requires_shared
 def test_ligurian_file_is_rejected_naming_missing_variables(name: str) -> None:
@@ -152,8 +157,9 @@ def test_field_protocol_and_local_direction(tiny_wrf, frame) -> None:
     assert float(d) == pytest.approx(150.0, abs=1e-4)
 
 
-def _linear_field(frame: LocalFrame, a: float = 4.0, bx: float = 1e-3, by: float = -5e-4,
-                  bt: float = 1e-3):
+def _linear_field(
+    frame: LocalFrame, a: float = 4.0, bx: float = 1e-3, by: float = -5e-4, bt: float = 1e-3
+):
     """u_e = a + bx x + by y + bt (t - T0), v_e = 0: linear in local x, y and t."""
 
     def f(t: float, lat: np.ndarray, lon: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -168,8 +174,7 @@ def _linear_field(frame: LocalFrame, a: float = 4.0, bx: float = 1e-3, by: float
 
 def _exact_local(frame: LocalFrame, exact, t, x, y):
     """Local-frame components of the earth-relative (exact(t, x, y), 0) wind."""
-    t, x, y = np.broadcast_arrays(np.asarray(t, float), np.asarray(x, float),
-                                  np.asarray(y, float))
+    t, x, y = np.broadcast_arrays(np.asarray(t, float), np.asarray(x, float), np.asarray(y, float))
     lat, lon = frame.to_latlon(x, y)
     return earth_to_local(exact(t, x, y), 0.0, frame.grid_north_deg(lat, lon))
 
@@ -241,8 +246,7 @@ def test_unusable_fit_falls_back_to_u10_with_fallback_exponent(tiny_wrf, frame) 
     s = float(np.hypot(*f.sample(T0, 0.0, 0.0)))
     assert s == pytest.approx(5.0 * 0.268 ** (1 / 7), abs=1e-5)
     wider = open_wrf(path, frame, height_m=2.68, exponent_range=(0.0, 1.0))
-    assert float(np.hypot(*wider.sample(T0, 0.0, 0.0))) == pytest.approx(
-        5.0 * 0.268**0.8, abs=1e-5)
+    assert float(np.hypot(*wider.sample(T0, 0.0, 0.0))) == pytest.approx(5.0 * 0.268**0.8, abs=1e-5)
 
 
 def test_u10_levels_and_log_law(tiny_wrf, frame) -> None:
@@ -260,20 +264,31 @@ def test_crop_to_bbox_and_time_window(tiny_wrf, frame) -> None:
     # apart in x (Lambert scale factor 0.994 at 45 N for 30/60) and rows ~1003 m in y.
     path = tiny_wrf(wind10=wind10, level_heights_m=None, nx=25, ny=21, stand_lon=10.0)
     h = read_wrf_header(path)
-    w = crop_window(h, frame, bbox=(-1000.0, 1500.0, -500.0, 500.0), margin_m=1000.0,
-                    time_window=(T0 + 700.0, T0 + 1100.0))
+    w = crop_window(
+        h,
+        frame,
+        bbox=(-1000.0, 1500.0, -500.0, 500.0),
+        margin_m=1000.0,
+        time_window=(T0 + 700.0, T0 + 1100.0),
+    )
     # x in [-2000, 2500] m -> columns 11..14 (x = -1006 .. 2013) plus one ring -> 10..15;
     # y in [-1500, 1500] -> rows 9..11 plus one ring -> 8..12; slices 08:10 .. 08:20.
     assert (w.i0, w.i1, w.j0, w.j1) == (10, 16, 8, 13)
     assert (w.k0, w.k1) == (1, 3)
-    f = open_wrf(path, frame, bbox=(-1000.0, 1500.0, -500.0, 500.0), margin_m=1000.0,
-                 time_window=(T0 + 700.0, T0 + 1100.0))
+    f = open_wrf(
+        path,
+        frame,
+        bbox=(-1000.0, 1500.0, -500.0, 500.0),
+        margin_m=1000.0,
+        time_window=(T0 + 700.0, T0 + 1100.0),
+    )
     c = f.coverage
     assert c.xmin <= -2000 and c.xmax >= 2500 and c.ymin <= -1500 and c.ymax >= 1500
     assert (c.t0, c.t1) == (T0 + 600.0, T0 + 1200.0)
     u, _ = f.sample(T0 + 900.0, 1200.0, 300.0)
     assert float(u) == pytest.approx(
-        float(_exact_local(frame, exact, T0 + 900.0, 1200.0, 300.0)[0]), abs=2e-4)
+        float(_exact_local(frame, exact, T0 + 900.0, 1200.0, 300.0)[0]), abs=2e-4
+    )
 
 
 def test_no_utm_seam_across_6_east(tiny_wrf) -> None:
@@ -281,8 +296,9 @@ def test_no_utm_seam_across_6_east(tiny_wrf) -> None:
     deg2utm) maps to evenly spaced local cells, and a linear field stays linear across it."""
     frame = LocalFrame(43.07, 6.0)
     wind10, exact = _linear_field(frame)
-    path = tiny_wrf("seam.nc", wind10=wind10, level_heights_m=None, center=(43.07, 6.0),
-                    stand_lon=6.0, nx=9)
+    path = tiny_wrf(
+        "seam.nc", wind10=wind10, level_heights_m=None, center=(43.07, 6.0), stand_lon=6.0, nx=9
+    )
     raw = read_wrf(path)
     assert raw.lon.min() < 6.0 < raw.lon.max()
     x, _ = frame.to_xy(raw.lat, raw.lon)
@@ -304,8 +320,9 @@ def test_outside_coverage_raises_naming_both_ranges_and_clamp(tiny_wrf, frame) -
     assert "requested" in msg and "covered" in msg and "clamp" in msg
     assert iso(T0 + 3600.0) in msg and iso(T0 + 1800.0) in msg
     fc = open_wrf(path, frame, clamp=True)
-    np.testing.assert_allclose(fc.sample(T0 + 3600.0, 1e6, 0.0),
-                               fc.sample(T0 + 1800.0, fc.coverage.xmax, 0.0), atol=1e-12)
+    np.testing.assert_allclose(
+        fc.sample(T0 + 3600.0, 1e6, 0.0), fc.sample(T0 + 1800.0, fc.coverage.xmax, 0.0), atol=1e-12
+    )
 
 
 def test_bbox_outside_domain_is_an_error(tiny_wrf, frame) -> None:

@@ -28,7 +28,9 @@ FORMATS: tuple[Format, ...] = ("gpx", "csv", "kml", "racexml")
 """The formats read (``--format``)."""
 
 READERS: dict[str, Callable[[Path], ImportedCourse]] = {
-    "gpx": read_gpx_course, "csv": read_csv_course, "kml": read_kml_course,
+    "gpx": read_gpx_course,
+    "csv": read_csv_course,
+    "kml": read_kml_course,
     "racexml": read_race_xml,
 }
 SUFFIXES = {".gpx": "gpx", ".csv": "csv", ".txt": "csv", ".tsv": "csv", ".kml": "kml"}
@@ -52,15 +54,20 @@ def detect_format(path: Path) -> Format:
         except OSError as exc:
             raise InputError(f"{path}: cannot read the file ({exc.strerror})") from None
 
-        m = re.search(r"<([A-Za-z_][\w.-]*:)?([A-Za-z_][\w.-]*)[\s>/]",
-                      re.sub(r"<[?!][^>]*>", "", head))
+        m = re.search(
+            r"<([A-Za-z_][\w.-]*:)?([A-Za-z_][\w.-]*)[\s>/]", re.sub(r"<[?!][^>]*>", "", head)
+        )
         root = m.group(2).lower() if m else ""
         if root in ROOTS:
             return ROOTS[root]  # type: ignore[return-value]
-        raise InputError(f"{path}: root element <{root or '?'}>; expected <Race> (race XML), "
-                         "<gpx> or <kml>, or give --format")
-    raise InputError(f"{path}: cannot tell the format from the suffix {path.suffix!r}; "
-                     "expected .gpx, .csv, .kml or .xml, or give --format gpx|csv|kml|racexml")
+        raise InputError(
+            f"{path}: root element <{root or '?'}>; expected <Race> (race XML), "
+            "<gpx> or <kml>, or give --format"
+        )
+    raise InputError(
+        f"{path}: cannot tell the format from the suffix {path.suffix!r}; "
+        "expected .gpx, .csv, .kml or .xml, or give --format gpx|csv|kml|racexml"
+    )
 
 
 def read_course_source(path: str | Path, fmt: str = "auto") -> tuple[ImportedCourse, Format]:

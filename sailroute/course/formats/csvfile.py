@@ -43,9 +43,11 @@ def _columns(header: list[str], src: Path) -> dict[str, int]:
             cols[canon] = hit
     missing = [c for c in ("name", "lat", "lon") if c not in cols]
     if missing:
-        raise InputError(f"{src}, line 1: missing column {', '.join(missing)}; expected a "
-                         f"header with name, lat, lon (optional type, rounding); got "
-                         f"{quote_header(header)}")
+        raise InputError(
+            f"{src}, line 1: missing column {', '.join(missing)}; expected a "
+            f"header with name, lat, lon (optional type, rounding); got "
+            f"{quote_header(header)}"
+        )
     return cols
 
 
@@ -81,29 +83,35 @@ def read_csv_course(path: str | Path) -> ImportedCourse:
     try:
         text = src.read_text(encoding="utf-8-sig", errors="replace")
     except OSError as exc:
-        raise InputError(f"{src}: cannot read the file ({exc.strerror}); expected a CSV "
-                         "file of marks") from None
+        raise InputError(
+            f"{src}: cannot read the file ({exc.strerror}); expected a CSV file of marks"
+        ) from None
     if looks_binary(text):
         raise InputError(f"{src}: a binary file; expected a CSV file of marks (name, lat, lon)")
-    numbered = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
-                if ln.strip() and not ln.lstrip().startswith("#")]
+    numbered = [
+        (k + 1, ln)
+        for k, ln in enumerate(text.splitlines())
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if not numbered:
-        raise InputError(f"{src}: no rows; expected a header (name, lat, lon) and one mark "
-                         "per row")
+        raise InputError(f"{src}: no rows; expected a header (name, lat, lon) and one mark per row")
     head = numbered[0][1]
     delim = next((d for d in (",", ";", "\t") if d in head), ",")
     rows = csv_rows(numbered, delim, str(src))
     if not looks_like_header(rows[0]):
-        raise InputError(f"{src}, line {numbered[0][0]}: the first line is not a header of "
-                         "column names; expected name, lat, lon (optional type, rounding)")
+        raise InputError(
+            f"{src}, line {numbered[0][0]}: the first line is not a header of "
+            "column names; expected name, lat, lon (optional type, rounding)"
+        )
     cols = _columns(rows[0], src)
     points: list[Waypoint] = []
     width = max(cols.values()) + 1
     for (lineno, _), row in zip(numbered[1:], rows[1:], strict=True):
         where = f"{src}, line {lineno}"
         if len(row) < width:
-            raise InputError(f"{where}: {len(row)} fields; expected at least {width} (the "
-                             "columns of the header)")
+            raise InputError(
+                f"{where}: {len(row)} fields; expected at least {width} (the columns of the header)"
+            )
         name = row[cols["name"]].strip()
         if not name:
             raise InputError(f"{where}: empty name; expected the mark's name")
@@ -112,7 +120,9 @@ def read_csv_course(path: str | Path) -> ImportedCourse:
         kind = parse_type(row[cols["type"]], where) if "type" in cols else "mark"
         rounding = parse_rounding(row[cols["rounding"]], where) if "rounding" in cols else None
         if rounding is not None and kind != "mark":
-            raise InputError(f"{where}: rounding {rounding!r} on a point of type {kind}; "
-                             "expected a rounding on marks only (leave it empty)")
+            raise InputError(
+                f"{where}: rounding {rounding!r} on a point of type {kind}; "
+                "expected a rounding on marks only (leave it empty)"
+            )
         points.append(Waypoint(name, lat, lon, kind, rounding, where))
     return from_waypoints(points, name=src.stem, src=str(src))

@@ -30,11 +30,15 @@ def _point(node: Node, src: Path, k: int) -> Waypoint:
     try:
         lat, lon = float(node.attrs["lat"]), float(node.attrs["lon"])
     except (KeyError, ValueError):
-        raise InputError(f"{where}: <{node.tag} lat={node.attrs.get('lat')!r} "
-                         f"lon={node.attrs.get('lon')!r}>: expected decimal degrees") from None
+        raise InputError(
+            f"{where}: <{node.tag} lat={node.attrs.get('lat')!r} "
+            f"lon={node.attrs.get('lon')!r}>: expected decimal degrees"
+        ) from None
     if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 360.0):
-        raise InputError(f"{where}: <{node.tag}> at lat {lat}, lon {lon}; expected lat in "
-                         "[-90, 90] and lon in [-180, 360] degrees")
+        raise InputError(
+            f"{where}: <{node.tag}> at lat {lat}, lon {lon}; expected lat in "
+            "[-90, 90] and lon in [-180, 360] degrees"
+        )
     name = node.child_text("name") or f"{node.tag}{k + 1}"
     text = node.child_text("type")
     kind, rounding = "mark", None
@@ -70,16 +74,22 @@ def read_gpx_course(path: str | Path) -> ImportedCourse:
     wpts = [_point(n, src, k) for k, n in enumerate(root.findall("wpt"))]
     routes = root.findall("rte")
     if len(routes) > 1:
-        raise InputError(f"{src}: line {routes[1].line}: a second <rte>; expected one route "
-                         "(the course), or none")
-    rpts = ([_point(n, src, k) for k, n in enumerate(routes[0].findall("rtept"))]
-            if routes else [])
+        raise InputError(
+            f"{src}: line {routes[1].line}: a second <rte>; expected one route "
+            "(the course), or none"
+        )
+    rpts = [_point(n, src, k) for k, n in enumerate(routes[0].findall("rtept"))] if routes else []
     if not wpts and not rpts:
-        raise InputError(f"{src}: line {root.line}: no waypoints (<wpt>) and no route points "
-                         "(<rte><rtept>); expected the marks as waypoints or a route")
+        raise InputError(
+            f"{src}: line {root.line}: no waypoints (<wpt>) and no route points "
+            "(<rte><rtept>); expected the marks as waypoints or a route"
+        )
     meta = root.find("metadata")
-    name = ((routes[0].child_text("name") if routes else "")
-            or (meta.child_text("name") if meta is not None else "") or src.stem)
+    name = (
+        (routes[0].child_text("name") if routes else "")
+        or (meta.child_text("name") if meta is not None else "")
+        or src.stem
+    )
     if rpts:
         return from_waypoints(rpts, name=name, src=str(src), extra_marks=wpts)
     return from_waypoints(wpts, name=name, src=str(src))

@@ -42,11 +42,14 @@ def _coords(node: Node, where: str) -> list[LatLon]:
         try:
             lon, lat = float(parts[0]), float(parts[1])
         except (IndexError, ValueError):
-            raise InputError(f"{where}: coordinates {tup!r}; expected lon,lat[,alt] in "
-                             "decimal degrees") from None
+            raise InputError(
+                f"{where}: coordinates {tup!r}; expected lon,lat[,alt] in decimal degrees"
+            ) from None
         if not (-90.0 <= lat <= 90.0 and -180.0 <= lon <= 360.0):
-            raise InputError(f"{where}: coordinates {tup!r}; expected lat in [-90, 90] and "
-                             "lon in [-180, 360] degrees (KML writes lon first)")
+            raise InputError(
+                f"{where}: coordinates {tup!r}; expected lat in [-90, 90] and "
+                "lon in [-180, 360] degrees (KML writes lon first)"
+            )
         out.append((lat, lon))
     return out
 
@@ -62,11 +65,15 @@ def _data(pm: Node) -> dict[str, str]:
 def _geometry(pm: Node, where: str) -> Node:
     geo = [c for c in pm.children if c.tag in GEOMETRIES or c.tag == "MultiGeometry"]
     if not geo:
-        raise InputError(f"{where}: placemark {pm.child_text('name')!r} has no Point, "
-                         "LineString or Polygon; expected one")
+        raise InputError(
+            f"{where}: placemark {pm.child_text('name')!r} has no Point, "
+            "LineString or Polygon; expected one"
+        )
     if geo[0].tag == "MultiGeometry":
-        raise InputError(f"{src_of(where)}: line {geo[0].line}: <MultiGeometry>; expected "
-                         "a Point, LineString or Polygon per placemark (split it)")
+        raise InputError(
+            f"{src_of(where)}: line {geo[0].line}: <MultiGeometry>; expected "
+            "a Point, LineString or Polygon per placemark (split it)"
+        )
     return geo[0]
 
 
@@ -103,8 +110,7 @@ def read_kml_course(path: str | Path) -> ImportedCourse:
     points: list[Waypoint] = []
     rings: list[Ring] = []
     n_items = 0
-    lines = [pm for pm in placemarks if _geometry(pm, f"{src}: line {pm.line}").tag
-             == "LineString"]
+    lines = [pm for pm in placemarks if _geometry(pm, f"{src}: line {pm.line}").tag == "LineString"]
     for pm in placemarks:
         where = f"{src}: line {pm.line}"
         geo = _geometry(pm, where)
@@ -116,33 +122,44 @@ def read_kml_course(path: str | Path) -> ImportedCourse:
         data = _data(pm)
         if geo.tag == "Point":
             if len(coords) != 1:
-                raise InputError(f"{src}: line {coords_node.line}: a Point with {len(coords)} "
-                                 "coordinates; expected one lon,lat")
+                raise InputError(
+                    f"{src}: line {coords_node.line}: a Point with {len(coords)} "
+                    "coordinates; expected one lon,lat"
+                )
             kind = parse_type(data.get("type", ""), where)
             rounding = parse_rounding(data.get("rounding", ""), where)
             points.append(Waypoint(name, coords[0][0], coords[0][1], kind, rounding, where))
             n_items += 1
         elif geo.tag == "LineString":
             if len(coords) != 2:
-                raise InputError(f"{src}: line {coords_node.line}: LineString {name!r} of "
-                                 f"{len(coords)} points; expected 2 (a line's two ends)")
+                raise InputError(
+                    f"{src}: line {coords_node.line}: LineString {name!r} of "
+                    f"{len(coords)} points; expected 2 (a line's two ends)"
+                )
             kind = parse_type(data.get("type", ""), where)
             if kind == "mark":
                 low = name.lower()
-                kind = ("start" if "start" in low else "finish" if "finish" in low
-                        else "start" if n_items == 0 and pm is lines[0] else "finish")
-            line_name = name if kind == "gate" else (
-                kind if name.lower() == kind else name)
+                kind = (
+                    "start"
+                    if "start" in low
+                    else "finish"
+                    if "finish" in low
+                    else "start"
+                    if n_items == 0 and pm is lines[0]
+                    else "finish"
+                )
+            line_name = name if kind == "gate" else (kind if name.lower() == kind else name)
             for k, (lat, lon) in enumerate(coords):
-                points.append(Waypoint(f"{name}_{k + 1}", lat, lon, kind, None, where,
-                                       line_name))
+                points.append(Waypoint(f"{name}_{k + 1}", lat, lon, kind, None, where, line_name))
             n_items += 1
         else:
             outer = geo.find("outerBoundaryIs")
             ring_node = next(outer.iter("coordinates"), None) if outer is not None else None
             if ring_node is None:
-                raise InputError(f"{src}: line {geo.line}: Polygon {name!r} without "
-                                 "<outerBoundaryIs><LinearRing><coordinates>")
+                raise InputError(
+                    f"{src}: line {geo.line}: Polygon {name!r} without "
+                    "<outerBoundaryIs><LinearRing><coordinates>"
+                )
             ring = _coords(ring_node, f"{src}: line {ring_node.line}")
             if len(ring) > 1 and ring[0] == ring[-1]:
                 ring = ring[:-1]  # KML closes its rings; a course ring does not

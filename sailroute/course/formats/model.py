@@ -29,8 +29,14 @@ from sailroute.routing.rings import ring_problem
 from sailroute.routing.types import Side
 
 __all__ = [
-    "POINT_TYPES", "ImportedCourse", "Ring", "Waypoint", "classify_rings", "from_waypoints",
-    "parse_rounding", "parse_type",
+    "POINT_TYPES",
+    "ImportedCourse",
+    "Ring",
+    "Waypoint",
+    "classify_rings",
+    "from_waypoints",
+    "parse_rounding",
+    "parse_type",
 ]
 
 LatLon = tuple[float, float]
@@ -139,8 +145,10 @@ def parse_type(text: str, where: str) -> PointType:
     """A point type from its text (case-insensitive; empty: ``mark``)."""
     t = text.strip().lower() or "mark"
     if t not in POINT_TYPES:
-        raise InputError(f"{where}: type {text!r}; expected one of {', '.join(POINT_TYPES)} "
-                         "(or leave it empty for a mark)")
+        raise InputError(
+            f"{where}: type {text!r}; expected one of {', '.join(POINT_TYPES)} "
+            "(or leave it empty for a mark)"
+        )
     return t
 
 
@@ -156,23 +164,29 @@ def parse_rounding(text: str, where: str) -> Side | None:
     raise InputError(f"{where}: rounding {text!r}; expected port or starboard (or empty)")
 
 
-def _add_mark(marks: dict[str, tuple[float, float, str]], p: Waypoint, frame: LocalFrame
-              ) -> None:
+def _add_mark(marks: dict[str, tuple[float, float, str]], p: Waypoint, frame: LocalFrame) -> None:
     """Record mark ``p``; a name seen before must be the same place."""
     if p.name in marks:
         lat, lon, first = marks[p.name]
         x, y = frame.to_xy([lat, p.lat], [lon, p.lon])
         d = float(math.hypot(x[1] - x[0], y[1] - y[0]))
         if d > SAME_PLACE_M:
-            raise InputError(f"{p.where}: mark {p.name!r} is {d:.1f} m from the point of the "
-                             f"same name at {first}; expected one place per name (rename one)")
+            raise InputError(
+                f"{p.where}: mark {p.name!r} is {d:.1f} m from the point of the "
+                f"same name at {first}; expected one place per name (rename one)"
+            )
         return
     marks[p.name] = (p.lat, p.lon, p.where)
 
 
 def from_waypoints(
-    points: Sequence[Waypoint], *, name: str, src: str, rings: Sequence[Ring] = (),
-    start_time: datetime | None = None, extra_marks: Sequence[Waypoint] = (),
+    points: Sequence[Waypoint],
+    *,
+    name: str,
+    src: str,
+    rings: Sequence[Ring] = (),
+    start_time: datetime | None = None,
+    extra_marks: Sequence[Waypoint] = (),
 ) -> ImportedCourse:
     """Assemble a course from a list of points in sailing order.
 
@@ -204,8 +218,9 @@ def from_waypoints(
     """
     if not points:
         raise InputError(f"{src}: no points; expected the marks in sailing order")
-    frame = LocalFrame(float(np.mean([p.lat for p in points])),
-                       float(np.mean([p.lon for p in points])))
+    frame = LocalFrame(
+        float(np.mean([p.lat for p in points])), float(np.mean([p.lon for p in points]))
+    )
     marks: dict[str, tuple[float, float, str]] = {}
     lines: dict[str, tuple[str, str]] = {}
     gates: dict[str, tuple[str, str]] = {}
@@ -220,11 +235,15 @@ def from_waypoints(
             continue
         q = points[k + 1] if k + 1 < len(points) else None
         if q is None or q.kind != p.kind:
-            raise InputError(f"{p.where}: point {p.name!r} of type {p.kind} stands alone; "
-                             f"expected two consecutive points of type {p.kind} (its two ends)")
+            raise InputError(
+                f"{p.where}: point {p.name!r} of type {p.kind} stands alone; "
+                f"expected two consecutive points of type {p.kind} (its two ends)"
+            )
         if q.name == p.name:
-            raise InputError(f"{q.where}: both ends of the {p.kind} are called {p.name!r}; "
-                             "expected two different marks")
+            raise InputError(
+                f"{q.where}: both ends of the {p.kind} are called {p.name!r}; "
+                "expected two different marks"
+            )
         _add_mark(marks, q, frame)
         if p.kind == "gate":
             gname = p.line_name or f"{p.name}-{q.name}"
@@ -238,12 +257,16 @@ def from_waypoints(
     for p in extra_marks:
         _add_mark(marks, p, frame)
     if len(seq) < 2:
-        raise InputError(f"{src}: one item ({seq[0][0]!r}); expected at least two in sailing "
-                         "order: where the first leg starts and the mark it sails to")
+        raise InputError(
+            f"{src}: one item ({seq[0][0]!r}); expected at least two in sailing "
+            "order: where the first leg starts and the mark it sails to"
+        )
     for n in marks:
         if n in lines or n in gates:
-            raise InputError(f"{src}: {n!r} names a mark and a line or gate; expected "
-                             "different names (rename the mark)")
+            raise InputError(
+                f"{src}: {n!r} names a mark and a line or gate; expected "
+                "different names (rename the mark)"
+            )
     course = ImportedCourse(
         name=name,
         marks=tuple((n, lat, lon) for n, (lat, lon, _) in marks.items()),
@@ -286,18 +309,24 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
         inside = shapely.contains_xy(shapely.Polygon(xy), mx, my)
         if "boundary" in r.name.lower():
             if boundary is not None:
-                raise InputError(f"{r.where}: a second boundary {r.name!r} (the first is at "
-                                 f"{boundary_where}); expected one (rename the other)")
+                raise InputError(
+                    f"{r.where}: a second boundary {r.name!r} (the first is at "
+                    f"{boundary_where}); expected one (rename the other)"
+                )
             outside = [m[0] for m, ok in zip(course.marks, inside, strict=True) if not ok]
             if outside:  # a course file's boundary holds every mark (course-format.md)
-                notes.append(f"the boundary {r.name!r} ({r.where}) leaves the marks "
-                             f"{', '.join(outside)} outside: left out (routes are not kept "
-                             "inside it); add a `boundary:` that holds every mark to use one")
+                notes.append(
+                    f"the boundary {r.name!r} ({r.where}) leaves the marks "
+                    f"{', '.join(outside)} outside: left out (routes are not kept "
+                    "inside it); add a `boundary:` that holds every mark to use one"
+                )
             else:
                 boundary, boundary_where = r.points, r.where
         elif inside.all():
-            notes.append(f"polygon {r.name!r} ({r.where}) holds every mark: an outer limit "
-                         "around the race area, not an area to stay out of; left out")
+            notes.append(
+                f"polygon {r.name!r} ({r.where}) holds every mark: an outer limit "
+                "around the race area, not an area to stay out of; left out"
+            )
         else:
             if inside.any():
                 held = [m[0] for m, ok in zip(course.marks, inside, strict=True) if ok]
@@ -309,5 +338,14 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
             taken.add(name)
             obstacles.append((name, r.points))
     return ImportedCourse(
-        course.name, course.marks, course.lines, course.gates, course.start_from,
-        course.legs, course.start_time, boundary, tuple(obstacles), tuple(notes))
+        course.name,
+        course.marks,
+        course.lines,
+        course.gates,
+        course.start_from,
+        course.legs,
+        course.start_time,
+        boundary,
+        tuple(obstacles),
+        tuple(notes),
+    )

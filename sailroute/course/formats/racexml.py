@@ -41,11 +41,14 @@ def _float(node: Node, key: str, lo: float, hi: float, src: Path) -> float:
     try:
         v = float(text if text is not None else "")
     except ValueError:
-        raise InputError(f"{src}: line {node.line}: <{node.tag}> {key}={text!r}; expected "
-                         "decimal degrees") from None
+        raise InputError(
+            f"{src}: line {node.line}: <{node.tag}> {key}={text!r}; expected decimal degrees"
+        ) from None
     if not (math.isfinite(v) and lo <= v <= hi):
-        raise InputError(f"{src}: line {node.line}: <{node.tag}> {key}={text!r}; expected a "
-                         f"number in [{lo:g}, {hi:g}]")
+        raise InputError(
+            f"{src}: line {node.line}: <{node.tag}> {key}={text!r}; expected a "
+            f"number in [{lo:g}, {hi:g}]"
+        )
     return v
 
 
@@ -53,8 +56,10 @@ def _seq(node: Node, src: Path) -> int:
     try:
         return int(node.attrs["SeqID"])
     except (KeyError, ValueError):
-        raise InputError(f"{src}: line {node.line}: <{node.tag}> SeqID="
-                         f"{node.attrs.get('SeqID')!r}; expected a whole number") from None
+        raise InputError(
+            f"{src}: line {node.line}: <{node.tag}> SeqID="
+            f"{node.attrs.get('SeqID')!r}; expected a whole number"
+        ) from None
 
 
 def _compound_marks(course: Node, src: Path) -> dict[str, list[tuple[str, float, float, int]]]:
@@ -62,19 +67,25 @@ def _compound_marks(course: Node, src: Path) -> dict[str, list[tuple[str, float,
     out: dict[str, list[tuple[str, float, float, int]]] = {}
     for cm in course.children:
         if cm.tag != "CompoundMark":
-            raise InputError(f"{src}: line {cm.line}: <{cm.tag}> in <Course>; expected "
-                             "<CompoundMark> elements only")
+            raise InputError(
+                f"{src}: line {cm.line}: <{cm.tag}> in <Course>; expected "
+                "<CompoundMark> elements only"
+            )
         cid = cm.attrs.get("CompoundMarkID", "")
         if not cid:
             raise InputError(f"{src}: line {cm.line}: <CompoundMark> without CompoundMarkID")
         if cid in out:
-            raise InputError(f"{src}: line {cm.line}: CompoundMarkID {cid!r} used twice; "
-                             "expected each compound mark once")
+            raise InputError(
+                f"{src}: line {cm.line}: CompoundMarkID {cid!r} used twice; "
+                "expected each compound mark once"
+            )
         marks = []
         for m in cm.children:
             if m.tag != "Mark":
-                raise InputError(f"{src}: line {m.line}: <{m.tag}> in CompoundMark {cid!r}; "
-                                 "expected <Mark Name TargetLat TargetLng> elements only")
+                raise InputError(
+                    f"{src}: line {m.line}: <{m.tag}> in CompoundMark {cid!r}; "
+                    "expected <Mark Name TargetLat TargetLng> elements only"
+                )
             name = m.attrs.get("Name", "").strip()
             if not name:
                 raise InputError(f"{src}: line {m.line}: <Mark> without a Name")
@@ -82,8 +93,10 @@ def _compound_marks(course: Node, src: Path) -> dict[str, list[tuple[str, float,
             lon = _float(m, "TargetLng", -180.0, 360.0, src)
             marks.append((_seq(m, src), name, lat, lon, m.line))
         if len(marks) not in (1, 2):
-            raise InputError(f"{src}: line {cm.line}: CompoundMark {cid!r} holds {len(marks)} "
-                             "marks; expected 1 (a mark) or 2 (a gate or line)")
+            raise InputError(
+                f"{src}: line {cm.line}: CompoundMark {cid!r} holds {len(marks)} "
+                "marks; expected 1 (a mark) or 2 (a gate or line)"
+            )
         out[cid] = [(n, la, lo, ln) for _, n, la, lo, ln in sorted(marks)]
     return out
 
@@ -91,13 +104,20 @@ def _compound_marks(course: Node, src: Path) -> dict[str, list[tuple[str, float,
 def _rings(root: Node, src: Path) -> list[Ring]:
     rings = []
     for lim in root.findall("CourseLimit"):
-        pts = sorted((_seq(p, src), _float(p, "Lat", -90.0, 90.0, src),
-                      _float(p, "Lon", -180.0, 360.0, src)) for p in lim.findall("Limit"))
+        pts = sorted(
+            (_seq(p, src), _float(p, "Lat", -90.0, 90.0, src), _float(p, "Lon", -180.0, 360.0, src))
+            for p in lim.findall("Limit")
+        )
         ring = [(la, lo) for _, la, lo in pts]
         if len(ring) > 1 and ring[0] == ring[-1]:
             ring = ring[:-1]
-        rings.append(Ring(lim.attrs.get("name", "") or f"limit{lim.line}", tuple(ring),
-                          f"{src}: line {lim.line}"))
+        rings.append(
+            Ring(
+                lim.attrs.get("name", "") or f"limit{lim.line}",
+                tuple(ring),
+                f"{src}: line {lim.line}",
+            )
+        )
     return rings
 
 
@@ -125,53 +145,68 @@ def read_race_xml(path: str | Path) -> ImportedCourse:
     src = Path(path)
     root = parse_xml(src, "a race XML file (<Race>)")
     if root.tag != "Race":
-        raise InputError(f"{src}: line {root.line}: root element <{root.tag}>; expected "
-                         "<Race> (a SailGP / America's Cup race XML)")
+        raise InputError(
+            f"{src}: line {root.line}: root element <{root.tag}>; expected "
+            "<Race> (a SailGP / America's Cup race XML)"
+        )
     course = root.find("Course")
     sequence = root.find("CompoundMarkSequence")
     if course is None or sequence is None:
-        raise InputError(f"{src}: line {root.line}: <Race> without <Course> and "
-                         "<CompoundMarkSequence>; expected both")
+        raise InputError(
+            f"{src}: line {root.line}: <Race> without <Course> and "
+            "<CompoundMarkSequence>; expected both"
+        )
     cms = _compound_marks(course, src)
     corners = sorted((_seq(c, src), c) for c in sequence.findall("Corner"))
     if len(corners) < 2:
-        raise InputError(f"{src}: line {sequence.line}: {len(corners)} corner(s); expected "
-                         "at least 2 (the start and one mark)")
+        raise InputError(
+            f"{src}: line {sequence.line}: {len(corners)} corner(s); expected "
+            "at least 2 (the start and one mark)"
+        )
     marks: dict[str, tuple[float, float, int]] = {}
     all_ll = [(la, lo) for ms in cms.values() for _, la, lo, _ in ms]
-    frame = LocalFrame(sum(p[0] for p in all_ll) / len(all_ll),
-                       sum(p[1] for p in all_ll) / len(all_ll))
+    frame = LocalFrame(
+        sum(p[0] for p in all_ll) / len(all_ll), sum(p[1] for p in all_ll) / len(all_ll)
+    )
     lines: dict[str, tuple[str, str]] = {}
     gates: dict[str, tuple[str, str]] = {}
     seq: list[tuple[str, Side | None]] = []
     for k, (_, corner) in enumerate(corners):
         cid = corner.attrs.get("CompoundMarkID", "")
         if cid not in cms:
-            raise InputError(f"{src}: line {corner.line}: Corner CompoundMarkID={cid!r}; "
-                             f"expected one of {', '.join(cms)}")
+            raise InputError(
+                f"{src}: line {corner.line}: Corner CompoundMarkID={cid!r}; "
+                f"expected one of {', '.join(cms)}"
+            )
         ms = cms[cid]
         for name, lat, lon, line in ms:
             if name in marks:
                 x, y = frame.to_xy([marks[name][0], lat], [marks[name][1], lon])
                 d = float(math.hypot(x[1] - x[0], y[1] - y[0]))
                 if d > 1.0:
-                    raise InputError(f"{src}: line {line}: mark {name!r} is {d:.1f} m from "
-                                     f"the mark of that name at line {marks[name][2]}; "
-                                     "expected one place per name")
+                    raise InputError(
+                        f"{src}: line {line}: mark {name!r} is {d:.1f} m from "
+                        f"the mark of that name at line {marks[name][2]}; "
+                        "expected one place per name"
+                    )
             else:
                 marks[name] = (lat, lon, line)
         rounding = corner.attrs.get("Rounding", "").strip().lower()
         if len(ms) == 1:
             if rounding not in MARK_SIDES:
-                raise InputError(f"{src}: line {corner.line}: Rounding="
-                                 f"{corner.attrs.get('Rounding')!r} at the single mark "
-                                 f"{ms[0][0]!r}; expected Port or Stbd")
+                raise InputError(
+                    f"{src}: line {corner.line}: Rounding="
+                    f"{corner.attrs.get('Rounding')!r} at the single mark "
+                    f"{ms[0][0]!r}; expected Port or Stbd"
+                )
             seq.append((ms[0][0], MARK_SIDES[rounding]))
             continue
         if rounding not in PASS_BETWEEN:
-            raise InputError(f"{src}: line {corner.line}: Rounding="
-                             f"{corner.attrs.get('Rounding')!r} at the two marks "
-                             f"{ms[0][0]!r}, {ms[1][0]!r}; expected SP or PS (pass between)")
+            raise InputError(
+                f"{src}: line {corner.line}: Rounding="
+                f"{corner.attrs.get('Rounding')!r} at the two marks "
+                f"{ms[0][0]!r}, {ms[1][0]!r}; expected SP or PS (pass between)"
+            )
         pair = (ms[0][0], ms[1][0])
         if k == 0 or k == len(corners) - 1:
             lname = "start" if k == 0 else "finish"

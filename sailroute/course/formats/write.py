@@ -82,11 +82,15 @@ def course_yaml(
     """
     out = [f"# Imported by `sailroute course import` from {source} ({fmt})."]
     if boat is None:
-        out += ["# NO BOAT GIVEN (--boat): add a `boat:` section for the boat you race, e.g.",
-                "#   boat: {polar: my-boat.pol}   or   boat: {builtin: ilca6}",
-                "# until then `sailroute plan` routes the default ILCA 7 polar."]
-    out += [f"# Wind: one uniform scenario ({tws_kn:g} kn from {twd_deg:g} deg); add or replace",
-            "# scenarios (docs/course-format.md, `scenarios`)."]
+        out += [
+            "# NO BOAT GIVEN (--boat): add a `boat:` section for the boat you race, e.g.",
+            "#   boat: {polar: my-boat.pol}   or   boat: {builtin: ilca6}",
+            "# until then `sailroute plan` routes the default ILCA 7 polar.",
+        ]
+    out += [
+        f"# Wind: one uniform scenario ({tws_kn:g} kn from {twd_deg:g} deg); add or replace",
+        "# scenarios (docs/course-format.md, `scenarios`).",
+    ]
     if course.boundary is not None or course.obstacles:
         out.append("# boundary/obstacles: read into the course; the routers do not use them yet.")
     out += [f"name: {_q(course.name)}", f"start_time: {_q(start_time.isoformat())}", "marks:"]
@@ -106,8 +110,7 @@ def course_yaml(
         out.append(f"  - {{{', '.join(items)}}}")
     if boat is not None:
         out.append(f"boat: {_flow(boat)}")
-    out += ["scenarios:",
-            f"  uniform: {{type: uniform, tws_kn: {tws_kn!r}, twd_deg: {twd_deg!r}}}"]
+    out += ["scenarios:", f"  uniform: {{type: uniform, tws_kn: {tws_kn!r}, twd_deg: {twd_deg!r}}}"]
     if course.boundary is not None:
         out += ["boundary:", "  points:", *_ring(course.boundary, "    ")]
     if course.obstacles:

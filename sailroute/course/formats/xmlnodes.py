@@ -91,16 +91,18 @@ def parse_xml(path: Path, what: str) -> Node:
     try:
         data = path.read_bytes()
     except OSError as exc:
-        raise InputError(f"{path}: cannot read the file ({exc.strerror}); expected {what}"
-                         ) from None
+        raise InputError(
+            f"{path}: cannot read the file ({exc.strerror}); expected {what}"
+        ) from None
     parser = expat.ParserCreate(namespace_separator="}")
     stack: list[Node] = []
     texts: list[list[str]] = []
     root: list[Node] = []
 
     def start(name: str, attrs: dict[str, str]) -> None:
-        node = Node(_local(name), {_local(k): v for k, v in attrs.items()},
-                    parser.CurrentLineNumber)
+        node = Node(
+            _local(name), {_local(k): v for k, v in attrs.items()}, parser.CurrentLineNumber
+        )
         if stack:
             stack[-1].children.append(node)
         else:
@@ -117,8 +119,10 @@ def parse_xml(path: Path, what: str) -> Node:
             texts[-1].append(chunk)
 
     def doctype(*_: object) -> None:
-        raise InputError(f"{path}: line {parser.CurrentLineNumber}: a document type "
-                         f"declaration (<!DOCTYPE>); expected {what} without one (remove it)")
+        raise InputError(
+            f"{path}: line {parser.CurrentLineNumber}: a document type "
+            f"declaration (<!DOCTYPE>); expected {what} without one (remove it)"
+        )
 
     parser.StartElementHandler = start
     parser.EndElementHandler = end
@@ -128,8 +132,10 @@ def parse_xml(path: Path, what: str) -> Node:
     try:
         parser.Parse(data, True)
     except expat.ExpatError as exc:
-        raise InputError(f"{path}:{exc.lineno}:{exc.offset + 1}: not well-formed XML "
-                         f"({expat.errors.messages[exc.code]}); expected {what}") from None
+        raise InputError(
+            f"{path}:{exc.lineno}:{exc.offset + 1}: not well-formed XML "
+            f"({expat.errors.messages[exc.code]}); expected {what}"
+        ) from None
     if not root:
         raise InputError(f"{path}: no XML element found; expected {what}")
     return root[0]

@@ -15,16 +15,23 @@ HERE = Path(__file__).resolve().parent
 REAL = HERE.parents[2].parent / "shared" / "data" / "real"
 
 
-def crop_wrf(src: Path, dst: Path, *, j: slice, i: slice, nlev: int, note: str,
-             variables: tuple[str, ...]) -> None:
+def crop_wrf(
+    src: Path, dst: Path, *, j: slice, i: slice, nlev: int, note: str, variables: tuple[str, ...]
+) -> None:
     """Copy a window of a wrfout file, keeping dimensions, attributes and staggering."""
     with netCDF4.Dataset(src) as s, netCDF4.Dataset(dst, "w", format="NETCDF4") as d:
         d.setncatts({k: s.getncattr(k) for k in s.ncattrs()})
         d.setncattr("SAILROUTE_CROP", note)
         ny = len(range(*j.indices(s.dimensions["south_north"].size)))
         nx = len(range(*i.indices(s.dimensions["west_east"].size)))
-        sizes = {"south_north": ny, "west_east": nx, "south_north_stag": ny + 1,
-                 "west_east_stag": nx + 1, "bottom_top": nlev, "bottom_top_stag": nlev + 1}
+        sizes = {
+            "south_north": ny,
+            "west_east": nx,
+            "south_north_stag": ny + 1,
+            "west_east_stag": nx + 1,
+            "bottom_top": nlev,
+            "bottom_top_stag": nlev + 1,
+        }
         for name, dim in s.dimensions.items():
             if name in ("soil_layers_stag",):
                 continue
@@ -55,8 +62,11 @@ def crop_wrf(src: Path, dst: Path, *, j: slice, i: slice, nlev: int, note: str,
 def crop_result(src: Path, dst: Path, *, j: slice, i: slice, nlev: int) -> None:
     """wrf-python's expected diagnostics (time 0) for the same window."""
     with netCDF4.Dataset(src) as s, netCDF4.Dataset(dst, "w", format="NETCDF4") as d:
-        d.setncattr("SAILROUTE_CROP", f"south_north {j.start}:{j.stop}, west_east "
-                    f"{i.start}:{i.stop}, bottom_top 0:{nlev} of ci_result_file.nc")
+        d.setncattr(
+            "SAILROUTE_CROP",
+            f"south_north {j.start}:{j.stop}, west_east "
+            f"{i.start}:{i.stop}, bottom_top 0:{nlev} of ci_result_file.nc",
+        )
         ny, nx = j.stop - j.start, i.stop - i.start
         d.createDimension("u_v", 2)
         d.createDimension("bottom_top", nlev)
@@ -99,18 +109,34 @@ def excerpt_ndbc_txt(src: Path, dst: Path, times: set[str]) -> None:
 def main() -> None:
     ci = REAL / "wrf" / "wrf-python-ci"
     base = ("Times", "XLAT", "XLONG", "U10", "V10", "HGT", "U", "V", "PH", "PHB")
-    crop_wrf(ci / "ci_test_file.nc", HERE / "wrfpython_ci_crop.nc", j=slice(0, 16),
-             i=slice(0, 24), nlev=2, variables=base,
-             note="south_north 0:16, west_east 0:24, bottom_top 0:2 of wrf-python "
-                  "test/ci_tests/ci_test_file.nc (commit 59018ff)")
-    crop_result(ci / "ci_result_file.nc", HERE / "wrfpython_ci_result_crop.nc",
-                j=slice(0, 16), i=slice(0, 24), nlev=2)
+    crop_wrf(
+        ci / "ci_test_file.nc",
+        HERE / "wrfpython_ci_crop.nc",
+        j=slice(0, 16),
+        i=slice(0, 24),
+        nlev=2,
+        variables=base,
+        note="south_north 0:16, west_east 0:24, bottom_top 0:2 of wrf-python "
+        "test/ci_tests/ci_test_file.nc (commit 59018ff)",
+    )
+    crop_result(
+        ci / "ci_result_file.nc",
+        HERE / "wrfpython_ci_result_crop.nc",
+        j=slice(0, 16),
+        i=slice(0, 24),
+        nlev=2,
+    )
     sal = REAL / "wrf" / "salem"
-    crop_wrf(sal / "wrf_d01_allvars_cropped.nc", HERE / "salem_lambert_crop.nc",
-             j=slice(0, 8), i=slice(0, 10), nlev=2,
-             variables=(*base, "COSALPHA", "SINALPHA"),
-             note="all 10 x 8 columns, bottom_top 0:2, 12 of 147 variables of salem-sample-data "
-                  "salem-test/grid/wrf_d01_allvars_cropped.nc (commit 8ad39d1)")
+    crop_wrf(
+        sal / "wrf_d01_allvars_cropped.nc",
+        HERE / "salem_lambert_crop.nc",
+        j=slice(0, 8),
+        i=slice(0, 10),
+        nlev=2,
+        variables=(*base, "COSALPHA", "SINALPHA"),
+        note="all 10 x 8 columns, bottom_top 0:2, 12 of 147 variables of salem-sample-data "
+        "salem-test/grid/wrf_d01_allvars_cropped.nc (commit 8ad39d1)",
+    )
     nd = REAL / "wind" / "ndbc-41008-cwind"
     rows = [range(96, 127), range(4240, 4256)]
     excerpt_csv(nd / "41008_cwind_2018.csv", HERE / "ndbc_41008_excerpt.csv", rows)

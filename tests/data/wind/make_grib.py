@@ -25,19 +25,27 @@ def main() -> None:
     lat, lon = np.meshgrid(lats, lons, indexing="ij")
     with open(OUT, "wb") as out:
         for step in (0, 1):
-            for short, vals in (("10u", 5 + 10 * (lat - 43) + step),
-                                ("10v", -3 + 20 * (lon - 7) - step)):
+            for short, vals in (
+                ("10u", 5 + 10 * (lat - 43) + step),
+                ("10v", -3 + 20 * (lon - 7) - step),
+            ):
                 h = ec.codes_grib_new_from_samples("regular_ll_sfc_grib2")
                 for key, value in (
-                        ("Ni", lons.size), ("Nj", lats.size),
-                        ("latitudeOfFirstGridPointInDegrees", float(lats[0])),
-                        ("latitudeOfLastGridPointInDegrees", float(lats[-1])),
-                        ("longitudeOfFirstGridPointInDegrees", float(lons[0])),
-                        ("longitudeOfLastGridPointInDegrees", float(lons[-1])),
-                        ("iDirectionIncrementInDegrees", 0.05),
-                        ("jDirectionIncrementInDegrees", 0.05),
-                        ("dataDate", 20141007), ("dataTime", 1200), ("stepUnits", 1),
-                        ("forecastTime", step), ("shortName", short), ("bitsPerValue", 16)):
+                    ("Ni", lons.size),
+                    ("Nj", lats.size),
+                    ("latitudeOfFirstGridPointInDegrees", float(lats[0])),
+                    ("latitudeOfLastGridPointInDegrees", float(lats[-1])),
+                    ("longitudeOfFirstGridPointInDegrees", float(lons[0])),
+                    ("longitudeOfLastGridPointInDegrees", float(lons[-1])),
+                    ("iDirectionIncrementInDegrees", 0.05),
+                    ("jDirectionIncrementInDegrees", 0.05),
+                    ("dataDate", 20141007),
+                    ("dataTime", 1200),
+                    ("stepUnits", 1),
+                    ("forecastTime", step),
+                    ("shortName", short),
+                    ("bitsPerValue", 16),
+                ):
                     ec.codes_set(h, key, value)
                 ec.codes_set_values(h, vals.ravel())
                 ec.codes_write(h, out)
