@@ -373,10 +373,10 @@ def plot_route(
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
         # an (n, 2, 2) array is the segment list matplotlib documents; its stubs want a Sequence
         lc = LineCollection(
-            segs,
+            segs,  # type: ignore[arg-type]
             cmap="viridis",
             norm=norm,
-            linewidths=2.2,  # type: ignore[arg-type]
+            linewidths=2.2,
             zorder=3,
         )
         lc.set_array(r.track.bsp_ms[:-1] / KNOT)

@@ -171,7 +171,10 @@ def read_track(
     if not text.strip():
         raise InputError(f"{src}: the track file is empty; expected GPX or CSV with time, lat, lon")
     tz = _zone(time_zone, src) if time_zone is not None else None
-    if text.lstrip().startswith("<"):
+    if text.lstrip().startswith("{"):  # the JSON-lines log of `sailroute live`
+        t, lat, lon, lines, channels = read_live_log(text, src)
+        default_name = p.stem
+    elif text.lstrip().startswith("<"):
         if columns:
             raise InputError(f"{src}: `columns` applies to CSV tracks only; this is GPX")
         t, lat, lon, lines, gpx_name, channels = _read_gpx(text, src, tz)
@@ -182,6 +185,94 @@ def read_track(
     return clean_track(
         t, lat, lon, lines, channels, src, clean_text(name if name is not None else default_name)
     )
+
+
+# ------------------------------------------------------------------------------ live log
+LIVE_LOG_MAX_AGE_S: Final = 5.0
+"""A channel of a ``sailroute live`` log is given at a fix from its last sample at most this
+old [s] (the instruments' sentences arrive one by one, between the position fixes)."""
+_LIVE_CHANNELS: Final = {
+    "sog_ms": "sog_ms",
+    "cog_deg": "cog_deg",
+    "hdg_deg": "hdg_deg",
+    "stw_ms": "bsp_ms",
+    "tws_ms": "tws_ms",
+    "twd_deg": "twd_deg",
+    "twa_deg": "twa_deg",
+    "aws_ms": "aws_ms",
+    "awa_deg": "awa_deg",
+}
+
+
+def read_live_log(
+    text: str, src: str
+) -> tuple[NDArray, NDArray, NDArray, NDArray, dict[str, NDArray]]:
+    """The track in a ``sailroute live`` JSON-lines log (``--log``): its input samples.
+
+    Each position fix (an ``"input"`` record with ``lat`` and ``lon``) is a track point;
+    each measured channel (SOG, COG, heading, speed through the water, true and apparent
+    wind) takes at that fix the channel's last sample at most
+    :data:`LIVE_LOG_MAX_AGE_S` old, else NaN.  The other records (re-plans, link
+    changes, errors) are skipped.
+
+    Returns
+    -------
+    t, lat, lon : ndarray
+        Epoch seconds and degrees of the fixes, in the log's order.
+    lines : ndarray of int
+        1-based line of each fix.
+    channels : dict of str to ndarray
+        :data:`sailroute.track.model.CHANNELS` names (``stw_ms`` as ``bsp_ms``).
+
+    Raises
+    ------
+    InputError
+        A line that is not a JSON object, a sample without a time, or no position fix.
+    """
+    import json
+
+    samples: list[tuple[int, dict[str, Any]]] = []
+    for k, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        try:
+            rec = json.loads(line)
+        except ValueError:
+            raise InputError(
+                f"{src}: line {k}: not a JSON object; a `sailroute live` log has one "
+                "JSON object per line"
+            ) from None
+        if not isinstance(rec, dict):
+            raise InputError(f"{src}: line {k}: expected a JSON object; got {excerpt(line)!r}")
+        if rec.get("kind") != "input":
+            continue
+        t = rec.get("t")
+        if isinstance(t, bool) or not isinstance(t, int | float) or not math.isfinite(t):
+            raise InputError(f"{src}: line {k}: an input sample needs a time `t` [epoch s]")
+        samples.append((k, rec))
+    fixes = [(k, r) for k, r in samples if _number(r.get("lat")) and _number(r.get("lon"))]
+    if not fixes:
+        raise InputError(
+            f"{src}: no position fix in this `sailroute live` log ({len(samples)} input "
+            "samples); a track needs samples with lat and lon"
+        )
+    t = np.array([float(r["t"]) for _, r in fixes])
+    channels: dict[str, NDArray] = {}
+    for key, name in _LIVE_CHANNELS.items():
+        have = [(float(r["t"]), float(r[key])) for _, r in samples if _number(r.get(key))]
+        if not have:
+            continue
+        ts, vs = (np.array(c) for c in zip(*sorted(have, key=lambda p: p[0]), strict=True))
+        last = np.searchsorted(ts, t, side="right") - 1
+        ok = (last >= 0) & (t - ts[np.maximum(last, 0)] <= LIVE_LOG_MAX_AGE_S)
+        channels[name] = np.where(ok, vs[np.maximum(last, 0)], np.nan)
+    lat = np.array([float(r["lat"]) for _, r in fixes])
+    lon = np.array([float(r["lon"]) for _, r in fixes])
+    return t, lat, lon, np.array([k for k, _ in fixes]), channels
+
+
+def _number(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
 # ------------------------------------------------------------------------------ times

@@ -364,8 +364,8 @@ def fleet_wind(
         method=method,
         radius_m=radius_m,
         clamp=clamp,
-        **opts,
-    )  # type: ignore[arg-type]
+        **opts,  # type: ignore[arg-type]
+    )
     notes = [
         f"{f.name}: method {method}, {len(used)} boat(s)"
         + (f", resampled to {resample_s:g} s" if resample_s > 0 else "")

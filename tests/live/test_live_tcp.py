@@ -11,11 +11,13 @@ import time
 import urllib.request
 from pathlib import Path
 
+import numpy as np
 import pynmea2
 import pytest
 
 from sailroute.commands.live import run_live_command, start_live
 from sailroute.live.engine import LiveSettings
+from sailroute.track.read import read_track
 from tests.live.feed import FeedServer, approach, lines_of, trieste, write_feed
 
 
@@ -89,6 +91,12 @@ def test_tcp_feed_replans_page_and_nmea_out(tmp_path: Path) -> None:
     records = _records(log)
     assert records[-1]["kind"] == "end" and records[-1]["plans"] == len(plans)
     assert sum(r["kind"] == "input" for r in records) == records[-1]["readings"]
+    # the log reads back as a track (what `sailroute analyze` reads): one point per fix
+    fixes = [r for r in records if r["kind"] == "input" and "lat" in r]
+    track = read_track(log)
+    assert len(track.t_s) == len({r["t"] for r in fixes})
+    assert np.allclose(track.lat_deg, [r["lat"] for r in fixes], atol=1e-7)
+    assert np.allclose(track.channels["sog_ms"], 2.5, atol=0.01)
 
 
 def test_wind_shift_changes_the_side_that_pays(tmp_path: Path) -> None:
