@@ -35,6 +35,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import IO, Any
 
+import numpy as np
+
 from sailroute.boat.model import BoatModel
 from sailroute.course.geometry import feature_centre
 from sailroute.course.model import Course
@@ -47,6 +49,7 @@ from sailroute.live.replan import DEFAULT_REACH_M, LivePlan, current_leg
 from sailroute.live.sources import Source
 from sailroute.live.web import PageServer
 from sailroute.routing.types import RoutingSettings
+from sailroute.units import KNOT
 from sailroute.wind.base import WindField
 
 TRUE_WIND_HOLD_S: float = 10.0
@@ -125,6 +128,38 @@ class JsonLog:
                 self._fh.flush()
                 self._fh.close()
                 self._fh = None
+
+
+FAR_FROM_COURSE_M = 20_000.0
+"""A position farther than this from every mark [m] is not re-planned from (another place,
+or a wrong fix)."""
+
+
+def input_problem(
+    course: Course, boat: BoatModel, xy: tuple[float, float], tws_ms: float
+) -> str | None:
+    """Why a re-plan from this position in this wind would mislead, or None.
+
+    A position more than :data:`FAR_FROM_COURSE_M` from every mark, or a measured wind
+    above the polar's highest wind speed (its speeds there would be extrapolated), is
+    said on the page and in the log instead of routed from.
+    """
+    d = min(math.hypot(m.xy[0] - xy[0], m.xy[1] - xy[1]) for m in course.marks.values())
+    if d > FAR_FROM_COURSE_M:
+        return (
+            f"the position is {d / 1000:.1f} km from the nearest mark, outside the course "
+            "area: not re-planned (check the GPS source and the course file)"
+        )
+    polar = boat.routing_polar()
+    if polar is not None and math.isfinite(tws_ms):
+        top = float(np.max(polar.tws_ms))
+        if tws_ms > top:
+            return (
+                f"the measured wind, {tws_ms / KNOT:.1f} kn, is above the polar's highest "
+                f"wind speed, {top / KNOT:.1f} kn: not re-planned (the boat's speeds there "
+                "are unknown; give a polar that covers it)"
+            )
+    return None
 
 
 class LiveEngine:
@@ -391,6 +426,12 @@ class LiveEngine:
             self.leg = leg = current_leg(self.course, self.leg, (x, y), self.settings.reach_m)
             self._plan_wind, self._plan_t = (tws, twd), t
         if leg >= self.course.n_legs:
+            return None
+        problem = input_problem(self.course, self.boat, (x, y), tws)
+        if problem is not None:  # said on the page and in the log; no re-plan on it
+            with self._lock:
+                self.error = problem
+            self.log.write({"kind": "error", "t": t, "message": problem})
             return None
         req = PlanRequest(self.n_plans + 1, reason, t, x, y, leg, tws, twd, self.settings.fade_s)
         w0 = time.perf_counter()
