@@ -124,7 +124,9 @@ def test_wind_shift_changes_the_side_that_pays(tmp_path: Path) -> None:
     assert any(p["reason"] == "wind" for p in plans[1:])
     assert plans[0]["side"]["side"] == "right" and plans[0]["side"]["gain_s"] > 10
     assert plans[-1]["side"]["side"] == "left" and plans[-1]["side"]["gain_s"] > 10
-    assert plans[-1]["wind_twd_deg"] == pytest.approx(80.0, abs=0.5)
+    # the last re-plan is in the veered wind: a re-plan waits for a 5° change of the 10 s
+    # mean, so how close it is to the final 80° depends on when the plan loop woke
+    assert 72.0 < plans[-1]["wind_twd_deg"] <= 80.5
     assert res.data is not None and res.data.number == plans[-1]["number"]
 
 
