@@ -22,7 +22,14 @@ import sailroute
 from tests.conftest import COURSES, ROOT
 
 GALLERY = ROOT / "docs" / "gallery"
-SCRIPTS = ("plan_course", "wrf_vs_stations", "vpp_polar", "strategy_map", "analyze_track")
+SCRIPTS = (
+    "plan_course",
+    "wrf_vs_stations",
+    "vpp_polar",
+    "strategy_map",
+    "analyze_track",
+    "race_day",
+)
 
 
 def run_script(name: str, out: Path) -> tuple[dict[str, str], str]:
@@ -151,3 +158,29 @@ def test_analyze_track(tmp_path: Path) -> None:
     for leg, written in zip(legs, doc["legs"], strict=True):
         span = _epoch(written["end_time"]) - _epoch(written["start_time"])
         assert leg["sailed"] == pytest.approx(span, abs=2e-3)
+
+
+def test_race_day(tmp_path: Path) -> None:
+    """Marks in a CSV -> course file -> plan -> plotter files: the start line in a wind
+    10° off its square has bias 10°, the starboard (upwind) end favoured by L·sin 10°; the
+    route's NMEA sentences parse with valid checksums and name the GPX route's points."""
+    import xml.etree.ElementTree as ET
+
+    import pynmea2
+
+    v, _ = run_script("race_day", tmp_path)
+    length, bias = float(v["line_length_m"]), float(v["bias_deg"])
+    assert bias == pytest.approx(10.0, abs=0.05)  # the line runs east-west, the wind is 10°
+    assert v["favoured_end"] == "boat"  # the east (starboard) end is upwind
+    assert float(v["gain_m"]) == pytest.approx(length * np.sin(np.radians(bias)), abs=1e-2)
+    out = tmp_path / "race_day"
+    sentences = [
+        pynmea2.parse(line, check=True)
+        for line in (out / "route.nmea").read_text(encoding="ascii").splitlines()
+        if line
+    ]
+    wpl = [s for s in sentences if s.sentence_type == "WPL"]
+    ns = {"g": "http://www.topografix.com/GPX/1/1"}
+    rte = ET.parse(out / "route.gpx").getroot().findall("g:rte/g:rtept", ns)
+    assert len(wpl) == len(rte) >= 5  # the start, a point per leg end, the tacks and gybes
+    assert {s.sentence_type for s in sentences} == {"WPL", "RTE"}
