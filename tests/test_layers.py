@@ -30,6 +30,7 @@ BASE = (
     "outdir",
     "progress",
     "tabular",
+    "nmea",
 )
 LAYERS: tuple[tuple[str, ...], ...] = (
     BASE,

@@ -27,7 +27,8 @@ from datetime import UTC, datetime, timedelta, timezone
 from pathlib import Path
 
 from sailroute.errors import InputError
-from sailroute.live.nmeaout import lat_field, lon_field, sentence
+from sailroute.live.nmeaout import sentence
+from sailroute.nmea import lat_field, lon_field
 
 FORMATS = ("trieste", "tallinn")
 

@@ -13,8 +13,8 @@ import math
 import socket
 import threading
 from collections.abc import Sequence
-from functools import reduce
 
+from sailroute.nmea import frame, lat_field, lon_field, rte_bodies
 from sailroute.units import wrap180
 
 NM: float = 1852.0
@@ -23,21 +23,8 @@ _TALKER = "SR"  # a "proprietary-looking" talker would confuse plotters; SR = sa
 
 
 def sentence(body: str) -> str:
-    """``$<body>*<checksum>`` with CR LF: the XOR of the body's bytes, two hex digits."""
-    cs = reduce(lambda a, c: a ^ ord(c), body, 0)
-    return f"${body}*{cs:02X}\r\n"
-
-
-def lat_field(lat: float) -> tuple[str, str]:
-    a = abs(lat)
-    d = int(a)
-    return f"{d:02d}{(a - d) * 60:07.4f}", "N" if lat >= 0 else "S"
-
-
-def lon_field(lon: float) -> tuple[str, str]:
-    a = abs(lon)
-    d = int(a)
-    return f"{d:03d}{(a - d) * 60:07.4f}", "E" if lon >= 0 else "W"
+    """``$<body>*<checksum>`` with CR LF (:func:`sailroute.nmea.frame`)."""
+    return frame(body) + "\r\n"
 
 
 def _name(name: str) -> str:
@@ -62,13 +49,7 @@ def route_sentences(number: int, waypoints: Sequence[tuple[str, float, float]]) 
         out.append(
             sentence(f"{_TALKER}WPL,{','.join(lat_field(la))},{','.join(lon_field(lo))},{wid}")
         )
-    groups: list[list[str]] = [[]]
-    for wid in ids:  # an NMEA sentence holds at most 82 characters
-        if len(",".join([*groups[-1], wid])) > 50:
-            groups.append([])
-        groups[-1].append(wid)
-    for k, g in enumerate(groups, 1):
-        out.append(sentence(f"{_TALKER}RTE,{len(groups)},{k},c,live{number},{','.join(g)}"))
+    out += [sentence(body) for body in rte_bodies(_TALKER, f"live{number}", ids)]
     return out
 
 

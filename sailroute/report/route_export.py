@@ -25,21 +25,19 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
-from functools import reduce
 from pathlib import Path
 from typing import Literal
 from xml.etree import ElementTree as ET
 
 from sailroute import __version__
+from sailroute.nmea import frame, lat_field, lon_field, rte_bodies
 from sailroute.planning.result import Plan
 from sailroute.textin import clean_text
 from sailroute.timeutil import iso
 
 __all__ = [
     "KML_NS",
-    "NMEA_MAX_LEN",
     "RoutePoint",
-    "nmea_checksum",
     "nmea_ids",
     "nmea_sentences",
     "route_points",
@@ -48,8 +46,6 @@ __all__ = [
 ]
 
 KML_NS = "http://www.opengis.net/kml/2.2"
-NMEA_MAX_LEN = 82
-"""Longest NMEA 0183 sentence, ``$`` to CR LF inclusive [characters]."""
 NMEA_ID_LEN = 6
 TALKER = "GP"
 
@@ -211,15 +207,6 @@ def write_kml(path: str | Path, plan: Plan) -> Path:
 
 
 # ----------------------------------------------------------------------------- NMEA 0183
-def nmea_checksum(body: str) -> str:
-    """The checksum of a sentence body (the text between ``$`` and ``*``): two hex digits."""
-    return f"{reduce(lambda a, ch: a ^ ord(ch), body, 0):02X}"
-
-
-def _sentence(body: str) -> str:
-    return f"${body}*{nmea_checksum(body)}"
-
-
 def nmea_ids(names: Sequence[str]) -> tuple[str, ...]:
     """Waypoint identifiers for NMEA 0183: unique, at most 6 characters.
 
@@ -244,24 +231,6 @@ def nmea_ids(names: Sequence[str]) -> tuple[str, ...]:
     )
 
 
-def _lat(lat: float) -> str:
-    a = abs(lat)
-    d = int(a)
-    m = round((a - d) * 60.0, 4)
-    if m >= 60.0:
-        d, m = d + 1, 0.0
-    return f"{d:02d}{m:07.4f},{'N' if lat >= 0 else 'S'}"
-
-
-def _lon(lon: float) -> str:
-    a = abs(lon)
-    d = int(a)
-    m = round((a - d) * 60.0, 4)
-    if m >= 60.0:
-        d, m = d + 1, 0.0
-    return f"{d:03d}{m:07.4f},{'E' if lon >= 0 else 'W'}"
-
-
 def nmea_sentences(points: Sequence[RoutePoint], route_id: str = "1") -> list[str]:
     """The ``WPL`` and ``RTE`` sentences of a route (without line ends).
 
@@ -276,27 +245,14 @@ def nmea_sentences(points: Sequence[RoutePoint], route_id: str = "1") -> list[st
     -------
     list of str
         One ``$GPWPL`` per waypoint, then the ``$GPRTE`` sentences, each at most
-        :data:`NMEA_MAX_LEN` characters with its line end.
+        :data:`sailroute.nmea.NMEA_MAX_LEN` characters with its line end.
     """
     ids = nmea_ids([p.name for p in points])
     out = [
-        _sentence(f"{TALKER}WPL,{_lat(p.lat)},{_lon(p.lon)},{i}")
+        frame(f"{TALKER}WPL,{','.join(lat_field(p.lat))},{','.join(lon_field(p.lon))},{i}")
         for p, i in zip(points, ids, strict=True)
     ]
-    # "$" + body + "*hh" + CR LF <= 82; the header's counts are at most 2 digits each
-    room = NMEA_MAX_LEN - len("$") - len("*hh") - len("\r\n")
-    head = len(f"{TALKER}RTE,99,99,c,{route_id}")
-    groups: list[list[str]] = [[]]
-    for i in ids:
-        if groups[-1] and head + sum(len(x) + 1 for x in groups[-1]) + len(i) + 1 > room:
-            groups.append([])
-        groups[-1].append(i)
-    n = len(groups)
-    out += [
-        _sentence(f"{TALKER}RTE,{n},{k + 1},c,{route_id},{','.join(g)}")
-        for k, g in enumerate(groups)
-    ]
-    return out
+    return out + [frame(body) for body in rte_bodies(TALKER, route_id, ids)]
 
 
 def write_nmea(path: str | Path, plan: Plan) -> Path:

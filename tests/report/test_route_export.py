@@ -9,12 +9,11 @@ import numpy as np
 import pynmea2
 import pytest
 
+from sailroute.nmea import NMEA_MAX_LEN, checksum
 from sailroute.report.files import write_gpx, write_plan_outputs
 from sailroute.report.route_export import (
     KML_NS,
-    NMEA_MAX_LEN,
     RoutePoint,
-    nmea_checksum,
     nmea_ids,
     nmea_sentences,
     route_points,
@@ -122,7 +121,7 @@ def test_nmea_sentences_parse_and_their_checksums_verify(tmp_path, plan):
 def test_nmea_checksum_of_a_published_sentence():
     # the RMC example of the NMEA 0183 references (gpsinformation.org, D. DePriest)
     body = "GPRMC,081836,A,3751.65,S,14507.36,E,000.0,360.0,130998,011.3,E"
-    assert nmea_checksum(body) == "62"
+    assert checksum(body) == "62"
 
 
 def test_a_long_route_is_split_over_several_rte_sentences():
