@@ -25,6 +25,7 @@ from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.course.geometry import target_of
 from sailroute.course.model import Course
+from sailroute.planning.route import route_course
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
@@ -93,7 +94,9 @@ def route_remaining(
     xy: XY,
     t: float,
 ) -> list[LegResult]:
-    """Route legs ``leg`` .. last from the boat at ``xy`` [m] at epoch ``t`` [s].
+    """Route legs ``leg`` .. last from the boat at ``xy`` [m] at epoch ``t`` [s]
+    (:func:`~sailroute.planning.route.route_course` from a boat under way: inside the
+    course's boundary and round its obstacles, as ``plan`` routes).
 
     Returns
     -------
@@ -101,15 +104,9 @@ def route_remaining(
         One per remaining leg, chained: each starts where and when the previous one
         ended, and marks are rounded on their sides.
     """
-    results: list[LegResult] = []
-    for i in range(leg, course.n_legs):
-        previous = results[-1] if results else None
-        following = target_of(course, i + 1) if i + 1 < course.n_legs else None
-        start = Start((float(xy[0]), float(xy[1])), None, name="boat")
-        start, target = chain_leg(start, target_of(course, i), previous, following)
-        t0 = previous.t_end if previous is not None else t
-        results.append(route_leg(start, target, t0, wind, boat, settings))
-    return results
+    return route_course(
+        course, wind, boat, settings, from_leg=leg, under_way=((float(xy[0]), float(xy[1])), t)
+    )
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,7 @@ from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.batch import batchable, route_leg_batch
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.obstacles import RaceArea, land_filled, obstacles_for
-from sailroute.routing.types import LegResult, RouterName, RoutingSettings
+from sailroute.routing.types import LegResult, RouterName, RoutingSettings, Start
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
 
@@ -199,6 +199,8 @@ def route_course(
     backend: str = "numpy",
     progress: Progress | None = None,
     current: object | None = None,
+    from_leg: int = 0,
+    under_way: tuple[tuple[float, float], float] | None = None,
 ) -> list[LegResult]:
     """Route every leg in order, each starting where and when the previous one ended.
 
@@ -220,11 +222,16 @@ def route_course(
         Receives per-leg start/update/end calls.
     current : CurrentField, optional
         Surface current (isochrone router only); None: still water.
+    from_leg : int
+        First leg to route (0-based); the legs before it are left out of the result.
+    under_way : ((float, float), float), optional
+        A boat under way: its position ``(x, y)`` [m] and time [epoch s], where and when
+        leg ``from_leg`` starts (instead of that leg's start feature at the start time).
 
     Returns
     -------
     list of LegResult
-        One per leg; ``results[i].t_start == results[i - 1].t_end`` and
+        One per leg routed; ``results[i].t_start == results[i - 1].t_end`` and
         ``results[i].start_xy == results[i - 1].end_xy``.  A leg to a mark ends once
         the mark is rounded on its side, and the next leg may not cross back.  Every
         leg stays inside the course's boundary and round its obstacles
@@ -233,14 +240,19 @@ def route_course(
     results: list[LegResult] = []
     obstacles = obstacles_for(course.area, wind)
     wind = land_filled(course.area, wind)  # the NaN (land) cells, now obstacles, filled
-    for i, spec in enumerate(course.legs):
+    for i in range(from_leg, course.n_legs):
+        spec = course.legs[i]
         previous = results[-1] if results else None
         # chain_leg starts the leg at the previous arrival; a mark is rounded on its side:
         # the leg ends past the rounding (towards the next target) and the next leg may not
         # cross back (routing/geometry.py)
         following = target_of(course, i + 1) if i + 1 < course.n_legs else None
-        start, target = chain_leg(*leg_endpoints(course, i), previous, following)
+        ends = leg_endpoints(course, i)
         t0 = previous.t_end if previous is not None else course.start_epoch
+        if previous is None and under_way is not None:
+            ends = (Start(under_way[0], None, name="boat"), ends[1])
+            t0 = under_way[1]
+        start, target = chain_leg(*ends, previous, following)
         if progress is not None:
             progress.start_leg(i, spec.label)
         res = route_leg(
@@ -252,7 +264,7 @@ def route_course(
             settings,
             backend=backend,
             progress=progress.update if progress is not None else None,
-            **({} if current is None else {"current": current}),
+            current=current,
             obstacles=obstacles,
         )
         if progress is not None:
