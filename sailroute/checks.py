@@ -23,11 +23,12 @@ from __future__ import annotations
 
 import difflib
 import math
+import numbers
 import re
 from collections.abc import Iterable, Iterator, Mapping
 from datetime import datetime
 from pathlib import Path
-from typing import Any, Final
+from typing import Any, Final, SupportsFloat
 
 from sailroute.errors import InputError, format_problems
 from sailroute.yamlfile import join_path
@@ -75,12 +76,20 @@ def quoted(choices: Iterable[Any]) -> str:
     return ", ".join(repr(c) for c in choices)
 
 
-def finite(v: float) -> bool:
+def finite(v: SupportsFloat) -> bool:
     """True for a number that is a finite float (an integer of 400 digits is not)."""
     try:
         return math.isfinite(float(v))
     except OverflowError:
         return False
+
+
+def real_number(v: Any) -> bool:
+    """True for a finite real number given as one: an int or a float (NumPy's too), not a
+    bool, not text."""
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        return False
+    return finite(v)
 
 
 def show(value: Any) -> str:

@@ -21,18 +21,13 @@ import numpy as np
 
 from sailroute.boat.model import BoatModel
 from sailroute.errors import SailrouteError
-from sailroute.units import wind_speed_direction
+from sailroute.units import wind_speed_direction, wrap180
 from sailroute.wind.base import WindField
 
 __all__ = ["TIE", "layline_times", "side_verdict"]
 
 TIE: Final = "tie"
 """The verdict when neither side beats the other by more than the margin."""
-
-
-def _wrap(a: float) -> float:
-    """Angle in (-180, 180] [°]."""
-    return (a + 180.0) % 360.0 - 180.0
 
 
 def _sail_extreme(
@@ -61,7 +56,7 @@ def _sail_extreme(
         tws_a, twd_a = wind_speed_direction(u, v)
         tws, twd = float(tws_a), float(twd_a)
         bearing = math.degrees(math.atan2(dx, dy))
-        off = _wrap(bearing - twd)  # TWA of the bearing, signed
+        off = float(wrap180(bearing - twd))  # TWA of the bearing, signed
         key = round(tws, 2)
         if key not in vmg:
             vmg[key] = boat.vmg_angles_deg(key)
@@ -74,7 +69,7 @@ def _sail_extreme(
             # the two tacks' headings; the one on the side to go (left of the bearing:
             # counter-clockwise from it) until the layline, then the other one
             cand = [twd + angle, twd - angle]
-            lefts = [_wrap(h - bearing) < 0 for h in cand]
+            lefts = [float(wrap180(h - bearing)) < 0 for h in cand]
             want_left = (first > 0) != reached
             heading = next(
                 (h for h, lf in zip(cand, lefts, strict=True) if lf == want_left), cand[0]
@@ -83,7 +78,7 @@ def _sail_extreme(
             reached = True
             upwind = abs(off) < 90.0
             heading = bearing
-        twa = _wrap(heading - twd)
+        twa = float(wrap180(heading - twd))
         side = 1 if twa > 0 else -1
         if tack and side != tack:
             t += tack_penalty_s if upwind else gybe_penalty_s

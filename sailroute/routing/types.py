@@ -6,7 +6,6 @@ a boat and :class:`RoutingSettings`, and returns a :class:`LegResult`.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from types import ModuleType
@@ -15,6 +14,7 @@ from typing import TYPE_CHECKING, Final, Literal, Protocol, get_args
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.checks import real_number
 from sailroute.errors import InputError
 
 if TYPE_CHECKING:
@@ -305,15 +305,6 @@ def _work_problems(s: RoutingSettings) -> list[str]:
     return problems
 
 
-def _is_number(v: object) -> bool:
-    """A finite real number (not a bool)."""
-    return (
-        isinstance(v, int | float | np.integer | np.floating)
-        and not isinstance(v, bool)
-        and math.isfinite(v)
-    )
-
-
 class _Problems(list[str]):
     """The problems of one settings object, with the two common checks."""
 
@@ -323,7 +314,7 @@ class _Problems(list[str]):
 
     def number(self, name: str, *, strict: bool = True) -> None:
         v = getattr(self.s, name)
-        if not (_is_number(v) and (v > 0 if strict else v >= 0)):
+        if not (real_number(v) and (v > 0 if strict else v >= 0)):
             self.append(f"{name} must be a number {'>' if strict else '>='} 0, got {v!r}")
 
     def integer(self, name: str, lo: int, hi: int, text: str) -> None:
@@ -360,19 +351,19 @@ def _common_problems(p: _Problems) -> None:
 def _isochrone_problems(p: _Problems) -> None:
     """The isochrone router's steps, fan and front size."""
     s = p.s
-    if _is_number(s.heading_step_deg) and s.heading_step_deg > 45:
+    if real_number(s.heading_step_deg) and s.heading_step_deg > 45:
         p.append(f"heading_step_deg must be <= 45, got {s.heading_step_deg!r}")
-    if _is_number(s.heading_step_deg) and 0 < s.heading_step_deg < MIN_HEADING_STEP_DEG:
+    if real_number(s.heading_step_deg) and 0 < s.heading_step_deg < MIN_HEADING_STEP_DEG:
         p.append(
             f"heading_step_deg must be in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer "
             f"steps only slow the router), got {s.heading_step_deg!r}"
         )
-    if _is_number(s.dt_s) and 0 < s.dt_s < MIN_DT_S:
+    if real_number(s.dt_s) and 0 < s.dt_s < MIN_DT_S:
         p.append(
             f"dt_s must be >= {MIN_DT_S:g} s (default 10; finer steps hardly "
             f"change the route and make it slow), got {s.dt_s!r}"
         )
-    if _is_number(s.min_dt_s) and 0 < s.min_dt_s < MIN_MIN_DT_S:
+    if real_number(s.min_dt_s) and 0 < s.min_dt_s < MIN_MIN_DT_S:
         p.append(f"min_dt_s must be >= {MIN_MIN_DT_S:g} s (default 1), got {s.min_dt_s!r}")
     p.integer("max_front_points", 8, MAX_FRONT_POINTS, f"in [8, {MAX_FRONT_POINTS}]")
     if s.heading_fan not in ("hull", "full"):
@@ -386,10 +377,10 @@ def _griddp_problems(p: _Problems) -> None:
     p.integer("dp_cols", 2, 1024, "in [2, 1024]")
     p.integer("dp_refinements", 0, 20, "in [0, 20]")
     p.integer("dp_samples", 1, 64, "in [1, 64]")
-    if not (_is_number(s.dp_shrink) and 0 < s.dp_shrink <= 1):
+    if not (real_number(s.dp_shrink) and 0 < s.dp_shrink <= 1):
         p.append(f"dp_shrink must be in (0, 1], got {s.dp_shrink!r}")
     hw = s.dp_half_width_m
-    if hw is not None and not (_is_number(hw) and hw > 0):
+    if hw is not None and not (real_number(hw) and hw > 0):
         p.append(f"dp_half_width_m must be > 0 m or None (automatic), got {hw!r}")
 
 

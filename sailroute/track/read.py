@@ -46,6 +46,7 @@ from zoneinfo import ZoneInfo, ZoneInfoNotFoundError
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.checks import real_number
 from sailroute.errors import InputError
 from sailroute.geo import wrap_lon
 from sailroute.tabular import (
@@ -247,10 +248,10 @@ def read_live_log(
         if rec.get("kind") != "input":
             continue
         t = rec.get("t")
-        if isinstance(t, bool) or not isinstance(t, int | float) or not math.isfinite(t):
+        if not real_number(t):
             raise InputError(f"{src}: line {k}: an input sample needs a time `t` [epoch s]")
         samples.append((k, rec))
-    fixes = [(k, r) for k, r in samples if _number(r.get("lat")) and _number(r.get("lon"))]
+    fixes = [(k, r) for k, r in samples if real_number(r.get("lat")) and real_number(r.get("lon"))]
     if not fixes:
         raise InputError(
             f"{src}: no position fix in this `sailroute live` log ({len(samples)} input "
@@ -259,7 +260,7 @@ def read_live_log(
     t = np.array([float(r["t"]) for _, r in fixes])
     channels: dict[str, NDArray] = {}
     for key, name in _LIVE_CHANNELS.items():
-        have = [(float(r["t"]), float(r[key])) for _, r in samples if _number(r.get(key))]
+        have = [(float(r["t"]), float(r[key])) for _, r in samples if real_number(r.get(key))]
         if not have:
             continue
         ts, vs = (np.array(c) for c in zip(*sorted(have, key=lambda p: p[0]), strict=True))
@@ -269,10 +270,6 @@ def read_live_log(
     lat = np.array([float(r["lat"]) for _, r in fixes])
     lon = np.array([float(r["lon"]) for _, r in fixes])
     return t, lat, lon, np.array([k for k, _ in fixes]), channels
-
-
-def _number(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
 # ------------------------------------------------------------------------------ times

@@ -12,9 +12,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from sailroute.checks import Checker, Problems, resolve_path, show
+from sailroute.checks import Checker, Problems, real_number, resolve_path, show
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.geo import LocalFrame
 from sailroute.timeutil import parse_time, to_epoch
@@ -921,14 +919,7 @@ def _diamond_rows(chk: Checker, table: Any, scale: float) -> list[tuple[float, f
     rows: list[tuple[float, float, float]] = []
     tchk = chk.child("table")
     for k, row in enumerate(table):
-        ok = (
-            isinstance(row, list | tuple)
-            and len(row) == 3
-            and all(
-                isinstance(a, int | float) and not isinstance(a, bool) and np.isfinite(a)
-                for a in row
-            )
-        )
+        ok = isinstance(row, list | tuple) and len(row) == 3 and all(real_number(a) for a in row)
         if not ok:
             tchk.add(
                 k,
