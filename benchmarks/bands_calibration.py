@@ -52,7 +52,7 @@ sys.path.insert(0, str(ROOT))
 
 from race_polar_validation import SNIPE, _s, snipe_course  # noqa: E402
 
-from sailroute.commands.bands import band_summary  # noqa: E402
+from sailroute.bands.route import band_summary  # noqa: E402
 from sailroute.course.load import build_specs, load_course  # noqa: E402
 from sailroute.course.model import Course  # noqa: E402
 from sailroute.course.uncertainty import uncertainty_from_mapping  # noqa: E402

@@ -19,15 +19,16 @@ from sailroute.bands.members import (
     one_at_a_time,
     resolve_shifts,
 )
+from sailroute.bands.route import spec_for
+from sailroute.bands.sides import honest_side
 from sailroute.bands.summary import BandSummary
 from sailroute.cli import app
-from sailroute.commands.bands import run_bands_command, spec_for
+from sailroute.commands.bands import run_bands_command
 from sailroute.course.load import load_course
 from sailroute.course.specs import build_boat
 from sailroute.course.uncertainty import UncertaintySpec, uncertainty_from_mapping
 from sailroute.errors import InputError
 from sailroute.planning.route import plan_course
-from sailroute.report.ensemble import honest_side
 from sailroute.routing.sides import layline_times, side_verdict
 from sailroute.units import KNOT
 from sailroute.wind.perturbed import PerturbedWind

@@ -25,12 +25,10 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import NDArray
 
-from sailroute.analysis.loss import lateral_offset, side_label, time_mean
+from sailroute.bands.sides import honest_side, leg_side
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError
 from sailroute.planning.result import Plan
-from sailroute.routing.sides import layline_times, side_verdict
-from sailroute.routing.types import LegResult
 from sailroute.textin import CleanCsvWriter
 from sailroute.wind.base import WindField
 
@@ -89,56 +87,6 @@ class EnsembleSummary:
                 for k in range(len(self.leg_labels))
             ]
         )
-
-
-def leg_side(res: LegResult) -> str:
-    """Side of the course (left, middle, right) that a routed leg used."""
-    tr = res.track
-    a, b = res.start_xy, res.end_xy
-    off = lateral_offset(np.asarray(tr.x), np.asarray(tr.y), a, b)
-    length = float(np.hypot(b[0] - a[0], b[1] - a[1]))
-    return side_label(time_mean(np.asarray(tr.t), off), length)
-
-
-def honest_side(
-    res: LegResult,
-    wind: WindField,
-    boat: BoatModel,
-    *,
-    tack_penalty_s: float = 0.0,
-    gybe_penalty_s: float = 0.0,
-    margin_s: float = 2.0,
-    margin_pct: float = 0.5,
-) -> str:
-    """The side a routed leg used if it beat the other side by more than the margin, else "tie".
-
-    Parameters
-    ----------
-    res : LegResult
-        The routed leg.
-    wind : WindField
-        The wind it was routed in.
-    boat : BoatModel
-        The boat it was routed with.
-    tack_penalty_s, gybe_penalty_s : float
-        Manoeuvre penalties of the routing settings [s].
-    margin_s, margin_pct : float
-        Margin ``max(margin_s, margin_pct % of the leg time)``
-        (:func:`sailroute.routing.sides.side_verdict`).
-    """
-    t_left, t_right = layline_times(
-        res.start_xy,
-        res.end_xy,
-        res.t_start,
-        wind,
-        boat,
-        tack_penalty_s=tack_penalty_s,
-        gybe_penalty_s=gybe_penalty_s,
-        max_time_s=max(4.0 * res.time_s, 600.0),
-    )
-    return side_verdict(
-        leg_side(res), res.time_s, t_left, t_right, margin_s=margin_s, margin_pct=margin_pct
-    )
 
 
 def route_side(

@@ -1,0 +1,211 @@
+"""Route the members of a scenario's leg-time bands and summarize them.
+
+The members come from :mod:`sailroute.bands.members` (the course's ``uncertainty``
+section, or :data:`~sailroute.course.uncertainty.DEFAULT_UNCERTAINTY`);
+:func:`route_members` routes a list of members one by one with the course's router
+(any function with its signature can route them instead, e.g. a batched router);
+:func:`band_summary` routes the main ensemble, the nominal member and the one-at-a-time
+members and returns the bands, the breakdown and the side verdicts as a
+:class:`~sailroute.bands.summary.BandSummary`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from sailroute.bands.members import (
+    NOMINAL,
+    Member,
+    draw_members,
+    member_boat,
+    member_wind,
+    one_at_a_time,
+    resolve_shifts,
+)
+from sailroute.bands.sides import honest_side
+from sailroute.bands.summary import BandSummary
+from sailroute.course.load import build_current
+from sailroute.course.model import Course
+from sailroute.course.uncertainty import DEFAULT_UNCERTAINTY, UncertaintySpec
+from sailroute.planning.route import route_course
+from sailroute.progress import Progress
+from sailroute.routing.types import LegResult, RoutingSettings
+from sailroute.wind.base import WindField
+
+__all__ = ["RouteMembers", "band_summary", "route_members", "spec_for"]
+
+
+RouteMembers = Callable[..., list[list[LegResult]]]
+"""``route(course, scenario, members, *, wind, boat, settings, backend, progress)``:
+leg results of each member, in order."""
+
+
+def spec_for(course: Course, n: int | None = None) -> tuple[UncertaintySpec, tuple[str, ...]]:
+    """The course's uncertainty (or the defaults), with ``n`` members if given, shifts fitted.
+
+    Returns
+    -------
+    spec : UncertaintySpec
+    notes : tuple of str
+        Says when the defaults were used.
+    """
+    notes: tuple[str, ...] = ()
+    spec = course.uncertainty
+    if spec is None:
+        spec = DEFAULT_UNCERTAINTY
+        notes = (
+            "the course has no `uncertainty:` section: default uncertainties (TWS 1 kn, "
+            "TWD 5° 1 sigma, shifts ±5° every 6 min; docs/course-format.md)",
+        )
+    if n is not None:
+        spec = spec.with_members(n)
+    return resolve_shifts(spec), notes
+
+
+def route_members(
+    course: Course,
+    scenario: str,
+    members: Sequence[Member],
+    *,
+    wind: WindField,
+    boat: Any,
+    settings: RoutingSettings,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+) -> list[list[LegResult]]:
+    """Route the course once per member, one after the other.
+
+    Parameters
+    ----------
+    course : Course
+        The course.
+    scenario : str
+        The scenario (its current, if any, is used for every member).
+    members : sequence of Member
+        The members (:func:`sailroute.bands.members.draw_members`).
+    wind : WindField
+        The scenario's built wind.
+    boat : Polar
+        The course's built boat.
+    settings : RoutingSettings
+        Router and its settings.
+    backend : str
+        Array backend of the router kernels.
+    progress : Progress, optional
+        Per-leg progress, prefixed with the member's name.
+
+    Returns
+    -------
+    list of list of LegResult
+        Per member, its legs.
+    """
+    current = build_current(course, scenario)
+    where = course.boat_where or str(course.source or "<course>")
+    out = []
+    for m in members:
+        if progress is not None:
+            progress.set_prefix(f"{scenario} {m.name}: ")
+        w = member_wind(wind, m, course.start_epoch)
+        b = member_boat(course.boat_spec, boat, m, base_dir=course.base_dir, where=where)
+        out.append(
+            route_course(
+                course, w, b, settings, backend=backend, progress=progress, current=current
+            )
+        )
+    return out
+
+
+def _times(results: Sequence[Sequence[LegResult]]) -> np.ndarray:
+    return np.array([[r.time_s for r in legs] for legs in results], dtype=float)
+
+
+def band_summary(
+    course: Course,
+    scenario: str,
+    spec: UncertaintySpec,
+    *,
+    wind: WindField,
+    boat: Any,
+    settings: RoutingSettings,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+    route: RouteMembers = route_members,
+    notes: Sequence[str] = (),
+    oat: bool = True,
+) -> BandSummary:
+    """Route a scenario's members (main ensemble, nominal, one-at-a-time) and summarize.
+
+    Parameters
+    ----------
+    course, scenario, wind, boat, settings, backend, progress
+        As :func:`route_members`.
+    spec : UncertaintySpec
+        The uncertainty (shifts resolved: :func:`spec_for`).
+    route : callable
+        Routes a member list (default :func:`route_members`).
+    notes : sequence of str
+        Carried into the summary.
+    oat : bool
+        Also route the one-at-a-time members (the breakdown by source).
+
+    Returns
+    -------
+    BandSummary
+    """
+    main = draw_members(spec, course.time_limit_s)
+    oat_members = one_at_a_time(spec, course.time_limit_s) if oat else {}
+    flat = [NOMINAL, *main, *(m for ms in oat_members.values() for m in ms)]
+    # a one-at-a-time member equal to the nominal one (a source's median) is not routed twice
+    key = {m.name: dataclasses.replace(m, name="") for m in flat}
+    unique: dict[Member, Member] = {}
+    for m in flat:
+        unique.setdefault(key[m.name], m)
+    todo = list(unique.values())
+    results = route(
+        course,
+        scenario,
+        todo,
+        wind=wind,
+        boat=boat,
+        settings=settings,
+        backend=backend,
+        progress=progress,
+    )
+    by_key = {key[m.name]: r for m, r in zip(todo, results, strict=True)}
+    res_of = {m.name: by_key[key[m.name]] for m in flat}
+    where = course.boat_where or str(course.source or "<course>")
+    sides = []
+    for m in main:
+        w = member_wind(wind, m, course.start_epoch)
+        b = member_boat(course.boat_spec, boat, m, base_dir=course.base_dir, where=where)
+        sides.append(
+            tuple(
+                honest_side(
+                    r,
+                    w,
+                    b,
+                    tack_penalty_s=settings.tack_penalty_s,
+                    gybe_penalty_s=settings.gybe_penalty_s,
+                    margin_s=spec.side_margin_s,
+                    margin_pct=spec.side_margin_pct,
+                )
+                for r in res_of[m.name]
+            )
+        )
+    return BandSummary(
+        scenario=scenario,
+        leg_labels=tuple(leg.label for leg in course.legs),
+        members=tuple(m.name for m in main),
+        times_s=_times([res_of[m.name] for m in main]),
+        nominal_s=_times([res_of[NOMINAL.name]])[0],
+        oat_s={s: _times([res_of[m.name] for m in ms]) for s, ms in oat_members.items()},
+        sides=tuple(sides),
+        references=course.references_for(scenario),
+        uncertainty=spec,
+        notes=tuple(notes),
+        nominal_legs=tuple(res_of[NOMINAL.name]),
+    )
