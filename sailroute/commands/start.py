@@ -14,14 +14,13 @@ from pathlib import Path
 
 from sailroute import __version__
 from sailroute.commands.result import CommandResult
-from sailroute.course.geometry import course_bbox
+from sailroute.course.geometry import FAR_FROM_COURSE_M, course_gap_m
 from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.timeutil import parse_time, to_epoch
 
-__all__ = ["MAX_OFFSET_M", "parse_position", "parse_start_time", "position_xy", "run_start_command"]
+__all__ = ["parse_position", "parse_start_time", "position_xy", "run_start_command"]
 
-MAX_OFFSET_M = 20_000.0
 """A position further than this from the course area (the marks' box) is refused [m]."""
 
 SCHEMA_VERSION = 1
@@ -95,8 +94,8 @@ def position_xy(course: Course, at: str | None, xy: str | None) -> tuple[float, 
     Raises
     ------
     InputError
-        Neither or both given, unparsable, or more than :data:`MAX_OFFSET_M` from the
-        course area.
+        Neither or both given, unparsable, or more than
+        :data:`~sailroute.course.geometry.FAR_FROM_COURSE_M` from the course area.
     """
     if (at is None) == (xy is None):
         raise InputError(
@@ -115,13 +114,12 @@ def position_xy(course: Course, at: str | None, xy: str | None) -> tuple[float, 
     else:
         x, y = parse_position(str(xy), "--xy")
         given = f"--xy {xy}"
-    xmin, xmax, ymin, ymax = course_bbox(course)
-    gap = math.hypot(max(xmin - x, 0.0, x - xmax), max(ymin - y, 0.0, y - ymax))
-    if not math.isfinite(gap) or gap > MAX_OFFSET_M:
+    gap = course_gap_m(course, (x, y))
+    if not math.isfinite(gap) or gap > FAR_FROM_COURSE_M:
         raise InputError(
             f"{given}: the position is {gap / 1000:.0f} km from the course area (the marks "
-            f"of {course.source or course.name}); it must be within {MAX_OFFSET_M / 1000:.0f} km"
-            " (check the order LAT,LON and the signs)"
+            f"of {course.source or course.name}); it must be within "
+            f"{FAR_FROM_COURSE_M / 1000:.0f} km (check the order LAT,LON and the signs)"
         )
     return x, y
 

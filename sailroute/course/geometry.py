@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Final, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -206,6 +206,22 @@ def course_bbox(course: Course, margin_m: float = 0.0) -> tuple[float, float, fl
         float(y.min()) - margin_m,
         float(y.max()) + margin_m,
     )
+
+
+FAR_FROM_COURSE_M: Final = 20_000.0
+"""A boat position farther than this from the course area [m] (:func:`course_gap_m`) is
+refused by ``sailroute start`` and not re-planned from by ``sailroute live``: another
+place, swapped latitude and longitude, or a wrong fix."""
+
+
+def course_gap_m(course: Course, xy: tuple[float, float]) -> float:
+    """Distance [m] from ``xy`` (course frame) to the marks' bounding box
+    (:func:`course_bbox`); 0 inside it, NaN for a non-finite position."""
+    xmin, xmax, ymin, ymax = course_bbox(course)
+    x, y = xy
+    if not (math.isfinite(x) and math.isfinite(y)):
+        return math.nan
+    return math.hypot(max(xmin - x, 0.0, x - xmax), max(ymin - y, 0.0, y - ymax))
 
 
 def thesis_time_window(

@@ -38,7 +38,7 @@ from typing import IO, Any
 import numpy as np
 
 from sailroute.boat.model import BoatModel
-from sailroute.course.geometry import feature_centre
+from sailroute.course.geometry import FAR_FROM_COURSE_M, course_gap_m, feature_centre
 from sailroute.course.model import Course
 from sailroute.errors import InputError, SailrouteError
 from sailroute.live.decode import NmeaDecoder, Reading, SignalKDecoder
@@ -130,25 +130,21 @@ class JsonLog:
                 self._fh = None
 
 
-FAR_FROM_COURSE_M = 20_000.0
-"""A position farther than this from every mark [m] is not re-planned from (another place,
-or a wrong fix)."""
-
-
 def input_problem(
     course: Course, boat: BoatModel, xy: tuple[float, float], tws_ms: float
 ) -> str | None:
     """Why a re-plan from this position in this wind would mislead, or None.
 
-    A position more than :data:`FAR_FROM_COURSE_M` from every mark, or a measured wind
+    A position more than :data:`~sailroute.course.geometry.FAR_FROM_COURSE_M` from the
+    course area (:func:`~sailroute.course.geometry.course_gap_m`), or a measured wind
     above the polar's highest wind speed (its speeds there would be extrapolated), is
     said on the page and in the log instead of routed from.
     """
-    d = min(math.hypot(m.xy[0] - xy[0], m.xy[1] - xy[1]) for m in course.marks.values())
-    if d > FAR_FROM_COURSE_M:
+    d = course_gap_m(course, xy)
+    if not d <= FAR_FROM_COURSE_M:  # NaN too
         return (
-            f"the position is {d / 1000:.1f} km from the nearest mark, outside the course "
-            "area: not re-planned (check the GPS source and the course file)"
+            f"the position is {d / 1000:.1f} km from the course area (the marks' box): "
+            "not re-planned (check the GPS source and the course file)"
         )
     polar = boat.routing_polar()
     if polar is not None and math.isfinite(tws_ms):
