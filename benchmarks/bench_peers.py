@@ -921,10 +921,10 @@ PROFILE_GROUPS: dict[str, tuple[str, str]] = {
     "wind sampling (`GridWind.sample`)": ("sailroute/wind/grid.py", "sample"),
     "polar lookups (`Polar.speed`)": ("sailroute/boat/polar.py", "speed"),
     "polar tables (`polar_tables`, cached after the first leg)": (
-        "sailroute/routing/isochrone_kernel.py",
+        "sailroute/routing/isochrone_polar.py",
         "polar_tables",
     ),
-    "candidate set-up (`_prepare`)": ("sailroute/routing/isochrone_kernel.py", "_prepare"),
+    "candidate set-up (`_prepare`)": ("sailroute/routing/isochrone_inputs.py", "_prepare"),
     "expansion and arrival test (`_expand`)": ("sailroute/routing/isochrone_kernel.py", "_expand"),
     "pruning (`_survivors`)": ("sailroute/routing/isochrone_kernel.py", "_survivors"),
     "track building (`_backtrack`)": ("sailroute/routing/isochrone.py", "_backtrack"),

@@ -65,22 +65,10 @@ from sailroute.routing.isochrone import (
     _timeout_error,
     check_leg_work,
 )
-from sailroute.routing.isochrone_kernel import (
-    _CHUNK_ELEMENTS,
-    Groups,
-    _Arrival,
-    _Context,
-    _device_tables,
-    _DeviceTables,
-    _expand,
-    _group_argmin,
-    _Layer,
-    _LegFrame,
-    _prepare,
-    _step_length,
-    _survivors,
-    polar_tables,
-)
+from sailroute.routing.isochrone_inputs import _prepare, _step_length
+from sailroute.routing.isochrone_kernel import _CHUNK_ELEMENTS, _expand, _group_argmin, _survivors
+from sailroute.routing.isochrone_polar import _device_tables, _DeviceTables, polar_tables
+from sailroute.routing.isochrone_records import Groups, _Arrival, _Context, _Layer, _LegFrame
 from sailroute.routing.track import make_leg_result
 from sailroute.routing.types import LegResult, RoutingSettings, Start, Target, check_settings
 from sailroute.wind.base import Coverage, WindField
@@ -261,7 +249,7 @@ class _MemberWinds:
     """The members' winds behind one ``sample`` call of the kernel.
 
     The kernel samples ``PATH_SAMPLES + 1`` rows of the ``n`` front points at once
-    (:func:`~sailroute.routing.isochrone_kernel._sample_step`); each member's columns
+    (:func:`~sailroute.routing.isochrone_inputs._sample_step`); each member's columns
     go to its own wind, clipped to its own coverage, in the order the single-member
     router passes them.  The coverage seen by the kernel is unbounded (each member's
     is applied here).

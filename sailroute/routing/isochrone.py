@@ -32,7 +32,12 @@ The route is then backtracked through the parent indices and turned into a
 method, the defaults and the measured accuracy and speed.
 
 The per-step array functions (the kernel) are in
-:mod:`sailroute.routing.isochrone_kernel`; this module is the driver.
+:mod:`sailroute.routing.isochrone_kernel` (the step and its candidates), with
+:mod:`~sailroute.routing.isochrone_records` (the leg frame and the records),
+:mod:`~sailroute.routing.isochrone_polar` (the polar tables),
+:mod:`~sailroute.routing.isochrone_togo` (the time to go) and
+:mod:`~sailroute.routing.isochrone_inputs` (the inputs of a step); this module is the
+driver.
 """
 
 from __future__ import annotations
@@ -58,22 +63,17 @@ from sailroute.routing.geometry import (
     target_barrier,
     target_geometry,
 )
-from sailroute.routing.isochrone_kernel import (
-    _BIG_S,
-    NEAR_TARGET_STEPS,
-    PATH_SAMPLES,
+from sailroute.routing.isochrone_inputs import NEAR_TARGET_STEPS, PATH_SAMPLES
+from sailroute.routing.isochrone_kernel import _step
+from sailroute.routing.isochrone_polar import (
     TABLE_TWS_STEP_MS,
     PolarTables,
-    _Arrival,
-    _Context,
     _device_tables,
     _DeviceTables,
-    _floats,
-    _Layer,
-    _LegFrame,
-    _step,
     polar_tables,
 )
+from sailroute.routing.isochrone_records import _Arrival, _Context, _floats, _Layer, _LegFrame
+from sailroute.routing.isochrone_togo import _BIG_S
 from sailroute.routing.obstacles import Obstacles
 from sailroute.routing.track import build_track, make_leg_result
 from sailroute.routing.types import (

@@ -1,0 +1,267 @@
+"""Polar tables of the isochrone kernel, and the lookups in them.
+
+:func:`polar_tables` samples a polar once per polar object and heading step (cached,
+keyed weakly on the polar): the boat speed on a grid of |TWA| and of TWS nodes, the VMG
+angles and the VMG, the top speed and the polar's support (the best speed component
+towards each direction).  :func:`_device_tables` puts them in the kernel's array module;
+:func:`_support` (the polar support towards a direction) and :func:`_grid_speeds` (the
+boat speed of the grid columns of a step) interpolate in them at each point's TWS.
+
+Used by the driver (:mod:`sailroute.routing.isochrone`, which builds the tables of a
+leg), :mod:`sailroute.routing.batch`, the time to go
+(:mod:`~sailroute.routing.isochrone_togo`), the step inputs
+(:mod:`~sailroute.routing.isochrone_inputs`) and the candidate kernel
+(:mod:`~sailroute.routing.isochrone_kernel`).
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sailroute.boat.polar import Polar
+from sailroute.numerics import clip
+from sailroute.routing.isochrone_records import _StepInputs
+
+# --------------------------------------------------------------------------------------
+# polar tables (cached per polar and heading step)
+
+TABLE_TWS_STEP_MS = 0.05
+"""TWS spacing of the cached polar table of the grid candidates [m s⁻¹]."""
+
+
+@dataclass(frozen=True, eq=False)
+class PolarTables:
+    """Polar sampled for the isochrone kernel.
+
+    Attributes
+    ----------
+    twa_deg : ndarray, shape (n_a,)
+        Grid of ``|TWA|`` [°], ``180/n_a, 2·180/n_a, ..., 180``.
+    cos_a, sin_a : ndarray, shape (n_a,)
+        Their cosine and sine.
+    tws_ms : ndarray, shape (n_w,)
+        TWS nodes [m s⁻¹]: every 0.05 m s⁻¹ from 0 to the polar's top TWS,
+        plus the polar's own columns (so a bilinear polar is reproduced exactly).
+    speed_ms : ndarray, shape (n_w, n_a)
+        Boat speed at the nodes [m s⁻¹].
+    up_deg, down_deg : ndarray, shape (n_w,)
+        Upwind and downwind VMG angles [°] at the nodes.
+    up_vmg_ms, down_vmg_ms : ndarray, shape (n_w,)
+        The VMG there [m s⁻¹] (positive).
+    vmax_ms : ndarray, shape (n_w,)
+        Highest boat speed on the grid at the nodes [m s⁻¹].
+    sup_beta_deg : ndarray, shape (n_b,)
+        Directions ``beta`` [°] in ``[-180, 180]``, measured from the upwind direction
+        towards one side (every 1°).
+    sup_ms, sup_deg : ndarray, shape (n_w, n_b)
+        Support of the polar: the largest speed component ``S(a) cos(a - beta)`` over
+        the headings of that side [m s⁻¹], and the |TWA| ``a`` giving it [°] (grid
+        maximum refined by a parabola, or a VMG angle).
+    """
+
+    twa_deg: NDArray[np.float64]
+    cos_a: NDArray[np.float64]
+    sin_a: NDArray[np.float64]
+    tws_ms: NDArray[np.float64]
+    speed_ms: NDArray[np.float64]
+    up_deg: NDArray[np.float64]
+    down_deg: NDArray[np.float64]
+    up_vmg_ms: NDArray[np.float64]
+    down_vmg_ms: NDArray[np.float64]
+    vmax_ms: NDArray[np.float64]
+    sup_beta_deg: NDArray[np.float64]
+    sup_ms: NDArray[np.float64]
+    sup_deg: NDArray[np.float64]
+
+
+_TABLE_CACHE: weakref.WeakKeyDictionary[Any, dict[int, PolarTables]] = weakref.WeakKeyDictionary()
+
+
+def _vmg_angles(polar: Polar, tws: NDArray, upwind: bool) -> tuple[NDArray, NDArray]:
+    a, v = polar.vmg_upwind(tws) if upwind else polar.vmg_downwind(tws)
+    return np.asarray(a, dtype=float), np.asarray(v, dtype=float)
+
+
+def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
+    """Sample ``polar`` for the kernel (cached per polar object and TWA grid).
+
+    Parameters
+    ----------
+    polar : Polar
+        Boat polar.
+    heading_step_deg : float
+        Requested TWA step [°]; the grid uses ``n_a = ceil(180/step)`` equal steps.
+
+    Returns
+    -------
+    PolarTables
+    """
+    n_a = max(2, math.ceil(180.0 / heading_step_deg - 1e-9))
+    try:
+        per_polar = _TABLE_CACHE.setdefault(polar, {})
+    except TypeError:  # not weak-referenceable: no caching
+        per_polar = {}
+    cached = per_polar.get(n_a)
+    if cached is not None:
+        return cached
+    a = np.linspace(180.0 / n_a, 180.0, n_a)
+    own = np.asarray(polar.tws_ms, dtype=float).ravel()
+    top = float(own.max()) if own.size and own.max() > 0 else 30.0
+    nodes = np.sort(
+        np.concatenate(
+            [
+                np.linspace(0.0, top, math.ceil(top / TABLE_TWS_STEP_MS) + 1),
+                own[(own >= 0) & (own <= top)],
+            ]
+        )
+    )
+    # distinct values (np.unique's result without NaNs; np.unique imports numpy.ma, 22 ms
+    # of a plan's start-up)
+    nodes = nodes[np.concatenate([[True], nodes[1:] != nodes[:-1]])]
+    speed = np.asarray(polar.speed(nodes[:, None], a[None, :]), dtype=float)
+    up, vu = _vmg_angles(polar, nodes, True)
+    down, vd = _vmg_angles(polar, nodes, False)
+    up = _backfill_calm(up, vu)
+    down = _backfill_calm(down, vd)
+    rad = np.radians(a)
+    vmax = np.maximum(
+        speed.max(axis=1), np.asarray(polar.speed(nodes, np.stack([up, down], 1).T)).max(axis=0)
+    )
+    vu, vd = np.maximum(vu, 0.0), np.maximum(vd, 0.0)
+    beta = np.linspace(-180.0, 180.0, 361)
+    sup_ms, sup_deg = _support_table(a, speed, up, down, vu, vd, beta)
+    tables = PolarTables(
+        a, np.cos(rad), np.sin(rad), nodes, speed, up, down, vu, vd, vmax, beta, sup_ms, sup_deg
+    )
+    per_polar[n_a] = tables
+    return tables
+
+
+def _support_table(
+    a: NDArray,
+    speed: NDArray,
+    up: NDArray,
+    down: NDArray,
+    vu: NDArray,
+    vd: NDArray,
+    beta: NDArray,
+) -> tuple[NDArray, NDArray]:
+    """Largest speed component towards ``beta`` and its |TWA|, per TWS node (see
+    :class:`PolarTables`); grid maxima refined by a parabola through their neighbours."""
+    n_w, n_a = speed.shape
+    cb, sb = np.cos(np.radians(beta)), np.sin(np.radians(beta))
+    ca, sa = np.cos(np.radians(a)), np.sin(np.radians(a))
+    cos_ab = ca[None, :] * cb[:, None] + sa[None, :] * sb[:, None]  # (n_b, n_a)
+    val = np.empty((n_w, beta.size))
+    ang = np.empty((n_w, beta.size))
+    step = a[1] - a[0]
+    for r0 in range(0, n_w, 64):
+        r1 = min(n_w, r0 + 64)
+        obj = speed[r0:r1, None, :] * cos_ab[None]  # (rows, n_b, n_a)
+        k = np.argmax(obj, axis=2)
+        f1 = np.take_along_axis(obj, k[..., None], 2)[..., 0]
+        f0 = np.take_along_axis(obj, np.maximum(k - 1, 0)[..., None], 2)[..., 0]
+        f2 = np.take_along_axis(obj, np.minimum(k + 1, n_a - 1)[..., None], 2)[..., 0]
+        den = f0 - 2.0 * f1 + f2
+        inner = (k > 0) & (k < n_a - 1) & (den < 0)
+        off = np.where(inner, 0.5 * (f0 - f2) / np.where(inner, den, -1.0), 0.0)
+        best, where = f1, a[k] + np.clip(off, -0.5, 0.5) * step
+        for ang_c, v_c in ((up[r0:r1], vu[r0:r1]), (down[r0:r1], vd[r0:r1])):
+            c = np.abs(np.cos(np.radians(ang_c)))
+            v_c = np.where(c > 1e-9, v_c / np.where(c > 1e-9, c, 1.0), 0.0)  # VMG -> speed
+            rc = np.radians(ang_c)[:, None]
+            o = v_c[:, None] * (np.cos(rc) * cb[None, :] + np.sin(rc) * sb[None, :])
+            better = o > best
+            best = np.where(better, o, best)
+            where = np.where(better, ang_c[:, None], where)
+        val[r0:r1] = best
+        ang[r0:r1] = where
+    return val, ang
+
+
+def _backfill_calm(angle: NDArray, vmg: NDArray) -> NDArray:
+    """Replace the angle at calm nodes (no VMG) by the first windy node's angle."""
+    ok = vmg > 0
+    if not ok.any():
+        return angle
+    first = int(np.flatnonzero(ok)[0])
+    out = angle.copy()
+    out[:first] = angle[first]
+    return out
+
+
+# --------------------------------------------------------------------------------------
+# the tables in the kernel's array module
+
+
+@dataclass(frozen=True, eq=False)
+class _DeviceTables:
+    """The :class:`PolarTables` arrays in the kernel's array module ``xp`` (same units).
+
+    ``n_w`` TWS nodes (rows), ``n_a`` grid |TWA|s, ``n_b`` support directions.
+    """
+
+    twa_deg: Any  # (n_a,) grid |TWA| [°]
+    cos_a: Any  # (n_a,) its cosine
+    sin_a: Any  # (n_a,) its sine
+    tws_ms: Any  # (n_w,) TWS nodes [m s⁻¹]
+    speed_ms: Any  # (n_w, n_a) boat speed [m s⁻¹]
+    up_deg: Any  # (n_w,) upwind VMG angle [°]
+    down_deg: Any  # (n_w,) downwind VMG angle [°]
+    up_vmg_ms: Any  # (n_w,) upwind VMG [m s⁻¹]
+    down_vmg_ms: Any  # (n_w,) downwind VMG [m s⁻¹]
+    vmax_ms: Any  # (n_w,) highest boat speed [m s⁻¹]
+    sup_ms: Any  # (n_w, n_b) polar support: best speed component [m s⁻¹]
+    sup_deg: Any  # (n_w, n_b) the |TWA| giving it [°]
+
+
+def _device_tables(tab: PolarTables, xp: ModuleType) -> _DeviceTables:
+    return _DeviceTables(
+        xp.asarray(tab.twa_deg),
+        xp.asarray(tab.cos_a),
+        xp.asarray(tab.sin_a),
+        xp.asarray(tab.tws_ms),
+        xp.asarray(tab.speed_ms),
+        xp.asarray(tab.up_deg),
+        xp.asarray(tab.down_deg),
+        xp.asarray(tab.up_vmg_ms),
+        xp.asarray(tab.down_vmg_ms),
+        xp.asarray(tab.vmax_ms),
+        xp.asarray(tab.sup_ms),
+        xp.asarray(tab.sup_deg),
+    )
+
+
+# --------------------------------------------------------------------------------------
+# lookups in the tables at the points' TWS
+
+
+def _support(
+    node: Any, weight: Any, beta_deg: Any, dev: _DeviceTables, xp: ModuleType
+) -> tuple[Any, Any]:
+    """Polar support towards ``beta_deg`` (from the upwind direction, towards the side)
+    at the table rows ``node, weight``: the best speed component [m s⁻¹] and its |TWA|
+    [°], interpolated bilinearly in (TWS, beta) from :attr:`PolarTables.sup_ms`."""
+    pos = (beta_deg + 180.0) * (dev.sup_ms.shape[1] - 1) / 360.0
+    col = clip(xp.floor(pos).astype(xp.int64), 0, dev.sup_ms.shape[1] - 2, xp=xp)
+    frac = clip(pos - col, 0.0, 1.0, xp=xp)
+    out = []
+    for tab in (dev.sup_ms, dev.sup_deg):
+        below = tab[node, col] + frac * (tab[node, col + 1] - tab[node, col])
+        above = tab[node + 1, col] + frac * (tab[node + 1, col + 1] - tab[node + 1, col])
+        out.append(below + weight * (above - below))
+    return out[0], out[1]
+
+
+def _grid_speeds(c: _StepInputs, dev: _DeviceTables) -> Any:
+    """Boat speed [m s⁻¹] of the grid columns, shape (rows, n_grid)."""
+    node, weight = c.wind.row, c.wind.weight
+    s_lo = dev.speed_ms[node, c.first : c.stop]
+    return s_lo + weight[:, None] * (dev.speed_ms[node + 1, c.first : c.stop] - s_lo)
