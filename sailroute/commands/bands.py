@@ -43,7 +43,8 @@ from sailroute.planning.route import (
 )
 from sailroute.progress import Progress
 from sailroute.report.ensemble import honest_side
-from sailroute.routing.types import LegResult, RoutingSettings
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
 __all__ = ["RouteMembers", "band_summary", "route_members", "run_bands_command", "spec_for"]

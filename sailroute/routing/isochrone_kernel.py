@@ -54,10 +54,8 @@ from sailroute.routing.geometry import (
     segment_crossing,
 )
 from sailroute.routing.obstacles import Obstacles
-from sailroute.routing.types import (
-    Barrier,
-    RoutingSettings,
-)
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import Barrier
 from sailroute.wind.base import WindField
 from sailroute.wind.current import CurrentField
 
@@ -1135,9 +1133,9 @@ def _time_to_go_current(
 def _step_length(s: RoutingSettings, tau_hint: float) -> float:
     """``dt_s``, shortened to ``max(min_dt_s, tau_hint / NEAR_TARGET_STEPS)`` [s] once the
     estimated time to go ``tau_hint`` [s] is below ``NEAR_TARGET_STEPS`` steps."""
-    dt = float(s.dt_s)
-    if tau_hint < NEAR_TARGET_STEPS * dt and s.min_dt_s < dt:
-        dt = max(float(s.min_dt_s), tau_hint / NEAR_TARGET_STEPS)
+    dt = float(s.isochrone.dt_s)
+    if tau_hint < NEAR_TARGET_STEPS * dt and s.isochrone.min_dt_s < dt:
+        dt = max(float(s.isochrone.min_dt_s), tau_hint / NEAR_TARGET_STEPS)
     return dt
 
 

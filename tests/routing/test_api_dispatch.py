@@ -14,7 +14,8 @@ from sailroute.errors import InputError, RoutingError
 from sailroute.routing import api
 from sailroute.routing.api import get_router, route_leg
 from sailroute.routing.isochrone import route_isochrone
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import Start, Target
 from sailroute.wind.uniform import UniformWind
 
 T0 = 1_524_567_600.0
