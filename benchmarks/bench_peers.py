@@ -670,7 +670,8 @@ def section_course(args: argparse.Namespace) -> None:
     st = dataclasses.replace(course.routing, router="isochrone")
     print(f"\n## Isochrone router per leg and per course: {COURSE.relative_to(ROOT)}\n")
     print(
-        f"Course settings: dt {st.isochrone.dt_s:g} s, heading step {st.isochrone.heading_step_deg:g}°, tack "
+        f"Course settings: dt {st.isochrone.dt_s:g} s, heading step "
+        f"{st.isochrone.heading_step_deg:g}°, tack "
         f"{st.tack_penalty_s:g} s, gybe {st.gybe_penalty_s:g} s.  Legs chained in time and "
         f"place by `planning.route.route_course` (as `sailroute plan` does); wind and boat "
         f"built once outside the leg timings.  Best of "

@@ -257,10 +257,10 @@ def test_calm_wind_gives_routing_error() -> None:
 @pytest.mark.parametrize(
     ("kw", "key"),
     [
-        (dict(dp_cols=1), "dp_cols"),
-        (dict(dp_shrink=0.0), "dp_shrink"),
-        (dict(dp_half_width_m=-5.0), "dp_half_width_m"),
-        (dict(dp_samples=0), "dp_samples"),
+        (dict(dp_cols=1), r"griddp\.cols"),
+        (dict(dp_shrink=0.0), r"griddp\.shrink"),
+        (dict(dp_half_width_m=-5.0), r"griddp\.half_width_m"),
+        (dict(dp_samples=0), r"griddp\.samples"),
         (dict(tack_penalty_s=-1.0), "tack_penalty_s"),
     ],
 )

@@ -674,5 +674,5 @@ def test_invalid_settings_are_input_errors_naming_the_field(field, value):
             Start((0.0, 0.0)),
             north_mark(500.0),
             UniformWind(TWS, 0.0),
-            replace(SET, **{field: value}),
+            routing_settings(SET, **{field: value}),
         )
