@@ -11,7 +11,7 @@ time the boat sails it.
 Two boat models (see ``docs/design/griddp.md``):
 
 ``Polar``
-    Steady polar speed on ``dp_samples`` pieces of each segment (wind at the
+    Steady polar speed on ``settings.griddp.samples`` pieces of each segment (wind at the
     piece midpoint, at the time the boat is there), plus ``tack_penalty_s`` /
     ``gybe_penalty_s`` for every change of side.  DP state: (row, node, side
     of the last piece); ``2 C²`` segment evaluations per row.
@@ -24,7 +24,7 @@ Two boat models (see ``docs/design/griddp.md``):
 
 After each pass the best path is re-evaluated exactly (sequentially, with the
 actual departure times) and the next pass re-centres the rows on it with the
-band scaled by ``dp_shrink`` (node ``C // 2`` on the incumbent, so a pass never
+band scaled by ``settings.griddp.shrink`` (node ``C // 2`` on the incumbent, so a pass never
 gets worse).  The best pass is returned as a :class:`LegResult` built with the
 shared track builder.
 """
@@ -74,12 +74,12 @@ def _options(g: GridDPSettings) -> GridDPSettings:
     with plain Python numbers (a NumPy integer is a valid count)."""
     hw = g.half_width_m
     return GridDPSettings(
-        int(g.rows),
-        int(g.cols),
-        int(g.refinements),
-        None if hw is None else float(hw),
-        float(g.shrink),
-        int(g.samples),
+        rows=int(g.rows),
+        cols=int(g.cols),
+        refinements=int(g.refinements),
+        half_width_m=None if hw is None else float(hw),
+        shrink=float(g.shrink),
+        samples=int(g.samples),
     )
 
 

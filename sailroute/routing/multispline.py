@@ -101,7 +101,7 @@ class Edges:
         Accumulated cost of the start states (elapsed time for routing).
     carry : ndarray, shape (C0, S0, 1, 1), or None
         State carried along the best path into the start states (the boat
-        speed for routing with ``spline_carry_speed``); None on the first row
+        speed for routing with ``settings.spline.carry_speed``); None on the first row
         or when the edge cost carries nothing.
     """
 
