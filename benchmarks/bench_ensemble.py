@@ -110,7 +110,8 @@ def main() -> None:
     print(f"load average at the end: {load()}")
     print(
         f"Hyères R1, {n} members ({args.wind}), {len(course.legs)} legs, isochrone "
-        f"dt {s.dt_s:g} s, {s.heading_step_deg:g}°: best of {args.repeat}, wall (CPU)"
+        f"dt {s.isochrone.dt_s:g} s, {s.isochrone.heading_step_deg:g}°: best of "
+        f"{args.repeat}, wall (CPU)"
     )
     for way, (wall, cpu) in best.items():
         print(f"  {way:<11} {wall:8.2f} s ({cpu:.2f} s)  {wall / n * 1e3:7.1f} ms per member")

@@ -53,7 +53,8 @@ from sailroute.boat.dynamic import DynamicBoat  # noqa: E402
 from sailroute.errors import InputError  # noqa: E402
 from sailroute.routing import isochrone  # noqa: E402
 from sailroute.routing.griddp import solve_griddp  # noqa: E402
-from sailroute.routing.types import RoutingSettings, Start, Target  # noqa: E402
+from sailroute.routing.settings import RoutingSettings, routing_settings  # noqa: E402
+from sailroute.routing.types import Start, Target  # noqa: E402
 from sailroute.strategy import _deadline_jit as _jit  # noqa: E402
 from sailroute.strategy.deadline import solve_deadline  # noqa: E402
 from sailroute.strategy.shiftmodel import DriftDiffusionShift  # noqa: E402
@@ -118,9 +119,9 @@ def iso_section(cp: Any, repeat: int) -> list[dict]:
             "uniform, headings/4, sectors/10 (big fronts)",
             UniformWind(8.5 * KNOT, 0.0),
             t0,
-            RoutingSettings(
-                heading_step_deg=st0.heading_step_deg / 4,
-                prune_sector_deg=st0.prune_sector_deg / 10,
+            routing_settings(
+                heading_step_deg=st0.isochrone.heading_step_deg / 4,
+                prune_sector_deg=st0.isochrone.prune_sector_deg / 10,
             ),
         )
     )
@@ -152,7 +153,7 @@ def dp_section(cp: Any, repeat: int) -> list[dict]:
     out = []
     for model_name, b in (("dynamic", boat), ("polar", polar)):
         for c in (32, 64, 128):
-            s = RoutingSettings(
+            s = routing_settings(
                 router="griddp",
                 dp_cols=c,
                 dp_rows=13,

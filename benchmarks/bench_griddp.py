@@ -37,7 +37,8 @@ from sailroute.backend import get_xp  # noqa: E402
 from sailroute.boat.dynamic import DynamicBoat, build_table  # noqa: E402
 from sailroute.routing.griddp import solve_griddp  # noqa: E402
 from sailroute.routing.multispline import fit_function, solve_spline  # noqa: E402
-from sailroute.routing.types import RoutingSettings, Start, Target  # noqa: E402
+from sailroute.routing.settings import routing_settings  # noqa: E402
+from sailroute.routing.types import Start, Target  # noqa: E402
 from sailroute.wind.analytic import debski_test_wind  # noqa: E402
 from sailroute.wind.uniform import UniformWind  # noqa: E402
 
@@ -64,7 +65,7 @@ def _grid_rows(cols: list[int], quick: bool, xp=np) -> None:
         for model_name, b in (("dynamic", boat), ("polar", polar)):
             for c in cols:
                 for ref in (0, 2):
-                    s = RoutingSettings(
+                    s = routing_settings(
                         router="griddp",
                         dp_cols=c,
                         dp_rows=13,
@@ -92,7 +93,7 @@ def _paper_convergence(quick: bool) -> None:
     print("   (the paper's row count is not stated; R = 30 reproduces its C = 8 value)")
     print(f"{'C':>5}{'t_f here s':>12}{'paper t_f s':>13}{'wall s':>9}")
     for c in cols:
-        s = RoutingSettings(
+        s = routing_settings(
             router="griddp",
             dp_cols=c,
             dp_rows=30,
@@ -124,7 +125,7 @@ def _splines() -> None:
     polar = boat.steady_polar(np.arange(0.0, 61.0, 2.0), twa_step=1.0)
     for model_name, b, pens in (("polar", polar, (0.0, 1e3)), ("dynamic", boat, (0.0,))):
         for pen in pens:
-            s = RoutingSettings(
+            s = routing_settings(
                 router="spline",
                 dp_rows=13,
                 dp_half_width_m=400.0,

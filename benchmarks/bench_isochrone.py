@@ -41,7 +41,8 @@ import numpy as np  # noqa: E402
 from sailroute.backend import get_xp, xp_name  # noqa: E402
 from sailroute.boat.polar import Polar  # noqa: E402
 from sailroute.routing import isochrone  # noqa: E402
-from sailroute.routing.types import RoutingSettings, Start, Target  # noqa: E402
+from sailroute.routing.settings import RoutingSettings, routing_settings  # noqa: E402
+from sailroute.routing.types import Start, Target  # noqa: E402
 from sailroute.units import KNOT, wind_components, wind_speed_direction  # noqa: E402
 from sailroute.wind.uniform import UniformWind  # noqa: E402
 
@@ -137,7 +138,7 @@ def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repe
         isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)
         walls.append(time.perf_counter() - w0)
         cpus.append(time.process_time() - c0)
-    tab = isochrone.polar_tables(polar, st.heading_step_deg)
+    tab = isochrone.polar_tables(polar, st.isochrone.heading_step_deg)
     u, v = wind.sample(t0, 0.0, 0.0)
     tws = float(np.hypot(u, v))
     a_up = float(np.interp(tws, tab.tws_ms, tab.up_deg))
@@ -195,7 +196,7 @@ def main() -> None:
         )
         if v is not None
     }
-    st = RoutingSettings(**kw)
+    st = routing_settings(**kw)
     polar = load_polar()
     print(
         f"command: python {' '.join(sys.argv)}; load average (1, 5, 15 min): "
@@ -203,8 +204,8 @@ def main() -> None:
     )
     print(
         f"isochrone router, one thread, numpy {np.__version__}; polar {polar.name!r}; "
-        f"dt {st.dt_s:g} s, heading step {st.heading_step_deg:g} deg, sectors "
-        f"{st.prune_sector_deg:g} deg, tack {st.tack_penalty_s:g} s, gybe "
+        f"dt {st.isochrone.dt_s:g} s, heading step {st.isochrone.heading_step_deg:g} deg, sectors "
+        f"{st.isochrone.prune_sector_deg:g} deg, tack {st.tack_penalty_s:g} s, gybe "
         f"{st.gybe_penalty_s:g} s; backend {xp_name(xp)}"
     )
     t0 = 1524567600.0  # 2018-04-24T11:00Z, inside the synthetic WRF file

@@ -44,7 +44,8 @@ import numpy as np  # noqa: E402
 
 from sailroute.boat.dynamic import DynamicBoat  # noqa: E402
 from sailroute.routing.multispline import fit_function, solve_spline  # noqa: E402
-from sailroute.routing.types import RoutingSettings, Start, Target  # noqa: E402
+from sailroute.routing.settings import RoutingSettings, routing_settings  # noqa: E402
+from sailroute.routing.types import Start, Target  # noqa: E402
 from sailroute.wind.analytic import debski_test_wind  # noqa: E402
 
 PAPER = {
@@ -114,7 +115,7 @@ def example2(repeat: int, options: bool) -> None:
             ("carry speed + from rest", True, True),
         ]
     for name, carry, rest in variants:
-        s = RoutingSettings(
+        s = routing_settings(
             router="spline",
             dp_half_width_m=400.0,
             tack_penalty_s=0.0,

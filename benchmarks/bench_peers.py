@@ -122,7 +122,8 @@ from sailroute.boat.io import read_polar  # noqa: E402
 from sailroute.boat.polar import Polar, fold_twa  # noqa: E402
 from sailroute.geo import LocalFrame  # noqa: E402
 from sailroute.routing.api import route_leg  # noqa: E402
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target  # noqa: E402
+from sailroute.routing.settings import RoutingSettings, routing_settings  # noqa: E402
+from sailroute.routing.types import LegResult, Start, Target  # noqa: E402
 from sailroute.units import KNOT, wind_speed_direction  # noqa: E402
 from sailroute.wind.base import WindField  # noqa: E402
 from sailroute.wind.uniform import UniformWind  # noqa: E402
@@ -489,10 +490,10 @@ def our_settings(dt_s: float) -> dict[str, RoutingSettings]:
     """Our two configurations of the peer comparison (both without manoeuvre cost)."""
     common = dict(tack_penalty_s=0.0, gybe_penalty_s=0.0, zone_m=MARK_TOLERANCE_M)
     return {
-        f"ours, same settings (dt {dt_s:g} s, 5°)": RoutingSettings(
+        f"ours, same settings (dt {dt_s:g} s, 5°)": routing_settings(
             dt_s=dt_s, heading_step_deg=5.0, prune_sector_deg=1.0, **common
         ),
-        "ours, defaults (dt 10 s, 2°)": RoutingSettings(**common),
+        "ours, defaults (dt 10 s, 2°)": routing_settings(**common),
     }
 
 
@@ -586,7 +587,7 @@ def section_griddp(args: argparse.Namespace) -> None:
     }
     for name, kw in setups.items():
         for c in cols:
-            st = RoutingSettings(
+            st = routing_settings(
                 router="griddp",
                 dp_cols=c,
                 dp_half_width_m=400.0,
@@ -669,7 +670,8 @@ def section_course(args: argparse.Namespace) -> None:
     st = dataclasses.replace(course.routing, router="isochrone")
     print(f"\n## Isochrone router per leg and per course: {COURSE.relative_to(ROOT)}\n")
     print(
-        f"Course settings: dt {st.dt_s:g} s, heading step {st.heading_step_deg:g}°, tack "
+        f"Course settings: dt {st.isochrone.dt_s:g} s, heading step "
+        f"{st.isochrone.heading_step_deg:g}°, tack "
         f"{st.tack_penalty_s:g} s, gybe {st.gybe_penalty_s:g} s.  Legs chained in time and "
         f"place by `planning.route.route_course` (as `sailroute plan` does); wind and boat "
         f"built once outside the leg timings.  Best of "

@@ -47,7 +47,7 @@ _EXPORTS: dict[str, str] = {
     "write_plan_outputs": "sailroute.report.files",
     # routing one leg
     "LegResult": "sailroute.routing.types",
-    "RoutingSettings": "sailroute.routing.types",
+    "RoutingSettings": "sailroute.routing.settings",
     "Start": "sailroute.routing.types",
     "Target": "sailroute.routing.types",
     "route_leg": "sailroute.routing.api",
@@ -168,7 +168,8 @@ if TYPE_CHECKING:  # pragma: no cover - the same names, for static tools
     from sailroute.planning.route import PlannedCourse, compare_scenarios, plan_course, route_course
     from sailroute.report.files import write_plan_outputs
     from sailroute.routing.api import route_leg
-    from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
+    from sailroute.routing.settings import RoutingSettings
+    from sailroute.routing.types import LegResult, Start, Target
     from sailroute.strategy.shiftmodel import DriftDiffusionShift, OUShift
     from sailroute.strategy.study import StrategyResult, StrategySettings, run_strategy
     from sailroute.track.read import read_track

@@ -249,7 +249,7 @@ def test_leg_work_is_estimated_before_routing(tmp_path):
 
 
 def test_grid_dp_and_spline_work_limits_pass_the_shipped_settings():
-    from sailroute.routing.types import RoutingSettings, settings_problems
+    from sailroute.routing.settings import routing_settings, settings_problems
 
     for kw in (
         {},
@@ -258,12 +258,12 @@ def test_grid_dp_and_spline_work_limits_pass_the_shipped_settings():
         {"dp_cols": 1024},
         {"spline_refinements": 3},
     ):
-        assert settings_problems(RoutingSettings(**kw)) == []
+        assert settings_problems(routing_settings(**kw)) == []
 
 
 def test_leg_work_estimate_passes_the_defaults():
     from sailroute.routing.isochrone import MAX_LEG_WORK, leg_work
-    from sailroute.routing.types import RoutingSettings
+    from sailroute.routing.settings import RoutingSettings
 
     # a 1 h leg at the defaults: 360 steps of 2 x 726 points x 94 angles
     steps, per_step = leg_work(RoutingSettings(), 726, 90, 3600.0)

@@ -21,7 +21,8 @@ from sailroute.boat.io import read_polar
 from sailroute.course.load import load_course
 from sailroute.planning.route import RunOptions, plan_course
 from sailroute.routing.api import route_leg
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings, routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.strategy.deadline import DeadlineGrid, solve_deadline
 from sailroute.units import KNOT
 from sailroute.wind.analytic import debski_test_wind
@@ -57,7 +58,7 @@ def test_isochrone_on_cupy_is_the_numpy_route(start) -> None:
 @pytest.mark.parametrize("boat", ["dynamic", "polar"])
 def test_griddp_on_cupy_is_the_numpy_route(boat) -> None:
     model = DynamicBoat() if boat == "dynamic" else POLAR
-    st = RoutingSettings(
+    st = routing_settings(
         router="griddp", dp_cols=32, dp_rows=9, dp_refinements=1, dp_half_width_m=400.0
     )
     tgt = Target("mark", (500.0, 0.0))

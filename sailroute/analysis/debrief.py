@@ -47,7 +47,8 @@ from sailroute.planning.route import default_scenario, settings_for
 from sailroute.progress import Progress
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import target_barrier
-from sailroute.routing.types import LegResult, RoutingSettings, Start
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import LegResult, Start
 from sailroute.timeutil import iso
 from sailroute.track.kinematics import track_xy, velocity
 from sailroute.track.model import Track

@@ -33,7 +33,8 @@ from sailroute.course.model import Course
 from sailroute.course.uncertainty import DEFAULT_UNCERTAINTY, UncertaintySpec
 from sailroute.planning.route import route_course
 from sailroute.progress import Progress
-from sailroute.routing.types import LegResult, RoutingSettings
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
 __all__ = ["RouteMembers", "band_summary", "route_members", "spec_for"]

@@ -17,7 +17,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import typing
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from datetime import date, datetime
 from pathlib import Path
@@ -37,20 +37,15 @@ from sailroute.checks import (
 )
 from sailroute.course.area import AREA_KEYS, check_area
 from sailroute.course.model import LegKind
+from sailroute.course.routing_section import load_routing
 from sailroute.course.templates import TEMPLATES, CourseLayout
 from sailroute.course.uncertainty import UncertaintySpec, check_uncertainty
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.outdir import path_part_problem
 from sailroute.routing.obstacles import RaceArea
-from sailroute.routing.types import (
-    MIN_DT_S,
-    MIN_HEADING_STEP_DEG,
-    RouterName,
-    RoutingSettings,
-    Side,
-    settings_problems,
-)
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import Side
 from sailroute.timeutil import parse_time, utc_offset_s
 from sailroute.units import KNOT
 from sailroute.wind.build import CURRENT_BUILDERS, WIND_TYPES
@@ -475,75 +470,6 @@ def _check_leg_length(
             f"the leg {frm!r} -> {to!r} is {d:.2f} m long; "
             f"expected at least {MIN_SEPARATION_M:g} m",
         )
-
-
-def _routing(c: Checker, raw: Any) -> RoutingSettings:
-    if raw is None:
-        return RoutingSettings()
-    if not c.at("routing").is_mapping(raw, "a mapping of routing settings"):
-        return RoutingSettings()
-    fields = {f.name: f for f in dataclasses.fields(RoutingSettings)}
-    c.at("routing").keys(raw, list(fields))
-    defaults = RoutingSettings()
-    kw: dict[str, Any] = {}
-    r = c.at("routing")
-    special: dict[str, Callable[[], Any]] = {
-        "router": lambda: r.choice(raw, "router", typing.get_args(RouterName)),
-        "dt_s": lambda: r.number(
-            raw,
-            "dt_s",
-            lo=MIN_DT_S,
-            what=(
-                f"a time step >= {MIN_DT_S:g} s (default 10; finer steps hardly change the "
-                "route and make it slow)"
-            ),
-        ),
-        "heading_step_deg": lambda: r.number(
-            raw,
-            "heading_step_deg",
-            lo=MIN_HEADING_STEP_DEG,
-            hi=45.0,
-            what=(
-                f"a number in [{MIN_HEADING_STEP_DEG:g}, 45] (default 2; finer steps only slow "
-                "the router)"
-            ),
-        ),
-        "tack_penalty_s": lambda: r.number(raw, "tack_penalty_s", lo=0.0),
-        "gybe_penalty_s": lambda: r.number(raw, "gybe_penalty_s", lo=0.0),
-        "initial_side": lambda: r.choice(raw, "initial_side", (*SIDES, None)),
-    }
-    for key in raw:
-        if key not in fields:
-            continue
-        v = special[key]() if key in special else _generic(c, raw, key, str(fields[key].type))
-        if v is not None or raw[key] is None:
-            kw[key] = v
-    try:
-        settings = dataclasses.replace(defaults, **kw)
-    except (TypeError, ValueError) as exc:  # a future field with its own checks
-        c.p.add("routing", str(exc))
-        return defaults
-    # the routers' own rules (e.g. dp_cols >= 2), at load time rather than mid-plan
-    for problem in settings_problems(settings):
-        name = problem.split(" ", 1)[0]
-        c.p.add(f"routing.{name}" if name in raw else "routing", problem)
-    return settings
-
-
-def _generic(c: Checker, raw: Mapping[str, Any], key: str, type_text: str) -> Any:
-    """Type-check a RoutingSettings field by its annotation (``float``, ``int | None``, ...)."""
-    optional = "None" in type_text
-    if optional and raw[key] is None:
-        return None
-    if "bool" in type_text:
-        return c.at("routing").boolean(raw, key, False)
-    if "int" in type_text:
-        return c.at("routing").integer(raw, key, None, lo=0)
-    if "float" in type_text:
-        return c.at("routing").number(raw, key, what="a number" + (" or null" if optional else ""))
-    if "str" in type_text or "Literal" in type_text:
-        return c.at("routing").string(raw, key)
-    return raw[key]
 
 
 def _boat(c: Checker, raw: Any) -> dict[str, Any]:
@@ -974,7 +900,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     )
 
     boat = _boat(c, data.get("boat"))
-    routing = _routing(c, data.get("routing"))
+    routing = load_routing(c, data.get("routing"))
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
     area = check_area(c, data, frame, xy, _position)

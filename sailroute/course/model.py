@@ -26,7 +26,8 @@ import numpy as np
 from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.geo import LocalFrame
 from sailroute.routing.obstacles import RaceArea
-from sailroute.routing.types import RoutingSettings, Side
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import Side
 from sailroute.timeutil import to_epoch
 
 LegKind = Literal["mark", "gate", "line"]

@@ -48,7 +48,7 @@ from sailroute.live.planner import PlanCore, Planner, PlanRequest, ThreadPlanner
 from sailroute.live.replan import DEFAULT_REACH_M, LivePlan, current_leg
 from sailroute.live.sources import Source
 from sailroute.live.web import PageServer
-from sailroute.routing.types import RoutingSettings
+from sailroute.routing.settings import RoutingSettings
 from sailroute.units import KNOT
 from sailroute.wind.base import WindField
 

@@ -30,7 +30,8 @@ from sailroute.live.replan import (
     side_that_pays,
     summarise,
 )
-from sailroute.routing.types import LegResult, RoutingSettings
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
 

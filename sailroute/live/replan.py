@@ -28,7 +28,8 @@ from sailroute.course.model import Course
 from sailroute.planning.route import route_course
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import chain_leg
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import LegResult, Start, Target
 from sailroute.units import bearing_deg, wind_speed_direction, wrap360
 from sailroute.wind.base import WindField
 

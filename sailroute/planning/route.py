@@ -33,7 +33,8 @@ from sailroute.routing.api import check_current_router, get_router, route_leg
 from sailroute.routing.batch import batchable, route_leg_batch
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.obstacles import RaceArea, land_filled, obstacles_for
-from sailroute.routing.types import LegResult, RouterName, RoutingSettings, Start
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import LegResult, RouterName, Start
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
 

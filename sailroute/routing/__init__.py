@@ -1,13 +1,24 @@
 """Leg routers (isochrones, grid DP, multi-spline) and their shared types."""
 
-from sailroute.routing.types import (
-    Barrier,
-    LegResult,
-    Manoeuvre,
-    RouteTrack,
+from sailroute.routing.settings import (
+    GridDPSettings,
+    IsochroneSettings,
     RoutingSettings,
-    Start,
-    Target,
+    SplineSettings,
+    routing_settings,
 )
+from sailroute.routing.types import Barrier, LegResult, Manoeuvre, RouteTrack, Start, Target
 
-__all__ = ["Barrier", "LegResult", "Manoeuvre", "RouteTrack", "RoutingSettings", "Start", "Target"]
+__all__ = [
+    "Barrier",
+    "GridDPSettings",
+    "IsochroneSettings",
+    "LegResult",
+    "Manoeuvre",
+    "RouteTrack",
+    "RoutingSettings",
+    "SplineSettings",
+    "Start",
+    "Target",
+    "routing_settings",
+]

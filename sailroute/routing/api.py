@@ -8,7 +8,7 @@ router         function                                         module
 ``spline``     ``route_spline``                                 ``routing/multispline.py``
 =============  ===============================================  ==========================
 
-All routers share the signature declared by :class:`~sailroute.routing.types.Router`,
+All routers share the signature declared by :class:`Router`,
 ``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy, current=None,
 obstacles=None) -> LegResult`` (``boat`` a :class:`~sailroute.boat.model.BoatModel`; ``xp``,
 an array module, is passed by :func:`route_leg` only for a non-NumPy ``backend``;
@@ -25,7 +25,8 @@ from __future__ import annotations
 import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from types import ModuleType
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -33,11 +34,49 @@ from sailroute.backend import get_xp
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError, RoutingError
 from sailroute.routing.geometry import leg_label, start_centre
-from sailroute.routing.types import LegResult, Router, RoutingSettings, Start, Target
+from sailroute.routing.settings import (
+    GridDPSettings,
+    IsochroneSettings,
+    RoutingSettings,
+    SplineSettings,
+)
+from sailroute.routing.types import LegResult, Start, Target
 from sailroute.wind.base import WindField
 
 if TYPE_CHECKING:
     from sailroute.routing.obstacles import Obstacles
+    from sailroute.wind.current import CurrentField
+
+
+class Router(Protocol):
+    """A leg router: the signature every routing function shares.
+
+    ``(start, target, t0, wind, boat, settings, *, progress=None, xp=numpy, current=None,
+    obstacles=None) -> LegResult`` (:mod:`sailroute.routing.api` lists the
+    implementations and what each supports; each router module declares
+    ``_ROUTER: Router = route_...`` so that mypy checks it against this).  ``current``
+    is a surface current (:class:`~sailroute.wind.current.CurrentField`), ``obstacles`` the
+    race area (:class:`~sailroute.routing.obstacles.Obstacles`); a router that cannot
+    honour one refuses it with an :class:`~sailroute.errors.InputError`.
+    """
+
+    def __call__(
+        self,
+        start: Start,
+        target: Target,
+        t0: float,
+        wind: WindField,
+        boat: BoatModel,
+        settings: RoutingSettings,
+        /,
+        *,
+        progress: Callable[[float], None] | None = None,
+        xp: ModuleType = ...,
+        current: CurrentField | None = None,
+        obstacles: Obstacles | None = None,
+    ) -> LegResult:
+        """Fastest route of one leg (see :func:`~sailroute.routing.api.route_leg`)."""
+        ...
 
 
 @dataclass(frozen=True)
@@ -48,6 +87,10 @@ class RouterEntry:
     ----------
     module, function : str
         The routing function ``module.function`` (imported when first asked for).
+    settings_type : type
+        Its settings class, the :class:`~sailroute.routing.settings.RoutingSettings`
+        field named as the router (``settings.griddp`` is a
+        :class:`~sailroute.routing.settings.GridDPSettings`).
     current : bool
         Routes a surface current (``current=`` keyword).
     obstacles : bool
@@ -60,6 +103,7 @@ class RouterEntry:
 
     module: str
     function: str
+    settings_type: type[IsochroneSettings | GridDPSettings | SplineSettings]
     current: bool = False
     obstacles: bool = False
     dynamic_boat: bool = False
@@ -68,12 +112,22 @@ class RouterEntry:
 
 ROUTERS: dict[str, RouterEntry] = {
     "isochrone": RouterEntry(
-        "sailroute.routing.isochrone", "route_isochrone", current=True, obstacles=True
+        "sailroute.routing.isochrone",
+        "route_isochrone",
+        IsochroneSettings,
+        current=True,
+        obstacles=True,
     ),
     "griddp": RouterEntry(
-        "sailroute.routing.griddp", "route_griddp", obstacles=True, dynamic_boat=True
+        "sailroute.routing.griddp",
+        "route_griddp",
+        GridDPSettings,
+        obstacles=True,
+        dynamic_boat=True,
     ),
-    "spline": RouterEntry("sailroute.routing.multispline", "route_spline", dynamic_boat=True),
+    "spline": RouterEntry(
+        "sailroute.routing.multispline", "route_spline", SplineSettings, dynamic_boat=True
+    ),
 }
 """Router name -> :class:`RouterEntry`."""
 

@@ -69,8 +69,9 @@ from sailroute.routing.isochrone_inputs import _prepare, _step_length
 from sailroute.routing.isochrone_kernel import _CHUNK_ELEMENTS, _expand, _group_argmin, _survivors
 from sailroute.routing.isochrone_polar import _device_tables, _DeviceTables, polar_tables
 from sailroute.routing.isochrone_records import Groups, _Arrival, _Context, _Layer, _LegFrame
+from sailroute.routing.settings import RoutingSettings, check_settings
 from sailroute.routing.track import make_leg_result
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target, check_settings
+from sailroute.routing.types import LegResult, Start, Target
 from sailroute.wind.base import Coverage, WindField
 
 __all__ = ["batchable", "route_leg_batch"]
@@ -141,7 +142,7 @@ def route_leg_batch(
         )
     check_settings(settings, label)
     polar = _routing_polar(boat, label)
-    tab = polar_tables(polar, settings.heading_step_deg)
+    tab = polar_tables(polar, settings.isochrone.heading_step_deg)
     geom = target_geometry(target, starts[0], settings.zone_m)
     frame = _LegFrame.for_leg(geom.centre, start_centre(starts[0]))
     barriers = leg_barriers(starts[0], target)
@@ -292,7 +293,7 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
     sizes = [a.shape[0] for a in x0]
     root = _root_layer(np.concatenate(t0), np.concatenate(x0), np.concatenate(y0), s, np)
     history = [_Front(root, tuple(members), _groups(members, sizes))]
-    dt = float(s.dt_s)
+    dt = float(s.isochrone.dt_s)
     while history[-1].members:
         front = history[-1]
         # a member whose step shortens near the target finishes alone

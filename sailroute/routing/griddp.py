@@ -11,7 +11,7 @@ time the boat sails it.
 Two boat models (see ``docs/design/griddp.md``):
 
 ``Polar``
-    Steady polar speed on ``dp_samples`` pieces of each segment (wind at the
+    Steady polar speed on ``settings.griddp.samples`` pieces of each segment (wind at the
     piece midpoint, at the time the boat is there), plus ``tack_penalty_s`` /
     ``gybe_penalty_s`` for every change of side.  DP state: (row, node, side
     of the last piece); ``2 C²`` segment evaluations per row.
@@ -24,7 +24,7 @@ Two boat models (see ``docs/design/griddp.md``):
 
 After each pass the best path is re-evaluated exactly (sequentially, with the
 actual departure times) and the next pass re-centres the rows on it with the
-band scaled by ``dp_shrink`` (node ``C // 2`` on the incumbent, so a pass never
+band scaled by ``settings.griddp.shrink`` (node ``C // 2`` on the incumbent, so a pass never
 gets worse).  The best pass is returned as a :class:`LegResult` built with the
 shared track builder.
 """
@@ -55,17 +55,11 @@ from sailroute.routing._dp_grid import (
     penalty_of,
     sample_chains,
 )
+from sailroute.routing.api import Router
 from sailroute.routing.geometry import leg_label, target_barrier
+from sailroute.routing.settings import GridDPSettings, RoutingSettings, check_settings
 from sailroute.routing.track import build_track, make_leg_result
-from sailroute.routing.types import (
-    LegResult,
-    Router,
-    RoutingSettings,
-    Start,
-    Target,
-    check_settings,
-    side_sign,
-)
+from sailroute.routing.types import LegResult, Start, Target, side_sign
 from sailroute.wind.base import WindField
 
 if TYPE_CHECKING:
@@ -75,30 +69,18 @@ if TYPE_CHECKING:
 _SIDE_VALUE = np.array([-1, 1], dtype=np.int8)  # state index 0 = port, 1 = starboard
 
 
-@dataclass(frozen=True)
-class GridDPOptions:
-    """Grid-DP settings taken from :class:`RoutingSettings` (see its ``dp_*`` fields)."""
-
-    rows: int
-    cols: int
-    refinements: int
-    half_width_m: float | None
-    shrink: float
-    samples: int
-
-    @classmethod
-    def from_settings(cls, s: RoutingSettings) -> GridDPOptions:
-        """The ``dp_*`` fields of settings validated by
-        :func:`~sailroute.routing.types.check_settings`."""
-        hw = s.dp_half_width_m
-        return cls(
-            int(s.dp_rows),
-            int(s.dp_cols),
-            int(s.dp_refinements),
-            None if hw is None else float(hw),
-            float(s.dp_shrink),
-            int(s.dp_samples),
-        )
+def _options(g: GridDPSettings) -> GridDPSettings:
+    """``settings.griddp`` (validated by :func:`~sailroute.routing.settings.check_settings`)
+    with plain Python numbers (a NumPy integer is a valid count)."""
+    hw = g.half_width_m
+    return GridDPSettings(
+        rows=int(g.rows),
+        cols=int(g.cols),
+        refinements=int(g.refinements),
+        half_width_m=None if hw is None else float(hw),
+        shrink=float(g.shrink),
+        samples=int(g.samples),
+    )
 
 
 @dataclass(frozen=True)
@@ -186,8 +168,8 @@ def route_griddp(
     boat : BoatModel
         Boat model (see the module docstring).
     settings : RoutingSettings
-        The ``dp_*`` fields, the penalties (polar model), ``initial_side``
-        (polar model) and ``zone_m``.
+        ``settings.griddp`` (:class:`~sailroute.routing.settings.GridDPSettings`), the
+        penalties (polar model), ``initial_side`` (polar model) and ``zone_m``.
     progress : callable, optional
         Called with the fraction done, in [0, 1].
     xp : module
@@ -241,8 +223,8 @@ def solve_griddp(
     """Like :func:`route_griddp`, with per-pass diagnostics (:class:`GridDPSolution`)."""
     check_settings(settings, leg_label(start, target))
     t0 = float(t0)
-    grid = make_grid(start, target, settings.dp_rows, settings.zone_m)
-    opts = GridDPOptions.from_settings(settings)
+    grid = make_grid(start, target, settings.griddp.rows, settings.zone_m)
+    opts = _options(settings.griddp)
     if not math.isfinite(t0):
         raise InputError(f"leg {grid.label}: start time must be finite, got {t0!r}")
     model = GridBoat.of(boat, grid.label)
@@ -354,7 +336,7 @@ def _dp_polar(
     wind: WindField,
     xy: list,
     t0: float,
-    opts: GridDPOptions,
+    opts: GridDPSettings,
     s: RoutingSettings,
     lim: PathLimits,
     xp: ModuleType,
@@ -441,7 +423,7 @@ def _dp_dynamic(
     wind: WindField,
     xy: list,
     t0: float,
-    opts: GridDPOptions,
+    opts: GridDPSettings,
     lim: PathLimits,
     xp: ModuleType,
     progress: Callable[[float], None],

@@ -54,6 +54,7 @@ from numpy.typing import NDArray
 from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
+from sailroute.routing.api import Router
 from sailroute.routing.geometry import (
     TargetGeometry,
     leg_barriers,
@@ -75,16 +76,14 @@ from sailroute.routing.isochrone_polar import (
 from sailroute.routing.isochrone_records import _Arrival, _Context, _floats, _Layer, _LegFrame
 from sailroute.routing.isochrone_togo import _BIG_S
 from sailroute.routing.obstacles import Obstacles
+from sailroute.routing.settings import RoutingSettings, check_settings
 from sailroute.routing.track import build_track, make_leg_result
 from sailroute.routing.types import (
     Barrier,
     LegResult,
-    Router,
     RouteTrack,
-    RoutingSettings,
     Start,
     Target,
-    check_settings,
     side_sign,
 )
 from sailroute.wind.base import WindField
@@ -136,10 +135,11 @@ def route_isochrone(
         The boat: its steady polar (:meth:`~sailroute.boat.model.BoatModel.routing_polar`)
         is routed; a boat without one (the dynamic model) is refused.
     settings : RoutingSettings
-        ``dt_s``, ``heading_step_deg``, penalties, ``initial_side`` and the
-        isochrone options (``min_dt_s``, ``prune_sector_deg``,
-        ``max_front_points``, ``heading_fan``, ``zone_m``,
-        ``start_line_spacing_m``, ``max_leg_time_s``).
+        The common fields (penalties, ``initial_side``, ``zone_m``,
+        ``start_line_spacing_m``, ``max_leg_time_s``) and ``settings.isochrone``
+        (:class:`~sailroute.routing.settings.IsochroneSettings`: ``dt_s``,
+        ``heading_step_deg``, ``min_dt_s``, ``prune_sector_deg``, ``max_front_points``,
+        ``heading_fan``).
     progress : callable, optional
         Called after each step with the estimated fraction done, in [0, 1].
     xp : module
@@ -182,7 +182,7 @@ def route_isochrone(
     _check_start_time(t0, label)
     polar = _routing_polar(boat, label)
     geom = target_geometry(target, start, settings.zone_m)
-    tab = polar_tables(polar, settings.heading_step_deg)
+    tab = polar_tables(polar, settings.isochrone.heading_step_deg)
     frame = _LegFrame.for_leg(geom.centre, start_centre(start))
     ctx = _context(
         label,
@@ -314,7 +314,7 @@ def leg_work(
         Steps still to go and candidate moves per step (keep and switch side, each with
         every grid TWA and the exact VMG and direct headings).
     """
-    return time_to_go_s / float(settings.dt_s), float(n_points) * 2.0 * (n_angles + 4)
+    return time_to_go_s / float(settings.isochrone.dt_s), float(n_points) * 2.0 * (n_angles + 4)
 
 
 def check_leg_work(
@@ -337,8 +337,9 @@ def check_leg_work(
         return
     dt_fit = time_to_go_s * per_step / MAX_LEG_WORK
     raise InputError(
-        f"leg {label}: routing.dt_s = {settings.dt_s:g} s with routing.heading_step_deg = "
-        f"{settings.heading_step_deg:g} needs about {steps * per_step:.1e} candidate moves "
+        f"leg {label}: routing.dt_s = {settings.isochrone.dt_s:g} s with "
+        f"routing.heading_step_deg = {settings.isochrone.heading_step_deg:g} needs about "
+        f"{steps * per_step:.1e} candidate moves "
         f"({steps:.0f} steps to go of up to {per_step:.1e}), more than {MAX_LEG_WORK:.0e} "
         f"(minutes of work per leg); use routing.dt_s >= {dt_fit:.2g} s, a coarser "
         "heading_step_deg or fewer max_front_points (the defaults, 10 s and 2, are accurate "
@@ -406,10 +407,10 @@ def _context(
         geom=frame.geometry(geom),
         tack_s=float(s.tack_penalty_s),
         gybe_s=float(s.gybe_penalty_s),
-        sector_rad=math.radians(s.prune_sector_deg),
-        n_bins=math.ceil(2.0 * math.pi / math.radians(s.prune_sector_deg)) + 3,
-        max_points=int(s.max_front_points),
-        fan_hull=s.heading_fan == "hull",
+        sector_rad=math.radians(s.isochrone.prune_sector_deg),
+        n_bins=math.ceil(2.0 * math.pi / math.radians(s.isochrone.prune_sector_deg)) + 3,
+        max_points=int(s.isochrone.max_front_points),
+        fan_hull=s.isochrone.heading_fan == "hull",
         box=box,
         barriers=tuple((frame.barrier(b), c) for b, c in barriers),
         current=current,

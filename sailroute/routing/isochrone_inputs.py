@@ -41,7 +41,7 @@ from sailroute.routing.isochrone_records import (
     _TimeToGo,
 )
 from sailroute.routing.isochrone_togo import _fastest_aim, _time_to_go, _time_to_go_current
-from sailroute.routing.types import RoutingSettings
+from sailroute.routing.settings import RoutingSettings
 from sailroute.wind.base import WindField
 
 NEAR_TARGET_STEPS = 3.0
@@ -65,9 +65,9 @@ _CRAB_ITERATIONS = 8
 def _step_length(s: RoutingSettings, tau_hint: float) -> float:
     """``dt_s``, shortened to ``max(min_dt_s, tau_hint / NEAR_TARGET_STEPS)`` [s] once the
     estimated time to go ``tau_hint`` [s] is below ``NEAR_TARGET_STEPS`` steps."""
-    dt = float(s.dt_s)
-    if tau_hint < NEAR_TARGET_STEPS * dt and s.min_dt_s < dt:
-        dt = max(float(s.min_dt_s), tau_hint / NEAR_TARGET_STEPS)
+    dt = float(s.isochrone.dt_s)
+    if tau_hint < NEAR_TARGET_STEPS * dt and s.isochrone.min_dt_s < dt:
+        dt = max(float(s.isochrone.min_dt_s), tau_hint / NEAR_TARGET_STEPS)
     return dt
 
 

@@ -57,7 +57,7 @@ from sailroute.routing.isochrone_inputs import _prepare
 from sailroute.routing.isochrone_polar import _DeviceTables, _grid_speeds
 from sailroute.routing.isochrone_records import _Arrival, _Context, _Layer, _LegFrame, _StepInputs
 from sailroute.routing.obstacles import Obstacles
-from sailroute.routing.types import RoutingSettings
+from sailroute.routing.settings import RoutingSettings
 from sailroute.wind.base import WindField
 
 # --------------------------------------------------------------------------------------

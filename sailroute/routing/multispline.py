@@ -52,16 +52,11 @@ from sailroute.routing._dp_grid import (
     sample_chains,
     sample_wind,
 )
+from sailroute.routing.api import Router
 from sailroute.routing.geometry import leg_label, target_barrier
+from sailroute.routing.settings import RoutingSettings, check_settings
 from sailroute.routing.track import build_track, make_leg_result
-from sailroute.routing.types import (
-    LegResult,
-    Router,
-    RoutingSettings,
-    Start,
-    Target,
-    check_settings,
-)
+from sailroute.routing.types import LegResult, Start, Target
 from sailroute.wind.base import WindField
 
 if TYPE_CHECKING:
@@ -106,7 +101,7 @@ class Edges:
         Accumulated cost of the start states (elapsed time for routing).
     carry : ndarray, shape (C0, S0, 1, 1), or None
         State carried along the best path into the start states (the boat
-        speed for routing with ``spline_carry_speed``); None on the first row
+        speed for routing with ``settings.spline.carry_speed``); None on the first row
         or when the edge cost carries nothing.
     """
 
@@ -525,8 +520,7 @@ def route_spline(
     ----------
     start, target, t0, wind, boat, settings, progress, xp
         As :func:`~sailroute.routing.griddp.route_griddp`; the grid uses
-        ``dp_rows``, ``dp_half_width_m``, ``spline_cols``, ``spline_slopes`` and
-        ``spline_refinements``.
+        ``settings.spline`` (:class:`~sailroute.routing.settings.SplineSettings`).
     current, obstacles : optional
         Refused with an :class:`InputError`: the spline router routes still, open
         water only (a smooth curve round an obstacle would need its tangents fitted to
@@ -569,17 +563,17 @@ def solve_spline(
     """Like :func:`route_spline`, also returning the :class:`SplineFit` diagnostics."""
     check_settings(settings, leg_label(start, target))
     t0 = float(t0)
-    grid = make_grid(start, target, settings.dp_rows, settings.zone_m)
+    grid = make_grid(start, target, settings.spline.rows, settings.zone_m)
     model = GridBoat.of(boat, grid.label)
-    half = settings.dp_half_width_m or default_half_width(grid.frame, wind, t0, model)
+    half = settings.spline.half_width_m or default_half_width(grid.frame, wind, t0, model)
     cost = _route_cost(grid.frame, wind, model, t0, settings, grid.limits, len(grid.rows))
     fit = fit_multispline(
         cost,
         grid.frame,
         grid.rows,
-        n_cols=settings.spline_cols,
-        n_slopes=settings.spline_slopes,
-        n_refine=settings.spline_refinements,
+        n_cols=settings.spline.cols,
+        n_slopes=settings.spline.slopes,
+        n_refine=settings.spline.refinements,
         half_width=half,
         xp=xp,
         progress=progress,
@@ -884,8 +878,8 @@ def _route_cost(
 ) -> EdgeCost:
     t = np.linspace(0.0, 1.0, CHORDS + 1)
     boat = model.dynamic
-    carry = bool(settings.spline_carry_speed) and boat is not None
-    rest = bool(settings.spline_start_from_rest) and boat is not None
+    carry = bool(settings.spline.carry_speed) and boat is not None
+    rest = bool(settings.spline.start_from_rest) and boat is not None
     cap = _speed_cap(boat) if boat is not None else None
 
     def cost(r: int, e: Edges) -> NDArray | tuple[NDArray, NDArray]:
@@ -927,8 +921,8 @@ def _sail_curve(
     tt = np.linspace(0.0, 1.0, CHORDS + 1)
     t = t0
     dyn = model.dynamic is not None
-    carry = bool(settings.spline_carry_speed) and dyn
-    rest = bool(settings.spline_start_from_rest) and dyn
+    carry = bool(settings.spline.carry_speed) and dyn
+    rest = bool(settings.spline.start_from_rest) and dyn
     v_prev: float | None = None
     out_t, out_x, out_y, out_s, out_v = [], [], [], [], []
     for r in range(fit.along.size - 1):

@@ -38,7 +38,8 @@ from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.geo import LocalFrame
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import chain_leg
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import Start, Target
 from sailroute.track.model import Track
 from sailroute.units import bearing_deg, wind_components, wind_speed_direction, wrap180
 from sailroute.wind.analytic import AnalyticWind

@@ -10,7 +10,7 @@ import pytest
 
 from sailroute.course.load import course_from_mapping, load_course
 from sailroute.errors import InputError
-from sailroute.routing.types import RoutingSettings
+from sailroute.routing.settings import RoutingSettings
 from tests.conftest import TESTS_DATA
 
 DATA = TESTS_DATA / "course"
@@ -109,8 +109,8 @@ def test_routing_section_maps_to_settings(tmp_path):
     r = load_course(write(tmp_path, text)).routing
     assert (
         r.router,
-        r.dt_s,
-        r.heading_step_deg,
+        r.isochrone.dt_s,
+        r.isochrone.heading_step_deg,
         r.tack_penalty_s,
         r.gybe_penalty_s,
         r.initial_side,
@@ -312,7 +312,7 @@ def test_routing_problems(tmp_path, routing, expected):
     ],
 )
 def test_router_rules_are_checked_when_the_course_loads(tmp_path, routing, expected):
-    # the routers' rules (routing.types.settings_problems) at load time, with the line:
+    # the routers' rules (routing.settings.settings_problems) at load time, with the line:
     # before, such a file loaded and the plan stopped at its first leg
     n_lines = BASE.count("\n") + 2  # the key below "routing:"
     assert f"c.yaml:{n_lines}: {expected}" in problems(

@@ -13,6 +13,7 @@ from pathlib import Path
 from sailroute.course.load import load_course
 from sailroute.course.model import Course
 from sailroute.live.convert import Row, nmea_lines
+from sailroute.routing.settings import routing_settings
 from tests.conftest import COURSES
 
 TRIESTE = COURSES / "trieste-coach-wl.yaml"
@@ -28,7 +29,9 @@ def trieste(coarse: bool = True) -> Course:
     course = load_course(TRIESTE)
     if not coarse:
         return course
-    return replace(course, routing=replace(course.routing, dt_s=10.0, heading_step_deg=4.0))
+    return replace(
+        course, routing=routing_settings(course.routing, dt_s=10.0, heading_step_deg=4.0)
+    )
 
 
 def approach(

@@ -14,7 +14,8 @@ from sailroute.errors import InputError, RoutingError
 from sailroute.routing import api
 from sailroute.routing.api import get_router, route_leg
 from sailroute.routing.isochrone import route_isochrone
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import GridDPSettings, RoutingSettings, SplineSettings
+from sailroute.routing.types import Start, Target
 from sailroute.wind.uniform import UniformWind
 
 T0 = 1_524_567_600.0
@@ -55,7 +56,9 @@ def test_unknown_router_is_an_input_error_listing_the_choices():
 
 def test_missing_router_module_is_a_routing_error(monkeypatch):
     monkeypatch.setitem(
-        api.ROUTERS, "griddp", api.RouterEntry("sailroute.routing._no_such_module", "f")
+        api.ROUTERS,
+        "griddp",
+        api.RouterEntry("sailroute.routing._no_such_module", "f", GridDPSettings),
     )
     with pytest.raises(RoutingError, match=r"'griddp' is not available.*_no_such_module"):
         get_router("griddp")
@@ -65,7 +68,9 @@ def test_module_without_the_function_is_a_routing_error(monkeypatch):
     mod = types.ModuleType("sailroute_fake_router")
     monkeypatch.setitem(sys.modules, "sailroute_fake_router", mod)
     monkeypatch.setitem(
-        api.ROUTERS, "spline", api.RouterEntry("sailroute_fake_router", "route_spline")
+        api.ROUTERS,
+        "spline",
+        api.RouterEntry("sailroute_fake_router", "route_spline", SplineSettings),
     )
     with pytest.raises(RoutingError, match="has no function route_spline"):
         get_router("spline")
@@ -82,7 +87,9 @@ def test_other_routers_are_called_lazily_with_the_shared_signature(monkeypatch):
     mod.route_griddp = route_griddp  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "sailroute_fake_griddp", mod)
     monkeypatch.setitem(
-        api.ROUTERS, "griddp", api.RouterEntry("sailroute_fake_griddp", "route_griddp")
+        api.ROUTERS,
+        "griddp",
+        api.RouterEntry("sailroute_fake_griddp", "route_griddp", GridDPSettings),
     )
     st = replace(RoutingSettings(), router="griddp")
     # a router's RoutingError without the leg gets the leg label prepended

@@ -10,7 +10,8 @@ import pytest
 from sailroute.errors import InputError, RoutingError
 from sailroute.routing.batch import batchable, route_leg_batch
 from sailroute.routing.isochrone import route_isochrone
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import Start, Target
 from sailroute.wind.uniform import UniformWind
 from tests.routing.polars import laser_like_polar
 

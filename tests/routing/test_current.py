@@ -19,7 +19,8 @@ from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
 from sailroute.routing.api import route_leg
 from sailroute.routing.isochrone import route_isochrone
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings, routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.units import KNOT
 from sailroute.wind.build import current_from_spec
 from sailroute.wind.current import DiamondCurrent, RelativeWind, UniformCurrent
@@ -110,7 +111,7 @@ def laylines_time(wind, current, target, pen):
 @pytest.mark.parametrize(("rate", "set_deg"), [(0.6, 90.0), (0.6, 270.0), (0.4, 135.0)])
 def test_beat_in_uniform_current_is_the_layline_solution(rate, set_deg):
     L = 1000.0
-    st = replace(SET, dt_s=5.0)
+    st = routing_settings(SET, dt_s=5.0)
     wind, cur = UniformWind(TWS, 0.0), UniformCurrent(rate, set_deg)
     r = route_isochrone(Start((0.0, 0.0)), mark(L), T0, wind, POLAR, st, current=cur)
     # the leg ends on the mark's 13 m rounding segment (pointing east); the closed form

@@ -14,7 +14,8 @@ from sailroute.errors import InputError, RoutingError
 from sailroute.routing._dp_grid import GridBoat, make_grid
 from sailroute.routing.geometry import target_geometry
 from sailroute.routing.griddp import evaluate_path, route_griddp, solve_griddp
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings, routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.wind.analytic import debski_test_wind
 from sailroute.wind.uniform import UniformWind
 
@@ -33,7 +34,7 @@ A = Start((0.0, 0.0), name="A")
 def settings(**kw: object) -> RoutingSettings:
     base = dict(router="griddp", dp_cols=17, dp_rows=9, dp_refinements=1)
     base.update(kw)
-    return RoutingSettings(**base)  # type: ignore[arg-type]
+    return routing_settings(**base)  # type: ignore[arg-type]
 
 
 def test_reach_in_uniform_wind_is_straight_and_exact() -> None:
@@ -110,9 +111,9 @@ def test_mesh_convergence_reproduces_the_paper() -> None:
 
 
 def _brute_force(boat: Polar | DynamicBoat, wind, tgt: Target, s: RoutingSettings) -> float:
-    grid = make_grid(A, tgt, s.dp_rows, s.zone_m)
-    half = s.dp_half_width_m
-    xy = [row.points(grid.frame, row.initial(s.dp_cols, half)) for row in grid.rows]
+    grid = make_grid(A, tgt, s.griddp.rows, s.zone_m)
+    half = s.griddp.half_width_m
+    xy = [row.points(grid.frame, row.initial(s.griddp.cols, half)) for row in grid.rows]
     model = GridBoat.of(boat, "test")
     best = math.inf
     for path in itertools.product(*[range(p[0].size) for p in xy]):
@@ -120,7 +121,7 @@ def _brute_force(boat: Polar | DynamicBoat, wind, tgt: Target, s: RoutingSetting
         ys = np.array([xy[r][1][c] for r, c in enumerate(path)])
         best = min(
             best,
-            evaluate_path(model, wind, xs, ys, 0.0, s.dp_samples, s, limits=grid.limits).time_s,
+            evaluate_path(model, wind, xs, ys, 0.0, s.griddp.samples, s, limits=grid.limits).time_s,
         )
     return best
 
@@ -256,10 +257,10 @@ def test_calm_wind_gives_routing_error() -> None:
 @pytest.mark.parametrize(
     ("kw", "key"),
     [
-        (dict(dp_cols=1), "dp_cols"),
-        (dict(dp_shrink=0.0), "dp_shrink"),
-        (dict(dp_half_width_m=-5.0), "dp_half_width_m"),
-        (dict(dp_samples=0), "dp_samples"),
+        (dict(dp_cols=1), r"griddp\.cols"),
+        (dict(dp_shrink=0.0), r"griddp\.shrink"),
+        (dict(dp_half_width_m=-5.0), r"griddp\.half_width_m"),
+        (dict(dp_samples=0), r"griddp\.samples"),
         (dict(tack_penalty_s=-1.0), "tack_penalty_s"),
     ],
 )

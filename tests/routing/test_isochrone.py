@@ -28,7 +28,8 @@ from sailroute.boat import builtin_polar
 from sailroute.boat.dynamic import DynamicBoat
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
 from sailroute.routing.isochrone import polar_tables, route_isochrone
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings, routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.units import wind_components
 from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import Coverage
@@ -123,7 +124,7 @@ def test_reach_to_a_long_line_maximises_the_speed_towards_it():
 # --- beats and runs: one manoeuvre, closed forms --------------------------------------
 
 
-FINE = replace(SET, dt_s=5.0)
+FINE = routing_settings(SET, dt_s=5.0)
 """5 s steps: tacks 5 s apart land 2 v sin(A_UP) dt = 11.7 m apart across the leg, less
 than the 13 m rounding segment, so some one-tack route lands on it at the VMG angle on
 both boards and the closed form is reached exactly."""
@@ -171,7 +172,7 @@ def test_dead_upwind_at_the_default_step_is_within_the_tack_timing_bound(side):
     r = route(Start((0.0, 0.0)), north_mark(L), UniformWind(TWS, 0.0), st)
     expected = L / VMG_UP + st.tack_penalty_s
     v = float(POLAR.speed(TWS, A_UP))
-    miss = (2 * v * math.sin(math.radians(A_UP)) * st.dt_s - SET.zone_m) / 2 + 1.0
+    miss = (2 * v * math.sin(math.radians(A_UP)) * st.isochrone.dt_s - SET.zone_m) / 2 + 1.0
     board_m = L / math.cos(math.radians(A_UP))  # both boards together: a safe length
     bound = vmg_loss_bound(board_m / 2, miss, L / VMG_UP)
     # (bound: 0.28 s = 3.5e-4 here; measured losses 0.00-0.04 s)
@@ -262,7 +263,7 @@ def test_steps_shrink_near_the_target():
     # adaptive step: dt_s far from the target, down to min_dt_s for the last steps
     # (then the exact arrival inside the last one).  A run with no manoeuvre, so the
     # track has one vertex per step.
-    st = replace(SET, dt_s=10.0, min_dt_s=1.0)
+    st = routing_settings(SET, dt_s=10.0, min_dt_s=1.0)
     r = route(Start((0.0, 0.0)), north_mark(800.0), UniformWind(TWS, 90.0), st)
     steps = np.diff(r.track.t)
     full, last = steps[:-1], steps[-1]
@@ -277,7 +278,9 @@ def test_thesis_validation_beat_closed_form():
     # the thesis (Pardo 2018, §5.7): 8.5 kn from 0°, a 1809 m beat, 10 s per manoeuvre, dt 5 s, 1°
     # headings.  The thesis's optimum (1100-1225 s) used its own Laser VPP, which is
     # not available; with this polar the closed form L / VMG* + 10 s must hold.
-    st = replace(SET, tack_penalty_s=10.0, gybe_penalty_s=10.0, heading_step_deg=1.0, dt_s=5.0)
+    st = routing_settings(
+        SET, tack_penalty_s=10.0, gybe_penalty_s=10.0, heading_step_deg=1.0, dt_s=5.0
+    )
     r = route(Start((0.0, 0.0)), north_mark(1809.0), UniformWind(TWS, 0.0), st)
     expected = 1809.0 / VMG_UP + 10.0
     assert r.time_s >= expected * (1 - ROUNDOFF)
@@ -287,7 +290,7 @@ def test_thesis_validation_beat_closed_form():
 
 def test_penalty_is_exact_when_longer_than_the_step():
     # a 7 s tack with 2 s steps: the boat stops for exactly 7 s (time debt)
-    st = replace(SET, dt_s=2.0, tack_penalty_s=7.0, gybe_penalty_s=7.0)
+    st = routing_settings(SET, dt_s=2.0, tack_penalty_s=7.0, gybe_penalty_s=7.0)
     r = route(Start((0.0, 0.0)), north_mark(500.0), UniformWind(TWS, 0.0), st)
     assert r.time_s == pytest.approx(500.0 / VMG_UP + 7.0, rel=1e-7)
     tr = r.track
@@ -538,7 +541,7 @@ def test_generic_array_module_path_gives_the_same_route(case):
     w = AnalyticWind(lambda t, x, y: wind_components(TWS + 0.0005 * x, 5.0 * np.sin(y / 300)))
     start, st = Start((0.0, 0.0)), SET
     if case == "forced-side":
-        st = replace(SET, initial_side="port", tack_penalty_s=12.0, dt_s=5.0)
+        st = routing_settings(SET, initial_side="port", tack_penalty_s=12.0, dt_s=5.0)
     elif case == "start-line":
         start = Start((-100.0, 0.0), (100.0, 30.0))
     a = route_isochrone(start, north_mark(700.0), T0, w, POLAR, st)
@@ -671,5 +674,5 @@ def test_invalid_settings_are_input_errors_naming_the_field(field, value):
             Start((0.0, 0.0)),
             north_mark(500.0),
             UniformWind(TWS, 0.0),
-            replace(SET, **{field: value}),
+            routing_settings(SET, **{field: value}),
         )

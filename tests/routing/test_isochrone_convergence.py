@@ -32,7 +32,8 @@ import numpy as np
 import pytest
 
 from sailroute.routing.isochrone import route_isochrone
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.units import wind_components
 from sailroute.wind.analytic import AnalyticWind
 from tests.routing.polars import laser_like_polar
@@ -54,7 +55,7 @@ def wind() -> AnalyticWind:
 
 
 def leg_time(dt, heading, sector):
-    st = RoutingSettings(dt_s=dt, heading_step_deg=heading, prune_sector_deg=sector)
+    st = routing_settings(dt_s=dt, heading_step_deg=heading, prune_sector_deg=sector)
     r = route_isochrone(
         Start((0.0, 0.0)), Target("mark", (0.0, L), rounding="port"), 0.0, wind(), POLAR, st
     )

@@ -9,7 +9,8 @@ import pytest
 
 from sailroute.boat import builtin_polar
 from sailroute.routing.isochrone import route_isochrone
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.wind.uniform import UniformWind
 
 T0 = 1_524_567_600.0
@@ -21,7 +22,7 @@ WINDS_MS = np.round(np.arange(0.8, 3.01, 0.3), 2)
 def test_uniform_light_air_run_has_at_most_one_gybe(boat: str, twd_off: float) -> None:
     # a 600 m run dead downwind (and 7° off), wind from 0.8 to 3.0 m/s
     polar = builtin_polar(boat)
-    settings = RoutingSettings(dt_s=5.0)
+    settings = routing_settings(dt_s=5.0)
     for tws in WINDS_MS:
         r = route_isochrone(
             Start((0.0, 0.0)),

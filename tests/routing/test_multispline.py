@@ -18,7 +18,8 @@ from sailroute.routing.multispline import (
     route_spline,
     solve_spline,
 )
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.wind.uniform import UniformWind
 
 ISO = Polar.from_arrays(
@@ -86,7 +87,7 @@ def test_function_fitting_problem_converges() -> None:
 
 def test_spline_reach_is_straight_and_exact() -> None:
     wind = UniformWind(8.0, 270.0)
-    s = RoutingSettings(
+    s = routing_settings(
         router="spline", dp_rows=7, spline_cols=11, spline_slopes=5, spline_refinements=1
     )
     r = route_spline(
@@ -99,7 +100,7 @@ def test_spline_reach_is_straight_and_exact() -> None:
 
 def test_spline_refinement_costs_never_increase() -> None:
     wind = UniformWind([8.0, 9.0], [260.0, 300.0], times=[0.0, 300.0])
-    s = RoutingSettings(
+    s = routing_settings(
         router="spline",
         dp_rows=7,
         spline_cols=11,
@@ -115,8 +116,8 @@ def test_spline_refinement_costs_never_increase() -> None:
 
 
 def test_invalid_spline_settings() -> None:
-    s = RoutingSettings(router="spline", spline_slopes=0)
-    with pytest.raises(InputError, match="spline_slopes"):
+    s = routing_settings(router="spline", spline_slopes=0)
+    with pytest.raises(InputError, match=r"spline\.slopes"):
         route_spline(
             Start((0.0, 0.0)), Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO, s
         )
@@ -130,7 +131,7 @@ def _debski_small(carry: bool = False, rest: bool = False) -> tuple:
     from sailroute.boat.dynamic import DynamicBoat
     from sailroute.wind.analytic import debski_test_wind
 
-    s = RoutingSettings(
+    s = routing_settings(
         router="spline",
         dp_rows=6,
         spline_cols=9,
@@ -215,7 +216,7 @@ def test_reach_from_rest_costs_the_acceleration_loss_and_carrying_changes_nothin
     beta = np.radians(90.0)
 
     def route(**kw: bool) -> float:
-        s = RoutingSettings(
+        s = routing_settings(
             router="spline", dp_rows=5, spline_cols=7, spline_slopes=3, spline_refinements=1, **kw
         )
         return route_spline(
@@ -264,8 +265,8 @@ def test_separable_fitting_cost_equals_quadrature_per_edge() -> None:
 
 
 def test_invalid_spline_options_are_named() -> None:
-    s = RoutingSettings(router="spline", spline_carry_speed="yes")  # type: ignore[arg-type]
-    with pytest.raises(InputError, match="spline_carry_speed"):
+    s = routing_settings(router="spline", spline_carry_speed="yes")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"spline\.carry_speed"):
         route_spline(
             Start((0.0, 0.0)), Target("mark", (0.0, 300.0)), 0.0, UniformWind(8.0, 270.0), ISO, s
         )

@@ -9,7 +9,6 @@ follows from the channel's width, its length and the VMG angle.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -28,7 +27,8 @@ from sailroute.routing.obstacles import (
     land_obstacle,
     obstacles_for,
 )
-from sailroute.routing.types import LegResult, RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings, routing_settings
+from sailroute.routing.types import LegResult, Start, Target
 from sailroute.wind.uniform import UniformWind
 from tests.routing.polars import laser_like_polar
 
@@ -63,7 +63,7 @@ REACH_LENGTH = math.hypot(300, 700) + 600 + math.hypot(250, 700)
 
 
 def reach_settings(router: str = "isochrone") -> RoutingSettings:
-    return RoutingSettings(
+    return routing_settings(
         router=router,
         dt_s=5.0,
         tack_penalty_s=0.0,
@@ -205,7 +205,7 @@ def test_beat_up_a_channel_tacks_at_its_edges() -> None:
     assert obs is not None
     start = Start((0.0, 0.0), name="start")
     target = Target("line", (-width / 2 + 1, along), (width / 2 - 1, along), name="top")
-    s = RoutingSettings(dt_s=5.0, tack_penalty_s=10.0, heading_step_deg=1.0)
+    s = routing_settings(dt_s=5.0, tack_penalty_s=10.0, heading_step_deg=1.0)
     res = route_isochrone(start, target, T0, UniformWind(tws, 0.0), polar, s, obstacles=obs)
     assert track_free(res, obs)
     assert res.n_tacks == n_expected
@@ -275,7 +275,7 @@ def test_generic_array_module_path_goes_round_the_same_way() -> None:
     fake.__getattr__ = lambda name: getattr(np, name)  # type: ignore[method-assign]
     obs = Obstacles.build(RaceArea(obstacles=(rect("block", -150, 250, 300, 500),)))
     start, target = Start((0.0, 0.0)), Target("line", (-20.0, 800.0), (20.0, 800.0))
-    s = replace(reach_settings(), dt_s=10.0)
+    s = routing_settings(reach_settings(), dt_s=10.0)
     a = route_isochrone(start, target, T0, REACH_WIND, constant_polar(), s, obstacles=obs)
     b = route_isochrone(start, target, T0, REACH_WIND, constant_polar(), s, obstacles=obs, xp=fake)
     assert b.time_s == pytest.approx(a.time_s, rel=1e-12)

@@ -42,7 +42,8 @@ from sailroute.routing.geometry import (
 from sailroute.routing.griddp import route_griddp
 from sailroute.routing.isochrone import route_isochrone
 from sailroute.routing.multispline import route_spline
-from sailroute.routing.types import Barrier, RoutingSettings, Start, Target
+from sailroute.routing.settings import RoutingSettings, routing_settings
+from sailroute.routing.types import Barrier, Start, Target
 from sailroute.wind.uniform import UniformWind
 from tests.routing.polars import laser_like_polar
 
@@ -259,7 +260,7 @@ def test_mirrored_course_rounded_the_other_way_takes_the_same_time(router):
 
 def test_spline_router_respects_the_rounding():
     # a smooth case (no manoeuvre): close reach north, broad reach west-south-west
-    st = RoutingSettings(router="spline", spline_cols=15, spline_slopes=5, spline_refinements=2)
+    st = routing_settings(router="spline", spline_cols=15, spline_slopes=5, spline_refinements=2)
     r1, r2 = two_legs("spline", 45.0, (-600.0, L - 100.0), "port", settings=st)
     x, y = joined(r1, r2)
     expected = string_winding_deg((x[0], y[0]), (x[-1], y[-1]), MARK, "port")

@@ -15,7 +15,8 @@ from sailroute.boat.dynamic import DynamicBoat
 from sailroute.routing.geometry import target_geometry
 from sailroute.routing.griddp import route_griddp
 from sailroute.routing.multispline import route_spline
-from sailroute.routing.types import RoutingSettings, Start, Target
+from sailroute.routing.settings import routing_settings
+from sailroute.routing.types import Start, Target
 from sailroute.wind.analytic import debski_test_wind
 from sailroute.wind.uniform import UniformWind
 
@@ -25,8 +26,8 @@ route_isochrone = iso_mod.route_isochrone
 BOAT = DynamicBoat()
 POLAR = BOAT.steady_polar(np.arange(0.0, 61.0, 2.0), twa_step=1.0)
 A = Start((0.0, 0.0), name="A")
-ISO = RoutingSettings(dt_s=2.0, heading_step_deg=1.0, tack_penalty_s=5.0)
-DP = RoutingSettings(router="griddp", dp_cols=64, dp_rows=13, dp_refinements=3, tack_penalty_s=5.0)
+ISO = routing_settings(dt_s=2.0, heading_step_deg=1.0, tack_penalty_s=5.0)
+DP = routing_settings(router="griddp", dp_cols=64, dp_rows=13, dp_refinements=3, tack_penalty_s=5.0)
 
 
 def _best_straight_time(tws: float, twd: float, tgt: Target) -> float:
@@ -76,7 +77,7 @@ def test_debski_wind_isochrone_vs_griddp() -> None:
     tgt = Target("mark", (500.0, 0.0), rounding="port")
     t_iso = route_isochrone(A, tgt, 0.0, wind, POLAR, ISO).time_s
     dp = route_griddp(
-        A, tgt, 0.0, wind, POLAR, RoutingSettings(**{**DP.__dict__, "dp_half_width_m": 400.0})
+        A, tgt, 0.0, wind, POLAR, routing_settings(**{**DP.__dict__, "dp_half_width_m": 400.0})
     )
     assert dp.time_s == pytest.approx(t_iso, rel=5e-3)
     assert dp.n_tacks == 1
@@ -88,14 +89,14 @@ def test_debski_wind_dynamic_model_adds_only_momentum_losses() -> None:
     # 0.5 s in this wind).  Measured: 147.27 s vs 146.74 s
     wind = debski_test_wind()
     tgt = Target("mark", (500.0, 0.0))
-    s = RoutingSettings(
+    s = routing_settings(
         **{**DP.__dict__, "dp_half_width_m": 400.0, "tack_penalty_s": 0.0, "gybe_penalty_s": 0.0}
     )
     steady = route_griddp(A, tgt, 0.0, wind, POLAR, s)
     dyn = route_griddp(A, tgt, 0.0, wind, BOAT, s)
     assert 0.0 < dyn.time_s - steady.time_s < 2.0
     t_iso = route_isochrone(
-        A, tgt, 0.0, wind, POLAR, RoutingSettings(**{**ISO.__dict__, "tack_penalty_s": 0.0})
+        A, tgt, 0.0, wind, POLAR, routing_settings(**{**ISO.__dict__, "tack_penalty_s": 0.0})
     ).time_s
     assert steady.time_s == pytest.approx(t_iso, rel=5e-3)
 
@@ -105,7 +106,7 @@ def test_debski_wind_spline_vs_griddp_without_tacks() -> None:
     # axis): measured grid DP 172.98 s, multi-spline 172.75 s; asserted within 1 %
     wind = debski_test_wind()
     tgt = Target("mark", (500.0, 0.0))
-    s = RoutingSettings(
+    s = routing_settings(
         **{**DP.__dict__, "dp_half_width_m": 400.0, "tack_penalty_s": 1e3, "gybe_penalty_s": 1e3}
     )
     dp = route_griddp(A, tgt, 0.0, wind, POLAR, s)

@@ -236,7 +236,8 @@ def test_nan_land_cells_are_holes_that_routing_may_not_cross(tmp_path) -> None:
 def test_routing_into_nan_cells_raises(tmp_path) -> None:
     from sailroute.boat.build import boat_from_spec
     from sailroute.routing.api import route_leg
-    from sailroute.routing.types import RoutingSettings, Start, Target
+    from sailroute.routing.settings import RoutingSettings
+    from sailroute.routing.types import Start, Target
 
     lats = np.arange(43.3, 42.69, -0.05)
     lons = np.arange(6.6, 7.41, 0.05)
