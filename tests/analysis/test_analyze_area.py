@@ -112,7 +112,8 @@ def analysed(tmp_path_factory):
 
 def test_optimal_leg_rounds_the_obstacle_in_the_closed_form_time(analysed):
     course, open_water, boat, _, track = analysed
-    (leg,) = analyze_track(course, track).legs
+    a = analyze_track(course, track)
+    (leg,) = a.legs
     want = closed_form_detour(boat, leg.start_xy, ray_end(course, leg.start_xy))
     assert leg.optimal_time_s == pytest.approx(want, rel=0.005)
     obs = obstacles_for(course.area)
@@ -129,6 +130,18 @@ def test_optimal_leg_rounds_the_obstacle_in_the_closed_form_time(analysed):
     assert free.optimal_time_s < leg.optimal_time_s - 5.0
     assert free.loss_s == pytest.approx(leg.optimal_time_s - free.optimal_time_s, abs=2.0)
     assert np.any((np.abs(free.optimal.track.y) < 100) & (np.abs(free.optimal.track.x - 500) < 100))
+    # the analysis maps show the pontoon: the leg map and the page's figure
+    from sailroute.report.analysis import plot_legs
+    from sailroute.report.html import analysis_report
+    from sailroute.report.page_figure import figure
+
+    (ax,) = plot_legs(a).axes
+    (patch,) = [p for p in ax.patches if p.get_gid() == "obstacle:pontoon"]
+    np.testing.assert_allclose(
+        patch.get_xy()[:4], [(400, -100), (600, -100), (600, 100), (400, 100)]
+    )
+    names = [t.get("name") for t in figure(analysis_report(a))["data"]]
+    assert names.count("obstacle: pontoon") == 1
 
 
 def test_no_area_gives_the_same_analysis_as_before(analysed):
