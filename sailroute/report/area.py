@@ -53,12 +53,15 @@ def _num(x: float, nd: int) -> float | None:
     return round(float(x), nd) if math.isfinite(float(x)) else None
 
 
-def kept_ring(p: AreaPolygon) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-    """The closed line the routes keep to [m]: the obstacle grown or the boundary shrunk
-    by its clearance (the outer ring of the largest part); None without a clearance."""
+def kept_ring(
+    p: AreaPolygon, *, boundary: bool = False
+) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
+    """The closed line the routes keep to [m]: the obstacle grown or (``boundary``) the
+    boundary shrunk by its clearance (the outer ring of the largest part); None without a
+    clearance."""
     if p.clearance_m <= 0:
         return None
-    grow = -p.clearance_m if p.where == "boundary" else p.clearance_m
+    grow = -p.clearance_m if boundary else p.clearance_m
     g = shapely.buffer(p.polygon(), grow, quad_segs=QUAD_SEGS)
     parts = [q for q in shapely.get_parts(g) if not q.is_empty]
     if not parts:
@@ -130,7 +133,7 @@ def fit_area(
     for p in polys:
         xs += [min(p.x), max(p.x)]
         ys += [min(p.y), max(p.y)]
-        ring = kept_ring(p) if p.where != "boundary" else None
+        ring = kept_ring(p) if p is not area.boundary else None  # a boundary shrinks
         if ring is not None:
             xs += [float(ring[0].min()), float(ring[0].max())]
             ys += [float(ring[1].min()), float(ring[1].max())]
@@ -155,7 +158,7 @@ def draw_area(ax: Any, area: RaceArea) -> None:
     """
     from matplotlib.patches import Polygon
 
-    clear_label = "clearance kept"
+    clear_label: str | None = "clearance kept"
     for k, p in enumerate(area.obstacles):
         patch = Polygon(
             np.column_stack([p.x, p.y]),
@@ -169,20 +172,21 @@ def draw_area(ax: Any, area: RaceArea) -> None:
         patch.set_gid(f"obstacle:{p.name}")
         ax.add_patch(patch)
     for p in area_polygons(area):
-        ring = kept_ring(p)
+        outer = p is area.boundary
+        ring = kept_ring(p, boundary=outer)
         if ring is None:
             continue
-        gid = "boundary-clearance" if p.where == "boundary" else f"obstacle-clearance:{p.name}"
+        gid = "boundary-clearance" if outer else f"obstacle-clearance:{p.name}"
         ax.plot(
             *ring,
             linestyle=(0, (3, 2)),
-            color=BOUNDARY_COLOUR if p.where == "boundary" else OBSTACLE_EDGE,
+            color=BOUNDARY_COLOUR if outer else OBSTACLE_EDGE,
             lw=0.8,
             zorder=1.6,
             gid=gid,
             label=clear_label,
         )
-        clear_label = None  # type: ignore[assignment]
+        clear_label = None
     b = area.boundary
     if b is not None:
         ax.plot(

@@ -276,7 +276,7 @@ def area_traces(course: Course) -> list[dict[str, Any]]:
         )
     first = True
     for p in area_polygons(area):
-        ring = kept_ring(p)
+        ring = kept_ring(p, boundary=p is b)
         if ring is None:
             continue
         lon, lat = _closed_lonlat(frame, ring[0][:-1], ring[1][:-1])
