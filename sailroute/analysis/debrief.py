@@ -47,6 +47,7 @@ from sailroute.planning.route import default_scenario, settings_for
 from sailroute.progress import Progress
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import target_barrier
+from sailroute.routing.obstacles import Obstacles, land_filled, obstacles_for
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import LegResult, Start
 from sailroute.timeutil import iso
@@ -186,6 +187,8 @@ def analyze_track(
     else:
         boat, wind = built
     sources = list(winds) if winds else [WindSource("scenario", wind, f"scenario {name!r}")]
+    # the optimal legs keep inside the boundary and round the obstacles, as plan's do
+    obstacles = obstacles_for(course.area, wind)
     where = f"{track.source or track.name}"
     x, y = track_xy(track, course.frame)
     check_same_race(course, track, x, y)
@@ -257,7 +260,17 @@ def analyze_track(
         )
         if not (a.known and b.known):
             leg = _unknown_leg(
-                course, i, bounds, sources, chosen[i], boat, settings, target, centre, progress
+                course,
+                i,
+                bounds,
+                sources,
+                chosen[i],
+                boat,
+                settings,
+                target,
+                centre,
+                progress,
+                obstacles=obstacles,
             )
             legs.append(leg)
             for k, v in (
@@ -286,7 +299,17 @@ def analyze_track(
             vmg = (vx * ux + vy * uy) / np.maximum(np.hypot(ux, uy), 1e-9)
         # optimal route from the same point and time
         opt, src = _optimal_leg(
-            course, i, bounds, sources, chosen[i], (tl, xl, yl), boat, settings, target, progress
+            course,
+            i,
+            bounds,
+            sources,
+            chosen[i],
+            (tl, xl, yl),
+            boat,
+            settings,
+            target,
+            progress,
+            obstacles=obstacles,
         )
         sailed = b.t - a.t
         loss = sailed - opt.time_s
@@ -593,11 +616,15 @@ def _optimal_leg(
     settings: RoutingSettings,
     target: Any,
     progress: Progress | None,
+    *,
+    obstacles: Obstacles | None = None,
 ) -> tuple[LegResult, WindSource]:
     """The optimal route of leg ``i`` from the boat's own leg start point and time.
 
-    Routed in ``sources[k]``; when that wind ends before the optimal route does, in the
-    next source that covers the leg's sailed ``points``.
+    Routed in ``sources[k]``, inside the race area's ``obstacles`` (the course's
+    boundary and obstacles, :func:`~sailroute.routing.obstacles.obstacles_for`); when
+    that wind ends before the optimal route does, in the next source that covers the
+    leg's sailed ``points``.
     """
     a = bounds[i]
     barrier = None
@@ -618,10 +645,11 @@ def _optimal_leg(
                 start,
                 target,
                 a.t,
-                sources[k].for_routing,
+                land_filled(course.area, sources[k].for_routing),
                 boat,
                 settings,
                 progress=progress.update if progress is not None else None,
+                obstacles=obstacles,
             )
             if sources[k].route_field is not None:  # raises if the route crosses a hole
                 sources[k].field.sample(opt.track.t, opt.track.x, opt.track.y)
@@ -647,6 +675,8 @@ def _unknown_leg(
     target: Any,
     centre: tuple[float, float],
     progress: Progress | None,
+    *,
+    obstacles: Obstacles | None = None,
 ) -> LegAnalysis:
     """A leg whose start or end time is unknown: no sailed time, loss or split; the
     optimal route when the start is known."""
@@ -662,7 +692,17 @@ def _unknown_leg(
         k = len(sources) - 1 if found is None else found
         mode = leg_wind_mode(sources[k].field, a.t, (a.x, a.y), centre)
         opt, source = _optimal_leg(
-            course, i, bounds, sources, k, start_pt, boat, settings, target, progress
+            course,
+            i,
+            bounds,
+            sources,
+            k,
+            start_pt,
+            boat,
+            settings,
+            target,
+            progress,
+            obstacles=obstacles,
         )
     note = (
         b.note

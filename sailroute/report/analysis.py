@@ -478,9 +478,11 @@ def fleet_table(rows: Sequence[Mapping[str, Any]], notes: Sequence[str] = ()) ->
 
 def plot_legs(a: TrackAnalysis) -> Figure:
     """One map per leg: the sailed track (solid, coloured by leg) and the optimal route
-    (dashed) from the same start, with the course and the sailed manoeuvres."""
+    (dashed) from the same start, with the course, its race area (boundary, obstacles) and
+    the sailed manoeuvres."""
     from matplotlib.figure import Figure
 
+    from sailroute.report.area import draw_area
     from sailroute.report.plots import draw_course
 
     n = len(a.legs)
@@ -490,6 +492,7 @@ def plot_legs(a: TrackAnalysis) -> Figure:
     p = a.points
     for i, leg in enumerate(a.legs):
         ax = fig.add_subplot(nrow, ncol, i + 1)
+        draw_area(ax, a.course.area)
         draw_course(ax, a.course)
         m = p.leg == i + 1
         ax.plot(

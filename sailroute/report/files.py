@@ -32,6 +32,7 @@ from sailroute import __version__
 from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
 from sailroute.planning.result import Comparison, Plan, percent_error
+from sailroute.report.area import area_to_dict
 from sailroute.report.route_export import route_points, write_kml, write_nmea
 from sailroute.report.startline import laylines_to_dicts, start_line_to_dict
 from sailroute.routing.types import side_name
@@ -103,8 +104,9 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
         Keys ``schema_version``, ``sailroute_version``, ``course``, ``source``,
         ``scenario``, ``router``, ``start_time``, ``end_time``, ``total_time_s``,
         ``total_distance_m``, ``total_tacks``, ``total_gybes``, ``start_line``,
-        ``legs`` (each with its ``laylines``), ``references``; see
-        ``docs/output-format.md``.
+        ``area`` (only when the course has a boundary or obstacles:
+        :func:`sailroute.report.area.area_to_dict`), ``legs`` (each with its
+        ``laylines``), ``references``; see ``docs/output-format.md``.
     """
     c = plan.course
     legs = []
@@ -143,6 +145,7 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
             }
         )
     total = plan.total_time_s
+    area = area_to_dict(c.area, c.frame)
     return {
         "schema_version": SCHEMA_VERSION,
         "sailroute_version": __version__,
@@ -159,6 +162,7 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
         "origin": {"lat": c.frame.lat0, "lon": c.frame.lon0},
         "current": _current_of(plan),
         "start_line": start_line_to_dict(plan.start_line, c.frame),
+        **({} if area is None else {"area": area}),
         "legs": legs,
         "references": {
             name: {

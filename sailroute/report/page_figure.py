@@ -15,6 +15,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.course.model import Course
+from sailroute.geo import LocalFrame
+from sailroute.report.area import (
+    BOUNDARY_COLOUR,
+    OBSTACLE_EDGE,
+    OBSTACLE_FILL,
+    area_polygons,
+    kept_ring,
+)
 from sailroute.report.page import (
     ARROW_FILL,
     BOAT_COLOUR,
@@ -35,7 +43,7 @@ from sailroute.textin import clean_text
 from sailroute.timeutil import offset_text
 from sailroute.units import wrap360
 
-__all__ = ["boat_at", "figure", "label_positions", "plotly_label", "wind_arrows"]
+__all__ = ["area_traces", "boat_at", "figure", "label_positions", "plotly_label", "wind_arrows"]
 
 
 def plotly_label(text: str) -> str:
@@ -218,6 +226,82 @@ def _course_traces(course: Course) -> list[dict[str, Any]]:
     return out
 
 
+def _closed_lonlat(frame: LocalFrame, x: Any, y: Any) -> tuple[Any, Any]:
+    """A ring's ``(lon, lat)`` lists [°], 7 decimals, its first point repeated last."""
+    xs, ys = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    lat, lon = frame.to_latlon(np.append(xs, xs[0]), np.append(ys, ys[0]))
+    return _r(lon, 7), _r(lat, 7)
+
+
+def area_traces(course: Course) -> list[dict[str, Any]]:
+    """The race area (:mod:`sailroute.report.area`) as plotly traces in lon/lat: one per
+    polygon, closed (``race-area boundary``, a line; ``obstacle: <name>``, filled), the
+    hover naming it and its clearance; then one dashed trace per polygon with a
+    clearance: the line the routes keep to.  Empty without a boundary or obstacles."""
+    area, frame = course.area, course.frame
+    out: list[dict[str, Any]] = []
+    b = area.boundary
+    if b is not None:
+        lon, lat = _closed_lonlat(frame, b.x, b.y)
+        out.append(
+            {
+                "type": "scatter",
+                "mode": "lines",
+                "name": "race-area boundary",
+                "legendgroup": "area",
+                "x": lon,
+                "y": lat,
+                "line": {"color": BOUNDARY_COLOUR, "width": 2},
+                "hovertemplate": f"race-area boundary, clearance {b.clearance_m:g} m"
+                "<extra></extra>",
+            }
+        )
+    for p in area.obstacles:
+        lon, lat = _closed_lonlat(frame, p.x, p.y)
+        name = plotly_label(p.name)
+        out.append(
+            {
+                "type": "scatter",
+                "mode": "lines",
+                "name": f"obstacle: {name}",
+                "legendgroup": "area",
+                "x": lon,
+                "y": lat,
+                "fill": "toself",
+                "fillcolor": OBSTACLE_FILL,
+                "line": {"color": OBSTACLE_EDGE, "width": 1},
+                "hoveron": "fills+points",
+                "hovertemplate": f"obstacle {name}, clearance {p.clearance_m:g} m<extra></extra>",
+            }
+        )
+    first = True
+    for p in area_polygons(area):
+        ring = kept_ring(p, boundary=p is b)
+        if ring is None:
+            continue
+        lon, lat = _closed_lonlat(frame, ring[0][:-1], ring[1][:-1])
+        whose = "the boundary" if p is b else f"obstacle {plotly_label(p.name)}"
+        out.append(
+            {
+                "type": "scatter",
+                "mode": "lines",
+                "name": "clearance kept",
+                "legendgroup": "area",
+                "showlegend": first,
+                "x": lon,
+                "y": lat,
+                "line": {
+                    "color": BOUNDARY_COLOUR if p is b else OBSTACLE_EDGE,
+                    "width": 1,
+                    "dash": "dash",
+                },
+                "hovertemplate": f"{p.clearance_m:g} m clearance of {whose}<extra></extra>",
+            }
+        )
+        first = False
+    return out
+
+
 def _leg_number_trace(r: Route, group: str) -> dict[str, Any]:
     """The leg numbers along ``r``, spread between 30 % and 70 % of each leg (golden-ratio
     steps, as on ``route.png``) so legs over the same water do not hide each other's."""
@@ -249,7 +333,8 @@ def _leg_number_trace(r: Route, group: str) -> dict[str, Any]:
 def figure(report: Report) -> dict[str, Any]:
     """The plotly figure of the page: ``{"data", "layout", "frames", "config"}``.
 
-    Trace order: wind layers, course (lines and gates, marks), the overlays, then per
+    Trace order: wind layers, the race area (:func:`area_traces`), course (lines and
+    gates, marks), the overlays, then per
     route its line, tacks, gybes (and leg numbers on the first route) and the boat
     marker.  Frame ``k`` (named ``str(k)``) moves every boat marker and every
     time-varying wind layer to ``report.times[k]``; the slider's steps animate to them.
@@ -315,6 +400,7 @@ def figure(report: Report) -> dict[str, Any]:
             moving.append((len(data) - 2, [sh for sh, _ in rows]))
             moving.append((len(data) - 1, [hd for _, hd in rows]))
 
+    data += area_traces(course)
     data += _course_traces(course)
     data += list(report.overlays)
 

@@ -10,7 +10,9 @@ lines, one point per manoeuvre), ``marks``, ``line:<name>``, ``gate:<name>``,
 ``wind`` (quiver), ``wind-field`` (speed background, only for non-uniform wind),
 ``legno:<n>`` (the leg number, on the track), ``wind-leg:<n>`` (the wind where and when
 the boat passes the leg's number; drawn only when the wind differs between legs),
-``route:<scenario>`` and ``bars:<scenario>`` in comparison charts.
+``route:<scenario>`` and ``bars:<scenario>`` in comparison charts; the race area's
+``boundary``, ``obstacle:<name>`` and their dashed clearances
+(:func:`sailroute.report.area.draw_area`).
 
 Map conventions (``route.png``): x/y metres of the course's local frame with latitude
 and longitude on the top and right axes; the boat-speed colour scale spans the 2nd-98th
@@ -32,6 +34,7 @@ from numpy.typing import NDArray
 from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.planning.result import Comparison, Plan
+from sailroute.report.area import draw_area, fit_area
 from sailroute.routing.types import LegResult
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, circular_mean_deg, wind_speed_direction
@@ -46,12 +49,14 @@ WIND_GRID = 15
 
 
 def _extent(course: Course, legs: Sequence[LegResult], pad: float = 0.08) -> tuple[float, ...]:
+    """``(x0, x1, y0, y1)`` [m]: the marks and legs, and the race area within reach of
+    them (:func:`sailroute.report.area.fit_area`), padded by ``pad`` of the larger side."""
     xs = [m.x for m in course.marks.values()]
     ys = [m.y for m in course.marks.values()]
     for r in legs:
         xs += [float(r.track.x.min()), float(r.track.x.max())]
         ys += [float(r.track.y.min()), float(r.track.y.max())]
-    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+    x0, x1, y0, y1 = fit_area(course.area, (min(xs), max(xs), min(ys), max(ys)))
     span = max(x1 - x0, y1 - y0, 100.0)
     return x0 - pad * span, x1 + pad * span, y0 - pad * span, y1 + pad * span
 
@@ -326,7 +331,9 @@ def plot_route(
     Parameters
     ----------
     course : Course
-        Marks, lines and gates to draw.
+        Marks, lines and gates to draw, and the race area (boundary and obstacles,
+        under the routes; the map's extent takes them in as
+        :func:`sailroute.report.area.fit_area` says).
     legs : sequence of LegResult
         The routed legs; each is one ``LineCollection`` coloured by boat speed [kn].
     wind : WindField, optional
@@ -363,6 +370,7 @@ def plot_route(
     if t is None:
         t = legs[0].t_start if legs else course.start_epoch
     wind_label = _draw_wind(ax, fig, wind, t, extent, utc_offset_s) if wind is not None else None
+    draw_area(ax, course.area)
     draw_course(ax, course)
     bsp_all = np.concatenate([r.track.bsp_ms for r in legs]) / KNOT if legs else np.zeros(1)
     norm = Normalize(*speed_limits(bsp_all))
@@ -514,6 +522,7 @@ def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:
     if with_map:
         mx = axes[1]
         course = plans[0].course
+        draw_area(mx, course.area)
         draw_course(mx, course)
         for i, p in enumerate(plans):
             xs = np.concatenate([r.track.x for r in p.results])

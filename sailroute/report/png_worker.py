@@ -162,6 +162,7 @@ def _child() -> int:
     # what plot_route draws with, and the classes the job unpickles into
     import matplotlib.collections
     import matplotlib.colors
+    import matplotlib.patches
     import matplotlib.transforms  # noqa: F401
     from matplotlib.figure import Figure
 

@@ -290,8 +290,9 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
     Raises
     ------
     InputError
-        A self-intersecting ring, fewer than 3 points, or two boundaries, naming the
-        file and line of the ring.
+        A self-intersecting ring, fewer than 3 points, two boundaries, or an obstacle
+        that holds a mark (the course file would refuse it), naming the file and line of
+        the ring.
     """
     frame = course.frame
     mx, my = frame.to_xy([m[1] for m in course.marks], [m[2] for m in course.marks])
@@ -328,9 +329,13 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
                 "around the race area, not an area to stay out of; left out"
             )
         else:
-            if inside.any():
-                held = [m[0] for m, ok in zip(course.marks, inside, strict=True) if ok]
-                notes.append(f"obstacle {r.name!r} holds the marks {', '.join(held)}")
+            if inside.any():  # the course file would refuse it: say so at the source
+                held = [repr(m[0]) for m, ok in zip(course.marks, inside, strict=True) if ok]
+                raise InputError(
+                    f"{r.where}: polygon {r.name!r} holds the mark{'s' * (len(held) > 1)} "
+                    f"{', '.join(held)}; expected an area to stay out of, clear of every "
+                    "mark (check the polygon's points and the marks' positions)"
+                )
             name, n = r.name, 1
             while name in taken:  # obstacle names are unique in a course file
                 n += 1
