@@ -298,6 +298,7 @@ def analyze_track(
             ux, uy = centre[0] - xl, centre[1] - yl
             vmg = (vx * ux + vy * uy) / np.maximum(np.hypot(ux, uy), 1e-9)
         # optimal route from the same point and time
+        leg_obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
         opt, src = _optimal_leg(
             course,
             i,
@@ -309,7 +310,7 @@ def analyze_track(
             settings,
             target,
             progress,
-            obstacles=obstacles,
+            obstacles=leg_obstacles,
         )
         sailed = b.t - a.t
         loss = sailed - opt.time_s
@@ -356,6 +357,7 @@ def analyze_track(
                 optimal=opt,
                 wind_source=src.kind,
                 wind_label=src.label,
+                note=area_note,
             )
         )
         loss_before += loss
@@ -605,6 +607,25 @@ def _summary_text(sm: Mapping[str, Any]) -> str:
     return text + f", {sm['t_start']} .. {sm['t_end']}"
 
 
+def _leg_area(
+    obstacles: Obstacles | None, xy: tuple[float, float], label: str
+) -> tuple[Obstacles | None, str]:
+    """The race area a leg's optimal route keeps to, and a note when it cannot.
+
+    A boat may sail inside a clearance (or over an obstacle a plan avoids); a leg that
+    starts there has no optimal route inside the area, so its route ignores the area
+    and the note says so (an error would lose the whole analysis for one leg).
+    """
+    if obstacles is None or bool(obstacles.points_free(xy[0], xy[1])):
+        return obstacles, ""
+    name = obstacles.nearest_name(xy[0], xy[1])
+    what = name if name.startswith("the ") else f"obstacle {name!r}"
+    return None, (
+        f"leg {label} starts inside the clearance of {what} (or outside the boundary's): "
+        "its optimal route ignores the race area"
+    )
+
+
 def _optimal_leg(
     course: Course,
     i: int,
@@ -685,12 +706,14 @@ def _unknown_leg(
     a, b = bounds[i], bounds[i + 1]
     opt = None
     mode = ""
+    area_note = ""
     source = sources[k]
     if a.known:
         start_pt = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
         found = first_covering(sources, *start_pt, skip=k - 1)
         k = len(sources) - 1 if found is None else found
         mode = leg_wind_mode(sources[k].field, a.t, (a.x, a.y), centre)
+        obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
         opt, source = _optimal_leg(
             course,
             i,
@@ -709,7 +732,7 @@ def _unknown_leg(
         if not b.known
         else f"leg {i + 1} ({spec.label}) starts at an unknown time "
         f"(leg {i} ended in a data gap): sailed time unknown"
-    )
+    ) + (f"; {area_note}" if area_note else "")
     return LegAnalysis(
         index=i,
         label=spec.label,

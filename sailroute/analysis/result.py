@@ -107,7 +107,8 @@ class LegAnalysis:
     optimal : LegResult or None
         The optimal route of the leg (None: the leg's start is unknown).
     note : str
-        Why the leg is unknown (empty when known).
+        Why the leg is unknown, and when its start lies inside a clearance of the race
+        area, that its optimal route ignores the area (empty otherwise).
     wind_source, wind_label : str
         The wind the leg was judged in (:data:`sailroute.analysis.windsource.KINDS`)
         and what it is.

@@ -425,6 +425,7 @@ def analysis_table(a: TrackAnalysis) -> str:
             f"{leg.sailed_tacks:>3}/{leg.sailed_gybes}:{leg.optimal_tacks}/{leg.optimal_gybes:<3}"
             f"{leg.mean_polar_pct:>6.0f}{'*' if leg.above_polar else ' '}"
             f"{leg.side_sailed:>8}/{leg.side_optimal:<6}  {leg.wind_source:<9}"
+            + (f"\n  {leg.note}" if leg.note else "")
         )
     tot = [
         sum(getattr(leg.split, k) for leg in a.known_legs) for k in ("manoeuvres", "speed", "route")

@@ -172,3 +172,32 @@ def test_spline_router_refuses_the_area_as_plan_does(analysed, tmp_path):
     with pytest.raises(InputError, match="honoured by the isochrone and griddp routers only"):
         analyze_track(course, track)
     assert math.isfinite(analyze_track(_course(tmp_path, "", "spline", "o"), track).loss_s)
+
+
+def test_a_leg_starting_inside_a_clearance_is_analysed_without_the_area(tmp_path):
+    """A boat may cross the line inside an obstacle's clearance (the clearance is the
+    router's margin, not the water's edge): that leg's optimal route cannot keep to the
+    area, so it ignores it, the note says so, and the other numbers are those of open
+    water (nothing is lost to an error)."""
+    near = """
+obstacles:
+  - name: committee boat
+    clearance_m: 30
+    points: [{x: 20, y: -20}, {x: 60, y: -20}, {x: 60, y: 20}, {x: 20, y: 20}]
+"""
+    course = _course(tmp_path, area=near, name="near")
+    open_water = _course(tmp_path, area="", name="open")
+    obs = obstacles_for(course.area)
+    assert obs is not None and not obs.points_free(0.0, 0.0)  # the line's middle
+    # a straight reach along y = 0 at 5 m/s from 50 m behind the line, round the mark
+    x = np.arange(-50.0, 1000.0, 5.0)
+    t = course.start_epoch + 10.0 + np.arange(x.size, dtype=float)
+    lat, lon = course.frame.to_latlon(x, np.zeros_like(x))
+    track = _round_the_mark(course, Track(t, lat, lon, "reach", "synthetic"))
+    (leg,) = analyze_track(course, track).legs
+    (free,) = analyze_track(open_water, track).legs
+    assert "starts inside the clearance of obstacle 'committee boat'" in leg.note
+    assert "ignores the race area" in leg.note
+    assert free.note == ""
+    assert leg.optimal_time_s == free.optimal_time_s
+    assert leg.loss_s == free.loss_s
