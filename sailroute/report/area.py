@@ -153,12 +153,12 @@ def draw_area(ax: Any, area: RaceArea) -> None:
     """The boundary (line) and obstacles (filled) on a matplotlib map, under the routes.
 
     Artists carry gids ``boundary``, ``boundary-clearance``, ``obstacle:<name>`` (a
-    ``Polygon`` patch) and ``obstacle-clearance:<name>``; the first of each kind has a
-    legend label.
+    ``Polygon`` patch) and ``obstacle-clearance:<name>``; the first obstacle and the
+    boundary have a legend label, and one grey dashed entry stands for the clearances.
     """
     from matplotlib.patches import Polygon
 
-    clear_label: str | None = "clearance kept"
+    clear_label = True
     for k, p in enumerate(area.obstacles):
         patch = Polygon(
             np.column_stack([p.x, p.y]),
@@ -184,9 +184,10 @@ def draw_area(ax: Any, area: RaceArea) -> None:
             lw=0.8,
             zorder=1.6,
             gid=gid,
-            label=clear_label,
         )
-        clear_label = None
+        if clear_label:  # one legend entry, in neutral grey (the lines take their polygon's)
+            ax.plot([], [], linestyle=(0, (3, 2)), color="0.4", lw=0.8, label="clearance kept")
+            clear_label = False
     b = area.boundary
     if b is not None:
         ax.plot(
