@@ -274,7 +274,8 @@ class Course:
         ``start_time`` is written with (``+02:00`` -> 7200); for reports.
     key_lines : mapping of str to int
         1-based line of each key path of the course file (``"scenarios.a.wind.tws_kn"``),
-        so that the wind, current and boat factories report problems at their lines;
+        so that the boat factory reports problems at their lines (the wind and current
+        specs were parsed with it at load);
         empty for a course built from a mapping.
     area : RaceArea
         The race area: ``boundary``, ``obstacles`` and ``wind_land_is_obstacle``,

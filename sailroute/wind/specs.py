@@ -204,7 +204,7 @@ def _speed(chk: Checker, spec: Mapping[str, Any], required: bool) -> float | Non
     return None
 
 
-def _parse_uniform(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> UniformWindSpec:
+def _parse_uniform(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> UniformWindSpec | None:
     n0 = len(chk.p)
     chk.keys(spec, _UNIFORM_KEYS)
     clamp = chk.boolean(spec, "clamp", False)
@@ -222,7 +222,7 @@ def _parse_uniform(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> Uni
             "table",
             f"expected a non-empty list of rows {{time, tws_kn, twd_deg}}; got {show(table)}",
         )
-        return UniformWindSpec(where=chk.where())
+        return None
     rows: list[tuple[float, float, float]] = []
     tchk = chk.child("table")
     for k, row in enumerate(table):
@@ -331,7 +331,7 @@ def _minutes_to_s(v: float | None) -> float | None:
     return None if v is None else v * 60.0
 
 
-def _parse_wrf(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> WrfWindSpec:
+def _parse_wrf(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> WrfWindSpec | None:
     """Check a ``type: wrf`` spec (also the ``wrf`` part of ``type: blended``)."""
     chk.keys(spec, _WRF_KEYS, ("path",))
     path = chk.file(spec, "path", base_dir)
@@ -359,8 +359,10 @@ def _parse_wrf(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> WrfWind
             "'model' levels are only used for a height correction; set height_m "
             "(e.g. 2.68 for a Laser's centre of effort) or use levels: auto",
         )
+    if path is None:  # (reported)
+        return None
     return WrfWindSpec(
-        path=path,  # type: ignore[arg-type]  # None only with a problem recorded
+        path=path,
         height_m=height_m,
         time_step_s=_minutes_to_s(step),
         interpolation=interpolation,
@@ -577,13 +579,15 @@ def _grid_fields(
     return fields
 
 
-def _parse_netcdf(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> NetcdfWindSpec:
-    return NetcdfWindSpec(**_grid_fields(spec, chk, base_dir))
+def _parse_netcdf(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> NetcdfWindSpec | None:
+    fields = _grid_fields(spec, chk, base_dir)
+    return None if fields["path"] is None else NetcdfWindSpec(**fields)
 
 
-def _parse_grib(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> GribWindSpec:
+def _parse_grib(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> GribWindSpec | None:
     fields = _grid_fields(spec, chk, base_dir, extra=("filter",))
-    return GribWindSpec(**fields, filter=_pairs(chk.mapping(spec, "filter", None)))
+    filt = _pairs(chk.mapping(spec, "filter", None))
+    return None if fields["path"] is None else GribWindSpec(**fields, filter=filt)
 
 
 def _open_netcdf(spec: NetcdfWindSpec, ctx: BuildContext) -> WindField:
@@ -786,7 +790,7 @@ def _missing(chk: Checker, spec: Mapping[str, Any]) -> tuple[str, ...] | None:
     return tuple(DEFAULT_MISSING) + tuple(str(m) for m in miss)
 
 
-def _parse_read(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> StationReadSpec:
+def _parse_read(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> StationReadSpec | None:
     """The station-file keys of a ``stations`` spec (or of a blend's ``stations`` part)."""
     path = chk.file(spec, "path", base_dir)
     fmt = chk.choice(spec, "format", ["auto", "csv", "ndbc"], "auto")
@@ -799,8 +803,11 @@ def _parse_read(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> Statio
         chk.add("station", f"expected a station id; got {show(st)}")
     position = _position(chk, spec)
     height_m = chk.number(spec, "measurement_height_m", None, lo=0.0, lo_open=True)
+    missing = _missing(chk, spec)
+    if path is None:  # (reported)
+        return None
     return StationReadSpec(
-        path=path,  # type: ignore[arg-type]  # None only with a problem recorded
+        path=path,
         format=fmt,
         speed_unit=unit,
         columns=columns,
@@ -809,27 +816,30 @@ def _parse_read(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> Statio
         station=None if st is None else str(st),
         position=position,
         height_m=height_m,
-        missing=_missing(chk, spec),
+        missing=missing,
         where=chk.where(),
     )
 
 
-def _parse_stations(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> StationsWindSpec:
+def _parse_stations(
+    spec: Mapping[str, Any], chk: Checker, base_dir: Path
+) -> StationsWindSpec | None:
     chk.keys(spec, ("type", *_READ_KEYS, *_STATION_FIELD_KEYS), ("path",))
     read = _parse_read(spec, chk, base_dir)
-    return StationsWindSpec(
-        read=read,
-        method=chk.choice(spec, "method", ["idw", "rbf"], "idw"),
-        power=chk.number(spec, "power", 2.0, lo=0.0, lo_open=True),
-        radius_m=chk.number(spec, "radius_m", 2000.0, lo=0.0),
-        max_gap_s=chk.number(spec, "max_gap_s", 1800.0, lo=0.0, lo_open=True),
-        height_m=chk.number(spec, "height_m", None, lo=0.0, lo_open=True),
-        shear=chk.choice(spec, "shear", ["power", "log"], "power"),
-        exponent=chk.number(spec, "exponent", DEFAULT_EXPONENT, lo=-1.0, hi=1.0),
-        roughness_m=chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, lo=0.0, lo_open=True),
-        clamp=chk.boolean(spec, "clamp", False),
-        where=chk.where(),
-    )
+    fields = {
+        "method": chk.choice(spec, "method", ["idw", "rbf"], "idw"),
+        "power": chk.number(spec, "power", 2.0, lo=0.0, lo_open=True),
+        "radius_m": chk.number(spec, "radius_m", 2000.0, lo=0.0),
+        "max_gap_s": chk.number(spec, "max_gap_s", 1800.0, lo=0.0, lo_open=True),
+        "height_m": chk.number(spec, "height_m", None, lo=0.0, lo_open=True),
+        "shear": chk.choice(spec, "shear", ["power", "log"], "power"),
+        "exponent": chk.number(spec, "exponent", DEFAULT_EXPONENT, lo=-1.0, hi=1.0),
+        "roughness_m": chk.number(spec, "roughness_m", DEFAULT_ROUGHNESS_M, lo=0.0, lo_open=True),
+        "clamp": chk.boolean(spec, "clamp", False),
+    }
+    if read is None:  # (reported)
+        return None
+    return StationsWindSpec(read=read, **fields, where=chk.where())
 
 
 def _read_station_data(spec: StationReadSpec) -> StationData:
@@ -954,7 +964,7 @@ class BlendedWindSpec:
     where: str = ""
 
 
-def _parse_blended(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> BlendedWindSpec:
+def _parse_blended(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> BlendedWindSpec | None:
     chk.keys(spec, _BLEND_KEYS, ("wrf", "stations"))
     wspec = chk.mapping(spec, "wrf")
     sspec = chk.mapping(spec, "stations")
@@ -984,9 +994,11 @@ def _parse_blended(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> Ble
                 f"expected [min, max] with 0 < min <= 1 <= max, e.g. [0.5, 2.0]; "
                 f"got {spec['ratio_range']!r}",
             )
+    if wrf is None or stations is None:  # (reported)
+        return None
     return BlendedWindSpec(
-        wrf=wrf,  # type: ignore[arg-type]  # None only with a problem recorded
-        stations=stations,  # type: ignore[arg-type]
+        wrf=wrf,
+        stations=stations,
         length_scale_m=length_scale_m,
         time_scale_s=time_scale_s,
         min_speed_ms=min_speed_ms,
@@ -1204,11 +1216,13 @@ def _current_rate(chk: Checker, spec: Mapping[str, Any]) -> float | None:
 
 def _parse_uniform_current(
     spec: Mapping[str, Any], chk: Checker, base_dir: Path
-) -> UniformCurrentSpec:
+) -> UniformCurrentSpec | None:
     chk.keys(spec, _CURRENT_UNIFORM_KEYS, ("set_deg",))
     rate = _current_rate(chk, spec)
     set_deg = chk.number(spec, "set_deg", lo=0.0, hi=360.0) if "set_deg" in spec else None
-    return UniformCurrentSpec(rate_ms=rate, set_deg=set_deg, where=chk.where())  # type: ignore[arg-type]
+    if rate is None or set_deg is None:  # (reported)
+        return None
+    return UniformCurrentSpec(rate_ms=rate, set_deg=set_deg, where=chk.where())
 
 
 def _build_uniform_current(spec: UniformCurrentSpec, ctx: BuildContext) -> CurrentField:
@@ -1265,7 +1279,7 @@ def _diamond_rows(chk: Checker, table: Any, scale: float) -> list[tuple[float, f
 
 def _parse_diamond_current(
     spec: Mapping[str, Any], chk: Checker, base_dir: Path
-) -> DiamondCurrentSpec:
+) -> DiamondCurrentSpec | None:
     chk.keys(spec, _CURRENT_DIAMOND_KEYS, ("high_water", "table"))
     unit = chk.choice(spec, "rate_unit", ["kn", "m/s"], "kn")
     scale = KNOT if unit == "kn" else 1.0
@@ -1281,8 +1295,10 @@ def _parse_diamond_current(
         )
     elif isinstance(table, list):
         rows = _diamond_rows(chk, table, scale)
+    if hw is None:  # (reported)
+        return None
     return DiamondCurrentSpec(
-        high_water=hw,  # type: ignore[arg-type]  # None only with a problem recorded
+        high_water=hw,
         table=tuple(rows),
         clamp=clamp,
         where=chk.where(),
@@ -1331,7 +1347,7 @@ class NetcdfCurrentSpec:
 
 def _parse_netcdf_current(
     spec: Mapping[str, Any], chk: Checker, base_dir: Path
-) -> NetcdfCurrentSpec:
+) -> NetcdfCurrentSpec | None:
     chk.keys(spec, _CURRENT_NETCDF_KEYS, ("path",))
     path = chk.file(spec, "path", base_dir)
     var = chk.mapping(spec, "variables", None)
@@ -1345,14 +1361,19 @@ def _parse_netcdf_current(
     if unit is not None and unit.strip().lower() not in SPEED_UNITS:
         chk.add("speed_unit", f"expected one of 'm/s', 'kn', 'km/h', 'mph'; got {show(unit)}")
     sel = chk.mapping(spec, "select", None)
+    interpolation = chk.choice(spec, "interpolation", ["linear", "nearest"], "linear")
+    steady = chk.boolean(spec, "steady", False)
+    clamp = chk.boolean(spec, "clamp", False)
+    if path is None:  # (reported)
+        return None
     return NetcdfCurrentSpec(
-        path=path,  # type: ignore[arg-type]  # None only with a problem recorded
+        path=path,
         variables=_pairs(var),
         speed_unit=unit,
         select=_pairs(sel),
-        interpolation=chk.choice(spec, "interpolation", ["linear", "nearest"], "linear"),
-        steady=chk.boolean(spec, "steady", False),
-        clamp=chk.boolean(spec, "clamp", False),
+        interpolation=interpolation,
+        steady=steady,
+        clamp=clamp,
         where=chk.where(),
     )
 
@@ -1400,8 +1421,9 @@ class SpecKind:
     spec : type
         The dataclass (its ``type`` class attribute is the YAML ``type``).
     parse : callable
-        ``parse(mapping, checker, base_dir) -> spec``: every check that needs no
-        file content, problems recorded by the checker.
+        ``parse(mapping, checker, base_dir) -> spec or None``: every check that needs no
+        file content, problems recorded by the checker (None: a required value is
+        missing or invalid).
     build : callable
         ``build(spec, BuildContext) -> field``: reads the files, makes the field.
     """
