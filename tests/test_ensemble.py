@@ -48,7 +48,7 @@ def test_members_expand_to_scenarios_and_the_ensemble_keeps_its_name(tmp_path) -
     assert c.ensembles == {"spread": tuple(f"spread#{k}" for k in range(1, 6))}
     assert c.scenario_names == ("spread", "steady")
     assert default_scenario(c) == "spread"
-    assert c.scenarios["spread#4"].wind["twd_deg"] == 274.0
+    assert c.scenarios["spread#4"].wind.twd_deg == 274.0  # type: ignore[union-attr]
     with pytest.raises(InputError, match="'spread' is an ensemble of 5 members"):
         plan_course(c, "spread")
 

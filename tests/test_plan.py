@@ -10,6 +10,7 @@ is the arrival interpolation), so 1e-3 leaves margin without hiding a wrong answ
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 import pickle
@@ -152,7 +153,8 @@ def test_compare_equals_individual_plans(hyeres, hyeres_constant):
 
 def test_course_pickles_for_workers(hyeres):
     back = pickle.loads(pickle.dumps(hyeres))
-    assert back.scenarios["wrf10"].wind["time_step_min"] == 10
+    assert back.scenarios["wrf10"].wind == hyeres.scenarios["wrf10"].wind
+    assert back.scenarios["wrf10"].wind.time_step_s == 600.0  # type: ignore[union-attr]
     np.testing.assert_allclose(
         back.frame.to_latlon(500.0, -300.0),
         hyeres.frame.to_latlon(500.0, -300.0),
@@ -160,7 +162,9 @@ def test_course_pickles_for_workers(hyeres):
         atol=1e-12,
     )
     with pytest.raises(TypeError):  # still read-only after the round trip
-        back.scenarios["wrf10"].wind["time_step_min"] = 60  # type: ignore[index]
+        back.scenarios["wrf10"].references["x"] = (1.0,)  # type: ignore[index]
+    with pytest.raises(dataclasses.FrozenInstanceError):  # the parsed wind spec too
+        back.scenarios["wrf10"].wind.time_step_s = 60.0  # type: ignore[misc,union-attr]
 
 
 def test_bad_names_fail_before_routing(hyeres):

@@ -65,7 +65,7 @@ def samples_from_course_wind(
     """
     from sailroute.course.load import load_course
     from sailroute.track.kinematics import sog_cog, track_xy
-    from sailroute.wind.build import wind_from_spec
+    from sailroute.wind.build import build_wind_field
 
     course = load_course(course_path)
     names = list(course.scenarios)
@@ -82,14 +82,10 @@ def samples_from_course_wind(
         )
     frame = course.frame
     x, y = track_xy(track, frame)
-    sc = course.scenarios[name]
-    wind = wind_from_spec(
-        dict(sc.wind),
+    wind = build_wind_field(
+        course.scenarios[name].wind,
         frame=frame,
-        base_dir=course.base_dir,
-        where=sc.where or course.where(f"scenarios.{name}"),
         crop_bbox=(float(x.min()), float(x.max()), float(y.min()), float(y.max())),
-        lines=course.key_lines,
     )
     notes: list[str] = []
     t = np.asarray(track.t_s, float)

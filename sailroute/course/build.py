@@ -70,13 +70,13 @@ def build_course(
 
 
 def _scenario(kw: Mapping[str, Any]) -> ScenarioSpec:
-    """The :class:`ScenarioSpec` of one checked scenario, its mappings made read-only."""
-    current = kw.get("current")
+    """The :class:`ScenarioSpec` of one checked scenario, its mappings made read-only
+    (its wind and current specs are frozen dataclasses already)."""
+    given = kw.get("current_given")
     return ScenarioSpec(
         **{
             **kw,
-            "wind": frozen_mapping(kw["wind"]),
             "references": frozen_mapping(kw.get("references")),
-            "current": None if current is None else frozen_mapping(current),
+            "current_given": None if given is None else frozen_mapping(given),
         }
     )

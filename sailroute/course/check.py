@@ -8,8 +8,9 @@ expected ...; got ...``, unknown keys with a did-you-mean) and returns a
 positions in the local frame), from which :mod:`sailroute.course.build` makes the
 model objects.
 
-Wind, current and boat specs are stored raw and checked structurally here; their
-factories check their own keys (:mod:`sailroute.course.specs`).
+Wind and current specs are parsed here, each into its frozen dataclass
+(:mod:`sailroute.wind.specs`), their problems listed with the course's; the boat spec
+is stored raw and checked by its factory (:mod:`sailroute.course.specs`).
 """
 
 from __future__ import annotations
@@ -31,7 +32,6 @@ from sailroute.checks import (
     finite,
     join_path,
     missing_file_message,
-    resolve_path,
     show,
     suggest,
 )
@@ -48,7 +48,15 @@ from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import Side
 from sailroute.timeutil import parse_time, utc_offset_s
 from sailroute.units import KNOT
-from sailroute.wind.build import CURRENT_BUILDERS, WIND_TYPES
+from sailroute.wind.specs import (
+    CURRENT_TYPES,
+    WIND_TYPES,
+    CurrentSpec,
+    NetcdfWindSpec,
+    WindSpec,
+    check_current_spec,
+    check_wind_spec,
+)
 
 __all__ = ["TOP_KEYS", "CheckedCourse", "check_course"]
 
@@ -537,6 +545,23 @@ def _wind_spec(c: Checker, value: Any, path: str) -> bool:
     return True
 
 
+def _parse_wind(c: Checker, value: Any, path: str) -> WindSpec | None:
+    """The parsed wind spec at ``path`` (:mod:`sailroute.wind.specs`); None after a problem."""
+    if not _wind_spec(c, value, path):
+        return None
+    return check_wind_spec(value, c.at(path), _base_dir(c))
+
+
+def _base_dir(c: Checker) -> Path:
+    """Folder that relative paths of the file resolve against (the working folder for a
+    course built from a mapping, as :attr:`Course.base_dir`)."""
+    return Path.cwd() if c.p.file == "<course>" else Path(c.p.file).parent
+
+
+_Current = tuple[CurrentSpec | None, str, dict[str, Any] | None]
+"""A scenario's current: the parsed spec, its key path, the mapping as given."""
+
+
 def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, Any]]:
     """Scenario name -> the keyword arguments of its ``ScenarioSpec`` (an ensemble:
     one scenario ``NAME#k`` per member)."""
@@ -568,7 +593,7 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
         ):
             continue
         keys = ("wind", "members", "references", "description", "current")
-        cur, cwhere = None, ""  # surface current spec (sailroute.wind.current), key path
+        current: _Current = (None, "", None)
         if "type" in value or not any(k in value for k in keys):
             # shorthand: the scenario is the wind spec itself
             wind, wpath, refs, desc = value, path, {}, ""
@@ -585,47 +610,49 @@ def _scenarios(c: Checker, raw: Any, n_legs: int | None) -> dict[str, dict[str, 
             desc = c.at(path).string(value, "description", "") or ""
             cchk = c.at(join_path(path, "current"))
             if value.get("current") is not None and cchk.is_mapping(
-                value["current"], "a current spec {type: " + "|".join(CURRENT_BUILDERS) + ", ...}"
+                value["current"], "a current spec {type: " + "|".join(CURRENT_TYPES) + ", ...}"
             ):
-                cur, cwhere = dict(value["current"]), cchk.where()
+                cur = check_current_spec(value["current"], cchk, _base_dir(c))
+                current = (cur, cchk.where(), dict(value["current"]))
             if "members" in value:
                 mpath = join_path(path, "members")
                 for k, (spec, where) in enumerate(_members(c, value["members"], mpath), 1):
                     out[f"{name}#{k}"] = _scenario(
-                        f"{name}#{k}", spec, refs, desc, c.p.prefix(where), str(name), cur, cwhere
+                        f"{name}#{k}", spec, refs, desc, c.p.prefix(where), str(name), current
                     )
                 continue
             wind, wpath = value["wind"], join_path(path, "wind")
-        if _wind_spec(c, wind, wpath):
-            out[name] = _scenario(name, wind, refs, desc, c.p.prefix(wpath), "", cur, cwhere)
+        parsed = _parse_wind(c, wind, wpath)
+        if parsed is not None:
+            out[name] = _scenario(name, parsed, refs, desc, c.p.prefix(wpath), "", current)
     return out
 
 
 def _scenario(
     name: str,
-    wind: Mapping[str, Any],
+    wind: WindSpec,
     refs: dict[str, tuple[float, ...]],
     desc: str,
     where: str,
     ensemble: str,
-    current: dict[str, Any] | None,
-    current_where: str,
+    current: _Current,
 ) -> dict[str, Any]:
     """The keyword arguments of one ``ScenarioSpec`` (its field names)."""
     return {
         "name": name,
-        "wind": dict(wind),
+        "wind": wind,
         "references": refs,
         "description": desc,
         "where": where,
         "ensemble": ensemble,
-        "current": current,
-        "current_where": current_where,
+        "current": current[0],
+        "current_where": current[1],
+        "current_given": current[2],
     }
 
 
-def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], str]]:
-    """The member wind specs of an ensemble scenario, each with its key path.
+def _members(c: Checker, raw: Any, path: str) -> list[tuple[WindSpec, str]]:
+    """The parsed member wind specs of an ensemble scenario, each with its key path.
 
     ``members`` is a list of wind specs, or ``{dim: NAME, wind: {type: netcdf, ...}}``:
     one member per index of the NetCDF dimension ``NAME`` (the spec's ``select`` picks it).
@@ -634,8 +661,10 @@ def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], s
         if len(raw) < 2:
             c.p.add(path, f"an ensemble needs at least 2 members; got {len(raw)}")
             return []
-        items = [(spec, f"{path}[{k}]") for k, spec in enumerate(raw)]
-        return [(s, w) for s, w in items if _wind_spec(c, s, w)]
+        items = [
+            (_parse_wind(c, spec, f"{path}[{k}]"), f"{path}[{k}]") for k, spec in enumerate(raw)
+        ]
+        return [(s, w) for s, w in items if s is not None]
     if not c.at(path).is_mapping(
         raw,
         "a list of wind specs, or {dim: NAME, wind: {type: "
@@ -652,12 +681,18 @@ def _members(c: Checker, raw: Any, path: str) -> list[tuple[Mapping[str, Any], s
     if wind.get("type") != "netcdf" or not isinstance(wind.get("path"), str):
         c.p.add(wpath, "members along a dimension need `type: netcdf` with a `path`")
         return []
-    base = Path(c.p.file).parent
-    n = _dimension_size(c, resolve_path(base, wind["path"]), base, dim, wpath)
+    spec = check_wind_spec(wind, c.at(wpath), _base_dir(c))
+    if not isinstance(spec, NetcdfWindSpec):
+        return []
+    n = _dimension_size(c, spec.path, _base_dir(c), dim, wpath)
     if n is None:
         return []
     return [
-        ({**wind, "select": {**dict(wind.get("select") or {}), dim: k}}, wpath) for k in range(n)
+        (
+            dataclasses.replace(spec, select=tuple({**dict(spec.select or ()), dim: k}.items())),
+            wpath,
+        )
+        for k in range(n)
     ]
 
 

@@ -9,9 +9,10 @@ Three steps, one module each:
 3. :mod:`sailroute.course.build`: the model objects (marks, lines, gates, legs,
    scenarios, the course).
 
-The boat, wind and current specs stay raw in the course and are built on demand by
-:mod:`sailroute.course.specs` (re-exported here: :func:`build_boat`, :func:`build_wind`,
-:func:`build_current`, :func:`build_specs`, :func:`validate_specs`).
+The wind and current specs are parsed in step 2 (:mod:`sailroute.wind.specs`), so their
+problems are reported with the course's; the boat spec stays raw.  The fields and the boat
+are built on demand by :mod:`sailroute.course.specs` (re-exported here: :func:`build_boat`,
+:func:`build_wind`, :func:`build_current`, :func:`build_specs`, :func:`validate_specs`).
 """
 
 from __future__ import annotations

@@ -5,10 +5,11 @@ position is stored in the course's :class:`~sailroute.geo.LocalFrame` (metres ea
 ``x`` and north ``y`` of the origin) and in latitude/longitude, so that routers work
 in metres and reports can write geographic coordinates.
 
-Wind and boat specifications are kept as the raw YAML mappings; they are turned into
-a :class:`~sailroute.wind.base.WindField` and a :class:`~sailroute.boat.polar.Polar`
-by the factories in ``sailroute.wind.build`` and ``sailroute.boat.build`` when a
-plan is run (see :func:`sailroute.course.load.validate_specs`).
+Wind and current specifications are parsed when the course loads, each into its frozen
+dataclass (:mod:`sailroute.wind.specs`); the boat specification is kept as the raw YAML
+mapping.  They are turned into a :class:`~sailroute.wind.base.WindField` and a
+:class:`~sailroute.boat.polar.Polar` by ``sailroute.wind.build.build_wind_field`` and
+``sailroute.boat.build`` when a plan is run (see :func:`sailroute.course.load.validate_specs`).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from sailroute.routing.obstacles import RaceArea
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import Side
 from sailroute.timeutil import to_epoch
+from sailroute.wind.specs import CURRENT_KINDS, WIND_KINDS, CurrentSpec, WindSpec
 
 LegKind = Literal["mark", "gate", "line"]
 """What ends a leg: round a mark, pass through a gate, or cross a line."""
@@ -175,10 +177,10 @@ class ScenarioSpec:
     ----------
     name : str
         Scenario name (the key under ``scenarios``).
-    wind : mapping
-        The raw wind spec (``{type: ..., ...}``, a type of
-        :data:`sailroute.wind.build.WIND_TYPES`),
-        passed to ``sailroute.wind.build.wind_from_spec`` unchanged.
+    wind : WindSpec
+        The parsed wind spec (a dataclass of :mod:`sailroute.wind.specs`, one per type
+        of :data:`~sailroute.wind.specs.WIND_TYPES`), built into a field by
+        ``sailroute.wind.build.build_wind_field``.
     references : mapping of str to tuple of float
         Leg times [s] to compare this scenario with, in addition to the course-wide
         ``references`` (e.g. the thesis's own model output for the same wind).
@@ -190,27 +192,43 @@ class ScenarioSpec:
     ensemble : str
         For a member of an ensemble scenario (``members:``), the ensemble's name; the
         member itself is called ``"<ensemble>#<k>"`` (k from 1).  Empty otherwise.
-    current : mapping or None
-        The raw surface-current spec (``scenarios.<name>.current``, built by
-        ``sailroute.wind.build.current_from_spec``); None: still water.
+    current : CurrentSpec or None
+        The parsed surface-current spec (``scenarios.<name>.current``, built by
+        ``sailroute.wind.build.build_current_field``); None: still water.
     current_where : str
         Key path of the current spec for error messages.
+    current_given : mapping or None
+        The current spec as the file gives it (written to ``plan.json``).
     """
 
     name: str
-    wind: Mapping[str, Any]
+    wind: WindSpec
     references: Mapping[str, tuple[float, ...]] = field(default_factory=_empty)
     description: str = ""
     where: str = ""
     ensemble: str = ""
-    current: Mapping[str, Any] | None = None
+    current: CurrentSpec | None = None
     current_where: str = ""
+    current_given: Mapping[str, Any] | None = None
 
     def __post_init__(self) -> None:
-        _require_frozen("ScenarioSpec", "wind", self.wind)
+        if self.current_given is not None:
+            _require_frozen("ScenarioSpec", "current_given", self.current_given)
+        _require_spec("wind", self.wind, WIND_KINDS, "parse_wind_spec")
         _require_frozen("ScenarioSpec", "references", self.references)
         if self.current is not None:
-            _require_frozen("ScenarioSpec", "current", self.current)
+            _require_spec("current", self.current, CURRENT_KINDS, "parse_current_spec")
+
+
+def _require_spec(field_name: str, value: object, kinds: Mapping[str, Any], parser: str) -> None:
+    """Raise TypeError unless ``value`` is a parsed spec of one of ``kinds``."""
+    if not any(type(value) is k.spec for k in kinds.values()):
+        raise TypeError(
+            f"ScenarioSpec.{field_name} must be a parsed {field_name} spec (a dataclass of "
+            f"sailroute.wind.specs), got {type(value).__name__}; parse the mapping with "
+            f"sailroute.wind.specs.{parser}(...), or load the course with "
+            "sailroute.course.load.load_course, which does"
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -257,7 +275,8 @@ class Course:
         ``start_time`` is written with (``+02:00`` -> 7200); for reports.
     key_lines : mapping of str to int
         1-based line of each key path of the course file (``"scenarios.a.wind.tws_kn"``),
-        so that the wind, current and boat factories report problems at their lines;
+        so that the boat factory reports problems at their lines (the wind and current
+        specs were parsed with it at load);
         empty for a course built from a mapping.
     area : RaceArea
         The race area: ``boundary``, ``obstacles`` and ``wind_land_is_obstacle``,

@@ -1,10 +1,11 @@
 """Build a course's boat, wind and current from its specs (the factories' entry points).
 
-A :class:`~sailroute.course.model.Course` keeps its boat, wind and current specs
-raw; these functions hand them to their factories (:mod:`sailroute.boat.build`,
-:mod:`sailroute.wind.build`, :mod:`sailroute.wind.current`) with the course's folder,
-local frame, bounding box, race time window and line map, so that every problem
-is reported as ``file:line: key.path: ...``.
+A :class:`~sailroute.course.model.Course` keeps its boat spec raw and its wind and
+current specs parsed (:mod:`sailroute.wind.specs`, checked when the course loads);
+these functions hand them to their factories (:mod:`sailroute.boat.build`,
+:mod:`sailroute.wind.build`) with the course's folder, local frame, bounding box, race
+time window and line map, so that every problem is reported as
+``file:line: key.path: ...``.
 """
 
 from __future__ import annotations
@@ -52,7 +53,7 @@ def build_wind(course: Course, scenario: str) -> Any:
         The wind data do not cover the course or the race time.
     """
     from sailroute.course.geometry import course_bbox, race_time_window
-    from sailroute.wind.build import wind_from_spec
+    from sailroute.wind.build import build_wind_field
 
     if scenario not in course.scenarios:
         names = list(course.scenarios)
@@ -60,15 +61,11 @@ def build_wind(course: Course, scenario: str) -> Any:
             f"{course.where('scenarios')}: no scenario {scenario!r}; "
             f"{suggest(scenario, names)}scenarios are: {', '.join(names)}"
         )
-    sc = course.scenarios[scenario]
-    return wind_from_spec(
-        dict(sc.wind),
+    return build_wind_field(
+        course.scenarios[scenario].wind,
         frame=course.frame,
-        base_dir=course.base_dir,
-        where=sc.where or course.where(f"scenarios.{scenario}"),
         crop_bbox=course_bbox(course),
         time_window=race_time_window(course),
-        lines=course.key_lines,
     )
 
 
@@ -79,19 +76,16 @@ def build_current(course: Course, scenario: str) -> Any:
     and the current must cover the course box and the race time window.
     """
     from sailroute.course.geometry import course_bbox, race_time_window
-    from sailroute.wind.build import current_from_spec
+    from sailroute.wind.build import build_current_field
 
     sc = course.scenarios.get(scenario)
     if sc is None or sc.current is None:  # (an unknown name is build_wind's error)
         return None
-    return current_from_spec(
-        dict(sc.current),
+    return build_current_field(
+        sc.current,
         frame=course.frame,
-        base_dir=course.base_dir,
-        where=sc.current_where or course.where(f"scenarios.{scenario}.current"),
         crop_bbox=course_bbox(course),
         time_window=race_time_window(course),
-        lines=course.key_lines,
     )
 
 

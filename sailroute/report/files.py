@@ -188,7 +188,7 @@ def _speeds(r: Any) -> dict[str, float | None]:
 def _current_of(plan: Plan) -> dict[str, Any] | None:
     """The scenario's surface-current spec as given (None: still water)."""
     sc = plan.course.scenarios.get(plan.scenario)
-    cur = getattr(sc, "current", None)
+    cur = getattr(sc, "current_given", None)
     return None if cur is None else json.loads(json.dumps(dict(cur), default=str))
 
 

@@ -11,6 +11,8 @@ import pytest
 from sailroute.course.load import course_from_mapping, load_course
 from sailroute.errors import InputError
 from sailroute.routing.settings import RoutingSettings
+from sailroute.units import KNOT
+from sailroute.wind.specs import UniformWindSpec, WrfWindSpec
 from tests.conftest import TESTS_DATA
 
 DATA = TESTS_DATA / "course"
@@ -132,9 +134,13 @@ def test_scenario_forms_and_references(tmp_path):
               model: [1, 2, 3, 4]
         """),
     )
+    (tmp_path / "x.nc").write_bytes(b"")  # parsing checks that the file is there, not its data
     c = load_course(write(tmp_path, text))
-    assert dict(c.scenarios["north"].wind) == {"type": "uniform", "tws_kn": 10, "twd_deg": 0}
-    assert c.scenarios["full"].wind["type"] == "wrf"
+    north, full = c.scenarios["north"].wind, c.scenarios["full"].wind
+    assert isinstance(north, UniformWindSpec) and north.twd_deg == 0.0
+    assert north.tws_ms == pytest.approx(10 * KNOT, rel=1e-15)  # parsed at load, in m/s
+    assert isinstance(full, WrfWindSpec) and full.height_m == 2.68
+    assert full.path == (tmp_path / "x.nc").resolve()
     assert c.scenarios["full"].description == "with its own reference"
     assert c.references == {"winner": (100.0, 200.0, 300.0, 40.5)}
     assert c.references_for("full") == {
@@ -444,9 +450,8 @@ def test_missing_file(tmp_path):
     assert "is a folder" in problems(tmp_path)
 
 
-def test_validate_specs_reports_boat_and_wind_problems_together(tmp_path):
+def test_wind_problems_found_at_load_boat_problems_by_validate_specs(tmp_path):
     pytest.importorskip("sailroute.boat.build")
-    pytest.importorskip("sailroute.wind.build")
     from sailroute.course.load import validate_specs
 
     text = (
@@ -458,14 +463,14 @@ def test_validate_specs_reports_boat_and_wind_problems_together(tmp_path):
         + "boat: {builtin: ilca9}\n"
     )
     path = write(tmp_path, text)
-    c = load_course(path)  # structurally fine: specs are checked by their factories
-    with pytest.raises(InputError) as ei:
-        validate_specs(c)
+    with pytest.raises(InputError) as ei:  # the wind spec is parsed when the course loads
+        load_course(path)
     msg = str(ei.value)
-    assert msg.startswith(f"{path}: ")
-    assert f"{path}:21: boat.builtin: expected one of 'ilca4', 'ilca4-steady', 'ilca6'" in msg
-    assert f"{path}:20: scenarios.bad.twd_degs: unknown key" in msg
-    with pytest.raises(InputError, match=r"boat\.builtin"):
+    assert msg.startswith(f"{path}: 2 problems in the course file")
+    assert f"{path}:20: scenarios.bad.twd_degs: unknown key; did you mean 'twd_deg'?" in msg
+    assert f"{path}:20: scenarios.bad.twd_deg: missing required key" in msg
+    c = load_course(write(tmp_path, text.replace("twd_degs", "twd_deg")))
+    with pytest.raises(InputError, match=r"boat\.builtin: expected one of 'ilca4'"):
         validate_specs(c, ["north"])  # the boat is always checked
 
 

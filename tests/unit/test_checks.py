@@ -9,7 +9,7 @@ import pytest
 
 from sailroute.boat.boatfile import load_boat_file
 from sailroute.checks import Checker, Problems, split_where, suggest
-from sailroute.course.load import build_boat, load_course, validate_specs
+from sailroute.course.load import build_boat, load_course
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
 from sailroute.wind.build import wind_from_spec
@@ -60,7 +60,7 @@ def test_one_did_you_mean_for_course_wind_and_boat_files(tmp_path: Path) -> None
     assert f"{course}:16: referencez: unknown key; did you mean 'references'? valid keys: " in msg
     # wind spec inside it: an unknown key of the scenario's spec, at its own line
     course = _write(tmp_path, "w.yaml", COURSE.replace("twd_deg: 0", "twd: 0"))
-    msg = _error(validate_specs, load_course(course))
+    msg = _error(load_course, course)  # found when the course loads
     assert (
         f"{course}:15: scenarios.steady.twd: unknown key; did you mean 'twd_deg'? "
         "valid keys: type, tws_kn" in msg
@@ -88,7 +88,7 @@ def test_a_bad_choice_gets_the_same_hint_in_a_course_and_a_wind_spec(tmp_path: P
     course = _write(
         tmp_path, "w.yaml", COURSE.replace("type: uniform", "type: uniform\n    interpolation: lin")
     )
-    msg = _error(validate_specs, load_course(course))
+    msg = _error(load_course, course)  # found when the course loads
     assert msg == (
         f"{course}:14: scenarios.steady.interpolation: expected one of 'linear', "
         "'previous'; got 'lin' (did you mean 'linear'?)"
@@ -99,7 +99,7 @@ def test_a_bad_choice_gets_the_same_hint_in_a_course_and_a_wind_spec(tmp_path: P
 def test_a_wind_spec_problem_is_reported_at_its_own_line(tmp_path: Path) -> None:
     # before sailroute.checks, the line was the scenario's (12), not the key's (14)
     course = _write(tmp_path, "c.yaml", COURSE.replace("tws_kn: 10", "tws_kn: ten"))
-    msg = _error(validate_specs, load_course(course))
+    msg = _error(load_course, course)  # found when the course loads
     assert msg == f"{course}:14: scenarios.steady.tws_kn: expected a number >= 0; got 'ten'"
 
 
@@ -119,7 +119,7 @@ def test_a_wind_spec_with_a_wind_key_reports_lines_below_it(tmp_path: Path) -> N
 """,
     )
     course = _write(tmp_path, "c.yaml", text)
-    msg = _error(validate_specs, load_course(course))
+    msg = _error(load_course, course)  # found when the course loads
     assert (
         msg == f"{course}:17: scenarios.steady.wind.twd_deg: expected a number in [0, 360]; got 400"
     )

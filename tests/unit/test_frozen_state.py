@@ -23,6 +23,7 @@ from sailroute.track.model import Track
 from sailroute.wind.blended import BlendedWind
 from sailroute.wind.current import DiamondCurrent, UniformCurrent
 from sailroute.wind.grid import GridWind
+from sailroute.wind.specs import UniformWindSpec, WrfWindSpec
 from sailroute.wind.stations import StationWind
 from sailroute.wind.uniform import UniformWind
 from tests.conftest import ROOT
@@ -215,12 +216,19 @@ FROZEN_HINT = (
 
 
 def test_scenario_spec_refuses_plain_mappings() -> None:
-    wind = frozen_mapping({"type": "uniform"})
+    wind = UniformWindSpec(tws_ms=5.0, twd_deg=90.0)
     assert ScenarioSpec("a", wind).references == {}
-    with pytest.raises(TypeError, match=r"^ScenarioSpec\.wind " + FROZEN_HINT):
-        ScenarioSpec("a", {"type": "uniform"})
-    with pytest.raises(TypeError, match=r"^ScenarioSpec\.current " + FROZEN_HINT):
-        ScenarioSpec("a", wind, current={"type": "uniform"})
+    with pytest.raises(
+        TypeError,
+        match=r"^ScenarioSpec\.wind must be a parsed wind spec \(a dataclass of "
+        r"sailroute\.wind\.specs\), got mappingproxy; parse the mapping with "
+        r"sailroute\.wind\.specs\.parse_wind_spec\(\.\.\.\), or load the course",
+    ):
+        ScenarioSpec("a", frozen_mapping({"type": "uniform"}))  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"^ScenarioSpec\.current must be a parsed current spec"):
+        ScenarioSpec("a", wind, current=wind)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=r"^ScenarioSpec\.references " + FROZEN_HINT):
+        ScenarioSpec("a", wind, references={})
 
 
 def test_loaded_course_is_read_only_and_replace_refuses_plain_values() -> None:
@@ -228,7 +236,7 @@ def test_loaded_course_is_read_only_and_replace_refuses_plain_values() -> None:
     for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):
         assert isinstance(getattr(course, name), MappingProxyType), name
     spec = next(iter(course.scenarios.values()))
-    assert isinstance(spec.wind, MappingProxyType)
+    assert isinstance(spec.wind, WrfWindSpec | UniformWindSpec)  # parsed at load, frozen
     assert isinstance(spec.references, MappingProxyType)
     assert isinstance(course.legs, tuple)
     again = pickle.loads(pickle.dumps(course))  # process workers get a copy
