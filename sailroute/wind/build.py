@@ -19,13 +19,13 @@ from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.geo import LocalFrame
 from sailroute.wind.base import Coverage, WindField
 from sailroute.wind.current import CurrentField
+from sailroute.wind.spec_base import BBox
 from sailroute.wind.specs import (
     CURRENT_KINDS,
     CURRENT_TYPES,
     MEASURED_MARGIN_S,
     WIND_KINDS,
     WIND_TYPES,
-    BBox,
     BuildContext,
     CurrentSpec,
     WindSpec,
