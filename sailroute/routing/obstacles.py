@@ -15,8 +15,10 @@ vectorised predicates that every router uses:
   through ``shapely.intersects`` on linestrings, kept for comparison: see
   ``benchmarks/bench_obstacles.py``);
 * :meth:`Obstacles.moves_free`: the same for a fan of moves from each of ``n``
-  points (the isochrone's candidates), testing exactly only the points that lie
-  within one move of an edge.
+  points (the isochrone's candidates), testing exactly only the moves that can touch
+  an edge (three bounding-box filters: the point's moves against each group of
+  edges, each move against the groups near its point, then against each edge of
+  those groups).
 
 Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C).
 """
@@ -26,7 +28,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Final
 
@@ -176,6 +178,12 @@ class Obstacles:
         ``(G, 4)`` bounding box ``xmin, ymin, xmax, ymax`` [m] of each group of edges.
     group_start : ndarray of int
         ``(G + 1,)`` the groups' first edges (and the end).
+    group_edges : ndarray
+        ``(G, K, 4)`` each group's edges, padded to the largest group's ``K`` (the
+        padding is never read).
+    group_edge_box : ndarray
+        ``(G, K, 4)`` the bounding box ``xmin, ymin, xmax, ymax`` [m] of each of them
+        (NaN for the padding, which meets nothing).
     """
 
     names: tuple[str, ...]
@@ -185,6 +193,8 @@ class Obstacles:
     owner: NDArray[np.int64]
     group_box: NDArray[np.float64]
     group_start: NDArray[np.int64]
+    group_edges: NDArray[np.float64]
+    group_edge_box: NDArray[np.float64]
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -251,7 +261,8 @@ class Obstacles:
                 for a, b in itertools.pairwise(bounds)
             ]
         ).reshape(-1, 4)
-        return cls(tuple(names), inside, blocked, edges, own, box, bounds)
+        padded, edge_box = _padded(edges, bounds)
+        return cls(tuple(names), inside, blocked, edges, own, box, bounds, padded, edge_box)
 
     # ------------------------------------------------------------------ predicates
     def points_free(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
@@ -270,7 +281,9 @@ class Obstacles:
     ) -> NDArray[np.bool_]:
         """True where the segment touches or crosses any ring edge (orientation test,
         touching included, so a move through a vertex counts).  Each group of edges is
-        tested only against the segments whose bounding box meets the group's."""
+        tested only against the segments whose bounding box meets the group's, and each
+        of its edges only against those whose bounding box meets the edge's
+        (:meth:`_pairs_cross`)."""
         a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
         shape = a[0].shape
         sx0, sy0, sx1, sy1 = (v.reshape(-1) for v in a)
@@ -279,12 +292,14 @@ class Obstacles:
             return hit.reshape(shape)
         xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
         ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
+        seg, grp = [], []
         for g in range(self.group_box.shape[0]):
             b = self.group_box[g]
             idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
-            if idx.size:
-                e = self.edges[self.group_start[g] : self.group_start[g + 1]]
-                hit[idx] |= _cross(sx0[idx], sy0[idx], sx1[idx], sy1[idx], e)
+            seg.append(idx)
+            grp.append(np.full(idx.size, g))
+        pair = self._pairs_cross((sx0, sy0, sx1, sy1), np.concatenate(seg), np.concatenate(grp))
+        hit[np.concatenate(seg)[pair]] = True
         return hit.reshape(shape)
 
     def segments_free(
@@ -318,7 +333,14 @@ class Obstacles:
             ok &= ~shapely.intersects(self.blocked, lines)
         return ok.reshape(shape)
 
-    def moves_free(self, px: Any, py: Any, qx: Any, qy: Any) -> NDArray[np.bool_]:
+    def moves_free(
+        self,
+        px: Any,
+        py: Any,
+        qx: Any,
+        qy: Any,
+        to_world: Callable[[Any, Any], tuple[Any, Any]] | None = None,
+    ) -> NDArray[np.bool_]:
         """Which moves of a fan stay in free water.
 
         Parameters
@@ -327,44 +349,95 @@ class Obstacles:
             Start of the moves of each row [m].
         qx, qy : array, shape (n, m)
             Their end points [m].
+        to_world : callable, optional
+            ``to_world(x, y)``: the course frame from the frame of ``px, py, qx, qy``
+            (a rotation and a shift applied element by element, as the isochrone's leg
+            frame); only the ends of the moves that are tested are moved.  None: they
+            are in the course frame.
 
         Returns
         -------
         ndarray of bool, shape (n, m)
-            A row whose start is farther than its longest move from every group's
-            bounding box is decided by its start alone; the others are tested move by
-            move (:meth:`segments_cross`).
+            :meth:`segments_free` move by move (the same arithmetic), found with three
+            bounding-box filters: a row whose box round its moves meets no group of
+            edges is decided by its start alone; a move of the other rows is tested only
+            against the groups near its row whose box meets the move's, and within a
+            group only against the edges whose box meets it (:meth:`_pairs_cross`).
         """
-        px, py = np.asarray(px, dtype=float), np.asarray(py, dtype=float)
+        tw = _same if to_world is None else to_world
+        lx, ly = np.asarray(px, dtype=float), np.asarray(py, dtype=float)
         qx, qy = np.asarray(qx, dtype=float), np.asarray(qy, dtype=float)
-        start_ok = self.points_free(px, py)
+        wx, wy = tw(lx, ly)
+        start_ok = self.points_free(wx, wy)
         out = np.broadcast_to(start_ok[:, None], qx.shape).copy()
-        reach = np.max(np.hypot(qx - px[:, None], qy - py[:, None]), axis=1, initial=0.0)
-        r = reach[:, None]
-        b = self.group_box
-        near = (
-            (px[:, None] + r >= b[:, 0])
-            & (px[:, None] - r <= b[:, 2])
-            & (py[:, None] + r >= b[:, 1])
-            & (py[:, None] - r <= b[:, 3])
+        if qx.shape[1] == 0 or self.group_box.shape[0] == 0:
+            return out
+        near = self._near_rows(lx, ly, qx, qy, tw)
+        rows = np.flatnonzero(near.any(axis=1) & start_ok)
+        if rows.size == 0:
+            return out
+        r, g = np.nonzero(near[rows])  # (row, group) pairs
+        ex, ey = tw(qx[rows], qy[rows])
+        x0, y0 = wx[rows][r, None], wy[rows][r, None]
+        x1, y1 = ex[r], ey[r]
+        b = self.group_box[g]
+        p, j = np.nonzero(
+            (np.maximum(x0, x1) >= b[:, 0, None])
+            & (np.minimum(x0, x1) <= b[:, 2, None])
+            & (np.maximum(y0, y1) >= b[:, 1, None])
+            & (np.minimum(y0, y1) <= b[:, 3, None])
         )
-        for g in np.flatnonzero(near.any(axis=0)):
-            rows = np.flatnonzero(near[:, g])
-            sx1, sy1 = qx[rows], qy[rows]
-            sx0 = np.broadcast_to(px[rows, None], sx1.shape)
-            sy0 = np.broadcast_to(py[rows, None], sx1.shape)
-            box = (
-                (np.maximum(sx0, sx1) >= b[g, 0])
-                & (np.minimum(sx0, sx1) <= b[g, 2])
-                & (np.maximum(sy0, sy1) >= b[g, 1])
-                & (np.minimum(sy0, sy1) <= b[g, 3])
-            )
-            ri, ci = np.nonzero(box)
-            if ri.size:
-                e = self.edges[self.group_start[g] : self.group_start[g + 1]]
-                hit = _cross(sx0[ri, ci], sy0[ri, ci], sx1[ri, ci], sy1[ri, ci], e)
-                out[rows[ri[hit]], ci[hit]] = False
+        seg = (x0[p, 0], y0[p, 0], x1[p, j], y1[p, j])
+        hit = self._pairs_cross(seg, np.arange(p.size), g[p])
+        out[rows[r[p[hit]]], j[hit]] = False
         return out
+
+    def _near_rows(
+        self, lx: Any, ly: Any, qx: Any, qy: Any, tw: Callable[[Any, Any], tuple[Any, Any]]
+    ) -> NDArray[np.bool_]:
+        """``(n, G)``: True where the group ``g``'s bounding box meets the box round
+        row ``n``'s moves (in their own frame: the square round the circle through its
+        corners in the course frame, grown by :data:`BOX_MARGIN_M` against rounding)."""
+        xlo, xhi = np.minimum(lx, qx.min(axis=1)), np.maximum(lx, qx.max(axis=1))
+        ylo, yhi = np.minimum(ly, qy.min(axis=1)), np.maximum(ly, qy.max(axis=1))
+        cx, cy = tw(0.5 * (xlo + xhi), 0.5 * (ylo + yhi))
+        rad = (0.5 * np.hypot(xhi - xlo, yhi - ylo) + BOX_MARGIN_M)[:, None]
+        b = self.group_box
+        return (
+            (cx[:, None] + rad >= b[:, 0])
+            & (cx[:, None] - rad <= b[:, 2])
+            & (cy[:, None] + rad >= b[:, 1])
+            & (cy[:, None] - rad <= b[:, 3])
+        )
+
+    def _pairs_cross(
+        self, segments: tuple[Any, Any, Any, Any], seg: Any, grp: Any
+    ) -> NDArray[np.bool_]:
+        """Which (segment, group) pairs touch or cross an edge of the group.
+
+        ``segments`` are the flat arrays ``x0, y0, x1, y1`` [m]; pair ``k`` is segment
+        ``seg[k]`` with group ``grp[k]``.  Each pair is tested against the edges of the
+        group whose bounding boxes meet the segment's (:func:`_cross_flat`), at most
+        :data:`_CHUNK` (pair, edge) boxes at once.
+        """
+        sx0, sy0, sx1, sy1 = segments
+        hit = np.zeros(seg.size, dtype=bool)
+        k = self.group_edges.shape[1]
+        step = max(1, _CHUNK // k)
+        for i in range(0, seg.size, step):
+            s, g = seg[i : i + step], grp[i : i + step]
+            a0, b0, a1, b1 = sx0[s], sy0[s], sx1[s], sy1[s]
+            eb = self.group_edge_box[g]
+            pair, edge = np.nonzero(
+                (np.maximum(a0, a1)[:, None] >= eb[:, :, 0])
+                & (np.minimum(a0, a1)[:, None] <= eb[:, :, 2])
+                & (np.maximum(b0, b1)[:, None] >= eb[:, :, 1])
+                & (np.minimum(b0, b1)[:, None] <= eb[:, :, 3])
+            )
+            e = self.group_edges[g[pair], edge]
+            crossed = _cross_flat(a0[pair], b0[pair], a1[pair], b1[pair], e)
+            hit[i + pair[crossed]] = True
+        return hit
 
     def edge_distance(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
         """Distance [m] from each point to the nearest ring edge."""
@@ -468,38 +541,66 @@ OBSTACLE_RUN: Final = 32
 """Most edges of an obstacle per group (a grown rectangle has 20: one group)."""
 
 
+def _same(x: Any, y: Any) -> tuple[Any, Any]:
+    """The identity change of frame (:meth:`Obstacles.moves_free`)."""
+    return x, y
+
+
+BOX_MARGIN_M: Final = 1e-3
+"""Margin [m] of the box round a row's moves (:meth:`Obstacles.moves_free`): the change
+of frame rounds each end point by far less, so every move's end lies inside."""
+
+
+def _padded(
+    edges: NDArray[np.float64], bounds: NDArray[np.int64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(G, K, 4)`` the edges of each group ``bounds[g]:bounds[g + 1]``, padded to the
+    largest group's ``K`` (copies of the group's first edge), and their bounding boxes
+    ``xmin, ymin, xmax, ymax`` (NaN for the padding)."""
+    width = np.diff(bounds)
+    if width.size == 0:
+        return np.zeros((0, 1, 4)), np.zeros((0, 1, 4))
+    k = np.arange(int(width.max()))
+    pad = k >= width[:, None]
+    e = edges[bounds[:-1, None] + np.where(pad, 0, k)]
+    box = np.stack(
+        [
+            np.minimum(e[..., 0], e[..., 2]),
+            np.minimum(e[..., 1], e[..., 3]),
+            np.maximum(e[..., 0], e[..., 2]),
+            np.maximum(e[..., 1], e[..., 3]),
+        ],
+        axis=-1,
+    )
+    box[pad] = np.nan
+    return e, box
+
+
 def _first(owner: NDArray[np.int64], i: int) -> int:
     """Index of the first edge with the owner of edge ``i``."""
     return int(np.flatnonzero(owner == owner[i])[0])
 
 
-def _cross(sx0: Any, sy0: Any, sx1: Any, sy1: Any, e: NDArray[np.float64]) -> Any:
-    """Segments (shape (m,)) that touch or cross any of the edges ``e`` (shape (k, 4)),
-    in chunks of at most :data:`_CHUNK` pairs."""
-    hit = np.zeros(sx0.size, dtype=bool)
-    ex0, ey0, ex1, ey1 = (e[:, k] for k in range(4))
-    step = max(1, _CHUNK // max(1, e.shape[0]))
-    for i in range(0, sx0.size, step):
-        a0, b0 = sx0[i : i + step, None], sy0[i : i + step, None]
-        a1, b1 = sx1[i : i + step, None], sy1[i : i + step, None]
-        o1 = _orient(a0, b0, a1, b1, ex0, ey0)
-        o2 = _orient(a0, b0, a1, b1, ex1, ey1)
-        o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
-        o4 = _orient(ex0, ey0, ex1, ey1, a1, b1)
-        both = (o1 * o2 <= 0.0) & (o3 * o4 <= 0.0)
-        # collinear pairs (and a point on an edge's line) meet only where their extents
-        # overlap
-        line = (o1 == 0.0) & (o2 == 0.0) & (o3 == 0.0) & (o4 == 0.0)
-        if line.any():
-            over = (
-                (np.minimum(a0, a1) <= np.maximum(ex0, ex1))
-                & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
-                & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
-                & (np.maximum(b0, b1) >= np.minimum(ey0, ey1))
-            )
-            both = np.where(line, over, both)
-        hit[i : i + step] = both.any(axis=1)
-    return hit
+def _cross_flat(a0: Any, b0: Any, a1: Any, b1: Any, e: NDArray[np.float64]) -> Any:
+    """Which segments ``(a0, b0) -> (a1, b1)`` (shape (p,)) touch or cross their own edge
+    ``e[k]`` (shape (p, 4)): both ends of each on either side of (or on) the other's
+    line; collinear pairs meet only where their extents overlap."""
+    ex0, ey0, ex1, ey1 = e[:, 0], e[:, 1], e[:, 2], e[:, 3]
+    o1 = _orient(a0, b0, a1, b1, ex0, ey0)
+    o2 = _orient(a0, b0, a1, b1, ex1, ey1)
+    o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
+    o4 = _orient(ex0, ey0, ex1, ey1, a1, b1)
+    both = (o1 * o2 <= 0.0) & (o3 * o4 <= 0.0)
+    line = (o1 == 0.0) & (o2 == 0.0) & (o3 == 0.0) & (o4 == 0.0)
+    if line.any():  # collinear: they meet only where their extents overlap
+        over = (
+            (np.minimum(a0, a1) <= np.maximum(ex0, ex1))
+            & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
+            & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
+            & (np.maximum(b0, b1) >= np.minimum(ey0, ey1))
+        )
+        both = np.where(line, over, both)
+    return both
 
 
 def _orient(ax: Any, ay: Any, bx: Any, by: Any, cx: Any, cy: Any) -> Any:
