@@ -181,8 +181,8 @@ class Obstacles:
     group_edges : ndarray
         ``(G, K, 4)`` each group's edges, padded to the largest group's ``K`` (the
         padding is never read).
-    group_edge_box : ndarray
-        ``(G, K, 4)`` the bounding box ``xmin, ymin, xmax, ymax`` [m] of each of them
+    group_edge_box : tuple of ndarray
+        ``xmin, ymin, xmax, ymax``, each ``(G, K)``: the bounding box [m] of each of them
         (NaN for the padding, which meets nothing).
     """
 
@@ -194,7 +194,7 @@ class Obstacles:
     group_box: NDArray[np.float64]
     group_start: NDArray[np.int64]
     group_edges: NDArray[np.float64]
-    group_edge_box: NDArray[np.float64]
+    group_edge_box: tuple[NDArray[np.float64], ...]
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -422,18 +422,16 @@ class Obstacles:
         """
         sx0, sy0, sx1, sy1 = segments
         hit = np.zeros(seg.size, dtype=bool)
-        k = self.group_edges.shape[1]
-        step = max(1, _CHUNK // k)
+        step = max(1, _CHUNK // self.group_edges.shape[1])
         for i in range(0, seg.size, step):
             s, g = seg[i : i + step], grp[i : i + step]
             a0, b0, a1, b1 = sx0[s], sy0[s], sx1[s], sy1[s]
-            eb = self.group_edge_box[g]
-            pair, edge = np.nonzero(
-                (np.maximum(a0, a1)[:, None] >= eb[:, :, 0])
-                & (np.minimum(a0, a1)[:, None] <= eb[:, :, 2])
-                & (np.maximum(b0, b1)[:, None] >= eb[:, :, 1])
-                & (np.minimum(b0, b1)[:, None] <= eb[:, :, 3])
-            )
+            xmin, ymin, xmax, ymax = (v[g] for v in self.group_edge_box)
+            meet = np.maximum(a0, a1)[:, None] >= xmin
+            meet &= np.minimum(a0, a1)[:, None] <= xmax
+            meet &= np.maximum(b0, b1)[:, None] >= ymin
+            meet &= np.minimum(b0, b1)[:, None] <= ymax
+            pair, edge = np.nonzero(meet)
             e = self.group_edges[g[pair], edge]
             crossed = _cross_flat(a0[pair], b0[pair], a1[pair], b1[pair], e)
             hit[i + pair[crossed]] = True
@@ -553,26 +551,24 @@ of frame rounds each end point by far less, so every move's end lies inside."""
 
 def _padded(
     edges: NDArray[np.float64], bounds: NDArray[np.int64]
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+) -> tuple[NDArray[np.float64], tuple[NDArray[np.float64], ...]]:
     """``(G, K, 4)`` the edges of each group ``bounds[g]:bounds[g + 1]``, padded to the
-    largest group's ``K`` (copies of the group's first edge), and their bounding boxes
-    ``xmin, ymin, xmax, ymax`` (NaN for the padding)."""
+    largest group's ``K`` (copies of the group's first edge), and their bounding boxes:
+    ``xmin, ymin, xmax, ymax``, each ``(G, K)`` (NaN for the padding)."""
     width = np.diff(bounds)
     if width.size == 0:
-        return np.zeros((0, 1, 4)), np.zeros((0, 1, 4))
+        return np.zeros((0, 1, 4)), tuple(np.zeros((0, 1)) for _ in range(4))
     k = np.arange(int(width.max()))
     pad = k >= width[:, None]
     e = edges[bounds[:-1, None] + np.where(pad, 0, k)]
-    box = np.stack(
-        [
-            np.minimum(e[..., 0], e[..., 2]),
-            np.minimum(e[..., 1], e[..., 3]),
-            np.maximum(e[..., 0], e[..., 2]),
-            np.maximum(e[..., 1], e[..., 3]),
-        ],
-        axis=-1,
+    box = (
+        np.minimum(e[..., 0], e[..., 2]),
+        np.minimum(e[..., 1], e[..., 3]),
+        np.maximum(e[..., 0], e[..., 2]),
+        np.maximum(e[..., 1], e[..., 3]),
     )
-    box[pad] = np.nan
+    for v in box:
+        v[pad] = np.nan
     return e, box
 
 
