@@ -292,14 +292,14 @@ class Obstacles:
             return hit.reshape(shape)
         xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
         ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
-        seg, grp = [], []
+        seg, grp = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
         for g in range(self.group_box.shape[0]):
             b = self.group_box[g]
             idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
             seg.append(idx)
             grp.append(np.full(idx.size, g))
-        pair = self._pairs_cross((sx0, sy0, sx1, sy1), np.concatenate(seg), np.concatenate(grp))
-        hit[np.concatenate(seg)[pair]] = True
+        s = np.concatenate(seg)
+        hit[s[self._pairs_cross((sx0, sy0, sx1, sy1), s, np.concatenate(grp))]] = True
         return hit.reshape(shape)
 
     def segments_free(
@@ -387,8 +387,7 @@ class Obstacles:
             & (np.maximum(y0, y1) >= b[:, 1, None])
             & (np.minimum(y0, y1) <= b[:, 3, None])
         )
-        seg = (x0[p, 0], y0[p, 0], x1[p, j], y1[p, j])
-        hit = self._pairs_cross(seg, np.arange(p.size), g[p])
+        hit = self._pairs_cross((x0[p, 0], y0[p, 0], x1[p, j], y1[p, j]), None, g[p])
         out[rows[r[p[hit]]], j[hit]] = False
         return out
 
@@ -411,21 +410,23 @@ class Obstacles:
         )
 
     def _pairs_cross(
-        self, segments: tuple[Any, Any, Any, Any], seg: Any, grp: Any
+        self, segments: tuple[Any, Any, Any, Any], seg: Any, grp: NDArray[np.int64]
     ) -> NDArray[np.bool_]:
         """Which (segment, group) pairs touch or cross an edge of the group.
 
         ``segments`` are the flat arrays ``x0, y0, x1, y1`` [m]; pair ``k`` is segment
-        ``seg[k]`` with group ``grp[k]``.  Each pair is tested against the edges of the
-        group whose bounding boxes meet the segment's (:func:`_cross_flat`), at most
-        :data:`_CHUNK` (pair, edge) boxes at once.
+        ``seg[k]`` (``k`` when ``seg`` is None) with group ``grp[k]``.  Each pair is
+        tested against the edges of the group whose bounding boxes meet the segment's
+        (:func:`_cross_flat`), at most :data:`_CHUNK` (pair, edge) boxes at once.
         """
-        sx0, sy0, sx1, sy1 = segments
-        hit = np.zeros(seg.size, dtype=bool)
+        hit = np.zeros(grp.size, dtype=bool)
         step = max(1, _CHUNK // self.group_edges.shape[1])
-        for i in range(0, seg.size, step):
-            s, g = seg[i : i + step], grp[i : i + step]
-            a0, b0, a1, b1 = sx0[s], sy0[s], sx1[s], sy1[s]
+        for i in range(0, grp.size, step):
+            g = grp[i : i + step]
+            if seg is None:
+                a0, b0, a1, b1 = (v[i : i + step] for v in segments)
+            else:
+                a0, b0, a1, b1 = (v[seg[i : i + step]] for v in segments)
             xmin, ymin, xmax, ymax = (v[g] for v in self.group_edge_box)
             meet = np.maximum(a0, a1)[:, None] >= xmin
             meet &= np.minimum(a0, a1)[:, None] <= xmax
