@@ -1654,7 +1654,7 @@ def _obstacle_blocked(
     frame: _LegFrame,
     obstacles: Obstacles,
     xp: ModuleType,
-) -> list[Any]:
+) -> list[Any] | None:
     """``blocked`` (:func:`_barrier_blocked`) with the moves that leave free water added:
     each move from its row's point to its end, in the world frame
     (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`, which moves to the
@@ -1664,6 +1664,8 @@ def _obstacle_blocked(
     qx = np.hstack([to_numpy(q[0]) for q in ends])  # both blocks in one call
     qy = np.hstack([to_numpy(q[1]) for q in ends])
     bad = ~obstacles.moves_free(px, py, qx, qy, frame.to_world)
+    if not bad.any():  # nothing more to mask
+        return blocked
     cut = int(ends[0][0].shape[1])
     out = [xp.asarray(bad[:, :cut]), xp.asarray(bad[:, cut:])]
     return out if blocked is None else [b | o for b, o in zip(blocked, out, strict=True)]

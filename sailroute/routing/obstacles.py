@@ -587,16 +587,18 @@ def _cross_flat(a0: Any, b0: Any, a1: Any, b1: Any, e: NDArray[np.float64]) -> A
     o2 = _orient(a0, b0, a1, b1, ex1, ey1)
     o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
     o4 = _orient(ex0, ey0, ex1, ey1, a1, b1)
-    both = (o1 * o2 <= 0.0) & (o3 * o4 <= 0.0)
-    line = (o1 == 0.0) & (o2 == 0.0) & (o3 == 0.0) & (o4 == 0.0)
-    if line.any():  # collinear: they meet only where their extents overlap
-        over = (
-            (np.minimum(a0, a1) <= np.maximum(ex0, ex1))
-            & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
-            & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
-            & (np.maximum(b0, b1) >= np.minimum(ey0, ey1))
+    p12, p34 = o1 * o2, o3 * o4
+    both = (p12 <= 0.0) & (p34 <= 0.0)
+    maybe = np.flatnonzero(both & (p12 == 0.0) & (p34 == 0.0))  # holds every collinear pair
+    if maybe.size:
+        k = maybe[(o1[maybe] == 0.0) & (o2[maybe] == 0.0) & (o3[maybe] == 0.0) & (o4[maybe] == 0.0)]
+        # collinear: they meet only where their extents overlap
+        both[k] = (
+            (np.minimum(a0[k], a1[k]) <= np.maximum(ex0[k], ex1[k]))
+            & (np.maximum(a0[k], a1[k]) >= np.minimum(ex0[k], ex1[k]))
+            & (np.minimum(b0[k], b1[k]) <= np.maximum(ey0[k], ey1[k]))
+            & (np.maximum(b0[k], b1[k]) >= np.minimum(ey0[k], ey1[k]))
         )
-        both = np.where(line, over, both)
     return both
 
 
