@@ -184,6 +184,10 @@ class Obstacles:
     group_edge_box : tuple of ndarray
         ``xmin, ymin, xmax, ymax``, each ``(G, K)``: the bounding box [m] of each of them
         (NaN for the padding, which meets nothing).
+    core : shapely geometry or None
+        Where no move from free water can end without touching an edge: the grown
+        obstacles shrunk by :data:`CORE_M` and what lies farther than that outside the
+        shrunk boundary (prepared); None: nothing.
     """
 
     names: tuple[str, ...]
@@ -195,6 +199,7 @@ class Obstacles:
     group_start: NDArray[np.int64]
     group_edges: NDArray[np.float64]
     group_edge_box: tuple[NDArray[np.float64], ...]
+    core: Any
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -262,7 +267,8 @@ class Obstacles:
             ]
         ).reshape(-1, 4)
         padded, edge_box = _padded(edges, bounds)
-        return cls(tuple(names), inside, blocked, edges, own, box, bounds, padded, edge_box)
+        core = _core(inside, blocked)
+        return cls(tuple(names), inside, blocked, edges, own, box, bounds, padded, edge_box, core)
 
     # ------------------------------------------------------------------ predicates
     def points_free(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
@@ -387,9 +393,18 @@ class Obstacles:
             & (np.maximum(y0, y1) >= b[:, 1, None])
             & (np.minimum(y0, y1) <= b[:, 3, None])
         )
-        hit = self._pairs_cross((x0[p, 0], y0[p, 0], x1[p, j], y1[p, j]), None, g[p])
+        ex, ey = x1[p, j], y1[p, j]
+        # a move from free water that ends in the core crosses an edge; the others are
+        # tested edge by edge
+        hit = np.zeros(p.size, dtype=bool) if self.core is None else self._in_core(ex, ey)
+        k = np.flatnonzero(~hit)
+        hit[k] = self._pairs_cross((x0[p[k], 0], y0[p[k], 0], ex[k], ey[k]), None, g[p[k]])
         out[rows[r[p[hit]]], j[hit]] = False
         return out
+
+    def _in_core(self, x: Any, y: Any) -> NDArray[np.bool_]:
+        """True where ``(x, y)`` [m] lies in :attr:`core`."""
+        return np.asarray(shapely.contains_xy(self.core, x, y), dtype=bool)
 
     def _near_rows(
         self, lx: Any, ly: Any, qx: Any, qy: Any, tw: Callable[[Any, Any], tuple[Any, Any]]
@@ -548,6 +563,28 @@ def _same(x: Any, y: Any) -> tuple[Any, Any]:
 BOX_MARGIN_M: Final = 1e-3
 """Margin [m] of the box round a row's moves (:meth:`Obstacles.moves_free`): the change
 of frame rounds each end point by far less, so every move's end lies inside."""
+
+
+CORE_M: Final = 1e-3
+"""Depth [m] of the core (:attr:`Obstacles.core`): far more than the rounding of the
+orientation test, so a move that ends there crosses an edge by its arithmetic too."""
+
+
+def _core(inside: Any, blocked: Any) -> Any:
+    """The core of the blocked water (:attr:`Obstacles.core`), prepared, or None."""
+    parts = []
+    if blocked is not None:
+        parts.append(shapely.buffer(blocked, -CORE_M, quad_segs=QUAD_SEGS))
+    if inside is not None:
+        x0, y0, x1, y1 = shapely.bounds(inside)
+        pad = 1e6 + max(x1 - x0, y1 - y0)
+        far = shapely.box(x0 - pad, y0 - pad, x1 + pad, y1 + pad)
+        parts.append(shapely.difference(far, shapely.buffer(inside, CORE_M, quad_segs=QUAD_SEGS)))
+    core = shapely.union_all([g for g in parts if not g.is_empty])
+    if core.is_empty:
+        return None
+    shapely.prepare(core)
+    return core
 
 
 def _padded(
