@@ -184,10 +184,14 @@ class Obstacles:
     group_edge_box : tuple of ndarray
         ``xmin, ymin, xmax, ymax``, each ``(G, K)``: the bounding box [m] of each of them
         (NaN for the padding, which meets nothing).
-    core : shapely geometry or None
-        Where no move from free water can end without touching an edge: the grown
-        obstacles shrunk by :data:`CORE_M` and what lies farther than that outside the
-        shrunk boundary (prepared); None: nothing.
+    core_box : ndarray
+        ``(G, 4)`` per group of edges, a box ``xmin, ymin, xmax, ymax`` [m] of the
+        *core* of the blocked water, where no move from free water can end without
+        touching an edge: for an obstacle's groups, a box that lies :data:`CORE_M` or
+        more inside the obstacle (NaN where none was found); for the boundary's, the
+        box round the shrunk boundary grown by :data:`CORE_M` (outside it is core).
+    core_outer : ndarray of bool
+        ``(G,)`` the core of group ``g`` lies outside its box (the boundary's groups).
     """
 
     names: tuple[str, ...]
@@ -199,7 +203,8 @@ class Obstacles:
     group_start: NDArray[np.int64]
     group_edges: NDArray[np.float64]
     group_edge_box: tuple[NDArray[np.float64], ...]
-    core: Any
+    core_box: NDArray[np.float64]
+    core_outer: NDArray[np.bool_]
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -267,8 +272,26 @@ class Obstacles:
             ]
         ).reshape(-1, 4)
         padded, edge_box = _padded(edges, bounds)
-        core = _core(inside, blocked)
-        return cls(tuple(names), inside, blocked, edges, own, box, bounds, padded, edge_box, core)
+        cells = [_inner_box(g) for g in grown]
+        if inside is not None:  # beyond the box of the boundary's core
+            x0, y0, x1, y1 = shapely.bounds(shapely.buffer(inside, CORE_M, quad_segs=QUAD_SEGS))
+            cells.append((x0, y0, x1, y1))
+        first = own[bounds[:-1]]
+        core_box = np.asarray(cells, dtype=float).reshape(-1, 4)[first]
+        outer = np.asarray([names[k] == BOUNDARY_NAME for k in first], dtype=bool)
+        return cls(
+            tuple(names),
+            inside,
+            blocked,
+            edges,
+            own,
+            box,
+            bounds,
+            padded,
+            edge_box,
+            core_box,
+            outer,
+        )
 
     # ------------------------------------------------------------------ predicates
     def points_free(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
@@ -396,15 +419,18 @@ class Obstacles:
         ex, ey = x1[p, j], y1[p, j]
         # a move from free water that ends in the core crosses an edge; the others are
         # tested edge by edge
-        hit = np.zeros(p.size, dtype=bool) if self.core is None else self._in_core(ex, ey)
+        hit = self._in_core(ex, ey, g[p])
         k = np.flatnonzero(~hit)
         hit[k] = self._pairs_cross((x0[p[k], 0], y0[p[k], 0], ex[k], ey[k]), None, g[p[k]])
         out[rows[r[p[hit]]], j[hit]] = False
         return out
 
-    def _in_core(self, x: Any, y: Any) -> NDArray[np.bool_]:
-        """True where ``(x, y)`` [m] lies in :attr:`core`."""
-        return np.asarray(shapely.contains_xy(self.core, x, y), dtype=bool)
+    def _in_core(self, x: Any, y: Any, grp: Any) -> NDArray[np.bool_]:
+        """True where ``(x, y)`` [m] lies in the core of the blocked water by the box of
+        group ``grp`` (:attr:`core_box`; False where the box cannot tell)."""
+        b = self.core_box[grp]
+        inner = (x >= b[:, 0]) & (x <= b[:, 2]) & (y >= b[:, 1]) & (y <= b[:, 3])
+        return inner ^ self.core_outer[grp]
 
     def _near_rows(
         self, lx: Any, ly: Any, qx: Any, qy: Any, tw: Callable[[Any, Any], tuple[Any, Any]]
@@ -566,25 +592,25 @@ of frame rounds each end point by far less, so every move's end lies inside."""
 
 
 CORE_M: Final = 1e-3
-"""Depth [m] of the core (:attr:`Obstacles.core`): far more than the rounding of the
+"""Depth [m] of the core (:attr:`Obstacles.core_box`): far more than the rounding of the
 orientation test, so a move that ends there crosses an edge by its arithmetic too."""
 
 
-def _core(inside: Any, blocked: Any) -> Any:
-    """The core of the blocked water (:attr:`Obstacles.core`), prepared, or None."""
-    parts = []
-    if blocked is not None:
-        parts.append(shapely.buffer(blocked, -CORE_M, quad_segs=QUAD_SEGS))
-    if inside is not None:
-        x0, y0, x1, y1 = shapely.bounds(inside)
-        pad = 1e6 + max(x1 - x0, y1 - y0)
-        far = shapely.box(x0 - pad, y0 - pad, x1 + pad, y1 + pad)
-        parts.append(shapely.difference(far, shapely.buffer(inside, CORE_M, quad_segs=QUAD_SEGS)))
-    core = shapely.union_all([g for g in parts if not g.is_empty])
+def _inner_box(grown: Any) -> tuple[float, float, float, float]:
+    """A box inside the core of one grown obstacle (:data:`CORE_M` inside it): its
+    bounding box shrunk towards a point inside it until the core holds it; NaN if no
+    shrink of 1/64 or more fits."""
+    core = shapely.buffer(grown, -CORE_M, quad_segs=QUAD_SEGS)
     if core.is_empty:
-        return None
+        return (math.nan,) * 4
+    cx, cy = shapely.get_coordinates(shapely.point_on_surface(core))[0]
+    x0, y0, x1, y1 = shapely.bounds(core)
     shapely.prepare(core)
-    return core
+    for f in (1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.35, 0.25, 0.125, 1.0 / 64):
+        b = (cx + f * (x0 - cx), cy + f * (y0 - cy), cx + f * (x1 - cx), cy + f * (y1 - cy))
+        if shapely.contains(core, shapely.box(*b)):
+            return b
+    return (math.nan,) * 4
 
 
 def _padded(
