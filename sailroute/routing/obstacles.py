@@ -29,7 +29,7 @@ import dataclasses
 import itertools
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Final
 
 import numpy as np
@@ -205,6 +205,9 @@ class Obstacles:
     group_edge_box: tuple[NDArray[np.float64], ...]
     core_box: NDArray[np.float64]
     core_outer: NDArray[np.bool_]
+    _frames: dict[tuple[float, ...], NDArray[np.float64]] = field(
+        default_factory=dict, repr=False, compare=False
+    )
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -379,51 +382,99 @@ class Obstacles:
         qx, qy : array, shape (n, m)
             Their end points [m].
         to_world : callable, optional
-            ``to_world(x, y)``: the course frame from the frame of ``px, py, qx, qy``
-            (a rotation and a shift applied element by element, as the isochrone's leg
-            frame); only the ends of the moves that are tested are moved.  None: they
-            are in the course frame.
+            ``to_world(x, y)``: the course frame from the frame of ``px, py, qx, qy``, a
+            rotation and a shift applied element by element (the isochrone's leg frame);
+            only the ends of the moves that are tested are moved.  None: they are in the
+            course frame.
 
         Returns
         -------
         ndarray of bool, shape (n, m)
-            :meth:`segments_free` move by move (the same arithmetic), found with three
-            bounding-box filters: a row whose box round its moves meets no group of
-            edges is decided by its start alone; a move of the other rows is tested only
-            against the groups near its row whose box meets the move's, and within a
-            group only against the edges whose box meets it (:meth:`_pairs_cross`).
+            :meth:`segments_free` move by move, the same answers: a row whose moves'
+            box meets no group of edges (:attr:`group_box`, seen in the frame of the
+            moves) is decided by its start alone; a move of the other rows is blocked
+            if it ends in the core of the blocked water (:attr:`core_box`), else tested
+            against the groups near its row whose box meets its own, edge by edge
+            (:meth:`_pairs_cross`).
         """
-        tw = _same if to_world is None else to_world
         lx, ly = np.asarray(px, dtype=float), np.asarray(py, dtype=float)
         qx, qy = np.asarray(qx, dtype=float), np.asarray(qy, dtype=float)
+        tw = _same if to_world is None else to_world
         wx, wy = tw(lx, ly)
-        start_ok = self.points_free(wx, wy)
+        start_ok = self._free_xy(wx, wy)
         out = np.broadcast_to(start_ok[:, None], qx.shape).copy()
         if qx.shape[1] == 0 or self.group_box.shape[0] == 0:
             return out
-        near = self._near_rows(lx, ly, qx, qy, tw)
-        rows = np.flatnonzero(near.any(axis=1) & start_ok)
-        if rows.size == 0:
+        gb = self._boxes_in(to_world)
+        xlo, xhi = np.minimum(lx, qx.min(axis=1)), np.maximum(lx, qx.max(axis=1))
+        ylo, yhi = np.minimum(ly, qy.min(axis=1)), np.maximum(ly, qy.max(axis=1))
+        near = (xhi[:, None] >= gb[:, 0]) & (xlo[:, None] <= gb[:, 2])
+        near &= (yhi[:, None] >= gb[:, 1]) & (ylo[:, None] <= gb[:, 3])
+        near &= start_ok[:, None]
+        r, g = np.nonzero(near)  # (row, group) pairs
+        if r.size == 0:
             return out
-        r, g = np.nonzero(near[rows])  # (row, group) pairs
-        ex, ey = tw(qx[rows], qy[rows])
-        x0, y0 = wx[rows][r, None], wy[rows][r, None]
-        x1, y1 = ex[r], ey[r]
-        b = self.group_box[g]
+        x0, y0, x1, y1 = lx[r, None], ly[r, None], qx[r], qy[r]
+        b = gb[g]
         p, j = np.nonzero(
             (np.maximum(x0, x1) >= b[:, 0, None])
             & (np.minimum(x0, x1) <= b[:, 2, None])
             & (np.maximum(y0, y1) >= b[:, 1, None])
             & (np.minimum(y0, y1) <= b[:, 3, None])
         )
-        ex, ey = x1[p, j], y1[p, j]
+        row, grp = r[p], g[p]
+        ex, ey = tw(qx[row, j], qy[row, j])
         # a move from free water that ends in the core crosses an edge; the others are
         # tested edge by edge
-        hit = self._in_core(ex, ey, g[p])
+        hit = self._in_core(ex, ey, grp)
         k = np.flatnonzero(~hit)
-        hit[k] = self._pairs_cross((x0[p[k], 0], y0[p[k], 0], ex[k], ey[k]), None, g[p[k]])
-        out[rows[r[p[hit]]], j[hit]] = False
+        rk = row[k]
+        hit[k] = self._pairs_cross((wx[rk], wy[rk], ex[k], ey[k]), None, grp[k])
+        out[row[hit], j[hit]] = False
         return out
+
+    def _free_xy(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """:meth:`points_free` of float arrays of one shape."""
+        if self.inside is not None:
+            ok = np.asarray(shapely.contains_xy(self.inside, x, y), dtype=bool)
+        else:
+            ok = np.ones(x.shape, dtype=bool)
+        if self.blocked is not None:
+            ok &= ~np.asarray(shapely.intersects_xy(self.blocked, x, y), dtype=bool)
+        return ok
+
+    def _boxes_in(self, to_world: Callable[[Any, Any], tuple[Any, Any]] | None) -> Any:
+        """``(G, 4)`` the groups' bounding boxes seen in the frame that ``to_world``
+        leaves (the box round each box's corners moved back), grown by
+        :data:`BOX_MARGIN_M` against rounding; kept per frame."""
+        if to_world is None:
+            return self.group_box + BOX_MARGIN_M * np.array([-1.0, -1.0, 1.0, 1.0])
+        ox, oy = (float(v) for v in to_world(0.0, 0.0))
+        ax, ay = (float(v) - o for v, o in zip(to_world(1.0, 0.0), (ox, oy), strict=True))
+        bx, by = (float(v) - o for v, o in zip(to_world(0.0, 1.0), (ox, oy), strict=True))
+        key = (ox, oy, ax, ay, bx, by)
+        boxes = self._frames.get(key)
+        if boxes is None:
+            if len(self._frames) > 64:
+                self._frames.clear()
+            det = ax * by - ay * bx
+            b = self.group_box
+            cx = np.stack([b[:, 0], b[:, 0], b[:, 2], b[:, 2]], axis=1) - ox
+            cy = np.stack([b[:, 1], b[:, 3], b[:, 1], b[:, 3]], axis=1) - oy
+            x = (cx * by - cy * bx) / det
+            y = (cy * ax - cx * ay) / det
+            pad = BOX_MARGIN_M + 1e-9 * (np.abs(b).max(axis=1) + abs(ox) + abs(oy))
+            boxes = np.stack(
+                [
+                    x.min(axis=1) - pad,
+                    y.min(axis=1) - pad,
+                    x.max(axis=1) + pad,
+                    y.max(axis=1) + pad,
+                ],
+                axis=1,
+            )
+            self._frames[key] = boxes
+        return boxes
 
     def _in_core(self, x: Any, y: Any, grp: Any) -> NDArray[np.bool_]:
         """True where ``(x, y)`` [m] lies in the core of the blocked water by the box of
@@ -431,24 +482,6 @@ class Obstacles:
         b = self.core_box[grp]
         inner = (x >= b[:, 0]) & (x <= b[:, 2]) & (y >= b[:, 1]) & (y <= b[:, 3])
         return inner ^ self.core_outer[grp]
-
-    def _near_rows(
-        self, lx: Any, ly: Any, qx: Any, qy: Any, tw: Callable[[Any, Any], tuple[Any, Any]]
-    ) -> NDArray[np.bool_]:
-        """``(n, G)``: True where the group ``g``'s bounding box meets the box round
-        row ``n``'s moves (in their own frame: the square round the circle through its
-        corners in the course frame, grown by :data:`BOX_MARGIN_M` against rounding)."""
-        xlo, xhi = np.minimum(lx, qx.min(axis=1)), np.maximum(lx, qx.max(axis=1))
-        ylo, yhi = np.minimum(ly, qy.min(axis=1)), np.maximum(ly, qy.max(axis=1))
-        cx, cy = tw(0.5 * (xlo + xhi), 0.5 * (ylo + yhi))
-        rad = (0.5 * np.hypot(xhi - xlo, yhi - ylo) + BOX_MARGIN_M)[:, None]
-        b = self.group_box
-        return (
-            (cx[:, None] + rad >= b[:, 0])
-            & (cx[:, None] - rad <= b[:, 2])
-            & (cy[:, None] + rad >= b[:, 1])
-            & (cy[:, None] - rad <= b[:, 3])
-        )
 
     def _pairs_cross(
         self, segments: tuple[Any, Any, Any, Any], seg: Any, grp: NDArray[np.int64]
@@ -587,8 +620,8 @@ def _same(x: Any, y: Any) -> tuple[Any, Any]:
 
 
 BOX_MARGIN_M: Final = 1e-3
-"""Margin [m] of the box round a row's moves (:meth:`Obstacles.moves_free`): the change
-of frame rounds each end point by far less, so every move's end lies inside."""
+"""Margin [m] of the groups' boxes seen in the frame of the moves
+(:meth:`Obstacles.moves_free`): the change of frame rounds each point by far less."""
 
 
 CORE_M: Final = 1e-3
