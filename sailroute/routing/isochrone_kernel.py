@@ -1661,8 +1661,8 @@ def _obstacle_blocked(
     world frame only the ends it tests; the drift during a penalty pause is not tested
     separately)."""
     px, py = to_numpy(c.x), to_numpy(c.y)
-    qx = np.hstack([to_numpy(q[0]) for q in ends])  # both blocks in one call
-    qy = np.hstack([to_numpy(q[1]) for q in ends])
+    qx = np.concatenate([to_numpy(q[0]) for q in ends], axis=1)  # both blocks in one call
+    qy = np.concatenate([to_numpy(q[1]) for q in ends], axis=1)
     bad = ~obstacles.moves_free(px, py, qx, qy, frame.to_world)
     if not bad.any():  # nothing more to mask
         return blocked

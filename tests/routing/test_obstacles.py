@@ -22,6 +22,8 @@ from sailroute.routing.griddp import route_griddp
 from sailroute.routing.isochrone import route_isochrone
 from sailroute.routing.obstacles import (
     BOUNDARY_NAME,
+    CORE_M,
+    QUAD_SEGS,
     AreaPolygon,
     Obstacles,
     RaceArea,
@@ -159,6 +161,19 @@ def test_fan_in_a_rotated_frame_agrees_with_the_segment_test() -> None:
     theirs = obs.segments_free(wx[:, None], wy[:, None], *to_world(qx, qy))
     assert 0.2 < ours.mean() < 0.9  # both outcomes are exercised
     assert np.array_equal(ours, theirs)
+    # the moves that end in the core of the blocked water (blocked without the edge
+    # test) are among them; the obstacles' core boxes lie CORE_M or more inside them
+    ex, ey = to_world(qx, qy)
+    cores = obs.core_box[~obs.core_outer]
+    in_core = np.zeros(ex.shape, dtype=bool)
+    grown = [
+        shapely.buffer(o.polygon(), o.clearance_m, quad_segs=QUAD_SEGS) for o in area.obstacles
+    ]
+    for b in cores[np.isfinite(cores[:, 0])]:
+        core = shapely.box(*b)
+        assert any(shapely.contains(shapely.buffer(g, -CORE_M), core) for g in grown)
+        in_core |= (ex >= b[0]) & (ex <= b[2]) & (ey >= b[1]) & (ey <= b[3])
+    assert in_core.sum() > 100 and not np.any(theirs[in_core])
     # and in the course frame, with the shapely linestrings for a second opinion
     assert np.array_equal(obs.moves_free(wx, wy, *to_world(qx, qy)), theirs)
     free = obs.segments_free_shapely(wx[:, None], wy[:, None], *to_world(qx, qy))
