@@ -15,10 +15,11 @@ vectorised predicates that every router uses:
   through ``shapely.intersects`` on linestrings, kept for comparison: see
   ``benchmarks/bench_obstacles.py``);
 * :meth:`Obstacles.moves_free`: the same for a fan of moves from each of ``n``
-  points (the isochrone's candidates), testing exactly only the moves that can touch
-  an edge (three bounding-box filters: the point's moves against each group of
-  edges, each move against the groups near its point, then against each edge of
-  those groups).
+  points (the isochrone's candidates, in its leg frame), with the same answers for a
+  fraction of the work: bounding-box filters (the point's moves against each group of
+  edges, each move against the groups near its point, then against each edge of those
+  groups) and a box per group inside its blocked water (a move from free water that
+  ends there is blocked without the edge test).
 
 Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C).
 """
