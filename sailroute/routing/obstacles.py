@@ -316,7 +316,7 @@ class Obstacles:
         touching included, so a move through a vertex counts).  Each group of edges is
         tested only against the segments whose bounding box meets the group's, and each
         of its edges only against those whose bounding box meets the edge's
-        (:meth:`_pairs_cross`)."""
+        (:func:`_cross_flat`)."""
         a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
         shape = a[0].shape
         sx0, sy0, sx1, sy1 = (v.reshape(-1) for v in a)
@@ -325,14 +325,23 @@ class Obstacles:
             return hit.reshape(shape)
         xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
         ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
-        seg, grp = [np.zeros(0, dtype=np.int64)], [np.zeros(0, dtype=np.int64)]
+        width = np.diff(self.group_start)
         for g in range(self.group_box.shape[0]):
             b = self.group_box[g]
             idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
-            seg.append(idx)
-            grp.append(np.full(idx.size, g))
-        s = np.concatenate(seg)
-        hit[s[self._pairs_cross((sx0, sy0, sx1, sy1), s, np.concatenate(grp))]] = True
+            w = int(width[g])
+            xmin, ymin, xmax, ymax = (v[g, :w] for v in self.group_edge_box)
+            step = max(1, _CHUNK // w)
+            for i in range(0, idx.size, step):
+                s = idx[i : i + step]
+                meet = xhi[s, None] >= xmin
+                meet &= xlo[s, None] <= xmax
+                meet &= yhi[s, None] >= ymin
+                meet &= ylo[s, None] <= ymax
+                pair, edge = np.nonzero(meet)
+                s = s[pair]
+                e = self.group_edges[g, edge]
+                hit[s[_cross_flat(sx0[s], sy0[s], sx1[s], sy1[s], e)]] = True
         return hit.reshape(shape)
 
     def segments_free(
