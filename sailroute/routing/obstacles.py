@@ -499,27 +499,34 @@ class Obstacles:
         """Which (segment, group) pairs touch or cross an edge of the group.
 
         ``segments`` are the flat arrays ``x0, y0, x1, y1`` [m]; pair ``k`` is segment
-        ``seg[k]`` (``k`` when ``seg`` is None) with group ``grp[k]``.  Each pair is
-        tested against the edges of the group whose bounding boxes meet the segment's
-        (:func:`_cross_flat`), at most :data:`_CHUNK` (pair, edge) boxes at once.
+        ``seg[k]`` (``k`` when ``seg`` is None) with group ``grp[k]``.  The pairs of each
+        group are tested against the edges of the group whose bounding boxes meet the
+        segment's (:func:`_cross_flat`), at most :data:`_CHUNK` (pair, edge) boxes at once.
         """
         hit = np.zeros(grp.size, dtype=bool)
-        step = max(1, _CHUNK // self.group_edges.shape[1])
-        for i in range(0, grp.size, step):
-            g = grp[i : i + step]
-            if seg is None:
-                a0, b0, a1, b1 = (v[i : i + step] for v in segments)
-            else:
-                a0, b0, a1, b1 = (v[seg[i : i + step]] for v in segments)
-            xmin, ymin, xmax, ymax = (v[g] for v in self.group_edge_box)
-            meet = np.maximum(a0, a1)[:, None] >= xmin
-            meet &= np.minimum(a0, a1)[:, None] <= xmax
-            meet &= np.maximum(b0, b1)[:, None] >= ymin
-            meet &= np.minimum(b0, b1)[:, None] <= ymax
-            pair, edge = np.nonzero(meet)
-            e = self.group_edges[g[pair], edge]
-            crossed = _cross_flat(a0[pair], b0[pair], a1[pair], b1[pair], e)
-            hit[i + pair[crossed]] = True
+        if grp.size == 0:
+            return hit
+        sx0, sy0, sx1, sy1 = segments if seg is None else (v[seg] for v in segments)
+        xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
+        ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
+        order = np.argsort(grp, kind="stable")
+        cut = np.flatnonzero(np.diff(grp[order])) + 1
+        width = np.diff(self.group_start)
+        for run in np.split(order, cut):
+            g = int(grp[run[0]])
+            w = int(width[g])
+            xmin, ymin, xmax, ymax = (v[g, :w] for v in self.group_edge_box)
+            step = max(1, _CHUNK // w)
+            for i in range(0, run.size, step):
+                k = run[i : i + step]
+                meet = xhi[k, None] >= xmin
+                meet &= xlo[k, None] <= xmax
+                meet &= yhi[k, None] >= ymin
+                meet &= ylo[k, None] <= ymax
+                pair, edge = np.nonzero(meet)
+                k = k[pair]
+                e = self.group_edges[g, edge]
+                hit[k[_cross_flat(sx0[k], sy0[k], sx1[k], sy1[k], e)]] = True
         return hit
 
     def edge_distance(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
