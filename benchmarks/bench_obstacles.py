@@ -6,9 +6,11 @@ The course is a windward-leeward of 1000 m legs laid by the template in a unifor
 12 kn wind (no data files).  The obstructed copy adds a boundary 350 m or more round the marks
 (20 m clearance) and ten 40 m x 40 m obstacles (10 m clearance) scattered over the
 course area, some across the direct routes.  Each plan is timed as ``plan_course`` does
-it (wind, boat, every leg routed), the best of ``--repeat``; the script prints the
-machine's load average (``os.getloadavg``) before and after, both times, their ratio,
-and the race times (which differ: the obstructed routes go round).
+it (wind, boat, every leg routed), the two plans in turn, the best of ``--repeat`` each
+(so both see the same load); the script prints the machine's load average
+(``os.getloadavg``) before and after, both wall times, their ratio, the ratio of the
+process CPU times (less sensitive to other processes on a shared machine) and the race
+times (which differ: the obstructed routes go round).
 
 It also times the two forms of the segment predicate on 200 000 random moves:
 ``Obstacles.segments_free`` (an orientation test against every ring edge, NumPy) and
@@ -25,7 +27,7 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXP
     os.environ[_v] = "1"
 
 import argparse  # noqa: E402
-import sys  # noqa: E402
+import math  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -35,9 +37,6 @@ import numpy as np  # noqa: E402
 from sailroute.course.load import load_course  # noqa: E402
 from sailroute.planning.route import plan_course  # noqa: E402
 from sailroute.routing.obstacles import obstacles_for  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_polar import best_of  # noqa: E402  (one timing rule for the benchmarks)
 
 COURSE = """
 name: obstacle benchmark
@@ -114,12 +113,21 @@ def main() -> None:
     def run(name: str, course: object) -> None:
         plans[name] = plan_course(course, "steady").plan  # type: ignore[arg-type]
 
-    t_open = best_of(lambda: run("open", open_course), args.repeat)
-    t_area = best_of(lambda: run("area", area_course), args.repeat)
+    wall = {"open": math.inf, "area": math.inf}
+    cpu = dict(wall)
+    for _ in range(args.repeat):  # in turn, so that both see the same load
+        for name, course in (("open", open_course), ("area", area_course)):
+            w0, c0 = time.perf_counter(), time.process_time()
+            run(name, course)
+            wall[name] = min(wall[name], time.perf_counter() - w0)
+            cpu[name] = min(cpu[name], time.process_time() - c0)
+    t_open, t_area = wall["open"], wall["area"]
     print(f"plan, {args.router}, {args.laps} lap(s), {open_course.n_legs} legs:")
     print(f"  no obstacles        {t_open:7.2f} s  race {plans['open'].total_time_s:7.1f} s")
     print(f"  10 obstacles + area {t_area:7.2f} s  race {plans['area'].total_time_s:7.1f} s")
     print(f"  ratio {t_area / t_open:.2f} (target <= 1.30)")
+    c_open, c_area = cpu["open"], cpu["area"]
+    print(f"  CPU time {c_open:.2f} s and {c_area:.2f} s, ratio {c_area / c_open:.2f}")
 
     obs = obstacles_for(area_course.area)
     assert obs is not None

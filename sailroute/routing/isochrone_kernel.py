@@ -409,15 +409,18 @@ def _obstacle_blocked(
     frame: _LegFrame,
     obstacles: Obstacles,
     xp: ModuleType,
-) -> list[Any]:
+) -> list[Any] | None:
     """``blocked`` (:func:`_barrier_blocked`) with the moves that leave free water added:
     each move from its row's point to its end, in the world frame
-    (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`; the drift during a
-    penalty pause is not tested separately)."""
-    px, py = (to_numpy(v) for v in frame.to_world(c.x, c.y))
-    qx = np.hstack([to_numpy(q[0]) for q in ends])  # both blocks in one call
-    qy = np.hstack([to_numpy(q[1]) for q in ends])
-    bad = ~obstacles.moves_free(px, py, *frame.to_world(qx, qy))
+    (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`, which moves to the
+    world frame only the ends it tests; the drift during a penalty pause is not tested
+    separately)."""
+    px, py = to_numpy(c.x), to_numpy(c.y)
+    qx = np.concatenate([to_numpy(q[0]) for q in ends], axis=1)  # both blocks in one call
+    qy = np.concatenate([to_numpy(q[1]) for q in ends], axis=1)
+    bad = ~obstacles.moves_free(px, py, qx, qy, frame.to_world)
+    if not bad.any():  # nothing more to mask
+        return blocked
     cut = int(ends[0][0].shape[1])
     out = [xp.asarray(bad[:, :cut]), xp.asarray(bad[:, cut:])]
     return out if blocked is None else [b | o for b, o in zip(blocked, out, strict=True)]

@@ -15,8 +15,11 @@ vectorised predicates that every router uses:
   through ``shapely.intersects`` on linestrings, kept for comparison: see
   ``benchmarks/bench_obstacles.py``);
 * :meth:`Obstacles.moves_free`: the same for a fan of moves from each of ``n``
-  points (the isochrone's candidates), testing exactly only the points that lie
-  within one move of an edge.
+  points (the isochrone's candidates, in its leg frame), with the same answers for a
+  fraction of the work: bounding-box filters (the point's moves against each group of
+  edges, each move against the groups near its point, then against each edge of those
+  groups) and a box per group inside its blocked water (a move from free water that
+  ends there is blocked without the edge test).
 
 Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C).
 """
@@ -26,8 +29,8 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 from typing import Any, Final
 
 import numpy as np
@@ -176,6 +179,20 @@ class Obstacles:
         ``(G, 4)`` bounding box ``xmin, ymin, xmax, ymax`` [m] of each group of edges.
     group_start : ndarray of int
         ``(G + 1,)`` the groups' first edges (and the end).
+    group_edges : ndarray
+        ``(G, K, 4)`` each group's edges, padded to the largest group's ``K`` (the
+        padding is never read).
+    group_edge_box : tuple of ndarray
+        ``xmin, ymin, xmax, ymax``, each ``(G, K)``: the bounding box [m] of each of them
+        (NaN for the padding, which meets nothing).
+    core_box : ndarray
+        ``(G, 4)`` per group of edges, a box ``xmin, ymin, xmax, ymax`` [m] of the
+        *core* of the blocked water, where no move from free water can end without
+        touching an edge: for an obstacle's groups, a box that lies :data:`CORE_M` or
+        more inside the obstacle (NaN where none was found); for the boundary's, the
+        box round the shrunk boundary grown by :data:`CORE_M` (outside it is core).
+    core_outer : ndarray of bool
+        ``(G,)`` the core of group ``g`` lies outside its box (the boundary's groups).
     """
 
     names: tuple[str, ...]
@@ -185,6 +202,13 @@ class Obstacles:
     owner: NDArray[np.int64]
     group_box: NDArray[np.float64]
     group_start: NDArray[np.int64]
+    group_edges: NDArray[np.float64]
+    group_edge_box: tuple[NDArray[np.float64], ...]
+    core_box: NDArray[np.float64]
+    core_outer: NDArray[np.bool_]
+    _frames: dict[tuple[float, ...], NDArray[np.float64]] = field(
+        default_factory=dict, repr=False, compare=False
+    )
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -251,7 +275,27 @@ class Obstacles:
                 for a, b in itertools.pairwise(bounds)
             ]
         ).reshape(-1, 4)
-        return cls(tuple(names), inside, blocked, edges, own, box, bounds)
+        padded, edge_box = _padded(edges, bounds)
+        cells = [_inner_box(g) for g in grown]
+        if inside is not None:  # beyond the box of the boundary's core
+            x0, y0, x1, y1 = shapely.bounds(shapely.buffer(inside, CORE_M, quad_segs=QUAD_SEGS))
+            cells.append((x0, y0, x1, y1))
+        first = own[bounds[:-1]]
+        core_box = np.asarray(cells, dtype=float).reshape(-1, 4)[first]
+        outer = np.asarray([names[k] == BOUNDARY_NAME for k in first], dtype=bool)
+        return cls(
+            tuple(names),
+            inside,
+            blocked,
+            edges,
+            own,
+            box,
+            bounds,
+            padded,
+            edge_box,
+            core_box,
+            outer,
+        )
 
     # ------------------------------------------------------------------ predicates
     def points_free(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.bool_]:
@@ -270,7 +314,9 @@ class Obstacles:
     ) -> NDArray[np.bool_]:
         """True where the segment touches or crosses any ring edge (orientation test,
         touching included, so a move through a vertex counts).  Each group of edges is
-        tested only against the segments whose bounding box meets the group's."""
+        tested only against the segments whose bounding box meets the group's, and each
+        of its edges only against those whose bounding box meets the edge's
+        (:func:`_cross_flat`)."""
         a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
         shape = a[0].shape
         sx0, sy0, sx1, sy1 = (v.reshape(-1) for v in a)
@@ -279,12 +325,23 @@ class Obstacles:
             return hit.reshape(shape)
         xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
         ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
+        width = np.diff(self.group_start)
         for g in range(self.group_box.shape[0]):
             b = self.group_box[g]
             idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
-            if idx.size:
-                e = self.edges[self.group_start[g] : self.group_start[g + 1]]
-                hit[idx] |= _cross(sx0[idx], sy0[idx], sx1[idx], sy1[idx], e)
+            w = int(width[g])
+            xmin, ymin, xmax, ymax = (v[g, :w] for v in self.group_edge_box)
+            step = max(1, _CHUNK // w)
+            for i in range(0, idx.size, step):
+                s = idx[i : i + step]
+                meet = xhi[s, None] >= xmin
+                meet &= xlo[s, None] <= xmax
+                meet &= yhi[s, None] >= ymin
+                meet &= ylo[s, None] <= ymax
+                pair, edge = np.nonzero(meet)
+                s = s[pair]
+                e = self.group_edges[g, edge]
+                hit[s[_cross_flat(sx0[s], sy0[s], sx1[s], sy1[s], e)]] = True
         return hit.reshape(shape)
 
     def segments_free(
@@ -318,7 +375,14 @@ class Obstacles:
             ok &= ~shapely.intersects(self.blocked, lines)
         return ok.reshape(shape)
 
-    def moves_free(self, px: Any, py: Any, qx: Any, qy: Any) -> NDArray[np.bool_]:
+    def moves_free(
+        self,
+        px: Any,
+        py: Any,
+        qx: Any,
+        qy: Any,
+        to_world: Callable[[Any, Any], tuple[Any, Any]] | None = None,
+    ) -> NDArray[np.bool_]:
         """Which moves of a fan stay in free water.
 
         Parameters
@@ -327,44 +391,143 @@ class Obstacles:
             Start of the moves of each row [m].
         qx, qy : array, shape (n, m)
             Their end points [m].
+        to_world : callable, optional
+            ``to_world(x, y)``: the course frame from the frame of ``px, py, qx, qy``, a
+            rotation and a shift applied element by element (the isochrone's leg frame);
+            only the ends of the moves that are tested are moved.  None: they are in the
+            course frame.
 
         Returns
         -------
         ndarray of bool, shape (n, m)
-            A row whose start is farther than its longest move from every group's
-            bounding box is decided by its start alone; the others are tested move by
-            move (:meth:`segments_cross`).
+            :meth:`segments_free` move by move, the same answers: a row whose moves'
+            box meets no group of edges (:attr:`group_box`, seen in the frame of the
+            moves) is decided by its start alone; a move of the other rows is blocked
+            if it ends in the core of the blocked water (:attr:`core_box`), else tested
+            against the groups near its row whose box meets its own, edge by edge
+            (:meth:`_pairs_cross`).
         """
-        px, py = np.asarray(px, dtype=float), np.asarray(py, dtype=float)
+        lx, ly = np.asarray(px, dtype=float), np.asarray(py, dtype=float)
         qx, qy = np.asarray(qx, dtype=float), np.asarray(qy, dtype=float)
-        start_ok = self.points_free(px, py)
+        tw = _same if to_world is None else to_world
+        wx, wy = tw(lx, ly)
+        start_ok = self._free_xy(wx, wy)
         out = np.broadcast_to(start_ok[:, None], qx.shape).copy()
-        reach = np.max(np.hypot(qx - px[:, None], qy - py[:, None]), axis=1, initial=0.0)
-        r = reach[:, None]
-        b = self.group_box
-        near = (
-            (px[:, None] + r >= b[:, 0])
-            & (px[:, None] - r <= b[:, 2])
-            & (py[:, None] + r >= b[:, 1])
-            & (py[:, None] - r <= b[:, 3])
+        if qx.shape[1] == 0 or self.group_box.shape[0] == 0:
+            return out
+        gb = self._boxes_in(to_world)
+        xlo, xhi = np.minimum(lx, qx.min(axis=1)), np.maximum(lx, qx.max(axis=1))
+        ylo, yhi = np.minimum(ly, qy.min(axis=1)), np.maximum(ly, qy.max(axis=1))
+        near = (xhi[:, None] >= gb[:, 0]) & (xlo[:, None] <= gb[:, 2])
+        near &= (yhi[:, None] >= gb[:, 1]) & (ylo[:, None] <= gb[:, 3])
+        near &= start_ok[:, None]
+        r, g = np.nonzero(near)  # (row, group) pairs
+        if r.size == 0:
+            return out
+        x0, y0, x1, y1 = lx[r, None], ly[r, None], qx[r], qy[r]
+        b = gb[g]
+        p, j = np.nonzero(
+            (np.maximum(x0, x1) >= b[:, 0, None])
+            & (np.minimum(x0, x1) <= b[:, 2, None])
+            & (np.maximum(y0, y1) >= b[:, 1, None])
+            & (np.minimum(y0, y1) <= b[:, 3, None])
         )
-        for g in np.flatnonzero(near.any(axis=0)):
-            rows = np.flatnonzero(near[:, g])
-            sx1, sy1 = qx[rows], qy[rows]
-            sx0 = np.broadcast_to(px[rows, None], sx1.shape)
-            sy0 = np.broadcast_to(py[rows, None], sx1.shape)
-            box = (
-                (np.maximum(sx0, sx1) >= b[g, 0])
-                & (np.minimum(sx0, sx1) <= b[g, 2])
-                & (np.maximum(sy0, sy1) >= b[g, 1])
-                & (np.minimum(sy0, sy1) <= b[g, 3])
-            )
-            ri, ci = np.nonzero(box)
-            if ri.size:
-                e = self.edges[self.group_start[g] : self.group_start[g + 1]]
-                hit = _cross(sx0[ri, ci], sy0[ri, ci], sx1[ri, ci], sy1[ri, ci], e)
-                out[rows[ri[hit]], ci[hit]] = False
+        row, grp = r[p], g[p]
+        ex, ey = tw(qx[row, j], qy[row, j])
+        # a move from free water that ends in the core crosses an edge; the others are
+        # tested edge by edge
+        hit = self._in_core(ex, ey, grp)
+        k = np.flatnonzero(~hit)
+        rk = row[k]
+        hit[k] = self._pairs_cross((wx[rk], wy[rk], ex[k], ey[k]), None, grp[k])
+        out[row[hit], j[hit]] = False
         return out
+
+    def _free_xy(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """:meth:`points_free` of float arrays of one shape."""
+        if self.inside is not None:
+            ok = np.asarray(shapely.contains_xy(self.inside, x, y), dtype=bool)
+        else:
+            ok = np.ones(x.shape, dtype=bool)
+        if self.blocked is not None:
+            ok &= ~np.asarray(shapely.intersects_xy(self.blocked, x, y), dtype=bool)
+        return ok
+
+    def _boxes_in(self, to_world: Callable[[Any, Any], tuple[Any, Any]] | None) -> Any:
+        """``(G, 4)`` the groups' bounding boxes seen in the frame that ``to_world``
+        leaves (the box round each box's corners moved back), grown by
+        :data:`BOX_MARGIN_M` against rounding; kept per frame."""
+        if to_world is None:
+            return self.group_box + BOX_MARGIN_M * np.array([-1.0, -1.0, 1.0, 1.0])
+        ox, oy = (float(v) for v in to_world(0.0, 0.0))
+        ax, ay = (float(v) - o for v, o in zip(to_world(1.0, 0.0), (ox, oy), strict=True))
+        bx, by = (float(v) - o for v, o in zip(to_world(0.0, 1.0), (ox, oy), strict=True))
+        key = (ox, oy, ax, ay, bx, by)
+        boxes = self._frames.get(key)
+        if boxes is None:
+            if len(self._frames) > 64:
+                self._frames.clear()
+            det = ax * by - ay * bx
+            b = self.group_box
+            cx = np.stack([b[:, 0], b[:, 0], b[:, 2], b[:, 2]], axis=1) - ox
+            cy = np.stack([b[:, 1], b[:, 3], b[:, 1], b[:, 3]], axis=1) - oy
+            x = (cx * by - cy * bx) / det
+            y = (cy * ax - cx * ay) / det
+            pad = BOX_MARGIN_M + 1e-9 * (np.abs(b).max(axis=1) + abs(ox) + abs(oy))
+            boxes = np.stack(
+                [
+                    x.min(axis=1) - pad,
+                    y.min(axis=1) - pad,
+                    x.max(axis=1) + pad,
+                    y.max(axis=1) + pad,
+                ],
+                axis=1,
+            )
+            self._frames[key] = boxes
+        return boxes
+
+    def _in_core(self, x: Any, y: Any, grp: Any) -> NDArray[np.bool_]:
+        """True where ``(x, y)`` [m] lies in the core of the blocked water by the box of
+        group ``grp`` (:attr:`core_box`; False where the box cannot tell)."""
+        b = self.core_box[grp]
+        inner = (x >= b[:, 0]) & (x <= b[:, 2]) & (y >= b[:, 1]) & (y <= b[:, 3])
+        return inner ^ self.core_outer[grp]
+
+    def _pairs_cross(
+        self, segments: tuple[Any, Any, Any, Any], seg: Any, grp: NDArray[np.int64]
+    ) -> NDArray[np.bool_]:
+        """Which (segment, group) pairs touch or cross an edge of the group.
+
+        ``segments`` are the flat arrays ``x0, y0, x1, y1`` [m]; pair ``k`` is segment
+        ``seg[k]`` (``k`` when ``seg`` is None) with group ``grp[k]``.  The pairs of each
+        group are tested against the edges of the group whose bounding boxes meet the
+        segment's (:func:`_cross_flat`), at most :data:`_CHUNK` (pair, edge) boxes at once.
+        """
+        hit = np.zeros(grp.size, dtype=bool)
+        if grp.size == 0:
+            return hit
+        sx0, sy0, sx1, sy1 = segments if seg is None else (v[seg] for v in segments)
+        xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
+        ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
+        order = np.argsort(grp, kind="stable")
+        cut = np.flatnonzero(np.diff(grp[order])) + 1
+        width = np.diff(self.group_start)
+        for run in np.split(order, cut):
+            g = int(grp[run[0]])
+            w = int(width[g])
+            xmin, ymin, xmax, ymax = (v[g, :w] for v in self.group_edge_box)
+            step = max(1, _CHUNK // w)
+            for i in range(0, run.size, step):
+                k = run[i : i + step]
+                meet = xhi[k, None] >= xmin
+                meet &= xlo[k, None] <= xmax
+                meet &= yhi[k, None] >= ymin
+                meet &= ylo[k, None] <= ymax
+                pair, edge = np.nonzero(meet)
+                k = k[pair]
+                e = self.group_edges[g, edge]
+                hit[k[_cross_flat(sx0[k], sy0[k], sx1[k], sy1[k], e)]] = True
+        return hit
 
     def edge_distance(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
         """Distance [m] from each point to the nearest ring edge."""
@@ -468,38 +631,88 @@ OBSTACLE_RUN: Final = 32
 """Most edges of an obstacle per group (a grown rectangle has 20: one group)."""
 
 
+def _same(x: Any, y: Any) -> tuple[Any, Any]:
+    """The identity change of frame (:meth:`Obstacles.moves_free`)."""
+    return x, y
+
+
+BOX_MARGIN_M: Final = 1e-3
+"""Margin [m] of the groups' boxes seen in the frame of the moves
+(:meth:`Obstacles.moves_free`): the change of frame rounds each point by far less."""
+
+
+CORE_M: Final = 1e-3
+"""Depth [m] of the core (:attr:`Obstacles.core_box`): far more than the rounding of the
+orientation test, so a move that ends there crosses an edge by its arithmetic too."""
+
+
+def _inner_box(grown: Any) -> tuple[float, float, float, float]:
+    """A box inside the core of one grown obstacle (:data:`CORE_M` inside it): its
+    bounding box shrunk towards a point inside it until the core holds it; NaN if no
+    shrink of 1/64 or more fits."""
+    core = shapely.buffer(grown, -CORE_M, quad_segs=QUAD_SEGS)
+    if core.is_empty:
+        return (math.nan,) * 4
+    cx, cy = shapely.get_coordinates(shapely.point_on_surface(core))[0]
+    x0, y0, x1, y1 = shapely.bounds(core)
+    shapely.prepare(core)
+    for f in (1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.35, 0.25, 0.125, 1.0 / 64):
+        b = (cx + f * (x0 - cx), cy + f * (y0 - cy), cx + f * (x1 - cx), cy + f * (y1 - cy))
+        if shapely.contains(core, shapely.box(*b)):
+            return b
+    return (math.nan,) * 4
+
+
+def _padded(
+    edges: NDArray[np.float64], bounds: NDArray[np.int64]
+) -> tuple[NDArray[np.float64], tuple[NDArray[np.float64], ...]]:
+    """``(G, K, 4)`` the edges of each group ``bounds[g]:bounds[g + 1]``, padded to the
+    largest group's ``K`` (copies of the group's first edge), and their bounding boxes:
+    ``xmin, ymin, xmax, ymax``, each ``(G, K)`` (NaN for the padding)."""
+    width = np.diff(bounds)
+    if width.size == 0:
+        return np.zeros((0, 1, 4)), tuple(np.zeros((0, 1)) for _ in range(4))
+    k = np.arange(int(width.max()))
+    pad = k >= width[:, None]
+    e = edges[bounds[:-1, None] + np.where(pad, 0, k)]
+    box = (
+        np.minimum(e[..., 0], e[..., 2]),
+        np.minimum(e[..., 1], e[..., 3]),
+        np.maximum(e[..., 0], e[..., 2]),
+        np.maximum(e[..., 1], e[..., 3]),
+    )
+    for v in box:
+        v[pad] = np.nan
+    return e, box
+
+
 def _first(owner: NDArray[np.int64], i: int) -> int:
     """Index of the first edge with the owner of edge ``i``."""
     return int(np.flatnonzero(owner == owner[i])[0])
 
 
-def _cross(sx0: Any, sy0: Any, sx1: Any, sy1: Any, e: NDArray[np.float64]) -> Any:
-    """Segments (shape (m,)) that touch or cross any of the edges ``e`` (shape (k, 4)),
-    in chunks of at most :data:`_CHUNK` pairs."""
-    hit = np.zeros(sx0.size, dtype=bool)
-    ex0, ey0, ex1, ey1 = (e[:, k] for k in range(4))
-    step = max(1, _CHUNK // max(1, e.shape[0]))
-    for i in range(0, sx0.size, step):
-        a0, b0 = sx0[i : i + step, None], sy0[i : i + step, None]
-        a1, b1 = sx1[i : i + step, None], sy1[i : i + step, None]
-        o1 = _orient(a0, b0, a1, b1, ex0, ey0)
-        o2 = _orient(a0, b0, a1, b1, ex1, ey1)
-        o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
-        o4 = _orient(ex0, ey0, ex1, ey1, a1, b1)
-        both = (o1 * o2 <= 0.0) & (o3 * o4 <= 0.0)
-        # collinear pairs (and a point on an edge's line) meet only where their extents
-        # overlap
-        line = (o1 == 0.0) & (o2 == 0.0) & (o3 == 0.0) & (o4 == 0.0)
-        if line.any():
-            over = (
-                (np.minimum(a0, a1) <= np.maximum(ex0, ex1))
-                & (np.maximum(a0, a1) >= np.minimum(ex0, ex1))
-                & (np.minimum(b0, b1) <= np.maximum(ey0, ey1))
-                & (np.maximum(b0, b1) >= np.minimum(ey0, ey1))
-            )
-            both = np.where(line, over, both)
-        hit[i : i + step] = both.any(axis=1)
-    return hit
+def _cross_flat(a0: Any, b0: Any, a1: Any, b1: Any, e: NDArray[np.float64]) -> Any:
+    """Which segments ``(a0, b0) -> (a1, b1)`` (shape (p,)) touch or cross their own edge
+    ``e[k]`` (shape (p, 4)): both ends of each on either side of (or on) the other's
+    line; collinear pairs meet only where their extents overlap."""
+    ex0, ey0, ex1, ey1 = e[:, 0], e[:, 1], e[:, 2], e[:, 3]
+    o1 = _orient(a0, b0, a1, b1, ex0, ey0)
+    o2 = _orient(a0, b0, a1, b1, ex1, ey1)
+    o3 = _orient(ex0, ey0, ex1, ey1, a0, b0)
+    o4 = _orient(ex0, ey0, ex1, ey1, a1, b1)
+    p12, p34 = o1 * o2, o3 * o4
+    both = (p12 <= 0.0) & (p34 <= 0.0)
+    maybe = np.flatnonzero(both & (p12 == 0.0) & (p34 == 0.0))  # holds every collinear pair
+    if maybe.size:
+        k = maybe[(o1[maybe] == 0.0) & (o2[maybe] == 0.0) & (o3[maybe] == 0.0) & (o4[maybe] == 0.0)]
+        # collinear: they meet only where their extents overlap
+        both[k] = (
+            (np.minimum(a0[k], a1[k]) <= np.maximum(ex0[k], ex1[k]))
+            & (np.maximum(a0[k], a1[k]) >= np.minimum(ex0[k], ex1[k]))
+            & (np.minimum(b0[k], b1[k]) <= np.maximum(ey0[k], ey1[k]))
+            & (np.maximum(b0[k], b1[k]) >= np.minimum(ey0[k], ey1[k]))
+        )
+    return both
 
 
 def _orient(ax: Any, ay: Any, bx: Any, by: Any, cx: Any, cy: Any) -> Any:

@@ -21,6 +21,8 @@ from sailroute.routing.griddp import route_griddp
 from sailroute.routing.isochrone import route_isochrone
 from sailroute.routing.obstacles import (
     BOUNDARY_NAME,
+    CORE_M,
+    QUAD_SEGS,
     AreaPolygon,
     Obstacles,
     RaceArea,
@@ -121,6 +123,61 @@ def test_edge_test_agrees_with_shapely_linestrings() -> None:
     assert np.array_equal(
         obs.moves_free(px, py, qx, qy), obs.segments_free(px[:, None], py[:, None], qx, qy)
     )
+
+
+def test_fan_in_a_rotated_frame_agrees_with_the_segment_test() -> None:
+    # the isochrone's form: fans in its leg frame (rotated and shifted), only the tested
+    # ends moved to the course frame; obstacles of 4 to 70 edges (groups of 32 and a
+    # rest, padded), a boundary with clearance, moves of every length from none to
+    # several edges' widths; the answer is the course-frame segment test move by move
+    disc = AreaPolygon(
+        "disc",
+        tuple(120 + 60 * np.cos(np.linspace(0, 2 * np.pi, 70, endpoint=False))),
+        tuple(-80 + 60 * np.sin(np.linspace(0, 2 * np.pi, 70, endpoint=False))),
+        4.0,
+    )
+    tri = AreaPolygon("tri", (-200.0, -120.0, -160.0), (150.0, 150.0, 260.0))
+    area = RaceArea(
+        rect("bound", -400, 400, -300, 300, clearance=15.0),
+        (disc, tri, rect("pier", 0, 10, 0, 200), rect("box", -300, -250, -200, -120, 8.0)),
+    )
+    obs = Obstacles.build(area)
+    assert obs is not None
+    assert obs.group_edges.shape[1] == 32 and obs.group_box.shape[0] > 8
+    ang = math.radians(37.0)
+    fx, fy, cx, cy = math.sin(ang), math.cos(ang), 35.0, -20.0
+
+    def to_world(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return cx + x * fy + y * fx, cy - x * fx + y * fy
+
+    rng = np.random.default_rng(5)
+    n, m = 400, 60
+    px, py = rng.uniform(-450, 450, n), rng.uniform(-450, 450, n)
+    length = rng.uniform(0, 120, (n, m)) * (rng.uniform(size=(n, m)) > 0.05)
+    heading = rng.uniform(0, 2 * np.pi, (n, m))
+    qx, qy = px[:, None] + length * np.sin(heading), py[:, None] + length * np.cos(heading)
+    ours = obs.moves_free(px, py, qx, qy, to_world)
+    wx, wy = to_world(px, py)
+    theirs = obs.segments_free(wx[:, None], wy[:, None], *to_world(qx, qy))
+    assert 0.2 < ours.mean() < 0.9  # both outcomes are exercised
+    assert np.array_equal(ours, theirs)
+    # the moves that end in the core of the blocked water (blocked without the edge
+    # test) are among them; the obstacles' core boxes lie CORE_M or more inside them
+    ex, ey = to_world(qx, qy)
+    cores = obs.core_box[~obs.core_outer]
+    in_core = np.zeros(ex.shape, dtype=bool)
+    grown = [
+        shapely.buffer(o.polygon(), o.clearance_m, quad_segs=QUAD_SEGS) for o in area.obstacles
+    ]
+    for b in cores[np.isfinite(cores[:, 0])]:
+        core = shapely.box(*b)
+        assert any(shapely.contains(shapely.buffer(g, -CORE_M), core) for g in grown)
+        in_core |= (ex >= b[0]) & (ex <= b[2]) & (ey >= b[1]) & (ey <= b[3])
+    assert in_core.sum() > 100 and not np.any(theirs[in_core])
+    # and in the course frame, with the shapely linestrings for a second opinion
+    assert np.array_equal(obs.moves_free(wx, wy, *to_world(qx, qy)), theirs)
+    free = obs.segments_free_shapely(wx[:, None], wy[:, None], *to_world(qx, qy))
+    assert np.mean(free == theirs) > 0.999  # the same up to touching
 
 
 def test_clearance_grows_obstacles_and_shrinks_the_boundary() -> None:
