@@ -452,8 +452,9 @@ def _prepare(
     first_clear = (
         None if groups is None or groups.clearance is None else groups.clearance[groups.member]
     )
-    near, near_barrier = _within_reach(x, y, top_ms * dt * 1.0001, ctx, xp, first_clear)
-    box_clear = ctx.box is None or _box_holds(x, y, top_ms * dt * 1.0001, ctx, xp)
+    reach = top_ms * dt * 1.0001
+    near, near_barrier = _within_reach(x, y, reach, ctx, xp, first_clear)
+    box_clear = ctx.box is None or _box_holds(x, y, reach, ctx, xp)
 
     pre = _StepInputs(
         t=f.t,
@@ -477,5 +478,7 @@ def _prepare(
         fan_hi=fan_hi,
         box_clear=box_clear,
         first_clear=first_clear,
+        starts_free=ctx.obstacles is not None and not bool(xp.any(f.parent < 0)),
+        reach_m=reach,
     )
     return pre, tau_min, dist_min

@@ -414,11 +414,17 @@ def _obstacle_blocked(
     each move from its row's point to its end, in the world frame
     (:meth:`~sailroute.routing.obstacles.Obstacles.moves_free`, which moves to the
     world frame only the ends it tests; the drift during a penalty pause is not tested
-    separately)."""
+    separately).  The points themselves are tested for free water only in the leg's
+    start layer (:attr:`_StepInputs.starts_free`): every later point ends a move found free."""
     px, py = to_numpy(c.x), to_numpy(c.y)
+    reach = None if c.reach_m is None else to_numpy(c.reach_m)
+    if c.starts_free and reach is not None and obstacles.fan_clear(px, py, reach, frame.to_world):
+        return blocked  # the whole front is far from the race area's edges
     qx = np.concatenate([to_numpy(q[0]) for q in ends], axis=1)  # both blocks in one call
     qy = np.concatenate([to_numpy(q[1]) for q in ends], axis=1)
-    bad = ~obstacles.moves_free(px, py, qx, qy, frame.to_world)
+    bad = ~obstacles.moves_free(
+        px, py, qx, qy, frame.to_world, starts_free=c.starts_free, reach=reach
+    )
     if not bad.any():  # nothing more to mask
         return blocked
     cut = int(ends[0][0].shape[1])

@@ -364,6 +364,12 @@ class _StepInputs(NamedTuple):
     first_clear : array or None
         Members: each point's clearance from the mark of the first barrier of the leg
         (the start's, :attr:`Groups.clearance`) [m]; None: the barrier's own.
+    starts_free : bool
+        Every point ends a move found in free water (no point of the leg's start
+        layer), so the race-area test need not test the points themselves.
+    reach_m : array or None
+        An upper bound of each point's move length in the step [m] (the fastest polar
+        speed of its wind, plus the current, times the step); None: unknown.
     """
 
     t: Any
@@ -387,6 +393,8 @@ class _StepInputs(NamedTuple):
     fan_hi: Any = None
     box_clear: bool = True
     first_clear: Any = None
+    starts_free: bool = False
+    reach_m: Any = None
 
     @property
     def n(self) -> int:
@@ -431,6 +439,8 @@ class _StepInputs(NamedTuple):
             fan_hi=None if self.fan_hi is None else self.fan_hi[sl],
             box_clear=self.box_clear,
             first_clear=None if self.first_clear is None else self.first_clear[sl],
+            starts_free=self.starts_free,
+            reach_m=None if self.reach_m is None else self.reach_m[sl],
         )
 
 

@@ -209,6 +209,7 @@ class Obstacles:
     _frames: dict[tuple[float, ...], NDArray[np.float64]] = field(
         default_factory=dict, repr=False, compare=False
     )
+    _last: list[Any] = field(default_factory=list, repr=False, compare=False)
 
     @classmethod
     def build(cls, area: RaceArea, extra: Sequence[Any] = ()) -> Obstacles | None:
@@ -382,6 +383,9 @@ class Obstacles:
         qx: Any,
         qy: Any,
         to_world: Callable[[Any, Any], tuple[Any, Any]] | None = None,
+        *,
+        starts_free: bool = False,
+        reach: ArrayLike | None = None,
     ) -> NDArray[np.bool_]:
         """Which moves of a fan stay in free water.
 
@@ -396,6 +400,14 @@ class Obstacles:
             rotation and a shift applied element by element (the isochrone's leg frame);
             only the ends of the moves that are tested are moved.  None: they are in the
             course frame.
+        starts_free : bool
+            The caller knows every start is in free water, so it is not tested again
+            (an isochrone front after the first: each of its points ends a move found
+            free).
+        reach : array, shape (n,), optional
+            An upper bound of each row's move lengths [m] (the moves' box is then the
+            square round the start, not the box of the ends: a cheaper filter, the same
+            answers).
 
         Returns
         -------
@@ -411,13 +423,17 @@ class Obstacles:
         qx, qy = np.asarray(qx, dtype=float), np.asarray(qy, dtype=float)
         tw = _same if to_world is None else to_world
         wx, wy = tw(lx, ly)
-        start_ok = self._free_xy(wx, wy)
+        start_ok = np.ones(lx.shape, dtype=bool) if starts_free else self._free_xy(wx, wy)
         out = np.broadcast_to(start_ok[:, None], qx.shape).copy()
         if qx.shape[1] == 0 or self.group_box.shape[0] == 0:
             return out
         gb = self._boxes_in(to_world)
-        xlo, xhi = np.minimum(lx, qx.min(axis=1)), np.maximum(lx, qx.max(axis=1))
-        ylo, yhi = np.minimum(ly, qy.min(axis=1)), np.maximum(ly, qy.max(axis=1))
+        if reach is None:
+            xlo, xhi = np.minimum(lx, qx.min(axis=1)), np.maximum(lx, qx.max(axis=1))
+            ylo, yhi = np.minimum(ly, qy.min(axis=1)), np.maximum(ly, qy.max(axis=1))
+        else:
+            rr = np.asarray(reach, dtype=float)
+            xlo, xhi, ylo, yhi = lx - rr, lx + rr, ly - rr, ly + rr
         near = (xhi[:, None] >= gb[:, 0]) & (xlo[:, None] <= gb[:, 2])
         near &= (yhi[:, None] >= gb[:, 1]) & (ylo[:, None] <= gb[:, 3])
         near &= start_ok[:, None]
@@ -443,6 +459,26 @@ class Obstacles:
         out[row[hit], j[hit]] = False
         return out
 
+    def fan_clear(
+        self,
+        px: Any,
+        py: Any,
+        reach: Any,
+        to_world: Callable[[Any, Any], tuple[Any, Any]] | None = None,
+    ) -> bool:
+        """Whether no move of a fan can come near an edge: the box round every start
+        ``px, py`` [m] grown by the largest ``reach`` [m] meets no group's box (seen in
+        the frame of the moves, as in :meth:`moves_free`).  Then every move from free
+        water stays in free water, and :meth:`moves_free` need not be called."""
+        if self.group_box.shape[0] == 0 or np.size(px) == 0:
+            return True
+        r = float(np.max(reach))
+        x0, x1 = float(np.min(px)) - r, float(np.max(px)) + r
+        y0, y1 = float(np.min(py)) - r, float(np.max(py)) + r
+        gb = self._boxes_in(to_world)
+        near = (x1 >= gb[:, 0]) & (x0 <= gb[:, 2]) & (y1 >= gb[:, 1]) & (y0 <= gb[:, 3])
+        return not bool(near.any())
+
     def _free_xy(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.bool_]:
         """:meth:`points_free` of float arrays of one shape."""
         if self.inside is not None:
@@ -459,6 +495,17 @@ class Obstacles:
         :data:`BOX_MARGIN_M` against rounding; kept per frame."""
         if to_world is None:
             return self.group_box + BOX_MARGIN_M * np.array([-1.0, -1.0, 1.0, 1.0])
+        owner = getattr(to_world, "__self__", None)  # a frozen frame's bound method
+        last = self._last[0] if self._last else None  # (frame, boxes), read at once
+        if owner is not None and last is not None and last[0] is owner:
+            return last[1]
+        boxes = self._boxes_of(to_world)
+        if owner is not None:
+            self._last[:] = [(owner, boxes)]
+        return boxes
+
+    def _boxes_of(self, to_world: Callable[[Any, Any], tuple[Any, Any]]) -> Any:
+        """:meth:`_boxes_in` for one frame, kept per its transform (at most 64)."""
         ox, oy = (float(v) for v in to_world(0.0, 0.0))
         ax, ay = (float(v) - o for v, o in zip(to_world(1.0, 0.0), (ox, oy), strict=True))
         bx, by = (float(v) - o for v, o in zip(to_world(0.0, 1.0), (ox, oy), strict=True))
