@@ -9,6 +9,7 @@ follows from the channel's width, its length and the VMG angle.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import pytest
@@ -178,6 +179,62 @@ def test_fan_in_a_rotated_frame_agrees_with_the_segment_test() -> None:
     assert np.array_equal(obs.moves_free(wx, wy, *to_world(qx, qy)), theirs)
     free = obs.segments_free_shapely(wx[:, None], wy[:, None], *to_world(qx, qy))
     assert np.mean(free == theirs) > 0.999  # the same up to touching
+
+
+@dataclass(frozen=True)
+class _Frame:
+    """A rotated, shifted frame whose bound ``to_world`` the move test may cache by."""
+
+    deg: float
+    cx: float
+    cy: float
+
+    def to_world(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        fx, fy = math.sin(math.radians(self.deg)), math.cos(math.radians(self.deg))
+        return self.cx + x * fy + y * fx, self.cy - x * fx + y * fy
+
+
+def test_the_isochrone_shortcuts_give_the_segment_test_answers() -> None:
+    # the isochrone's calls: starts known free (a front after the first), the rows'
+    # reach bound instead of their ends' box, a whole front far from every edge skipped,
+    # and two frames in turn (the groups' boxes kept for the last one): the same answers
+    # as the course-frame segment test, move by move
+    area = RaceArea(
+        rect("bound", -400, 400, -300, 300, clearance=15.0),
+        (rect("pier", 0, 10, 0, 200), rect("box", -300, -250, -200, -120, 8.0)),
+    )
+    obs = Obstacles.build(area)
+    assert obs is not None
+    rng = np.random.default_rng(11)
+    n, m = 300, 40
+    for frame in (_Frame(37.0, 35.0, -20.0), _Frame(-120.0, -60.0, 15.0)) * 2:
+        px, py = rng.uniform(-420, 420, n), rng.uniform(-420, 420, n)
+        wx, wy = frame.to_world(px, py)
+        keep = obs.points_free(wx, wy)  # starts in free water only
+        px, py, wx, wy = px[keep], py[keep], wx[keep], wy[keep]
+        reach = rng.uniform(0, 80, px.size)
+        length = reach[:, None] * rng.uniform(0, 1, (px.size, m))
+        heading = rng.uniform(0, 2 * np.pi, (px.size, m))
+        qx = px[:, None] + length * np.sin(heading)
+        qy = py[:, None] + length * np.cos(heading)
+        theirs = obs.segments_free(wx[:, None], wy[:, None], *frame.to_world(qx, qy))
+        assert 0.5 < theirs.mean() < 1.0
+        for kw in (
+            {},
+            {"starts_free": True},
+            {"reach": reach},
+            {"starts_free": True, "reach": reach},
+        ):
+            assert np.array_equal(obs.moves_free(px, py, qx, qy, frame.to_world, **kw), theirs)
+    # a front far from every edge: clear, and nothing of it blocked; one near: not clear
+    frame = _Frame(10.0, 0.0, 0.0)
+    px, py = np.array([200.0, 210.0]), np.array([-150.0, -140.0])
+    far = np.array([5.0, 5.0])
+    assert obs.fan_clear(px, py, far, frame.to_world)
+    qx = px[:, None] + np.array([[-5.0, 0.0, 5.0]])
+    assert obs.moves_free(px, py, qx, py[:, None] + 0 * qx, frame.to_world).all()
+    assert not obs.fan_clear(px, py, np.array([5.0, 400.0]), frame.to_world)
+    assert obs.fan_clear(px[:0], py[:0], far[:0], frame.to_world)
 
 
 def test_clearance_grows_obstacles_and_shrinks_the_boundary() -> None:
