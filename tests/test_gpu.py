@@ -76,6 +76,25 @@ def test_plan_on_cupy_is_the_numpy_plan() -> None:
         _same_leg(la, lb)
 
 
+def test_plan_round_obstacles_on_cupy_is_the_numpy_plan(tmp_path) -> None:
+    """A boundary and ten obstacles (benchmarks/bench_obstacles.py's course, one lap): the
+    race-area move test runs on the host from the device's front, the same routes."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import bench_obstacles
+
+    text = bench_obstacles.COURSE.replace("LAPS", "1").replace("ROUTER", "isochrone")
+    path = tmp_path / "area.yaml"
+    path.write_text(text + bench_obstacles.area_yaml(), encoding="utf-8")
+    course = load_course(path)
+    a = plan_course(course, "steady").plan
+    b = plan_course(course, "steady", RunOptions(backend="cupy")).plan
+    assert b.total_time_s == pytest.approx(a.total_time_s, rel=1e-9)
+    for la, lb in zip(a.results, b.results, strict=True):
+        _same_leg(la, lb)
+
+
 @pytest.mark.parametrize(
     ("interpolation", "fig", "dtype", "shape"),
     [*ENGINE_CASES, ("linear", (0.05, 46.0, SIGMA), "float32", (100, 128))],
