@@ -326,23 +326,11 @@ class Obstacles:
             return hit.reshape(shape)
         xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
         ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
-        width = np.diff(self.group_start)
+        box, seg = (xlo, xhi, ylo, yhi), (sx0, sy0, sx1, sy1)
         for g in range(self.group_box.shape[0]):
             b = self.group_box[g]
             idx = np.flatnonzero((xhi >= b[0]) & (xlo <= b[2]) & (yhi >= b[1]) & (ylo <= b[3]))
-            w = int(width[g])
-            xmin, ymin, xmax, ymax = (v[g, :w] for v in self.group_edge_box)
-            step = max(1, _CHUNK // w)
-            for i in range(0, idx.size, step):
-                s = idx[i : i + step]
-                meet = xhi[s, None] >= xmin
-                meet &= xlo[s, None] <= xmax
-                meet &= yhi[s, None] >= ymin
-                meet &= ylo[s, None] <= ymax
-                pair, edge = np.nonzero(meet)
-                s = s[pair]
-                e = self.group_edges[g, edge]
-                hit[s[_cross_flat(sx0[s], sy0[s], sx1[s], sy1[s], e)]] = True
+            self._group_hits(g, idx, box, seg, hit)
         return hit.reshape(shape)
 
     def segments_free(
@@ -558,23 +546,38 @@ class Obstacles:
         ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
         order = np.argsort(grp, kind="stable")
         cut = np.flatnonzero(np.diff(grp[order])) + 1
-        width = np.diff(self.group_start)
+        box, seg = (xlo, xhi, ylo, yhi), (sx0, sy0, sx1, sy1)
         for run in np.split(order, cut):
-            g = int(grp[run[0]])
-            w = int(width[g])
-            xmin, ymin, xmax, ymax = (v[g, :w] for v in self.group_edge_box)
-            step = max(1, _CHUNK // w)
-            for i in range(0, run.size, step):
-                k = run[i : i + step]
-                meet = xhi[k, None] >= xmin
-                meet &= xlo[k, None] <= xmax
-                meet &= yhi[k, None] >= ymin
-                meet &= ylo[k, None] <= ymax
-                pair, edge = np.nonzero(meet)
-                k = k[pair]
-                e = self.group_edges[g, edge]
-                hit[k[_cross_flat(sx0[k], sy0[k], sx1[k], sy1[k], e)]] = True
+            self._group_hits(int(grp[run[0]]), run, box, seg, hit)
         return hit
+
+    def _group_hits(
+        self,
+        g: int,
+        idx: NDArray[np.int64],
+        box: tuple[Any, Any, Any, Any],
+        seg: tuple[Any, Any, Any, Any],
+        hit: NDArray[np.bool_],
+    ) -> None:
+        """Set ``hit`` where segment ``idx[k]`` (``seg``: flat ``x0, y0, x1, y1`` [m]; ``box``:
+        their ``xlo, xhi, ylo, yhi``) touches or crosses an edge of group ``g``, each tested
+        only against the edges whose own boxes meet its box, at most :data:`_CHUNK`
+        (segment, edge) boxes at once (:func:`_cross_flat`)."""
+        xlo, xhi, ylo, yhi = box
+        sx0, sy0, sx1, sy1 = seg
+        w = int(self.group_start[g + 1] - self.group_start[g])
+        xmin, ymin, xmax, ymax = (v[g, :w] for v in self.group_edge_box)
+        step = max(1, _CHUNK // w)
+        for i in range(0, idx.size, step):
+            k = idx[i : i + step]
+            meet = xhi[k, None] >= xmin
+            meet &= xlo[k, None] <= xmax
+            meet &= yhi[k, None] >= ymin
+            meet &= ylo[k, None] <= ymax
+            pair, edge = np.nonzero(meet)
+            k = k[pair]
+            e = self.group_edges[g, edge]
+            hit[k[_cross_flat(sx0[k], sy0[k], sx1[k], sy1[k], e)]] = True
 
     def edge_distance(self, x: ArrayLike, y: ArrayLike) -> NDArray[np.float64]:
         """Distance [m] from each point to the nearest ring edge."""
