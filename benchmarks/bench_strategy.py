@@ -21,12 +21,13 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import argparse  # noqa: E402
 import math  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
 from sailroute.boat.build import builtin_polar  # noqa: E402
-from sailroute.boat.polar import Polar  # noqa: E402
 from sailroute.parallel import open_runner  # noqa: E402
 from sailroute.strategy import (  # noqa: E402
     BeatGrid,
@@ -44,58 +45,8 @@ from sailroute.strategy import (  # noqa: E402
 )
 from sailroute.units import KNOT  # noqa: E402
 
-SO40_TWA = [
-    0,
-    5,
-    10,
-    15,
-    20,
-    25,
-    32,
-    36,
-    40,
-    45,
-    52,
-    60,
-    70,
-    80,
-    90,
-    100,
-    110,
-    120,
-    130,
-    140,
-    150,
-    160,
-    170,
-    180,
-]
-SO40_KN = [
-    0.0,
-    0.6,
-    1.2,
-    1.8,
-    2.1,
-    2.5,
-    4.1,
-    4.6,
-    5.0,
-    5.4,
-    5.8,
-    6.2,
-    6.4,
-    6.5,
-    6.5,
-    6.5,
-    6.4,
-    6.2,
-    5.7,
-    5.2,
-    4.7,
-    4.2,
-    3.9,
-    3.6,
-]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_deadline import so40  # noqa: E402  (one Sun Odyssey 40 table for the benchmarks)
 
 
 def bench_sdp(repeat: int, runs: int, grid: BeatGrid | None = None) -> ExpectedTimePolicy:
@@ -188,18 +139,8 @@ def bench_scale_out(
                 )
 
 
-def _so40() -> Polar:
-    return Polar.from_arrays(
-        np.array(SO40_TWA, float),
-        np.array([1.0]),
-        (np.array(SO40_KN) * 0.05 / 6.5)[:, None],
-        name="SO40",
-        interpolation="linear",
-    )
-
-
 def bench_paper(n_r: int, n_theta: int, ds: float, runs: int, interp: str) -> None:
-    polar = _so40()
+    polar = so40()
     cases = [
         (
             "Fig 3",
