@@ -47,7 +47,7 @@ from sailroute.planning.route import default_scenario, settings_for
 from sailroute.progress import Progress
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import target_barrier
-from sailroute.routing.obstacles import Obstacles, land_filled, obstacles_for
+from sailroute.routing.obstacles import Obstacles, constraint_label, land_filled, obstacles_for
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import LegResult, Start
 from sailroute.timeutil import iso
@@ -619,7 +619,7 @@ def _leg_area(
     if obstacles is None or bool(obstacles.points_free(xy[0], xy[1])):
         return obstacles, ""
     name = obstacles.nearest_name(xy[0], xy[1])
-    what = name if name.startswith("the ") else f"obstacle {name!r}"
+    what = constraint_label(name)
     return None, (
         f"leg {label} starts inside the clearance of {what} (or outside the boundary's): "
         "its optimal route ignores the race area"

@@ -252,7 +252,9 @@ def _check_passage(obstacles: Obstacles, start: Start, target: Target) -> None:
     """Refuse a leg whose start and target lie in separate parts of free water."""
     name = obstacles.separated(start_centre(start), target.centre)
     if name is not None:
-        what = name if name.startswith("the ") else f"obstacle {name!r}"
+        from sailroute.routing.obstacles import constraint_label  # shapely: only with an area
+
+        what = constraint_label(name)
         raise RoutingError(
             f"leg {leg_label(start, target)}: no route round {what}: the start and the "
             f"target lie in separate parts of free water ({obstacles.describe()}).\n  Try: "

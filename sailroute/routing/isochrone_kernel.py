@@ -56,7 +56,7 @@ from sailroute.routing.geometry import barrier_blocks, segment_crossing
 from sailroute.routing.isochrone_inputs import _prepare
 from sailroute.routing.isochrone_polar import _DeviceTables, _grid_speeds
 from sailroute.routing.isochrone_records import _Arrival, _Context, _Layer, _LegFrame, _StepInputs
-from sailroute.routing.obstacles import Obstacles
+from sailroute.routing.obstacles import Obstacles, constraint_label
 from sailroute.routing.settings import RoutingSettings
 from sailroute.wind.base import WindField
 
@@ -437,7 +437,7 @@ def _blocked_error(f: _Layer, ctx: _Context, t: float) -> RoutingError:
     assert ctx.obstacles is not None
     wx, wy = (to_numpy(v) for v in ctx.frame.to_world(f.x, f.y))
     name = ctx.obstacles.nearest_name(wx, wy)
-    what = name if name.startswith("the ") else f"obstacle {name!r}"
+    what = constraint_label(name)
     return RoutingError(
         f"leg {ctx.label}: no route round {what}: every move from the front "
         f"{t - ctx.t0:.0f} s after the leg start leaves free water ({ctx.obstacles.describe()}) "

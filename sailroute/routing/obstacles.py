@@ -45,6 +45,7 @@ __all__ = [
     "AreaPolygon",
     "Obstacles",
     "RaceArea",
+    "constraint_label",
     "land_filled",
     "land_obstacle",
     "obstacles_for",
@@ -58,6 +59,12 @@ QUAD_SEGS: Final = 4
 cuts at most ``1 - cos(11.25°)``, 1.9 %, of the clearance at a corner)."""
 _CHUNK: Final = 1 << 18
 """Most segment x edge pairs tested at once (memory of the orientation test)."""
+
+
+def constraint_label(name: str) -> str:
+    """How a message names the constraint ``name`` (:attr:`Obstacles.names`): as given when
+    it is already a phrase (:data:`BOUNDARY_NAME`, ``"the ..."``), else ``obstacle 'name'``."""
+    return name if name.startswith("the ") else f"obstacle {name!r}"
 
 
 @dataclass(frozen=True)
