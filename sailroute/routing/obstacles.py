@@ -310,12 +310,7 @@ class Obstacles:
         """True where ``(x, y)`` [m] is in free water (strictly inside the shrunk
         boundary, not in or on a grown obstacle)."""
         xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        ok = np.ones(xa.shape, dtype=bool)
-        if self.inside is not None:
-            ok &= shapely.contains_xy(self.inside, xa, ya)
-        if self.blocked is not None:
-            ok &= ~shapely.intersects_xy(self.blocked, xa, ya)
-        return ok
+        return self._free_xy(xa, ya)
 
     def segments_cross(
         self, x0: ArrayLike, y0: ArrayLike, x1: ArrayLike, y1: ArrayLike
@@ -450,7 +445,7 @@ class Obstacles:
         hit = self._in_core(ex, ey, grp)
         k = np.flatnonzero(~hit)
         rk = row[k]
-        hit[k] = self._pairs_cross((wx[rk], wy[rk], ex[k], ey[k]), None, grp[k])
+        hit[k] = self._pairs_cross((wx[rk], wy[rk], ex[k], ey[k]), grp[k])
         out[row[hit], j[hit]] = False
         return out
 
@@ -536,26 +531,28 @@ class Obstacles:
         return inner ^ self.core_outer[grp]
 
     def _pairs_cross(
-        self, segments: tuple[Any, Any, Any, Any], seg: Any, grp: NDArray[np.int64]
+        self, segments: tuple[Any, Any, Any, Any], grp: NDArray[np.int64]
     ) -> NDArray[np.bool_]:
         """Which (segment, group) pairs touch or cross an edge of the group.
 
         ``segments`` are the flat arrays ``x0, y0, x1, y1`` [m]; pair ``k`` is segment
-        ``seg[k]`` (``k`` when ``seg`` is None) with group ``grp[k]``.  The pairs of each
-        group are tested against the edges of the group whose bounding boxes meet the
-        segment's (:func:`_cross_flat`), at most :data:`_CHUNK` (pair, edge) boxes at once.
+        ``k`` with group ``grp[k]``.  The pairs of each group are tested against the edges
+        of the group whose bounding boxes meet the segment's (:meth:`_group_hits`).
         """
         hit = np.zeros(grp.size, dtype=bool)
         if grp.size == 0:
             return hit
-        sx0, sy0, sx1, sy1 = segments if seg is None else (v[seg] for v in segments)
-        xlo, xhi = np.minimum(sx0, sx1), np.maximum(sx0, sx1)
-        ylo, yhi = np.minimum(sy0, sy1), np.maximum(sy0, sy1)
+        sx0, sy0, sx1, sy1 = segments
+        box = (
+            np.minimum(sx0, sx1),
+            np.maximum(sx0, sx1),
+            np.minimum(sy0, sy1),
+            np.maximum(sy0, sy1),
+        )
         order = np.argsort(grp, kind="stable")
         cut = np.flatnonzero(np.diff(grp[order])) + 1
-        box, seg = (xlo, xhi, ylo, yhi), (sx0, sy0, sx1, sy1)
         for run in np.split(order, cut):
-            self._group_hits(int(grp[run[0]]), run, box, seg, hit)
+            self._group_hits(int(grp[run[0]]), run, box, segments, hit)
         return hit
 
     def _group_hits(
