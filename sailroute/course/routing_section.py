@@ -28,6 +28,7 @@ from sailroute.routing.settings import (
     RoutingSettings,
     flat_name,
     settings_problems,
+    with_paths,
 )
 from sailroute.routing.types import SIDE_NAMES, RouterName
 
@@ -148,20 +149,6 @@ def _keys(r: Checker, raw: Mapping[str, Any]) -> list[_Key]:
     return out
 
 
-def _build(values: Mapping[str, Any]) -> RoutingSettings:
-    """Settings from ``{field path: value}`` (``"zone_m"``, ``"griddp.cols"``)."""
-    common = {p: v for p, v in values.items() if "." not in p}
-    groups: dict[str, dict[str, Any]] = {}
-    for path, v in values.items():
-        group, _, attr = path.partition(".")
-        if attr:
-            groups.setdefault(group, {})[attr] = v
-    out = dataclasses.replace(RoutingSettings(), **common)
-    return dataclasses.replace(
-        out, **{g: dataclasses.replace(getattr(out, g), **kw) for g, kw in groups.items()}
-    )
-
-
 def load_routing(c: Checker, raw: Any) -> RoutingSettings:
     """The course's routing settings from its ``routing:`` section (``raw``; None: absent).
 
@@ -189,7 +176,7 @@ def load_routing(c: Checker, raw: Any) -> RoutingSettings:
         if v is not None or k.raw[k.key] is None:
             values.update(dict.fromkeys(k.paths, v))
     try:
-        settings = _build(values)
+        settings = with_paths(RoutingSettings(), values)
     except (TypeError, ValueError) as exc:  # a future field with its own checks
         r.add(None, str(exc))
         return RoutingSettings()

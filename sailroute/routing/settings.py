@@ -424,23 +424,31 @@ def routing_settings(base: RoutingSettings | None = None, /, **flat: Any) -> Rou
     InputError
         For an unknown name, with a did-you-mean and the valid names.
     """
-    out = RoutingSettings() if base is None else base
-    common: dict[str, Any] = {}
-    groups: dict[str, dict[str, Any]] = {}
+    values: dict[str, Any] = {}
     for key, value in flat.items():
         if key in COMMON_FIELDS or key in GROUPS:
-            common[key] = value
+            values[key] = value
         elif key in FLAT_NAMES:
-            for path in FLAT_NAMES[key]:
-                group, _, attr = path.partition(".")
-                groups.setdefault(group, {})[attr] = value
+            values.update(dict.fromkeys(FLAT_NAMES[key], value))
         else:
             valid = [*COMMON_FIELDS, *FLAT_NAMES, *GROUPS]
             raise InputError(
                 f"routing setting {key!r}: unknown name; {suggest(key, valid)}valid names: "
                 + ", ".join(valid)
             )
-    out = dataclasses.replace(out, **common)
+    return with_paths(RoutingSettings() if base is None else base, values)
+
+
+def with_paths(base: RoutingSettings, values: Mapping[str, Any]) -> RoutingSettings:
+    """``base`` with the fields at the paths of ``values`` replaced: common fields and whole
+    groups (``"zone_m"``, ``"griddp"``) first, then the groups' fields (``"griddp.cols"``).
+    Values are not checked (see :func:`check_settings`)."""
+    groups: dict[str, dict[str, Any]] = {}
+    for path, v in values.items():
+        group, _, attr = path.partition(".")
+        if attr:
+            groups.setdefault(group, {})[attr] = v
+    out = dataclasses.replace(base, **{p: v for p, v in values.items() if "." not in p})
     changed = {g: dataclasses.replace(getattr(out, g), **kw) for g, kw in groups.items()}
     return dataclasses.replace(out, **changed)
 
