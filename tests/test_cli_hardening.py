@@ -324,12 +324,15 @@ def test_default_output_folders_are_git_ignored():
     ],
 )
 def test_strategy_errors_name_the_options(tmp_path, monkeypatch, args, message):
-    import sailroute.strategy.study
+    import sailroute.commands.strategy
 
     def solve(*a: object, **k: object) -> None:
         raise AssertionError("solving started")
 
-    monkeypatch.setattr(sailroute.strategy.study, "run_strategy", solve)
+    # on the name the command calls: patching sailroute.strategy.study would miss it once
+    # the command module is imported, and bind the stand-in for good when it is imported
+    # first here (the next test then saw "solving started")
+    monkeypatch.setattr(sailroute.commands.strategy, "run_strategy", solve)
     res = runner.invoke(app, ["strategy", *args, "-q", "--no-plots", "-o", str(tmp_path / "o")])
     assert res.exit_code == 2, res.output
     assert res.output.startswith("error: --") and message in res.output
