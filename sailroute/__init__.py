@@ -20,11 +20,11 @@ from __future__ import annotations
 
 import importlib
 
+from sailroute._version import __version__
+
 # ``typing`` is not imported at run time: ``import sailroute`` (the first thing the
 # ``sailroute`` command runs, before its Ctrl-C guard) stays a few statements long.
 TYPE_CHECKING = False
-
-__version__ = "0.1.0"
 
 # Public name -> module that defines it.  ``__all__`` lists the same names and the
 # TYPE_CHECKING block below repeats them as imports, for type checkers, IDEs, linters

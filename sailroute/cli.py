@@ -26,7 +26,7 @@ import typer
 from typer._click.exceptions import BadParameter
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
-from sailroute import __version__
+from sailroute._version import __version__
 from sailroute.errors import SailrouteError
 
 if TYPE_CHECKING:

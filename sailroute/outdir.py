@@ -193,7 +193,7 @@ def _safe_relative(name: str) -> bool:
 
 
 def _write_manifest(folder: Path, names: set[str]) -> None:
-    from sailroute import __version__
+    from sailroute._version import __version__
 
     tmp = folder / f"{MANIFEST_NAME}.{secrets.token_hex(4)}"
     tmp.write_text(

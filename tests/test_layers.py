@@ -1,6 +1,6 @@
 """The package's layers: no module imports a higher layer, and no import cycle.
 
-The layers, low to high (``docs/design.md``): the base modules (units, errors, geometry
+The layers, low to high (``docs/design.md``): the base modules (the version, units, errors, geometry
 helpers, parsing helpers, progress), then ``track``, ``wind``, ``boat``, ``routing``,
 ``course``, ``planning``, ``analysis``, ``strategy``, ``bands``, ``live``, ``report``,
 ``commands`` and, on top, the API facade, the CLI and the package namespace.  A module may
@@ -17,6 +17,7 @@ from tests.conftest import ROOT
 
 PACKAGE = ROOT / "sailroute"
 BASE = (
+    "_version",
     "units",
     "errors",
     "geo",
@@ -90,10 +91,8 @@ def test_no_import_goes_up_the_layers() -> None:
     bad = []
     for module, path in _modules():
         src = _unit(module)
-        for line, target, names in _imports(module, path):
+        for line, target, _ in _imports(module, path):
             dst = _unit(target)
-            if target == "sailroute" and set(names) <= {"__version__"}:
-                continue  # the version constant of the package namespace
             if dst == src:
                 continue
             peers = src in BASE or src in LAYERS[-1]  # base modules, and the top, use each other
@@ -110,8 +109,6 @@ def _graph() -> dict[str, set[str]]:
     for module, path in _modules():
         deps = set()
         for _, target, names in _imports(module, path):
-            if target == "sailroute" and set(names) <= {"__version__"}:
-                continue  # a constant of the namespace, whose other imports are lazy
             cands = (*(f"{target}.{n}" for n in names), target)
             dep = next((c for c in cands if c in known and c != module), None)
             if dep is not None:

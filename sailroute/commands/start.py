@@ -12,7 +12,7 @@ import json
 import math
 from pathlib import Path
 
-from sailroute import __version__
+from sailroute._version import __version__
 from sailroute.commands.result import CommandResult
 from sailroute.course.geometry import FAR_FROM_COURSE_M, course_gap_m
 from sailroute.course.model import Course

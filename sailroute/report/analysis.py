@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from sailroute import __version__
+from sailroute._version import __version__
 from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.report.files import _num, _point
 from sailroute.textin import CleanCsvWriter

@@ -28,7 +28,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from sailroute import __version__
+from sailroute._version import __version__
 from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
 from sailroute.planning.result import Comparison, Plan, percent_error

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from sailroute import __version__
+from sailroute._version import __version__
 from sailroute.report.page import DIV_ID, FIGURE_ID, Report, Table, course_area
 from sailroute.report.page_figure import figure
 from sailroute.textin import clean_text

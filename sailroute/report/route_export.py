@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Literal
 from xml.etree import ElementTree as ET
 
-from sailroute import __version__
+from sailroute._version import __version__
 from sailroute.nmea import frame, lat_field, lon_field, rte_bodies
 from sailroute.planning.result import Plan
 from sailroute.textin import clean_text
