@@ -402,7 +402,7 @@ class SignalKDecoder:
         """Decode one WebSocket message; an empty list when it says nothing usable."""
         try:
             msg = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):  # RecursionError: nested thousands deep
             self.counts.by_kind["malformed"] += 1
             return []
         if not isinstance(msg, dict):
