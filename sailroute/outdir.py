@@ -189,9 +189,7 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
-def check_out_file(
-    path: str | Path, inputs: Iterable[str | Path] = (), option: str = "-o"
-) -> Path:
+def check_out_file(path: str | Path, inputs: Iterable[str | Path] = (), option: str = "-o") -> Path:
     """Check that ``path`` can be written as a command's one output file, creating nothing.
 
     Parameters

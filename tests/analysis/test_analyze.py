@@ -188,8 +188,8 @@ def test_leg_times_where_the_boat_is_not_are_refused(
     assert res.stderr.count("\n") == 1 and "Traceback" not in res.output
     assert re.fullmatch(
         rf"error: {re.escape(str(track))}: leg time {re.escape(iso(t0 + 0.001))} "
-        rf"\(--leg-times, the end of leg 1\): the boat is then {gap:.0f} m from 'top'; expected it within 300 m \(check the "
-        r"time, or give '-' to detect it\)\n",
+        rf"\(--leg-times, the end of leg 1\): the boat is then {gap:.0f} m from 'top'; "
+        r"expected it within 300 m \(check the time, or give '-' to detect it\)\n",
         res.stderr,
     ), res.stderr
     assert not out.exists()
