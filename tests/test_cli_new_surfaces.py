@@ -28,7 +28,8 @@ from sailroute.course.formats import read_course_source
 from sailroute.course.load import load_course
 from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.errors import InputError
-from sailroute.live.decode import SignalKDecoder
+from sailroute.live.decode import NmeaDecoder, SignalKDecoder
+from sailroute.nmea import frame
 from sailroute.routing.rings import _pairs_hit, ring_crossing, ring_problem
 from sailroute.timeutil import FIRST_YEAR, LAST_YEAR, parse_local_time, parse_time
 from sailroute.yamlfile import parse_yaml
@@ -604,6 +605,32 @@ def test_live_ports_out_of_range(tmp_path, option, value):
     args = ["live", str(tmp_path / "c.yaml"), "--source", str(TALLINN_NMEA), option, value]
     msg = refused(tmp_path, [*args, "--duration", "1"])
     assert msg == f"{option} {value}: expected a TCP port in 0..65535 (0: any free port)"
+
+
+def test_decoders_leave_out_positions_off_the_globe_and_numbers_past_a_float():
+    nmea = NmeaDecoder()
+    assert (
+        nmea.feed(frame("GPRMC,094430.00,A,9933.1074,N,01338.5333,E,4.20,37.0,150218,,,A")) is None
+    )
+    assert nmea.counts.by_kind["malformed"] == 1 and nmea.clock is None  # no clock from it
+    ok = nmea.feed(frame("GPRMC,094430.00,A,4533.1074,N,01338.5333,E,4.20,37.0,150218,,,A"))
+    assert ok is not None and ok.lat == pytest.approx(45 + 33.1074 / 60)
+    sk = SignalKDecoder()
+    delta = {
+        "updates": [
+            {
+                "timestamp": "2024-05-01T10:00:01Z",
+                "values": [
+                    {"path": "navigation.position", "value": {"latitude": 1e20, "longitude": 13}},
+                    {"path": "navigation.speedOverGround", "value": 10**400},
+                    {"path": "navigation.headingTrue", "value": 0.5},
+                ],
+            }
+        ]
+    }
+    (r,) = sk.feed(json.dumps(delta))
+    assert (r.lat, r.lon, r.sog_ms) == (None, None, None)
+    assert r.hdg_deg == pytest.approx(np.degrees(0.5))
 
 
 def test_signal_k_delta_nested_deep_is_malformed():

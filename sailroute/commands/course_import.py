@@ -21,7 +21,7 @@ from typing import Any
 from sailroute.boat.build import boat_from_spec
 from sailroute.commands.result import CommandResult
 from sailroute.course.formats import ImportedCourse, course_yaml, read_course_source
-from sailroute.course.load import course_from_mapping, load_course, validate_specs
+from sailroute.course.load import course_from_mapping, validate_specs
 from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.outdir import check_out_file, replacing
@@ -111,23 +111,30 @@ def _files_of(boat: Mapping[str, Any] | None, dest: Path) -> list[Path]:
     return [dest.absolute().parent / polar] if isinstance(polar, str) and polar else []
 
 
-def _check_written(text: str, ic: ImportedCourse, src: Path, dest: Path) -> None:
+def _checked(text: str, ic: ImportedCourse, src: Path, dest: Path) -> Course:
     """Check the course file ``text`` as ``sailroute plan`` reads it, before it is written.
 
     The course (marks, lines, legs, areas, start time, wind) is checked with the lines of
     the imported file, so a problem is reported at ``src``'s line it came from; the boat
     on its own, at ``--boat``, resolving a polar file against ``dest``'s folder.
 
+    Returns
+    -------
+    Course
+        The course as ``dest`` will load, with ``dest``'s lines.
+
     Raises
     ------
     InputError
         Whatever the course file's checks or the boat and wind factories refuse.
     """
-    data = parse_yaml(text, str(src)).data
+    doc = parse_yaml(text, str(src))
+    data = dict(doc.data)
     boat = data.pop("boat", None)
     validate_specs(course_from_mapping(data, source=src, key_lines=dict(ic.key_lines)))
     if boat is not None:
         boat_from_spec(boat, base_dir=dest.absolute().parent, where="--boat", key="")
+    return course_from_mapping(doc.data, source=dest, key_lines=doc.lines)
 
 
 def _summary(ic: ImportedCourse, course: Course, out: Path, fmt: str) -> str:
@@ -222,10 +229,9 @@ def run_course_import_command(
         start_time=t0,
         boat=boat_spec,
     )
-    _check_written(text, ic, src, dest)
+    course = _checked(text, ic, src, dest)
     with replacing(dest) as fh:
         fh.write(text)
-    course = load_course(dest)
     notes = list(ic.notes)
     if boat is None:
         notes.append(
