@@ -34,6 +34,7 @@ from sailroute.routing.rings import _pairs_hit, ring_crossing, ring_problem
 from sailroute.timeutil import FIRST_YEAR, LAST_YEAR, parse_local_time, parse_time
 from sailroute.yamlfile import parse_yaml
 from tests.conftest import TESTS_DATA
+from tests.course.test_area_errors import RACE as RACE_WITH_LIMITS
 
 runner = CliRunner()
 MINIMAL = (TESTS_DATA / "course" / "minimal.yaml").read_text()
@@ -42,26 +43,8 @@ WIND = ["--wind-twd", "0", "--wind-tws", "10"]
 T0 = "2024-05-01T10:00:00Z"
 LATE = "9999-12-31T23:59:59-12:00"
 EARLY = "0001-01-01T00:00:00+13:00"
-RACE = """\
-<?xml version="1.0" encoding="utf-8"?>
-<Race>
-  <RaceID>7</RaceID>
-  <RaceStartTime Start="2025-01-19T16:08:00+13:00" Postpone="False" />
-  <Course>
-    <CompoundMark CompoundMarkID="1" Name="SL">
-      <Mark SeqID="1" Name="SL1" TargetLat="-36.8300" TargetLng="174.7600" />
-      <Mark SeqID="2" Name="SL2" TargetLat="-36.8300" TargetLng="174.7620" />
-    </CompoundMark>
-    <CompoundMark CompoundMarkID="2" Name="M1">
-      <Mark SeqID="1" Name="M1" TargetLat="-36.8200" TargetLng="174.7610" />
-    </CompoundMark>
-  </Course>
-  <CompoundMarkSequence>
-    <Corner SeqID="1" CompoundMarkID="1" Rounding="SP" ZoneSize="3" />
-    <Corner SeqID="2" CompoundMarkID="2" Rounding="Port" ZoneSize="3" />
-  </CompoundMarkSequence>
-</Race>
-"""
+RACE = RACE_WITH_LIMITS.replace("LIMITS", "")  # start 2024-05-01T12:00:00+02:00
+RACE_START = "2024-05-01T12:00:00+02:00"
 MARKS_CSV = "name,lat,lon,type\npin,45.0,13.0,mark\ntop,45.009,13.001,\n"
 LOG_HEADER = (
     "datetime_local,ts_s,bs_kn,awa_deg,aws_kn,hdg_deg,twa_deg,tws_kn,twd_deg,sog_kn,cog_deg,"
@@ -139,7 +122,7 @@ def test_every_command_that_reads_a_time_refuses_them(tmp_path, stamp):
         import_args(tmp_path / "m.csv", tmp_path / "i.yaml", "--start-time", stamp),
     )
     assert msg.startswith(f"--start-time: time {stamp} is {years}")
-    xml = files(tmp_path / "x", **{"r.xml": RACE.replace("2025-01-19T16:08:00+13:00", stamp)})
+    xml = files(tmp_path / "x", **{"r.xml": RACE.replace(RACE_START, stamp)})
     msg = refused(tmp_path, import_args(xml / "r.xml", tmp_path / "i.yaml"))
     assert msg.startswith(f"{xml / 'r.xml'}: line 4: RaceStartTime Start: time {stamp} is {years}")
     args = ["analyze", c, str(tmp_path / "t.gpx"), "-q", "-o", f"{c}.o"]
@@ -174,19 +157,17 @@ def test_kml_nested_1100_folders_deep(tmp_path):
     )
 
 
-def test_race_xml_with_two_corners_of_one_seqid(tmp_path):
-    files(tmp_path, **{"r.xml": RACE.replace('<Corner SeqID="2"', '<Corner SeqID="1"')})
+@pytest.mark.parametrize(
+    ("tag", "line", "within"),
+    [("Corner", 16, "<CompoundMarkSequence>"), ("Mark", 8, "CompoundMark '1'")],
+)
+def test_race_xml_with_two_elements_of_one_seqid(tmp_path, tag, line, within):
+    files(tmp_path, **{"r.xml": RACE.replace(f'<{tag} SeqID="2"', f'<{tag} SeqID="1"')})
     msg = refused(tmp_path, import_args(tmp_path / "r.xml", tmp_path / "c.yaml"))
     assert msg == (
-        f"{tmp_path / 'r.xml'}: line 16: <Corner> SeqID=1 again (also at line 15) in "
-        "<CompoundMarkSequence>; expected each SeqID once (they give the order)"
+        f"{tmp_path / 'r.xml'}: line {line}: <{tag}> SeqID=1 again (also at line {line - 1}) "
+        f"in {within}; expected each SeqID once (they give the order)"
     )
-
-
-def test_race_xml_with_two_marks_of_one_seqid(tmp_path):
-    files(tmp_path, **{"r.xml": RACE.replace('<Mark SeqID="2"', '<Mark SeqID="1"')})
-    msg = refused(tmp_path, import_args(tmp_path / "r.xml", tmp_path / "c.yaml"))
-    assert msg.startswith(f"{tmp_path / 'r.xml'}: line 8: <Mark> SeqID=1 again (also at line 7)")
 
 
 def test_race_xml_without_compound_marks(tmp_path):
@@ -200,11 +181,11 @@ def test_race_xml_without_compound_marks(tmp_path):
 
 
 def test_race_start_time_in_lower_case_z_is_utc(tmp_path):
-    files(tmp_path, **{"r.xml": RACE.replace("2025-01-19T16:08:00+13:00", "2025-01-19T03:08:00z")})
+    files(tmp_path, **{"r.xml": RACE.replace(RACE_START, "2024-05-01T10:00:00z")})
     res = runner.invoke(app, import_args(tmp_path / "r.xml", tmp_path / "c.yaml"))
     assert res.exit_code == 0, res.output
     course = load_course(tmp_path / "c.yaml")
-    assert course.start_time == parse_time("2025-01-19T03:08:00Z") and course.utc_offset_s == 0
+    assert course.start_time == parse_time("2024-05-01T10:00:00Z") and course.utc_offset_s == 0
 
 
 @pytest.mark.parametrize(
@@ -368,39 +349,11 @@ def test_the_output_may_not_be_an_input(tmp_path):
     files(
         tmp_path, **{"m.yaml": MARKS_CSV, "p.yaml": "TWA\\TWS\t6\t10\n45\t3.5\t4.5\n90\t4.5\t5.5\n"}
     )
-    msg = refused(
-        tmp_path,
-        [
-            "course",
-            "import",
-            str(tmp_path / "m.yaml"),
-            "--format",
-            "csv",
-            "-o",
-            str(tmp_path / "m.yaml"),
-            *WIND,
-            "--start-time",
-            T0,
-        ],
-    )
-    assert msg.startswith(f"-o {tmp_path / 'm.yaml'}: the same file as the input")
     (tmp_path / "link.yaml").symlink_to(tmp_path / "m.yaml")
-    msg = refused(
-        tmp_path,
-        [
-            "course",
-            "import",
-            str(tmp_path / "m.yaml"),
-            "--format",
-            "csv",
-            "-o",
-            str(tmp_path / "link.yaml"),
-            *WIND,
-            "--start-time",
-            T0,
-        ],
-    )
-    assert msg.startswith(f"-o {tmp_path / 'link.yaml'}: the same file as the input")
+    for out in ("m.yaml", "link.yaml"):  # the input itself, and a link to it
+        args = import_args(tmp_path / "m.yaml", tmp_path / out, "--format", "csv")
+        msg = refused(tmp_path, [*args, "--start-time", T0])
+        assert msg.startswith(f"-o {tmp_path / out}: the same file as the input")
     files(tmp_path, **{"c.csv": MARKS_CSV})
     msg = refused(
         tmp_path,

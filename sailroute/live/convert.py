@@ -172,6 +172,23 @@ TRIESTE_COLUMNS = (
 TALLINN_COLUMNS = "time, lat, lng, sog, cog, hdg, awa, aws, tack"
 
 
+def _fixes(
+    path: Path,
+    what: str,
+    columns: str,
+    keys: tuple[str, str, str],
+    offset_s: float | None,
+    default_s: float,
+) -> Iterator[tuple[_Row, float, float, float]]:
+    """``(row, t, lat, lon)`` of every row of a log that has a position (the others are
+    skipped); ``keys`` name the time, latitude and longitude columns."""
+    for r in _rows(path, what, columns):
+        t = r.time(keys[0], offset_s, default_s)
+        lat, lon = r.num(keys[1], "lat"), r.num(keys[2], "lon")
+        if lat is not None and lon is not None:
+            yield r, t, lat, lon
+
+
 def read_trieste(path: Path, utc_offset_s: float | None = None) -> list[Row]:
     """Rows of the Trieste coach-boat CSV (see the module docstring).
 
@@ -179,54 +196,37 @@ def read_trieste(path: Path, utc_offset_s: float | None = None) -> list[Row]:
     (default +01:00); a time written with one keeps it, and an ``utc_offset_s`` that
     differs from it is an error.
     """
-    out = []
-    for r in _rows(path, "Trieste coach-boat CSV", TRIESTE_COLUMNS):
-        t = r.time("datetime_local", utc_offset_s, 3600.0)
-        lat, lon = r.num("lat", "lat"), r.num("lon", "lon")
-        if lat is None or lon is None:
-            continue
-        out.append(
-            Row(
-                t,
-                lat,
-                lon,
-                r.num("sog_kn", "speed"),
-                r.num("cog_deg", "angle"),
-                r.num("hdg_deg", "angle"),
-                r.num("bs_kn", "speed"),
-                r.num("aws_kn", "speed"),
-                r.num("awa_deg", "angle"),
-                r.num("tws_kn", "speed"),
-                r.num("twd_deg", "angle"),
-            )
+    keys = ("datetime_local", "lat", "lon")
+    return [
+        Row(
+            t,
+            lat,
+            lon,
+            r.num("sog_kn", "speed"),
+            r.num("cog_deg", "angle"),
+            r.num("hdg_deg", "angle"),
+            r.num("bs_kn", "speed"),
+            r.num("aws_kn", "speed"),
+            r.num("awa_deg", "angle"),
+            r.num("tws_kn", "speed"),
+            r.num("twd_deg", "angle"),
         )
-    return out
+        for r, t, lat, lon in _fixes(
+            path, "Trieste coach-boat CSV", TRIESTE_COLUMNS, keys, utc_offset_s, 3600.0
+        )
+    ]
 
 
 def read_tallinn(path: Path) -> list[Row]:
     """Rows of the Tallinn race log CSV (see the module docstring); apparent wind only.
     Its times are UTC (a time written with an offset keeps it)."""
     out = []
-    for r in _rows(path, "Tallinn race log", TALLINN_COLUMNS):
-        t = r.time("time", None, 0.0)
-        lat, lon = r.num("lat", "lat"), r.num("lng", "lon")
-        if lat is None or lon is None:
-            continue
+    keys = ("time", "lat", "lng")
+    for r, t, lat, lon in _fixes(path, "Tallinn race log", TALLINN_COLUMNS, keys, None, 0.0):
         awa, tack = r.num("awa", "angle"), r.num("tack", "tack")
         signed = None if awa is None or tack is None else awa * (1 if tack >= 0 else -1)
-        out.append(
-            Row(
-                t,
-                lat,
-                lon,
-                r.num("sog", "speed"),
-                r.num("cog", "angle"),
-                r.num("hdg", "angle"),
-                None,
-                r.num("aws", "speed"),
-                signed,
-            )
-        )
+        sog, cog, hdg = r.num("sog", "speed"), r.num("cog", "angle"), r.num("hdg", "angle")
+        out.append(Row(t, lat, lon, sog, cog, hdg, None, r.num("aws", "speed"), signed))
     return out
 
 
