@@ -25,7 +25,7 @@ from sailroute import outdir
 from sailroute.bands.members import MAX_ENSEMBLE_BYTES, draw_members
 from sailroute.cli import app
 from sailroute.course.formats import read_course_source
-from sailroute.course.load import load_course
+from sailroute.course.load import course_from_mapping, load_course
 from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.errors import InputError
 from sailroute.live.decode import NmeaDecoder, SignalKDecoder
@@ -463,6 +463,23 @@ def test_a_kml_polygon_of_20000_points_imports_in_bounded_memory(tmp_path):
         tracemalloc.stop()
     assert ic.boundary is not None and len(ic.boundary) == 20_000
     assert peak < 256 * 2**20
+
+
+@pytest.mark.slow  # some 15 s under tracemalloc: the checks read the points one by one
+def test_a_course_boundary_of_15000_points_loads_in_bounded_memory():
+    data = parse_yaml(MINIMAL, "minimal.yaml").data
+    a = np.linspace(0.0, 2 * np.pi, 15_000, endpoint=False)
+    data["boundary"] = {
+        "points": [{"lat": 45.0045 + 0.03 * np.sin(k), "lon": 13.001 + 0.04 * np.cos(k)} for k in a]
+    }
+    tracemalloc.start()
+    try:
+        course = course_from_mapping(data)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert course.area.boundary is not None and len(course.area.boundary.x) == 15_000
+    assert peak < 256 * 2**20  # the test of every pair took gigabytes
 
 
 # ------------------------------------------------------------------ live-convert
