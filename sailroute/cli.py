@@ -1180,11 +1180,13 @@ def live_convert_command(
         str, typer.Option("--out", "-o", metavar="FILE", help="The .nmea file to write.")
     ],
     utc_offset: Annotated[
-        str,
+        str | None,
         typer.Option(
-            "--utc-offset", metavar="+HH:MM", help="The logger clock's UTC offset (trieste)."
+            "--utc-offset",
+            metavar="+HH:MM",
+            help="The logger clock's UTC offset, for times without one (trieste; default +01:00).",
         ),
-    ] = "+01:00",
+    ] = None,
     start: Annotated[
         str | None, typer.Option("--from", metavar="TIME", help="First time kept (ISO 8601).")
     ] = None,

@@ -14,6 +14,11 @@ Rules (``docs/usage.md``, "The output folder"):
   (``route.png`` after a ``--no-plots`` rerun) are deleted, and nothing else is.  A
   user's own files in the folder are never listed, so never deleted (only a file with
   the same name as an output is overwritten, as by any program that writes there).
+* A command that writes one file (``course import -o``, ``live-convert -o``) checks it
+  with :func:`check_out_file` (not a folder, its folder exists, not one of the
+  command's inputs) and writes it with :func:`replacing`: into a draft of an
+  unpredictable name beside it, created exclusively (never through a symbolic link
+  someone placed there), moved onto the file only once complete.
 * Every file lands inside the output folder: a name that becomes a path part (a
   scenario, an ensemble member: :func:`path_part_problem`, checked when the course is
   read) cannot climb out of it, files are never written through a symbolic link to a
@@ -29,10 +34,10 @@ import secrets
 import shutil
 import signal
 import threading
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path, PurePosixPath
-from typing import Any, TypeVar
+from typing import IO, Any, TypeVar
 
 from sailroute.errors import InputError
 
@@ -128,9 +133,15 @@ def check_out_dir(path: str | Path, option: str = "--out") -> Path:
     Raises
     ------
     InputError
-        ``path`` or one of its parents is a file, or there is no permission to write.
+        ``path`` is empty, ``path`` or one of its parents is a file, or there is no
+        permission to write.
     """
     d = Path(path)
+    if not str(path).strip():
+        raise InputError(
+            f"{option} {str(path)!r}: an empty folder name; give the output folder "
+            f"(e.g. {option} out/run, or {option} . for the working folder)"
+        )
     if d.exists():
         if not d.is_dir():
             raise _cannot(d, "a file of that name exists", option)
@@ -165,6 +176,113 @@ def make_out_dir(path: str | Path) -> Path:
         why = "a file of that name exists" if d.is_file() else (exc.strerror or str(exc))
         raise _cannot(d, why, "--out") from None
     return d
+
+
+# --- writing one file ----------------------------------------------------------------------
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file (through links too); False if either is missing."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_out_file(path: str | Path, inputs: Iterable[str | Path] = (), option: str = "-o") -> Path:
+    """Check that ``path`` can be written as a command's one output file, creating nothing.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write.
+    inputs : iterable of str or Path
+        Every file the command reads: the output may be none of them (writing it would
+        replace an input before, or while, it is read).
+    option : str
+        The option named in messages.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    InputError
+        An empty name, a folder, a folder that does not exist, or one of ``inputs``.
+    """
+    p = Path(path)
+    if not str(path).strip():
+        raise InputError(f"{option} {str(path)!r}: an empty file name; give the file to write")
+    if p.is_dir():
+        raise InputError(f"{option} {p}: a folder; expected the name of the file to write")
+    if not p.absolute().parent.is_dir():
+        raise InputError(
+            f"{option} {p}: the folder {p.absolute().parent} does not exist; create it "
+            "first or choose another"
+        )
+    for src in inputs:
+        if _same_file(p, Path(src)):
+            raise InputError(
+                f"{option} {p}: the same file as the input {src}; writing it would replace "
+                "the input; choose another name"
+            )
+    return p
+
+
+@contextmanager
+def replacing(
+    path: str | Path, option: str = "-o", *, newline: str | None = None
+) -> Iterator[IO[str]]:
+    """A text file to write that replaces ``path`` only once the block ends without error.
+
+    The text goes to a draft ``.<name>.<random>.sailroute-tmp`` in the same folder,
+    created with ``O_EXCL | O_NOFOLLOW`` (a file or symbolic link already there is an
+    error, never followed), then moved onto ``path`` (which replaces a symbolic link at
+    ``path`` itself, not its target).  If the block raises (or Ctrl-C interrupts it),
+    the draft is removed and ``path`` is left as it was.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (checked with :func:`check_out_file` first).
+    option : str
+        The option named in messages.
+    newline : str, optional
+        As :func:`open` (``"\r\n"`` writes CR LF line ends).
+
+    Yields
+    ------
+    file
+        Open for writing text in UTF-8.
+
+    Raises
+    ------
+    InputError
+        The draft cannot be created or the file written (disk full, no permission).
+    """
+    dest = Path(path)
+    draft = dest.with_name(f".{dest.name}.{secrets.token_hex(8)}.sailroute-tmp")
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(draft, flags, 0o666)
+    except OSError as exc:
+        raise InputError(
+            f"{option} {dest}: cannot create a file in {dest.absolute().parent} "
+            f"({exc.strerror or exc}); choose another folder"
+        ) from None
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline=newline) as fh:
+            yield fh
+        os.replace(draft, dest)
+    except OSError as exc:
+        raise InputError(
+            f"{option} {dest}: cannot write the file ({exc.strerror or exc}); check the "
+            "disk space and permissions"
+        ) from None
+    finally:
+        draft.unlink(missing_ok=True)
 
 
 # --- writing a set of files ---------------------------------------------------------------

@@ -2,6 +2,8 @@
 
 Shared by the station and track readers (and any reader of delimited text):
 
+* :func:`text_lines` splits a file's text at its line ends only (``\n``, ``\r\n``,
+  ``\r``): a U+2028 or a form feed inside a name is not a line end;
 * :func:`csv_rows` splits each line on its own, so that a stray quote spoils one line
   (and is reported with its number) instead of swallowing the rest of the file;
 * :func:`looks_binary` tells a text file from a binary one before anything is parsed;
@@ -35,6 +37,7 @@ __all__ = [
     "looks_binary",
     "looks_like_header",
     "quote_header",
+    "text_lines",
 ]
 
 EXCERPT_CHARS = 60
@@ -143,6 +146,22 @@ def looks_like_header(header: Sequence[str]) -> bool:
     return len(names) >= 2 and all(_COLUMN_NAME.fullmatch(h) for h in names if h)
 
 
+_LINE_END = re.compile(r"\r\n|\r|\n")
+
+
+def text_lines(text: str) -> list[str]:
+    """The lines of a text file, split at ``\n``, ``\r\n`` and ``\r`` only.
+
+    :meth:`str.splitlines` also splits at U+2028/U+2029, U+0085, form feed, vertical
+    tab and the file/group/record separators, which a name in a CSV cell may hold: the
+    row would be cut in two and its second half read as a row of its own.
+    """
+    lines = _LINE_END.split(text)
+    if lines and lines[-1] == "":
+        lines.pop()  # the line end of the last line
+    return lines
+
+
 def looks_binary(text: str) -> bool:
     """True for the text of a binary file: a NUL, or mostly undecodable bytes, in its
     first 4096 characters (read with ``errors="replace"``)."""
@@ -179,6 +198,12 @@ def csv_rows(lines: Sequence[tuple[int, str]], delimiter: str, src: str) -> list
         try:
             out.append(next(csv.reader([line], delimiter=delimiter, strict=True), []))
         except csv.Error as exc:
+            if len(line) > csv.field_size_limit():
+                raise InputError(
+                    f"{src}, line {lineno}: a line of {len(line)} characters, with a field "
+                    f"longer than {csv.field_size_limit()}; expected short fields (is it "
+                    "the right file?)"
+                ) from None
             raise InputError(
                 f"{src}, line {lineno}: cannot split the line into fields ({exc}); check "
                 'its quotes: a field that starts with " must end with " before the next '

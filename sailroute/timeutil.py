@@ -3,7 +3,10 @@
 Internally every time is a ``float`` number of seconds since
 1970-01-01T00:00:00Z ("epoch seconds"), so wind sampling and routing can use
 plain float64 arrays.  Timestamps read from files must carry an offset or ``Z``;
-naive timestamps are rejected with an :class:`~sailroute.errors.InputError`.
+naive timestamps are rejected with an :class:`~sailroute.errors.InputError`, and so
+are times outside the years :data:`FIRST_YEAR` .. :data:`LAST_YEAR` (UTC): a race is not
+sailed then, and a time near the ends of Python's calendar (year 1 or 9999) overflows
+once it is converted to UTC or a race's hours are added to it.
 """
 
 from __future__ import annotations
@@ -11,6 +14,13 @@ from __future__ import annotations
 from datetime import UTC, datetime
 
 from sailroute.errors import InputError
+
+FIRST_YEAR = 1900
+"""Earliest year (UTC) of a time read from the user [year]."""
+LAST_YEAR = 2199
+"""Latest year (UTC) of a time read from the user [year]."""
+_EARLIEST = datetime(FIRST_YEAR, 1, 1, tzinfo=UTC)
+_LATEST = datetime(LAST_YEAR + 1, 1, 1, tzinfo=UTC)
 
 
 def parse_time(text: str | datetime, where: str = "time") -> datetime:
@@ -31,9 +41,41 @@ def parse_time(text: str | datetime, where: str = "time") -> datetime:
     Raises
     ------
     InputError
-        If the text is not ISO 8601 or has no offset.
+        If the text is not ISO 8601, has no offset, or is outside the years
+        :data:`FIRST_YEAR` .. :data:`LAST_YEAR`.
     """
     return _aware(text, where).astimezone(UTC)
+
+
+def parse_local_time(text: str | datetime, where: str = "time") -> datetime:
+    """:func:`parse_time`, keeping the offset the time is written with
+    (``"2025-01-19T16:08:00+13:00"`` stays at +13:00; a trailing ``z`` is UTC).
+
+    Raises
+    ------
+    InputError
+        As :func:`parse_time`.
+    """
+    return _aware(text, where)
+
+
+def check_time(dt: datetime, where: str = "time") -> datetime:
+    """``dt`` (timezone-aware) if it lies in the years :data:`FIRST_YEAR` ..
+    :data:`LAST_YEAR` (UTC), else an error naming ``where``.
+
+    Raises
+    ------
+    InputError
+        ``dt`` is naive or out of that span.
+    """
+    if dt.tzinfo is None or dt.utcoffset() is None:
+        raise InputError(f"{where}: time {dt.isoformat()} has no UTC offset")
+    if not _EARLIEST <= dt < _LATEST:  # compared as instants, without converting dt
+        raise InputError(
+            f"{where}: time {dt.isoformat()} is outside the years {FIRST_YEAR}-{LAST_YEAR} "
+            "(UTC); check the date"
+        )
+    return dt
 
 
 def iso_datetime(text: str) -> datetime:
@@ -72,7 +114,7 @@ def _aware(text: str | datetime, where: str) -> datetime:
             f"{where}: time {text!r} has no UTC offset; add one, e.g. "
             f"'{dt.isoformat()}+00:00' or '{dt.isoformat()}Z'"
         )
-    return dt
+    return check_time(dt, where)
 
 
 def utc_offset_s(text: str | datetime, where: str = "time") -> float:

@@ -257,8 +257,32 @@ def read_yaml(path: str | Path, *, what: str = "course file", hint: str = "") ->
         raise InputError(f"{p}: not a UTF-8 text file ({exc.reason}); save it as UTF-8") from None
     except OSError as exc:
         raise InputError(f"{p}: cannot read the {what} ({exc.strerror or exc})") from None
+    return parse_yaml(text, str(p))
+
+
+def parse_yaml(text: str, where: str) -> YamlDoc:
+    """Parse YAML text as :func:`read_yaml` parses a file's (the same checks and messages).
+
+    Parameters
+    ----------
+    text : str
+        The YAML text.
+    where : str
+        What it is, first in every message (a file, or an option such as ``--boat``).
+
+    Returns
+    -------
+    YamlDoc
+
+    Raises
+    ------
+    InputError
+        A syntax error (with line and column), nesting deeper than :data:`MAX_DEPTH`,
+        more than :data:`MAX_NODES` values, an alias inside its own node, or text with a
+        control character.
+    """
     try:
-        _check_events(yaml.parse(text, Loader=YamlLoader), str(p))
+        _check_events(yaml.parse(text, Loader=YamlLoader), where)
         loader = YamlLoader(text)  # a SafeLoader
         try:
             node = loader.get_single_node()
@@ -267,7 +291,7 @@ def read_yaml(path: str | Path, *, what: str = "course file", hint: str = "") ->
             loader.dispose()
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
-        where = f"{p}:{mark.line + 1}:{mark.column + 1}" if mark is not None else str(p)
+        at = f"{where}:{mark.line + 1}:{mark.column + 1}" if mark is not None else where
         problem = exc.problem or "invalid YAML"
         cm = exc.context_mark
         if exc.context and cm is not None and (mark is None or cm.line != mark.line):
@@ -275,11 +299,11 @@ def read_yaml(path: str | Path, *, what: str = "course file", hint: str = "") ->
         elif exc.context:
             problem += f" ({exc.context})"
         raise InputError(
-            f"{where}: YAML syntax error: {problem}; check indentation, colons, quotes and "
+            f"{at}: YAML syntax error: {problem}; check indentation, colons, quotes and "
             "brackets on this line and the ones before"
         ) from None
     except yaml.YAMLError as exc:
-        raise InputError(f"{p}: YAML syntax error: {exc}") from None
+        raise InputError(f"{where}: YAML syntax error: {exc}") from None
     lines: dict[str, int] = {}
     dup: list[Duplicate] = []
     if node is not None:

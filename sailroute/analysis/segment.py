@@ -39,6 +39,7 @@ from sailroute.course.geometry import feature_centre, leg_endpoints, target_of
 from sailroute.course.model import Course, Mark
 from sailroute.errors import InputError
 from sailroute.routing.geometry import TargetGeometry, segment_crossing, target_geometry
+from sailroute.routing.startline import distance_to_segment
 from sailroute.routing.types import Start, Target
 from sailroute.timeutil import iso
 from sailroute.units import bearing_deg, wrap180
@@ -398,6 +399,67 @@ def _not_found(
     )
 
 
+GIVEN_NEAR_M = 300.0
+"""At a leg time given by hand (``--leg-times``) the boat must be within this distance
+of what that time ends (the start line, the leg's mark, gate or line) [m]: some tens of
+seconds of a fast boat, so that a time off by more (a typing error, legs given
+milliseconds apart) is refused instead of timing a leg the boat did not sail."""
+
+
+def _check_leg_times(
+    course: Course, given: Sequence[float | None], t: NDArray, x: NDArray, y: NDArray, where: str
+) -> None:
+    """Refuse leg times given by hand: the wrong count, not increasing, outside the
+    track, or at a moment the boat is not near what they end (:data:`GIVEN_NEAR_M`)."""
+    n = course.n_legs
+    if len(given) != n + 1:
+        raise InputError(
+            f"{where}: leg times: got {len(given)} times for {n} legs; give {n + 1} (the "
+            "start crossing, then the end of each leg), or none to detect them"
+        )
+    vals = [g for g in given if g is not None]
+    if any(b <= a for a, b in itertools.pairwise(vals)):
+        raise InputError(
+            f"{where}: leg times must increase; got " + ", ".join(iso(v) for v in vals)
+        )
+    for v in vals:
+        if not t[0] <= v <= t[-1]:
+            raise InputError(
+                f"{where}: leg time {iso(v)} is outside the track ({iso(t[0])} .. {iso(t[-1])})"
+            )
+    for k, g in enumerate(given):
+        if g is not None:
+            _check_given(course, k, g, t, x, y, where)
+
+
+def _check_given(
+    course: Course,
+    k: int,
+    tq: float,
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    where: str,
+) -> None:
+    """Refuse the given time ``tq`` of boundary ``k`` (0: the start crossing, ``i + 1``:
+    the end of leg ``i``) if the boat is then further than :data:`GIVEN_NEAR_M` from
+    its feature."""
+    name = course.legs[0].from_name if k == 0 else course.legs[k - 1].to_name
+    feat = course.feature(name)
+    px, py = _point_at(t, x, y, tq)
+    if isinstance(feat, Mark):
+        gap = math.hypot(px - feat.xy[0], py - feat.xy[1])
+    else:
+        gap = distance_to_segment((px, py), feat.a.xy, feat.b.xy)[0]
+    if gap > GIVEN_NEAR_M:
+        what = "the start crossing" if k == 0 else f"the end of leg {k}"
+        raise InputError(
+            f"{where}: leg time {iso(tq)} (--leg-times, {what}): the boat is then "
+            f"{gap:.0f} m from {name!r}; expected it within {GIVEN_NEAR_M:.0f} m (check "
+            "the time, or give '-' to detect it)"
+        )
+
+
 def _verb(feat: object) -> str:
     return "rounds" if isinstance(feat, Mark) else "crosses"
 
@@ -718,21 +780,7 @@ def segment_track(
     if gate_end not in ("line", "rounding"):
         raise InputError(f"gate end {gate_end!r}: expected 'line' or 'rounding'")
     given: list[float | None] = list(leg_times) if leg_times is not None else [None] * (n + 1)
-    if len(given) != n + 1:
-        raise InputError(
-            f"{where}: leg times: got {len(given)} times for {n} legs; give {n + 1} (the "
-            "start crossing, then the end of each leg), or none to detect them"
-        )
-    vals = [g for g in given if g is not None]
-    if any(b <= a for a, b in itertools.pairwise(vals)):
-        raise InputError(
-            f"{where}: leg times must increase; got " + ", ".join(iso(v) for v in vals)
-        )
-    for v in vals:
-        if not t[0] <= v <= t[-1]:
-            raise InputError(
-                f"{where}: leg time {iso(v)} is outside the track ({iso(t[0])} .. {iso(t[-1])})"
-            )
+    _check_leg_times(course, given, t, x, y, where)
     gap_s = gap_limit_s(t)
     report = find_start(
         course,

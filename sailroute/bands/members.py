@@ -6,7 +6,9 @@ value in each of ``n`` equal-probability strata of every source (McKay, Beckman 
 Conover 1979), so even a small ``n`` spans the tails.  A stratum value ``u`` becomes:
 
 * ``tws``: ``z = Φ⁻¹(u)`` standard deviations of speed, added (``tws_kn``) or as a
-  factor ``1 + z · tws_pct / 100``;
+  log-normal factor ``(1 + tws_pct / 100) ** z`` (one sigma up multiplies the speed by
+  ``1 + tws_pct / 100``, one down divides it; never zero, so a wide spread such as
+  ``tws_pct: 100`` gives light-air members, not calm ones);
 * ``twd``: a constant direction offset ``z · twd_deg``;
 * ``shifts``: ``oscillating``, the phase ``2π u``; ``persistent``, a rate
   ``z · rate``; ``ou``, the starting shift ``z · sigma`` of an Ornstein-Uhlenbeck
@@ -39,8 +41,10 @@ from sailroute.wind.base import WindField
 from sailroute.wind.perturbed import PerturbedWind
 
 __all__ = [
+    "MAX_ENSEMBLE_BYTES",
     "NOMINAL",
     "Member",
+    "check_ensemble_size",
     "draw_members",
     "fit_shifts",
     "member_boat",
@@ -53,6 +57,17 @@ SHIFT_STEP_S: Final = 10.0
 """Time step of a member's shift series [s]."""
 OAT_QUANTILES: Final = (0.1, 0.5, 0.9)
 """Quantiles of one source in the one-at-a-time breakdown."""
+MAX_ENSEMBLE_BYTES: Final = 2.0**30
+"""Most memory the members of one band may hold, as :func:`check_ensemble_size`
+estimates it [bytes] (1 GiB: some 15 000 members of a two-leg course)."""
+MEMBER_BYTES: Final = 1024.0
+"""A member without its shift series, and its place in the lists [bytes]."""
+SHIFT_SAMPLE_BYTES: Final = 64.0
+"""One sample of a member's shift series: a time and a shift, as Python floats in
+tuples [bytes]."""
+LEG_ROUTE_BYTES: Final = 16384.0
+"""One member's routed leg: its track and records [bytes] (3-14 kB measured, pickled,
+on the legs of tests/data/course/minimal.yaml and courses/hyeres-r1.yaml)."""
 
 
 @dataclass(frozen=True)
@@ -169,7 +184,7 @@ def _apply(
     z = float(ndtri(u))
     if source == "tws":
         return dataclasses.replace(
-            member, tws_add_ms=z * spec.tws_add_ms, tws_scale=max(1.0 + z * spec.tws_rel, 0.0)
+            member, tws_add_ms=z * spec.tws_add_ms, tws_scale=(1.0 + spec.tws_rel) ** z
         )
     if source == "twd":
         return dataclasses.replace(member, twd_offset_deg=z * spec.twd_deg)
@@ -180,6 +195,41 @@ def _apply(
     name = source.removeprefix("boat.")
     lo, hi = next((lo, hi) for p, lo, hi in spec.boat if p == name)
     return dataclasses.replace(member, boat=(*member.boat, (name, lo + u * (hi - lo))))
+
+
+def check_ensemble_size(spec: UncertaintySpec, n: int, duration_s: float, n_legs: int) -> None:
+    """Refuse ``n`` members whose shift series and routes would need more than
+    :data:`MAX_ENSEMBLE_BYTES`, before anything is drawn (as the routers refuse
+    settings whose work they estimate would take minutes).
+
+    Parameters
+    ----------
+    spec : UncertaintySpec
+        The uncertainties (a shift model makes each member hold a shift series).
+    n : int
+        Members of the main ensemble.
+    duration_s : float
+        Time span of the shift series [s] (the course's time limit).
+    n_legs : int
+        Legs each member routes.
+
+    Raises
+    ------
+    InputError
+        Naming the estimate and the most members that fit.
+    """
+    samples = duration_s / SHIFT_STEP_S + 2.0 if spec.shifts is not None else 0.0
+    each = MEMBER_BYTES + SHIFT_SAMPLE_BYTES * samples + LEG_ROUTE_BYTES * n_legs
+    need = float(n) * each
+    if need <= MAX_ENSEMBLE_BYTES:
+        return
+    fit = int(MAX_ENSEMBLE_BYTES // each)
+    raise InputError(
+        f"{n} members would hold about {need / 2**30:.3g} GiB (each its shift series and "
+        f"the routes of {n_legs} legs, about {each / 1024:.0f} kiB), more than "
+        f"{MAX_ENSEMBLE_BYTES / 2**30:.0f} GiB; give at most {fit} members (--ensemble N "
+        "or uncertainty.members; a band is steady from a few dozen)"
+    )
 
 
 def draw_members(

@@ -20,6 +20,7 @@ import numpy as np
 from sailroute.bands.members import (
     NOMINAL,
     Member,
+    check_ensemble_size,
     draw_members,
     member_boat,
     member_wind,
@@ -156,7 +157,13 @@ def band_summary(
     Returns
     -------
     BandSummary
+
+    Raises
+    ------
+    InputError
+        More members than fit in memory (:func:`~sailroute.bands.members.check_ensemble_size`).
     """
+    check_ensemble_size(spec, spec.members, course.time_limit_s, course.n_legs)
     main = draw_members(spec, course.time_limit_s)
     oat_members = one_at_a_time(spec, course.time_limit_s) if oat else {}
     flat = [NOMINAL, *main, *(m for ms in oat_members.values() for m in ms)]

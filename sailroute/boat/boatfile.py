@@ -21,9 +21,9 @@ def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
     Raises
     ------
     InputError
-        Missing file, folder, not UTF-8, YAML syntax error (with line and
-        column), duplicate key, unknown key or bad value (with the key and its
-        line), all in one message.
+        Missing file, folder, not UTF-8, an empty file (nothing set: leaving the file
+        out says that), YAML syntax error (with line and column), duplicate key, unknown
+        key or bad value (with the key and its line), all in one message.
     """
     from sailroute.yamlfile import read_yaml
 
@@ -33,7 +33,13 @@ def load_boat_file(path: str | Path) -> tuple[LaserParams, str]:
         what="boat file",
         hint="check the path, or leave BOAT.yaml out to use the shipped ILCA 7 parameters",
     )
-    doc = {} if ydoc.data is None else ydoc.data
+    doc = ydoc.data
+    if doc is None or doc == {}:
+        raise InputError(
+            f"{p}: the boat file is empty; expected the parameters to change, e.g. "
+            "'class: ilca7' and 'crew_mass_kg: 80' (docs/vpp.md), or leave BOAT.yaml out "
+            "to use the shipped ILCA 7 parameters"
+        )
     if not isinstance(doc, dict):
         raise InputError(
             f"{p}: a boat file is a mapping like 'class: ilca7' and 'crew_mass_kg: 80'; "

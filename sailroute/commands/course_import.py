@@ -1,13 +1,16 @@
 """``sailroute course import``: a course file (YAML) from GPX, CSV, KML or race XML.
 
-The command reads the file (:mod:`sailroute.course.formats`), writes the course file
-next to nothing else, and loads what it wrote (:func:`~sailroute.course.load.load_course`
-and the boat and wind factories) before keeping it: a course that would not plan is
-never written.
+The command reads the file (:mod:`sailroute.course.formats`), composes the course file's
+text and checks it as ``sailroute plan`` would (:func:`~sailroute.course.load.course_from_mapping`
+and the boat and wind factories) before writing it: a course that would not plan is never
+written, and what the checks find is reported at the line of the imported file it came
+from (the boat at ``--boat``).  The file is written whole or not at all
+(:func:`sailroute.outdir.replacing`), and never over one of the command's inputs.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from collections.abc import Mapping
@@ -15,15 +18,16 @@ from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-import yaml
-
+from sailroute.boat.build import boat_from_spec
 from sailroute.commands.result import CommandResult
 from sailroute.course.formats import ImportedCourse, course_yaml, read_course_source
-from sailroute.course.load import course_from_mapping, load_course, validate_specs
+from sailroute.course.load import course_from_mapping, validate_specs
 from sailroute.course.model import Course
-from sailroute.course.read import read_course_file
 from sailroute.errors import InputError
+from sailroute.outdir import check_out_file, replacing
+from sailroute.textin import excerpt
 from sailroute.timeutil import parse_time
+from sailroute.yamlfile import parse_yaml
 
 __all__ = ["boat_spec_of", "run_course_import_command"]
 
@@ -48,21 +52,38 @@ def boat_spec_of(text: str | None, out: Path) -> dict[str, Any] | None:
     Raises
     ------
     InputError
-        A mapping that does not parse.
+        A mapping that does not parse (read as course files are: nesting, size and
+        characters checked), or holds a value that is not text, a number, true/false,
+        a list or a mapping.
     """
     if text is None:
         return None
     t = text.strip()
     if t.startswith("{"):
+        given = f"--boat {excerpt(text)!r}"
         try:
-            spec = yaml.safe_load(t)
-        except yaml.YAMLError as exc:
+            spec = parse_yaml(t, "--boat").data
+        except InputError as exc:  # "--boat:1:6: YAML syntax error: ..."
             raise InputError(
-                f"--boat {text!r}: not a YAML mapping ({exc.__class__.__name__});"
-                " expected e.g. '{polar: f50.csv, speed_unit: km/h}'"
+                f"{given}: not a YAML mapping (at {str(exc).removeprefix('--boat:')}); "
+                "expected e.g. '{polar: f50.csv, speed_unit: km/h}'"
             ) from None
         if not isinstance(spec, dict):
-            raise InputError(f"--boat {text!r}: expected a mapping such as '{{builtin: ilca7}}'")
+            raise InputError(f"{given}: expected a mapping such as '{{builtin: ilca7}}'")
+        bad = next((k for k in _keys(spec) if not (isinstance(k, str) and k.isprintable())), None)
+        if bad is not None:
+            raise InputError(
+                f"{given}: the key {bad!a} is not a name; expected keys such as polar, "
+                "builtin, speed_unit"
+            )
+        try:
+            json.dumps(spec, allow_nan=False)  # as course_yaml writes it
+        except (TypeError, ValueError) as exc:
+            what = "a date, time or binary value" if isinstance(exc, TypeError) else "NaN or inf"
+            raise InputError(
+                f"{given}: holds {what}; expected text, numbers, true/false, lists and "
+                "mappings (quote a value meant as text)"
+            ) from None
         return spec
     p = Path(t)
     if p.suffix.lower() in (".pol", ".csv", ".txt") or p.is_file():
@@ -73,6 +94,47 @@ def boat_spec_of(text: str | None, out: Path) -> dict[str, Any] | None:
             )
         return {"polar": os.path.relpath(p.resolve(), out.resolve().parent)}
     return {"builtin": t}
+
+
+def _keys(value: Any) -> list[Any]:
+    """Every mapping key in ``value``, at any depth (``value`` is at most 50 deep)."""
+    if isinstance(value, dict):
+        return [*value, *(k for v in value.values() for k in _keys(v))]
+    if isinstance(value, list):
+        return [k for v in value for k in _keys(v)]
+    return []
+
+
+def _files_of(boat: Mapping[str, Any] | None, dest: Path) -> list[Path]:
+    """The polar file a ``--boat`` names (relative to the course file's folder), if any."""
+    polar = (boat or {}).get("polar")
+    return [dest.absolute().parent / polar] if isinstance(polar, str) and polar else []
+
+
+def _checked(text: str, ic: ImportedCourse, src: Path, dest: Path) -> Course:
+    """Check the course file ``text`` as ``sailroute plan`` reads it, before it is written.
+
+    The course (marks, lines, legs, areas, start time, wind) is checked with the lines of
+    the imported file, so a problem is reported at ``src``'s line it came from; the boat
+    on its own, at ``--boat``, resolving a polar file against ``dest``'s folder.
+
+    Returns
+    -------
+    Course
+        The course as ``dest`` will load, with ``dest``'s lines.
+
+    Raises
+    ------
+    InputError
+        Whatever the course file's checks or the boat and wind factories refuse.
+    """
+    doc = parse_yaml(text, str(src))
+    data = dict(doc.data)
+    boat = data.pop("boat", None)
+    validate_specs(course_from_mapping(data, source=src, key_lines=dict(ic.key_lines)))
+    if boat is not None:
+        boat_from_spec(boat, base_dir=dest.absolute().parent, where="--boat", key="")
+    return course_from_mapping(doc.data, source=dest, key_lines=doc.lines)
 
 
 def _summary(ic: ImportedCourse, course: Course, out: Path, fmt: str) -> str:
@@ -147,9 +209,9 @@ def run_course_import_command(
     dest = Path(out) if out is not None else Path(f"{src.stem}.yaml")
     if dest.suffix.lower() not in (".yaml", ".yml"):
         raise InputError(f"-o {dest}: expected a .yaml file name")
+    boat_spec = boat_spec_of(boat, dest)
+    check_out_file(dest, [src, *_files_of(boat_spec, dest)])
     ic, chosen = read_course_source(src, fmt)
-    if dest.exists() and dest.resolve() == src.resolve():
-        raise InputError(f"-o {dest}: the same file as the input; choose another name")
     t0: datetime | None = (
         parse_time(start_time, where="--start-time") if start_time is not None else ic.start_time
     )
@@ -165,21 +227,11 @@ def run_course_import_command(
         twd_deg=float(wind_twd_deg),
         tws_kn=float(wind_tws_kn),
         start_time=t0,
-        boat=boat_spec_of(boat, dest),
+        boat=boat_spec,
     )
-    if not dest.parent.is_dir():
-        raise InputError(f"-o {dest}: the folder {dest.parent} does not exist; create it first")
-    tmp = dest.with_name(f".{dest.name}.sailroute-tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        doc = read_course_file(tmp)  # messages name the file to be written, not the draft
-        validate_specs(course_from_mapping(doc.data, source=dest, key_lines=doc.lines))
-        os.replace(tmp, dest)
-    except OSError as exc:
-        raise InputError(f"-o {dest}: cannot write the file ({exc.strerror})") from None
-    finally:
-        tmp.unlink(missing_ok=True)
-    course = load_course(dest)
+    course = _checked(text, ic, src, dest)
+    with replacing(dest) as fh:
+        fh.write(text)
     notes = list(ic.notes)
     if boat is None:
         notes.append(

@@ -16,6 +16,7 @@ from sailroute.live.engine import LiveEngine, LiveSettings
 from sailroute.live.planner import ProcessPlanner
 from sailroute.live.sources import parse_source
 from sailroute.planning.route import default_scenario, settings_for
+from sailroute.tabular import parse_offset
 from sailroute.timeutil import iso, parse_time, to_epoch
 
 __all__ = ["live_report", "run_live_command", "run_live_convert_command", "start_live"]
@@ -44,8 +45,14 @@ def start_live(
     Raises
     ------
     InputError
-        A bad course, scenario, source, leg number, interval, or a port in use.
+        A bad course, scenario, source, leg number, interval, a port out of 0..65535 or
+        in use.
     """
+    for option, value in (("--port", port), ("--nmea-port", nmea_port)):
+        if value is not None and not 0 <= value <= 65535:
+            raise InputError(
+                f"{option} {value}: expected a TCP port in 0..65535 (0: any free port)"
+            )
     loaded = course if isinstance(course, Course) else load_course(course)
     name = default_scenario(loaded) if scenario is None else scenario
     if name in loaded.ensembles:
@@ -210,7 +217,7 @@ def run_live_convert_command(
     *,
     fmt: str,
     out: str | Path,
-    utc_offset: str = "+01:00",
+    utc_offset: str | None = None,
     start: str | None = None,
     end: str | None = None,
 ) -> CommandResult:
@@ -224,20 +231,21 @@ def run_live_convert_command(
         Its format.
     out : str or Path
         The ``.nmea`` file to write.
-    utc_offset : str
-        The logger's UTC offset, ``+HH:MM`` (``trieste``: the logger's local clock).
+    utc_offset : str, optional
+        The logger's UTC offset, ``+HH:MM``, for times written without one (``trieste``:
+        the logger's local clock; default +01:00).
     start, end : str, optional
         ISO 8601 times with an offset: keep that span only.
     """
-    try:
-        sign = -1.0 if utc_offset.startswith("-") else 1.0
-        hh, mm = utc_offset.lstrip("+-").split(":")
-        offset = sign * (int(hh) * 3600 + int(mm) * 60)
-    except ValueError:
-        raise InputError(f"--utc-offset {utc_offset}: expected +HH:MM, e.g. +01:00") from None
+    zone = None if utc_offset is None else parse_offset(utc_offset, "--utc-offset").utcoffset(None)
+    offset = None if zone is None else zone.total_seconds()
     t0 = None if start is None else to_epoch(parse_time(start, "--from"))
     t1 = None if end is None else to_epoch(parse_time(end, "--to"))
     n = convert_log(Path(log), fmt, Path(out), utc_offset_s=offset, t0=t0, t1=t1)
     return CommandResult(
-        f"{n} seconds of {fmt} log written as NMEA 0183", {"nmea": Path(out)}, n, main=()
+        f"{n} seconds of {fmt} log written as NMEA 0183",
+        {"nmea": Path(out)},
+        n,
+        main=(),
+        labels={"nmea": "replay (NMEA 0183)"},
     )

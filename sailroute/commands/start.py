@@ -17,7 +17,7 @@ from sailroute.commands.result import CommandResult
 from sailroute.course.geometry import FAR_FROM_COURSE_M, course_gap_m
 from sailroute.course.model import Course
 from sailroute.errors import InputError
-from sailroute.timeutil import parse_time, to_epoch
+from sailroute.timeutil import iso_datetime, parse_time, to_epoch
 
 __all__ = ["parse_position", "parse_start_time", "position_xy", "run_start_command"]
 
@@ -25,6 +25,9 @@ __all__ = ["parse_position", "parse_start_time", "position_xy", "run_start_comma
 
 SCHEMA_VERSION = 1
 """Version of the ``start.json`` schema."""
+
+MAX_FROM_GUN_S = 86400.0
+"""Most seconds before or after the gun ``--time`` may be given as [s]."""
 
 
 def parse_position(text: str, option: str = "--at") -> tuple[float, float]:
@@ -70,22 +73,34 @@ def parse_start_time(text: str, gun: float) -> float:
     Raises
     ------
     InputError
-        Neither form.
+        Neither form, seconds without a sign or further than a day from the gun, or a
+        time without an offset or out of range.
     """
     s = str(text).strip()
     try:
         rel = float(s)
     except ValueError:
         rel = None
-    if rel is not None and math.isfinite(rel) and (s.startswith(("-", "+")) or s == "0"):
+    if rel is not None:
+        if not (math.isfinite(rel) and abs(rel) <= MAX_FROM_GUN_S):
+            raise InputError(
+                f"--time {text!r}: expected seconds from the gun within "
+                f"±{MAX_FROM_GUN_S:.0f} (a day), e.g. -90"
+            )
+        if rel != 0 and not s.startswith(("-", "+")):
+            raise InputError(
+                f"--time {text!r}: seconds from the gun need a sign: -{s} ({s} s before "
+                f"the gun) or +{s} (after it)"
+            )
         return gun + rel
     try:
-        return to_epoch(parse_time(s, "--time"))
-    except InputError:
+        iso_datetime(s)
+    except ValueError:
         raise InputError(
             f"--time {text!r}: expected an ISO 8601 time with a UTC offset "
             "(e.g. 2018-04-24T12:08:30+02:00) or seconds from the gun (e.g. -90)"
         ) from None
+    return to_epoch(parse_time(s, "--time"))  # its own words: no offset, out of range
 
 
 def position_xy(course: Course, at: str | None, xy: str | None) -> tuple[float, float]:
@@ -116,8 +131,9 @@ def position_xy(course: Course, at: str | None, xy: str | None) -> tuple[float, 
         given = f"--xy {xy}"
     gap = course_gap_m(course, (x, y))
     if not math.isfinite(gap) or gap > FAR_FROM_COURSE_M:
+        far = f"{gap / 1000:.0f} km" if gap < 1e8 else "more than 100 000 km"
         raise InputError(
-            f"{given}: the position is {gap / 1000:.0f} km from the course area (the marks "
+            f"{given}: the position is {far} from the course area (the marks "
             f"of {course.source or course.name}); it must be within "
             f"{FAR_FROM_COURSE_M / 1000:.0f} km (check the order LAT,LON and the signs)"
         )

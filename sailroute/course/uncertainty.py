@@ -120,7 +120,8 @@ class UncertaintySpec:
     tws_add_ms : float
         Standard deviation of an added true wind speed [m s⁻¹] (``tws_kn``/``tws_ms``).
     tws_rel : float
-        Standard deviation of a relative speed change (``tws_pct / 100``).
+        Relative speed change at one standard deviation (``tws_pct / 100``): the
+        members' speeds are scaled by the log-normal factor ``(1 + tws_rel) ** z``.
     twd_deg : float
         Standard deviation of a constant direction offset [°].
     shifts : ShiftSpec or None

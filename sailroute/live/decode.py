@@ -3,9 +3,10 @@
 Both decoders turn their input into :class:`Reading` objects: one per sentence or
 Signal K value, with the data time and only the quantities that input carries, in SI
 units (m s⁻¹, degrees true).  Bad input never raises: a sentence with a wrong
-checksum, a malformed sentence and a delta that is not JSON are counted in
-:class:`Counts` and skipped, so that one noisy instrument does not take the feed
-down.
+checksum, a malformed sentence (a position off the globe among them) and a delta that
+is not JSON are counted in :class:`Counts` and skipped, so that one noisy instrument
+does not take the feed down; a Signal K value that is not a finite number, or a
+position off the globe, is left out of its reading.
 
 NMEA 0183 sentences read (with pynmea2): ``RMC`` (time, date, position, SOG, COG),
 ``GGA``/``GLL`` (position), ``VTG`` (COG, SOG), ``HDT``/``HDG`` (heading, true;
@@ -142,6 +143,21 @@ def _f(value: Any) -> float | None:
     return out
 
 
+def _position(lat: Any, lon: Any) -> tuple[float, float]:
+    """A fix's latitude and longitude [°].
+
+    Raises
+    ------
+    ValueError
+        Not finite, or off the globe (|lat| > 90, |lon| > 180): the sentence is counted
+        as malformed.
+    """
+    la, lo = float(lat), float(lon)
+    if not (-90.0 <= la <= 90.0 and -180.0 <= lo <= 180.0):
+        raise ValueError(f"position {la}, {lo} is off the globe")
+    return la, lo
+
+
 def _epoch(d: date, tm: time) -> float:
     tz = tm.tzinfo or UTC
     return datetime.combine(d, tm.replace(tzinfo=None)).replace(tzinfo=tz).timestamp()
@@ -235,6 +251,7 @@ class NmeaDecoder:
         if msg.status != "A" or msg.datestamp is None or msg.timestamp is None:
             self.counts.by_kind["ignored"] += 1
             return None
+        lat, lon = _position(msg.latitude, msg.longitude)
         self._date = msg.datestamp
         self._t = _epoch(msg.datestamp, msg.timestamp)
         var = _f(msg.mag_variation)
@@ -243,8 +260,8 @@ class NmeaDecoder:
         sog = _f(msg.spd_over_grnd)
         return Reading(
             self._t,
-            lat=float(msg.latitude),
-            lon=float(msg.longitude),
+            lat=lat,
+            lon=lon,
             sog_ms=None if sog is None else sog * KN,
             cog_deg=_f(msg.true_course),
             timed=True,
@@ -259,8 +276,9 @@ class NmeaDecoder:
         if t is None:
             self.counts.by_kind["untimed"] += 1
             return None
+        lat, lon = _position(msg.latitude, msg.longitude)
         self._t = t
-        return Reading(t, lat=float(msg.latitude), lon=float(msg.longitude), timed=True)
+        return Reading(t, lat=lat, lon=lon, timed=True)
 
     def _zda(self, msg: Any) -> Reading | None:
         """The date and time only."""
@@ -346,7 +364,9 @@ def _sk_fields(path: Any, value: Any) -> dict[str, Any]:
     """The :class:`Reading` fields of one Signal K path and value (empty when unused)."""
     if path == "navigation.position" and isinstance(value, dict):
         lat, lon = _sk_f(value.get("latitude")), _sk_f(value.get("longitude"))
-        return {} if lat is None or lon is None else {"lat": lat, "lon": lon}
+        if lat is None or lon is None or not (abs(lat) <= 90.0 and abs(lon) <= 180.0):
+            return {}
+        return {"lat": lat, "lon": lon}
     if not (isinstance(path, str) and path in _SK_PATHS):
         return {}
     v = _sk_f(value)
@@ -362,10 +382,14 @@ def _sk_fields(path: Any, value: Any) -> dict[str, Any]:
 
 
 def _sk_f(value: Any) -> float | None:
-    """A Signal K number, or None (null, text, NaN)."""
+    """A Signal K number, or None (null, text, NaN, an integer past a float)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
         return None
-    return float(value) if math.isfinite(value) else None
+    try:
+        v = float(value)
+    except OverflowError:
+        return None
+    return v if math.isfinite(v) else None
 
 
 def _sk_time(text: Any) -> float | None:
@@ -402,7 +426,7 @@ class SignalKDecoder:
         """Decode one WebSocket message; an empty list when it says nothing usable."""
         try:
             msg = json.loads(text)
-        except ValueError:
+        except (ValueError, RecursionError):  # RecursionError: nested thousands deep
             self.counts.by_kind["malformed"] += 1
             return []
         if not isinstance(msg, dict):

@@ -7,6 +7,7 @@ importers (:mod:`sailroute.course.formats`), so both word a bad polygon the same
 from __future__ import annotations
 
 import numpy as np
+import shapely
 from numpy.typing import NDArray
 
 __all__ = ["ring_crossing", "ring_problem"]
@@ -16,28 +17,13 @@ def _cross(ax: NDArray, ay: NDArray, bx: NDArray, by: NDArray) -> NDArray:
     return ax * by - ay * bx
 
 
-def ring_crossing(xy: NDArray) -> tuple[int, int] | None:
-    """The first pair of edges of a closed ring that cross or touch, if any.
+CROSSING_BLOCK = 512
+"""Edges tested at a time by :func:`ring_crossing`: its memory is bounded by this many
+edges times the edges each one's box overlaps, not by the square of the ring's size."""
 
-    Parameters
-    ----------
-    xy : ndarray, shape (n, 2)
-        The vertices [m] (any planar units), the ring not repeating its first point.
 
-    Returns
-    -------
-    (i, j) or None
-        Edge ``i`` runs from vertex ``i`` to ``i + 1`` (``n - 1`` closes the ring back to
-        vertex 0); None when no two non-adjacent edges meet.
-    """
-    p = np.asarray(xy, dtype=float)
-    n = p.shape[0]
-    if n < 4:
-        return None
-    a, b = p, np.roll(p, -1, axis=0)
-    i, j = np.triu_indices(n, k=2)
-    keep = ~((i == 0) & (j == n - 1))  # the first and last edges share vertex 0
-    i, j = i[keep], j[keep]
+def _pairs_hit(a: NDArray, b: NDArray, i: NDArray, j: NDArray) -> NDArray:
+    """Whether edge ``i`` (``a[i]`` to ``b[i]``) and edge ``j`` cross, touch or overlap."""
     d1, d2 = b[i] - a[i], b[j] - a[j]
     r = a[j] - a[i]
     den = _cross(d1[:, 0], d1[:, 1], d2[:, 0], d2[:, 1])
@@ -55,8 +41,48 @@ def ring_crossing(xy: NDArray) -> tuple[int, int] | None:
             u0 = np.einsum("ij,ij->i", r, d1) / dd
             u1 = np.einsum("ij,ij->i", r + d2, d1) / dd
         hit |= collinear & (np.maximum(u0, u1) >= 0) & (np.minimum(u0, u1) <= 1)
-    k = np.flatnonzero(hit)
-    return None if k.size == 0 else (int(i[k[0]]), int(j[k[0]]))
+    return np.asarray(hit)
+
+
+def ring_crossing(xy: NDArray) -> tuple[int, int] | None:
+    """The first pair of edges of a closed ring that cross or touch, if any.
+
+    Only pairs whose bounding boxes overlap are tested (found with a shapely
+    ``STRtree``), :data:`CROSSING_BLOCK` edges at a time: O(n log n) time for the rings
+    of a course, and memory bounded by the block, not O(n²) (a ring of 15 000 points
+    would need gigabytes for every pair at once).
+
+    Parameters
+    ----------
+    xy : ndarray, shape (n, 2)
+        The vertices [m] (any planar units), the ring not repeating its first point.
+
+    Returns
+    -------
+    (i, j) or None
+        Edge ``i`` runs from vertex ``i`` to ``i + 1`` (``n - 1`` closes the ring back to
+        vertex 0); None when no two non-adjacent edges meet.  The pair with the smallest
+        ``i``, then the smallest ``j``.
+    """
+    p = np.asarray(xy, dtype=float)
+    n = p.shape[0]
+    if n < 4:
+        return None
+    a, b = p, np.roll(p, -1, axis=0)
+    pad = 1e-9 * (1.0 + float(np.abs(p).max()))  # a point's box is a box, not empty
+    lo, hi = np.minimum(a, b) - pad, np.maximum(a, b) + pad
+    tree = shapely.STRtree(shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1]))
+    for start in range(0, n, CROSSING_BLOCK):
+        block = np.arange(start, min(start + CROSSING_BLOCK, n))
+        sel, j = tree.query(shapely.box(*lo[block].T, *hi[block].T))
+        i = block[sel]
+        keep = (j >= i + 2) & ~((i == 0) & (j == n - 1))  # not adjacent, each pair once
+        i, j = i[keep], j[keep]
+        k = np.flatnonzero(_pairs_hit(a, b, i, j))
+        if k.size:
+            first = k[np.lexsort((j[k], i[k]))[0]]
+            return int(i[first]), int(j[first])
+    return None
 
 
 def ring_problem(xy: NDArray) -> str | None:

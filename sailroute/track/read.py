@@ -238,7 +238,7 @@ def read_live_log(
             continue
         try:
             rec = json.loads(line)
-        except ValueError:
+        except (ValueError, RecursionError):  # RecursionError: nested thousands deep
             raise InputError(
                 f"{src}: line {k}: not a JSON object; a `sailroute live` log has one "
                 "JSON object per line"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -147,6 +148,55 @@ def test_explicit_leg_times_override(routed: tuple[Course, list[LegResult]]) -> 
     assert a.legs[1].detected
     with pytest.raises(InputError, match="got 2 times for 3 legs"):
         analyze_track(course, tr, leg_times=[None, None])
+
+
+def test_leg_times_where_the_boat_is_not_are_refused(
+    tmp_path: Path, routed: tuple[Course, list[LegResult]]
+) -> None:
+    """Leg times 1 ms apart timed leg 1 as a millisecond: exit 0 and "lost -1051 s".  A
+    given time must find the boat near what it ends (segment.GIVEN_NEAR_M)."""
+    course, legs = routed
+    tr = _sailed(course, legs)
+    track = tmp_path / "boat.csv"
+    track.write_text(
+        "time,lat,lon\n"
+        + "".join(
+            f"{iso(float(t))},{la:.8f},{lo:.8f}\n"
+            for t, la, lo in zip(tr.t_s, tr.lat_deg, tr.lon_deg, strict=True)
+        )
+    )
+    t0 = course.start_epoch + 2.0
+    x, y = course.frame.to_xy(np.interp(t0, tr.t_s, tr.lat_deg), np.interp(t0, tr.t_s, tr.lon_deg))
+    top = course.marks["top"].xy
+    gap = float(np.hypot(x - top[0], y - top[1]))  # the boat near the line, the mark 500 m up
+    assert 450 < gap < 510
+    out = tmp_path / "out"
+    res = CliRunner().invoke(
+        app,
+        [
+            "analyze",
+            str(course.source),
+            str(track),
+            "-q",
+            "-o",
+            str(out),
+            "--leg-times",
+            f"{iso(t0)},{iso(t0 + 0.001)},-,-",
+        ],
+    )
+    assert res.exit_code == 2, res.output
+    assert res.stderr.count("\n") == 1 and "Traceback" not in res.output
+    assert re.fullmatch(
+        rf"error: {re.escape(str(track))}: leg time {re.escape(iso(t0 + 0.001))} "
+        rf"\(--leg-times, the end of leg 1\): the boat is then {gap:.0f} m from 'top'; "
+        r"expected it within 300 m \(check the time, or give '-' to detect it\)\n",
+        res.stderr,
+    ), res.stderr
+    assert not out.exists()
+    # the times the route itself ends its legs at are accepted
+    given = [t0, *(leg.t_end for leg in legs)]
+    a = analyze_track(course, tr, leg_times=given)
+    assert [leg.t_end for leg in a.legs] == given[1:]
 
 
 def test_bad_tracks_are_refused(tmp_path: Path, routed: tuple[Course, list[LegResult]]) -> None:

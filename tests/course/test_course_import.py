@@ -328,7 +328,7 @@ def test_self_intersecting_polygon(tmp_path):
 
 def test_wind_is_required(tmp_path):
     src = tmp_path / "m.csv"
-    src.write_text("name,lat,lon\nA,45.0,13.0\nB,45.01,13.0\n")
+    src.write_text("name,lat,lon,type\nA,45.0,13.0,mark\nB,45.01,13.0,\n")
     with pytest.raises(InputError, match="--wind-twd and --wind-tws are required"):
         run_course_import_command(src, out=tmp_path / "c.yaml", start_time=T0)
     with pytest.raises(InputError, match="gives no start time; give --start-time"):
@@ -386,7 +386,7 @@ def test_cli_writes_the_course_and_reports_it(tmp_path):
 
 def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path):
     src = tmp_path / "m.csv"
-    src.write_text("name,lat,lon\npin,45.0,13.0\ntop,45.009,13.001\n")
+    src.write_text("name,lat,lon,type\npin,45.0,13.0,mark\ntop,45.009,13.001,\n")
     out = tmp_path / "c.yaml"
     res = runner.invoke(
         app,

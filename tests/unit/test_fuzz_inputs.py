@@ -1,4 +1,5 @@
-"""Fuzzing the input readers and ``plan`` with mutated copies of small valid files (hypothesis).
+"""Fuzzing the input readers, ``plan``, ``course import``, ``live-convert`` and the live
+decoders with mutated copies of small valid files (hypothesis).
 
 The starting files are small valid inputs of the project (``tests/data``, ``data/``, the built-in
 polars) or written here (a 3 x 3 CF NetCDF grid in the classic and the NetCDF-4 format;
@@ -12,8 +13,13 @@ quotes, separators, line breaks, brackets, anchors, NUL), and feeds it to a read
 The property: the reader returns, or raises the project's input error (exit code 2) with
 a message whose first line is not empty; ``plan`` exits 0, 2 (bad input, ``error: ...``)
 or 3 (a leg that cannot be routed, documented in docs/usage.md), writes nothing when it
-fails, and never prints a traceback or "internal error".  Each example runs under a hard
-time limit (``SIGALRM``): a hang fails the test.
+fails, and never prints a traceback or "internal error".  ``course import`` (GPX, CSV,
+KML, race XML) and ``live-convert`` (the Trieste and Tallinn logs) return or raise the
+input error too, and leave the folder with nothing but the input when they fail (no
+course or replay file, no draft).  The live decoders (NMEA 0183 sentences, Signal K
+deltas) never raise: every line or message gives readings or none, and every value of a
+reading is finite, a latitude within ±90° and a longitude within ±180°.  Each example
+runs under a hard time limit (``SIGALRM``): a hang fails the test.
 
 The default suite runs a few examples per reader (derandomized: the same ones every run,
 about ten seconds in all); ``pytest -m slow tests/unit/test_fuzz_inputs.py`` runs many
@@ -24,6 +30,8 @@ many examples each test ran and how they ended (``ok`` / ``input error``).
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import re
 import signal
@@ -43,9 +51,13 @@ from typer.testing import CliRunner
 from sailroute.boat.io import read_polar, write_polar_csv, write_polar_json
 from sailroute.boat.polar import Polar
 from sailroute.cli import app
+from sailroute.commands.course_import import run_course_import_command
 from sailroute.course.load import load_course
 from sailroute.errors import SailrouteError
 from sailroute.geo import LocalFrame
+from sailroute.live.convert import convert_log
+from sailroute.live.decode import NmeaDecoder, Reading, SignalKDecoder
+from sailroute.nmea import frame
 from sailroute.track.read import read_track
 from sailroute.wind.cf import open_netcdf
 from sailroute.wind.ndbc import read_ndbc
@@ -421,6 +433,234 @@ def _grid_numbers(g: dict[str, Any]) -> str:
         return outcome(lambda: _read_grid(p))
 
 
+# ------------------------------------------------------------------------- course import
+_POINTS = [  # name, lat, lon, type, rounding: a start line, a mark, a gate, a finish
+    ("pin", 45.0, 13.0, "start", ""),
+    ("boat", 45.0, 13.002, "start", ""),
+    ("top", 45.009, 13.001, "mark", "port"),
+    ("g1", 45.0015, 13.0005, "gate", ""),
+    ("g2", 45.0015, 13.0015, "gate", ""),
+    ("f1", 45.0005, 13.0, "finish", ""),
+    ("f2", 45.0005, 13.002, "finish", ""),
+]
+_ROCK = [(45.004, 13.004), (45.004, 13.005), (45.005, 13.005), (45.005, 13.004)]
+_AREA = [(44.995, 12.995), (44.995, 13.007), (45.012, 13.007), (45.012, 12.995)]
+
+
+def _import_files() -> dict[str, bytes]:
+    def gpx_type(t: str, r: str) -> str:
+        return r or t
+
+    wpts = "".join(
+        f'<wpt lat="{la}" lon="{lo}"><name>{n}</name><type>{gpx_type(t, r)}</type></wpt>\n'
+        for n, la, lo, t, r in _POINTS
+    )
+    rte = wpts.replace("<wpt", "<rtept").replace("</wpt>", "</rtept>")
+    csv_text = "name,lat,lon,type,rounding\n" + "".join(
+        f"{n},{la},{lo},{t},{r}\n" for n, la, lo, t, r in _POINTS
+    )
+
+    def ring(points: list[tuple[float, float]]) -> str:
+        return " ".join(f"{lo},{la},0" for la, lo in [*points, points[0]])
+
+    pms = "".join(
+        f'<Placemark><name>{n}</name><ExtendedData><Data name="type"><value>{t}</value>'
+        f'</Data><Data name="rounding"><value>{r}</value></Data></ExtendedData>'
+        f"<Point><coordinates>{lo},{la},0</coordinates></Point></Placemark>\n"
+        for n, la, lo, t, r in _POINTS[2:]
+    )
+    kml = (
+        '<?xml version="1.0" encoding="UTF-8"?>\n<kml xmlns="http://www.opengis.net/kml/2.2">'
+        "<Document><name>club</name>\n<Folder><Placemark><name>Start</name><LineString>"
+        "<coordinates>13.0,45.0 13.002,45.0</coordinates></LineString></Placemark>\n"
+        f"{pms}</Folder>\n"
+        "<Placemark><name>Boundary</name><Polygon><outerBoundaryIs><LinearRing><coordinates>"
+        f"{ring(_AREA)}</coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark>\n"
+        "<Placemark><name>rock</name><Polygon><outerBoundaryIs><LinearRing><coordinates>"
+        f"{ring(_ROCK)}</coordinates></LinearRing></outerBoundaryIs></Polygon></Placemark>\n"
+        "</Document></kml>\n"
+    )
+
+    def limits(name: str, points: list[tuple[float, float]]) -> str:
+        return (
+            f'  <CourseLimit name="{name}">\n'
+            + "".join(
+                f'    <Limit SeqID="{k + 1}" Lat="{la}" Lon="{lo}" />\n'
+                for k, (la, lo) in enumerate(points)
+            )
+            + "  </CourseLimit>\n"
+        )
+
+    race = (
+        '<?xml version="1.0" encoding="utf-8"?>\n<Race>\n  <RaceID>25011905</RaceID>\n'
+        '  <RaceStartTime Start="2025-01-19T16:08:00+13:00" Postpone="False" />\n'
+        "  <Course>\n"
+        '    <CompoundMark CompoundMarkID="1" Name="SL">\n'
+        '      <Mark SeqID="1" Name="SL1" TargetLat="45.0" TargetLng="13.0" />\n'
+        '      <Mark SeqID="2" Name="SL2" TargetLat="45.0" TargetLng="13.002" />\n'
+        "    </CompoundMark>\n"
+        '    <CompoundMark CompoundMarkID="2" Name="M1">\n'
+        '      <Mark SeqID="1" Name="M1" TargetLat="45.009" TargetLng="13.001" />\n'
+        "    </CompoundMark>\n"
+        '    <CompoundMark CompoundMarkID="3" Name="LG">\n'
+        '      <Mark SeqID="1" Name="LG1" TargetLat="45.0015" TargetLng="13.0005" />\n'
+        '      <Mark SeqID="2" Name="LG2" TargetLat="45.0015" TargetLng="13.0015" />\n'
+        "    </CompoundMark>\n"
+        '    <CompoundMark CompoundMarkID="4" Name="FL">\n'
+        '      <Mark SeqID="1" Name="FL1" TargetLat="45.0005" TargetLng="13.0" />\n'
+        '      <Mark SeqID="2" Name="FL2" TargetLat="45.0005" TargetLng="13.002" />\n'
+        "    </CompoundMark>\n  </Course>\n  <CompoundMarkSequence>\n"
+        '    <Corner SeqID="1" CompoundMarkID="1" Rounding="SP" ZoneSize="3" />\n'
+        '    <Corner SeqID="2" CompoundMarkID="2" Rounding="Port" ZoneSize="3" />\n'
+        '    <Corner SeqID="3" CompoundMarkID="3" Rounding="PS" ZoneSize="3" />\n'
+        '    <Corner SeqID="4" CompoundMarkID="4" Rounding="SP" ZoneSize="3" />\n'
+        "  </CompoundMarkSequence>\n"
+        + limits("Boundary", _AREA)
+        + limits("AY", _ROCK)
+        + "</Race>\n"
+    )
+    head = '<?xml version="1.0"?>\n<gpx version="1.1" creator="t" xmlns="http://www.topografix.com/GPX/1/1">\n'
+    return {
+        "waypoints.gpx": (
+            head + f"<metadata><name>club</name></metadata>\n{wpts}</gpx>\n"
+        ).encode(),
+        "route.gpx": (head + f"<rte><name>club</name>\n{rte}</rte>\n</gpx>\n").encode(),
+        "marks.csv": csv_text.encode(),
+        "club.kml": kml.encode(),
+        "race.xml": race.encode(),
+    }
+
+
+IMPORT_FILES = _import_files()
+IMPORT_FORMATS = {
+    "gpx": ("waypoints.gpx", "route.gpx"),
+    "csv": ("marks.csv",),
+    "kml": ("club.kml",),
+    "racexml": ("race.xml",),
+}
+
+
+def _import(case: tuple[str, bytes]) -> str:
+    """``course import`` of one file into its folder: the course file, or nothing new."""
+    name, data = case
+    with written(name, data) as p:
+        out = p.parent / "course.yaml"
+        start = None if name.endswith(".xml") else "2024-05-01T10:00:00+02:00"
+        result = outcome(
+            lambda: run_course_import_command(
+                p, out=out, wind_twd_deg=200.0, wind_tws_kn=10.0, start_time=start
+            )
+        )
+        left = sorted(f.name for f in p.parent.iterdir())
+        assert left == sorted([name, *(["course.yaml"] if result == "ok" else [])]), left
+        return result
+
+
+# ------------------------------------------------------------------------- live-convert
+TALLINN_LOG = (
+    "time,lat,lng,sog,cog,hdg,awa,aws,tack,dpt\n"
+    "2023-09-27 14:31:56+00:00,59.4766293,24.8130137,4.8,329.0,,57.0,18.3,-1.0,10.7\n"
+    "2023-09-27 14:31:57+00:00,59.4766110,24.8130674,7.098,123.76,288.0,55.0,18.9,-1.0,10.8\n"
+    "2023-09-27 14:32:04+00:00,59.4765720,24.8134001,6.91,121.5,287.0,52.0,18.1,-1.0,10.9\n"
+    "2023-09-27 14:32:11+00:00,59.4765102,24.8137453,7.02,120.2,,49.0,17.6,1.0,11.0\n"
+)
+LOG_FILES = {
+    "trieste.csv": head(WIND_DATA / "coach_wind_1hz_excerpt.csv", 12),
+    "tallinn.csv": TALLINN_LOG.encode(),
+}
+
+
+def _live_convert(case: tuple[str, bytes]) -> str:
+    """``live-convert`` of one log into its folder: the replay file, or nothing new."""
+    name, data = case
+    with written(name, data) as p:
+        out = p.parent / "replay.nmea"
+        result = outcome(lambda: convert_log(p, name.removesuffix(".csv"), out))
+        left = sorted(f.name for f in p.parent.iterdir())
+        assert left == sorted([name, *(["replay.nmea"] if result == "ok" else [])]), left
+        return result
+
+
+# ------------------------------------------------------------------------- live decoders
+_MORE_SENTENCES = (  # the other sentences the decoder reads, framed with their checksums
+    "GPGGA,144024.00,5928.5950,N,02447.9290,E,1,08,0.9,3.0,M,18.0,M,,",
+    "GPGLL,5928.5945,N,02447.9285,E,144025.00,A,A",
+    "GPVTG,256.9,T,,M,5.75,N,10.65,K,A",
+    "HCHDG,120.0,,,7.1,E",
+    "GPZDA,144026.00,27,09,2023,00,00",
+    "IIMWV,40.0,T,8.1,M,A",
+)
+NMEA_FILES = {
+    "trieste.nmea": head(TESTS_DATA / "live" / "trieste-coach-2018-02-15.nmea", 15),
+    "tallinn.nmea": head(TESTS_DATA / "live" / "tallinn-2023-09-27.nmea", 9)
+    + "".join(frame(b) + "\r\n" for b in _MORE_SENTENCES).encode(),
+}
+_SK_HELLO = {"name": "signalk-server", "version": "2.0.0", "self": "vessels.urn:mrn:imo:mmsi:1"}
+_SK_DELTA = {
+    "context": "vessels.urn:mrn:imo:mmsi:1",
+    "updates": [
+        {
+            "timestamp": "2024-05-01T10:00:01.000Z",
+            "values": [
+                {"path": "navigation.position", "value": {"latitude": 45.01, "longitude": 13.02}},
+                {"path": "navigation.speedOverGround", "value": 3.1},
+                {"path": "navigation.courseOverGroundTrue", "value": 0.61},
+                {"path": "navigation.headingTrue", "value": 0.58},
+                {"path": "environment.wind.angleApparent", "value": -0.71},
+                {"path": "environment.wind.speedApparent", "value": 6.2},
+            ],
+        },
+        {
+            "timestamp": "2024-05-01T10:00:01.500Z",
+            "values": [
+                {"path": "environment.wind.directionTrue", "value": 4.9},
+                {"path": "environment.wind.speedTrue", "value": 5.1},
+                {"path": "environment.wind.angleTrueWater", "value": 1.2},
+                {"path": "navigation.speedThroughWater", "value": 2.9},
+            ],
+        },
+    ],
+}
+SIGNALK_FILES = {
+    "deltas.jsonl": "\n".join(
+        json.dumps(m) for m in (_SK_HELLO, _SK_DELTA, {**_SK_DELTA, "context": "vessels.ais"})
+    ).encode()
+}
+
+
+def _check_readings(readings: list[Reading]) -> str:
+    """Every value of every reading finite, positions on the globe; ``"readings"`` or
+    ``"none"``."""
+    for r in readings:
+        for key, v in r.as_dict().items():
+            assert math.isfinite(v), (key, v, r)
+        assert r.lat is None or -90.0 <= r.lat <= 90.0, r
+        assert r.lon is None or -180.0 <= r.lon <= 180.0, r
+    return "readings" if readings else "none"
+
+
+def _nmea(case: tuple[str, bytes]) -> str:
+    """Each line of the mutated file fed to one decoder, as a TCP source decodes it."""
+    dec = NmeaDecoder()
+    out: list[Reading] = []
+    with time_limit(READER_LIMIT_S):
+        for raw in case[1].split(b"\n"):
+            r = dec.feed(raw.decode("ascii", "replace"))
+            if r is not None:
+                out.append(r)
+    return _check_readings(out)
+
+
+def _signalk(case: tuple[str, bytes]) -> str:
+    """Each line of the mutated file fed to one decoder as a WebSocket message."""
+    dec = SignalKDecoder()
+    out: list[Reading] = []
+    with time_limit(READER_LIMIT_S):
+        for raw in case[1].split(b"\n"):
+            out += dec.feed(raw.decode("utf-8", "replace"))
+    return _check_readings(out)
+
+
 # ------------------------------------------------------------------------- plan
 PLAN_COURSE = COURSE_FILES["minimal.yaml"].decode()
 runner = CliRunner()
@@ -456,6 +696,13 @@ CASES = {
         byte_mutations(GRID_FILES["NETCDF3_CLASSIC.nc"]).map(lambda b: ("NETCDF3_CLASSIC.nc", b)),
     ),
     "netcdf_numbers": (_grid_numbers, grid_numbers()),
+    **{
+        f"import_{fmt}": (_import, mutated({n: IMPORT_FILES[n] for n in names}))
+        for fmt, names in IMPORT_FORMATS.items()
+    },
+    "live_convert": (_live_convert, mutated(LOG_FILES)),
+    "nmea": (_nmea, mutated(NMEA_FILES)),
+    "signalk": (_signalk, mutated(SIGNALK_FILES)),
     # plan: mostly plausible values, so that many examples are routed
     "plan": (
         _plan,
@@ -479,6 +726,14 @@ def test_unmutated_files_are_valid():
         for name, data in files.items():
             if name != "hyeres-r1.yaml":  # names wind files beside it, absent in a tmp folder
                 assert CASES[case][0]((name, data)) == "ok", (case, name)
+    for fmt, names in IMPORT_FORMATS.items():
+        for name in names:
+            assert _import((name, IMPORT_FILES[name])) == "ok", (fmt, name)
+    for name, data in LOG_FILES.items():
+        assert _live_convert((name, data)) == "ok", name
+    for name, data in NMEA_FILES.items():
+        assert _nmea((name, data)) == "readings", name
+    assert _signalk(("deltas.jsonl", SIGNALK_FILES["deltas.jsonl"])) == "readings"
     assert _plan(PLAN_COURSE) == "ok"
 
 
@@ -523,6 +778,48 @@ def test_netcdf_numbers(x: Any) -> None:
 @given(CASES["plan"][1])
 def test_plan(x: Any) -> None:
     event(_plan(x))
+
+
+@FAST
+@given(CASES["import_gpx"][1])
+def test_course_import_gpx(x: Any) -> None:
+    event(_import(x))
+
+
+@FAST
+@given(CASES["import_csv"][1])
+def test_course_import_csv(x: Any) -> None:
+    event(_import(x))
+
+
+@FAST
+@given(CASES["import_kml"][1])
+def test_course_import_kml(x: Any) -> None:
+    event(_import(x))
+
+
+@FAST
+@given(CASES["import_racexml"][1])
+def test_course_import_race_xml(x: Any) -> None:
+    event(_import(x))
+
+
+@FAST
+@given(CASES["live_convert"][1])
+def test_live_convert(x: Any) -> None:
+    event(_live_convert(x))
+
+
+@FAST
+@given(CASES["nmea"][1])
+def test_nmea_decoder(x: Any) -> None:
+    event(_nmea(x))
+
+
+@FAST
+@given(CASES["signalk"][1])
+def test_signalk_decoder(x: Any) -> None:
+    event(_signalk(x))
 
 
 # the same, with many fresh random examples each run: pytest -m slow
@@ -573,3 +870,52 @@ def test_netcdf_numbers_long(x: Any) -> None:
 @given(CASES["plan"][1])
 def test_plan_long(x: Any) -> None:
     event(_plan(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["import_gpx"][1])
+def test_course_import_gpx_long(x: Any) -> None:
+    event(_import(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["import_csv"][1])
+def test_course_import_csv_long(x: Any) -> None:
+    event(_import(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["import_kml"][1])
+def test_course_import_kml_long(x: Any) -> None:
+    event(_import(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["import_racexml"][1])
+def test_course_import_race_xml_long(x: Any) -> None:
+    event(_import(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["live_convert"][1])
+def test_live_convert_long(x: Any) -> None:
+    event(_live_convert(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["nmea"][1])
+def test_nmea_decoder_long(x: Any) -> None:
+    event(_nmea(x))
+
+
+@pytest.mark.slow
+@LONG
+@given(CASES["signalk"][1])
+def test_signalk_decoder_long(x: Any) -> None:
+    event(_signalk(x))

@@ -20,7 +20,13 @@ from sailroute.course.formats.model import (
     parse_type,
 )
 from sailroute.errors import InputError
-from sailroute.textin import csv_rows, looks_binary, looks_like_header, quote_header
+from sailroute.textin import (
+    csv_rows,
+    looks_binary,
+    looks_like_header,
+    quote_header,
+    text_lines,
+)
 
 __all__ = ["read_csv_course"]
 
@@ -90,7 +96,7 @@ def read_csv_course(path: str | Path) -> ImportedCourse:
         raise InputError(f"{src}: a binary file; expected a CSV file of marks (name, lat, lon)")
     numbered = [
         (k + 1, ln)
-        for k, ln in enumerate(text.splitlines())
+        for k, ln in enumerate(text_lines(text))
         if ln.strip() and not ln.lstrip().startswith("#")
     ]
     if not numbered:
@@ -117,12 +123,17 @@ def read_csv_course(path: str | Path) -> ImportedCourse:
             raise InputError(f"{where}: empty name; expected the mark's name")
         lat = _number(row[cols["lat"]], -90.0, 90.0, "lat", where)
         lon = _number(row[cols["lon"]], -180.0, 360.0, "lon", where)
-        kind = parse_type(row[cols["type"]], where) if "type" in cols else "mark"
-        rounding = parse_rounding(row[cols["rounding"]], where) if "rounding" in cols else None
+        type_text = row[cols["type"]] if "type" in cols else ""
+        side_text = row[cols["rounding"]] if "rounding" in cols else ""
+        kind = parse_type(type_text, where)
+        rounding = parse_rounding(side_text, where)
         if rounding is not None and kind != "mark":
             raise InputError(
                 f"{where}: rounding {rounding!r} on a point of type {kind}; "
                 "expected a rounding on marks only (leave it empty)"
             )
-        points.append(Waypoint(name, lat, lon, kind, rounding, where))
-    return from_waypoints(points, name=src.stem, src=str(src))
+        typed = bool(type_text.strip() or side_text.strip())
+        points.append(Waypoint(name, lat, lon, kind, rounding, where, line=lineno, typed=typed))
+    return from_waypoints(
+        points, name=src.stem, src=str(src), how_to_type="a type or rounding column in a CSV"
+    )

@@ -46,7 +46,16 @@ def _point(node: Node, src: Path, k: int) -> Waypoint:
         rounding = parse_rounding(text, where)
     else:
         kind = parse_type(text, where)
-    return Waypoint(name, lat, lon, kind, rounding, where)  # type: ignore[arg-type]
+    return Waypoint(
+        name,
+        lat,
+        lon,
+        kind,  # type: ignore[arg-type]
+        rounding,
+        where,
+        line=node.line,
+        typed=bool(text.strip()),
+    )
 
 
 def read_gpx_course(path: str | Path) -> ImportedCourse:
@@ -90,6 +99,7 @@ def read_gpx_course(path: str | Path) -> ImportedCourse:
         or (meta.child_text("name") if meta is not None else "")
         or src.stem
     )
+    how = "<type> in a GPX file"
     if rpts:
-        return from_waypoints(rpts, name=name, src=str(src), extra_marks=wpts)
-    return from_waypoints(wpts, name=name, src=str(src))
+        return from_waypoints(rpts, name=name, src=str(src), extra_marks=wpts, how_to_type=how)
+    return from_waypoints(wpts, name=name, src=str(src), how_to_type=how)

@@ -128,7 +128,19 @@ def read_kml_course(path: str | Path) -> ImportedCourse:
                 )
             kind = parse_type(data.get("type", ""), where)
             rounding = parse_rounding(data.get("rounding", ""), where)
-            points.append(Waypoint(name, coords[0][0], coords[0][1], kind, rounding, where))
+            typed = bool(data.get("type", "").strip() or data.get("rounding", "").strip())
+            points.append(
+                Waypoint(
+                    name,
+                    coords[0][0],
+                    coords[0][1],
+                    kind,
+                    rounding,
+                    where,
+                    line=pm.line,
+                    typed=typed,
+                )
+            )
             n_items += 1
         elif geo.tag == "LineString":
             if len(coords) != 2:
@@ -150,7 +162,9 @@ def read_kml_course(path: str | Path) -> ImportedCourse:
                 )
             line_name = name if kind == "gate" else (kind if name.lower() == kind else name)
             for k, (lat, lon) in enumerate(coords):
-                points.append(Waypoint(f"{name}_{k + 1}", lat, lon, kind, None, where, line_name))
+                points.append(
+                    Waypoint(f"{name}_{k + 1}", lat, lon, kind, None, where, line_name, pm.line)
+                )
             n_items += 1
         else:
             outer = geo.find("outerBoundaryIs")
@@ -163,7 +177,13 @@ def read_kml_course(path: str | Path) -> ImportedCourse:
             ring = _coords(ring_node, f"{src}: line {ring_node.line}")
             if len(ring) > 1 and ring[0] == ring[-1]:
                 ring = ring[:-1]  # KML closes its rings; a course ring does not
-            rings.append(Ring(name, tuple(ring), f"{src}: line {pm.line}"))
+            rings.append(Ring(name, tuple(ring), f"{src}: line {pm.line}", pm.line))
     doc = root.find("Document")
     title = (doc.child_text("name") if doc is not None else "") or src.stem
-    return from_waypoints(points, name=title, src=str(src), rings=rings)
+    return from_waypoints(
+        points,
+        name=title,
+        src=str(src),
+        rings=rings,
+        how_to_type="a `type` or `rounding` ExtendedData entry, or a LineString, in a KML file",
+    )

@@ -10,10 +10,18 @@ list of :class:`Waypoint` s in sailing order, assembled by :func:`from_waypoints
 * ``gate``: two consecutive points of this type are a gate, named ``"<a>-<b>"``.
 
 The first item of the list is where the first leg starts (the start line, or a mark).
+A file in which no point says what it is (no type, no rounding) is refused: every point
+would be a mark and the course would have no start line, which is what a plotter's
+export of a race course's marks gives, not a course.
+
+Every course remembers the line of the file each of its parts came from
+(:attr:`ImportedCourse.key_lines`), so that what the course file's checks find is
+reported at the line of the file that was imported.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -27,12 +35,14 @@ from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
 from sailroute.routing.rings import ring_problem
 from sailroute.routing.types import Side
+from sailroute.textin import bad_char
 
 __all__ = [
     "POINT_TYPES",
     "ImportedCourse",
     "Ring",
     "Waypoint",
+    "check_name",
     "classify_rings",
     "from_waypoints",
     "parse_rounding",
@@ -66,6 +76,11 @@ class Waypoint:
     line_name : str
         For an end of a line or gate: its name (default: the type for a start or
         finish line, ``"<a>-<b>"`` for a gate).
+    line : int
+        1-based line of the point in its file (0: unknown).
+    typed : bool
+        The file says what the point is (a type or a rounding side); False for a mark
+        by default.
     """
 
     name: str
@@ -75,6 +90,8 @@ class Waypoint:
     rounding: Side | None = None
     where: str = ""
     line_name: str = ""
+    line: int = 0
+    typed: bool = True
 
 
 @dataclass(frozen=True)
@@ -89,11 +106,14 @@ class Ring:
         Vertices ``(lat, lon)`` [deg], not repeating the first.
     where : str
         ``"file: line N"`` for messages.
+    line : int
+        1-based line of the polygon in its file (0: unknown).
     """
 
     name: str
     points: tuple[LatLon, ...]
     where: str
+    line: int = 0
 
 
 @dataclass(frozen=True)
@@ -120,6 +140,10 @@ class ImportedCourse:
         Areas to stay out of: name and ring.
     notes : tuple of str
         What the import decided that the user should know (areas left out, ...).
+    key_lines : tuple of (str, int)
+        Key path of the course file to be written (``"marks.M1"``, ``"legs[2]"``,
+        ``"boundary"``, ``"obstacles[0]"``) -> 1-based line of the imported file it
+        comes from.
     """
 
     name: str
@@ -132,6 +156,7 @@ class ImportedCourse:
     boundary: tuple[LatLon, ...] | None = None
     obstacles: tuple[tuple[str, tuple[LatLon, ...]], ...] = ()
     notes: tuple[str, ...] = ()
+    key_lines: tuple[tuple[str, int], ...] = ()
 
     @property
     def frame(self) -> LocalFrame:
@@ -139,6 +164,23 @@ class ImportedCourse:
         lat = float(np.mean([m[1] for m in self.marks]))
         lon = float(np.mean([m[2] for m in self.marks]))
         return LocalFrame(lat, lon)
+
+
+def check_name(name: str, where: str, what: str = "name") -> str:
+    """``name`` if a course file and every output can carry it, else an error at ``where``.
+
+    Raises
+    ------
+    InputError
+        A control character, a lone surrogate or U+FFFE/U+FFFF in the name
+        (:func:`~sailroute.textin.bad_char`).
+    """
+    bad = bad_char(name)
+    if bad is not None:
+        raise InputError(
+            f"{where}: the {what} {name!a} holds {bad}, which no output file can carry; remove it"
+        )
+    return name
 
 
 def parse_type(text: str, where: str) -> PointType:
@@ -164,10 +206,13 @@ def parse_rounding(text: str, where: str) -> Side | None:
     raise InputError(f"{where}: rounding {text!r}; expected port or starboard (or empty)")
 
 
-def _add_mark(marks: dict[str, tuple[float, float, str]], p: Waypoint, frame: LocalFrame) -> None:
+def _add_mark(
+    marks: dict[str, tuple[float, float, str, int]], p: Waypoint, frame: LocalFrame
+) -> None:
     """Record mark ``p``; a name seen before must be the same place."""
+    check_name(p.name, p.where, "mark name")
     if p.name in marks:
-        lat, lon, first = marks[p.name]
+        lat, lon, first, _ = marks[p.name]
         x, y = frame.to_xy([lat, p.lat], [lon, p.lon])
         d = float(math.hypot(x[1] - x[0], y[1] - y[0]))
         if d > SAME_PLACE_M:
@@ -176,7 +221,18 @@ def _add_mark(marks: dict[str, tuple[float, float, str]], p: Waypoint, frame: Lo
                 f"same name at {first}; expected one place per name (rename one)"
             )
         return
-    marks[p.name] = (p.lat, p.lon, p.where)
+    marks[p.name] = (p.lat, p.lon, p.where, p.line)
+
+
+def _untyped(points: Sequence[Waypoint], how_to_type: str) -> InputError:
+    """The error for a file in which no point says what it is."""
+    p = points[0]
+    return InputError(
+        f"{p.where}: no point says what it is ({how_to_type}), so every point would be a "
+        f"mark and the course would start at the mark {p.name!r}, with no start line; "
+        "give the start line's two ends the type start (the finish's finish, a gate's "
+        "gate), or the first point the type mark to start the first leg there"
+    )
 
 
 def from_waypoints(
@@ -187,6 +243,7 @@ def from_waypoints(
     rings: Sequence[Ring] = (),
     start_time: datetime | None = None,
     extra_marks: Sequence[Waypoint] = (),
+    how_to_type: str = "a type",
 ) -> ImportedCourse:
     """Assemble a course from a list of points in sailing order.
 
@@ -205,6 +262,9 @@ def from_waypoints(
     extra_marks : sequence of Waypoint
         Marks that are not in the sequence (a GPX file's waypoints beside its route); a
         name also in ``points`` must be the same place.
+    how_to_type : str
+        How the file gives a point's type, for the message when none does
+        (``"<type> in a GPX file"``).
 
     Returns
     -------
@@ -213,22 +273,27 @@ def from_waypoints(
     Raises
     ------
     InputError
-        Fewer than two items, a start/finish/gate point without its partner, a name
-        used for two places, or a bad polygon.
+        Fewer than two items, no point with a type or rounding, a start/finish/gate
+        point without its partner, a name used for two places or holding a control
+        character, or a bad polygon.
     """
     if not points:
         raise InputError(f"{src}: no points; expected the marks in sailing order")
+    if not any(p.typed for p in points):
+        raise _untyped(points, how_to_type)
     frame = LocalFrame(
         float(np.mean([p.lat for p in points])), float(np.mean([p.lon for p in points]))
     )
-    marks: dict[str, tuple[float, float, str]] = {}
+    marks: dict[str, tuple[float, float, str, int]] = {}
     lines: dict[str, tuple[str, str]] = {}
     gates: dict[str, tuple[str, str]] = {}
     seq: list[tuple[str, Side | None]] = []
+    key_lines: dict[str, int] = {}
     k = 0
     while k < len(points):
         p = points[k]
         _add_mark(marks, p, frame)
+        key_lines["legs[0].from" if not seq else f"legs[{len(seq) - 1}]"] = p.line
         if p.kind == "mark":
             seq.append((p.name, p.rounding or "port"))
             k += 1
@@ -246,12 +311,14 @@ def from_waypoints(
             )
         _add_mark(marks, q, frame)
         if p.kind == "gate":
-            gname = p.line_name or f"{p.name}-{q.name}"
+            gname = check_name(p.line_name or f"{p.name}-{q.name}", p.where, "gate name")
             gates[gname] = (p.name, q.name)
+            key_lines.setdefault(f"gates.{gname}", p.line)
             seq.append((gname, None))
         else:
-            lname = p.line_name or p.kind
+            lname = check_name(p.line_name or p.kind, p.where, "line name")
             lines[lname] = (p.name, q.name)
+            key_lines.setdefault(f"lines.{lname}", p.line)
             seq.append((lname, None))
         k += 2
     for p in extra_marks:
@@ -267,14 +334,16 @@ def from_waypoints(
                 f"{src}: {n!r} names a mark and a line or gate; expected "
                 "different names (rename the mark)"
             )
+    key_lines.update({f"marks.{n}": line for n, (_, _, _, line) in marks.items()})
     course = ImportedCourse(
-        name=name,
-        marks=tuple((n, lat, lon) for n, (lat, lon, _) in marks.items()),
+        name=check_name(name, src, "course name"),
+        marks=tuple((n, lat, lon) for n, (lat, lon, _, _) in marks.items()),
         lines=tuple((n, a, b) for n, (a, b) in lines.items()),
         gates=tuple((n, a, b) for n, (a, b) in gates.items()),
         start_from=seq[0][0],
         legs=tuple(seq[1:]),
         start_time=start_time,
+        key_lines=tuple((k, v) for k, v in key_lines.items() if v > 0),
     )
     return classify_rings(course, rings)
 
@@ -300,8 +369,10 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
     boundary_where = ""
     obstacles: list[tuple[str, tuple[LatLon, ...]]] = []
     notes = list(course.notes)
+    key_lines = dict(course.key_lines)
     taken: set[str] = set()
     for r in rings:
+        check_name(r.name, r.where, "polygon name")
         x, y = frame.to_xy([p[0] for p in r.points], [p[1] for p in r.points])
         xy = np.column_stack([x, y])
         problem = ring_problem(xy)
@@ -323,6 +394,7 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
                 )
             else:
                 boundary, boundary_where = r.points, r.where
+                key_lines["boundary"] = r.line
         elif inside.all():
             notes.append(
                 f"polygon {r.name!r} ({r.where}) holds every mark: an outer limit "
@@ -341,16 +413,12 @@ def classify_rings(course: ImportedCourse, rings: Sequence[Ring]) -> ImportedCou
                 n += 1
                 name = f"{r.name}-{n}"
             taken.add(name)
+            key_lines[f"obstacles[{len(obstacles)}]"] = r.line
             obstacles.append((name, r.points))
-    return ImportedCourse(
-        course.name,
-        course.marks,
-        course.lines,
-        course.gates,
-        course.start_from,
-        course.legs,
-        course.start_time,
-        boundary,
-        tuple(obstacles),
-        tuple(notes),
+    return dataclasses.replace(
+        course,
+        boundary=boundary,
+        obstacles=tuple(obstacles),
+        notes=tuple(notes),
+        key_lines=tuple((k, v) for k, v in key_lines.items() if v > 0),
     )

@@ -19,16 +19,16 @@ A gate is named ``"<mark 1>-<mark 2>"`` (``LG1-LG2``), the lines ``start`` and `
 
 from __future__ import annotations
 
+import itertools
 import math
-from datetime import datetime
 from pathlib import Path
 
-from sailroute.course.formats.model import ImportedCourse, Ring, classify_rings
+from sailroute.course.formats.model import ImportedCourse, Ring, check_name, classify_rings
 from sailroute.course.formats.xmlnodes import Node, parse_xml
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
 from sailroute.routing.types import Side
-from sailroute.timeutil import parse_time
+from sailroute.timeutil import parse_local_time
 
 __all__ = ["read_race_xml"]
 
@@ -62,6 +62,18 @@ def _seq(node: Node, src: Path) -> int:
         ) from None
 
 
+def _in_seq_order(nodes: list[Node], src: Path, what: str) -> list[Node]:
+    """``nodes`` sorted by their ``SeqID``; two of one SeqID are an error (which comes first?)."""
+    keyed = sorted(((_seq(n, src), n) for n in nodes), key=lambda sn: sn[0])
+    for (a, na), (b, nb) in itertools.pairwise(keyed):
+        if a == b:
+            raise InputError(
+                f"{src}: line {nb.line}: <{nb.tag}> SeqID={b} again (also at line "
+                f"{na.line}) in {what}; expected each SeqID once (they give the order)"
+            )
+    return [n for _, n in keyed]
+
+
 def _compound_marks(course: Node, src: Path) -> dict[str, list[tuple[str, float, float, int]]]:
     """CompoundMarkID -> its marks ``(name, lat, lon, line)`` in SeqID order."""
     out: dict[str, list[tuple[str, float, float, int]]] = {}
@@ -86,36 +98,43 @@ def _compound_marks(course: Node, src: Path) -> dict[str, list[tuple[str, float,
                     f"{src}: line {m.line}: <{m.tag}> in CompoundMark {cid!r}; "
                     "expected <Mark Name TargetLat TargetLng> elements only"
                 )
-            name = m.attrs.get("Name", "").strip()
+        for m in _in_seq_order(cm.children, src, f"CompoundMark {cid!r}"):
+            name = check_name(m.attrs.get("Name", "").strip(), f"{src}: line {m.line}", "Name")
             if not name:
                 raise InputError(f"{src}: line {m.line}: <Mark> without a Name")
             lat = _float(m, "TargetLat", -90.0, 90.0, src)
             lon = _float(m, "TargetLng", -180.0, 360.0, src)
-            marks.append((_seq(m, src), name, lat, lon, m.line))
+            marks.append((name, lat, lon, m.line))
         if len(marks) not in (1, 2):
             raise InputError(
                 f"{src}: line {cm.line}: CompoundMark {cid!r} holds {len(marks)} "
                 "marks; expected 1 (a mark) or 2 (a gate or line)"
             )
-        out[cid] = [(n, la, lo, ln) for _, n, la, lo, ln in sorted(marks)]
+        out[cid] = marks
+    if not out:
+        raise InputError(
+            f"{src}: line {course.line}: <Course> holds no <CompoundMark>; expected the "
+            "course's marks, each in a <CompoundMark>"
+        )
     return out
 
 
 def _rings(root: Node, src: Path) -> list[Ring]:
     rings = []
     for lim in root.findall("CourseLimit"):
-        pts = sorted(
-            (_seq(p, src), _float(p, "Lat", -90.0, 90.0, src), _float(p, "Lon", -180.0, 360.0, src))
-            for p in lim.findall("Limit")
-        )
-        ring = [(la, lo) for _, la, lo in pts]
+        name = lim.attrs.get("name", "")
+        ring = [
+            (_float(p, "Lat", -90.0, 90.0, src), _float(p, "Lon", -180.0, 360.0, src))
+            for p in _in_seq_order(lim.findall("Limit"), src, f"CourseLimit {name!r}")
+        ]
         if len(ring) > 1 and ring[0] == ring[-1]:
             ring = ring[:-1]
         rings.append(
             Ring(
-                lim.attrs.get("name", "") or f"limit{lim.line}",
+                name or f"limit{lim.line}",
                 tuple(ring),
                 f"{src}: line {lim.line}",
+                lim.line,
             )
         )
     return rings
@@ -157,7 +176,7 @@ def read_race_xml(path: str | Path) -> ImportedCourse:
             "<CompoundMarkSequence>; expected both"
         )
     cms = _compound_marks(course, src)
-    corners = sorted((_seq(c, src), c) for c in sequence.findall("Corner"))
+    corners = _in_seq_order(sequence.findall("Corner"), src, "<CompoundMarkSequence>")
     if len(corners) < 2:
         raise InputError(
             f"{src}: line {sequence.line}: {len(corners)} corner(s); expected "
@@ -171,7 +190,9 @@ def read_race_xml(path: str | Path) -> ImportedCourse:
     lines: dict[str, tuple[str, str]] = {}
     gates: dict[str, tuple[str, str]] = {}
     seq: list[tuple[str, Side | None]] = []
-    for k, (_, corner) in enumerate(corners):
+    key_lines: dict[str, int] = {}
+    for k, corner in enumerate(corners):
+        key_lines["legs[0].from" if k == 0 else f"legs[{k - 1}]"] = corner.line
         cid = corner.attrs.get("CompoundMarkID", "")
         if cid not in cms:
             raise InputError(
@@ -211,18 +232,21 @@ def read_race_xml(path: str | Path) -> ImportedCourse:
         if k == 0 or k == len(corners) - 1:
             lname = "start" if k == 0 else "finish"
             lines[lname] = pair
+            key_lines.setdefault(f"lines.{lname}", corner.line)
             seq.append((lname, None))
         else:
             gname = f"{pair[0]}-{pair[1]}"
             gates[gname] = pair
+            key_lines.setdefault(f"gates.{gname}", corner.line)
             seq.append((gname, None))
     rst = root.find("RaceStartTime")
     start = None
     if rst is not None and rst.attrs.get("Start"):
         text = rst.attrs["Start"]
-        parse_time(text, where=f"{src}: line {rst.line}: RaceStartTime Start")  # the checks
-        start = datetime.fromisoformat(text.replace("Z", "+00:00"))  # keeps the local offset
-    race_id = root.child_text("RaceID")
+        start = parse_local_time(text, where=f"{src}: line {rst.line}: RaceStartTime Start")
+        key_lines["start_time"] = rst.line
+    race_id = check_name(root.child_text("RaceID"), f"{src}: line {root.line}", "RaceID")
+    key_lines.update({f"marks.{n}": line for n, (_, _, line) in marks.items()})
     imported = ImportedCourse(
         name=f"race {race_id}" if race_id else src.stem,
         marks=tuple((n, la, lo) for n, (la, lo, _) in marks.items()),
@@ -231,5 +255,6 @@ def read_race_xml(path: str | Path) -> ImportedCourse:
         start_from=seq[0][0],
         legs=tuple(seq[1:]),
         start_time=start,
+        key_lines=tuple(key_lines.items()),
     )
     return classify_rings(imported, _rings(root, src))

@@ -3,8 +3,11 @@
 The text follows ``docs/course-format.md``: ``marks`` in degrees, ``lines``, ``gates``,
 ``legs`` (the first with ``from:``), one uniform wind scenario, and the ``boundary`` and
 ``obstacles`` areas.  Names are written double-quoted (a name such as ``1`` or ``no``
-stays text); coordinates with 9 decimals (0.1 mm).  Comments at the top say where the
-course came from and what the user has to add.
+stays text, and a line break inside one is an escape, not a new line), the ``boat``
+section as JSON (every key quoted); coordinates with 9 decimals (0.1 mm).  Comments at
+the top say where the course came from and what the user has to add; the source's file
+name in them has every character that could end the comment replaced, so no text of the
+imported file can add a key to the course file.
 """
 
 from __future__ import annotations
@@ -15,13 +18,20 @@ from datetime import datetime
 from typing import Any
 
 from sailroute.course.formats.model import ImportedCourse, LatLon
+from sailroute.textin import excerpt
 
 __all__ = ["course_yaml"]
 
 
+def _yaml_json(text: str) -> str:
+    """JSON text as YAML reads it: U+2028 and U+2029, which JSON writes as they are but
+    YAML takes for line breaks, escaped."""
+    return text.replace("\u2028", "\\u2028").replace("\u2029", "\\u2029")
+
+
 def _q(text: str) -> str:
     """A YAML double-quoted scalar (JSON's string syntax is valid YAML)."""
-    return json.dumps(text, ensure_ascii=False)
+    return _yaml_json(json.dumps(text, ensure_ascii=False))
 
 
 def _deg(v: float) -> str:
@@ -38,15 +48,9 @@ def _ring(points: tuple[LatLon, ...], indent: str) -> list[str]:
     return [f"{indent}- {_point(p)}" for p in points]
 
 
-def _flow(value: Any) -> str:
-    """A small mapping or scalar in YAML flow style."""
-    if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{k}: {_flow(v)}" for k, v in value.items()) + "}"
-    if isinstance(value, str):
-        return _q(value)
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return repr(value)
+def _flow(value: Mapping[str, Any]) -> str:
+    """A small mapping in YAML flow style: as JSON, every key and text quoted."""
+    return _yaml_json(json.dumps(value, ensure_ascii=False, allow_nan=False))
 
 
 def course_yaml(
@@ -80,7 +84,7 @@ def course_yaml(
     str
         YAML text, ending in a newline.
     """
-    out = [f"# Imported by `sailroute course import` from {source} ({fmt})."]
+    out = [f"# Imported by `sailroute course import` from {excerpt(source, 200)} ({fmt})."]
     if boat is None:
         out += [
             "# NO BOAT GIVEN (--boat): add a `boat:` section for the boat you race, e.g.",

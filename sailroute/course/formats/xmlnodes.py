@@ -3,11 +3,15 @@
 The course importers (GPX, KML, race XML) name the line of a bad element in their
 messages; :mod:`xml.etree.ElementTree` does not keep lines, so the tree is built here
 from the expat parser's callbacks.  Document type declarations are refused: no course
-file needs one, and refusing them rules out entity expansion.
+file needs one, and refusing them rules out entity expansion.  So are elements nested
+deeper than :data:`MAX_DEPTH` (a course file needs a few levels; thousands of nested
+KML folders would exhaust the stack of whatever walks the tree) and an encoding that
+expat cannot read (``encoding="rot13"``, UTF-7).
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -15,7 +19,11 @@ from xml.parsers import expat
 
 from sailroute.errors import InputError
 
-__all__ = ["Node", "parse_xml"]
+__all__ = ["MAX_DEPTH", "Node", "parse_xml"]
+
+MAX_DEPTH = 100
+"""Deepest nesting of elements a course file may have (KML's Document/Folder/Placemark/
+Polygon/outerBoundaryIs/LinearRing/coordinates needs 8 and a few folders)."""
 
 
 @dataclass(eq=False)
@@ -57,10 +65,12 @@ class Node:
 
     def iter(self, tag: str) -> Iterator[Node]:
         """Every element called ``tag`` below this one (and itself), in document order."""
-        if self.tag == tag:
-            yield self
-        for c in self.children:
-            yield from c.iter(tag)
+        todo = [self]
+        while todo:
+            node = todo.pop()
+            if node.tag == tag:
+                yield node
+            todo.extend(reversed(node.children))
 
 
 def _local(name: str) -> str:
@@ -100,6 +110,11 @@ def parse_xml(path: Path, what: str) -> Node:
     root: list[Node] = []
 
     def start(name: str, attrs: dict[str, str]) -> None:
+        if len(stack) >= MAX_DEPTH:
+            raise InputError(
+                f"{path}: line {parser.CurrentLineNumber}: elements nested more than "
+                f"{MAX_DEPTH} levels deep; expected {what} (a course needs a few levels)"
+            )
         node = Node(
             _local(name), {_local(k): v for k, v in attrs.items()}, parser.CurrentLineNumber
         )
@@ -135,6 +150,15 @@ def parse_xml(path: Path, what: str) -> Node:
         raise InputError(
             f"{path}:{exc.lineno}:{exc.offset + 1}: not well-formed XML "
             f"({expat.errors.messages[exc.code]}); expected {what}"
+        ) from None
+    except InputError:  # from the handlers above
+        raise
+    except (LookupError, ValueError) as exc:  # an encoding expat cannot use
+        declared = re.search(rb"""encoding\s*=\s*["']([^"']{0,40})""", data[:200])
+        name = declared.group(1).decode("ascii", "replace") if declared else "?"
+        raise InputError(
+            f"{path}: line 1: cannot read the encoding {name!r} the XML declaration "
+            f"names ({exc}); expected {what} in UTF-8 (save it as UTF-8)"
         ) from None
     if not root:
         raise InputError(f"{path}: no XML element found; expected {what}")
