@@ -98,6 +98,7 @@ from sailroute.boat.polar import Polar
 from sailroute.course.geometry import leg_endpoints, target_of, wind_mode, xy_bearing_deg
 from sailroute.course.load import course_from_mapping
 from sailroute.course.model import Course
+from sailroute.geo import LocalFrame
 from sailroute.routing.batch import route_leg_batch
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.settings import IsochroneSettings, RoutingSettings
@@ -309,9 +310,9 @@ class FaultPlan:
     ocs_margin_m: tuple[float, float] = (8.0, 35.0)
     late_s: tuple[float, float] = (25.0, 90.0)
     gap_s: tuple[float, float] = (45.0, 120.0)
-    noise_white_m: float = 1.5
-    noise_corr_m: float = 2.0
-    noise_tau_s: float = 30.0
+    noise_white_m: float = 0.7
+    noise_corr_m: float = 1.5
+    noise_tau_s: float = 60.0
     sog_cog: bool = False
 
     @classmethod
@@ -400,8 +401,9 @@ class BoatTruth:
         where no gate mark was rounded).
     sample_s : float
         Interval between fixes [s].
-    noise_white_m, noise_corr_m, noise_tau_s : float
-        GPS error of its track (per axis).
+    spans : tuple of (float, float)
+        The true-time intervals its tracker logged [epoch s] (two around a data gap, two
+        for a log of two races).
     faults : tuple of Fault
     duplicate_of : str or None
         For a duplicate: the boat whose data it repeats.
@@ -430,9 +432,7 @@ class BoatTruth:
     gate_marks: tuple[str, ...]
     gate_round_t: tuple[float, ...]
     sample_s: float
-    noise_white_m: float
-    noise_corr_m: float
-    noise_tau_s: float
+    spans: tuple[tuple[float, float], ...]
     faults: tuple[Fault, ...]
     duplicate_of: str | None
     legs: tuple[LegResult, ...]
@@ -505,6 +505,18 @@ class Fleet:
     tracks: tuple[Track, ...]
     seed: int
     plan: FaultPlan
+
+    def resampled(self, *, clock_lag_s: float | None = None, noise: bool = True) -> Fleet:
+        """The same boats recorded again: with another clock lag, or without GPS error
+        (the same fixes otherwise; :func:`record_tracks`)."""
+        lag = self.clock_lag_s if clock_lag_s is None else clock_lag_s
+        plan = (
+            self.plan
+            if noise
+            else dataclasses.replace(self.plan, noise_white_m=0.0, noise_corr_m=0.0)
+        )
+        tracks = record_tracks(self.boats, lag, self.course.frame, plan, self.seed)
+        return dataclasses.replace(self, clock_lag_s=lag, plan=plan, tracks=tracks)
 
     def truth(self, name: str) -> BoatTruth:
         """The truth of the track ``name``."""
@@ -865,11 +877,22 @@ class Routed:
     legs: tuple[LegResult, ...]
     roundings: tuple[Rounding, ...]
 
+    @property
+    def start_t(self) -> float:
+        """When the boat leaves the start line [epoch s]: a route that begins with a tack
+        on the line starts when the tack is over."""
+        tr = self.legs[0].track
+        moved = np.flatnonzero((tr.x != tr.x[0]) | (tr.y != tr.y[0]))
+        return float(tr.t[moved[0] - 1]) if moved.size else float(tr.t[0])
+
     def knots(self) -> list[Knot]:
-        """The path from the start to the finish (repeated times dropped)."""
+        """The path from the start (:attr:`start_t`) to the finish (repeated times
+        dropped)."""
         out: list[Knot] = []
         for k, leg in enumerate(self.legs):
             pts = zip(leg.track.t.tolist(), leg.track.x.tolist(), leg.track.y.tolist(), strict=True)
+            if k == 0:
+                pts = itertools.dropwhile(lambda p: p[0] < self.start_t, pts)
             if k > 0:
                 r = self.roundings[k - 1]
                 pts = itertools.chain(zip(r.t, r.x, r.y, strict=True), pts)
@@ -1245,13 +1268,13 @@ def _draw_start(race: _Race, b: _Boat, rng: np.random.Generator, key: str, gun: 
     return _Drawn(b, plan, tuple(head), approach, ocs_s, returned)
 
 
-def _prestart(d: _Drawn, legs: Sequence[LegResult], line: _Line) -> list[Knot]:
+def _prestart(d: _Drawn, r: Routed, line: _Line) -> list[Knot]:
     """The drawn path up to the start: head, zigzags, the approach on the route's first
     heading."""
     assert d.plan is not None
-    h, v = _first_heading(legs)
+    h, v = _first_heading(r.legs)
     k = list(d.head)
-    e = _approach(h, 0.8 * v, d.plan.start_xy, d.plan.t_start, d.approach_s)
+    e = _approach(h, 0.8 * v, d.plan.start_xy, r.start_t, d.approach_s)
     _zigzag(k, e[0], (e[1], e[2]), line)
     k.append(e)
     return k
@@ -1337,7 +1360,7 @@ class _Sailed:
 
 
 def _race_path(d: _Drawn, r: Routed, race: _Race, rng: np.random.Generator) -> list[Knot]:
-    return _prestart(d, r.legs, race.line) + r.knots() + _tail(r.legs, race.line, rng)
+    return _prestart(d, r, race.line) + r.knots() + _tail(r.legs, race.line, rng)
 
 
 def _whole(k: Sequence[Knot]) -> tuple[tuple[float, float], ...]:
@@ -1367,9 +1390,10 @@ def _sail(
     if b.role in ("racing", "late", "ocs_returned", "ocs_not_returned"):
         faults: tuple[Fault, ...] = ()
         if b.role == "late":
-            faults = (Fault("late", {"late_s": d.plan.t_start - race.gun}),)
+            faults = (Fault("late", {"late_s": r.start_t - race.gun}),)
         elif b.role.startswith("ocs"):
-            faults = (Fault("ocs", {"ocs_s": d.ocs_s, "returned": b.role == "ocs_returned"}),)
+            ocs = d.ocs_s if b.role == "ocs_returned" else race.gun - r.start_t
+            faults = (Fault("ocs", {"ocs_s": ocs, "returned": b.role == "ocs_returned"}),)
         return _Sailed(b.role, k, _whole(k), r, faults)
     if b.role == "data_gap":
         return _data_gap(k, r, race.plan, rng)
@@ -1382,7 +1406,7 @@ def _sail(
             "two_races",
             {
                 "gun2": extra["gun2"],
-                "start2_t": second.legs[0].t_start,
+                "start2_t": second.start_t,
                 "leg_end2_t": tuple(leg.t_end for leg in second.legs),
                 "gap": (k[-1][0], k2[0][0]),
             },
@@ -1439,48 +1463,35 @@ def _gps_error(
 ) -> NDArray:
     """GPS error along one axis [m]: white plus first-order autoregressive (sd ``corr``,
     correlation time ``tau``) at a fix every ``dt`` s."""
-    e = rng.normal(0.0, white, n) if white > 0 else np.zeros(n)
+    e = white * rng.normal(0.0, 1.0, n)
+    a = math.exp(-dt / tau)
+    z = (corr * math.sqrt(1.0 - a * a) * rng.normal(0.0, 1.0, n)).tolist()
     if corr > 0 and n:
-        a = math.exp(-dt / tau)
-        z = (rng.normal(0.0, corr * math.sqrt(1.0 - a * a), n)).tolist()
         z[0] = corr * z[0] / math.sqrt(1.0 - a * a)
         for k in range(1, n):
             z[k] += a * z[k - 1]
-        e = e + np.array(z)
-    return e
+    return e + np.array(z)
 
 
 def _record(
-    name: str,
-    s: _Sailed,
-    dt: float,
-    lag: float,
-    course: Course,
-    plan: FaultPlan,
-    rng: np.random.Generator,
+    b: BoatTruth, lag: float, frame: LocalFrame, plan: FaultPlan, rng: np.random.Generator
 ) -> Track:
-    """The tracker's record of the path: fixes every ``dt`` s on whole seconds of a clock
-    ``lag`` s behind, GPS error, optionally SOG/COG."""
+    """The tracker's record of a boat's path: fixes every ``b.sample_s`` s on whole seconds
+    of a clock ``lag`` s behind, over its spans, with GPS error and optionally SOG/COG."""
+    dt = b.sample_s
     phase = float(rng.integers(int(dt)))
     rec = []
-    for lo, hi in s.spans:
+    for lo, hi in b.spans:
         r0 = math.ceil((lo - lag - phase) / dt) * dt + phase
         r = np.arange(r0, hi - lag + 1e-9, dt)
         rec.append(r[(r + lag >= lo) & (r + lag <= hi)])
     r = np.concatenate(rec)
-    gaps = [(f.params["t0"], f.params["t1"]) for f in s.faults if f.kind == "data_gap"]
-    for g0, g1 in gaps:
-        r = r[(r + lag <= g0) | (r + lag >= g1)]
     t = r + lag
-    kt = np.array([p[0] for p in s.knots])
-    kx, ky = np.array([p[1] for p in s.knots]), np.array([p[2] for p in s.knots])
-    x = np.interp(t, kt, kx) + _gps_error(
-        rng, t.size, dt, plan.noise_white_m, plan.noise_corr_m, plan.noise_tau_s
-    )
-    y = np.interp(t, kt, ky) + _gps_error(
-        rng, t.size, dt, plan.noise_white_m, plan.noise_corr_m, plan.noise_tau_s
-    )
-    lat, lon = course.frame.to_latlon(x, y)
+    kt, kx, ky = b.path_t, b.path_x, b.path_y
+    noise = (plan.noise_white_m, plan.noise_corr_m, plan.noise_tau_s)
+    x = np.interp(t, kt, kx) + _gps_error(rng, t.size, dt, *noise)
+    y = np.interp(t, kt, ky) + _gps_error(rng, t.size, dt, *noise)
+    lat, lon = frame.to_latlon(x, y)
     channels: dict[str, NDArray] = {}
     if plan.sog_cog:
         seg = np.clip(np.searchsorted(kt, t, side="right") - 1, 0, kt.size - 2)
@@ -1488,7 +1499,23 @@ def _record(
         vx, vy = np.diff(kx)[seg] / span, np.diff(ky)[seg] / span
         channels["sog_ms"] = np.hypot(vx, vy) + rng.normal(0.0, 0.1, t.size)
         channels["cog_deg"] = (bearing_deg(vx, vy) + rng.normal(0.0, 2.0, t.size)) % 360.0
-    return Track(r.astype(float), lat, lon, name, f"{name}", MappingProxyType(channels), ())
+    return Track(r.astype(float), lat, lon, b.name, b.name, MappingProxyType(channels), ())
+
+
+def record_tracks(
+    boats: Sequence[BoatTruth], lag: float, frame: LocalFrame, plan: FaultPlan, seed: int
+) -> tuple[Track, ...]:
+    """Every boat's track (:func:`_record`; a duplicate: its source's data under its own
+    name), from the random stream ``[seed, 1]``: the same fixes and error whatever the
+    routing drew."""
+    rng = np.random.default_rng([seed, 1])
+    own = {b.name: _record(b, lag, frame, plan, rng) for b in boats if b.duplicate_of is None}
+    return tuple(
+        own[b.name]
+        if b.duplicate_of is None
+        else dataclasses.replace(own[b.duplicate_of], name=b.name, source=b.name)
+        for b in boats
+    )
 
 
 OTHER_CLASS_SKILL: Final = 1.22
@@ -1519,9 +1546,7 @@ def _outside_gate(race: _Race, rng: np.random.Generator) -> tuple[str, Target]:
     )
 
 
-def _truth(
-    d: _Drawn, s: _Sailed, race: _Race, name: str, n_legs: int, track_dt: float
-) -> BoatTruth:
+def _truth(d: _Drawn, s: _Sailed, race: _Race, name: str, n_legs: int) -> BoatTruth:
     kt = np.array([p[0] for p in s.knots])
     kx, ky = np.array([p[1] for p in s.knots]), np.array([p[2] for p in s.knots])
     gun = d.plan.gun if d.plan is not None else race.gun
@@ -1536,7 +1561,7 @@ def _truth(
         return float(race.line.side(np.interp(t, kt, kx), np.interp(t, kt, ky)))
 
     ends = [leg.t_end for leg in s.legs] + [math.nan] * (n_legs - len(s.legs))
-    start = s.legs[0].t_start if s.legs else math.nan
+    start = s.routed.start_t if s.legs else math.nan
     b = d.boat
     pen = TACK_CLASSES[b.tack]
     rounds = [*s.routed.roundings, Rounding((), (), ())][: len(s.legs)]
@@ -1553,15 +1578,13 @@ def _truth(
         start_delay_s=start - gun,
         distance_at_gun_m=side_at(gun),
         distance_at_first_gun_m=side_at(race.first_gun),
-        ocs_s=d.ocs_s,
+        ocs_s=next((f.params["ocs_s"] for f in s.faults if f.kind == "ocs"), None),
         returned_t=d.returned_t,
         leg_end_t=tuple(float(v) for v in ends),
         gate_marks=tuple(q.mark for q in rounds),
         gate_round_t=tuple(q.apex_t for q in rounds),
-        sample_s=track_dt,
-        noise_white_m=race.plan.noise_white_m,
-        noise_corr_m=race.plan.noise_corr_m,
-        noise_tau_s=race.plan.noise_tau_s,
+        sample_s=d.boat.sample_s,
+        spans=s.spans,
         faults=s.faults,
         duplicate_of=None,
         legs=s.legs,
@@ -1684,21 +1707,18 @@ def messy_fleet(
     routes = route_plans(course, plans, polar, wind, router)
     t_end = max(r.legs[-1].t_end for k, r in routes.items() if not k.endswith("#2")) + 120.0
     extra = {"second": second, "gun2": gun2, "outside": outside, "kinds": kinds}
-    boats_out: list[BoatTruth] = []
-    tracks: list[Track] = []
-    for d in drawn:
-        s = _sail(d, routes, race, rng, t_end, extra)
-        dt = d.boat.sample_s
-        tracks.append(_record(d.boat.name, s, dt, clock_lag_s, course, plan, rng))
-        boats_out.append(_truth(d, s, race, d.boat.name, course.n_legs, dt))
-    _add_duplicates(boats_out, tracks, plan, rng)
-    order = np.argsort([b.name for b in boats_out])
+    truths = [
+        _truth(d, _sail(d, routes, race, rng, t_end, extra), race, d.boat.name, course.n_legs)
+        for d in drawn
+    ]
+    truths += _duplicates(truths, plan, rng)
+    truths.sort(key=lambda b: b.name)
     comment = (
         f"A generated fleet (tests/fleetgen.py, seed {seed}): {n_boats} boats, about "
         f"{minutes:.0f} min.\nWind: TWD {twd:.0f}° ± shifts, TWS {tws_kn:.1f} kn.\n"
         + (f"General recall: first gun {iso(first_gun)}.\n" if first_gun is not None else "")
     )
-    return Fleet(
+    fleet = Fleet(
         course=course,
         course_yaml=course_yaml(data, comment),
         wind=wind,
@@ -1707,30 +1727,29 @@ def messy_fleet(
         guns=(gun,) if first_gun is None else (first_gun, gun),
         clock_lag_s=clock_lag_s,
         marks=MappingProxyType(dict(marks)),
-        boats=tuple(boats_out[k] for k in order),
-        tracks=tuple(tracks[k] for k in order),
+        boats=tuple(truths),
+        tracks=(),
         seed=seed,
         plan=plan,
     )
+    return fleet.resampled()
 
 
-def _add_duplicates(
-    boats: list[BoatTruth], tracks: list[Track], plan: FaultPlan, rng: np.random.Generator
-) -> None:
-    """Append ``plan.duplicates`` copies of clean boats' tracks under new names."""
-    clean = [k for k, b in enumerate(boats) if b.clean]
+def _duplicates(
+    boats: Sequence[BoatTruth], plan: FaultPlan, rng: np.random.Generator
+) -> list[BoatTruth]:
+    """``plan.duplicates`` copies of clean boats under new names."""
+    clean = [b for b in boats if b.clean]
     taken = {b.name for b in boats}
     fresh = (n for n in _names(rng, 4 * len(boats) + 8) if n not in taken)
-    for k in rng.choice(clean, size=min(plan.duplicates, len(clean)), replace=False):
-        src, tr = boats[int(k)], tracks[int(k)]
-        name = next(fresh)
-        tracks.append(dataclasses.replace(tr, name=name, source=name))
-        boats.append(
-            dataclasses.replace(
-                src,
-                name=name,
-                status="duplicate_of",
-                duplicate_of=src.name,
-                faults=(Fault("duplicate", {"of": src.name}),),
-            )
+    pick = rng.choice(len(clean), size=min(plan.duplicates, len(clean)), replace=False)
+    return [
+        dataclasses.replace(
+            clean[int(k)],
+            name=next(fresh),
+            status="duplicate_of",
+            duplicate_of=clean[int(k)].name,
+            faults=(Fault("duplicate", {"of": clean[int(k)].name}),),
         )
+        for k in pick
+    ]
