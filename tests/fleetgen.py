@@ -565,6 +565,57 @@ class Fleet:
         twd = float(self.wind.direction(t, *a))
         return wind_mode(xy_bearing_deg(a, target.centre), twd)
 
+    def truth_json(self) -> dict[str, Any]:
+        """The truth as plain JSON values (times ISO 8601 UTC, true clock; NaN: null)."""
+
+        def val(v: Any) -> Any:
+            if isinstance(v, float | np.floating):
+                return None if math.isnan(v) else float(v)
+            if isinstance(v, tuple | list):
+                return [val(e) for e in v]
+            return v
+
+        def t(v: float) -> str | None:
+            return None if math.isnan(v) else iso(v)
+
+        boats = {
+            b.name: {
+                "status": b.status,
+                "duplicate_of": b.duplicate_of,
+                "skill": b.skill,
+                "tack_cost_s": b.tack_cost_s,
+                "first_side": b.first_side,
+                "gun": t(b.gun_t),
+                "start": t(b.start_t),
+                "start_delay_s": val(b.start_delay_s),
+                "distance_at_gun_m": val(b.distance_at_gun_m),
+                "ocs_s": b.ocs_s,
+                "returned": None if b.returned_t is None else t(b.returned_t),
+                "leg_ends": [t(v) for v in b.leg_end_t],
+                "gate_marks": list(b.gate_marks),
+                "gate_rounds": [t(v) for v in b.gate_round_t],
+                "sample_s": b.sample_s,
+                "faults": [
+                    {"kind": f.kind, **{k: val(v) for k, v in f.params.items()}} for f in b.faults
+                ],
+            }
+            for b in self.boats
+        }
+        return {
+            "seed": self.seed,
+            "guns": [iso(g) for g in self.guns],
+            "clock_lag_s": self.clock_lag_s,
+            "clock": "recorded time = true time - clock_lag_s",
+            "wind": {k: val(v) for k, v in dataclasses.asdict(self.wind).items()},
+            "gps_error_m": {
+                "white": self.plan.noise_white_m,
+                "correlated": self.plan.noise_corr_m,
+                "tau_s": self.plan.noise_tau_s,
+            },
+            "legs": [self.point_of_sail(i) for i in range(self.course.n_legs)],
+            "boats": boats,
+        }
+
     def write(
         self, folder: str | Path, fmt: str = "gpx", *, gun: str = "race"
     ) -> tuple[Path, list[Path]]:
