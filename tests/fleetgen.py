@@ -100,12 +100,12 @@ from sailroute.course.load import course_from_mapping
 from sailroute.course.model import Course
 from sailroute.geo import LocalFrame
 from sailroute.routing.batch import route_leg_batch
-from sailroute.routing.geometry import chain_leg
+from sailroute.routing.geometry import chain_leg, target_geometry
 from sailroute.routing.settings import IsochroneSettings, RoutingSettings
 from sailroute.routing.types import LegResult, Manoeuvre, Side, Start, Target
 from sailroute.timeutil import iso, parse_time, to_epoch
 from sailroute.track.model import Track
-from sailroute.units import KNOT, bearing_deg
+from sailroute.units import KNOT, bearing_deg, wrap180
 from sailroute.wind.base import Coverage
 
 GUN: Final = to_epoch(parse_time("2024-06-01T13:00:00Z"))
@@ -847,20 +847,44 @@ def _true_time(res: LegResult, plan: _Plan) -> LegResult:
     )
 
 
-ROUND_RADIUS_M: Final = 8.0
-"""Radius of a drawn gate rounding [m]."""
+ROUND_RADIUS_M: Final = 6.0
+"""How far from a mark boats round it [m]: the router aims this far off each mark
+(:func:`clear_target`), and the drawn roundings circle the mark at least this far off."""
 ROUND_ON_M: Final = 8.0
-"""A boat sails this far on past a mark's rounding segment before its next leg [m]."""
+"""After passing a gate outside its marks a boat sails this far on before its next leg
+[m]."""
+
+
+def clear_target(target: Target, start: Start, zone_m: float) -> Target:
+    """The target the boats are routed to: a mark moved :data:`ROUND_RADIUS_M` out along
+    its rounding segment, a gate narrowed by it at both ends (a line as it is), so that no
+    route touches a mark.  The segment crossed lies on the course target's own segment
+    (detection finds the crossing at the same place)."""
+    r = ROUND_RADIUS_M
+    if target.kind == "mark" and target.rounding is not None:
+        g = target_geometry(target, start, zone_m)
+        ex, ey = g.b[0] - g.a[0], g.b[1] - g.a[1]
+        n = math.hypot(ex, ey)
+        return dataclasses.replace(target, a=(g.a[0] + r * ex / n, g.a[1] + r * ey / n))
+    if target.kind == "gate" and target.b is not None:
+        (ax, ay), (bx, by) = target.a, target.b
+        n = math.hypot(bx - ax, by - ay)
+        ux, uy = (bx - ax) / n, (by - ay) / n
+        return dataclasses.replace(
+            target, a=(ax + r * ux, ay + r * uy), b=(bx - r * ux, by - r * uy)
+        )
+    return target
 
 
 @dataclass(frozen=True)
 class Rounding:
     """What a boat sailed between two routed legs (drawn, not routed).
 
-    After a mark (or a gate passed outside) it sails :data:`ROUND_ON_M` straight on past
-    the rounding segment; after a gate it goes on below the gate and round the gate mark
-    nearer to where it passed, on a circle of :data:`ROUND_RADIUS_M`, to the mark's outer
-    side, where its next leg starts.
+    After a mark it goes on round the mark, on a circle through its arrival point (at least
+    :data:`ROUND_RADIUS_M` off), through half the turn to the next leg; after a gate it
+    goes on below the gate and round the gate mark nearer to where it passed, on a circle of
+    :data:`ROUND_RADIUS_M`, to the mark's outer side; after a gate passed outside it sails
+    :data:`ROUND_ON_M` straight on.  The next leg starts where the drawing ends.
 
     Attributes
     ----------
@@ -869,7 +893,7 @@ class Rounding:
     mark : str
         The gate mark rounded ("" after a mark).
     apex_t : float
-        When it passed straight below that mark [epoch s] (NaN after a mark).
+        When it passed straight below that gate mark [epoch s] (NaN after a mark).
     """
 
     t: tuple[float, ...]
@@ -877,6 +901,20 @@ class Rounding:
     y: tuple[float, ...]
     mark: str = ""
     apex_t: float = math.nan
+
+
+def _arc(
+    t0: float, p0: XY, centre: XY, sweep_deg: float, v: float
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Points every 15° (or less) on the circle round ``centre`` through ``p0``, turned
+    ``sweep_deg`` (+ anticlockwise: a port rounding), and their times at ``v`` [m s⁻¹]."""
+    r = math.hypot(p0[0] - centre[0], p0[1] - centre[1])
+    a0 = math.atan2(p0[1] - centre[1], p0[0] - centre[0])
+    steps = max(2, math.ceil(abs(sweep_deg) / 15.0))
+    ang = a0 + np.radians(sweep_deg) * np.arange(1, steps + 1) / steps
+    x, y = centre[0] + r * np.cos(ang), centre[1] + r * np.sin(ang)
+    t = t0 + r * np.abs(np.radians(sweep_deg)) * np.arange(1, steps + 1) / steps / v
+    return t, x, y
 
 
 def _rounding(res: LegResult, target: Target, course: Course, i: int) -> Rounding:
@@ -888,12 +926,18 @@ def _rounding(res: LegResult, target: Target, course: Course, i: int) -> Roundin
     dx, dy = float(tr.x[k + 1] - tr.x[k]), float(tr.y[k + 1] - tr.y[k])
     n = math.hypot(dx, dy) or 1.0
     v = 0.7 * float(tr.bsp_ms[k]) if tr.bsp_ms[k] > 0 else 1.0
-    gate = (
-        course.gates.get(course.legs[i].to_name) if target.name == course.legs[i].to_name else None
-    )
-    if gate is None or course.legs[i].kind != "gate":
+    spec = course.legs[i]
+    if target.name != spec.to_name:  # a gate passed outside
         step = ROUND_ON_M / v
         return Rounding((t0 + step,), (x0 + ROUND_ON_M * dx / n,), (y0 + ROUND_ON_M * dy / n,))
+    if spec.kind == "mark":
+        m = course.marks[spec.to_name]
+        nxt = target_of(course, i + 1).centre
+        turn = float(wrap180(bearing_deg(nxt[0] - m.x, nxt[1] - m.y) - bearing_deg(dx, dy)))
+        sweep = 0.5 * abs(turn) * (1.0 if spec.rounding == "port" else -1.0)
+        t, x, y = _arc(t0, (x0, y0), (m.x, m.y), sweep, v)
+        return Rounding(tuple(t.tolist()), tuple(x.tolist()), tuple(y.tolist()))
+    gate = course.gates[spec.to_name]
     ends = (gate.a, gate.b)
     m = min(ends, key=lambda e: math.hypot(e.x - x0, e.y - y0))
     o = ends[1] if m is ends[0] else ends[0]
@@ -982,7 +1026,11 @@ def route_plans(
         for p in plans:
             groups.setdefault(_group_key(p, i), []).append(p)
         for (tack, side, own), members in groups.items():
-            target = members[0].overrides[i] if own else chain_leg(*ends, None, following)[1]
+            target = (
+                members[0].overrides[i]
+                if own
+                else clear_target(chain_leg(*ends, None, following)[1], ends[0], router.zone_m)
+            )
             starts, t0s = [], []
             for p in members:
                 if not done[p.key]:
