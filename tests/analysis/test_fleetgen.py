@@ -29,6 +29,7 @@ from sailroute.timeutil import iso
 from sailroute.track.read import read_track
 from sailroute.units import KNOT, bearing_deg, wrap180
 from sailroute.wind.base import WindField
+from tests.conftest import TESTS_DATA
 from tests.fleetgen import (
     GUN,
     OTHER_CLASS_AFTER_S,
@@ -598,3 +599,27 @@ def test_five_seeds_of_forty_boats_hold_their_truth(seed: int) -> None:
     ocs = {b.name for b in f.with_status("ocs_returned", "ocs_not_returned")}
     own = [b for b in f.boats if b.status != "other_fleet"]
     assert {b.name for b in own if b.distance_at_gun_m > 0.0} == ocs
+
+
+def test_a_gybing_class_runs_at_its_best_downwind_angle(tmp_path) -> None:
+    # the J/70 (an ORC certificate in tests/data/boat) gybes at TWA 145-150°: its runs
+    # hold information on the wind, where the ILCA's (dead downwind) hold none
+    polar = TESTS_DATA / "boat" / "ITA_ITA455J70.json"
+    f = messy_fleet(7, n_boats=6, minutes=20, faults=CLEAN, boat=str(polar))
+    err, gybes = [], 0
+    for b in f.boats:
+        for i, leg in enumerate(b.legs):
+            if f.point_of_sail(i) != "downwind":
+                continue
+            gybes += leg.n_gybes
+            tr = leg.track
+            dt, dx, dy = np.diff(tr.t), np.diff(tr.x), np.diff(tr.y)
+            m = (np.hypot(dx, dy) > 1.0) & (dt > 1.0)
+            tm, xm, ym = (0.5 * (a[1:] + a[:-1])[m] for a in (tr.t, tr.x, tr.y))
+            twa = np.abs(wrap180(bearing_deg(dx[m], dy[m]) - f.wind.direction(tm, xm, ym)))
+            err.append(twa - f.polar.vmg_downwind(f.wind.speed(tm, xm, ym))[0])
+    e = np.abs(np.concatenate(err))
+    assert float(np.median(e)) < 1.5 and gybes >= len(f.boats)
+    course, _ = f.write(tmp_path)
+    assert load_course(course).boat_spec == {"polar": polar.name}
+    assert (tmp_path / polar.name).read_bytes() == polar.read_bytes()
