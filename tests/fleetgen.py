@@ -58,9 +58,9 @@ autoregressive error (``noise_corr_m`` sd, default 1.5 m, correlation time
 0.8 s at 2 m s⁻¹ (more where a path meets a mark's rounding ray at a slant): with the
 defaults and ``analysis.segment``, 80-90 % of the clean boats' crossings lie within one
 fix interval of the truth and over 95 % within two (seeds 0-2); without the error
-(:meth:`Fleet.resampled` with ``noise=False``) every one lies within half an interval.  Fixes, error and SOG/COG
-come from their own random stream (``[seed, 1]``), so a fleet recorded again with another
-lag or without error keeps every other draw.
+(:meth:`Fleet.resampled` with ``noise=False``) every one lies within half an interval.
+Fixes, error and SOG/COG come from their own random stream (``[seed, 1]``), so a fleet
+recorded again with another lag or without error keeps every other draw.
 
 Faults (each on its own boats, recorded in :attr:`BoatTruth.faults`)
 -------------------------------------------------------------------
