@@ -1,15 +1,15 @@
 """A messy fleet with a known answer: tracks of N boats and the exact truth behind them.
 
 :func:`messy_fleet` sails ``n_boats`` boats of varied skill round a windward-leeward
-course (start line ``pin``/``committee``, windward mark ``1``, leeward gate ``4s``/``4p``,
-leeward finish line, two laps by default) through a known wind (:class:`FleetWind`: an
-oscillating and a persistent shift, TWS varying in time and optionally from one side of the
-course to the other), injects the faults of a :class:`FaultPlan` on chosen boats, and
-returns a :class:`Fleet`: the recorded tracks (what a tracker delivers), the course (a
-:class:`~sailroute.course.model.Course` and its YAML text) and the truth (a
-:class:`BoatTruth` per track, the wind, the guns, the tracker's clock lag).
-:meth:`Fleet.write` puts the course file and the tracks (GPX or CSV) in a folder for
-``sailroute analyze``; :meth:`Fleet.truth_json` gives the truth as JSON.
+course (sailroute's template: start line ``start_pin``/``start_boat``, windward mark
+``1``, leeward gate ``4s``/``4p``, leeward finish line, two laps by default) through a
+known wind (:class:`FleetWind`: an oscillating and a persistent shift, TWS varying in time
+and optionally from one side of the course to the other), injects the faults of a
+:class:`FaultPlan` on chosen boats, and returns a :class:`Fleet`: the recorded tracks (what
+a tracker delivers), the course (a :class:`~sailroute.course.model.Course` and its YAML
+text) and the truth (a :class:`BoatTruth` per track, the wind, the guns, the tracker's
+clock lag).  :meth:`Fleet.write` puts the course file and the tracks (GPX or CSV) in a
+folder for ``sailroute analyze``; :meth:`Fleet.truth_json` gives the truth as JSON.
 
 How the boats are sailed
 ------------------------
@@ -119,6 +119,7 @@ from sailroute.boat.polar import Polar
 from sailroute.course.geometry import leg_endpoints, target_of, wind_mode, xy_bearing_deg
 from sailroute.course.load import course_from_mapping
 from sailroute.course.model import Course
+from sailroute.course.templates import CourseLayout, windward_leeward
 from sailroute.geo import LocalFrame
 from sailroute.routing.batch import route_leg_batch
 from sailroute.routing.geometry import chain_leg, target_geometry
@@ -126,7 +127,7 @@ from sailroute.routing.settings import IsochroneSettings, RoutingSettings
 from sailroute.routing.types import LegResult, Manoeuvre, Side, Start, Target
 from sailroute.timeutil import iso, parse_time, to_epoch
 from sailroute.track.model import Track
-from sailroute.units import KNOT, bearing_deg, wrap180
+from sailroute.units import KNOT, bearing_deg, heading_unit, wrap180
 from sailroute.wind.base import Coverage
 
 GUN: Final = to_epoch(parse_time("2024-06-01T13:00:00Z"))
@@ -161,8 +162,23 @@ LOITER_MS: Final = 1.5
 # ------------------------------------------------------------------------------ the wind
 
 
+class _Everywhere:
+    """A wind defined everywhere at all times (the :class:`~sailroute.wind.base.WindField`
+    coverage and clamp)."""
+
+    @property
+    def coverage(self) -> Coverage:
+        """Everywhere, at all times."""
+        return Coverage.everywhere()
+
+    @property
+    def clamp(self) -> bool:
+        """Nothing lies outside: never clamped."""
+        return False
+
+
 @dataclass(frozen=True)
-class FleetWind:
+class FleetWind(_Everywhere):
     """The known wind: a :class:`~sailroute.wind.base.WindField` defined everywhere.
 
     ``TWD(t) = twd_deg + osc_amp_deg sin(2π (t − t0)/osc_period_s + osc_phase) +
@@ -209,16 +225,6 @@ class FleetWind:
     tws_phase: float = 0.0
     pressure_left: float = 0.0
 
-    @property
-    def coverage(self) -> Coverage:
-        """Everywhere, at all times."""
-        return Coverage.everywhere()
-
-    @property
-    def clamp(self) -> bool:
-        """Nothing lies outside: never clamped."""
-        return False
-
     def direction(self, t: ArrayLike, x: ArrayLike = 0.0, y: ArrayLike = 0.0) -> NDArray:
         """TWD (from) [°, in [0, 360)] at ``t`` [epoch s], ``x, y`` [m]."""
         t, x, y = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (t, x, y)))
@@ -236,18 +242,13 @@ class FleetWind:
         return self._speed(t, x, y)
 
     def _speed(self, t: NDArray, x: NDArray, y: NDArray) -> NDArray:
+        phase = 2.0 * np.pi * (t - self.t0) / self.tws_period_s + self.tws_phase
+        tws = self.tws_ms * (1.0 + self.tws_amp * np.sin(phase))
         if self.pressure_left == 0.0:
-            return self.tws_ms * (
-                1.0
-                + self.tws_amp
-                * np.sin(2.0 * np.pi * (t - self.t0) / self.tws_period_s + self.tws_phase)
-            )
+            return tws
         th = math.radians(self.axis_deg)
         left = -(x - self.centre[0]) * math.cos(th) + (y - self.centre[1]) * math.sin(th)
-        osc = self.tws_amp * np.sin(
-            2.0 * np.pi * (t - self.t0) / self.tws_period_s + self.tws_phase
-        )
-        return self.tws_ms * (1.0 + osc) * (1.0 + self.pressure_left * left / 1000.0)
+        return tws * (1.0 + self.pressure_left * left / 1000.0)
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] (the direction the air moves to)."""
@@ -261,23 +262,13 @@ class FleetWind:
 
 
 @dataclass(frozen=True)
-class DilatedWind:
+class DilatedWind(_Everywhere):
     """:class:`FleetWind` in a boat's dilated time ``τ = gun + skill (t − gun)``
     (a :class:`~sailroute.wind.base.WindField`; module docstring)."""
 
     wind: FleetWind
     gun: float
     skill: float
-
-    @property
-    def coverage(self) -> Coverage:
-        """Everywhere, at all times."""
-        return Coverage.everywhere()
-
-    @property
-    def clamp(self) -> bool:
-        """Nothing lies outside: never clamped."""
-        return False
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] at dilated time ``t`` [epoch s]."""
@@ -490,8 +481,9 @@ class Fleet:
     Attributes
     ----------
     course : Course
-        The course (start line ``start`` = pin, committee; mark ``1``; gate ``4`` =
-        ``4s``, ``4p``; line ``finish``), its ``start_time`` the race's gun.
+        The course (start line ``start`` = ``start_pin``, ``start_boat``; mark ``1``; gate
+        ``4`` = ``4s``, ``4p``; line ``finish``; :func:`layout`), its ``start_time`` the
+        race's gun.
     course_yaml : str
         The course file's text (``start_time`` the race's gun).
     wind : FleetWind
@@ -749,39 +741,20 @@ class _Line:
 
 
 def _unit(deg: float) -> XY:
-    return (math.sin(math.radians(deg)), math.cos(math.radians(deg)))
+    """The unit vector of a compass heading [°] (:func:`~sailroute.units.heading_unit`)."""
+    ux, uy = heading_unit(deg)
+    return float(ux), float(uy)
 
 
-def layout(
-    axis_deg: float,
-    leg_m: float,
-    *,
-    gate_m: float = 50.0,
-    start_m: float = 150.0,
-    start_below_m: float = 50.0,
-    finish_m: float = 60.0,
-) -> dict[str, XY]:
-    """Mark positions [m] of a windward-leeward course centred on the origin, laid for
-    ``axis_deg`` (docs/course-format.md, "Templates"): ``1`` up the axis, gate ``4s``
-    (left looking upwind) / ``4p``, start line ``pin`` (left) / ``committee``
-    ``start_below_m`` under the gate, and a leeward finish ``finish_pin`` /
-    ``finish_boat`` on the start line's centre."""
-    ux, uy = _unit(axis_deg)
-    lx, ly = -uy, ux  # left, looking upwind
-
-    def at(up: float, left: float) -> XY:
-        return (round(up * ux + left * lx, 3), round(up * uy + left * ly, 3))
-
-    lo, s = -leg_m / 2.0, -leg_m / 2.0 - start_below_m
-    return {
-        "pin": at(s, start_m / 2.0),
-        "committee": at(s, -start_m / 2.0),
-        "1": at(leg_m / 2.0, 0.0),
-        "4s": at(lo, gate_m / 2.0),
-        "4p": at(lo, -gate_m / 2.0),
-        "finish_pin": at(s, finish_m / 2.0),
-        "finish_boat": at(s, -finish_m / 2.0),
-    }
+def layout(axis_deg: float, leg_m: float, laps: int) -> CourseLayout:
+    """The windward-leeward course of sailroute's template, centred on the origin, laid
+    for ``axis_deg`` (:func:`~sailroute.course.templates.windward_leeward`; docs/course-format.md,
+    "Templates"): mark ``1``, gate ``4`` (``4s`` left looking upwind, ``4p``), start line
+    ``start`` (``start_pin`` left, ``start_boat``) 50 m under the gate, leeward finish line
+    ``finish`` on its centre; marks rounded to the millimetre."""
+    lay = windward_leeward((0.0, 0.0), axis_deg, leg_m, laps)
+    marks = {k: (round(v[0], 3), round(v[1], 3)) for k, v in lay.marks.items()}
+    return dataclasses.replace(lay, marks=marks)
 
 
 def boat_spec(boat: str) -> dict[str, str]:
@@ -800,27 +773,25 @@ def course_yaml_boat(spec: Mapping[str, str]) -> dict[str, str]:
 def course_mapping(
     name: str,
     gun: float,
-    marks: Mapping[str, XY],
+    lay: CourseLayout,
     origin: tuple[float, float],
-    laps: int,
     wind: FleetWind,
     boat: str,
     time_limit_min: float,
 ) -> dict[str, Any]:
     """The course file's content (a mapping for the course loader)."""
-    legs: list[dict[str, str]] = [{"to": "1", "rounding": "port"}]
-    for _ in range(laps - 1):
-        legs += [{"to": "4"}, {"to": "1", "rounding": "port"}]
-    legs.append({"to": "finish"})
     return {
         "name": name,
         "start_time": iso(gun),
         "time_limit_min": time_limit_min,
         "origin": {"lat": origin[0], "lon": origin[1]},
-        "marks": {k: {"x": v[0], "y": v[1]} for k, v in marks.items()},
-        "lines": {"start": ["pin", "committee"], "finish": ["finish_pin", "finish_boat"]},
-        "gates": {"4": ["4s", "4p"]},
-        "legs": legs,
+        "marks": {k: {"x": v[0], "y": v[1]} for k, v in lay.marks.items()},
+        "lines": {k: list(v) for k, v in lay.lines.items()},
+        "gates": {k: list(v) for k, v in lay.gates.items()},
+        "legs": [
+            {"to": leg.to} if leg.rounding is None else {"to": leg.to, "rounding": leg.rounding}
+            for leg in lay.legs
+        ],
         "boat": boat_spec(boat),
         "routing": {"router": "isochrone", "tack_penalty_s": 5.0, "gybe_penalty_s": 3.0},
         "scenarios": {
@@ -1435,7 +1406,7 @@ def _non_starter(d: _Drawn, race: _Race, rng: np.random.Generator, t_end: float)
 
 
 def _line_of(marks: Mapping[str, XY]) -> _Line:
-    pin, com, top = marks["pin"], marks["committee"], marks["1"]
+    pin, com, top = marks["start_pin"], marks["start_boat"], marks["1"]
     ex, ey = com[0] - pin[0], com[1] - pin[1]
     n = math.hypot(ex, ey)
     ex, ey = ex / n, ey / n
@@ -1801,9 +1772,10 @@ def messy_fleet(
         tws_phase=float(rng.uniform(0.0, 2.0 * math.pi)),
         pressure_left=pressure_left,
     )
-    marks = layout(twd, _leg_length(polar, wind.tws_ms, minutes, laps))
+    lay = layout(twd, _leg_length(polar, wind.tws_ms, minutes, laps), laps)
+    marks = lay.marks
     data = course_mapping(
-        f"messy fleet (seed {seed})", gun, marks, centre, laps, wind, boat, max(90.0, 3.0 * minutes)
+        f"messy fleet (seed {seed})", gun, lay, centre, wind, boat, max(90.0, 3.0 * minutes)
     )
     course = course_from_mapping(data)
     first_gun = gun - plan.recall_s if plan.general_recall else None

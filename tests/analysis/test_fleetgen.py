@@ -91,7 +91,7 @@ def side_at_gun(f: Fleet, name: str) -> float:
 
 def line_side(f: Fleet, x, y) -> np.ndarray:
     """Signed distance from the start line [m], + towards mark 1."""
-    pin, com, top = f.marks["pin"], f.marks["committee"], f.marks["1"]
+    pin, com, top = f.marks["start_pin"], f.marks["start_boat"], f.marks["1"]
     ex, ey = com[0] - pin[0], com[1] - pin[1]
     n = math.hypot(ex, ey)
     nx, ny = -ey / n, ex / n
@@ -131,7 +131,7 @@ def test_course_is_a_windward_leeward_with_a_gate(fleet: Fleet) -> None:
     assert c.start_epoch == fleet.gun == GUN
     assert [fleet.point_of_sail(i) for i in range(4)] == ["upwind", "downwind"] * 2
     # mark 1 lies up the wind axis from the start line's centre
-    s = np.mean([fleet.marks["pin"], fleet.marks["committee"]], axis=0)
+    s = np.mean([fleet.marks["start_pin"], fleet.marks["start_boat"]], axis=0)
     m = fleet.marks["1"]
     axis = float(bearing_deg(m[0] - s[0], m[1] - s[1]))
     assert abs(float(wrap180(axis - fleet.wind.twd_deg))) < 1.0
@@ -272,7 +272,7 @@ def test_a_boat_of_skill_s_sails_the_polar_scaled_by_s(fleet: Fleet) -> None:
     scaled = Polar.from_arrays(p.twa_deg, p.tws_ms, s * p.speed_ms, name="scaled")
     st, tg = leg_endpoints(fleet.course, 0)
     tg = chain_leg(st, tg, None, target_of(fleet.course, 1))[1]
-    pin, com = fleet.marks["pin"], fleet.marks["committee"]
+    pin, com = fleet.marks["start_pin"], fleet.marks["start_boat"]
     start = Start(((pin[0] + com[0]) / 2.0, (pin[1] + com[1]) / 2.0), None, "start")
     settings = RoutingSettings()
     plain = route_leg(start, tg, GUN, fleet.wind, scaled, settings)
