@@ -97,11 +97,14 @@ general recall (fleet-wide, :attr:`Fleet.guns` holds both guns)
 
 Determinism: every random choice comes from ``numpy.random.default_rng(seed)`` (the
 recording from ``[seed, 1]``); the same arguments give identical tracks and truth.
+:func:`shared_fleet` keeps up to eight fleets for the test run, so that test modules
+asking for the same one generate it once.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
 from collections.abc import Mapping, Sequence
@@ -1866,3 +1869,11 @@ def _duplicates(
         )
         for k in pick
     ]
+
+
+@functools.lru_cache(maxsize=8)
+def shared_fleet(seed: int = 0, **kwargs: Any) -> Fleet:
+    """:func:`messy_fleet` computed once per test run for the same arguments (keyword
+    arguments only besides ``seed``; all hashable), for test modules that use the same
+    fleet.  The fleet is shared: do not change its arrays."""
+    return messy_fleet(seed, **kwargs)

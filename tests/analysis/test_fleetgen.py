@@ -41,6 +41,7 @@ from tests.fleetgen import (
     Fleet,
     FleetWind,
     messy_fleet,
+    shared_fleet,
 )
 
 CLEAN = FaultPlan.clean()
@@ -50,7 +51,7 @@ MINUTE = timedelta(seconds=60.0)
 @pytest.fixture(scope="module")
 def fleet() -> Fleet:
     """The default faults and clock lag (7 s) on 24 boats of 30 min (40 of 45 min: slow)."""
-    return messy_fleet(0, n_boats=24, minutes=30)
+    return shared_fleet(0, n_boats=24, minutes=30)
 
 
 @pytest.fixture(scope="module")
@@ -554,6 +555,7 @@ def test_sog_and_cog_are_the_true_velocity(recall: Fleet) -> None:
 
 
 def test_same_seed_same_fleet(clean: Fleet) -> None:
+    assert shared_fleet(0, n_boats=24, minutes=30) is shared_fleet(0, n_boats=24, minutes=30)
     again = messy_fleet(1, n_boats=10, minutes=25, faults=CLEAN, clock_lag_s=0.0)
     assert again.course_yaml == clean.course_yaml
     for a, b in zip(clean.tracks, again.tracks, strict=True):
