@@ -998,10 +998,11 @@ class Routed:
         """The path from the start (:attr:`start_t`) to the finish (repeated times
         dropped)."""
         out: list[Knot] = []
+        t0 = self.start_t
         for k, leg in enumerate(self.legs):
             pts = zip(leg.track.t.tolist(), leg.track.x.tolist(), leg.track.y.tolist(), strict=True)
             if k == 0:
-                pts = itertools.dropwhile(lambda p: p[0] < self.start_t, pts)
+                pts = itertools.dropwhile(lambda p: p[0] < t0, pts)
             if k > 0:
                 r = self.roundings[k - 1]
                 pts = itertools.chain(zip(r.t, r.x, r.y, strict=True), pts)
