@@ -50,6 +50,11 @@ CASES = [
         else r"^bench_fleet_wind\.py: .* not present .*: nothing measured$",
     ),
     ("bench_gpu.py", r"^(bench_gpu\.py: no GPU here, nothing measured: |GPU .* GiB; CPU )"),
+    (
+        "fleet_input.py",
+        r"^fleet input: 16 tracks \(14 boats, 10 min, 1 Hz, \d+ fixes\) in .*: generated in "
+        r"[\d.]+ s, written in [\d.]+ s$",
+    ),
     ("gpu_checks.sh", r"^(gpu_checks\.sh: no NVIDIA GPU here|cupy \d)"),
     ("bench_obstacles.py", r"^  ratio \d+\.\d\d \(target <= 1\.30\)$"),
     pytest.param(
