@@ -75,8 +75,12 @@ def check_report_html(path: Path, doc: dict, course) -> None:
     from sailroute.report.page_render import read_figure
     from sailroute.report.tables import format_duration
 
+    from sailroute.report.page_render import plotly_js
+
     page = path.read_text(encoding="utf-8")
-    assert "<script src" not in page and len(page) > 3_000_000  # plotly.js inlined
+    # plotly.js is one file beside the page, loaded by a relative address (offline)
+    assert '<script src="plotly.min.js"></script>' in page and len(page) < 1_000_000
+    assert (path.parent / "plotly.min.js").read_text(encoding="utf-8") == plotly_js()
     fig = read_figure(page)
     (route,) = [t for t in fig["data"] if t["name"] == f"route: {doc['scenario']}"]
     with (path.parent / "track.csv").open() as f:
