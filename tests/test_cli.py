@@ -72,10 +72,8 @@ def check_report_html(path: Path, doc: dict, course) -> None:
     """report.html agrees with plan.json and track.csv: offline page, the route's points and
     times, the marks, the leg table."""
     from sailroute.report.page import REPEAT_SHIFT, clock
-    from sailroute.report.page_render import read_figure
+    from sailroute.report.page_render import plotly_js, read_figure
     from sailroute.report.tables import format_duration
-
-    from sailroute.report.page_render import plotly_js
 
     page = path.read_text(encoding="utf-8")
     # plotly.js is one file beside the page, loaded by a relative address (offline)

@@ -18,7 +18,7 @@ import subprocess
 import tempfile
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
@@ -156,10 +156,8 @@ def browser(exe: str, width: int = 1280, height: int = 900) -> Iterator[Page]:
             )
             yield page
         finally:
-            try:
+            with suppress(RuntimeError, TimeoutError, OSError):
                 page.send("Browser.close", timeout=10)
-            except (RuntimeError, TimeoutError, OSError):
-                pass
             try:
                 proc.wait(timeout=20)
             except subprocess.TimeoutExpired:

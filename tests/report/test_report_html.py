@@ -39,6 +39,7 @@ from sailroute.units import KNOT
 from sailroute.wind.analytic import AnalyticWind
 from tests.report.conftest import COURSE, timed_track
 
+
 def page_of(report) -> tuple[str, dict]:
     page = render_html(report)
     return page, read_figure(page)
