@@ -6,7 +6,6 @@ the same :class:`~sailroute.report.page.Report` gives the same dict.
 
 from __future__ import annotations
 
-import html
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -23,6 +22,7 @@ from sailroute.report.area import (
     area_polygons,
     kept_ring,
 )
+from sailroute.report.markup import plotly_label
 from sailroute.report.page import (
     ARROW_FILL,
     BOAT_COLOUR,
@@ -45,17 +45,6 @@ from sailroute.timeutil import offset_text
 from sailroute.units import wrap360
 
 __all__ = ["area_traces", "boat_at", "figure", "label_positions", "plotly_label", "wind_arrows"]
-
-
-def plotly_label(text: str) -> str:
-    """User text (a name) for plotly: trace names, hover text and mark labels.
-
-    Plotly draws these as its own small markup (``<b>``, ``<a href>``, ``<br>``, entities)
-    and reads ``%{...}`` in a hover template as a placeholder: ``&``, ``<`` and ``>``
-    become entities, ``%`` becomes ``&#37;``, control characters U+FFFD.  (``&quot;``
-    is not among the entities plotly knows, so quotes stay as they are.)
-    """
-    return html.escape(clean_text(text), quote=False).replace("%", "&#37;")
 
 
 def _r(a: Any, nd: int) -> Any:

@@ -25,9 +25,9 @@ from urllib.parse import quote
 import numpy as np
 
 from sailroute import __version__
+from sailroute.report.markup import html_text as _h
 from sailroute.report.page import DIV_ID, FIGURE_ID, NoteGroup, Report, Table, course_area
 from sailroute.report.page_figure import figure
-from sailroute.textin import clean_text
 
 __all__ = [
     "PLOTLY_FILE",
@@ -167,7 +167,8 @@ _JS = """
     return null;
   }
   if (typeof Plotly === 'undefined') {
-    fail('the drawing library %(js)s did not load: keep it beside this page, as written');
+    fail('the drawing library ' + %(js)s + ' did not load: keep it where it was written ' +
+         '(the whole output folder together)');
     return;
   }
   try {
@@ -190,11 +191,6 @@ _JS = """
   } catch (e) { fail(e); }
 })();
 """
-
-
-def _h(text: str) -> str:
-    """User text for the page's HTML: escaped, control characters replaced."""
-    return html.escape(clean_text(text))
 
 
 def _json_for_script(obj: Any) -> str:
@@ -326,7 +322,12 @@ def render_html(report: Report, plotly_src: str = PLOTLY_FILE) -> str:
     summary = "\n".join(f'<p class="summary">{_h(s)}</p>' for s in report.summary)
     tables = "\n".join(_table_html(t) for t in report.tables)
     src = html.escape(quote(plotly_src, safe="/._-~"))
-    js = _JS % {"fig": FIGURE_ID, "div": DIV_ID, "pick": PICK_ID, "js": html.escape(plotly_src)}
+    js = _JS % {
+        "fig": FIGURE_ID,
+        "div": DIV_ID,
+        "pick": PICK_ID,
+        "js": _json_for_script(plotly_src),
+    }
     return f"""<!DOCTYPE html>
 <html lang="en">
 <head>
