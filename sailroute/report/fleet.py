@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
@@ -459,6 +459,38 @@ def _sum(values: Sequence[float]) -> float:
     return float(sum(values)) if values else math.nan
 
 
+Cell = tuple[str, float | None]
+"""A table cell: its text and the number it sorts by (None: text, or unknown)."""
+
+
+def _boat_table(
+    caption: str,
+    headers: Sequence[str],
+    page: FleetPage,
+    order: Sequence[int],
+    places: Mapping[int, int],
+    cells: Callable[[FleetBoat], Sequence[Cell]],
+    **kw: Any,
+) -> Table:
+    """A sortable table with a row per boat of ``order``: its place, its name, then
+    ``cells(boat)``; a click on a row picks the boat."""
+    rows, keys = [], []
+    for k in order:
+        b = page.boats[k]
+        row: list[Cell] = [(str(places[k]) if k in places else "-", places.get(k)), (b.name, None)]
+        row += cells(b)
+        rows.append(tuple(c for c, _ in row))
+        keys.append(tuple(v for _, v in row))
+    return Table(
+        caption,
+        ("place", "boat", *headers),
+        tuple(rows),
+        keys=tuple(keys),
+        boats=tuple(order),
+        **kw,
+    )
+
+
 def _results_table(
     page: FleetPage, order: Sequence[int], places: Mapping[int, int], colours: Sequence[str]
 ) -> Table:
@@ -466,63 +498,35 @@ def _results_table(
     common = common_legs(boats)
     n_legs = len(page.course.legs)
     best = min((b.finish_s for b in boats if b.ranked and math.isfinite(b.finish_s)), default=None)
-    rows, keys = [], []
     status = any(not b.ranked for b in boats)
-    for k in order:
-        b = boats[k]
+
+    def cells(b: FleetBoat) -> list[Cell]:
         sailed = _sum([b.legs[j].time_s for j in common]) if b.ranked else math.nan
         lost = _sum([b.legs[j].loss_s for j in common]) if b.ranked else math.nan
         behind = b.finish_s - best if best is not None else math.nan
         known = sum(math.isfinite(leg.time_s) for leg in b.legs)
-        row = [
-            str(places[k]) if k in places else "-",
-            b.name,
-            _duration(b.finish_s),
-            format_duration(behind) if math.isfinite(behind) else "-",
-            f"{known} of {n_legs}",
-            _duration(sailed) if common else "-",
-            _signed(lost),
-            _signed(b.late_s),
-            b.over_early,
+        out = [
+            (_duration(b.finish_s), _key(b.finish_s)),
+            (format_duration(behind) if math.isfinite(behind) else "-", _key(behind)),
+            (f"{known} of {n_legs}", float(known)),
+            (_duration(sailed) if common else "-", _key(sailed)),
+            (_signed(lost), _key(lost)),
+            (_signed(b.late_s), _key(b.late_s)),
+            (b.over_early, None),
         ]
-        key = [
-            places.get(k),
-            None,
-            _key(b.finish_s),
-            _key(behind),
-            float(known),
-            _key(sailed),
-            _key(lost),
-            _key(b.late_s),
-            None,
-        ]
-        if status:
-            row.append(b.status or "racing")
-            key.append(None)
-        rows.append(tuple(row))
-        keys.append(tuple(key))
-    headers = [
-        "place",
-        "boat",
-        "finish",
-        "behind",
-        "legs known",
-        "sailed",
-        "lost s",
-        "start late s",
-        "over early",
-    ]
-    if status:
-        headers.append("status")
-    return Table(
+        return out + ([(b.status or "racing", None)] if status else [])
+
+    headers = ["finish", "behind", "legs known", "sailed", "lost s", "start late s", "over early"]
+    return _boat_table(
         "Results: place at the finish (boats whose finish is unknown come after, by how far "
         "their known times go); finish and behind from the gun; sailed (from the start "
         f"crossing) and lost against the optimal legs over {_legs_text(common, n_legs)}, "
         "the legs every boat's time is known for",
-        tuple(headers),
-        tuple(rows),
-        keys=tuple(keys),
-        boats=tuple(order),
+        [*headers, *(["status"] if status else [])],
+        page,
+        order,
+        places,
+        cells,
         swatches=tuple(colours[k] for k in order),
         name="results",
     )
@@ -530,131 +534,91 @@ def _results_table(
 
 def _leg_times_table(page: FleetPage, order: Sequence[int], places: Mapping[int, int]) -> Table:
     legs = page.course.legs
-    rows, keys = [], []
-    for k in order:
-        b = page.boats[k]
-        cells = [str(places[k]) if k in places else "-", b.name]
-        key: list[float | None] = [places.get(k), None]
+
+    def cells(b: FleetBoat) -> list[Cell]:
+        out: list[Cell] = []
         for j in range(len(legs)):
             leg = b.legs[j] if j < len(b.legs) else None
             if leg is None or not math.isfinite(leg.time_s):
-                cells.append("unknown")
-                key.append(None)
+                out.append(("unknown", None))
             else:
-                cells.append(format_duration(leg.time_s) + (f" ({leg.rank})" if leg.rank else ""))
-                key.append(leg.time_s)
-        rows.append(tuple(cells))
-        keys.append(tuple(key))
-    return Table(
+                rank = f" ({leg.rank})" if leg.rank else ""
+                out.append((format_duration(leg.time_s) + rank, leg.time_s))
+        return out
+
+    return _boat_table(
         "Leg times (rank on the leg)",
-        ("place", "boat", *(f"{j + 1}: {s.label.replace('->', '→')}" for j, s in enumerate(legs))),
-        tuple(rows),
-        keys=tuple(keys),
-        boats=tuple(order),
+        [f"{j + 1}: {s.label.replace('->', '→')}" for j, s in enumerate(legs)],
+        page,
+        order,
+        places,
+        cells,
         name="legs",
     )
 
 
 def _start_table(page: FleetPage, order: Sequence[int], places: Mapping[int, int]) -> Table:
     off = page.course.utc_offset_s
-    rows, keys = [], []
-    for k in order:
-        b = page.boats[k]
-        rows.append(
-            (
-                str(places[k]) if k in places else "-",
-                b.name,
-                clock(b.start_t, off) if math.isfinite(b.start_t) else "unknown",
-                _signed(b.late_s),
-                f"{b.to_line_m:.0f} ({b.side})" if math.isfinite(b.to_line_m) else "-",
-                f"{b.speed_kn:.1f}" if math.isfinite(b.speed_kn) else "-",
-                b.over_early,
-                f"{b.line_offset_m:.0f}" if math.isfinite(b.line_offset_m) else "-",
-            )
-        )
+
+    def cells(b: FleetBoat) -> list[Cell]:
         signed_line = b.to_line_m * (-1.0 if b.side == "course" else 1.0)
-        keys.append(
+        return [
+            (clock(b.start_t, off) if math.isfinite(b.start_t) else "unknown", _key(b.start_t)),
+            (_signed(b.late_s), _key(b.late_s)),
             (
-                places.get(k),
-                None,
-                _key(b.start_t),
-                _key(b.late_s),
+                f"{b.to_line_m:.0f} ({b.side})" if math.isfinite(b.to_line_m) else "-",
                 _key(signed_line),
-                _key(b.speed_kn),
-                None,
+            ),
+            (f"{b.speed_kn:.1f}" if math.isfinite(b.speed_kn) else "-", _key(b.speed_kn)),
+            (b.over_early, None),
+            (
+                f"{b.line_offset_m:.0f}" if math.isfinite(b.line_offset_m) else "-",
                 _key(b.line_offset_m),
-            )
-        )
-    return Table(
+            ),
+        ]
+
+    return _boat_table(
         "Start",
-        (
-            "place",
-            "boat",
+        [
             "start (local)",
             "late s",
             "to the line at the gun m",
             "speed at the gun kn",
             "over early",
             "line offset m",
-        ),
-        tuple(rows),
-        keys=tuple(keys),
-        boats=tuple(order),
+        ],
+        page,
+        order,
+        places,
+        cells,
         name="start",
     )
 
 
 def _leg_table(page: FleetPage, j: int, order: Sequence[int], places: Mapping[int, int]) -> Table:
     spec = page.course.legs[j]
-    rows, keys, boats = [], [], []
-    for k in order:
-        b = page.boats[k]
-        if j >= len(b.legs):
-            continue
-        boats.append(k)
+
+    def cells(b: FleetBoat) -> list[Cell]:
         g = b.legs[j]
-        rows.append(
-            (
-                str(places[k]) if k in places else "-",
-                b.name,
-                _duration(g.time_s),
-                str(g.rank) if g.rank is not None else "-",
-                _duration(g.elapsed_s),
-                str(g.position) if g.position is not None else "-",
-                _signed(g.loss_s),
-                _signed(g.manoeuvres_s),
-                _signed(g.speed_s),
-                _signed(g.route_s),
-                g.polar,
-                f"{g.tacks}/{g.gybes}",
-                g.wind,
-                g.note,
-            )
-        )
-        keys.append(
-            (
-                places.get(k),
-                None,
-                _key(g.time_s),
-                g.rank,
-                _key(g.elapsed_s),
-                g.position,
-                _key(g.loss_s),
-                _key(g.manoeuvres_s),
-                _key(g.speed_s),
-                _key(g.route_s),
-                _polar_key(g.polar),
-                float(g.tacks + g.gybes),
-                None,
-                None,
-            )
-        )
-    return Table(
+        return [
+            (_duration(g.time_s), _key(g.time_s)),
+            (str(g.rank) if g.rank is not None else "-", g.rank),
+            (_duration(g.elapsed_s), _key(g.elapsed_s)),
+            (str(g.position) if g.position is not None else "-", g.position),
+            (_signed(g.loss_s), _key(g.loss_s)),
+            (_signed(g.manoeuvres_s), _key(g.manoeuvres_s)),
+            (_signed(g.speed_s), _key(g.speed_s)),
+            (_signed(g.route_s), _key(g.route_s)),
+            (g.polar, _polar_key(g.polar)),
+            (f"{g.tacks}/{g.gybes}", float(g.tacks + g.gybes)),
+            (g.wind, None),
+            (g.note, None),
+        ]
+
+    return _boat_table(
         f"Leg {j + 1}: {spec.label.replace('->', '→')}: time (rank), at its end from the gun "
         "(position), time lost against the optimal leg and its split",
-        (
-            "place",
-            "boat",
+        [
             "time",
             "rank",
             "at the end",
@@ -667,11 +631,12 @@ def _leg_table(page: FleetPage, j: int, order: Sequence[int], places: Mapping[in
             "tacks/gybes",
             "wind",
             "note",
-        ),
-        tuple(rows),
+        ],
+        page,
+        [k for k in order if j < len(page.boats[k].legs)],
+        places,
+        cells,
         collapsed=True,
-        keys=tuple(keys),
-        boats=tuple(boats),
         name=f"leg-{j + 1}",
     )
 

@@ -22,7 +22,7 @@ from contextlib import contextmanager, suppress
 from pathlib import Path
 from typing import Any
 
-FLAGS = [
+OFFLINE_FLAGS = [
     "--headless",
     "--no-sandbox",
     "--disable-gpu",
@@ -31,10 +31,12 @@ FLAGS = [
     "--disable-background-networking",
     "--disable-component-update",
     "--disable-sync",
-    "--hide-scrollbars",
     "--host-resolver-rules=MAP * ~NOTFOUND",
-    "--remote-debugging-pipe",
 ]
+"""Headless, a fresh profile's first run quiet, and every host name resolving to nothing (a
+fetch would fail loudly)."""
+
+FLAGS = [*OFFLINE_FLAGS, "--hide-scrollbars", "--remote-debugging-pipe"]
 
 
 class Page:
