@@ -42,6 +42,7 @@ from sailroute.report.html import (
     _times_note,
     _wind_name,
     _wind_note,
+    above_polar_legs,
 )
 from sailroute.report.page import (
     FLEET_POINTS,
@@ -296,7 +297,11 @@ def rank_colours(n: int) -> list[str]:
     return ["#{:02x}{:02x}{:02x}".format(*c) for c in rgb]
 
 
-_NUMBER = re.compile(r"[-+]?\d+(?:[.:]\d+)*")
+_NUMBER = re.compile(
+    r"\d{4}-\d\d-\d\d(?:[T ][\d:.]+(?:Z|[+-]\d\d:\d\d)?)?"  # a date or time stamp
+    r"|(?<!\w)[-+]?\d+(?:[.:]\d+)*"  # a number (not one inside a name: B1, P01)
+)
+"""What :func:`fold_notes` reads as a number: the part that may differ between boats."""
 
 
 def fold_notes(notes: Sequence[tuple[str, str]]) -> tuple[NoteGroup, ...]:
@@ -304,12 +309,15 @@ def fold_notes(notes: Sequence[tuple[str, str]]) -> tuple[NoteGroup, ...]:
     (the same words, numbers aside) make one group, in the order of their first one.
 
     A group of one boat is ``"boat: note"``; a note several boats share word for word is
-    said once with the boats named; notes that differ only in their numbers are said once
-    with ``…`` for the numbers, each boat's own wording unfolded.
+    said once with the boats named; notes that differ only in their numbers (or in the
+    boat's own name, as in a file name) are said once with ``…`` for what differs, each
+    boat's own wording unfolded.
     """
     groups: dict[str, list[tuple[str, str]]] = {}
     for boat, note in notes:
-        groups.setdefault(_NUMBER.sub("…", note), []).append((boat, note))
+        # a boat's own name in its note (its file): a word of its own, not inside another
+        own = re.sub(rf"(?<!\w){re.escape(boat)}(?!\w)", "…", note) if boat else note
+        groups.setdefault(_NUMBER.sub("…", own), []).append((boat, note))
     out = []
     for template, members in groups.items():
         boats = list(dict.fromkeys(b for b, _ in members))
@@ -358,6 +366,23 @@ def _over_early(st: Any) -> str:
     return "returned" if st.ocs_returned else "no"
 
 
+def _boat_notes(
+    notes: Sequence[str], names: Sequence[str]
+) -> tuple[list[str], dict[str, list[str]]]:
+    """The run's notes split into those about the fleet and those about one boat (written
+    ``"<boat>: ..."``), the latter by boat without the prefix."""
+    fleet: list[str] = []
+    own: dict[str, list[str]] = {}
+    by_length = sorted(names, key=len, reverse=True)  # "a-2: ..." is a-2's, not a's
+    for n in notes:
+        boat = next((b for b in by_length if n.startswith(f"{b}: ")), None)
+        if boat is None:
+            fleet.append(n)
+        else:
+            own.setdefault(boat, []).append(n[len(boat) + 2 :])
+    return fleet, own
+
+
 def fleet_page(
     analyses: Sequence[TrackAnalysis],
     rows: Sequence[Mapping[str, Any]],
@@ -376,7 +401,8 @@ def fleet_page(
         The leg ranking, :func:`sailroute.analysis.debrief.fleet_ranking` (``leg``,
         ``boat``, ``leg_rank``, ``elapsed_s``, ``position``, ...).
     notes : sequence of str
-        About the fleet as a whole.
+        The run's notes; one that starts ``"<boat>: "`` is that boat's (folded with the
+        other boats' findings on the page), the others are about the fleet.
     wind : (str, WindField), optional
         The wind drawn; default the first boat's first leg's.
     budget : int
@@ -385,6 +411,7 @@ def fleet_page(
     course = analyses[0].course
     by = {(r["leg"], r["boat"]): r for r in rows}
     share = boat_points(len(analyses), budget)
+    fleet_notes, own = _boat_notes(notes, [a.track.name for a in analyses])
     boats = []
     for a in analyses:
         st = a.segmentation.start
@@ -402,7 +429,11 @@ def fleet_page(
                 speed_kn=float(st.speed_at_gun_ms) / KNOT,
                 over_early=_over_early(st),
                 line_offset_m=float(st.line_offset_m),
-                notes=tuple(a.notes),
+                notes=(
+                    *a.notes,
+                    *([above] if (above := above_polar_legs(a)) else []),
+                    *own.get(a.track.name, ()),
+                ),
             )
         )
     lead = leader(boats)
@@ -416,8 +447,8 @@ def fleet_page(
         scenario=analyses[0].scenario,
         router=analyses[0].router,
         gun_t=float(analyses[0].segmentation.start.gun_t),
-        notes=tuple(notes),
-        judged=tuple(_judged_notes(analyses)),
+        notes=tuple(fleet_notes),
+        judged=tuple(_judged_notes(analyses, name_legs=False)),
         optimal=opt,
         wind=wind if wind is not None else (_wind_name(analyses[0]), analyses[0].wind),
     )

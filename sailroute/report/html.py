@@ -403,8 +403,10 @@ def _polar_pct(leg: Any) -> str:
     return f"{leg.mean_polar_pct:.0f}" + (" *" if leg.above_polar else "")
 
 
-def _judged_notes(analyses: Sequence[TrackAnalysis]) -> list[str]:
-    """What the boats are judged against and in which wind, and the above-polar warning."""
+def _judged_notes(analyses: Sequence[TrackAnalysis], *, name_legs: bool = True) -> list[str]:
+    """What the boats are judged against and in which wind, and the above-polar warning
+    (naming every boat and leg sailed above the polar; with ``name_legs`` False the
+    warning alone, the legs said per boat elsewhere: :func:`above_polar_legs`)."""
     out = []
     refs = dict.fromkeys(a.reference for a in analyses if a.reference)
     out += [
@@ -424,12 +426,25 @@ def _judged_notes(analyses: Sequence[TrackAnalysis]) -> list[str]:
     ]
     if above:
         out.append(
-            f"* Sailed above {ABOVE_POLAR_PCT:.0f} % of the polar ({', '.join(above)}): "
-            "the polar stands in for another class, or the wind is wrong (too light); "
+            f"* Sailed above {ABOVE_POLAR_PCT:.0f} % of the polar"
+            + (f" ({', '.join(above)})" if name_legs else f" ({len(above)} legs of the boats)")
+            + ": the polar stands in for another class, or the wind is wrong (too light); "
             "those losses are not a debrief (analyze --reference fleet judges the boats "
             "against what the fleet sails)."
         )
     return out
+
+
+def above_polar_legs(a: TrackAnalysis) -> str:
+    """``sailed above 110 % of the polar on legs 1, 2`` for a boat, or empty."""
+    legs = [str(leg.index + 1) for leg in a.legs if leg.above_polar]
+    if not legs:
+        return ""
+    return (
+        f"sailed above {ABOVE_POLAR_PCT:.0f} % of the polar on leg"
+        + ("s " if len(legs) > 1 else " ")
+        + ", ".join(legs)
+    )
 
 
 # ---------------------------------------------------------------------------------------------

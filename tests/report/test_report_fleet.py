@@ -237,6 +237,27 @@ def test_rank_colours_run_from_dark_to_light_along_the_scale() -> None:
 
 
 def test_findings_shared_by_boats_are_said_once() -> None:
+    # a time stamp is one number, a mark named B1 is no number, a boat's own name in its
+    # note (its file) does not keep it apart
+    stamps = [
+        ("p", "came back at 2025-06-21T11:23:33.863Z past B1"),
+        ("q", "came back at 2025-06-21T11:24:02.100Z past B1"),
+        ("p", "no wind in /data/p.csv"),
+        ("q", "no wind in /data/q.csv"),
+    ]
+    assert fold_notes(stamps) == (
+        NoteGroup(
+            "2 boats: came back at … past B1",
+            (
+                "p: came back at 2025-06-21T11:23:33.863Z past B1",
+                "q: came back at 2025-06-21T11:24:02.100Z past B1",
+            ),
+        ),
+        NoteGroup(
+            "2 boats: no wind in /data/….csv",
+            ("p: no wind in /data/p.csv", "q: no wind in /data/q.csv"),
+        ),
+    )
     notes = [
         ("a", "OCS by 9 s: crossed the start line 9 s before the gun"),
         ("b", "gate passed outside its marks"),
@@ -438,3 +459,64 @@ def _rgb(path: Path) -> np.ndarray:
 def _count(img: np.ndarray, hex_colour: str, tol: int = 6) -> int:
     rgb = np.array([int(hex_colour[i : i + 2], 16) for i in (1, 3, 5)])
     return int(np.all(np.abs(img - rgb) <= tol, axis=-1).sum())
+
+
+# --- from the analyses --------------------------------------------------------------------
+
+
+def test_the_page_is_built_from_the_analyses_in_one_place(tmp_path_factory) -> None:
+    """Three boats of the analysis tests' windward-leeward course: ``fast``, ``slow`` (a 360°
+    turn on leg 1) and ``short`` (its data end before the first mark)."""
+    from sailroute.analysis.debrief import analyze_track, fleet_ranking
+    from sailroute.course.load import build_specs
+    from sailroute.planning.route import route_course, settings_for
+    from sailroute.report.fleet import fleet_page
+    from tests.analysis.test_analyze import _course, _sailed
+
+    course = _course(tmp_path_factory.mktemp("wl"))
+    boat, winds = build_specs(course, ["steady"])
+    legs = route_course(course, winds["steady"], boat, settings_for(course))
+    fast = _sailed(course, legs)
+    tracks = {
+        "fast": fast,
+        "slow": _sailed(course, legs, turn_at_s=60.0),
+        "short": fast.between(fast.t_start, legs[0].t_end - 60.0),
+    }
+    analyses = [
+        analyze_track(course, dataclasses.replace(tr, name=name), missing="unknown")
+        for name, tr in tracks.items()
+    ]
+    rows = fleet_ranking(analyses)
+    notes = [
+        "short: no measured wind (/data/short.csv: no usable wind columns)",
+        "fast: no measured wind (/data/fast.csv: no usable wind columns)",
+        "the start line lay elsewhere",
+    ]
+    page = fleet_page(analyses, rows, notes)
+    by = {b.name: b for b in page.boats}
+    assert [b.name for b in page.boats] == ["fast", "slow", "short"]  # as given
+    assert page.notes == ("the start line lay elsewhere",)  # the fleet's own
+    assert by["fast"].notes[-1] == "no measured wind (/data/fast.csv: no usable wind columns)"
+    assert by["short"].notes[0].startswith("leg 1 (start -> top): the track never rounds 'top'")
+    # the leg ranking's ranks and positions, the analyses' times
+    r = {(row["leg"], row["boat"]): row for row in rows}
+    for b in page.boats:
+        for j, leg in enumerate(b.legs):
+            assert leg.rank == r[(j + 1, b.name)]["leg_rank"]
+            assert leg.position == r[(j + 1, b.name)]["position"]
+    a_fast = analyses[0]
+    assert [g.time_s for g in by["fast"].legs] == [leg.sailed_time_s for leg in a_fast.legs]
+    assert by["slow"].legs[0].rank == 2 and math.isnan(by["short"].finish_s)
+    assert by["fast"].late_s == pytest.approx(a_fast.segmentation.start.late_s)
+    # results: the finishers by finish time, then short; the leader is fast
+    assert [page.boats[k].name for k in results_order(page.boats)] == ["fast", "slow", "short"]
+    assert page.optimal is not None and page.optimal.name == "optimal from fast's leg starts"
+    assert page.boats[leader(page.boats)].name == "fast"
+    # no leg is known for short, so nothing is summed over legs every boat has
+    assert common_legs(page.boats) == ()
+    report = fleet_report(page)
+    assert "over no leg, the legs every boat" in report.tables[0].caption
+    assert [row[5] for row in report.tables[0].rows] == ["-", "-", "-"]
+    folded = [g.summary for g in report.folded]
+    assert "2 boats: no measured wind (/data/….csv: no usable wind columns)" in folded
+    assert all(len(b.route.t) <= MAX_ROUTE_POINTS for b in page.boats)
