@@ -974,6 +974,15 @@ def analyze_command(
             "to what the fleet sails (fleet).",
         ),
     ] = "course",
+    pages: Annotated[
+        Literal["fleet", "boat"],
+        typer.Option(
+            "--pages",
+            case_sensitive=False,
+            help="Several tracks: the fleet's report.html only (fleet), or also each "
+            "boat's report.html, legs.png and loss.png in its folder (boat).",
+        ),
+    ] = "fleet",
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -1008,6 +1017,7 @@ def analyze_command(
                 gate_end=gate_end,
                 wind=wind,
                 reference=reference,
+                pages=pages,
             )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)

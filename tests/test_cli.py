@@ -72,11 +72,13 @@ def check_report_html(path: Path, doc: dict, course) -> None:
     """report.html agrees with plan.json and track.csv: offline page, the route's points and
     times, the marks, the leg table."""
     from sailroute.report.page import REPEAT_SHIFT, clock
-    from sailroute.report.page_render import read_figure
+    from sailroute.report.page_render import plotly_js, read_figure
     from sailroute.report.tables import format_duration
 
     page = path.read_text(encoding="utf-8")
-    assert "<script src" not in page and len(page) > 3_000_000  # plotly.js inlined
+    # plotly.js is one file beside the page, loaded by a relative address (offline)
+    assert '<script src="plotly.min.js"></script>' in page and len(page) < 1_000_000
+    assert (path.parent / "plotly.min.js").read_text(encoding="utf-8") == plotly_js()
     fig = read_figure(page)
     (route,) = [t for t in fig["data"] if t["name"] == f"route: {doc['scenario']}"]
     with (path.parent / "track.csv").open() as f:

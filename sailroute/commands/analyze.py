@@ -37,7 +37,10 @@ from sailroute.report.analysis import (
 )
 from sailroute.track.read import read_track
 
-__all__ = ["run_analyze_command"]
+__all__ = ["PAGES", "run_analyze_command"]
+
+PAGES = ("fleet", "boat")
+"""``--pages``: the fleet's page only (default), or each boat's page and charts too."""
 
 
 def run_analyze_command(
@@ -57,6 +60,7 @@ def run_analyze_command(
     gate_end: str = "line",
     wind: str = "auto",
     reference: str = "course",
+    pages: str = "fleet",
 ) -> CommandResult:
     """Everything ``sailroute analyze`` does, minus printing.
 
@@ -65,9 +69,13 @@ def run_analyze_command(
     (:func:`sailroute.outdir.write_output_set`), so a bad input or an interrupted run
     leaves the folder as it was.  One track: ``analysis.json``, ``analysis.csv``,
     ``points.csv``, ``legs.png``, ``loss.png`` in ``out_dir`` (default
-    ``out/<course>/analysis-<track stem>``).  Several: the same per boat in
-    ``out_dir/<track stem>/`` plus ``fleet.csv`` and ``fleet.json`` (default
-    ``out/<course>/analysis-fleet``).
+    ``out/<course>/analysis-<track stem>``), and ``report.html`` with ``plotly.min.js``.
+    Several: ``fleet.csv``, ``fleet.json``, the fleet's ``report.html`` and
+    ``plotly.min.js`` (default folder ``out/<course>/analysis-fleet``), and per boat its
+    ``analysis.json``, ``analysis.csv`` and ``points.csv`` in ``out_dir/<track stem>/``;
+    with ``pages="boat"`` also each boat's ``report.html``, ``legs.png`` and ``loss.png``
+    there (they load the one ``plotly.min.js`` of ``out_dir``).  ``plots=False`` writes
+    no page and no chart.
 
     ``wind`` chooses the wind each leg is judged in (:func:`analysis_winds`);
     ``reference="fleet"`` judges every boat against the course's polar scaled to what
@@ -77,6 +85,8 @@ def run_analyze_command(
     course = course if isinstance(course, Course) else load_course(course)
     if not tracks:
         raise InputError("analyze: give at least one track file")
+    if pages not in PAGES:
+        raise InputError(f"--pages: expected one of {', '.join(PAGES)}; got {pages!r}")
     if reference not in REFERENCES:
         raise InputError(f"--reference: expected one of {', '.join(REFERENCES)}; got {reference!r}")
     name = default_scenario(course) if scenario is None else scenario
@@ -145,8 +155,9 @@ def run_analyze_command(
 
     def write(d: Path) -> dict[str, Path]:
         files: dict[str, Path] = {}
+        boat_pages = plots and pages == "boat"
         for s, a in zip(stems, analyses, strict=True):
-            for kind, p in write_analysis(d / s, a, plots=plots).items():
+            for kind, p in write_analysis(d / s, a, plots=boat_pages, scripts=d).items():
                 files[f"{s}/{kind}"] = p
         files.update(
             write_fleet(d, analyses, rows, plots=plots, notes=notes, wind=fleet_wind_layer)

@@ -67,7 +67,7 @@ def run_bands_command(
         ``bands_png``; ``data``: the tuple of :class:`BandSummary`.
     """
     from sailroute.report.bands import bands_page, bands_table, write_bands
-    from sailroute.report.page_render import write_report
+    from sailroute.report.page_render import PLOTLY_FILE, write_report
 
     router, backend, progress = options.router, options.backend, options.progress
     scheduler = options.scheduler
@@ -121,6 +121,7 @@ def run_bands_command(
             files["html"] = write_report(
                 d / "report.html", bands_page(course, summaries, winds, router=settings.router)
             )
+            files["plotly_js"] = d / PLOTLY_FILE
         return files
 
     files = write_output_set(out, write)

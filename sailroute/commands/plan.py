@@ -86,11 +86,12 @@ def run_plan_command(
             files = dict(write_plan_outputs(d, run.plan, wind=run.wind, plot=False))
             if plots:
                 from sailroute.report.html import plan_report
-                from sailroute.report.page_render import write_report
+                from sailroute.report.page_render import PLOTLY_FILE, write_report
 
                 html = write_report(d / "report.html", plan_report(run.plan, run.wind))
                 files["png"] = png.result()
                 files["html"] = html
+                files["plotly_js"] = d / PLOTLY_FILE
             return files
 
         files = write_output_set(out, write)
@@ -119,9 +120,10 @@ def _run_ensemble(
         files: dict[str, Path] = dict(write_ensemble(d, summary))
         if plots:
             from sailroute.report.html import comparison_report
-            from sailroute.report.page_render import write_report
+            from sailroute.report.page_render import PLOTLY_FILE, write_report
 
             files["html"] = write_report(d / "report.html", comparison_report(cmp, plans, winds))
+            files["plotly_js"] = d / PLOTLY_FILE
         for p in plans:
             sub = d / safe_part(p.scenario, "scenario")
             for kind, path in write_plan_outputs(sub, p, plot=False).items():
@@ -178,12 +180,13 @@ def run_compare_command(
         files: dict[str, Path] = {"comparison_json": js, "comparison_csv": cs}
         if plots:
             from sailroute.report.html import comparison_report
-            from sailroute.report.page_render import write_report
+            from sailroute.report.page_render import PLOTLY_FILE, write_report
             from sailroute.report.plots import plot_comparison
 
             plot_comparison(cmp, plans).savefig(d / "comparison.png", dpi=150)
             files["comparison_png"] = d / "comparison.png"
             files["html"] = write_report(d / "report.html", comparison_report(cmp, plans, winds))
+            files["plotly_js"] = d / PLOTLY_FILE
         for p in plans:
             sub = d / safe_part(p.scenario, "scenario")
             for kind, path in write_plan_outputs(sub, p, plot=False).items():

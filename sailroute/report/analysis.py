@@ -223,9 +223,19 @@ def _fmt(v: Any) -> Any:
     return v
 
 
-def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True) -> dict[str, Path]:
+def write_analysis(
+    out_dir: str | Path,
+    a: TrackAnalysis,
+    *,
+    plots: bool = True,
+    scripts: str | Path | None = None,
+) -> dict[str, Path]:
     """Write ``analysis.json``, ``analysis.csv``, ``points.csv`` and (with ``plots``)
-    ``legs.png``, ``loss.png`` and ``report.html`` into ``out_dir`` (created)."""
+    ``legs.png``, ``loss.png`` and ``report.html`` into ``out_dir`` (created).
+
+    The page loads plotly.js from the folder ``scripts``
+    (:func:`sailroute.report.page_render.write_report`); default ``out_dir``, and then the
+    bundle is among the files returned (``plotly_js``)."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     files: dict[str, Path] = {}
@@ -315,9 +325,11 @@ def write_analysis(out_dir: str | Path, a: TrackAnalysis, *, plots: bool = True)
         plot_loss(a).savefig(out / "loss.png", dpi=120)
         files["loss_png"] = out / "loss.png"
         from sailroute.report.html import analysis_report
-        from sailroute.report.page_render import write_report
+        from sailroute.report.page_render import PLOTLY_FILE, write_report
 
-        files["html"] = write_report(out / "report.html", analysis_report(a))
+        files["html"] = write_report(out / "report.html", analysis_report(a), scripts=scripts)
+        if scripts is None:
+            files["plotly_js"] = out / PLOTLY_FILE
     return files
 
 
@@ -331,7 +343,8 @@ def write_fleet(
     wind: tuple[str, WindField] | None = None,
 ) -> dict[str, Path]:
     """Write ``fleet.csv`` (one row per leg and boat), ``fleet.json`` and (with ``plots``)
-    the fleet's ``report.html`` (:func:`sailroute.report.html.fleet_report`).
+    the fleet's ``report.html`` (:mod:`sailroute.report.fleet`) with the plotly.js bundle
+    beside it (``plotly.min.js``, which the boats' pages in the folders below load too).
 
     ``notes`` (the run's findings on the wind and the reference) go into ``fleet.json``
     and the page; ``wind`` is the fleet-wide wind drawn on the page (name, field)."""
@@ -354,6 +367,7 @@ def write_fleet(
         for r in rows:
             w.writerow([_fmt(r[c]) if r[c] is not None else "" for c in cols])
     jp = out / "fleet.json"
+    all_notes = [*fleet_notes(analyses), *notes]
     doc = {
         "schema_version": SCHEMA_VERSION,
         "sailroute_version": __version__,
@@ -367,19 +381,18 @@ def write_fleet(
             }
             for a in analyses
         ],
-        "notes": [*fleet_notes(analyses), *notes],
+        "notes": all_notes,
         "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()} for r in rows],
     }
     jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     files = {"fleet_csv": cp, "fleet_json": jp}
     if plots:
-        from sailroute.report.html import fleet_report
-        from sailroute.report.page_render import write_report
+        from sailroute.report.fleet import fleet_page, fleet_report
+        from sailroute.report.page_render import PLOTLY_FILE, write_report
 
-        files["html"] = write_report(
-            out / "report.html",
-            fleet_report(analyses, rows, [*fleet_notes(analyses), *notes], wind),
-        )
+        page = fleet_page(analyses, rows, all_notes, wind)
+        files["html"] = write_report(out / "report.html", fleet_report(page))
+        files["plotly_js"] = out / PLOTLY_FILE
     return files
 
 

@@ -431,6 +431,7 @@ FILE_LABELS: dict[str, str] = {
     "fleet_json": "fleet ranking (JSON)",
     "fleet_csv": "fleet ranking (CSV)",
     "html": "interactive report (HTML)",
+    "plotly_js": "drawing library of the pages (plotly.js)",
 }
 """Human names of the output kinds (the keys of the commands' ``files`` mappings)."""
 

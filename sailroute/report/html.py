@@ -1,4 +1,4 @@
-"""``report.html``: one self-contained interactive page that works offline; its builders.
+"""``report.html``: an interactive page that works offline; its builders.
 
 The page holds the course and the routes on a latitude/longitude map (a plain sea-coloured
 background: no chart, no coastline, no web tiles), the scenario's wind as arrows, a time
@@ -7,20 +7,21 @@ at every track point (local time and UTC, TWS, TWA, speed, VMG) and the leg tabl
 comparison puts every scenario's route on the same map; clicking a legend entry hides or
 shows it.
 
-The drawing is `plotly.js <https://plotly.com/javascript/>`_, inlined into the file (about
-4.8 MB; no CDN, no network).  The page's content is :mod:`sailroute.report.page`, its
-figure, built as plain JSON (traces, layout, animation frames) without plotly's Python
-figure classes, :mod:`sailroute.report.page_figure`, and its text and file
+The drawing is `plotly.js <https://plotly.com/javascript/>`_, one copy per output folder
+(``plotly.min.js`` beside the pages, about 4.8 MB; no CDN, no network).  The page's
+content is :mod:`sailroute.report.page`, its figure, built as plain JSON (traces, layout,
+animation frames) without plotly's Python figure classes,
+:mod:`sailroute.report.page_figure`, and its text and files
 :mod:`sailroute.report.page_render`.  Everything but
 :func:`~sailroute.report.page_render.write_report` is pure: data in, dict or string out,
 and the same input gives the same bytes (fixed element ids, rounded numbers, no
 timestamps).
 
-Four builders make a :class:`Report`: :func:`plan_report` (``sailroute plan``),
-:func:`comparison_report` (``compare-scenarios`` and ``plan`` on an ensemble),
-:func:`analysis_report` (``sailroute analyze``, one track) and :func:`fleet_report`
-(``sailroute analyze`` with several tracks); :func:`~sailroute.report.page_render.render_html`
-turns it into the page.
+Three builders make a :class:`Report`: :func:`plan_report` (``sailroute plan``),
+:func:`comparison_report` (``compare-scenarios`` and ``plan`` on an ensemble) and
+:func:`analysis_report` (``sailroute analyze``, one track); the fleet's page (``sailroute
+analyze`` with several tracks) is :mod:`sailroute.report.fleet`;
+:func:`~sailroute.report.page_render.render_html` turns a report into the page.
 
 Conventions: times are the course's local time (``Course.utc_offset_s``, the offset its
 ``start_time`` is written with) and UTC; speeds in knots, angles in degrees.  VMG is the
@@ -32,7 +33,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -42,7 +42,6 @@ from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.course.model import Course
 from sailroute.planning.result import Comparison, Plan, percent_error
 from sailroute.report.page import (
-    FLEET_STEPS,
     MAX_WIND_LAYERS,
     N_STEPS,
     WIND_GRID,
@@ -404,8 +403,10 @@ def _polar_pct(leg: Any) -> str:
     return f"{leg.mean_polar_pct:.0f}" + (" *" if leg.above_polar else "")
 
 
-def _judged_notes(analyses: Sequence[TrackAnalysis]) -> list[str]:
-    """What the boats are judged against and in which wind, and the above-polar warning."""
+def _judged_notes(analyses: Sequence[TrackAnalysis], *, name_legs: bool = True) -> list[str]:
+    """What the boats are judged against and in which wind, and the above-polar warning
+    (naming every boat and leg sailed above the polar; with ``name_legs`` False the
+    warning alone, the legs said per boat elsewhere: :func:`above_polar_legs`)."""
     out = []
     refs = dict.fromkeys(a.reference for a in analyses if a.reference)
     out += [
@@ -425,176 +426,24 @@ def _judged_notes(analyses: Sequence[TrackAnalysis]) -> list[str]:
     ]
     if above:
         out.append(
-            f"* Sailed above {ABOVE_POLAR_PCT:.0f} % of the polar ({', '.join(above)}): "
-            "the polar stands in for another class, or the wind is wrong (too light); "
+            f"* Sailed above {ABOVE_POLAR_PCT:.0f} % of the polar"
+            + (f" ({', '.join(above)})" if name_legs else f" ({len(above)} legs of the boats)")
+            + ": the polar stands in for another class, or the wind is wrong (too light); "
             "those losses are not a debrief (analyze --reference fleet judges the boats "
             "against what the fleet sails)."
         )
     return out
 
 
-def _leader(analyses: Sequence[TrackAnalysis]) -> int:
-    """Index of the boat ahead at the last leg end whose time is known for some boat."""
-    for i in reversed(range(min(len(a.legs) for a in analyses))):
-        ends = np.array([a.legs[i].t_end for a in analyses])
-        if np.isfinite(ends).any():
-            return int(np.nanargmin(ends))
-    return 0
-
-
-def _signed(v: float, nd: int = 1) -> str:
-    return f"{v:+.{nd}f}" if math.isfinite(v) else "-"
-
-
-def fleet_report(
-    analyses: Sequence[TrackAnalysis],
-    rows: Sequence[Mapping[str, Any]],
-    notes: Sequence[str] = (),
-    wind: tuple[str, WindField] | None = None,
-) -> Report:
-    """The page of ``sailroute analyze`` with several tracks.
-
-    Every boat's sailed track on one map with one time slider (a marker per boat), the
-    optimal legs from the *leader's* leg starts (the boat ahead at the last leg end of
-    known time; each boat's own optimal legs are on its own page), the wind (``wind``),
-    and three tables: the leg ranking (``rows`` of
-    :func:`sailroute.analysis.debrief.fleet_ranking`), the start (time late, distance to the line,
-    side and speed at the gun, over early, line offset) and the loss split per boat and
-    leg.  ``notes`` (fleet-wide) and each boat's own notes go under the map.  ``wind``
-    (name, field) is the wind drawn; default the first boat's first leg's.
-    """
-    course, off = analyses[0].course, analyses[0].course.utc_offset_s
-    sailed = [replace(routes_from_analysis(a)[0], name=a.track.name) for a in analyses]
-    lead = _leader(analyses)
-    opt = replace(
-        routes_from_analysis(analyses[lead])[1],
-        name=f"optimal from {analyses[lead].track.name}'s leg starts",
-    )
-    routes = (*sailed, opt)
-    times = slider_times(sailed, FLEET_STEPS)
-    name, field = wind if wind is not None else (_wind_name(analyses[0]), analyses[0].wind)
-    layers = _layers({name: field}, course, routes, times)
-    names = [a.track.name for a in analyses]
-    by = {(r["leg"], r["boat"]): r for r in rows}
-    rank_rows = []
-    for i, spec in enumerate(course.legs):
-        cells = []
-        for b in names:
-            row = by.get((i + 1, b))
-            if row is None or row["leg_rank"] is None:
-                cells.append("unknown")
-            else:
-                pos = f", pos {row['position']}" if row["position"] is not None else ""
-                cells.append(
-                    f"{format_duration(row['leg_time_s'])} ({row['leg_rank']}{pos}) "
-                    f"{_signed(row['loss_s'])} s"
-                )
-        rank_rows.append((str(i + 1), spec.label.replace("->", "→"), *cells))
-    ranking = Table(
-        "Leg ranking: leg time (rank, position at the leg's end) and time lost "
-        "against the optimal leg",
-        ("leg", "from → to", *names),
-        tuple(rank_rows),
-    )
-    start_rows = []
-    for a in analyses:
-        st = a.segmentation.start
-        start_rows.append(
-            (
-                a.track.name,
-                clock(st.crossing.t, off),
-                f"{st.late_s:+.1f}",
-                f"{st.distance_at_gun_m:.0f} ({st.side_at_gun})",
-                f"{st.speed_at_gun_ms / KNOT:.1f}" if math.isfinite(st.speed_at_gun_ms) else "-",
-                (
-                    f"{st.ocs_s:.0f} s" + (", returned" if st.ocs_returned else "")
-                    if st.ocs_s is not None
-                    else ("returned" if st.ocs_returned else "no")
-                ),
-                f"{st.line_offset_m:.0f}",
-                "; ".join(st.notes),
-            )
-        )
-    start = Table(
-        "Start",
-        (
-            "boat",
-            "start (local)",
-            "late s",
-            "to the line at the gun m",
-            "speed at the gun kn",
-            "over early",
-            "line offset m",
-            "notes",
-        ),
-        tuple(start_rows),
-    )
-    split_rows = []
-    for a in analyses:
-        for leg in a.legs:
-            split_rows.append(
-                (
-                    a.track.name,
-                    str(leg.index + 1),
-                    leg.label.replace("->", "→"),
-                    _signed(leg.loss_s),
-                    _signed(leg.split.manoeuvres),
-                    _signed(leg.split.speed),
-                    _signed(leg.split.route),
-                    _polar_pct(leg),
-                    leg.wind_source,
-                    leg.note,
-                )
-            )
-    split = Table(
-        "Time lost per boat and leg, split into manoeuvres, speed and route",
-        (
-            "boat",
-            "leg",
-            "from → to",
-            "lost s",
-            "manoeuvres s",
-            "speed s",
-            "route s",
-            "polar %",
-            "wind",
-            "note",
-        ),
-        tuple(split_rows),
-        collapsed=len(split_rows) > 40,
-    )
-    t0 = course.start_epoch
-    summary = (
-        f"{len(analyses)} boats · scenario {analyses[0].scenario} · router "
-        f"{analyses[0].router} · gun {time_label(t0, off)} on {iso(t0 + off)[:10]}",
-        "Sailed (legs of known time): "
-        + ", ".join(
-            f"{a.track.name} {format_duration(a.sailed_time_s)}"
-            + ("" if a.complete else f" ({len(a.known_legs)} of {len(a.legs)} legs)")
-            for a in analyses
-        ),
-    )
-    page_notes = [
-        HELP,
-        *_judged_notes(analyses),
-        *notes,
-        *(f"{a.track.name}: {n}" for a in analyses for n in a.notes),
-        "The dashed line is the optimal route of each leg from the leader's own leg "
-        "start point and time.",
-        _times_note(course),
-        _wind_note(layers),
-    ]
-    return Report(
-        f"{course.name} — fleet of {len(analyses)}",
-        summary,
-        course,
-        routes,
-        tuple(layers),
-        times,
-        (ranking, start, split),
-        tuple(page_notes),
-        leg_numbers=False,
-        legend_beside=True,
+def above_polar_legs(a: TrackAnalysis) -> str:
+    """``sailed above 110 % of the polar on legs 1, 2`` for a boat, or empty."""
+    legs = [str(leg.index + 1) for leg in a.legs if leg.above_polar]
+    if not legs:
+        return ""
+    return (
+        f"sailed above {ABOVE_POLAR_PCT:.0f} % of the polar on leg"
+        + ("s " if len(legs) > 1 else " ")
+        + ", ".join(legs)
     )
 
 
@@ -602,4 +451,4 @@ def fleet_report(
 # page
 
 
-__all__ = ["analysis_report", "comparison_report", "fleet_report", "plan_report"]
+__all__ = ["analysis_report", "comparison_report", "plan_report"]

@@ -71,8 +71,16 @@ MAX_ROUTE_POINTS = 4000
 """A sailed track is drawn with at most this many points (every k-th fix, each leg's first
 and last kept): a 3-hour 10 Hz log would otherwise make a page of 100 MB that no browser
 draws; the hover text is at the drawn points."""
+FLEET_POINTS = 40_000
+"""Points of all the boats' tracks on a fleet's page together, shared equally by the boats
+(each at most :data:`MAX_ROUTE_POINTS`, at least :data:`MIN_BOAT_POINTS`): 60 boats of
+45 min at 1 Hz are drawn every 4 s, and the page stays about 6 MB."""
+MIN_BOAT_POINTS = 300
+"""Fewest points of one boat's track on a fleet's page (a very large fleet)."""
 FLEET_STEPS = 60
 """Slider positions of a fleet's replay."""
+GREY = "#a9b4bf"
+"""Colour of the boats that are not picked when the reader picks one on a fleet's page."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,6 +120,9 @@ class Route:
         Added to ``lat``/``lon`` where the line is drawn [°]: a leg over the same water
         as an earlier one is drawn beside it (:data:`REPEAT_SHIFT`); the hover gives the
         true position.
+    colour : str
+        Line colour (``#rrggbb``); empty: the page's palette in route order
+        (:data:`ROUTE_COLOURS`).
     """
 
     name: str
@@ -132,6 +143,7 @@ class Route:
     boat: bool = True
     lat_shift: NDArray[np.float64] | None = None
     lon_shift: NDArray[np.float64] | None = None
+    colour: str = ""
 
     def drawn(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(lat, lon)`` where the line is drawn [°]."""
@@ -195,6 +207,20 @@ class Table:
     rows, footer : tuple of tuple of str
     collapsed : bool
         Rendered inside a closed ``<details>`` (per-scenario tables of a comparison).
+    keys : tuple of tuple of (float or None)
+        With ``rows``, one per cell: the number a click on the column's header sorts by
+        (a time in seconds for ``4:12.0``); None where the cell is text or unknown.
+        Empty: the table is not sortable.  Unknown cells of a numeric column sort last
+        both ways.
+    boats : tuple of int
+        With ``rows``, one per row: the index of the boat (route) the row is about, among
+        the routes that carry a boat marker; a click on the row picks that boat
+        (:attr:`Report.pick`).  Empty: rows pick nothing.
+    swatches : tuple of str
+        With ``rows``, one per row: a colour (``#rrggbb``) shown as a dot before the
+        first cell (the boat's colour on the map).
+    name : str
+        ``id`` of the ``<table>`` (letters, digits and ``-``); empty: none.
     """
 
     caption: str
@@ -202,6 +228,27 @@ class Table:
     rows: tuple[tuple[str, ...], ...]
     footer: tuple[tuple[str, ...], ...] = ()
     collapsed: bool = False
+    keys: tuple[tuple[float | None, ...], ...] = ()
+    boats: tuple[int, ...] = ()
+    swatches: tuple[str, ...] = ()
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class NoteGroup:
+    """One finding shared by several boats, shown once and folded (a ``<details>`` block).
+
+    Attributes
+    ----------
+    summary : str
+        The line shown folded: the finding and how many boats, which.
+    items : tuple of str
+        The lines shown unfolded (each boat's own wording); empty when the summary says
+        it all.
+    """
+
+    summary: str
+    items: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -231,6 +278,12 @@ class Report:
         Legend in a column right of the map (many entries) instead of a row above it.
     overlays : tuple of dict
         More plotly traces drawn over the course (laylines, the favoured start end).
+    folded : tuple of NoteGroup
+        Findings shared by several boats, under the notes, folded.
+    pick : bool
+        A fleet: the reader picks a boat (a list above the map, a click on its track or
+        on its row, ``#boat=NAME`` in the address) and the others turn grey; tacks and
+        gybes are drawn for the picked boat only and the course over the tracks.
     """
 
     title: str
@@ -245,6 +298,8 @@ class Report:
     leg_numbers: bool = True
     legend_beside: bool = False
     overlays: tuple[dict[str, Any], ...] = ()
+    folded: tuple[NoteGroup, ...] = ()
+    pick: bool = False
 
 
 def clock(t: float, utc_offset_s: float = 0.0) -> str:
@@ -429,7 +484,13 @@ def decimated(r: Route, max_points: int = MAX_ROUTE_POINTS) -> Route:
 def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
     """The sailed track (speed over the ground; at most :data:`MAX_ROUTE_POINTS` points)
     and the optimal legs from its leg starts (legs of unknown start left out)."""
-    p, course = a.points, a.course
+    return sailed_route(a), optimal_route(a)
+
+
+def sailed_route(a: TrackAnalysis, max_points: int = MAX_ROUTE_POINTS) -> Route:
+    """The sailed track of ``a`` (speed over the ground), at most about ``max_points``
+    points (:func:`decimated`), its tacks and gybes."""
+    p = a.points
     modes = [leg.mode for leg in a.legs]
     sailed_parts = [
         {
@@ -446,9 +507,16 @@ def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
     man = []
     for m in (m for leg in a.legs for m in leg.manoeuvres):
         man.append((m.kind, m.t, float(np.interp(m.t, p.t, p.x)), float(np.interp(m.t, p.t, p.y))))
-    sailed = decimated(
-        _route(f"sailed: {a.track.name}", course, sailed_parts, modes, man, speed_name="SOG")
+    return decimated(
+        _route(f"sailed: {a.track.name}", a.course, sailed_parts, modes, man, speed_name="SOG"),
+        max_points,
     )
+
+
+def optimal_route(a: TrackAnalysis) -> Route:
+    """The optimal legs of ``a`` from its own leg starts (legs of unknown start left out),
+    dashed, without a boat marker."""
+    course = a.course
     opt_parts = [
         _leg_columns(course, leg.index, leg.optimal, leg.mode)
         for leg in a.legs
@@ -460,17 +528,16 @@ def routes_from_analysis(a: TrackAnalysis) -> tuple[Route, Route]:
         if leg.optimal is not None
         for m in leg.optimal.manoeuvres
     ]
-    optimal = _route(
+    return _route(
         "optimal from the boat's leg starts",
         course,
         opt_parts,
-        modes,
+        [leg.mode for leg in a.legs],
         opt_man,
         gaps=True,
         dash="dash",
         boat=False,
     )
-    return sailed, optimal
 
 
 def course_area(

@@ -6,7 +6,6 @@ the same :class:`~sailroute.report.page.Report` gives the same dict.
 
 from __future__ import annotations
 
-import html
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -23,9 +22,11 @@ from sailroute.report.area import (
     area_polygons,
     kept_ring,
 )
+from sailroute.report.markup import plotly_label
 from sailroute.report.page import (
     ARROW_FILL,
     BOAT_COLOUR,
+    GREY,
     ROUTE_COLOURS,
     SEA,
     WIND_COLOUR,
@@ -37,24 +38,13 @@ from sailroute.report.page import (
     course_area,
     time_label,
 )
-from sailroute.report.plots import SPEED_SPAN_KN, speed_limits
+from sailroute.report.plots import speed_limits
 from sailroute.report.tables import format_duration
 from sailroute.textin import clean_text
 from sailroute.timeutil import offset_text
 from sailroute.units import wrap360
 
 __all__ = ["area_traces", "boat_at", "figure", "label_positions", "plotly_label", "wind_arrows"]
-
-
-def plotly_label(text: str) -> str:
-    """User text (a name) for plotly: trace names, hover text and mark labels.
-
-    Plotly draws these as its own small markup (``<b>``, ``<a href>``, ``<br>``, entities)
-    and reads ``%{...}`` in a hover template as a placeholder: ``&``, ``<`` and ``>``
-    become entities, ``%`` becomes ``&#37;``, control characters U+FFFD.  (``&quot;``
-    is not among the entities plotly knows, so quotes stay as they are.)
-    """
-    return html.escape(clean_text(text), quote=False).replace("%", "&#37;")
 
 
 def _r(a: Any, nd: int) -> Any:
@@ -330,19 +320,209 @@ def _leg_number_trace(r: Route, group: str) -> dict[str, Any]:
     }
 
 
+def _manoeuvre_trace(
+    kind: str, pts: Sequence[tuple[str, float, float, float]], name: str, group: str, off: float
+) -> dict[str, Any]:
+    """The tacks (``kind="tack"``) or gybes of a route as one marker trace."""
+    symbol, colour = MANOEUVRE_SYMBOLS[kind]
+    return {
+        "type": "scatter",
+        "mode": "markers",
+        "name": f"{kind}s",
+        "legendgroup": group,
+        "showlegend": False,
+        "x": _r([m[3] for m in pts], 7),
+        "y": _r([m[2] for m in pts], 7),
+        "text": [f"{kind} {clock(m[1], off)} local · {clock(m[1])} UTC" for m in pts],
+        "marker": {
+            "symbol": symbol,
+            "color": colour,
+            "size": 10,
+            "line": {"color": "white", "width": 1},
+        },
+        "hovertemplate": f"%{{text}}<extra>{plotly_label(name)}</extra>",
+    }
+
+
+MANOEUVRE_SYMBOLS = {"tack": ("triangle-up", "crimson"), "gybe": ("square", "royalblue")}
+"""Marker symbol and colour of the tacks and gybes."""
+
+
+def _route_trace(
+    r: Route, colour: str, group: str, custom: Sequence[Any], off: float, width: float
+) -> dict[str, Any]:
+    drawn_lat, drawn_lon = r.drawn()
+    return {
+        "type": "scatter",
+        "mode": "lines",
+        "name": plotly_label(r.name),
+        "legendgroup": group,
+        "x": _r(drawn_lon, 7),
+        "y": _r(drawn_lat, 7),
+        "line": {"color": colour, "width": width, "dash": r.dash},
+        "customdata": custom,
+        "hovertemplate": _hover(r, off),
+    }
+
+
+def _speed_colours(report: Report) -> dict[str, Any]:
+    """Marker colours of a single route by its speed, with the colour bar."""
+    (r,) = report.routes
+    slo, shi = speed_limits(r.speed_kn, decimals=2)
+    return {
+        "color": _r(r.speed_kn, 3),
+        "colorscale": "Viridis",
+        "cmin": slo,
+        "cmax": shi,
+        "size": 5,
+        "colorbar": {
+            "title": {"text": "boat speed [kn]"},
+            "x": 1.02,
+            "y": 1.0,
+            "yanchor": "top",
+            "len": 0.45,
+            "thickness": 14,
+        },
+    }
+
+
+def _boat_trace(
+    r: Route, states: Sequence[dict[str, Any]], colour: str, group: str, off: float, size: int
+) -> dict[str, Any]:
+    return {
+        "type": "scatter",
+        "mode": "markers",
+        "name": plotly_label(f"boat: {r.name}"),
+        "legendgroup": group,
+        "showlegend": False,
+        **states[0],
+        "marker": {
+            "symbol": "circle",
+            "size": size,
+            "color": colour,
+            "line": {"color": "white", "width": 2.5 if size > 10 else 1.0},
+        },
+        "hovertemplate": "boat · " + _hover(r, off),
+    }
+
+
+def _highlight_traces() -> list[dict[str, Any]]:
+    """The picked boat's line, tacks and gybes (filled in by the page's script)."""
+    line = {
+        "type": "scatter",
+        "mode": "lines",
+        "name": "picked boat",
+        "showlegend": False,
+        "x": [],
+        "y": [],
+        "line": {"color": GREY, "width": 4.5},
+        "hoverinfo": "skip",
+    }
+    out = [line]
+    for kind in ("tack", "gybe"):
+        out.append({**_manoeuvre_trace(kind, (), "picked boat", "picked", 0.0), "text": []})
+    return out
+
+
+def _pick_entry(r: Route, line: int, marker: int, colour: str, off: float) -> dict[str, Any]:
+    """What the page's script needs to highlight one boat."""
+    entry: dict[str, Any] = {
+        "name": clean_text(r.name),
+        "label": plotly_label(r.name),
+        "line": line,
+        "marker": marker,
+        "colour": colour,
+    }
+    for kind in ("tack", "gybe"):
+        tr = _manoeuvre_trace(kind, [m for m in r.manoeuvres if m[0] == kind], r.name, "", off)
+        entry[f"{kind}s"] = {"x": tr["x"], "y": tr["y"], "text": tr["text"]}
+    return entry
+
+
 def figure(report: Report) -> dict[str, Any]:
-    """The plotly figure of the page: ``{"data", "layout", "frames", "config"}``.
+    """The plotly figure of the page: ``{"data", "layout", "frames", "config"}``, plus
+    ``"pick"`` on a fleet's page (:attr:`Report.pick`).
 
     Trace order: wind layers, the race area (:func:`area_traces`), course (lines and
     gates, marks), the overlays, then per
     route its line, tacks, gybes (and leg numbers on the first route) and the boat
     marker.  Frame ``k`` (named ``str(k)``) moves every boat marker and every
     time-varying wind layer to ``report.times[k]``; the slider's steps animate to them.
+
+    On a fleet's page (``report.pick``) the routes have no tack and gybe traces, the
+    course comes after the routes (over them), and three traces end the list: the picked
+    boat's line, tacks and gybes, empty until the reader picks one.  ``"pick"`` holds
+    ``grey`` (:data:`~sailroute.report.page.GREY`), ``highlight`` (those three traces'
+    indices) and per boat (route with a marker) ``name``, ``label`` (for plotly),
+    ``line`` and ``marker`` (trace indices), ``colour``, ``tacks`` and ``gybes``
+    (``x``, ``y``, ``text``).
     """
     course, off = report.course, report.course.utc_offset_s
     data: list[dict[str, Any]] = []
     moving: list[tuple[int, list[dict[str, Any]]]] = []  # (trace, its state per frame)
+    data += _wind_traces(report, moving)
+    data += area_traces(course)
+    if not report.pick:
+        data += _course_traces(course)
+    data += list(report.overlays)
 
+    single = report.colour_by_speed and len(report.routes) == 1
+    picks = []
+    for i, r in enumerate(report.routes):
+        group = f"route{i}"
+        colour = "#333333" if single else (r.colour or _colour(i))
+        custom = _customdata(r, off)
+        tr = _route_trace(r, colour, group, custom, off, 1.6 if report.pick else 2.5)
+        if single:
+            tr["mode"] = "lines+markers"
+            tr["marker"] = _speed_colours(report)
+        data.append(tr)
+        line = len(data) - 1
+        if not report.pick:
+            for kind in ("tack", "gybe"):
+                pts = [m for m in r.manoeuvres if m[0] == kind]
+                data.append(_manoeuvre_trace(kind, pts, r.name, group, off))
+        if i == 0 and report.leg_numbers:
+            data.append(_leg_number_trace(r, group))
+        if r.boat:
+            states = _boat_states(r, report.times, off, custom)
+            marker_colour = BOAT_COLOUR if single else colour
+            data.append(_boat_trace(r, states, marker_colour, group, off, 9 if report.pick else 15))
+            moving.append((len(data) - 1, states))
+            picks.append(_pick_entry(r, line, len(data) - 1, colour, off))
+
+    out: dict[str, Any] = {}
+    if report.pick:
+        data += _course_traces(course)
+        data += _highlight_traces()
+        n = len(data)
+        out["pick"] = {"grey": GREY, "highlight": [n - 3, n - 2, n - 1], "boats": picks}
+    frames = []
+    if len(report.times) > 1 and moving:
+        for k in range(len(report.times)):
+            frames.append(
+                {
+                    "name": str(k),
+                    "data": [states[k] for _, states in moving],
+                    "traces": [i for i, _ in moving],
+                }
+            )
+    return {
+        "data": data,
+        "layout": _layout(report, frames),
+        "frames": frames,
+        "config": {"responsive": True, "displaylogo": False, "scrollZoom": True},
+        **out,
+    }
+
+
+def _wind_traces(
+    report: Report, moving: list[tuple[int, list[dict[str, Any]]]]
+) -> list[dict[str, Any]]:
+    """Shafts and heads of every wind layer (the first shown); the time-varying ones are
+    added to ``moving`` with their state per frame."""
+    course = report.course
+    data: list[dict[str, Any]] = []
     top = max(
         (float(np.nanmax(w.tws_kn)) for w in report.winds if np.isfinite(w.tws_kn).any()),
         default=0.0,
@@ -399,114 +579,7 @@ def figure(report: Report) -> dict[str, Any]:
         if not w.steady:
             moving.append((len(data) - 2, [sh for sh, _ in rows]))
             moving.append((len(data) - 1, [hd for _, hd in rows]))
-
-    data += area_traces(course)
-    data += _course_traces(course)
-    data += list(report.overlays)
-
-    single = report.colour_by_speed and len(report.routes) == 1
-    slo, shi = (
-        speed_limits(np.concatenate([r.speed_kn for r in report.routes]), decimals=2)
-        if report.routes
-        else (0.0, SPEED_SPAN_KN)
-    )
-    for i, r in enumerate(report.routes):
-        group = f"route{i}"
-        colour = "#333333" if single else _colour(i)
-        custom = _customdata(r, off)
-        drawn_lat, drawn_lon = r.drawn()
-        tr = {
-            "type": "scatter",
-            "mode": "lines+markers" if single else "lines",
-            "name": plotly_label(r.name),
-            "legendgroup": group,
-            "x": _r(drawn_lon, 7),
-            "y": _r(drawn_lat, 7),
-            "line": {"color": colour, "width": 2.5, "dash": r.dash},
-            "customdata": custom,
-            "hovertemplate": _hover(r, off),
-        }
-        if single:
-            tr["marker"] = {
-                "color": _r(r.speed_kn, 3),
-                "colorscale": "Viridis",
-                "cmin": slo,
-                "cmax": shi,
-                "size": 5,
-                "colorbar": {
-                    "title": {"text": "boat speed [kn]"},
-                    "x": 1.02,
-                    "y": 1.0,
-                    "yanchor": "top",
-                    "len": 0.45,
-                    "thickness": 14,
-                },
-            }
-        data.append(tr)
-        for kind, symbol, mc in (
-            ("tack", "triangle-up", "crimson"),
-            ("gybe", "square", "royalblue"),
-        ):
-            pts = [m for m in r.manoeuvres if m[0] == kind]
-            data.append(
-                {
-                    "type": "scatter",
-                    "mode": "markers",
-                    "name": f"{kind}s",
-                    "legendgroup": group,
-                    "showlegend": False,
-                    "x": _r([m[3] for m in pts], 7),
-                    "y": _r([m[2] for m in pts], 7),
-                    "text": [f"{kind} {clock(m[1], off)} local · {clock(m[1])} UTC" for m in pts],
-                    "marker": {
-                        "symbol": symbol,
-                        "color": mc,
-                        "size": 10,
-                        "line": {"color": "white", "width": 1},
-                    },
-                    "hovertemplate": f"%{{text}}<extra>{plotly_label(r.name)}</extra>",
-                }
-            )
-        if i == 0 and report.leg_numbers:
-            data.append(_leg_number_trace(r, group))
-        if r.boat:
-            states = _boat_states(r, report.times, off, custom)
-            st = states[0]
-            data.append(
-                {
-                    "type": "scatter",
-                    "mode": "markers",
-                    "name": plotly_label(f"boat: {r.name}"),
-                    "legendgroup": group,
-                    "showlegend": False,
-                    **st,
-                    "marker": {
-                        "symbol": "circle",
-                        "size": 15,
-                        "color": BOAT_COLOUR if single else colour,
-                        "line": {"color": "white", "width": 2.5},
-                    },
-                    "hovertemplate": "boat · " + _hover(r, off),
-                }
-            )
-            moving.append((len(data) - 1, states))
-
-    frames = []
-    if len(report.times) > 1 and moving:
-        for k in range(len(report.times)):
-            frames.append(
-                {
-                    "name": str(k),
-                    "data": [states[k] for _, states in moving],
-                    "traces": [i for i, _ in moving],
-                }
-            )
-    return {
-        "data": data,
-        "layout": _layout(report, frames),
-        "frames": frames,
-        "config": {"responsive": True, "displaylogo": False, "scrollZoom": True},
-    }
+    return data
 
 
 def _layout(report: Report, frames: Sequence[Any]) -> dict[str, Any]:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from sailroute.geo import LocalFrame
+from sailroute.report.markup import plotly_label
 from sailroute.routing.laylines import Layline
 from sailroute.routing.startline import Approach, LineApproach, StartLineNumbers
 from sailroute.timeutil import iso
@@ -153,7 +154,8 @@ def draw_start_and_laylines(
 def plotly_traces(
     sl: StartLineNumbers | None, laylines: Sequence[Sequence[Layline]], frame: LocalFrame
 ) -> list[dict[str, Any]]:
-    """Plotly traces (lon/lat) of the laylines and the favoured end for ``report.html``."""
+    """Plotly traces (lon/lat) of the laylines and the favoured end for ``report.html``
+    (mark names as text: :func:`sailroute.report.markup.plotly_label`)."""
     out: list[dict[str, Any]] = []
     first = True
     for k, leg in enumerate(laylines):
@@ -170,7 +172,7 @@ def plotly_traces(
                     "y": [round(float(v), 7) for v in np.atleast_1d(lat)],
                     "line": {"color": LAYLINE_COLOUR, "width": 1.2, "dash": "dash"},
                     "hovertemplate": f"leg {k + 1}: {ll.tack} {ll.kind} layline to "
-                    f"{ll.mark}<extra></extra>",
+                    f"{plotly_label(ll.mark)}<extra></extra>",
                 }
             )
             first = False
@@ -190,7 +192,7 @@ def plotly_traces(
                     "line": {"color": "black", "width": 1},
                 },
                 "hovertemplate": (
-                    f"favoured end {sl.favoured_end}: bias "
+                    f"favoured end {plotly_label(sl.favoured_end or '')}: bias "
                     f"{sl.bias_deg:+.1f}°, {sl.gain_m:.0f} m, "
                     f"{sl.gain_s:.0f} s<extra></extra>"
                 ),

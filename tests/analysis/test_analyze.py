@@ -254,7 +254,9 @@ def test_shipped_example_runs_and_writes_every_file(tmp_path: Path) -> None:
         "legs_png",
         "loss_png",
         "html",
+        "plotly_js",
     }
+    assert res.files["plotly_js"] == out / "plotly.min.js" and res.files["plotly_js"].is_file()
     doc = json.loads((out / "analysis.json").read_text())
     assert doc["schema_version"] == 1 and len(doc["legs"]) == 4
     ends = [leg["end_time"][11:19] for leg in doc["legs"]]

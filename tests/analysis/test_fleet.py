@@ -296,7 +296,7 @@ def test_fleet_page_escapes_names_and_draws_every_boat(fleet_files, tmp_path: Pa
     markers = [t for t in fig["data"] if t["name"].startswith("boat: ")]
     assert len(markers) == 3 and all("<" not in t["name"] for t in markers)
     assert len(fig["frames"]) == 60
-    for caption in ("Leg ranking", "Start", "Time lost per boat and leg"):
+    for caption in ("<h2>Results: ", "<h2>Leg times", "<h2>Start</h2>", "<summary>Leg 1: "):
         assert caption in page
 
 

@@ -30,6 +30,7 @@ from sailroute.planning.result import compare
 from sailroute.report.html import comparison_report, plan_report
 from sailroute.report.page import BOAT_COLOUR, N_STEPS, SEA, clock
 from sailroute.report.page_render import write_report
+from tests.report.cdp import OFFLINE_FLAGS
 
 
 def find_chromium() -> str | None:
@@ -54,15 +55,7 @@ pytestmark = [
 ]
 
 FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--host-resolver-rules=MAP * ~NOTFOUND",
+    *OFFLINE_FLAGS,
     "--enable-logging=stderr",
     "--v=0",
     "--virtual-time-budget=10000",

@@ -1,8 +1,8 @@
 """``report.html`` builder (``sailroute.report.html``): what the page embeds is the plan.
 
-The page is checked through the figure JSON it embeds (:func:`read_figure`), with a stub
-in place of the 4.8 MB plotly.js bundle; ``test_report_browser.py`` loads real pages in
-Chromium.
+The page is checked through the figure JSON it embeds (:func:`read_figure`); the 4.8 MB
+plotly.js bundle is a file beside the page, not in it; ``test_report_browser.py`` loads
+real pages in Chromium.
 """
 
 from __future__ import annotations
@@ -10,6 +10,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -38,11 +39,9 @@ from sailroute.units import KNOT
 from sailroute.wind.analytic import AnalyticWind
 from tests.report.conftest import COURSE, timed_track
 
-STUB = "/* plotly.js stub */"
-
 
 def page_of(report) -> tuple[str, dict]:
-    page = render_html(report, STUB)
+    page = render_html(report)
     return page, read_figure(page)
 
 
@@ -125,7 +124,7 @@ def test_plan_page_embeds_the_plan(plan, wind):
         assert f"<td>{clock(pl.result.t_start, 7200)}</td>" in page, k
     assert page.count("<tr>") == 1 + len(plan.legs) + 1  # header, legs, total
     assert "<th>winner</th>" in page and "<th>model</th>" in page
-    assert f'id="{DIV_ID}"' in page and STUB in page
+    assert f'id="{DIV_ID}"' in page and '<script src="plotly.min.js"></script>' in page
 
 
 def test_slider_moves_the_boat_along_the_route(plan, wind):
@@ -224,15 +223,17 @@ def test_comparison_page_has_every_scenario(plan, wind):
 
 
 def test_page_is_deterministic_and_escapes_text(plan, wind):
-    a = render_html(plan_report(plan, wind), STUB)
-    assert a == render_html(plan_report(plan, wind), STUB)
+    a = render_html(plan_report(plan, wind))
+    assert a == render_html(plan_report(plan, wind))
     evil = dataclasses.replace(plan, scenario="x</script><b>")
-    page = render_html(plan_report(evil, wind), STUB)
+    page = render_html(plan_report(evil, wind))
     assert "x</script>" not in page
     fig = read_figure(page)  # still parses
     assert route_trace(fig, "route: x&lt;/script&gt;&lt;b&gt;")
     assert "<h1>report test — x&lt;/script&gt;&lt;b&gt;</h1>" in page
-    assert "<script src" not in page and "<link" not in page  # nothing to fetch
+    # nothing to fetch but the plotly.js bundle beside the page
+    assert re.findall(r"<script src=\"([^\"]*)\"", page) == ["plotly.min.js"]
+    assert "<link" not in page and "http" not in page.split("<script type")[0]
 
 
 def test_figure_is_valid_for_plotly(plan, wind):
