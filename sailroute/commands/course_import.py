@@ -25,7 +25,7 @@ from sailroute.course.read import read_course_file
 from sailroute.errors import InputError
 from sailroute.timeutil import parse_time
 
-__all__ = ["boat_spec_of", "run_course_import_command"]
+__all__ = ["boat_spec_of", "run_course_import_command", "write_course_file"]
 
 
 def boat_spec_of(text: str | None, out: Path) -> dict[str, Any] | None:
@@ -73,6 +73,32 @@ def boat_spec_of(text: str | None, out: Path) -> dict[str, Any] | None:
             )
         return {"polar": os.path.relpath(p.resolve(), out.resolve().parent)}
     return {"builtin": t}
+
+
+def write_course_file(text: str, dest: Path) -> Course:
+    """Write a course file only if it loads and its boat and wind build; return it.
+
+    The text goes to a draft next to ``dest`` first and is checked there (messages name
+    ``dest``), then replaces ``dest``: a course that would not plan is never written.
+
+    Raises
+    ------
+    InputError
+        The folder is missing or not writable, or the text does not load.
+    """
+    if not dest.parent.is_dir():
+        raise InputError(f"-o {dest}: the folder {dest.parent} does not exist; create it first")
+    tmp = dest.with_name(f".{dest.name}.sailroute-tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        doc = read_course_file(tmp)  # messages name the file to be written, not the draft
+        validate_specs(course_from_mapping(doc.data, source=dest, key_lines=doc.lines))
+        os.replace(tmp, dest)
+    except OSError as exc:
+        raise InputError(f"-o {dest}: cannot write the file ({exc.strerror})") from None
+    finally:
+        tmp.unlink(missing_ok=True)
+    return load_course(dest)
 
 
 def _summary(ic: ImportedCourse, course: Course, out: Path, fmt: str) -> str:
@@ -167,19 +193,7 @@ def run_course_import_command(
         start_time=t0,
         boat=boat_spec_of(boat, dest),
     )
-    if not dest.parent.is_dir():
-        raise InputError(f"-o {dest}: the folder {dest.parent} does not exist; create it first")
-    tmp = dest.with_name(f".{dest.name}.sailroute-tmp")
-    try:
-        tmp.write_text(text, encoding="utf-8")
-        doc = read_course_file(tmp)  # messages name the file to be written, not the draft
-        validate_specs(course_from_mapping(doc.data, source=dest, key_lines=doc.lines))
-        os.replace(tmp, dest)
-    except OSError as exc:
-        raise InputError(f"-o {dest}: cannot write the file ({exc.strerror})") from None
-    finally:
-        tmp.unlink(missing_ok=True)
-    course = load_course(dest)
+    course = write_course_file(text, dest)
     notes = list(ic.notes)
     if boat is None:
         notes.append(

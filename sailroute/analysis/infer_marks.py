@@ -1,0 +1,774 @@
+"""A course inferred from a fleet's tracks: marks, gates, lines, roundings, legs, gun, wind.
+
+For a race whose marks are unknown, or were moved, the fleet shows where they were: every
+boat turns round each mark, and a mark is where many boats' roundings fall together.
+The steps (``docs/analysis.md``, "Marks from the fleet"):
+
+1. **Turns** of every track (:mod:`sailroute.analysis.turns`: boards of the simplified
+   track and the turns between them), and the **wind axis** from the boards' courses
+   (:func:`sailroute.analysis.infer_wind.wind_axis_deg`, weighted by their durations).
+2. **Roundings**: the turns that change the point of sail
+   (:func:`~sailroute.analysis.turns.is_rounding`) after which the boat sails on at
+   ``PACE_SHARE`` of its pace (a luff after the finish is not a rounding).
+3. **Clusters**: the roundings gathered by a density rule (DBSCAN, Ester et al. 1996,
+   counting boats rather than points): two roundings the same way within ``eps`` are
+   neighbours, a rounding with neighbours from ``MIN_SHARE`` of the fleet (and at least
+   two boats) is a core, and the cores that are neighbours, with the roundings next to
+   them, form one cluster.  ``eps`` is ``CLUSTER_S`` of sailing at the fleet's speed, at
+   least ``CLUSTER_MIN_M``.  Roundings of nobody's cluster (a boat's own detour) are left.
+4. **Gun** (given, or :func:`sailroute.analysis.infer_lines.infer_gun` towards the first
+   mark the fleet rounds), each boat's **end of racing**
+   (:func:`~sailroute.analysis.infer_lines.race_ends`), and steps 3-5 again on the
+   roundings between them.
+5. **Gates**: two clusters rounded opposite ways, less than ``GATE_S`` of sailing apart
+   (at least ``GATE_MIN_M``), that no boat rounds one right after the other, are the two
+   marks of one gate.
+6. **Sequence**: each boat's roundings in time order as a list of marks and gates; the
+   course is the list among them with the most support (each item a boat's list shares
+   counts +1/2, each it lacks −1/2: an item half the fleet misses does not count), and
+   every boat's roundings are aligned to it (longest common subsequence).
+7. **Marks**: a boat passes a mark outside its turn, so each rounding puts the mark
+   ``CLEAR_S`` of sailing inside its apex; the mark is the median of those points and its
+   **spread** the median distance of them from it.  A mark at two places in the race (moved
+   between laps) is two clusters and two marks.
+8. **Start and finish lines** (:mod:`sailroute.analysis.infer_lines`), and the wind: its
+   axis from step 1, the end it blows from by :func:`~sailroute.analysis.infer_wind.infer_wind`
+   over the race (the slower boards when that fails).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Final
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sailroute.analysis.infer_lines import (
+    GunEstimate,
+    LineEstimate,
+    finish_line,
+    infer_gun,
+    race_ends,
+    start_line,
+)
+from sailroute.analysis.turns import (
+    EPS_MIN_M,
+    EPS_S,
+    BoatPath,
+    Turn,
+    find_turns,
+    is_rounding,
+    typical_speed_ms,
+)
+from sailroute.errors import InputError
+from sailroute.geo import LocalFrame
+from sailroute.timeutil import iso
+from sailroute.track.model import Track
+from sailroute.units import circular_mean_deg, wrap180, wrap360
+
+__all__ = [
+    "AFTER_S",
+    "CLEAR_S",
+    "CLUSTER_MIN_M",
+    "CLUSTER_S",
+    "GATE_MIN_M",
+    "GATE_S",
+    "MAX_APART_M",
+    "MIN_SHARE",
+    "InferredCourse",
+    "InferredMark",
+    "infer_course",
+]
+
+CLUSTER_S: Final = 2.0
+"""Roundings within this much sailing at the fleet's speed are neighbours [s]."""
+
+CLUSTER_MIN_M: Final = 30.0
+"""Roundings within this are always neighbours [m]."""
+
+MIN_SHARE: Final = 0.2
+"""A cluster's cores have neighbours from this share of the fleet (and two boats)."""
+
+GATE_S: Final = 20.0
+"""The two marks of a gate lie less than this much sailing apart [s]."""
+
+GATE_MIN_M: Final = 150.0
+"""... or less than this [m]."""
+
+CLEAR_S: Final = 1.0
+"""A boat rounds a mark about this much sailing outside it [s] (4 m for a dinghy at 8 kn,
+15 m for a foiling catamaran at 30 kn)."""
+
+AFTER_S: Final = 10.0
+"""A rounding is followed by this long at racing pace [s] (from 2 s after the apex)."""
+
+MAX_APART_M: Final = 20_000.0
+"""Tracks whose middles lie further apart than this are of different races [m]."""
+
+MIN_FIXES: Final = 10
+"""A track needs this many fixes in the window to count."""
+
+
+@dataclass(frozen=True)
+class InferredMark:
+    """A mark the fleet rounded.
+
+    Attributes
+    ----------
+    name : str
+        ``M1``, ``M2``, ... in the order first rounded; a gate's marks ``G1a``, ``G1b``.
+    x, y : float
+        Position [m].
+    lat, lon : float
+        Position [°].
+    rounding : {"port", "starboard"}
+        The side the fleet left it on (the majority).
+    spread_m : float
+        Median distance of the single roundings' estimates from the mark [m].
+    n_roundings, n_boats : int
+        Roundings and boats it is inferred from.
+    gate : str or None
+        The gate it belongs to.
+    """
+
+    name: str
+    x: float
+    y: float
+    lat: float
+    lon: float
+    rounding: str
+    spread_m: float
+    n_roundings: int
+    n_boats: int
+    gate: str | None = None
+
+
+@dataclass(frozen=True)
+class InferredCourse:
+    """What :func:`infer_course` found.
+
+    Attributes
+    ----------
+    frame : LocalFrame
+        The frame of ``x, y``.
+    boats : tuple of str
+        The tracks used, in input order.
+    marks : tuple of InferredMark
+        The rounding marks, with the gates' marks.
+    gates : tuple of (str, str, str)
+        ``(name, mark a, mark b)``.
+    start, finish : LineEstimate or None
+        The lines (the finish None when the tracks show none).
+    legs : tuple of (str, str or None)
+        ``(to, rounding)`` of each leg after the start, in sailing order.
+    leg_roundings : tuple of tuple of float
+        Per leg, each boat's rounding of its mark or gate [epoch s] (NaN: not found).
+    gun : GunEstimate
+    axis_deg : float
+        The wind axis [°, 0-180].
+    twd_deg : float
+        The wind direction [°, from] over the race.
+    twd_how : str
+        How the direction's end was decided.
+    speed_ms : float
+        The fleet's typical speed [m s⁻¹].
+    eps_m : float
+        The clustering radius [m].
+    notes : tuple of str
+        What the user should know (tracks left out, a finish not found, ...).
+    """
+
+    frame: LocalFrame
+    boats: tuple[str, ...]
+    marks: tuple[InferredMark, ...]
+    gates: tuple[tuple[str, str, str], ...]
+    start: LineEstimate
+    finish: LineEstimate | None
+    legs: tuple[tuple[str, str | None], ...]
+    leg_roundings: tuple[tuple[float, ...], ...]
+    gun: GunEstimate
+    axis_deg: float
+    twd_deg: float
+    twd_how: str
+    speed_ms: float
+    eps_m: float
+    notes: tuple[str, ...] = field(default=())
+
+    def mark(self, name: str) -> InferredMark:
+        """The mark called ``name``."""
+        return next(m for m in self.marks if m.name == name)
+
+    def latlon(self, xy: tuple[float, float]) -> tuple[float, float]:
+        """``(lat, lon)`` [°] of a point of the frame."""
+        lat, lon = self.frame.to_latlon(xy[0], xy[1])
+        return float(lat), float(lon)
+
+
+# ------------------------------------------------------------------------------ input
+def _paths(tracks: Sequence[Track], t_from: float, t_until: float) -> list[Track]:
+    """The tracks cut to the window; refuses too few, or tracks of different times."""
+    if len(tracks) < 2:
+        raise InputError(
+            f"course infer: {len(tracks)} track given; the marks are where a fleet turns: "
+            "give the tracks of two boats or more of the same race (ten or more for a "
+            "course you can trust)"
+        )
+    cut = []
+    for tr in tracks:
+        part = tr.between(t_from, t_until)
+        if len(part) >= MIN_FIXES:
+            cut.append(part)
+    if len(cut) < 2:
+        where = "" if not math.isfinite(t_from) else f" between {iso(t_from)} and {iso(t_until)}"
+        raise InputError(
+            f"course infer: {len(cut)} of {len(tracks)} tracks have {MIN_FIXES} fixes or "
+            f"more{where}; expected the tracks of one race (check --from/--until)"
+        )
+    lo = max(float(np.median([tr.t_start for tr in cut])), min(tr.t_start for tr in cut))
+    hi = min(float(np.median([tr.t_end for tr in cut])), max(tr.t_end for tr in cut))
+    overlap = [tr for tr in cut if tr.t_start < hi and tr.t_end > lo]
+    if len(overlap) < 2 or hi <= lo:
+        raise InputError(
+            f"course infer: the tracks do not overlap in time ({iso(min(tr.t_start for tr in cut))}"
+            f" .. {iso(max(tr.t_end for tr in cut))}); expected the boats of one race"
+        )
+    return cut
+
+
+def _check_place(paths: Sequence[BoatPath]) -> None:
+    """Refuse tracks whose middles lie more than ``MAX_APART_M`` apart."""
+    mids = [(p.name, float(np.median(p.x)), float(np.median(p.y))) for p in paths]
+    cx, cy = float(np.median([m[1] for m in mids])), float(np.median([m[2] for m in mids]))
+    far = [(n, math.hypot(x - cx, y - cy)) for n, x, y in mids]
+    n, d = max(far, key=lambda f: f[1])
+    if d > MAX_APART_M:
+        raise InputError(
+            f"course infer: track {n!r} lies {d / 1000:.0f} km from the rest of the fleet "
+            f"(more than {MAX_APART_M / 1000:.0f} km): expected the tracks of one race; "
+            "leave it out"
+        )
+
+
+# ------------------------------------------------------------------------------ turns
+@dataclass(frozen=True)
+class _Rounding:
+    boat: int
+    turn: Turn
+    est: tuple[float, float]  # where this rounding puts the mark [m]
+
+
+def _turns(paths: Sequence[BoatPath], eps_dp: float) -> tuple[list[list[Turn]], float]:
+    """Every boat's turns, and the wind axis from all boards [°]."""
+    per: list[list[Turn]] = []
+    courses, weights = [], []
+    for p in paths:
+        out: list[Turn] = []
+        for sl in p.pieces():
+            tu, bc, bs = find_turns(p.t[sl], p.x[sl], p.y[sl], eps_dp)
+            out.extend(tu)
+            courses.append(bc)
+            weights.append(bs)
+        per.append(out)
+    from sailroute.analysis.infer_wind import wind_axis_deg
+
+    c = np.concatenate(courses) if courses else np.zeros(0)
+    if c.size < 4:
+        raise InputError(
+            "course infer: the tracks hold almost no straight sailing (fewer than 4 boards "
+            "in all); expected race tracks with fixes every few seconds"
+        )
+    axis, _ = wind_axis_deg(c, np.concatenate(weights))
+    return per, axis
+
+
+def _roundings(
+    paths: Sequence[BoatPath],
+    turns: Sequence[Sequence[Turn]],
+    axis: float,
+    paces: Sequence[float],
+    clear_m: float,
+    windows: Sequence[tuple[float, float]],
+) -> list[_Rounding]:
+    """The turns that round a mark within each boat's window."""
+    out = []
+    for b, (tu, (lo, hi)) in enumerate(zip(turns, windows, strict=True)):
+        for turn in tu:
+            if not (lo < turn.t < hi) or not is_rounding(turn, axis):
+                continue
+            ox, oy = turn.outward
+            out.append(_Rounding(b, turn, (turn.x - clear_m * ox, turn.y - clear_m * oy)))
+    return out
+
+
+def _clusters(rs: Sequence[_Rounding], eps: float, min_boats: int) -> NDArray[np.int64]:
+    """Cluster label of each rounding (−1: none), by step 3 of the module notes."""
+    n = len(rs)
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    xy = np.array([r.est for r in rs])
+    side = np.array([r.turn.turn_deg < 0 for r in rs])
+    boat = np.array([r.boat for r in rs])
+    d = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
+    near = (d <= eps) & (side[:, None] == side[None, :])
+    onehot = np.zeros((n, int(boat.max()) + 1), dtype=bool)
+    onehot[np.arange(n), boat] = True
+    boats_near = (near.astype(np.int64) @ onehot.astype(np.int64) > 0).sum(axis=1)
+    core = boats_near >= min_boats
+    link = near & core[:, None] & core[None, :]
+    _, comp = connected_components(csr_matrix(link), directed=False)
+    label = np.full(n, -1, dtype=np.int64)
+    label[core] = comp[core]
+    for i in np.flatnonzero(~core):
+        c = np.flatnonzero(near[i] & core)
+        if c.size:
+            label[i] = comp[c[int(np.argmin(d[i, c]))]]
+    used = sorted(set(label[label >= 0].tolist()))
+    remap = {v: k for k, v in enumerate(used)}
+    return np.array([remap.get(int(v), -1) for v in label], dtype=np.int64)
+
+
+# --------------------------------------------------------------------------- sequence
+def _lcs(a: Sequence[int], b: Sequence[int]) -> list[tuple[int, int]]:
+    """Index pairs of a longest common subsequence of ``a`` and ``b``."""
+    m, n = len(a), len(b)
+    L = np.zeros((m + 1, n + 1), dtype=np.int64)
+    for i in range(m - 1, -1, -1):
+        for j in range(n - 1, -1, -1):
+            L[i, j] = L[i + 1, j + 1] + 1 if a[i] == b[j] else max(L[i + 1, j], L[i, j + 1])
+    out, i, j = [], 0, 0
+    while i < m and j < n:
+        if a[i] == b[j]:
+            out.append((i, j))
+            i, j = i + 1, j + 1
+        elif L[i + 1, j] >= L[i, j + 1]:
+            i += 1
+        else:
+            j += 1
+    return out
+
+
+def _consensus(seqs: Sequence[Sequence[int]]) -> list[int]:
+    """The boat's list with the most support (step 6 of the module notes)."""
+    best: list[int] = []
+    best_score = -math.inf
+    for cand in sorted({tuple(s) for s in seqs if s}, key=lambda s: (-len(s), s)):
+        score = sum(len(_lcs(cand, s)) - 0.5 * len(cand) for s in seqs)
+        if score > best_score:
+            best, best_score = list(cand), score
+    return best
+
+
+def _gate_pairs(
+    rs: Sequence[_Rounding],
+    label: NDArray[np.int64],
+    centres: NDArray,
+    sides: Sequence[bool],
+    seqs: Sequence[Sequence[int]],
+    gate_max: float,
+) -> dict[int, int]:
+    """Cluster -> the item it counts as (a gate's second mark -> its first)."""
+    k = centres.shape[0]
+    pairs = []
+    for a in range(k):
+        for b in range(a + 1, k):
+            if sides[a] == sides[b]:
+                continue
+            dist = math.hypot(*(centres[a] - centres[b]))
+            if dist > gate_max:
+                continue
+            both = sum(any({s[i], s[i + 1]} == {a, b} for i in range(len(s) - 1)) for s in seqs)
+            if both <= 0.1 * len(seqs):
+                pairs.append((dist, a, b))
+    item = {c: c for c in range(k)}
+    taken: set[int] = set()
+    for _, a, b in sorted(pairs):
+        if a in taken or b in taken:
+            continue
+        taken |= {a, b}
+        item[b] = a
+    return item
+
+
+def _sequences(
+    rs: Sequence[_Rounding], label: NDArray[np.int64], n_boats: int, item: dict[int, int]
+) -> list[list[tuple[int, int]]]:
+    """Per boat, its roundings in time order as ``(item, rounding index)``, a repeat of
+    the same item right after it dropped (a second turn at the same mark)."""
+    per: list[list[tuple[int, int]]] = [[] for _ in range(n_boats)]
+    for i in sorted(range(len(rs)), key=lambda i: rs[i].turn.t):
+        if label[i] < 0:
+            continue
+        it = item[int(label[i])]
+        row = per[rs[i].boat]
+        if row and row[-1][0] == it:
+            continue
+        row.append((it, i))
+    return per
+
+
+@dataclass(frozen=True)
+class _Found:
+    """Clusters, items and the aligned course of one pass."""
+
+    rs: list[_Rounding]
+    label: NDArray[np.int64]
+    centres: NDArray
+    sides: list[bool]
+    item: dict[int, int]
+    course: list[int]
+    aligned: list[list[int | None]]  # per course position, per boat: rounding index
+
+
+def _find(rs: list[_Rounding], n_boats: int, eps: float, min_boats: int, gate_max: float) -> _Found:
+    label = _clusters(rs, eps, min_boats)
+    k = int(label.max()) + 1 if label.size else 0
+    centres = np.array(
+        [np.median([rs[i].est for i in np.flatnonzero(label == c)], axis=0) for c in range(k)]
+    ).reshape(k, 2)
+    sides = [
+        bool(np.mean([rs[i].turn.turn_deg < 0 for i in np.flatnonzero(label == c)]) > 0.5)
+        for c in range(k)
+    ]
+    plain = _sequences(rs, label, n_boats, {c: c for c in range(k)})
+    item = _gate_pairs(rs, label, centres, sides, [[c for c, _ in s] for s in plain], gate_max)
+    seqs = _sequences(rs, label, n_boats, item)
+    course = _consensus([[c for c, _ in s] for s in seqs])
+    aligned: list[list[int | None]] = [[None] * n_boats for _ in course]
+    for b, s in enumerate(seqs):
+        for p, q in _lcs(course, [c for c, _ in s]):
+            aligned[p][b] = s[q][1]
+    return _Found(rs, label, centres, sides, item, course, aligned)
+
+
+# ------------------------------------------------------------------------------ wind
+def _twd(
+    tracks: Sequence[Track],
+    frame: LocalFrame,
+    axis: float,
+    gun: float,
+    end: float,
+    paths: Sequence[BoatPath],
+    turns: Sequence[Sequence[Turn]],
+) -> tuple[float, str]:
+    """The wind's direction [°, from] and how its end was decided."""
+    from sailroute.analysis.infer_wind import infer_wind
+
+    try:
+        iw = infer_wind(list(tracks), frame, t0=gun, t1=end)
+        ok = np.isfinite(iw.twd_deg)
+        if ok.any():
+            twd = circular_mean_deg(iw.twd_deg[ok])
+            off = abs(float(wrap180(twd - axis)))
+            end_deg = axis if off <= 90.0 else (axis + 180.0) % 360.0
+            return (
+                end_deg,
+                f"the end of the axis the wind inferred from the tracks blows from ({twd:.0f}°)",
+            )
+    except InputError as exc:
+        why = str(exc)
+    else:
+        why = "no direction inferred"
+    # the slower boards are the upwind ones
+    speeds: dict[int, list[float]] = {0: [], 1: []}
+    for p in paths:
+        v = p.speed(10.0)
+        c = np.degrees(np.arctan2(np.gradient(p.x), np.gradient(p.y)))
+        for end_i, e in enumerate((axis, axis + 180.0)):
+            m = np.abs(wrap180(c - e)) < 60.0
+            if m.any():
+                speeds[end_i].append(float(np.median(v[m])))
+    s0 = float(np.median(speeds[0])) if speeds[0] else math.inf
+    s1 = float(np.median(speeds[1])) if speeds[1] else math.inf
+    twd = axis if s0 <= s1 else (axis + 180.0) % 360.0
+    return float(wrap360(twd)), f"the end the slower boards sail towards ({why})"
+
+
+# ------------------------------------------------------------------------------ main
+def infer_course(
+    tracks: Sequence[Track],
+    *,
+    gun_t: float | None = None,
+    t_from: float = -math.inf,
+    t_until: float = math.inf,
+) -> InferredCourse:
+    """Infer a course from a fleet's tracks (module notes).
+
+    Parameters
+    ----------
+    tracks : sequence of Track
+        Two or more boats of one race.
+    gun_t : float, optional
+        The gun [epoch s]; inferred when None.
+    t_from, t_until : float
+        Only the fixes in this window are used [epoch s] (logs holding several races).
+
+    Returns
+    -------
+    InferredCourse
+
+    Raises
+    ------
+    InputError
+        Fewer than two tracks in the window, tracks of different times or places, no
+        roundings shared by the fleet, no gun found (give it), no start found.
+    """
+    cut = _paths(tracks, t_from, t_until)
+    lat = np.concatenate([tr.lat_deg for tr in cut])
+    lon = np.concatenate([tr.lon_deg for tr in cut])
+    frame = LocalFrame(float(np.median(lat)), float(np.median(lon)))
+    paths = [BoatPath.of_track(tr, frame) for tr in cut]
+    _check_place(paths)
+    n = len(paths)
+    notes: list[str] = []
+    if len(cut) < len(tracks):
+        notes.append(
+            f"{len(tracks) - len(cut)} track(s) with fewer than {MIN_FIXES} fixes in the "
+            "window left out"
+        )
+    speed = float(np.median([typical_speed_ms(p.t, p.x, p.y) for p in paths]))
+    if not speed > 0.5:
+        raise InputError(
+            f"course infer: the boats' typical speed is {speed:.1f} m/s; expected racing "
+            "tracks (moving boats, positions changing between fixes)"
+        )
+    eps_dp = max(EPS_MIN_M, EPS_S * speed)
+    eps = max(CLUSTER_MIN_M, CLUSTER_S * speed)
+    gate_max = max(GATE_MIN_M, GATE_S * speed)
+    clear = CLEAR_S * speed
+    min_boats = max(2, math.ceil(MIN_SHARE * n))
+    turns, axis = _turns(paths, eps_dp)
+    t0 = max(float(np.median([p.t[0] for p in paths])), -1e18)
+    t_gun_lo = gun_t if gun_t is not None else -math.inf
+    _, paces0 = race_ends(paths, t0)
+    pre = _roundings(paths, turns, axis, paces0, clear, [(t_gun_lo, math.inf)] * n)
+    if not pre:
+        raise InputError(
+            "course infer: no mark roundings in the tracks (no turn that changes the point "
+            "of sail); expected race tracks that round marks"
+        )
+    found = _find(pre, n, eps, min_boats, gate_max)
+    if not found.course:
+        raise InputError(
+            f"course infer: the boats' roundings fall together nowhere (no place rounded by "
+            f"{min_boats} boats or more within {eps:.0f} m); expected tracks of one race"
+        )
+    # the gun: the fleet's departure towards the first item it rounds that it leaves for
+    if gun_t is None:
+        gun = None
+        for p, it in enumerate(found.course):
+            tv = [found.rs[i].turn.t for i in found.aligned[p] if i is not None]
+            gun = infer_gun(paths, _item_centre(found, it), t0, float(np.median(tv)), speed)
+            if gun is not None:
+                break
+        if gun is None:
+            raise InputError(
+                "course infer: no gun found (no moment when the fleet leaves together for "
+                "a mark it then rounds); give it with --start-time (ISO 8601 with offset)"
+            )
+    else:
+        gun = GunEstimate(float(gun_t), 0.0, "given")
+    ends, paces = race_ends(paths, gun.t)
+    rs = _roundings(
+        paths,
+        turns,
+        axis,
+        paces,
+        clear,
+        [(gun.t, e if math.isfinite(e) else -math.inf) for e in ends],
+    )
+    found = _find(rs, n, eps, min_boats, gate_max)
+    if not found.course:
+        raise InputError(
+            f"course infer: after the gun ({iso(gun.t)}) the boats' roundings fall together "
+            "nowhere; check --start-time"
+        )
+    return _assemble(cut, paths, frame, found, gun, ends, axis, speed, eps, notes)
+
+
+def _item_centre(found: _Found, it: int) -> tuple[float, float]:
+    """A mark's centre, or the middle of a gate's two marks [m]."""
+    members = [c for c, v in found.item.items() if v == it]
+    c = np.mean(found.centres[members], axis=0)
+    return float(c[0]), float(c[1])
+
+
+def _assemble(
+    tracks: Sequence[Track],
+    paths: Sequence[BoatPath],
+    frame: LocalFrame,
+    found: _Found,
+    gun: GunEstimate,
+    ends: Sequence[float],
+    axis: float,
+    speed: float,
+    eps: float,
+    notes: list[str],
+) -> InferredCourse:
+    n = len(paths)
+    rs = found.rs
+    # names in the order first rounded
+    names: dict[int, str] = {}
+    gates: list[tuple[str, str, str]] = []
+    gate_of: dict[int, str] = {}
+    n_mark = n_gate = 0
+    for it in found.course:
+        if it in names:
+            continue
+        members = sorted(c for c, v in found.item.items() if v == it)
+        if len(members) == 2:
+            n_gate += 1
+            g = f"G{n_gate}"
+            names[it] = g
+            a, b = f"{g}a", f"{g}b"
+            gates.append((g, a, b))
+            gate_of[members[0]], gate_of[members[1]] = a, b
+        else:
+            n_mark += 1
+            names[it] = f"M{n_mark}"
+            gate_of[members[0]] = names[it]
+    marks = []
+    for c, mname in gate_of.items():
+        idx = np.flatnonzero(found.label == c)
+        est = np.array([rs[i].est for i in idx])
+        centre = np.median(est, axis=0)
+        spread = float(np.median(np.hypot(*(est - centre).T)))
+        port = sum(rs[i].turn.turn_deg < 0 for i in idx)
+        lat, lon = frame.to_latlon(centre[0], centre[1])
+        marks.append(
+            InferredMark(
+                mname,
+                float(centre[0]),
+                float(centre[1]),
+                float(lat),
+                float(lon),
+                "port" if 2 * port >= idx.size else "starboard",
+                spread,
+                int(idx.size),
+                len({rs[i].boat for i in idx}),
+                mname[:-1] if mname.startswith("G") else None,
+            )
+        )
+    marks.sort(
+        key=lambda m: (m.name[0] != "M", int("".join(ch for ch in m.name if ch.isdigit())), m.name)
+    )
+    by_name = {m.name: m for m in marks}
+    legs: list[tuple[str, str | None]] = []
+    rounded: list[tuple[float, ...]] = []
+    for p, it in enumerate(found.course):
+        nm = names[it]
+        legs.append((nm, None if nm.startswith("G") else by_name[nm].rounding))
+        rounded.append(tuple(rs[i].turn.t if i is not None else math.nan for i in found.aligned[p]))
+    first_c = _item_centre(found, found.course[0])
+    median_first = float(np.nanmedian(rounded[0]))
+    first_t = [t if math.isfinite(t) else median_first for t in rounded[0]]
+    got = start_line(paths, gun.t, first_c, first_t, speed)
+    if got is None:
+        raise InputError(
+            f"course infer: no start line the fleet crosses together near {iso(gun.t)}; "
+            "give the gun with --start-time or tracks that cover the start"
+        )
+    start, early, early_sd = got
+    if gun.source == "inferred":
+        gun = GunEstimate(early, early_sd, "inferred", gun.boats_spread_s, gun.n_boats)
+    last_c = _item_centre(found, found.course[-1])
+    finish = finish_line(paths, ends, last_c, rounded[-1], speed)
+    if finish is None:
+        notes.append(
+            f"no finish line in the tracks (the boats do not stop together after the last "
+            f"mark): the course ends at {legs[-1][0]}; add the finish line by hand"
+        )
+    else:
+        legs.append(("finish", None))
+        rounded.append(finish.times)
+    for p, (nm, _) in enumerate(legs):
+        missing = sum(not math.isfinite(t) for t in rounded[p])
+        if missing:
+            notes.append(f"leg {p + 1} ({nm}): {missing} of {n} boats' roundings not found")
+    race_end = float(np.nanmax([e for e in ends if math.isfinite(e)] or [gun.t + 600.0]))
+    twd, how = _twd(tracks, frame, axis, gun.t, race_end, paths, [])
+    return InferredCourse(
+        frame=frame,
+        boats=tuple(p.name for p in paths),
+        marks=tuple(marks),
+        gates=tuple(gates),
+        start=start,
+        finish=finish,
+        legs=tuple(legs),
+        leg_roundings=tuple(rounded),
+        gun=gun,
+        axis_deg=axis,
+        twd_deg=twd,
+        twd_how=how,
+        speed_ms=speed,
+        eps_m=eps,
+        notes=tuple(notes),
+    )
+
+
+def summary(ic: InferredCourse) -> dict[str, Any]:
+    """The inferred course as a JSON-ready mapping (``docs/output-format.md``)."""
+
+    def pt(xy: tuple[float, float]) -> dict[str, float]:
+        lat, lon = ic.latlon(xy)
+        return {
+            "lat": round(lat, 9),
+            "lon": round(lon, 9),
+            "x_m": round(xy[0], 2),
+            "y_m": round(xy[1], 2),
+        }
+
+    def line(le: LineEstimate | None) -> dict[str, Any] | None:
+        if le is None:
+            return None
+        return {
+            "pin": pt(le.pin),
+            "committee": pt(le.committee),
+            "length_m": round(le.length_m, 1),
+            "depth_m": round(le.depth_m, 1),
+            "n_boats": le.n_boats,
+        }
+
+    return {
+        "boats": list(ic.boats),
+        "gun": {
+            "time": iso(ic.gun.t),
+            "source": ic.gun.source,
+            "sd_s": round(ic.gun.sd_s, 1),
+            "boats_spread_s": None
+            if not math.isfinite(ic.gun.boats_spread_s)
+            else round(ic.gun.boats_spread_s, 1),
+        },
+        "marks": [
+            {
+                "name": m.name,
+                "lat": round(m.lat, 9),
+                "lon": round(m.lon, 9),
+                "x_m": round(m.x, 2),
+                "y_m": round(m.y, 2),
+                "rounding": m.rounding,
+                "spread_m": round(m.spread_m, 1),
+                "n_roundings": m.n_roundings,
+                "n_boats": m.n_boats,
+                "gate": m.gate,
+            }
+            for m in ic.marks
+        ],
+        "gates": [{"name": g, "marks": [a, b]} for g, a, b in ic.gates],
+        "start": line(ic.start),
+        "finish": line(ic.finish),
+        "legs": [{"to": to, "rounding": r} for to, r in ic.legs],
+        "wind": {
+            "axis_deg": round(ic.axis_deg, 1),
+            "twd_deg": round(ic.twd_deg, 1),
+            "how": ic.twd_how,
+        },
+        "speed_ms": round(ic.speed_ms, 2),
+        "cluster_radius_m": round(ic.eps_m, 1),
+        "notes": list(ic.notes),
+    }
