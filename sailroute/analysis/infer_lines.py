@@ -1,31 +1,41 @@
 """The gun, the start line and the finish line, from where a fleet goes and stops.
 
-* **Gun** (:func:`infer_gun`): before the start a fleet waits behind the line, so the
-  median boat's distance to the first mark stays about level, and at the gun it starts
-  falling at the speed the fleet makes towards the mark.  The fleet's departure is the
+* **Departure** (:func:`infer_gun`): before the start a fleet waits behind the line, so
+  the median boat's distance to the first mark stays about level, and when the fleet
+  goes it falls at the speed the fleet makes towards the mark.  The departure is the
   knee of that median distance: the break of the continuous two-piece line fitted to it
   by least squares (a first fit over the whole window, then over ``±PRE_FIT_S`` about the
-  knee until it stays put).  The same fit about it on each boat's own distance gives
-  each boat's departure, and the gun is their median (with fewer than three boats, the
-  fleet's knee); its standard error is that of a median, from the boats' scatter.
-* **Start line** (:func:`start_line`): square to the way the fleet goes at the gun
-  (towards the first mark), or along the fleet's line-up at the gun when that is clearly
-  elongated (``ELONGATION`` or more, and within 30° of square); placed at the front of
-  the fleet at the gun (the ``LINE_QUANTILE`` of the boats' positions along the first
-  leg); its ends the outermost of the boats' crossings, ``LINE_END_M`` beyond.  The
-  committee boat is the right-hand end looking towards the first mark, the pin the
-  left.
+  knee until it stays put).  A place the fleet does not leave for (the median distance
+  falls slower than ``DEPART_SHARE`` of the fleet's speed after the knee, or changes at
+  more than half that rate before it) is not the first mark.
+* **Start line and gun** (:func:`start_line`): the line is square to the way the fleet
+  goes at the departure (towards the first mark), or along the fleet's line-up then when
+  that is clearly elongated (``ELONGATION`` or more, within 30° of square).  Lines of
+  that direction from ``LINE_BEHIND_M`` behind the rearmost boat to ``SCAN_AHEAD_S`` of
+  sailing ahead of the foremost, every ``SCAN_STEP_M``, are each crossed by every boat
+  (its last crossing before it rounds the first mark).  The fleet crosses the start line
+  together: among the lines whose crossings spread (interquartile range) within
+  ``TOGETHER_S`` or ``TOGETHER_SHARE`` of the tightest, the start line is the one where
+  the fleet speeds up most (its median speed across the lines, ``±CROSS_SPEED_S`` about
+  each crossing, ``JUMP_S`` of sailing after minus before): boats hold back or reach
+  along below the line and sail at full speed from the gun.  Its ends are the outermost
+  crossings, ``LINE_END_M`` beyond; the committee boat is the right-hand end looking
+  towards the first mark, the pin the left.  The gun is the fleet's early crossing (the
+  ``CROSS_QUANTILE`` of the crossings, the first with fewer than ten boats); its standard
+  error combines a bootstrap over the boats, the sampling interval and the time to sail
+  across the speed-up.
 * **Finish line** (:func:`finish_line`): a boat stops racing when it finishes; its race
-  ends at the last fix where it still sails at ``PACE_SHARE`` of its pace (the
-  ``PACE_QUANTILE`` of its speeds over ``SPEED_WINDOW_S``) and is slow from there to the
-  end of its track for ``FINISH_SLOW_S`` or more; a track that ends at speed ends its
-  race.  The finish line is square to the last leg (or along the finish points when
-  they are clearly elongated), just before the nearest boat's finish point so that every
-  boat crosses it, and as long as the spread of those points plus ``LINE_END_M`` at each
-  end.  Finish points further than ``FINISH_SPREAD_MAX`` median absolute deviations from
-  the median along the last leg are left out (a boat that retired or whose log stops
-  mid-leg), and when the rest lie more than ``FINISH_DEPTH_S`` of sailing deep there is
-  no line (the tracks end wherever: no finish in them).
+  ends where it starts to sail slower than ``PACE_SHARE`` of its pace (the
+  ``PACE_QUANTILE`` of its speeds over ``SPEED_WINDOW_S``) to the end of its track, for
+  ``FINISH_SLOW_S`` or more; a track that ends at speed ends its race.  The finish points
+  (where each boat slowed) further than ``FINISH_SPREAD_MAX`` median absolute deviations
+  from the median along the last leg are left out (a boat that retired, a log that stops
+  mid-leg); when the rest lie more than ``FINISH_DEPTH_S`` of sailing deep there is no
+  line (the tracks end wherever: no finish in them).  The line is square to the last leg
+  (or along the finish points when they are clearly elongated), at the line within
+  ``FINISH_SCAN_S`` of sailing before the first stop where the fleet's speed across it
+  drops most (by ``FINISH_DROP`` or more; else just before the first stop), and reaches
+  from the outermost crossing to the other, ``LINE_END_M`` beyond.
 """
 
 from __future__ import annotations
@@ -45,12 +55,16 @@ __all__ = [
     "BOOTSTRAP",
     "CROSS_QUANTILE",
     "CROSS_SHARE",
+    "CROSS_SPEED_S",
     "DEPART_SHARE",
     "ELONGATION",
     "FINISH_DEPTH_S",
+    "FINISH_DROP",
+    "FINISH_SCAN_S",
     "FINISH_SLOW_S",
     "FINISH_SPREAD_MAX",
     "GUN_EDGE_S",
+    "JUMP_S",
     "LINE_BEHIND_M",
     "LINE_END_M",
     "PACE_QUANTILE",
@@ -58,7 +72,10 @@ __all__ = [
     "PRE_FIT_S",
     "SCAN_AHEAD_S",
     "SCAN_STEP_M",
+    "SLOW_NOISE",
     "SPEED_WINDOW_S",
+    "TOGETHER_S",
+    "TOGETHER_SHARE",
     "GunEstimate",
     "LineEstimate",
     "finish_line",
@@ -98,27 +115,52 @@ SCAN_STEP_M: Final = 2.0
 BOOTSTRAP: Final = 200
 """Bootstrap draws of the gun's standard error."""
 
+TOGETHER_S: Final = 1.0
+"""Start line levels whose crossings spread less than this more than the tightest
+(interquartile range, the full range with fewer than four boats) are the fleet crossing
+together [s] ..."""
+
+TOGETHER_SHARE: Final = 0.25
+"""... or less than this share more."""
+
+CROSS_SPEED_S: Final = 3.0
+"""A boat's speed across a line is measured over this either side of its crossing [s]."""
+
+JUMP_S: Final = 2.0
+"""The fleet's speed-up at the line is measured over this much sailing either side of a
+level [s at the fleet's typical speed]."""
+
 CROSS_SHARE: Final = 0.8
 """A start line is crossed by this share of the fleet or more."""
 
 LINE_END_M: Final = 10.0
 """A line extends this far beyond the outermost crossing at each end [m]."""
 
-SPEED_WINDOW_S: Final = 10.0
+SPEED_WINDOW_S: Final = 20.0
 """Speeds that decide the finish are over this window [s]."""
 
 PACE_QUANTILE: Final = 75.0
 """A boat's pace is this percentile of its speeds after the gun."""
 
-PACE_SHARE: Final = 0.5
+PACE_SHARE: Final = 0.6
 """A boat below this share of its pace is not racing."""
 
 FINISH_SLOW_S: Final = 20.0
 """A boat slow for this long to the end of its track has finished [s]."""
 
+SLOW_NOISE: Final = 0.1
+"""... slow: all but this share of its fixes there (speed noise on a slow track)."""
+
 FINISH_SPREAD_MAX: Final = 4.0
 """Finish points more than this many (scaled) median absolute deviations from the
 median along the last leg are left out of the line."""
+
+FINISH_SCAN_S: Final = 30.0
+"""The finish line is searched over this much sailing before the first stop [s]."""
+
+FINISH_DROP: Final = 0.15
+"""... where the fleet's speed across it drops by this share or more (else at the first
+stop)."""
 
 FINISH_DEPTH_S: Final = 15.0
 """Finish points spread deeper than this much sailing at the fleet's speed (median
@@ -348,16 +390,51 @@ def _early(times: NDArray) -> float:
     return float(np.quantile(times, CROSS_QUANTILE)) if times.size >= 10 else float(times.min())
 
 
-def _last_crossings(t: NDArray, s: NDArray, levels: NDArray) -> NDArray[np.float64]:
-    """Time of the last forward crossing of each level by ``s(t)`` [epoch s] (NaN: none)."""
+def _crossings(
+    t: NDArray, s: NDArray, levels: NDArray, *, last: bool = True
+) -> NDArray[np.float64]:
+    """Time [epoch s] of the last (or first) forward crossing of each level by ``s(t)``
+    (NaN: none)."""
     if t.size < 2:
         return np.full(levels.size, np.nan)
     up = (s[None, :-1] < levels[:, None]) & (s[None, 1:] >= levels[:, None])
     has = up.any(axis=1)
-    k = up.shape[1] - 1 - np.argmax(up[:, ::-1], axis=1)
+    k = up.shape[1] - 1 - np.argmax(up[:, ::-1], axis=1) if last else np.argmax(up, axis=1)
+    dt = t[k + 1] - t[k]
     with np.errstate(divide="ignore", invalid="ignore"):
         f = (levels - s[k]) / (s[k + 1] - s[k])
-    return np.where(has, t[k] + f * (t[k + 1] - t[k]), np.nan)
+    return np.where(has, t[k] + f * dt, np.nan)
+
+
+def _scan(
+    paths: Sequence[BoatPath],
+    windows: Sequence[tuple[float, float]],
+    centre: NDArray,
+    normal: NDArray,
+    levels: NDArray,
+    *,
+    last: bool,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Each boat's crossing of each level in its window (boats x levels) [epoch s], and
+    the fleet's median speed across each level (over ``±CROSS_SPEED_S``) [m s⁻¹]."""
+    rows, speeds = [], []
+    for p, (lo, hi) in zip(paths, windows, strict=True):
+        m = (p.t >= lo) & (p.t <= hi)
+        s = (p.x[m] - centre[0]) * normal[0] + (p.y[m] - centre[1]) * normal[1]
+        c = _crossings(p.t[m], s, levels, last=last)
+        xa, ya = p.at(c - CROSS_SPEED_S)
+        xb, yb = p.at(c + CROSS_SPEED_S)
+        rows.append(c)
+        speeds.append(((xb - xa) * normal[0] + (yb - ya) * normal[1]) / (2.0 * CROSS_SPEED_S))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # levels nobody crosses
+        return np.vstack(rows), np.nanmedian(np.vstack(speeds), axis=0)
+
+
+def _jump(speed: NDArray, at: NDArray, j: int) -> NDArray[np.float64]:
+    """Speed ``j`` levels after minus ``j`` levels before each level in ``at``."""
+    sp = np.where(np.isfinite(speed), speed, 0.0)
+    return np.asarray(sp[np.minimum(at + j, sp.size - 1)] - sp[np.maximum(at - j, 0)], float)
 
 
 def start_line(
@@ -405,12 +482,14 @@ def start_line(
         float(s_ref.max()) + SCAN_AHEAD_S * speed_ms,
         SCAN_STEP_M,
     )
-    rows = []
-    for p, tv in zip(paths, first_visits, strict=True):
-        m = (p.t >= ref_t - PRE_FIT_S) & (p.t <= tv)
-        s = (p.x[m] - centre[0]) * normal[0] + (p.y[m] - centre[1]) * normal[1]
-        rows.append(_last_crossings(p.t[m], s, levels))
-    cross = np.vstack(rows)  # boats x levels
+    cross, speed = _scan(
+        paths,
+        [(ref_t - PRE_FIT_S, tv) for tv in first_visits],
+        centre,
+        normal,
+        levels,
+        last=True,
+    )
     n_cross = np.isfinite(cross).sum(axis=0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # levels nobody crosses
@@ -421,8 +500,12 @@ def start_line(
     spread = np.where(n_cross >= CROSS_SHARE * len(paths), spread, np.inf)
     if not np.isfinite(spread).any():
         return None
-    smooth = np.convolve(np.where(np.isfinite(spread), spread, 1e9), np.ones(5) / 5, mode="same")
-    k = int(np.argmin(np.where(np.isfinite(spread), smooth, np.inf)))
+    best = float(np.min(spread))
+    together = np.flatnonzero(spread <= best + max(TOGETHER_S, TOGETHER_SHARE * best))
+    # within those, where the fleet speeds up most: the release at the line
+    j = max(1, round(JUMP_S * speed_ms / SCAN_STEP_M))
+    jump = _jump(speed, together, j)
+    k = int(together[int(np.argmax(jump))])
     level = float(levels[k])
     times = cross[:, k]
     ok_t = times[np.isfinite(times)]
@@ -438,7 +521,8 @@ def start_line(
     rng = np.random.default_rng(0)
     boot = [_early(rng.choice(ok_t, ok_t.size)) for _ in range(BOOTSTRAP)]
     step = float(np.median([np.median(np.diff(p.t)) for p in paths if p.t.size > 1]))
-    sd = math.hypot(float(np.std(boot)), step)
+    across = j * SCAN_STEP_M / max(float(np.nan_to_num(speed[k])), 0.1)  # the jump's half-width
+    sd = math.sqrt(float(np.var(boot)) + step**2 + across**2)
     line = LineEstimate(
         (float(pin[0]), float(pin[1])),
         (float(com[0]), float(com[1])),
@@ -455,24 +539,34 @@ def race_ends(paths: Sequence[BoatPath], gun_t: float) -> tuple[list[float], lis
     Returns
     -------
     ends : list of float
-        The last fix at racing pace before a slow stretch to the end of the track, or the
+        The first fix from which the boat is slow to the end of its track (all but
+        ``SLOW_NOISE`` of the fixes there followed by ``SPEED_WINDOW_S`` below
+        ``PACE_SHARE`` of its pace), when that lasts ``FINISH_SLOW_S`` or more, else the
         track's end [epoch s] (NaN: no fix after the gun).
     pace : list of float
         The boat's pace [m s⁻¹] (NaN: no fix after the gun).
     """
     ends, paces = [], []
     for p in paths:
-        v = p.speed(SPEED_WINDOW_S)
         after = p.t >= gun_t
         if not after.any():
             ends.append(math.nan)
             paces.append(math.nan)
             continue
-        pace = float(np.percentile(v[after], PACE_QUANTILE))
-        fast = np.flatnonzero(after & (v >= PACE_SHARE * pace))
+        v = p.speed(SPEED_WINDOW_S)[after]
+        if not np.isfinite(v).any():
+            ends.append(float(p.t[-1]))
+            paces.append(math.nan)
+            continue
+        pace = float(np.nanpercentile(v, PACE_QUANTILE))
+        with np.errstate(invalid="ignore"):
+            fast = after & (p.speed(SPEED_WINDOW_S, ahead=True) >= PACE_SHARE * pace)
+        # from the first fix after which at most SLOW_NOISE of the fixes are fast
+        share = np.cumsum(fast[::-1])[::-1] / np.arange(fast.size, 0, -1)
+        slow = np.flatnonzero(after & (share <= SLOW_NOISE))
         end = float(p.t[-1])
-        if fast.size and p.t[-1] - p.t[fast[-1]] >= FINISH_SLOW_S:
-            end = float(p.t[fast[-1]])
+        if slow.size and p.t[-1] - p.t[slow[0]] >= FINISH_SLOW_S + SPEED_WINDOW_S:
+            end = float(p.t[slow[0]])
         ends.append(end)
         paces.append(pace)
     return ends, paces
@@ -509,7 +603,7 @@ def finish_line(
     for k, (p, e, tv) in enumerate(zip(paths, ends, last_visits, strict=True)):
         if not (math.isfinite(e) and math.isfinite(tv) and e > tv):
             continue
-        x, y = p.at(np.array([e]))
+        x, y = p.at(np.array([min(e + 0.5 * SPEED_WINDOW_S, float(p.t[-1]))]))
         if math.isfinite(float(x[0])):
             pts.append((float(x[0]), float(y[0])))
             rows.append(k)
@@ -527,17 +621,33 @@ def finish_line(
     along = _axis(xy, fwd)
     normal = np.array([-along[1], along[0]])
     centre = np.median(xy, axis=0)
-    level = float(np.min((xy - centre) @ normal)) - 1.0
-    w = (xy - centre) @ along
+    # before anyone stops, where the fleet slows most: the line (the first stop without)
+    stop = float(np.min((xy - centre) @ normal)) - 1.0
+    levels = np.arange(stop - FINISH_SCAN_S * speed_ms, stop + 0.5 * SCAN_STEP_M, SCAN_STEP_M)
+    windows = [
+        (tv, e + SPEED_WINDOW_S) if k in kept else (math.inf, -math.inf)
+        for k, (e, tv) in enumerate(zip(ends, last_visits, strict=True))
+    ]
+    cross, speed = _scan(paths, windows, centre, normal, levels, last=False)
+    ok = np.flatnonzero(np.isfinite(cross).sum(axis=0) >= CROSS_SHARE * len(kept))
+    j = max(1, round(JUMP_S * speed_ms / SCAN_STEP_M))
+    drop = -_jump(speed, ok, j) if ok.size else np.zeros(0)
+    k = int(ok[int(np.argmax(drop))]) if ok.size else levels.size - 1
+    if not (drop.size and drop.max() >= FINISH_DROP * float(np.nanmax(speed[ok]))):
+        k = levels.size - 1
+    level = float(levels[k])
+    got = [
+        _crossing(p, centre, normal, level, lo, hi, last=False)
+        for p, (lo, hi) in zip(paths, windows, strict=True)
+    ]
+    times = tuple(c[0] for c in got)
+    w = np.array([(np.array(c[1:]) - centre) @ along for c in got if math.isfinite(c[0])])
+    if w.size < 2:
+        return None
+    w = w[np.abs(w - np.median(w)) <= FINISH_SPREAD_MAX * max(_mad(w), 1.0)]
     base = centre + level * normal
     pin = base + (float(w.min()) - LINE_END_M) * along
     com = base + (float(w.max()) + LINE_END_M) * along
-    times = tuple(
-        _crossing(p, centre, normal, level, tv, e + FINISH_SLOW_S, last=False)[0]
-        if k in kept
-        else math.nan
-        for k, (p, e, tv) in enumerate(zip(paths, ends, last_visits, strict=True))
-    )
     return LineEstimate(
         (float(pin[0]), float(pin[1])),
         (float(com[0]), float(com[1])),

@@ -8,32 +8,45 @@ The steps (``docs/analysis.md``, "Marks from the fleet"):
    track and the turns between them), and the **wind axis** from the boards' courses
    (:func:`sailroute.analysis.infer_wind.wind_axis_deg`, weighted by their durations).
 2. **Roundings**: the turns that change the point of sail
-   (:func:`~sailroute.analysis.turns.is_rounding`) after which the boat sails on at
-   ``PACE_SHARE`` of its pace (a luff after the finish is not a rounding).
-3. **Clusters**: the roundings gathered by a density rule (DBSCAN, Ester et al. 1996,
+   (:func:`~sailroute.analysis.turns.is_rounding`).  A boat passes a mark outside its
+   turn, so each rounding puts the mark ``CLEAR_S`` of sailing inside its apex.
+3. **Clusters**: those points gathered by a density rule (DBSCAN, Ester et al. 1996,
    counting boats rather than points): two roundings the same way within ``eps`` are
    neighbours, a rounding with neighbours from ``MIN_SHARE`` of the fleet (and at least
    two boats) is a core, and the cores that are neighbours, with the roundings next to
    them, form one cluster.  ``eps`` is ``CLUSTER_S`` of sailing at the fleet's speed, at
-   least ``CLUSTER_MIN_M``.  Roundings of nobody's cluster (a boat's own detour) are left.
-4. **Gun** (given, or :func:`sailroute.analysis.infer_lines.infer_gun` towards the first
-   mark the fleet rounds), each boat's **end of racing**
-   (:func:`~sailroute.analysis.infer_lines.race_ends`), and steps 3-5 again on the
-   roundings between them.
-5. **Gates**: two clusters rounded opposite ways, less than ``GATE_S`` of sailing apart
-   (at least ``GATE_MIN_M``), that no boat rounds one right after the other, are the two
-   marks of one gate.
-6. **Sequence**: each boat's roundings in time order as a list of marks and gates; the
+   least ``CLUSTER_MIN_M``.  Two clusters rounded opposite ways within ``eps`` are one
+   mark (boats that turned the other way round it).  Roundings of nobody's cluster (a
+   boat's own detour) are left out.
+4. **Gates**: two clusters rounded opposite ways, less than ``GATE_S`` of sailing apart
+   (at least ``GATE_MIN_M``), rounded in the same minutes (the middle 80 % of their
+   roundings' times overlap) and that hardly a boat rounds one right after the other
+   (``GATE_BOTH``), are the two marks of one gate.
+5. **Sequence**: each boat's roundings in time order as a list of marks and gates; the
    course is the list among them with the most support (each item a boat's list shares
    counts +1/2, each it lacks −1/2: an item half the fleet misses does not count), and
-   every boat's roundings are aligned to it (longest common subsequence).
-7. **Marks**: a boat passes a mark outside its turn, so each rounding puts the mark
-   ``CLEAR_S`` of sailing inside its apex; the mark is the median of those points and its
-   **spread** the median distance of them from it.  A mark at two places in the race (moved
-   between laps) is two clusters and two marks.
-8. **Start and finish lines** (:mod:`sailroute.analysis.infer_lines`), and the wind: its
-   axis from step 1, the end it blows from by :func:`~sailroute.analysis.infer_wind.infer_wind`
-   over the race (the slower boards when that fails).
+   every boat's roundings are aligned to it (longest common subsequence).  A gate mark
+   most of the fleet leaves alone may be rounded by fewer boats than a cluster needs:
+   among the roundings left over, a group of ``GATE_SHARE`` of the fleet (two boats at
+   least) is the partner of a mark of the course rounded the other way, more than
+   ``eps`` and less than the gate distance away, when ``GATE_FILL`` of its boats or more
+   round it where they miss that mark (between their roundings of the marks before and
+   after it), and is nothing else.
+6. **Start and gun**: steps 2-5 on every turn give the first mark; the fleet's
+   departure towards it, the start line it crosses together and the gun
+   (:func:`~sailroute.analysis.infer_lines.infer_gun`,
+   :func:`~sailroute.analysis.infer_lines.start_line`; a given gun places the line
+   only).  Each boat's race runs from its start crossing to its **end of racing**
+   (:func:`~sailroute.analysis.infer_lines.race_ends`), and steps 2-5 again on the turns
+   in it give the course: pre-start manoeuvres, returns of boats over early and luffs
+   after the finish are left out.
+7. **Marks**: the median of a cluster's points; its **spread** the median distance of
+   them from it.  A mark at two places in the race (moved between laps) is two clusters
+   and two marks.
+8. **Finish line** (:func:`~sailroute.analysis.infer_lines.finish_line`), and the wind:
+   its axis from step 1, the direction it blows from
+   (:func:`~sailroute.analysis.infer_wind.infer_wind` over the race, within
+   ``TWD_AXIS_DEG`` of the axis; else the end the slower boards sail towards).
 """
 
 from __future__ import annotations
@@ -70,14 +83,17 @@ from sailroute.track.model import Track
 from sailroute.units import circular_mean_deg, wrap180, wrap360
 
 __all__ = [
-    "AFTER_S",
     "CLEAR_S",
     "CLUSTER_MIN_M",
     "CLUSTER_S",
+    "GATE_BOTH",
+    "GATE_FILL",
     "GATE_MIN_M",
     "GATE_S",
+    "GATE_SHARE",
     "MAX_APART_M",
     "MIN_SHARE",
+    "TWD_AXIS_DEG",
     "InferredCourse",
     "InferredMark",
     "infer_course",
@@ -98,12 +114,24 @@ GATE_S: Final = 20.0
 GATE_MIN_M: Final = 150.0
 """... or less than this [m]."""
 
+GATE_BOTH: Final = 0.1
+"""At most this share of the boats that round the less rounded of two gate marks round
+both, one right after the other (a gate is passed round one of its marks)."""
+
+GATE_FILL: Final = 0.5
+"""... when this share of its boats or more round it where they miss that mark."""
+
+GATE_SHARE: Final = 0.05
+"""A gate's second mark may be rounded by as few as this share of the fleet (and two
+boats)."""
+
 CLEAR_S: Final = 1.0
 """A boat rounds a mark about this much sailing outside it [s] (4 m for a dinghy at 8 kn,
 15 m for a foiling catamaran at 30 kn)."""
 
-AFTER_S: Final = 10.0
-"""A rounding is followed by this long at racing pace [s] (from 2 s after the apex)."""
+
+TWD_AXIS_DEG: Final = 30.0
+"""The wind inferred from the tracks is used within this of the boards' axis [°]."""
 
 MAX_APART_M: Final = 20_000.0
 """Tracks whose middles lie further apart than this are of different races [m]."""
@@ -288,7 +316,6 @@ def _roundings(
     paths: Sequence[BoatPath],
     turns: Sequence[Sequence[Turn]],
     axis: float,
-    paces: Sequence[float],
     clear_m: float,
     windows: Sequence[tuple[float, float]],
 ) -> list[_Rounding]:
@@ -374,16 +401,21 @@ def _gate_pairs(
 ) -> dict[int, int]:
     """Cluster -> the item it counts as (a gate's second mark -> its first)."""
     k = centres.shape[0]
+    when = [
+        np.percentile([rs[int(i)].turn.t for i in np.flatnonzero(label == c)], [10, 90])
+        for c in range(k)
+    ]
     pairs = []
     for a in range(k):
         for b in range(a + 1, k):
-            if sides[a] == sides[b]:
+            if sides[a] == sides[b] or when[a][1] < when[b][0] or when[b][1] < when[a][0]:
                 continue
             dist = math.hypot(*(centres[a] - centres[b]))
             if dist > gate_max:
                 continue
             both = sum(any({s[i], s[i + 1]} == {a, b} for i in range(len(s) - 1)) for s in seqs)
-            if both <= 0.1 * len(seqs):
+            fewer = min(sum(a in s for s in seqs), sum(b in s for s in seqs))
+            if both <= GATE_BOTH * fewer:
                 pairs.append((dist, a, b))
     item = {c: c for c in range(k)}
     taken: set[int] = set()
@@ -425,24 +457,104 @@ class _Found:
     aligned: list[list[int | None]]  # per course position, per boat: rounding index
 
 
-def _find(rs: list[_Rounding], n_boats: int, eps: float, min_boats: int, gate_max: float) -> _Found:
-    label = _clusters(rs, eps, min_boats)
-    k = int(label.max()) + 1 if label.size else 0
-    centres = np.array(
-        [np.median([rs[i].est for i in np.flatnonzero(label == c)], axis=0) for c in range(k)]
-    ).reshape(k, 2)
-    sides = [
-        bool(np.mean([rs[i].turn.turn_deg < 0 for i in np.flatnonzero(label == c)]) > 0.5)
-        for c in range(k)
-    ]
-    plain = _sequences(rs, label, n_boats, {c: c for c in range(k)})
-    item = _gate_pairs(rs, label, centres, sides, [[c for c, _ in s] for s in plain], gate_max)
+def _centres_sides(
+    rs: Sequence[_Rounding], label: NDArray[np.int64], k: int
+) -> tuple[NDArray, list[bool]]:
+    """Each cluster's median estimate [m] and whether most of it is rounded to port."""
+    members = [np.flatnonzero(label == c).tolist() for c in range(k)]
+    centres = np.array([np.median([rs[i].est for i in m], axis=0) for m in members])
+    sides = [bool(np.mean([rs[i].turn.turn_deg < 0 for i in m]) > 0.5) for m in members]
+    return centres.reshape(k, 2), sides
+
+
+def _aligned(
+    rs: Sequence[_Rounding], label: NDArray[np.int64], n_boats: int, item: dict[int, int]
+) -> tuple[list[int], list[list[int | None]]]:
+    """The course (items) and, per position and boat, the rounding aligned to it."""
     seqs = _sequences(rs, label, n_boats, item)
     course = _consensus([[c for c, _ in s] for s in seqs])
     aligned: list[list[int | None]] = [[None] * n_boats for _ in course]
     for b, s in enumerate(seqs):
         for p, q in _lcs(course, [c for c, _ in s]):
             aligned[p][b] = s[q][1]
+    return course, aligned
+
+
+def _fills(
+    rs: Sequence[_Rounding],
+    members: NDArray,
+    course: Sequence[int],
+    aligned: Sequence[Sequence[int | None]],
+    p: int,
+) -> int:
+    """Boats missing at course position ``p`` that round the cluster ``members`` between
+    their roundings of the positions before and after it."""
+    n = len(aligned[p])
+    out = set()
+    for b in range(n):
+        if aligned[p][b] is not None:
+            continue
+        prev = aligned[p - 1][b] if p > 0 else None
+        nxt = aligned[p + 1][b] if p + 1 < len(course) else None
+        lo = rs[prev].turn.t if prev is not None else -math.inf
+        hi = rs[nxt].turn.t if nxt is not None else math.inf
+        if any(rs[i].boat == b and lo < rs[i].turn.t < hi for i in members):
+            out.add(b)
+    return len(out)
+
+
+def _merge_near(rs: Sequence[_Rounding], label: NDArray[np.int64], eps: float) -> NDArray[np.int64]:
+    """``label`` with clusters rounded opposite ways whose centres lie within ``eps`` as
+    one (boats that went round the same mark turning the other way)."""
+    k = int(label.max()) + 1 if label.size else 0
+    centres, _ = _centres_sides(rs, label, k)
+    target = list(range(k))
+    for a in range(k):
+        for b in range(a + 1, k):
+            if math.hypot(*(centres[a] - centres[b])) <= eps:
+                target[b] = target[a]
+    used = sorted(set(target))
+    remap = np.array([used.index(target[c]) for c in range(k)] + [-1], dtype=np.int64)
+    return remap[label]
+
+
+def _find(rs: list[_Rounding], n_boats: int, eps: float, min_boats: int, gate_max: float) -> _Found:
+    label = _merge_near(rs, _clusters(rs, eps, min_boats), eps)
+    k = int(label.max()) + 1 if label.size else 0
+    centres, sides = _centres_sides(rs, label, k)
+    plain = _sequences(rs, label, n_boats, {c: c for c in range(k)})
+    item = _gate_pairs(rs, label, centres, sides, [[c for c, _ in s] for s in plain], gate_max)
+    course, aligned = _aligned(rs, label, n_boats, item)
+    # a gate's mark the fleet mostly leaves alone: a group of fewer boats among the rest
+    # that rounds it instead of a mark of the course, at its place in the course
+    rest = np.flatnonzero(label < 0)
+    minor = _clusters([rs[i] for i in rest], eps, max(2, math.ceil(GATE_SHARE * n_boats)))
+    singles = {c for c in set(course) if list(item.values()).count(c) == 1}
+    found = False
+    for m in range(int(minor.max()) + 1 if minor.size else 0):
+        members = rest[minor == m]
+        centre = np.median([rs[i].est for i in members], axis=0)
+        port = bool(np.mean([rs[i].turn.turn_deg < 0 for i in members]) > 0.5)
+        boats = len({rs[i].boat for i in members})
+        best = None
+        for p, c in enumerate(course):
+            if c not in singles or sides[c] == port:
+                continue
+            if not eps < math.hypot(*(centre - centres[c])) <= gate_max:
+                continue
+            n_fill = _fills(rs, members, course, aligned, p)
+            if n_fill >= max(2, GATE_FILL * boats) and (best is None or n_fill > best[0]):
+                best = (n_fill, c)
+        if best is not None:
+            label[members] = k
+            item[k] = best[1]
+            singles.discard(best[1])
+            centres = np.vstack([centres, centre])
+            sides.append(port)
+            k += 1
+            found = True
+    if found:
+        course, aligned = _aligned(rs, label, n_boats, item)
     return _Found(rs, label, centres, sides, item, course, aligned)
 
 
@@ -454,39 +566,40 @@ def _twd(
     gun: float,
     end: float,
     paths: Sequence[BoatPath],
-    turns: Sequence[Sequence[Turn]],
 ) -> tuple[float, str]:
-    """The wind's direction [°, from] and how its end was decided."""
+    """The wind's direction over the race [°, from] and where it comes from: the mean of
+    the wind inferred from the tracks when that lies within ``TWD_AXIS_DEG`` of the axis,
+    else the end of the axis the slower boards sail towards."""
     from sailroute.analysis.infer_wind import infer_wind
 
     try:
         iw = infer_wind(list(tracks), frame, t0=gun, t1=end)
         ok = np.isfinite(iw.twd_deg)
-        if ok.any():
-            twd = circular_mean_deg(iw.twd_deg[ok])
-            off = abs(float(wrap180(twd - axis)))
-            end_deg = axis if off <= 90.0 else (axis + 180.0) % 360.0
-            return (
-                end_deg,
-                f"the end of the axis the wind inferred from the tracks blows from ({twd:.0f}°)",
-            )
+        twd = circular_mean_deg(iw.twd_deg[ok]) if ok.any() else math.nan
     except InputError as exc:
         why = str(exc)
     else:
-        why = "no direction inferred"
+        off = abs(float(wrap180(twd - axis))) if math.isfinite(twd) else math.nan
+        if min(off, 180.0 - off) <= TWD_AXIS_DEG:
+            return twd, "the mean of the wind inferred from the tracks"
+        why = (
+            "no direction inferred"
+            if not math.isfinite(twd)
+            else f"the wind inferred from the tracks, {twd:.0f}°, lies off the boards' axis"
+        )
     # the slower boards are the upwind ones
     speeds: dict[int, list[float]] = {0: [], 1: []}
     for p in paths:
         v = p.speed(10.0)
         c = np.degrees(np.arctan2(np.gradient(p.x), np.gradient(p.y)))
         for end_i, e in enumerate((axis, axis + 180.0)):
-            m = np.abs(wrap180(c - e)) < 60.0
+            m = (np.abs(wrap180(c - e)) < 60.0) & np.isfinite(v)
             if m.any():
                 speeds[end_i].append(float(np.median(v[m])))
     s0 = float(np.median(speeds[0])) if speeds[0] else math.inf
     s1 = float(np.median(speeds[1])) if speeds[1] else math.inf
     twd = axis if s0 <= s1 else (axis + 180.0) % 360.0
-    return float(wrap360(twd)), f"the end the slower boards sail towards ({why})"
+    return float(wrap360(twd)), f"the end of the boards' axis the slower boards sail to ({why})"
 
 
 # ------------------------------------------------------------------------------ main
@@ -545,8 +658,7 @@ def infer_course(
     turns, axis = _turns(paths, eps_dp)
     t0 = max(float(np.median([p.t[0] for p in paths])), -1e18)
     t_gun_lo = gun_t if gun_t is not None else -math.inf
-    _, paces0 = race_ends(paths, t0)
-    pre = _roundings(paths, turns, axis, paces0, clear, [(t_gun_lo, math.inf)] * n)
+    pre = _roundings(paths, turns, axis, clear, [(t_gun_lo, math.inf)] * n)
     if not pre:
         raise InputError(
             "course infer: no mark roundings in the tracks (no turn that changes the point "
@@ -558,37 +670,55 @@ def infer_course(
             f"course infer: the boats' roundings fall together nowhere (no place rounded by "
             f"{min_boats} boats or more within {eps:.0f} m); expected tracks of one race"
         )
-    # the gun: the fleet's departure towards the first item it rounds that it leaves for
-    if gun_t is None:
-        gun = None
-        for p, it in enumerate(found.course):
-            tv = [found.rs[i].turn.t for i in found.aligned[p] if i is not None]
-            gun = infer_gun(paths, _item_centre(found, it), t0, float(np.median(tv)), speed)
-            if gun is not None:
-                break
-        if gun is None:
-            raise InputError(
-                "course infer: no gun found (no moment when the fleet leaves together for "
-                "a mark it then rounds); give it with --start-time (ISO 8601 with offset)"
-            )
-    else:
-        gun = GunEstimate(float(gun_t), 0.0, "given")
-    ends, paces = race_ends(paths, gun.t)
-    rs = _roundings(
+    # the fleet's departure towards the first item it rounds that it leaves for
+    dep = None
+    for p, it in enumerate(found.course):
+        tv = [found.rs[i].turn.t for i in found.aligned[p] if i is not None]
+        first = p, it
+        dep = infer_gun(paths, _item_centre(found, it), t0, float(np.median(tv)), speed)
+        if dep is not None or gun_t is not None:
+            break
+    if dep is None and gun_t is None:
+        raise InputError(
+            "course infer: no gun found (no moment when the fleet leaves together for "
+            "a mark it then rounds); give it with --start-time (ISO 8601 with offset)"
+        )
+    # the start line it crosses together, and the gun
+    p1, it1 = first
+    rounded = [found.rs[i].turn.t if i is not None else math.nan for i in found.aligned[p1]]
+    median_first = float(np.nanmedian(rounded))
+    got = start_line(
         paths,
-        turns,
-        axis,
-        paces,
-        clear,
-        [(gun.t, e if math.isfinite(e) else -math.inf) for e in ends],
+        float(gun_t) if gun_t is not None else dep.t,  # type: ignore[union-attr]
+        _item_centre(found, it1),
+        [t if math.isfinite(t) else median_first for t in rounded],
+        speed,
     )
+    if got is None:
+        raise InputError(
+            "course infer: no start line that the fleet crosses together; give the gun with "
+            "--start-time, or tracks that cover the start"
+        )
+    start, early, early_sd = got
+    if gun_t is not None:
+        gun = GunEstimate(float(gun_t), 0.0, "given")
+    else:
+        assert dep is not None
+        gun = GunEstimate(early, early_sd, "inferred", dep.boats_spread_s, dep.n_boats)
+    # the race: each boat from its start (the gun when none is found) to its end
+    ends, _ = race_ends(paths, gun.t)
+    windows = [
+        (st if math.isfinite(st) else gun.t, e if math.isfinite(e) else -math.inf)
+        for st, e in zip(start.times, ends, strict=True)
+    ]
+    rs = _roundings(paths, turns, axis, clear, windows)
     found = _find(rs, n, eps, min_boats, gate_max)
     if not found.course:
         raise InputError(
             f"course infer: after the gun ({iso(gun.t)}) the boats' roundings fall together "
             "nowhere; check --start-time"
         )
-    return _assemble(cut, paths, frame, found, gun, ends, axis, speed, eps, notes)
+    return _assemble(cut, paths, frame, found, gun, start, ends, axis, speed, eps, notes)
 
 
 def _item_centre(found: _Found, it: int) -> tuple[float, float]:
@@ -604,6 +734,7 @@ def _assemble(
     frame: LocalFrame,
     found: _Found,
     gun: GunEstimate,
+    start: LineEstimate,
     ends: Sequence[float],
     axis: float,
     speed: float,
@@ -664,18 +795,6 @@ def _assemble(
         nm = names[it]
         legs.append((nm, None if nm.startswith("G") else by_name[nm].rounding))
         rounded.append(tuple(rs[i].turn.t if i is not None else math.nan for i in found.aligned[p]))
-    first_c = _item_centre(found, found.course[0])
-    median_first = float(np.nanmedian(rounded[0]))
-    first_t = [t if math.isfinite(t) else median_first for t in rounded[0]]
-    got = start_line(paths, gun.t, first_c, first_t, speed)
-    if got is None:
-        raise InputError(
-            f"course infer: no start line the fleet crosses together near {iso(gun.t)}; "
-            "give the gun with --start-time or tracks that cover the start"
-        )
-    start, early, early_sd = got
-    if gun.source == "inferred":
-        gun = GunEstimate(early, early_sd, "inferred", gun.boats_spread_s, gun.n_boats)
     last_c = _item_centre(found, found.course[-1])
     finish = finish_line(paths, ends, last_c, rounded[-1], speed)
     if finish is None:
@@ -691,7 +810,7 @@ def _assemble(
         if missing:
             notes.append(f"leg {p + 1} ({nm}): {missing} of {n} boats' roundings not found")
     race_end = float(np.nanmax([e for e in ends if math.isfinite(e)] or [gun.t + 600.0]))
-    twd, how = _twd(tracks, frame, axis, gun.t, race_end, paths, [])
+    twd, how = _twd(tracks, frame, axis, gun.t, race_end, paths)
     return InferredCourse(
         frame=frame,
         boats=tuple(p.name for p in paths),

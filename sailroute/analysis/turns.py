@@ -135,15 +135,18 @@ class BoatPath:
             bad |= (self.t[k] - self.t[k - 1]) > self.gap_s
         return np.where(bad, np.nan, x), np.where(bad, np.nan, y)
 
-    def speed(self, window_s: float) -> NDArray[np.float64]:
-        """Speed over ground over ``±window_s / 2`` about each fix [m s⁻¹]."""
+    def speed(self, window_s: float, *, ahead: bool = False) -> NDArray[np.float64]:
+        """Speed over ground over ``±window_s / 2`` about each fix, or over the
+        ``window_s`` after it (``ahead``) [m s⁻¹]; NaN where the fixes in the window span
+        less than half of it (the ends of the track)."""
         t = self.t
-        lo = np.searchsorted(t, t - 0.5 * window_s, side="left")
-        hi = np.searchsorted(t, t + 0.5 * window_s, side="right") - 1
+        a, b = (0.0, window_s) if ahead else (-0.5 * window_s, 0.5 * window_s)
+        lo = np.searchsorted(t, t + a, side="left")
+        hi = np.searchsorted(t, t + b, side="right") - 1
         dt = t[hi] - t[lo]
         d = np.hypot(self.x[hi] - self.x[lo], self.y[hi] - self.y[lo])
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(dt > 0, d / np.where(dt > 0, dt, 1.0), 0.0)
+            return np.where(dt >= 0.5 * window_s, d / np.where(dt > 0, dt, 1.0), np.nan)
 
 
 @dataclass(frozen=True)
