@@ -14,16 +14,18 @@
   that direction from ``LINE_BEHIND_M`` behind the rearmost boat to ``SCAN_AHEAD_S`` of
   sailing ahead of the foremost, every ``SCAN_STEP_M``, are each crossed by every boat
   (its last crossing before it rounds the first mark).  The fleet crosses the start line
-  together: among the lines whose crossings spread (interquartile range) within
-  ``TOGETHER_S`` or ``TOGETHER_SHARE`` of the tightest, the start line is the one where
+  together: among the lines whose crossings spread (interquartile range, its running
+  median over the speed-up's width below) within ``TOGETHER_S`` or ``TOGETHER_SHARE`` of
+  the tightest, the start line is the one where
   the fleet speeds up most (its median speed across the lines, ``±CROSS_SPEED_S`` about
-  each crossing, ``JUMP_S`` of sailing after minus before): boats hold back or reach
-  along below the line and sail at full speed from the gun.  Its ends are the outermost
+  each crossing, ``JUMP_S`` of sailing after minus before): boats hold back or reach along
+  below the line and sail at full speed from the gun.  Its ends are the outermost
   crossings, ``LINE_END_M`` beyond; the committee boat is the right-hand end looking
   towards the first mark, the pin the left.  The gun is the fleet's early crossing (the
   ``CROSS_QUANTILE`` of the crossings, the first with fewer than ten boats); its standard
-  error combines a bootstrap over the boats, the sampling interval and the time to sail
-  across the speed-up.
+  error combines a bootstrap over the boats, the sampling interval, the time to sail
+  across the speed-up and half the spread of the guns of the rival lines (those scoring
+  ``RIVAL_SHARE`` of the best or more).
 * **Finish line** (:func:`finish_line`): a boat stops racing when it finishes; its race
   ends where it starts to sail slower than ``PACE_SHARE`` of its pace (the
   ``PACE_QUANTILE`` of its speeds over ``SPEED_WINDOW_S``) to the end of its track, for
@@ -70,6 +72,7 @@ __all__ = [
     "PACE_QUANTILE",
     "PACE_SHARE",
     "PRE_FIT_S",
+    "RIVAL_SHARE",
     "SCAN_AHEAD_S",
     "SCAN_STEP_M",
     "SLOW_NOISE",
@@ -122,6 +125,10 @@ together [s] ..."""
 
 TOGETHER_SHARE: Final = 0.25
 """... or less than this share more."""
+
+RIVAL_SHARE: Final = 0.5
+"""Start lines whose speed-up scores this share of the best's or more make the gun
+uncertain by half the spread of their early crossings."""
 
 CROSS_SPEED_S: Final = 3.0
 """A boat's speed across a line is measured over this either side of its crossing [s]."""
@@ -500,12 +507,20 @@ def start_line(
     spread = np.where(n_cross >= CROSS_SHARE * len(paths), spread, np.inf)
     if not np.isfinite(spread).any():
         return None
+    j = max(1, round(JUMP_S * speed_ms / SCAN_STEP_M))
+    # the spread's running median over the jump's width: one line's lucky spread is noise
+    pad = np.pad(spread, j, mode="edge")
+    spread = np.median(np.lib.stride_tricks.sliding_window_view(pad, 2 * j + 1), axis=1)
     best = float(np.min(spread))
     together = np.flatnonzero(spread <= best + max(TOGETHER_S, TOGETHER_SHARE * best))
-    # within those, where the fleet speeds up most: the release at the line
-    j = max(1, round(JUMP_S * speed_ms / SCAN_STEP_M))
-    jump = _jump(speed, together, j)
-    k = int(together[int(np.argmax(jump))])
+    # within those, where the fleet speeds up most: the release at the gun
+    score = _jump(speed, together, j)
+    k = int(together[int(np.argmax(score))])
+    # the lines nearly as good: how far the gun may be off
+    rivals = together[score >= RIVAL_SHARE * float(np.max(score))]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        rival_t = [_early(cross[:, r][np.isfinite(cross[:, r])]) for r in rivals]
     level = float(levels[k])
     times = cross[:, k]
     ok_t = times[np.isfinite(times)]
@@ -522,7 +537,8 @@ def start_line(
     boot = [_early(rng.choice(ok_t, ok_t.size)) for _ in range(BOOTSTRAP)]
     step = float(np.median([np.median(np.diff(p.t)) for p in paths if p.t.size > 1]))
     across = j * SCAN_STEP_M / max(float(np.nan_to_num(speed[k])), 0.1)  # the jump's half-width
-    sd = math.sqrt(float(np.var(boot)) + step**2 + across**2)
+    ambiguity = 0.5 * (max(rival_t) - min(rival_t))
+    sd = math.sqrt(float(np.var(boot)) + step**2 + across**2 + ambiguity**2)
     line = LineEstimate(
         (float(pin[0]), float(pin[1])),
         (float(com[0]), float(com[1])),

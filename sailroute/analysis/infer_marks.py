@@ -18,14 +18,15 @@ The steps (``docs/analysis.md``, "Marks from the fleet"):
    least ``CLUSTER_MIN_M``.  Two clusters rounded opposite ways within ``eps`` are one
    mark (boats that turned the other way round it).  Roundings of nobody's cluster (a
    boat's own detour) are left out.
-4. **Gates**: two clusters rounded opposite ways, less than ``GATE_S`` of sailing apart
-   (at least ``GATE_MIN_M``), rounded in the same minutes (the middle 80 % of their
-   roundings' times overlap) and that hardly a boat rounds one right after the other
-   (``GATE_BOTH``), are the two marks of one gate.
-5. **Sequence**: each boat's roundings in time order as a list of marks and gates; the
+4. **Sequence**: each boat's roundings in time order as a list of marks and gates; the
    course is the list among them with the most support (each item a boat's list shares
    counts +1/2, each it lacks −1/2: an item half the fleet misses does not count), and
-   every boat's roundings are aligned to it (longest common subsequence).  A gate mark
+   every boat's roundings are aligned to it (longest common subsequence).
+5. **Gates**: two clusters rounded opposite ways, less than ``GATE_S`` of sailing apart
+   (at least ``GATE_MIN_M``), that hardly a boat rounds one right after the other
+   (``GATE_BOTH``), are the two marks of one gate when the course counted with them as
+   one item has more support than without (the boats round one or the other at the same
+   places in the course); the nearest pairs first.  A gate mark
    most of the fleet leaves alone may be rounded by fewer boats than a cluster needs:
    among the roundings left over, a group of ``GATE_SHARE`` of the fleet (two boats at
    least) is the partner of a mark of the course rounded the other way, more than
@@ -86,6 +87,7 @@ __all__ = [
     "CLEAR_S",
     "CLUSTER_MIN_M",
     "CLUSTER_S",
+    "FIRST_LEG_S",
     "GATE_BOTH",
     "GATE_FILL",
     "GATE_MIN_M",
@@ -129,6 +131,10 @@ CLEAR_S: Final = 1.0
 """A boat rounds a mark about this much sailing outside it [s] (4 m for a dinghy at 8 kn,
 15 m for a foiling catamaran at 30 kn)."""
 
+
+FIRST_LEG_S: Final = 15.0
+"""The fleet crosses the start line at least this long before it rounds the first mark
+(the median boat) [s]."""
 
 TWD_AXIS_DEG: Final = 30.0
 """The wind inferred from the tracks is used within this of the boards' axis [°]."""
@@ -380,15 +386,16 @@ def _lcs(a: Sequence[int], b: Sequence[int]) -> list[tuple[int, int]]:
     return out
 
 
-def _consensus(seqs: Sequence[Sequence[int]]) -> list[int]:
-    """The boat's list with the most support (step 6 of the module notes)."""
+def _consensus(seqs: Sequence[Sequence[int]]) -> tuple[list[int], float]:
+    """The boats' list with the most support, and its support (step 5 of the module
+    notes)."""
     best: list[int] = []
     best_score = -math.inf
     for cand in sorted({tuple(s) for s in seqs if s}, key=lambda s: (-len(s), s)):
         score = sum(len(_lcs(cand, s)) - 0.5 * len(cand) for s in seqs)
         if score > best_score:
             best, best_score = list(cand), score
-    return best
+    return best, best_score
 
 
 def _gate_pairs(
@@ -396,34 +403,37 @@ def _gate_pairs(
     label: NDArray[np.int64],
     centres: NDArray,
     sides: Sequence[bool],
-    seqs: Sequence[Sequence[int]],
+    n_boats: int,
     gate_max: float,
 ) -> dict[int, int]:
     """Cluster -> the item it counts as (a gate's second mark -> its first)."""
     k = centres.shape[0]
-    when = [
-        np.percentile([rs[int(i)].turn.t for i in np.flatnonzero(label == c)], [10, 90])
-        for c in range(k)
-    ]
+    item = {c: c for c in range(k)}
+
+    def lists(it: dict[int, int]) -> list[list[int]]:
+        return [[c for c, _ in s] for s in _sequences(rs, label, n_boats, it)]
+
+    seqs = lists(item)
     pairs = []
     for a in range(k):
         for b in range(a + 1, k):
-            if sides[a] == sides[b] or when[a][1] < when[b][0] or when[b][1] < when[a][0]:
-                continue
             dist = math.hypot(*(centres[a] - centres[b]))
-            if dist > gate_max:
+            if sides[a] == sides[b] or dist > gate_max:
                 continue
             both = sum(any({s[i], s[i + 1]} == {a, b} for i in range(len(s) - 1)) for s in seqs)
             fewer = min(sum(a in s for s in seqs), sum(b in s for s in seqs))
             if both <= GATE_BOTH * fewer:
                 pairs.append((dist, a, b))
-    item = {c: c for c in range(k)}
+    score = _consensus(seqs)[1]
     taken: set[int] = set()
     for _, a, b in sorted(pairs):
         if a in taken or b in taken:
             continue
-        taken |= {a, b}
-        item[b] = a
+        trial = {**item, b: a}
+        merged = _consensus(lists(trial))[1]
+        if merged > score:
+            item, score = trial, merged
+            taken |= {a, b}
     return item
 
 
@@ -472,7 +482,7 @@ def _aligned(
 ) -> tuple[list[int], list[list[int | None]]]:
     """The course (items) and, per position and boat, the rounding aligned to it."""
     seqs = _sequences(rs, label, n_boats, item)
-    course = _consensus([[c for c, _ in s] for s in seqs])
+    course, _ = _consensus([[c for c, _ in s] for s in seqs])
     aligned: list[list[int | None]] = [[None] * n_boats for _ in course]
     for b, s in enumerate(seqs):
         for p, q in _lcs(course, [c for c, _ in s]):
@@ -522,8 +532,7 @@ def _find(rs: list[_Rounding], n_boats: int, eps: float, min_boats: int, gate_ma
     label = _merge_near(rs, _clusters(rs, eps, min_boats), eps)
     k = int(label.max()) + 1 if label.size else 0
     centres, sides = _centres_sides(rs, label, k)
-    plain = _sequences(rs, label, n_boats, {c: c for c in range(k)})
-    item = _gate_pairs(rs, label, centres, sides, [[c for c, _ in s] for s in plain], gate_max)
+    item = _gate_pairs(rs, label, centres, sides, n_boats, gate_max)
     course, aligned = _aligned(rs, label, n_boats, item)
     # a gate's mark the fleet mostly leaves alone: a group of fewer boats among the rest
     # that rounds it instead of a mark of the course, at its place in the course
@@ -670,41 +679,16 @@ def infer_course(
             f"course infer: the boats' roundings fall together nowhere (no place rounded by "
             f"{min_boats} boats or more within {eps:.0f} m); expected tracks of one race"
         )
-    # the fleet's departure towards the first item it rounds that it leaves for
-    dep = None
-    for p, it in enumerate(found.course):
-        tv = [found.rs[i].turn.t for i in found.aligned[p] if i is not None]
-        first = p, it
-        dep = infer_gun(paths, _item_centre(found, it), t0, float(np.median(tv)), speed)
-        if dep is not None or gun_t is not None:
-            break
-    if dep is None and gun_t is None:
+    # the first mark: the first item the fleet leaves for together, crossing a start line
+    # together on the way (a place the fleet turns at before the start is none)
+    start_at = _first_mark(found, paths, t0, speed, gun_t)
+    if start_at is None:
         raise InputError(
-            "course infer: no gun found (no moment when the fleet leaves together for "
-            "a mark it then rounds); give it with --start-time (ISO 8601 with offset)"
+            "course infer: no start found (no moment when the fleet leaves together for a "
+            "mark it then rounds, crossing a line together on the way); give the gun with "
+            "--start-time (ISO 8601 with offset), or tracks that cover the start"
         )
-    # the start line it crosses together, and the gun
-    p1, it1 = first
-    rounded = [found.rs[i].turn.t if i is not None else math.nan for i in found.aligned[p1]]
-    median_first = float(np.nanmedian(rounded))
-    got = start_line(
-        paths,
-        float(gun_t) if gun_t is not None else dep.t,  # type: ignore[union-attr]
-        _item_centre(found, it1),
-        [t if math.isfinite(t) else median_first for t in rounded],
-        speed,
-    )
-    if got is None:
-        raise InputError(
-            "course infer: no start line that the fleet crosses together; give the gun with "
-            "--start-time, or tracks that cover the start"
-        )
-    start, early, early_sd = got
-    if gun_t is not None:
-        gun = GunEstimate(float(gun_t), 0.0, "given")
-    else:
-        assert dep is not None
-        gun = GunEstimate(early, early_sd, "inferred", dep.boats_spread_s, dep.n_boats)
+    start, gun = start_at
     # the race: each boat from its start (the gun when none is found) to its end
     ends, _ = race_ends(paths, gun.t)
     windows = [
@@ -719,6 +703,37 @@ def infer_course(
             "nowhere; check --start-time"
         )
     return _assemble(cut, paths, frame, found, gun, start, ends, axis, speed, eps, notes)
+
+
+def _first_mark(
+    found: _Found, paths: Sequence[BoatPath], t0: float, speed: float, gun_t: float | None
+) -> tuple[LineEstimate, GunEstimate] | None:
+    """The start line and gun towards the first item of the course the fleet leaves for
+    together (:func:`~sailroute.analysis.infer_lines.infer_gun`) over a line it crosses
+    together (:func:`~sailroute.analysis.infer_lines.start_line`), at least
+    ``FIRST_LEG_S`` before it rounds it."""
+    for p, it in enumerate(found.course):
+        rounded = [found.rs[i].turn.t if i is not None else math.nan for i in found.aligned[p]]
+        median_first = float(np.nanmedian(rounded))
+        dep = infer_gun(paths, _item_centre(found, it), t0, median_first, speed)
+        if dep is None and gun_t is None:
+            continue
+        ref = float(gun_t) if gun_t is not None else dep.t  # type: ignore[union-attr]
+        got = start_line(
+            paths,
+            ref,
+            _item_centre(found, it),
+            [t if math.isfinite(t) else median_first for t in rounded],
+            speed,
+        )
+        if got is None or got[1] > median_first - FIRST_LEG_S:
+            continue
+        line, early, early_sd = got
+        if gun_t is not None:
+            return line, GunEstimate(float(gun_t), 0.0, "given")
+        assert dep is not None
+        return line, GunEstimate(early, early_sd, "inferred", dep.boats_spread_s, dep.n_boats)
+    return None
 
 
 def _item_centre(found: _Found, it: int) -> tuple[float, float]:
