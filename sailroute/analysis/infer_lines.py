@@ -16,16 +16,16 @@
   (its last crossing before it rounds the first mark).  The fleet crosses the start line
   together: among the lines whose crossings spread (interquartile range, its running
   median over the speed-up's width below) within ``TOGETHER_S`` or ``TOGETHER_SHARE`` of
-  the tightest, the start line is the one where
-  the fleet speeds up most (its median speed across the lines, ``±CROSS_SPEED_S`` about
-  each crossing, ``JUMP_S`` of sailing after minus before): boats hold back or reach along
-  below the line and sail at full speed from the gun.  Its ends are the outermost
+  the tightest, the start line is the one where the fleet speeds up most (its median
+  speed across the lines, ``±CROSS_SPEED_S`` about each crossing, ``JUMP_S`` of sailing
+  after minus before): boats hold back or reach along below the line and sail at full
+  speed from the gun.  Its ends are the outermost
   crossings, ``LINE_END_M`` beyond; the committee boat is the right-hand end looking
   towards the first mark, the pin the left.  The gun is the fleet's early crossing (the
   ``CROSS_QUANTILE`` of the crossings, the first with fewer than ten boats); its standard
   error combines a bootstrap over the boats, the sampling interval, the time to sail
-  across the speed-up and half the spread of the guns of the rival lines (those scoring
-  ``RIVAL_SHARE`` of the best or more).
+  across the speed-up and half the spread of the guns of the lines where the fleet speeds
+  up by ``RIVAL_SHARE`` of the most or more (the boats' approach to the line may be one).
 * **Finish line** (:func:`finish_line`): a boat stops racing when it finishes; its race
   ends where it starts to sail slower than ``PACE_SHARE`` of its pace (the
   ``PACE_QUANTILE`` of its speeds over ``SPEED_WINDOW_S``) to the end of its track, for
@@ -127,8 +127,8 @@ TOGETHER_SHARE: Final = 0.25
 """... or less than this share more."""
 
 RIVAL_SHARE: Final = 0.5
-"""Start lines whose speed-up scores this share of the best's or more make the gun
-uncertain by half the spread of their early crossings."""
+"""Start lines where the fleet speeds up by this share of the most or more are rivals:
+half the spread of their early crossings is the gun's doubt."""
 
 CROSS_SPEED_S: Final = 3.0
 """A boat's speed across a line is measured over this either side of its crossing [s]."""
@@ -516,7 +516,8 @@ def start_line(
     # within those, where the fleet speeds up most: the release at the gun
     score = _jump(speed, together, j)
     k = int(together[int(np.argmax(score))])
-    # the lines nearly as good: how far the gun may be off
+    # the speed-ups nearly as strong (the boats' approach to the line may be one): the
+    # spread of their guns is the doubt
     rivals = together[score >= RIVAL_SHARE * float(np.max(score))]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)

@@ -71,6 +71,7 @@ from sailroute.analysis.infer_lines import (
 from sailroute.analysis.turns import (
     EPS_MIN_M,
     EPS_S,
+    MIN_BOARD_S,
     BoatPath,
     Turn,
     find_turns,
@@ -309,10 +310,10 @@ def _turns(paths: Sequence[BoatPath], eps_dp: float) -> tuple[list[list[Turn]], 
     from sailroute.analysis.infer_wind import wind_axis_deg
 
     c = np.concatenate(courses) if courses else np.zeros(0)
-    if c.size < 4:
+    if c.size == 0:
         raise InputError(
-            "course infer: the tracks hold almost no straight sailing (fewer than 4 boards "
-            "in all); expected race tracks with fixes every few seconds"
+            "course infer: the tracks hold no straight sailing (no board of "
+            f"{MIN_BOARD_S:.0f} s or more); expected race tracks with fixes every few seconds"
         )
     axis, _ = wind_axis_deg(c, np.concatenate(weights))
     return per, axis
