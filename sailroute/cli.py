@@ -311,6 +311,22 @@ SpeedUnitOpt = Annotated[
 ]
 
 
+TimeZoneOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--time-zone",
+        metavar="ZONE",
+        help="Zone of naive track times: '+02:00', 'UTC' or an IANA name.",
+    ),
+]
+ColumnOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--column", metavar="CANON=NAME", help="CSV column mapping, e.g. time=when (repeat)."
+    ),
+]
+
+
 def _complete_scheduler(incomplete: str) -> list[str]:
     return [s for s in ("serial", "processes", "tcp://") if s.startswith(incomplete)]
 
@@ -941,20 +957,8 @@ def analyze_command(
         ),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
-    time_zone: Annotated[
-        str | None,
-        typer.Option(
-            "--time-zone",
-            metavar="ZONE",
-            help="Zone of naive track times: '+02:00', 'UTC' or an IANA name.",
-        ),
-    ] = None,
-    column: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--column", metavar="CANON=NAME", help="CSV column mapping, e.g. time=when (repeat)."
-        ),
-    ] = None,
+    time_zone: TimeZoneOpt = None,
+    column: ColumnOpt = None,
     router: RouterOpt = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Skip legs.png, loss.png and report.html.")
@@ -1188,20 +1192,8 @@ def course_infer_command(
         typer.Option("--name", metavar="TEXT", help="Course name (default: inferred course)."),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
-    time_zone: Annotated[
-        str | None,
-        typer.Option(
-            "--time-zone",
-            metavar="ZONE",
-            help="Zone of naive track times: '+02:00', 'UTC' or an IANA name.",
-        ),
-    ] = None,
-    column: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--column", metavar="CANON=NAME", help="CSV column mapping, e.g. time=when (repeat)."
-        ),
-    ] = None,
+    time_zone: TimeZoneOpt = None,
+    column: ColumnOpt = None,
     json_out: JsonOpt = False,
 ) -> None:
     """Infer a course from a fleet's tracks: marks, gates, lines, legs, gun; writes it."""

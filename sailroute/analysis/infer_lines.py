@@ -363,32 +363,12 @@ def _unit(v: NDArray) -> NDArray:
     return v / n if n > 0 else np.array([0.0, 1.0])
 
 
-def _crossing(
-    p: BoatPath,
-    centre: NDArray,
-    normal: NDArray,
-    level: float,
-    t_from: float,
-    t_to: float,
-    *,
-    last: bool,
-) -> tuple[float, float, float]:
-    """Time [epoch s] and place [m] of the boat's first (or last) crossing of the line
-    ``(xy - centre) · normal = level`` forwards between ``t_from`` and ``t_to`` (NaN: none;
-    a crossing across a gap in the log counts with its time interpolated)."""
-    m = (p.t >= t_from) & (p.t <= t_to)
-    tt, xx, yy = p.t[m], p.x[m], p.y[m]
-    s = (xx - centre[0]) * normal[0] + (yy - centre[1]) * normal[1] - level
-    up = np.flatnonzero((s[:-1] < 0) & (s[1:] >= 0))
-    if up.size == 0:
-        return math.nan, math.nan, math.nan
-    k = int(up[-1] if last else up[0])
-    f = float(s[k] / (s[k] - s[k + 1]))
-    return (
-        float(tt[k] + f * (tt[k + 1] - tt[k])),
-        float(xx[k] + f * (xx[k + 1] - xx[k])),
-        float(yy[k] + f * (yy[k + 1] - yy[k])),
-    )
+def _along(p: BoatPath, t: float, centre: NDArray, along: NDArray) -> float:
+    """Where along the line the boat is at ``t`` [m from ``centre``] (NaN: no fix then)."""
+    if not math.isfinite(t):
+        return math.nan
+    x, y = p.at(np.array([t]))
+    return float((x[0] - centre[0]) * along[0] + (y[0] - centre[1]) * along[1])
 
 
 def _early(times: NDArray) -> float:
@@ -525,11 +505,13 @@ def start_line(
     level = float(levels[k])
     times = cross[:, k]
     ok_t = times[np.isfinite(times)]
-    where = []
-    for p, tc in zip(paths, times, strict=True):
-        if math.isfinite(tc):
-            x, y = p.at(np.array([tc]))
-            where.append(float((np.array([x[0], y[0]]) - centre) @ along))
+    where = [
+        w
+        for w in (_along(p, tc, centre, along) for p, tc in zip(paths, times, strict=True))
+        if math.isfinite(w)
+    ]
+    if not where:
+        return None
     base = centre + level * normal
     lo, hi = min(where) - LINE_END_M, max(where) + LINE_END_M
     pin, com = base + lo * along, base + hi * along
@@ -653,12 +635,9 @@ def finish_line(
     if not (drop.size and drop.max() >= FINISH_DROP * float(np.nanmax(speed[ok]))):
         k = levels.size - 1
     level = float(levels[k])
-    got = [
-        _crossing(p, centre, normal, level, lo, hi, last=False)
-        for p, (lo, hi) in zip(paths, windows, strict=True)
-    ]
-    times = tuple(c[0] for c in got)
-    w = np.array([(np.array(c[1:]) - centre) @ along for c in got if math.isfinite(c[0])])
+    times = tuple(float(v) for v in cross[:, k])
+    w = np.array([_along(p, tc, centre, along) for p, tc in zip(paths, times, strict=True)])
+    w = w[np.isfinite(w)]
     if w.size < 2:
         return None
     w = w[np.abs(w - np.median(w)) <= FINISH_SPREAD_MAX * max(_mad(w), 1.0)]
