@@ -37,7 +37,7 @@
   (or along the finish points when they are clearly elongated), at the line within
   ``FINISH_SCAN_S`` of sailing before the first stop where the fleet's speed across it
   drops most (by ``FINISH_DROP`` or more; else just before the first stop), and reaches
-  from the outermost crossing to the other, ``LINE_END_M`` beyond.
+  from the outermost crossing of the boats kept to the other, ``LINE_END_M`` beyond.
 """
 
 from __future__ import annotations
@@ -640,7 +640,6 @@ def finish_line(
     w = w[np.isfinite(w)]
     if w.size < 2:
         return None
-    w = w[np.abs(w - np.median(w)) <= FINISH_SPREAD_MAX * max(_mad(w), 1.0)]
     base = centre + level * normal
     pin = base + (float(w.min()) - LINE_END_M) * along
     com = base + (float(w.max()) + LINE_END_M) * along
@@ -649,5 +648,5 @@ def finish_line(
         (float(com[0]), float(com[1])),
         times,
         _mad(s),
-        int(keep.sum()),
+        int(np.isfinite(np.asarray(times)).sum()),
     )

@@ -292,6 +292,11 @@ def run_course_infer_command(
     lo = _epoch(t_from, "--from")
     hi = _epoch(t_until, "--until")
     trs, notes = read_fleet(tracks, columns=columns, speed_unit=speed_unit, time_zone=time_zone)
+    if len(trs) < 2 <= len(tracks):
+        raise InputError(
+            f"course infer: the {len(tracks)} files hold one track ({notes[0]}); the marks "
+            "are where a fleet turns: give the tracks of two boats or more of the same race"
+        )
     ic = infer_course(
         trs,
         gun_t=gun,

@@ -211,7 +211,7 @@ def test_course_infer_errors_are_one_line_and_exit_2(tmp_path):
     for args, text in (
         ([str(a)], "1 track given"),
         ([str(a), str(b)], "do not overlap in time"),
-        ([str(a), str(a)], "1 track given"),  # the same file twice is one boat
+        ([str(a), str(a)], "the 2 files hold one track (left out as copies: "),
     ):
         res = runner.invoke(app, ["course", "infer", *args, "-o", out, "--wind-tws", "10"])
         assert res.exit_code == 2, res.output
@@ -455,3 +455,46 @@ def test_49erfx_analyzed_in_the_inferred_course(tmp_path):
     rank_m = np.argsort(np.argsort(last_mark[[order[a.track.name] for a in analyses]][ok]))
     rho = 1.0 - 6.0 * np.sum((rank_f - rank_m) ** 2) / (ok.sum() * (ok.sum() ** 2 - 1))
     assert rho >= 0.9 and ok.sum() >= 22
+
+
+def test_analyze_marks_infer_needs_a_wind_speed_without_a_course_file(tmp_path):
+    t, x, y = path_of([(45.0, 60.0), (315.0, 60.0), (160.0, 60.0)])
+    a = write_gpx(tmp_path / "a.gpx", as_track(t, x, y, "a"))
+    b = write_gpx(tmp_path / "b.gpx", as_track(t, x + 20.0, y, "b"))
+    res = runner.invoke(app, ["analyze", "--marks", "infer", str(a), str(b), "-q"])
+    assert res.exit_code == 2 and res.output.count("\n") == 1
+    assert "--wind-tws is required: --marks infer without a course file" in res.output
+
+
+@pytest.mark.slow
+def test_analyze_marks_infer_keeps_the_course_file_but_its_marks(tmp_path):
+    """``analyze --marks infer COURSE.yaml``: the course file's marks are 300 m off (moved),
+    its boat, wind and gun are kept; the analysis runs in the inferred course (the report
+    starts with it) and times every boat's finish."""
+    plan = FaultPlan.clean(noise_white_m=1.5, noise_corr_m=2.0)
+    small = messy_fleet(seed=1, n_boats=8, minutes=15, faults=plan, clock_lag_s=0.0)
+    course, paths = small.write(tmp_path / "in", "gpx")
+    data = yaml.safe_load(course.read_text(encoding="utf-8"))
+    for m in data["marks"].values():
+        m["x"] += 300.0
+    course.write_text(yaml.safe_dump(data), encoding="utf-8")
+    res = runner.invoke(
+        app,
+        [
+            "analyze",
+            "--marks",
+            "infer",
+            str(course),
+            *map(str, paths),
+            "--no-plots",
+            "-q",
+            "-o",
+            str(tmp_path / "out"),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert res.output.startswith("course inferred from the tracks:\ngun ")
+    assert "(given)" in res.output.splitlines()[1]
+    fleet = json.loads((tmp_path / "out" / "fleet.json").read_text(encoding="utf-8"))
+    finish = [r for r in fleet["legs"] if r["leg"] == 4]
+    assert len(finish) == 8 and all(r["elapsed_s"] is not None for r in finish)
