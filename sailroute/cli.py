@@ -1064,6 +1064,16 @@ course_app = typer.Typer(
 )
 app.add_typer(course_app, name="course")
 
+CourseBoatOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--boat",
+        metavar="BOAT",
+        help="Built-in polar (ilca7), a polar file, "
+        "or a mapping '{polar: f50.csv, speed_unit: km/h}' (default: none).",
+    ),
+]
+
 
 @course_app.command(
     "import", cls=_Command, short_help="A course file (YAML) from GPX, CSV, KML or race XML."
@@ -1090,15 +1100,7 @@ def course_import_command(
             help="Input format (auto: by suffix, or the root element of .xml).",
         ),
     ] = "auto",
-    boat: Annotated[
-        str | None,
-        typer.Option(
-            "--boat",
-            metavar="BOAT",
-            help="Built-in polar (ilca7), a polar file, "
-            "or a mapping '{polar: f50.csv, speed_unit: km/h}' (default: none).",
-        ),
-    ] = None,
+    boat: CourseBoatOpt = None,
     wind_twd: Annotated[
         float | None,
         typer.Option(
@@ -1179,14 +1181,7 @@ def course_infer_command(
         str | None,
         typer.Option("--until", metavar="TIME", help="... up to this time."),
     ] = None,
-    boat: Annotated[
-        str | None,
-        typer.Option(
-            "--boat",
-            metavar="BOAT",
-            help="Built-in polar, polar file or mapping, as for `course import`.",
-        ),
-    ] = None,
+    boat: CourseBoatOpt = None,
     name: Annotated[
         str | None,
         typer.Option("--name", metavar="TEXT", help="Course name (default: inferred course)."),
