@@ -255,6 +255,19 @@ def _finish(res: CommandResult, json_out: bool) -> None:
         typer.echo(f"wrote {file_label(kind, path, res.labels or FILE_LABELS)}: {path}")
 
 
+def _columns(column: list[str] | None) -> dict[str, str] | None:
+    """``--column CANON=NAME`` options as a mapping (None: none given)."""
+    from sailroute.errors import InputError
+
+    columns = {}
+    for item in column or []:
+        canon, sep, name = item.partition("=")
+        if not sep or not canon.strip() or not name.strip():
+            raise InputError(f"--column {item!r}: expected CANON=NAME, e.g. time=when")
+        columns[canon.strip()] = name.strip()
+    return columns or None
+
+
 # --- commands -------------------------------------------------------------------
 # Each command parses options and delegates to the package API.  Keep logic out.
 
@@ -294,6 +307,22 @@ SpeedUnitOpt = Annotated[
     SpeedUnit | None,
     typer.Option(
         "--speed-unit", case_sensitive=False, help="Unit of the input's unsuffixed speed columns."
+    ),
+]
+
+
+TimeZoneOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--time-zone",
+        metavar="ZONE",
+        help="Zone of naive track times: '+02:00', 'UTC' or an IANA name.",
+    ),
+]
+ColumnOpt = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--column", metavar="CANON=NAME", help="CSV column mapping, e.g. time=when (repeat)."
     ),
 ]
 
@@ -928,20 +957,8 @@ def analyze_command(
         ),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
-    time_zone: Annotated[
-        str | None,
-        typer.Option(
-            "--time-zone",
-            metavar="ZONE",
-            help="Zone of naive track times: '+02:00', 'UTC' or an IANA name.",
-        ),
-    ] = None,
-    column: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--column", metavar="CANON=NAME", help="CSV column mapping, e.g. time=when (repeat)."
-        ),
-    ] = None,
+    time_zone: TimeZoneOpt = None,
+    column: ColumnOpt = None,
     router: RouterOpt = None,
     no_plots: Annotated[
         bool, typer.Option("--no-plots", help="Skip legs.png, loss.png and report.html.")
@@ -983,6 +1000,24 @@ def analyze_command(
             "boat's report.html, legs.png and loss.png in its folder (boat).",
         ),
     ] = "fleet",
+    marks: Annotated[
+        Literal["course", "infer"],
+        typer.Option(
+            "--marks",
+            case_sensitive=False,
+            help="The course's marks (course), or marks, lines and legs inferred from the "
+            "tracks' turns (infer; COURSE keeps its boat, wind and gun, or is the first "
+            "track when it is not a .yaml file).",
+        ),
+    ] = "course",
+    wind_tws: Annotated[
+        float | None,
+        typer.Option(
+            "--wind-tws",
+            metavar="KN",
+            help="With --marks infer and no course file: wind speed, knots.",
+        ),
+    ] = None,
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -992,24 +1027,30 @@ def analyze_command(
     def run() -> Any:
         _check_out(out)
         from sailroute.course.load import load_course
-        from sailroute.errors import InputError
 
-        columns = {}
-        for item in column or []:
-            canon, sep, name = item.partition("=")
-            if not sep or not canon.strip() or not name.strip():
-                raise InputError(f"--column {item!r}: expected CANON=NAME, e.g. time=when")
-            columns[canon.strip()] = name.strip()
-        loaded = load_course(course)
-        with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
-            return run_analyze_command(
-                loaded,
+        columns = _columns(column)
+        if marks == "infer":  # the course's marks from the fleet's turns
+            from sailroute.commands.course_infer import infer_for_analyze
+
+            loaded, found, tracks_ = infer_for_analyze(
+                course,
                 tracks,
+                wind_tws,
+                columns=columns,
+                speed_unit=speed_unit,
+                time_zone=time_zone,
+            )
+        else:
+            loaded, found, tracks_ = load_course(course), None, tracks
+        with _progress(loaded.n_legs, quiet) as progress, _terminal_tables(json_out):
+            res = run_analyze_command(
+                loaded,
+                tracks_,
                 scenario=scenario,
                 router=router,
                 out_dir=out,
                 leg_times=leg_times,
-                columns=columns or None,
+                columns=columns,
                 speed_unit=speed_unit,
                 time_zone=time_zone,
                 plots=not no_plots,
@@ -1019,6 +1060,7 @@ def analyze_command(
                 reference=reference,
                 pages=pages,
             )
+        return res if found is None else found.before(res)
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
@@ -1031,6 +1073,16 @@ course_app = typer.Typer(
     help="Course files from other programs.",
 )
 app.add_typer(course_app, name="course")
+
+CourseBoatOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--boat",
+        metavar="BOAT",
+        help="Built-in polar (ilca7), a polar file, "
+        "or a mapping '{polar: f50.csv, speed_unit: km/h}' (default: none).",
+    ),
+]
 
 
 @course_app.command(
@@ -1058,15 +1110,7 @@ def course_import_command(
             help="Input format (auto: by suffix, or the root element of .xml).",
         ),
     ] = "auto",
-    boat: Annotated[
-        str | None,
-        typer.Option(
-            "--boat",
-            metavar="BOAT",
-            help="Built-in polar (ilca7), a polar file, "
-            "or a mapping '{polar: f50.csv, speed_unit: km/h}' (default: none).",
-        ),
-    ] = None,
+    boat: CourseBoatOpt = None,
     wind_twd: Annotated[
         float | None,
         typer.Option(
@@ -1102,6 +1146,80 @@ def course_import_command(
         )
 
     _finish(run_guarded(run, debug=_debug(ctx)), False)
+
+
+@course_app.command(
+    "infer",
+    cls=_Command,
+    short_help="A course file (YAML) from a fleet's tracks: marks where it turned.",
+)
+def course_infer_command(
+    ctx: typer.Context,
+    tracks: Annotated[
+        list[str],
+        typer.Argument(
+            help="Track files (GPX/CSV) of two boats or more of one race.", metavar="TRACK..."
+        ),
+    ],
+    out: Annotated[
+        str,
+        typer.Option("--out", "-o", metavar="COURSE.yaml", help="Course file to write."),
+    ],
+    wind_tws: Annotated[
+        float | None,
+        typer.Option(
+            "--wind-tws",
+            metavar="KN",
+            help="Wind speed, knots; required (the direction comes from the tracks).",
+        ),
+    ] = None,
+    start_time: Annotated[
+        str | None,
+        typer.Option(
+            "--start-time",
+            metavar="TIME",
+            help="The gun, ISO 8601 with offset (default: inferred).",
+        ),
+    ] = None,
+    t_from: Annotated[
+        str | None,
+        typer.Option(
+            "--from", metavar="TIME", help="Use the fixes from this time (logs of several races)."
+        ),
+    ] = None,
+    t_until: Annotated[
+        str | None,
+        typer.Option("--until", metavar="TIME", help="... up to this time."),
+    ] = None,
+    boat: CourseBoatOpt = None,
+    name: Annotated[
+        str | None,
+        typer.Option("--name", metavar="TEXT", help="Course name (default: inferred course)."),
+    ] = None,
+    speed_unit: SpeedUnitOpt = None,
+    time_zone: TimeZoneOpt = None,
+    column: ColumnOpt = None,
+    json_out: JsonOpt = False,
+) -> None:
+    """Infer a course from a fleet's tracks: marks, gates, lines, legs, gun; writes it."""
+    from sailroute.commands.course_infer import run_course_infer_command
+
+    def run() -> Any:
+        return run_course_infer_command(
+            tracks,
+            out=out,
+            start_time=start_time,
+            t_from=t_from,
+            t_until=t_until,
+            wind_tws_kn=wind_tws,
+            boat=boat,
+            name=name,
+            columns=_columns(column),
+            speed_unit=speed_unit,
+            time_zone=time_zone,
+        )
+
+    _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 
 
 # --- live (re-plan from the instruments) ----------------------------------------------

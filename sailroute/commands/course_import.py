@@ -29,7 +29,7 @@ from sailroute.textin import excerpt
 from sailroute.timeutil import parse_time
 from sailroute.yamlfile import parse_yaml
 
-__all__ = ["boat_spec_of", "run_course_import_command"]
+__all__ = ["boat_spec_of", "run_course_import_command", "write_course_file"]
 
 
 def boat_spec_of(text: str | None, out: Path) -> dict[str, Any] | None:
@@ -111,12 +111,15 @@ def _files_of(boat: Mapping[str, Any] | None, dest: Path) -> list[Path]:
     return [dest.absolute().parent / polar] if isinstance(polar, str) and polar else []
 
 
-def _checked(text: str, ic: ImportedCourse, src: Path, dest: Path) -> Course:
+def _checked(
+    text: str, dest: Path, src: Path | None, src_lines: Mapping[str, int] | None
+) -> Course:
     """Check the course file ``text`` as ``sailroute plan`` reads it, before it is written.
 
     The course (marks, lines, legs, areas, start time, wind) is checked with the lines of
-    the imported file, so a problem is reported at ``src``'s line it came from; the boat
-    on its own, at ``--boat``, resolving a polar file against ``dest``'s folder.
+    the file it came from (``src`` and its key lines, when given), so a problem is
+    reported at the line it came from, else at ``dest``'s own lines; the boat on its own,
+    at ``--boat``, resolving a polar file against ``dest``'s folder.
 
     Returns
     -------
@@ -128,13 +131,40 @@ def _checked(text: str, ic: ImportedCourse, src: Path, dest: Path) -> Course:
     InputError
         Whatever the course file's checks or the boat and wind factories refuse.
     """
-    doc = parse_yaml(text, str(src))
+    doc = parse_yaml(text, str(src or dest))
     data = dict(doc.data)
     boat = data.pop("boat", None)
-    validate_specs(course_from_mapping(data, source=src, key_lines=dict(ic.key_lines)))
+    lines = dict(src_lines) if src_lines is not None else doc.lines
+    validate_specs(course_from_mapping(data, source=src or dest, key_lines=lines))
     if boat is not None:
         boat_from_spec(boat, base_dir=dest.absolute().parent, where="--boat", key="")
     return course_from_mapping(doc.data, source=dest, key_lines=doc.lines)
+
+
+def write_course_file(
+    text: str,
+    dest: Path,
+    *,
+    src: Path | None = None,
+    src_lines: Mapping[str, int] | None = None,
+) -> Course:
+    """Write a course file only if it loads and its boat and wind build; return it.
+
+    ``text`` is checked first (:func:`_checked`; messages name ``src`` and its lines when
+    given, else ``dest``), then written through :func:`sailroute.outdir.replacing` (a
+    draft with an unpredictable name, never through a link, moved onto ``dest``): a
+    course that would not plan is never written, and a failed write leaves ``dest`` as
+    it was.
+
+    Raises
+    ------
+    InputError
+        The text does not load, or the file cannot be written.
+    """
+    course = _checked(text, dest, src, src_lines)
+    with replacing(dest) as fh:
+        fh.write(text)
+    return course
 
 
 def _summary(ic: ImportedCourse, course: Course, out: Path, fmt: str) -> str:
@@ -229,9 +259,7 @@ def run_course_import_command(
         start_time=t0,
         boat=boat_spec,
     )
-    course = _checked(text, ic, src, dest)
-    with replacing(dest) as fh:
-        fh.write(text)
+    course = write_course_file(text, dest, src=src, src_lines=dict(ic.key_lines))
     notes = list(ic.notes)
     if boat is None:
         notes.append(

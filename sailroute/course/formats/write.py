@@ -13,7 +13,8 @@ imported file can add a key to the course file.
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
+import unicodedata
+from collections.abc import Mapping, Sequence
 from datetime import datetime
 from typing import Any
 
@@ -32,6 +33,11 @@ def _yaml_json(text: str) -> str:
 def _q(text: str) -> str:
     """A YAML double-quoted scalar (JSON's string syntax is valid YAML)."""
     return _yaml_json(json.dumps(text, ensure_ascii=False))
+
+
+def _one_line(text: str) -> str:
+    """``text`` with every line break (and other control character) as a space."""
+    return "".join(" " if unicodedata.category(c)[0] in "CZ" and c != " " else c for c in text)
 
 
 def _deg(v: float) -> str:
@@ -62,6 +68,8 @@ def course_yaml(
     tws_kn: float,
     start_time: datetime,
     boat: Mapping[str, Any] | None = None,
+    header: Sequence[str] | None = None,
+    mark_notes: Mapping[str, str] | None = None,
 ) -> str:
     """The course file text of an imported course.
 
@@ -78,13 +86,26 @@ def course_yaml(
     boat : mapping, optional
         The ``boat`` section; None writes none, and the header comment says that
         ``sailroute plan`` then uses the default ILCA 7 polar.
+    header : sequence of str, optional
+        The first comment lines (default: where the course was imported from).
+    mark_notes : mapping of str to str, optional
+        A comment after the line of each mark named.
+
+    Line breaks in ``header`` and ``mark_notes`` are written as spaces: a comment never
+    spills into a key.
 
     Returns
     -------
     str
         YAML text, ending in a newline.
     """
-    out = [f"# Imported by `sailroute course import` from {excerpt(source, 200)} ({fmt})."]
+    notes = mark_notes or {}
+    lines = (
+        header
+        if header is not None
+        else [f"Imported by `sailroute course import` from {excerpt(source, 200)} ({fmt})."]
+    )
+    out = [f"# {_one_line(h)}" for h in lines]
     if boat is None:
         out += [
             "# NO BOAT GIVEN (--boat): add a `boat:` section for the boat you race, e.g.",
@@ -98,7 +119,10 @@ def course_yaml(
     if course.boundary is not None or course.obstacles:
         out.append("# boundary/obstacles: read into the course; the routers do not use them yet.")
     out += [f"name: {_q(course.name)}", f"start_time: {_q(start_time.isoformat())}", "marks:"]
-    out += [f"  {_q(n)}: {_point((lat, lon))}" for n, lat, lon in course.marks]
+    out += [
+        f"  {_q(n)}: {_point((lat, lon))}" + (f"  # {_one_line(notes[n])}" if n in notes else "")
+        for n, lat, lon in course.marks
+    ]
     if course.lines:
         out.append("lines:")
         out += [f"  {_q(n)}: [{_q(a)}, {_q(b)}]" for n, a, b in course.lines]
