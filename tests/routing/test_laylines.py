@@ -2,7 +2,7 @@
 turning with the wind where it veers across the course.
 
 The midpoint rule is second order: with 50 steps over 1 km in a wind veering 10° per km
-the heading error per step is far below 0.01°, so 0.1° (the brief's tolerance) is loose
+the heading error per step is far below 0.01°, so a tolerance of 0.1° is loose
 for the uniform case (exact to rounding) and for the local-heading check.
 """
 
