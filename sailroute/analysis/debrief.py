@@ -552,6 +552,7 @@ def analysis_winds(
                 boat=boat,
                 t0=gun - 60.0,
                 t1=_race_end(course, tracks),
+                marks=[m.xy for m in course.marks.values()],
             )
         except InputError as exc:
             if choice == "inferred":

@@ -107,9 +107,17 @@ ALPHA_PRIOR_DEG: Final = (42.0, 10.0)
 GAMMA_PRIOR_DEG: Final = (25.0, 10.0)
 """Prior of a gybing boat's angle off dead downwind without a polar: mean and sd [°]."""
 
-NO_GO_SHARE: Final = 0.05
-"""A boat that spends more than this share of its steady time within its tacking angle
-of the wind is not racing in this wind and is left out [-] (:func:`left_out`)."""
+NO_GO_FRACTION: Final = 0.6
+"""The no-go zone of :func:`no_go_share`: this fraction of a boat's tacking half-angle
+either side of the wind [-]."""
+
+NO_GO_SPEED: Final = 0.6
+"""Only a boat this fast (a share of its median speed) in the no-go zone counts [-]."""
+
+NO_GO_SHARE: Final = 0.03
+"""A boat that spends more than this share of its steady time in the no-go zone is not
+racing in this wind and is left out [-] (:func:`left_out`; the SailGP F50s: at most
+0.3 %; a coach boat driven at random: 3.5-31 %)."""
 
 COMMON_SD_DEG: Final = (4.5, 4.5)
 """Sd of an error all boats share on upwind and on downwind boards [°]: it does not
@@ -348,24 +356,33 @@ def systematic_var(
 def no_go_share(
     obs: Obs, twa_deg: NDArray, sd_deg: NDArray, ang: BoatAngles
 ) -> NDArray[np.float64]:
-    """Per boat, the share of its steady time spent where no sailing boat goes: within its
-    tacking half-angle (less ``FREE_MARGIN_DEG`` and twice the estimate's sd) of the wind.
-    A racing boat is there only in its tacks; a coach boat or one that races in another
-    wind is there often."""
+    """Per boat, the share of its steady time spent where no sailing boat goes: closer to
+    the wind than ``NO_GO_FRACTION`` of its tacking half-angle (less twice the estimate's
+    sd) at ``NO_GO_SPEED`` of its median speed or more.  A racing boat gets there only
+    slowly (luffing before the start: SailGP's F50s at 16-20° and a third of their speed);
+    a coach boat, or a boat that races in another wind, often and at speed."""
     K = ang.alpha.size
-    inside = np.abs(twa_deg) < ang.alpha[obs.boat] - FREE_MARGIN_DEG - 2.0 * sd_deg
+    med = np.array(
+        [np.median(obs.sog[obs.boat == k]) if (obs.boat == k).any() else 0.0 for k in range(K)]
+    )
+    inside = (np.abs(twa_deg) < NO_GO_FRACTION * ang.alpha[obs.boat] - 2.0 * sd_deg) & (
+        obs.sog >= NO_GO_SPEED * med[obs.boat]
+    )
     tot = np.bincount(obs.boat, obs.seconds, K)
     return np.asarray(
         np.bincount(obs.boat, obs.seconds * inside, K) / np.maximum(tot, 1e-12), dtype=float
     )
 
 
-def left_out(share: NDArray) -> NDArray[np.bool_]:
-    """The boats to leave out: whose :func:`no_go_share` exceeds ``NO_GO_SHARE`` and three
-    times the fleet's median (a wind estimate that is wrong puts the whole fleet there);
-    none when that would be half the fleet or more."""
-    out = share > max(NO_GO_SHARE, 3.0 * float(np.median(share)))
-    return out if 2 * int(out.sum()) < share.size else np.zeros(share.size, bool)
+def left_out(share: NDArray, use: NDArray) -> NDArray[np.bool_]:
+    """The boats of ``use`` to leave out: whose :func:`no_go_share` exceeds
+    ``NO_GO_SHARE`` and three times the median of those used (a wind estimate that is
+    wrong puts the whole fleet there); none when that would leave out half of them or
+    more."""
+    if not use.any():
+        return np.zeros(share.size, bool)
+    out = use & (share > max(NO_GO_SHARE, 3.0 * float(np.median(share[use]))))
+    return out if 2 * int(out.sum()) < int(use.sum()) else np.zeros(share.size, bool)
 
 
 def _robust_sd(r: NDArray, w: NDArray) -> float:
@@ -554,7 +571,9 @@ __all__ = [
     "FREE",
     "GYBE",
     "MODEL_CORR_S",
+    "NO_GO_FRACTION",
     "NO_GO_SHARE",
+    "NO_GO_SPEED",
     "RUN",
     "RUN_BOX_DEG",
     "TACK",

@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any, Final
 
@@ -499,11 +499,42 @@ def _passes(
     n_boats: int,
     t0: float,
     n_bins: int,
+    prior_twd_deg: float | None,
+    priors: tuple[tuple[float, float], tuple[float, float]],
+    at_mark: NDArray[np.bool_],
+) -> tuple[_Pass, float, str, list[str]]:
+    """Classify, fit the boats' angles and smooth, ``N_ITER`` times (module notes); the
+    passes start again without the boats the first pass finds not racing in this wind
+    (:func:`~sailroute.analysis.infer_obs.left_out`).  Also the upwind end of the wind
+    axis, how it was decided, and notes."""
+    use = np.ones(n_boats, bool)
+    for _ in range(3):
+        mine = use[p.boat]
+        kept = _Points(
+            *(getattr(p, f)[mine] for f in ("t", "cog", "sog", "boat", "weight", "board"))
+        )
+        start, how, notes = _start_guess(kept, prior_twd_deg)
+        res, again = _pass_loop(p, boards, turns, n_boats, t0, n_bins, start, priors, at_mark, use)
+        if not again.any():
+            break
+        use = use & ~again
+    return res, start, how, notes
+
+
+def _pass_loop(
+    p: _Points,
+    boards: _Boards,
+    turns: _Turns,
+    n_boats: int,
+    t0: float,
+    n_bins: int,
     start: float,
     priors: tuple[tuple[float, float], tuple[float, float]],
     at_mark: NDArray[np.bool_],
-) -> _Pass:
-    """Classify, fit the boats' angles and smooth, ``N_ITER`` times (module notes)."""
+    use: NDArray[np.bool_],
+) -> tuple[_Pass, NDArray[np.bool_]]:
+    """The passes with the boats ``use``; stops after the first when it finds more boats
+    to leave out (returned)."""
     obs = observations(p, t0, n_bins)
     tb = t0 + (np.arange(n_bins) + 0.5) * BIN_S
     un = np.full(n_bins, start)
@@ -517,7 +548,7 @@ def _passes(
         np.full(n_boats, UP_MODEL_SD),
         np.full(n_boats, DOWN_MODEL_SD),
         np.full(n_boats, TURN_SD_DEG),
-        np.ones(n_boats, bool),
+        use.copy(),
     )
     res: _Pass | None = None
     q = Q_GRID[0]
@@ -535,7 +566,7 @@ def _passes(
         cls = bcls[obs.board]
         ll_boards, ll_bounds, ll_turns = log_likelihoods(obs, cls, turns, kinds, ang, t0, n_bins)
         ll = ll_boards + ll_bounds + ll_turns
-        if it < 2:  # the rate settles with the classes of the first passes
+        if it < N_ITER - 1:  # the rate settles with the classes of the passes before
             q = max(
                 Q_GRID[int(np.argmax(log_marginal(ll, start)))],
                 Q_GRID[int(np.argmax(log_marginal(ll_turns, start)))],
@@ -555,10 +586,12 @@ def _passes(
             ang,
         )
         res = _Pass(obs, post, bcls, cls, kinds, ang, twa, sd, turns.boat, share)
-        if it < N_ITER - 1:
-            ang = replace(ang, use=~left_out(share))
+        if it == 0:
+            out = use & left_out(share, use)
+            if out.any():
+                return res, out
     assert res is not None
-    return res
+    return res, np.zeros(n_boats, bool)
 
 
 def _at_marks(turns: _Turns, marks: Sequence[tuple[float, float]]) -> NDArray[np.bool_]:
@@ -696,13 +729,15 @@ def infer_wind(
             f"not turning) in {iso(t0)} .. {iso(t1)}; need at least 60: give longer tracks "
             "or the race's time span"
         )
-    start, how, axis_notes = _start_guess(p, prior_twd_deg)
-    notes.extend(axis_notes)
+
     K = len(trs)
     n_bins = int(np.ceil((t1 - t0) / BIN_S)) + 1
     priors = _angle_priors(boat, p)
     at_mark = _at_marks(turns, marks)
-    res = _passes(p, boards, turns, K, t0, n_bins, start, priors, at_mark)
+    res, start, how, axis_notes = _passes(
+        p, boards, turns, K, t0, n_bins, prior_twd_deg, priors, at_mark
+    )
+    notes.extend(axis_notes)
     _check_boards(p, res, start, how)
     # the output grid
     tg = np.arange(t0, t1 + 1e-6, step_s)
@@ -717,14 +752,17 @@ def infer_wind(
     tws_ms, tws_sd, tws_note = _tws(tws, tg, p, res, tbin, un, h, bad)
     notes.append(tws_note)
     notes.extend(_boat_notes(names, p, res, priors, boat is not None))
-    sec = np.bincount(res.cls, res.obs.seconds, 4)
+    used = res.ang.use[res.obs.boat]
+    sec = np.bincount(res.cls[used], res.obs.seconds[used], 4)
+    turned = res.ang.use[res.turn_boat]
     n_out = int((~res.ang.use).sum())
     method = (
         f"inferred from {K - n_out} track(s)"
         + (f" ({n_out} left out)" if n_out else "")
         + ": "
         + ", ".join(f"{sec[c]:.0f} s on {CLASS_NAMES[c]}s" for c in (UP, DOWN, RUN, FREE))
-        + f"; {int((res.kinds == TACK).sum())} tacks, {int((res.kinds == GYBE).sum())} "
+        + f"; {int((turned & (res.kinds == TACK)).sum())} tacks, "
+        f"{int((turned & (res.kinds == GYBE)).sum())} "
         f"gybes; random walk {res.post.q:g} °²/s; TWS from {tws.kind}"
         + (f" ({tws.label})" if tws.label and tws.label != tws.kind else "")
     )
@@ -799,9 +837,9 @@ def _boat_notes(
     for k, name in enumerate(names):
         if not ang.use[k]:
             out.append(
-                f"{name}: left out: {100 * res.no_go[k]:.0f} % of its steady time within its "
-                "tacking angle of the wind (not racing in this wind: a coach boat, another "
-                "race?)"
+                f"{name}: left out: {100 * res.no_go[k]:.0f} % of its steady time closer to "
+                "the wind than any boat sails (not racing in this wind: a coach boat, "
+                "another race?)"
             )
             continue
         mine = p.boat == k
