@@ -566,7 +566,7 @@ def _pass_loop(
         cls = bcls[obs.board]
         ll_boards, ll_bounds, ll_turns = log_likelihoods(obs, cls, turns, kinds, ang, t0, n_bins)
         ll = ll_boards + ll_bounds + ll_turns
-        if it < N_ITER - 1:  # the rate settles with the classes of the passes before
+        if it < 2:  # the rate settles with the classes of the first passes
             q = max(
                 Q_GRID[int(np.argmax(log_marginal(ll, start)))],
                 Q_GRID[int(np.argmax(log_marginal(ll_turns, start)))],
@@ -575,21 +575,21 @@ def _pass_loop(
         un = np.degrees(np.unwrap(np.radians(post.mean_deg)))
         twa = wrap180(np.interp(obs.t, tb, un) - obs.cog)
         sd = np.sqrt(post.sd_deg**2 + systematic_var(obs, cls, ang, twa, n_bins))
-        # which boats sail where no racing boat goes, in the wind the beats, gybes and
-        # turns tell (the bounds of a boat that is not racing would move that wind)
-        info = smooth(ll_boards + ll_turns, start, q)
-        un_i = np.degrees(np.unwrap(np.radians(info.mean_deg)))
-        share = no_go_share(
-            obs,
-            wrap180(np.interp(obs.t, tb, un_i) - obs.cog),
-            np.interp(obs.t, tb, info.sd_deg),
-            ang,
-        )
-        res = _Pass(obs, post, bcls, cls, kinds, ang, twa, sd, turns.boat, share)
         if it == 0:
+            # which boats sail where no racing boat goes, in the wind the beats, gybes and
+            # turns tell (the bounds of a boat that is not racing would move that wind)
+            info = smooth(ll_boards + ll_turns, start, q)
+            un_i = np.degrees(np.unwrap(np.radians(info.mean_deg)))
+            share = no_go_share(
+                obs,
+                wrap180(np.interp(obs.t, tb, un_i) - obs.cog),
+                np.interp(obs.t, tb, info.sd_deg),
+                ang,
+            )
             out = use & left_out(share, use)
-            if out.any():
-                return res, out
+        res = _Pass(obs, post, bcls, cls, kinds, ang, twa, sd, turns.boat, share)
+        if out.any():
+            return res, out
     assert res is not None
     return res, np.zeros(n_boats, bool)
 

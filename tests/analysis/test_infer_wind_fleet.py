@@ -26,10 +26,12 @@ from sailroute.analysis.windsource import MEASURED_TWD_SD_DEG, WindSource
 from sailroute.boat import builtin_polar
 from sailroute.course.load import course_from_mapping
 from sailroute.errors import InputError
+from sailroute.geo import LocalFrame
 from sailroute.track.model import Track
 from sailroute.units import wind_components, wrap180
 from sailroute.wind.analytic import AnalyticWind
 from tests.analysis import windfleet as wf
+from tests.conftest import requires_shared
 
 MARKS = [wf.W, wf.R, wf.L]
 
@@ -76,7 +78,7 @@ def test_boats_that_do_not_race_in_this_wind_are_left_out(swing) -> None:
     t0, t1 = float(fleet[0].t_s[0]), float(max(tr.t_s[-1] for tr in fleet))
     alone = infer_wind(fleet, wf.FRAME, prior_twd_deg=wf.BASE, marks=MARKS)
     mixed = infer_wind(
-        fleet + [coach(t0, t1 - t0, 1), coach(t0, t1 - t0, 2)],
+        [*fleet, coach(t0, t1 - t0, 1), coach(t0, t1 - t0, 2)],
         wf.FRAME,
         prior_twd_deg=wf.BASE,
         marks=MARKS,
@@ -234,10 +236,6 @@ def test_a_wind_source_gives_its_own_uncertainty(course) -> None:
 # ------------------------------------------------------------------ slow: many boats
 
 
-def _coverage_rows(iw, boats, wind) -> dict[str, tuple[float, float, float]]:
-    return wf.coverage(iw, boats, wind)
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize(
     ("wind", "kind", "rms_max"),
@@ -250,9 +248,11 @@ def _coverage_rows(iw, boats, wind) -> dict[str, tuple[float, float, float]]:
 )
 def test_more_boats_never_make_it_worse(wind: str, kind: str, rms_max: dict) -> None:
     # 12 boats of one race, logged every 3 s with 3 m of GPS error; the first 3, the first
-    # 6 and all 12 inferred on their own: every point of sail covered at 90 % or more,
-    # and the RMS error of 12 boats no more than that of 3 (plus 0.5°, the sampling of
-    # which boats sail which leg when)
+    # 6 and all 12 inferred on their own: every point of sail covered at 90 % or more on
+    # each subset's own legs, and on the legs of the first 3 boats the RMS error of 6 and
+    # 12 boats no more than that of 3 plus 1° (where nobody beats the estimate of any
+    # subset is the random walk between the beats, and which boats sailed which leg when
+    # moves it by a degree or so; its sd there is 8-13°)
     boats = wf.routed_fleet(wind, 12, seed=0, kind=kind)
     rms = {}
     for n in (3, 6, 12):
@@ -261,9 +261,9 @@ def test_more_boats_never_make_it_worse(wind: str, kind: str, rms_max: dict) -> 
         for mode, (r, inside, _) in cov.items():
             assert inside >= 0.9, (n, mode, cov)
             assert r <= rms_max[mode], (n, mode, cov)
-        rms[n] = {m: v[0] for m, v in cov.items()}
+        rms[n] = {m: v[0] for m, v in wf.coverage(iw, boats[:3], wind).items()}
     for mode in rms[3]:
-        assert rms[12][mode] <= rms[3][mode] + 0.5, (mode, rms)
+        assert max(rms[6][mode], rms[12][mode]) <= rms[3][mode] + 1.0, (mode, rms)
 
 
 @pytest.mark.slow
@@ -304,3 +304,75 @@ def test_messy_windward_leeward_fleets(seed: int) -> None:
         e, s = np.concatenate(errs[mode]), np.concatenate(sds[mode])
         assert float(np.mean(np.abs(e) <= 2.0 * s)) >= 0.9, (seed, mode)
         assert float(np.sqrt(np.mean(e**2))) <= 8.0, (seed, mode)
+
+
+# ------------------------------------------------------------------ real tracks
+
+
+@requires_shared
+def test_sailgp_race_05_against_the_boats_own_wind() -> None:
+    # SailGP Auckland 2025, race 25011905, the three shared F50 logs: the wind inferred
+    # from their positions alone (the course axis of the race XML, leeward to windward
+    # gate, as the prior; its marks), against each boat's own logged TWD (smoothed 30 s)
+    # along its legs (start to last leg change), per point of sail of its logged TWA.  The
+    # boats' own TWD differ from each other by 4.3-5.6° RMS.  Measured: RMS upwind 4.8°,
+    # reach 5.9°, downwind 3.7°; every logged TWD within 2 sd.
+    import xml.etree.ElementTree as ET
+
+    from sailroute.timeutil import parse_time, to_epoch
+    from sailroute.track import read_track
+    from sailroute.units import bearing_deg
+    from tests.analysis.test_sailgp_fleet import BOATS, RACE, XML, leg_counter_changes
+
+    root = ET.parse(XML).getroot()
+    start = root.find("RaceStartTime")
+    assert start is not None
+    gun = to_epoch(parse_time(start.get("Start", "")))
+    frame = LocalFrame(-36.83, 174.76)
+    marks = {}
+    for m in root.iterfind("Course/CompoundMark/Mark"):
+        x, y = frame.to_xy(
+            np.array([float(m.get("TargetLat", ""))]), np.array([float(m.get("TargetLng", ""))])
+        )
+        marks[m.get("Name", "")] = (float(x[0]), float(y[0]))
+    lg = np.mean([marks["LG1"], marks["LG2"]], axis=0)
+    wg = np.mean([marks["WG1"], marks["WG2"]], axis=0)
+    axis = float(bearing_deg(wg[0] - lg[0], wg[1] - lg[1]))
+    legs = {b: leg_counter_changes(b) for b in BOATS}
+    tracks = [
+        read_track(RACE / "Boat_logs" / f"data_{b}.csv", time_zone="UTC", name=b) for b in BOATS
+    ]
+    t1 = max(v[-1] for v in legs.values()) + 30.0
+    iw = infer_wind(
+        tracks, frame, prior_twd_deg=axis, t0=gun - 60.0, t1=t1, marks=list(marks.values())
+    )
+    assert "inferred from 3 track(s):" in iw.method
+    ok = np.isfinite(iw.twd_deg)
+    un = np.degrees(np.unwrap(np.radians(iw.twd_deg[ok])))
+    err: dict[str, list[np.ndarray]] = {}
+    sd: dict[str, list[np.ndarray]] = {}
+    for tr in tracks:
+        t, d, a = tr.t_s, tr.channels["twd_deg"], tr.channels["twa_deg"]
+        m = np.isfinite(d) & np.isfinite(a)
+        t, d, a = t[m], d[m], np.abs(a[m])
+        r, k = np.radians(d), np.ones(31) / 31.0
+        d = np.degrees(
+            np.arctan2(np.convolve(np.sin(r), k, "same"), np.convolve(np.cos(r), k, "same"))
+        )
+        race = (t >= legs[tr.name][0]) & (t <= legs[tr.name][-1])
+        e = wrap180(np.interp(t, iw.t[ok], un) - d)[race]
+        s = np.interp(t, iw.t[ok], iw.twd_sd_deg[ok])[race]
+        a = a[race]
+        for mode, sel in (
+            ("upwind", a < 70.0),
+            ("reach", (a >= 70.0) & (a <= 120.0)),
+            ("downwind", a > 120.0),
+        ):
+            err.setdefault(mode, []).append(e[sel])
+            sd.setdefault(mode, []).append(s[sel])
+    bounds = {"upwind": 5.5, "reach": 7.0, "downwind": 4.5}
+    for mode, es in err.items():
+        e, s = np.concatenate(es), np.concatenate(sd[mode])
+        assert e.size > 100, mode
+        assert float(np.mean(np.abs(e) <= 2.0 * s)) >= 0.9, mode
+        assert float(np.sqrt(np.mean(e**2))) <= bounds[mode], mode

@@ -21,7 +21,9 @@ from functools import cache
 from types import MappingProxyType
 
 import numpy as np
+from numpy.typing import ArrayLike
 
+from sailroute.analysis.infer_wind import InferredWind
 from sailroute.boat import builtin_polar
 from sailroute.boat.efficiency import scale_polar
 from sailroute.boat.polar import Polar
@@ -57,17 +59,17 @@ L = _xy(0.0, 0.0)
 MARKS = (("W", W), ("R", R), ("L", L), ("W", W), ("L", L))
 
 
-def twd_osc(t):
+def twd_osc(t: ArrayLike) -> np.ndarray:
     """TWD 200° ± 10°, period 6 min."""
     return BASE + 10.0 * np.sin(2.0 * np.pi * (np.asarray(t, float) - T0) / 360.0)
 
 
-def twd_shift(t):
+def twd_shift(t: ArrayLike) -> np.ndarray:
     """A persistent veer of 15° between minutes 6.7 and 16.7."""
     return BASE - 7.5 + 15.0 * np.clip((np.asarray(t, float) - T0 - 400.0) / 600.0, 0.0, 1.0)
 
 
-def twd_swing(t):
+def twd_swing(t: ArrayLike) -> np.ndarray:
     """A 25° backing over the first 20 min (the wind turns while the fleet reaches and
     runs), then steady."""
     return BASE + 12.5 - 25.0 * np.clip((np.asarray(t, float) - T0) / 1200.0, 0.0, 1.0)
@@ -210,7 +212,9 @@ def truth_by_mode(
     }
 
 
-def coverage(iw, boats, wind: str) -> dict[str, tuple[float, float, float]]:
+def coverage(
+    iw: InferredWind, boats: tuple[Boat, ...], wind: str
+) -> dict[str, tuple[float, float, float]]:
     """Per leg mode: RMS error [°], the share of (boat, grid time) whose truth lies within
     2 sd (NaN grid times count as covered: the estimate says it does not know), and the
     share with a direction."""
