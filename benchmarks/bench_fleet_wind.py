@@ -52,7 +52,6 @@ import argparse  # noqa: E402
 import csv  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
-import xml.etree.ElementTree as ET  # noqa: E402
 from collections.abc import Sequence  # noqa: E402
 from datetime import UTC, datetime  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -61,10 +60,9 @@ import numpy as np  # noqa: E402
 
 from sailroute.analysis.infer_wind import InferredWind, infer_wind  # noqa: E402
 from sailroute.geo import LocalFrame  # noqa: E402
-from sailroute.timeutil import parse_time, to_epoch  # noqa: E402
 from sailroute.track.model import Track  # noqa: E402
 from sailroute.track.read import read_track  # noqa: E402
-from sailroute.units import bearing_deg, wind_components, wrap180  # noqa: E402
+from sailroute.units import wind_components, wrap180  # noqa: E402
 from sailroute.wind.measured import (  # noqa: E402
     LooRow,
     MeasuredSeries,
@@ -183,21 +181,10 @@ MEASURED_SD_DEG = 4.0
 
 
 def xml_course(race: int) -> tuple[float, list[tuple[float, float]], float]:
-    """Gun [epoch s], mark positions [m] and course axis [°] (the bearing from the leeward
-    to the windward gate) of a race's XML."""
-    root = ET.parse(next((LOGS.parent / "Race_XMLs").glob(f"{race}_*.xml"))).getroot()
-    start = root.find("RaceStartTime")
-    assert start is not None
-    marks = {}
-    for m in root.iterfind("Course/CompoundMark/Mark"):
-        x, y = FRAME.to_xy(
-            np.array([float(m.get("TargetLat", ""))]), np.array([float(m.get("TargetLng", ""))])
-        )
-        marks[m.get("Name", "")] = (float(x[0]), float(y[0]))
-    lg = np.mean([marks["LG1"], marks["LG2"]], axis=0)
-    wg = np.mean([marks["WG1"], marks["WG2"]], axis=0)
-    axis = float(bearing_deg(wg[0] - lg[0], wg[1] - lg[1]))
-    return to_epoch(parse_time(start.get("Start", ""))), list(marks.values()), axis
+    """Gun [epoch s], mark positions [m] and course axis [°] of a race's XML."""
+    from tests.analysis.windfleet import race_xml
+
+    return race_xml(next((LOGS.parent / "Race_XMLs").glob(f"{race}_*.xml")), FRAME)
 
 
 def leg_changes(boat: str, race: int) -> list[float]:

@@ -492,49 +492,44 @@ class _Pass:
     no_go: NDArray[np.float64]  # per boat: share of its time in the no-go zone
 
 
-def _passes(
-    p: _Points,
-    boards: _Boards,
-    turns: _Turns,
-    n_boats: int,
-    t0: float,
-    n_bins: int,
-    prior_twd_deg: float | None,
-    priors: tuple[tuple[float, float], tuple[float, float]],
-    at_mark: NDArray[np.bool_],
-) -> tuple[_Pass, float, str, list[str]]:
+@dataclass(frozen=True)
+class _Fleet:
+    """What the passes work on: the steady points, boards and turns of all boats."""
+
+    p: _Points
+    boards: _Boards
+    turns: _Turns
+    n_boats: int
+    t0: float  # start of the first bin [epoch s]
+    n_bins: int
+    priors: tuple[tuple[float, float], tuple[float, float]]  # α and γ [°]: mean, sd
+    at_mark: NDArray[np.bool_]  # per turn: near a mark (a rounding)
+
+
+def _passes(f: _Fleet, prior_twd_deg: float | None) -> tuple[_Pass, float, str, list[str]]:
     """Classify, fit the boats' angles and smooth, ``N_ITER`` times (module notes); the
     passes start again without the boats the first pass finds not racing in this wind
     (:func:`~sailroute.analysis.infer_obs.left_out`).  Also the upwind end of the wind
     axis, how it was decided, and notes."""
-    use = np.ones(n_boats, bool)
+    use = np.ones(f.n_boats, bool)
     for _ in range(3):
-        mine = use[p.boat]
+        mine = use[f.p.boat]
         kept = _Points(
-            *(getattr(p, f)[mine] for f in ("t", "cog", "sog", "boat", "weight", "board"))
+            *(getattr(f.p, k)[mine] for k in ("t", "cog", "sog", "boat", "weight", "board"))
         )
         start, how, notes = _start_guess(kept, prior_twd_deg)
-        res, again = _pass_loop(p, boards, turns, n_boats, t0, n_bins, start, priors, at_mark, use)
+        res, again = _pass_loop(f, start, use)
         if not again.any():
             break
         use = use & ~again
     return res, start, how, notes
 
 
-def _pass_loop(
-    p: _Points,
-    boards: _Boards,
-    turns: _Turns,
-    n_boats: int,
-    t0: float,
-    n_bins: int,
-    start: float,
-    priors: tuple[tuple[float, float], tuple[float, float]],
-    at_mark: NDArray[np.bool_],
-    use: NDArray[np.bool_],
-) -> tuple[_Pass, NDArray[np.bool_]]:
+def _pass_loop(f: _Fleet, start: float, use: NDArray[np.bool_]) -> tuple[_Pass, NDArray[np.bool_]]:
     """The passes with the boats ``use``; stops after the first when it finds more boats
     to leave out (returned)."""
+    p, boards, turns, n_boats, t0, n_bins = f.p, f.boards, f.turns, f.n_boats, f.t0, f.n_bins
+    priors, at_mark = f.priors, f.at_mark
     obs = observations(p, t0, n_bins)
     tb = t0 + (np.arange(n_bins) + 0.5) * BIN_S
     un = np.full(n_bins, start)
@@ -735,7 +730,7 @@ def infer_wind(
     priors = _angle_priors(boat, p)
     at_mark = _at_marks(turns, marks)
     res, start, how, axis_notes = _passes(
-        p, boards, turns, K, t0, n_bins, prior_twd_deg, priors, at_mark
+        _Fleet(p, boards, turns, K, t0, n_bins, priors, at_mark), prior_twd_deg
     )
     notes.extend(axis_notes)
     _check_boards(p, res, start, how)

@@ -47,6 +47,7 @@ from sailroute.track.model import Track
 from sailroute.units import bearing_deg, wind_components, wind_speed_direction, wrap180
 from sailroute.wind.analytic import AnalyticWind
 from sailroute.wind.base import WindField
+from tests.analysis.windfleet import ar_noise
 from tests.conftest import SHARED_REAL, requires_shared
 
 T0 = 1_750_000_000.0
@@ -176,19 +177,6 @@ def test_known_wind_is_found(routes, wind: str, n: int, noise: float) -> None:
     # tacks at the headers of the oscillating wind, about 41° in the steady one)
     for alpha, _ in iw.half_angles_deg.values():
         assert (36.0 if wind == "osc" else 39.0) < alpha < 43.0
-
-
-def ar_noise(n: int, sigma_m: float, tau_s: float, rng) -> np.ndarray:
-    """Correlated GPS error [m]: first-order autoregressive at 1 Hz, sd ``sigma_m``,
-    correlation time ``tau_s``."""
-    a = np.exp(-1.0 / tau_s)
-    z = rng.normal(0.0, sigma_m * np.sqrt(1.0 - a * a), n)
-    z[0] = rng.normal(0.0, sigma_m)
-    e = np.empty(n)
-    e[0] = z[0]
-    for i in range(1, n):
-        e[i] = a * e[i - 1] + z[i]
-    return e
 
 
 def logged(route, name: str, every: int, sigma_m: float, rng) -> Track:

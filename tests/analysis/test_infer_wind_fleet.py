@@ -317,35 +317,17 @@ def test_sailgp_race_05_against_the_boats_own_wind() -> None:
     # along its legs (start to last leg change), per point of sail of its logged TWA.  The
     # boats' own TWD differ from each other by 4.3-5.6° RMS.  Measured: RMS upwind 4.8°,
     # reach 5.9°, downwind 3.7°; every logged TWD within 2 sd.
-    import xml.etree.ElementTree as ET
-
-    from sailroute.timeutil import parse_time, to_epoch
     from sailroute.track import read_track
-    from sailroute.units import bearing_deg
     from tests.analysis.test_sailgp_fleet import BOATS, RACE, XML, leg_counter_changes
 
-    root = ET.parse(XML).getroot()
-    start = root.find("RaceStartTime")
-    assert start is not None
-    gun = to_epoch(parse_time(start.get("Start", "")))
     frame = LocalFrame(-36.83, 174.76)
-    marks = {}
-    for m in root.iterfind("Course/CompoundMark/Mark"):
-        x, y = frame.to_xy(
-            np.array([float(m.get("TargetLat", ""))]), np.array([float(m.get("TargetLng", ""))])
-        )
-        marks[m.get("Name", "")] = (float(x[0]), float(y[0]))
-    lg = np.mean([marks["LG1"], marks["LG2"]], axis=0)
-    wg = np.mean([marks["WG1"], marks["WG2"]], axis=0)
-    axis = float(bearing_deg(wg[0] - lg[0], wg[1] - lg[1]))
+    gun, marks, axis = wf.race_xml(XML, frame)
     legs = {b: leg_counter_changes(b) for b in BOATS}
     tracks = [
         read_track(RACE / "Boat_logs" / f"data_{b}.csv", time_zone="UTC", name=b) for b in BOATS
     ]
     t1 = max(v[-1] for v in legs.values()) + 30.0
-    iw = infer_wind(
-        tracks, frame, prior_twd_deg=axis, t0=gun - 60.0, t1=t1, marks=list(marks.values())
-    )
+    iw = infer_wind(tracks, frame, prior_twd_deg=axis, t0=gun - 60.0, t1=t1, marks=marks)
     assert "inferred from 3 track(s):" in iw.method
     ok = np.isfinite(iw.twd_deg)
     un = np.degrees(np.unwrap(np.radians(iw.twd_deg[ok])))

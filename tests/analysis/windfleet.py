@@ -15,9 +15,11 @@ mode from the course geometry in the true wind at the leg start (``course.geomet
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cache
+from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
@@ -33,6 +35,7 @@ from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import Start, Target
+from sailroute.timeutil import parse_time, to_epoch
 from sailroute.track.model import Track
 from sailroute.units import bearing_deg, wind_components, wrap180
 from sailroute.wind.analytic import AnalyticWind
@@ -233,3 +236,22 @@ def coverage(
             float(ok.mean()),
         )
     return out
+
+
+def race_xml(path: Path, frame: LocalFrame) -> tuple[float, list[tuple[float, float]], float]:
+    """A SailGP race XML's gun [epoch s], mark positions in ``frame`` [m] and course axis
+    [°]: the bearing from the leeward to the windward gate, the wind the course was laid
+    in."""
+    root = ET.parse(path).getroot()
+    start = root.find("RaceStartTime")
+    assert start is not None
+    marks = {}
+    for m in root.iterfind("Course/CompoundMark/Mark"):
+        x, y = frame.to_xy(
+            np.array([float(m.get("TargetLat", ""))]), np.array([float(m.get("TargetLng", ""))])
+        )
+        marks[m.get("Name", "")] = (float(x[0]), float(y[0]))
+    lg = np.mean([marks["LG1"], marks["LG2"]], axis=0)
+    wg = np.mean([marks["WG1"], marks["WG2"]], axis=0)
+    axis = float(bearing_deg(wg[0] - lg[0], wg[1] - lg[1]))
+    return to_epoch(parse_time(start.get("Start", ""))), list(marks.values()), axis
