@@ -1,8 +1,9 @@
 """Steady courses of GPS tracks and the wind axis they imply (steps 1 and 2 of
 :mod:`sailroute.analysis.infer_wind`): the points sailed on a board, away from manoeuvres,
-roundings and gaps (:func:`_steady_points`); the direction about which their histogram is
-most symmetric (:func:`wind_axis_deg`, :func:`axis_near_prior`); the boards' half-separation
-(:func:`half_separation_deg`)."""
+roundings and gaps, the boards they make and the turns between them, with the courses
+before and after each (:func:`_steady_points`); the direction about which the courses'
+histogram is most symmetric (:func:`wind_axis_deg`, :func:`axis_near_prior`); the boards'
+half-separation (:func:`half_separation_deg`)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,10 @@
 """The smoother of :mod:`sailroute.analysis.infer_wind`: TWD(t) as a hidden random walk on
-a grid of directions, observed through the boats' boards (step 4).
+a grid of directions, observed through the boats' boards and turns (step 4).
 
 TWD is discretised on the circle (``GRID_DEG``) and in time (bins of ``BIN_S``).  Between
 bins it moves as a random walk (variance ``q`` per second, chosen by the marginal
 likelihood among ``Q_GRID``); in each bin the boards sailed there multiply in their
-likelihoods (:func:`log_likelihoods`).  The forward-backward recursion
+likelihoods (:func:`sailroute.analysis.infer_obs.log_likelihoods`).  The forward-backward recursion
 (:func:`smooth`) gives each bin's posterior distribution of TWD: its circular mean is the
 estimate and its spread the standard error.  Where the boards say nothing the random
 walk spreads the posterior, so the standard error grows with the time since the last

@@ -685,8 +685,8 @@ def infer_wind(
     ------
     InputError
         No tracks, bad parameters, an empty or too long time span, tracks sailed more
-        than ``MAX_APART_M`` apart, too few steady points, or boards on one side only
-        (the message says how many).
+        than ``MAX_APART_M`` apart with no majority of them together, too few steady
+        points, boards on one side only or no upwind boards (the message says how many).
     """
     trs = _check_inputs(tracks, step_s, window_s, prior_twd_deg, min_speed_ms)
     if tws is None:
@@ -724,7 +724,6 @@ def infer_wind(
             f"not turning) in {iso(t0)} .. {iso(t1)}; need at least 60: give longer tracks "
             "or the race's time span"
         )
-
     K = len(trs)
     n_bins = int(np.ceil((t1 - t0) / BIN_S)) + 1
     priors = _angle_priors(boat, p)
@@ -746,7 +745,7 @@ def infer_wind(
     n = np.searchsorted(p.t, tg + h, side="right") - np.searchsorted(p.t, tg - h, side="left")
     tws_ms, tws_sd, tws_note = _tws(tws, tg, p, res, tbin, un, h, bad)
     notes.append(tws_note)
-    notes.extend(_boat_notes(names, p, res, priors, boat is not None))
+    notes.extend(_boat_notes(names, p, res, boat is not None))
     used = res.ang.use[res.obs.boat]
     sec = np.bincount(res.cls[used], res.obs.seconds[used], 4)
     turned = res.ang.use[res.turn_boat]
@@ -822,7 +821,6 @@ def _boat_notes(
     names: Sequence[str],
     p: _Points,
     res: _Pass,
-    priors: tuple[tuple[float, float], tuple[float, float]],
     polar: bool,
 ) -> list[str]:
     """One line per boat: its angles, how well it holds them, its boards."""
@@ -847,8 +845,7 @@ def _boat_notes(
             else f"gybing half-angle {180.0 - ang.gamma[k]:.1f} ± {ang.gamma_sd[k]:.1f}°"
         )
         weak = (
-            f" (no tacks: the {'polar' if polar else 'fleet'}'s {ang.alpha[k]:.0f}° ± "
-            f"{ang.alpha_sd[k]:.0f}°)"
+            f" (no tacks of its own: the fleet's{' and the polar' if polar else ''})"
             if n_tk == 0
             else ""
         )
@@ -857,7 +854,6 @@ def _boat_notes(
             f"from {n_tk} tacks, boards within {ang.sd_up[k]:.1f}°, {down} ({n_up} upwind, "
             f"{n_dn} downwind points)"
         )
-    del priors
     return out
 
 
