@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.analysis.legmode import source_leg_mode
 from sailroute.analysis.loss import (
     LossSplit,
     axis_progress,
@@ -39,7 +40,7 @@ from sailroute.analysis.segment import (
     segment_track,
 )
 from sailroute.analysis.windsource import WindSource, first_covering
-from sailroute.course.geometry import feature_centre, leg_wind_mode
+from sailroute.course.geometry import feature_centre
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
@@ -271,6 +272,7 @@ def analyze_track(
                 centre,
                 progress,
                 obstacles=obstacles,
+                design=wind,
             )
             legs.append(leg)
             for k, v in (
@@ -289,7 +291,7 @@ def analyze_track(
             ):
                 cols[k].append(v)
             continue
-        mode = leg_wind_mode(chosen_field, a.t, (a.x, a.y), centre)
+        mode = source_leg_mode(course, i, sources[chosen[i]], wind, a.t, (a.x, a.y), centre).mode
         if mode == "upwind":
             vmg = sog * np.cos(np.radians(twa))
         elif mode == "downwind":
@@ -550,6 +552,7 @@ def analysis_winds(
                 boat=boat,
                 t0=gun - 60.0,
                 t1=_race_end(course, tracks),
+                marks=[m.xy for m in course.marks.values()],
             )
         except InputError as exc:
             if choice == "inferred":
@@ -565,6 +568,7 @@ def analysis_winds(
                 "inferred",
                 field,
                 f"TWD inferred from {len(tracks)} track(s), TWS of scenario {scenario!r}",
+                twd_sd=inf.sd_at,
             )
             notes.append(f"inferred wind: {_summary_text(sm)}")
     out: dict[str, list[WindSource]] = {}
@@ -698,6 +702,7 @@ def _unknown_leg(
     progress: Progress | None,
     *,
     obstacles: Obstacles | None = None,
+    design: WindField | None = None,
 ) -> LegAnalysis:
     """A leg whose start or end time is unknown: no sailed time, loss or split; the
     optimal route when the start is known."""
@@ -712,7 +717,7 @@ def _unknown_leg(
         start_pt = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
         found = first_covering(sources, *start_pt, skip=k - 1)
         k = len(sources) - 1 if found is None else found
-        mode = leg_wind_mode(sources[k].field, a.t, (a.x, a.y), centre)
+        mode = source_leg_mode(course, i, sources[k], design, a.t, (a.x, a.y), centre).mode
         obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
         opt, source = _optimal_leg(
             course,

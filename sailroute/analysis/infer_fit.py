@@ -1,8 +1,16 @@
-"""The joint fit of :mod:`sailroute.analysis.infer_wind` (steps 3 and 4): TWD(t) piecewise
-linear with a curvature penalty and per-boat half-angles, robust (Huber) weighted least
-squares (:func:`_joint_fit`); the local-linear kernel regression of the points' own TWD
-observations onto the output grid and its variance (:func:`_local_linear`,
-:func:`_group_var`)."""
+"""The smoother of :mod:`sailroute.analysis.infer_wind`: TWD(t) as a hidden random walk on
+a grid of directions, observed through the boats' boards and turns (step 4).
+
+TWD is discretised on the circle (``GRID_DEG``) and in time (bins of ``BIN_S``).  Between
+bins it moves as a random walk (variance ``q`` per second, chosen by the marginal
+likelihood among ``Q_GRID``); in each bin the boards sailed there multiply in their
+likelihoods (:func:`sailroute.analysis.infer_obs.log_likelihoods`).  The forward-backward recursion
+(:func:`smooth`) gives each bin's posterior distribution of TWD: its circular mean is the
+estimate and its spread the standard error.  Where the boards say nothing the random
+walk spreads the posterior, so the standard error grows with the time since the last
+informative board, on both sides of a gap.  Also the local-linear kernel regression
+used for TWS (:func:`_local_linear`).
+"""
 
 from __future__ import annotations
 
@@ -11,246 +19,144 @@ from typing import Final
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import solveh_banded
+from scipy import fft as sfft
 
-from sailroute.analysis.infer_courses import _Points
 from sailroute.units import wrap180
 
-LAMBDA_SCALE: Final = 0.125
-"""The curvature penalty of the joint fit lets TWD(t) bend on a time scale of about
-``LAMBDA_SCALE * window_s`` (the equivalent kernel of a second-difference penalty spans
-``(lambda / rho) ** 0.25`` knots, rho the data weight per knot)."""
+GRID_DEG: Final = 1.0
+"""Resolution of the direction grid [°] (a board's course is rounded to it: an error of
+0.3° sd, well below a board's own)."""
 
-N_ITER: Final = 4
-"""Classify-and-fit passes of the joint fit."""
+BIN_S: Final = 10.0
+"""Time step of the random walk and of the binned observations [s]."""
 
-UP_HALF_DEG: Final = (15.0, 65.0)
-"""First-pass range of upwind |TWA| [°] (tacking half-angles)."""
+Q_GRID: Final = (1.0, 3.0)
+"""Candidate variances of the random walk [°² s⁻¹]; the one of the larger marginal
+likelihood is used.  The least, 1.0, lets TWD wander 10° in 100 s (a wind that swings
+±10° every 6 min; the SailGP boats' logged TWD changes 5-6.5° RMS in 30-60 s, Auckland
+2025), so that a wind the tracks do not see shifting (a fleet on one board at a constant
+heading, a reach, a run) is not held steadier than that: the standard error grows by
+this rate on both sides of such a stretch."""
 
-DOWN_OFF_DEG: Final = 50.0
-"""First pass: downwind boards lie within this of dead downwind [°]."""
-
-BAND_DEG: Final = 20.0
-"""Later passes: a point is on a board when its |TWA| is within this of the boat's fitted
-half-angle [°]; anything else is a reach and is rejected."""
-
-GAMMA_PRIOR_DEG: Final = (10.0, 5.0)
-"""Prior of the downwind angle off dead downwind (180° − gybing half-angle) [°]."""
-
-UP_MODEL_SD: Final = 3.0
-"""How far from one constant angle a boat sails on an upwind board [°]: the VMG optimum is
-flat, so a few degrees higher or lower cost little (sailroute's own routes sail 40-50° in
-an oscillating wind).  Correlated along a board: it does not average down
-with the number of points."""
-
-RUN_MODEL_SD: Final = 8.0
-"""The same for a boat that runs (``RUN_GAMMA_DEG``) [°]: near
-dead downwind the polar is flat and the boat steers towards the mark, up to 10° by the lee
-or on a broad reach without a gybe."""
-
-DOWN_MODEL_SD: Final = 3.0
-"""The same for downwind boards of a boat that gybes through a clear angle [°]."""
-
-RUN_WEIGHT: Final = 0.1
-"""Runs count for this share of their variance weight [-]: they give the direction where
-no boat is on a board, but do not pull a beat's estimate towards the rhumb line (their
-error is a bias towards the mark, not noise)."""
-
-RUN_GAMMA_DEG: Final = 12.0
-"""A boat whose downwind courses spread less than this either side of dead downwind runs
-[°] (:func:`half_separation_deg`)."""
+START_SD_DEG: Final = 45.0
+"""Sd of the direction at the first bin about the starting guess [°]: enough to leave
+the boards free, not so much that the other end of the wind axis comes in."""
 
 
 @dataclass(frozen=True)
-class _Fit:
-    knots: NDArray[np.float64]
-    twd: NDArray[np.float64]  # unwrapped TWD at the knots [°]
-    alpha: NDArray[np.float64]  # per boat [°]
-    gamma: NDArray[np.float64]  # per boat [°]
-    alpha_sd: NDArray[np.float64]
-    gamma_sd: NDArray[np.float64]
-    up: NDArray[np.bool_]  # per point: on an upwind board
-    used: NDArray[np.bool_]  # per point: on a board (up or down)
-    boat: NDArray[np.int64]  # per point: boat index
-    side: NDArray[np.float64]  # per point: +1 starboard, -1 port
-    obs: NDArray[np.float64]  # per point: its own TWD observation (unwrapped) [°]
-    w: NDArray[np.float64]  # per point: fit weight (1/sd^2 x robust x correlation)
-    msd: NDArray[np.float64]  # per point: model sd (UP/RUN/DOWN_MODEL_SD) [°]
-    sigma: tuple[float, float]  # residual sd upwind, downwind [°]
+class Posterior:
+    """The smoother's result, per time bin.
 
-
-def _basis(t: NDArray, knots: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-    """Linear-interpolation basis: left knot index and the two weights."""
-    j = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, knots.size - 2)
-    f = np.clip((t - knots[j]) / (knots[j + 1] - knots[j]), 0.0, 1.0)
-    return j, 1.0 - f, f
-
-
-def _joint_fit(
-    p: _Points,
-    n_boats: int,
-    knots: NDArray,
-    twd0: NDArray,
-    alpha0: NDArray,
-    gamma0: NDArray,
-    alpha_prior_sd: float,
-    window_s: float,
-    *,
-    use_down: bool = True,
-    alpha_sd_fixed: NDArray | None = None,
-    gamma_prior_sd: NDArray | None = None,
-) -> _Fit:
-    """Fit TWD(t) at the knots and the boats' half-angles (module notes, step 3).
-
-    ``use_down=False`` fits the upwind boards alone; ``alpha_sd_fixed`` holds the tacking
-    half-angles at ``alpha0`` (their sd as given) and fits the rest.
+    Attributes
+    ----------
+    mean_deg : ndarray
+        Circular mean of the posterior [°, in ``[0, 360)``].
+    sd_deg : ndarray
+        Its standard deviation about the mean [°].
+    q : float
+        The random walk's variance rate used [°² s⁻¹].
     """
-    J, K = knots.size, n_boats
-    P = J + 2 * K
-    j, w0, w1 = _basis(p.t, knots)
-    twd = twd0.copy()
-    alpha, gamma = alpha0.copy(), gamma0.copy()
-    robust = np.ones(p.t.size)
-    sig_up, sig_dn = 5.0, 10.0
-    par_var: NDArray[np.float64] = np.ones(2 * K)
-    # D'D of the second-difference operator D, built band by band (pentadiagonal)
-    dtd = np.zeros((J, J))
-    r = np.arange(J - 2)
-    for a_, ca in enumerate((1.0, -2.0, 1.0)):
-        for b_, cb in enumerate((1.0, -2.0, 1.0)):
-            np.add.at(dtd, (r + a_, r + b_), ca * cb)
-    up = used = np.zeros(p.t.size, bool)
-    side = np.ones(p.t.size)
-    y = np.zeros(p.t.size)
-    coef = np.zeros(p.t.size)
-    wt = np.zeros(p.t.size)
-    for it in range(N_ITER):
-        cur = twd[j] * w0 + twd[j + 1] * w1
-        twa = wrap180(cur - p.cog)
-        a = np.abs(twa)
-        side = np.where(twa >= 0, 1.0, -1.0)
-        if it == 0 and alpha_sd_fixed is None:
-            up = (a >= UP_HALF_DEG[0]) & (a <= UP_HALF_DEG[1])
-            dn = a >= 180.0 - DOWN_OFF_DEG
-        else:
-            up = np.abs(a - alpha[p.boat]) <= BAND_DEG
-            dn = (
-                (np.abs((180.0 - a) - gamma[p.boat]) <= BAND_DEG + 5.0)
-                if it
-                else (a >= 180.0 - DOWN_OFF_DEG)
-            )
-        if not use_down:
-            dn = np.zeros_like(up)
-        used = up | dn
-        # observation relative to the current curve: y = dTWD(t) - s alpha (up),
-        # y = dTWD(t) + s gamma (down); unknowns: knot increments, alpha, gamma (absolute)
-        y = np.where(up, wrap180(p.cog - cur), wrap180(p.cog + 180.0 - cur))
-        col = np.where(up, J + p.boat, J + K + p.boat)
-        coef = np.where(up, -side, side)
-        msd = _model_sd(up, gamma[p.boat])
-        run = ~up & (np.abs(gamma[p.boat]) < RUN_GAMMA_DEG)
-        wt = (
-            robust
-            * p.weight
-            * used
-            * np.where(run, RUN_WEIGHT, 1.0)
-            / (np.where(up, sig_up, sig_dn) ** 2 + msd**2)
-        )
-        # normal equations by accumulation: 3 non-zeros per row
-        idx = np.stack([j, j + 1, col], axis=1)
-        val = np.stack([w0, w1, coef], axis=1)
-        rows = (idx[:, :, None] * P + idx[:, None, :]).reshape(-1)
-        prods = (val[:, :, None] * val[:, None, :] * wt[:, None, None]).reshape(-1)
-        N: NDArray[np.float64] = (
-            np.bincount(rows, weights=prods, minlength=P * P).reshape(P, P).astype(float)
-        )
-        b: NDArray[np.float64] = np.bincount(
-            idx.reshape(-1), weights=(val * (wt * y)[:, None]).reshape(-1), minlength=P
-        ).astype(float)
-        # curvature penalty on the increments (bridges gaps; resolution ~ window_s)
-        per_knot = np.bincount(j, weights=wt, minlength=J)
-        rho = float(np.median(per_knot[per_knot > 0])) if (per_knot > 0).any() else 1.0
-        lam = rho * (LAMBDA_SCALE * window_s / (knots[1] - knots[0])) ** 4
-        N[:J, :J] += lam * dtd
-        N[np.arange(J), np.arange(J)] += 1e-6
-        # penalise the curvature of the total curve, not only of the increment
-        b[:J] -= lam * (dtd @ twd)
-        # priors on the half-angles (absolute values)
-        ia, ig = J + np.arange(K), J + K + np.arange(K)
-        a_sd = alpha_prior_sd if alpha_sd_fixed is None else 1e-3
-        N[ia, ia] += 1.0 / a_sd**2
-        g_sd = GAMMA_PRIOR_DEG[1] if gamma_prior_sd is None else gamma_prior_sd
-        N[ig, ig] += 1.0 / g_sd**2
-        b[ia] += alpha0 / a_sd**2
-        b[ig] += gamma0 / g_sd**2
-        sol, par_var = _solve_bordered(N, b, J)
-        twd = twd + sol[:J]
-        alpha, gamma = sol[ia], sol[ig]
-        # residuals and robust weights
-        fitted = sol[:J][j] * w0 + sol[:J][j + 1] * w1 + coef * sol[col]
-        r = y - fitted
-        sig_up = _mad(r[up & used]) if (up & used).sum() > 10 else sig_up
-        sig_dn = _mad(r[~up & used]) if (~up & used).sum() > 10 else sig_dn
-        sig_up, sig_dn = max(sig_up, 0.5), max(sig_dn, 0.5)
-        sc = np.where(up, sig_up, sig_dn)
-        robust = np.minimum(1.0, 1.5 * sc / np.maximum(np.abs(r), 1e-9))
-    cur = twd[j] * w0 + twd[j + 1] * w1
-    obs = cur + wrap180(
-        np.where(up, p.cog + side * alpha[p.boat], p.cog + 180.0 - side * gamma[p.boat]) - cur
-    )
-    ia, ig = J + np.arange(K), J + K + np.arange(K)
-    # the covariance of a weighted fit with weights 1/sigma^2 is in deg^2 already
-    a_out = np.sqrt(par_var[:K]) if alpha_sd_fixed is None else alpha_sd_fixed
-    return _Fit(
-        knots,
-        twd,
-        alpha,
-        gamma,
-        a_out,
-        np.sqrt(par_var[K:]),
-        up & used,
-        used,
-        p.boat,
-        side,
-        obs,
-        wt,
-        _model_sd(up, gamma[p.boat]),
-        (sig_up, sig_dn),
-    )
+
+    mean_deg: NDArray[np.float64]
+    sd_deg: NDArray[np.float64]
+    q: float
 
 
-def _solve_bordered(
-    N: NDArray, b: NDArray, J: int
+def grid_deg() -> NDArray[np.float64]:
+    """The direction grid [°]: cell centres ``0, GRID_DEG, ...``."""
+    return np.arange(0.0, 360.0, GRID_DEG)
+
+
+def _kernel(var_deg2: float) -> NDArray[np.complex128]:
+    """Real FFT of the wrapped Gaussian step of variance ``var_deg2`` on the grid."""
+    g = grid_deg()
+    d = np.minimum(g, 360.0 - g)
+    k = np.exp(-0.5 * d * d / max(var_deg2, 1e-12))
+    return np.asarray(sfft.rfft(k / k.sum()), dtype=complex)
+
+
+def _step(a: NDArray, kf: NDArray) -> NDArray[np.float64]:
+    """One random-walk step of the distributions in the rows of ``a`` (circular
+    convolution), clipped at 0 against round-off."""
+    return np.maximum(sfft.irfft(sfft.rfft(a, axis=-1) * kf, n=a.shape[-1], axis=-1), 0.0)
+
+
+def _forward(
+    lik: NDArray, prior: NDArray, kfs: NDArray
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Solve the normal equations ``N x = b`` whose knot block ``N[:J, :J]`` is banded
-    (pentadiagonal: linear basis plus the second-difference penalty) and bordered by a few
-    dense parameter rows, by the Schur complement in O(J); also the variances of the
-    parameters (the diagonal of the parameter block of ``N⁻¹``)."""
-    A, B, C = N[:J, :J], N[:J, J:], N[J:, J:]
-    ab = np.zeros((3, J))
-    for u in range(3):  # upper banded storage: ab[2 - u, j] = A[j - u, j]
-        ab[2 - u, u:] = np.diagonal(A, u)
-    rhs = np.column_stack([b[:J], B])
-    try:
-        z = solveh_banded(ab, rhs)
-        S = C - B.T @ z[:, 1:]
-        par = np.linalg.solve(S, b[J:] - B.T @ z[:, 0])
-        var = np.diag(np.linalg.inv(S))
-    except (np.linalg.LinAlgError, ValueError):
-        sol = np.linalg.lstsq(N, b, rcond=None)[0]
-        return sol, np.diag(np.linalg.pinv(N))[J:].astype(float)
-    x = z[:, 0] - z[:, 1:] @ par
-    return np.concatenate([x, par]), np.asarray(var, dtype=float)
+    """Filtered distributions (bins x candidates x grid) and the log normaliser of each
+    step (bins x candidates), for several kernels at once."""
+    nb, G = lik.shape
+    nq = kfs.shape[0]
+    out = np.empty((nb, nq, G))
+    logc = np.empty((nb, nq))
+    a = np.broadcast_to(prior, (nq, G))
+    for b in range(nb):
+        if b:
+            a = _step(a, kfs)
+        a = a * lik[b]
+        c = a.sum(-1)
+        c = np.where(c > 0, c, 1e-300)
+        a = a / c[:, None]
+        out[b], logc[b] = a, np.log(c)
+    return out, logc
 
 
-def _model_sd(up: NDArray, gamma: NDArray) -> NDArray[np.float64]:
-    return np.where(
-        up, UP_MODEL_SD, np.where(np.abs(gamma) < RUN_GAMMA_DEG, RUN_MODEL_SD, DOWN_MODEL_SD)
-    )
+def _prior(start_deg: float) -> NDArray[np.float64]:
+    g = grid_deg()
+    prior = np.exp(-0.5 * (wrap180(g - start_deg) / START_SD_DEG) ** 2)
+    return np.asarray(prior / prior.sum(), dtype=float)
 
 
-def _mad(r: NDArray) -> float:
-    return float(1.4826 * np.median(np.abs(r - np.median(r))))
+def log_marginal(ll: NDArray, start_deg: float) -> NDArray[np.float64]:
+    """Log marginal likelihood of the bins' log likelihoods ``ll`` for each candidate
+    random-walk rate of ``Q_GRID``."""
+    top = ll.max(axis=1, keepdims=True)
+    kfs = np.stack([_kernel(c * BIN_S) for c in Q_GRID])
+    _, logc = _forward(np.exp(ll - top), _prior(start_deg), kfs)
+    return np.asarray(logc.sum(0) + float(top.sum()), dtype=float)
+
+
+def smooth(ll: NDArray, start_deg: float, q: float) -> Posterior:
+    """Posterior of TWD in each bin from the bins' log likelihoods on the grid.
+
+    Parameters
+    ----------
+    ll : ndarray, shape (bins, grid)
+        Log likelihood of each grid direction in each bin (0 where nothing is observed).
+    start_deg : float
+        Starting guess of the first bin's direction [°] (sd ``START_SD_DEG``).
+    q : float
+        Random-walk variance rate [°² s⁻¹].
+
+    Returns
+    -------
+    Posterior
+    """
+    top = ll.max(axis=1, keepdims=True)
+    lik = np.exp(ll - top)
+    kf = _kernel(q * BIN_S)
+    fwd, _ = _forward(lik, _prior(start_deg), kf[None, :])
+    a = fwd[:, 0]
+    post = np.empty_like(a)
+    beta = np.ones(a.shape[1])
+    for b in range(a.shape[0] - 1, -1, -1):
+        p = a[b] * beta
+        post[b] = p / max(p.sum(), 1e-300)
+        beta = _step(lik[b] * beta, kf)
+        beta /= max(beta.max(), 1e-300)
+    mean, sd = circular_stats(post)
+    return Posterior(mean, sd, float(q))
+
+
+def circular_stats(p: NDArray) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Circular mean [°] and the sd about it [°] of distributions on the grid (rows)."""
+    g = grid_deg()
+    r = np.radians(g)
+    mean = np.degrees(np.arctan2(p @ np.sin(r), p @ np.cos(r))) % 360.0
+    d = wrap180(g[None, :] - mean[:, None])
+    sd = np.sqrt(np.sum(p * d * d, axis=1) / np.maximum(p.sum(1), 1e-300))
+    return mean, sd
 
 
 def _local_linear(
@@ -322,38 +228,3 @@ def _local_linear(
     est[ok], var[ok], n[:] = e[ok], var_[ok], n_
     mu2[ok] = m2[ok]
     return est, var, n, mu2
-
-
-def _group_var(
-    tg: NDArray, t: NDArray, w: NDArray, h: float, fit: _Fit, m: NDArray
-) -> NDArray[np.float64]:
-    """Variance [°²] at the grid times from errors shared by a boat's board.
-
-    Two terms per boat and board (upwind, downwind), with ``f_i`` the point's share of the
-    kernel weight: the model error (``(sum f_i msd_i)²``: how far a board's angle may sit
-    from the fitted constant, the same along the board) and the uncertainty of the fitted
-    half-angle (``(sum f_i s_i)² sd²`` with ``s_i`` the board's sign: it cancels where both
-    boards are sailed in the window and adds up where only one is).
-    """
-    up, boat = fit.up[m], fit.boat[m]
-    coef = np.where(up, fit.side[m], -fit.side[m])
-    msd = fit.msd[m]
-    var = np.zeros(tg.size)
-    lo = np.searchsorted(t, tg - h, side="left")
-    hi = np.searchsorted(t, tg + h, side="right")
-    width = int(np.max(hi - lo)) if tg.size else 0
-    if width == 0:
-        return var
-    k = lo[:, None] + np.arange(width)[None, :]
-    inside = k < hi[:, None]
-    k = np.minimum(k, t.size - 1)
-    kern = (
-        np.where(inside, (1.0 - np.clip(np.abs(t[k] - tg[:, None]) / h, 0, 1) ** 3) ** 3, 0.0)
-        * w[k]
-    )
-    f = kern / np.maximum(kern.sum(1), 1e-300)[:, None]
-    for is_up, sds in ((True, fit.alpha_sd), (False, fit.gamma_sd)):
-        for b, sd in enumerate(sds):
-            sel = (up[k] == is_up) & (boat[k] == b)
-            var += ((f * coef[k] * sel).sum(1) * sd) ** 2 + ((f * msd[k] * sel).sum(1)) ** 2
-    return var

@@ -1,51 +1,44 @@
-"""Wind inferred from GPS tracks without instruments: TWD(t), and TWS(t) with a polar.
+"""Wind inferred from GPS tracks without instruments: TWD(t) with an honest uncertainty,
+and TWS(t) from a source the caller chooses.
 
 A boat racing upwind sails close to its best-VMG angle on each board, so its course over
-ground is the wind direction minus (starboard) or plus (port) its tacking half-angle α;
-downwind the same holds with the gybing half-angle.  One or more boats' tracks thus hold
-the wind direction and its shifts over time.  The method (``docs/analysis.md``, "Wind
-inferred from tracks"):
+ground is the wind direction minus (starboard) or plus (port) its tacking half-angle α; a
+boat that gybes downwind does the same about the downwind direction; a tack turns the bow
+through the wind and a gybe away from it.  Reaches and runs steer for a mark: they bound
+the wind more than they tell it.  The method (``docs/analysis.md``, "Wind inferred from
+tracks"):
 
-1. **Steady points.**  The course at each point is that of the displacement over
-   ``COG_WINDOW_S`` centred on it.  A point is kept where the boat is faster than
-   ``min_speed_ms``, its courses over the ``TURN_WINDOW_S`` before and after it differ by
-   less than ``TURN_DEG`` (no manoeuvre), no turning or slow point lies within ``PAD_S``
-   (the acceleration after a tack or gybe), no turn of more than ``ROUNDING_DEG`` (a mark
-   rounding) within ``ROUNDING_PAD_S``, and no gap in the log nearby.
+1. **Steady points, boards and turns** (:mod:`~sailroute.analysis.infer_courses`): the
+   course of each point over ``COG_WINDOW_S``; points away from manoeuvres, roundings,
+   slow stretches and gaps; a board is one boat's run of steady points between two turns,
+   and each turn has the courses before and after it.
 2. **The wind axis** from the pooled histogram of steady courses: the direction about
-   which the histogram is most symmetric (pairs of courses 2 x 15° to 2 x 60° apart: the two
-   upwind boards, the two downwind boards).  The up/down ambiguity is resolved with
-   ``prior_twd_deg`` (the axis end within 90° of it), or, without a prior, by the boards'
-   separation (tacking half-angles exceed the downwind boards' angle off dead downwind)
-   and, where that is not clear, by speeds (the upwind boards are sailed slower).
-3. **A joint fit.**  Each steady point on an upwind board is one observation of TWD:
-   ``course + α_k`` on starboard and ``course − α_k`` on port, with α_k an unknown per
-   boat.  TWD(t) is piecewise linear (knots every ``KNOT_S``) with a weak curvature
-   penalty that bridges gaps; the fit is a robust (Huber) weighted least squares,
-   re-classified and re-fitted ``N_ITER`` times.  Points that fit neither board (reaches)
-   are rejected.  The tack jumps of one boat (the bisector of the courses before and
-   after), the two boards' courses in the same window (their half-difference is α) and
-   the course changes along a board all enter that fit; several boats pool into the one
-   TWD(t).  The downwind boards are then added with α held: ``course + 180° ∓ γ_k``
-   (``γ_k = 180° − gybing half-angle``, fitted), or, for a boat whose downwind courses
-   spread less than ``RUN_GAMMA_DEG`` about dead downwind, ``course + 180°`` at
-   ``RUN_WEIGHT`` of its weight (a run: the boat steers for the mark).
-4. **The output grid**: TWD at each grid time is a local-linear kernel regression
-   (tricube kernel of half-width ``window_s / 2``) of the points' own TWD observations;
-   its standard error combines the scatter of those observations (each 1 Hz point counts
-   for ``1 / CORR_S`` of an independent one: course errors are correlated over several
-   seconds), per boat and board a model error that does not average down
-   (``UP_MODEL_SD``, ``RUN_MODEL_SD``, ``DOWN_MODEL_SD``) and the fitted half-angle's
-   uncertainty, and an estimate of the smoothing bias (from the fitted curvature).
-5. **TWS** (only with a polar): each steady point's speed over ground, at its TWA from the
-   inferred TWD, is the polar's speed at one TWS; those TWS are smoothed like TWD.  This
-   is the wind in which the polar sails the observed speeds: right only for a boat that
-   sails to its polar.
+   which it is most symmetric.  Which end is upwind: the one nearer ``prior_twd_deg``,
+   or without a prior the end about which the boards lie further apart (tacking
+   half-angles exceed the downwind boards' angle off dead downwind) and, where that is
+   not clear, the slower boards.
+3. **Observations** (:mod:`~sailroute.analysis.infer_obs`): each board is an upwind board
+   (next to a tack of its boat, at ``α_k``), a downwind board (next to a gybe, at
+   ``180° − γ_k``), a run (a box about the course + 180°) or free (a reach, or a board
+   the estimate cannot place: only ``|TWA| >= α_k − 8°``); each tack and gybe observes the
+   wind through the direction its bow passed half-way round.  The boats' angles come
+   from their own tacks and gybes (half the angle turned through), the fleet's, or the
+   polar; each boat's scatter about them weights its boards (a boat that holds its
+   angles badly counts less), and every likelihood has a floor (an outlier boat cannot
+   pull the estimate further than its floor allows).
+4. **The smoother** (:mod:`~sailroute.analysis.infer_fit`): TWD on a grid of directions
+   follows a random walk between bins of 10 s (its rate chosen by the marginal
+   likelihood); the forward-backward recursion gives each bin's posterior.  Its mean is
+   the estimate; its spread, plus the fitted angles' uncertainty and an error all boats
+   share, the standard error.  Where no board tells the wind the posterior spreads, so
+   the standard error grows with the time since the last informative board.  Classes
+   and angles are re-fitted ``N_ITER`` times.
+5. **TWS** from an explicit source (:class:`~sailroute.analysis.infer_tws.TwsSource`): a
+   series (scenario, measured, station) or the polar inverted at the observed speeds.
 
-Assumptions: boats sail close to constant angles on each board (their best VMG); no
-current (COG = heading, no leeway); a symmetric polar (same angle on both boards); the
-wind uniform over the area the boats sail.  A shift between two tacks of the same board
-is seen only through the course changes on that board.
+Assumptions: boats sail close to one angle on each upwind board and on each gybing
+downwind board; no current (COG = heading, no leeway); the same angle on both tacks; the
+wind uniform over the area the boats sail.
 """
 
 from __future__ import annotations
@@ -69,28 +62,47 @@ from sailroute.analysis.infer_courses import (
     ROUNDING_PAD_S,
     TURN_DEG,
     TURN_WINDOW_S,
+    _Boards,
     _Points,
     _steady_points,
+    _Turns,
     axis_near_prior,
     half_separation_deg,
     wind_axis_deg,
 )
 from sailroute.analysis.infer_fit import (
-    BAND_DEG,
-    DOWN_MODEL_SD,
-    DOWN_OFF_DEG,
-    GAMMA_PRIOR_DEG,
-    LAMBDA_SCALE,
-    N_ITER,
-    RUN_GAMMA_DEG,
-    RUN_MODEL_SD,
-    RUN_WEIGHT,
-    UP_HALF_DEG,
-    UP_MODEL_SD,
-    _group_var,
-    _joint_fit,
+    BIN_S,
+    Q_GRID,
+    Posterior,
     _local_linear,
+    log_marginal,
+    smooth,
 )
+from sailroute.analysis.infer_obs import (
+    ALPHA_PRIOR_DEG,
+    CLASS_NAMES,
+    DOWN,
+    DOWN_MODEL_SD,
+    FREE,
+    GAMMA_PRIOR_DEG,
+    GYBE,
+    RUN,
+    TACK,
+    TURN_SD_DEG,
+    UP,
+    UP_MODEL_SD,
+    BoatAngles,
+    Obs,
+    boat_angles,
+    classify_boards,
+    left_out,
+    log_likelihoods,
+    no_go_share,
+    observations,
+    systematic_var,
+    turn_kinds,
+)
+from sailroute.analysis.infer_tws import TwsSource, invert_polar
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError
 from sailroute.geo import LocalFrame
@@ -103,14 +115,8 @@ from sailroute.wind.base import Coverage, prepare_points
 __all__ = [
     "ALPHA_PRIOR_DEG",
     "AXIS_TIE",
-    "BAND_DEG",
     "COG_WINDOW_S",
     "CORR_S",
-    "DOWN_MODEL_SD",
-    "DOWN_OFF_DEG",
-    "GAMMA_PRIOR_DEG",
-    "KNOT_S",
-    "LAMBDA_SCALE",
     "MAX_APART_M",
     "MAX_GAP_S",
     "MAX_SD_DEG",
@@ -122,18 +128,13 @@ __all__ = [
     "PAD_S",
     "ROUNDING_DEG",
     "ROUNDING_PAD_S",
-    "RUN_GAMMA_DEG",
-    "RUN_MODEL_SD",
-    "RUN_WEIGHT",
-    "SEPARATION_MARGIN_DEG",
     "STEP_S",
     "TURN_DEG",
     "TURN_WINDOW_S",
-    "UP_HALF_DEG",
-    "UP_MODEL_SD",
     "WINDOW_S",
     "InferredWind",
     "InferredWindField",
+    "TwsSource",
     "axis_near_prior",
     "half_separation_deg",
     "infer_wind",
@@ -144,18 +145,14 @@ __all__ = [
 MIN_SPEED_MS: Final = 1.0
 """Points slower than this [m s⁻¹] are rejected (no steady course)."""
 
-KNOT_S: Final = 20.0
-"""Knot spacing of the piecewise-linear TWD(t) of the joint fit [s]."""
-
 STEP_S: Final = 30.0
 """Default output grid step [s]."""
 
 WINDOW_S: Final = 90.0
-"""Default full width of the output smoothing kernel [s]."""
+"""Default full width of the kernel that smooths TWS and counts ``n_obs`` [s]."""
 
-ALPHA_PRIOR_DEG: Final = (42.0, 10.0)
-"""Prior of a tacking half-angle without a polar: mean and sd [°] (keeps a boat that
-sails one board only solvable; the data dominate otherwise)."""
+N_ITER: Final = 4
+"""Classify-and-smooth passes."""
 
 SEPARATION_MARGIN_DEG: Final = 10.0
 """Without a prior, the wind axis end about which the boards are this much further apart
@@ -168,13 +165,19 @@ MAX_APART_M: Final = 20_000.0
 """Tracks whose mean positions lie further apart than this [m] are refused."""
 
 MIN_BOARD_POINTS: Final = 20
-"""Steady points needed on each upwind board (all boats together)."""
+"""Steady points needed on each side (starboard, port) of the boards that observe the
+wind (upwind and gybing downwind boards, all boats together)."""
 
 MIN_OBS_S: Final = 20.0
-"""A grid time needs at least this many seconds of observations in its window."""
+"""TWS at a grid time needs at least this many seconds of observations in its window."""
 
-MAX_SD_DEG: Final = 15.0
-"""A grid time whose direction has a larger standard error gets none (NaN) [°]."""
+POLAR_TWA_SD_DEG: Final = 15.0
+"""TWS from the polar uses the steady points whose TWA is known to this standard error
+[°]."""
+
+MAX_SD_DEG: Final = 25.0
+"""A grid time whose direction has a larger standard error gets none (NaN) [°]: its
+posterior spreads over most of a quadrant, the tracks do not tell the wind there."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,7 +204,10 @@ class InferredWind:
     notes : tuple of str
         Per-boat half-angles, the up/down decision, checks and warnings.
     half_angles_deg : mapping of str to (float, float)
-        Per boat: fitted tacking half-angle α and gybing half-angle 180° − γ [°].
+        Per boat: fitted tacking half-angle α and gybing half-angle 180° − γ [°] (180°
+        for a boat that runs).
+    tws_source : str
+        Where ``tws_ms`` comes from (:data:`~sailroute.analysis.infer_tws.TWS_KINDS`).
     """
 
     t: NDArray[np.float64]
@@ -215,6 +221,7 @@ class InferredWind:
     half_angles_deg: Mapping[str, tuple[float, float]] = field(
         default_factory=lambda: MappingProxyType({})
     )
+    tws_source: str = "none"
 
     def __post_init__(self) -> None:
         n = np.shape(self.t)
@@ -234,6 +241,18 @@ class InferredWind:
                 f"(types.MappingProxyType), got {type(self.half_angles_deg).__name__}; "
                 "pass MappingProxyType(dict(half_angles))"
             )
+
+    def sd_at(self, t: float) -> float:
+        """Standard error of the direction at ``t`` [°]: linear between the grid times; the
+        nearest edge's outside; infinite where no grid time nearby has a direction."""
+        ok = np.isfinite(self.twd_sd_deg)
+        if not ok.any():
+            return float("inf")
+        i = int(np.clip(np.searchsorted(self.t, t), 1, max(self.t.size - 1, 1)))
+        near = self.twd_sd_deg[max(i - 1, 0) : i + 1]
+        if not np.isfinite(near).all():
+            return float("inf")
+        return float(np.interp(t, self.t[ok], self.twd_sd_deg[ok]))
 
     def field(
         self, frame: LocalFrame | None = None, tws_ms: float | None = None, *, clamp: bool = False
@@ -322,47 +341,6 @@ def _unwrap_deg(a: NDArray) -> NDArray[np.float64]:
     return np.degrees(np.unwrap(np.radians(np.asarray(a, float))))
 
 
-def _invert_polar(boat: BoatModel, twa_deg: NDArray, sog_ms: NDArray) -> NDArray[np.float64]:
-    """TWS [m s⁻¹] at which the boat's polar sails ``sog_ms`` at ``twa_deg`` (NaN where it
-    cannot: faster than the polar's top speed at that angle, or slower than at 0.5 m/s)."""
-    grid = np.arange(0.5, 25.01, 0.1)
-    ang = np.arange(0.0, 181.0)
-    table = np.asarray(boat.steady_speed(grid[None, :], ang[:, None]), float)
-    table = np.maximum.accumulate(table, axis=1)  # the rising part of each column
-    row = table[np.clip(np.rint(np.abs(twa_deg)).astype(int), 0, 180)]
-    c = (row < sog_ms[:, None]).sum(1)
-    ok = (c > 0) & (c < grid.size)
-    ci = np.clip(c, 1, grid.size - 1)
-    s0 = row[np.arange(c.size), ci - 1]
-    s1 = row[np.arange(c.size), ci]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        f = np.where(s1 > s0, (sog_ms - s0) / (s1 - s0), 0.0)
-    return np.where(ok, grid[ci - 1] + f * (grid[ci] - grid[ci - 1]), np.nan)
-
-
-def _gamma_priors(
-    p: _Points, n_boats: int, twd_axis: float, default: float
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Prior angle off dead downwind [°] per boat, and its sd.
-
-    From each boat's downwind courses: their half-separation about the downwind end of the
-    race's wind axis (:func:`half_separation_deg`).  Below ``RUN_GAMMA_DEG`` the boat runs:
-    its angle is held at 0 (a run has no boards to tell apart: the sign of a TWA near 180°
-    is noise); above, it is the prior mean with sd ``GAMMA_PRIOR_DEG[1]``.  A boat with
-    fewer than 30 downwind points gets ``default``.
-    """
-    a = np.abs(wrap180(p.cog - twd_axis - 180.0))
-    mean = np.full(n_boats, float(default))
-    sd = np.full(n_boats, GAMMA_PRIOR_DEG[1])
-    for k in range(n_boats):
-        sel = (p.boat == k) & (a < 50.0)
-        if sel.sum() >= 30:
-            g = half_separation_deg(p.cog[sel], twd_axis + 180.0, p.weight[sel])
-            if np.isfinite(g):
-                mean[k], sd[k] = (0.0, 1e-3) if g < RUN_GAMMA_DEG else (g, GAMMA_PRIOR_DEG[1])
-    return mean, sd
-
-
 def _upwind_end(p: _Points, cands: tuple[float, float]) -> tuple[float, str]:
     """Which end of the wind axis is upwind, without a prior: the end about which the
     boards are further apart (tacking half-angles exceed the downwind boards' angle off
@@ -387,23 +365,45 @@ def _upwind_end(p: _Points, cands: tuple[float, float]) -> tuple[float, str]:
     )
 
 
-def _check_same_place(trs: Sequence[Track], frame: LocalFrame, t0: float, t1: float) -> None:
-    """Refuse tracks whose mean positions over the span lie more than ``MAX_APART_M``
-    apart (boats of different races: one wind does not fit both)."""
+def _same_place(
+    trs: Sequence[Track], xy: Sequence[tuple[NDArray, NDArray]], t0: float, t1: float
+) -> tuple[list[int], list[str]]:
+    """The tracks sailed in one place, and a note for each left out.
+
+    A track whose mean position over the span lies more than ``MAX_APART_M`` from the
+    fleet's median is left out when most tracks lie together (a boat of another race:
+    one wind does not fit both); with no such majority the tracks are refused.
+    """
     centres = []
-    for i, tr in enumerate(trs):
-        part = tr.between(t0, t1)
-        if len(part):
-            x, y = track_xy(part, frame)
-            centres.append((tr.name or f"track {i + 1}", float(np.mean(x)), float(np.mean(y))))
-    for (na, xa, ya), (nb, xb, yb) in itertools.combinations(centres, 2):
+    for i, (tr, (x, y)) in enumerate(zip(trs, xy, strict=True)):
+        m = (tr.t_s >= t0) & (tr.t_s <= t1)
+        if m.any():
+            centres.append((i, float(np.mean(x[m])), float(np.mean(y[m]))))
+    if not centres:
+        return [], []
+    c = np.array([(x, y) for _, x, y in centres])
+    med = np.median(c, axis=0)
+    far = np.hypot(*(c - med).T) > MAX_APART_M
+    if 2 * int(far.sum()) >= far.size:  # no majority: judge the pairs of all tracks
+        far[:] = False
+    kept = [centres[j] for j in np.flatnonzero(~far)]
+    for (a, xa, ya), (b, xb, yb) in itertools.combinations(kept, 2):
         d = float(np.hypot(xb - xa, yb - ya))
         if d > MAX_APART_M:
             raise InputError(
-                f"infer_wind: {na!r} and {nb!r} sailed {d / 1000:.1f} km apart in the time "
-                f"span (more than {MAX_APART_M / 1000:.0f} km): one wind does not fit boats of "
-                "different places; infer each race on its own tracks"
+                f"infer_wind: {trs[a].name or f'track {a + 1}'!r} and "
+                f"{trs[b].name or f'track {b + 1}'!r} sailed {d / 1000:.1f} km apart in the "
+                f"time span (more than {MAX_APART_M / 1000:.0f} km): one wind does not fit "
+                "boats of different places; infer each race on its own tracks"
             )
+    names = [trs[i].name or f"track {i + 1}" for i, _, _ in centres]
+    notes = [
+        f"{n}: left out: sailed {np.hypot(*(c[j] - med)) / 1000:.1f} km from the fleet "
+        f"(more than {MAX_APART_M / 1000:.0f} km: another race?)"
+        for j, n in enumerate(names)
+        if far[j]
+    ]
+    return [i for j, (i, _, _) in enumerate(centres) if not far[j]], notes
 
 
 def _check_inputs(
@@ -434,82 +434,9 @@ def _check_inputs(
     return trs
 
 
-def infer_wind(
-    tracks: Sequence[Track] | Track,
-    frame: LocalFrame,
-    *,
-    prior_twd_deg: float | None = None,
-    boat: BoatModel | None = None,
-    t0: float | None = None,
-    t1: float | None = None,
-    step_s: float = STEP_S,
-    window_s: float = WINDOW_S,
-    min_speed_ms: float = MIN_SPEED_MS,
-) -> InferredWind:
-    """Estimate TWD(t), and TWS(t) with a polar, from boats' GPS tracks.
-
-    Parameters
-    ----------
-    tracks : Track or sequence of Track
-        One or more boats' tracks (positions; instrument channels are not used).
-    frame : LocalFrame
-        Local metric frame (the course's ``Course.frame``); directions are in its grid.
-    prior_twd_deg : float, optional
-        A rough TWD [°, from] (the course axis, the sailor's estimate; within ~60°) that
-        decides which end of the inferred axis the wind comes from.  Without it the
-        upwind end is the one about which the boards lie further apart (or, where that
-        is not clear, are sailed slower); ``notes`` says which decided.
-    boat : BoatModel, optional
-        The boats' polar: gives TWS(t) (the wind in which it sails the observed speeds)
-        and the prior half-angles (its best-VMG angles at a TWS guessed from the median
-        speed).  Without it TWS stays NaN.
-    t0, t1 : float, optional
-        Time span [epoch s] of the grid; default the tracks' span (at most
-        ``MAX_SPAN_S``).
-    step_s : float
-        Grid step [s].
-    window_s : float
-        Full width of the smoothing window [s]: the time resolution of the estimate.
-    min_speed_ms : float
-        Points slower than this are rejected [m s⁻¹].
-
-    Returns
-    -------
-    InferredWind
-
-    Raises
-    ------
-    InputError
-        No tracks, bad parameters, an empty or too long time span, tracks sailed more
-        than ``MAX_APART_M`` apart, or too few steady points on upwind or downwind boards
-        to infer a direction (the message says how many).
-    """
-    trs = _check_inputs(tracks, step_s, window_s, prior_twd_deg, min_speed_ms)
-    ta = min(float(tr.t_s[0]) for tr in trs if len(tr)) if any(len(tr) for tr in trs) else 0.0
-    tb = max(float(tr.t_s[-1]) for tr in trs if len(tr)) if any(len(tr) for tr in trs) else 0.0
-    t0 = ta if t0 is None else float(t0)
-    t1 = tb if t1 is None else float(t1)
-    if not t1 > t0:
-        raise InputError(
-            f"infer_wind: empty time span {iso(t0)} .. {iso(t1)}; "
-            "give t0 < t1 within the tracks' times"
-        )
-    if t1 - t0 > MAX_SPAN_S:
-        raise InputError(
-            f"infer_wind: the time span {iso(t0)} .. {iso(t1)} is {(t1 - t0) / 3600:.1f} h, "
-            f"more than {MAX_SPAN_S / 3600:.0f} h (tracks of different days?); infer one race "
-            "at a time: give t0 and t1, or the tracks of one race"
-        )
-    _check_same_place(trs, frame, t0, t1)
-    names = [tr.name or f"track {i + 1}" for i, tr in enumerate(trs)]
-    p, notes = _steady_points(trs, frame, t0, t1, min_speed_ms)
-    if p.t.size < 60:
-        raise InputError(
-            f"infer_wind: only {p.t.size} steady points (faster than {min_speed_ms} m/s, "
-            f"not turning) in {iso(t0)} .. {iso(t1)}; need at least 60: give longer tracks "
-            "or the race's time span"
-        )
-    # 1. the axis and which end is upwind
+def _start_guess(p: _Points, prior_twd_deg: float | None) -> tuple[float, str, list[str]]:
+    """The upwind end of the tracks' wind axis [°], how it was decided, and notes."""
+    notes: list[str] = []
     axis, strength = wind_axis_deg(p.cog, p.weight)
     if prior_twd_deg is not None:
         tied = axis_near_prior(p.cog, float(prior_twd_deg), p.weight)
@@ -534,129 +461,400 @@ def infer_wind(
     else:
         twd_axis, how = _upwind_end(p, cands)
     notes.append(f"wind axis {wrap360(twd_axis):.0f}° (symmetry contrast {strength:.2f}); {how}")
-    # 2. the joint fit
-    K = len(trs)
-    knots = np.arange(t0, t1 + KNOT_S, KNOT_S)
-    if knots.size < 3:
-        knots = np.linspace(t0, t1, 3)
-    a0, g0 = ALPHA_PRIOR_DEG[0], GAMMA_PRIOR_DEG[0]
-    a_sd = ALPHA_PRIOR_DEG[1]
-    if boat is not None:
-        a0v, b0v = boat.vmg_angles_deg(float(np.clip(np.median(p.sog) * 1.6, 2.0, 12.0)))
-        a0, g0 = float(a0v), float(180.0 - b0v)
-    # upwind boards alone give TWD and the tacking half-angles; the downwind boards are
-    # then fitted with those held (a running boat steers for the mark within ~10° of dead
-    # downwind, which would otherwise pull the half-angles and damp the shifts)
-    fit_up = _joint_fit(
-        p,
-        K,
-        knots,
-        np.full(knots.size, float(twd_axis)),
-        np.full(K, a0),
-        np.full(K, g0),
-        a_sd,
-        window_s,
-        use_down=False,
+    return float(twd_axis), how, notes
+
+
+def _angle_priors(
+    boat: BoatModel | None, p: _Points
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Priors of the tacking half-angle and of a gybing boat's angle off dead downwind
+    [°]: the polar's best-VMG angles at a TWS guessed from the median speed, or the
+    defaults."""
+    if boat is None:
+        return ALPHA_PRIOR_DEG, GAMMA_PRIOR_DEG
+    up, down = boat.vmg_angles_deg(float(np.clip(np.median(p.sog) * 1.6, 2.0, 12.0)))
+    return (float(up), ALPHA_PRIOR_DEG[1]), (float(180.0 - down), GAMMA_PRIOR_DEG[1])
+
+
+@dataclass(frozen=True)
+class _Pass:
+    """The last classify-and-smooth pass."""
+
+    obs: Obs
+    post: Posterior
+    board_cls: NDArray[np.int64]  # per board
+    cls: NDArray[np.int64]  # per board-bin observation
+    kinds: NDArray[np.int64]  # per turn
+    ang: BoatAngles
+    twa: NDArray[np.float64]  # per board-bin, at the posterior mean [°]
+    sd: NDArray[np.float64]  # per bin: posterior and systematic [°]
+    turn_boat: NDArray[np.int64]  # per turn
+    no_go: NDArray[np.float64]  # per boat: share of its time in the no-go zone
+
+
+@dataclass(frozen=True)
+class _Fleet:
+    """What the passes work on: the steady points, boards and turns of all boats."""
+
+    p: _Points
+    boards: _Boards
+    turns: _Turns
+    n_boats: int
+    t0: float  # start of the first bin [epoch s]
+    n_bins: int
+    priors: tuple[tuple[float, float], tuple[float, float]]  # α and γ [°]: mean, sd
+    at_mark: NDArray[np.bool_]  # per turn: near a mark (a rounding)
+
+
+def _passes(f: _Fleet, prior_twd_deg: float | None) -> tuple[_Pass, float, str, list[str]]:
+    """Classify, fit the boats' angles and smooth, ``N_ITER`` times (module notes); the
+    passes start again without the boats the first pass finds not racing in this wind
+    (:func:`~sailroute.analysis.infer_obs.left_out`).  Also the upwind end of the wind
+    axis, how it was decided, and notes."""
+    use = np.ones(f.n_boats, bool)
+    for _ in range(3):
+        mine = use[f.p.boat]
+        kept = _Points(
+            *(getattr(f.p, k)[mine] for k in ("t", "cog", "sog", "boat", "weight", "board"))
+        )
+        start, how, notes = _start_guess(kept, prior_twd_deg)
+        res, again = _pass_loop(f, start, use)
+        if not again.any():
+            break
+        use = use & ~again
+    return res, start, how, notes
+
+
+def _pass_loop(f: _Fleet, start: float, use: NDArray[np.bool_]) -> tuple[_Pass, NDArray[np.bool_]]:
+    """The passes with the boats ``use``; stops after the first when it finds more boats
+    to leave out (returned)."""
+    p, boards, turns, n_boats, t0, n_bins = f.p, f.boards, f.turns, f.n_boats, f.t0, f.n_bins
+    priors, at_mark = f.priors, f.at_mark
+    obs = observations(p, t0, n_bins)
+    tb = t0 + (np.arange(n_bins) + 0.5) * BIN_S
+    un = np.full(n_bins, start)
+    sd = np.full(n_bins, 10.0)
+    ang = BoatAngles(
+        np.full(n_boats, priors[0][0]),
+        np.full(n_boats, priors[0][1]),
+        np.full(n_boats, priors[1][0]),
+        np.full(n_boats, priors[1][1]),
+        np.zeros(n_boats, bool),
+        np.full(n_boats, UP_MODEL_SD),
+        np.full(n_boats, DOWN_MODEL_SD),
+        np.full(n_boats, TURN_SD_DEG),
+        use.copy(),
     )
-    g0s, g_sd = _gamma_priors(p, K, float(twd_axis), g0)
-    fit = _joint_fit(
-        p,
-        K,
-        knots,
-        fit_up.twd,
-        fit_up.alpha,
-        g0s,
-        a_sd,
-        window_s,
-        gamma_prior_sd=g_sd,
-        alpha_sd_fixed=fit_up.alpha_sd,
-    )
-    n_up, n_dn = int(fit.up.sum()), int((fit.used & ~fit.up).sum())
-    n_stbd = int((fit_up.up & (fit_up.side > 0)).sum())
-    n_port = int((fit_up.up & (fit_up.side < 0)).sum())
-    if n_stbd + n_port < MIN_BOARD_POINTS and n_dn >= 60:
+    res: _Pass | None = None
+    q = Q_GRID[0]
+    for it in range(N_ITER):
+        twa = wrap180(np.interp(obs.t, tb, un) - obs.cog)
+        sd_obs = np.interp(obs.t, tb, sd)
+        twd_turn = np.interp(turns.t, tb, un)
+        loose = turn_kinds(turns, twd_turn, None, at_mark)
+        bcls = classify_boards(obs, boards, loose, ang, twa, sd_obs)
+        ang = boat_angles(
+            n_boats, obs, bcls[obs.board], twa, turns, loose, twd_turn, *priors, ang.use
+        )
+        kinds = turn_kinds(turns, twd_turn, ang, at_mark)
+        bcls = classify_boards(obs, boards, kinds, ang, twa, sd_obs)
+        cls = bcls[obs.board]
+        ll_boards, ll_bounds, ll_turns = log_likelihoods(obs, cls, turns, kinds, ang, t0, n_bins)
+        ll = ll_boards + ll_bounds + ll_turns
+        if it < 2:  # the rate settles with the classes of the first passes
+            q = max(
+                Q_GRID[int(np.argmax(log_marginal(ll, start)))],
+                Q_GRID[int(np.argmax(log_marginal(ll_turns, start)))],
+            )
+        post = smooth(ll, start, q)
+        un = np.degrees(np.unwrap(np.radians(post.mean_deg)))
+        twa = wrap180(np.interp(obs.t, tb, un) - obs.cog)
+        sd = np.sqrt(post.sd_deg**2 + systematic_var(obs, cls, ang, twa, n_bins))
+        if it == 0:
+            # which boats sail where no racing boat goes, in the wind the beats, gybes and
+            # turns tell (the bounds of a boat that is not racing would move that wind)
+            info = smooth(ll_boards + ll_turns, start, q)
+            un_i = np.degrees(np.unwrap(np.radians(info.mean_deg)))
+            share = no_go_share(
+                obs,
+                wrap180(np.interp(obs.t, tb, un_i) - obs.cog),
+                np.interp(obs.t, tb, info.sd_deg),
+                ang,
+            )
+            out = use & left_out(share, use)
+        res = _Pass(obs, post, bcls, cls, kinds, ang, twa, sd, turns.boat, share)
+        if out.any():
+            return res, out
+    assert res is not None
+    return res, np.zeros(n_boats, bool)
+
+
+def _at_marks(turns: _Turns, marks: Sequence[tuple[float, float]]) -> NDArray[np.bool_]:
+    """True for the turns whose peak lies within ``turns.near_m`` of a mark."""
+    near = np.zeros(turns.t.size, bool)
+    for mx, my in marks:
+        near |= np.hypot(turns.x - float(mx), turns.y - float(my)) <= turns.near_m
+    return near
+
+
+def _check_boards(p: _Points, res: _Pass, start: float, how: str) -> None:
+    """Refuse a span whose observing boards lie on one side only, or that has downwind
+    boards but no upwind ones (the prior on the wrong end of the axis)."""
+    cls = res.board_cls[p.board]
+    i = np.searchsorted(res.obs.t, p.t).clip(0, res.obs.t.size - 1)
+    side = res.twa[i] >= 0.0
+    n = {(c, s): int(((cls == c) & (side == s)).sum()) for c in (UP, DOWN) for s in (True, False)}
+    n_up = n[UP, True] + n[UP, False]
+    n_dn = n[DOWN, True] + n[DOWN, False] + int((cls == RUN).sum())
+    if n_up < MIN_BOARD_POINTS and n[DOWN, True] + n[DOWN, False] >= 60:
         raise InputError(
-            f"infer_wind: no upwind boards with the wind from {wrap360(twd_axis):.0f}° "
+            f"infer_wind: no upwind boards with the wind from {wrap360(start):.0f}° "
             f"({how}), but {n_dn} points on downwind boards: the wind more likely comes from "
-            f"the other end of the axis, {wrap360(twd_axis + 180.0):.0f}°; check "
+            f"the other end of the axis, {wrap360(start + 180.0):.0f}°; check "
             "prior_twd_deg"
         )
-    if n_up + n_dn < 60 or min(n_stbd, n_port) < MIN_BOARD_POINTS:
+    if (
+        min(n[UP, True], n[UP, False]) < MIN_BOARD_POINTS
+        and min(n[DOWN, True], n[DOWN, False]) < MIN_BOARD_POINTS
+    ):
         raise InputError(
-            f"infer_wind: {n_stbd} starboard and {n_port} port upwind points, {n_dn} downwind "
-            f"(need {MIN_BOARD_POINTS} on each upwind board): the wind cannot be told from "
-            "one course; give a span with at least one beat sailed on both tacks"
+            f"infer_wind: {n[UP, True]} starboard and {n[UP, False]} port upwind points, "
+            f"{n[DOWN, True]} and {n[DOWN, False]} on gybing downwind boards (need "
+            f"{MIN_BOARD_POINTS} on each board of a beat or of a gybing run): the wind "
+            "cannot be told from one course; give a span with at least one beat sailed on "
+            "both tacks"
         )
-    # 3. the output grid
+
+
+def infer_wind(
+    tracks: Sequence[Track] | Track,
+    frame: LocalFrame,
+    *,
+    prior_twd_deg: float | None = None,
+    boat: BoatModel | None = None,
+    t0: float | None = None,
+    t1: float | None = None,
+    step_s: float = STEP_S,
+    window_s: float = WINDOW_S,
+    min_speed_ms: float = MIN_SPEED_MS,
+    tws: TwsSource | None = None,
+    marks: Sequence[tuple[float, float]] = (),
+) -> InferredWind:
+    """Estimate TWD(t) with its uncertainty, and TWS(t) from a chosen source, from boats'
+    GPS tracks.
+
+    Parameters
+    ----------
+    tracks : Track or sequence of Track
+        One or more boats' tracks (positions; instrument channels are not used).
+    frame : LocalFrame
+        Local metric frame (the course's ``Course.frame``); directions are in its grid.
+    prior_twd_deg : float, optional
+        A rough TWD [°, from] (the course axis, the sailor's estimate; within ~60°) that
+        decides which end of the inferred axis the wind comes from.  Without it the
+        upwind end is the one about which the boards lie further apart (or, where that
+        is not clear, are sailed slower); ``notes`` says which decided.
+    boat : BoatModel, optional
+        The boats' polar: the prior of the boats' angles (its best-VMG angles at a TWS
+        guessed from the median speed), and TWS by inverting it when ``tws`` is not
+        given.  Without it the angles come from the fleet's own tacks and gybes.
+    t0, t1 : float, optional
+        Time span [epoch s] of the grid; default the tracks' span (at most
+        ``MAX_SPAN_S``).
+    step_s : float
+        Grid step [s].
+    window_s : float
+        Full width [s] of the kernel that smooths TWS and counts ``n_obs``.
+    min_speed_ms : float
+        Points slower than this are rejected [m s⁻¹].
+    tws : TwsSource, optional
+        Where TWS comes from (:class:`~sailroute.analysis.infer_tws.TwsSource`): a series
+        (scenario, measured, station), the polar inverted, or none.  Default: the polar
+        of ``boat`` when given, else none.
+    marks : sequence of (float, float)
+        The course's marks (gate and line ends too) in ``frame`` [m]: a turn near one is
+        a rounding, not a tack or a gybe (a rounding from a reach to a broad reach turns
+        the stern through the wind as a gybe does, with courses that are not symmetric
+        about it).
+
+    Returns
+    -------
+    InferredWind
+
+    Raises
+    ------
+    InputError
+        No tracks, bad parameters, an empty or too long time span, tracks sailed more
+        than ``MAX_APART_M`` apart with no majority of them together, too few steady
+        points, boards on one side only or no upwind boards (the message says how many).
+    """
+    trs = _check_inputs(tracks, step_s, window_s, prior_twd_deg, min_speed_ms)
+    if tws is None:
+        tws = TwsSource.polar(boat) if boat is not None else TwsSource.none()
+    if not isinstance(tws, TwsSource):
+        raise InputError(
+            f"infer_wind: tws must be a TwsSource, got {type(tws).__name__}; build one with "
+            "TwsSource.from_series, TwsSource.from_field, TwsSource.polar or TwsSource.none"
+        )
+    have = [tr for tr in trs if len(tr)]
+    ta = min(float(tr.t_s[0]) for tr in have) if have else 0.0
+    tb = max(float(tr.t_s[-1]) for tr in have) if have else 0.0
+    t0 = ta if t0 is None else float(t0)
+    t1 = tb if t1 is None else float(t1)
+    if not t1 > t0:
+        raise InputError(
+            f"infer_wind: empty time span {iso(t0)} .. {iso(t1)}; "
+            "give t0 < t1 within the tracks' times"
+        )
+    if t1 - t0 > MAX_SPAN_S:
+        raise InputError(
+            f"infer_wind: the time span {iso(t0)} .. {iso(t1)} is {(t1 - t0) / 3600:.1f} h, "
+            f"more than {MAX_SPAN_S / 3600:.0f} h (tracks of different days?); infer one race "
+            "at a time: give t0 and t1, or the tracks of one race"
+        )
+    xy = [track_xy(tr, frame) for tr in trs]
+    keep, far_notes = _same_place(trs, xy, t0, t1)
+    trs, xy = [trs[i] for i in keep], [xy[i] for i in keep]
+    names = [tr.name or f"track {i + 1}" for i, tr in enumerate(trs)]
+    p, boards, turns, notes = _steady_points(trs, frame, t0, t1, min_speed_ms, xy)
+    notes = far_notes + notes
+    if p.t.size < 60:
+        raise InputError(
+            f"infer_wind: only {p.t.size} steady points (faster than {min_speed_ms} m/s, "
+            f"not turning) in {iso(t0)} .. {iso(t1)}; need at least 60: give longer tracks "
+            "or the race's time span"
+        )
+    K = len(trs)
+    n_bins = int(np.ceil((t1 - t0) / BIN_S)) + 1
+    priors = _angle_priors(boat, p)
+    at_mark = _at_marks(turns, marks)
+    res, start, how, axis_notes = _passes(
+        _Fleet(p, boards, turns, K, t0, n_bins, priors, at_mark), prior_twd_deg
+    )
+    notes.extend(axis_notes)
+    _check_boards(p, res, start, how)
+    # the output grid
     tg = np.arange(t0, t1 + 1e-6, step_s)
-    h = 0.5 * window_s
-    m = fit.used
-    wgt = fit.w[m]
-    # each point counts for p.weight (its sampling interval / CORR_S) of an independent one
-    est, var, n, mu2 = _local_linear(tg, p.t[m], fit.obs[m], wgt, h, 1.0 / p.weight[m])
-    # half-angle uncertainty: imbalance of boards within the window
-    ang_var = _group_var(tg, p.t[m], wgt, h, fit, m)
-    # smoothing bias from the fitted curvature
-    curv = np.interp(tg, fit.knots[1:-1], np.diff(fit.twd, 2) / (fit.knots[1] - fit.knots[0]) ** 2)
-    bias = 0.5 * curv * np.nan_to_num(mu2)
-    sd_all = np.sqrt(var + ang_var + bias**2)
-    secs = _seconds_in_window(tg, p.t[m], h, p.weight[m])
-    bad = ~np.isfinite(est) | (secs < MIN_OBS_S) | ~(sd_all <= MAX_SD_DEG)
-    twd = np.where(bad, np.nan, wrap360(est))
+    tbin = t0 + (np.arange(n_bins) + 0.5) * BIN_S
+    un = np.degrees(np.unwrap(np.radians(res.post.mean_deg)))
+    sd_all = np.interp(tg, tbin, res.sd)
+    bad = ~(sd_all <= MAX_SD_DEG)
+    twd = np.where(bad, np.nan, wrap360(np.interp(tg, tbin, un)))
     sd = np.where(bad, np.nan, sd_all)
-    # 4. TWS from the polar
-    tws = np.full(tg.size, np.nan)
-    tws_sd = np.full(tg.size, np.nan)
-    if boat is not None:
-        curve = np.interp(p.t, fit.knots, fit.twd)
-        twa = wrap180(curve - p.cog)
-        s_pt = _invert_polar(boat, twa, p.sog)
-        ok = m & np.isfinite(s_pt)
-        if ok.sum() >= 30:
-            e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h, 1.0 / p.weight[ok])
-            sec2 = _seconds_in_window(tg, p.t[ok], h, p.weight[ok])
-            good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
-            tws = np.where(good, np.maximum(e2, 0.0), np.nan)
-            tws_sd = np.where(good, np.sqrt(v2), np.nan)
-            s_med = float(np.nanmedian(tws)) if np.isfinite(tws).any() else float("nan")
-            up_pol = boat.vmg_angles_deg(s_med)[0] if np.isfinite(s_med) else float("nan")
-            notes.append(
-                f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which "
-                f"it sails the observed speeds (median {s_med / KNOT:.1f} kn); check: "
-                f"its best-VMG upwind angle there is {up_pol:.1f}°, the boats' "
-                "tacking half-angles " + ", ".join(f"{a:.1f}°" for a in fit.alpha)
+    h = 0.5 * window_s
+    n = np.searchsorted(p.t, tg + h, side="right") - np.searchsorted(p.t, tg - h, side="left")
+    tws_ms, tws_sd, tws_note = _tws(tws, tg, p, res, tbin, un, h, bad)
+    notes.append(tws_note)
+    notes.extend(_boat_notes(names, p, res, boat is not None))
+    used = res.ang.use[res.obs.boat]
+    sec = np.bincount(res.cls[used], res.obs.seconds[used], 4)
+    turned = res.ang.use[res.turn_boat]
+    n_out = int((~res.ang.use).sum())
+    method = (
+        f"inferred from {K - n_out} track(s)"
+        + (f" ({n_out} left out)" if n_out else "")
+        + ": "
+        + ", ".join(f"{sec[c]:.0f} s on {CLASS_NAMES[c]}s" for c in (UP, DOWN, RUN, FREE))
+        + f"; {int((turned & (res.kinds == TACK)).sum())} tacks, "
+        f"{int((turned & (res.kinds == GYBE)).sum())} "
+        f"gybes; random walk {res.post.q:g} °²/s; TWS from {tws.kind}"
+        + (f" ({tws.label})" if tws.label and tws.label != tws.kind else "")
+    )
+    half = {names[k]: (float(res.ang.alpha[k]), float(180.0 - res.ang.gamma[k])) for k in range(K)}
+    return InferredWind(
+        tg,
+        twd,
+        sd,
+        tws_ms,
+        tws_sd,
+        n.astype(np.int64),
+        method,
+        tuple(notes),
+        MappingProxyType(half),
+        tws.kind,
+    )
+
+
+def _tws(
+    src: TwsSource,
+    tg: NDArray,
+    p: _Points,
+    res: _Pass,
+    tbin: NDArray,
+    un: NDArray,
+    h: float,
+    bad: NDArray,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], str]:
+    """TWS and its sd on the grid from the chosen source, and a note."""
+    nan = np.full(tg.size, np.nan)
+    if src.kind == "none":
+        return nan, nan.copy(), "TWS not inferred (no source chosen)"
+    if src.kind != "polar":
+        s, sd = src.at(tg)
+        return s, sd, f"TWS from the {src.kind} ({src.label})"
+    boat = src.boat
+    assert boat is not None
+    twa = wrap180(np.interp(p.t, tbin, un) - p.cog)
+    used = np.interp(p.t, tbin, res.sd) <= POLAR_TWA_SD_DEG  # the TWA is known
+    s_pt = invert_polar(boat, twa, p.sog)
+    ok = used & np.isfinite(s_pt)
+    if ok.sum() < 30:
+        return nan, nan.copy(), "TWS not inferred: too few points within the polar's speed range"
+    e2, v2, _, _ = _local_linear(tg, p.t[ok], s_pt[ok], p.weight[ok], h, 1.0 / p.weight[ok])
+    sec2 = _seconds_in_window(tg, p.t[ok], h, p.weight[ok])
+    good = np.isfinite(e2) & (sec2 >= MIN_OBS_S) & ~bad
+    tws = np.where(good, np.maximum(e2, 0.0), np.nan)
+    tws_sd = np.where(good, np.sqrt(v2), np.nan)
+    s_med = float(np.nanmedian(tws)) if np.isfinite(tws).any() else float("nan")
+    up_pol = boat.vmg_angles_deg(s_med)[0] if np.isfinite(s_med) else float("nan")
+    return (
+        tws,
+        tws_sd,
+        f"TWS from the polar {getattr(boat, 'name', '')!r}: the wind in which it sails the "
+        f"observed speeds (median {s_med / KNOT:.1f} kn); check: its best-VMG upwind angle "
+        f"there is {up_pol:.1f}°, the boats' tacking half-angles "
+        + ", ".join(f"{a:.1f}°" for a in res.ang.alpha),
+    )
+
+
+def _boat_notes(
+    names: Sequence[str],
+    p: _Points,
+    res: _Pass,
+    polar: bool,
+) -> list[str]:
+    """One line per boat: its angles, how well it holds them, its boards."""
+    out = []
+    ang = res.ang
+    cls = res.board_cls[p.board]
+    for k, name in enumerate(names):
+        if not ang.use[k]:
+            out.append(
+                f"{name}: left out: {100 * res.no_go[k]:.0f} % of its steady time closer to "
+                "the wind than any boat sails (not racing in this wind: a coach boat, "
+                "another race?)"
             )
-        else:
-            notes.append("TWS not inferred: too few points within the polar's speed range")
-    half = {names[k]: (float(fit.alpha[k]), float(180.0 - fit.gamma[k])) for k in range(K)}
-    for k in range(K):
-        nk_up = int((fit.up & (p.boat == k)).sum())
-        nk_dn = int((fit.used & ~fit.up & (p.boat == k)).sum())
+            continue
+        mine = p.boat == k
+        n_up = int((mine & (cls == UP)).sum())
+        n_dn = int((mine & np.isin(cls, (DOWN, RUN))).sum())
+        n_tk = int(((res.kinds == TACK) & (res.turn_boat == k)).sum())
         down = (
-            f"runs (downwind held at 180°, {RUN_WEIGHT:g} weight)"
-            if abs(fit.gamma[k]) < RUN_GAMMA_DEG and fit.gamma_sd[k] < 0.01
-            else f"gybing half-angle {180.0 - fit.gamma[k]:.1f} ± {fit.gamma_sd[k]:.1f}°"
+            "runs (a box about dead downwind)"
+            if ang.runner[k]
+            else f"gybing half-angle {180.0 - ang.gamma[k]:.1f} ± {ang.gamma_sd[k]:.1f}°"
         )
         weak = (
-            f" (weakly determined by the track: leans on its prior {a0:.0f}° ± "
-            f"{a_sd:.0f}°{', the polar' if boat is not None else ''})"
-            if fit.alpha_sd[k] > 0.5 * a_sd
+            f" (no tacks of its own: the fleet's{' and the polar' if polar else ''})"
+            if n_tk == 0
             else ""
         )
-        notes.append(
-            f"{names[k]}: tacking half-angle {fit.alpha[k]:.1f} ± "
-            f"{fit.alpha_sd[k]:.1f}°{weak}, {down} ({nk_up} upwind, {nk_dn} downwind "
-            "points)"
+        out.append(
+            f"{name}: tacking half-angle {ang.alpha[k]:.1f} ± {ang.alpha_sd[k]:.1f}°{weak} "
+            f"from {n_tk} tacks, boards within {ang.sd_up[k]:.1f}°, {down} ({n_up} upwind, "
+            f"{n_dn} downwind points)"
         )
-    method = (
-        f"inferred from {K} track(s): {n_up} upwind and {n_dn} downwind board points "
-        f"(course ± fitted half-angles), window {window_s:.0f} s, "
-        f"course scatter {fit.sigma[0]:.1f}° upwind / {fit.sigma[1]:.1f}° downwind"
-        + ("; TWS from the polar" if boat is not None else "; TWS not inferred (no polar)")
-    )
-    return InferredWind(
-        tg, twd, sd, tws, tws_sd, n.astype(np.int64), method, tuple(notes), MappingProxyType(half)
-    )
+    return out
 
 
 def _seconds_in_window(tg: NDArray, t: NDArray, h: float, weight: NDArray) -> NDArray[np.float64]:
@@ -679,9 +877,11 @@ def summary(inferred: InferredWind) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``twd_mean_deg`` (circular mean), ``twd_min_deg``/``twd_max_deg`` and
-        ``twd_range_deg`` (of the unwrapped series), ``twd_shift_rms_deg`` (RMS of TWD
-        about its mean), ``twd_sd_median_deg``, ``tws_mean_ms``/``tws_min_ms``/
+        ``twd_mean_deg`` (circular mean, each grid time weighted by ``1 / sd²``: a
+        stretch where the tracks hardly tell the wind counts little),
+        ``twd_min_deg``/``twd_max_deg`` and ``twd_range_deg`` (of the unwrapped series),
+        ``twd_shift_rms_deg`` (RMS of TWD about its mean, weighted alike),
+        ``twd_sd_median_deg``, ``tws_mean_ms``/``tws_min_ms``/
         ``tws_max_ms`` (None without TWS), ``t_start``/``t_end`` (ISO UTC of the grid
         times with a direction), ``n_grid`` (of them), ``method``.  None where no grid
         time has a direction.
@@ -706,7 +906,8 @@ def summary(inferred: InferredWind) -> dict[str, Any]:
             )
         }
     d = inferred.twd_deg[ok]
-    mean = circular_mean_deg(d)
+    w = 1.0 / np.maximum(inferred.twd_sd_deg[ok], 1e-3) ** 2
+    mean = circular_mean_deg(d, w)
     dev = wrap180(d - mean)
     s = inferred.tws_ms[ok]
     s = s[np.isfinite(s)]
@@ -715,7 +916,7 @@ def summary(inferred: InferredWind) -> dict[str, Any]:
         "twd_min_deg": round(float(wrap360(mean + dev.min())), 2),
         "twd_max_deg": round(float(wrap360(mean + dev.max())), 2),
         "twd_range_deg": round(float(dev.max() - dev.min()), 2),
-        "twd_shift_rms_deg": round(float(np.sqrt(np.mean(dev**2))), 2),
+        "twd_shift_rms_deg": round(float(np.sqrt(np.sum(w * dev**2) / np.sum(w))), 2),
         "twd_sd_median_deg": round(float(np.median(inferred.twd_sd_deg[ok])), 2),
         "tws_mean_ms": round(float(s.mean()), 3) if s.size else None,
         "tws_min_ms": round(float(s.min()), 3) if s.size else None,

@@ -19,7 +19,7 @@ Every output names the source of each leg.  Nothing here reads files.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Final
 
@@ -34,6 +34,10 @@ KINDS: Final = ("measured", "fleet", "inferred", "scenario")
 
 CHOICES: Final = ("auto", "measured", "inferred", "scenario")
 """Values of ``analyze --wind``: ``auto`` takes the best available per leg."""
+
+MEASURED_TWD_SD_DEG: Final = 4.0
+"""Standard error of a measured TWD at one instant [°]: three SailGP boats' logged TWD
+(Auckland 2025, smoothed 30 s) differ pairwise by 3.4-8.0° RMS."""
 
 ABOVE_POLAR_PCT: Final = 110.0
 """A leg sailed above this mean polar percentage is flagged: the polar (a stand-in for
@@ -58,12 +62,24 @@ class WindSource:
         the wind along the way to the target far beyond the route's own time, and a
         hole there says nothing about the route.  The routed track itself is then
         checked against :attr:`field` (:func:`route_covered`).
+    twd_sd : callable, optional
+        The standard error of the direction at a time [epoch s -> °] (an inferred wind's);
+        None: the kind's (:meth:`twd_sd_at`).
     """
 
     kind: str
     field: WindField
     label: str
     route_field: WindField | None = None
+    twd_sd: Callable[[float], float] | None = None
+
+    def twd_sd_at(self, t: float) -> float:
+        """Standard error of the direction at ``t`` [°]: :attr:`twd_sd`'s, else
+        ``MEASURED_TWD_SD_DEG`` for a measured wind and 0 for a scenario (the wind the
+        course was laid in)."""
+        if self.twd_sd is not None:
+            return float(self.twd_sd(t))
+        return MEASURED_TWD_SD_DEG if self.kind in ("measured", "fleet") else 0.0
 
     @property
     def for_routing(self) -> WindField:
@@ -137,6 +153,7 @@ __all__ = [
     "ABOVE_POLAR_PCT",
     "CHOICES",
     "KINDS",
+    "MEASURED_TWD_SD_DEG",
     "WindSource",
     "covers",
     "first_covering",
