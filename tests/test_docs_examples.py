@@ -241,11 +241,12 @@ def mismatch(block: Block, cmd: Command, status: int, want: int, got: str, same:
 
 def example_env(bin_dir: Path) -> dict[str, str]:
     """The commands' environment: this interpreter's ``sailroute`` and ``python`` first
-    on PATH, matplotlib without a display."""
+    on PATH, importing the package of this tree (as tests/test_gallery.py), matplotlib
+    without a display."""
     env = {k: v for k, v in os.environ.items() if not k.startswith("SAILROUTE_")}
     env["PATH"] = f"{bin_dir}{os.pathsep}{env.get('PATH', '')}"
+    env["PYTHONPATH"] = str(ROOT)
     env["MPLBACKEND"] = "Agg"
-    env["PYTHONPATH"] = ""
     return env
 
 
