@@ -133,6 +133,7 @@ def analyze_track(
     progress: Progress | None = None,
     missing: str = "error",
     gate_end: str = "line",
+    wind: str = "auto",
 ) -> TrackAnalysis:
     """Analyse a sailed track against the optimal route of each leg.
 
@@ -155,7 +156,8 @@ def analyze_track(
         Already built boat and scenario wind (a fleet shares them).
     winds : sequence of WindSource, optional
         Candidate winds, best first (:func:`sailroute.analysis.windsource.wind_order`);
-        each leg is judged in the first that covers it.  Default: the scenario's.
+        each leg is judged in the first that covers it.  Default: those ``wind`` chooses
+        for this track (:func:`analysis_winds`).
     progress : Progress, optional
         Per-leg progress of the optimal routing.
     missing : {"error", "unknown"}
@@ -165,6 +167,11 @@ def analyze_track(
         A gate leg ends passing between the marks, or having rounded the chosen mark
         (:func:`sailroute.analysis.segment.gate_rounding`; the optimal leg still ends at
         the gate line, so the leg's loss then includes that turn).
+    wind : {"auto", "measured", "inferred", "scenario"}
+        The candidate winds when ``winds`` is not given, as ``sailroute analyze
+        --wind``: ``auto`` (default, as the command) the track's own measured wind, then
+        the direction inferred from the track, then the scenario; ``scenario`` the
+        scenario's wind alone.
 
     Returns
     -------
@@ -184,12 +191,16 @@ def analyze_track(
     settings: RoutingSettings = settings_for(course, router)
     if built is None:
         boat, scenario_winds = build_specs(course, [name])
-        wind = scenario_winds[name]
+        scen_wind = scenario_winds[name]
     else:
-        boat, wind = built
-    sources = list(winds) if winds else [WindSource("scenario", wind, f"scenario {name!r}")]
+        boat, scen_wind = built
+    if winds:
+        sources = list(winds)
+    else:
+        by_track, _ = analysis_winds(course, [track], name, scen_wind, boat, wind)
+        sources = by_track[track.name]
     # the optimal legs keep inside the boundary and round the obstacles, as plan's do
-    obstacles = obstacles_for(course.area, wind)
+    obstacles = obstacles_for(course.area, scen_wind)
     where = f"{track.source or track.name}"
     x, y = track_xy(track, course.frame)
     check_same_race(course, track, x, y)
@@ -406,7 +417,7 @@ def analyze_track(
         seg,
         tuple(legs),
         points,
-        sources[chosen[0]].field if chosen else wind,
+        sources[chosen[0]].field if chosen else scen_wind,
     )
 
 

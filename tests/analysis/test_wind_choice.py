@@ -86,7 +86,7 @@ def test_each_leg_is_judged_in_the_first_wind_that_covers_it(
 ) -> None:
     course, legs = routed
     track = _sailed(course, legs)
-    base = analyze_track(course, track)
+    base = analyze_track(course, track, wind="scenario")
     # "measured" = the scenario's wind, but its log ends during leg 2
     t_end = 0.5 * (legs[1].t_start + legs[1].t_end)
     measured = UniformWind([10 * KNOT] * 2, [0.0, 0.0], times=[track.t_s[0], t_end])
