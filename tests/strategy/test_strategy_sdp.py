@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 
@@ -194,11 +196,14 @@ def test_decision_reports_the_segment(sine_steady) -> None:
 
 
 def test_solve_time_at_shepherd_et_al_resolution_is_seconds() -> None:
-    # "Seconds" at 801 x 160 x 19 x 2 (single thread ~1 s measured;
-    # generous bound for a loaded CI machine)
+    # "Seconds" at 801 x 160 x 19 x 2 (single thread ~1 s measured).  The bound is on
+    # the CPU time this process spends, not the wall clock, which a machine shared with
+    # other work stretches (25 s of wall seen at a load of 9 on 2 cores).
+    cpu0 = time.process_time()
     pol = solve_expected_time(ILCA7, TWS, OUShift(10.0, 600.0), BeatGrid(), 5.0)
+    cpu_s = time.process_time() - cpu0
     assert pol.value_s.shape == (161, 2, 19, 801)
-    assert pol.solve_time_s < 20.0
+    assert cpu_s < 20.0
 
 
 @pytest.mark.parametrize(
