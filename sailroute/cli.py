@@ -974,6 +974,15 @@ def analyze_command(
             "to what the fleet sails (fleet).",
         ),
     ] = "course",
+    gun: Annotated[
+        str | None,
+        typer.Option(
+            "--gun",
+            metavar="TIME",
+            help="The gun the race is timed from, ISO with offset: the restart after a "
+            "general recall (default: the course's restart_time, else start_time).",
+        ),
+    ] = None,
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -1008,6 +1017,7 @@ def analyze_command(
                 gate_end=gate_end,
                 wind=wind,
                 reference=reference,
+                gun=gun,
             )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
