@@ -1053,7 +1053,9 @@ def _leg_end(
             return stopped, Crossing(nan, nan, nan, note=later, issue=LegIssue.AFTER_LOST)
         if missing == "error":
             raise err
-        end = Crossing(nan, nan, nan, note=str(err).removeprefix(f"{where}: "), issue=issue)
+        label = f"leg {i + 1} ({course.legs[i].label}): "
+        note = str(err).removeprefix(f"{where}: ").removeprefix(label)
+        end = Crossing(nan, nan, nan, note=note, issue=issue)
         later = f"leg {i + 1} never ended: later legs unknown"
         return end, Crossing(nan, nan, nan, note=later, issue=LegIssue.AFTER_LOST)
     end = found[0]

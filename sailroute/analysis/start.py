@@ -36,8 +36,6 @@ from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import minimize
-from scipy.special import expit, log_ndtr
 
 from sailroute.analysis.segment import (
     OCS_MIN_S,
@@ -302,6 +300,8 @@ def _unpack(theta: NDArray, free: tuple[bool, bool]) -> tuple[float, float, NDAr
 
 def _emg(e: NDArray, s: NDArray, scale: float) -> NDArray:
     """Log density of an exponential delay (mean ``scale``) blurred by a normal error ``s``."""
+    from scipy.special import log_ndtr
+
     out: NDArray = (
         -math.log(scale) + s * s / (2 * scale * scale) - e / scale + log_ndtr(e / s - s / scale)
     )
@@ -315,6 +315,8 @@ def _log_mixture(
     the front row, mean ``lam``), over early (an exponential lead, mean ``kappa``), late
     (uniform up to :data:`LATE_SPAN_S`, its blurred edge at 0 neglected), all blurred by
     ``s``; and the floor."""
+    from scipy.special import log_ndtr
+
     p_clean = max(1.0 - p_ocs - p_late, 1e-9)
     parts = np.empty((4, e.size))
     parts[0] = math.log(p_clean) + _emg(e, s, lam)
@@ -328,6 +330,8 @@ def _log_mixture(
 
 
 def _neg_log_post(theta: NDArray, d: NDArray, v: NDArray, free: tuple[bool, bool]) -> float:
+    from scipy.special import expit
+
     tau, delta, tail = _unpack(theta, free)
     ls, ll, lk = (min(max(float(q), -5.0), 5.0) for q in tail[:3])
     p_ocs, p_late = 0.5 * float(expit(tail[3])), 0.5 * float(expit(tail[4]))
@@ -373,6 +377,8 @@ class _Fit:
 def _fit(d: NDArray, v: NDArray, model: str, start: _Fit | None = None) -> _Fit:
     """The maximum of the posterior for ``model``: each boat in turn taken as the front row
     (its start time 0) at the prior's scales, the best three refined."""
+    from scipy.optimize import minimize
+
     free = _MODELS[model]
     tail = np.array([*_PRIOR, -2.0, -2.0])
     if model == "line":
