@@ -91,6 +91,10 @@ pass between them within this time after [s] has passed the gate outside its mar
 ends there, flagged (:attr:`LegIssue.OUTSIDE`), instead of at the next time it passes
 between the marks (a lap later)."""
 
+LATE_START_S = 10.0
+"""A boat that starts more than this after the gun is a late starter [s] (in a fleet, and
+beyond the fleet's clean starts: :attr:`StartClock.late_s`)."""
+
 V_MIN_MS = 0.5
 """Slowest speed towards the course side used to turn a distance over the start line into a
 time over it [m s⁻¹] (a boat drifting over the line is over by its distance at this speed)."""
@@ -195,12 +199,24 @@ class StartClock:
     sd_s : float
         Standard deviation of a boat's time over the line about the fleet's front row [s]
         (NaN: no fleet estimate); a boat over early is called with its margin in these.
+    over_s : float
+        The fleet estimate's time the boat was over the line at the gun [s] (negative:
+        behind it; NaN: no estimate, the geometry at the gun decides).
+    called : bool or None
+        The fleet estimate's verdict: over early by more than its uncertainty (None: no
+        estimate; over early beyond ``on_time_s``).
+    late_s : float
+        A start later than this after the gun is late [s]: :data:`LATE_START_S`, or in a
+        fleet beyond its clean starts by the boat's uncertainty.
     """
 
     gun_t: float
     shift_m: float = 0.0
     on_time_s: float = OCS_MIN_S
     sd_s: float = math.nan
+    over_s: float = math.nan
+    called: bool | None = None
+    late_s: float = LATE_START_S
 
     @classmethod
     def plain(cls, gun_t: float) -> StartClock:
@@ -257,6 +273,8 @@ class StartReport:
     shift_m : float
         The line the start was searched on lay this far up the course from the
         surveyed one [m] (the clock's ``shift_m``).
+    late_limit_s : float
+        A start later than this after the gun is late [s] (the clock's ``late_s``).
     """
 
     gun_t: float
@@ -274,6 +292,17 @@ class StartReport:
     ocs_sd: float = math.nan
     ocs_p: float = math.nan
     shift_m: float = 0.0
+    late_limit_s: float = LATE_START_S
+
+    @property
+    def late(self) -> bool:
+        """Started (detected) later than ``late_limit_s`` after the gun, not over early."""
+        return (
+            self.crossing.detected
+            and self.ocs_s is None
+            and math.isfinite(self.late_s)
+            and self.late_s > self.late_limit_s
+        )
 
     @property
     def started(self) -> bool:
@@ -614,7 +643,9 @@ def find_start(
     over = t[0] <= gun <= t[-1] and abreast and _side(sg, gx, gy) > 0
     speed = speed_at(t, x, y, gun, gap_s)
     over_s = math.nan
-    if over:
+    if over and clock.called is not None:
+        over_s = clock.over_s
+    elif over:
         vx, vy = velocity_at(t, x, y, gun, gap_s)
         vn = vx * sg.normal[0] + vy * sg.normal[1]
         over_s = _side(sg, gx, gy) / max(vn if math.isfinite(vn) else 0.0, V_MIN_MS)
@@ -642,7 +673,9 @@ def find_start(
             return _no_start(gun, reason, dist, over, speed, clock.shift_m)
         after = gun
         early = [c for c in _crossings(t, x, y, wide, t[0], gap_s, gun) if c.known] if over else []
-        on_time = over and over_s <= clock.on_time_s
+        on_time = over and (
+            not clock.called if clock.called is not None else over_s <= clock.on_time_s
+        )
         crossed = (
             f"crossed the start line {gun - early[-1].t:.0f} s before the gun " if early else ""
         )
@@ -723,6 +756,7 @@ def find_start(
         sd,
         _phi(sd) if math.isfinite(sd) else math.nan,
         clock.shift_m,
+        clock.late_s,
     )
 
 

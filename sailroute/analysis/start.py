@@ -13,8 +13,8 @@ The model (per boat *i*, at the course's gun): ``d_i`` its distance over the sur
 [m], ``v_i`` its speed towards the course side [m s⁻¹].  With the line laid ``shift_m``
 (``δ``) up the course and the tracks stamped ``time_offset_s`` (``τ``) late, the boat
 crossed the line the fleet used ``e_i = (δ − d_i)/v_i − τ`` seconds after the gun.  The
-``e_i`` of the fleet are a mixture: clean starts, an exponential delay (mean ``λ``) after
-the front row blurred by a normal error (the front row's spread along the course, ``σ_m``
+``e_i`` of the fleet are a mixture: clean starts, spread evenly over the ``W`` seconds after
+the front row and blurred by a normal error (the front row's spread along the course, ``σ_m``
 metres, over ``v_i``, and :data:`SIGMA_T_S`); over-early boats, an exponential lead (mean
 ``κ``) before the gun; late starters, up to :data:`LATE_SPAN_S` after it.  The parameters
 are the maximum of the likelihood with weak priors (so that three boats give an answer);
@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.analysis.segment import (
+    LATE_START_S,
     OCS_MIN_S,
     START_EXTENSION_M,
     V_MIN_MS,
@@ -68,6 +69,9 @@ Z_OCS = 3.0
 this many standard deviations (of the front row's spread, the GPS error over its speed and
 the estimate's own error): one false call in ~700 clean starts."""
 
+CROSS_WINDOW_S = 120.0
+"""A boat's crossing of the line counts for the clock's estimate within this of the gun [s]."""
+
 SIGMA_T_S = 0.3
 """Timing error of a boat's start [s] besides the front row's spread in metres (fixes
 stamped to the second: 1/√12 s)."""
@@ -93,6 +97,13 @@ starts again has come back; most of the fleet doing so is a general recall."""
 RECALL_SHARE = 0.5
 """Share of the started boats that must come back for a general recall."""
 
+PULSE_S = 60.0
+"""The boats of a start cross within this of their median time [s] (a general recall is
+one start of the fleet, not boats sailing over the line one by one before it)."""
+
+RECALL_BEFORE_S = 30.0
+"""A general recall before the gun is looked for up to this before it [s]."""
+
 
 @dataclass(frozen=True)
 class StartObservation:
@@ -109,22 +120,30 @@ class StartObservation:
         NaN across a gap).
     abreast : bool
         Within the line's searched extension (:data:`START_EXTENSION_M` beyond each end).
+    cross_s : float
+        When it crossed the surveyed line (or its extension) towards the course side,
+        nearest the gun: the last crossing before the gun when over at it, else the first
+        after; relative to the gun [s] (NaN: none within :data:`CROSS_WINDOW_S`).
+    cross_speed_ms : float
+        Its velocity towards the course side at that crossing [m s⁻¹].
     """
 
     boat: str
     distance_m: float
     speed_ms: float
     abreast: bool
+    cross_s: float = math.nan
+    cross_speed_ms: float = math.nan
 
-    @property
-    def usable(self) -> bool:
-        """Near the line, moving towards the course side: it enters the fleet estimate."""
-        return (
-            self.abreast
-            and math.isfinite(self.distance_m)
-            and math.isfinite(self.speed_ms)
-            and self.speed_ms >= V_MIN_MS
-        )
+    def usable(self, model: str) -> bool:
+        """Near the line and timed for ``model``: it enters the fleet estimate (the line's
+        shift needs a boat moving towards the course side at the gun, the clock a
+        crossing)."""
+        if not (self.abreast and math.isfinite(self.distance_m)):
+            return False
+        moving = math.isfinite(self.speed_ms) and self.speed_ms >= V_MIN_MS
+        crossed = math.isfinite(self.cross_s) and self.cross_speed_ms >= V_MIN_MS
+        return moving if model == "line" else crossed if model == "clock" else moving and crossed
 
 
 def observe_start(
@@ -134,15 +153,41 @@ def observe_start(
     if t.size < 2 or not t[0] <= gun_t <= t[-1]:
         return None
     sg = start_geometry(course)
+    wide = _extended(sg, START_EXTENSION_M)
     gx, gy = float(np.interp(gun_t, t, x)), float(np.interp(gun_t, t, y))
     vx, vy = velocity_at(t, x, y, gun_t, gap_s)
-    f = _segment_offset(_extended(sg, START_EXTENSION_M), gx, gy)[0]
-    return StartObservation(
-        boat,
-        _side(sg, gx, gy),
-        vx * sg.normal[0] + vy * sg.normal[1],
-        0.0 <= f <= 1.0,
-    )
+    f = _segment_offset(wide, gx, gy)[0]
+    d = _side(sg, gx, gy)
+    if d > 0:
+        found = _crossings(t, x, y, wide, gun_t - CROSS_WINDOW_S, gap_s, gun_t)
+        cross = [c for c in found if c.known][-1:]
+    else:
+        found = _crossings(t, x, y, wide, gun_t, gap_s, gun_t + CROSS_WINDOW_S)
+        cross = [c for c in found if c.known][:1]
+    cs = cv = math.nan
+    if cross:
+        cs = cross[0].t - gun_t
+        cx, cy = velocity_at(t, x, y, cross[0].t, gap_s)
+        cv = cx * sg.normal[0] + cy * sg.normal[1]
+    return StartObservation(boat, d, vx * sg.normal[0] + vy * sg.normal[1], 0.0 <= f <= 1.0, cs, cv)
+
+
+def _times(
+    d: NDArray, v: NDArray, c: NDArray, vc: NDArray, tau: float, delta: float, model: str
+) -> tuple[NDArray, NDArray]:
+    """Each boat's start after the fleet's front row ``e`` [s] and the speed that turns a
+    distance error into a time error [m s⁻¹], for ``model``: the line's shift from where the
+    boat was at the gun (``(δ − d)/v``), the clock from when it crossed (``c − τ``), both from
+    the crossing moved by the shift (``c + δ/v_c − τ``).  Where the crossing is unknown, the
+    distance at the gun stands in; speeds are at least :data:`V_MIN_MS`."""
+    vv = np.maximum(np.where(np.isfinite(v), v, 0.0), V_MIN_MS)
+    vcc = np.maximum(np.where(np.isfinite(vc), vc, 0.0), V_MIN_MS)
+    at_gun = (delta - d) / vv - tau
+    if model == "line":
+        return at_gun, vv
+    crossed = c + (delta / vcc if model == "both" else 0.0) - tau
+    ok = np.isfinite(c)
+    return np.where(ok, crossed, at_gun), np.where(ok, vcc, vv)
 
 
 @dataclass(frozen=True)
@@ -166,16 +211,17 @@ class FleetStart:
         The other single explanation fits clearly worse (BIC difference of 4 or more): the
         fleet says whether it was the line or the clock.
     spread_m : float
-        Spread of the front row along the course at the gun [m] (``σ_m``: where the boats
-        were and the GPS error of where they were).
-    delay_s : float
-        Mean delay of a clean start after the front row [s] (``λ``).
+        Spread of the front row along the course [m] (``σ_m``: where the boats were and
+        the GPS error of where they were).
+    spread_s : float
+        The clean starts spread evenly over this time after the front row [s] (``W``).
     se_time_offset_s, se_shift_m : float
         Standard errors [s, m] (0 for the one not estimated).
     n_boats : int
         Boats in the estimate.
     clocks : mapping of str to StartClock
-        Per boat: the gun and line in its track, and its threshold for over early.
+        Per boat: the gun and line in its track and the verdict on over early
+        (:attr:`StartClock.called`).
     speed_ms : float
         Median speed towards the course side at the gun of the boats in the estimate
         [m s⁻¹] (converts the line's shift into time).
@@ -187,7 +233,7 @@ class FleetStart:
     model: str = "none"
     told_apart: bool = False
     spread_m: float = math.nan
-    delay_s: float = math.nan
+    spread_s: float = math.nan
     se_time_offset_s: float = 0.0
     se_shift_m: float = 0.0
     n_boats: int = 0
@@ -200,24 +246,9 @@ class FleetStart:
         return self.gun_t + self.time_offset_s
 
     def clock(self, boat: str) -> StartClock:
-        """The boat's clock (the plain gun and surveyed line when it was not observed)."""
-        return self.clocks.get(boat, self.plain_clock())
-
-    def plain_clock(self) -> StartClock:
-        """The fleet's gun and line for a boat not in the estimate, with the fleet's spread
-        but no speed of its own (:data:`V_MIN_MS` … its GPS error counts in full)."""
-        if self.model == "none":
-            return StartClock.plain(self.gun_t)
-        return self._clock(np.nan, None)
-
-    def _clock(self, v: float, cov: NDArray | None) -> StartClock:
-        sd = boat_sd_s(self.spread_m, v, self.se_time_offset_s, self.se_shift_m, cov)
-        return StartClock(
-            self.gun_t + self.time_offset_s,
-            self.shift_m,
-            max(OCS_MIN_S, Z_OCS * sd),
-            sd,
-        )
+        """The boat's clock: the fleet's gun and line, and its verdict (a boat not
+        observed at the gun: no verdict, over early beyond :data:`OCS_MIN_S`)."""
+        return self.clocks.get(boat, StartClock(self.track_gun_t, self.shift_m))
 
     def describe(self) -> str:
         """One line for the fleet's notes."""
@@ -250,25 +281,9 @@ class FleetStart:
             )
             text += f" (or {other}: the boats' speeds at the gun cannot tell which)"
         return (
-            text + f"; the front row spread {self.spread_m:.1f} m, a clean start "
-            f"{self.delay_s:.1f} s behind it on average; over early is called beyond "
-            f"{Z_OCS:.0f} sd"
+            text + f"; the front row spread {self.spread_m:.1f} m, the clean starts "
+            f"within {self.spread_s:.0f} s of it; over early is called beyond {Z_OCS:.0f} sd"
         )
-
-
-def boat_sd_s(
-    spread_m: float, v: float, se_tau: float, se_shift: float, cov: NDArray | None = None
-) -> float:
-    """Standard deviation of one boat's start time about the fleet's front row [s]: the
-    front row's spread over its speed towards the course side, :data:`SIGMA_T_S`, and the
-    estimate's own error at that speed (``cov``: the covariance of ``(τ, δ)``)."""
-    vv = v if math.isfinite(v) and v >= V_MIN_MS else V_MIN_MS
-    if cov is not None:
-        j = np.array([-1.0, 1.0 / vv])
-        est = float(j @ cov @ j)
-    else:
-        est = se_tau**2 + (se_shift / vv) ** 2
-    return math.sqrt((spread_m / vv) ** 2 + SIGMA_T_S**2 + max(est, 0.0))
 
 
 # --- the fit ------------------------------------------------------------------------------
@@ -276,13 +291,12 @@ def boat_sd_s(
 _MODELS = {"line": (False, True), "clock": (True, False), "both": (True, True)}
 """Model -> (τ free, δ free)."""
 
-
 _N_TAIL = 5
-"""Parameters besides the offsets: log σ_m, log λ, log κ, logit of the over-early and late
+"""Parameters besides the offsets: log σ_m, log W, log κ, logit of the over-early and late
 shares."""
 
-_PRIOR = (math.log(3.0), math.log(3.0), math.log(3.0))
-"""Prior medians of the front row's spread [m], λ and κ [s] (log-normal, a factor e either
+_PRIOR = (math.log(2.0), math.log(5.0), math.log(3.0))
+"""Prior medians of the front row's spread [m], W and κ [s] (log-normal, a factor e either
 way)."""
 
 
@@ -308,40 +322,71 @@ def _emg(e: NDArray, s: NDArray, scale: float) -> NDArray:
     return out
 
 
-def _log_mixture(
-    e: NDArray, s: NDArray, lam: float, kappa: float, p_ocs: float, p_late: float
-) -> NDArray:
-    """Log density of each start time ``e`` [s]: a clean start (an exponential delay after
-    the front row, mean ``lam``), over early (an exponential lead, mean ``kappa``), late
-    (uniform up to :data:`LATE_SPAN_S`, its blurred edge at 0 neglected), all blurred by
-    ``s``; and the floor."""
+def _log_uniform(e: NDArray, s: NDArray, width: float) -> NDArray:
+    """Log density of a delay spread evenly over ``[0, width]`` blurred by a normal error
+    ``s``: ``log((Φ(e/s) − Φ((e − width)/s))/width)``, computed on the side of the smaller
+    tail."""
     from scipy.special import log_ndtr
 
+    a, b = e / s, (e - width) / s
+    # Φ(a) − Φ(b) = Φ(−b) − Φ(−a): take the pair whose larger term is not near 1
+    flip = b > 0
+    hi = np.where(flip, -b, a)
+    lo = np.where(flip, -a, b)
+    lhi, llo = log_ndtr(hi), log_ndtr(lo)
+    out: NDArray = lhi + np.log1p(-np.exp(np.minimum(llo - lhi, -1e-300))) - math.log(width)
+    return out
+
+
+def _log_mixture(
+    e: NDArray, s: NDArray, width: float, kappa: float, p_ocs: float, p_late: float
+) -> NDArray:
+    """Log density of each start time ``e`` [s]: a clean start (spread evenly over ``width``
+    after the front row), over early (an exponential lead, mean ``kappa``), late (spread
+    evenly over :data:`LATE_SPAN_S`), all blurred by ``s``; and the floor."""
     p_clean = max(1.0 - p_ocs - p_late, 1e-9)
     parts = np.empty((4, e.size))
-    parts[0] = math.log(p_clean) + _emg(e, s, lam)
+    parts[0] = math.log(p_clean) + _log_uniform(e, s, width)
     parts[1] = math.log(max(p_ocs, 1e-12)) + _emg(-e, s, kappa)
-    parts[2] = math.log(max(p_late, 1e-12)) - math.log(LATE_SPAN_S) + log_ndtr(e / s)
-    parts[2, e > LATE_SPAN_S] = -np.inf
+    parts[2] = math.log(max(p_late, 1e-12)) + _log_uniform(e, s, LATE_SPAN_S)
     parts[3] = math.log(FLOOR_DENSITY)
     top = parts.max(axis=0)
     out: NDArray = top + np.log(np.exp(parts - top).sum(axis=0))
     return out
 
 
-def _neg_log_post(theta: NDArray, d: NDArray, v: NDArray, free: tuple[bool, bool]) -> float:
+@dataclass(frozen=True)
+class _Data:
+    """The observations of the boats in a fit, as arrays."""
+
+    d: NDArray
+    v: NDArray
+    c: NDArray
+    vc: NDArray
+
+    @classmethod
+    def of(cls, obs: Sequence[StartObservation]) -> _Data:
+        return cls(
+            np.array([o.distance_m for o in obs]),
+            np.array([o.speed_ms for o in obs]),
+            np.array([o.cross_s for o in obs]),
+            np.array([o.cross_speed_ms for o in obs]),
+        )
+
+
+def _neg_log_post(theta: NDArray, data: _Data, model: str) -> float:
     from scipy.special import expit
 
-    tau, delta, tail = _unpack(theta, free)
-    ls, ll, lk = (min(max(float(q), -5.0), 5.0) for q in tail[:3])
+    tau, delta, tail = _unpack(theta, _MODELS[model])
+    ls, lw, lk = (min(max(float(q), -5.0), 6.0) for q in tail[:3])
     p_ocs, p_late = 0.5 * float(expit(tail[3])), 0.5 * float(expit(tail[4]))
-    e = (delta - d) / v - tau
+    e, v = _times(data.d, data.v, data.c, data.vc, tau, delta, model)
     s = np.sqrt((math.exp(ls) / v) ** 2 + SIGMA_T_S**2)
-    ll_data = float(np.sum(_log_mixture(e, s, math.exp(ll), math.exp(lk), p_ocs, p_late)))
+    ll_data = float(np.sum(_log_mixture(e, s, math.exp(lw), math.exp(lk), p_ocs, p_late)))
     # weak priors: the scales log-normal about _PRIOR; few over early or late (Beta(1, 9)
     # on each share); offsets within minutes and hundreds of metres
     prior = (
-        -0.5 * sum((q - m) ** 2 for q, m in zip((ls, ll, lk), _PRIOR, strict=True))
+        -0.5 * sum((q - m) ** 2 for q, m in zip((ls, lw, lk), _PRIOR, strict=True))
         + 8.0 * math.log1p(-2 * p_ocs * 0.999)
         + 8.0 * math.log1p(-2 * p_late * 0.999)
         - 0.5 * (tau / 60.0) ** 2
@@ -372,36 +417,69 @@ class _Fit:
     theta: NDArray
     nlp: float
     n_params: int
+    n: int
 
 
-def _fit(d: NDArray, v: NDArray, model: str, start: _Fit | None = None) -> _Fit:
-    """The maximum of the posterior for ``model``: each boat in turn taken as the front row
-    (its start time 0) at the prior's scales, the best three refined."""
+def _fit(obs: Sequence[StartObservation], model: str, start: _Fit | None = None) -> _Fit:
+    """The maximum of the posterior for ``model`` over the boats it can use: each boat in
+    turn taken as the front row (its start time 0) at the prior's scales, the best two
+    refined."""
     from scipy.optimize import minimize
 
+    data = _Data.of([o for o in obs if o.usable(model)])
     free = _MODELS[model]
     tail = np.array([*_PRIOR, -2.0, -2.0])
     if model == "line":
-        heads = [np.array([dk + vk * 0.0]) for dk, vk in zip(d, v, strict=True)]
+        heads = [np.array([d]) for d in data.d]
     elif model == "clock":
-        heads = [np.array([-dk / vk]) for dk, vk in zip(d, v, strict=True)]
+        heads = [np.array([c]) for c in data.c]
     else:
         assert start is not None
         tau, delta, _ = _unpack(start.theta, _MODELS[start.model])
         heads = [np.array([tau, delta])]
     cand = [np.concatenate([h, tail]) for h in heads]
-    score = [_neg_log_post(c, d, v, free) for c in cand]
+    score = [_neg_log_post(c, data, model) for c in cand]
     best: _Fit | None = None
     for k in np.argsort(score)[:2]:
-        r = minimize(_neg_log_post, cand[int(k)], args=(d, v, free), method="Powell")
+        r = minimize(_neg_log_post, cand[int(k)], args=(data, model), method="Powell")
         if best is None or float(r.fun) < best.nlp:
-            best = _Fit(model, np.asarray(r.x, float), float(r.fun), sum(free) + _N_TAIL)
+            best = _Fit(
+                model, np.asarray(r.x, float), float(r.fun), sum(free) + _N_TAIL, data.d.size
+            )
     assert best is not None
     return best
 
 
+def _covariance(fit: _Fit, obs: Sequence[StartObservation]) -> NDArray:
+    """Covariance of ``(τ, δ)`` from the curvature of the posterior (a diagonal guess from
+    the spread where it is not positive definite)."""
+    data = _Data.of([o for o in obs if o.usable(fit.model)])
+    free = _MODELS[fit.model]
+    k = sum(free)
+    cov2 = np.zeros((2, 2))
+    idx = [j for j, f in enumerate(free) if f]
+    try:
+        h = np.full(fit.theta.size, 0.01)
+        h[:k] = [0.05 if free[0] and j == 0 else 0.2 for j in range(k)]
+        hess = _hessian(lambda th: _neg_log_post(th, data, fit.model), fit.theta, h)
+        cov = np.linalg.inv(hess)
+        for a, ia in enumerate(idx):
+            for b, ib in enumerate(idx):
+                cov2[ia, ib] = cov[a, b]
+        if np.any(np.diag(cov2)[idx] <= 0) or not np.all(np.isfinite(cov2)):
+            raise np.linalg.LinAlgError
+    except np.linalg.LinAlgError:
+        sm = math.exp(float(fit.theta[k]))
+        v = float(np.median(data.v))
+        cov2 = np.diag(
+            [(sm / v) ** 2 / fit.n if free[0] else 0.0, sm**2 / fit.n if free[1] else 0.0]
+        )
+    return cov2
+
+
 def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float) -> FleetStart:
-    """The fleet's gun and line from where its boats were at the gun.
+    """The fleet's gun and line from where its boats were at the gun, and each boat's
+    verdict on over early.
 
     Parameters
     ----------
@@ -413,63 +491,75 @@ def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float)
     Returns
     -------
     FleetStart
-        ``model="none"`` (the course's gun and line, :data:`~sailroute.analysis.segment.OCS_MIN_S`)
-        with fewer than :data:`MIN_FLEET` usable boats.
+        ``model="none"`` (the course's gun and line, no verdicts: over early beyond
+        :data:`~sailroute.analysis.segment.OCS_MIN_S`) with fewer than :data:`MIN_FLEET`
+        usable boats.
     """
-    use = [o for o in observations if o.usable]
-    if len(use) < MIN_FLEET:
-        return FleetStart(gun_t, n_boats=len(use))
-    d = np.array([o.distance_m for o in use])
-    v = np.array([o.speed_ms for o in use])
-    n = d.size
-    fits = {m: _fit(d, v, m) for m in ("line", "clock")}
-    spread = float(np.std(1.0 / v) / np.mean(1.0 / v))
-    if n >= 8 and spread > 0.1:
-        fits["both"] = _fit(d, v, "both", min(fits.values(), key=lambda f: f.nlp))
-    bic = {m: 2 * f.nlp + f.n_params * math.log(n) for m, f in fits.items()}
+    usable = {m: sum(o.usable(m) for o in observations) for m in _MODELS}
+    if max(usable["line"], usable["clock"]) < MIN_FLEET:
+        return FleetStart(gun_t, n_boats=max(usable.values()))
+    fits = {m: _fit(observations, m) for m in ("line", "clock") if usable[m] >= MIN_FLEET}
+    v = np.array([o.speed_ms for o in observations if o.usable("both")])
+    if usable["both"] >= 8 and float(np.std(1.0 / v) / np.mean(1.0 / v)) > 0.1:
+        fits["both"] = _fit(observations, "both", min(fits.values(), key=lambda f: f.nlp))
+    # the same boats for every model: a model that can use fewer is charged for the rest
+    # at the floor density
+    n_all = max(f.n for f in fits.values())
+    bic = {
+        m: 2 * (f.nlp - (n_all - f.n) * math.log(FLOOR_DENSITY)) + f.n_params * math.log(n_all)
+        for m, f in fits.items()
+    }
     order = sorted(bic, key=lambda m: (bic[m], m != "line"))
     best = fits[order[0]]
-    singles = sorted(bic[m] for m in ("line", "clock"))
-    told = singles[1] - singles[0] >= 4.0 or best.model == "both"
+    singles = sorted(bic[m] for m in ("line", "clock") if m in bic)
+    told = best.model == "both" or (len(singles) == 2 and singles[1] - singles[0] >= 4.0)
     free = _MODELS[best.model]
     tau, delta, tail = _unpack(best.theta, free)
-    ls, ll = float(tail[0]), float(tail[1])
-    k = sum(free)
-    cov2 = np.zeros((2, 2))
-    try:
-        h = np.full(best.theta.size, 0.01)
-        h[:k] = [0.05 if free[0] and j == 0 else 0.2 for j in range(k)]
-        hess = _hessian(lambda th: _neg_log_post(th, d, v, free), best.theta, h)
-        cov = np.linalg.inv(hess)
-        idx = [j for j, f in enumerate(free) if f]
-        for a, ia in enumerate(idx):
-            for b, ib in enumerate(idx):
-                cov2[ia, ib] = cov[a, b]
-        if np.any(np.diag(cov2)[list(idx)] <= 0) or not np.all(np.isfinite(cov2)):
-            raise np.linalg.LinAlgError
-    except np.linalg.LinAlgError:
-        sm = math.exp(ls)
-        cov2 = np.diag(
-            [(sm / np.median(v)) ** 2 / n if free[0] else 0.0, sm**2 / n if free[1] else 0.0]
-        )
+    spread_m, spread_s = math.exp(float(tail[0])), math.exp(float(tail[1]))
+    cov = _covariance(best, observations)
     est = FleetStart(
         gun_t,
         tau,
         delta,
         best.model,
         told,
-        math.exp(ls),
-        math.exp(ll),
-        math.sqrt(max(cov2[0, 0], 0.0)),
-        math.sqrt(max(cov2[1, 1], 0.0)),
-        n,
-        speed_ms=float(np.median(v)),
+        spread_m,
+        spread_s,
+        math.sqrt(max(cov[0, 0], 0.0)),
+        math.sqrt(max(cov[1, 1], 0.0)),
+        best.n,
+        speed_ms=float(np.median([o.speed_ms for o in observations if o.usable(best.model)])),
     )
-    clocks = {
-        o.boat: est._clock(o.speed_ms if math.isfinite(o.speed_ms) else math.nan, cov2)
-        for o in observations
-    }
-    return replace(est, clocks=MappingProxyType(clocks))
+    return replace(est, clocks=MappingProxyType(_verdicts(est, observations, cov)))
+
+
+def _verdicts(
+    est: FleetStart, observations: Sequence[StartObservation], cov: NDArray
+) -> dict[str, StartClock]:
+    """Each observed boat's clock: its start after the front row under the fleet's model,
+    its standard deviation, and over early when more than :data:`Z_OCS` of them ahead."""
+    out = {}
+    for o in observations:
+        if not (o.abreast and math.isfinite(o.distance_m)):
+            out[o.boat] = StartClock(est.track_gun_t, est.shift_m)
+            continue
+        data = _Data.of([o])
+        e, v = _times(data.d, data.v, data.c, data.vc, est.time_offset_s, est.shift_m, est.model)
+        j = np.array([-1.0, 1.0 / float(v[0]) if est.model != "clock" else 0.0])
+        sd = math.sqrt(
+            (est.spread_m / float(v[0])) ** 2 + SIGMA_T_S**2 + max(float(j @ cov @ j), 0.0)
+        )
+        over = -float(e[0])
+        out[o.boat] = StartClock(
+            est.track_gun_t,
+            est.shift_m,
+            max(OCS_MIN_S, Z_OCS * sd),
+            sd,
+            over_s=over,
+            called=over > Z_OCS * sd,
+            late_s=max(LATE_START_S, est.spread_s) + Z_OCS * sd,
+        )
+    return out
 
 
 # --- general recall ------------------------------------------------------------------------
@@ -477,14 +567,16 @@ def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float)
 
 @dataclass(frozen=True)
 class GeneralRecall:
-    """Most of the fleet started at the gun, came back and started again.
+    """Most of the fleet started, came back and started again.
 
     Attributes
     ----------
     boats : tuple of str
         The boats that came back and started again.
     n_started : int
-        Boats that started at the gun.
+        Boats that started the first time.
+    first_t : float
+        When the fleet started the first time [epoch s]: the median of its crossings.
     restart_t : float
         When the fleet crossed again [epoch s]: the first of its second crossings within
         the spread of the rest (the 10th percentile), an estimate of the restart's gun.
@@ -492,27 +584,31 @@ class GeneralRecall:
 
     boats: tuple[str, ...]
     n_started: int
+    first_t: float
     restart_t: float
 
 
 def detect_general_recall(
     course: Course,
     tracks: Mapping[str, tuple[NDArray, NDArray, NDArray]],
-    gun_t: float,
+    after_t: float,
     gap_s: Mapping[str, float],
+    before_t: float = math.inf,
 ) -> GeneralRecall | None:
-    """A general recall the course does not give: most boats (:data:`RECALL_SHARE`, and at
-    least :data:`MIN_FLEET`) crossed the start line after the gun, crossed back within
-    :data:`RECALL_WINDOW_S` before getting halfway to the first mark, and crossed forward
-    again.
+    """A general recall: most boats (:data:`RECALL_SHARE`, and at least :data:`MIN_FLEET`)
+    crossed the start line together (within :data:`PULSE_S` of their median) between
+    ``after_t`` and ``before_t`` (at most :data:`RECALL_WINDOW_S` after ``after_t``), crossed
+    back within :data:`RECALL_WINDOW_S` before getting halfway to the first mark, and
+    crossed forward again.
 
     Parameters
     ----------
     course : Course
     tracks : mapping of str to (t, x, y)
         Each boat's track in the course frame.
-    gun_t : float
-        The gun [epoch s] (in the tracks' clock).
+    after_t, before_t : float
+        Where the first start is looked for [epoch s] (after the course's gun when it gives
+        no restart; before the gun, to say there was a recall before it).
     gap_s : mapping of str to float
         Each track's gap limit (:func:`~sailroute.analysis.segment.gap_limit_s`).
     """
@@ -521,14 +617,15 @@ def detect_general_recall(
     back_geom = _reversed(wide)
     mx, my = leg_target(course, 0).centre
     half = 0.5 * abs(_side(sg, mx, my))
-    started = 0
+    first_t: dict[str, float] = {}
     again: dict[str, float] = {}
+    t_to = min(after_t + RECALL_WINDOW_S, before_t)
     for boat, (t, x, y) in tracks.items():
         g = gap_s[boat]
-        first = [c for c in _crossings(t, x, y, wide, gun_t, g, gun_t + RECALL_WINDOW_S) if c.known]
+        first = [c for c in _crossings(t, x, y, wide, after_t, g, t_to) if c.known]
         if not first:
             continue
-        started += 1
+        first_t[boat] = first[0].t
         back = [
             c
             for c in _crossings(t, x, y, back_geom, first[0].t, g, first[0].t + RECALL_WINDOW_S)
@@ -543,8 +640,15 @@ def detect_general_recall(
         nxt = [c for c in _crossings(t, x, y, wide, back[0].t, g) if c.known]
         if nxt:
             again[boat] = nxt[0].t
-    if len(again) < max(MIN_FLEET, RECALL_SHARE * started) or started == 0:
+    if not again:
+        return None
+    pulse = float(np.median([first_t[b] for b in again]))
+    came = {b: v for b, v in again.items() if abs(first_t[b] - pulse) <= PULSE_S}
+    if len(came) < max(MIN_FLEET, RECALL_SHARE * len(first_t)):
         return None
     return GeneralRecall(
-        tuple(sorted(again)), started, float(np.percentile(list(again.values()), 10.0))
+        tuple(sorted(came)),
+        len(first_t),
+        pulse,
+        float(np.percentile(list(came.values()), 10.0)),
     )

@@ -20,7 +20,7 @@ passed outside).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -35,6 +35,9 @@ from sailroute.analysis.segment import (
     segment_track,
 )
 from sailroute.analysis.start import (
+    MIN_FLEET,
+    RECALL_BEFORE_S,
+    RECALL_WINDOW_S,
     FleetStart,
     GeneralRecall,
     detect_general_recall,
@@ -80,13 +83,20 @@ the data beyond it (another race, the next day) are dropped."""
 
 PACE_FACTOR = 2.0
 """A boat whose legs take more than this many times the fleet's median for the same legs
-(or less than its inverse) sails at another fleet's pace (needs :data:`PACE_MIN_BOATS`)."""
+(or less than its inverse) sails at another fleet's pace (needs :data:`PACE_MIN_BOATS`);
+so does one far outside the fleet's own spread (:data:`PACE_Z`)."""
 
 PACE_MIN_BOATS = 4
 """Boats with timed legs needed before a boat's pace is compared with the fleet's."""
 
-LATE_START_S = 10.0
-"""A boat that starts more than this after the (fleet's) gun is a late starter [s]."""
+PACE_Z = 4.0
+"""A boat whose pace (:data:`PACE_FACTOR`) lies this many robust standard deviations (1.4826
+median absolute deviations of the fleet's log pace) from the fleet's median, and more than
+:data:`PACE_MIN_FACTOR` off it, sails at another fleet's pace."""
+
+PACE_MIN_FACTOR = 1.15
+"""Smallest pace difference from the fleet's median called another fleet's (a one-design
+fleet's pace spread can be tiny)."""
 
 
 class BoatClass(StrEnum):
@@ -97,7 +107,9 @@ class BoatClass(StrEnum):
     OTHER_FLEET = "another fleet"
     NON_STARTER = "did not start"
     OCS = "over early at the gun (OCS)"
+    OCS_RETURNED = "over early, came back and started"
     LATE_START = "late start"
+    DATA_GAP = "data gap during the race"
     MULTI_RACE = "log spans more than the race"
     RETIRED = "retired or data end mid-race"
     GATE_OUTSIDE = "gate passed outside its marks"
@@ -215,6 +227,9 @@ class Triage:
     gap_allow_s : float
         Longest gap a log may have inside the race [s] (:data:`RACE_GAP_FACTOR`); inf
         when no leg was timed.
+    restart_estimated : bool
+        The gun is the restart after a general recall found in the tracks, estimated from
+        the fleet's second start (the course gave none, nor ``--gun``).
     """
 
     entries: tuple[BoatEntry, ...]
@@ -222,6 +237,7 @@ class Triage:
     recall: GeneralRecall | None
     race_end_t: float
     gap_allow_s: float
+    restart_estimated: bool = False
 
     @property
     def analysed(self) -> tuple[BoatEntry, ...]:
@@ -231,13 +247,19 @@ class Triage:
     def notes(self) -> tuple[str, ...]:
         """The start's estimate, a general recall, and one note per class of finding."""
         out = []
-        if self.recall is not None:
-            r = self.recall
+        r = self.recall
+        if r is not None and not self.restart_estimated:
             out.append(
-                f"general recall: {len(r.boats)} of {r.n_started} boats started at the gun, "
-                f"came back and started again from {iso(r.restart_t)}; the restart's gun is "
-                "not in the course (restart_time) nor given (--gun): taken there, from the "
-                "fleet's second start"
+                f"general recall: {len(r.boats)} of {r.n_started} boats started at "
+                f"{iso(r.first_t)}, came back and started again at the gun "
+                f"({iso(self.start.gun_t)}); the race is timed from it"
+            )
+        elif r is not None:
+            out.append(
+                f"general recall: {len(r.boats)} of {r.n_started} boats started at "
+                f"{iso(r.first_t)}, came back and started again from {iso(r.restart_t)}; "
+                "the restart's gun is not in the course (restart_time) nor given (--gun): "
+                "the race is timed from the fleet's second start"
             )
         if self.start.model != "none" or self.start.n_boats:
             out.append(self.start.describe())
@@ -274,24 +296,54 @@ def race_window_problem(
     return None
 
 
-def cut_at_gaps(t: NDArray, gun_t: float, allow_s: float) -> tuple[int, int]:
-    """Index range ``[lo, hi)`` of the part of a track around the gun without a gap longer
-    than ``allow_s`` [s] (from the first fix after the gun when the gun falls in such a gap
-    or before the track)."""
-    if t.size < 2 or not math.isfinite(allow_s):
+def cut_at_gaps(
+    t: NDArray, gun_t: float, allow_s: float, end_t: float = math.inf, gap_s: float = math.inf
+) -> tuple[int, int]:
+    """Index range ``[lo, hi)`` of the part of a track that can belong to the race.
+
+    Around the gun, the part without a gap longer than ``allow_s`` [s] (from the first fix
+    after the gun when the gun falls in such a gap or before the track); then cut before
+    the first data gap (longer than ``gap_s``) after the gun that ends after the race's end
+    ``end_t`` [epoch s], and at ``end_t``: nothing after it is of this race.
+    """
+    if t.size < 2:
         return 0, t.size
-    big = np.flatnonzero(np.diff(t) > allow_s)  # a gap between fix k and k + 1
-    k = int(np.searchsorted(t, gun_t, side="right")) - 1  # last fix at or before the gun
-    k = max(k, 0)
-    before = big[big < k]
-    after = big[big >= k]
-    lo = int(before[-1]) + 1 if before.size else 0
-    hi = int(after[0]) + 1 if after.size else t.size
-    if t[hi - 1] < gun_t and hi < t.size:  # the gun falls in a long gap: the part after it
-        lo = hi
-        nxt = big[big >= hi]
-        hi = int(nxt[0]) + 1 if nxt.size else t.size
+    lo, hi = 0, t.size
+    if math.isfinite(allow_s):
+        big = np.flatnonzero(np.diff(t) > allow_s)  # a gap between fix k and k + 1
+        k = max(int(np.searchsorted(t, gun_t, side="right")) - 1, 0)  # last fix <= gun
+        before = big[big < k]
+        after = big[big >= k]
+        lo = int(before[-1]) + 1 if before.size else 0
+        hi = int(after[0]) + 1 if after.size else t.size
+        if t[hi - 1] < gun_t and hi < t.size:  # the gun falls in a long gap: the part after
+            lo = hi
+            nxt = big[big >= hi]
+            hi = int(nxt[0]) + 1 if nxt.size else t.size
+    if math.isfinite(end_t):
+        gaps = lo + np.flatnonzero(np.diff(t[lo:hi]) > gap_s)
+        late = gaps[(t[gaps] >= gun_t) & (t[np.minimum(gaps + 1, t.size - 1)] > end_t)]
+        if late.size:
+            hi = int(late[0]) + 1
+        hi = min(hi, max(int(np.searchsorted(t, end_t, side="right")), lo + 2))
     return lo, hi
+
+
+def _race_end_t(segs: Sequence[Segmentation], gun_t: float, longest_s: float) -> float:
+    """When the race is over [epoch s]: the last finish of the fleet (of the boats that took
+    at most twice the median boat's time: a log bridged into another race does not count),
+    else its last leg end found, plus the longest leg (``longest_s``); inf when nothing is
+    timed."""
+    fin = np.array([s.ends[-1].t for s in segs if s.ends and s.ends[-1].known])
+    if fin.size:
+        el = fin - gun_t
+        last = float(fin[el <= 2.0 * float(np.median(el))].max())
+    else:
+        ends = [c.t for s in segs for c in s.ends if c.known]
+        if not ends:
+            return math.inf
+        last = max(ends)
+    return last + (longest_s if math.isfinite(longest_s) else 0.0)
 
 
 def _duplicates(
@@ -343,12 +395,12 @@ def _same_data(
     return bool(np.median(d) <= DUPLICATE_M)
 
 
-def _typical_leg_s(segs: Sequence[Segmentation]) -> float:
-    """The median over the legs of the fleet's median leg time [s] (NaN: none timed)."""
+def _leg_medians(segs: Sequence[Segmentation]) -> NDArray:
+    """The fleet's median time of each leg [s] (NaN: no boat timed it)."""
     if not segs:
-        return math.nan
+        return np.zeros(0)
     n = len(segs[0].ends)
-    med = []
+    med = np.full(n, np.nan)
     for i in range(n):
         times = [
             s.bounds[i + 1].t - s.bounds[i].t
@@ -356,8 +408,8 @@ def _typical_leg_s(segs: Sequence[Segmentation]) -> float:
             if s.bounds[i].known and s.bounds[i + 1].known
         ]
         if times:
-            med.append(float(np.median(times)))
-    return float(np.median(med)) if med else math.nan
+            med[i] = float(np.median(times))
+    return med
 
 
 def _pace(segs: Mapping[str, Segmentation]) -> dict[str, float]:
@@ -380,6 +432,135 @@ def _pace(segs: Mapping[str, Segmentation]) -> dict[str, float]:
     return {
         b: float(np.nanmedian(ratio[r])) for r, b in enumerate(names) if np.isfinite(ratio[r]).any()
     }
+
+
+@dataclass
+class _Fleet:
+    """Triage's working state: per boat, its status, file, track and course-frame points."""
+
+    status: dict[str, BoatStatus]
+    source: dict[str, str]
+    kept: dict[str, Track] = field(default_factory=dict)
+    xy: dict[str, tuple[NDArray, NDArray, NDArray]] = field(default_factory=dict)
+    gaps: dict[str, float] = field(default_factory=dict)
+
+    def find(self, name: str, finding: Finding) -> None:
+        self.status[name] = self.status[name].with_finding(finding)
+
+    def drop(self, name: str, finding: Finding) -> None:
+        """Leave ``name`` out with ``finding``."""
+        self.find(name, finding)
+        self.kept.pop(name, None)
+        self.xy.pop(name, None)
+
+
+def _readable(
+    course: Course, tracks: Sequence[tuple[str, str, Track | Exception]], gun: float
+) -> _Fleet:
+    """The tracks that were read, hold two fixes and lie in the race's time and place."""
+    fleet = _Fleet({n: BoatStatus() for n, _, _ in tracks}, {n: s for n, s, _ in tracks})
+    for name, _, got in tracks:
+        if isinstance(got, Exception):
+            fleet.find(name, Finding(BoatClass.EMPTY, str(got)))
+            continue
+        if len(got) < 2:
+            fleet.find(name, Finding(BoatClass.EMPTY, f"{len(got)} fix(es)"))
+            continue
+        x, y = track_xy(got, course.frame)
+        problem = race_window_problem(course, got, x, y, gun)
+        if problem is not None and gun - PRESTART_S <= got.t_end < gun:
+            end = f"the data end at {iso(got.t_end)}, before the gun"
+            fleet.find(name, Finding(BoatClass.NON_STARTER, end))
+        elif problem is not None:
+            fleet.find(name, Finding(BoatClass.OTHER_FLEET, problem))
+        else:
+            fleet.kept[name] = got
+            fleet.xy[name] = (got.t_s, x, y)
+            fleet.gaps[name] = gap_limit_s(got.t_s)
+    return fleet
+
+
+def _fleet_start(
+    course: Course, fleet: _Fleet, gun: float, given: bool, estimate: bool
+) -> tuple[FleetStart, GeneralRecall | None, bool]:
+    """The fleet's start: a general recall after the gun when the course gives no restart
+    (the restart's gun then estimated from the fleet: the flag), before it otherwise
+    (noted), and the fleet's gun and line."""
+    recall = None
+    moved = False
+    if len(fleet.xy) >= MIN_FLEET:
+        if not given:
+            recall = detect_general_recall(course, fleet.xy, gun, fleet.gaps)
+        if recall is None:
+            before = gun - RECALL_BEFORE_S
+            recall = detect_general_recall(
+                course, fleet.xy, before - RECALL_WINDOW_S, fleet.gaps, before
+            )
+        else:
+            gun, moved = round(recall.restart_t), True
+    obs = [
+        o
+        for n, (t, x, y) in fleet.xy.items()
+        if (o := observe_start(course, t, x, y, gun, n, fleet.gaps[n])) is not None
+    ]
+    return estimate_fleet_start(obs if estimate else [], gun), recall, moved
+
+
+def _cut_to_race(
+    fleet: _Fleet,
+    segs: dict[str, Segmentation],
+    start: FleetStart,
+    segment: Callable[[str], Segmentation],
+) -> tuple[dict[str, tuple[float, float]], float]:
+    """Cut every log to the race (:func:`cut_at_gaps`), segmenting again the ones cut; the
+    cuts that dropped another race's data, and the longest gap a log may have."""
+    med = _leg_medians(list(segs.values()))
+    timed = med[np.isfinite(med)]
+    allow = RACE_GAP_FACTOR * float(np.median(timed)) if timed.size else math.inf
+    longest = float(timed.max()) if timed.size else math.inf
+    gun = start.track_gun_t
+    end_t = _race_end_t([s for s in segs.values() if s.start.started], gun, longest)
+    cut: dict[str, tuple[float, float]] = {}
+    for n, (t, x, y) in list(fleet.xy.items()):
+        lo, hi = cut_at_gaps(t, gun, allow, end_t, fleet.gaps[n])
+        if (lo, hi) == (0, t.size) or hi - lo < 2:
+            continue
+        dropped = [
+            f"a gap of {t[k + 1] - t[k]:.0f} s {where}"
+            for k, where in ((lo - 1, "before"), (hi - 1, "after"))
+            if 0 <= k < t.size - 1 and t[k + 1] - t[k] > fleet.gaps[n]
+        ]
+        if t[-1] - t[hi - 1] > longest and not dropped:
+            dropped = [f"{t[-1] - t[hi - 1]:.0f} s of data after the race's end"]
+        if dropped:
+            kept = f"cut to {iso(float(t[lo]))} .. {iso(float(t[hi - 1]))}, "
+            fleet.find(n, Finding(BoatClass.MULTI_RACE, kept + " and ".join(dropped)))
+            cut[n] = (float(t[lo]), float(t[hi - 1]))
+        fleet.kept[n] = fleet.kept[n].between(float(t[lo]), float(t[hi - 1]))
+        fleet.xy[n] = (t[lo:hi], x[lo:hi], y[lo:hi])
+        segs[n] = segment(n)
+    return cut, allow
+
+
+def _other_pace(fleet: _Fleet, segs: Mapping[str, Segmentation]) -> None:
+    """Leave out the boats that sail at another fleet's pace (:data:`PACE_FACTOR`,
+    :data:`PACE_Z`)."""
+    pace = _pace({k: v for k, v in segs.items() if v.start.started})
+    if not pace:
+        return
+    lp = np.log(np.array(list(pace.values())))
+    med = float(np.median(lp))
+    sd = 1.4826 * float(np.median(np.abs(lp - med)))
+    for n, ratio in pace.items():
+        off = abs(math.log(ratio) - med)
+        if off > math.log(PACE_FACTOR) or (off > math.log(PACE_MIN_FACTOR) and off > PACE_Z * sd):
+            fleet.find(
+                n,
+                Finding(
+                    BoatClass.OTHER_FLEET,
+                    f"its legs take {ratio:.2f} times the fleet's median: another class or fleet?",
+                ),
+            )
 
 
 def triage_fleet(
@@ -414,133 +595,60 @@ def triage_fleet(
     -------
     Triage
     """
-    given_gun = gun_t is not None or course.restart_time is not None
     gun = gun_t if gun_t is not None else course.gun_epoch
-    status: dict[str, BoatStatus] = {}
-    source: dict[str, str] = {}
-    kept: dict[str, Track] = {}
-    xy: dict[str, tuple[NDArray, NDArray, NDArray]] = {}
-    for name, src, got in tracks:
-        source[name] = src
-        status[name] = BoatStatus()
-        if isinstance(got, Exception):
-            status[name] = BoatStatus((Finding(BoatClass.EMPTY, str(got)),))
-            continue
-        if len(got) < 2:
-            status[name] = BoatStatus((Finding(BoatClass.EMPTY, f"{len(got)} fix(es)"),))
-            continue
-        x, y = track_xy(got, course.frame)
-        problem = race_window_problem(course, got, x, y, gun)
-        if problem is not None and gun - PRESTART_S <= got.t_end < gun:
-            status[name] = BoatStatus(
-                (
-                    Finding(
-                        BoatClass.NON_STARTER, f"the data end at {iso(got.t_end)}, before the gun"
-                    ),
-                )
-            )
-            continue
-        if problem is not None:
-            status[name] = BoatStatus((Finding(BoatClass.OTHER_FLEET, problem),))
-            continue
-        kept[name] = got
-        xy[name] = (got.t_s, x, y)
+    fleet = _readable(course, tracks, gun)
     window = (course.start_epoch - PRESTART_S, gun + course.time_limit_s)
-    for dup, first in _duplicates(xy, *window).items():
-        status[dup] = BoatStatus((Finding(BoatClass.DUPLICATE, f"the same data as {first}"),))
-        del kept[dup], xy[dup]
-    gaps = {n: gap_limit_s(t) for n, (t, _, _) in xy.items()}
-    recall = None if given_gun else detect_general_recall(course, xy, gun, gaps)
-    if recall is not None:
-        gun = round(recall.restart_t)
-    obs = [
-        o
-        for n, (t, x, y) in xy.items()
-        if (o := observe_start(course, t, x, y, gun, n, gaps[n])) is not None
-    ]
-    start = estimate_fleet_start(obs if fleet_start else [], gun)
+    for dup, first in _duplicates(fleet.xy, *window).items():
+        fleet.drop(dup, Finding(BoatClass.DUPLICATE, f"the same data as {first}"))
+    given = gun_t is not None or course.restart_time is not None
+    start, recall, moved = _fleet_start(course, fleet, gun, given, fleet_start)
     times = leg_times or {}
 
-    def segment(name: str, t: NDArray, x: NDArray, y: NDArray) -> Segmentation:
+    def segment(name: str) -> Segmentation:
         return segment_track(
             course,
-            t,
-            x,
-            y,
+            *fleet.xy[name],
             leg_times=times.get(name),
             detect_m=detect_m,
-            where=source[name],
+            where=fleet.source[name],
             missing="unknown",
             gate_end=gate_end,
             clock=start.clock(name),
         )
 
-    segs = {n: segment(n, *xy[n]) for n in xy}
-    typical = _typical_leg_s(list(segs.values()))
-    allow = RACE_GAP_FACTOR * typical if math.isfinite(typical) else math.inf
-    cut: dict[str, tuple[float, float]] = {}
-    for n, (t, x, y) in list(xy.items()):
-        lo, hi = cut_at_gaps(t, gun, allow)
-        if (lo, hi) == (0, t.size) or hi - lo < 2:
-            continue
-        dropped = [
-            f"a gap of {t[k + 1] - t[k]:.0f} s {where}"
-            for k, where in ((lo - 1, "before"), (hi - 1, "after"))
-            if 0 <= k < t.size - 1
-        ]
-        status[n] = status[n].with_finding(
-            Finding(
-                BoatClass.MULTI_RACE,
-                f"cut to {iso(float(t[lo]))} .. {iso(float(t[hi - 1]))}, "
-                + " and ".join(dropped)
-                + f" (the race's legs allow {allow:.0f} s)",
-            )
-        )
-        kept[n] = kept[n].between(float(t[lo]), float(t[hi - 1]))
-        xy[n] = (t[lo:hi], x[lo:hi], y[lo:hi])
-        cut[n] = (float(t[lo]), float(t[hi - 1]))
-        segs[n] = segment(n, *xy[n])
-    for n, ratio in _pace({k: v for k, v in segs.items() if v.start.started}).items():
-        if ratio > PACE_FACTOR or ratio < 1.0 / PACE_FACTOR:
-            status[n] = status[n].with_finding(
-                Finding(
-                    BoatClass.OTHER_FLEET,
-                    f"its legs take {ratio:.1f} times the fleet's median: another class or fleet?",
-                )
-            )
+    segs = {n: segment(n) for n in fleet.xy}
+    cut, allow = _cut_to_race(fleet, segs, start, segment)
+    _other_pace(fleet, segs)
     for n, seg in segs.items():
-        status[n] = _own_findings(status[n], seg, course)
+        if fleet.status[n].analysed:
+            fleet.status[n] = _own_findings(fleet.status[n], seg, course, *fleet.xy[n])
     ends = [c.t for s in segs.values() for c in s.bounds[1:] if c.known]
     race_end = min(window[1], max(ends) + 60.0) if ends else window[1]
     entries = tuple(
-        BoatEntry(
-            name,
-            source[name],
-            kept.get(name),
-            status[name],
-            segs.get(name),
-            cut.get(name),
-        )
-        for name, _, _ in tracks
+        BoatEntry(n, fleet.source[n], fleet.kept.get(n), fleet.status[n], segs.get(n), cut.get(n))
+        for n, _, _ in tracks
     )
-    return Triage(entries, start, recall, race_end, allow)
+    return Triage(entries, start, recall, race_end, allow, moved)
 
 
-def _own_findings(status: BoatStatus, seg: Segmentation, course: Course) -> BoatStatus:
-    """A boat's findings from its own start and legs."""
+def _own_findings(
+    status: BoatStatus, seg: Segmentation, course: Course, t: NDArray, x: NDArray, y: NDArray
+) -> BoatStatus:
+    """A boat's findings from its own start, legs and data gaps."""
     st = seg.start
     if not st.started:
         reason = st.crossing.note.removeprefix("did not start: ")
         return status.with_finding(Finding(BoatClass.NON_STARTER, reason))
-    if st.ocs:
+    if st.ocs_s is not None:
         status = status.with_finding(
             Finding(
-                BoatClass.OCS,
+                BoatClass.OCS_RETURNED if st.ocs_returned else BoatClass.OCS,
                 f"{st.ocs_s:.1f} s / {st.distance_at_gun_m:.0f} m over"
-                + (f", {st.ocs_sd:.1f} sd, p = {st.ocs_p:.3f}" if math.isfinite(st.ocs_sd) else ""),
+                + (f", {st.ocs_sd:.1f} sd, p = {st.ocs_p:.3f}" if math.isfinite(st.ocs_sd) else "")
+                + (f", restarted {st.late_s:+.0f} s" if st.ocs_returned else ""),
             )
         )
-    elif st.crossing.detected and st.late_s > LATE_START_S:
+    elif st.late:
         behind = (
             f", {st.distance_at_gun_m:.0f} m behind the line at the gun"
             if st.side_at_gun == "pre-start"
@@ -555,6 +663,9 @@ def _own_findings(status: BoatStatus, seg: Segmentation, course: Course) -> Boat
                 ", ".join(f"leg {i + 1} ({course.legs[i].label})" for i in outside),
             )
         )
+    gaps = _race_gaps(seg, t)
+    if gaps:
+        status = status.with_finding(Finding(BoatClass.DATA_GAP, ", ".join(gaps)))
     stopped = next(
         (
             i
@@ -577,6 +688,23 @@ def _own_findings(status: BoatStatus, seg: Segmentation, course: Course) -> Boat
             )
         )
     return status
+
+
+def _race_gaps(seg: Segmentation, t: NDArray) -> list[str]:
+    """The data gaps (longer than :func:`gap_limit_s`) between the start and the last leg
+    end found, as ``"57 s in leg 2"``."""
+    bounds = [c.t_lo for c in seg.bounds if math.isfinite(c.t_lo)]
+    if len(bounds) < 2:
+        return []
+    lim = gap_limit_s(t)
+    k = np.flatnonzero(np.diff(t) > lim)
+    k = k[(t[k] >= bounds[0]) & (t[k] < bounds[-1])]
+    ends = np.array([c.t_hi for c in seg.ends])
+    out = []
+    for j in k:
+        leg = int(np.searchsorted(np.where(np.isfinite(ends), ends, np.inf), t[j], side="left"))
+        out.append(f"{t[j + 1] - t[j]:.0f} s in leg {min(leg, len(ends) - 1) + 1}")
+    return out
 
 
 def class_notes(entries: Sequence[BoatEntry]) -> tuple[str, ...]:

@@ -435,7 +435,7 @@ def fleet_to_dict(fleet: FleetAnalysis) -> dict[str, Any]:
             "line_shift_m": _num(st.shift_m, 1),
             "se_line_shift_m": _num(st.se_shift_m, 1),
             "front_row_spread_m": _num(st.spread_m, 2),
-            "mean_delay_s": _num(st.delay_s, 2),
+            "clean_spread_s": _num(st.spread_s, 2),
             "boats": st.n_boats,
         },
         "general_recall": None
