@@ -85,6 +85,18 @@ GAP_FACTOR = 5.0
 """An interval between fixes longer than ``max(GAP_MIN_S, GAP_FACTOR x median interval)``
 is a data gap: a leg end that falls inside it is unknown, not interpolated."""
 
+RAY_ANGLE_DEG = 30.0
+"""A mark's rounding ray counts as crossed only at this angle or steeper [°] (the boat's
+velocity over 4 s): the apex is crossed nearly head-on, while a boat passing close
+alongside the ray (a gate mark rounded tight, 180°) can wander across it on GPS noise
+seconds before it turns."""
+
+CLOSE_PASS_TURN_DEG = 60.0
+"""A boat that passes within :data:`MARK_TOLERANCE_M` of a mark and turns this much in the
+rounding's sense over the 20 s either side [°] has rounded it, at its closest approach,
+even where GPS noise keeps its track from crossing the rounding ray (a rounding that
+grazes the mark)."""
+
 GATE_OUTSIDE_S = 60.0
 """A boat that crosses a gate's line beyond its marks (up to ``detect_m`` off) and does not
 pass between them within this time after [s] has passed the gate outside its marks: its leg
@@ -868,9 +880,11 @@ def gate_rounding(
     """When the boat, having passed between the marks of leg ``i``'s gate, went round one.
 
     The mark is the one it comes closest to within :data:`GATE_ROUNDING_S` of ``passed``;
-    it is left to port when it lies left of the boat's crossing direction, and its rounding
-    is the crossing of its rounding ray (as for a mark leg, towards the next leg's
-    target).  Official leg counters (SailGP's ``TRK_LEG_NUM``) change there.
+    it is left to port when it is the gate's left end looking along the crossing
+    direction, and its rounding is the steep crossing of its rounding ray (as for a mark
+    leg, towards the next leg's target), or a close pass that turns round it
+    (:func:`_close_pass`).  Official leg counters (SailGP's ``TRK_LEG_NUM``) change
+    there.
 
     Returns
     -------
@@ -888,19 +902,101 @@ def gate_rounding(
         return None
     ends = (gate.a, gate.b)
     d = [float(np.min(np.hypot(x[w] - m.x, y[w] - m.y))) for m in ends]
-    mark = ends[int(np.argmin(d))]
+    k = int(np.argmin(d))
+    mark, other = ends[k], ends[1 - k]
     line = detection_geometry(course, i, from_xy, detect_m)
     nx, ny = line.normal  # the crossing direction
-    left = nx * (mark.y - passed.y) - ny * (mark.x - passed.x) > 0
+    # the mark's side from the other mark, not from where the boat passed: a boat that
+    # passes at the mark itself leaves it on the gate's side
+    left = nx * (mark.y - other.y) - ny * (mark.x - other.x) > 0
     exit_xy = leg_target(course, i + 1).centre if i + 1 < course.n_legs else None
     target = Target(
         "mark", mark.xy, None, "port" if left else "starboard", exit_xy=exit_xy, name=mark.name
     )
     geom = _behind_mark(target_geometry(target, Start(from_xy, None), zone_m=detect_m))
-    found = [
-        c for c in _crossings(t, x, y, geom, passed.t, gap_s, passed.t + GATE_ROUNDING_S) if c.known
-    ]
-    return found[0] if found else None
+    end = passed.t + GATE_ROUNDING_S
+    found = [c for c in _steep(_crossings(t, x, y, geom, passed.t, gap_s, end), geom, t, x, y)]
+    found = [c for c in found if c.known]
+    if found:
+        return found[0]
+    return _close_pass(mark.xy, target.rounding, t, x, y, passed.t, end)
+
+
+def _steep(
+    found: Sequence[Crossing], geom: TargetGeometry, t: NDArray, x: NDArray, y: NDArray
+) -> list[Crossing]:
+    """The crossings of a rounding ray at :data:`RAY_ANGLE_DEG` or steeper (those inside a
+    data gap kept)."""
+    out = []
+    lim = math.sin(math.radians(RAY_ANGLE_DEG))
+    for c in found:
+        if not c.known:
+            out.append(c)
+            continue
+        x0, y0 = _point_at(t, x, y, c.t - 2.0)
+        x1, y1 = _point_at(t, x, y, c.t + 2.0)
+        v = math.hypot(x1 - x0, y1 - y0)
+        if v > 0 and ((x1 - x0) * geom.normal[0] + (y1 - y0) * geom.normal[1]) >= lim * v:
+            out.append(c)
+    return out
+
+
+def smooth_turn_deg(t: NDArray, x: NDArray, y: NDArray, t0: float, t1: float) -> float:
+    """Net turn of the course over ground from ``t0`` to ``t1`` [°] (− to the left), from
+    the track resampled every 4 s (single fixes' noise does not flip a tight turn's sense)."""
+    tq = np.arange(t0, t1 + 1e-9, 4.0)
+    if tq.size < 3:
+        return 0.0
+    xq, yq = np.interp(tq, t, x), np.interp(tq, t, y)
+    return turn_deg(xq, yq)
+
+
+def _close_pass(
+    mark: tuple[float, float],
+    rounding: str | None,
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    t_from: float,
+    t_before: float,
+) -> Crossing | None:
+    """The first pass within :data:`MARK_TOLERANCE_M` of ``mark`` after ``t_from`` (before
+    ``t_before``) that turns :data:`CLOSE_PASS_TURN_DEG` in the rounding's sense, at its
+    closest approach."""
+    idx = np.flatnonzero((t > t_from) & (t < t_before))
+    if idx.size == 0 or rounding is None:
+        return None
+    d = np.hypot(x[idx] - mark[0], y[idx] - mark[1])
+    near = d <= MARK_TOLERANCE_M
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], near.astype(int), [0]])))
+    for a, b in zip(edges[::2], edges[1::2], strict=True):
+        k = int(idx[a + int(np.argmin(d[a:b]))])
+        turn = smooth_turn_deg(t, x, y, float(t[k]) - 20.0, float(t[k]) + 20.0)
+        if (turn <= -CLOSE_PASS_TURN_DEG) if rounding == "port" else (turn >= CLOSE_PASS_TURN_DEG):
+            return Crossing(float(t[k]), float(x[k]), float(y[k]))
+    return None
+
+
+def _mark_crossings(
+    geom: TargetGeometry,
+    mark: tuple[float, float],
+    rounding: str | None,
+    t: NDArray,
+    x: NDArray,
+    y: NDArray,
+    t_from: float,
+    gap_s: float,
+    t_before: float,
+) -> list[Crossing]:
+    """The roundings of a mark after ``t_from``: its rounding ray's steep crossings
+    (:func:`_steep`), led by a close pass (:func:`_close_pass`) that comes
+    :data:`GATE_ROUNDING_S` or more before the first of them (or when there is none)."""
+    found = _steep(_crossings(t, x, y, geom, t_from, gap_s, t_before), geom, t, x, y)
+    first = next((c.t_lo for c in found), math.inf)
+    close = _close_pass(mark, rounding, t, x, y, t_from, min(first, t_before))
+    if close is not None and close.t + GATE_ROUNDING_S < first:
+        return [close, *found]
+    return found
 
 
 def _closest_m(geom: TargetGeometry, x: NDArray, y: NDArray) -> float:
@@ -1071,8 +1167,15 @@ def _leg_end(
     geom = detection_geometry(course, i, (prev.x, prev.y), detect_m, line_margin_m)
     nxt = [v for v in given[i + 2 :] if v is not None]
     t_before = nxt[0] if nxt else math.inf
-    found = _crossings(t, x, y, geom, prev.t_hi + 1e-6, gap_s, t_before)
-    is_gate = course.legs[i].kind == "gate"
+    spec = course.legs[i]
+    if spec.kind == "mark":
+        mark = course.marks[spec.to_name]
+        found = _mark_crossings(
+            geom, mark.xy, spec.rounding, t, x, y, prev.t_hi + 1e-6, gap_s, t_before
+        )
+    else:
+        found = _crossings(t, x, y, geom, prev.t_hi + 1e-6, gap_s, t_before)
+    is_gate = spec.kind == "gate"
     if is_gate:
         found = _outside_pass(course, i, prev, t, x, y, geom, found, gap_s, detect_m, t_before)
     stop = _stop_near(t, x, y, geom, prev.t_hi, gap_s, detect_m)

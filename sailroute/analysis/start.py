@@ -14,8 +14,9 @@ The model (per boat *i*, at the course's gun): ``d_i`` its distance over the sur
 (``δ``) up the course and the tracks stamped ``time_offset_s`` (``τ``) late, the boat
 crossed the line the fleet used ``e_i = (δ − d_i)/v_i − τ`` seconds after the gun.  The
 ``e_i`` of the fleet are a mixture: clean starts, spread evenly over the ``W`` seconds after
-the front row and blurred by a normal error (the front row's spread along the course, ``σ_m``
-metres, over ``v_i``, and :data:`SIGMA_T_S`); over-early boats, an exponential lead (mean
+the front row or (a share of them) over a wider ``W₂``, blurred by a normal error (the front
+row's spread along the course, ``σ_m`` metres, over ``v_i``, and :data:`SIGMA_T_S`); over-early
+boats, an exponential lead (mean
 ``κ``) before the gun; late starters, up to :data:`LATE_SPAN_S` after it.  The parameters
 are the maximum of the likelihood with weak priors (so that three boats give an answer);
 ``δ`` alone, ``τ`` alone, or both are tried, and the one the data favour (BIC) is kept;
@@ -89,6 +90,9 @@ LATE_SPAN_S = 600.0
 FLOOR_DENSITY = 1e-6
 """Density [s⁻¹] under every boat: a boat far outside the model (over by minutes, or
 drifting) weighs no more than this."""
+
+N_FRONT = 10
+"""The earliest boats each tried as the front row in a fit."""
 
 RECALL_WINDOW_S = 600.0
 """A boat that crosses back to the pre-start side within this time after starting [s] and
@@ -214,7 +218,7 @@ class FleetStart:
         Spread of the front row along the course [m] (``σ_m``: where the boats were and
         the GPS error of where they were).
     spread_s : float
-        The clean starts spread evenly over this time after the front row [s] (``W``).
+        95 % of the clean starts lie within this time after the front row [s].
     se_time_offset_s, se_shift_m : float
         Standard errors [s, m] (0 for the one not estimated).
     n_boats : int
@@ -291,13 +295,17 @@ class FleetStart:
 _MODELS = {"line": (False, True), "clock": (True, False), "both": (True, True)}
 """Model -> (τ free, δ free)."""
 
-_N_TAIL = 5
-"""Parameters besides the offsets: log σ_m, log W, log κ, logit of the over-early and late
-shares."""
+_N_TAIL = 7
+"""Parameters besides the offsets: log σ_m, log W, log W₂, log κ, logit of the wide body's
+share of the clean starts, logits of the over-early and late shares."""
 
-_PRIOR = (math.log(2.0), math.log(5.0), math.log(3.0))
-"""Prior medians of the front row's spread [m], W and κ [s] (log-normal, a factor e either
-way)."""
+_PRIOR = (math.log(2.0), math.log(3.0), math.log(15.0), math.log(3.0))
+"""Prior medians of the front row's spread [m], W, W₂ and κ [s] (log-normal)."""
+
+_PRIOR_SD = (0.5, 1.0, 1.0, 1.0)
+"""Their prior standard deviations in log: the front row's spread within a factor 1.65 of
+2 m (a GPS receiver's error; the fleet widens it only with clear evidence), the rest a
+factor e."""
 
 
 def _unpack(theta: NDArray, free: tuple[bool, bool]) -> tuple[float, float, NDArray]:
@@ -339,17 +347,26 @@ def _log_uniform(e: NDArray, s: NDArray, width: float) -> NDArray:
 
 
 def _log_mixture(
-    e: NDArray, s: NDArray, width: float, kappa: float, p_ocs: float, p_late: float
+    e: NDArray,
+    s: NDArray,
+    widths: tuple[float, float],
+    p_wide: float,
+    kappa: float,
+    p_ocs: float,
+    p_late: float,
 ) -> NDArray:
-    """Log density of each start time ``e`` [s]: a clean start (spread evenly over ``width``
-    after the front row), over early (an exponential lead, mean ``kappa``), late (spread
-    evenly over :data:`LATE_SPAN_S`), all blurred by ``s``; and the floor."""
+    """Log density of each start time ``e`` [s]: a clean start (spread evenly over the
+    first of ``widths`` after the front row, or with the share ``p_wide`` over the second),
+    over early (an exponential lead, mean ``kappa``), late (spread evenly over
+    :data:`LATE_SPAN_S`), all blurred by ``s``; and the floor.  The two widths let the
+    body of the clean starts take any rough shape, so that ``s`` is the front row's own."""
     p_clean = max(1.0 - p_ocs - p_late, 1e-9)
-    parts = np.empty((4, e.size))
-    parts[0] = math.log(p_clean) + _log_uniform(e, s, width)
-    parts[1] = math.log(max(p_ocs, 1e-12)) + _emg(-e, s, kappa)
-    parts[2] = math.log(max(p_late, 1e-12)) + _log_uniform(e, s, LATE_SPAN_S)
-    parts[3] = math.log(FLOOR_DENSITY)
+    parts = np.empty((5, e.size))
+    parts[0] = math.log(p_clean * (1.0 - p_wide)) + _log_uniform(e, s, widths[0])
+    parts[1] = math.log(p_clean * p_wide) + _log_uniform(e, s, widths[1])
+    parts[2] = math.log(max(p_ocs, 1e-12)) + _emg(-e, s, kappa)
+    parts[3] = math.log(max(p_late, 1e-12)) + _log_uniform(e, s, LATE_SPAN_S)
+    parts[4] = math.log(FLOOR_DENSITY)
     top = parts.max(axis=0)
     out: NDArray = top + np.log(np.exp(parts - top).sum(axis=0))
     return out
@@ -378,15 +395,19 @@ def _neg_log_post(theta: NDArray, data: _Data, model: str) -> float:
     from scipy.special import expit
 
     tau, delta, tail = _unpack(theta, _MODELS[model])
-    ls, lw, lk = (min(max(float(q), -5.0), 6.0) for q in tail[:3])
-    p_ocs, p_late = 0.5 * float(expit(tail[3])), 0.5 * float(expit(tail[4]))
+    scales = [min(max(float(q), -5.0), 6.0) for q in tail[:4]]
+    ls, lw, lw2, lk = scales
+    # the shares between 0.05 % and 49 %: a share run to 0 leaves the posterior flat in it
+    p_wide = float(expit(min(max(float(tail[4]), -7.0), 7.0)))
+    p_ocs, p_late = (0.5 * float(expit(min(max(float(q), -7.0), 4.0))) for q in tail[5:7])
     e, v = _times(data.d, data.v, data.c, data.vc, tau, delta, model)
     s = np.sqrt((math.exp(ls) / v) ** 2 + SIGMA_T_S**2)
-    ll_data = float(np.sum(_log_mixture(e, s, math.exp(lw), math.exp(lk), p_ocs, p_late)))
+    widths = (math.exp(lw), math.exp(lw) + math.exp(lw2))
+    ll_data = float(np.sum(_log_mixture(e, s, widths, p_wide, math.exp(lk), p_ocs, p_late)))
     # weak priors: the scales log-normal about _PRIOR; few over early or late (Beta(1, 9)
     # on each share); offsets within minutes and hundreds of metres
     prior = (
-        -0.5 * sum((q - m) ** 2 for q, m in zip((ls, lw, lk), _PRIOR, strict=True))
+        -0.5 * sum(((q - m) / w) ** 2 for q, m, w in zip(scales, _PRIOR, _PRIOR_SD, strict=True))
         + 8.0 * math.log1p(-2 * p_ocs * 0.999)
         + 8.0 * math.log1p(-2 * p_late * 0.999)
         - 0.5 * (tau / 60.0) ** 2
@@ -421,14 +442,16 @@ class _Fit:
 
 
 def _fit(obs: Sequence[StartObservation], model: str, start: _Fit | None = None) -> _Fit:
-    """The maximum of the posterior for ``model`` over the boats it can use: each boat in
-    turn taken as the front row (its start time 0) at the prior's scales, the best two
-    refined."""
+    """The maximum of the posterior for ``model`` over the boats it can use.
+
+    Each boat in turn is taken as the front row (its start time 0) and the other
+    parameters fitted with it held; the best two are refined with everything free.
+    """
     from scipy.optimize import minimize
 
     data = _Data.of([o for o in obs if o.usable(model)])
     free = _MODELS[model]
-    tail = np.array([*_PRIOR, -2.0, -2.0])
+    tail = np.array([*_PRIOR, 0.0, -2.0, -2.0])
     if model == "line":
         heads = [np.array([d]) for d in data.d]
     elif model == "clock":
@@ -437,17 +460,41 @@ def _fit(obs: Sequence[StartObservation], model: str, start: _Fit | None = None)
         assert start is not None
         tau, delta, _ = _unpack(start.theta, _MODELS[start.model])
         heads = [np.array([tau, delta])]
-    cand = [np.concatenate([h, tail]) for h in heads]
-    score = [_neg_log_post(c, data, model) for c in cand]
+    # the front row is among the earliest boats: each of them in turn
+    order = np.argsort(
+        [float(_neg_log_post(np.concatenate([h, tail]), data, model)) for h in heads]
+    )
+    first = np.argsort([float(h[-1]) * (1.0 if model == "clock" else -1.0) for h in heads])
+    heads = [heads[int(k)] for k in dict.fromkeys([*first[:N_FRONT].tolist(), *order[:2].tolist()])]
+    cand = []
+    for h in heads:
+
+        def held(q: NDArray, h: NDArray = h) -> float:
+            return _neg_log_post(np.concatenate([h, q]), data, model)
+
+        r = minimize(held, tail, method="Powell", options={"maxfev": 200, "xtol": 1e-2})
+        cand.append((float(r.fun), np.concatenate([h, r.x])))
     best: _Fit | None = None
-    for k in np.argsort(score)[:2]:
-        r = minimize(_neg_log_post, cand[int(k)], args=(data, model), method="Powell")
+    for _, x0 in sorted(cand, key=lambda c: c[0])[:2]:
+        r = minimize(_neg_log_post, x0, args=(data, model), method="Powell")
         if best is None or float(r.fun) < best.nlp:
             best = _Fit(
                 model, np.asarray(r.x, float), float(r.fun), sum(free) + _N_TAIL, data.d.size
             )
     assert best is not None
     return best
+
+
+def _clean_p95(tail: NDArray) -> float:
+    """The time after the front row within which 95 % of the clean starts lie [s]."""
+    from scipy.special import expit
+
+    w1 = math.exp(float(tail[1]))
+    w2 = w1 + math.exp(float(tail[2]))
+    pw = float(expit(min(max(float(tail[4]), -7.0), 7.0)))
+    grid = np.linspace(0.0, w2, 401)
+    cdf = (1 - pw) * np.minimum(grid / w1, 1.0) + pw * grid / w2
+    return float(grid[np.searchsorted(cdf, 0.95)])
 
 
 def _covariance(fit: _Fit, obs: Sequence[StartObservation]) -> NDArray:
@@ -515,7 +562,7 @@ def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float)
     told = best.model == "both" or (len(singles) == 2 and singles[1] - singles[0] >= 4.0)
     free = _MODELS[best.model]
     tau, delta, tail = _unpack(best.theta, free)
-    spread_m, spread_s = math.exp(float(tail[0])), math.exp(float(tail[1]))
+    spread_m, spread_s = math.exp(float(tail[0])), _clean_p95(tail)
     cov = _covariance(best, observations)
     est = FleetStart(
         gun_t,
