@@ -510,11 +510,13 @@ def analysis_winds(
     if choice in ("auto", "measured"):
         from sailroute.wind.measured import boat_wind, fleet_wind, sensor_from_track
 
+        without: dict[str, list[str]] = {}  # why -> boats: one note per reason
         for tr in tracks:
             try:
                 series[tr.name] = sensor_from_track(tr)
             except InputError as exc:
-                notes.append(f"{tr.name}: no measured wind ({exc})")
+                why = str(exc).removeprefix(f"{tr.source}: ")
+                without.setdefault(why, []).append(tr.name)
                 continue
             own[tr.name] = WindSource(
                 "measured",
@@ -522,6 +524,12 @@ def analysis_winds(
                 f"measured on board ({series[tr.name].source})",
                 route_field=boat_wind(series[tr.name], frame, max_gap_s=BRIDGE_S),
             )
+        notes.extend(
+            f"{', '.join(boats)}: no measured wind ({why})"
+            if len(boats) < 4
+            else f"no measured wind in {len(boats)} tracks ({why}): {', '.join(boats)}"
+            for why, boats in without.items()
+        )
         if len(series) >= 2:
             fw = fleet_wind(list(series.values()), frame)
             fleet = WindSource(

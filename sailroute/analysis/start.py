@@ -91,7 +91,7 @@ FLOOR_DENSITY = 1e-6
 """Density [s⁻¹] under every boat: a boat far outside the model (over by minutes, or
 drifting) weighs no more than this."""
 
-N_FRONT = 10
+N_FRONT = 8
 """The earliest boats each tried as the front row in a fit."""
 
 RECALL_WINDOW_S = 600.0
@@ -444,8 +444,9 @@ class _Fit:
 def _fit(obs: Sequence[StartObservation], model: str, start: _Fit | None = None) -> _Fit:
     """The maximum of the posterior for ``model`` over the boats it can use.
 
-    Each boat in turn is taken as the front row (its start time 0) and the other
-    parameters fitted with it held; the best two are refined with everything free.
+    Each of the :data:`N_FRONT` earliest boats in turn is taken as the front row (its
+    start time 0) and the other parameters fitted with it held; the best is refined with
+    everything free.
     """
     from scipy.optimize import minimize
 
@@ -472,11 +473,11 @@ def _fit(obs: Sequence[StartObservation], model: str, start: _Fit | None = None)
         def held(q: NDArray, h: NDArray = h) -> float:
             return _neg_log_post(np.concatenate([h, q]), data, model)
 
-        r = minimize(held, tail, method="Powell", options={"maxfev": 200, "xtol": 1e-2})
+        r = minimize(held, tail, method="Powell", options={"maxfev": 120, "xtol": 1e-2})
         cand.append((float(r.fun), np.concatenate([h, r.x])))
     best: _Fit | None = None
-    for _, x0 in sorted(cand, key=lambda c: c[0])[:2]:
-        r = minimize(_neg_log_post, x0, args=(data, model), method="Powell")
+    for _, x0 in sorted(cand, key=lambda c: c[0])[:1]:
+        r = minimize(_neg_log_post, x0, args=(data, model), method="Powell", options={"xtol": 1e-3})
         if best is None or float(r.fun) < best.nlp:
             best = _Fit(
                 model, np.asarray(r.x, float), float(r.fun), sum(free) + _N_TAIL, data.d.size

@@ -530,8 +530,9 @@ def _cut_to_race(
             for k, where in ((lo - 1, "before"), (hi - 1, "after"))
             if 0 <= k < t.size - 1 and t[k + 1] - t[k] > fleet.gaps[n]
         ]
-        if t[-1] - t[hi - 1] > longest and not dropped:
-            dropped = [f"{t[-1] - t[hi - 1]:.0f} s of data after the race's end"]
+        after = t[-1] - t[hi - 1]
+        if not dropped and after > end_t - gun:  # more than a race after the race's end
+            dropped = [f"{after:.0f} s of data after the race's end"]
         if dropped:
             kept = f"cut to {iso(float(t[lo]))} .. {iso(float(t[hi - 1]))}, "
             fleet.find(n, Finding(BoatClass.MULTI_RACE, kept + " and ".join(dropped)))
