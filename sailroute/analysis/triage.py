@@ -36,6 +36,7 @@ from sailroute.analysis.segment import (
 )
 from sailroute.analysis.start import (
     MIN_FLEET,
+    PULSE_S,
     RECALL_BEFORE_S,
     RECALL_WINDOW_S,
     FleetStart,
@@ -489,8 +490,8 @@ def _fleet_start(
     recall = None
     moved = False
     if len(fleet.xy) >= MIN_FLEET:
-        if not given:
-            recall = detect_general_recall(course, fleet.xy, gun, fleet.gaps)
+        if not given:  # the first start from a minute before the gun: a clock lag
+            recall = detect_general_recall(course, fleet.xy, gun - PULSE_S, fleet.gaps)
         if recall is None:
             before = gun - RECALL_BEFORE_S
             recall = detect_general_recall(
