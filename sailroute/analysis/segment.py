@@ -85,11 +85,14 @@ GAP_FACTOR = 5.0
 """An interval between fixes longer than ``max(GAP_MIN_S, GAP_FACTOR x median interval)``
 is a data gap: a leg end that falls inside it is unknown, not interpolated."""
 
-RAY_ANGLE_DEG = 30.0
-"""A mark's rounding ray counts as crossed only at this angle or steeper [°] (the boat's
-velocity over 4 s): the apex is crossed nearly head-on, while a boat passing close
-alongside the ray (a gate mark rounded tight, 180°) can wander across it on GPS noise
-seconds before it turns."""
+SETTLE_M = 4.0
+"""A mark's rounding ray counts as crossed only when the boat then gets this far beyond it
+[m] ... """
+
+SETTLE_S = 20.0
+"""... within this time [s], without crossing back (:func:`_settled`): a boat passing close
+alongside the ray (a mark rounded tight, 180°) can wander across it on GPS noise seconds
+before it turns."""
 
 CLOSE_PASS_TURN_DEG = 60.0
 """A boat that passes within :data:`MARK_TOLERANCE_M` of a mark and turns this much in the
@@ -881,7 +884,7 @@ def gate_rounding(
 
     The mark is the one it comes closest to within :data:`GATE_ROUNDING_S` of ``passed``;
     it is left to port when it is the gate's left end looking along the crossing
-    direction, and its rounding is the steep crossing of its rounding ray (as for a mark
+    direction, and its rounding is the settled crossing of its rounding ray (as for a mark
     leg, towards the next leg's target), or a close pass that turns round it
     (:func:`_close_pass`).  Official leg counters (SailGP's ``TRK_LEG_NUM``) change
     there.
@@ -915,28 +918,32 @@ def gate_rounding(
     )
     geom = _behind_mark(target_geometry(target, Start(from_xy, None), zone_m=detect_m))
     end = passed.t + GATE_ROUNDING_S
-    found = [c for c in _steep(_crossings(t, x, y, geom, passed.t, gap_s, end), geom, t, x, y)]
+    found = _settled(_crossings(t, x, y, geom, passed.t, gap_s, end), geom, t, x, y)
     found = [c for c in found if c.known]
     if found:
         return found[0]
     return _close_pass(mark.xy, target.rounding, t, x, y, passed.t, end)
 
 
-def _steep(
+def _settled(
     found: Sequence[Crossing], geom: TargetGeometry, t: NDArray, x: NDArray, y: NDArray
 ) -> list[Crossing]:
-    """The crossings of a rounding ray at :data:`RAY_ANGLE_DEG` or steeper (those inside a
-    data gap kept)."""
+    """The crossings of a rounding ray after which the boat gets :data:`SETTLE_M` clear on
+    the far side within :data:`SETTLE_S` without crossing back (those inside a data gap, and
+    those where the data end first without a way back, kept): a boat that wanders across
+    the ray on GPS noise while sailing close alongside it comes back; one that has rounded
+    sails away."""
     out = []
-    lim = math.sin(math.radians(RAY_ANGLE_DEG))
     for c in found:
         if not c.known:
             out.append(c)
             continue
-        x0, y0 = _point_at(t, x, y, c.t - 2.0)
-        x1, y1 = _point_at(t, x, y, c.t + 2.0)
-        v = math.hypot(x1 - x0, y1 - y0)
-        if v > 0 and ((x1 - x0) * geom.normal[0] + (y1 - y0) * geom.normal[1]) >= lim * v:
+        k = np.flatnonzero((t > c.t) & (t <= c.t + SETTLE_S))
+        side = (x[k] - geom.a[0]) * geom.normal[0] + (y[k] - geom.a[1]) * geom.normal[1]
+        clear = np.flatnonzero(side >= SETTLE_M)
+        back = np.flatnonzero(side < -0.5)  # beyond the rounding of the crossing's time
+        ends = float(t[-1]) < c.t + SETTLE_S  # the data end first: nothing against it
+        if (clear.size and (not back.size or clear[0] < back[0])) or (ends and not back.size):
             out.append(c)
     return out
 
@@ -988,10 +995,10 @@ def _mark_crossings(
     gap_s: float,
     t_before: float,
 ) -> list[Crossing]:
-    """The roundings of a mark after ``t_from``: its rounding ray's steep crossings
-    (:func:`_steep`), led by a close pass (:func:`_close_pass`) that comes
+    """The roundings of a mark after ``t_from``: its rounding ray's settled crossings
+    (:func:`_settled`), led by a close pass (:func:`_close_pass`) that comes
     :data:`GATE_ROUNDING_S` or more before the first of them (or when there is none)."""
-    found = _steep(_crossings(t, x, y, geom, t_from, gap_s, t_before), geom, t, x, y)
+    found = _settled(_crossings(t, x, y, geom, t_from, gap_s, t_before), geom, t, x, y)
     first = next((c.t_lo for c in found), math.inf)
     close = _close_pass(mark, rounding, t, x, y, t_from, min(first, t_before))
     if close is not None and close.t + GATE_ROUNDING_S < first:

@@ -525,7 +525,11 @@ def _covariance(fit: _Fit, obs: Sequence[StartObservation]) -> NDArray:
     return cov2
 
 
-def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float) -> FleetStart:
+def estimate_fleet_start(
+    observations: Sequence[StartObservation],
+    gun_t: float,
+    models: Sequence[str] = ("line", "clock", "both"),
+) -> FleetStart:
     """The fleet's gun and line from where its boats were at the gun, and each boat's
     verdict on over early.
 
@@ -535,6 +539,9 @@ def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float)
         One per boat that was on the water at the gun (:func:`observe_start`).
     gun_t : float
         The gun in the race's clock [epoch s].
+    models : sequence of str
+        The explanations tried (``"clock"`` alone where the gun itself is an estimate: a
+        restart found in the tracks).
 
     Returns
     -------
@@ -544,11 +551,12 @@ def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float)
         usable boats.
     """
     usable = {m: sum(o.usable(m) for o in observations) for m in _MODELS}
-    if max(usable["line"], usable["clock"]) < MIN_FLEET:
+    singles = [m for m in ("line", "clock") if m in models and usable[m] >= MIN_FLEET]
+    if not singles:
         return FleetStart(gun_t, n_boats=max(usable.values()))
-    fits = {m: _fit(observations, m) for m in ("line", "clock") if usable[m] >= MIN_FLEET}
+    fits = {m: _fit(observations, m) for m in singles}
     v = np.array([o.speed_ms for o in observations if o.usable("both")])
-    if usable["both"] >= 8 and float(np.std(1.0 / v) / np.mean(1.0 / v)) > 0.1:
+    if "both" in models and usable["both"] >= 8 and float(np.std(1.0 / v) / np.mean(1.0 / v)) > 0.1:
         fits["both"] = _fit(observations, "both", min(fits.values(), key=lambda f: f.nlp))
     # the same boats for every model: a model that can use fewer is charged for the rest
     # at the floor density
@@ -559,8 +567,8 @@ def estimate_fleet_start(observations: Sequence[StartObservation], gun_t: float)
     }
     order = sorted(bic, key=lambda m: (bic[m], m != "line"))
     best = fits[order[0]]
-    singles = sorted(bic[m] for m in ("line", "clock") if m in bic)
-    told = best.model == "both" or (len(singles) == 2 and singles[1] - singles[0] >= 4.0)
+    ranked = sorted(bic[m] for m in ("line", "clock") if m in bic)
+    told = best.model == "both" or (len(ranked) == 2 and ranked[1] - ranked[0] >= 4.0)
     free = _MODELS[best.model]
     tau, delta, tail = _unpack(best.theta, free)
     spread_m, spread_s = math.exp(float(tail[0])), _clean_p95(tail)

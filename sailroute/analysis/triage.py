@@ -260,9 +260,10 @@ class Triage:
                 f"general recall: {len(r.boats)} of {r.n_started} boats started at "
                 f"{iso(r.first_t)}, came back and started again from {iso(r.restart_t)}; "
                 "the restart's gun is not in the course (restart_time) nor given (--gun): "
-                "the race is timed from the fleet's second start"
+                f"taken as {iso(self.start.track_gun_t)} in the tracks' clock, its front row "
+                "on the line at the gun"
             )
-        if self.start.model != "none" or self.start.n_boats:
+        if (self.start.model != "none" or self.start.n_boats) and not self.restart_estimated:
             out.append(self.start.describe())
         return (*out, *class_notes(self.entries))
 
@@ -504,7 +505,9 @@ def _fleet_start(
         for n, (t, x, y) in fleet.xy.items()
         if (o := observe_start(course, t, x, y, gun, n, fleet.gaps[n])) is not None
     ]
-    return estimate_fleet_start(obs if estimate else [], gun), recall, moved
+    # a restart found in the tracks: its gun is the estimate's unknown, not the line
+    models = ("clock",) if moved else ("line", "clock", "both")
+    return estimate_fleet_start(obs if estimate else [], gun, models), recall, moved
 
 
 def _cut_to_race(
