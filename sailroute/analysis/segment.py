@@ -85,20 +85,26 @@ GAP_FACTOR = 5.0
 """An interval between fixes longer than ``max(GAP_MIN_S, GAP_FACTOR x median interval)``
 is a data gap: a leg end that falls inside it is unknown, not interpolated."""
 
+RAY_ANGLE_DEG = 30.0
+"""A crossing of a mark's rounding ray at this angle or steeper [°] (the fixes either side
+of it) is a rounding, if the boat does not come back (:func:`_settled`)."""
+
 SETTLE_M = 4.0
-"""A mark's rounding ray counts as crossed only when the boat then gets this far beyond it
-[m] ... """
+"""A shallower crossing counts when the boat gets this far beyond the ray [m] ..."""
 
 SETTLE_S = 20.0
-"""... within this time [s], without crossing back (:func:`_settled`): a boat passing close
-alongside the ray (a mark rounded tight, 180°) can wander across it on GPS noise seconds
-before it turns."""
+"""... within this time [s] (:func:`_settled`); no crossing counts when the boat comes back
+over the ray within it."""
 
 CLOSE_PASS_TURN_DEG = 60.0
 """A boat that passes within :data:`MARK_TOLERANCE_M` of a mark and turns this much in the
 rounding's sense over the 20 s either side [°] has rounded it, at its closest approach,
 even where GPS noise keeps its track from crossing the rounding ray (a rounding that
 grazes the mark)."""
+
+REVERSAL_DEG = 120.0
+"""A close pass that turns this much or more [°] in a sense the noisy track cannot tell
+(:func:`turn_sense`) is a rounding too."""
 
 GATE_OUTSIDE_S = 60.0
 """A boat that crosses a gate's line beyond its marks (up to ``detect_m`` off) and does not
@@ -928,34 +934,59 @@ def gate_rounding(
 def _settled(
     found: Sequence[Crossing], geom: TargetGeometry, t: NDArray, x: NDArray, y: NDArray
 ) -> list[Crossing]:
-    """The crossings of a rounding ray after which the boat gets :data:`SETTLE_M` clear on
-    the far side within :data:`SETTLE_S` without crossing back (those inside a data gap, and
-    those where the data end first without a way back, kept): a boat that wanders across
-    the ray on GPS noise while sailing close alongside it comes back; one that has rounded
-    sails away."""
+    """The crossings of a rounding ray that are a rounding, not GPS noise (those inside a
+    data gap kept).
+
+    A boat that rounds tight sails close alongside the ray (for a 180° turn the ray lies
+    along its approach and its exit) and can wander across it on GPS noise before it turns.
+    A crossing counts when the boat does not come back over the ray within
+    :data:`SETTLE_S`, and either crosses it steeply (the fixes either side of the crossing
+    move at :data:`RAY_ANGLE_DEG` or more to it) or gets :data:`SETTLE_M` beyond it in that
+    time."""
     out = []
+    lim = math.sin(math.radians(RAY_ANGLE_DEG))
     for c in found:
         if not c.known:
             out.append(c)
             continue
         k = np.flatnonzero((t > c.t) & (t <= c.t + SETTLE_S))
         side = (x[k] - geom.a[0]) * geom.normal[0] + (y[k] - geom.a[1]) * geom.normal[1]
-        clear = np.flatnonzero(side >= SETTLE_M)
-        back = np.flatnonzero(side < -0.5)  # beyond the rounding of the crossing's time
-        ends = float(t[-1]) < c.t + SETTLE_S  # the data end first: nothing against it
-        if (clear.size and (not back.size or clear[0] < back[0])) or (ends and not back.size):
+        # back over the ray beyond the mark (the part behind it is where a boat that has
+        # rounded a leeward mark tight crosses on its way back up)
+        ex, ey = geom.b[0] - geom.a[0], geom.b[1] - geom.a[1]
+        n2 = ex * ex + ey * ey
+        along = ((x[k] - geom.a[0]) * ex + (y[k] - geom.a[1]) * ey) / n2
+        if ((side < -0.5) & (along >= MARK_TOLERANCE_M / math.sqrt(n2)) & (along <= 1.0)).any():
+            continue
+        j = min(max(int(np.searchsorted(t, c.t, side="left")), 1), t.size - 1)
+        i = j - 1  # the fixes either side of the crossing
+        dx, dy = float(x[j] - x[i]), float(y[j] - y[i])
+        step = math.hypot(dx, dy)
+        steep = step > 0 and dx * geom.normal[0] + dy * geom.normal[1] >= lim * step
+        if steep or (side >= SETTLE_M).any():
             out.append(c)
     return out
 
 
-def smooth_turn_deg(t: NDArray, x: NDArray, y: NDArray, t0: float, t1: float) -> float:
-    """Net turn of the course over ground from ``t0`` to ``t1`` [°] (− to the left), from
-    the track resampled every 4 s (single fixes' noise does not flip a tight turn's sense)."""
-    tq = np.arange(t0, t1 + 1e-9, 4.0)
-    if tq.size < 3:
-        return 0.0
-    xq, yq = np.interp(tq, t, x), np.interp(tq, t, y)
-    return turn_deg(xq, yq)
+def turn_sense(t: NDArray, x: NDArray, y: NDArray, t0: float, t1: float) -> tuple[float, bool]:
+    """Net turn of the course over ground from ``t0`` to ``t1`` [°] (− to the left), and
+    whether its sense is decided.
+
+    The track is resampled every 1, 2, 3 and 4 s; the turn is their median.  Its sense is
+    decided when they agree: a boat that reverses at a mark within GPS error of it (a
+    rounding that grazes the mark) turns 180° in one or two steps, and its sense is then
+    noise; the turn is then the median of their sizes (positive).
+    """
+    turns = []
+    for step in (1.0, 2.0, 3.0, 4.0):
+        tq = np.arange(t0, t1 + 1e-9, step)
+        if tq.size >= 3:
+            turns.append(turn_deg(np.interp(tq, t, x), np.interp(tq, t, y)))
+    if not turns:
+        return 0.0, True
+    if all(v < 0 for v in turns) or all(v > 0 for v in turns):
+        return float(np.median(turns)), True
+    return float(np.median(np.abs(turns))), False
 
 
 def _close_pass(
@@ -968,8 +999,9 @@ def _close_pass(
     t_before: float,
 ) -> Crossing | None:
     """The first pass within :data:`MARK_TOLERANCE_M` of ``mark`` after ``t_from`` (before
-    ``t_before``) that turns :data:`CLOSE_PASS_TURN_DEG` in the rounding's sense, at its
-    closest approach."""
+    ``t_before``) that turns :data:`CLOSE_PASS_TURN_DEG` in the rounding's sense, or
+    reverses (:data:`REVERSAL_DEG`) in a sense the track cannot tell
+    (:func:`turn_sense`), at its closest approach."""
     idx = np.flatnonzero((t > t_from) & (t < t_before))
     if idx.size == 0 or rounding is None:
         return None
@@ -978,8 +1010,9 @@ def _close_pass(
     edges = np.flatnonzero(np.diff(np.concatenate([[0], near.astype(int), [0]])))
     for a, b in zip(edges[::2], edges[1::2], strict=True):
         k = int(idx[a + int(np.argmin(d[a:b]))])
-        turn = smooth_turn_deg(t, x, y, float(t[k]) - 20.0, float(t[k]) + 20.0)
-        if (turn <= -CLOSE_PASS_TURN_DEG) if rounding == "port" else (turn >= CLOSE_PASS_TURN_DEG):
+        turn, decided = turn_sense(t, x, y, float(t[k]) - 20.0, float(t[k]) + 20.0)
+        sense = -turn if rounding == "port" else turn
+        if sense >= CLOSE_PASS_TURN_DEG or (not decided and abs(turn) >= REVERSAL_DEG):
             return Crossing(float(t[k]), float(x[k]), float(y[k]))
     return None
 
