@@ -4,7 +4,6 @@ route round the windward-leeward course of ``test_analyze.py``."""
 
 from __future__ import annotations
 
-import csv
 import json
 import re
 from pathlib import Path
@@ -22,10 +21,9 @@ from sailroute.course.model import Course
 from sailroute.errors import InputError
 from sailroute.planning.route import route_course, settings_for
 from sailroute.routing.types import LegResult
-from sailroute.timeutil import iso
 from sailroute.track.model import Track
 from tests.analysis.test_analyze import _course, _sailed
-from tests.analysis.test_fleet import GATE_COURSE, _east, _with_tail
+from tests.analysis.test_fleet import GATE_COURSE, _east, _with_tail, _write_csv
 
 
 @pytest.fixture(scope="module")
@@ -293,15 +291,6 @@ def test_leg_table_totals_over_common_legs_and_the_leader_from_known_legs() -> N
     assert tab.leg_ranks(1) == [1, 2, None, 3]
 
 
-def _write_csv(path: Path, tr: Track, dt: float = 0.0) -> Path:
-    with path.open("w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(["time", "lat", "lon"])
-        for t, la, lo in zip(tr.t_s, tr.lat_deg, tr.lon_deg, strict=True):
-            w.writerow([iso(float(t) + dt), f"{la:.8f}", f"{lo:.8f}"])
-    return path
-
-
 def test_bad_input_in_a_fleet_is_one_line_each(fleet, tmp_path: Path) -> None:
     """An empty track, a track of another day, the same file twice: one note each, the
     rest analysed (exit 0); a fleet where nobody starts: exit 2, nothing written."""
@@ -423,6 +412,15 @@ def _recalled(course: Course, base: Track, k: int, restart_s: float) -> Track:
     )
 
 
+def _with_restart(course: Course, restart: str, folder: Path) -> Path:
+    """The course file with a ``restart_time``."""
+    text = Path(course.source).read_text(encoding="utf-8")
+    start = 'start_time: "2024-05-01T12:00:00Z"'
+    p = folder / "restart.yaml"
+    p.write_text(text.replace(start, f'{start}\nrestart_time: "{restart}"'), encoding="utf-8")
+    return p
+
+
 def test_a_general_recall_found_in_the_tracks(routed, tmp_path: Path) -> None:
     course, legs = routed
     base = _lead(_with_tail(_sailed(course, legs)), 120.0)
@@ -446,17 +444,7 @@ def test_a_general_recall_found_in_the_tracks(routed, tmp_path: Path) -> None:
     assert given.start.gun_t == gun + 300.0 and not given.restart_estimated
     assert given.notes()[0].startswith("general recall: 5 of 5 boats started at ")
     assert "came back and started again at the gun" in given.notes()[0]
-    text = (
-        Path(course.source)
-        .read_text(encoding="utf-8")
-        .replace(
-            'start_time: "2024-05-01T12:00:00Z"',
-            'start_time: "2024-05-01T12:00:00Z"\nrestart_time: "2024-05-01T12:05:00Z"',
-        )
-    )
-    p = tmp_path / "recall.yaml"
-    p.write_text(text, encoding="utf-8")
-    restart = load_course(p)
+    restart = load_course(_with_restart(course, "2024-05-01T12:05:00Z", tmp_path))
     assert restart.gun_epoch == gun + 300.0 and restart.start_epoch == gun
     tri = triage_fleet(restart, entries)
     assert tri.start.gun_t == gun + 300.0 and tri.recall is not None
@@ -464,16 +452,7 @@ def test_a_general_recall_found_in_the_tracks(routed, tmp_path: Path) -> None:
 
 def test_restart_time_must_follow_the_start(routed, tmp_path: Path) -> None:
     course, _ = routed
-    text = (
-        Path(course.source)
-        .read_text(encoding="utf-8")
-        .replace(
-            'start_time: "2024-05-01T12:00:00Z"',
-            'start_time: "2024-05-01T12:00:00Z"\nrestart_time: "2024-05-01T11:55:00Z"',
-        )
-    )
-    p = tmp_path / "bad.yaml"
-    p.write_text(text, encoding="utf-8")
+    p = _with_restart(course, "2024-05-01T11:55:00Z", tmp_path)
     with pytest.raises(InputError, match="restart_time: the restart after a general recall"):
         load_course(p)
 
