@@ -237,10 +237,7 @@ def analyze_track(
     )
 
     legs: list[LegAnalysis] = []
-    cols: dict[str, list[NDArray]] = {
-        k: []
-        for k in ("leg", "t", "x", "y", "sog", "cog", "tws", "twd", "twa", "polar", "vmg", "loss")
-    }
+    cols: dict[str, list[NDArray]] = {k: [] for k in _POINT_COLUMNS}
     loss_before = 0.0
     for i, spec in enumerate(course.legs):
         a, b = bounds[i], bounds[i + 1]
@@ -273,21 +270,8 @@ def analyze_track(
                 obstacles=obstacles,
             )
             legs.append(leg)
-            for k, v in (
-                ("leg", np.full(tl.size, i + 1)),
-                ("t", tl),
-                ("x", xl),
-                ("y", yl),
-                ("sog", sog),
-                ("cog", cog),
-                ("tws", tws),
-                ("twd", twd),
-                ("twa", twa),
-                ("polar", polar),
-                ("vmg", np.full(tl.size, np.nan)),
-                ("loss", np.full(tl.size, np.nan)),
-            ):
-                cols[k].append(v)
+            unknown = np.full(tl.size, np.nan)
+            _add_points(cols, i, tl, xl, yl, sog, cog, tws, twd, twa, polar, unknown, unknown)
             continue
         mode = leg_wind_mode(chosen_field, a.t, (a.x, a.y), centre)
         if mode == "upwind":
@@ -361,21 +345,7 @@ def analyze_track(
             )
         )
         loss_before += loss
-        for k, v in (
-            ("leg", np.full(tl.size, i + 1)),
-            ("t", tl),
-            ("x", xl),
-            ("y", yl),
-            ("sog", sog),
-            ("cog", cog),
-            ("tws", tws),
-            ("twd", twd),
-            ("twa", twa),
-            ("polar", polar),
-            ("vmg", vmg),
-            ("loss", cum),
-        ):
-            cols[k].append(v)
+        _add_points(cols, i, tl, xl, yl, sog, cog, tws, twd, twa, polar, vmg, cum)
     c = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
     lat, lon = course.frame.to_latlon(c["x"], c["y"])
     pct = np.where(c["polar"] >= 0.3, 100.0 * c["sog"] / np.maximum(c["polar"], 1e-9), np.nan)
@@ -406,6 +376,18 @@ def analyze_track(
         points,
         sources[chosen[0]].field if chosen else wind,
     )
+
+
+_POINT_COLUMNS = ("leg", "t", "x", "y", "sog", "cog", "tws", "twd", "twa", "polar", "vmg", "loss")
+"""The point table's columns as :func:`analyze_track` gathers them, leg by leg."""
+
+
+def _add_points(cols: dict[str, list[NDArray]], i: int, t: NDArray, *values: NDArray) -> None:
+    """Append leg ``i``'s points to ``cols``: ``t`` and ``values`` in the order of
+    :data:`_POINT_COLUMNS` after ``leg`` and ``t``."""
+    full = (np.full(t.size, i + 1), t, *values)
+    for k, v in zip(_POINT_COLUMNS, full, strict=True):
+        cols[k].append(v)
 
 
 def _leg_points(
