@@ -1,37 +1,45 @@
 """A messy fleet with a known answer: tracks of N boats and the exact truth behind them.
 
 :func:`messy_fleet` sails ``n_boats`` boats of varied skill round a windward-leeward
-course (start line, windward mark ``1``, leeward gate ``4s``/``4p``, leeward finish line,
-two laps by default) through a known wind (:class:`FleetWind`: an oscillating and a
-persistent shift, TWS varying in time and optionally from one side of the course to the
-other), injects the faults of a :class:`FaultPlan` on chosen boats, and returns a
-:class:`Fleet`: the recorded tracks (what a tracker delivers), the course (a
-:class:`~sailroute.course.model.Course` and its YAML text) and the truth (:class:`BoatTruth`
-per track, the wind, the guns, the tracker's clock lag).  :meth:`Fleet.write` puts the
-course file and the tracks (GPX or CSV) in a folder for ``sailroute analyze``.
+course (sailroute's template: start line ``start_pin``/``start_boat``, windward mark
+``1``, leeward gate ``4s``/``4p``, leeward finish line, two laps by default) through a
+known wind (:class:`FleetWind`: an oscillating and a persistent shift, TWS varying in time
+and optionally from one side of the course to the other), injects the faults of a
+:class:`FaultPlan` on chosen boats, and returns a :class:`Fleet`: the recorded tracks (what
+a tracker delivers), the course (a :class:`~sailroute.course.model.Course` and its YAML
+text) and the truth (a :class:`BoatTruth` per track, the wind, the guns, the tracker's
+clock lag).  :meth:`Fleet.write` puts the course file and the tracks (GPX or CSV) in a
+folder for ``sailroute analyze``; :meth:`Fleet.truth_json` gives the truth as JSON.
 
 How the boats are sailed
 ------------------------
 Every boat is routed by sailroute's own isochrone router, leg by leg, from its own start
-point on the line and its own start time; nothing is copied between boats.  A boat's
-skill ``s`` (1 for the best, down to about 0.88) scales the class polar's speeds.  Instead
-of one polar per boat, each boat is routed with the class polar in its own *time-dilated*
-wind ``W_s(τ, x, y) = W(gun + (τ − gun)/s, x, y)`` and its times are mapped back with
-``t = gun + (τ − gun)/s``: the boat then passes the same points as a boat with the polar
+point on the line and its own start time; nothing is copied between boats.  A boat's skill
+``s`` (1 for the best, down to about 0.88) scales the class polar's speeds.  Instead of one
+polar per boat, each boat is routed with the class polar in its own *time-dilated* wind
+``W_s(τ, x, y) = W(gun + (τ − gun)/s, x, y)`` and its times are mapped back with
+``t = gun + (τ − gun)/s``: it then passes the same points as a boat with the polar
 ``s × polar`` in the true wind, exactly (``dx/dt = s dx/dτ``), and at every point its
-heading is the router's answer to the true wind at its own true time.  Tack and gybe
-costs are served in τ, so a boat's cost in true time is ``penalty / s`` (a slower boat
-also tacks slower).  One polar for all lets the batched router
-(:func:`~sailroute.routing.batch.route_leg_batch`) route the fleet one front per leg and
-per group of boats that share the router's settings (the tack-cost class, and on the first
-leg the first tack): a 40-boat, 45-minute fleet routes in a few seconds with the coarse
-router settings :data:`ROUTER` (4° headings and pruning sectors; the route stays within a
-few seconds of the default settings' route, see ``tests/analysis/test_fleetgen.py``).
+heading is the router's answer to the true wind at its own true time.  Tack and gybe costs
+are served in τ, so a boat's cost in true time is ``penalty / s`` (:data:`TACK_CLASSES`:
+two manoeuvre classes; a slower boat also tacks slower).  One polar for all lets the batched
+router (:func:`~sailroute.routing.batch.route_leg_batch`) route the fleet as one front per
+leg and per group of boats that share the router's settings (the manoeuvre class, and on
+the first leg the first tack): with the coarse settings :data:`ROUTER` (4° headings and
+pruning sectors, 10 s steps) a 40-boat, 45-minute fleet takes about 3.5 s of CPU, a
+60-boat one about 5 s, and the best boat's legs stay within 1 % of the router's default settings
+(``tests/analysis/test_fleetgen.py``).
 
-Before the start each boat waits below the line (reaching back and forth, zigzags at
-1-2 m s⁻¹) and then sails its approach on the route's first heading into its start point;
-after the finish it sails on for a minute or two.  These pre-start and post-finish paths
-are drawn, not routed: the router's headings hold from the start crossing to the finish.
+The router aims :data:`ROUND_RADIUS_M` (6 m) off each mark along the mark's rounding
+segment and through the gate narrowed by as much at each end (:func:`clear_target`), so
+that no track touches a mark; the segment it crosses lies on the course target's own, so
+detection finds the crossing where the route made it.  Between two legs a rounding is
+drawn (:class:`Rounding`): round the mark on a circle through half the turn, or below the
+gate and round the gate mark nearer to where the boat passed; the next leg is routed from
+where the drawing ends.  Before the start each boat waits below the line (zigzags at
+1.5 m s⁻¹) and then sails its approach on the route's first heading into its start point;
+after the finish it sails on for a minute or two.  The pre-start, the roundings and the
+post-finish are drawn, not routed: the router's headings hold on the legs.
 
 Time
 ----
@@ -39,49 +47,64 @@ All truth times are *true* times [epoch s].  The tracker's clock lags the true t
 ``clock_lag_s`` (common to the fleet): a fix taken at true time ``T`` is stamped
 ``T − clock_lag_s``, so with a positive lag every recorded crossing looks that much
 *earlier* (a fleet that looks over the line at the gun).  Fixes are stamped on whole
-seconds of the tracker's clock, every 1-3 s per boat (:attr:`BoatTruth.sample_s`).
+seconds of the tracker's clock, every 1-3 s per boat (:attr:`BoatTruth.sample_s`).  A
+boat's start (:attr:`BoatTruth.start_t`) is when it leaves the line: a route that begins
+with a tack on the line starts when the tack is over.
 
-GPS error, per axis: white (``noise_white_m`` sd) plus a first-order autoregressive error
-(``noise_corr_m`` sd, correlation time ``noise_tau_s``); the recorded position minus the
-true one has the RMS ``sqrt(white² + corr²)`` per axis.
+GPS error, per axis: white (``noise_white_m`` sd, default 0.7 m) plus a first-order
+autoregressive error (``noise_corr_m`` sd, default 1.5 m, correlation time
+``noise_tau_s`` 60 s); the recorded position minus the true one has the RMS
+``sqrt(white² + corr²)`` per axis.  That error alone moves a detected crossing by about
+0.8 s at 2 m s⁻¹ (more where a path meets a mark's rounding ray at a slant): with the
+defaults and ``analysis.segment``, 80-90 % of the clean boats' crossings lie within one
+fix interval of the truth and over 95 % within two (seeds 0-2); without the error
+(:meth:`Fleet.resampled` with ``noise=False``) every one lies within half an interval.
+Fixes, error and SOG/COG come from their own random stream (``[seed, 1]``), so a fleet
+recorded again with another lag or without error keeps every other draw.
 
 Faults (each on its own boats, recorded in :attr:`BoatTruth.faults`)
 -------------------------------------------------------------------
 ``non_starter``
     waits below the line and drifts away downwind after the gun; never crosses the line.
 ``ocs`` (statuses ``ocs_returned`` / ``ocs_not_returned``)
-    crosses ``ocs_s`` before the gun and is ``ocs_margin_m`` over at the gun; a returning
-    boat turns back a few seconds after the gun, recrosses the line (``returned_t``) and
-    restarts.
+    crosses ``ocs_s`` before the gun and is :attr:`BoatTruth.distance_at_gun_m` over at
+    the gun; a returning boat turns back a few seconds after the gun, recrosses the line
+    (``returned_t``) and restarts.
 ``late``
     starts ``late_s`` after the gun, ``-distance_at_gun_m`` metres behind the line at it.
-``general_recall`` (fleet-wide, :attr:`Fleet.guns` holds both guns)
-    the whole fleet starts at a first gun, part of it over; the boats sail on for 30-70 s,
-    come back below the line and start again at the restart gun (the race's gun).
+general recall (fleet-wide, :attr:`Fleet.guns` holds both guns)
+    the whole fleet crosses the line round a first gun, part of it over
+    (:attr:`BoatTruth.distance_at_first_gun_m` > 0); the boats sail on for 30-70 s, come
+    back below the line and start again at the restart gun (the race's gun).
 ``data_gap``
     no fixes between ``t0`` and ``t1`` inside a leg.
-``retired`` / ``data_ends``
-    leaves the course at ``t`` in the middle of a leg (sails off for a few minutes), or the
-    log simply stops at ``t``; later legs are NaN.
+``retired`` / ``data_ends`` (status ``retired``)
+    leaves the course at ``t`` in the middle of a leg (sails 500 m off), or the log simply
+    stops at ``t``; later legs are NaN.
 ``two_races``
-    after the finish the log stops and resumes ``gap`` seconds later for a second race of
-    the same course at ``gun2`` (leg ends of that race in the fault's parameters).
-``duplicate``
+    after the finish the log stops and resumes (``gap``) for a second race of the same
+    course at ``gun2`` (its start and leg ends in the fault's parameters).
+``duplicate`` (status ``duplicate_of``)
     an extra track: another boat's recorded data, identical, under another name.
 ``other_fleet``
-    an extra boat: of a faster class (``class``, its own gun later than the fleet's), or the
-    same race sailed 4 km away (``area``) or a day later (``day``).
+    an extra boat: of a faster class (``class``: skill 1.22, its own gun 4 min after the
+    fleet's), or a boat of this race moved 4 km away (``area``) or a day later (``day``),
+    its wind the fleet's carried along.
 ``gate_outside``
-    on the first gate leg the boat passes outside the gate, beyond one of its marks, and
-    goes on up the next beat from there (:attr:`BoatTruth.leg_end_t` holds when it passed).
+    on the first gate leg the boat passes outside the gate, 20-80 m beyond one of its marks,
+    and goes on up the next beat from there (:attr:`BoatTruth.leg_end_t` holds when it
+    passed).
 
-Determinism: every random choice comes from ``numpy.random.default_rng(seed)``; the same
-arguments give identical tracks and truth.
+Determinism: every random choice comes from ``numpy.random.default_rng(seed)`` (the
+recording from ``[seed, 1]``); the same arguments give identical tracks and truth.
+:func:`shared_fleet` keeps up to eight fleets for the test run, so that test modules
+asking for the same one generate it once.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
 from collections.abc import Mapping, Sequence
@@ -94,18 +117,20 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat import builtin_polar
+from sailroute.boat.io import read_polar
 from sailroute.boat.polar import Polar
 from sailroute.course.geometry import leg_endpoints, target_of, wind_mode, xy_bearing_deg
 from sailroute.course.load import course_from_mapping
 from sailroute.course.model import Course
+from sailroute.course.templates import CourseLayout, windward_leeward
 from sailroute.geo import LocalFrame
 from sailroute.routing.batch import route_leg_batch
-from sailroute.routing.geometry import chain_leg
+from sailroute.routing.geometry import chain_leg, target_geometry
 from sailroute.routing.settings import IsochroneSettings, RoutingSettings
 from sailroute.routing.types import LegResult, Manoeuvre, Side, Start, Target
 from sailroute.timeutil import iso, parse_time, to_epoch
 from sailroute.track.model import Track
-from sailroute.units import KNOT, bearing_deg
+from sailroute.units import KNOT, bearing_deg, heading_unit, wrap180
 from sailroute.wind.base import Coverage
 
 GUN: Final = to_epoch(parse_time("2024-06-01T13:00:00Z"))
@@ -140,8 +165,23 @@ LOITER_MS: Final = 1.5
 # ------------------------------------------------------------------------------ the wind
 
 
+class _Everywhere:
+    """A wind defined everywhere at all times (the :class:`~sailroute.wind.base.WindField`
+    coverage and clamp)."""
+
+    @property
+    def coverage(self) -> Coverage:
+        """Everywhere, at all times."""
+        return Coverage.everywhere()
+
+    @property
+    def clamp(self) -> bool:
+        """Nothing lies outside: never clamped."""
+        return False
+
+
 @dataclass(frozen=True)
-class FleetWind:
+class FleetWind(_Everywhere):
     """The known wind: a :class:`~sailroute.wind.base.WindField` defined everywhere.
 
     ``TWD(t) = twd_deg + osc_amp_deg sin(2π (t − t0)/osc_period_s + osc_phase) +
@@ -188,16 +228,6 @@ class FleetWind:
     tws_phase: float = 0.0
     pressure_left: float = 0.0
 
-    @property
-    def coverage(self) -> Coverage:
-        """Everywhere, at all times."""
-        return Coverage.everywhere()
-
-    @property
-    def clamp(self) -> bool:
-        """Nothing lies outside: never clamped."""
-        return False
-
     def direction(self, t: ArrayLike, x: ArrayLike = 0.0, y: ArrayLike = 0.0) -> NDArray:
         """TWD (from) [°, in [0, 360)] at ``t`` [epoch s], ``x, y`` [m]."""
         t, x, y = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (t, x, y)))
@@ -215,18 +245,13 @@ class FleetWind:
         return self._speed(t, x, y)
 
     def _speed(self, t: NDArray, x: NDArray, y: NDArray) -> NDArray:
+        phase = 2.0 * np.pi * (t - self.t0) / self.tws_period_s + self.tws_phase
+        tws = self.tws_ms * (1.0 + self.tws_amp * np.sin(phase))
         if self.pressure_left == 0.0:
-            return self.tws_ms * (
-                1.0
-                + self.tws_amp
-                * np.sin(2.0 * np.pi * (t - self.t0) / self.tws_period_s + self.tws_phase)
-            )
+            return tws
         th = math.radians(self.axis_deg)
         left = -(x - self.centre[0]) * math.cos(th) + (y - self.centre[1]) * math.sin(th)
-        osc = self.tws_amp * np.sin(
-            2.0 * np.pi * (t - self.t0) / self.tws_period_s + self.tws_phase
-        )
-        return self.tws_ms * (1.0 + osc) * (1.0 + self.pressure_left * left / 1000.0)
+        return tws * (1.0 + self.pressure_left * left / 1000.0)
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] (the direction the air moves to)."""
@@ -240,23 +265,13 @@ class FleetWind:
 
 
 @dataclass(frozen=True)
-class DilatedWind:
+class DilatedWind(_Everywhere):
     """:class:`FleetWind` in a boat's dilated time ``τ = gun + skill (t − gun)``
     (a :class:`~sailroute.wind.base.WindField`; module docstring)."""
 
     wind: FleetWind
     gun: float
     skill: float
-
-    @property
-    def coverage(self) -> Coverage:
-        """Everywhere, at all times."""
-        return Coverage.everywhere()
-
-    @property
-    def clamp(self) -> bool:
-        """Nothing lies outside: never clamped."""
-        return False
 
     def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
         """Wind ``(u, v)`` [m s⁻¹] at dilated time ``t`` [epoch s]."""
@@ -469,8 +484,9 @@ class Fleet:
     Attributes
     ----------
     course : Course
-        The course (start line ``start`` = pin, committee; mark ``1``; gate ``4`` =
-        ``4s``, ``4p``; line ``finish``), its ``start_time`` the race's gun.
+        The course (start line ``start`` = ``start_pin``, ``start_boat``; mark ``1``; gate
+        ``4`` = ``4s``, ``4p``; line ``finish``; :func:`layout`), its ``start_time`` the
+        race's gun.
     course_yaml : str
         The course file's text (``start_time`` the race's gun).
     wind : FleetWind
@@ -646,6 +662,10 @@ class Fleet:
             raise ValueError(f"gun {gun!r}: expected 'race' or 'first'")
         course = d / "course.yaml"
         course.write_text(yaml_text, encoding="utf-8")
+        spec = self.course.boat_spec
+        if "polar" in spec:  # the polar file beside the course, as the course names it
+            src = Path(spec["polar"])
+            (d / src.name).write_bytes(src.read_bytes())
         writer = {"gpx": write_gpx, "csv": write_csv}[fmt]
         paths = [writer(d / f"{tr.name}.{fmt}", tr) for tr in self.tracks]
         return course, paths
@@ -724,66 +744,58 @@ class _Line:
 
 
 def _unit(deg: float) -> XY:
-    return (math.sin(math.radians(deg)), math.cos(math.radians(deg)))
+    """The unit vector of a compass heading [°] (:func:`~sailroute.units.heading_unit`)."""
+    ux, uy = heading_unit(deg)
+    return float(ux), float(uy)
 
 
-def layout(
-    axis_deg: float,
-    leg_m: float,
-    *,
-    gate_m: float = 50.0,
-    start_m: float = 150.0,
-    start_below_m: float = 50.0,
-    finish_m: float = 60.0,
-) -> dict[str, XY]:
-    """Mark positions [m] of a windward-leeward course centred on the origin, laid for
-    ``axis_deg`` (docs/course-format.md, "Templates"): ``1`` up the axis, gate ``4s``
-    (left looking upwind) / ``4p``, start line ``pin`` (left) / ``committee``
-    ``start_below_m`` under the gate, and a leeward finish ``finish_pin`` /
-    ``finish_boat`` on the start line's centre."""
-    ux, uy = _unit(axis_deg)
-    lx, ly = -uy, ux  # left, looking upwind
+def layout(axis_deg: float, leg_m: float, laps: int) -> CourseLayout:
+    """The windward-leeward course of sailroute's template, centred on the origin, laid
+    for ``axis_deg`` (:func:`~sailroute.course.templates.windward_leeward`; docs/course-format.md,
+    "Templates"): mark ``1``, gate ``4`` (``4s`` left looking upwind, ``4p``), start line
+    ``start`` (``start_pin`` left, ``start_boat``) 50 m under the gate, leeward finish line
+    ``finish`` on its centre; marks rounded to the millimetre."""
+    lay = windward_leeward((0.0, 0.0), axis_deg, leg_m, laps)
+    marks = {k: (round(v[0], 3), round(v[1], 3)) for k, v in lay.marks.items()}
+    return dataclasses.replace(lay, marks=marks)
 
-    def at(up: float, left: float) -> XY:
-        return (round(up * ux + left * lx, 3), round(up * uy + left * ly, 3))
 
-    lo, s = -leg_m / 2.0, -leg_m / 2.0 - start_below_m
-    return {
-        "pin": at(s, start_m / 2.0),
-        "committee": at(s, -start_m / 2.0),
-        "1": at(leg_m / 2.0, 0.0),
-        "4s": at(lo, gate_m / 2.0),
-        "4p": at(lo, -gate_m / 2.0),
-        "finish_pin": at(s, finish_m / 2.0),
-        "finish_boat": at(s, -finish_m / 2.0),
-    }
+def boat_spec(boat: str) -> dict[str, str]:
+    """The course's ``boat`` section: a built-in polar's name, or a polar file (its absolute
+    path; :meth:`Fleet.write` copies it beside the course file)."""
+    if Path(boat).suffix.lower() in (".json", ".pol", ".csv"):
+        return {"polar": str(Path(boat).resolve())}
+    return {"builtin": boat}
+
+
+def course_yaml_boat(spec: Mapping[str, str]) -> dict[str, str]:
+    """The ``boat`` section as written: a polar file by its name (copied beside it)."""
+    return {"polar": Path(spec["polar"]).name} if "polar" in spec else dict(spec)
 
 
 def course_mapping(
     name: str,
     gun: float,
-    marks: Mapping[str, XY],
+    lay: CourseLayout,
     origin: tuple[float, float],
-    laps: int,
     wind: FleetWind,
     boat: str,
     time_limit_min: float,
 ) -> dict[str, Any]:
     """The course file's content (a mapping for the course loader)."""
-    legs: list[dict[str, str]] = [{"to": "1", "rounding": "port"}]
-    for _ in range(laps - 1):
-        legs += [{"to": "4"}, {"to": "1", "rounding": "port"}]
-    legs.append({"to": "finish"})
     return {
         "name": name,
         "start_time": iso(gun),
         "time_limit_min": time_limit_min,
         "origin": {"lat": origin[0], "lon": origin[1]},
-        "marks": {k: {"x": v[0], "y": v[1]} for k, v in marks.items()},
-        "lines": {"start": ["pin", "committee"], "finish": ["finish_pin", "finish_boat"]},
-        "gates": {"4": ["4s", "4p"]},
-        "legs": legs,
-        "boat": {"builtin": boat},
+        "marks": {k: {"x": v[0], "y": v[1]} for k, v in lay.marks.items()},
+        "lines": {k: list(v) for k, v in lay.lines.items()},
+        "gates": {k: list(v) for k, v in lay.gates.items()},
+        "legs": [
+            {"to": leg.to} if leg.rounding is None else {"to": leg.to, "rounding": leg.rounding}
+            for leg in lay.legs
+        ],
+        "boat": boat_spec(boat),
         "routing": {"router": "isochrone", "tack_penalty_s": 5.0, "gybe_penalty_s": 3.0},
         "scenarios": {
             "mean": {
@@ -804,6 +816,8 @@ def course_yaml(data: Mapping[str, Any], comment: str) -> str:
         if isinstance(value, Mapping) and key in ("marks", "lines", "gates", "scenarios"):
             out.append(f"{key}:")
             out += [f"  {json.dumps(k)}: {json.dumps(v)}" for k, v in value.items()]
+        elif key == "boat":
+            out.append(f"boat: {json.dumps(course_yaml_boat(value))}")
         elif key == "legs":
             out.append("legs:")
             out += [f"  - {json.dumps(v)}" for v in value]
@@ -847,20 +861,44 @@ def _true_time(res: LegResult, plan: _Plan) -> LegResult:
     )
 
 
-ROUND_RADIUS_M: Final = 8.0
-"""Radius of a drawn gate rounding [m]."""
+ROUND_RADIUS_M: Final = 6.0
+"""How far from a mark boats round it [m]: the router aims this far off each mark
+(:func:`clear_target`), and the drawn roundings circle the mark at least this far off."""
 ROUND_ON_M: Final = 8.0
-"""A boat sails this far on past a mark's rounding segment before its next leg [m]."""
+"""After passing a gate outside its marks a boat sails this far on before its next leg
+[m]."""
+
+
+def clear_target(target: Target, start: Start, zone_m: float) -> Target:
+    """The target the boats are routed to: a mark moved :data:`ROUND_RADIUS_M` out along
+    its rounding segment, a gate narrowed by it at both ends (a line as it is), so that no
+    route touches a mark.  The segment crossed lies on the course target's own segment
+    (detection finds the crossing at the same place)."""
+    r = ROUND_RADIUS_M
+    if target.kind == "mark" and target.rounding is not None:
+        g = target_geometry(target, start, zone_m)
+        ex, ey = g.b[0] - g.a[0], g.b[1] - g.a[1]
+        n = math.hypot(ex, ey)
+        return dataclasses.replace(target, a=(g.a[0] + r * ex / n, g.a[1] + r * ey / n))
+    if target.kind == "gate" and target.b is not None:
+        (ax, ay), (bx, by) = target.a, target.b
+        n = math.hypot(bx - ax, by - ay)
+        ux, uy = (bx - ax) / n, (by - ay) / n
+        return dataclasses.replace(
+            target, a=(ax + r * ux, ay + r * uy), b=(bx - r * ux, by - r * uy)
+        )
+    return target
 
 
 @dataclass(frozen=True)
 class Rounding:
     """What a boat sailed between two routed legs (drawn, not routed).
 
-    After a mark (or a gate passed outside) it sails :data:`ROUND_ON_M` straight on past
-    the rounding segment; after a gate it goes on below the gate and round the gate mark
-    nearer to where it passed, on a circle of :data:`ROUND_RADIUS_M`, to the mark's outer
-    side, where its next leg starts.
+    After a mark it goes on round the mark, on a circle through its arrival point (at least
+    :data:`ROUND_RADIUS_M` off), through half the turn to the next leg; after a gate it
+    goes on below the gate and round the gate mark nearer to where it passed, on a circle of
+    :data:`ROUND_RADIUS_M`, to the mark's outer side; after a gate passed outside it sails
+    :data:`ROUND_ON_M` straight on.  The next leg starts where the drawing ends.
 
     Attributes
     ----------
@@ -869,7 +907,7 @@ class Rounding:
     mark : str
         The gate mark rounded ("" after a mark).
     apex_t : float
-        When it passed straight below that mark [epoch s] (NaN after a mark).
+        When it passed straight below that gate mark [epoch s] (NaN after a mark).
     """
 
     t: tuple[float, ...]
@@ -877,6 +915,20 @@ class Rounding:
     y: tuple[float, ...]
     mark: str = ""
     apex_t: float = math.nan
+
+
+def _arc(
+    t0: float, p0: XY, centre: XY, sweep_deg: float, v: float
+) -> tuple[NDArray, NDArray, NDArray]:
+    """Points every 15° (or less) on the circle round ``centre`` through ``p0``, turned
+    ``sweep_deg`` (+ anticlockwise: a port rounding), and their times at ``v`` [m s⁻¹]."""
+    r = math.hypot(p0[0] - centre[0], p0[1] - centre[1])
+    a0 = math.atan2(p0[1] - centre[1], p0[0] - centre[0])
+    steps = max(2, math.ceil(abs(sweep_deg) / 15.0))
+    ang = a0 + np.radians(sweep_deg) * np.arange(1, steps + 1) / steps
+    x, y = centre[0] + r * np.cos(ang), centre[1] + r * np.sin(ang)
+    t = t0 + r * np.abs(np.radians(sweep_deg)) * np.arange(1, steps + 1) / steps / v
+    return t, x, y
 
 
 def _rounding(res: LegResult, target: Target, course: Course, i: int) -> Rounding:
@@ -888,12 +940,18 @@ def _rounding(res: LegResult, target: Target, course: Course, i: int) -> Roundin
     dx, dy = float(tr.x[k + 1] - tr.x[k]), float(tr.y[k + 1] - tr.y[k])
     n = math.hypot(dx, dy) or 1.0
     v = 0.7 * float(tr.bsp_ms[k]) if tr.bsp_ms[k] > 0 else 1.0
-    gate = (
-        course.gates.get(course.legs[i].to_name) if target.name == course.legs[i].to_name else None
-    )
-    if gate is None or course.legs[i].kind != "gate":
+    spec = course.legs[i]
+    if target.name != spec.to_name:  # a gate passed outside
         step = ROUND_ON_M / v
         return Rounding((t0 + step,), (x0 + ROUND_ON_M * dx / n,), (y0 + ROUND_ON_M * dy / n,))
+    if spec.kind == "mark":
+        m = course.marks[spec.to_name]
+        nxt = target_of(course, i + 1).centre
+        turn = float(wrap180(bearing_deg(nxt[0] - m.x, nxt[1] - m.y) - bearing_deg(dx, dy)))
+        sweep = 0.5 * abs(turn) * (1.0 if spec.rounding == "port" else -1.0)
+        t, x, y = _arc(t0, (x0, y0), (m.x, m.y), sweep, v)
+        return Rounding(tuple(t.tolist()), tuple(x.tolist()), tuple(y.tolist()))
+    gate = course.gates[spec.to_name]
     ends = (gate.a, gate.b)
     m = min(ends, key=lambda e: math.hypot(e.x - x0, e.y - y0))
     o = ends[1] if m is ends[0] else ends[0]
@@ -940,10 +998,11 @@ class Routed:
         """The path from the start (:attr:`start_t`) to the finish (repeated times
         dropped)."""
         out: list[Knot] = []
+        t0 = self.start_t
         for k, leg in enumerate(self.legs):
             pts = zip(leg.track.t.tolist(), leg.track.x.tolist(), leg.track.y.tolist(), strict=True)
             if k == 0:
-                pts = itertools.dropwhile(lambda p: p[0] < self.start_t, pts)
+                pts = itertools.dropwhile(lambda p: p[0] < t0, pts)
             if k > 0:
                 r = self.roundings[k - 1]
                 pts = itertools.chain(zip(r.t, r.x, r.y, strict=True), pts)
@@ -982,7 +1041,11 @@ def route_plans(
         for p in plans:
             groups.setdefault(_group_key(p, i), []).append(p)
         for (tack, side, own), members in groups.items():
-            target = members[0].overrides[i] if own else chain_leg(*ends, None, following)[1]
+            target = (
+                members[0].overrides[i]
+                if own
+                else clear_target(chain_leg(*ends, None, following)[1], ends[0], router.zone_m)
+            )
             starts, t0s = [], []
             for p in members:
                 if not done[p.key]:
@@ -1347,7 +1410,7 @@ def _non_starter(d: _Drawn, race: _Race, rng: np.random.Generator, t_end: float)
 
 
 def _line_of(marks: Mapping[str, XY]) -> _Line:
-    pin, com, top = marks["pin"], marks["committee"], marks["1"]
+    pin, com, top = marks["start_pin"], marks["start_boat"], marks["1"]
     ex, ey = com[0] - pin[0], com[1] - pin[1]
     n = math.hypot(ex, ey)
     ex, ey = ex / n, ey / n
@@ -1679,7 +1742,9 @@ def messy_fleet(
     clock_lag_s : float
         The tracker's clock lag [s]: recorded time = true time − lag.
     boat : str
-        Built-in class polar (``ilca7``, ...).
+        The class polar: a built-in name (``ilca7``, ...; they run dead downwind), or a
+        polar file (``tests/data/boat/ITA_ITA455J70.json``: a J/70, which gybes at TWA
+        145-150°).
     laps : int
         Beats (the gate is passed ``laps − 1`` times).
     tws_kn : float
@@ -1697,7 +1762,7 @@ def messy_fleet(
     """
     plan = FaultPlan() if faults is None else faults
     rng = np.random.default_rng(seed)
-    polar = builtin_polar(boat)
+    polar = read_polar(boat) if "polar" in boat_spec(boat) else builtin_polar(boat)
     twd = float(5 * rng.integers(72)) if twd_deg is None else float(twd_deg)
     wind = FleetWind(
         gun,
@@ -1711,9 +1776,10 @@ def messy_fleet(
         tws_phase=float(rng.uniform(0.0, 2.0 * math.pi)),
         pressure_left=pressure_left,
     )
-    marks = layout(twd, _leg_length(polar, wind.tws_ms, minutes, laps))
+    lay = layout(twd, _leg_length(polar, wind.tws_ms, minutes, laps), laps)
+    marks = lay.marks
     data = course_mapping(
-        f"messy fleet (seed {seed})", gun, marks, centre, laps, wind, boat, max(90.0, 3.0 * minutes)
+        f"messy fleet (seed {seed})", gun, lay, centre, wind, boat, max(90.0, 3.0 * minutes)
     )
     course = course_from_mapping(data)
     first_gun = gun - plan.recall_s if plan.general_recall else None
@@ -1804,3 +1870,11 @@ def _duplicates(
         )
         for k in pick
     ]
+
+
+@functools.lru_cache(maxsize=8)
+def shared_fleet(seed: int = 0, **kwargs: Any) -> Fleet:
+    """:func:`messy_fleet` computed once per test run for the same arguments (keyword
+    arguments only besides ``seed``; all hashable), for test modules that use the same
+    fleet.  The fleet is shared: do not change its arrays."""
+    return messy_fleet(seed, **kwargs)

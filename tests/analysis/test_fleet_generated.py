@@ -4,10 +4,11 @@ stops for one boat, every injected fault is classified, over-early boats are cal
 precision and recall, and leg ends are found within a fix of the truth.
 
 Measured on seeds 1-5 (lags 5, 10, 7.5, 6 with a general recall, 9 s): every fault
-classified; 9 of the 10 boats over early and not back called, none wrongly (the one missed
-was 0.4 s / 0.8 m over at the gun); the lag found within 0.2-1.3 s; leg ends within one fix
-of the truth: 100 % of 560 without GPS error, 89 % with the generator's 1.7 m (its
-correlated part moves a crossing by about a second at 1.5-2 m/s) and 97 % within 3 s.
+classified; 18 of the 20 boats over at the gun called (back or not), none wrongly (the two
+missed were 0.4 s / 0.8 m and 4.0 s / 8.3 m over at the gun, 0.5 and 2.7 sd); the lag
+found within 0.3-1.0 s; leg ends within one fix of the truth: 100 % of 560 without GPS
+error, 91 % with the generator's 1.7 m (its correlated part moves a crossing by about a
+second at 1.5-2 m/s) and 99 % within 3 s.
 """
 
 from __future__ import annotations
@@ -79,8 +80,9 @@ def test_every_injected_fault_is_classified_and_ocs_called(fleets: list[Fleet]) 
                 assert by[dup[0]].status.findings[0].detail.endswith((pair - {dup[0]}).pop())
             if b.clean:
                 assert not got - {BoatClass.DUPLICATE}, (f.seed, b.name, got)
-            called = BoatClass.OCS in got
-            over = b.status == "ocs_not_returned"
+            # over at the gun (then back or not) against called over early
+            called = bool(got & {BoatClass.OCS, BoatClass.OCS_RETURNED})
+            over = b.status in ("ocs_not_returned", "ocs_returned")
             tp, fp, fn = (
                 tp + (called and over),
                 fp + (called and not over),
@@ -112,7 +114,7 @@ def test_leg_ends_within_a_fix_of_the_truth(fleets: list[Fleet]) -> None:
     within = np.mean([err <= dt for err, dt in exact])
     assert within >= 0.95, within
     noisy = [e for f in fleets for e in _errors(f)]
-    assert np.mean([err <= dt for err, dt in noisy]) >= 0.80
+    assert np.mean([err <= dt for err, dt in noisy]) >= 0.85
     assert np.mean([err <= 3.0 for err, _ in noisy]) >= 0.95
 
 
