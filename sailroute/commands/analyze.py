@@ -249,8 +249,8 @@ def _fleet(
         parts.append(fleet_table(rows))
     else:
         parts.append(
-            f"(each boat's legs: {len(fleet.analyses)} boats, their tables are in their "
-            "folders: <boat>/analysis.csv)"
+            f"({len(fleet.analyses)} boats debriefed: each boat's table is in its folder, "
+            "<boat>/analysis.csv)"
         )
     parts.append(_notes_text(fleet.all_notes()))
     return CommandResult(
