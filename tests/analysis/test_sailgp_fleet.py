@@ -10,7 +10,7 @@ What the race shows:
 * the fleet is 153-180 m over the surveyed start line at the gun (NZL crossed its
   extension 29 s before the gun, AUS and GBR the line itself 13 and 12 s before), and
   its leg counters start 1-3 s after the gun: the fleet's start is estimated from the
-  boats, a line laid ~183 m up the course, and no boat is called over early;
+  boats, a line laid ~185 m up the course, and no boat is called over early;
 * each log runs on into the next races after a gap of 370-592 s: it is cut there; NZL's and
   GBR's data then end 10 m and 7 m short of the finish, AUS's finish falls inside a data gap
   of 116 s: the three finish legs are unknown, not interpolated;
