@@ -1018,6 +1018,15 @@ def analyze_command(
             help="With --marks infer and no course file: wind speed, knots.",
         ),
     ] = None,
+    gun: Annotated[
+        str | None,
+        typer.Option(
+            "--gun",
+            metavar="TIME",
+            help="The gun the race is timed from, ISO with offset: the restart after a "
+            "general recall (default: the course's restart_time, else start_time).",
+        ),
+    ] = None,
     quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
@@ -1059,6 +1068,7 @@ def analyze_command(
                 wind=wind,
                 reference=reference,
                 pages=pages,
+                gun=gun,
             )
         return res if found is None else found.before(res)
 

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.analysis.fleet import fleet_ranking
 from sailroute.analysis.legmode import source_leg_mode
 from sailroute.analysis.loss import (
     LossSplit,
@@ -36,9 +37,12 @@ from sailroute.analysis.result import LegAnalysis, PointTable, TrackAnalysis
 from sailroute.analysis.segment import (
     DETECT_M,
     Crossing,
+    Segmentation,
+    StartClock,
     leg_target,
     segment_track,
 )
+from sailroute.analysis.triage import race_window_problem
 from sailroute.analysis.windsource import WindSource, first_covering
 from sailroute.course.geometry import feature_centre
 from sailroute.course.load import build_specs, load_course
@@ -51,7 +55,6 @@ from sailroute.routing.geometry import target_barrier
 from sailroute.routing.obstacles import Obstacles, constraint_label, land_filled, obstacles_for
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import LegResult, Start
-from sailroute.timeutil import iso
 from sailroute.track.kinematics import track_xy, velocity
 from sailroute.track.model import Track
 from sailroute.track.read import read_track
@@ -67,8 +70,6 @@ BRIDGE_S = 1e9
 :attr:`sailroute.analysis.windsource.WindSource.route_field`)."""
 REFERENCES = ("course", "fleet")
 """Values of ``analyze --reference``: the course's polar, or it scaled to the fleet."""
-NEAR_COURSE_M = 3000.0
-"""During the race the track must come this close to a mark [m], or it is another place."""
 SMOOTH_S = 3.0
 """Window of the velocity smoothing used for COG, TWA and the manoeuvre detection [s]."""
 
@@ -79,28 +80,13 @@ def check_same_race(course: Course, track: Track, x: NDArray, y: NDArray) -> Non
     Raises
     ------
     InputError
-        No track point inside the race window ``[start_time, start_time +
-        time_limit]``, or none of them within :data:`NEAR_COURSE_M` of a mark.
+        No track point inside the race window ``[start_time, gun + time_limit]``, or
+        none of them within :data:`~sailroute.analysis.triage.NEAR_COURSE_M` of a mark
+        (:func:`~sailroute.analysis.triage.race_window_problem`).
     """
-    t0 = course.start_epoch
-    t1 = t0 + course.time_limit_s
-    inside = (track.t_s >= t0) & (track.t_s <= t1)
-    if not inside.any():
-        raise InputError(
-            f"{track.source}: the track runs {iso(track.t_start)} .. {iso(track.t_end)} but "
-            f"the race ({course.source}) runs {iso(t0)} .. {iso(t1)} (start_time + "
-            "time_limit_min): another day or time zone? Check the track's times (time_zone "
-            "for naive times) and the course's start_time"
-        )
-    mx = np.array([m.x for m in course.marks.values()])
-    my = np.array([m.y for m in course.marks.values()])
-    d = np.hypot(x[inside, None] - mx[None, :], y[inside, None] - my[None, :]).min()
-    if d > NEAR_COURSE_M:
-        raise InputError(
-            f"{track.source}: during the race the track never comes within "
-            f"{NEAR_COURSE_M / 1000:.0f} km of a mark of {course.source} (closest "
-            f"{d / 1000:.1f} km): a track from another place? Check the files"
-        )
+    problem = race_window_problem(course, track, x, y)
+    if problem is not None:
+        raise InputError(f"{track.source}: {problem}")
 
 
 def _smoothed_velocity(t: NDArray, x: NDArray, y: NDArray) -> tuple[NDArray, NDArray]:
@@ -134,6 +120,8 @@ def analyze_track(
     missing: str = "error",
     gate_end: str = "line",
     wind: str = "auto",
+    segmentation: Segmentation | None = None,
+    clock: StartClock | None = None,
 ) -> TrackAnalysis:
     """Analyse a sailed track against the optimal route of each leg.
 
@@ -172,6 +160,14 @@ def analyze_track(
         --wind``: ``auto`` (default, as the command) the track's own measured wind, then
         the direction inferred from the track, then the scenario; ``scenario`` the
         scenario's wind alone.
+    segmentation : Segmentation, optional
+        The track's start and leg ends, already found (a fleet's triage,
+        :func:`sailroute.analysis.triage.triage_fleet`): the track is then not checked
+        against the race window nor segmented again (``leg_times``, ``detect_m``,
+        ``missing`` and ``gate_end`` are not used).
+    clock : StartClock, optional
+        The gun and start line (:func:`sailroute.analysis.segment.find_start`; default
+        the course's gun and surveyed line).
 
     Returns
     -------
@@ -203,19 +199,23 @@ def analyze_track(
     obstacles = obstacles_for(course.area, scen_wind)
     where = f"{track.source or track.name}"
     x, y = track_xy(track, course.frame)
-    check_same_race(course, track, x, y)
     t = track.t_s
-    seg = segment_track(
-        course,
-        t,
-        x,
-        y,
-        leg_times=leg_times,
-        detect_m=detect_m,
-        where=where,
-        missing=missing,
-        gate_end=gate_end,
-    )
+    if segmentation is None:
+        check_same_race(course, track, x, y)
+        seg = segment_track(
+            course,
+            t,
+            x,
+            y,
+            leg_times=leg_times,
+            detect_m=detect_m,
+            where=where,
+            missing=missing,
+            gate_end=gate_end,
+            clock=clock,
+        )
+    else:
+        seg = segmentation
     svx, svy = _smoothed_velocity(t, x, y)
     bounds = seg.bounds
     t_a = bounds[0].t
@@ -249,10 +249,7 @@ def analyze_track(
     )
 
     legs: list[LegAnalysis] = []
-    cols: dict[str, list[NDArray]] = {
-        k: []
-        for k in ("leg", "t", "x", "y", "sog", "cog", "tws", "twd", "twa", "polar", "vmg", "loss")
-    }
+    cols: dict[str, list[NDArray]] = {k: [] for k in _POINT_COLUMNS}
     loss_before = 0.0
     for i, spec in enumerate(course.legs):
         a, b = bounds[i], bounds[i + 1]
@@ -283,26 +280,14 @@ def analyze_track(
                 centre,
                 progress,
                 obstacles=obstacles,
-                design=wind,
+                design=scen_wind,
             )
             legs.append(leg)
-            for k, v in (
-                ("leg", np.full(tl.size, i + 1)),
-                ("t", tl),
-                ("x", xl),
-                ("y", yl),
-                ("sog", sog),
-                ("cog", cog),
-                ("tws", tws),
-                ("twd", twd),
-                ("twa", twa),
-                ("polar", polar),
-                ("vmg", np.full(tl.size, np.nan)),
-                ("loss", np.full(tl.size, np.nan)),
-            ):
-                cols[k].append(v)
+            unknown = np.full(tl.size, np.nan)
+            _add_points(cols, i, tl, xl, yl, sog, cog, tws, twd, twa, polar, unknown, unknown)
             continue
-        mode = source_leg_mode(course, i, sources[chosen[i]], wind, a.t, (a.x, a.y), centre).mode
+        src = sources[chosen[i]]
+        mode = source_leg_mode(course, i, src, scen_wind, a.t, (a.x, a.y), centre).mode
         if mode == "upwind":
             vmg = sog * np.cos(np.radians(twa))
         elif mode == "downwind":
@@ -370,25 +355,11 @@ def analyze_track(
                 optimal=opt,
                 wind_source=src.kind,
                 wind_label=src.label,
-                note=area_note,
+                note="; ".join(n for n in (b.note, area_note) if n),
             )
         )
         loss_before += loss
-        for k, v in (
-            ("leg", np.full(tl.size, i + 1)),
-            ("t", tl),
-            ("x", xl),
-            ("y", yl),
-            ("sog", sog),
-            ("cog", cog),
-            ("tws", tws),
-            ("twd", twd),
-            ("twa", twa),
-            ("polar", polar),
-            ("vmg", vmg),
-            ("loss", cum),
-        ):
-            cols[k].append(v)
+        _add_points(cols, i, tl, xl, yl, sog, cog, tws, twd, twa, polar, vmg, cum)
     c = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
     lat, lon = course.frame.to_latlon(c["x"], c["y"])
     pct = np.where(c["polar"] >= 0.3, 100.0 * c["sog"] / np.maximum(c["polar"], 1e-9), np.nan)
@@ -419,6 +390,18 @@ def analyze_track(
         points,
         sources[chosen[0]].field if chosen else scen_wind,
     )
+
+
+_POINT_COLUMNS = ("leg", "t", "x", "y", "sog", "cog", "tws", "twd", "twa", "polar", "vmg", "loss")
+"""The point table's columns as :func:`analyze_track` gathers them, leg by leg."""
+
+
+def _add_points(cols: dict[str, list[NDArray]], i: int, t: NDArray, *values: NDArray) -> None:
+    """Append leg ``i``'s points to ``cols``: ``t`` and ``values`` in the order of
+    :data:`_POINT_COLUMNS` after ``leg`` and ``t``."""
+    full = (np.full(t.size, i + 1), t, *values)
+    for k, v in zip(_POINT_COLUMNS, full, strict=True):
+        cols[k].append(v)
 
 
 def _leg_points(
@@ -468,6 +451,9 @@ def analysis_winds(
     wind: WindField,
     boat: Any,
     choice: str = "auto",
+    *,
+    gun_t: float | None = None,
+    race_end_t: float | None = None,
 ) -> tuple[dict[str, list[WindSource]], list[str]]:
     """The candidate winds each boat is judged in, best first, and what was found.
 
@@ -488,6 +474,11 @@ def analysis_winds(
         The course, the fleet's tracks, the scenario's name and wind, the boat.
     choice : str
         ``analyze --wind`` (:data:`sailroute.analysis.windsource.CHOICES`).
+    gun_t : float, optional
+        The gun [epoch s] (default the course's): the inferred wind starts a minute before.
+    race_end_t : float, optional
+        The race's end [epoch s] (a fleet's :attr:`~sailroute.analysis.triage.Triage.race_end_t`);
+        default the last leg end found in any track.
 
     Returns
     -------
@@ -515,11 +506,13 @@ def analysis_winds(
     if choice in ("auto", "measured"):
         from sailroute.wind.measured import boat_wind, fleet_wind, sensor_from_track
 
+        without: dict[str, list[str]] = {}  # why -> boats: one note per reason
         for tr in tracks:
             try:
                 series[tr.name] = sensor_from_track(tr)
             except InputError as exc:
-                notes.append(f"{tr.name}: no measured wind ({exc})")
+                why = str(exc).removeprefix(f"{tr.source}: ")
+                without.setdefault(why, []).append(tr.name)
                 continue
             own[tr.name] = WindSource(
                 "measured",
@@ -527,6 +520,12 @@ def analysis_winds(
                 f"measured on board ({series[tr.name].source})",
                 route_field=boat_wind(series[tr.name], frame, max_gap_s=BRIDGE_S),
             )
+        notes.extend(
+            f"{', '.join(boats)}: no measured wind ({why})"
+            if len(boats) < 4
+            else f"no measured wind in {len(boats)} tracks ({why}): {', '.join(boats)}"
+            for why, boats in without.items()
+        )
         if len(series) >= 2:
             fw = fleet_wind(list(series.values()), frame)
             fleet = WindSource(
@@ -536,7 +535,7 @@ def analysis_winds(
                 route_field=fleet_wind(list(series.values()), frame, max_gap_s=BRIDGE_S).field,
             )
             notes.extend(fw.notes)
-            t0, t1 = course.start_epoch, course.start_epoch + course.time_limit_s
+            t0, t1 = course.start_epoch, course.gun_epoch + course.time_limit_s
             parts = []
             for tr in tracks:
                 m = (tr.t_s >= t0) & (tr.t_s <= t1)
@@ -551,7 +550,7 @@ def analysis_winds(
         from sailroute.analysis.infer_wind import infer_wind, summary
         from sailroute.wind.combine import SpeedDirectionWind
 
-        gun = course.start_epoch
+        gun = course.gun_epoch if gun_t is None else gun_t
         cx = float(np.mean([m.x for m in course.marks.values()]))
         cy = float(np.mean([m.y for m in course.marks.values()]))
         tws0, twd0 = _wind_at(wind, np.array([gun]), np.array([cx]), np.array([cy]))
@@ -562,7 +561,7 @@ def analysis_winds(
                 prior_twd_deg=float(twd0[0]),
                 boat=boat,
                 t0=gun - 60.0,
-                t1=_race_end(course, tracks),
+                t1=_race_end(course, tracks) if race_end_t is None else race_end_t,
                 marks=[m.xy for m in course.marks.values()],
             )
         except InputError as exc:
@@ -592,7 +591,7 @@ def analysis_winds(
 def _race_end(course: Course, tracks: Sequence[Track]) -> float:
     """The last leg end found in any of the tracks [epoch s] (the race window's end when
     none is): the wind is inferred over the race, not the sail home."""
-    end = course.start_epoch + course.time_limit_s
+    end = course.gun_epoch + course.time_limit_s
     found = []
     for tr in tracks:
         x, y = track_xy(tr, course.frame)
@@ -783,46 +782,6 @@ def _unknown_leg(
     )
 
 
-def fleet_ranking(analyses: Sequence[TrackAnalysis]) -> list[dict[str, Any]]:
-    """Rank boats per leg by sailed leg time and by elapsed time at the leg's end.
-
-    A leg of unknown time (:attr:`LegAnalysis.known` False) is left out of that leg's
-    ranking (``leg_rank`` None); a leg end of unknown time out of the positions
-    (``position`` None).
-
-    Returns
-    -------
-    list of dict
-        One row per (leg, boat): ``leg`` (1-based), ``label``, ``boat``,
-        ``leg_time_s``, ``leg_rank``, ``elapsed_s`` (from the gun), ``position``,
-        ``loss_s`` (NaN when unknown), ``note`` (why unknown, else empty).
-    """
-    rows: list[dict[str, Any]] = []
-    if not analyses:
-        return rows
-    n = min(len(a.legs) for a in analyses)
-    for i in range(n):
-        times = [a.legs[i].sailed_time_s for a in analyses]
-        elapsed = [a.legs[i].t_end - a.segmentation.start.gun_t for a in analyses]
-        leg_rank = _ranks(times)
-        pos = _ranks(elapsed)
-        for k, a in enumerate(analyses):
-            rows.append(
-                {
-                    "leg": i + 1,
-                    "label": a.legs[i].label,
-                    "boat": a.track.name,
-                    "leg_time_s": times[k],
-                    "leg_rank": leg_rank[k],
-                    "elapsed_s": elapsed[k],
-                    "position": pos[k],
-                    "loss_s": a.legs[i].loss_s,
-                    "note": a.legs[i].note,
-                }
-            )
-    return rows
-
-
 def fleet_reference(analyses: Sequence[TrackAnalysis], reference: Polar) -> FleetPolar:
     """The fleet-relative polar (:func:`sailroute.analysis.fleetpolar.fleet_polar`) from
     tracks analysed against ``reference``: their straight-line points' TWA and SOG/polar."""
@@ -839,16 +798,6 @@ def fleet_reference(analyses: Sequence[TrackAnalysis], reference: Polar) -> Flee
         for a in analyses
     ]
     return fleet_polar(samples, reference, [a.track.name for a in analyses])
-
-
-def _ranks(values: Sequence[float]) -> list[int | None]:
-    """1-based ranks of the finite values (ties in input order), None for the others."""
-    v = np.asarray(values, float)
-    ok = np.flatnonzero(np.isfinite(v))
-    out: list[int | None] = [None] * v.size
-    for r, k in enumerate(ok[np.argsort(v[ok], kind="stable")]):
-        out[int(k)] = r + 1
-    return out
 
 
 def parse_leg_times(text: str | None, n_legs: int) -> list[float | None] | None:

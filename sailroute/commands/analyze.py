@@ -1,7 +1,9 @@
 """``sailroute analyze``: read the tracks, analyse each against the optimal route, write.
 
-The analysis is :mod:`sailroute.analysis.debrief`; the files, tables and pages are
-:mod:`sailroute.report.analysis`.
+The analysis is :mod:`sailroute.analysis.debrief`; a fleet is first triaged
+(:mod:`sailroute.analysis.triage`: which boats can be debriefed, the fleet's start) and
+debriefed as a :class:`~sailroute.analysis.fleet.FleetAnalysis`; the files, tables and pages
+are :mod:`sailroute.report.analysis`.
 """
 
 from __future__ import annotations
@@ -15,12 +17,13 @@ from sailroute.analysis.debrief import (
     REFERENCES,
     analysis_winds,
     analyze_track,
-    fleet_ranking,
     fleet_reference,
     parse_boat_leg_times,
 )
+from sailroute.analysis.fleet import FleetAnalysis
 from sailroute.analysis.result import TrackAnalysis
-from sailroute.analysis.segment import DETECT_M
+from sailroute.analysis.segment import DETECT_M, StartClock
+from sailroute.analysis.triage import BoatEntry, Triage, class_notes, triage_fleet
 from sailroute.commands.result import CommandResult
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
@@ -30,17 +33,24 @@ from sailroute.planning.route import default_scenario, settings_for
 from sailroute.progress import Progress
 from sailroute.report.analysis import (
     analysis_table,
-    fleet_notes,
     fleet_table,
+    results_table,
     write_analysis,
     write_fleet,
 )
+from sailroute.timeutil import iso
+from sailroute.track.model import Track
 from sailroute.track.read import read_track
 
-__all__ = ["PAGES", "run_analyze_command"]
+__all__ = ["PAGES", "TABLES_MAX", "run_analyze_command"]
 
 PAGES = ("fleet", "boat")
 """``--pages``: the fleet's page only (default), or each boat's page and charts too."""
+
+TABLES_MAX = 10
+"""A fleet of up to this many debriefed boats gets each boat's table and the per-leg
+ranking in the terminal report; a larger one the results table only (every boat's tables
+are in its folder)."""
 
 
 def run_analyze_command(
@@ -61,6 +71,7 @@ def run_analyze_command(
     wind: str = "auto",
     reference: str = "course",
     pages: str = "fleet",
+    gun: str | float | None = None,
 ) -> CommandResult:
     """Everything ``sailroute analyze`` does, minus printing.
 
@@ -69,18 +80,24 @@ def run_analyze_command(
     (:func:`sailroute.outdir.write_output_set`), so a bad input or an interrupted run
     leaves the folder as it was.  One track: ``analysis.json``, ``analysis.csv``,
     ``points.csv``, ``legs.png``, ``loss.png`` in ``out_dir`` (default
-    ``out/<course>/analysis-<track stem>``), and ``report.html`` with ``plotly.min.js``.
-    Several: ``fleet.csv``, ``fleet.json``, the fleet's ``report.html`` and
-    ``plotly.min.js`` (default folder ``out/<course>/analysis-fleet``), and per boat its
-    ``analysis.json``, ``analysis.csv`` and ``points.csv`` in ``out_dir/<track stem>/``;
-    with ``pages="boat"`` also each boat's ``report.html``, ``legs.png`` and ``loss.png``
+    ``out/<course>/analysis-<track stem>``), and ``report.html`` with ``plotly.min.js``; a
+    track that cannot be analysed is an error.  Several: ``fleet.csv``, ``fleet.json``,
+    the fleet's ``report.html`` and ``plotly.min.js`` (default folder
+    ``out/<course>/analysis-fleet``), and per debriefed boat its ``analysis.json``,
+    ``analysis.csv`` and ``points.csv`` in ``out_dir/<track stem>/``; with
+    ``pages="boat"`` also each boat's ``report.html``, ``legs.png`` and ``loss.png``
     there (they load the one ``plotly.min.js`` of ``out_dir``).  ``plots=False`` writes
-    no page and no chart.
+    no page and no chart.  A boat that cannot be debriefed
+    (:func:`sailroute.analysis.triage.triage_fleet`) is left out with a note, and the run
+    fails only when no boat can be debriefed.
 
     ``wind`` chooses the wind each leg is judged in (:func:`analysis_winds`);
     ``reference="fleet"`` judges every boat against the course's polar scaled to what
     the fleet sails (:func:`sailroute.analysis.fleetpolar.fleet_polar`): the boats are
-    analysed twice.
+    analysed twice.  ``gun`` (an ISO time with offset, or epoch seconds) replaces the
+    course's gun (``restart_time``, else ``start_time``): the restart after a general
+    recall.  ``data`` of the result is the :class:`~sailroute.analysis.fleet.FleetAnalysis`
+    (a sequence of the boats' analyses) for a fleet, a one-analysis tuple for one track.
     """
     course = course if isinstance(course, Course) else load_course(course)
     if not tracks:
@@ -89,6 +106,7 @@ def run_analyze_command(
         raise InputError(f"--pages: expected one of {', '.join(PAGES)}; got {pages!r}")
     if reference not in REFERENCES:
         raise InputError(f"--reference: expected one of {', '.join(REFERENCES)}; got {reference!r}")
+    gun_t = _gun(gun, course)
     name = default_scenario(course) if scenario is None else scenario
     stems = _unique_stems(tracks)
     times = parse_boat_leg_times(leg_times, stems, course.n_legs)
@@ -99,10 +117,42 @@ def run_analyze_command(
         / (f"analysis-{Path(tracks[0]).stem}" if len(tracks) == 1 else "analysis-fleet")
     )
     out = check_out_dir(Path(out_dir) if out_dir is not None else default)
-    read = [
-        read_track(p, columns=columns, speed_unit=speed_unit, time_zone=time_zone, name=s)
-        for p, s in zip(tracks, stems, strict=True)
-    ]
+    read_kw: dict[str, Any] = {
+        "columns": columns,
+        "speed_unit": speed_unit,
+        "time_zone": time_zone,
+    }
+    one = len(tracks) == 1
+    read: list[tuple[str, str, Track | Exception]] = []
+    for p, s in zip(tracks, stems, strict=True):
+        try:
+            read.append((s, str(p), read_track(p, name=s, **read_kw)))
+        except InputError as exc:
+            if one:
+                raise
+            read.append((s, str(p), exc))
+    tri = triage_fleet(
+        course,
+        read,
+        gun_t=gun_t,
+        leg_times=times,
+        detect_m=detect_m,
+        gate_end=gate_end,
+        fleet_start=not one,
+    )
+    debriefed = tri.analysed
+    if one:
+        got = read[0][2]
+        assert isinstance(got, Track)  # one unreadable track raised above
+        # one boat: its own errors, word for word (never starts, a leg never completed)
+        debriefed = (
+            BoatEntry(stems[0], str(tracks[0]), tri.entries[0].track or got, tri.entries[0].status),
+        )
+    elif not debriefed:
+        raise InputError(
+            f"analyze: no boat of the {len(tracks)} tracks can be analysed: "
+            + " | ".join(class_notes(tri.entries))
+        )
     settings_for(course, router)
     boat, winds = build_specs(course, [name])
     polar = boat.routing_polar()
@@ -111,25 +161,38 @@ def run_analyze_command(
             "--reference fleet scales a polar; the course's boat has none (a "
             "dynamic boat model): use --reference course"
         )
-    sources, notes = analysis_winds(course, read, name, winds[name], boat, wind)
+    boat_tracks = [e.track for e in debriefed if e.track is not None]
+    sources, notes = analysis_winds(
+        course,
+        boat_tracks,
+        name,
+        winds[name],
+        boat,
+        wind,
+        gun_t=tri.start.track_gun_t,
+        race_end_t=tri.race_end_t,
+    )
 
     def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
         out_a = []
-        for tr in read:
+        for e in debriefed:
+            assert e.track is not None
             if progress is not None:
-                progress.set_prefix(f"{tr.name}: ")
+                progress.set_prefix(f"{e.name}: ")
             a = analyze_track(
                 course,
-                tr,
+                e.track,
                 name,
-                leg_times=times[tr.name],
+                leg_times=times[e.name],
                 router=router,
                 detect_m=detect_m,
                 built=(judged_by, winds[name]),
-                winds=sources[tr.name],
+                winds=sources[e.name],
                 progress=progress,
-                missing="error" if len(read) == 1 else "unknown",
+                missing="error",
                 gate_end=gate_end,
+                segmentation=None if one else e.segmentation,
+                clock=StartClock.plain(tri.start.track_gun_t),
             )
             out_a.append(replace(a, reference=label))
         return out_a
@@ -139,49 +202,101 @@ def run_analyze_command(
         fp = fleet_reference(analyses, polar)
         notes.append(fp.describe())
         analyses = analyse_all(fp.polar, fp.describe())
-    if len(analyses) == 1:
-        files = write_output_set(out, lambda d: write_analysis(d, analyses[0], plots=plots))
-        return CommandResult(
-            "\n\n".join([analysis_table(analyses[0]), _notes_text(notes)]),
-            files,
-            data=tuple(analyses),
-            notes=tuple(notes),
-            main=("analysis_json",),
-        )
-    rows = fleet_ranking(analyses)
+    if one:
+        return _one_boat(out, analyses[0], tri, notes, plots)
+    fleet = FleetAnalysis(course, tri, tuple(analyses), tuple(notes))
+    return _fleet(out, fleet, sources, plots, pages)
+
+
+def _one_boat(
+    out: Path, a: TrackAnalysis, tri: Triage, notes: list[str], plots: bool
+) -> CommandResult:
+    """The result of one track: its files, its table and the run's notes."""
+    all_notes = [*tri.notes(), *notes]
+    files = write_output_set(out, lambda d: write_analysis(d, a, plots=plots))
+    return CommandResult(
+        "\n\n".join([analysis_table(a), _notes_text(all_notes)]),
+        files,
+        data=(a,),
+        notes=tuple(all_notes),
+        main=("analysis_json",),
+    )
+
+
+def _fleet(
+    out: Path,
+    fleet: FleetAnalysis,
+    sources: Mapping[str, Sequence[Any]],
+    plots: bool,
+    pages: str,
+) -> CommandResult:
+    """The result of a fleet: every debriefed boat's files, the fleet's, the tables."""
+    rows = fleet.rows()
     # the page draws the fleet-wide wind: the first boat's first candidate not its own log
-    shared = next((s for s in sources[read[0].name] if s.kind != "measured"), None)
+    first = fleet.analyses[0].track.name
+    shared = next((s for s in sources[first] if s.kind != "measured"), None)
     fleet_wind_layer = (shared.label, shared.field) if shared is not None else None
 
     def write(d: Path) -> dict[str, Path]:
         files: dict[str, Path] = {}
         boat_pages = plots and pages == "boat"
-        for s, a in zip(stems, analyses, strict=True):
+        for a in fleet.analyses:
+            s = a.track.name
             for kind, p in write_analysis(d / s, a, plots=boat_pages, scripts=d).items():
                 files[f"{s}/{kind}"] = p
         files.update(
-            write_fleet(d, analyses, rows, plots=plots, notes=notes, wind=fleet_wind_layer)
+            write_fleet(
+                d,
+                fleet.analyses,
+                rows,
+                plots=plots,
+                notes=fleet.notes,
+                wind=fleet_wind_layer,
+                fleet=fleet,
+            )
         )
         return files
 
-    report = "\n\n".join(
-        [
-            *(analysis_table(a) for a in analyses),
-            fleet_table(rows, fleet_notes(analyses)),
-            _notes_text(notes),
-        ]
-    )
+    few = len(fleet.analyses) <= TABLES_MAX
+    n = len(fleet)
+    parts = [analysis_table(a, legend=k == n - 1) for k, a in enumerate(fleet)] if few else []
+    parts.append(results_table(fleet))
+    if few:
+        parts.append(fleet_table(rows))
+    else:
+        parts.append(
+            f"({len(fleet.analyses)} boats debriefed: each boat's table is in its folder, "
+            "<boat>/analysis.csv)"
+        )
+    parts.append(_notes_text(fleet.all_notes()))
     return CommandResult(
-        report,
+        "\n\n".join(parts),
         write_output_set(out, write),
-        data=tuple(analyses),
-        notes=tuple(notes),
+        data=fleet,
+        notes=fleet.all_notes(),
         main=("fleet_json",),
     )
 
 
+def _gun(gun: str | float | None, course: Course) -> float | None:
+    """``--gun``: an ISO time with offset (or epoch seconds) of the gun [epoch s]."""
+    if gun is None:
+        return None
+    if isinstance(gun, int | float):
+        return float(gun)
+    from sailroute.timeutil import parse_time, to_epoch
+
+    t = to_epoch(parse_time(gun, "--gun"))
+    if not course.start_epoch - 6 * 3600.0 <= t <= course.start_epoch + 6 * 3600.0:
+        raise InputError(
+            f"--gun {gun}: expected the gun of this race, within 6 h of the course's "
+            f"start_time {iso(course.start_epoch)}; check the date and the UTC offset"
+        )
+    return t
+
+
 def _notes_text(notes: Sequence[str]) -> str:
-    """The run's wind and reference notes, one per line."""
+    """The run's notes, one per line."""
     return "\n".join(f"note: {n}" for n in notes)
 
 

@@ -64,6 +64,7 @@ TOP_KEYS = (
     "name",
     "description",
     "start_time",
+    "restart_time",
     "time_limit_min",
     "origin",
     "marks",
@@ -140,6 +141,8 @@ class CheckedCourse:
         (:mod:`sailroute.course.area`).
     uncertainty : UncertaintySpec or None
         The ``uncertainty`` section (leg-time bands), if given.
+    restart_time : datetime or None
+        The restart's signal after a general recall, if given (after ``start_time``).
     """
 
     name: str
@@ -160,33 +163,49 @@ class CheckedCourse:
     template: dict[str, Any] | None
     area: RaceArea = dataclasses.field(default_factory=RaceArea)
     uncertainty: UncertaintySpec | None = None
+    restart_time: datetime | None = None
 
 
 # ----------------------------------------------------------------------------- sections
-def _start_time(c: Checker, data: Mapping[str, Any]) -> datetime | None:
-    if "start_time" not in data:
+def _start_time(c: Checker, data: Mapping[str, Any], key: str = "start_time") -> datetime | None:
+    if key not in data:
         c.p.add(
-            "start_time",
+            key,
             "missing required key; expected an ISO 8601 time with a UTC "
             "offset, e.g. '2018-04-24T12:10:00+02:00'",
         )
         return None
-    v = data["start_time"]
+    v = data[key]
     if isinstance(v, date) and not isinstance(v, datetime):
         c.p.add(
-            "start_time",
+            key,
             f"expected a date and time with a UTC offset, e.g. "
             f"'{v.isoformat()}T12:00:00+02:00'; got the date {v.isoformat()}",
         )
         return None
     if not isinstance(v, str | datetime):
-        c.p.add("start_time", f"expected an ISO 8601 time with a UTC offset; got {show(v)}")
+        c.p.add(key, f"expected an ISO 8601 time with a UTC offset; got {show(v)}")
         return None
     try:
-        return parse_time(v, where=c.p.prefix("start_time"))
+        return parse_time(v, where=c.p.prefix(key))
     except InputError as exc:
         c.p.extend([str(exc)])
         return None
+
+
+def _restart_time(c: Checker, data: Mapping[str, Any], start: datetime | None) -> datetime | None:
+    """``restart_time``: the restart's signal after a general recall, after ``start_time``."""
+    if data.get("restart_time") is None:
+        return None
+    restart = _start_time(c, data, "restart_time")
+    if restart is not None and start is not None and restart <= start:
+        c.p.add(
+            "restart_time",
+            f"the restart after a general recall must come after start_time "
+            f"({start.isoformat()}); got {restart.isoformat()}",
+        )
+        return None
+    return restart
 
 
 def _latlon(c: Checker, d: Mapping[str, Any], path: str) -> tuple[float, float] | None:
@@ -884,6 +903,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         probs.add("description", f"expected text; got {show(description)}")
         description = ""
     start_time = _start_time(c, data) if "start_time" in data else None
+    restart_time = _restart_time(c, data, start_time)
     time_limit = c.number(data, "time_limit_min", DEFAULT_TIME_LIMIT_MIN, lo=0.0, lo_open=True)
 
     # -- layout: explicit marks/lines/gates/legs, or a template
@@ -966,6 +986,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         template=dict(template) if template is not None else None,
         area=area,
         uncertainty=uncertainty,
+        restart_time=restart_time,
     )
 
 

@@ -284,6 +284,9 @@ class Course:
     uncertainty : UncertaintySpec or None
         The ``uncertainty`` section (how far the leg-time bands of ``plan --ensemble``
         spread, :mod:`sailroute.course.uncertainty`); None: not given.
+    restart_time : datetime or None
+        The start signal of the restart after a general recall (``restart_time`` in the
+        file); ``analyze`` times the race from it.  None: no recall.
     """
 
     name: str
@@ -306,6 +309,7 @@ class Course:
     key_lines: Mapping[str, int] = field(default_factory=dict)
     area: RaceArea = field(default_factory=RaceArea)
     uncertainty: UncertaintySpec | None = None
+    restart_time: datetime | None = None
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):
@@ -320,6 +324,12 @@ class Course:
     def start_epoch(self) -> float:
         """Start time [epoch s]."""
         return to_epoch(self.start_time)
+
+    @property
+    def gun_epoch(self) -> float:
+        """The gun a sailed race is timed from [epoch s]: ``restart_time`` after a general
+        recall, else ``start_time``."""
+        return to_epoch(self.restart_time) if self.restart_time is not None else self.start_epoch
 
     @property
     def base_dir(self) -> Path:

@@ -26,6 +26,7 @@ from sailroute.units import KNOT
 if TYPE_CHECKING:  # pragma: no cover
     from matplotlib.figure import Figure
 
+    from sailroute.analysis.fleet import FleetAnalysis
     from sailroute.analysis.result import TrackAnalysis
     from sailroute.wind.base import WindField
 
@@ -181,6 +182,10 @@ def start_to_dict(a: TrackAnalysis) -> dict[str, Any]:
         "line_fraction": _num(st.line_fraction),
         "ocs_s": None if st.ocs_s is None else _num(st.ocs_s, 1),
         "ocs_returned": st.ocs_returned,
+        "over_s": _num(st.over_s, 2),
+        "ocs_sd": _num(st.ocs_sd, 2),
+        "ocs_p": _num(st.ocs_p, 4),
+        "line_shift_m": _num(st.shift_m, 1),
         "line_offset_m": _num(st.line_offset_m, 1),
         "notes": list(st.notes),
         "point": _point(a.course, (st.crossing.x, st.crossing.y)),
@@ -194,13 +199,6 @@ def speed_at_gun_kn(a: TrackAnalysis) -> float:
 
 def _iso(t: float) -> str | None:
     return iso(t) if math.isfinite(t) else None
-
-
-def fleet_notes(analyses: Sequence[TrackAnalysis]) -> tuple[str, ...]:
-    """Notes on the fleet as a whole (the start line: :func:`fleet_start_notes`)."""
-    from sailroute.analysis.segment import fleet_start_notes
-
-    return fleet_start_notes([a.segmentation.start for a in analyses])
 
 
 def iso_column(t: Any) -> list[str]:
@@ -341,13 +339,16 @@ def write_fleet(
     plots: bool = True,
     notes: Sequence[str] = (),
     wind: tuple[str, WindField] | None = None,
+    fleet: FleetAnalysis | None = None,
 ) -> dict[str, Path]:
     """Write ``fleet.csv`` (one row per leg and boat), ``fleet.json`` and (with ``plots``)
     the fleet's ``report.html`` (:mod:`sailroute.report.fleet`) with the plotly.js bundle
     beside it (``plotly.min.js``, which the boats' pages in the folders below load too).
 
     ``notes`` (the run's findings on the wind and the reference) go into ``fleet.json``
-    and the page; ``wind`` is the fleet-wide wind drawn on the page (name, field)."""
+    and the page; ``wind`` is the fleet-wide wind drawn on the page (name, field).
+    ``fleet`` (the triaged fleet) adds every track's status (debriefed or not), the
+    results, the fleet's start and triage's notes."""
     out = Path(out_dir)
     cp = out / "fleet.csv"
     cols = (
@@ -367,8 +368,8 @@ def write_fleet(
         for r in rows:
             w.writerow([_fmt(r[c]) if r[c] is not None else "" for c in cols])
     jp = out / "fleet.json"
-    all_notes = [*fleet_notes(analyses), *notes]
-    doc = {
+    all_notes = [*(fleet.triage.notes() if fleet is not None else ()), *notes]
+    doc: dict[str, Any] = {
         "schema_version": SCHEMA_VERSION,
         "sailroute_version": __version__,
         "course": analyses[0].course.name if analyses else None,
@@ -384,6 +385,8 @@ def write_fleet(
         "notes": all_notes,
         "legs": [{k: (_num(v) if isinstance(v, float) else v) for k, v in r.items()} for r in rows],
     }
+    if fleet is not None:
+        doc.update(fleet_to_dict(fleet))
     jp.write_text(json.dumps(doc, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     files = {"fleet_csv": cp, "fleet_json": jp}
     if plots:
@@ -396,6 +399,66 @@ def write_fleet(
     return files
 
 
+def fleet_to_dict(fleet: FleetAnalysis) -> dict[str, Any]:
+    """``fleet.json``'s ``entries`` (every track: status, findings), ``results``, ``start``
+    (the fleet's estimate) and ``leader`` (see ``docs/output-format.md``)."""
+    st = fleet.triage.start
+    tab = fleet.table
+    return {
+        "entries": [
+            {
+                "name": e.name,
+                "source": e.source,
+                "analysed": e.analysed,
+                "ranked": e.status.ranked and e.analysed,
+                "status": [f.kind.name.lower() for f in e.status.findings],
+                "findings": [
+                    {"kind": f.kind.name.lower(), "text": f.kind.value, "detail": f.detail}
+                    for f in e.status.findings
+                ],
+                "cut": None if e.cut is None else [iso(e.cut[0]), iso(e.cut[1])],
+            }
+            for e in fleet.entries
+        ],
+        "results": [
+            {
+                "boat": r.boat,
+                "position": r.position,
+                "finish_elapsed_s": _num(r.finish_s),
+                "common_position": r.common_position,
+                "common_total_s": _num(r.total_s),
+                "common_loss_s": _num(r.loss_s),
+                "known_legs": r.known_legs,
+                "status": list(r.status),
+                "analysed": r.analysed,
+                "ranked": r.ranked,
+            }
+            for r in fleet.results()
+        ],
+        "common_legs": [i + 1 for i in tab.common_legs()],
+        "leader": fleet.leader(),
+        "fleet_start": {
+            "gun_time": iso(st.gun_t),
+            "gun_time_in_tracks": iso(st.track_gun_t),
+            "model": st.model,
+            "told_apart": st.told_apart,
+            "time_offset_s": _num(st.time_offset_s, 2),
+            "se_time_offset_s": _num(st.se_time_offset_s, 2),
+            "line_shift_m": _num(st.shift_m, 1),
+            "se_line_shift_m": _num(st.se_shift_m, 1),
+            "front_row_spread_m": _num(st.spread_m, 2),
+            "clean_spread_s": _num(st.spread_s, 2),
+            "boats": st.n_boats,
+        },
+        "general_recall": None
+        if fleet.triage.recall is None
+        else {
+            "boats": list(fleet.triage.recall.boats),
+            "restart_time": iso(fleet.triage.recall.restart_t),
+        },
+    }
+
+
 def _mss(s: float) -> str:
     if not math.isfinite(s):
         return "unknown"
@@ -404,8 +467,9 @@ def _mss(s: float) -> str:
     return f"{sign}{tenths // 600}:{(tenths % 600) / 10:04.1f}"
 
 
-def analysis_table(a: TrackAnalysis) -> str:
-    """Terminal report: start, then one row per leg and a total."""
+def analysis_table(a: TrackAnalysis, legend: bool = True) -> str:
+    """Terminal report: start, then one row per leg and a total (``legend``: and the lines
+    that explain the columns, once for a fleet)."""
     st = a.segmentation.start
     head = (
         f"{a.track.name} on {a.course.name} ({a.scenario}, {a.router})\n"
@@ -448,13 +512,14 @@ def analysis_table(a: TrackAnalysis) -> str:
         f"{label:<14}{'':<9}{_mss(a.sailed_time_s):>9}{_mss(a.optimal_time_s):>9}"
         f"{a.loss_s:>+8.1f}{tot[0]:>+7.1f}{tot[1]:>+7.1f}{tot[2]:>+7.1f}"
     )
-    rows.append(
-        "(lost = sailed - optimal from the same point and time, split into "
-        "manoeuvres + speed + route; tk/gb sailed:optimal"
-        + ("" if a.complete else "; totals over the legs of known time")
-        + ")"
-    )
-    if any(leg.above_polar for leg in a.legs):
+    if legend:
+        rows.append(
+            "(lost = sailed - optimal from the same point and time, split into "
+            "manoeuvres + speed + route; tk/gb sailed:optimal"
+            + ("" if a.complete else "; totals over the legs of known time")
+            + ")"
+        )
+    if legend and any(leg.above_polar for leg in a.legs):
         rows.append(
             f"* sailed above {ABOVE_POLAR_PCT:.0f} % of the polar: the polar stands in "
             "for another class, or the wind is wrong (too light); these losses are not "
@@ -468,6 +533,49 @@ def analysis_table(a: TrackAnalysis) -> str:
     if a.track.notes:
         rows.append("track: " + "; ".join(a.track.notes))
     return "\n".join(rows)
+
+
+def results_table(fleet: FleetAnalysis) -> str:
+    """The fleet's results: finish place where known, elapsed time at the finish, the
+    sailed time and loss over the legs every ranked boat has, the place at the last leg
+    end they all have, and what triage found; every track, debriefed or not."""
+    tab = fleet.table
+    legs = tab.common_legs()
+    span = _leg_span(legs)
+    last = tab.last_common_end()
+    at = f"at leg {last + 1}" if last is not None else "at -"
+    head = "results: place and elapsed time at the finish (from the gun), time and loss over " + (
+        f"legs {span}, the legs every ranked boat has" if legs else "no leg every ranked boat has"
+    )
+    if last is not None:
+        head += f"; leader: {fleet.leader()} (ahead at the end of leg {last + 1})"
+    out = [
+        head,
+        f"  {'pos':>4} {'boat':<24}{'finish':>9}{'legs ' + span:>12}{'lost':>8}{at:>9}  status",
+    ]
+    for r in fleet.results():
+        pos = f"{r.position}." if r.position is not None else "-"
+        cpos = f"{r.common_position}." if r.common_position is not None else "-"
+        if not r.analysed:
+            out.append(f"  {'-':>4} {r.boat:<24}{'':>38}  {'; '.join(r.status)}")
+            continue
+        lost = f"{r.loss_s:+.1f}" if math.isfinite(r.loss_s) else "?"
+        out.append(
+            f"  {pos:>4} {r.boat:<24}{_mss(r.finish_s):>9}{_mss(r.total_s):>12}{lost:>8}"
+            f"{cpos:>9}  {'; '.join(r.status)}"
+        )
+    return "\n".join(out)
+
+
+def _leg_span(legs: Sequence[int]) -> str:
+    """``(0, 1, 2, 4)`` -> ``"1-3, 5"`` (1-based)."""
+    runs: list[list[int]] = []
+    for i in legs:
+        if runs and runs[-1][1] == i:
+            runs[-1][1] = i + 1
+        else:
+            runs.append([i, i + 1])
+    return ", ".join(f"{a + 1}" if b == a + 1 else f"{a + 1}-{b}" for a, b in runs) or "-"
 
 
 def fleet_table(rows: Sequence[Mapping[str, Any]], notes: Sequence[str] = ()) -> str:
