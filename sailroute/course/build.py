@@ -66,6 +66,7 @@ def build_course(
         utc_offset_s=checked.utc_offset_s,
         key_lines=MappingProxyType(dict(key_lines or {})),
         area=checked.area,
+        chart=checked.chart,
     )
 
 

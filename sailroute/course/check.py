@@ -36,6 +36,7 @@ from sailroute.checks import (
     suggest,
 )
 from sailroute.course.area import AREA_KEYS, check_area
+from sailroute.course.chart import ChartFile, check_chart
 from sailroute.course.model import LegKind
 from sailroute.course.routing_section import load_routing
 from sailroute.course.templates import TEMPLATES, CourseLayout
@@ -76,6 +77,7 @@ TOP_KEYS = (
     "scenarios",
     "references",
     "uncertainty",
+    "chart",
     *AREA_KEYS,
 )
 """Keys allowed at the top level of a course file."""
@@ -140,6 +142,8 @@ class CheckedCourse:
         (:mod:`sailroute.course.area`).
     uncertainty : UncertaintySpec or None
         The ``uncertainty`` section (leg-time bands), if given.
+    chart : ChartFile or None
+        The ``chart`` file (coast or land drawn under the maps), if given.
     """
 
     name: str
@@ -160,6 +164,7 @@ class CheckedCourse:
     template: dict[str, Any] | None
     area: RaceArea = dataclasses.field(default_factory=RaceArea)
     uncertainty: UncertaintySpec | None = None
+    chart: ChartFile | None = None
 
 
 # ----------------------------------------------------------------------------- sections
@@ -939,6 +944,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
     area = check_area(c, data, frame, xy, _position)
+    chart = check_chart(c, data)
     uncertainty = (
         check_uncertainty(c.at("uncertainty"), data["uncertainty"], Path(probs.file).parent)
         if data.get("uncertainty") is not None
@@ -966,6 +972,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         template=dict(template) if template is not None else None,
         area=area,
         uncertainty=uncertainty,
+        chart=chart,
     )
 
 

@@ -24,6 +24,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from sailroute.course.chart import ChartFile
 from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.geo import LocalFrame
 from sailroute.routing.obstacles import RaceArea
@@ -284,6 +285,9 @@ class Course:
     uncertainty : UncertaintySpec or None
         The ``uncertainty`` section (how far the leg-time bands of ``plan --ensemble``
         spread, :mod:`sailroute.course.uncertainty`); None: not given.
+    chart : ChartFile or None
+        The ``chart`` file: coast or land polygons drawn under the maps
+        (:mod:`sailroute.course.chart`); None: not given.
     """
 
     name: str
@@ -306,6 +310,7 @@ class Course:
     key_lines: Mapping[str, int] = field(default_factory=dict)
     area: RaceArea = field(default_factory=RaceArea)
     uncertainty: UncertaintySpec | None = None
+    chart: ChartFile | None = None
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):
