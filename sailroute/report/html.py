@@ -40,6 +40,7 @@ from numpy.typing import NDArray
 
 from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.course.model import Course
+from sailroute.report.chart import Chart
 from sailroute.planning.result import Comparison, Plan, percent_error
 from sailroute.report.page import (
     MAX_WIND_LAYERS,
@@ -161,9 +162,18 @@ def _wind_note(layers: Sequence[WindLayer]) -> str:
 HELP = (
     "Drag the time slider (or press ▶) to move the boat and the wind; click a legend "
     "entry to hide or show it; hover over a route for its time, wind and speed; scroll "
-    "to zoom, drag to pan, double-click to reset the view. Background: plain water "
-    "(no chart or coastline); positions WGS-84."
+    "to zoom, drag to pan, double-click to reset the view. Labels that had to move off "
+    "their point have a thin line to it; positions WGS-84."
 )
+
+
+def page_chart(
+    course: Course, winds: Sequence[WindField | None], routes: Sequence[Route]
+) -> Chart:
+    """The land under a page's map (:func:`sailroute.report.chart.chart_for`)."""
+    from sailroute.report.chart import chart_for
+
+    return chart_for(course, [w for w in winds if w is not None], course_area(course, routes))
 
 
 def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
@@ -201,6 +211,7 @@ def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
         (HELP, _times_note(c), _wind_note(layers)),
         colour_by_speed=True,
         overlays=tuple(plotly_traces(plan.start_line, plan.laylines, c.frame)),
+        chart=page_chart(c, [wind], [route]),
     )
 
 
@@ -282,6 +293,7 @@ def comparison_report(
         tuple(notes),
         leg_numbers=False,
         legend_beside=True,
+        chart=page_chart(course, list((winds or {}).values()), routes),
     )
 
 

@@ -23,6 +23,7 @@ from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.planning.result import Plan
 from sailroute.report.area import fit_area
+from sailroute.report.chart import Chart
 from sailroute.report.plots import repeat_index_of_ends
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, wind_speed_direction, wrap180
@@ -280,6 +281,8 @@ class Report:
         More plotly traces drawn over the course (laylines, the favoured start end).
     folded : tuple of NoteGroup
         Findings shared by several boats, under the notes, folded.
+    chart : Chart or None
+        The land under the map (:func:`sailroute.report.chart.chart_for`); None: none.
     pick : bool
         A fleet: the reader picks a boat (a list above the map, a click on its track or
         on its row, ``#boat=NAME`` in the address) and the others turn grey; tacks and
@@ -300,6 +303,7 @@ class Report:
     overlays: tuple[dict[str, Any], ...] = ()
     folded: tuple[NoteGroup, ...] = ()
     pick: bool = False
+    chart: Chart | None = None
 
 
 def clock(t: float, utc_offset_s: float = 0.0) -> str:
