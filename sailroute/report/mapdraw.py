@@ -56,10 +56,13 @@ def _px(ax: Any, xy: NDArray) -> NDArray:
     return np.asarray(ax.transData.transform(np.asarray(xy, float).reshape(-1, 2)))
 
 
-def _segments(ax: Any, lines: Sequence[NDArray]) -> NDArray:
+def _segments(
+    ax: Any, lines: Sequence[NDArray], shifts: Sequence[tuple[float, float]] = ()
+) -> NDArray:
+    """The lines' segments [px] (each line moved by its shift [px], if given)."""
     segs = []
-    for ln in lines:
-        p = _px(ax, ln)
+    for k, ln in enumerate(lines):
+        p = _px(ax, ln) + (np.asarray(shifts[k]) if k < len(shifts) else 0.0)
         p = p[np.all(np.isfinite(p), axis=1)]
         if len(p) >= 2:
             segs.append(np.column_stack([p[:-1], p[1:]]))
@@ -138,6 +141,7 @@ def finish_map(
     lines: Sequence[NDArray] = (),
     items: Sequence[MapItem] = (),
     mark_ms: float = 7.0,
+    shifts_pt: Sequence[tuple[float, float]] = (),
 ) -> None:
     """Scale bar, north arrow and the placed items on a map (see the module docstring).
 
@@ -154,6 +158,11 @@ def finish_map(
         More lines that names may not cover (start and finish lines, gates).
     items : sequence of MapItem
         Symbols and leg numbers; the mark names are added from ``marks``.
+    mark_ms : float
+        Size of the mark symbols [pt].
+    shifts_pt : sequence of (float, float)
+        Per route, where it is drawn on screen from its true place [pt] (a leg sailed
+        again over the same water is drawn beside the first).
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.collections import LineCollection
@@ -163,8 +172,9 @@ def finish_map(
     ax.apply_aspect()
     px_per_pt = fig.dpi / 72.0
     bounds = np.asarray(ax.bbox.extents, float) + np.array([2, 2, -2, -2])
-    segs = _segments(ax, [*routes, *lines])
-    route_segs = _segments(ax, routes)
+    shifts = [(a * px_per_pt, b * px_per_pt) for a, b in shifts_pt]
+    segs = _segments(ax, [*routes, *lines], shifts)
+    route_segs = _segments(ax, routes, shifts)
     mr = 0.5 * mark_ms * px_per_pt + 1.0
     mp = _px(ax, [(x, y) for _, x, y in marks]) if marks else np.zeros((0, 2))
     fixed = np.column_stack([mp[:, 0] - mr, mp[:, 1] - mr, mp[:, 0] + mr, mp[:, 1] + mr])

@@ -243,18 +243,18 @@ def _annotation(lon: float, lat: float, text: str, **style: Any) -> dict[str, An
 
 
 def mark_annotations(course: Course) -> list[dict[str, Any]]:
-    """The marks' names as annotations (``name`` ``mark:<name>``)."""
+    """The marks' names as annotations (``name`` ``mark:<k>``, ``k`` the mark's index)."""
     return [
         _annotation(
             m.lon,
             m.lat,
             plotly_label(m.name),
-            name=f"mark:{clean_text(m.name)}",
+            name=f"mark:{k}",
             font={"size": 12, "color": "#222"},
             bgcolor="rgba(255,255,255,0.55)",
             borderpad=1,
         )
-        for m in course.marks.values()
+        for k, m in enumerate(course.marks.values())
     ]
 
 

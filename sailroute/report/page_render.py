@@ -355,7 +355,11 @@ _JS = """
     probe.onload = function () {
       document.body.setAttribute('data-tiles', 'shown');
       status.textContent = 'OSM tiles shown.';
-      document.getElementById('sailroute-osm').hidden = false;
+      var osm = document.getElementById('sailroute-osm'), link = document.createElement('a');
+      link.href = 'https://www.openstreetmap.org/copyright';
+      link.textContent = 'OpenStreetMap';
+      osm.append('© ', link, ' contributors');
+      osm.hidden = false;
       tiles(gd, fig, true);
     };
     probe.onerror = function () {
@@ -567,8 +571,7 @@ def render_html(report: Report, plotly_src: str = PLOTLY_FILE) -> str:
 <div id="sailroute-wrap">
 <div id="{DIV_ID}" style="height: {map_height(report)}px"></div>
 <div id="sailroute-furniture"></div>
-<div id="sailroute-osm" style="top: {map_height(report) - 125}px" hidden>© <a
-href="https://www.openstreetmap.org/copyright">OpenStreetMap</a> contributors</div>
+<div id="sailroute-osm" style="top: {map_height(report) - 125}px" hidden></div>
 </div>
 <p class="note" id="sailroute-chart">{_h(fig.get("chart", {}).get("note", ""))} <span
 id="sailroute-tiles">OSM tiles: not tried yet.</span></p>

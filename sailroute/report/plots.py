@@ -383,6 +383,7 @@ def plot_route(
     lc = None
     repeats = repeat_index(legs)
     items: list[MapItem] = []
+    shifts: list[tuple[float, float]] = []
     for k, r in enumerate(legs):
         pts = np.column_stack([r.track.x, r.track.y])
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
@@ -396,10 +397,12 @@ def plot_route(
         )
         lc.set_array(r.track.bsp_ms[:-1] / KNOT)
         lc.set_gid(f"leg:{k + 1}")
+        shifts.append((0.0, 0.0))
         if repeats[k]:  # the same water as an earlier leg: shift it sideways on screen
             dx, dy = np.subtract(r.end_xy, r.start_xy)
             n = float(np.hypot(dx, dy)) or 1.0
             off = OFFSET_PT * repeats[k]
+            shifts[-1] = (off * dy / n, -off * dx / n)
             lc.set_transform(
                 offset_copy(ax.transData, fig=fig, x=off * dy / n, y=-off * dx / n, units="points")
             )
@@ -424,6 +427,7 @@ def plot_route(
         ax,
         routes=[np.column_stack([r.track.x, r.track.y]) for r in legs],
         items=items,
+        shifts_pt=shifts,
         **course_labels(course),
     )
     legend_under(ax, wind_label)
