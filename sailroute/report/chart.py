@@ -238,7 +238,7 @@ def chart_for(course: Course, winds: Sequence[Any], extent: Sequence[float]) -> 
         found.append((f"land: {mask.source}", _cells(mask)))
     elif mask is None:
         missing.append("a land mask in the wind data")
-    layers = []
+    layers: list[LandLayer] = []
     for name, geom in found:
         layer = _layer(name, geom, box, shown=not layers)
         if layer is not None:
@@ -250,7 +250,7 @@ def in_view(layer: LandLayer, extent: Sequence[float]) -> bool:
     """Whether some of ``layer`` lies inside ``extent`` = ``(x0, x1, y0, y1)`` [m]."""
     x0, x1, y0, y1 = extent
     view = shapely.box(x0, y0, x1, y1)
-    parts = [shapely.Polygon(r) for r in layer.rings if len(r) >= 4]
+    parts: list[shapely.Geometry] = [shapely.Polygon(r) for r in layer.rings if len(r) >= 4]
     parts += [shapely.LineString(r) for r in layer.lines]
     return any(shapely.intersects(view, shapely.make_valid(p)) for p in parts)
 

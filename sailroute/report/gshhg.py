@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import importlib.util
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import shapely
@@ -75,7 +76,7 @@ def gshhg_land(
                 lon = pts[:, 0] + shift
                 if lon.max() < west or lon.min() > east or npts < 3:
                     continue
-                ring = shapely.Polygon(np.column_stack([lon, pts[:, 1]]))
+                ring: Any = shapely.Polygon(np.column_stack([lon, pts[:, 1]]))
                 if not ring.is_valid:
                     ring = shapely.make_valid(ring)
                 part = shapely.clip_by_rect(ring, west, south, east, north)

@@ -28,6 +28,8 @@ MAX_SEGMENTS = 4000
 """Route segments the placer looks at (longer routes are thinned evenly)."""
 TACK_STYLE = {"marker": "^", "color": "crimson", "ms": 6.0}
 GYBE_STYLE = {"marker": "s", "color": "royalblue", "ms": 5.0}
+BADGE = {"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.3", "lw": 0.6}
+"""The circle round a leg number."""
 FAVOURED_STYLE = {"marker": "*", "color": "#2ca02c", "ms": 15.0, "mec": "black", "mew": 0.6}
 
 
@@ -52,7 +54,7 @@ def nice_length(limit: float) -> float:
     return 10.0**k  # pragma: no cover - limit >= 10**k always
 
 
-def _px(ax: Any, xy: NDArray) -> NDArray:
+def _px(ax: Any, xy: Any) -> NDArray:
     return np.asarray(ax.transData.transform(np.asarray(xy, float).reshape(-1, 2)))
 
 
@@ -83,10 +85,10 @@ def _text_size(fig: Any, text: str, size: float) -> tuple[float, float]:
     return w + 4.0, h + 4.0
 
 
-def _furniture(fig: Any, ax: Any, segs: NDArray, fixed: NDArray, bounds: NDArray) -> NDArray:
+def _furniture(fig: Any, ax: Any, segs: NDArray, fixed: NDArray, bounds: Any) -> NDArray:
     """The scale bar and north arrow in the emptiest corner; returns their box [px]."""
     px_per_pt = fig.dpi / 72.0
-    (x0, y0), (x1, _) = _px(ax, [[ax.get_xlim()[0], 0.0], [ax.get_xlim()[1], 0.0]])
+    (x0, _), (x1, _) = _px(ax, [[ax.get_xlim()[0], 0.0], [ax.get_xlim()[1], 0.0]])
     m_per_px = (ax.get_xlim()[1] - ax.get_xlim()[0]) / (x1 - x0)
     length = nice_length(70.0 * px_per_pt * m_per_px)
     bar_px = length / m_per_px
@@ -171,7 +173,7 @@ def finish_map(
         FigureCanvasAgg(fig)
     ax.apply_aspect()
     px_per_pt = fig.dpi / 72.0
-    bounds = np.asarray(ax.bbox.extents, float) + np.array([2, 2, -2, -2])
+    bounds = [float(v) for v in np.asarray(ax.bbox.extents, float) + np.array([2, 2, -2, -2])]
     shifts = [(a * px_per_pt, b * px_per_pt) for a, b in shifts_pt]
     segs = _segments(ax, [*routes, *lines], shifts)
     route_segs = _segments(ax, routes, shifts)
@@ -185,7 +187,7 @@ def finish_map(
     todo += [MapItem("mark", x, y, name) for name, x, y in marks]
     labels = []
     for it in todo:
-        (ax_, ay_), = _px(ax, [(it.x, it.y)])
+        ((ax_, ay_),) = _px(ax, [(it.x, it.y)])
         if it.kind in ("tack", "gybe", "favoured"):
             style = {"tack": TACK_STYLE, "gybe": GYBE_STYLE}.get(it.kind, FAVOURED_STYLE)
             s = float(style["ms"]) * px_per_pt + 2.0  # type: ignore[arg-type]
@@ -202,8 +204,13 @@ def finish_map(
     for it, p in fav:
         w, h = _text_size(fig, it.text, 7)
         taken = np.vstack(
-            [fixed, [[q.cx - lb.w / 2, q.cy - lb.h / 2, q.cx + lb.w / 2, q.cy + lb.h / 2]
-                     for q, lb in zip(placed, labels, strict=True)]]
+            [
+                fixed,
+                [
+                    [q.cx - lb.w / 2, q.cy - lb.h / 2, q.cx + lb.w / 2, q.cy + lb.h / 2]
+                    for q, lb in zip(placed, labels, strict=True)
+                ],
+            ]
         )
         s = float(FAVOURED_STYLE["ms"]) * px_per_pt / 2  # type: ignore[arg-type]
         (q,) = place_labels([Label(p.cx, p.cy, w, h, s, False)], segs, taken, bounds)
@@ -236,8 +243,7 @@ def finish_map(
                     label="favoured start end", **FAVOURED_STYLE)  # fmt: skip
         elif it.kind == "legno":
             ax.text(x, y, it.text, ha="center", va="center", fontsize=7, zorder=9,
-                    gid=f"legno:{it.text}",
-                    bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.3", "lw": 0.6})  # fmt: skip
+                    gid=f"legno:{it.text}", bbox=BADGE)  # fmt: skip
         elif it.kind == "favoured-label":
             ax.text(x, y, it.text, ha="center", va="center", fontsize=7, color="#1b5e20",
                     zorder=9, gid="favoured-label")  # fmt: skip
@@ -253,7 +259,7 @@ def finish_map(
             zorder=7,
             gid=kind,
             label=f"{kind} ({n})",
-            **style,  # type: ignore[arg-type]
+            **style,
         )
     if leaders:
         lc = LineCollection(leaders, colors="0.35", linewidths=0.6, zorder=6.5)

@@ -80,6 +80,25 @@ MIN_BOAT_POINTS = 300
 """Fewest points of one boat's track on a fleet's page (a very large fleet)."""
 FLEET_STEPS = 60
 """Slider positions of a fleet's replay."""
+LEG_COLOURS = (
+    "#1f77b4",
+    "#d62728",
+    "#2ca02c",
+    "#9467bd",
+    "#ff7f0e",
+    "#8c564b",
+    "#e377c2",
+    "#17becf",
+)
+"""Colours of the legs of an analysis (sailed; the optimal legs in a lighter shade)."""
+
+
+def lighter(colour: str, share: float = 0.55) -> str:
+    """``colour`` (``#rrggbb``) mixed with ``share`` of white."""
+    rgb = [int(colour[i : i + 2], 16) for i in (1, 3, 5)]
+    return "#" + "".join(f"{round(c + share * (255 - c)):02x}" for c in rgb)
+
+
 GREY = "#a9b4bf"
 """Colour of the boats that are not picked when the reader picks one on a fleet's page."""
 
@@ -124,6 +143,9 @@ class Route:
     colour : str
         Line colour (``#rrggbb``); empty: the page's palette in route order
         (:data:`ROUTE_COLOURS`).
+    leg_colours : tuple of str
+        A colour per leg (``#rrggbb``, by leg number − 1): the line is drawn leg by leg,
+        each in its colour (an analysis: the sailed legs, the optimal ones lighter).
     """
 
     name: str
@@ -145,6 +167,7 @@ class Route:
     lat_shift: NDArray[np.float64] | None = None
     lon_shift: NDArray[np.float64] | None = None
     colour: str = ""
+    leg_colours: tuple[str, ...] = ()
 
     def drawn(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(lat, lon)`` where the line is drawn [°]."""

@@ -465,6 +465,27 @@ def _route_trace(
     }
 
 
+def _leg_pieces(r: Route, tr: dict[str, Any], custom: Sequence[Any]) -> list[dict[str, Any]]:
+    """The route trace ``tr`` of ``r`` cut leg by leg, each in its :attr:`Route.leg_colours`."""
+    out = []
+    for k, c in enumerate(r.leg_colours):
+        idx = np.flatnonzero(r.leg == k + 1)
+        if idx.size == 0:
+            continue
+        out.append(
+            {
+                **tr,
+                "name": f"{tr['name']}, leg {k + 1}",
+                "x": [tr["x"][j] for j in idx],
+                "y": [tr["y"][j] for j in idx],
+                "customdata": [custom[int(j)] for j in idx],
+                "line": {**tr["line"], "color": c},
+                "showlegend": True,
+            }
+        )
+    return out
+
+
 def _speed_colours(report: Report) -> dict[str, Any]:
     """Marker colours of a single route by its speed, with the colour bar."""
     (r,) = report.routes
@@ -582,6 +603,11 @@ def figure(report: Report) -> dict[str, Any]:
         if single:
             tr["mode"] = "lines+markers"
             tr["marker"] = _speed_colours(report)
+        if r.leg_colours:  # leg by leg, each in its colour; the hover as on the whole line
+            for piece in _leg_pieces(r, tr, custom):
+                data.append(piece)
+                routes.append(len(data) - 1)
+            tr = {**tr, "visible": "legendonly", "showlegend": False}
         data.append(tr)
         line = len(data) - 1
         routes.append(line)
@@ -590,10 +616,18 @@ def figure(report: Report) -> dict[str, Any]:
                 pts = [m for m in r.manoeuvres if m[0] == kind]
                 legend = not any(t.get("showlegend") and t.get("name") == f"{kind}s" for t in data)
                 data.append(
-                    _manoeuvre_trace(kind, pts, r.name, f"{kind}s", off, legend=legend and bool(pts))
+                    _manoeuvre_trace(
+                        kind, pts, r.name, f"{kind}s", off, legend=legend and bool(pts)
+                    )
                 )
                 symbols += [
-                    {"trace": len(data) - 1, "point": k, "size": MANOEUVRE_SIZE + 2, "gap": 0, "route": True}
+                    {
+                        "trace": len(data) - 1,
+                        "point": k,
+                        "size": MANOEUVRE_SIZE + 2,
+                        "gap": 0,
+                        "route": True,
+                    }
                     for k in range(len(pts))
                 ]
         if i == 0 and report.leg_numbers:
@@ -613,6 +647,45 @@ def figure(report: Report) -> dict[str, Any]:
         data += _highlight_traces()
         n = len(data)
         out["pick"] = {"grey": GREY, "highlight": [n - 3, n - 2, n - 1], "boats": picks}
+    out["place"] = _place(report, data, annotations, routes, symbols, badges)
+    out["chart"] = {
+        "note": (report.chart or Chart()).note(),
+        "lat0": course.frame.lat0,
+    }
+    frames = []
+    if len(report.times) > 1 and moving:
+        for k in range(len(report.times)):
+            frames.append(
+                {
+                    "name": str(k),
+                    "data": [states[k] for _, states in moving],
+                    "traces": [i for i, _ in moving],
+                }
+            )
+    layout = _layout(report, frames)
+    layout["annotations"] = annotations
+    return {
+        "data": data,
+        "layout": layout,
+        "frames": frames,
+        "config": {"responsive": True, "displaylogo": False, "scrollZoom": True},
+        **out,
+    }
+
+
+def _place(
+    report: Report,
+    data: list[dict[str, Any]],
+    annotations: list[dict[str, Any]],
+    routes: list[int],
+    symbols: list[dict[str, Any]],
+    badges: list[dict[str, Any]],
+) -> dict[str, Any]:
+    """What the page's script places (:mod:`sailroute.report.page_render`), in order: the
+    favoured end, the tack and gybe symbols, the leg numbers, the marks' names, the
+    favoured end's label; what they keep off (the routes and lines, the marks and the
+    boats where the page opens); the trace of the leader lines (appended to ``data``; -1
+    on a fleet's page).  Adds the favoured end's label to ``annotations``."""
     favoured = []
     for k, t in enumerate(data):
         if t.get("meta") == "favoured" and t.get("x"):
@@ -627,7 +700,8 @@ def figure(report: Report) -> dict[str, Any]:
                 )
             )
             favoured.append({"ann": len(annotations) - 1, "gap": 12, "route": False})
-    names = [{"ann": k, "gap": 0.5 * MARK_SIZE + 3, "route": False} for k in range(len(course.marks))]
+    n_marks = len(report.course.marks)
+    names = [{"ann": k, "gap": 0.5 * MARK_SIZE + 3, "route": False} for k in range(n_marks)]
     marks = next(k for k, t in enumerate(data) if t.get("meta") == "marks")
     fixed = [{"trace": marks, "size": MARK_SIZE + 2, "first": False}]
     fixed += [  # the boats where the page opens (the boat at the start covers the route)
@@ -652,35 +726,12 @@ def figure(report: Report) -> dict[str, Any]:
             }
         )
         leaders = len(data) - 1
-    out["place"] = {
+    return {
         "leaders": leaders,
         "routes": routes,
         "lines": lines,
         "fixed": fixed,
         "items": favoured[:1] + symbols + badges + names + favoured[1:],
-    }
-    out["chart"] = {
-        "note": (report.chart or Chart()).note(),
-        "lat0": course.frame.lat0,
-    }
-    frames = []
-    if len(report.times) > 1 and moving:
-        for k in range(len(report.times)):
-            frames.append(
-                {
-                    "name": str(k),
-                    "data": [states[k] for _, states in moving],
-                    "traces": [i for i, _ in moving],
-                }
-            )
-    layout = _layout(report, frames)
-    layout["annotations"] = annotations
-    return {
-        "data": data,
-        "layout": layout,
-        "frames": frames,
-        "config": {"responsive": True, "displaylogo": False, "scrollZoom": True},
-        **out,
     }
 
 

@@ -347,7 +347,9 @@ _JS = """
       gd.data.forEach(function (t, i) { if (t.meta === 'land') { land.push(i); } });
       placing = true;
       return Plotly.relayout(gd, {images: tileImages(gd), plot_bgcolor: 'rgba(0,0,0,0)'})
-        .then(function () { return land.length ? Plotly.restyle(gd, {opacity: 0.35}, land) : null; })
+        .then(function () {
+          return land.length ? Plotly.restyle(gd, {opacity: 0.35}, land) : null;
+        })
         .then(function () { placing = false; });
     }
     var first = tileImages(gd)[0], probe = new Image();

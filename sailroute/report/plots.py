@@ -444,7 +444,7 @@ def legend_under(ax: Axes, title: str | None = None) -> None:
     if not handles:
         return
     ax.apply_aspect()
-    height_in = ax.get_position().height * ax.figure.get_figheight()
+    height_in = ax.get_position().height * float(ax.get_figure(root=True).get_figheight())  # type: ignore[union-attr]
     ax.legend(
         handles,
         labels,

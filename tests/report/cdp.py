@@ -45,8 +45,11 @@ TILE_HOST = "https://tile.openstreetmap.org/"
 def page_errors(console: list[str]) -> list[str]:
     """The console lines of a page, less the failed load of the OSM tile it tries once to
     learn whether the browser is online (every host resolves to nothing here)."""
-    return [c for c in console if not (c.startswith("log error: Failed to load resource")
-                                       and TILE_HOST in c)]
+    return [
+        c
+        for c in console
+        if not (c.startswith("log error: Failed to load resource") and TILE_HOST in c)
+    ]
 
 
 class Page:

@@ -177,7 +177,9 @@ def _png_boxes(fig):
             for s in a.get_segments():
                 q = a.get_transform().transform(s)
                 routes.append((*q[0], *q[1]))
-    furniture = [a.get_window_extent(r) for a in fig.findobj() if a.get_gid() in ("scale-bar", "north-arrow")]
+    furniture = [
+        a.get_window_extent(r) for a in fig.findobj() if a.get_gid() in ("scale-bar", "north-arrow")
+    ]
     items.append(
         (
             "scale bar and north arrow",
