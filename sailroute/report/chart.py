@@ -39,6 +39,7 @@ __all__ = [
     "LandLayer",
     "chart_for",
     "draw_chart",
+    "fit_chart",
     "in_view",
 ]
 
@@ -108,6 +109,38 @@ class Chart:
         if tiles:
             text += " OSM tiles: only when the browser is online."
         return text
+
+
+@lru_cache(maxsize=8)
+def _chart_land(course: Course) -> Any:
+    """The land of the course's chart file in its frame (None without one)."""
+    if course.chart is None or not course.chart.land:
+        return None
+    land = shapely.union_all([shapely.make_valid(shapely.Polygon(r)) for r in course.chart.land])
+    return _to_frame(course.frame, land)
+
+
+def fit_chart(
+    course: Course, box: tuple[float, float, float, float], reach: float = 0.5
+) -> tuple[float, float, float, float]:
+    """``box`` = ``(x0, x1, y0, y1)`` [m] grown to show the shore of the course's chart
+    file when it lies within ``reach`` times the box's larger side (as the race area's
+    polygons are taken in: :func:`sailroute.report.area.fit_area`): the box reaches past
+    the nearest land by 15 % of that side, no farther."""
+    land = _chart_land(course)
+    if land is None:
+        return box
+    x0, x1, y0, y1 = box
+    span = max(x1 - x0, y1 - y0, 100.0)
+    gap = float(shapely.distance(shapely.box(x0, y0, x1, y1), land))
+    if gap > reach * span:
+        return box
+    grow = gap + 0.15 * span
+    near = shapely.clip_by_rect(land, x0 - grow, y0 - grow, x1 + grow, y1 + grow)
+    if near.is_empty:
+        return box
+    bx0, by0, bx1, by1 = near.bounds
+    return min(x0, bx0), max(x1, bx1), min(y0, by0), max(y1, by1)
 
 
 def _clip_box(extent: Sequence[float]) -> tuple[float, float, float, float]:

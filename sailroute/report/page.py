@@ -23,7 +23,7 @@ from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.planning.result import Plan
 from sailroute.report.area import fit_area
-from sailroute.report.chart import Chart
+from sailroute.report.chart import Chart, fit_chart
 from sailroute.report.plots import repeat_index_of_ends
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, wind_speed_direction, wrap180
@@ -570,15 +570,17 @@ def optimal_route(a: TrackAnalysis) -> Route:
 def course_area(
     course: Course, routes: Sequence[Route], pad: float = 0.08
 ) -> tuple[float, float, float, float]:
-    """``(x0, x1, y0, y1)`` [m]: the marks and routes, and the race area within reach of
-    them (:func:`sailroute.report.area.fit_area`), padded by ``pad`` of the larger side."""
+    """``(x0, x1, y0, y1)`` [m]: the marks and routes, and the race area and the chart
+    file's shore within reach of them (:func:`sailroute.report.area.fit_area`,
+    :func:`sailroute.report.chart.fit_chart`), padded by ``pad`` of the larger side."""
     xs = [m.x for m in course.marks.values()]
     ys = [m.y for m in course.marks.values()]
     for r in routes:
         if np.isfinite(r.x).any():
             xs += [float(np.nanmin(r.x)), float(np.nanmax(r.x))]
             ys += [float(np.nanmin(r.y)), float(np.nanmax(r.y))]
-    x0, x1, y0, y1 = fit_area(course.area, (min(xs), max(xs), min(ys), max(ys)))
+    box = (min(xs), max(xs), min(ys), max(ys))
+    x0, x1, y0, y1 = fit_chart(course, fit_area(course.area, box))
     span = max(x1 - x0, y1 - y0, 100.0)
     return x0 - pad * span, x1 + pad * span, y0 - pad * span, y1 + pad * span
 

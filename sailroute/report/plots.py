@@ -58,7 +58,9 @@ def _extent(course: Course, legs: Sequence[LegResult], pad: float = 0.08) -> tup
     for r in legs:
         xs += [float(r.track.x.min()), float(r.track.x.max())]
         ys += [float(r.track.y.min()), float(r.track.y.max())]
-    x0, x1, y0, y1 = fit_area(course.area, (min(xs), max(xs), min(ys), max(ys)))
+    from sailroute.report.chart import fit_chart
+
+    x0, x1, y0, y1 = fit_chart(course, fit_area(course.area, (min(xs), max(xs), min(ys), max(ys))))
     span = max(x1 - x0, y1 - y0, 100.0)
     return x0 - pad * span, x1 + pad * span, y0 - pad * span, y1 + pad * span
 
