@@ -59,7 +59,9 @@ def wrf_land_mask(path: str | Path, frame: LocalFrame) -> LandMask | None:
         if name is None:
             return None
         var = ds.variables[name]
-        a = np.ma.filled(np.ma.asarray(var[0] if var.ndim == 3 else var[:], dtype=float), 0.0)
+        a: NDArray[np.float64] = np.ma.filled(
+            np.ma.asarray(var[0] if var.ndim == 3 else var[:], dtype=float), 0.0
+        )
     finally:
         ds.close()
     if a.shape != header.lat.shape:

@@ -157,8 +157,8 @@ def test_a_real_wrf_files_land_mask():
 
 def test_html_and_png_draw_the_layers(giens):
     """The page's land trace and route.png's land patches are the shown layer's rings."""
-    from sailroute.report.page_figure import land_traces
     from sailroute.report.chart import draw_chart
+    from sailroute.report.page_figure import land_traces
 
     ring = np.array([[0.0, 0.0], [100.0, 0.0], [100.0, 80.0], [0.0, 0.0]])
     ch = Chart((LandLayer("land: a", (ring,)), LandLayer("land: b", (ring,), shown=False)))
