@@ -132,6 +132,11 @@ def pages(tmp_path_factory) -> dict[str, Path]:
 def test_no_label_overlaps_on_the_shipped_pages(pages, tmp_path):
     from tests.report.cdp import browser, page_errors
 
+    # Hyeres's page stays small beside the shared drawing library
+    hyeres = pages["hyeres-r1 plan"]
+    assert hyeres.stat().st_size < 1_000_000
+    assert (hyeres.parent / "plotly.min.js").stat().st_size > 3_000_000
+
     script = (Path(__file__).parent / "overlaps.js").read_text(encoding="utf-8")
     found = {}
     for width in WIDTHS:
