@@ -80,16 +80,7 @@ MIN_BOAT_POINTS = 300
 """Fewest points of one boat's track on a fleet's page (a very large fleet)."""
 FLEET_STEPS = 60
 """Slider positions of a fleet's replay."""
-LEG_COLOURS = (
-    "#1f77b4",
-    "#d62728",
-    "#2ca02c",
-    "#9467bd",
-    "#ff7f0e",
-    "#8c564b",
-    "#e377c2",
-    "#17becf",
-)
+LEG_COLOURS = ROUTE_COLOURS[:8]
 """Colours of the legs of an analysis (sailed; the optimal legs in a lighter shade)."""
 
 

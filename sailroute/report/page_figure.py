@@ -258,6 +258,17 @@ def mark_annotations(course: Course) -> list[dict[str, Any]]:
     ]
 
 
+def _joined_lonlat(frame: LocalFrame, parts: Sequence[NDArray]) -> tuple[list[Any], list[Any]]:
+    """``(lon, lat)`` lists [°] of lines in the course frame [m], a null between them."""
+    xs: list[Any] = []
+    ys: list[Any] = []
+    for part in parts:
+        lat, lon = frame.to_latlon(part[:, 0], part[:, 1])
+        xs += [*_r(lon, 6), None]
+        ys += [*_r(lat, 6), None]
+    return xs[:-1], ys[:-1]
+
+
 def land_traces(chart: Chart | None, frame: LocalFrame) -> list[dict[str, Any]]:
     """The chart's land layers (:mod:`sailroute.report.chart`) as filled traces in lon/lat
     (``meta`` ``land``), the first shown, the others in the legend only; shorelines as
@@ -274,33 +285,24 @@ def land_traces(chart: Chart | None, frame: LocalFrame) -> list[dict[str, Any]]:
             **({} if layer.shown else {"visible": "legendonly"}),
         }
         if layer.rings:
-            xs: list[Any] = []
-            ys: list[Any] = []
-            for ring in layer.rings:
-                lat, lon = frame.to_latlon(ring[:, 0], ring[:, 1])
-                xs += [*_r(lon, 6), None]
-                ys += [*_r(lat, 6), None]
+            xs, ys = _joined_lonlat(frame, layer.rings)
             out.append(
                 {
                     **common,
-                    "x": xs[:-1],
-                    "y": ys[:-1],
+                    "x": xs,
+                    "y": ys,
                     "fill": "toself",
                     "fillcolor": LAND_FILL,
                     "line": {"color": LAND_EDGE, "width": 1},
                 }
             )
         if layer.lines:
-            xs, ys = [], []
-            for ln in layer.lines:
-                lat, lon = frame.to_latlon(ln[:, 0], ln[:, 1])
-                xs += [*_r(lon, 6), None]
-                ys += [*_r(lat, 6), None]
+            xs, ys = _joined_lonlat(frame, layer.lines)
             out.append(
                 {
                     **common,
-                    "x": xs[:-1],
-                    "y": ys[:-1],
+                    "x": xs,
+                    "y": ys,
                     "line": {"color": LAND_EDGE, "width": 1.5},
                     "showlegend": not layer.rings,
                 }
