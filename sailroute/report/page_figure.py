@@ -477,7 +477,7 @@ def _leg_pieces(r: Route, tr: dict[str, Any], custom: Sequence[Any]) -> list[dic
         out.append(
             {
                 **tr,
-                "name": f"{tr['name']}, leg {k + 1}",
+                "name": f"leg {k + 1} · {tr['name']}",
                 "x": [tr["x"][j] for j in idx],
                 "y": [tr["y"][j] for j in idx],
                 "customdata": [custom[int(j)] for j in idx],

@@ -79,15 +79,14 @@ def test_the_analyze_page_of_the_shipped_track(tmp_path):
     assert "not a debrief" in page.split('<div id="sailroute-error">')[1]
     assert re.search(r"lost [+-]?\d", header) is None and "no time lost stated" in header
     fig = read_figure(page)
-    sailed = [t for t in fig["data"] if str(t.get("name", "")).startswith("sailed: ")]
-    optimal = [t for t in fig["data"] if str(t.get("name", "")).startswith("optimal ")]
+    names = [str(t.get("name", "")) for t in fig["data"]]
+    colour = {n: t.get("line", {}).get("color") for n, t in zip(names, fig["data"], strict=True)}
     legs = len(doc["legs"])
-    assert [t["line"]["color"] for t in sailed if t.get("visible") != "legendonly"] == list(
-        LEG_COLOURS[:legs]
-    )
-    assert [t["line"]["color"] for t in optimal if t.get("visible") != "legendonly"] == [
-        lighter(c) for c in LEG_COLOURS[:legs]
-    ]
+    sailed = [n for n in names if n.startswith("leg ") and " · sailed: " in n]
+    optimal = [n for n in names if n.startswith("leg ") and " · optimal " in n]
+    assert sailed == [f"leg {k + 1} · sailed: {doc['track']['name']}" for k in range(legs)]
+    assert [colour[n] for n in sailed] == list(LEG_COLOURS[:legs])
+    assert [colour[n] for n in optimal] == [lighter(c) for c in LEG_COLOURS[:legs]]
     assert {"tacks", "gybes"} <= {t["name"] for t in fig["data"] if t.get("showlegend")}
 
 
