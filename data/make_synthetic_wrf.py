@@ -12,7 +12,10 @@ Hyères, start 12:10 CEST = 10:10Z; the thesis's reported WRF values, its Ch. 5)
   the start; the north of the course is windier at the start and the south at the end
   (+-0.053 m/s per km);
 * a power-law shear exponent of 0.10 .. 0.20 varying in space, so the 25 m level and
-  U10/V10 follow ``V(z) = V(7.5) (z / 7.5)^alpha``.
+  U10/V10 follow ``V(z) = V(7.5) (z / 7.5)^alpha``;
+* a land mask (``LANDMASK``, ``XLAND``): the cells whose centre lies on the real land of
+  ``data/hyeres-coast.geojson`` (GSHHG, cut by ``data/make_hyeres_coast.py``); the wind
+  is defined over them as over the sea.
 
 Deterministic (no random numbers).  Run from the repository root:
 
@@ -27,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from sailroute.course.chart import read_chart
 from sailroute.geo import LocalFrame
 from sailroute.units import wind_components
 from sailroute.wind.synthetic_wrf import LambertGrid, write_wrfout
@@ -48,6 +52,16 @@ GRID = LambertGrid(
 )
 FRAME = LocalFrame(*CENTER)
 OUT = Path(__file__).resolve().parent / "hyeres-2018-04-24-synthetic-wrfout.nc"
+COAST = Path(__file__).resolve().parent / "hyeres-coast.geojson"
+
+
+def land_cells() -> np.ndarray:
+    """The grid's land cells: centre inside a land polygon of :data:`COAST`."""
+    import shapely
+
+    land = shapely.union_all([shapely.Polygon(r) for r in read_chart(COAST).land])
+    lat, lon = GRID.mass_latlon()
+    return np.asarray(shapely.contains_xy(land, lon, lat), dtype=bool)
 
 
 def direction_deg(t: float, xk: np.ndarray, yk: np.ndarray) -> np.ndarray:
@@ -99,6 +113,7 @@ def main(out: Path = OUT) -> Path:
             "SAILROUTE_NOTE": "deterministic analytic wind designed after the thesis's "
             "description of its WRF field (see data/README.md)",
         },
+        land=land_cells(),
     )
 
 

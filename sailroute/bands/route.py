@@ -28,7 +28,7 @@ from sailroute.bands.members import (
     resolve_shifts,
 )
 from sailroute.bands.sides import honest_side
-from sailroute.bands.summary import BandSummary
+from sailroute.bands.summary import BandSummary, member_track
 from sailroute.course.load import build_current
 from sailroute.course.model import Course
 from sailroute.course.uncertainty import DEFAULT_UNCERTAINTY, UncertaintySpec
@@ -216,4 +216,5 @@ def band_summary(
         uncertainty=spec,
         notes=tuple(notes),
         nominal_legs=tuple(res_of[NOMINAL.name]),
+        member_tracks=tuple(member_track(res_of[m.name]) for m in main),
     )

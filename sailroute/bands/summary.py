@@ -19,13 +19,24 @@ from numpy.typing import NDArray
 from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.routing.types import LegResult
 
-__all__ = ["BAND_STATS", "SIDE_LABELS", "BandSummary"]
+__all__ = ["BAND_STATS", "MEMBER_TRACK_POINTS", "SIDE_LABELS", "BandSummary", "member_track"]
 
 BAND_STATS: Final = ("p10", "p50", "p90")
 """Columns of a band, in order."""
 SIDE_LABELS: Final = ("left", "middle", "right", "tie")
 """Side verdicts (:func:`sailroute.routing.sides.side_verdict`), in order."""
 _Q: Final = (10.0, 50.0, 90.0)
+MEMBER_TRACK_POINTS: Final = 400
+"""Most points kept of a member's route for the page's spread."""
+
+
+def member_track(legs: Any) -> NDArray[np.float64]:
+    """A member's route for the spread: its legs' track points joined, thinned evenly to
+    at most :data:`MEMBER_TRACK_POINTS` (the last point kept), shape (n, 2) [m]."""
+    xy = np.concatenate([np.column_stack([r.track.x, r.track.y]) for r in legs])
+    step = max(1, -(-len(xy) // MEMBER_TRACK_POINTS))
+    keep = np.unique(np.r_[np.arange(0, len(xy), step), len(xy) - 1])
+    return np.asarray(xy[keep], float)
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,6 +68,10 @@ class BandSummary:
         How the uncertainty was chosen (e.g. defaults used).
     nominal_legs : tuple of LegResult
         The routed legs of the scenario as given (for maps and the page).
+    member_tracks : tuple of ndarray, shape (n, 2)
+        The route of each member of the main ensemble, all legs joined, ``x, y`` in the
+        course frame [m], at most :data:`MEMBER_TRACK_POINTS` points (the page draws them
+        as a faint spread).
     """
 
     scenario: str
@@ -70,6 +85,7 @@ class BandSummary:
     uncertainty: UncertaintySpec = field(default_factory=UncertaintySpec)
     notes: tuple[str, ...] = ()
     nominal_legs: tuple[LegResult, ...] = ()
+    member_tracks: tuple[NDArray[np.float64], ...] = ()
 
     @property
     def totals_s(self) -> NDArray[np.float64]:

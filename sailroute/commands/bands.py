@@ -119,7 +119,8 @@ def run_bands_command(
         files = write_bands(d, summaries, course_name=course.name, plot=plots)
         if plots:
             files["html"] = write_report(
-                d / "report.html", bands_page(course, summaries, winds, router=settings.router)
+                d / "report.html",
+                bands_page(course, summaries, winds, router=settings.router, boat=boat),
             )
             files["plotly_js"] = d / PLOTLY_FILE
         return files

@@ -67,6 +67,7 @@ def build_course(
         key_lines=MappingProxyType(dict(key_lines or {})),
         area=checked.area,
         restart_time=checked.restart_time,
+        chart=checked.chart,
     )
 
 

@@ -36,6 +36,7 @@ from sailroute.checks import (
     suggest,
 )
 from sailroute.course.area import AREA_KEYS, check_area
+from sailroute.course.chart import ChartFile, check_chart
 from sailroute.course.model import LegKind
 from sailroute.course.routing_section import load_routing
 from sailroute.course.templates import TEMPLATES, CourseLayout
@@ -77,6 +78,7 @@ TOP_KEYS = (
     "scenarios",
     "references",
     "uncertainty",
+    "chart",
     *AREA_KEYS,
 )
 """Keys allowed at the top level of a course file."""
@@ -143,6 +145,8 @@ class CheckedCourse:
         The ``uncertainty`` section (leg-time bands), if given.
     restart_time : datetime or None
         The restart's signal after a general recall, if given (after ``start_time``).
+    chart : ChartFile or None
+        The ``chart`` file (coast or land drawn under the maps), if given.
     """
 
     name: str
@@ -164,6 +168,7 @@ class CheckedCourse:
     area: RaceArea = dataclasses.field(default_factory=RaceArea)
     uncertainty: UncertaintySpec | None = None
     restart_time: datetime | None = None
+    chart: ChartFile | None = None
 
 
 # ----------------------------------------------------------------------------- sections
@@ -959,6 +964,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
     scenarios = _scenarios(c, data.get("scenarios"), n_legs)
     references = _references(c, data.get("references"), "references", n_legs)
     area = check_area(c, data, frame, xy, _position)
+    chart = check_chart(c, data)
     uncertainty = (
         check_uncertainty(c.at("uncertainty"), data["uncertainty"], Path(probs.file).parent)
         if data.get("uncertainty") is not None
@@ -987,6 +993,7 @@ def check_course(data: Any, problems: Problems) -> CheckedCourse:
         area=area,
         uncertainty=uncertainty,
         restart_time=restart_time,
+        chart=chart,
     )
 
 

@@ -24,6 +24,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from sailroute.course.chart import ChartFile
 from sailroute.course.uncertainty import UncertaintySpec
 from sailroute.geo import LocalFrame
 from sailroute.routing.obstacles import RaceArea
@@ -287,6 +288,9 @@ class Course:
     restart_time : datetime or None
         The start signal of the restart after a general recall (``restart_time`` in the
         file); ``analyze`` times the race from it.  None: no recall.
+    chart : ChartFile or None
+        The ``chart`` file: coast or land polygons drawn under the maps
+        (:mod:`sailroute.course.chart`); None: not given.
     """
 
     name: str
@@ -310,6 +314,7 @@ class Course:
     area: RaceArea = field(default_factory=RaceArea)
     uncertainty: UncertaintySpec | None = None
     restart_time: datetime | None = None
+    chart: ChartFile | None = None
 
     def __post_init__(self) -> None:
         for name in ("marks", "lines", "gates", "boat_spec", "scenarios", "references"):

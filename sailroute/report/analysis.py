@@ -598,73 +598,108 @@ def fleet_table(rows: Sequence[Mapping[str, Any]], notes: Sequence[str] = ()) ->
     return "\n".join(out)
 
 
+def _leg_wind(a: TrackAnalysis, leg: Any) -> tuple[float, float] | None:
+    """The wind where and when a leg starts: ``(speed [kn], FROM-direction [°])``."""
+    from sailroute.errors import OutOfCoverageError
+    from sailroute.units import wind_speed_direction
+
+    if a.wind is None or not math.isfinite(leg.t_start):
+        return None
+    try:
+        u, v = a.wind.sample(leg.t_start, leg.start_xy[0], leg.start_xy[1])
+    except OutOfCoverageError:
+        return None
+    spd, twd = wind_speed_direction(u, v)
+    if not (np.isfinite(spd) and np.isfinite(twd)):
+        return None
+    return float(spd) / KNOT, float(twd)
+
+
 def plot_legs(a: TrackAnalysis) -> Figure:
-    """One map per leg: the sailed track (solid, coloured by leg) and the optimal route
-    (dashed) from the same start, with the course, its race area (boundary, obstacles) and
-    the sailed manoeuvres."""
+    """One map per leg, each leg in its colour: the sailed track (solid) and the optimal
+    route from the same start (dashed, a lighter shade), with the chart and the course,
+    its race area, the sailed manoeuvres, the wind where and when the leg starts (an
+    arrow where the air goes and its speed and direction in the title), a scale bar, a
+    north arrow and the names placed so that they overlap nothing
+    (:func:`sailroute.report.mapdraw.finish_map`)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from sailroute.report.area import draw_area
-    from sailroute.report.plots import draw_course
+    from sailroute.report.chart import chart_for, draw_chart
+    from sailroute.report.mapdraw import MapItem, finish_map
+    from sailroute.report.page import LEG_COLOURS, lighter
+    from sailroute.report.plots import course_labels, draw_course
 
     n = len(a.legs)
     ncol = min(n, 3)
     nrow = math.ceil(n / ncol)
-    fig = Figure(figsize=(4.6 * ncol, 4.4 * nrow), layout="constrained")
+    fig = Figure(figsize=(4.6 * ncol, 4.6 * nrow), layout="constrained")
     p = a.points
+    maps = []
     for i, leg in enumerate(a.legs):
+        colour = LEG_COLOURS[i % len(LEG_COLOURS)]
         ax = fig.add_subplot(nrow, ncol, i + 1)
-        draw_area(ax, a.course.area)
-        draw_course(ax, a.course)
         m = p.leg == i + 1
-        ax.plot(
-            p.x[m],
-            p.y[m],
-            "-",
-            color="tab:blue",
-            lw=1.4,
-            gid=f"sailed:{i + 1}",
-            label=f"sailed {_mss(leg.sailed_time_s)}",
-        )
         o = leg.optimal.track if leg.optimal is not None else None
-        if o is not None:
-            ax.plot(
-                o.x,
-                o.y,
-                "--",
-                color="tab:red",
-                lw=1.4,
-                gid=f"optimal:{i + 1}",
-                label=f"optimal {_mss(leg.optimal_time_s)}",
-            )
-        if leg.manoeuvres:
-            idx = [int(np.argmin(np.abs(p.t[m] - mm.t))) for mm in leg.manoeuvres]
-            ax.plot(
-                p.x[m][idx],
-                p.y[m][idx],
-                "^",
-                color="black",
-                ms=4,
-                linestyle="none",
-                label="sailed tacks/gybes",
-            )
         xs = np.concatenate([p.x[m], o.x if o is not None else [], [leg.start_xy[0]]])
         ys = np.concatenate([p.y[m], o.y if o is not None else [], [leg.start_xy[1]]])
         xs, ys = xs[np.isfinite(xs)], ys[np.isfinite(ys)]
         if xs.size == 0:
             xs, ys = np.array([0.0]), np.array([0.0])
-        pad = 0.1 * max(np.ptp(xs), np.ptp(ys), 50.0)
-        ax.set_xlim(xs.min() - pad, xs.max() + pad)
-        ax.set_ylim(ys.min() - pad, ys.max() + pad)
+        pad = 0.15 * max(np.ptp(xs), np.ptp(ys), 50.0)
+        extent = (xs.min() - pad, xs.max() + pad, ys.min() - pad, ys.max() + pad)
+        draw_chart(ax, chart_for(a.course, [a.wind], extent), extent)
+        draw_area(ax, a.course.area)
+        draw_course(ax, a.course)
+        ax.plot(p.x[m], p.y[m], "-", color=colour, lw=1.6, gid=f"sailed:{i + 1}",
+                label=f"sailed {_mss(leg.sailed_time_s)}")  # fmt: skip
+        if o is not None:
+            ax.plot(o.x, o.y, "--", color=lighter(colour), lw=1.6, gid=f"optimal:{i + 1}",
+                    label=f"optimal {_mss(leg.optimal_time_s)}")  # fmt: skip
+        items = []
+        for mm in leg.manoeuvres:
+            j = int(np.argmin(np.abs(p.t[m] - mm.t)))
+            items.append(MapItem(mm.kind, float(p.x[m][j]), float(p.y[m][j])))
+        ax.set_xlim(extent[0], extent[1])
+        ax.set_ylim(extent[2], extent[3])
         ax.set_aspect("equal", adjustable="box")
-        lost = f"lost {leg.loss_s:+.0f} s" if leg.known else "time unknown"
-        ax.set_title(f"leg {i + 1}: {leg.label} ({leg.mode}), {lost}", fontsize=9)
+        if not leg.known:
+            lost = "time unknown"
+        elif leg.above_polar:
+            lost = "above the polar: no loss stated"
+        else:
+            lost = f"lost {leg.loss_s:+.0f} s"
+        wind = _leg_wind(a, leg)
+        title = f"leg {i + 1}: {leg.label} ({leg.mode}), {lost}"
+        if wind is not None:
+            title += f"\nwind {wind[0]:.1f} kn from {wind[1]:.0f}° (arrow: where it goes)"
+            go = math.radians(wind[1] + 180.0)
+            ax.annotate(
+                "",
+                xy=(0.95 + 0.035 * math.sin(go), 1.075 + 0.035 * math.cos(go)),
+                xytext=(0.95 - 0.035 * math.sin(go), 1.075 - 0.035 * math.cos(go)),
+                xycoords="axes fraction",
+                arrowprops={"arrowstyle": "-|>", "color": "steelblue", "lw": 1.6},
+                annotation_clip=False,
+                gid=f"wind-leg:{i + 1}",
+            )
+        ax.set_title(title, fontsize=9)
         ax.set_xlabel("x [m]", fontsize=8)
         ax.set_ylabel("y [m]", fontsize=8)
         ax.tick_params(labelsize=7)
-        if ax.get_legend_handles_labels()[0]:
-            ax.legend(fontsize=7, loc="best")
+        routes = [np.column_stack([p.x[m], p.y[m]])]
+        if o is not None:
+            routes.append(np.column_stack([o.x, o.y]))
+        maps.append((ax, routes, items))
     fig.suptitle(f"{a.track.name}: sailed vs optimal ({a.scenario})", fontsize=10)
+    FigureCanvasAgg(fig).draw()  # type: ignore[no-untyped-call]  # the layout settles, kept
+    fig.set_layout_engine("none")
+    for ax, routes, items in maps:
+        finish_map(fig, ax, routes=routes, items=items, **course_labels(a.course))
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, -0.12), ncol=2,
+                      frameon=False)  # fmt: skip
     return fig
 
 

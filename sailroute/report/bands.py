@@ -161,14 +161,47 @@ def bands_html_table(b: BandSummary) -> Any:
     )
 
 
+SPREAD_COLOUR = "rgba(80, 80, 80, 0.22)"
+"""The members' routes on the bands page: a faint grey spread under the nominal route."""
+
+
+def spread_trace(course: Any, summaries: Sequence[BandSummary]) -> dict[str, Any] | None:
+    """The members' routes of every scenario as one faint line trace (lon/lat, a null
+    between members); None when the summaries kept none."""
+    xs: list[float | None] = []
+    ys: list[float | None] = []
+    n = 0
+    for b in summaries:
+        for xy in b.member_tracks:
+            lat, lon = course.frame.to_latlon(xy[:, 0], xy[:, 1])
+            xs += [round(float(v), 6) for v in np.atleast_1d(lon)] + [None]
+            ys += [round(float(v), 6) for v in np.atleast_1d(lat)] + [None]
+            n += 1
+    if not n:
+        return None
+    return {
+        "type": "scatter",
+        "mode": "lines",
+        "name": f"members' routes ({n})",
+        "x": xs[:-1],
+        "y": ys[:-1],
+        "line": {"color": SPREAD_COLOUR, "width": 1.2},
+        "hoverinfo": "skip",
+        "meta": "spread",
+    }
+
+
 def bands_page(
     course: Any,
     summaries: Sequence[BandSummary],
     winds: Mapping[str, Any],
     *,
     router: str = "",
+    boat: Any = None,
 ) -> Any:
-    """``report.html`` of a bands run: the nominal route(s) on the map and the band tables."""
+    """``report.html`` of a bands run: the nominal route(s) over the members' routes (a
+    faint spread), the laylines and start line of the nominal wind (with ``boat``), and
+    the band tables (P10 / P50 / P90 per leg)."""
     import dataclasses
 
     from sailroute.planning.result import compare, make_plan
@@ -178,6 +211,17 @@ def bands_page(
         make_plan(course, b.scenario, b.nominal_legs, winds.get(b.scenario), router=router)
         for b in summaries
     ]
+    if boat is not None and len(plans) == 1 and winds.get(plans[0].scenario) is not None:
+        from sailroute.planning.startline import course_laylines, course_start_line_numbers
+
+        w = winds[plans[0].scenario]
+        plans[0] = dataclasses.replace(
+            plans[0],
+            start_line=course_start_line_numbers(course, w, boat),
+            laylines=course_laylines(
+                course, [(pl.mode, pl.result) for pl in plans[0].legs], w, boat
+            ),
+        )
     if len(plans) == 1:
         page = plan_report(plans[0], winds.get(plans[0].scenario))
     else:
@@ -188,12 +232,15 @@ def bands_page(
         "Leg-time bands: P10/P50/P90 of the members' leg times; the nominal time is the "
         "scenario as given; the widest source is the one whose one-at-a-time band "
         "(P10-P90, the other sources nominal) is widest; a side counts only when it beats "
-        "the other side's layline extreme by more than the margin, else tie.",
+        "the other side's layline extreme by more than the margin, else tie. The grey "
+        "lines under the route are the members' routes.",
     )
+    spread = spread_trace(course, summaries)
     return dataclasses.replace(
         page,
         tables=(*(bands_html_table(b) for b in summaries), *page.tables),
         notes=(*notes, *page.notes),
+        overlays=((spread,) if spread else ()) + page.overlays,
     )
 
 
@@ -211,7 +258,7 @@ def plot_bands(summaries: Sequence[BandSummary]) -> Any:
     import matplotlib.pyplot as plt
 
     n_legs = len(summaries[0].leg_labels) + 1
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.3 * n_legs), 4.0))
+    fig, ax = plt.subplots(figsize=(max(6.0, 1.3 * n_legs) + 2.0, 4.0))
     width = 0.8 / len(summaries)
     for i, b in enumerate(summaries):
         nom = np.append(b.nominal_s, np.sum(b.nominal_s))
@@ -233,7 +280,8 @@ def plot_bands(summaries: Sequence[BandSummary]) -> Any:
     ax.set_xlabel("leg")
     ax.set_ylabel("time vs the nominal wind [%]")
     ax.set_title("leg-time bands (bar P10-P90, tick P50, dots references)")
-    ax.legend(fontsize=7)
+    # beside the bars, not over them (the last leg's bar stays whole)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     fig.tight_layout()
     return fig
 

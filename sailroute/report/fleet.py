@@ -43,6 +43,7 @@ from sailroute.report.html import (
     _wind_name,
     _wind_note,
     above_polar_legs,
+    page_chart,
 )
 from sailroute.report.page import (
     FLEET_POINTS,
@@ -753,4 +754,5 @@ def fleet_report(page: FleetPage) -> Report:
         legend_beside=True,
         folded=folded,
         pick=True,
+        chart=page_chart(course, [page.wind[1]] if page.wind else [], routes),
     )

@@ -31,6 +31,7 @@ on a downwind leg, towards the target's centre on a reach.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
@@ -41,7 +42,9 @@ from numpy.typing import NDArray
 from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.course.model import Course
 from sailroute.planning.result import Comparison, Plan, percent_error
+from sailroute.report.chart import Chart
 from sailroute.report.page import (
+    LEG_COLOURS,
     MAX_WIND_LAYERS,
     N_STEPS,
     WIND_GRID,
@@ -51,6 +54,7 @@ from sailroute.report.page import (
     WindLayer,
     clock,
     course_area,
+    lighter,
     route_from_plan,
     routes_from_analysis,
     slider_times,
@@ -161,9 +165,16 @@ def _wind_note(layers: Sequence[WindLayer]) -> str:
 HELP = (
     "Drag the time slider (or press ▶) to move the boat and the wind; click a legend "
     "entry to hide or show it; hover over a route for its time, wind and speed; scroll "
-    "to zoom, drag to pan, double-click to reset the view. Background: plain water "
-    "(no chart or coastline); positions WGS-84."
+    "to zoom, drag to pan, double-click to reset the view. Labels that had to move off "
+    "their point have a thin line to it; positions WGS-84."
 )
+
+
+def page_chart(course: Course, winds: Sequence[WindField | None], routes: Sequence[Route]) -> Chart:
+    """The land under a page's map (:func:`sailroute.report.chart.chart_for`)."""
+    from sailroute.report.chart import chart_for
+
+    return chart_for(course, [w for w in winds if w is not None], course_area(course, routes))
 
 
 def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
@@ -201,6 +212,7 @@ def plan_report(plan: Plan, wind: WindField | None = None) -> Report:
         (HELP, _times_note(c), _wind_note(layers)),
         colour_by_speed=True,
         overlays=tuple(plotly_traces(plan.start_line, plan.laylines, c.frame)),
+        chart=page_chart(c, [wind], [route]),
     )
 
 
@@ -282,6 +294,7 @@ def comparison_report(
         tuple(notes),
         leg_numbers=False,
         legend_beside=True,
+        chart=page_chart(course, list((winds or {}).values()), routes),
     )
 
 
@@ -290,6 +303,9 @@ def analysis_report(a: TrackAnalysis) -> Report:
     boat's own leg starts (dashed) and the leg table with the time lost."""
     course, off = a.course, a.course.utc_offset_s
     sailed, optimal = routes_from_analysis(a)
+    colours = tuple(LEG_COLOURS[k % len(LEG_COLOURS)] for k in range(len(a.legs)))
+    sailed = dataclasses.replace(sailed, leg_colours=colours)
+    optimal = dataclasses.replace(optimal, leg_colours=tuple(lighter(c) for c in colours))
     times = slider_times([sailed])
     layers = _layers({_wind_name(a): a.wind}, course, [sailed, optimal], times)
     rows = []
@@ -373,11 +389,19 @@ def analysis_report(a: TrackAnalysis) -> Report:
         footer,
     )
     t0 = a.legs[0].t_start if a.legs else course.start_epoch
+    above = above_polar_legs(a)
     summary = (
         f"Track {a.track.name} · scenario {a.scenario} · router {a.router} · start "
         f"{time_label(t0, off)} on {iso(t0 + off)[:10]}",
         f"Sailed {format_duration(a.sailed_time_s)}, optimal "
-        f"{format_duration(a.optimal_time_s)}, lost {a.loss_s:+.1f} s",
+        f"{format_duration(a.optimal_time_s)}, "
+        # a loss the notes disown is not stated in the header
+        + (
+            f"no time lost stated: the boat {above}, so the losses are not a debrief "
+            "(see the notes)"
+            if above
+            else f"lost {a.loss_s:+.1f} s"
+        ),
     )
     return Report(
         f"{course.name} — {a.track.name}",
@@ -387,7 +411,16 @@ def analysis_report(a: TrackAnalysis) -> Report:
         tuple(layers),
         times,
         (table,),
-        (HELP, *_judged_notes([a]), *a.notes, _times_note(course), _wind_note(layers)),
+        (
+            HELP,
+            "Each leg in its colour: the sailed track solid, the optimal leg from the same "
+            "point and time dashed, in a lighter shade of it.",
+            *_judged_notes([a]),
+            *a.notes,
+            _times_note(course),
+            _wind_note(layers),
+        ),
+        chart=page_chart(course, [a.wind], [sailed, optimal]),
     )
 
 

@@ -23,6 +23,7 @@ from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.planning.result import Plan
 from sailroute.report.area import fit_area
+from sailroute.report.chart import Chart, fit_chart
 from sailroute.report.plots import repeat_index_of_ends
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, wind_speed_direction, wrap180
@@ -79,6 +80,16 @@ MIN_BOAT_POINTS = 300
 """Fewest points of one boat's track on a fleet's page (a very large fleet)."""
 FLEET_STEPS = 60
 """Slider positions of a fleet's replay."""
+LEG_COLOURS = ROUTE_COLOURS[:8]
+"""Colours of the legs of an analysis (sailed; the optimal legs in a lighter shade)."""
+
+
+def lighter(colour: str, share: float = 0.55) -> str:
+    """``colour`` (``#rrggbb``) mixed with ``share`` of white."""
+    rgb = [int(colour[i : i + 2], 16) for i in (1, 3, 5)]
+    return "#" + "".join(f"{round(c + share * (255 - c)):02x}" for c in rgb)
+
+
 GREY = "#a9b4bf"
 """Colour of the boats that are not picked when the reader picks one on a fleet's page."""
 
@@ -123,6 +134,9 @@ class Route:
     colour : str
         Line colour (``#rrggbb``); empty: the page's palette in route order
         (:data:`ROUTE_COLOURS`).
+    leg_colours : tuple of str
+        A colour per leg (``#rrggbb``, by leg number − 1): the line is drawn leg by leg,
+        each in its colour (an analysis: the sailed legs, the optimal ones lighter).
     """
 
     name: str
@@ -144,6 +158,7 @@ class Route:
     lat_shift: NDArray[np.float64] | None = None
     lon_shift: NDArray[np.float64] | None = None
     colour: str = ""
+    leg_colours: tuple[str, ...] = ()
 
     def drawn(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(lat, lon)`` where the line is drawn [°]."""
@@ -280,6 +295,8 @@ class Report:
         More plotly traces drawn over the course (laylines, the favoured start end).
     folded : tuple of NoteGroup
         Findings shared by several boats, under the notes, folded.
+    chart : Chart or None
+        The land under the map (:func:`sailroute.report.chart.chart_for`); None: none.
     pick : bool
         A fleet: the reader picks a boat (a list above the map, a click on its track or
         on its row, ``#boat=NAME`` in the address) and the others turn grey; tacks and
@@ -300,6 +317,7 @@ class Report:
     overlays: tuple[dict[str, Any], ...] = ()
     folded: tuple[NoteGroup, ...] = ()
     pick: bool = False
+    chart: Chart | None = None
 
 
 def clock(t: float, utc_offset_s: float = 0.0) -> str:
@@ -543,15 +561,17 @@ def optimal_route(a: TrackAnalysis) -> Route:
 def course_area(
     course: Course, routes: Sequence[Route], pad: float = 0.08
 ) -> tuple[float, float, float, float]:
-    """``(x0, x1, y0, y1)`` [m]: the marks and routes, and the race area within reach of
-    them (:func:`sailroute.report.area.fit_area`), padded by ``pad`` of the larger side."""
+    """``(x0, x1, y0, y1)`` [m]: the marks and routes, and the race area and the chart
+    file's shore within reach of them (:func:`sailroute.report.area.fit_area`,
+    :func:`sailroute.report.chart.fit_chart`), padded by ``pad`` of the larger side."""
     xs = [m.x for m in course.marks.values()]
     ys = [m.y for m in course.marks.values()]
     for r in routes:
         if np.isfinite(r.x).any():
             xs += [float(np.nanmin(r.x)), float(np.nanmax(r.x))]
             ys += [float(np.nanmin(r.y)), float(np.nanmax(r.y))]
-    x0, x1, y0, y1 = fit_area(course.area, (min(xs), max(xs), min(ys), max(ys)))
+    box = (min(xs), max(xs), min(ys), max(ys))
+    x0, x1, y0, y1 = fit_chart(course, fit_area(course.area, box))
     span = max(x1 - x0, y1 - y0, 100.0)
     return x0 - pad * span, x1 + pad * span, y0 - pad * span, y1 + pad * span
 

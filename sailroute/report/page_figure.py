@@ -22,6 +22,7 @@ from sailroute.report.area import (
     area_polygons,
     kept_ring,
 )
+from sailroute.report.chart import LAND_EDGE, LAND_FILL, Chart
 from sailroute.report.markup import plotly_label
 from sailroute.report.page import (
     ARROW_FILL,
@@ -44,7 +45,15 @@ from sailroute.textin import clean_text
 from sailroute.timeutil import offset_text
 from sailroute.units import wrap360
 
-__all__ = ["area_traces", "boat_at", "figure", "label_positions", "plotly_label", "wind_arrows"]
+__all__ = [
+    "area_traces",
+    "boat_at",
+    "figure",
+    "land_traces",
+    "mark_annotations",
+    "plotly_label",
+    "wind_arrows",
+]
 
 
 def _r(a: Any, nd: int) -> Any:
@@ -162,21 +171,9 @@ def wind_arrows(
     return out
 
 
-def label_positions(course: Course) -> list[str]:
-    """plotly ``textposition`` of each mark's name: away from its line/gate partner, or from
-    the course's centre for a single mark (as on ``route.png``), so the two names of a
-    short line do not overlap."""
-    from sailroute.report.plots import _label_directions
-
-    out = []
-    for dx, dy in _label_directions(course).values():
-        v = "top" if dy > 0.3 else ("bottom" if dy < -0.3 else "middle")
-        h = "right" if dx > 0.3 else ("left" if dx < -0.3 else "center")
-        out.append(f"{v} {h}" if (v, h) != ("middle", "center") else "top right")
-    return out
-
-
 def _course_traces(course: Course) -> list[dict[str, Any]]:
+    """Lines and gates, and the marks (symbols; their names are annotations placed by the
+    page's script: :func:`mark_annotations`)."""
     out: list[dict[str, Any]] = []
     first = True
     for ln, dash in [
@@ -194,6 +191,7 @@ def _course_traces(course: Course) -> list[dict[str, Any]]:
                 "y": _r([ln.a.lat, ln.b.lat], 7),
                 "line": {"color": "black", "width": 2, "dash": dash},
                 "hovertemplate": f"{plotly_label(ln.name)}<extra></extra>",
+                "meta": "line",
             }
         )
         first = False
@@ -201,18 +199,114 @@ def _course_traces(course: Course) -> list[dict[str, Any]]:
     out.append(
         {
             "type": "scatter",
-            "mode": "markers+text",
+            "mode": "markers",
             "name": "marks",
             "legendgroup": "course",
             "x": _r([m.lon for m in marks], 7),
             "y": _r([m.lat for m in marks], 7),
             "text": [plotly_label(m.name) for m in marks],
-            "textposition": label_positions(course),
-            "textfont": {"size": 12, "color": "#222"},
-            "marker": {"color": "darkorange", "size": 11, "line": {"color": "black", "width": 1}},
+            "marker": {
+                "color": "darkorange",
+                "size": MARK_SIZE,
+                "line": {"color": "black", "width": 1},
+            },
             "hovertemplate": "mark %{text}<br>%{y:.6f}° N %{x:.6f}° E<extra></extra>",
+            "meta": "marks",
         }
     )
+    return out
+
+
+MARK_SIZE = 11
+"""Diameter of the mark symbols on the page [px]."""
+
+
+def _annotation(lon: float, lat: float, text: str, **style: Any) -> dict[str, Any]:
+    """A label at a point, moved by the page's script (``ax``/``ay``: its offset [px];
+    the arrow, the leader line, shown only when it had to move away)."""
+    return {
+        "x": _r(lon, 7),
+        "y": _r(lat, 7),
+        "text": text,
+        "showarrow": True,
+        "arrowhead": 0,
+        "arrowwidth": 0.8,
+        "arrowcolor": "rgba(0,0,0,0)",
+        "standoff": 0,
+        "ax": 0,
+        "ay": -14,
+        "axref": "pixel",
+        "ayref": "pixel",
+        "captureevents": False,
+        **style,
+    }
+
+
+def mark_annotations(course: Course) -> list[dict[str, Any]]:
+    """The marks' names as annotations (``name`` ``mark:<k>``, ``k`` the mark's index)."""
+    return [
+        _annotation(
+            m.lon,
+            m.lat,
+            plotly_label(m.name),
+            name=f"mark:{k}",
+            font={"size": 12, "color": "#222"},
+            bgcolor="rgba(255,255,255,0.55)",
+            borderpad=1,
+        )
+        for k, m in enumerate(course.marks.values())
+    ]
+
+
+def _joined_lonlat(frame: LocalFrame, parts: Sequence[NDArray]) -> tuple[list[Any], list[Any]]:
+    """``(lon, lat)`` lists [°] of lines in the course frame [m], a null between them."""
+    xs: list[Any] = []
+    ys: list[Any] = []
+    for part in parts:
+        lat, lon = frame.to_latlon(part[:, 0], part[:, 1])
+        xs += [*_r(lon, 6), None]
+        ys += [*_r(lat, 6), None]
+    return xs[:-1], ys[:-1]
+
+
+def land_traces(chart: Chart | None, frame: LocalFrame) -> list[dict[str, Any]]:
+    """The chart's land layers (:mod:`sailroute.report.chart`) as filled traces in lon/lat
+    (``meta`` ``land``), the first shown, the others in the legend only; shorelines as
+    lines."""
+    out: list[dict[str, Any]] = []
+    for layer in chart.layers if chart is not None else ():
+        common = {
+            "type": "scatter",
+            "mode": "lines",
+            "name": plotly_label(layer.name),
+            "legendgroup": layer.name,
+            "hoverinfo": "skip",
+            "meta": "land",
+            **({} if layer.shown else {"visible": "legendonly"}),
+        }
+        if layer.rings:
+            xs, ys = _joined_lonlat(frame, layer.rings)
+            out.append(
+                {
+                    **common,
+                    "x": xs,
+                    "y": ys,
+                    "fill": "toself",
+                    "fillcolor": LAND_FILL,
+                    "line": {"color": LAND_EDGE, "width": 1},
+                }
+            )
+        if layer.lines:
+            xs, ys = _joined_lonlat(frame, layer.lines)
+            out.append(
+                {
+                    **common,
+                    "x": xs,
+                    "y": ys,
+                    "line": {"color": LAND_EDGE, "width": 1.5},
+                    "showlegend": not layer.rings,
+                }
+            )
     return out
 
 
@@ -292,52 +386,58 @@ def area_traces(course: Course) -> list[dict[str, Any]]:
     return out
 
 
-def _leg_number_trace(r: Route, group: str) -> dict[str, Any]:
-    """The leg numbers along ``r``, spread between 30 % and 70 % of each leg (golden-ratio
-    steps, as on ``route.png``) so legs over the same water do not hide each other's."""
-    xs, ys, text = [], [], []
+def leg_number_annotations(r: Route) -> list[dict[str, Any]]:
+    """The leg numbers along ``r`` as badges (annotations ``legno:<n>``), at 30 % to 70 % of
+    each leg (golden-ratio steps, as on ``route.png``) so legs over the same water do not
+    hide each other's; the page's script slides one aside when something is there."""
+    out = []
     lat, lon = r.drawn()
     for k in range(len(r.modes)):
         idx = np.flatnonzero(r.leg == k + 1)
         if idx.size == 0:
             continue
         i = idx[min(int((0.3 + 0.4 * ((k * 0.6180339887) % 1.0)) * idx.size), idx.size - 1)]
-        xs.append(lon[i])
-        ys.append(lat[i])
-        text.append(str(k + 1))
-    return {
-        "type": "scatter",
-        "mode": "markers+text",
-        "name": "leg numbers",
-        "legendgroup": group,
-        "showlegend": False,
-        "x": _r(xs, 7),
-        "y": _r(ys, 7),
-        "text": text,
-        "textfont": {"size": 10, "color": "#222"},
-        "marker": {"color": "white", "size": 17, "line": {"color": "#555", "width": 1}},
-        "hovertemplate": "leg %{text}<extra></extra>",
-    }
+        out.append(
+            _annotation(
+                float(lon[i]),
+                float(lat[i]),
+                str(k + 1),
+                name=f"legno:{k + 1}",
+                ay=0,
+                font={"size": 10, "color": "#222"},
+                bgcolor="white",
+                bordercolor="#555",
+                borderwidth=1,
+                borderpad=2,
+            )
+        )
+    return out
 
 
 def _manoeuvre_trace(
-    kind: str, pts: Sequence[tuple[str, float, float, float]], name: str, group: str, off: float
+    kind: str,
+    pts: Sequence[tuple[str, float, float, float]],
+    name: str,
+    group: str,
+    off: float,
+    legend: bool = False,
 ) -> dict[str, Any]:
-    """The tacks (``kind="tack"``) or gybes of a route as one marker trace."""
+    """The tacks (``kind="tack"``) or gybes of a route as one marker trace (``legend``: with
+    the legend entry that says what the symbol is)."""
     symbol, colour = MANOEUVRE_SYMBOLS[kind]
     return {
         "type": "scatter",
         "mode": "markers",
         "name": f"{kind}s",
-        "legendgroup": group,
-        "showlegend": False,
+        "legendgroup": f"{kind}s" if legend else group,
+        "showlegend": legend,
         "x": _r([m[3] for m in pts], 7),
         "y": _r([m[2] for m in pts], 7),
         "text": [f"{kind} {clock(m[1], off)} local · {clock(m[1])} UTC" for m in pts],
         "marker": {
             "symbol": symbol,
             "color": colour,
-            "size": 10,
+            "size": MANOEUVRE_SIZE,
             "line": {"color": "white", "width": 1},
         },
         "hovertemplate": f"%{{text}}<extra>{plotly_label(name)}</extra>",
@@ -345,6 +445,8 @@ def _manoeuvre_trace(
 
 
 MANOEUVRE_SYMBOLS = {"tack": ("triangle-up", "crimson"), "gybe": ("square", "royalblue")}
+MANOEUVRE_SIZE = 10
+"""Size of the tack and gybe symbols [px]."""
 """Marker symbol and colour of the tacks and gybes."""
 
 
@@ -363,6 +465,27 @@ def _route_trace(
         "customdata": custom,
         "hovertemplate": _hover(r, off),
     }
+
+
+def _leg_pieces(r: Route, tr: dict[str, Any], custom: Sequence[Any]) -> list[dict[str, Any]]:
+    """The route trace ``tr`` of ``r`` cut leg by leg, each in its :attr:`Route.leg_colours`."""
+    out = []
+    for k, c in enumerate(r.leg_colours):
+        idx = np.flatnonzero(r.leg == k + 1)
+        if idx.size == 0:
+            continue
+        out.append(
+            {
+                **tr,
+                "name": f"leg {k + 1} · {tr['name']}",
+                "x": [tr["x"][j] for j in idx],
+                "y": [tr["y"][j] for j in idx],
+                "customdata": [custom[int(j)] for j in idx],
+                "line": {**tr["line"], "color": c},
+                "showlegend": True,
+            }
+        )
+    return out
 
 
 def _speed_colours(report: Report) -> dict[str, Any]:
@@ -460,11 +583,17 @@ def figure(report: Report) -> dict[str, Any]:
     course, off = report.course, report.course.utc_offset_s
     data: list[dict[str, Any]] = []
     moving: list[tuple[int, list[dict[str, Any]]]] = []  # (trace, its state per frame)
+    data += land_traces(report.chart, course.frame)
     data += _wind_traces(report, moving)
     data += area_traces(course)
     if not report.pick:
         data += _course_traces(course)
     data += list(report.overlays)
+    annotations = mark_annotations(course)
+    # what the page's script places (page_render): symbols first, then the names
+    symbols: list[dict[str, Any]] = []
+    badges: list[dict[str, Any]] = []
+    routes: list[int] = []
 
     single = report.colour_by_speed and len(report.routes) == 1
     picks = []
@@ -476,14 +605,37 @@ def figure(report: Report) -> dict[str, Any]:
         if single:
             tr["mode"] = "lines+markers"
             tr["marker"] = _speed_colours(report)
+        if r.leg_colours:  # leg by leg, each in its colour; the hover as on the whole line
+            for piece in _leg_pieces(r, tr, custom):
+                data.append(piece)
+                routes.append(len(data) - 1)
+            tr = {**tr, "visible": "legendonly", "showlegend": False}
         data.append(tr)
         line = len(data) - 1
+        routes.append(line)
         if not report.pick:
             for kind in ("tack", "gybe"):
                 pts = [m for m in r.manoeuvres if m[0] == kind]
-                data.append(_manoeuvre_trace(kind, pts, r.name, group, off))
+                legend = not any(t.get("showlegend") and t.get("name") == f"{kind}s" for t in data)
+                data.append(
+                    _manoeuvre_trace(
+                        kind, pts, r.name, f"{kind}s", off, legend=legend and bool(pts)
+                    )
+                )
+                symbols += [
+                    {
+                        "trace": len(data) - 1,
+                        "point": k,
+                        "size": MANOEUVRE_SIZE + 2,
+                        "gap": 0,
+                        "route": True,
+                    }
+                    for k in range(len(pts))
+                ]
         if i == 0 and report.leg_numbers:
-            data.append(_leg_number_trace(r, group))
+            for a in leg_number_annotations(r):
+                badges.append({"ann": len(annotations), "gap": 0, "route": True})
+                annotations.append(a)
         if r.boat:
             states = _boat_states(r, report.times, off, custom)
             marker_colour = BOAT_COLOUR if single else colour
@@ -497,6 +649,11 @@ def figure(report: Report) -> dict[str, Any]:
         data += _highlight_traces()
         n = len(data)
         out["pick"] = {"grey": GREY, "highlight": [n - 3, n - 2, n - 1], "boats": picks}
+    out["place"] = _place(report, data, annotations, routes, symbols, badges)
+    out["chart"] = {
+        "note": (report.chart or Chart()).note(),
+        "lat0": course.frame.lat0,
+    }
     frames = []
     if len(report.times) > 1 and moving:
         for k in range(len(report.times)):
@@ -507,12 +664,76 @@ def figure(report: Report) -> dict[str, Any]:
                     "traces": [i for i, _ in moving],
                 }
             )
+    layout = _layout(report, frames)
+    layout["annotations"] = annotations
     return {
         "data": data,
-        "layout": _layout(report, frames),
+        "layout": layout,
         "frames": frames,
         "config": {"responsive": True, "displaylogo": False, "scrollZoom": True},
         **out,
+    }
+
+
+def _place(
+    report: Report,
+    data: list[dict[str, Any]],
+    annotations: list[dict[str, Any]],
+    routes: list[int],
+    symbols: list[dict[str, Any]],
+    badges: list[dict[str, Any]],
+) -> dict[str, Any]:
+    """What the page's script places (:mod:`sailroute.report.page_render`), in order: the
+    favoured end, the tack and gybe symbols, the leg numbers, the marks' names, the
+    favoured end's label; what they keep off (the routes and lines, the marks and the
+    boats where the page opens); the trace of the leader lines (appended to ``data``; -1
+    on a fleet's page).  Adds the favoured end's label to ``annotations``."""
+    favoured = []
+    for k, t in enumerate(data):
+        if t.get("meta") == "favoured" and t.get("x"):
+            favoured.append({"trace": k, "point": 0, "size": 18, "gap": 0, "route": False})
+            annotations.append(
+                _annotation(
+                    t["x"][0],
+                    t["y"][0],
+                    t["text"][0],
+                    name="favoured-label",
+                    font={"size": 11, "color": "#1b5e20"},
+                )
+            )
+            favoured.append({"ann": len(annotations) - 1, "gap": 12, "route": False})
+    n_marks = len(report.course.marks)
+    names = [{"ann": k, "gap": 0.5 * MARK_SIZE + 3, "route": False} for k in range(n_marks)]
+    marks = next(k for k, t in enumerate(data) if t.get("meta") == "marks")
+    fixed = [{"trace": marks, "size": MARK_SIZE + 2, "first": False}]
+    fixed += [  # the boats where the page opens (the boat at the start covers the route)
+        {"trace": k, "size": t["marker"]["size"] + 2, "first": True}
+        for k, t in enumerate(data)
+        if str(t.get("name", "")).startswith("boat: ") and not report.pick
+    ]
+    lines = [k for k, t in enumerate(data) if t.get("meta") == "line"]
+    leaders = -1
+    if not report.pick:
+        data.append(
+            {
+                "type": "scatter",
+                "mode": "lines",
+                "name": "leaders",
+                "showlegend": False,
+                "x": [],
+                "y": [],
+                "line": {"color": "#555", "width": 0.8},
+                "hoverinfo": "skip",
+                "meta": "leaders",
+            }
+        )
+        leaders = len(data) - 1
+    return {
+        "leaders": leaders,
+        "routes": routes,
+        "lines": lines,
+        "fixed": fixed,
+        "items": favoured[:1] + symbols + badges + names + favoured[1:],
     }
 
 
@@ -610,13 +831,17 @@ def _layout(report: Report, frames: Sequence[Any]) -> dict[str, Any]:
         "hovermode": "closest",
         "dragmode": "pan",
         "margin": {"l": 70, "r": 30, "t": 40, "b": 40},
-        "legend": (
-            {"orientation": "v", "x": 1.02, "y": 1.0, "yanchor": "top"}
-            if report.legend_beside
-            else {"orientation": "h", "x": 0.0, "y": 1.02, "yanchor": "bottom"}
-        ),
+        "legend": {
+            **(
+                {"orientation": "v", "x": 1.02, "y": 1.0, "yanchor": "top"}
+                if report.legend_beside
+                else {"orientation": "h", "x": 0.0, "y": 1.02, "yanchor": "bottom"}
+            ),
+            "groupclick": "toggleitem",
+        },
         "font": {"family": "Helvetica, Arial, sans-serif", "size": 12},
         "uirevision": "sailroute",
+        "modebar": {"orientation": "v"},
     }
     if frames:
         step_args = {

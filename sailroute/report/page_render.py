@@ -52,6 +52,11 @@ h1 { font-size: 20px; margin: 0 0 6px 0; }
 h2 { font-size: 16px; margin: 18px 0 6px 0; }
 p.summary { margin: 2px 0; }
 #sailroute-map { width: 100%; }
+#sailroute-wrap { position: relative; }
+#sailroute-furniture { position: absolute; pointer-events: none;
+                       background: rgba(255,255,255,0.7); border-radius: 3px; }
+#sailroute-osm { position: absolute; right: 32px; font-size: 10px; color: #333;
+                 background: rgba(255,255,255,0.75); padding: 0 3px; }
 p.note, details.note { font-size: 12px; color: #555; margin: 2px 0; }
 details.note summary { cursor: pointer; }
 details.note ul { margin: 2px 0 6px 0; }
@@ -166,6 +171,224 @@ _JS = """
     }
     return null;
   }
+  // ---- map furniture, label placement and OSM tiles (sailroute.report.labels: the rules)
+  var STEPS = [0, 6, 14, 26, 42, 64, 92, 130], placing = false, timer = null;
+  var TILE = 'https://tile.openstreetmap.org/';
+  function niceLength(v) {
+    var k = Math.pow(10, Math.floor(Math.log10(v)));
+    return [5 * k, 2 * k, k].filter(function (x) { return x <= v; })[0] || k;
+  }
+  function overlap(a, b) {
+    var w = Math.min(a[2], b[2]) - Math.max(a[0], b[0]);
+    var h = Math.min(a[3], b[3]) - Math.max(a[1], b[1]);
+    return w > 0 && h > 0 ? w * h : 0;
+  }
+  function hits(b, segs) {
+    var n = 0;
+    for (var i = 0; i < segs.length; i++) {
+      var s = segs[i];
+      if (Math.max(s[0], s[2]) < b[0] || Math.min(s[0], s[2]) > b[2] ||
+          Math.max(s[1], s[3]) < b[1] || Math.min(s[1], s[3]) > b[3]) { continue; }
+      var dx = s[2] - s[0], dy = s[3] - s[1], pos = 0, neg = 0;
+      [[b[0], b[1]], [b[2], b[1]], [b[0], b[3]], [b[2], b[3]]].forEach(function (c) {
+        var v = dx * (c[1] - s[1]) - dy * (c[0] - s[0]);
+        if (v > 0) { pos++; } else if (v < 0) { neg++; }
+      });
+      if (pos < 4 && neg < 4) { n++; }
+    }
+    return n;
+  }
+  function best(cands, w, h, onRoute, segs, taken, B) {
+    var bi = 0, bc = Infinity;
+    cands.forEach(function (c, i) {
+      var b = [c[0] - w / 2, c[1] - h / 2, c[0] + w / 2, c[1] + h / 2];
+      var out = Math.max(0, B[0] - b[0]) + Math.max(0, b[2] - B[2]) +
+                Math.max(0, B[1] - b[1]) + Math.max(0, b[3] - B[3]);
+      var over = 0;
+      taken.forEach(function (t) { over += overlap(b, t); });
+      var v = (out > 0 ? 1e7 : 0) + 1e4 * out + (over > 0 ? 1e5 : 0) + 1e2 * over + c[2];
+      if (v < bc && !onRoute) { v += 1e5 * hits(b, segs); }
+      if (v < bc) { bc = v; bi = i; }
+    });
+    return bi;
+  }
+  function candidates(x, y, w, h, gap) {
+    var out = gap <= 0 ? [[x, y, 0]] : [];
+    STEPS.forEach(function (d) {
+      if (gap <= 0 && d === 0) { return; }
+      var r = Math.max(gap, 0) + d;
+      for (var k = 0; k < 16; k++) {
+        var a = 2 * Math.PI * k / 16, ux = Math.cos(a), uy = Math.sin(a);
+        out.push([x + ux * (w / 2 + r), y + uy * (h / 2 + r), d + 0.01 * Math.abs(uy)]);
+      }
+    });
+    return out;
+  }
+  function shown(tr) { return tr && tr.visible !== false && tr.visible !== 'legendonly'; }
+  function furniture(fig, xa, L, T, segs, taken, B) {
+    var box = document.getElementById('sailroute-furniture');
+    var mPerPx = (xa.range[1] - xa.range[0]) * 111320 *
+                 Math.cos(fig.chart.lat0 * Math.PI / 180) / xa._length;
+    var len = niceLength(90 * mPerPx), bar = len / mPerPx;
+    var text = len >= 1000 ? (len / 1000) + ' km' : len + ' m';
+    var w = Math.max(bar, 40) + 34, h = 38, i = 3;
+    var cs = [[B[0] + i + w / 2, B[3] - i - h / 2, 0], [B[2] - i - w / 2, B[3] - i - h / 2, 0.1],
+              [B[0] + i + w / 2, B[1] + i + h / 2, 0.2], [B[2] - i - w / 2, B[1] + i + h / 2, 0.3]];
+    var k = best(cs, w, h, false, segs, taken, B), x0 = cs[k][0] - w / 2, y0 = cs[k][1] - h / 2;
+    box.style.left = x0 + 'px'; box.style.top = y0 + 'px';
+    box.style.width = w + 'px'; box.style.height = h + 'px';
+    box.innerHTML = '<svg width="' + w + '" height="' + h + '">' +
+      '<rect x="4" y="24" width="' + bar + '" height="5" fill="#fff" stroke="#000"/>' +
+      '<rect x="4" y="24" width="' + bar / 2 + '" height="5" fill="#000"/>' +
+      '<text x="' + (4 + bar / 2) + '" y="19" text-anchor="middle" font-size="11">' + text +
+      '</text><path d="M' + (w - 13) + ',31 L' + (w - 13) + ',16" stroke="#000" ' +
+      'stroke-width="1.5"/><path d="M' + (w - 18) + ',19 L' + (w - 13) + ',8 L' + (w - 8) +
+      ',19 Z" fill="#000"/><text x="' + (w - 13) + '" y="7" text-anchor="middle" ' +
+      'font-size="9" font-weight="bold">N</text></svg>';
+    box.setAttribute('data-scale-m', String(len));
+    return [x0, y0, x0 + w, y0 + h];
+  }
+  function placeAll(gd, fig) {
+    var P = fig.place, fl = gd._fullLayout, xa = fl.xaxis, ya = fl.yaxis;
+    var L = xa._offset, T = ya._offset;
+    function px(lon, lat) { return [L + xa.l2p(lon), T + ya.l2p(lat)]; }
+    var B = [L + 2, T + 2, L + xa._length - 2, T + ya._length - 2], segs = [], taken = [];
+    P.routes.concat(P.lines).forEach(function (i) {
+      var tr = gd.data[i];
+      if (!shown(tr)) { return; }
+      var n = tr.x.length, step = Math.max(1, Math.ceil(n / 1500)), prev = null;
+      for (var k = 0; k < n; k = (k + step < n || k === n - 1) ? k + step : n - 1) {
+        if (tr.x[k] === null || tr.y[k] === null) { prev = null; continue; }
+        var p = px(tr.x[k], tr.y[k]);
+        if (prev) { segs.push([prev[0], prev[1], p[0], p[1]]); }
+        prev = p;
+      }
+    });
+    P.fixed.forEach(function (f) {
+      var tr = gd.data[f.trace], r = f.size / 2;
+      if (!shown(tr)) { return; }
+      for (var k = 0; k < (f.first ? Math.min(1, tr.x.length) : tr.x.length); k++) {
+        if (tr.x[k] === null) { continue; }
+        var p = px(tr.x[k], tr.y[k]);
+        taken.push([p[0] - r, p[1] - r, p[0] + r, p[1] + r]);
+      }
+    });
+    taken.push(furniture(fig, xa, L, T, segs, taken, B));
+    var anns = gd.layout.annotations || [], upd = {}, moved = {}, lead = [], lx = [], ly = [];
+    P.items.forEach(function (it) {
+      var x, y, w, h, tr = it.trace !== undefined ? gd.data[it.trace] : null;
+      if (tr) {
+        if (!shown(tr)) { return; }
+        if (it.lon === undefined) { it.lon = tr.x[it.point]; it.lat = tr.y[it.point]; }
+        var q = px(it.lon, it.lat);
+        x = q[0]; y = q[1]; w = h = it.size;
+      } else {
+        var a = anns[it.ann], el = gd.querySelector('.annotation[data-index="' + it.ann +
+                                                    '"] .annotation-text-g');
+        var r = el ? el.getBoundingClientRect() : {width: 30, height: 16};
+        var p = px(a.x, a.y);
+        x = p[0]; y = p[1]; w = r.width + 2; h = r.height + 2;
+      }
+      var c = candidates(x, y, w, h, it.gap), k = best(c, w, h, it.route, segs, taken, B);
+      var cx = c[k][0], cy = c[k][1], leader = (it.gap <= 0 && k > 0) || c[k][2] > 10;
+      taken.push([cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2]);
+      if (tr) {
+        var m = moved[it.trace] = moved[it.trace] || {x: tr.x.slice(), y: tr.y.slice()};
+        m.x[it.point] = xa.p2l(cx - L); m.y[it.point] = ya.p2l(cy - T);
+        if (leader) { lx.push(it.lon, m.x[it.point], null); ly.push(it.lat, m.y[it.point], null); }
+      } else {
+        upd['annotations[' + it.ann + '].ax'] = cx - x;
+        upd['annotations[' + it.ann + '].ay'] = cy - y;
+        upd['annotations[' + it.ann + '].arrowcolor'] = leader ? '#555' : 'rgba(0,0,0,0)';
+      }
+    });
+    var ids = Object.keys(moved).map(Number);
+    placing = true;
+    return Plotly.relayout(gd, upd).then(function () {
+      return ids.length ? Plotly.restyle(gd, {x: ids.map(function (i) { return moved[i].x; }),
+                                              y: ids.map(function (i) { return moved[i].y; })},
+                                         ids) : null;
+    }).then(function () {
+      return P.leaders >= 0 ? Plotly.restyle(gd, {x: [lx], y: [ly]}, [P.leaders]) : null;
+    }).then(function () {
+      placing = false;
+      document.body.setAttribute('data-placed', String(P.items.length));
+    });
+  }
+  function tileBox(z, x, y) {
+    var n = Math.pow(2, z);
+    function lat(t) { return Math.atan(Math.sinh(Math.PI * (1 - 2 * t / n))) * 180 / Math.PI; }
+    return [x / n * 360 - 180, (x + 1) / n * 360 - 180, lat(y + 1), lat(y)];
+  }
+  function tileImages(gd) {
+    var xa = gd._fullLayout.xaxis, ya = gd._fullLayout.yaxis;
+    var z = Math.max(0, Math.min(19, Math.round(Math.log2(
+      xa._length / (xa.range[1] - xa.range[0]) * 360 / 256))));
+    var n = Math.pow(2, z), out = [];
+    function tx(lon) { return Math.floor((lon + 180) / 360 * n); }
+    function ty(lat) {
+      var r = lat * Math.PI / 180;
+      return Math.floor((1 - Math.log(Math.tan(r) + 1 / Math.cos(r)) / Math.PI) / 2 * n);
+    }
+    for (var x = tx(xa.range[0]); x <= tx(xa.range[1]) && out.length < 120; x++) {
+      for (var y = ty(ya.range[1]); y <= ty(ya.range[0]) && out.length < 120; y++) {
+        var b = tileBox(z, x, y);
+        out.push({source: TILE + z + '/' + x + '/' + y + '.png', xref: 'x', yref: 'y',
+                  x: b[0], y: b[3], sizex: b[1] - b[0], sizey: b[3] - b[2],
+                  sizing: 'stretch', layer: 'below', xanchor: 'left', yanchor: 'top'});
+      }
+    }
+    return out;
+  }
+  function tiles(gd, fig, online) {
+    var status = document.getElementById('sailroute-tiles');
+    if (online) {
+      var land = [];
+      gd.data.forEach(function (t, i) { if (t.meta === 'land') { land.push(i); } });
+      placing = true;
+      return Plotly.relayout(gd, {images: tileImages(gd), plot_bgcolor: 'rgba(0,0,0,0)'})
+        .then(function () {
+          return land.length ? Plotly.restyle(gd, {opacity: 0.35}, land) : null;
+        })
+        .then(function () { placing = false; });
+    }
+    var first = tileImages(gd)[0], probe = new Image();
+    if (!first) { return null; }
+    probe.onload = function () {
+      document.body.setAttribute('data-tiles', 'shown');
+      status.textContent = 'OSM tiles shown.';
+      var osm = document.getElementById('sailroute-osm'), link = document.createElement('a');
+      link.href = 'https://www.openstreetmap.org/copyright';
+      link.textContent = 'OpenStreetMap';
+      osm.append('© ', link, ' contributors');
+      osm.hidden = false;
+      tiles(gd, fig, true);
+    };
+    probe.onerror = function () {
+      document.body.setAttribute('data-tiles', 'offline');
+      status.textContent = 'OSM tiles: not shown (no network).';
+    };
+    probe.src = first.source;
+    return null;
+  }
+  function watch(gd, fig) {
+    function again() {
+      clearTimeout(timer);
+      timer = setTimeout(function () {
+        placeAll(gd, fig).then(function () {
+          return document.body.getAttribute('data-tiles') === 'shown' ? tiles(gd, fig, true) : null;
+        }).catch(fail);
+      }, 150);
+    }
+    gd.on('plotly_relayout', function (ev) {
+      if (placing) { return; }
+      if (Object.keys(ev).some(function (k) { return /^(xaxis|yaxis|autosize)/.test(k); })) {
+        again();
+      }
+    });
+    gd.on('plotly_restyle', function () { if (!placing) { again(); } });
+    window.addEventListener('resize', again);
+  }
   if (typeof Plotly === 'undefined') {
     fail('the drawing library ' + %(js)s + ' did not load: keep it where it was written ' +
          '(the whole output folder together)');
@@ -187,7 +410,12 @@ _JS = """
       return null;
     }).then(function () {
       return fig.pick ? setUpPick(gd, fig.pick) : null;
-    }).then(function () { document.body.setAttribute('data-map', 'drawn'); }, fail);
+    }).then(function () {
+      return fig.place ? placeAll(gd, fig) : null;
+    }).then(function () {
+      if (fig.place) { watch(gd, fig); tiles(gd, fig, false); }
+      document.body.setAttribute('data-map', 'drawn');
+    }, fail);
   } catch (e) { fail(e); }
 })();
 """
@@ -342,12 +570,18 @@ def render_html(report: Report, plotly_src: str = PLOTLY_FILE) -> str:
 {summary}
 <div id="sailroute-error"></div>
 {_pick_html(report) if report.pick else ""}
+<div id="sailroute-wrap">
 <div id="{DIV_ID}" style="height: {map_height(report)}px"></div>
+<div id="sailroute-furniture"></div>
+<div id="sailroute-osm" style="top: {map_height(report) - 125}px" hidden></div>
+</div>
+<p class="note" id="sailroute-chart">{_h(fig.get("chart", {}).get("note", ""))} <span
+id="sailroute-tiles">OSM tiles: not tried yet.</span></p>
 {notes}
 {folded}
 {tables}
 <footer>Written by sailroute {_h(__version__)}; drawing: plotly.js (MIT licence), in
-{_h(plotly_src)}.</footer>
+{_h(plotly_src)}; map tiles, when online: © OpenStreetMap contributors (ODbL).</footer>
 <script type="application/json" id="{FIGURE_ID}">{_json_for_script(fig)}</script>
 <script>{js}</script>
 </body>

@@ -35,6 +35,8 @@ from sailroute.course.model import Course
 from sailroute.errors import OutOfCoverageError
 from sailroute.planning.result import Comparison, Plan
 from sailroute.report.area import draw_area, fit_area
+from sailroute.routing.laylines import Layline
+from sailroute.routing.startline import StartLineNumbers
 from sailroute.routing.types import LegResult
 from sailroute.timeutil import iso, offset_text
 from sailroute.units import KNOT, circular_mean_deg, wind_speed_direction
@@ -56,7 +58,9 @@ def _extent(course: Course, legs: Sequence[LegResult], pad: float = 0.08) -> tup
     for r in legs:
         xs += [float(r.track.x.min()), float(r.track.x.max())]
         ys += [float(r.track.y.min()), float(r.track.y.max())]
-    x0, x1, y0, y1 = fit_area(course.area, (min(xs), max(xs), min(ys), max(ys)))
+    from sailroute.report.chart import fit_chart
+
+    x0, x1, y0, y1 = fit_chart(course, fit_area(course.area, (min(xs), max(xs), min(ys), max(ys))))
     span = max(x1 - x0, y1 - y0, 100.0)
     return x0 - pad * span, x1 + pad * span, y0 - pad * span, y1 + pad * span
 
@@ -71,23 +75,9 @@ def _map_frame(ax: Axes, extent: Sequence[float]) -> None:
     ax.grid(True, lw=0.3, alpha=0.5)
 
 
-def _label_directions(course: Course) -> dict[str, tuple[float, float]]:
-    """Unit offset direction of each mark's label: away from its line/gate partner, or
-    away from the course centroid for single marks."""
-    cx = float(np.mean([m.x for m in course.marks.values()]))
-    cy = float(np.mean([m.y for m in course.marks.values()]))
-    out = {name: (m.x - cx, m.y - cy) for name, m in course.marks.items()}
-    for ln in (*course.lines.values(), *course.gates.values()):
-        out[ln.a.name] = (ln.a.x - ln.b.x, ln.a.y - ln.b.y)
-        out[ln.b.name] = (ln.b.x - ln.a.x, ln.b.y - ln.a.y)
-    for k, (dx, dy) in out.items():
-        n = float(np.hypot(dx, dy))
-        out[k] = (dx / n, dy / n) if n > 0 else (0.7071, 0.7071)
-    return out
-
-
 def draw_course(ax: Axes, course: Course) -> None:
-    """Draw marks (with names), start/finish lines (solid) and gates (dotted) on ``ax``."""
+    """Draw marks, start/finish lines (solid) and gates (dotted) on ``ax``; the marks'
+    names are placed by :func:`sailroute.report.mapdraw.finish_map` (:func:`course_labels`)."""
     mx = [m.x for m in course.marks.values()]
     my = [m.y for m in course.marks.values()]
     ax.plot(
@@ -102,21 +92,6 @@ def draw_course(ax: Axes, course: Course) -> None:
         label="marks",
         linestyle="none",
     )
-    dirs = _label_directions(course)
-    for m in course.marks.values():
-        dx, dy = dirs[m.name]
-        ha = "left" if dx > 0.3 else ("right" if dx < -0.3 else "center")
-        va = "bottom" if dy > 0.3 else ("top" if dy < -0.3 else "center")
-        ax.annotate(
-            m.name,
-            (m.x, m.y),
-            xytext=(9 * dx, 9 * dy),
-            textcoords="offset points",
-            fontsize=8,
-            zorder=6,
-            ha=ha,
-            va=va,
-        )
     for ln in course.lines.values():
         ax.plot(
             [ln.a.x, ln.b.x],
@@ -137,6 +112,18 @@ def draw_course(ax: Axes, course: Course) -> None:
             zorder=4,
             gid=f"gate:{g.name}",
         )
+
+
+def course_labels(course: Course) -> dict[str, Any]:
+    """The keyword arguments of :func:`~sailroute.report.mapdraw.finish_map` for a
+    course: its marks and its lines and gates (which names keep off)."""
+    return {
+        "marks": [(m.name, m.x, m.y) for m in course.marks.values()],
+        "lines": [
+            np.array([[ln.a.x, ln.a.y], [ln.b.x, ln.b.y]])
+            for ln in (*course.lines.values(), *course.gates.values())
+        ],
+    }
 
 
 def _draw_wind(
@@ -175,9 +162,7 @@ def _draw_wind(
             vmax=hi,
         )
         mesh.set_gid("wind-field")
-        fig.colorbar(
-            mesh, ax=ax, orientation="horizontal", fraction=0.04, pad=0.08, label="wind speed [kn]"
-        )
+        fig.colorbar(mesh, ax=ax, shrink=0.8, pad=0.1, fraction=0.03, label="wind speed [kn]")
     q = ax.quiver(gx, gy, u, v, color="0.35", alpha=0.7, zorder=1, angles="xy", pivot="middle")
     q.set_gid("wind")
     mean_dir = circular_mean_deg(twd, weights=spd) if float(spd.sum()) > 0 else 0.0
@@ -325,6 +310,8 @@ def plot_route(
     *,
     title: str | None = None,
     utc_offset_s: float = 0.0,
+    start_line: StartLineNumbers | None = None,
+    laylines: Sequence[Sequence[Layline]] = (),
 ) -> Figure:
     """Map of a routed course.
 
@@ -333,7 +320,9 @@ def plot_route(
     course : Course
         Marks, lines and gates to draw, and the race area (boundary and obstacles,
         under the routes; the map's extent takes them in as
-        :func:`sailroute.report.area.fit_area` says).
+        :func:`sailroute.report.area.fit_area` says), over the chart
+        (:func:`sailroute.report.chart.chart_for`: the course's chart file, GSHHG or the
+        wind's land mask).
     legs : sequence of LegResult
         The routed legs; each is one ``LineCollection`` coloured by boat speed [kn].
     wind : WindField, optional
@@ -345,37 +334,58 @@ def plot_route(
         Axes title.
     utc_offset_s : float
         The course's local offset from UTC [s], for the times shown.
+    start_line : StartLineNumbers, optional
+        Its favoured end is starred.
+    laylines : sequence of sequence of Layline
+        Per leg, its laylines (dashed grey).
 
     Returns
     -------
     matplotlib.figure.Figure
+        The map, with the scale bar, north arrow and the names and symbols placed so that
+        they overlap nothing (:func:`sailroute.report.mapdraw.finish_map`); the legend
+        under the map.
     """
     from matplotlib.collections import LineCollection
     from matplotlib.colors import Normalize
     from matplotlib.figure import Figure
     from matplotlib.transforms import offset_copy
 
+    from sailroute.report.chart import chart_for, draw_chart
+    from sailroute.report.mapdraw import MapItem, finish_map
+    from sailroute.report.startline import draw_laylines
+
     extent = _extent(course, legs)
     aspect = (extent[3] - extent[2]) / (extent[1] - extent[0])
-    # the map axes is about 7 in wide once the margins and colour bar are taken
-    height = float(np.clip(7.0 * aspect + 1.6, 4.5, 11.0))
+    # the map axes is about 7 in wide once the margins and colour bar are taken; the
+    # legend goes under it
+    map_h = float(np.clip(7.0 * aspect, 3.0, 9.4))
+    height = map_h + 1.6 + LEGEND_IN
     fig = Figure(figsize=(10.0, height))
     # a fixed layout in inches (constrained layout cost 0.2-0.45 s of a 1.8 s plan):
-    # room for the metre ticks (left, bottom), the title and longitude axis (top), and
-    # the latitude axis and colour bar (right)
+    # room for the metre ticks (left, bottom) and the legend under them, the title and
+    # longitude axis (top), and the latitude axis and colour bar (right)
     fig.subplots_adjust(
-        left=0.75 / 10.0, right=1.0 - 1.2 / 10.0, bottom=0.55 / height, top=1.0 - 0.85 / height
+        left=0.75 / 10.0,
+        right=1.0 - 1.2 / 10.0,
+        bottom=(0.55 + LEGEND_IN) / height,
+        top=1.0 - 0.85 / height,
     )
     ax = fig.add_subplot()
     if t is None:
         t = legs[0].t_start if legs else course.start_epoch
     wind_label = _draw_wind(ax, fig, wind, t, extent, utc_offset_s) if wind is not None else None
+    chart = chart_for(course, [wind], extent)
+    draw_chart(ax, chart, extent)
     draw_area(ax, course.area)
     draw_course(ax, course)
+    draw_laylines(ax, laylines)
     bsp_all = np.concatenate([r.track.bsp_ms for r in legs]) / KNOT if legs else np.zeros(1)
     norm = Normalize(*speed_limits(bsp_all))
     lc = None
     repeats = repeat_index(legs)
+    items: list[MapItem] = []
+    shifts: list[tuple[float, float]] = []
     for k, r in enumerate(legs):
         pts = np.column_stack([r.track.x, r.track.y])
         segs = np.stack([pts[:-1], pts[1:]], axis=1)
@@ -389,61 +399,66 @@ def plot_route(
         )
         lc.set_array(r.track.bsp_ms[:-1] / KNOT)
         lc.set_gid(f"leg:{k + 1}")
+        shifts.append((0.0, 0.0))
         if repeats[k]:  # the same water as an earlier leg: shift it sideways on screen
             dx, dy = np.subtract(r.end_xy, r.start_xy)
             n = float(np.hypot(dx, dy)) or 1.0
             off = OFFSET_PT * repeats[k]
+            shifts[-1] = (off * dy / n, -off * dx / n)
             lc.set_transform(
                 offset_copy(ax.transData, fig=fig, x=off * dy / n, y=-off * dx / n, units="points")
             )
         ax.add_collection(lc)
         i = label_point(r, k)
-        ax.annotate(
-            str(k + 1),
-            (float(r.track.x[i]), float(r.track.y[i])),
-            xytext=(0, 0),
-            textcoords="offset points",
-            fontsize=7,
-            ha="center",
-            va="center",
-            zorder=9,
-            gid=f"legno:{k + 1}",
-            bbox={"boxstyle": "circle,pad=0.2", "fc": "white", "ec": "0.3", "lw": 0.6},
-        )
+        items.append(MapItem("legno", float(r.track.x[i]), float(r.track.y[i]), str(k + 1)))
     legs_wind = _leg_wind(ax, wind, legs, extent) if wind is not None else None
     if legs_wind:
         wind_label = f"{wind_label}\n{legs_wind}" if wind_label else legs_wind
     if lc is not None:
+        # beside the map's latitude axis (a wind speed bar moves out beyond it)
         fig.colorbar(lc, ax=ax, label="boat speed [kn]", shrink=0.8, pad=0.09, fraction=0.04)
-    tacks = [(m.x, m.y) for r in legs for m in r.manoeuvres if m.kind == "tack"]
-    gybes = [(m.x, m.y) for r in legs for m in r.manoeuvres if m.kind == "gybe"]
-    ax.plot(
-        [p[0] for p in tacks],
-        [p[1] for p in tacks],
-        "^",
-        color="crimson",
-        ms=6,
-        linestyle="none",
-        zorder=7,
-        gid="tacks",
-        label=f"tacks ({len(tacks)})",
-    )
-    ax.plot(
-        [p[0] for p in gybes],
-        [p[1] for p in gybes],
-        "s",
-        color="royalblue",
-        ms=5,
-        linestyle="none",
-        zorder=7,
-        gid="gybes",
-        label=f"gybes ({len(gybes)})",
-    )
+    items += [MapItem(m.kind, m.x, m.y) for r in legs for m in r.manoeuvres]
+    if start_line is not None and start_line.favoured_xy is not None:
+        fx, fy = start_line.favoured_xy
+        items.append(MapItem("favoured", fx, fy, f"favoured +{start_line.gain_m:.0f} m"))
     _map_frame(ax, extent)
     _latlon_axes(ax, course)
-    ax.legend(loc="best", fontsize=8, title=wind_label, title_fontsize=8)
     ax.set_title(title or course.name, fontsize=10)
+    finish_map(
+        fig,
+        ax,
+        routes=[np.column_stack([r.track.x, r.track.y]) for r in legs],
+        items=items,
+        shifts_pt=shifts,
+        **course_labels(course),
+    )
+    legend_under(ax, wind_label)
     return fig
+
+
+LEGEND_IN = 1.1
+"""Height under the map kept for its legend [in]."""
+
+
+def legend_under(ax: Axes, title: str | None = None) -> None:
+    """The map's legend under it (it covers nothing of the map), in columns."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return
+    ax.apply_aspect()
+    height_in = ax.get_position().height * float(ax.get_figure(root=True).get_figheight())  # type: ignore[union-attr]
+    ax.legend(
+        handles,
+        labels,
+        loc="upper left",
+        bbox_to_anchor=(0.0, -0.42 / max(height_in, 0.5)),
+        ncol=min(4, len(handles)),
+        fontsize=8,
+        title=title,
+        title_fontsize=8,
+        frameon=False,
+        alignment="left",
+    )
 
 
 def plot_plan(plan: Plan, wind: WindField | None = None) -> Figure:
@@ -456,11 +471,16 @@ def plot_plan(plan: Plan, wind: WindField | None = None) -> Figure:
         f"{plan.course.name} - {plan.scenario}: {format_duration(plan.total_time_s)} "
         f"({plan.total_time_s:.0f} s), start {local_time(plan.t_start, off)}"
     )
-    fig = plot_route(plan.course, plan.results, wind, plan.t_start, title=title, utc_offset_s=off)
-    from sailroute.report.startline import draw_start_and_laylines
-
-    draw_start_and_laylines(fig.axes[0], plan.start_line, plan.laylines)
-    return fig
+    return plot_route(
+        plan.course,
+        plan.results,
+        wind,
+        plan.t_start,
+        title=title,
+        utc_offset_s=off,
+        start_line=plan.start_line,
+        laylines=plan.laylines,
+    )
 
 
 def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:

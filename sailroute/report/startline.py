@@ -100,14 +100,10 @@ def laylines_to_dicts(laylines: Sequence[Layline], frame: LocalFrame) -> list[di
 # --- drawings --------------------------------------------------------------------------
 
 
-def draw_start_and_laylines(
-    ax: Any, sl: StartLineNumbers | None, laylines: Sequence[Sequence[Layline]]
-) -> None:
-    """Laylines (dashed grey) and the favoured end (green star) on a matplotlib map.
-
-    Artists carry gids ``layline:<leg>:<mark>:<tack>`` and ``favoured-end``; an existing
-    legend is drawn again with them (same title).
-    """
+def draw_laylines(ax: Any, laylines: Sequence[Sequence[Layline]]) -> None:
+    """Laylines (dashed grey) on a matplotlib map, gids ``layline:<leg>:<mark>:<tack>``
+    (the favoured end's star is placed with the map's labels:
+    :func:`sailroute.report.mapdraw.finish_map`)."""
     first = True
     for k, leg in enumerate(laylines):
         for ll in leg:
@@ -122,33 +118,6 @@ def draw_start_and_laylines(
                 label="laylines" if first else None,
             )
             first = False
-    if sl is not None and sl.favoured_xy is not None:
-        fx, fy = sl.favoured_xy
-        ax.plot(
-            [fx],
-            [fy],
-            marker="*",
-            ms=15,
-            color=FAVOURED_COLOUR,
-            mec="black",
-            mew=0.6,
-            linestyle="none",
-            zorder=8,
-            gid="favoured-end",
-            label="favoured start end",
-        )
-        ax.annotate(
-            f"favoured +{sl.gain_m:.0f} m",
-            (fx, fy),
-            xytext=(8, -12),
-            textcoords="offset points",
-            fontsize=7,
-            color="#1b5e20",
-            zorder=9,
-        )
-    old = ax.get_legend()
-    if old is not None and (not first or (sl is not None and sl.favoured_xy is not None)):
-        ax.legend(loc="best", fontsize=8, title=old.get_title().get_text(), title_fontsize=8)
 
 
 def plotly_traces(
@@ -183,8 +152,10 @@ def plotly_traces(
                 "type": "scatter",
                 "mode": "markers",
                 "name": "favoured end",
+                "meta": "favoured",
                 "x": [round(float(lon), 7)],
                 "y": [round(float(lat), 7)],
+                "text": [f"favoured +{sl.gain_m:.0f} m"],
                 "marker": {
                     "symbol": "star",
                     "size": 16,

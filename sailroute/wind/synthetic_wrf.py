@@ -117,6 +117,7 @@ def write_wrfout(
     title: str = "SYNTHETIC wrfout written by sailroute (not model output, not a forecast)",
     write_alpha: bool = True,
     extra_attrs: dict[str, object] | None = None,
+    land: NDArray[np.bool_] | None = None,
 ) -> Path:
     """Write a small wrfout-layout NetCDF file.
 
@@ -141,6 +142,9 @@ def write_wrfout(
         Write ``COSALPHA``/``SINALPHA`` (False tests the cone-factor fallback).
     extra_attrs : dict, optional
         More global attributes.
+    land : ndarray of bool, shape (ny, nx), optional
+        Land cells: written as WRF's ``LANDMASK`` (1 land, 0 water) and ``XLAND`` (1
+        land, 2 water) at every time.
 
     Returns
     -------
@@ -222,6 +226,10 @@ def write_wrfout(
                 sa, (nt, ny, nx)
             )
         var("HGT", d3, "Terrain Height", "m")[:] = np.zeros((nt, ny, nx))
+        if land is not None:
+            mask = np.broadcast_to(np.asarray(land, dtype=bool), (nt, ny, nx))
+            var("LANDMASK", d3, "LAND MASK (1 FOR LAND, 0 FOR WATER)", "")[:] = mask
+            var("XLAND", d3, "LAND MASK (1 FOR LAND, 2 FOR WATER)", "")[:] = np.where(mask, 1, 2)
         u10 = np.empty((nt, ny, nx))
         v10 = np.empty((nt, ny, nx))
         for k, tk in enumerate(t):

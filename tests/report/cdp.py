@@ -38,6 +38,19 @@ fetch would fail loudly)."""
 
 FLAGS = [*OFFLINE_FLAGS, "--hide-scrollbars", "--remote-debugging-pipe"]
 
+TILE_HOST = "https://tile.openstreetmap.org/"
+"""Where a page asks for OSM tiles: offline, its one try logs a failed load."""
+
+
+def page_errors(console: list[str]) -> list[str]:
+    """The console lines of a page, less the failed load of the OSM tile it tries once to
+    learn whether the browser is online (every host resolves to nothing here)."""
+    return [
+        c
+        for c in console
+        if not (c.startswith("log error: Failed to load resource") and TILE_HOST in c)
+    ]
+
 
 class Page:
     """One tab of a headless Chromium, driven by protocol messages."""

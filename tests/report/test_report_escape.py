@@ -69,7 +69,7 @@ def test_no_name_reaches_plotly_as_markup(planned: Path) -> None:
 
 @pytest.mark.browser
 def test_names_read_as_written_in_chromium(planned: Path) -> None:
-    from tests.report.cdp import browser
+    from tests.report.cdp import browser, page_errors
     from tests.report.test_report_browser import CHROMIUM, REQUIRED
 
     if CHROMIUM is None and not REQUIRED:
@@ -79,7 +79,8 @@ def test_names_read_as_written_in_chromium(planned: Path) -> None:
         tab.open(planned.as_uri())
         assert tab.evaluate("document.body.getAttribute('data-map')") == "drawn"
         labels = tab.evaluate(
-            "Array.from(document.querySelectorAll('#sailroute-map .textpoint text'))"
+            "Array.from(document.querySelectorAll("
+            "'#sailroute-map .textpoint text, #sailroute-map .annotation-text'))"
             ".map(function(t){return t.textContent;})"
         )
         assert set(NAMES.values()) <= set(labels)  # with the leg numbers
@@ -109,4 +110,4 @@ def test_names_read_as_written_in_chromium(planned: Path) -> None:
         assert hovers[0].endswith(f"layline to {NAMES['top']}"), hovers
         assert hovers[1].startswith(f"favoured end {NAMES['boat']}: bias"), hovers
         assert tab.evaluate("document.title") != "pwned"
-        assert tab.console == []
+        assert page_errors(tab.console) == []

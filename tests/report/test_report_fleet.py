@@ -378,7 +378,7 @@ EVIL = '<b>x</b><script>document.title="pwned"</script>'
 
 @pytest.mark.browser
 def test_sixty_boats_in_chromium_at_1280_px(plan_mod, tmp_path: Path) -> None:
-    from tests.report.cdp import browser
+    from tests.report.cdp import browser, page_errors
     from tests.report.test_report_browser import CHROMIUM, REQUIRED
 
     if CHROMIUM is None and not REQUIRED:
@@ -392,7 +392,7 @@ def test_sixty_boats_in_chromium_at_1280_px(plan_mod, tmp_path: Path) -> None:
     with browser(CHROMIUM, 1280, 900) as tab:
         tab.open(page.as_uri() + "#boat=boat%2003")
         assert tab.evaluate("document.body.getAttribute('data-map')") == "drawn"
-        assert tab.console == []
+        assert page_errors(tab.console) == []
         # the results table fits: nothing to scroll sideways, nor on the page
         sw, cw = tab.evaluate(
             "(function(){var d=document.getElementById('results').parentElement;"
@@ -446,7 +446,7 @@ def test_sixty_boats_in_chromium_at_1280_px(plan_mod, tmp_path: Path) -> None:
         )
         assert col[0] == max(c for c in col if c != "unknown")
         assert col[-3:] == ["45:00.0", "unknown", "unknown"]  # boats 60 and 59 last
-        assert tab.console == []
+        assert page_errors(tab.console) == []
 
 
 def _rgb(path: Path) -> np.ndarray:

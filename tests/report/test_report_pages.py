@@ -158,7 +158,7 @@ def test_the_bundle_is_written_whole_and_never_through_a_link(tmp_path: Path) ->
 def test_pages_open_offline_from_disk_and_say_when_the_bundle_is_missing(
     fleet_pages, tmp_path: Path
 ) -> None:
-    from tests.report.cdp import browser
+    from tests.report.cdp import browser, page_errors
     from tests.report.test_report_browser import CHROMIUM, REQUIRED
 
     if CHROMIUM is None and not REQUIRED:
@@ -170,7 +170,7 @@ def test_pages_open_offline_from_disk_and_say_when_the_bundle_is_missing(
             tab.open(page.as_uri())
             assert tab.evaluate("document.body.getAttribute('data-map')") == "drawn"
             assert tab.evaluate("document.querySelectorAll('#sailroute-map .scatterlayer').length")
-        assert tab.console == []
+        assert page_errors(tab.console) == []
         # the page copied away from its folder says what is missing
         alone = tmp_path / "alone"
         alone.mkdir()

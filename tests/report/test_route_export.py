@@ -95,6 +95,29 @@ def test_kml_holds_the_marks_the_route_line_and_the_waypoints(tmp_path, plan):
     assert [w.find("k:name", K).text for w in wps] == [p.name for p in pts]
     assert [w.find("k:TimeStamp/k:when", K).text for w in wps] == [iso(p.t) for p in pts]
     assert wps[1].find("k:description", K).text.startswith("tack, leg 1, ")
+    assert wps[1].find("k:description", K).text.endswith("plotter id T01")
+
+
+def test_kml_draws_marks_route_and_manoeuvres_in_their_styles(tmp_path, plan):
+    root = ET.parse(write_kml(tmp_path / "route.kml", plan)).getroot()
+    styles = {s.get("id"): s for s in root.findall("k:Document/k:Style", K)}
+    assert set(styles) == {"mark", "leg-end", "tack", "gybe", "route"}
+    # KML colours are aabbggrr: the route's #d62728 is ff2827d6
+    assert styles["route"].find("k:LineStyle/k:color", K).text == "ff2827d6"
+    assert styles["tack"].find("k:IconStyle/k:Icon/k:href", K).text.endswith("triangle.png")
+    assert styles["gybe"].find("k:IconStyle/k:Icon/k:href", K).text.endswith("square.png")
+    folders = {f.find("k:name", K).text: f for f in root.findall("k:Document/k:Folder", K)}
+
+    def used(folder):
+        return {
+            pm.find("k:name", K).text: pm.find("k:styleUrl", K).text
+            for pm in folders[folder].findall("k:Placemark", K)
+        }
+
+    assert set(used("marks").values()) == {"#mark"}
+    assert list(used("route").values()) == ["#route"]
+    wps = used("waypoints")
+    assert wps["T1"] == "#tack" and wps["G1"] == "#gybe" and wps["finish"] == "#leg-end"
 
 
 def test_nmea_sentences_parse_and_their_checksums_verify(tmp_path, plan):
@@ -140,14 +163,28 @@ def test_a_long_route_is_split_over_several_rte_sentences():
     assert ids == [m.waypoint_id for m in msgs if m.sentence_type == "WPL"]
     assert len(set(ids)) == 40
     # southern and eastern hemispheres: ddmm.mmmm,S and dddmm.mmmm,E
-    assert lines[0].startswith("$GPWPL,3648.0000,S,17442.0000,E,00MARK")
+    assert lines[0].startswith("$GPWPL,3648.0000,S,17442.0000,E,MARK0*")
+
+
+def test_nmea_ids_say_what_the_point_is_in_six_characters():
+    # the Hyeres R1 route: start, a tack, mark 1, gate4, mark 1 again, two gybes, 4p, finish
+    names = ["start", "T1", "1", "gate4", "1", "G1", "G2", "4p", "finish"]
+    kinds = ["start", "tack", "mark", "gate", "mark", "gybe", "gybe", "mark", "line"]
+    assert nmea_ids(names, kinds) == (
+        "START", "T01", "M1", "G4", "M1R2", "J01", "J02", "M4P", "FIN"
+    )  # fmt: skip
+    # a gate named by its number, a line that is not the finish, a lettered mark
+    assert nmea_ids(["4", "gate", "B1"], ["gate", "line", "mark"]) == ("G4", "LGATE", "B1")
 
 
 def test_nmea_ids_are_unique_and_short():
     ids = nmea_ids(["start", "M1", "T1", "LG1-LG2", "LG1-LG2", "a\x00b"])
-    assert ids == ("00STAR", "01M1", "02T1", "03LG1L", "04LG1L", "05AB")
-    many = nmea_ids([f"T{k}" for k in range(150)])
-    assert len(set(many)) == 150 and max(map(len, many)) <= 6 and many[120] == "120T12"
+    assert ids == ("START", "M1", "T1", "LG1LG2", "LG1LR2", "AB")
+    many = nmea_ids([f"T{k}" for k in range(150)], ["tack"] * 150)
+    assert len(set(many)) == 150 and max(map(len, many)) <= 6 and many[120] == "T120"
+    # names that collide once cut and cleaned still give distinct identifiers
+    same = nmea_ids(["wing mark 1", "wing-mark-1", "WINGMA", "wingma"], ["mark"] * 4)
+    assert len(set(same)) == 4 and max(map(len, same)) <= 6
 
 
 def test_the_plan_files_include_kml_and_nmea(tmp_path, plan):
