@@ -4,6 +4,7 @@ Usage::
 
     .venv/bin/python benchmarks/polar_learn_validation.py [--members 20] [--bootstrap 100]
     .venv/bin/python benchmarks/polar_learn_validation.py --only sailgp --members 0
+    .venv/bin/python benchmarks/polar_learn_validation.py --smoke  # Snipe P01 -> P02, no bands
 
 For each held-out race the polar is learned (``run_fit_command``, the same code as the
 command line) on the other races of the same fleet, and the held-out race is planned in
@@ -238,12 +239,12 @@ def snipe_course(race: str, tmp: Path) -> Path:
     return dest
 
 
-def snipe(tmp: Path, members: int, boot: int) -> list[dict[str, Any]]:
+def snipe(tmp: Path, members: int, boot: int, both: bool = True) -> list[dict[str, Any]]:
     if not SNIPE_DIR.is_dir():
         print(f"Snipe: {SNIPE_DIR} not present: left out")
         return []
     rows = []
-    for learn, held in (("P01", "P02"), ("P02", "P01")):
+    for learn, held in (("P01", "P02"), ("P02", "P01"))[: 2 if both else 1]:
         logs = sorted(SNIPE_DIR.glob(f"2025-06-21-*-{learn}.gpx"))
         out = tmp / f"snipe-{learn}"
         run_fit_command(
@@ -301,7 +302,10 @@ def main() -> None:
     ap.add_argument("--members", type=int, default=20, help="members of the bands (0: none)")
     ap.add_argument("--bootstrap", type=int, default=100, help="bootstrap replicates")
     ap.add_argument("--only", default="", help="sailgp or snipe")
+    ap.add_argument("--smoke", action="store_true", help="Snipe P01 -> P02, no members")
     args = ap.parse_args()
+    if args.smoke:
+        args.only, args.members, args.bootstrap = "snipe", 0, 10
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="polar-learn-") as d:
         tmp = Path(d)
@@ -309,7 +313,7 @@ def main() -> None:
         if args.only in ("", "sailgp"):
             rows += sailgp(tmp, args.members, args.bootstrap)
         if args.only in ("", "snipe"):
-            rows += snipe(tmp, args.members, args.bootstrap)
+            rows += snipe(tmp, args.members, args.bootstrap, both=not args.smoke)
         if rows:
             print_table(rows)
         cov = [r["cover"] for r in rows if "cover" in r]

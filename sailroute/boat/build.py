@@ -298,16 +298,24 @@ def _check_polar(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make |
 
 def _check_learned(c: Checker, spec: Mapping[str, Any], file: Path) -> _Make | None:
     """A learned polar's ``level`` and ``pace`` (the file is read here, once)."""
-    from sailroute.boat.learnfile import read_learned
+    from sailroute.boat.learnfile import is_learned, read_learned
 
     pace = c.choice(spec, "pace", PACES, "steady")
     for uk in ("speed_unit", "wind_unit", "format"):
         if uk in spec:
             c.add(uk, "a learned polar states its units and format: leave this key out")
+    key = "level" if "level" in spec else "pace"
+    if not is_learned(file):
+        c.add(
+            key,
+            f"{file.name} is not a learned polar (no 'learned' block): level and pace are "
+            "keys of the JSON files of `sailroute polar fit`",
+        )
+        return None
     try:
         learned = read_learned(file)
     except InputError as exc:
-        c.add("polar", f"{exc} (level and pace are keys of learned polars only)")
+        c.add("polar", str(exc))
         return None
     level = spec.get("level")
     if level is not None and (not isinstance(level, str) or level not in learned.levels):

@@ -76,6 +76,9 @@ N_MODES: Final = 8
 TAIL_FRACTION: Final = 0.25
 """An upwind (downwind) cell with fewer blocks than this fraction of its column's beat
 (run) row is a tail of it (:func:`_tails`)."""
+TAIL_SPAN_DEG: Final = 15.0
+"""Rows this close to a beat (run) row can hold its tail [°]: a wind-angle error of a
+block rarely exceeds it."""
 VMG_PERCENTILE: Final = 75.0
 """Percentile of a boat's own blocks' VMG that its VMG made good is taken at [%]: above
 the median, since boats sail round their best angle and only a few blocks at it."""
@@ -613,7 +616,7 @@ def _cap(
 ) -> NDArray:
     """Cap upwind cells at ``VMG_up / cos(TWA)`` and downwind at ``VMG_down / |cos|``;
     below the fleet's median upwind angle (above its median downwind angle) the VMG cap
-    falls as ``cos`` of the angle off it."""
+    falls as ``cos`` of the angle off it (a beat's VMG falls off at least that fast)."""
     a = twa[:, None]
     c = np.cos(np.radians(a))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -713,6 +716,7 @@ def learn_polar(
     if sailed_rows:
         twa_n = with_sailed_rows(twa_n, blocks)
     d = _design(blocks, twa_n, tws_n, shape)
+    _check_one_class(d, blocks)
     sup = _support(d, blocks, mb, min_blocks)
     if not sup.learned.any():
         raise InputError(
@@ -722,7 +726,6 @@ def learn_polar(
             f"TWA step: {label('twa_bins_deg')}) or lower {label('min_boats')} / "
             f"{label('min_blocks')}"
         )
-    _check_one_class(d, blocks)
     rows, cols = _kept(sup.learned, twa_n, shape is not None)
     qs = list(lv_map.values())
     lv, factors, e_log = _point(d, blocks, sup, percentile / 100.0, qs, rows, cols)
@@ -1020,9 +1023,10 @@ def _tails(cnt: NDArray, twa_n: NDArray) -> NDArray[np.int64]:
     """Per cell, the row of its column's beat (run) when the cell is a tail of it, else -1.
 
     In each TWS column the upwind (downwind) row with the most blocks is where the boats
-    beat (run); another upwind (downwind) row of that column with fewer than
-    :data:`TAIL_FRACTION` of its blocks holds mostly the beat's (run's) own blocks moved
-    there by wind-angle error (they read the beat's speed at another angle).
+    beat (run); another upwind (downwind) row of that column within :data:`TAIL_SPAN_DEG`
+    of it and with fewer than :data:`TAIL_FRACTION` of its blocks holds mostly the beat's
+    (run's) own blocks moved there by wind-angle error (they read the beat's speed at
+    another angle).
     """
     out = np.full(cnt.shape, -1, dtype=np.int64)
     band = np.digitize(twa_n, BOUNDARIES_DEG)
@@ -1033,7 +1037,8 @@ def _tails(cnt: NDArray, twa_n: NDArray) -> NDArray[np.int64]:
         for j in range(cnt.shape[1]):
             c = cnt[rows, j]
             top = int(rows[np.argmax(c)])
-            few = (c > 0) & (c < TAIL_FRACTION * cnt[top, j]) & (rows != top)
+            near = np.abs(twa_n[rows] - twa_n[top]) <= TAIL_SPAN_DEG
+            few = (c > 0) & (c < TAIL_FRACTION * cnt[top, j]) & (rows != top) & near
             out[rows[few], j] = top
     return out
 
@@ -1113,16 +1118,16 @@ def _check_one_class(d: _Design, blocks: Blocks) -> None:
     _, a = _factor_fit(c, d.band[real])
     w = np.array([(c.weight[:, d.band[real] == k]).sum(1) for k in range(3)]).T
     overall = np.nansum(np.nan_to_num(a) * w, axis=1) / np.maximum(w.sum(1), 1e-9)
-    for b in range(nb):
-        others = np.median(np.delete(overall, b))
-        r = float(np.exp(overall[b] - others))
-        if r > MAX_CLASS_RATIO or r < 1.0 / MAX_CLASS_RATIO:
-            raise InputError(
-                f"logs of different classes: {names[b]} sails {r:.2f}x the speed of the rest "
-                f"of the fleet in the same wind and at the same angles (one class differs by "
-                f"less than {MAX_CLASS_RATIO:g}x): these cannot be one boat; learn each class "
-                "on its own, or leave the log out"
-            )
+    ratio = np.array([overall[b] - np.median(np.delete(overall, b)) for b in range(nb)])
+    b = int(np.argmax(np.abs(ratio)))  # the boat furthest from the rest
+    r = float(np.exp(ratio[b]))
+    if r > MAX_CLASS_RATIO or r < 1.0 / MAX_CLASS_RATIO:
+        raise InputError(
+            f"logs of different classes: {names[b]} sails {r:.2f}x the speed of the rest "
+            f"of the fleet in the same wind and at the same angles (one class differs by "
+            f"less than {MAX_CLASS_RATIO:g}x): these cannot be one boat; learn each class "
+            "on its own, or leave the log out"
+        )
 
 
 def sanity_verdict(learned: LearnedPolar, blocks: Blocks, factors: NDArray) -> tuple[str, ...]:
