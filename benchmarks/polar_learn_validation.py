@@ -216,7 +216,7 @@ def sailgp(tmp: Path, members: int, boot: int) -> list[dict[str, Any]]:
             c = with_boat_and_wind(courses[held], tmp / f"held-{held}.yaml", spec, tws, twd)
             plans[tag] = plan_legs(c)
         bands = band(c, learned, tws, twd, members, 1)
-        r = row(f"SailGP 2501190{held} (learned on the other 3)", obs, LEGS, plans, bands)
+        r = row(f"SailGP 250119{held} (learned on the other 3)", obs, LEGS, plans, bands)
         r["wind"] = f"{tws:.1f} kn {twd:.0f} deg"
         rows.append(r)
     return rows

@@ -46,6 +46,7 @@ from typing import Final
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.boat.fit import check_non_negative
 from sailroute.errors import InputError
 from sailroute.units import bearing_deg, wrap180
 
@@ -93,10 +94,7 @@ class SteadyRules:
     min_block_s: float = 8.0
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            v = getattr(self, f.name)
-            if not (isinstance(v, (int, float)) and np.isfinite(v) and v >= 0):
-                raise InputError(f"steady rules: {f.name} must be a finite number >= 0; got {v!r}")
+        check_non_negative(self, "steady rules")
         if self.block_s <= 0 or self.smooth_s <= 0:
             raise InputError(
                 f"steady rules: block_s and smooth_s must be > 0; got {self.block_s}, "
