@@ -16,6 +16,10 @@ point of sail from the fleet's own tracks:
 3. the course's polar is scaled by these factors exactly as a course's
    ``boat: {efficiency: ...}`` scales it (:func:`sailroute.boat.efficiency.scale_polar`).
 
+The factors are :func:`sailroute.boat.efficiency.band_factors`, which ``polar fit`` shares
+(its race pace is the same three factors from leg times, :mod:`sailroute.analysis.racepace`;
+``--shape`` scales a polar to the learned cells with them).
+
 Three factors, not one per TWA row: the ratio at a single angle carries the error of
 the wind direction (a boat 10° higher than the wind it is judged in shows a high ratio
 at a low angle), and a per-angle envelope turns that noise into a polar that points

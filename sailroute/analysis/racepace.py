@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.analysis.learnsamples import FleetSamples
-from sailroute.boat.learn import BAND_NAMES, LearnedPolar
+from sailroute.boat.learn import LearnedPolar
 from sailroute.course.model import Course
 from sailroute.units import circular_mean_deg
 
@@ -119,7 +119,8 @@ def race_pace(
     learned : LearnedPolar
         With each level's race pace set (unchanged when no leg was timed).
     notes : tuple of str
-        One line per race routed, and the pace per level.
+        One line per race routed (the paces are the levels' own,
+        :attr:`sailroute.boat.learn.LevelTable.race_pace`).
     """
     from sailroute.planning.result import make_plan
     from sailroute.planning.route import route_course, settings_for
@@ -160,10 +161,6 @@ def race_pace(
         p = level_pace(f, t.percentile)
         if p is not None:
             pace[name] = p
-            notes.append(
-                f"race pace of {name}: "
-                + ", ".join(f"{b} x{v:.3f}" for b, v in zip(BAND_NAMES, p, strict=True))
-            )
     return learned.with_race_pace(pace), tuple(notes)
 
 

@@ -1,12 +1,11 @@
-"""Samples for a polar fit from a log, and a fitted polar's errors against a reference.
+"""Samples of one log for :func:`sailroute.boat.fit.fit_polar`, the TWS nodes of a fit,
+and a fitted polar's errors against a reference.
 
-Two kinds of input give the samples :func:`sailroute.boat.fit.fit_polar` needs:
-
-* an **instrument log** (CSV read by :func:`sailroute.track.read.read_track`) with
-  TWS and TWA (or TWD and a heading) and a boat speed: ``bsp`` if the log has
-  it, else ``sog`` (the report says which): :func:`samples_from_log`;
-* a **GPS track** (GPX or CSV) plus a course file and one of its wind scenarios:
-  :func:`sailroute.commands.polar_fit.samples_from_course_wind`.
+:func:`samples_from_log` reads an **instrument log** (CSV read by
+:func:`sailroute.track.read.read_track`) with TWS and TWA (or TWD and a heading) and a boat
+speed: ``bsp`` if the log has it, else ``sog``.  ``sailroute polar fit`` learns from a
+fleet instead (:mod:`sailroute.boat.learn`); it shares :func:`auto_tws_bins` and
+:func:`compare_polars`.
 """
 
 from __future__ import annotations

@@ -10,14 +10,16 @@ sanity verdict.
 Method
 ------
 1. **Cells.** Each block goes to the nearest TWS node and the nearest TWA node (bin edges
-   halfway).  Besides the table's cells, every upwind block (TWA below 70°) is one
-   sample of the boat's **upwind VMG** in its TWS column, and every downwind block (above
-   120°) of its downwind VMG (the point-of-sail bands of
+   halfway); the angles the fleet beats and runs at are rows of their own
+   (:func:`with_sailed_rows`).  Besides the table's cells, every upwind block (TWA below
+   70°) is one sample of the boat's **upwind VMG** in its TWS column, and every downwind
+   block (above 120°) of its downwind VMG (the point-of-sail bands of
    :mod:`sailroute.boat.efficiency`).
 2. **A boat's speed in a cell** is the ``percentile`` (default the median) of its blocks'
-   speeds there, weighted by duration.  A block's speed is first moved to the cell's node
-   along the current fit (``v P(node) / P(block)``, ratio clipped to 0.5-2, twice), so
-   that a cell sailed on its fast side is not read as fast at its node.
+   speeds there, weighted by duration; its VMG made good the :data:`VMG_PERCENTILE` of its
+   blocks' VMG.  A block's speed is first moved to the cell's node along the current fit
+   (``v P(node) / P(block)``, ratio clipped to 0.5-2, twice), so that a cell sailed on its
+   fast side is not read as fast at its node.
 3. **Levels across boats.**  ``log v[b, c] = p[c] + a[b, band(c)]``: a cell's speed is the
    cell's own value times the boat's factor on that point of sail (upwind, reach,
    downwind), fitted by weighted least squares (weights: blocks).  The level ``q`` of
@@ -25,23 +27,28 @@ Method
    factors, so that a cell sailed by some of the boats is placed as the whole fleet
    would sail it.  One boat: every level is that boat.
 4. **Learned or refused.**  A cell is learned when at least ``min_boats`` boats and
-   ``min_blocks`` blocks sailed it and its blocks' mean TWA lies within a quarter of the
-   cell's width of its node (else the value at the node would be an extrapolation of
-   data sailed elsewhere).  Every other cell with data is refused, with the reason.
+   ``min_blocks`` blocks sailed it, its blocks' mean TWA and TWS lie within a quarter of
+   the cell of its node (else the value at the node would be an extrapolation of data
+   sailed elsewhere), and it is not a tail of the beat or the run (:func:`_tails`).  Every
+   other cell with data is refused, with the reason.
 5. **Finish.**  Along each TWA row the learned values are made non-decreasing in TWS
    except across drops larger than twice their combined uncertainty (as
    :func:`sailroute.boat.fit.fit_polar`); then **no cell promises more VMG than the fleet
    made good**: upwind cells are capped at ``VMG_up / cos(TWA)`` and downwind cells at
-   ``VMG_down / |cos(TWA)|`` of their column's level.  A wind-angle error sends samples
+   ``VMG_down / |cos(TWA)|`` of their column's level, the cap falling as ``cos`` of the
+   angle beyond the fleet's median beat (run) angle.  A wind-angle error sends samples
    sailed at the boats' best angle into the cells beside it; at a lower angle upwind (a
    deeper one downwind) they promise a VMG no boat sailed, and a router would take it.
-   Rows and columns without a learned cell are left out; refused and empty cells inside
-   are filled (:func:`sailroute.boat.fit` step 5) and listed.
+   Rows and columns without a learned cell are left out, but for a guard row beside the
+   lowest upwind and the highest downwind learned row (:func:`_guard`); refused and empty
+   cells inside are filled (:func:`sailroute.boat.fit` step 5, or from a ``shape`` polar)
+   and listed.
 6. **Uncertainty.**  ``n_boot`` bootstrap replicates resample the boats and, within each
    boat, its blocks (time blocks), and repeat steps 2-5 on the same grid.  Per cell: the
-   standard deviation of ``log v`` (a relative uncertainty), the P10 and P90, and the
-   replicates' leading modes (the correlation of cells along a row and across the table),
-   from which :func:`draw_polars` draws whole polars.
+   standard deviation of ``log v`` (a relative uncertainty) with the within-cell move of
+   step 2 added in quadrature, the P10 and P90, and the replicates' leading modes (the
+   correlation of cells along a row and across the table), from which
+   :func:`draw_polars` draws whole polars.
 
 The result is independent of the order of the boats and the blocks; the bootstrap is
 seeded.

@@ -154,6 +154,8 @@ def read_learned(path: str | Path, interpolation: str = "pchip") -> LearnedPolar
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(f"{p}: {where}.{key}: missing or not numbers ({exc})") from None
         want = {1: (n,), 2: shape}.get(dims)
+        if dims == 3 and a.size == 0:  # learned without a bootstrap: no modes
+            a = a.reshape(0, m, n)
         if (want is not None and a.shape != want) or (dims == 3 and a.shape[1:] != shape):
             raise InputError(
                 f"{p}: {where}.{key} has shape {a.shape}; expected "
