@@ -136,7 +136,7 @@ def main() -> None:
                     min_count=min_count,
                 )
             t_ours = time.perf_counter() - t0
-            err = compare_polars(fit, ref)
+            err = compare_polars(fit.polar, fit.covered, ref)
             p = fit.polar
             cov = fit.covered
             ii, jj = np.nonzero(cov)

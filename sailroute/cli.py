@@ -799,35 +799,38 @@ polar_app = typer.Typer(
     cls=_Group,
     no_args_is_help=True,
     rich_markup_mode=None,
-    help="Boat polars: fit one from logged data.",
+    help="Boat polars: learn one from a fleet's logged data.",
 )
 app.add_typer(polar_app, name="polar")
 
 
-@polar_app.command("fit", cls=_Command, short_help="Fit a polar to a logged race.")
+@polar_app.command(
+    "fit", cls=_Command, short_help="Learn a polar from a fleet's logs or tracks, at levels."
+)
 def polar_fit_command(
     ctx: typer.Context,
-    log: Annotated[
-        str,
+    logs: Annotated[
+        list[str],
         typer.Argument(
-            help="Instrument log (CSV with tws, twa, bsp or sog) "
-            "or GPS track (GPX/CSV, with --course).",
-            metavar="LOG",
+            help="Instrument logs (CSV with wind columns) and/or GPS tracks (GPX/CSV, with "
+            "--course); several = a fleet.",
+            metavar="LOG...",
         ),
     ],
     course: Annotated[
-        str | None,
+        list[str] | None,
         typer.Option(
             "--course",
             metavar="COURSE",
-            help="Course file whose scenario wind "
-            "gives TWS/TWA at the track points (GPS track input).",
+            help="Course of a race the logs sailed (repeat for several races): each race "
+            "is learned in the wind analyze would judge it in, and its legs give the race "
+            "pace.  Needed for GPS tracks.",
         ),
     ] = None,
     scenario: Annotated[
         str | None,
         typer.Option(
-            "--scenario", "-s", metavar="NAME", help="Scenario of --course (default: the first)."
+            "--scenario", "-s", metavar="NAME", help="Scenario of the courses (default: the first)."
         ),
     ] = None,
     columns: Annotated[
@@ -835,8 +838,7 @@ def polar_fit_command(
         typer.Option(
             "--columns",
             metavar="MAP",
-            help="Log columns the reader does not "
-            "recognise, e.g. 'time=Time,bsp=BSP,tws=TWS,twa=TWA'.",
+            help="Log columns the reader does not recognise, e.g. 'time=Time,tws=TWS,twd=TWD'.",
         ),
     ] = None,
     speed_unit: SpeedUnitOpt = None,
@@ -848,13 +850,35 @@ def polar_fit_command(
             help="Zone of naive log times: UTC, +02:00, Europe/Tallinn.",
         ),
     ] = None,
+    levels: Annotated[
+        str | None,
+        typer.Option(
+            "--levels",
+            metavar="LIST",
+            help="Levels: percentiles of the boats, e.g. 'median=50,top=90' (the default).",
+        ),
+    ] = None,
     percentile: Annotated[
-        float, typer.Option("--percentile", metavar="P", help="Envelope percentile per cell.")
-    ] = 90.0,
-    min_count: Annotated[
+        float,
+        typer.Option(
+            "--percentile", metavar="P", help="Percentile of a boat's own steady speeds per cell."
+        ),
+    ] = 50.0,
+    min_boats: Annotated[
+        int | None,
+        typer.Option(
+            "--min-boats", metavar="N", help="Boats a cell needs (default 2; 1 for one log)."
+        ),
+    ] = None,
+    min_blocks: Annotated[
         int,
-        typer.Option("--min-count", metavar="N", help="Samples a cell needs to count as covered."),
-    ] = 5,
+        typer.Option("--min-blocks", metavar="N", help="Steady blocks a cell needs."),
+    ] = 3,
+    bootstrap: Annotated[
+        int,
+        typer.Option("--bootstrap", metavar="N", help="Bootstrap replicates (0: no uncertainty)."),
+    ] = 200,
+    seed: Annotated[int, typer.Option("--seed", metavar="N", help="Seed of the bootstrap.")] = 0,
     tws_bins: Annotated[
         str | None,
         typer.Option(
@@ -888,28 +912,52 @@ def polar_fit_command(
             help="Speed unit of --reference (default: the reader's, knots for .pol/CSV).",
         ),
     ] = None,
+    name: Annotated[
+        str | None,
+        typer.Option(
+            "--name",
+            metavar="NAME",
+            help="Name of the polar and stem of its files (default: <first log>-fleet).",
+        ),
+    ] = None,
+    shape: Annotated[
+        str | None,
+        typer.Option(
+            "--shape",
+            metavar="POLAR",
+            help="builtin:NAME or a polar file whose shape fills the winds and angles the "
+            "fleet did not sail, scaled to it per point of sail.",
+        ),
+    ] = None,
     json_out: JsonOpt = False,
 ) -> None:
-    """Fit a polar to a logged race: filtered percentile envelope; writes .pol/.csv/.json/.png."""
+    """Learn a polar from a fleet's steady sailing: levels, uncertainty, verdict; writes
+    .pol/.csv/.json/.png."""
     from sailroute.commands.polar_fit import run_fit_command
 
     def run() -> Any:
         _check_out(out)
         return run_fit_command(
-            log,
-            course=course,
+            logs,
+            courses=course or (),
             scenario=scenario,
             columns=columns,
             speed_unit=speed_unit,
             time_zone=time_zone,
+            levels=levels,
             percentile=percentile,
-            min_count=min_count,
+            min_boats=min_boats,
+            min_blocks=min_blocks,
+            bootstrap=bootstrap,
+            seed=seed,
             tws_bins=tws_bins,
             twa_step_deg=twa_step,
             out_dir=out,
             unit=unit,
             reference=reference,
             reference_unit=reference_unit,
+            shape=shape,
+            name=name,
         )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)

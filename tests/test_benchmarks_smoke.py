@@ -18,6 +18,14 @@ SLOW = pytest.mark.slow
 
 CASES = [
     ("bench_polar.py", r"^Polar\.speed \[pchip \]: +\d+ us per 1e5 lookups"),
+    ("bench_polar_learn.py", r"^\| gps \| [\d.]+ \| [\d.]+ \| \d+ \| \d+ \|$"),
+    pytest.param(
+        "polar_learn_validation.py",
+        r"^\| Snipe P02 \(learned on P01\) \| 8 kn 110 deg"
+        if SHARED_REAL.is_dir()
+        else r"^Snipe: .* not present: left out$",
+        marks=SLOW,
+    ),
     ("bench_wind.py", r"^  wrf bilinear \+ linear time +[\d.]+ ms +[\d.]+ Mpoints/s$"),
     (
         "bench_polar_fit.py",

@@ -370,22 +370,26 @@ def test_strategy_wind_within_the_polar_runs(tmp_path):
 
 
 def _log(tmp_path: Path) -> Path:
+    # 10 minutes east at 5 kn, the wind 10 kn from the north: steady reaching
     log = tmp_path / "log.csv"
     rows = [
-        f"2023-01-01T00:{k // 60:02d}:{k % 60:02d}Z,59.5,{24.8 + k * 1e-5:.5f},10,{40 + k % 100},5"
+        f"2023-01-01T00:{k // 60:02d}:{k % 60:02d}Z,59.5,{24.8 + k * 4.5e-5:.6f},10,0"
         for k in range(600)
     ]
-    log.write_text("time,lat,lon,tws_kn,twa_deg,bsp_kn\n" + "\n".join(rows) + "\n")
+    log.write_text("time,lat,lon,tws_kn,twd_deg\n" + "\n".join(rows) + "\n")
     return log
 
 
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--percentile", "0"], "error: --percentile must be in (0, 100], e.g. 90; got 0.0"),
-        (["--min-count", "0"], "error: --min-count must be a whole number >= 1, e.g. 5; got 0"),
-        (["--min-count", "100000"], "a lower --min-count or looser filters"),
-        (["--min-count", "100000"], "(fewer TWS nodes: --tws-bins, a larger TWA step: --twa-step)"),
+        (["--percentile", "0"], "error: --percentile must be in (0, 100], e.g. 50; got 0.0"),
+        (["--min-blocks", "0"], "error: --min-blocks must be a whole number >= 1; got 0"),
+        (["--min-blocks", "100000"], "or lower --min-boats / --min-blocks"),
+        (
+            ["--min-blocks", "100000"],
+            "(fewer TWS nodes: --tws-bins, a larger TWA step: --twa-step)",
+        ),
     ],
 )
 def test_polar_fit_errors_name_the_options(tmp_path, args, message):
@@ -393,8 +397,8 @@ def test_polar_fit_errors_name_the_options(tmp_path, args, message):
         app, ["polar", "fit", str(_log(tmp_path)), *args, "-o", str(tmp_path / "o")]
     )
     assert res.exit_code == 2, res.output
-    assert message in res.output and "fit_polar" not in res.output
-    assert "min_count" not in res.output and len(res.output.strip().splitlines()) == 1
+    assert message in res.output and "learn_polar" not in res.output
+    assert "min_blocks" not in res.output and len(res.output.strip().splitlines()) == 1
     assert not (tmp_path / "o").exists()
 
 

@@ -16,6 +16,10 @@ point of sail from the fleet's own tracks:
 3. the course's polar is scaled by these factors exactly as a course's
    ``boat: {efficiency: ...}`` scales it (:func:`sailroute.boat.efficiency.scale_polar`).
 
+The factors are :func:`sailroute.boat.efficiency.band_factors`, which ``polar fit`` shares
+(its race pace is the same three factors from leg times, :mod:`sailroute.analysis.racepace`;
+``--shape`` scales a polar to the learned cells with them).
+
 Three factors, not one per TWA row: the ratio at a single angle carries the error of
 the wind direction (a boat 10° higher than the wind it is judged in shows a high ratio
 at a low angle), and a per-angle envelope turns that noise into a polar that points
@@ -33,9 +37,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.analysis.loss import POLAR_MIN_MS, manoeuvre_mask
-from sailroute.boat.efficiency import BANDS, BOUNDARIES_DEG, scale_polar
+from sailroute.boat.efficiency import BANDS, band_factors, scale_polar
 from sailroute.boat.polar import Polar
-from sailroute.errors import InputError
 
 PERCENTILE: Final = 75.0
 """Percentile of the fleet's speed ratios that sets each band's factor [%]."""
@@ -80,53 +83,6 @@ class FleetPolar:
             f"fleet-relative polar: {self.polar.name} scaled to P{self.percentile:.0f} of "
             f"SOG/polar of {len(self.boats)} track(s): {parts}"
         )
-
-
-def band_factors(
-    twa_deg: NDArray, ratio: NDArray, *, percentile: float = PERCENTILE, min_count: int = MIN_COUNT
-) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
-    """Upwind, reach and downwind percentiles of speed ratios.
-
-    Parameters
-    ----------
-    twa_deg : ndarray
-        TWA of each point [°] (sign ignored).
-    ratio : ndarray
-        SOG / polar at each point [-]; non-finite and non-positive values are left out.
-    percentile, min_count
-        See the module notes.
-
-    Returns
-    -------
-    factor, count : ndarray, shape (3,)
-        Factors (a band with fewer than ``min_count`` points: the mean of the others)
-        and point counts.
-
-    Raises
-    ------
-    InputError
-        A bad percentile, or no band with enough points.
-    """
-    if not 0.0 < percentile <= 100.0:
-        raise InputError(f"fleet polar: percentile must be in (0, 100]; got {percentile}")
-    a = np.abs(np.asarray(twa_deg, float))
-    r = np.asarray(ratio, float)
-    ok = np.isfinite(a) & np.isfinite(r) & (r > 0)
-    band = np.digitize(a[ok], BOUNDARIES_DEG)  # 0 upwind, 1 reach, 2 downwind
-    count = np.bincount(band, minlength=3).astype(np.int64)
-    factor = np.array(
-        [
-            float(np.percentile(r[ok][band == k], percentile)) if count[k] >= min_count else np.nan
-            for k in range(3)
-        ]
-    )
-    if not np.isfinite(factor).any():
-        raise InputError(
-            f"fleet polar: no point of sail has {min_count} straight-line points "
-            f"(upwind {count[0]}, reach {count[1]}, downwind {count[2]}); analyse more or "
-            "longer tracks, or judge against the course's polar (--reference course)"
-        )
-    return np.where(np.isfinite(factor), factor, np.nanmean(factor)), count
 
 
 def straight_ratios(

@@ -5,6 +5,7 @@ A course file's ``boat`` value takes one of three forms::
     boat: {builtin: ilca7}                       # shipped race polar (default boat)
     boat: {builtin: ilca7-steady}                # shipped steady VPP polar
     boat: {polar: polars/mine.pol, speed_unit: kn, wind_unit: kn}
+    boat: {polar: fleet.json, level: top, pace: race}  # a polar learned by `polar fit`
     boat: {vpp: {class: ilca7, crew_mass_kg: 75}, kinetics: race}  # VPP at load time
 
 The built-in ``ilca7``, ``ilca6`` and ``ilca4`` are race polars (the steady VPP
@@ -12,10 +13,13 @@ plus wave riding and pumping, :mod:`sailroute.boat.kinetics`); ``<class>-steady`
 are the steady VPP alone.  ``kinetics`` (``race``, the default, ``steady``, or a
 mapping of race-model parameters such as ``{sea_age_h: 6}``) picks the same for
 the ``vpp`` form.  ``polar`` paths are relative to the course
-file's folder.  Optional key in every form: ``interpolation`` (``pchip``, the
-default, or ``linear``).  ``allow_extrapolation`` (default false) lets a course
-route in wind above the polar's highest TWS column, with a warning instead of an
-error (:mod:`sailroute.boat.sanity`).
+file's folder.  A polar learned from a fleet (``sailroute polar fit``,
+:mod:`sailroute.boat.learnfile`) takes ``level`` (``median``, ``top``, ... as the file
+holds; default its first) and ``pace`` (``steady``, the default: the table as learned
+from steady sailing; ``race``: scaled by the fleet's race pace per point of sail).
+Optional key in every form: ``interpolation`` (``pchip``, the default, or ``linear``).
+``allow_extrapolation`` (default false) lets a course route in wind above the polar's
+highest TWS column, with a warning instead of an error (:mod:`sailroute.boat.sanity`).
 """
 
 from __future__ import annotations
@@ -48,9 +52,11 @@ _FORMS: Final = ("builtin", "polar", "vpp")
 _COMMON: Final = ("interpolation", "efficiency", "allow_extrapolation")
 _ALLOWED: Final = {
     "builtin": {"builtin", *_COMMON},
-    "polar": {"polar", "speed_unit", "wind_unit", "format", *_COMMON},
+    "polar": {"polar", "speed_unit", "wind_unit", "format", "level", "pace", *_COMMON},
     "vpp": {"vpp", "kinetics", *_COMMON},
 }
+PACES: Final = ("steady", "race")
+"""Values of a learned polar's ``pace`` (:meth:`sailroute.boat.learn.LearnedPolar.polar`)."""
 STEADY_SUFFIX: Final = "-steady"
 """Suffix of the built-in names of the steady VPP polars (``ilca7-steady``)."""
 
@@ -279,6 +285,8 @@ def _check_polar(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make |
     file = c.file(spec, "polar", base_dir, value=path)
     if file is None:
         return None
+    if "level" in spec or "pace" in spec:
+        return _check_learned(c, spec, file)
     return lambda interpolation: read_polar(
         file,
         speed_unit=spec.get("speed_unit"),
@@ -286,6 +294,68 @@ def _check_polar(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make |
         format=fmt,
         interpolation=interpolation,
     )
+
+
+def _check_learned(c: Checker, spec: Mapping[str, Any], file: Path) -> _Make | None:
+    """A learned polar's ``level`` and ``pace`` (the file is read here, once)."""
+    from sailroute.boat.learnfile import is_learned, read_learned
+
+    pace = c.choice(spec, "pace", PACES, "steady")
+    for uk in ("speed_unit", "wind_unit", "format"):
+        if uk in spec:
+            c.add(uk, "a learned polar states its units and format: leave this key out")
+    key = "level" if "level" in spec else "pace"
+    if not is_learned(file):
+        c.add(
+            key,
+            f"{file.name} is not a learned polar (no 'learned' block): level and pace are "
+            "keys of the JSON files of `sailroute polar fit`",
+        )
+        return None
+    try:
+        learned = read_learned(file)
+    except InputError as exc:
+        c.add("polar", str(exc))
+        return None
+    level = spec.get("level")
+    if level is not None and (not isinstance(level, str) or level not in learned.levels):
+        hint = suggest(level, list(learned.levels)).strip() if isinstance(level, str) else ""
+        c.add(
+            "level",
+            f"expected one of {quoted(list(learned.levels))} (the levels of {file.name}); got "
+            f"{show(level)}" + (f" ({hint})" if hint else ""),
+        )
+        return None
+    if pace == "race" and learned.level(level).race_pace is None:
+        c.add(
+            "pace",
+            f"{file.name} has no race pace (it was learned without the races' courses); "
+            "use pace: steady or learn it again with --course",
+        )
+        return None
+    if pace not in PACES:
+        return None
+    return lambda interpolation: learned.polar(level, interpolation, pace)
+
+
+def boat_label(spec: Mapping[str, Any]) -> str:
+    """The boat of a course's ``boat`` block in a few words, for reports and ``plan.json``:
+    ``builtin ilca7``, ``polar f50.csv``, ``polar fleet.json, level top, race pace``,
+    ``vpp ilca7``; ``efficiency`` is added when given."""
+    if "builtin" in spec:
+        text = f"builtin {spec['builtin']}"
+    elif "polar" in spec:
+        text = f"polar {Path(str(spec['polar'])).name}"
+        if "level" in spec or "pace" in spec:
+            text += f", level {spec.get('level', 'default')}, {spec.get('pace', 'steady')} pace"
+    elif "vpp" in spec:
+        vpp = spec["vpp"]
+        text = f"vpp {vpp.get('class', 'ilca7') if isinstance(vpp, Mapping) else 'ilca7'}"
+    else:
+        text = "builtin ilca7"
+    if "efficiency" in spec:
+        text += ", efficiency " + ", ".join(f"{k} {v}" for k, v in dict(spec["efficiency"]).items())
+    return text
 
 
 def _check_vpp(c: Checker, spec: Mapping[str, Any], base_dir: Path) -> _Make | None:

@@ -174,3 +174,57 @@ def efficiency_from_spec(
     probs.raise_if_any()
     assert out is not None
     return out
+
+
+def band_factors(
+    twa_deg: NDArray, ratio: NDArray, *, percentile: float = 75.0, min_count: int = 30
+) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Upwind, reach and downwind percentiles of speed ratios (a polar's scale to data).
+
+    The factors a polar is scaled by to match what was sailed, band by band
+    (:data:`BANDS`): ``analyze --reference fleet``
+    (:mod:`sailroute.analysis.fleetpolar`) from the fleet's points, ``polar fit --shape``
+    (:mod:`sailroute.boat.learn`) from the learned cells.
+
+    Parameters
+    ----------
+    twa_deg : ndarray
+        TWA of each point [°] (sign ignored).
+    ratio : ndarray
+        SOG / polar at each point [-]; non-finite and non-positive values are left out.
+    percentile : float
+        Percentile of each band's ratios [%].
+    min_count : int
+        Points a band needs to set its own factor.
+
+    Returns
+    -------
+    factor, count : ndarray, shape (3,)
+        Factors (a band with fewer than ``min_count`` points: the mean of the others)
+        and point counts.
+
+    Raises
+    ------
+    InputError
+        A bad percentile, or no band with enough points.
+    """
+    if not 0.0 < percentile <= 100.0:
+        raise InputError(f"fleet polar: percentile must be in (0, 100]; got {percentile}")
+    a = np.abs(np.asarray(twa_deg, float))
+    r = np.asarray(ratio, float)
+    ok = np.isfinite(a) & np.isfinite(r) & (r > 0)
+    band = np.digitize(a[ok], BOUNDARIES_DEG)  # 0 upwind, 1 reach, 2 downwind
+    count = np.bincount(band, minlength=3).astype(np.int64)
+    factor = np.array(
+        [
+            float(np.percentile(r[ok][band == k], percentile)) if count[k] >= min_count else np.nan
+            for k in range(3)
+        ]
+    )
+    if not np.isfinite(factor).any():
+        raise InputError(
+            f"fleet polar: no point of sail has {min_count} straight-line points "
+            f"(upwind {count[0]}, reach {count[1]}, downwind {count[2]}); analyse more or "
+            "longer tracks, or judge against the course's polar (--reference course)"
+        )
+    return np.where(np.isfinite(factor), factor, np.nanmean(factor)), count

@@ -58,7 +58,7 @@ The result is a valid :class:`~sailroute.boat.polar.Polar` (finite, >= 0) with
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Final
 
 import numpy as np
@@ -106,16 +106,15 @@ class FitFilters:
     outlier_k: float = 3.0
 
     def __post_init__(self) -> None:
-        for name in (
-            "min_tws_ms",
-            "max_turn_rate_deg_s",
-            "manoeuvre_window_s",
-            "max_accel_per_s",
-            "outlier_k",
-        ):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and np.isfinite(v) and v >= 0):
-                raise InputError(f"fit filters: {name} must be a finite number >= 0; got {v!r}")
+        check_non_negative(self, "fit filters")
+
+
+def check_non_negative(settings: object, what: str) -> None:
+    """Every field of a settings dataclass a finite number >= 0, else an error naming it."""
+    for f in fields(settings):  # type: ignore[arg-type]
+        v = getattr(settings, f.name)
+        if not (isinstance(v, (int, float)) and np.isfinite(v) and v >= 0):
+            raise InputError(f"{what}: {f.name} must be a finite number >= 0; got {v!r}")
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,12 +1,11 @@
-"""Samples for a polar fit from a log, and a fitted polar's errors against a reference.
+"""Samples of one log for :func:`sailroute.boat.fit.fit_polar`, the TWS nodes of a fit,
+and a fitted polar's errors against a reference.
 
-Two kinds of input give the samples :func:`sailroute.boat.fit.fit_polar` needs:
-
-* an **instrument log** (CSV read by :func:`sailroute.track.read.read_track`) with
-  TWS and TWA (or TWD and a heading) and a boat speed: ``bsp`` if the log has
-  it, else ``sog`` (the report says which): :func:`samples_from_log`;
-* a **GPS track** (GPX or CSV) plus a course file and one of its wind scenarios:
-  :func:`sailroute.commands.polar_fit.samples_from_course_wind`.
+:func:`samples_from_log` reads an **instrument log** (CSV read by
+:func:`sailroute.track.read.read_track`) with TWS and TWA (or TWD and a heading) and a boat
+speed: ``bsp`` if the log has it, else ``sog``.  ``sailroute polar fit`` learns from a
+fleet instead (:mod:`sailroute.boat.learn`); it shares :func:`auto_tws_bins` and
+:func:`compare_polars`.
 """
 
 from __future__ import annotations
@@ -17,7 +16,7 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import NDArray
 
-from sailroute.boat.fit import PolarFit, twa_sign_from
+from sailroute.boat.fit import twa_sign_from
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
 from sailroute.track.model import Track
@@ -182,15 +181,16 @@ def auto_tws_bins(tws_ms: NDArray, step_ms: float) -> NDArray[np.float64]:
     return np.arange(first, last + 0.5 * step_ms, step_ms)
 
 
-def compare_polars(fit: PolarFit, reference: Polar) -> PolarErrors:
-    """Errors of the fitted polar against ``reference`` on the fit's covered cells.
+def compare_polars(polar: Polar, covered: NDArray[np.bool_], reference: Polar) -> PolarErrors:
+    """Errors of a fitted polar against ``reference`` on its covered cells.
 
-    The fitted speed of each covered cell (``fit.polar.speed_ms``) is compared
-    with ``reference.speed`` at the cell's node (TWS, TWA).  Only cells inside
-    the reference's own table (its first to last TWA row and TWS column) count:
-    outside it the reference is a taper or a clamp, not a measurement.
+    The fitted speed of each covered cell (``polar.speed_ms``, ``covered`` of the same
+    shape: a fit's covered or a learned polar's learned cells) is compared with
+    ``reference.speed`` at the cell's node (TWS, TWA).  Only cells inside the
+    reference's own table (its first to last TWA row and TWS column) count: outside it
+    the reference is a taper or a clamp, not a measurement.
     """
-    p = fit.polar
+    p = polar
     ref = reference.speed(p.tws_ms[None, :], p.twa_deg[:, None])
     inside = (
         (p.twa_deg[:, None] >= reference.twa_deg[0])
@@ -198,7 +198,7 @@ def compare_polars(fit: PolarFit, reference: Polar) -> PolarErrors:
         & (p.tws_ms[None, :] >= reference.tws_ms[0])
         & (p.tws_ms[None, :] <= reference.tws_ms[-1])
     )
-    cov = fit.covered & inside
+    cov = np.asarray(covered, dtype=bool) & inside
     if not cov.any():
         raise InputError(
             f"reference polar {reference.name!r} covers TWA {reference.twa_deg[0]:g}-"

@@ -1,133 +1,57 @@
-"""``sailroute polar fit``: read a log (and a course's wind), fit a polar, write its files.
+"""``sailroute polar fit``: learn a polar from a fleet's logs and tracks, write its files.
 
-The samples come from :mod:`sailroute.boat.fit_samples` (an instrument log) or
-:func:`samples_from_course_wind` (a GPS track in a course scenario's wind); the fit
-is :func:`sailroute.boat.fit.fit_polar`; the table, plot and files are
+The samples come from :mod:`sailroute.analysis.learnsamples` (each in the wind ``analyze``
+would judge it in), the steady blocks from :mod:`sailroute.boat.learn_blocks`, the polar
+at levels with its uncertainty from :func:`sailroute.boat.learn.learn_polar`, the race
+pace from :mod:`sailroute.analysis.racepace`; the table, plot and files are
 :mod:`sailroute.report.polar`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Final
 
 import numpy as np
 
+from sailroute.analysis.learnsamples import FleetSamples, fleet_samples
 from sailroute.boat.boatfile import slug
-from sailroute.boat.fit import FitFilters, PolarFit, fit_polar
-from sailroute.boat.fit_samples import (
-    DEFAULT_TWS_STEP,
-    FitSamples,
-    PolarErrors,
-    auto_tws_bins,
-    compare_polars,
-    finite_channel,
-    samples_from_log,
-)
+from sailroute.boat.fit_samples import DEFAULT_TWS_STEP, PolarErrors, auto_tws_bins, compare_polars
+from sailroute.boat.learn import N_BOOT, LearnFit, learn_polar, parse_levels
+from sailroute.boat.learn_blocks import Blocks, SteadyRules, steady_blocks
 from sailroute.commands.result import CommandResult
 from sailroute.commands.vpp import UNITS, parse_speed_list, twa_grid
 from sailroute.errors import InputError
 from sailroute.outdir import check_out_dir, write_output_set
 from sailroute.report.files import POLAR_FILE_LABELS
-from sailroute.report.polar import fit_report, write_fit_outputs
+from sailroute.report.polar import learned_report, write_learned_outputs
 from sailroute.track.model import Track
-from sailroute.units import speed_factor, wind_speed_direction, wrap180
+from sailroute.units import speed_factor
 
 
 @dataclass(frozen=True)
 class FitRun:
-    """What :func:`run_fit_command` computed (its ``CommandResult.data``)."""
+    """What :func:`run_fit_command` computed (its ``CommandResult.data``).
 
-    fit: PolarFit
-    samples: FitSamples
-    errors: PolarErrors | None = None
-
-
-def samples_from_course_wind(
-    track: Track, course_path: str | Path, scenario: str | None = None
-) -> FitSamples:
-    """Samples from a GPS track and a course scenario's wind.
-
-    The scenario's wind field (uniform, stations, WRF, blended; built as for
-    ``sailroute plan`` but over the track's extent) is sampled at every track
-    point; ``TWA = wrap180(TWD - COG)``, ``TWS`` from the field, boat speed = SOG.
-    SOG/COG come from the file if it has them, else from the positions
-    (:func:`sailroute.track.kinematics.sog_cog`).  Points outside the wind's time
-    span are left out (noted).  Leeway and current are ignored: TWA is relative to
-    the course over ground.
-
-    Raises
-    ------
-    InputError
-        Unreadable course, unknown scenario, bad wind spec, or wind data that do
-        not cover the track's area.
+    Attributes
+    ----------
+    fit : LearnFit
+        The learned polar and its blocks.
+    samples : FleetSamples
+        The samples, notes and leg times.
+    errors : dict of str to PolarErrors
+        Per level, the errors against ``--reference`` on the learned cells (empty
+        without one).
+    notes : tuple of str
+        The samples' notes and the race pace's.
     """
-    from sailroute.course.load import load_course
-    from sailroute.track.kinematics import sog_cog, track_xy
-    from sailroute.wind.build import build_wind_field
 
-    course = load_course(course_path)
-    names = list(course.scenarios)
-    if not names:
-        raise InputError(
-            f"{course_path}: the course has no wind scenarios; add one under "
-            "'scenarios:' to fit a GPS track"
-        )
-    name = names[0] if scenario is None else scenario
-    if name not in course.scenarios:
-        raise InputError(
-            f"--scenario: the course {str(course_path)!r} has no scenario "
-            f"{name!r}; its scenarios are: {', '.join(names)}"
-        )
-    frame = course.frame
-    x, y = track_xy(track, frame)
-    wind = build_wind_field(
-        course.scenarios[name].wind,
-        frame=frame,
-        crop_bbox=(float(x.min()), float(x.max()), float(y.min()), float(y.max())),
-    )
-    notes: list[str] = []
-    t = np.asarray(track.t_s, float)
-    cov = wind.coverage
-    inside = (t >= cov.t0) & (t <= cov.t1)
-    if not inside.any():
-        raise InputError(
-            f"{track.source}: no track point lies in the time span of scenario {name!r} "
-            f"({cov.describe()}); use a scenario whose wind covers the track's time"
-        )
-    if not inside.all():
-        notes.append(f"{int((~inside).sum())} track points outside the wind's time span left out")
-    ch = track.channels
-    sog, cog = finite_channel(ch, "sog_ms"), finite_channel(ch, "cog_deg")
-    source = "sog"
-    if sog is None or cog is None:
-        sog, cog = sog_cog(track, frame)
-        source = "sog (from positions)"
-    u, v = wind.sample(t[inside], x[inside], y[inside])
-    tws, twd_local = wind_speed_direction(u, v)
-    # local +y is rotated from true north by the meridian convergence
-    twd = twd_local - frame.grid_north_deg(track.lat_deg[inside], track.lon_deg[inside])
-    twa = wrap180(twd - cog[inside])
-    return FitSamples(
-        t_s=t[inside],
-        tws_ms=tws,
-        twa_deg=twa,
-        bsp_ms=sog[inside],
-        heading_deg=cog[inside],
-        speed_source=source,
-        wind_source=f"course {course_path}, scenario {name}",
-        notes=tuple(notes),
-    )
-
-
-# --- fit, compare ----------------------------------------------------------------------
-
-
-# --- report, plot, files -----------------------------------------------------------------
-
-
-# --- the command -----------------------------------------------------------------------
+    fit: LearnFit
+    samples: FleetSamples
+    errors: dict[str, PolarErrors]
+    notes: tuple[str, ...] = ()
 
 
 def parse_columns(text: str | None) -> dict[str, str] | None:
@@ -148,119 +72,213 @@ def parse_columns(text: str | None) -> dict[str, str] | None:
 
 FIT_OPTIONS: Final = {
     "percentile": "--percentile",
-    "min_count": "--min-count",
+    "min_boats": "--min-boats",
+    "min_blocks": "--min-blocks",
+    "n_boot": "--bootstrap",
     "tws_bins_ms": "--tws-bins",
     "twa_bins_deg": "--twa-step",
 }
-"""The ``polar fit`` options that give :func:`~sailroute.boat.fit.fit_polar`'s parameters
-(named in its messages)."""
+"""The ``polar fit`` options that give :func:`~sailroute.boat.learn.learn_polar`'s
+parameters (named in its messages)."""
+
+
+def read_fleet(
+    logs: Sequence[str | Path],
+    columns: str | None = None,
+    speed_unit: str | None = None,
+    time_zone: str | None = None,
+) -> list[Track]:
+    """Read every log; names made unique (a repeated name gets its file's stem).
+
+    Raises
+    ------
+    InputError
+        No log, or a log given twice.
+    """
+    from sailroute.track.read import read_track
+
+    if not logs:
+        raise InputError("polar fit: no LOG given; give one or more logs or tracks")
+    seen: set[Path] = set()
+    out: list[Track] = []
+    names: set[str] = set()
+    for log in logs:
+        p = Path(log).resolve()
+        if p in seen:
+            raise InputError(f"{log}: given twice; give each log once")
+        seen.add(p)
+        tr = read_track(
+            log, columns=parse_columns(columns), speed_unit=speed_unit, time_zone=time_zone
+        )
+        name = tr.name or Path(log).stem
+        if name in names:
+            name = f"{name} ({Path(log).stem})" if Path(log).stem != name else f"{name} ({log})"
+        names.add(name)
+        out.append(Track(tr.t_s, tr.lat_deg, tr.lon_deg, name, tr.source, tr.channels, tr.notes))
+    return out
 
 
 def run_fit_command(
-    log: str | Path,
+    logs: Sequence[str | Path] | str | Path,
     *,
-    course: str | Path | None = None,
+    courses: Sequence[str | Path] = (),
     scenario: str | None = None,
     columns: str | None = None,
     speed_unit: str | None = None,
     time_zone: str | None = None,
-    percentile: float = 90.0,
-    min_count: int = 5,
+    levels: str | None = None,
+    percentile: float = 50.0,
+    min_boats: int | None = None,
+    min_blocks: int = 3,
+    bootstrap: int = N_BOOT,
+    seed: int = 0,
     tws_bins: str | None = None,
     twa_step_deg: float = 10.0,
     out_dir: str | Path = "polar-fit-out",
     unit: str = "kn",
     reference: str | Path | None = None,
     reference_unit: str | None = None,
-    filters: FitFilters | None = None,
+    rules: SteadyRules | None = None,
     name: str | None = None,
+    shape: str | None = None,
 ) -> CommandResult:
     """Everything ``sailroute polar fit`` does, minus printing.
 
     Parameters
     ----------
-    log : path
-        Instrument log (CSV) or GPS track (GPX/CSV; needs ``course``).
-    course, scenario : optional
-        Course file and scenario name whose wind gives TWS/TWA at the track
-        points (default scenario: the course's first).
-    columns : str, optional
-        ``NAME=HEADER`` pairs for columns the reader does not recognise.
-    speed_unit : str, optional
-        Unit of unsuffixed speed columns of the log (``kn``, ``m/s``, ``km/h``, ``mph``).
-    time_zone : str, optional
-        Zone of naive log times (``UTC``, ``+02:00``, ``Europe/Tallinn``).
+    logs : path or sequence of path
+        Instrument logs (CSV with wind columns) and/or GPS tracks (GPX/CSV; need
+        ``courses``), one per boat and day.
+    courses : sequence of path
+        One course per race: each track's part of each race is learned in the wind
+        ``analyze`` would judge it in, and the races' legs give the race pace.  Without
+        courses every log is learned over its whole length in its own measured wind.
+    scenario : str, optional
+        Scenario of the courses (default each one's first).
+    columns, speed_unit, time_zone : optional
+        How to read the logs (:func:`sailroute.track.read.read_track`).
+    levels : str, optional
+        ``"median=50,top=90"`` (the default): level names and percentiles of the boats.
     percentile : float
-        Envelope percentile (0, 100].
-    min_count : int
-        Samples a cell needs to count as covered.
+        Percentile of a boat's own steady blocks in a cell (50: its typical speed).
+    min_boats, min_blocks : int
+        Boats and steady blocks a cell needs (default boats: 2, 1 for one log).
+    bootstrap : int
+        Bootstrap replicates of the uncertainty (0: none).
+    seed : int
+        Seed of the bootstrap.
     tws_bins : str, optional
-        Comma-separated TWS nodes in ``unit``; default every 2 kn (1 m/s) over the
-        data's 1st-99th percentile.
+        Comma-separated TWS nodes in ``unit``; default every 2 kn (1 m/s) over the data's
+        1st-99th percentile.
     twa_step_deg : float
-        TWA node spacing [°] (0 to 180).
+        TWA node spacing [°].
     out_dir : path
-        Output folder (checked before the work; written as a set, see
-        :mod:`sailroute.outdir`).
+        Output folder (checked before the work; written as a set).
     unit : {"kn", "m/s"}
         Unit of the printed table and the written files.
     reference : path, optional
-        Polar to compare with (RMS and per-angle errors in the report and JSON).
+        Polar to compare with (per level: RMS and per-angle errors on the learned cells).
     reference_unit : str, optional
-        Unit of the reference file's speeds and TWS (default: the reader's).
-    filters : FitFilters, optional
-        Filter thresholds.
+        Unit of the reference file's speeds and TWS.
+    rules : SteadyRules, optional
+        What counts as steady sailing.
     name : str, optional
-        Stem of the output files and polar name (default ``<log stem>-fit``).
+        Stem of the output files and polar name (default ``<first log stem>-fleet``, or
+        ``-fit`` for one log).
+    shape : str, optional
+        ``builtin:NAME`` or a polar file whose shape fills the cells the fleet did not
+        sail (every requested row and column kept), scaled per point of sail to the
+        learned cells.
     """
     from sailroute.boat.io import read_polar
-    from sailroute.track.read import read_track
+    from sailroute.course.load import load_course
 
     if unit not in UNITS:
         raise InputError(f"--unit: expected one of 'kn', 'm/s'; got {unit!r}")
-    if scenario is not None and course is None:
+    log_list = [logs] if isinstance(logs, (str, Path)) else list(logs)
+    if scenario is not None and not courses:
         raise InputError("--scenario needs --course: the scenario's wind comes from a course file")
+    lv = parse_levels(levels)
     check_out_dir(out_dir)
     ref = None
     if reference is not None:
         ref = read_polar(reference, speed_unit=reference_unit, wind_unit=reference_unit)
-    track = read_track(
-        log, columns=parse_columns(columns), speed_unit=speed_unit, time_zone=time_zone
-    )
-    samples = (
-        samples_from_log(track)
-        if course is None
-        else samples_from_course_wind(track, course, scenario)
-    )
+    shape_polar = None
+    if shape is not None:
+        from sailroute.commands.strategy import load_polar
+
+        shape_polar = load_polar(shape)
+    loaded = [load_course(c) for c in courses]
+    race_names = [c.name for c in loaded]
+    if len(set(race_names)) < len(race_names):
+        raise InputError(
+            "--course: two courses have the same name ("
+            + ", ".join(sorted({n for n in race_names if race_names.count(n) > 1}))
+            + "); give each race's course a name of its own"
+        )
+    tracks = read_fleet(log_list, columns, speed_unit, time_zone)
+    samples = fleet_samples(tracks, loaded, scenario)
+    blocks = steady_blocks(samples.series, rules)
+    step = DEFAULT_TWS_STEP[unit] * speed_factor(unit)
     tws_n = (
         np.asarray(parse_speed_list(tws_bins, unit, option="--tws-bins"))
         if tws_bins is not None
-        else auto_tws_bins(samples.tws_ms, DEFAULT_TWS_STEP[unit] * speed_factor(unit))
+        else auto_tws_bins(blocks.tws_ms, step)
+        if blocks.size
+        else np.array([step])  # learn_polar says there is no steady sailing
     )
-    stem = slug(name) if name else slug(Path(log).stem) + "-fit"
-    fit = fit_polar(
-        samples.tws_ms,
-        samples.twa_deg,
-        samples.bsp_ms,
-        samples.t_s,
+    first = Path(log_list[0]).stem
+    stem = slug(name) if name else slug(first) + ("-fit" if len(log_list) == 1 else "-fleet")
+    fit = learn_polar(
+        blocks,
         tws_bins_ms=tws_n,
         twa_bins_deg=twa_grid(twa_step_deg),
-        heading_deg=samples.heading_deg,
+        levels=lv,
         percentile=percentile,
-        min_count=min_count,
-        filters=filters,
+        min_boats=min_boats,
+        min_blocks=min_blocks,
+        n_boot=bootstrap,
+        seed=seed,
         name=stem,
         options=FIT_OPTIONS,
+        provenance={
+            "logs": [str(p) for p in log_list],
+            "courses": [str(c) for c in courses],
+            "scenario": scenario,
+            "wind_source_seconds": _source_seconds(blocks),
+            "shape": None if shape_polar is None else f"{shape} ({shape_polar.name})",
+        },
+        shape=shape_polar,
     )
-    errors = compare_polars(fit, ref) if ref is not None else None
-    report = fit_report(fit, samples, unit, errors, ref.name if ref is not None else "")
+    notes = list(samples.notes)
+    if loaded and samples.legs:
+        from sailroute.analysis.racepace import race_pace
+
+        learned, pace_notes = race_pace(fit.learned, loaded, samples)
+        fit = LearnFit(learned, fit.blocks, fit.cell, fit.factors)
+        notes += pace_notes
+    errors = {}
+    if ref is not None:
+        for lname in fit.learned.levels:
+            errors[lname] = compare_polars(
+                fit.learned.polar(lname), fit.learned.status == "learned", ref
+            )
+    report = learned_report(fit, unit, errors, ref.name if ref is not None else "", notes)
     files = write_output_set(
-        out_dir, lambda d: write_fit_outputs(fit, samples, d, stem, unit, ref, errors)
+        out_dir, lambda d: write_learned_outputs(fit, d, stem, unit, ref, errors, notes)
     )
     return CommandResult(
         report,
         files,
-        data=FitRun(fit=fit, samples=samples, errors=errors),
+        data=FitRun(fit=fit, samples=samples, errors=errors, notes=tuple(notes)),
         main=("json",),
         labels=POLAR_FILE_LABELS,
     )
+
+
+def _source_seconds(blocks: Blocks) -> dict[str, float]:
+    """Seconds of steady blocks judged in each wind source."""
+    return {
+        n: round(float(blocks.dur_s[blocks.source == k].sum()), 1)
+        for k, n in enumerate(blocks.sources)
+    }

@@ -29,6 +29,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from sailroute._version import __version__
+from sailroute.boat.build import boat_label
 from sailroute.course.model import Course
 from sailroute.outdir import make_out_dir
 from sailroute.planning.result import Comparison, Plan, percent_error
@@ -153,6 +154,10 @@ def plan_to_dict(plan: Plan) -> dict[str, Any]:
         "source": str(c.source) if c.source is not None else None,
         "scenario": plan.scenario,
         "router": plan.router,
+        "boat": {
+            "label": boat_label(c.boat_spec),
+            "spec": json.loads(json.dumps(dict(c.boat_spec), default=str)),
+        },
         "start_time": iso(plan.t_start),
         "end_time": iso(plan.t_end),
         "total_time_s": _num(total),

@@ -6,28 +6,30 @@ stays cheap.
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
-from sailroute.boat.fit import PolarFit
-from sailroute.boat.fit_samples import FitSamples, PolarErrors
+from sailroute.boat.fit_samples import PolarErrors
 from sailroute.boat.io import write_pol, write_polar_csv, write_polar_json
 from sailroute.boat.kinetics import STEADY, Kinetics
 from sailroute.boat.laser import LaserParams
+from sailroute.boat.learn import BAND_NAMES, LearnedPolar, LearnFit
 from sailroute.boat.polar import Polar
 from sailroute.outdir import make_out_dir
 from sailroute.units import speed_factor
 
 __all__ = [
     "draw_polar",
-    "fit_report",
-    "plot_fit",
+    "learned_report",
+    "plot_learned",
     "plot_polar",
     "polar_report",
-    "write_fit_outputs",
+    "write_learned_outputs",
     "write_vpp_outputs",
 ]
 
@@ -125,120 +127,145 @@ def _jsonable(d: dict[str, Any]) -> dict[str, Any]:
     return {k: list(v) if isinstance(v, tuple) else v for k, v in d.items()}
 
 
-def fit_report(
-    fit: PolarFit,
-    samples: FitSamples,
-    unit: str = "kn",
-    errors: PolarErrors | None = None,
-    reference_name: str = "",
-) -> str:
-    """Text report: table, per-cell counts, coverage, filter counts, reference errors."""
+def _grid_text(learned: LearnedPolar, unit: str, cells: NDArray[np.str_], title: str) -> list[str]:
+    """A TWA x TWS text grid of ``cells`` (strings, the table's shape)."""
     f = speed_factor(unit)
-    p = fit.polar
-    lines = [polar_report(p, unit), ""]
-    w = 7
-    lines.append(
-        f"samples per cell (0 = filled from neighbours; covered needs the "
-        f"{fit.percentile:g}th percentile of >= min_count samples)"
+    w = 8
+    label = f"TWA\\TWS [{unit}]"
+    lines = [title, f"{label:>14}" + "".join(f"{v / f:>{w}.1f}" for v in learned.tws_ms)]
+    for a, row in zip(learned.twa_deg, cells, strict=True):
+        lines.append(f"{a:>14.1f}" + "".join(f"{c:>{w}}" for c in row))
+    return lines
+
+
+def learned_report(
+    fit: LearnFit,
+    unit: str = "kn",
+    errors: Mapping[str, PolarErrors] | None = None,
+    reference_name: str = "",
+    notes: Sequence[str] = (),
+) -> str:
+    """Text report of a learned polar: each level's table and uncertainty, the cells
+    (blocks/boats, refused ``r``, empty ``.``), the refused cells, the sanity verdict, the
+    race pace, the samples and (with a reference) the errors per level."""
+    lp = fit.learned
+    pv = lp.provenance
+    f = speed_factor(unit)
+    bl = fit.blocks
+    lines = [
+        f"{lp.name}: learned from {len(pv.get('boats', []))} boat(s) in "
+        f"{len(pv.get('races', []))} race(s); {bl.size} steady blocks "
+        f"({bl.dur_s.sum() / 60:.0f} min) of {bl.n_samples} samples; a boat's speed in a cell: "
+        f"P{pv.get('percentile', 50):g} of its blocks"
+    ]
+    lines += [f"wind: {k} ({v:.0f} s)" for k, v in dict(pv.get("wind_source_seconds", {})).items()]
+    for name, t in lp.levels.items():
+        lines += ["", f"level {name}: P{t.percentile:g} of the boats"]
+        lines.append(polar_report(lp.polar(name), unit))
+        pct = np.vectorize(lambda v: f"{100 * v:.1f}")(t.sd_log).astype(np.str_)
+        lines += _grid_text(lp, unit, pct, "uncertainty (1 sd) [%]")
+        if t.race_pace is not None:
+            lines.append(
+                f"race pace of {name}: "
+                + ", ".join(f"{b} x{v:.3f}" for b, v in zip(BAND_NAMES, t.race_pace, strict=True))
+            )
+    mark = {"learned": "", "refused": "r"}
+    counts = np.array(
+        [
+            [
+                "." if st == "empty" else f"{nb}/{nbo}{mark[str(st)]}"
+                for st, nb, nbo in zip(srow, brow, borow, strict=True)
+            ]
+            for srow, brow, borow in zip(lp.status, lp.blocks, lp.boats, strict=True)
+        ],
+        dtype=np.str_,
     )
-    label = "TWA\\TWS"
-    lines.append(f"{label:>14}" + "".join(f"{v / f:>{w}.1f}" for v in p.tws_ms))
-    for a, row in zip(p.twa_deg, fit.counts, strict=True):
-        lines.append(f"{a:>14.1f}" + "".join(f"{int(c):>{w}d}" for c in row))
-    lines.append("")
-    lines.append(f"boat speed: {samples.speed_source}; wind: {samples.wind_source}")
-    for note in samples.notes:
-        lines.append(f"note: {note}")
+    lines += [
+        "",
+        *_grid_text(
+            lp,
+            unit,
+            counts,
+            "steady blocks / boats per cell (r: refused, listed below; .: no data; both filled)",
+        ),
+    ]
+    if lp.reasons:
+        lines += ["", f"refused cells ({len(lp.reasons)}):"] + [f"  {r}" for r in lp.reasons]
+    left = [
+        *(f"TWS {v / f:g}" for v in pv.get("left_out_tws_ms", [])),
+        *(f"TWA {v:g}" for v in pv.get("left_out_twa_deg", [])),
+    ]
+    if left:
+        lines.append("left out (no learned cell): " + ", ".join(left))
+    lines += ["", "verdict:"] + [f"  {v}" for v in lp.verdict]
     lines.append(
-        f"samples: {fit.n_samples}, used {fit.n_used}; dropped: "
-        + ", ".join(f"{k} {v}" for k, v in fit.dropped.items())
+        f"samples: {bl.n_samples}; dropped: " + ", ".join(f"{k} {v}" for k, v in bl.dropped.items())
     )
-    lines.append(
-        f"coverage: {fit.coverage * 100:.0f} % of {fit.covered.size} cells "
-        f"({int(fit.covered.sum())} covered)"
-    )
-    if fit.empty_tws_ms.size:
-        lines.append(
-            "TWS columns without data (left out): "
-            + ", ".join(f"{v / f:g}" for v in fit.empty_tws_ms)
-        )
-    if fit.empty_twa_deg.size:
-        lines.append(
-            "TWA rows without data (left out): " + ", ".join(f"{v:g}" for v in fit.empty_twa_deg)
-        )
-    if errors is not None:
+    lines += [f"note: {n}" for n in notes]
+    for name, e in (errors or {}).items():
         lines.append("")
         lines.append(
-            f"vs reference {reference_name}: RMS {errors.rms_ms / f:.2f} {unit} "
-            f"({errors.rms_pct:.1f} %), mean {errors.mean_ms / f:+.2f} {unit} "
-            f"({errors.mean_pct:+.1f} %) over {errors.n_cells} covered cells"
+            f"{name} vs reference {reference_name}: RMS {e.rms_ms / f:.2f} {unit} "
+            f"({e.rms_pct:.1f} %), mean {e.mean_ms / f:+.2f} {unit} ({e.mean_pct:+.1f} %) "
+            f"over {e.n_cells} learned cells"
         )
         lines.append(f"{'TWA [deg]':>10}{'mean %':>9}{'RMS %':>8}{'cells':>7}")
-        for a, m, r, n in zip(
-            errors.twa_deg, errors.row_mean_pct, errors.row_rms_pct, errors.row_cells, strict=True
-        ):
+        for a, m, r, n in zip(e.twa_deg, e.row_mean_pct, e.row_rms_pct, e.row_cells, strict=True):
             lines.append(f"{a:>10.1f}{m:>+9.1f}{r:>8.1f}{int(n):>7d}")
     return "\n".join(lines)
 
 
-def plot_fit(
-    fit: PolarFit, path: str | Path, unit: str = "kn", reference: Polar | None = None
+def plot_learned(
+    fit: LearnFit, path: str | Path, unit: str = "kn", reference: Polar | None = None
 ) -> Path:
-    """PNG: fitted curves over the data scatter (left) and per-cell counts (right)."""
+    """PNG: the levels' curves over the steady blocks (left) and the cells (right)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     f = speed_factor(unit)
-    p = fit.polar
+    lp = fit.learned
     fig = Figure(figsize=(13, 6.5))
     FigureCanvasAgg(fig)
     ax = fig.add_subplot(1, 2, 1, projection="polar")
-    used = fit.used
-    edges = np.concatenate([[0.0], 0.5 * (p.tws_ms[1:] + p.tws_ms[:-1]), [np.inf]])
-    col = np.clip(np.searchsorted(edges, fit.tws_ms, side="right") - 1, 0, p.tws_ms.size - 1)
-    cmap = _colours(p.tws_ms.size)
-    ax.scatter(np.radians(fit.twa_deg[~used]), fit.bsp_ms[~used] / f, s=3, c="0.8", label="dropped")
-    ax.scatter(
-        np.radians(fit.twa_deg[used]),
-        fit.bsp_ms[used] / f,
-        s=4,
-        alpha=0.5,
-        c=[cmap[k] for k in col[used]],
-    )
-    draw_polar(ax, p, unit, colors=cmap)
+    cmap = _colours(lp.tws_ms.size)
+    bl = fit.blocks
+    used = fit.cell >= 0
+    edges = np.concatenate([[0.0], 0.5 * (lp.tws_ms[1:] + lp.tws_ms[:-1]), [np.inf]])
+    col = np.clip(np.searchsorted(edges, bl.tws_ms, side="right") - 1, 0, lp.tws_ms.size - 1)
+    a = np.radians(np.abs(bl.twa_deg))
+    ax.scatter(a[~used], bl.speed_ms[~used] / f, s=4, c="0.8", label="outside the TWS bins")
+    ax.scatter(a[used], bl.speed_ms[used] / f, s=6, alpha=0.6, c=[cmap[k] for k in col[used]])
+    names = list(lp.levels)
+    draw_polar(ax, lp.polar(names[0]), unit, colors=cmap)
+    grid = np.linspace(0.0, 180.0, 361)
+    for name in names[1:]:
+        p = lp.polar(name)
+        for j, tws in enumerate(lp.tws_ms):
+            ax.plot(np.radians(grid), p.speed(tws, grid) / f, ls="--", lw=0.8, color=cmap[j])
     if reference is not None:
-        a = np.linspace(0.0, 180.0, 361)
-        for j, tws in enumerate(p.tws_ms):
-            ax.plot(np.radians(a), reference.speed(tws, a) / f, ls="--", lw=0.8, color=cmap[j])
+        for j, tws in enumerate(lp.tws_ms):
+            ax.plot(np.radians(grid), reference.speed(tws, grid) / f, ls=":", lw=0.8, color=cmap[j])
     ax.set_title(
-        f"{p.name}: {fit.percentile:g}th percentile fit [{unit}]"
-        + (" (dashed: reference)" if reference is not None else ""),
+        f"{lp.name}: {names[0]} (solid)"
+        + (f", {', '.join(names[1:])} (dashed)" if names[1:] else "")
+        + (", reference (dotted)" if reference is not None else "")
+        + f" [{unit}]",
         fontsize=9,
         pad=16,
-    )  # clear of the 0° label of the polar axes
-    ax2 = fig.add_subplot(1, 2, 2)
-    im = ax2.imshow(
-        np.where(fit.counts > 0, fit.counts, np.nan), origin="lower", aspect="auto", cmap="viridis"
     )
-    for (i, j), c in np.ndenumerate(fit.counts):
-        ax2.text(
-            j,
-            i,
-            str(int(c)),
-            ha="center",
-            va="center",
-            fontsize=6,
-            color="k" if fit.covered[i, j] else "r",
-        )
-    ax2.set_xticks(range(p.tws_ms.size), [f"{v / f:g}" for v in p.tws_ms], fontsize=7)
-    ax2.set_yticks(range(p.twa_deg.size), [f"{v:g}" for v in p.twa_deg], fontsize=7)
+    ax2 = fig.add_subplot(1, 2, 2)
+    code = np.where(lp.status == "learned", 2.0, np.where(lp.status == "refused", 1.0, np.nan))
+    ax2.imshow(code, origin="lower", aspect="auto", cmap="RdYlGn", vmin=0.0, vmax=2.0)
+    for (i, j), c in np.ndenumerate(lp.blocks):
+        if lp.status[i, j] != "empty":
+            ax2.text(j, i, f"{c}/{lp.boats[i, j]}", ha="center", va="center", fontsize=6)
+    ax2.set_xticks(range(lp.tws_ms.size), [f"{v / f:.3g}" for v in lp.tws_ms], fontsize=7)
+    ax2.set_yticks(range(lp.twa_deg.size), [f"{v:g}" for v in lp.twa_deg], fontsize=7)
     ax2.set_xlabel(f"TWS [{unit}]")
     ax2.set_ylabel("TWA [deg]")
     ax2.set_title(
-        f"samples per cell (red: < min_count, filled); coverage {fit.coverage * 100:.0f} %",
-        fontsize=9,
+        "steady blocks / boats per cell (green learned, red refused, white empty)", fontsize=9
     )
-    fig.colorbar(im, ax=ax2, shrink=0.8)
     fig.tight_layout()
     out = Path(path)
     fig.savefig(out, dpi=100, bbox_inches="tight")  # keeps the polar title in
@@ -252,47 +279,39 @@ def _colours(n: int) -> list[Any]:
     return [cm(k / max(n - 1, 1) * 0.9) for k in range(n)]
 
 
-def write_fit_outputs(
-    fit: PolarFit,
-    samples: FitSamples,
+def write_learned_outputs(
+    fit: LearnFit,
     out_dir: Path,
     stem: str,
     unit: str = "kn",
     reference: Polar | None = None,
-    errors: PolarErrors | None = None,
+    errors: Mapping[str, PolarErrors] | None = None,
+    notes: Sequence[str] = (),
 ) -> dict[str, Path]:
-    """Write ``<stem>.pol``, ``.csv``, ``.json`` (with counts, coverage, filters), ``.png``."""
+    """Write ``<stem>.pol`` and ``.csv`` (the default level), ``.json`` (every level,
+    its uncertainty, the cells, the verdict and the provenance) and ``.png``."""
+    from sailroute.boat.learnfile import write_learned
+
     f = speed_factor(unit)
-    extra: dict[str, Any] = {
-        "fit": {
-            "percentile": fit.percentile,
-            "counts": fit.counts.tolist(),
-            "raw_percentile": [
-                [None if not np.isfinite(v) else float(v / f) for v in row] for row in fit.raw_ms
-            ],
-            "covered": fit.covered.tolist(),
-            "coverage": fit.coverage,
-            "dropped": dict(fit.dropped),
-            "samples": fit.n_samples,
-            "used": fit.n_used,
-            "speed_source": samples.speed_source,
-            "wind_source": samples.wind_source,
-            "notes": list(samples.notes),
+    lp = fit.learned
+    extra: dict[str, Any] = {"notes": list(notes)}
+    if errors:
+        extra["reference"] = {
+            name: {
+                "rms": e.rms_ms / f,
+                "mean": e.mean_ms / f,
+                "rms_pct": e.rms_pct,
+                "mean_pct": e.mean_pct,
+                "twa_deg": e.twa_deg.tolist(),
+                "row_mean_pct": e.row_mean_pct.tolist(),
+                "row_rms_pct": e.row_rms_pct.tolist(),
+            }
+            for name, e in errors.items()
         }
-    }
-    if errors is not None:
-        extra["fit"]["reference"] = {
-            "rms": errors.rms_ms / f,
-            "mean": errors.mean_ms / f,
-            "rms_pct": errors.rms_pct,
-            "mean_pct": errors.mean_pct,
-            "twa_deg": errors.twa_deg.tolist(),
-            "row_mean_pct": errors.row_mean_pct.tolist(),
-            "row_rms_pct": errors.row_rms_pct.tolist(),
-        }
+    default = lp.polar(None)
     return {
-        "pol": write_pol(fit.polar, out_dir / f"{stem}.pol", unit=unit),
-        "csv": write_polar_csv(fit.polar, out_dir / f"{stem}.csv", unit=unit),
-        "json": write_polar_json(fit.polar, out_dir / f"{stem}.json", unit=unit, extra=extra),
-        "png": plot_fit(fit, out_dir / f"{stem}.png", unit=unit, reference=reference),
+        "pol": write_pol(default, out_dir / f"{stem}.pol", unit=unit),
+        "csv": write_polar_csv(default, out_dir / f"{stem}.csv", unit=unit),
+        "json": write_learned(lp, out_dir / f"{stem}.json", unit=unit, extra=extra),
+        "png": plot_learned(fit, out_dir / f"{stem}.png", unit=unit, reference=reference),
     }

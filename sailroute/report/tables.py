@@ -14,6 +14,7 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from typing import Any
 
+from sailroute.boat.build import boat_label
 from sailroute.planning.result import Comparison, Plan, PlannedLeg, percent_error
 from sailroute.routing.startline import Approach, LineApproach, StartLineNumbers
 from sailroute.timeutil import iso
@@ -197,7 +198,7 @@ def plan_table(plan: Plan) -> str:
         total += [format_duration(sum(times)), _pct(plan.total_time_s, sum(times))]
     title = (
         f"{plan.course.name} | scenario {plan.scenario} | router {plan.router or '-'} | "
-        f"start {iso(plan.t_start)}"
+        f"boat {boat_label(plan.course.boat_spec)} | start {iso(plan.t_start)}"
     )
     align = "rllrrrrrl" + "rr" * len(refs)
     start = start_line_text(plan.start_line)

@@ -1,32 +1,23 @@
-"""Polar fitting (``sailroute.boat.fit``, ``commands.polar_fit``, ``sailroute polar fit``) and the
-``efficiency`` key: known answers from synthetic logs, filter counts, real logs vs their
-reference polars, CLI and errors.
+"""Polar fitting of one series (``sailroute.boat.fit.fit_polar``) and the ``efficiency``
+key: known answers from synthetic logs, filter counts, errors; the ORC speed guide as
+published.  The fleet learner of ``sailroute polar fit`` is tested in ``test_learn*.py``.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
 
 from sailroute.boat.build import boat_from_spec, builtin_polar
 from sailroute.boat.efficiency import efficiency_factor, scale_polar
 from sailroute.boat.fit import FitFilters, fit_polar
-from sailroute.boat.fit_samples import compare_polars
 from sailroute.boat.io import read_polar
-from sailroute.cli import app
-from sailroute.commands.polar_fit import run_fit_command
 from sailroute.errors import InputError
-from tests.conftest import ROOT, SHARED_REAL, requires_shared
+from tests.conftest import ROOT
 
-runner = CliRunner()
-TALLINN = SHARED_REAL / "races" / "tallinn-wednesday-races-2023"
 ORC_GUIDE = ROOT / "tests" / "data" / "boat" / "ORC_Speed_Guide_Ref_04340002PIL.csv"  # MIT
-NZL_LOG = SHARED_REAL / "races" / "sailgp-auckland-2025" / "Boat_logs" / "data_NZL.csv"
-F50 = SHARED_REAL / "polars" / "sailgp-f50" / "2502_m8_APW_HSB2_HSRW.kph.csv"
 TWS_BINS = np.arange(2.0, 7.01, 1.0)
 TWA_BINS = np.arange(40.0, 170.01, 10.0)
 U_LO, U_HI = 0.73, 1.03  # the boat sails uniformly between 73 % and 103 % of the polar
@@ -254,112 +245,6 @@ def test_efficiency_in_the_course_boat_block(tmp_path: Path) -> None:
 # --- files, CLI ------------------------------------------------------------------------
 
 
-def write_log(path: Path, target, n_s: int = 20_000) -> None:
-    t, tws, twa, bsp = synthetic_log(target, n_s=n_s, seed=2)[:4]
-    kn = 1852.0 / 3600.0
-    lines = ["time,lat,lon,bsp_kn,tws_kn,twa"]
-    for k in range(n_s):
-        stamp = np.datetime_as_string(np.datetime64(1_700_000_000 + int(t[k]), "s")) + "Z"
-        b = "" if np.isnan(bsp[k]) else f"{bsp[k] / kn:.4f}"
-        lines.append(f"{stamp},59.5,24.8,{b},{tws[k] / kn:.4f},{twa[k]:.2f}")
-    path.write_text("\n".join(lines) + "\n")
-
-
-def test_cli_fit_writes_files_that_read_back_and_a_course_can_use(tmp_path: Path, target) -> None:
-    log = tmp_path / "synthetic.csv"
-    write_log(log, target)
-    ref = tmp_path / "target.pol"
-    from sailroute.boat.io import write_pol
-
-    write_pol(target, ref)
-    out = tmp_path / "out"
-    res = runner.invoke(
-        app,
-        [
-            "polar",
-            "fit",
-            str(log),
-            "--tws-bins",
-            "6,8,10,12",
-            "--out",
-            str(out),
-            "--reference",
-            str(ref),
-            "--min-count",
-            "30",
-        ],
-    )
-    assert res.exit_code == 0, res.output
-    assert "boat speed: bsp" in res.output and "coverage:" in res.output
-    assert "vs reference target: RMS" in res.output
-    for suffix in ("pol", "csv", "json", "png"):
-        assert (out / f"synthetic-fit.{suffix}").is_file()
-    fitted = read_polar(out / "synthetic-fit.pol")
-    doc = json.loads((out / "synthetic-fit.json").read_text())
-    assert doc["fit"]["reference"]["rms_pct"] < 3.0
-    assert np.array(doc["fit"]["counts"]).shape == fitted.speed_ms.shape
-    course_boat = boat_from_spec(
-        {"polar": "out/synthetic-fit.pol"}, base_dir=tmp_path, where="c.yaml"
-    )
-    np.testing.assert_allclose(course_boat.speed_ms, fitted.speed_ms)
-
-
-def test_cli_bad_input_exits_2_and_writes_nothing(tmp_path: Path) -> None:
-    out = tmp_path / "out"
-    res = runner.invoke(app, ["polar", "fit", str(tmp_path / "none.csv"), "--out", str(out)])
-    assert res.exit_code == 2 and "track file not found" in res.output
-    log = tmp_path / "gps.csv"
-    log.write_text(
-        "time,lat,lon\n2023-01-01T00:00:00Z,59.5,24.8\n2023-01-01T00:00:01Z,59.5,24.81\n"
-    )
-    res = runner.invoke(app, ["polar", "fit", str(log), "--out", str(out)])
-    assert res.exit_code == 2 and "no true wind speed column" in res.output
-    assert "--course" in res.output
-    assert not out.exists()  # --out is checked, not created, before the work
-    res = runner.invoke(app, ["polar", "fit", str(log), "--columns", "bsp", "--out", str(out)])
-    assert res.exit_code == 2 and "NAME=HEADER" in res.output
-
-
-def test_gps_track_with_a_course_wind(tmp_path: Path, target) -> None:
-    # a boat sailing a known polar in a uniform 10 kn north wind, as a GPS track
-    kn = 1852.0 / 3600.0
-    t, _, twa, bsp = synthetic_log(target, n_s=12_000, seed=5)[:4]
-    tws = 10.0 * kn
-    bsp = target.speed(tws, twa) * (U_LO + (U_HI - U_LO) * ((t / 31.0) % 1.0))
-    bsp = np.where(np.isfinite(bsp), bsp, 0.0)
-    cog = (0.0 - twa) % 360.0  # TWD 0: TWA = wrap180(0 - COG)
-    x = np.cumsum(bsp * np.sin(np.radians(cog)))
-    y = np.cumsum(bsp * np.cos(np.radians(cog)))
-    lat = 59.5 + y / 111_320.0
-    lon = 24.8 + x / (111_320.0 * np.cos(np.radians(59.5)))
-    lines = ["time,lat,lon"] + [
-        f"{np.datetime_as_string(np.datetime64(1_700_000_000 + int(t[k]), 's'))}Z,"
-        f"{lat[k]:.8f},{lon[k]:.8f}"
-        for k in range(t.size)
-    ]
-    (tmp_path / "track.csv").write_text("\n".join(lines) + "\n")
-    (tmp_path / "course.yaml").write_text(
-        "name: fit test\nstart_time: 2023-11-14T22:00:00Z\ntime_limit_min: 600\n"
-        "origin: {lat: 59.5, lon: 24.8}\n"
-        "marks: {A: {lat: 59.5, lon: 24.8}, B: {lat: 59.502, lon: 24.8}, "
-        "W: {lat: 59.52, lon: 24.8}}\n"
-        "lines: {start: [A, B]}\nlegs: [{from: start, to: W, rounding: port}]\n"
-        "boat: {builtin: ilca7}\n"
-        "scenarios: {north: {wind: {type: uniform, tws_kn: 10, twd_deg: 0}}}\n"
-    )
-    run = run_fit_command(
-        tmp_path / "track.csv",
-        course=tmp_path / "course.yaml",
-        tws_bins="10",
-        out_dir=tmp_path / "out",
-        min_count=30,
-    )
-    assert run.data.samples.speed_source == "sog (from positions)"
-    assert "scenario north" in run.data.samples.wind_source
-    err = compare_polars(run.data.fit, target)
-    assert err.rms_pct < 4.0  # SOG from 1 Hz positions of a turning track: a few %
-
-
 # --- real logs (../shared, not redistributable: read in place) ----------------------------
 
 
@@ -375,40 +260,3 @@ def test_orc_speed_guide_reads_as_published() -> None:
     for twa, kn in ((52.0, 5.11), (144.2, 4.11), (180.0, 3.03)):
         i = int(np.flatnonzero(guide.twa_deg == twa)[0])
         assert guide.speed_ms[i, 0] == pytest.approx(kn * KNOT, abs=1e-12)
-
-
-@requires_shared
-def test_tallinn_log_against_its_orc_speed_guide(tmp_path: Path) -> None:
-    # The ORC guide is read as published (its speed column is BTV, the target boat speed);
-    # the log has no bsp, so SOG is fitted (no current in Tallinn Bay).  Measured
-    # (min_count 10, default filters): RMS 6.6 %, mean -4.5 % over 14 covered cells
-    # (docs/polar-fit.md).
-    run = run_fit_command(
-        TALLINN / "kolmak_2023_09_27.csv",
-        speed_unit="kn",
-        out_dir=tmp_path / "out",
-        reference=ORC_GUIDE,
-        min_count=10,
-    )
-    assert run.data.samples.speed_source == "sog"
-    assert run.data.errors is not None and run.data.errors.n_cells >= 10
-    assert run.data.errors.rms_pct < 8.0
-    assert run.data.fit.dropped["manoeuvre"] > 100  # a race with many tacks
-
-
-@requires_shared
-def test_sailgp_nzl_log_against_the_f50_polar(tmp_path: Path) -> None:
-    # F50 at 1 Hz, TWS 16-24 kn; measured (min_count 20): RMS 19.4 %, mean +8.3 % over 21
-    # cells; the largest errors are at 40-60 deg, where the polar's speed doubles within
-    # one 10-deg bin (foiling take-off) and the log's TWA is noisy.
-    run = run_fit_command(
-        NZL_LOG,
-        time_zone="UTC",
-        out_dir=tmp_path / "out",
-        reference=F50,
-        reference_unit="km/h",
-        min_count=20,
-    )
-    assert run.data.samples.speed_source == "bsp"
-    assert run.data.errors is not None and run.data.errors.n_cells >= 15
-    assert run.data.errors.rms_pct < 25.0

@@ -43,7 +43,8 @@ def test_render_table_alignment():
 def test_plan_table(plan):
     out = plan_table(plan)
     lines = out.splitlines()
-    assert lines[0].startswith("report test | scenario north | router test | start ")
+    assert lines[0].startswith("report test | scenario north | router test | boat ")
+    assert " | start " in lines[0]
     header = lines[1].split()
     assert header[:9] == ["leg", "from", "->", "to", "mode", "time", "time", "s", "tacks"]
     assert header[-4:] == ["winner", "err", "model", "err"]
