@@ -66,9 +66,16 @@ from sailroute.routing.isochrone import (
     check_leg_work,
 )
 from sailroute.routing.isochrone_inputs import _prepare, _step_length
-from sailroute.routing.isochrone_kernel import _CHUNK_ELEMENTS, _expand, _group_argmin, _survivors
+from sailroute.routing.isochrone_kernel import _expand, _group_argmin, _survivors
 from sailroute.routing.isochrone_polar import _device_tables, _DeviceTables, polar_tables
-from sailroute.routing.isochrone_records import Groups, _Arrival, _Context, _Layer, _LegFrame
+from sailroute.routing.isochrone_records import (
+    _CHUNK_ELEMENTS,
+    Groups,
+    _Arrival,
+    _Context,
+    _Layer,
+    _LegFrame,
+)
 from sailroute.routing.settings import RoutingSettings, check_settings
 from sailroute.routing.track import make_leg_result
 from sailroute.routing.types import LegResult, Start, Target
