@@ -88,6 +88,7 @@ from sailroute.routing.isochrone_records import (
     _Layer,
     _LegFrame,
 )
+from sailroute.routing.isochrone_togo import _BIG_S
 from sailroute.routing.settings import RoutingSettings, check_settings
 from sailroute.routing.track import make_leg_result
 from sailroute.routing.types import LegResult, Start, Target
@@ -117,7 +118,7 @@ def route_leg_batch(
     boat: BoatModel | Sequence[BoatModel],
     settings: RoutingSettings,
     *,
-    progress: Callable[[float], None] | None = None,
+    progress: Callable[[float, str], None] | None = None,
     current: CurrentField | None = None,
 ) -> list[LegResult]:
     """Fastest route of one leg for every member of an ensemble, as one front.
@@ -140,7 +141,10 @@ def route_leg_batch(
     settings : RoutingSettings
         Isochrone settings, the same for every member.
     progress : callable, optional
-        Called with the fraction of members that have arrived, in [0, 1].
+        Called with the estimated share of the leg done, in [0, 1] (the members' mean:
+        time sailed over time sailed and time to go), and a note saying how many members
+        have arrived (``progress(0.4, "37 of 100 members arrived")``; a
+        :class:`~sailroute.progress.Progress` is such a callable).
     current : CurrentField, optional
         Surface current of every member (as :func:`~sailroute.routing.isochrone.
         route_isochrone` takes it); None: still water.
@@ -214,7 +218,6 @@ def route_leg_batch(
         tuple(_device_tables(t, np) for t in tabs),
         int(tabs[0].twa_deg.size),
         progress,
-        n,
         target_barrier(target, starts[0], settings.zone_m),
         current,
     )
@@ -243,8 +246,7 @@ class _Leg:
     dev: _DeviceTables  # their tables (stacked_tables where there are several)
     devs: tuple[_DeviceTables, ...]  # each polar's own (a member finishing alone)
     n_angles: int
-    progress: Callable[[float], None] | None
-    n_members: int
+    progress: Callable[[float, str], None] | None
     barrier: Any  # the rounding ray the legs end on (of the common target geometry)
     current: CurrentField | None
 
@@ -263,6 +265,7 @@ class _Member:
     clearance: float | None  # from the mark of the start's barrier [m]; None: no barrier
     calm_since: float | None = None
     tau_hint: float = math.inf
+    done: float = 0.0  # share of its leg sailed (estimated, for progress)
 
 
 @dataclass(frozen=True, eq=False)
@@ -379,6 +382,16 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
             continue
         history.append(out)
         _after_step(front, out, tau_min, dist_min, leg)
+        _report(members, results, leg)
+
+
+def _report(members: list[_Member], results: dict[int, LegResult], leg: _Leg) -> None:
+    """Tell ``leg.progress`` the share of the leg done and how many members arrived."""
+    if leg.progress is None:
+        return
+    share = sum(1.0 if m.index in results else m.done for m in members) / len(members)
+    arrived = sum(m.index in results for m in members)
+    leg.progress(share, f"{arrived} of {len(members)} members arrived")
 
 
 def _front_polar(front: _Front, leg: _Leg) -> Polar | PointPolars:
@@ -447,6 +460,8 @@ def _after_step(front: _Front, new: _Front, tau_min: Any, dist_min: Any, leg: _L
         elif m.calm_since is None:
             m.calm_since = t_old
         m.tau_hint = float(tau_min[k]) - (t_new - t_old)
+        sailed = t_new - m.ctx.t0
+        m.done = sailed / (sailed + m.tau_hint) if 0.0 <= m.tau_hint < _BIG_S else 0.0
         if first_step:
             check_leg_work(m.ctx.label, s, m.ctx, leg.n_angles, m.tau_hint)
         elapsed = t_new - m.ctx.t0
@@ -460,6 +475,7 @@ def _finish_alone(
     """Finish the legs of ``leaving`` one by one from their own fronts, and take them
     out of the common front (``history[-1]``)."""
     for m in leaving:
+        _report(list(history[0].members), results, leg)
         layers = _own_layers(m, history)
         arrival = _route_on(
             layers,
@@ -474,8 +490,6 @@ def _finish_alone(
             tau_hint=m.tau_hint,
         )
         results[m.index] = _result(m, layers, arrival, leg)
-        if leg.progress is not None:
-            leg.progress(len(results) / leg.n_members)
     front = history[-1]
     stay = tuple(m for m in front.members if m not in leaving)
     rows = (
