@@ -29,7 +29,7 @@ from sailroute.bands.members import (
     one_at_a_time,
     resolve_shifts,
 )
-from sailroute.bands.sides import honest_side
+from sailroute.bands.sides import honest_sides
 from sailroute.bands.summary import BandSummary
 from sailroute.course.load import build_current
 from sailroute.course.model import Course
@@ -244,23 +244,16 @@ def band_summary(
     )
     by_key = {key[m.name]: r for m, r in zip(todo, results, strict=True)}
     res_of = {m.name: by_key[key[m.name]] for m in flat}
-    sides = []
-    for m in main:
-        w, b = _member_inputs(course, m, wind, boat)
-        sides.append(
-            tuple(
-                honest_side(
-                    r,
-                    w,
-                    b,
-                    tack_penalty_s=settings.tack_penalty_s,
-                    gybe_penalty_s=settings.gybe_penalty_s,
-                    margin_s=spec.side_margin_s,
-                    margin_pct=spec.side_margin_pct,
-                )
-                for r in res_of[m.name]
-            )
-        )
+    inputs = [_member_inputs(course, m, wind, boat) for m in main]
+    sides = honest_sides(
+        [res_of[m.name] for m in main],
+        [w for w, _ in inputs],
+        [b for _, b in inputs],
+        tack_penalty_s=settings.tack_penalty_s,
+        gybe_penalty_s=settings.gybe_penalty_s,
+        margin_s=spec.side_margin_s,
+        margin_pct=spec.side_margin_pct,
+    )
     return BandSummary(
         scenario=scenario,
         leg_labels=tuple(leg.label for leg in course.legs),

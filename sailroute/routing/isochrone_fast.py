@@ -52,7 +52,7 @@ from sailroute.routing.isochrone_records import (
 from sailroute.routing.settings import ENGINES, RoutingSettings
 from sailroute.wind.base import WindField
 
-__all__ = ["compiled", "pack", "prepare", "survivors", "winners"]
+__all__ = ["candidates", "compiled", "pack", "prepare", "survivors"]
 
 _CALL_CANDIDATES = 60000
 """Candidates per :func:`~sailroute.routing.isochrone_jit.candidates` call (whole NumPy
@@ -62,6 +62,7 @@ _NO_FLOATS = np.zeros((0, 0))
 _NO_INTS = np.zeros((0, 0), dtype=np.int64)
 _NONE = np.zeros(0)
 _NO_MEMBERS = np.zeros(0, dtype=np.int64)
+_NO_FLAGS = np.zeros(0, dtype=np.bool_)
 
 
 AVAILABLE: Final = importlib.util.find_spec("numba") is not None
@@ -416,6 +417,7 @@ class _Geometry(NamedTuple):
     penalties: Any  # (tack, gybe) [s]
     vmg: Any  # (2, n_w): the upwind and downwind VMG of the polar tables [m/s]
     grid: Any  # (3, n_a): the grid's |TWA| [°], cosine and sine
+    cross: Any  # the target as geometry.segment_crossing takes it: a, b - a, normal
     inv_step: float  # 1 / the grid's |TWA| step [1/°] (isochrone_togo._time_to_go)
     inv_rad_step: float  # 1 / the grid's |TWA| step [1/rad]
 
@@ -445,6 +447,16 @@ def _geometry(ctx: _Context, dev: _DeviceTables) -> _Geometry:
         penalties=np.array([ctx.tack_s, ctx.gybe_s]),
         vmg=np.stack([dev.up_vmg_ms, dev.down_vmg_ms]),
         grid=np.stack([dev.twa_deg, dev.cos_a, dev.sin_a]),
+        cross=np.array(
+            [
+                ctx.geom.a[0],
+                ctx.geom.a[1],
+                ctx.geom.b[0] - ctx.geom.a[0],
+                ctx.geom.b[1] - ctx.geom.a[1],
+                *ctx.geom.normal,
+            ],
+            dtype=float,
+        ),
         inv_step=1.0 / step,
         inv_rad_step=1.0 / math.radians(step),
     )
@@ -489,9 +501,12 @@ def _buffer(name: str, size: int, dtype: Any) -> Any:
     return buf
 
 
-def winners(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any, Any] | None:
-    """The best candidate per key (sector and side, per member) of a step without an
-    arrival: ``(best, who)`` as the candidate loop of
+def candidates(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any, Any, Any] | None:
+    """Every candidate move of a step (no race area): ``(arrival, best, who)``, where
+    ``arrival`` is the earliest crossing of the target or None (:func:`~sailroute.
+    routing.isochrone_jit.candidates` writes it: the kernel's :func:`~sailroute.routing.
+    isochrone_kernel._arrival_of` makes it an arrival), and ``best, who`` the best
+    candidate per key (sector and side, per member) as the candidate loop of
     :func:`~sailroute.routing.isochrone_kernel._step` leaves them (score [s] and
     candidate id, infinite and 0 where a key has none); None where a score is NaN."""
     geo = _geometry(ctx, dev)
@@ -522,8 +537,12 @@ def winners(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any, A
             near_bars[k] = close
     box = _NONE if ctx.box is None or pre.box_clear else np.asarray(ctx.box, dtype=float)
     origin = np.zeros(2) if ctx.bin_origin is None else np.asarray(ctx.bin_origin, dtype=float)
+    near = pre.near_target if bool(np.any(pre.near_target)) else _NO_FLAGS
+    t_step = pre.t if isinstance(pre.t, float) else 0.0  # members: no arrival here
     scale = np.float32(1.0 / ctx.sector_rad)
     off = np.float32(ctx.n_bins // 2 + 0.5)
+    arrival: Any = None
+    found = np.empty(15)
     for r0 in range(0, n, rows):
         n_seg = kernels().candidates(
             r0,
@@ -532,6 +551,7 @@ def winners(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any, A
             pre.first,
             pre.stop,
             pre.dt,
+            t_step,
             pre.x,
             pre.y,
             p.move,
@@ -554,16 +574,24 @@ def winners(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any, A
             box,
             geo.frame,
             origin,
+            near,
+            geo.cross,
             score,
             qx,
             qy,
             segments,
+            found,
         )
+        if n_seg < 0:
+            return None
+        if found[0] > 0 and (arrival is None or t_step + found[1] < t_step + arrival[1]):
+            arrival = found.copy()
+        if arrival is not None:
+            continue  # the step ends at the target: no winners to keep
         m = int(segments[n_seg - 1, 0] + segments[n_seg - 1, 1])
         np.arctan2(qx[:m], qy[:m], out=phi[:m])  # NumPy's float32 bearings, as binned there
-        if not kernels().sector_winners(n_seg, segments, score, phi, scale, off, best, who):
-            return None
-    return best, who
+        kernels().sector_winners(n_seg, segments, score, phi, scale, off, best, who)
+    return arrival, best, who
 
 
 def survivors(

@@ -790,6 +790,134 @@ def _exact_moves(
         qy[j] = y[r] + mv * vy
 
 
+@_inline
+def _column(
+    j: int,
+    n_grid: int,
+    first: int,
+    r: int,
+    block: int,
+    move: Any,
+    move_row: Any,
+    exact: Any,
+    tables: Any,
+    speed_ms: Any,
+) -> tuple[float, float, float, float]:
+    """Boat speed, |TWA|, its cosine and sine of column ``j`` of row ``r`` and block
+    ``block`` (the grid's, then VMG up, VMG down, the block's direct column)."""
+    if j < n_grid:
+        cc = first + j
+        node = move_row[r]
+        s_lo = speed_ms[node, cc]
+        b = s_lo + move[3, r] * (speed_ms[node + 1, cc] - s_lo)
+        return b, tables[0, cc], tables[1, cc], tables[2, cc]
+    e = j - n_grid
+    if block == 1 and e == 2:
+        e = 3
+    return exact[1, r, e], exact[0, r, e], exact[2, r, e], exact[3, r, e]
+
+
+@_inline
+def _timing(
+    mode: int,
+    twa: float,
+    r: int,
+    man: Any,
+    debt: Any,
+    charged: Any,
+    free_owes: bool,
+    dt: float,
+) -> tuple[float, float]:
+    """``(delay, move)`` [s] of a candidate at |TWA| ``twa`` (``isochrone_kernel._Timing``)."""
+    owed = 0.0
+    if mode != _PLAIN:
+        owed = _owed(mode, man[2, r] if twa < 90.0 else man[3, r], debt[r], charged[r], free_owes)
+    delay = _mn(owed, dt)
+    return delay, dt - delay
+
+
+@_jit
+def _arrival_row(
+    r: int,
+    block: int,
+    j0: int,
+    n_grid: int,
+    first: int,
+    mode: int,
+    free_owes: bool,
+    dt: float,
+    x: Any,
+    y: Any,
+    move: Any,
+    move_row: Any,
+    man: Any,
+    debt: Any,
+    charged: Any,
+    exact: Any,
+    tables: Any,
+    speed_ms: Any,
+    current: Any,
+    cross: Any,
+    sc: Any,
+    qx: Any,
+    qy: Any,
+    best: Any,
+) -> None:
+    """The earliest crossing of the target by the allowed candidates of row ``r`` (a row
+    within reach of it; ``isochrone_kernel._arrival``), into ``best`` if it is earlier:
+    ``(found, time into the step, row, block, column, fraction of the move, start x, y
+    (after the drift of the block's first column, as there), end x, y, velocity x, y,
+    speed, delay, side)``."""
+    ax, ay, ex, ey, nx, ny = cross[0], cross[1], cross[2], cross[3], cross[4], cross[5]
+    drift = current.shape[0] > 0
+    for j in range(sc.shape[0]):
+        if not sc[j] < np.inf:  # forbidden (the arrival test's conditions)
+            continue
+        b, twa, ca, sa = _column(
+            j0 + j, n_grid, first, r, block, move, move_row, exact, tables, speed_ms
+        )
+        delay, mv = _timing(mode, twa, r, man, debt, charged, free_owes, dt)
+        px = x[r] + delay * current[0, r] if drift else x[r]
+        py = y[r] + delay * current[1, r] if drift else y[r]
+        dx = qx[j] - px
+        dy = qy[j] - py
+        wx = ax - px
+        wy = ay - py
+        den = dx * ey - dy * ex
+        sgn = -1.0 if den < 0 else 1.0
+        ns = (wx * ey - wy * ex) * sgn
+        nr = (wx * dy - wy * dx) * sgn
+        ad = den * sgn
+        if not (dx * nx + dy * ny > 0 and ad > 0 and ns >= 0 and ns <= ad and nr >= 0 and nr <= ad):
+            continue
+        frac = ns / ad
+        t_hit = delay + frac * mv
+        if not t_hit < best[1]:
+            continue
+        _, twa0, _, _ = _column(
+            j0, n_grid, first, r, block, move, move_row, exact, tables, speed_ms
+        )
+        delay0, _ = _timing(mode, twa0, r, man, debt, charged, free_owes, dt)
+        sigma = man[0, r] if block == 0 else -man[0, r]
+        sx, sy = b * ca, b * sa
+        upx, upy = move[1, r], move[2, r]
+        best[0] = 1.0
+        best[1] = t_hit
+        best[2] = r
+        best[3] = block
+        best[4] = j0 + j
+        best[5] = frac
+        best[6] = x[r] + delay0 * current[0, r] if drift else x[r]
+        best[7] = y[r] + delay0 * current[1, r] if drift else y[r]
+        best[8] = qx[j]
+        best[9] = qy[j]
+        best[10] = upx * sx - (sigma * upy) * sy
+        best[11] = upy * sx + (sigma * upx) * sy
+        best[12] = b
+        best[13] = delay
+        best[14] = sigma
+
+
 @_jit
 def candidates(
     r0: int,
@@ -798,6 +926,7 @@ def candidates(
     first: int,
     stop: int,
     dt: float,
+    t_step: float,
     x: Any,
     y: Any,
     move: Any,
@@ -820,10 +949,13 @@ def candidates(
     box: Any,
     frame: Any,
     origin: Any,
+    near: Any,
+    cross: Any,
     score: Any,
     qx32: Any,
     qy32: Any,
     segments: Any,
+    arrival: Any,
 ) -> int:
     """Every candidate move of the rows ``r0:r1`` of a front, in the order the NumPy
     kernel ranks them (chunks of ``chunk`` rows; per chunk block ``_KEEP`` row by row,
@@ -838,12 +970,19 @@ def candidates(
     writes them; ``tables = (twa, cos, sin)`` (3, n_a) of the grid; ``current`` (2, n)
     or empty; ``fans`` (3, n: the member's first key, its fan's first and stop column)
     or empty; ``bars`` (k, 8) as :func:`_barrier_blocks` takes them with the rows near
-    each ``near_bars`` (k, n) and their clearances.  Returns the number of segments.
+    each ``near_bars`` (k, n) and their clearances.  The rows ``near`` the target (or
+    none: empty) are tested for the arrival (``cross``: the target segment's end ``a``,
+    its vector to ``b`` and its normal): ``arrival`` (15,) gets the earliest crossing
+    (:func:`_arrival_row`; per chunk the earliest into the step ``t_step``, across chunks
+    the earliest in time, as the NumPy kernel compares them).  Returns the number of
+    segments, or -1 where a score is NaN (the NumPy kernel then decides the step).
     """
     n_grid = stop - first
     h = n_grid + 3
     tx, ty = np.empty(h), np.empty(h)
     twa, cos_a, sin_a = tables[0, first:stop], tables[1, first:stop], tables[2, first:stop]
+    in_chunk = np.empty(15)
+    arrival[0] = 0.0
     k = 0
     n_seg = 0
     for c0 in range(r0, r1, chunk):
@@ -853,6 +992,8 @@ def candidates(
         for r in range(c0, c1):
             any_free = any_free or flags[0, r]
             any_pending = any_pending or flags[1, r]
+        in_chunk[0] = 0.0
+        in_chunk[1] = np.inf
         for block in range(2):
             j0 = 0 if (block == 0 or any_free) else n_grid
             for r in range(c0, c1):
@@ -884,6 +1025,15 @@ def candidates(
                     r, block, first, j0, n_grid, pending, x, y, man, direct_sin, fans, bars,
                     near_bars, bar_clear, first_clear, box, frame, sc, qx, qy,
                 )  # fmt: skip
+                for j in range(m):
+                    if sc[j] != sc[j]:
+                        return -1
+                if near.shape[0] > 0 and near[r]:
+                    _arrival_row(
+                        r, block, j0, n_grid, first, mode, free_owes, dt, x, y, move, move_row,
+                        man, debt, charged, exact, tables, speed_ms, current, cross, sc, qx, qy,
+                        in_chunk,
+                    )  # fmt: skip
                 ox, oy = qx32[k : k + m], qy32[k : k + m]
                 for j in range(m):
                     ox[j] = np.float32(qx[j] - origin[0])
@@ -895,6 +1045,8 @@ def candidates(
                 segments[n_seg, 3] = sidx + (fans[0, r] if fans.shape[0] > 0 else 0)
                 n_seg += 1
                 k += m
+        if in_chunk[0] > 0 and (arrival[0] == 0 or t_step + in_chunk[1] < t_step + arrival[1]):
+            arrival[:] = in_chunk
     return n_seg
 
 
@@ -908,24 +1060,20 @@ def sector_winners(
     off: Any,
     best: Any,
     who: Any,
-) -> bool:
+) -> None:
     """Keep the best candidate per key of the first ``n_seg`` segments of
     :func:`candidates` (``isochrone_kernel._sector_winners``): key = ``floor(phi scale +
     off)`` (float32, as NumPy) times 2 plus the segment's side index; the first in
-    order wins a tie.  Returns False where a score is NaN (the NumPy kernel then decides
-    the step)."""
+    order wins a tie."""
     for g in range(n_seg):
         k0, m, wid0, sidx = segments[g, 0], segments[g, 1], segments[g, 2], segments[g, 3]
         for j in range(m):
             sc = score[k0 + j]
-            if sc != sc:
-                return False
             if sc < np.inf:
                 key = np.int64(phi[k0 + j] * scale + off) * 2 + sidx
                 if sc < best[key]:
                     best[key] = sc
                     who[key] = wid0 + j
-    return True
 
 
 @_jit

@@ -143,12 +143,12 @@ def _candidates(
     per key (sector and side, per member) with its score [s] and id (see :data:`_KEEP`),
     infinite and 0 where a key has none.
 
-    ``jit``: the compiled kernel scores the candidates of a step without an arrival or
-    obstacles (:func:`~sailroute.routing.isochrone_fast.winners`, the same winners)."""
-    if jit and ctx.obstacles is None and not bool(xp.any(pre.near_target)):
-        won = fast.winners(pre, dev, ctx)
-        if won is not None:
-            return None, won[0], won[1]
+    ``jit``: the compiled kernel scores the candidates of a step without obstacles
+    (:func:`~sailroute.routing.isochrone_fast.candidates`, the same results)."""
+    if jit and ctx.obstacles is None:
+        done = fast.candidates(pre, dev, ctx)
+        if done is not None:
+            return (None if done[0] is None else _arrival_of(pre, done[0])), done[1], done[2]
     n, n_columns = pre.n, pre.n_columns
     chunk = n if xp is not np else max(1, _CHUNK_ELEMENTS // (n_columns + 3))
     n_keys = 2 * ctx.n_bins * pre.n_groups
@@ -167,6 +167,29 @@ def _candidates(
         best[key[better]] = score[better]
         who[key[better]] = wid[better]
     return arrival, best, who
+
+
+def _arrival_of(pre: _StepInputs, rec: Any) -> _Arrival:
+    """The arrival the compiled kernel found, as :func:`_arrival` builds it from ``rec``
+    (:func:`~sailroute.routing.isochrone_jit.candidates`: time into the step, row,
+    block, column, fraction of the move, start, end, velocity, speed, delay, side)."""
+    t_hit, row, ds, x0, y0, end_x, end_y = (float(rec[i]) for i in (1, 2, 5, 6, 7, 8, 9))
+    heading = (
+        _heading_deg(end_x - x0, end_y - y0)
+        if pre.current_x is None  # through the water:
+        else _heading_deg(float(rec[10]), float(rec[11]))
+    )
+    return _Arrival(
+        parent=int(row),
+        t_start=pre.t,
+        t=pre.t + t_hit,
+        x=x0 + ds * (end_x - x0),
+        y=y0 + ds * (end_y - y0),
+        heading=heading,
+        bsp=float(rec[12]),
+        delay=float(rec[13]),
+        side=int(rec[14]),
+    )
 
 
 def _group_argmin(key: Any, score: Any, n_keys: int, xp: ModuleType) -> Any:

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError
 from sailroute.wind.base import Coverage, WindField
-from sailroute.wind.rotation import rotate_clockwise
+from sailroute.wind.rotation import rotate_by, rotate_clockwise
 
 __all__ = ["PerturbedWind", "sample_perturbed"]
 
@@ -174,14 +174,17 @@ def sample_perturbed(
         factor[adds] = _speed_factor(u[adds], v[adds], scale[adds], add[adds])
     turns = np.array([w.turns for w in params])[which]
     if turns.any():
-        turn = np.array([float(w.direction_offset_deg) for w in params])[which]
-        for k, w in enumerate(params):  # the shift series, member by member
+        # a constant turn's cosine and sine once per member; a shift series' per point
+        a = np.radians(np.array([float(w.direction_offset_deg) for w in params]))
+        cos, sin = np.cos(a)[which], np.sin(a)[which]
+        for k, w in enumerate(params):
             if w._series[0].size:
                 mine = np.flatnonzero(which == k)
-                turn[mine] = w.turn_deg(t[mine])
+                b = np.radians(w.turn_deg(t[mine]))
+                cos[mine], sin[mine] = np.cos(b), np.sin(b)
         if turns.all():
-            u, v = rotate_clockwise(u, v, turn)
+            u, v = rotate_by(u, v, cos, sin)
         else:
             idx = np.flatnonzero(turns)
-            u[idx], v[idx] = rotate_clockwise(u[idx], v[idx], turn[idx])
+            u[idx], v[idx] = rotate_by(u[idx], v[idx], cos[idx], sin[idx])
     return factor * u, factor * v
