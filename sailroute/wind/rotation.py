@@ -48,7 +48,9 @@ def rotate_by(
     same numbers, with the trigonometry done once per angle rather than per vector."""
     u = np.asarray(u, dtype=float)
     v = np.asarray(v, dtype=float)
-    return u * cos + v * sin, v * cos - u * sin
+    c = np.asarray(cos, dtype=float)
+    s = np.asarray(sin, dtype=float)
+    return u * c + v * s, v * c - u * s
 
 
 def grid_to_earth(
