@@ -14,7 +14,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -428,6 +428,21 @@ def _plan_of(
     )
 
 
+def _scenario_done(progress: Progress | None, names: Sequence[str]) -> Any:
+    """A line per scenario as it comes back from a worker (``scenario 2 of 5 done
+    (wrf10): ...``), or None without a progress display."""
+    if progress is None:
+        return None
+    progress.start_count(len(names), "scenario")
+    done = [0]
+
+    def report(k: int, plan: Plan) -> None:
+        done[0] += 1
+        progress.item_done(done[0], f"{names[k]}, {plan.total_time_s:.1f} s")
+
+    return report
+
+
 def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:
     """One scenario of :func:`compare_scenarios` (top level, so Dask can pickle it)."""
     course, name, router, backend = task
@@ -502,6 +517,9 @@ def route_scenarios(
     else:
         # workers build their own scenario (a wind field is not worth shipping)
         plans = map_tasks(
-            _plan_task, [(course, n, router, backend) for n in names], scheduler=where
+            _plan_task,
+            [(course, n, router, backend) for n in names],
+            scheduler=where,
+            on_done=_scenario_done(progress, names),
         )
     return compare(plans), plans, winds
