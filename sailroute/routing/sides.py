@@ -96,17 +96,12 @@ class _VmgAngles:
     ) -> tuple[NDArray, NDArray]:
         """Upwind and downwind best-VMG |TWA| [°] of the paths ``act`` at their TWS."""
         key = np.array([round(v, 2) for v in tws_ms.tolist()])
-        missing: dict[int, set[float]] = {}
+        missing: dict[int, tuple[BoatModel, set[float]]] = {}  # per boat
         for k, tws in zip(act.tolist(), key.tolist(), strict=True):
             if (id(boats[k]), tws) not in self._known:
-                missing.setdefault(k, set()).add(tws)
-        done: dict[int, set[float]] = {}
-        for k, values in missing.items():
-            boat = boats[k]
-            new = sorted(values - done.get(id(boat), set()))
-            if not new:
-                continue
-            done.setdefault(id(boat), set()).update(new)
+                missing.setdefault(id(boats[k]), (boats[k], set()))[1].add(tws)
+        for boat, values in missing.values():
+            new = sorted(values)
             if isinstance(boat, Polar):  # all the values in one vectorised search
                 beat = boat.vmg_upwind(np.asarray(new))[0].tolist()
                 run = boat.vmg_downwind(np.asarray(new))[0].tolist()

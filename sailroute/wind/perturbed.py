@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -145,6 +146,43 @@ def _speed_factor(u: NDArray, v: NDArray, scale: ArrayLike, add: ArrayLike) -> N
     return np.divide(new, speed, out=np.zeros_like(speed), where=speed > 0)
 
 
+@dataclass(frozen=True, eq=False)
+class _MemberParams:
+    """The perturbations of a list of winds as arrays (:func:`sample_perturbed`)."""
+
+    winds: tuple[PerturbedWind, ...]
+    scale: NDArray[np.float64]
+    add: NDArray[np.float64]
+    turns: NDArray[np.bool_]
+    cos: NDArray[np.float64]  # of the constant turn
+    sin: NDArray[np.float64]
+    series: tuple[int, ...]  # the winds with a shift series
+
+
+_PARAMS: list[Any] = [(), None]  # the last winds and their _MemberParams
+
+
+def _member_params(winds: Sequence[PerturbedWind | WindField]) -> _MemberParams:
+    """:class:`_MemberParams` of ``winds`` (kept for the next call with the same winds;
+    a wind that is not a :class:`PerturbedWind` is its own base, unchanged)."""
+    last = _PARAMS[0]
+    if len(last) == len(winds) and all(a is b for a, b in zip(last, winds, strict=True)):
+        return _PARAMS[1]
+    params = tuple(w if isinstance(w, PerturbedWind) else PerturbedWind(w) for w in winds)
+    a = np.radians(np.array([float(w.direction_offset_deg) for w in params]))
+    out = _MemberParams(
+        params,
+        np.array([w.speed_scale for w in params], dtype=float),
+        np.array([w.speed_add_ms for w in params], dtype=float),
+        np.array([w.turns for w in params]),
+        np.cos(a),
+        np.sin(a),
+        tuple(k for k, w in enumerate(params) if w._series[0].size),
+    )
+    _PARAMS[:] = [tuple(winds), out]
+    return out
+
+
 def sample_perturbed(
     winds: Sequence[PerturbedWind | WindField],
     which: NDArray[np.int64],
@@ -161,27 +199,24 @@ def sample_perturbed(
     are versions of one scenario's wind.
     """
     base = winds[0].base if isinstance(winds[0], PerturbedWind) else winds[0]
-    params = [w if isinstance(w, PerturbedWind) else PerturbedWind(w) for w in winds]
+    p = _member_params(winds)
     u, v = base.sample(t, x, y)
     u = np.array(np.broadcast_to(u, t.shape), dtype=float)
     v = np.array(np.broadcast_to(v, t.shape), dtype=float)
-    scale = np.array([w.speed_scale for w in params])[which]
-    add = np.array([w.speed_add_ms for w in params])[which]
+    scale, add = p.scale[which], p.add[which]
     factor = scale
     adds = np.flatnonzero(add != 0.0)
     if adds.shape[0]:
         factor = scale.copy()
         factor[adds] = _speed_factor(u[adds], v[adds], scale[adds], add[adds])
-    turns = np.array([w.turns for w in params])[which]
+    turns = p.turns[which]
     if turns.any():
         # a constant turn's cosine and sine once per member; a shift series' per point
-        a = np.radians(np.array([float(w.direction_offset_deg) for w in params]))
-        cos, sin = np.cos(a)[which], np.sin(a)[which]
-        for k, w in enumerate(params):
-            if w._series[0].size:
-                mine = np.flatnonzero(which == k)
-                b = np.radians(w.turn_deg(t[mine]))
-                cos[mine], sin[mine] = np.cos(b), np.sin(b)
+        cos, sin = p.cos[which], p.sin[which]
+        for k in p.series:
+            mine = np.flatnonzero(which == k)
+            b = np.radians(p.winds[k].turn_deg(t[mine]))
+            cos[mine], sin[mine] = np.cos(b), np.sin(b)
         if turns.all():
             u, v = rotate_by(u, v, cos, sin)
         else:
