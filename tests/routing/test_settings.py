@@ -127,7 +127,7 @@ def test_every_field_of_a_router_has_one_flat_name_and_back() -> None:
     for flat, ps in FLAT_NAMES.items():
         assert {flat_name(p) for p in ps} == {flat}
     assert flat_name("zone_m") == "zone_m"
-    assert len(FLAT_NAMES) == 17  # the flat fields of the former single class
+    assert len(FLAT_NAMES) == 18  # the former single class's, and isochrone.engine
 
 
 def test_routing_settings_changes_a_base_and_takes_whole_groups() -> None:
