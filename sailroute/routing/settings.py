@@ -130,7 +130,9 @@ class IsochroneSettings:
     engine : {"auto", "numpy", "numba"}
         Kernels of a step: ``"numba"`` compiled (``sailroute/routing/isochrone_jit.py``,
         the extra ``fast``), ``"numpy"`` NumPy calls, ``"auto"`` compiled where numba is
-        installed.  The routes are the same bit for bit.
+        installed and the work pays for its start-up (an ensemble, or a process that has
+        routed a while: :func:`~sailroute.routing.isochrone_fast.compiled`).  The routes
+        are the same bit for bit.
     """
 
     FLAT: ClassVar[Mapping[str, str]] = {
@@ -188,8 +190,8 @@ class IsochroneSettings:
         if self.engine not in ENGINES:
             p.append(
                 f"{p.name('engine')} must be one of {', '.join(repr(e) for e in ENGINES)} "
-                f"(the same routes; 'auto': compiled where numba is installed), "
-                f"got {self.engine!r}"
+                "(the same routes; 'auto': compiled where numba is installed and the work "
+                f"pays for its start-up), got {self.engine!r}"
             )
         return list(p)
 

@@ -188,6 +188,12 @@ BAD = [
         "isochrone.max_front_points must be an integer in [8, 100000], got 2",
     ),
     ("isochrone.heading_fan", "wide", "isochrone.heading_fan must be 'hull' or 'full', got 'wide'"),
+    (
+        "isochrone.engine",
+        "jit",
+        "isochrone.engine must be one of 'auto', 'numpy', 'numba' (the same routes; 'auto': "
+        "compiled where numba is installed and the work pays for its start-up), got 'jit'",
+    ),
     ("initial_side", "left", "initial_side must be 'port', 'starboard' or None, got 'left'"),
     ("griddp.rows", 2, "griddp.rows must be an integer in [3, 200], got 2"),
     ("griddp.cols", 1, "griddp.cols must be an integer in [2, 1024], got 1"),
