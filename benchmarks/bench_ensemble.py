@@ -71,6 +71,18 @@ def timed(fn: Any) -> tuple[Any, float, float]:
     return out, time.perf_counter() - w0, time.process_time() - c0
 
 
+def race(ways: dict[str, Any], repeat: int) -> tuple[dict[str, Any], dict[str, Any]]:
+    """Each way's result and best ``(wall, CPU)`` [s], the ways taking turns ``repeat``
+    times."""
+    best = {way: (np.inf, np.inf) for way in ways}
+    got: dict[str, Any] = {}
+    for _ in range(repeat):
+        for way, fn in ways.items():
+            got[way], wall, cpu = timed(fn)
+            best[way] = (min(best[way][0], wall), min(best[way][1], cpu))
+    return got, best
+
+
 def report(best: dict[str, tuple[float, float]], n: int, unit: str) -> None:
     for way, (wall, cpu) in best.items():
         print(f"  {way:<11} {wall:8.2f} s ({cpu:.2f} s)  {wall / n * 1e3:7.1f} ms per {unit}")
@@ -98,12 +110,7 @@ def members_race(args: argparse.Namespace) -> None:
     }
     if args.only is not None:
         ways = {args.only.replace("-", " "): ways[args.only.replace("-", " ")]}
-    best = {way: (np.inf, np.inf) for way in ways}
-    out: dict[str, list[list[Any]]] = {}
-    for _ in range(args.repeat):
-        for way, fn in ways.items():
-            out[way], wall, cpu = timed(fn)
-            best[way] = (min(best[way][0], wall), min(best[way][1], cpu))
+    out, best = race(ways, args.repeat)
     print(f"load average at the end: {load()}")
     print(
         f"Hyères R1, {n} members ({args.wind}), {len(course.legs)} legs, isochrone "
@@ -162,12 +169,7 @@ def bands_race(args: argparse.Namespace) -> None:
         "together": lambda: band(route_together, "auto"),
         "single plan": lambda: run_plan_command(course, out_dir=out / "plan", plots=False),
     }
-    best = {way: (np.inf, np.inf) for way in ways}
-    got: dict[str, Any] = {}
-    for _ in range(args.repeat):
-        for way, fn in ways.items():
-            got[way], wall, cpu = timed(fn)
-            best[way] = (min(best[way][0], wall), min(best[way][1], cpu))
+    got, best = race(ways, args.repeat)
     print(f"load average at the end: {load()}")
     print(
         f"the bands of plan courses/hyeres-r1.yaml --ensemble {n} in-process (constant "

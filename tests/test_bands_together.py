@@ -16,18 +16,9 @@ from sailroute.course.load import build_specs, load_course
 from sailroute.routing.sides import extreme_times, layline_times
 from sailroute.wind.perturbed import PerturbedWind, sample_perturbed
 from sailroute.wind.uniform import UniformWind
-from tests.conftest import ROOT
 from tests.routing.polars import laser_like_polar
 from tests.routing.winds import T0, gridded_wind
-
-TEMPLATE = yaml.safe_load((ROOT / "courses" / "windward-leeward-template.yaml").read_text())
-FAST = {
-    "router": "isochrone",
-    "tack_penalty_s": 5.0,
-    "gybe_penalty_s": 3.0,
-    "dt_s": 10.0,
-    "heading_step_deg": 4.0,
-}
+from tests.test_bands import FAST, TEMPLATE
 
 
 def lap_course(tmp_path: Path, scenario: dict, uncertainty: dict) -> Path:

@@ -162,6 +162,24 @@ class Packed(NamedTuple):
     direct_sin: Any
     ttg: Any
 
+    def front(self, pre: _StepInputs) -> tuple[Any, ...]:
+        """The step's arrays as the candidate and survivor kernels take them
+        (:data:`~sailroute.routing.isochrone_jit.FRONT`)."""
+        m = pre.manoeuvre
+        return (
+            pre.x,
+            pre.y,
+            self.move,
+            self.move_row,
+            self.man,
+            self.flags,
+            m.debt_s,
+            m.charged_s,
+            self.exact,
+            self.direct_sin,
+            self.ttg,
+        )
+
 
 # --------------------------------------------------------------------------------------
 # the inputs of a step
@@ -543,6 +561,7 @@ def candidates(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any
     off = np.float32(ctx.n_bins // 2 + 0.5)
     arrival: Any = None
     found = np.empty(15)
+    front = p.front(pre)
     for r0 in range(0, n, rows):
         n_seg = kernels().candidates(
             r0,
@@ -552,17 +571,7 @@ def candidates(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any
             pre.stop,
             pre.dt,
             t_step,
-            pre.x,
-            pre.y,
-            p.move,
-            p.move_row,
-            p.man,
-            p.flags,
-            pre.manoeuvre.debt_s,
-            pre.manoeuvre.charged_s,
-            p.exact,
-            p.direct_sin,
-            p.ttg,
+            front,
             current,
             fans,
             geo.grid,
@@ -611,15 +620,7 @@ def survivors(
         pre.first,
         pre.n_grid,
         pre.dt,
-        pre.x,
-        pre.y,
-        p.move,
-        p.move_row,
-        p.man,
-        p.flags,
-        pre.manoeuvre.debt_s,
-        pre.manoeuvre.charged_s,
-        p.exact,
+        p.front(pre),
         np.stack([dev.twa_deg, dev.cos_a, dev.sin_a]),
         dev.speed_ms,
         current,

@@ -40,19 +40,9 @@ from typing import Any
 
 import numpy as np
 
-try:  # optional extra
-    import numba
-
-    AVAILABLE = True
-    """True when numba is installed and the compiled kernels can be used."""
-except ImportError:  # pragma: no cover - exercised where numba is not installed
-    AVAILABLE = False
-
-
-def _jit(fn: Any) -> Any:
-    # cache=True: compiled once, then loaded from __pycache__ (or NUMBA_CACHE_DIR)
-    return numba.njit(cache=True, nogil=True)(fn) if AVAILABLE else fn
-
+from sailroute.jit import AVAILABLE as AVAILABLE  # re-exported: numba is installed
+from sailroute.jit import inline as _inline
+from sailroute.jit import jit as _jit
 
 _BIG_S = 1e12  # isochrone_togo._BIG_S (a calm's time to go [s])
 _CALM_MS = 1e-9  # isochrone_inputs._CALM_MS
@@ -606,10 +596,23 @@ def _barrier_blocks(px: float, py: float, qx: float, qy: float, bar: Any, clear:
     return cx * cx + cy * cy < clear * clear
 
 
-def _inline(fn: Any) -> Any:
-    # inlined into the caller: a call passes every array as a struct of its fields
-    return numba.njit(cache=True, nogil=True, inline="always")(fn) if AVAILABLE else fn
-
+FRONT = (
+    "x",
+    "y",
+    "move",
+    "move_row",
+    "man",
+    "flags",
+    "debt",
+    "charged",
+    "exact",
+    "direct_sin",
+    "ttg",
+)
+"""The arrays of a step that :func:`candidates` and :func:`survivors` take as one tuple
+``front``: positions, the wind of the move (:func:`wind_states`), manoeuvres, penalty
+debt and charge, the exact columns, the direct columns' sines and the time to go
+(:func:`step_inputs`); ``isochrone_fast.Packed.front`` makes it."""
 
 _PLAIN, _PENDING, _SWITCHED = 0, 1, 2
 """How a row's candidates are timed: a whole step of moving (block ``_KEEP``), a
@@ -927,17 +930,7 @@ def candidates(
     stop: int,
     dt: float,
     t_step: float,
-    x: Any,
-    y: Any,
-    move: Any,
-    move_row: Any,
-    man: Any,
-    flags: Any,
-    debt: Any,
-    charged: Any,
-    exact: Any,
-    direct_sin: Any,
-    ttg: Any,
+    front: Any,
     current: Any,
     fans: Any,
     tables: Any,
@@ -965,9 +958,10 @@ def candidates(
     infinite where forbidden) and its end point seen from the pruning's origin in
     float32 (``qx32, qy32``); per row and block one row of ``segments``: its first
     candidate, their number, the first one's id (``isochrone_kernel._KEEP``) and the
-    side index plus the member's first key.  ``exact`` (4, n, 4) and ``ttg`` (3, 2, n:
-    time to go, gradient x, y; block ``_KEEP``, ``_SWITCH``) as :func:`step_inputs`
-    writes them; ``tables = (twa, cos, sin)`` (3, n_a) of the grid; ``current`` (2, n)
+    side index plus the member's first key.  ``front``: the step's arrays (:data:`FRONT`;
+    ``exact`` (4, n, 4) and ``ttg`` (3, 2, n: time to go, gradient x, y; block ``_KEEP``,
+    ``_SWITCH``) as :func:`step_inputs` writes them); ``tables = (twa, cos, sin)`` (3,
+    n_a) of the grid; ``current`` (2, n)
     or empty; ``fans`` (3, n: the member's first key, its fan's first and stop column)
     or empty; ``bars`` (k, 8) as :func:`_barrier_blocks` takes them with the rows near
     each ``near_bars`` (k, n) and their clearances.  The rows ``near`` the target (or
@@ -977,6 +971,7 @@ def candidates(
     the earliest in time, as the NumPy kernel compares them).  Returns the number of
     segments, or -1 where a score is NaN (the NumPy kernel then decides the step).
     """
+    x, y, move, move_row, man, flags, debt, charged, exact, direct_sin, ttg = front
     n_grid = stop - first
     h = n_grid + 3
     tx, ty = np.empty(h), np.empty(h)
@@ -1084,15 +1079,7 @@ def survivors(
     first: int,
     n_grid: int,
     dt: float,
-    x: Any,
-    y: Any,
-    move: Any,
-    move_row: Any,
-    man: Any,
-    flags: Any,
-    debt: Any,
-    charged: Any,
-    exact: Any,
+    front: Any,
     tables: Any,
     speed_ms: Any,
     current: Any,
@@ -1100,9 +1087,11 @@ def survivors(
     moved: Any,
 ) -> None:
     """The new front from the winning candidates ``(row, block, column)``
-    (``isochrone_kernel._winner_columns`` and ``_survivors``): writes ``out`` (11, m: x,
-    y, side, debt, |TWA|, |TWA| before a pending manoeuvre or NaN, its penalty so far,
-    boat speed, delay, velocity x and y) and ``moved`` (m,)."""
+    (``isochrone_kernel._winner_columns`` and ``_survivors``) of the step's arrays
+    ``front`` (:data:`FRONT`): writes ``out`` (11, m: x, y, side, debt, |TWA|, |TWA| before
+    a pending manoeuvre or NaN, its penalty so far, boat speed, delay, velocity x and y)
+    and ``moved`` (m,)."""
+    x, y, move, move_row, man, flags, debt, charged, exact, _, _ = front
     for i in range(row.shape[0]):
         r, c = row[i], column[i]
         switch = block[i] == 1
