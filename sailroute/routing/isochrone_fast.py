@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import threading
 import time
 from types import ModuleType
 from typing import Any, Final, NamedTuple
@@ -391,16 +392,16 @@ def _speeds(polar: Polar | PointPolars, tws: Any, twa: Any, out: Any) -> None:
     kernels().dense_speeds(dense[0], dense[1], which, tws, twa, out)
 
 
-_DENSE: list[Any] = [(), None]  # the last polars and their stacked dense tables
+_DENSE: list[Any] = [((), None)]  # the last (polars, their stacked dense tables)
 
 
 def _dense_tables(polars: tuple[Polar, ...]) -> tuple[Any, Any] | None:
     """The dense tables of ``polars`` one after the other, and their parameters, as
     :func:`~sailroute.routing.isochrone_jit.dense_speeds` takes them; None if one is not
     a PCHIP polar."""
-    last = _DENSE[0]
+    last, known = _DENSE[0]  # one read: another thread may replace it
     if len(polars) == len(last) and all(a is b for a, b in zip(polars, last, strict=True)):
-        return _DENSE[1]
+        return known
     tables = [p.dense_table() for p in polars]
     cells, params, start = [], [], 0
     for table in tables:
@@ -411,7 +412,7 @@ def _dense_tables(polars: tuple[Polar, ...]) -> tuple[Any, Any] | None:
         params.append((inv_twa, inv_tws, tws_max, n_twa, n_tws, start))
         start += c.shape[0]
     out = (cells[0] if len(cells) == 1 else np.concatenate(cells), np.array(params, dtype=float))
-    _DENSE[:] = [polars, out]
+    _DENSE[0] = (polars, out)
     return out
 
 
@@ -440,13 +441,14 @@ class _Geometry(NamedTuple):
     inv_rad_step: float  # 1 / the grid's |TWA| step [1/rad]
 
 
-_GEOMETRY: list[Any] = [None, None, None]  # the last (ctx, dev, _Geometry)
+_GEOMETRY: list[Any] = [(None, None, None)]  # the last (ctx, dev, _Geometry)
 
 
 def _geometry(ctx: _Context, dev: _DeviceTables) -> _Geometry:
     """The kernels' constants of a leg (kept for its next step)."""
-    if _GEOMETRY[0] is ctx and _GEOMETRY[1] is dev:
-        return _GEOMETRY[2]
+    last_ctx, last_dev, known = _GEOMETRY[0]  # one read: another thread may replace it
+    if last_ctx is ctx and last_dev is dev:
+        return known
     fr = ctx.frame
     bars = []
     for b, _ in ctx.barriers:
@@ -478,7 +480,7 @@ def _geometry(ctx: _Context, dev: _DeviceTables) -> _Geometry:
         inv_step=1.0 / step,
         inv_rad_step=1.0 / math.radians(step),
     )
-    _GEOMETRY[:] = [ctx, dev, geo]
+    _GEOMETRY[0] = (ctx, dev, geo)
     return geo
 
 
@@ -506,16 +508,16 @@ def pack(pre: _StepInputs) -> Packed:
     )
 
 
-_BUFFERS: dict[str, Any] = {}
+_BUFFERS = threading.local()  # work arrays, one set per thread
 
 
 def _buffer(name: str, size: int, dtype: Any) -> Any:
     """A work array of at least ``size`` elements, kept between steps (fresh large
     arrays are mapped and faulted in by the allocator at every step)."""
-    buf = _BUFFERS.get(name)
+    buf = getattr(_BUFFERS, name, None)
     if buf is None or buf.shape[0] < size:
         buf = np.empty(max(size, 1024), dtype=dtype)
-        _BUFFERS[name] = buf
+        setattr(_BUFFERS, name, buf)
     return buf
 
 

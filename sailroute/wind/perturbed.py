@@ -159,15 +159,15 @@ class _MemberParams:
     series: tuple[int, ...]  # the winds with a shift series
 
 
-_PARAMS: list[Any] = [(), None]  # the last winds and their _MemberParams
+_PARAMS: list[Any] = [((), None)]  # the last (winds, their _MemberParams)
 
 
 def _member_params(winds: Sequence[PerturbedWind | WindField]) -> _MemberParams:
     """:class:`_MemberParams` of ``winds`` (kept for the next call with the same winds;
     a wind that is not a :class:`PerturbedWind` is its own base, unchanged)."""
-    last = _PARAMS[0]
+    last, known = _PARAMS[0]  # one read: another thread may replace it
     if len(last) == len(winds) and all(a is b for a, b in zip(last, winds, strict=True)):
-        return _PARAMS[1]
+        return known
     params = tuple(w if isinstance(w, PerturbedWind) else PerturbedWind(w) for w in winds)
     a = np.radians(np.array([float(w.direction_offset_deg) for w in params]))
     out = _MemberParams(
@@ -179,7 +179,7 @@ def _member_params(winds: Sequence[PerturbedWind | WindField]) -> _MemberParams:
         np.sin(a),
         tuple(k for k, w in enumerate(params) if w._series[0].size),
     )
-    _PARAMS[:] = [tuple(winds), out]
+    _PARAMS[0] = (tuple(winds), out)
     return out
 
 
