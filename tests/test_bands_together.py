@@ -154,3 +154,23 @@ def test_extremes_sailed_together_are_the_ones_sailed_alone():
     (left, right), _, (reach_l, reach_r) = alone
     assert right < left  # a veer pays the right
     assert reach_l == reach_r  # a reach is one straight line
+
+
+@pytest.mark.slow
+def test_members_with_boats_of_their_own_sail_as_one_by_one(tmp_path):
+    # race-polar members (the ILCA 7's sea_age_h drawn in [2, 4] h): each member's boat
+    # is its own polar (stacked tables in the common front); the first leg the same bit
+    # for bit as routed alone, the second within the pruning's tolerance
+    path = lap_course(
+        tmp_path,
+        {"wind": {"type": "uniform", "tws_kn": 12, "twd_deg": 250}},
+        {"tws_kn": 1, "boat": {"sea_age_h": [2, 4]}},
+    )
+    members, alone, together = routed_both_ways(path, 3)
+    assert len({dict(m.boat)["sea_age_h"] for m in members}) == 3
+    for a, b in zip(alone, together, strict=True):
+        assert b[0].time_s == a[0].time_s
+        np.testing.assert_array_equal(b[0].track.y, a[0].track.y)
+        assert b[1].time_s == pytest.approx(a[1].time_s, rel=2e-3)
+    # the members' polars differ, so do their times in one wind
+    assert len({legs[0].time_s for legs in together}) == 3

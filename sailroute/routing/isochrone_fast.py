@@ -1,20 +1,21 @@
-"""The compiled isochrone step: the NumPy step's inputs and sector winners, through numba.
+"""The compiled isochrone step: the NumPy step's inputs, candidates and survivors, through numba.
 
-:func:`prepare` is :func:`~sailroute.routing.isochrone_inputs._prepare` (still water)
-and :func:`winners` the candidate loop of
-:func:`~sailroute.routing.isochrone_kernel._step` (every candidate move, its score and
-the best per sector and side) through the kernels of
-:mod:`sailroute.routing.isochrone_jit`, with the same results bit for bit: a few
-hundred NumPy calls per step become six compiled calls and seven NumPy calls (the
-trigonometric functions, kept NumPy's: :mod:`~sailroute.routing.isochrone_jit`).  The
-wind and current are sampled as on the NumPy path, in one call per step; the polar is
+:func:`prepare` is :func:`~sailroute.routing.isochrone_inputs._prepare` (still water),
+:func:`candidates` the candidate loop of :func:`~sailroute.routing.isochrone_kernel._step`
+(every candidate move, its score, the arrival and the best per sector and side) and
+:func:`survivors` :func:`~sailroute.routing.isochrone_kernel._survivors`, through the
+kernels of :mod:`sailroute.routing.isochrone_jit`, with the same results bit for bit: a
+few hundred NumPy calls per step become nine compiled calls and about fifteen NumPy calls
+(the trigonometric functions, kept NumPy's: :mod:`~sailroute.routing.isochrone_jit`).
+The wind and current are sampled as on the NumPy path, in one call per step; the polar is
 looked up once per step (a PCHIP polar inside the kernels, from its dense table).
 
 :func:`compiled` says whether a step takes this path (``routing.engine``, NumPy arrays,
-numba installed).  The NumPy functions decide what this path leaves to them: the steps
-with a point within reach of the target (the arrival test), a race area
-(:class:`~sailroute.routing.obstacles.Obstacles`) and, for :func:`prepare`, a surface
-current (the candidates of such a step are still compiled, :func:`pack`).
+numba installed, and for ``auto`` whether the work pays for numba's start-up); numba is
+imported only then (:func:`kernels`).  The NumPy functions do what this path leaves to
+them: the candidates of a step in a race area (:class:`~sailroute.routing.obstacles.
+Obstacles`) and the inputs of a step in a surface current (its candidates are still
+compiled, :func:`pack`).
 """
 
 from __future__ import annotations

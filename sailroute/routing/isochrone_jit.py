@@ -24,9 +24,12 @@ of a step:
   (``isochrone_togo._time_to_go``), the reach of the moves and the points within reach
   of the target, a barrier or the coverage box (``_within_reach``, ``_box_holds``);
 - :func:`candidates`: every candidate move of a run of rows: speed, velocity, penalty
-  timing, end point, score and what forbids it (``isochrone_kernel._expand``);
-  :func:`sector_winners` then keeps the best candidate per sector and side from the
-  bearings NumPy computed in float32 (``_sector_winners``).
+  timing, end point, score and what forbids it (``isochrone_kernel._expand``), and the
+  earliest crossing of the target by the rows within reach of it (``_arrival``,
+  :func:`_arrival_row`); :func:`sector_winners` then keeps the best candidate per sector
+  and side from the bearings NumPy computed in float32 (``_sector_winners``);
+- :func:`survivors`: the new front from the winners (``_winner_columns``,
+  ``_survivors``).
 
 Without numba, :data:`AVAILABLE` is False and the router runs its NumPy path.
 
