@@ -1,7 +1,8 @@
-"""Benchmark: route a 1.8 km beat with the isochrone router on one core.
+"""Benchmark: route a 1.8 km beat with the isochrone router on one core, NumPy against compiled.
 
     python benchmarks/bench_isochrone.py [--repeat 7] [--dt 5] [--heading-step 2]
-                                         [--sector 0.5] [--penalty 0] [--smoke]
+                                         [--sector 0.5] [--penalty 0] [--engines numpy,numba]
+                                         [--smoke]
 
 Cases (Laser/ILCA 7 polar from ``sailroute/boat/data/ilca7.pol`` when present, else a
 synthetic Laser-like table):
@@ -13,12 +14,17 @@ synthetic Laser-like table):
 * a gridded analytic field (500 m cells, 10-min slices, shifts and pressure bands)
   sampled bilinearly by :class:`~sailroute.wind.grid.GridWind`, same geometry.
 
-Prints the command and the load average, then per case the best and median wall and
-CPU time per leg over ``--repeat`` runs (after one warm-up run, which also builds the
-cached polar tables), the number of steps, the mean and largest front size, the
-candidates tried per step, the CPU time of a step split into a fixed part and a part per
-front point (least squares over the steps of one run), and the leg time.  The machine's
-load matters: compare numbers taken on the same machine, in one run.
+Each case is routed by every engine of ``--engines`` (``routing.engine``: ``numpy``, the
+NumPy step; ``numba``, the compiled step of ``sailroute/routing/isochrone_jit.py``,
+when numba is installed), which must give the same route bit for bit.  Prints the
+command and the load average, then per case and engine the best and median wall and
+CPU time per leg over ``--repeat`` runs, the engines taking turns (after one warm-up
+run of each, which also builds the cached polar tables and loads or compiles the
+kernels), the number of steps, the mean and largest front size, the candidates tried
+per step, the CPU time of a step split into a fixed part and a part per front point
+(least squares over the steps of one run), the leg time, and the ratio of the engines'
+best CPU and wall times.  The machine's load matters: compare numbers taken on the same
+machine, in one run.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMEXP
     os.environ[_v] = "1"
 
 import argparse  # noqa: E402
+import dataclasses  # noqa: E402
 import math  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
@@ -41,6 +48,7 @@ import numpy as np  # noqa: E402
 from sailroute.backend import get_xp, xp_name  # noqa: E402
 from sailroute.boat.polar import Polar  # noqa: E402
 from sailroute.routing import isochrone  # noqa: E402
+from sailroute.routing import isochrone_fast as fast  # noqa: E402
 from sailroute.routing.settings import RoutingSettings, routing_settings  # noqa: E402
 from sailroute.routing.types import Start, Target  # noqa: E402
 from sailroute.units import KNOT, wind_components, wind_speed_direction  # noqa: E402
@@ -108,8 +116,8 @@ def beat(wind, t0: float) -> tuple[Start, Target]:
     )
 
 
-def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repeat: int, xp=np):
-    start, target = beat(wind, t0)
+def step_profile(start, target, t0, wind, polar, st, xp=np):
+    """The leg, with the front size and the CPU time of each of its steps."""
     sizes: list[int] = []
     step_s: list[float] = []
     orig = isochrone._step
@@ -123,21 +131,35 @@ def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repe
 
     isochrone._step = counting
     try:
-        res = isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)  # warm-up
-        sizes.clear()
-        step_s.clear()
-        isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)  # timed steps
-        steps, mean_n, max_n = len(sizes), float(np.mean(sizes)), max(sizes)
+        res = isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)
     finally:
         isochrone._step = orig
-    # CPU time of a step = fixed + per point x front size (least squares over the steps)
-    per_point, fixed = np.polyfit(np.asarray(sizes, dtype=float), np.asarray(step_s), 1)
-    walls, cpus = [], []
-    for _ in range(repeat):
-        w0, c0 = time.perf_counter(), time.process_time()
-        isochrone.route_isochrone(start, target, t0, wind, polar, st, xp=xp)
-        walls.append(time.perf_counter() - w0)
-        cpus.append(time.process_time() - c0)
+    return res, np.asarray(sizes, dtype=float), np.asarray(step_s)
+
+
+def with_engine(st: RoutingSettings, engine: str) -> RoutingSettings:
+    return dataclasses.replace(st, isochrone=dataclasses.replace(st.isochrone, engine=engine))
+
+
+def run_case(name, wind, t0, polar, st, repeat, engines, xp=np):
+    start, target = beat(wind, t0)
+    runs = {e: with_engine(st, e) for e in engines}
+    results = {}
+    for e, se in runs.items():  # warm-up: polar tables, kernels loaded or compiled
+        results[e] = isochrone.route_isochrone(start, target, t0, wind, polar, se, xp=xp)
+    first = results[engines[0]]
+    same = all(
+        r.time_s == first.time_s and np.array_equal(r.track.x, first.track.x)
+        for r in results.values()
+    )
+    walls = {e: [] for e in engines}
+    cpus = {e: [] for e in engines}
+    for _ in range(repeat):  # the engines take turns
+        for e, se in runs.items():
+            w0, c0 = time.perf_counter(), time.process_time()
+            isochrone.route_isochrone(start, target, t0, wind, polar, se, xp=xp)
+            walls[e].append(time.perf_counter() - w0)
+            cpus[e].append(time.process_time() - c0)
     tab = isochrone.polar_tables(polar, st.isochrone.heading_step_deg)
     u, v = wind.sample(t0, 0.0, 0.0)
     tws = float(np.hypot(u, v))
@@ -145,19 +167,29 @@ def run_case(name: str, wind, t0: float, polar: Polar, st: RoutingSettings, repe
     a_dn = float(np.interp(tws, tab.tws_ms, tab.down_deg))
     hull = int(np.count_nonzero((tab.twa_deg > a_up) & (tab.twa_deg < a_dn)))
     print(f"{name}")
+    for e, se in runs.items():
+        _, sizes, step_s = step_profile(start, target, t0, wind, polar, se, xp)
+        # CPU time of a step = fixed + per point x front size (least squares over the steps)
+        per_point, fixed = np.polyfit(sizes, step_s, 1)
+        print(
+            f"  {e:<6} wall {1e3 * min(walls[e]):7.1f} ms best, "
+            f"{1e3 * statistics.median(walls[e]):7.1f} ms median; cpu "
+            f"{1e3 * min(cpus[e]):7.1f} ms best ({repeat} runs); per step {1e6 * fixed:.0f} us "
+            f"fixed + {1e6 * per_point:.2f} us per front point"
+        )
+    if len(engines) == 2:
+        a, b = engines
+        print(
+            f"  ratio {a} / {b}: {min(cpus[a]) / min(cpus[b]):.2f}x CPU, "
+            f"{min(walls[a]) / min(walls[b]):.2f}x wall (best of each); the same route "
+            f"bit for bit: {'yes' if same else 'NO'}"
+        )
     print(
-        f"  wall {1e3 * min(walls):7.1f} ms best, {1e3 * statistics.median(walls):7.1f} ms "
-        f"median; cpu {1e3 * min(cpus):7.1f} ms best  ({repeat} runs)"
-    )
-    print(
-        f"  {steps} steps, front {mean_n:.0f} points mean / {max_n} max, "
+        f"  {sizes.size} steps, front {sizes.mean():.0f} points mean / {sizes.max():.0f} max, "
         f"{hull + 3} + 3 candidates per point (grid TWAs between the VMG angles "
         f"{a_up:.1f}-{a_dn:.1f} deg + 3 exact; 3 after a side change)"
     )
-    print(
-        f"  per step (CPU, least squares over the {steps} steps): {1e6 * fixed:.0f} us "
-        f"fixed + {1e6 * per_point:.2f} us per front point"
-    )
+    res = first
     print(
         f"  leg time {res.time_s:.1f} s, {res.n_tacks} tacks, {res.n_gybes} gybes, "
         f"sailed {res.distance_m:.0f} m, start -> end ({res.end_xy[0]:.0f}, "
@@ -179,6 +211,11 @@ def main() -> None:
     )
     ap.add_argument("--backend", default="numpy", help="numpy | cupy | auto (array backend)")
     ap.add_argument(
+        "--engines",
+        default="numpy,numba",
+        help="routing.engine values to compare (numba: only where it is installed)",
+    )
+    ap.add_argument(
         "--smoke", action="store_true", help="the uniform-wind leg once (checks the script runs)"
     )
     args = ap.parse_args()
@@ -197,6 +234,7 @@ def main() -> None:
         if v is not None
     }
     st = routing_settings(**kw)
+    engines = [e for e in args.engines.split(",") if e != "numba" or fast.AVAILABLE]
     polar = load_polar()
     print(
         f"command: python {' '.join(sys.argv)}; load average (1, 5, 15 min): "
@@ -216,6 +254,7 @@ def main() -> None:
         polar,
         st,
         args.repeat,
+        engines,
         xp,
     )
     if args.smoke:
@@ -225,7 +264,14 @@ def main() -> None:
         c = wrf.coverage
         t_w = c.t0 + 0.25 * (c.t1 - c.t0)
         run_case(
-            f"WRF {wrf.name} (grid {wrf.shape}), 1809 m beat", wrf, t_w, polar, st, args.repeat, xp
+            f"WRF {wrf.name} (grid {wrf.shape}), 1809 m beat",
+            wrf,
+            t_w,
+            polar,
+            st,
+            args.repeat,
+            engines,
+            xp,
         )
     else:
         print("WRF reader not available: WRF case skipped")
@@ -236,6 +282,7 @@ def main() -> None:
         polar,
         st,
         args.repeat,
+        engines,
         xp,
     )
 

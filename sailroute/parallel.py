@@ -103,12 +103,24 @@ class TaskRunner:
     description: str
 
     def map(
-        self, fn: Callable[..., R], items: Iterable[Any], shared: Sequence[Any] = ()
+        self,
+        fn: Callable[..., R],
+        items: Iterable[Any],
+        shared: Sequence[Any] = (),
+        on_done: Callable[[int, R], None] | None = None,
     ) -> list[R]:
-        """Run ``fn(item, *shared)`` for every item; results in the order of ``items``."""
+        """Run ``fn(item, *shared)`` for every item; results in the order of ``items``.
+
+        ``on_done(index, result)`` is called as each task finishes (in the order they
+        finish on a cluster), e.g. to report progress."""
         items = list(items)
         if self.client is None:
-            return [fn(item, *shared) for item in items]
+            out = []
+            for k, item in enumerate(items):
+                out.append(fn(item, *shared))
+                if on_done is not None:
+                    on_done(k, out[-1])
+            return out
         # one future per shared value (a list is scattered element by element; a tuple
         # value stays one object), copied to every worker once
         shared_futures = (
@@ -116,10 +128,25 @@ class TaskRunner:
         )
         futures = [self.client.submit(fn, item, *shared_futures, pure=False) for item in items]
         try:
-            return list(self.client.gather(futures))
+            if on_done is None:
+                return list(self.client.gather(futures))
+            return self._as_completed(futures, on_done)
         finally:
             for f in futures + shared_futures:
                 f.release()
+
+    @staticmethod
+    def _as_completed(futures: list[Any], on_done: Callable[[int, Any], None]) -> list[Any]:
+        """The futures' results in their order, ``on_done`` called as each finishes (a
+        failed task raises its exception, as ``gather`` does)."""
+        distributed = _import_distributed(PROCESSES)
+        index = {f.key: k for k, f in enumerate(futures)}
+        out: list[Any] = [None] * len(futures)
+        for future, result in distributed.as_completed(futures, with_results=True):
+            k = index[future.key]
+            out[k] = result
+            on_done(k, result)
+        return out
 
 
 def _import_distributed(scheduler: str) -> Any:
@@ -255,6 +282,7 @@ def map_tasks(
     scheduler: str | TaskRunner | None = None,
     n_workers: int | None = None,
     timeout_s: float = CONNECT_TIMEOUT_S,
+    on_done: Callable[[int, R], None] | None = None,
 ) -> list[R]:
     """Run ``fn(item, *shared)`` for every item, serially or on Dask; results in input order.
 
@@ -274,6 +302,8 @@ def map_tasks(
         Worker processes for ``"processes"`` (default ``os.cpu_count()``).
     timeout_s : float
         Connection timeout for an address [s].
+    on_done : callable, optional
+        ``on_done(index, result)`` as each task finishes (progress reports).
 
     Returns
     -------
@@ -292,4 +322,4 @@ def map_tasks(
     [9, 1, 4]
     """
     with open_runner(scheduler, n_workers, timeout_s) as runner:
-        return runner.map(fn, items, shared)
+        return runner.map(fn, items, shared, on_done)

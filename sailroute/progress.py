@@ -7,6 +7,14 @@ per finished leg above it.  Otherwise (pipes, CI logs, tests) it is a plain
 :class:`Progress`: only the start and end of each leg, one line each.  Both print
 the same lines for finished legs, notes and warnings, and are context managers
 (leaving the block removes the bar and restores the cursor).
+
+A run over many things (the members of an ensemble, the scenarios of a comparison,
+the boats of a fleet) counts them: :meth:`Progress.start_count`, then
+:meth:`Progress.start_item` before each and :meth:`Progress.item_done` after each
+(``boat 12 of 57 done (GBR 1234): 1 min 3 s elapsed, about 4 min left``); members
+routed together (:mod:`sailroute.routing.batch`) are counted with ``together=True``
+and the legs' notes say how many have arrived.  The time left is the elapsed time
+scaled by the share of the run still to do.
 """
 
 from __future__ import annotations
@@ -55,6 +63,9 @@ class Progress:
         self._t_last = -1e9
         self._width = 0
         self.prefix = ""
+        self._count: tuple[int, str, bool] | None = None  # (total, noun, together)
+        self._item = 0  # things done before the one under way
+        self._t_run = time.perf_counter()
 
     def __enter__(self) -> Progress:
         return self
@@ -73,6 +84,65 @@ class Progress:
     def set_prefix(self, text: str) -> None:
         """Put ``text`` (e.g. ``"wrf10: "``) before every line, for multi-scenario runs."""
         self.prefix = text
+
+    # --- counting the things of a run ----------------------------------------------
+
+    def start_count(self, total: int, noun: str, *, together: bool = False) -> None:
+        """Count ``total`` things (``noun``: ``"member"``, ``"scenario"``, ``"boat"``)
+        from now: the run's clock starts, and the lines and the bar show the elapsed
+        time and the time left.  ``together``: they are routed together, one leg at a
+        time (the batched ensemble), so the legs, not the things, measure the run."""
+        self._count = (max(int(total), 1), noun, together)
+        self._item = 0
+        self._t_run = time.perf_counter()
+
+    def start_item(self, index: int, name: str = "") -> None:
+        """Thing ``index`` (0-based) of the count begins: its lines start with its name
+        and ``"<noun> k of N"`` (e.g. ``"m37 (member 38 of 100): "``)."""
+        self._item = index
+        if self._count is None:
+            return
+        total, noun, _ = self._count
+        what = f"{noun} {index + 1} of {total}"
+        self.prefix = f"{name} ({what}): " if name else f"{what}: "
+
+    def item_done(self, done: int, name: str = "") -> None:
+        """``done`` of the counted things are finished (``name``: the last one): one line
+        ``"<noun> k of N done (name): 12 s elapsed, about 40 s left"``.  Generic: a loop
+        over things calls it after each (after :meth:`start_count`)."""
+        if self._count is None:
+            self.start_count(done, "item")
+        assert self._count is not None
+        total, noun, _ = self._count
+        self._item = done
+        if not self.enabled:
+            return
+        saved, self.prefix = self.prefix, ""
+        label = f" ({name})" if name else ""
+        try:
+            self._write(f"{noun} {done} of {total} done{label}: {self.clock()}", end="\n")
+        finally:
+            self.prefix = saved
+
+    def fraction(self, leg_fraction: float = 0.0) -> float:
+        """The share of the run done [0-1]: the things done, then the legs done of the
+        one under way and ``leg_fraction`` of its current leg."""
+        legs = (self._leg + min(max(leg_fraction, 0.0), 1.0)) / max(self.n_legs, 1)
+        if self._count is None:
+            return legs
+        total, _, together = self._count
+        return legs if together else (self._item + legs) / total
+
+    def clock(self, fraction: float | None = None) -> str:
+        """``"12 s elapsed, about 40 s left"``: the run's time so far and the time left
+        at this pace, given the share done (default: the things done of the count)."""
+        elapsed = time.perf_counter() - self._t_run
+        if fraction is None:
+            fraction = self._item / self._count[0] if self._count is not None else 0.0
+        out = f"{duration(elapsed)} elapsed"
+        if 0.0 < fraction < 1.0:
+            out += f", about {duration(elapsed * (1.0 - fraction) / fraction)} left"
+        return out
 
     def _write(self, text: str, *, end: str) -> None:
         text = self.prefix + text
@@ -132,6 +202,8 @@ class Progress:
         if note:
             parts.append(note)
         parts.append(f"({now - self._t_leg:.1f} s)")
+        if self._count is not None:
+            parts.append(f"- {self.clock(self.fraction(fraction or 0.0))}")
         self._write(" ".join(parts), end="")
 
     __call__ = update
@@ -142,9 +214,10 @@ class Progress:
             return
         wall = time.perf_counter() - self._t_leg
         extra = f", {summary}" if summary else ""
+        run = "" if self._count is None else f"; {self.clock(self.fraction(1.0))}"
         self._write(
             f"leg {self._leg + 1}/{self.n_legs} {self._label}: {leg_time_s:.1f} s{extra} "
-            f"(computed in {wall:.1f} s)",
+            f"(computed in {wall:.1f} s{run})",
             end="\n",
         )
 
@@ -226,6 +299,9 @@ class RichProgress(Progress):
         if now - self._t_last < self.min_interval_s:
             return
         self._t_last = now
+        if self._count is not None:
+            clock = self.clock(self.fraction(fraction or 0.0))
+            note = f"{note} - {clock}" if note else clock
         kw: dict[str, Any] = {"note": note}
         if fraction is not None:
             kw["completed"] = min(max(float(fraction), 0.0), 1.0)
@@ -247,6 +323,18 @@ class RichProgress(Progress):
         if self._running:
             self._bar.stop()
             self._running = False
+
+
+def duration(seconds: float) -> str:
+    """A duration for people: ``"8.2 s"``, ``"42 s"``, ``"3 min 5 s"``, ``"1 h 02 min"``."""
+    if seconds < 10.0:
+        return f"{seconds:.1f} s"
+    s = round(seconds)
+    if s < 60:
+        return f"{s} s"
+    if s < 3600:
+        return f"{s // 60} min {s % 60} s"
+    return f"{s // 3600} h {s % 3600 // 60:02d} min"
 
 
 def make_progress(n_legs: int, *, enabled: bool = True, stream: TextIO | None = None) -> Progress:

@@ -32,6 +32,7 @@ BASE = (
     "progress",
     "tabular",
     "nmea",
+    "jit",
 )
 LAYERS: tuple[tuple[str, ...], ...] = (
     BASE,

@@ -6,6 +6,7 @@ on 127.0.0.1) and are skipped when dask.distributed is not installed.
 
 from __future__ import annotations
 
+import io
 import re
 import sys
 
@@ -22,6 +23,7 @@ from sailroute.parallel import (
     map_tasks,
     open_runner,
 )
+from sailroute.progress import Progress
 from sailroute.strategy.montecarlo import CHUNK_SIZE, chunk_rng, simulate
 from sailroute.strategy.shiftmodel import OUShift
 from sailroute.strategy.study import StrategySettings, run_strategy
@@ -222,12 +224,40 @@ def test_compare_scenarios_on_a_cluster_equals_serial(cluster) -> None:
         Path(__file__).resolve().parents[1] / "courses" / "windward-leeward-template.yaml"
     )
     serial_cmp, serial_plans = compare_scenarios(course)
+    stream = io.StringIO()
     dist_cmp, dist_plans = compare_scenarios(
-        course, options=RunOptions(scheduler=cluster.scheduler_address)
+        course,
+        options=RunOptions(
+            scheduler=cluster.scheduler_address, progress=Progress(course.n_legs, stream)
+        ),
     )
     assert dist_cmp.scenarios == serial_cmp.scenarios == ("steady-12kn", "veered-10deg")
+    # a line per scenario as it comes back, with its race time
+    lines = stream.getvalue().splitlines()
+    assert [line.split(" (")[0] for line in lines] == [
+        "scenario 1 of 2 done",
+        "scenario 2 of 2 done",
+    ]
+    totals = {p.scenario: f"{p.total_time_s:.1f} s" for p in serial_plans}
+    assert {line.split("(")[1].split(")")[0] for line in lines} == {
+        f"{n}, {t}" for n, t in totals.items()
+    }
     np.testing.assert_array_equal(dist_cmp.times, serial_cmp.times)
     for a, b in zip(serial_plans, dist_plans, strict=True):
         for ra, rb in zip(a.results, b.results, strict=True):
             np.testing.assert_array_equal(ra.track.x, rb.track.x)
             np.testing.assert_array_equal(ra.track.t, rb.track.t)
+
+
+def test_each_task_is_reported_as_it_finishes(cluster) -> None:
+    # on_done(index, result) once per task, serially in order and on a cluster in any
+    # order, for a progress line per finished task
+    for scheduler in (None, cluster.scheduler_address):
+        seen: list[tuple[int, int]] = []
+        got = map_tasks(pow, ITEMS, shared=(2,), scheduler=scheduler, on_done=_recorder(seen))
+        assert got == SQUARES
+        assert sorted(seen) == list(enumerate(SQUARES))
+
+
+def _recorder(seen: list[tuple[int, int]]):
+    return lambda k, r: seen.append((k, r))

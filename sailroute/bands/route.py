@@ -2,8 +2,11 @@
 
 The members come from :mod:`sailroute.bands.members` (the course's ``uncertainty``
 section, or :data:`~sailroute.course.uncertainty.DEFAULT_UNCERTAINTY`);
-:func:`route_members` routes a list of members one by one with the course's router
-(any function with its signature can route them instead, e.g. a batched router);
+:func:`route_together` routes a list of members as one front per leg (the isochrone
+router on NumPy in open water: :func:`~sailroute.planning.route.route_course_batch`,
+each member with its own wind, shift series and boat, all in the scenario's current),
+:func:`route_members` one by one with the course's router (any router, backend or race
+area; any function with their signature can route them instead);
 :func:`band_summary` routes the main ensemble, the nominal member and the one-at-a-time
 members and returns the bands, the breakdown and the side verdicts as a
 :class:`~sailroute.bands.summary.BandSummary`.
@@ -27,18 +30,20 @@ from sailroute.bands.members import (
     one_at_a_time,
     resolve_shifts,
 )
-from sailroute.bands.sides import honest_side
+from sailroute.bands.sides import honest_sides
 from sailroute.bands.summary import BandSummary, member_track
 from sailroute.course.load import build_current
 from sailroute.course.model import Course
 from sailroute.course.uncertainty import DEFAULT_UNCERTAINTY, UncertaintySpec
-from sailroute.planning.route import route_course
+from sailroute.planning.route import route_course, route_course_batch
 from sailroute.progress import Progress
+from sailroute.routing.batch import batchable
+from sailroute.routing.obstacles import RaceArea
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
-__all__ = ["RouteMembers", "band_summary", "route_members", "spec_for"]
+__all__ = ["RouteMembers", "band_summary", "route_members", "route_together", "spec_for"]
 
 
 RouteMembers = Callable[..., list[list[LegResult]]]
@@ -106,19 +111,79 @@ def route_members(
         Per member, its legs.
     """
     current = build_current(course, scenario)
-    where = course.boat_where or str(course.source or "<course>")
+    if progress is not None:
+        progress.start_count(len(members), "member")
     out = []
-    for m in members:
+    for k, m in enumerate(members):
         if progress is not None:
-            progress.set_prefix(f"{scenario} {m.name}: ")
-        w = member_wind(wind, m, course.start_epoch)
-        b = member_boat(course.boat_spec, boat, m, base_dir=course.base_dir, where=where)
+            progress.start_item(k, f"{scenario} {m.name}")
+        w, b = _member_inputs(course, m, wind, boat)
         out.append(
             route_course(
                 course, w, b, settings, backend=backend, progress=progress, current=current
             )
         )
+    if progress is not None:
+        progress.set_prefix("")
+        progress.item_done(len(members), scenario)
     return out
+
+
+def route_together(
+    course: Course,
+    scenario: str,
+    members: Sequence[Member],
+    *,
+    wind: WindField,
+    boat: Any,
+    settings: RoutingSettings,
+    backend: str = "numpy",
+    progress: Progress | None = None,
+) -> list[list[LegResult]]:
+    """Route the course for every member at once: one front per leg.
+
+    As :func:`route_members` (the same parameters and results; the first leg's times the
+    same bit for bit, the later legs' within the batch's tolerance:
+    :mod:`sailroute.routing.batch`), through
+    :func:`~sailroute.planning.route.route_course_batch`: each member with its own wind
+    (speed, direction, shift series) and boat, all in the scenario's current.  Where the
+    batch cannot route the course (another router or array backend, a race area) the
+    members are routed one by one (:func:`route_members`).
+    """
+    current = build_current(course, scenario)
+    if not (batchable(settings, backend, [current]) and course.area == RaceArea()):
+        return route_members(
+            course,
+            scenario,
+            members,
+            wind=wind,
+            boat=boat,
+            settings=settings,
+            backend=backend,
+            progress=progress,
+        )
+    inputs = [_member_inputs(course, m, wind, boat) for m in members]
+    if progress is not None:
+        progress.set_prefix(f"{scenario}: ")
+    out = route_course_batch(
+        course,
+        [w for w, _ in inputs],
+        [b for _, b in inputs],
+        settings,
+        progress=progress,
+        current=current,
+    )
+    if progress is not None:
+        progress.set_prefix("")
+    return out
+
+
+def _member_inputs(course: Course, m: Member, wind: WindField, boat: Any) -> tuple[Any, Any]:
+    """A member's wind and boat (:func:`~sailroute.bands.members.member_wind`,
+    :func:`~sailroute.bands.members.member_boat`)."""
+    where = course.boat_where or str(course.source or "<course>")
+    w = member_wind(wind, m, course.start_epoch)
+    return w, member_boat(course.boat_spec, boat, m, base_dir=course.base_dir, where=where)
 
 
 def _times(results: Sequence[Sequence[LegResult]]) -> np.ndarray:
@@ -135,7 +200,7 @@ def band_summary(
     settings: RoutingSettings,
     backend: str = "numpy",
     progress: Progress | None = None,
-    route: RouteMembers = route_members,
+    route: RouteMembers = route_together,
     notes: Sequence[str] = (),
     oat: bool = True,
 ) -> BandSummary:
@@ -148,7 +213,8 @@ def band_summary(
     spec : UncertaintySpec
         The uncertainty (shifts resolved: :func:`spec_for`).
     route : callable
-        Routes a member list (default :func:`route_members`).
+        Routes a member list (default :func:`route_together`: all of them as one front
+        per leg).
     notes : sequence of str
         Carried into the summary.
     oat : bool
@@ -185,25 +251,16 @@ def band_summary(
     )
     by_key = {key[m.name]: r for m, r in zip(todo, results, strict=True)}
     res_of = {m.name: by_key[key[m.name]] for m in flat}
-    where = course.boat_where or str(course.source or "<course>")
-    sides = []
-    for m in main:
-        w = member_wind(wind, m, course.start_epoch)
-        b = member_boat(course.boat_spec, boat, m, base_dir=course.base_dir, where=where)
-        sides.append(
-            tuple(
-                honest_side(
-                    r,
-                    w,
-                    b,
-                    tack_penalty_s=settings.tack_penalty_s,
-                    gybe_penalty_s=settings.gybe_penalty_s,
-                    margin_s=spec.side_margin_s,
-                    margin_pct=spec.side_margin_pct,
-                )
-                for r in res_of[m.name]
-            )
-        )
+    inputs = [_member_inputs(course, m, wind, boat) for m in main]
+    sides = honest_sides(
+        [res_of[m.name] for m in main],
+        [w for w, _ in inputs],
+        [b for _, b in inputs],
+        tack_penalty_s=settings.tack_penalty_s,
+        gybe_penalty_s=settings.gybe_penalty_s,
+        margin_s=spec.side_margin_s,
+        margin_pct=spec.side_margin_pct,
+    )
     return BandSummary(
         scenario=scenario,
         leg_labels=tuple(leg.label for leg in course.legs),

@@ -12,15 +12,17 @@ summary (:mod:`sailroute.report.ensemble`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from sailroute.analysis.loss import lateral_offset, side_label, time_mean
 from sailroute.boat.model import BoatModel
-from sailroute.routing.sides import layline_times, side_verdict
+from sailroute.routing.sides import extreme_times, side_verdict
 from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
-__all__ = ["honest_side", "leg_side"]
+__all__ = ["honest_side", "honest_sides", "leg_side"]
 
 
 def leg_side(res: LegResult) -> str:
@@ -58,16 +60,64 @@ def honest_side(
         Margin ``max(margin_s, margin_pct % of the leg time)``
         (:func:`sailroute.routing.sides.side_verdict`).
     """
-    t_left, t_right = layline_times(
-        res.start_xy,
-        res.end_xy,
-        res.t_start,
-        wind,
-        boat,
+    return honest_sides(
+        [[res]],
+        [wind],
+        [boat],
         tack_penalty_s=tack_penalty_s,
         gybe_penalty_s=gybe_penalty_s,
-        max_time_s=max(4.0 * res.time_s, 600.0),
-    )
-    return side_verdict(
-        leg_side(res), res.time_s, t_left, t_right, margin_s=margin_s, margin_pct=margin_pct
-    )
+        margin_s=margin_s,
+        margin_pct=margin_pct,
+    )[0][0]
+
+
+def honest_sides(
+    results: Sequence[Sequence[LegResult]],
+    winds: Sequence[WindField],
+    boats: Sequence[BoatModel],
+    *,
+    tack_penalty_s: float = 0.0,
+    gybe_penalty_s: float = 0.0,
+    margin_s: float = 2.0,
+    margin_pct: float = 0.5,
+) -> list[tuple[str, ...]]:
+    """:func:`honest_side` of every leg of every member, their extremes sailed together
+    (:func:`~sailroute.routing.sides.extreme_times`: the members' winds sampled once per
+    step).
+
+    Parameters
+    ----------
+    results : sequence of sequence of LegResult
+        Per member, its routed legs.
+    winds, boats : sequence
+        Each member's wind and boat.
+    tack_penalty_s, gybe_penalty_s, margin_s, margin_pct : float
+        As :func:`honest_side`.
+
+    Returns
+    -------
+    list of tuple of str
+        Per member, the verdict of each leg.
+    """
+    legs = [(m, r) for m, rs in enumerate(results) for r in rs]
+    if not legs:
+        return [() for _ in results]
+    times = extreme_times(
+        [r.start_xy for _, r in legs for _ in (0, 1)],
+        [r.end_xy for _, r in legs for _ in (0, 1)],
+        [r.t_start for _, r in legs for _ in (0, 1)],
+        [winds[m] for m, _ in legs for _ in (0, 1)],
+        [boats[m] for m, _ in legs for _ in (0, 1)],
+        [1, -1] * len(legs),
+        tack_penalty_s=tack_penalty_s,
+        gybe_penalty_s=gybe_penalty_s,
+        max_time_s=[max(4.0 * r.time_s, 600.0) for _, r in legs for _ in (0, 1)],
+    ).reshape(-1, 2)
+    verdicts: list[list[str]] = [[] for _ in results]
+    for (m, r), (t_left, t_right) in zip(legs, times.tolist(), strict=True):
+        verdicts[m].append(
+            side_verdict(
+                leg_side(r), r.time_s, t_left, t_right, margin_s=margin_s, margin_pct=margin_pct
+            )
+        )
+    return [tuple(v) for v in verdicts]

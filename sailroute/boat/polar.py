@@ -305,6 +305,16 @@ class Polar:
         hi = c[..., 2] + fw * (c[..., 3] - c[..., 2])
         return lo + fa * (hi - lo)
 
+    def dense_table(self) -> tuple[float, float, float, int, int, NDArray[np.float64]] | None:
+        """What :meth:`speed` interpolates in for the ``"pchip"`` method (None for
+        ``"linear"``): ``(n_twa - 1) / 180`` [1/°], ``(n_tws - 1) / top TWS`` [s/m], the
+        top TWS [m s⁻¹], the dense grid's ``n_twa`` and ``n_tws`` nodes, and its cells
+        (row ``i (n_tws - 1) + j``: the speeds [m s⁻¹] at its corners ``(i, j)``,
+        ``(i, j + 1)``, ``(i + 1, j)``, ``(i + 1, j + 1)``; read-only).  A compiled
+        lookup (the isochrone's, ``sailroute/routing/isochrone_jit.py``) repeats
+        :meth:`speed`'s arithmetic on it."""
+        return None if self.interpolation == "linear" else self._dense
+
     def _speed_linear(self, tws_ms: ArrayLike, twa_deg: ArrayLike) -> NDArray[np.float64]:
         tws = np.asarray(tws_ms, dtype=float)
         a = fold_twa(twa_deg)

@@ -1,8 +1,8 @@
 """``plan --ensemble N`` / ``compare-scenarios --ensemble N``: leg-time bands of scenarios.
 
-The members are drawn and routed by :mod:`sailroute.bands.route` (one by one, or by the
-batched router); this module parses the command's choices, picks the router and writes
-the files (:mod:`sailroute.report.bands`).
+The members are drawn and routed by :mod:`sailroute.bands.route` (as one front per leg,
+:func:`~sailroute.bands.route.route_together`); this module parses the command's
+choices, picks the router and writes the files (:mod:`sailroute.report.bands`).
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ def run_bands_command(
         ``uncertainty.members`` (20 without the section).
     options : RunOptions, optional
         Router, backend and progress display, as ``sailroute plan``; the scheduler may
-        only be None or ``"serial"``: the members are routed here, one after the other.
+        only be None or ``"serial"``: the members are routed here, together.
     out_dir : str or Path, optional
         Default ``out/<course>/<scenario>-bands`` (one scenario) or
         ``out/<course>/<what>-bands``.
@@ -76,8 +76,8 @@ def run_bands_command(
         raise InputError(f"--ensemble {members}: a band needs at least 3 members; give N >= 3")
     if scheduler not in (None, "serial"):
         raise InputError(
-            f"--scheduler {scheduler}: --ensemble routes its members here, one "
-            "after the other; leave out --scheduler (or use serial)"
+            f"--scheduler {scheduler}: --ensemble routes its members here, as one "
+            "front per leg; leave out --scheduler (or use serial)"
         )
     course = course if isinstance(course, Course) else load_course(course)
     names = list(scenarios) if scenarios else [course.scenario_names[0]]

@@ -14,7 +14,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import cast
+from typing import Any, cast
 
 import numpy as np
 
@@ -37,6 +37,7 @@ from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import LegResult, RouterName, Start
 from sailroute.wind.base import WindField
 from sailroute.wind.build import wind_notes
+from sailroute.wind.current import CurrentField
 
 
 @dataclass(frozen=True)
@@ -277,15 +278,16 @@ def route_course(
 def route_course_batch(
     course: Course,
     winds: Sequence[WindField],
-    boat: BoatModel,
+    boat: BoatModel | Sequence[BoatModel],
     settings: RoutingSettings,
     *,
     progress: Progress | None = None,
+    current: CurrentField | None = None,
 ) -> list[list[LegResult]]:
     """Route every leg of ``course`` for every member wind, leg by leg as one front.
 
-    The batched counterpart of :func:`route_course` (isochrone router,
-    NumPy, still water): each member's leg starts where and when its previous leg ended.
+    The batched counterpart of :func:`route_course` (isochrone router, NumPy, open
+    water): each member's leg starts where and when its previous leg ended.
 
     Parameters
     ----------
@@ -293,13 +295,15 @@ def route_course_batch(
         The course.
     winds : sequence of WindField
         One wind per member.
-    boat : BoatModel
-        The boat.
+    boat : BoatModel or sequence of BoatModel
+        The boat, or one per member.
     settings : RoutingSettings
         Isochrone settings.
     progress : Progress, optional
-        Per leg: ``start_leg``, ``update`` (share of members arrived) and ``end_leg``
-        (the members' median leg time).
+        Counts the members (routed together); per leg: ``start_leg``, ``update`` (share
+        of the leg done, members arrived) and ``end_leg`` (the members' median leg time).
+    current : CurrentField, optional
+        Surface current of every member; None: still water.
 
     Returns
     -------
@@ -307,6 +311,8 @@ def route_course_batch(
         Per member, its legs in order.
     """
     results: list[list[LegResult]] = [[] for _ in winds]
+    if progress is not None:
+        progress.start_count(len(winds), "member", together=True)
     for i, spec in enumerate(course.legs):
         following = target_of(course, i + 1) if i + 1 < course.n_legs else None
         ends = leg_endpoints(course, i)
@@ -323,6 +329,7 @@ def route_course_batch(
             boat,
             settings,
             progress=progress.update if progress is not None else None,
+            current=current,
         )
         if progress is not None:
             progress.end_leg(
@@ -421,6 +428,21 @@ def _plan_of(
     )
 
 
+def _scenario_done(progress: Progress | None, names: Sequence[str]) -> Any:
+    """A line per scenario as it comes back from a worker (``scenario 2 of 5 done
+    (wrf10): ...``), or None without a progress display."""
+    if progress is None:
+        return None
+    progress.start_count(len(names), "scenario")
+    done = [0]
+
+    def report(k: int, plan: Plan) -> None:
+        done[0] += 1
+        progress.item_done(done[0], f"{names[k]}, {plan.total_time_s:.1f} s")
+
+    return report
+
+
 def _plan_task(task: tuple[Course, str, str | None, str]) -> Plan:
     """One scenario of :func:`compare_scenarios` (top level, so Dask can pickle it)."""
     course, name, router, backend = task
@@ -495,6 +517,9 @@ def route_scenarios(
     else:
         # workers build their own scenario (a wind field is not worth shipping)
         plans = map_tasks(
-            _plan_task, [(course, n, router, backend) for n in names], scheduler=where
+            _plan_task,
+            [(course, n, router, backend) for n in names],
+            scheduler=where,
+            on_done=_scenario_done(progress, names),
         )
     return compare(plans), plans, winds

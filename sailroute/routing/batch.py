@@ -1,13 +1,18 @@
 """Members of an ensemble routed as one isochrone front.
 
-The members of a leg (wind scenarios or perturbed winds, start times, start points)
-share the target, the settings and the boat.  :func:`route_leg_batch` puts all their
-fronts into one array front, the points of each member consecutive, and steps it with
-the kernel of :mod:`sailroute.routing.isochrone_kernel` once per step for all members:
-the fixed cost of a step (a few hundred array calls) is paid once, not once per member.
-Per member stay apart: the wind (one ``sample`` call per member and step), the time,
-the pruning bins (each member keeps its own best point per sector and side), the fan of
-headings, the arrival and the errors.
+The members of a leg (wind scenarios or perturbed winds, start times, start points, and
+boats) share the target, the settings and the surface current.  :func:`route_leg_batch`
+puts all their fronts into one array front, the points of each member consecutive, and
+steps it with the kernel of :mod:`sailroute.routing.isochrone_kernel` once per step for
+all members: the fixed cost of a step is paid once, not once per member, and with
+numba installed the step is compiled (:mod:`sailroute.routing.isochrone_fast`).  Per
+member stay apart: the wind, the time, the pruning bins (each member keeps its own best
+point per sector and side), the fan of headings, the polar (members with their own boat
+read their own polar's rows of stacked tables,
+:func:`~sailroute.routing.isochrone_polar.stacked_tables`), the arrival and the errors.
+The winds of the members are sampled in one call per step where they are versions of
+one wind (:func:`~sailroute.wind.perturbed.sample_perturbed`: the members of a leg-time
+band), and the polars looked up in one call per step.
 
 A member leaves the common front when its next step would be shorter than ``dt_s``
 (near the target) or one of its points can reach the target within the step; it
@@ -29,7 +34,8 @@ numbers:
   differs from its single-member route by the pruning's own tolerance
   (``docs/design/routing.md``; measured on Hyères R1 in ``docs/performance.md``).
 
-Surface currents and array modules other than NumPy are routed one member at a time.
+Array modules other than NumPy and race areas (obstacles) are routed one member at a
+time (:func:`batchable`).
 """
 
 from __future__ import annotations
@@ -43,8 +49,9 @@ from typing import Any
 import numpy as np
 
 from sailroute.boat.model import BoatModel
+from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
-from sailroute.numerics import clip
+from sailroute.routing import isochrone_fast as fast
 from sailroute.routing.geometry import (
     barrier_clearance,
     leg_barriers,
@@ -66,23 +73,40 @@ from sailroute.routing.isochrone import (
     check_leg_work,
 )
 from sailroute.routing.isochrone_inputs import _prepare, _step_length
-from sailroute.routing.isochrone_kernel import _CHUNK_ELEMENTS, _expand, _group_argmin, _survivors
-from sailroute.routing.isochrone_polar import _device_tables, _DeviceTables, polar_tables
-from sailroute.routing.isochrone_records import Groups, _Arrival, _Context, _Layer, _LegFrame
+from sailroute.routing.isochrone_kernel import _candidates, _group_argmin, _survivors
+from sailroute.routing.isochrone_polar import (
+    PointPolars,
+    _device_tables,
+    _DeviceTables,
+    polar_tables,
+    stacked_tables,
+)
+from sailroute.routing.isochrone_records import (
+    Groups,
+    _Arrival,
+    _Context,
+    _Layer,
+    _LegFrame,
+)
+from sailroute.routing.isochrone_togo import _BIG_S
 from sailroute.routing.settings import RoutingSettings, check_settings
 from sailroute.routing.track import make_leg_result
 from sailroute.routing.types import LegResult, Start, Target
-from sailroute.wind.base import Coverage, WindField
+from sailroute.wind.base import WindField
+from sailroute.wind.current import CurrentField, RelativeWind
+from sailroute.wind.perturbed import PerturbedWind, sample_perturbed
 
 __all__ = ["batchable", "route_leg_batch"]
 
 
 def batchable(settings: RoutingSettings, backend: str, currents: Sequence[object]) -> bool:
     """Whether :func:`~sailroute.planning.route.route_course_batch` can route these
-    members: the isochrone router on NumPy, every member in still water (``currents`` all
-    None)."""
+    members: the isochrone router on NumPy, every member in still water or in one
+    current (``currents``: each member's, the same object or None)."""
     return (
-        settings.router == "isochrone" and backend == "numpy" and all(c is None for c in currents)
+        settings.router == "isochrone"
+        and backend == "numpy"
+        and len({id(c) for c in currents}) <= 1
     )
 
 
@@ -91,10 +115,11 @@ def route_leg_batch(
     target: Target,
     t0s: Sequence[float],
     winds: Sequence[WindField],
-    boat: BoatModel,
+    boat: BoatModel | Sequence[BoatModel],
     settings: RoutingSettings,
     *,
-    progress: Callable[[float], None] | None = None,
+    progress: Callable[[float, str], None] | None = None,
+    current: CurrentField | None = None,
 ) -> list[LegResult]:
     """Fastest route of one leg for every member of an ensemble, as one front.
 
@@ -110,12 +135,19 @@ def route_leg_batch(
         Start time of each member [epoch s].
     winds : sequence of WindField
         Wind of each member (the same object may appear several times).
-    boat : BoatModel
-        The boat (its steady polar is routed, as by the isochrone router).
+    boat : BoatModel or sequence of BoatModel
+        The boat of every member, or one per member (its steady polar is routed, as by
+        the isochrone router).
     settings : RoutingSettings
         Isochrone settings, the same for every member.
     progress : callable, optional
-        Called with the fraction of members that have arrived, in [0, 1].
+        Called with the estimated share of the leg done, in [0, 1] (the members' mean:
+        time sailed over time sailed and time to go), and a note saying how many members
+        have arrived (``progress(0.4, "37 of 100 members arrived")``; a
+        :class:`~sailroute.progress.Progress` is such a callable).
+    current : CurrentField, optional
+        Surface current of every member (as :func:`~sailroute.routing.isochrone.
+        route_isochrone` takes it); None: still water.
 
     Returns
     -------
@@ -126,23 +158,29 @@ def route_leg_batch(
     Raises
     ------
     InputError
-        Members given in different numbers (starts, times, winds), no member, or
+        Members given in different numbers (starts, times, winds, boats), no member, or
         what :func:`~sailroute.routing.isochrone.route_isochrone` refuses.
     RoutingError, OutOfCoverageError
         A member's leg cannot be routed (the first such member's error).
     """
     n = len(t0s)
     starts = [start] * n if isinstance(start, Start) else list(start)
+    boats = list(boat) if isinstance(boat, Sequence) else [boat] * n
     label = leg_label(starts[0] if starts else Start((0.0, 0.0)), target)
-    if n == 0 or len(winds) != n or len(starts) != n:
+    if n == 0 or len(winds) != n or len(starts) != n or len(boats) != n:
         raise InputError(
             f"leg {label}: route_leg_batch needs one start time, one wind and (unless a "
-            f"single start is given) one start per member; got {n} start times, "
-            f"{len(winds)} winds and {len(starts)} starts"
+            f"single one is given) one start and one boat per member; got {n} start "
+            f"times, {len(winds)} winds, {len(starts)} starts and {len(boats)} boats"
         )
     check_settings(settings, label)
-    polar = _routing_polar(boat, label)
-    tab = polar_tables(polar, settings.isochrone.heading_step_deg)
+    polars: dict[int, Polar] = {}  # the different polars, in order of first use
+    which = []
+    for b in boats:
+        p = _routing_polar(b, label)
+        polars.setdefault(id(p), p)
+        which.append(list(polars).index(id(p)))
+    tabs = [polar_tables(p, settings.isochrone.heading_step_deg) for p in polars.values()]
     geom = target_geometry(target, starts[0], settings.zone_m)
     frame = _LegFrame.for_leg(geom.centre, start_centre(starts[0]))
     barriers = leg_barriers(starts[0], target)
@@ -151,41 +189,44 @@ def route_leg_batch(
         clearances = [
             barrier_clearance(dataclasses.replace(st, barrier=starts[0].barrier)) for st in starts
         ]
-    ctxs = []
+    members = []
     for k, (t0, wind) in enumerate(zip(t0s, winds, strict=True)):
         _check_start_time(t0, label)
         own = barriers if clearances is None else ((barriers[0][0], clearances[k]), *barriers[1:])
-        ctx = _context(label, float(t0), frame, geom, wind, settings, own)
+        felt = wind if current is None else RelativeWind(wind, current)
+        ctx = _context(label, float(t0), frame, geom, felt, settings, own, current)
         if ctx.box is not None:
-            _check_target_covered(geom, ctx.box, wind, label)
-        ctxs.append(ctx)
+            _check_target_covered(geom, ctx.box, felt, label)
+        members.append(
+            _Member(
+                k,
+                starts[k],
+                felt,
+                wind,
+                which[k],
+                ctx,
+                start_points(starts[k], settings.start_line_spacing_m),
+                None if clearances is None else clearances[k],
+            )
+        )
     leg = _Leg(
         target,
         settings,
-        polar,
+        tuple(polars.values()),
         frame,
-        _device_tables(tab, np),
-        int(tab.twa_deg.size),
+        _device_tables(tabs[0], np) if len(tabs) == 1 else stacked_tables(tabs),
+        tuple(_device_tables(t, np) for t in tabs),
+        int(tabs[0].twa_deg.size),
         progress,
-        n,
         target_barrier(target, starts[0], settings.zone_m),
+        current,
     )
-    members = [
-        _Member(
-            k,
-            starts[k],
-            winds[k],
-            ctxs[k],
-            start_points(starts[k], settings.start_line_spacing_m),
-            None if clearances is None else clearances[k],
-        )
-        for k in range(n)
-    ]
     results: dict[int, LegResult] = {}
-    by_box: dict[Any, list[_Member]] = {}
-    for m in members:  # one front per coverage box (the moves must stay in it)
-        by_box.setdefault(m.ctx.box, []).append(m)
-    for group in by_box.values():
+    fronts: dict[Any, list[_Member]] = {}
+    for m in members:  # one front per coverage (the moves stay in it, the samples too)
+        c = m.wind.coverage
+        fronts.setdefault((c.t0, c.t1, c.xmin, c.xmax, c.ymin, c.ymax, m.ctx.box), []).append(m)
+    for group in fronts.values():
         _route_front(group, leg, results)
     return [results[k] for k in range(n)]
 
@@ -200,13 +241,14 @@ class _Leg:
 
     target: Target
     settings: RoutingSettings
-    polar: Any
+    polars: tuple[Polar, ...]  # the members' different polars
     frame: _LegFrame
-    dev: _DeviceTables
+    dev: _DeviceTables  # their tables (stacked_tables where there are several)
+    devs: tuple[_DeviceTables, ...]  # each polar's own (a member finishing alone)
     n_angles: int
-    progress: Callable[[float], None] | None
-    n_members: int
+    progress: Callable[[float, str], None] | None
     barrier: Any  # the rounding ray the legs end on (of the common target geometry)
+    current: CurrentField | None
 
 
 @dataclass(eq=False)
@@ -215,12 +257,15 @@ class _Member:
 
     index: int
     start: Start
-    wind: WindField
+    wind: WindField  # the wind the boat feels (relative to the water in a current)
+    true_wind: WindField  # its wind over the ground
+    polar: int  # its polar, in _Leg.polars
     ctx: _Context
     world_start: tuple[Any, Any]
     clearance: float | None  # from the mark of the start's barrier [m]; None: no barrier
     calm_since: float | None = None
     tau_hint: float = math.inf
+    done: float = 0.0  # share of its leg sailed (estimated, for progress)
 
 
 @dataclass(frozen=True, eq=False)
@@ -250,38 +295,48 @@ class _MemberWinds:
     """The members' winds behind one ``sample`` call of the kernel.
 
     The kernel samples ``PATH_SAMPLES + 1`` rows of the ``n`` front points at once
-    (:func:`~sailroute.routing.isochrone_inputs._sample_step`); each member's columns
-    go to its own wind, clipped to its own coverage, in the order the single-member
-    router passes them.  The coverage seen by the kernel is unbounded (each member's
-    is applied here).
+    (:func:`~sailroute.routing.isochrone_inputs._sample_step`), clipped to the
+    coverage the members share; each member's columns go to its own wind: with one
+    ``sample`` call of their base for the members whose winds are versions of one wind
+    (:func:`~sailroute.wind.perturbed.sample_perturbed`), else member by member; in a
+    current, less the current (one call), as :class:`~sailroute.wind.current.
+    RelativeWind` gives it.
     """
 
-    def __init__(self, front: _Front) -> None:
+    def __init__(self, front: _Front, current: CurrentField | None) -> None:
         self._front = front
-        self.coverage = Coverage.everywhere()
-        self.clamp = True
+        self._current = current
+        self.coverage = front.members[0].wind.coverage
+        self.clamp = front.members[0].wind.clamp
+        bases: dict[int, list[int]] = {}  # members by the wind their winds perturb
+        for k, m in enumerate(front.members):
+            w = m.true_wind
+            bases.setdefault(id(w.base if isinstance(w, PerturbedWind) else w), []).append(k)
+        self._bases = list(bases.values())
 
     def sample(self, t: Any, x: Any, y: Any) -> tuple[Any, Any]:
         f = self._front
-        n = int(f.layer.x.shape[0])
-        t, x, y = (np.asarray(a, dtype=float).reshape(-1, n) for a in (t, x, y))
-        u = np.empty_like(t)
-        v = np.empty_like(t)
-        for m in f.members:
-            lo, hi = f.block(m)
-            cov = m.wind.coverage
-            uu, vv = m.wind.sample(
-                clip(t[:, lo:hi].ravel(), cov.t0, cov.t1),
-                clip(x[:, lo:hi].ravel(), cov.xmin, cov.xmax),
-                clip(y[:, lo:hi].ravel(), cov.ymin, cov.ymax),
-            )
-            u[:, lo:hi] = np.asarray(uu, dtype=float).reshape(-1, hi - lo)
-            v[:, lo:hi] = np.asarray(vv, dtype=float).reshape(-1, hi - lo)
-        return u.ravel(), v.ravel()
+        t, x, y = (np.asarray(a, dtype=float).reshape(-1) for a in (t, x, y))
+        rows = t.shape[0] // int(f.layer.x.shape[0])
+        position = np.tile(f.groups.member, rows)  # each sample's member, in f.members
+        u, v = np.empty_like(t), np.empty_like(t)
+        for ks in self._bases:
+            winds = [f.members[k].true_wind for k in ks]
+            if len(ks) == len(f.members):  # one base: no gathering
+                u, v = sample_perturbed(winds, position, t, x, y)
+                continue
+            local = np.full(len(f.members), -1, dtype=np.int64)
+            local[ks] = np.arange(len(ks))
+            idx = np.flatnonzero(local[position] >= 0)
+            u[idx], v[idx] = sample_perturbed(winds, local[position[idx]], t[idx], x[idx], y[idx])
+        if self._current is None:
+            return u, v
+        cu, cv = self._current.sample(t, x, y)
+        return u - cu, v - cv
 
 
 def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult]) -> None:
-    """Route ``members`` (same coverage box) as one front until each has finished."""
+    """Route ``members`` (same coverage) as one front until each has finished."""
     s = leg.settings
     x0, y0, t0 = [], [], []
     for m in members:
@@ -302,21 +357,49 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
             _finish_alone(short, history, leg, results)
             continue
         ctx = front.members[0].ctx
-        pre, tau_min, dist_min = _prepare(
-            front.layer, _MemberWinds(front), leg.polar, leg.dev, ctx, s, math.inf, np, front.groups
+        jit = fast.compiled(s, np, members=len(front.members))
+        winds = _MemberWinds(front, leg.current)
+        polar = _front_polar(front, leg)
+        prepared = (
+            fast.prepare(front.layer, winds, polar, leg.dev, ctx, s, math.inf, front.groups)
+            if jit
+            else None
         )
+        if prepared is None:
+            prepared = _prepare(
+                front.layer, winds, polar, leg.dev, ctx, s, math.inf, np, front.groups
+            )
+        pre, tau_min, dist_min = prepared
         near = np.logical_or.reduceat(pre.near_target, front.groups.starts)
         if near.any():  # the arrival is tested member by member
             _finish_alone(
                 [m for m, k in zip(front.members, near, strict=True) if k], history, leg, results
             )
             continue
-        out = _common_step(pre, front, ctx, leg)
+        out = _common_step(pre, front, ctx, leg, jit)
         if isinstance(out, list):  # members without a survivor: their own error
             _finish_alone(out, history, leg, results)
             continue
         history.append(out)
         _after_step(front, out, tau_min, dist_min, leg)
+        _report(members, results, leg)
+
+
+def _report(members: list[_Member], results: dict[int, LegResult], leg: _Leg) -> None:
+    """Tell ``leg.progress`` the share of the leg done and how many members arrived."""
+    if leg.progress is None:
+        return
+    share = sum(1.0 if m.index in results else m.done for m in members) / len(members)
+    arrived = sum(m.index in results for m in members)
+    leg.progress(share, f"{arrived} of {len(members)} members arrived")
+
+
+def _front_polar(front: _Front, leg: _Leg) -> Polar | PointPolars:
+    """The polar of the front's points: the members' one, or each point's own."""
+    if len(leg.polars) == 1:
+        return leg.polars[0]
+    own = np.array([m.polar for m in front.members], dtype=np.int64)
+    return PointPolars(leg.polars, own[front.groups.member])
 
 
 def _groups(members: Sequence[_Member], sizes: Any) -> Groups:
@@ -326,25 +409,16 @@ def _groups(members: Sequence[_Member], sizes: Any) -> Groups:
     return Groups.of_sizes(sizes, clear)
 
 
-def _common_step(pre: Any, front: _Front, ctx: _Context, leg: _Leg) -> _Front | list[_Member]:
+def _common_step(
+    pre: Any, front: _Front, ctx: _Context, leg: _Leg, jit: bool
+) -> _Front | list[_Member]:
     """Candidates, pruning per member and survivors of one common step (no arrival:
-    the members within reach of the target have left).  Returns the new front, or the
-    members left without a survivor."""
-    n, n_columns = pre.n, pre.n_columns
-    chunk = max(1, _CHUNK_ELEMENTS // (n_columns + 3))
+    the members within reach of the target have left); ``jit``: compiled
+    (:mod:`~sailroute.routing.isochrone_fast`).  Returns the new front, or the members
+    left without a survivor."""
+    n_columns = pre.n_columns
     per_member = 2 * ctx.n_bins
-    n_keys = per_member * len(front.members)
-    best = np.full(n_keys, np.inf)
-    who = np.zeros(n_keys, dtype=np.int64)
-    for r0 in range(0, n, chunk):
-        r1 = min(n, r0 + chunk)
-        _, win = _expand(pre, r0, r1, leg.dev, ctx, np, want_winners=True)
-        if win is None:
-            continue
-        key, score, wid = win
-        better = score < best[key]
-        best[key[better]] = score[better]
-        who[key[better]] = wid[better]
+    _, best, who = _candidates(pre, leg.dev, ctx, np, jit)
     won = np.flatnonzero(best < np.inf)
     owner = won // per_member
     counts = np.bincount(owner, minlength=len(front.members))
@@ -366,7 +440,10 @@ def _common_step(pre: Any, front: _Front, ctx: _Context, leg: _Leg) -> _Front | 
     column = wid % n_columns
     block = (wid // n_columns) % 2
     row = wid // (2 * n_columns)
-    layer, moved = _survivors(pre, row, block, column, best[won], leg.dev, np)
+    if jit:
+        layer, moved = fast.survivors(pre, row, block, column, best[won], leg.dev)
+    else:
+        layer, moved = _survivors(pre, row, block, column, best[won], leg.dev, np)
     return _Front(layer, front.members, _groups(front.members, counts), moved)
 
 
@@ -383,6 +460,8 @@ def _after_step(front: _Front, new: _Front, tau_min: Any, dist_min: Any, leg: _L
         elif m.calm_since is None:
             m.calm_since = t_old
         m.tau_hint = float(tau_min[k]) - (t_new - t_old)
+        sailed = t_new - m.ctx.t0
+        m.done = sailed / (sailed + m.tau_hint) if 0.0 <= m.tau_hint < _BIG_S else 0.0
         if first_step:
             check_leg_work(m.ctx.label, s, m.ctx, leg.n_angles, m.tau_hint)
         elapsed = t_new - m.ctx.t0
@@ -396,22 +475,21 @@ def _finish_alone(
     """Finish the legs of ``leaving`` one by one from their own fronts, and take them
     out of the common front (``history[-1]``)."""
     for m in leaving:
+        _report(list(history[0].members), results, leg)
         layers = _own_layers(m, history)
         arrival = _route_on(
             layers,
             m.wind,
-            leg.dev,
+            leg.devs[m.polar],
             m.ctx,
             leg.settings,
             leg.n_angles,
             np,
-            polar=leg.polar,
+            polar=leg.polars[m.polar],
             calm_since=m.calm_since,
             tau_hint=m.tau_hint,
         )
         results[m.index] = _result(m, layers, arrival, leg)
-        if leg.progress is not None:
-            leg.progress(len(results) / leg.n_members)
     front = history[-1]
     stay = tuple(m for m in front.members if m not in leaving)
     rows = (
@@ -464,5 +542,6 @@ def _own_layers(m: _Member, history: list[_Front]) -> list[_Layer]:
 
 def _result(m: _Member, layers: list[_Layer], arrival: _Arrival, leg: _Leg) -> LegResult:
     """The member's :class:`LegResult`, as the single-member router assembles it."""
-    track = _backtrack(layers, arrival, leg.frame, m.wind, leg.polar, m.world_start)
+    polar = leg.polars[m.polar]
+    track = _backtrack(layers, arrival, leg.frame, m.wind, polar, m.world_start, leg.current)
     return make_leg_result(track, "isochrone", leg.barrier)

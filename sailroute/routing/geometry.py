@@ -351,12 +351,21 @@ def aim_points(
     of ``P`` onto the segment, clipped to ``[m, L − m]`` from ``a`` with
     ``m = min(margin_m, L/2)``.
     """
+    ax, ay, ux, uy, m, length = segment_frame(geom, margin_m)
+    r = clip((px - ax) * ux + (py - ay) * uy, m, length - m, xp=xp)
+    return ax + r * ux, ay + r * uy
+
+
+def segment_frame(
+    geom: TargetGeometry, margin_m: float = AIM_MARGIN_M
+) -> tuple[float, float, float, float, float, float]:
+    """``(ax, ay, ux, uy, m, length)`` of the target segment: its end ``a`` [m], the unit
+    vector from ``a`` to ``b``, the margin ``m = min(margin_m, L/2)`` kept from its ends
+    and its length ``L`` [m] (:func:`aim_points`, the isochrone's fastest aim points)."""
     ax, ay = geom.a
     length = geom.length_m
     ux, uy = (geom.b[0] - ax) / length, (geom.b[1] - ay) / length
-    m = min(margin_m, 0.5 * length)
-    r = clip((px - ax) * ux + (py - ay) * uy, m, length - m, xp=xp)
-    return ax + r * ux, ay + r * uy
+    return ax, ay, ux, uy, min(margin_m, 0.5 * length), length
 
 
 def sample_line(
@@ -482,17 +491,7 @@ def barrier_blocks(
         ``clearance_m`` of the mark.
     """
     mx, my = barrier.mark
-    rx, ry = barrier.ray
-    nx, ny = barrier.normal
-    ax, ay = mx - BARRIER_SLACK_M * nx, my - BARRIER_SLACK_M * ny
-    back = TargetGeometry(
-        (ax, ay),
-        (ax + BARRIER_LENGTH_M * rx, ay + BARRIER_LENGTH_M * ry),
-        (-nx, -ny),
-        "barrier",
-        barrier.name,
-    )
-    blocked, _, _ = segment_crossing(px, py, qx, qy, back, xp=xp)
+    blocked, _, _ = segment_crossing(px, py, qx, qy, barrier_segment(barrier), xp=xp)
     if isinstance(clearance_m, np.ndarray) or clearance_m > 0:  # an array: one per move
         dx, dy = qx - px, qy - py
         wx, wy = mx - px, my - py
@@ -501,6 +500,23 @@ def barrier_blocks(
         cx, cy = wx - f * dx, wy - f * dy
         blocked = blocked | (cx * cx + cy * cy < clearance_m * clearance_m)
     return blocked
+
+
+def barrier_segment(barrier: Barrier) -> TargetGeometry:
+    """The segment :func:`barrier_blocks` tests a move against: the barrier's ray,
+    :data:`BARRIER_SLACK_M` behind it and :data:`BARRIER_LENGTH_M` long, crossed against
+    its normal."""
+    mx, my = barrier.mark
+    rx, ry = barrier.ray
+    nx, ny = barrier.normal
+    ax, ay = mx - BARRIER_SLACK_M * nx, my - BARRIER_SLACK_M * ny
+    return TargetGeometry(
+        (ax, ay),
+        (ax + BARRIER_LENGTH_M * rx, ay + BARRIER_LENGTH_M * ry),
+        (-nx, -ny),
+        "barrier",
+        barrier.name,
+    )
 
 
 def chain_leg(

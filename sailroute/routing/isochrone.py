@@ -54,6 +54,7 @@ from numpy.typing import NDArray
 from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError, OutOfCoverageError, RoutingError
+from sailroute.routing import isochrone_fast as fast
 from sailroute.routing.api import Router
 from sailroute.routing.geometry import (
     TargetGeometry,
@@ -264,7 +265,11 @@ def _route_on(
     """
     t0 = ctx.t0
     while True:
-        out = _step(layers[-1], wind, polar, dev, ctx, settings, tau_hint, xp)
+        jit = fast.compiled(settings, xp)
+        started = None if jit else fast.numpy_step_started()
+        out = _step(layers[-1], wind, polar, dev, ctx, settings, tau_hint, xp, jit)
+        if started is not None:
+            fast.numpy_step_done(started)
         if isinstance(out, _Arrival):
             return out
         layer, moved, tau_min, dist_min = out

@@ -27,7 +27,7 @@ from sailroute.backend import to_numpy
 from sailroute.boat.polar import Polar
 from sailroute.numerics import clip
 from sailroute.routing.geometry import BARRIER_LENGTH_M, TargetGeometry, aim_points
-from sailroute.routing.isochrone_polar import _DeviceTables
+from sailroute.routing.isochrone_polar import PointPolars, _DeviceTables, node_rows
 from sailroute.routing.isochrone_records import (
     Groups,
     _Context,
@@ -42,6 +42,7 @@ from sailroute.routing.isochrone_records import (
 )
 from sailroute.routing.isochrone_togo import _fastest_aim, _time_to_go, _time_to_go_current
 from sailroute.routing.settings import RoutingSettings
+from sailroute.routing.types import Barrier
 from sailroute.wind.base import WindField
 
 NEAR_TARGET_STEPS = 3.0
@@ -135,14 +136,17 @@ def _sample_step(
     return u, v, _Current(cu[0], cv[0], xp.mean(cu, axis=0), xp.mean(cv, axis=0))
 
 
-def _wind_state(u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleType) -> _PointWind:
-    """The wind ``(u, v)`` [m s⁻¹] (world frame, towards; any shape) for the kernel."""
+def _wind_state(
+    u: Any, v: Any, dev: _DeviceTables, fr: _LegFrame, xp: ModuleType, polar: Any = None
+) -> _PointWind:
+    """The wind ``(u, v)`` [m s⁻¹] (world frame, towards; shape (n,)) for the kernel;
+    ``polar``: each point's polar in stacked tables (:func:`node_rows`), or None."""
     tws = xp.sqrt(u * u + v * v)
     windy = tws > _CALM_MS
     inv = 1.0 / xp.where(windy, tws, 1.0)
     up_x, up_y = fr.vec_to_leg(xp.where(windy, -u * inv, 0.0), xp.where(windy, -v * inv, 1.0))
     nodes = dev.tws_ms
-    row = clip(xp.searchsorted(nodes, tws, side="right") - 1, 0, nodes.shape[0] - 2, xp=xp)
+    row = node_rows(tws, dev, polar, xp)
     weight = clip((tws - nodes[row]) / (nodes[row + 1] - nodes[row]), 0.0, 1.0, xp=xp)
     up_deg = dev.up_deg[row] + weight * (dev.up_deg[row + 1] - dev.up_deg[row])
     down_deg = dev.down_deg[row] + weight * (dev.down_deg[row + 1] - dev.down_deg[row])
@@ -202,7 +206,7 @@ def _exact_columns(
     aim_x: Any,
     aim_y: Any,
     cur: _Current | None,
-    polar: Polar,
+    polar: Polar | PointPolars,
     xp: ModuleType,
 ) -> _ExactColumns:
     """VMG up, VMG down and the direct columns to the aim points ``(aim_x, aim_y)`` (unit
@@ -210,22 +214,24 @@ def _exact_columns(
     In a current the direct heading is the one whose ground track goes to the aim
     (:func:`_crab`)."""
     tws_h = to_numpy(wind.tws_ms)
-    v_vmg = xp.asarray(
-        polar.speed(tws_h[:, None], to_numpy(xp.stack([wind.up_deg, wind.down_deg], 1))),
-        dtype=float,
-    )
     if cur is None:
         cos_d = clip(wind.up_y * aim_y + wind.up_x * aim_x, -1.0, 1.0, xp=xp)  # (2, n)
         sin_d = wind.up_x * aim_y - wind.up_y * aim_x
         a_d = xp.degrees(xp.arccos(cos_d))
-        v_d = xp.asarray(polar.speed(to_numpy(wind.tws_ms), to_numpy(a_d)), dtype=float)
     else:
         cos_d, sin_d, a_d, v_d = _crab(aim_x, aim_y, cur.move_x, cur.move_y, wind, polar, xp)
     twa = xp.concatenate([wind.up_deg[:, None], wind.down_deg[:, None], a_d.T], axis=1)
+    # the points along the last axis (PointPolars); the four columns in one lookup
+    if cur is None:
+        bsp = xp.asarray(polar.speed(tws_h[None, :], to_numpy(twa.T)).T, dtype=float)
+    else:
+        v_vmg = xp.asarray(polar.speed(tws_h[None, :], to_numpy(twa[:, :2].T)).T, dtype=float)
+        bsp = xp.concatenate([v_vmg, v_d.T], axis=1)
+    bsp = xp.ascontiguousarray(bsp)
     rad = xp.radians(twa[:, :2])
     return _ExactColumns(
         twa_deg=twa,
-        bsp_ms=xp.concatenate([v_vmg, v_d.T], axis=1),
+        bsp_ms=bsp,
         cos_twa=xp.concatenate([xp.cos(rad), cos_d.T], axis=1),
         sin_twa=xp.concatenate([xp.sin(rad), xp.abs(sin_d).T], axis=1),
         direct_sin_keep=sin_d[0],
@@ -239,7 +245,7 @@ def _crab(
     cx: Any,
     cy: Any,
     wind: _PointWind,
-    polar: Polar,
+    polar: Polar | PointPolars,
     xp: ModuleType,
 ) -> tuple[Any, Any, Any, Any]:
     """The direct column in a current: the heading through the water whose velocity
@@ -316,13 +322,7 @@ def _within_reach(
     for i, (b, clear) in enumerate(ctx.barriers):
         if i == 0 and first_clear is not None:
             clear = first_clear
-        ray = TargetGeometry(
-            b.mark,
-            (b.mark[0] + BARRIER_LENGTH_M * b.ray[0], b.mark[1] + BARRIER_LENGTH_M * b.ray[1]),
-            b.normal,
-            "ray",
-        )
-        close = _segment_distance(x, y, ray, xp) <= step_m + clear + 1e-3
+        close = _segment_distance(x, y, _barrier_ray(b), xp) <= step_m + clear + 1e-3
         near_barrier.append(close if bool(xp.any(close)) else None)
     return near, tuple(near_barrier)
 
@@ -345,13 +345,29 @@ def _box_holds(x: Any, y: Any, reach_m: Any, ctx: _Context, xp: ModuleType) -> b
 
 def _segment_distance(x: Any, y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
     """Distance from the points ``(x, y)`` to the segment ``g.a``-``g.b`` [m]."""
-    ax, ay = g.a
-    ex, ey = g.b[0] - ax, g.b[1] - ay
-    ll = ex * ex + ey * ey
+    ax, ay, ex, ey, ll = _segment_params(g)
     r = clip(((x - ax) * ex + (y - ay) * ey) / ll, 0.0, 1.0, xp=xp)
     dx = x - (ax + r * ex)
     dy = y - (ay + r * ey)
     return xp.sqrt(dx * dx + dy * dy)
+
+
+def _segment_params(g: TargetGeometry) -> tuple[float, float, float, float, float]:
+    """``(ax, ay, ex, ey, ll)`` of :func:`_segment_distance`: the end ``a`` [m], the
+    vector ``b - a`` [m] and its squared length [m²]."""
+    ax, ay = g.a
+    ex, ey = g.b[0] - ax, g.b[1] - ay
+    return ax, ay, ex, ey, ex * ex + ey * ey
+
+
+def _barrier_ray(b: Barrier) -> TargetGeometry:
+    """A barrier's ray as a segment :data:`BARRIER_LENGTH_M` long (:func:`_within_reach`)."""
+    return TargetGeometry(
+        b.mark,
+        (b.mark[0] + BARRIER_LENGTH_M * b.ray[0], b.mark[1] + BARRIER_LENGTH_M * b.ray[1]),
+        b.normal,
+        "ray",
+    )
 
 
 # --------------------------------------------------------------------------------------
@@ -361,7 +377,7 @@ def _segment_distance(x: Any, y: Any, g: TargetGeometry, xp: ModuleType) -> Any:
 def _prepare(
     f: _Layer,
     wind: WindField,
-    polar: Polar,
+    polar: Polar | PointPolars,
     dev: _DeviceTables,
     ctx: _Context,
     s: RoutingSettings,
@@ -390,7 +406,8 @@ def _prepare(
     aim_x, aim_y = aim_points(x, y, ctx.geom, xp=xp)  # direct bearing to the aim point
     ex, ey, dist = _direction(aim_x - x, aim_y - y, xp)
     u, v, cur = _sample_step(f, dt, aim_x, aim_y, dist, wind, ctx, s, xp)
-    move_wind = _wind_state(u[0], v[0], dev, ctx.frame, xp)
+    point_polar = polar.index if isinstance(polar, PointPolars) else None  # members' boats
+    move_wind = _wind_state(u[0], v[0], dev, ctx.frame, xp, point_polar)
     if groups is None:
         first, stop = _fan(dev, move_wind, ctx.fan_hull, xp)
         fan_lo = fan_hi = None
@@ -416,7 +433,7 @@ def _prepare(
     exact = _exact_columns(move_wind, aex, aey, cur, polar, xp)
 
     # time to go on either side, in the wind averaged along the way
-    mean_wind = _wind_state(xp.mean(u, axis=0), xp.mean(v, axis=0), dev, ctx.frame, xp)
+    mean_wind = _wind_state(xp.mean(u, axis=0), xp.mean(v, axis=0), dev, ctx.frame, xp, point_polar)
     tau, gx, gy = _time_to_go(
         mean_wind, aex, aey, adist, sides, man.free, ctx.tack_s, ctx.gybe_s, dev, xp
     )

@@ -52,21 +52,24 @@ import numpy as np
 from sailroute.backend import to_numpy
 from sailroute.boat.polar import Polar
 from sailroute.errors import RoutingError
+from sailroute.routing import isochrone_fast as fast
 from sailroute.routing.geometry import barrier_blocks, segment_crossing
 from sailroute.routing.isochrone_inputs import _prepare
 from sailroute.routing.isochrone_polar import _DeviceTables, _grid_speeds
-from sailroute.routing.isochrone_records import _Arrival, _Context, _Layer, _LegFrame, _StepInputs
+from sailroute.routing.isochrone_records import (
+    _CHUNK_ELEMENTS,
+    _Arrival,
+    _Context,
+    _Layer,
+    _LegFrame,
+    _StepInputs,
+)
 from sailroute.routing.obstacles import Obstacles, constraint_label
 from sailroute.routing.settings import RoutingSettings
 from sailroute.wind.base import WindField
 
 # --------------------------------------------------------------------------------------
 # candidate blocks and chunks
-
-_CHUNK_ELEMENTS = 15000
-"""Candidate rows are processed in chunks of about this many candidates, so that the
-float64 work arrays stay below 128 KB: larger NumPy temporaries are mmap-allocated by
-glibc on every operation, which costs ~10x in this kernel."""
 
 _KEEP, _SWITCH = 0, 1
 """Candidate blocks of a point: ``_KEEP`` sails on its side, ``_SWITCH`` changes side
@@ -89,31 +92,20 @@ def _step(
     s: RoutingSettings,
     tau_hint: float,
     xp: ModuleType,
+    jit: bool = False,
 ) -> _Arrival | tuple[_Layer, bool, float, float]:
-    """One isochrone step from the front ``f``.
+    """One isochrone step from the front ``f``; ``jit``: on the compiled path
+    (:mod:`~sailroute.routing.isochrone_fast`, the same results).
 
     Returns the arrival if a candidate crosses the target during the step, else the
     new front, whether any point moved, the front's least estimated time to go [s] and
     its least distance to the target [m].
     """
-    pre, tau_min, dist_min = _prepare(f, wind, polar, dev, ctx, s, tau_hint, xp)
-    n, n_columns = pre.n, pre.n_columns
-    chunk = n if xp is not np else max(1, _CHUNK_ELEMENTS // (n_columns + 3))
-    n_keys = 2 * ctx.n_bins
-    best = xp.full(n_keys, np.inf)
-    who = xp.zeros(n_keys, dtype=xp.int64)  # winner id per key (see _KEEP)
-    arrival: _Arrival | None = None
-    for r0 in range(0, n, chunk):
-        r1 = min(n, r0 + chunk)
-        arr, win = _expand(pre, r0, r1, dev, ctx, xp, want_winners=arrival is None)
-        if arr is not None and (arrival is None or arr.t < arrival.t):
-            arrival = arr
-        if arrival is not None or win is None:
-            continue
-        key, score, wid = win
-        better = score < best[key]
-        best[key[better]] = score[better]
-        who[key[better]] = wid[better]
+    prepared = fast.prepare(f, wind, polar, dev, ctx, s, tau_hint) if jit else None
+    if prepared is None:
+        prepared = _prepare(f, wind, polar, dev, ctx, s, tau_hint, xp)
+    pre, tau_min, dist_min = prepared
+    arrival, best, who = _candidates(pre, dev, ctx, xp, jit)
     if arrival is not None:
         return arrival
 
@@ -133,11 +125,71 @@ def _step(
         coarse = (won // 2 // m) * 2 + won % 2
         won = xp.sort(won[_group_argmin(coarse, best[won], int(xp.max(coarse)) + 1, xp)])
     wid = who[won]
+    n_columns = pre.n_columns
     column = wid % n_columns
     block = (wid // n_columns) % 2
     row = wid // (2 * n_columns)
-    layer, moved = _survivors(pre, row, block, column, best[won], dev, xp)
+    if jit:
+        layer, moved = fast.survivors(pre, row, block, column, best[won], dev)
+    else:
+        layer, moved = _survivors(pre, row, block, column, best[won], dev, xp)
     return layer, bool(xp.any(moved)), tau_min, dist_min
+
+
+def _candidates(
+    pre: _StepInputs, dev: _DeviceTables, ctx: _Context, xp: ModuleType, jit: bool
+) -> tuple[_Arrival | None, Any, Any]:
+    """Every candidate move of a step: the earliest arrival, or else the best candidate
+    per key (sector and side, per member) with its score [s] and id (see :data:`_KEEP`),
+    infinite and 0 where a key has none.
+
+    ``jit``: the compiled kernel scores the candidates of a step without obstacles
+    (:func:`~sailroute.routing.isochrone_fast.candidates`, the same results)."""
+    if jit and ctx.obstacles is None:
+        done = fast.candidates(pre, dev, ctx)
+        if done is not None:
+            return (None if done[0] is None else _arrival_of(pre, done[0])), done[1], done[2]
+    n, n_columns = pre.n, pre.n_columns
+    chunk = n if xp is not np else max(1, _CHUNK_ELEMENTS // (n_columns + 3))
+    n_keys = 2 * ctx.n_bins * pre.n_groups
+    best = xp.full(n_keys, np.inf)
+    who = xp.zeros(n_keys, dtype=xp.int64)  # winner id per key (see _KEEP)
+    arrival: _Arrival | None = None
+    for r0 in range(0, n, chunk):
+        r1 = min(n, r0 + chunk)
+        arr, win = _expand(pre, r0, r1, dev, ctx, xp, want_winners=arrival is None)
+        if arr is not None and (arrival is None or arr.t < arrival.t):
+            arrival = arr
+        if arrival is not None or win is None:
+            continue
+        key, score, wid = win
+        better = score < best[key]
+        best[key[better]] = score[better]
+        who[key[better]] = wid[better]
+    return arrival, best, who
+
+
+def _arrival_of(pre: _StepInputs, rec: Any) -> _Arrival:
+    """The arrival the compiled kernel found, as :func:`_arrival` builds it from ``rec``
+    (:func:`~sailroute.routing.isochrone_jit.candidates`: time into the step, row,
+    block, column, fraction of the move, start, end, velocity, speed, delay, side)."""
+    t_hit, row, ds, x0, y0, end_x, end_y = (float(rec[i]) for i in (1, 2, 5, 6, 7, 8, 9))
+    heading = (
+        _heading_deg(end_x - x0, end_y - y0)
+        if pre.current_x is None  # through the water:
+        else _heading_deg(float(rec[10]), float(rec[11]))
+    )
+    return _Arrival(
+        parent=int(row),
+        t_start=pre.t,
+        t=pre.t + t_hit,
+        x=x0 + ds * (end_x - x0),
+        y=y0 + ds * (end_y - y0),
+        heading=heading,
+        bsp=float(rec[12]),
+        delay=float(rec[13]),
+        side=int(rec[14]),
+    )
 
 
 def _group_argmin(key: Any, score: Any, n_keys: int, xp: ModuleType) -> Any:

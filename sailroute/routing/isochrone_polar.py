@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
@@ -220,6 +221,84 @@ class _DeviceTables:
     vmax_ms: Any  # (n_w,) highest boat speed [m s⁻¹]
     sup_ms: Any  # (n_w, n_b) polar support: best speed component [m s⁻¹]
     sup_deg: Any  # (n_w, n_b) the |TWA| giving it [°]
+    # several polars (members with their own boat, stacked_tables): the first row of
+    # each polar's TWS nodes and their number, shape (P,); None: one polar
+    node_start: Any = None
+    node_count: Any = None
+
+
+def stacked_tables(tabs: Sequence[PolarTables]) -> _DeviceTables:
+    """The tables of several polars (on the same |TWA| grid) as one, NumPy: their TWS
+    nodes one polar after the other (each point's rows stay within its own polar's,
+    :func:`node_rows`), so that a lookup at a point's row reads its own polar's numbers."""
+    first = tabs[0]
+
+    def rows(name: str) -> NDArray:
+        return np.concatenate([getattr(t, name) for t in tabs], axis=0)
+
+    counts = np.array([t.tws_ms.shape[0] for t in tabs], dtype=np.int64)
+    return _DeviceTables(
+        first.twa_deg,
+        first.cos_a,
+        first.sin_a,
+        rows("tws_ms"),
+        rows("speed_ms"),
+        rows("up_deg"),
+        rows("down_deg"),
+        rows("up_vmg_ms"),
+        rows("down_vmg_ms"),
+        rows("vmax_ms"),
+        rows("sup_ms"),
+        rows("sup_deg"),
+        np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64),
+        counts,
+    )
+
+
+def node_rows(tws: Any, dev: _DeviceTables, polar: Any, xp: ModuleType) -> Any:
+    """Table row at or below each TWS [m s⁻¹] (the weight of the next row is its
+    remainder), kept inside the table: ``polar`` the polar of each point (an index
+    into :func:`stacked_tables`' polars) or None (one polar)."""
+    nodes = dev.tws_ms
+    if dev.node_start is None or polar is None:
+        return clip(xp.searchsorted(nodes, tws, side="right") - 1, 0, nodes.shape[0] - 2, xp=xp)
+    row = xp.empty(tws.shape, dtype=xp.int64)
+    for p, (start, count) in enumerate(zip(dev.node_start, dev.node_count, strict=True)):
+        sel = polar == p
+        own = nodes[start : start + count]
+        row[sel] = start + clip(
+            xp.searchsorted(own, tws[sel], side="right") - 1, 0, count - 2, xp=xp
+        )
+    return row
+
+
+class PointPolars:
+    """The polars of a front whose points sail different boats (the members of
+    :mod:`sailroute.routing.batch`): :meth:`speed` as :meth:`Polar.speed`, each point with
+    its own polar.
+
+    Parameters
+    ----------
+    polars : sequence of Polar
+        The different polars.
+    index : ndarray of int, shape (n,)
+        Each point's polar (an index into ``polars``).
+    """
+
+    def __init__(self, polars: Sequence[Polar], index: NDArray[np.int64]) -> None:
+        self.polars = tuple(polars)
+        self.index = index
+
+    def speed(self, tws_ms: Any, twa_deg: Any) -> NDArray[np.float64]:
+        """Boat speed [m s⁻¹] as :meth:`Polar.speed`; the points are along the last axis
+        of the broadcast arguments."""
+        tws, twa = np.broadcast_arrays(np.asarray(tws_ms, dtype=float), np.asarray(twa_deg))
+        out = np.empty(tws.shape)
+        for p, polar in enumerate(self.polars):
+            cols = np.flatnonzero(self.index == p)
+            if cols.shape[0]:
+                out[..., cols] = polar.speed(tws[..., cols], twa[..., cols])
+        return out
 
 
 def _device_tables(tab: PolarTables, xp: ModuleType) -> _DeviceTables:

@@ -31,6 +31,13 @@ from sailroute.routing.obstacles import Obstacles
 from sailroute.routing.types import Barrier
 from sailroute.wind.current import CurrentField
 
+_CHUNK_ELEMENTS = 15000
+"""The candidate kernel takes the rows of a front in chunks of about this many
+candidates, so that the float64 work arrays stay below 128 KB: larger NumPy
+temporaries are mmap-allocated by glibc on every operation, which costs ~10x in this
+kernel.  The chunks also fix the order in which equal scores are ranked (the compiled
+kernel follows them)."""
+
 # --------------------------------------------------------------------------------------
 # leg frame: target centre at the origin, +Y towards the start centre
 
@@ -370,6 +377,8 @@ class _StepInputs(NamedTuple):
     reach_m : array or None
         An upper bound of each point's move length in the step [m] (the fastest polar
         speed of its wind, plus the current, times the step); None: unknown.
+    packed : isochrone_fast.Packed or None
+        The compiled path's arrays these are views of (None on the NumPy path).
     """
 
     t: Any
@@ -395,6 +404,7 @@ class _StepInputs(NamedTuple):
     first_clear: Any = None
     starts_free: bool = False
     reach_m: Any = None
+    packed: Any = None
 
     @property
     def n(self) -> int:

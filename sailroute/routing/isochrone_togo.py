@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from sailroute.numerics import clip
-from sailroute.routing.geometry import AIM_MARGIN_M, TargetGeometry
+from sailroute.routing.geometry import AIM_MARGIN_M, TargetGeometry, segment_frame
 from sailroute.routing.isochrone_polar import _DeviceTables, _support
 from sailroute.routing.isochrone_records import _Context, _PointWind
 
@@ -155,9 +155,7 @@ def _fastest_aim(
         dn = dx * nx + dy * ny
         ok = ok & (dn > 1e-9)
     t = xp.where(ok, ahead / xp.where(ok, dn, 1.0), 0.0)
-    length = g.length_m
-    ux, uy = (g.b[0] - ax0) / length, (g.b[1] - ay0) / length
-    m = min(AIM_MARGIN_M, 0.5 * length)
+    _, _, ux, uy, m, length = segment_frame(g, AIM_MARGIN_M)
     r = clip((x + t * dx - ax0) * ux + (y + t * dy - ay0) * uy, m, length - m, xp=xp)
     vx = ax0 + r * ux - x
     vy = ay0 + r * uy - y

@@ -60,6 +60,10 @@ MAX_SPLINE_EDGES: Final = 2_000_000_000
 of :class:`SplineSettings` (the defaults: 1.5e6)."""
 
 
+ENGINES: Final = ("auto", "numpy", "numba")
+"""Values of :attr:`IsochroneSettings.engine`."""
+
+
 class _Problems(list[str]):
     """The problems of one settings object, with the two common checks."""
 
@@ -123,6 +127,12 @@ class IsochroneSettings:
         (the rest of the polar is never optimal without a tack penalty; the exact VMG
         angles and the direct bearing to the target are always tried); ``"full"``
         tries the whole circle.
+    engine : {"auto", "numpy", "numba"}
+        Kernels of a step: ``"numba"`` compiled (``sailroute/routing/isochrone_jit.py``,
+        the extra ``fast``), ``"numpy"`` NumPy calls, ``"auto"`` compiled where numba is
+        installed and the work pays for its start-up (an ensemble, or a process that has
+        routed a while: :func:`~sailroute.routing.isochrone_fast.compiled`).  The routes
+        are the same bit for bit.
     """
 
     FLAT: ClassVar[Mapping[str, str]] = {
@@ -132,6 +142,7 @@ class IsochroneSettings:
         "prune_sector_deg": "prune_sector_deg",
         "max_front_points": "max_front_points",
         "heading_fan": "heading_fan",
+        "engine": "engine",
     }
     """Field -> its flat name in a course file's ``routing:`` section."""
 
@@ -141,6 +152,7 @@ class IsochroneSettings:
     prune_sector_deg: float = 1.0
     max_front_points: int = 2000
     heading_fan: str = "hull"
+    engine: str = "auto"
 
     def problems(self, name: Namer | None = None) -> list[str]:
         """What is wrong with these settings, one line per field (empty when valid).
@@ -175,6 +187,12 @@ class IsochroneSettings:
         p.integer("max_front_points", 8, MAX_FRONT_POINTS, f"in [8, {MAX_FRONT_POINTS}]")
         if self.heading_fan not in ("hull", "full"):
             p.append(f"{p.name('heading_fan')} must be 'hull' or 'full', got {self.heading_fan!r}")
+        if self.engine not in ENGINES:
+            p.append(
+                f"{p.name('engine')} must be one of {', '.join(repr(e) for e in ENGINES)} "
+                "(the same routes; 'auto': compiled where numba is installed and the work "
+                f"pays for its start-up), got {self.engine!r}"
+            )
         return list(p)
 
 

@@ -15,85 +15,212 @@ otherwise the leg is a ``"tie"``.
 from __future__ import annotations
 
 import math
-from typing import Final
+from collections.abc import Sequence
+from typing import Any, Final
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat.model import BoatModel
+from sailroute.boat.polar import Polar
 from sailroute.errors import SailrouteError
 from sailroute.units import wind_speed_direction, wrap180
 from sailroute.wind.base import WindField
+from sailroute.wind.perturbed import PerturbedWind, sample_perturbed
 
-__all__ = ["TIE", "layline_times", "side_verdict"]
+__all__ = ["TIE", "extreme_times", "layline_times", "side_verdict"]
 
 TIE: Final = "tie"
 """The verdict when neither side beats the other by more than the margin."""
 
 
-def _sail_extreme(
-    start: tuple[float, float],
-    target: tuple[float, float],
-    t0: float,
-    wind: WindField,
-    boat: BoatModel,
-    first: int,
+class _Extremes:
+    """The state of extreme paths sailed in lockstep (:func:`extreme_times`)."""
+
+    def __init__(self, start: NDArray, target: NDArray, t0: NDArray, first: NDArray) -> None:
+        self.x, self.y = start[:, 0].copy(), start[:, 1].copy()
+        self.tx, self.ty = target[:, 0], target[:, 1]
+        self.t0 = t0
+        self.t = t0.copy()
+        self.first = first  # +1: to the left first, -1: to the right
+        self.tack = np.zeros(t0.shape[0], dtype=np.int64)  # side the wind comes over; 0: none yet
+        self.reached = np.zeros(t0.shape[0], dtype=bool)  # reached the first layline
+        self.time = np.full(t0.shape[0], math.inf)  # the result [s]
+        self.active = np.ones(t0.shape[0], dtype=bool)
+
+    def finish(self, k: NDArray, time: Any) -> None:
+        """Paths ``k`` end with ``time`` [s] (``inf``: cannot be sailed)."""
+        self.time[k] = time
+        self.active[k] = False
+
+
+def _sample(
+    winds: Sequence[WindField], act: NDArray, state: _Extremes
+) -> tuple[NDArray, NDArray, NDArray]:
+    """The wind ``(u, v)`` at the active paths ``act`` (one call per wind the others
+    perturb, :func:`~sailroute.wind.perturbed.sample_perturbed`), and which of them
+    could be sampled (a path that leaves the wind data gives no time)."""
+    u, v = np.full(act.shape[0], np.nan), np.full(act.shape[0], np.nan)
+    ok = np.ones(act.shape[0], dtype=bool)
+    groups: dict[int, list[int]] = {}
+    for i, k in enumerate(act):
+        w = winds[k]
+        groups.setdefault(id(w.base if isinstance(w, PerturbedWind) else w), []).append(i)
+    t, x, y = state.t[act], state.x[act], state.y[act]
+    for rows in groups.values():
+        idx = np.asarray(rows, dtype=np.int64)
+        own = [winds[k] for k in act[idx]]
+        order = {id(w): j for j, w in enumerate(dict.fromkeys(own))}
+        members = list(dict.fromkeys(own))
+        which = np.array([order[id(w)] for w in own], dtype=np.int64)
+        try:
+            u[idx], v[idx] = sample_perturbed(members, which, t[idx], x[idx], y[idx])
+        except SailrouteError:  # one by one: only the paths out of the data stop
+            for i in idx:
+                try:
+                    uu, vv = winds[act[i]].sample(t[i], x[i], y[i])
+                    u[i], v[i] = float(uu), float(vv)
+                except SailrouteError:
+                    ok[i] = False
+    return u, v, ok
+
+
+class _VmgAngles:
+    """Best-VMG angles of the boats at TWS rounded to 0.01 m/s, computed once per value."""
+
+    def __init__(self) -> None:
+        self._known: dict[tuple[int, float], tuple[float, float]] = {}
+
+    def __call__(
+        self, boats: Sequence[BoatModel], act: NDArray, tws_ms: NDArray
+    ) -> tuple[NDArray, NDArray]:
+        """Upwind and downwind best-VMG |TWA| [°] of the paths ``act`` at their TWS."""
+        key = np.array([round(v, 2) for v in tws_ms.tolist()])
+        missing: dict[int, tuple[BoatModel, set[float]]] = {}  # per boat
+        for k, tws in zip(act.tolist(), key.tolist(), strict=True):
+            if (id(boats[k]), tws) not in self._known:
+                missing.setdefault(id(boats[k]), (boats[k], set()))[1].add(tws)
+        for boat, values in missing.values():
+            new = sorted(values)
+            if isinstance(boat, Polar):  # all the values in one vectorised search
+                beat = boat.vmg_upwind(np.asarray(new))[0].tolist()
+                run = boat.vmg_downwind(np.asarray(new))[0].tolist()
+                for tws, b, r in zip(new, beat, run, strict=True):
+                    self._known[(id(boat), tws)] = (float(b), float(r))
+            else:
+                for tws in new:
+                    self._known[(id(boat), tws)] = boat.vmg_angles_deg(tws)
+        pairs = [
+            self._known[(id(boats[k]), tws)]
+            for k, tws in zip(act.tolist(), key.tolist(), strict=True)
+        ]
+        angles = np.array(pairs, dtype=float).reshape(-1, 2)
+        return angles[:, 0], angles[:, 1]
+
+
+def _speeds(boats: Sequence[BoatModel], act: NDArray, tws: NDArray, twa: NDArray) -> NDArray:
+    """Steady speeds of the active paths' boats, one call per boat."""
+    out = np.empty(act.shape[0])
+    groups: dict[int, list[int]] = {}
+    for i, k in enumerate(act.tolist()):
+        groups.setdefault(id(boats[k]), []).append(i)
+    for rows in groups.values():
+        idx = np.asarray(rows, dtype=np.int64)
+        out[idx] = boats[act[idx[0]]].steady_speed(tws[idx], twa[idx])
+    return out
+
+
+def extreme_times(
+    start: ArrayLike,
+    target: ArrayLike,
+    t0: ArrayLike,
+    winds: Sequence[WindField],
+    boats: Sequence[BoatModel],
+    first: ArrayLike,
     *,
+    tack_penalty_s: float = 0.0,
+    gybe_penalty_s: float = 0.0,
+    dt_s: float = 2.0,
+    max_time_s: ArrayLike = 7200.0,
+) -> NDArray[np.float64]:
+    """Times [s] of extreme paths (see :func:`layline_times`), sailed in lockstep.
+
+    Path ``k`` goes from ``start[k]`` to ``target[k]`` (shape (K, 2), [m]) from time
+    ``t0[k]`` [epoch s] in ``winds[k]`` with ``boats[k]``, first to the left of the mark
+    (``first[k] = 1``) or to the right (-1); ``max_time_s`` one or per path.  All paths
+    take their steps together, so the winds are sampled once per step (one call per
+    wind that the others perturb: the members of a band) and the boats' speeds looked up
+    once per boat; a path out of its wind data, without speed or too long gets ``inf``.
+    """
+    st = _Extremes(
+        np.asarray(start, dtype=float).reshape(-1, 2),
+        np.asarray(target, dtype=float).reshape(-1, 2),
+        np.asarray(t0, dtype=float).reshape(-1),
+        np.asarray(first, dtype=np.int64).reshape(-1),
+    )
+    limit = np.broadcast_to(np.asarray(max_time_s, dtype=float), st.t.shape)
+    vmg = _VmgAngles()
+    while st.active.any():
+        st.finish(np.flatnonzero(st.active & (st.t - st.t0 >= limit)), math.inf)
+        act = np.flatnonzero(st.active)
+        if act.shape[0] == 0:
+            break
+        u, v, ok = _sample(winds, act, st)
+        st.finish(act[~ok], math.inf)
+        act, u, v = act[ok], u[ok], v[ok]
+        _extreme_step(st, act, u, v, vmg, boats, tack_penalty_s, gybe_penalty_s, dt_s)
+    return st.time
+
+
+def _extreme_step(
+    st: _Extremes,
+    act: NDArray,
+    u: NDArray,
+    v: NDArray,
+    vmg: _VmgAngles,
+    boats: Sequence[BoatModel],
     tack_penalty_s: float,
     gybe_penalty_s: float,
     dt_s: float,
-    max_time_s: float,
-) -> float:
-    """Time [s] of the extreme path that goes first to the side ``first`` (+1 left, -1 right)."""
-    x, y = float(start[0]), float(start[1])
-    t = t0
-    tack = 0  # +1 / -1: the side the wind comes over (sign of the TWA); 0: not yet
-    vmg: dict[float, tuple[float, float]] = {}  # best-VMG angles per TWS (0.01 m/s bins)
-    reached = False  # reached the first layline
-    while t - t0 < max_time_s:
-        dx, dy = target[0] - x, target[1] - y
-        dist = math.hypot(dx, dy)
-        u, v = wind.sample(t, x, y)
-        tws_a, twd_a = wind_speed_direction(u, v)
-        tws, twd = float(tws_a), float(twd_a)
-        bearing = math.degrees(math.atan2(dx, dy))
-        off = float(wrap180(bearing - twd))  # TWA of the bearing, signed
-        key = round(tws, 2)
-        if key not in vmg:
-            vmg[key] = boat.vmg_angles_deg(key)
-        beat, run = vmg[key]
-        if dist < 1e-6:
-            return t - t0
-        if abs(off) < beat or abs(off) > run:
-            upwind = abs(off) < beat
-            angle = beat if upwind else run
-            # the two tacks' headings; the one on the side to go (left of the bearing:
-            # counter-clockwise from it) until the layline, then the other one
-            cand = [twd + angle, twd - angle]
-            lefts = [float(wrap180(h - bearing)) < 0 for h in cand]
-            want_left = (first > 0) != reached
-            heading = next(
-                (h for h, lf in zip(cand, lefts, strict=True) if lf == want_left), cand[0]
-            )
-        else:
-            reached = True
-            upwind = abs(off) < 90.0
-            heading = bearing
-        twa = float(wrap180(heading - twd))
-        side = 1 if twa > 0 else -1
-        if tack and side != tack:
-            t += tack_penalty_s if upwind else gybe_penalty_s
-        tack = side
-        speed = float(boat.steady_speed(tws, abs(twa)))
-        if not speed > 0:
-            return math.inf
-        step = speed * dt_s
-        if heading == bearing and dist <= step:
-            return t + dist / speed - t0
-        h = math.radians(heading)
-        nx, ny = x + step * math.sin(h), y + step * math.cos(h)
-        x, y = nx, ny
-        t += dt_s
-    return math.inf
+) -> None:
+    """One step of the active paths ``act`` in the wind ``(u, v)`` sampled there."""
+    dx, dy = st.tx[act] - st.x[act], st.ty[act] - st.y[act]
+    dist = np.hypot(dx, dy)
+    tws, twd = wind_speed_direction(u, v)
+    bearing = np.degrees(np.arctan2(dx, dy))
+    off = np.abs(wrap180(bearing - twd))  # |TWA| of the bearing
+    beat, run = vmg(boats, act, tws)
+    there = dist < 1e-6
+    st.finish(act[there], st.t[act[there]] - st.t0[act[there]])
+    outside = (off < beat) | (off > run)  # the mark cannot be fetched
+    upwind = np.where(outside, off < beat, off < 90.0)
+    angle = np.where(off < beat, beat, run)
+    # the two tacks' headings; the one on the side to go (left of the bearing:
+    # counter-clockwise from it) until the layline, then the other one
+    want_left = (st.first[act] > 0) != st.reached[act]
+    one, two = twd + angle, twd - angle
+    pick_two = (wrap180(one - bearing) < 0) != want_left
+    pick_two &= (wrap180(two - bearing) < 0) == want_left
+    heading = np.where(outside, np.where(pick_two, two, one), bearing)
+    st.reached[act[~outside]] = True
+    twa = wrap180(heading - twd)
+    side = np.where(twa > 0, 1, -1)
+    turned = (st.tack[act] != 0) & (side != st.tack[act])
+    t = st.t[act] + np.where(turned, np.where(upwind, tack_penalty_s, gybe_penalty_s), 0.0)
+    st.tack[act] = side
+    speed = _speeds(boats, act, tws, np.abs(twa))
+    step = speed * dt_s
+    stop = ~(speed > 0)
+    arrive = ~stop & (heading == bearing) & (dist <= step) & ~there
+    st.finish(act[stop & ~there], math.inf)
+    safe = np.where(arrive, speed, 1.0)
+    st.finish(act[arrive], t[arrive] + dist[arrive] / safe[arrive] - st.t0[act[arrive]])
+    go = ~(stop | arrive | there)
+    h = np.radians(heading[go])
+    k = act[go]
+    st.x[k] = st.x[k] + step[go] * np.sin(h)
+    st.y[k] = st.y[k] + step[go] * np.cos(h)
+    st.t[k] = t[go] + dt_s
 
 
 def layline_times(
@@ -109,6 +236,11 @@ def layline_times(
     max_time_s: float = 7200.0,
 ) -> tuple[float, float]:
     """Times of a leg's left and right extremes (layline to layline), sailed in ``wind``.
+
+    Each step (``dt_s``) a path reads the wind where and when the boat is, sails the
+    boat's best-VMG angle on the tack that goes towards its side while the mark cannot
+    be fetched (to the layline, then the other tack), steers straight at the mark once
+    it can, and pays the tack or gybe penalty at every change of tack.
 
     Parameters
     ----------
@@ -133,28 +265,21 @@ def layline_times(
         Leg times [s] going first to the left / right of the mark (looking from the
         start); ``inf`` where the path cannot be sailed (no speed, out of the wind
         data, too long).  On a reach (the mark fetchable from the start) both are the
-        straight line's time.
+        straight line's time.  :func:`extreme_times` sails many at once.
     """
-    out = []
-    for first in (1, -1):
-        try:
-            out.append(
-                _sail_extreme(
-                    start,
-                    target,
-                    t0,
-                    wind,
-                    boat,
-                    first,
-                    tack_penalty_s=tack_penalty_s,
-                    gybe_penalty_s=gybe_penalty_s,
-                    dt_s=dt_s,
-                    max_time_s=max_time_s,
-                )
-            )
-        except SailrouteError:  # the extreme leaves the wind data: no verdict from it
-            out.append(math.inf)
-    return out[0], out[1]
+    times = extreme_times(
+        [start, start],
+        [target, target],
+        [t0, t0],
+        [wind, wind],
+        [boat, boat],
+        [1, -1],
+        tack_penalty_s=tack_penalty_s,
+        gybe_penalty_s=gybe_penalty_s,
+        dt_s=dt_s,
+        max_time_s=max_time_s,
+    )
+    return float(times[0]), float(times[1])
 
 
 def side_verdict(

@@ -10,17 +10,19 @@ angles veer the wind (clockwise, the direction it comes from increases).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from sailroute.errors import InputError
 from sailroute.wind.base import Coverage, WindField
-from sailroute.wind.rotation import rotate_clockwise
+from sailroute.wind.rotation import rotate_by, rotate_clockwise
 
-__all__ = ["PerturbedWind"]
+__all__ = ["PerturbedWind", "sample_perturbed"]
 
 
 def _frozen(values: ArrayLike) -> NDArray[np.float64]:
@@ -122,11 +124,102 @@ class PerturbedWind:
         if self.speed_add_ms == 0.0:
             factor: NDArray[np.float64] | float = self.speed_scale
         else:
-            speed = np.hypot(u, v)
-            new = np.maximum(self.speed_scale * speed + self.speed_add_ms, 0.0)
-            # a calm point stays calm: it has no direction to add the speed along
-            factor = np.divide(new, speed, out=np.zeros_like(speed), where=speed > 0)
-        if self._series[0].size or self.direction_offset_deg != 0.0:
+            factor = _speed_factor(
+                np.asarray(u), np.asarray(v), self.speed_scale, self.speed_add_ms
+            )
+        if self.turns:
             turn = self.turn_deg(np.broadcast_to(np.asarray(t, dtype=float), np.shape(u)))
             u, v = rotate_clockwise(u, v, turn)
         return factor * u, factor * v
+
+    @property
+    def turns(self) -> bool:
+        """Whether the direction is turned (an offset or a shift series)."""
+        return bool(self._series[0].size) or self.direction_offset_deg != 0.0
+
+
+def _speed_factor(u: NDArray, v: NDArray, scale: ArrayLike, add: ArrayLike) -> NDArray:
+    """Factor on the wind vector that makes its speed ``max(0, scale x speed + add)``."""
+    speed = np.hypot(u, v)
+    new = np.maximum(scale * speed + add, 0.0)
+    # a calm point stays calm: it has no direction to add the speed along
+    return np.divide(new, speed, out=np.zeros_like(speed), where=speed > 0)
+
+
+@dataclass(frozen=True, eq=False)
+class _MemberParams:
+    """The perturbations of a list of winds as arrays (:func:`sample_perturbed`)."""
+
+    winds: tuple[PerturbedWind, ...]
+    scale: NDArray[np.float64]
+    add: NDArray[np.float64]
+    turns: NDArray[np.bool_]
+    cos: NDArray[np.float64]  # of the constant turn
+    sin: NDArray[np.float64]
+    series: tuple[int, ...]  # the winds with a shift series
+
+
+_PARAMS: list[Any] = [((), None)]  # the last (winds, their _MemberParams)
+
+
+def _member_params(winds: Sequence[PerturbedWind | WindField]) -> _MemberParams:
+    """:class:`_MemberParams` of ``winds`` (kept for the next call with the same winds;
+    a wind that is not a :class:`PerturbedWind` is its own base, unchanged)."""
+    last, known = _PARAMS[0]  # one read: another thread may replace it
+    if len(last) == len(winds) and all(a is b for a, b in zip(last, winds, strict=True)):
+        return known
+    params = tuple(w if isinstance(w, PerturbedWind) else PerturbedWind(w) for w in winds)
+    a = np.radians(np.array([float(w.direction_offset_deg) for w in params]))
+    out = _MemberParams(
+        params,
+        np.array([w.speed_scale for w in params], dtype=float),
+        np.array([w.speed_add_ms for w in params], dtype=float),
+        np.array([w.turns for w in params]),
+        np.cos(a),
+        np.sin(a),
+        tuple(k for k, w in enumerate(params) if w._series[0].size),
+    )
+    _PARAMS[0] = (tuple(winds), out)
+    return out
+
+
+def sample_perturbed(
+    winds: Sequence[PerturbedWind | WindField],
+    which: NDArray[np.int64],
+    t: NDArray[np.float64],
+    x: NDArray[np.float64],
+    y: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Wind ``(u, v)`` [m s⁻¹] at the points ``(t[i], x[i], y[i])`` (1-D) of the winds
+    ``winds[which[i]]``, which all perturb one base field (or are it), with one
+    ``sample`` call of the base: each point's wind is the one ``winds[which[i]].sample``
+    gives there, bit for bit (the same operations, point by point).
+
+    Used by the ensemble router (:mod:`sailroute.routing.batch`), whose members' winds
+    are versions of one scenario's wind.
+    """
+    base = winds[0].base if isinstance(winds[0], PerturbedWind) else winds[0]
+    p = _member_params(winds)
+    u, v = base.sample(t, x, y)
+    u = np.array(np.broadcast_to(u, t.shape), dtype=float)
+    v = np.array(np.broadcast_to(v, t.shape), dtype=float)
+    scale, add = p.scale[which], p.add[which]
+    factor = scale
+    adds = np.flatnonzero(add != 0.0)
+    if adds.shape[0]:
+        factor = scale.copy()
+        factor[adds] = _speed_factor(u[adds], v[adds], scale[adds], add[adds])
+    turns = p.turns[which]
+    if turns.any():
+        # a constant turn's cosine and sine once per member; a shift series' per point
+        cos, sin = p.cos[which], p.sin[which]
+        for k in p.series:
+            mine = np.flatnonzero(which == k)
+            b = np.radians(p.winds[k].turn_deg(t[mine]))
+            cos[mine], sin[mine] = np.cos(b), np.sin(b)
+        if turns.all():
+            u, v = rotate_by(u, v, cos, sin)
+        else:
+            idx = np.flatnonzero(turns)
+            u[idx], v[idx] = rotate_by(u[idx], v[idx], cos[idx], sin[idx])
+    return factor * u, factor * v

@@ -38,9 +38,18 @@ def rotate_clockwise(
         Rotated components (float64, broadcast shape).
     """
     a = np.radians(np.asarray(angle_deg, dtype=float))
-    c, s = np.cos(a), np.sin(a)
+    return rotate_by(u, v, np.cos(a), np.sin(a))
+
+
+def rotate_by(
+    u: ArrayLike, v: ArrayLike, cos: ArrayLike, sin: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`rotate_clockwise` given the cosine and sine of the angle (broadcast): the
+    same numbers, with the trigonometry done once per angle rather than per vector."""
     u = np.asarray(u, dtype=float)
     v = np.asarray(v, dtype=float)
+    c = np.asarray(cos, dtype=float)
+    s = np.asarray(sin, dtype=float)
     return u * c + v * s, v * c - u * s
 
 

@@ -94,3 +94,63 @@ def test_rich_tables_keep_every_cell_whole_on_a_narrow_terminal():
     assert text.splitlines()[2] == "1    start -> windward  15:46.2"
     assert "…" not in text and text.splitlines()[4].split() == ["total", "49:42.7"]
     assert render_table(headers, rows, footer=footer) == plain  # plain again outside
+
+
+class _Clock:
+    """A stand-in for time.perf_counter that moves only when told."""
+
+    def __init__(self) -> None:
+        self.now = 1000.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_counted_members_say_k_of_n_the_elapsed_time_and_the_time_left(monkeypatch):
+    import sailroute.progress as progress_module
+
+    clock = _Clock()
+    monkeypatch.setattr(progress_module.time, "perf_counter", clock)
+    s = io.StringIO()
+    p = Progress(2, s)
+    p.start_count(4, "member")
+    p.start_item(1, "constant m2")  # the second of four members, its first leg
+    p.start_leg(0, "start -> 1")
+    clock.now += 30.0  # 30 s for a member and a half: 3/8 of the run
+    p.end_leg(900.0, "1 tack")
+    p.set_prefix("")
+    clock.now += 10.0
+    p.item_done(2, "constant m2")  # two of four in 40 s: 40 s left at this pace
+    lines = s.getvalue().splitlines()
+    assert lines[0] == "constant m2 (member 2 of 4): leg 1/2 start -> 1: routing..."
+    assert lines[1] == (
+        "constant m2 (member 2 of 4): leg 1/2 start -> 1: 900.0 s, 1 tack "
+        "(computed in 30.0 s; 30 s elapsed, about 50 s left)"
+    )
+    assert lines[2] == "member 2 of 4 done (constant m2): 40 s elapsed, about 40 s left"
+
+
+def test_members_routed_together_show_how_many_arrived(monkeypatch):
+    import sailroute.progress as progress_module
+
+    clock = _Clock()
+    monkeypatch.setattr(progress_module.time, "perf_counter", clock)
+    s = io.StringIO()
+    p = Progress(5, s, live=True, min_interval_s=0.0)
+    p.start_count(100, "member", together=True)
+    p.start_leg(1, "1 -> gate4")  # the second of five legs
+    clock.now += 12.0
+    p.update(0.5, "37 of 100 members arrived")  # 1.5 of 5 legs done in 12 s
+    assert "leg 2/5 1 -> gate4:  50% 37 of 100 members arrived" in s.getvalue()
+    assert "12 s elapsed, about 28 s left" in s.getvalue()
+
+
+def test_durations_read_as_people_say_them():
+    from sailroute.progress import duration
+
+    assert [duration(v) for v in (3.25, 42.4, 185.0, 3725.0)] == [
+        "3.2 s",
+        "42 s",
+        "3 min 5 s",
+        "1 h 02 min",
+    ]

@@ -98,7 +98,7 @@ def test_a_member_that_cannot_arrive_raises_its_own_error():
 
 def test_members_given_in_different_numbers_are_refused():
     finish = Target("line", (-100.0, 400.0), (100.0, 400.0), name="finish")
-    with pytest.raises(InputError, match=r"got 2 start times, 1 winds and 2 starts"):
+    with pytest.raises(InputError, match=r"got 2 start times, 1 winds, 2 starts and 2 boats"):
         route_leg_batch(Start((0.0, 0.0)), finish, [T0, T0], [UniformWind(4.0, 90.0)], POLAR, SET)
 
 

@@ -127,7 +127,7 @@ def test_every_field_of_a_router_has_one_flat_name_and_back() -> None:
     for flat, ps in FLAT_NAMES.items():
         assert {flat_name(p) for p in ps} == {flat}
     assert flat_name("zone_m") == "zone_m"
-    assert len(FLAT_NAMES) == 17  # the flat fields of the former single class
+    assert len(FLAT_NAMES) == 18  # the former single class's, and isochrone.engine
 
 
 def test_routing_settings_changes_a_base_and_takes_whole_groups() -> None:
@@ -188,6 +188,12 @@ BAD = [
         "isochrone.max_front_points must be an integer in [8, 100000], got 2",
     ),
     ("isochrone.heading_fan", "wide", "isochrone.heading_fan must be 'hull' or 'full', got 'wide'"),
+    (
+        "isochrone.engine",
+        "jit",
+        "isochrone.engine must be one of 'auto', 'numpy', 'numba' (the same routes; 'auto': "
+        "compiled where numba is installed and the work pays for its start-up), got 'jit'",
+    ),
     ("initial_side", "left", "initial_side must be 'port', 'starboard' or None, got 'left'"),
     ("griddp.rows", 2, "griddp.rows must be an integer in [3, 200], got 2"),
     ("griddp.cols", 1, "griddp.cols must be an integer in [2, 1024], got 1"),
