@@ -13,6 +13,7 @@ from pathlib import Path
 from sailroute.course.load import load_course
 from sailroute.course.model import Course
 from sailroute.live.convert import Row, nmea_lines
+from sailroute.nmea import checksum
 from sailroute.routing.settings import routing_settings
 from tests.conftest import COURSES
 
@@ -77,6 +78,45 @@ def approach(
             )
         )
     return rows
+
+
+def _field(value: int, n: int) -> str:
+    return format(value & ((1 << n) - 1), f"0{n}b")
+
+
+def ais_sentence(
+    mmsi: int,
+    lat: float,
+    lon: float,
+    sog_kn: float | None = None,
+    cog_deg: float | None = None,
+    hdg_deg: float | None = None,
+    second: int | None = None,
+) -> str:
+    """An AIS class B position report (message 18) as ``!AIVDM``, encoded by ITU-R M.1371
+    (the inverse of :func:`sailroute.live.ais.parse_ais`, written separately for tests)."""
+    bits = "".join(
+        [
+            _field(18, 6),
+            _field(0, 2),
+            _field(mmsi, 30),
+            _field(0, 8),
+            _field(1023 if sog_kn is None else round(sog_kn * 10), 10),
+            "1",
+            _field(round(lon * 600_000), 28),
+            _field(round(lat * 600_000), 27),
+            _field(3600 if cog_deg is None else round(cog_deg * 10) % 3600, 12),
+            _field(511 if hdg_deg is None else round(hdg_deg) % 360, 9),
+            _field(60 if second is None else second, 6),
+            "0" * 29,
+        ]
+    )
+    payload = "".join(
+        chr(v + 48 if v < 40 else v + 56)
+        for v in (int(bits[i : i + 6], 2) for i in range(0, 168, 6))
+    )
+    body = f"AIVDM,1,1,,B,{payload},0"
+    return f"!{body}*{checksum(body)}"
 
 
 def lines_of(rows: Sequence[Row]) -> list[str]:

@@ -132,6 +132,7 @@ def test_live_from_a_real_signalk_server(signalk: tuple[int, list], tmp_path: Pa
     log = tmp_path / "live.jsonl"
     engine = start_live(
         trieste(),
+        boat="self",
         source=f"signalk://127.0.0.1:{port}",
         scenario="mean",
         every_s=15,
