@@ -480,7 +480,9 @@ class SignalKDecoder:
     """Decode Signal K delta messages (JSON text).
 
     A delta is ``{"context": ..., "updates": [{"timestamp": ..., "values": [{"path": ...,
-    "value": ...}]}]}``; values at one update's timestamp become one :class:`Reading`.  The
+    "value": ...}]}]}``; values at one update's timestamp become one :class:`Reading`,
+    ``timed`` when it holds a position (a server stamps the values it got no time for
+    with its own clock, which need not be the GPS's).  The
     server's hello message names the own vessel (``self``); a delta of that context, of
     ``vessels.self`` or without a context is the own instruments', a delta of another
     ``vessels.<id>`` context another vessel's (``vessel`` ``<id>``: an AIS target, a
@@ -546,4 +548,6 @@ class SignalKDecoder:
         if not fields:
             return None
         self.counts.by_kind["delta"] += 1
-        return Reading(t, timed=True, vessel=vessel, **fields)
+        # a server stamps what it did not get a time for (a heading, the wind) with its own
+        # clock: only a position's time is the data clock (the engine places the rest at it)
+        return Reading(t, timed="lat" in fields, vessel=vessel, **fields)

@@ -48,7 +48,9 @@ def clean_hour(course) -> list[str]:
         )
         out.extend(nmea_lines(row))
         if s % 5 == 0:
-            out.append(ais_sentence(247000001, float(lat), float(lon) + 0.001, 4.0, 90.0, None, s % 60))
+            out.append(
+                ais_sentence(247000001, float(lat), float(lon) + 0.001, 4.0, 90.0, None, s % 60)
+            )
     return out
 
 
@@ -78,12 +80,14 @@ def corrupt(lines: list[str], rng: np.random.Generator) -> list[bytes]:
             text = ",".join(body)
             out.append(f"{line[0]}{text}*{checksum(text)}".encode("ascii"))
         elif u < 0.99:
-            fields = [str(rng.integers(-10**6, 10**6)) for _ in range(int(rng.integers(0, 20)))]
+            fields = [str(rng.integers(-(10**6), 10**6)) for _ in range(int(rng.integers(0, 20)))]
             talker = "".join(chr(int(c)) for c in rng.integers(65, 91, 5))
             text = ",".join([talker, *fields])
             out.append(f"${text}*{checksum(text)}".encode("ascii"))
         else:
-            payload = "".join(chr(int(v) + 48 if v < 40 else int(v) + 56) for v in rng.integers(0, 64, 28))
+            payload = "".join(
+                chr(int(v) + 48 if v < 40 else int(v) + 56) for v in rng.integers(0, 64, 28)
+            )
             text = f"AIVDM,1,1,,A,{payload},0"
             out.append(f"!{text}*{checksum(text)}".encode("ascii"))
     return out

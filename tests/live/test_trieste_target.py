@@ -59,9 +59,7 @@ def replay_with_target(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     for r in rows:
         out.extend(nmea_lines(r))
         while k < t.size and t[k] <= r.t:
-            out.append(
-                ais_sentence(MMSI, lat[k], lon[k], sog[k], cog[k], None, int(t[k]) % 60)
-            )
+            out.append(ais_sentence(MMSI, lat[k], lon[k], sog[k], cog[k], None, int(t[k]) % 60))
             k += 1
     assert k == t.size  # the whole race is inside the log
     path.write_text("\r\n".join(out) + "\r\n", encoding="ascii")
@@ -104,8 +102,7 @@ def test_the_leg_follows_the_ais_targets_roundings(tmp_path: Path) -> None:
     # analyze, on the track live received (AIS positions to 1/10 000 minute)
     track = tmp_path / "target.csv"
     track.write_text(
-        "time,lat,lon\n"
-        + "".join(f"{iso(r['t'])},{r['lat']:.7f},{r['lon']:.7f}\n" for r in got),
+        "time,lat,lon\n" + "".join(f"{iso(r['t'])},{r['lat']:.7f},{r['lon']:.7f}\n" for r in got),
         encoding="utf-8",
     )
     ana = run_analyze_command(TRIESTE, [track], out_dir=tmp_path / "analysis", plots=False)
