@@ -40,7 +40,7 @@ import math
 import threading
 import time
 import traceback
-from collections import Counter
+from collections import Counter, deque
 from collections.abc import Mapping
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
@@ -59,7 +59,14 @@ from sailroute.live.gates import GateLimits, ReadingGate
 from sailroute.live.legs import LegChange, LegTracker
 from sailroute.live.livewind import DEFAULT_FADE_S, apparent_to_true
 from sailroute.live.nmeaout import NmeaServer, open_nmea_server, route_sentences, steer_sentences
-from sailroute.live.planner import MEASURED_ONLY, PlanCore, Planner, PlanRequest, ThreadPlanner
+from sailroute.live.planner import (
+    MEASURED_ONLY,
+    PlanCore,
+    Planner,
+    PlanRequest,
+    Superseded,
+    ThreadPlanner,
+)
 from sailroute.live.replan import DEFAULT_REACH_M, LivePlan, upwind_or_downwind_laylines
 from sailroute.live.sources import TOO_LONG, Source
 from sailroute.live.web import PageServer, loopback
@@ -315,7 +322,8 @@ class LiveEngine:
         self.n_errors = 0
         self._errors_logged = -math.inf
         self.problems: Counter[str] = Counter()
-        self.plan_wall: list[float] = []  # wall time each plan was published (benchmark)
+        # (number, wall time, data clock) of the last plans published (the benchmark's)
+        self.published: deque[tuple[int, float, float | None]] = deque(maxlen=1000)
         self.notes: list[str] = []
         self.log = JsonLog(log)
         self.token = token
@@ -771,6 +779,9 @@ class LiveEngine:
         self._requested += 1
         self._in_flight += 1
         self._last_request_t = clock
+        urgent = reason != "interval"
+        if urgent:  # whatever is being computed is out of date: stop it
+            self.planner.supersede(self._requested)
         return reason, PlanRequest(
             self._requested,
             reason,
@@ -781,6 +792,7 @@ class LiveEngine:
             est[0],
             est[1],
             self.settings.fade_s,
+            coarse=urgent,
         )
 
     def replan(self, req: PlanRequest) -> LivePlan | None:
@@ -801,6 +813,9 @@ class LiveEngine:
         w0 = time.perf_counter()
         try:
             plan, first = self.planner.route(req)
+        except Superseded:
+            self.log.write({"kind": "superseded", "number": req.number, "t": req.t})
+            return None
         except (SailrouteError, BrokenProcessPool) as exc:
             self._failed(req, str(exc))
             return None
@@ -812,7 +827,7 @@ class LiveEngine:
                 self.plan, self._waypoint = plan, 0
                 self.error, self.error_t = "", None
                 self.n_plans += 1
-                self.plan_wall.append(time.monotonic())
+                self.published.append((plan.number, time.monotonic(), self._gate.clock))
         if superseded:
             self.log.write({"kind": "superseded", "number": plan.number, "t": plan.t})
             return None
@@ -821,6 +836,8 @@ class LiveEngine:
         if self.settings.side and not self._newer(plan.number):
             try:
                 side = self.planner.side(req, first, bool(plan.wind_note))
+            except Superseded:
+                pass  # a newer re-plan is on its way
             except (SailrouteError, BrokenProcessPool) as exc:
                 self.log.write({"kind": "error", "t": req.t, "message": f"side: {exc}"})
             else:

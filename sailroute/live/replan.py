@@ -15,7 +15,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +24,7 @@ from sailroute.boat.model import BoatModel
 from sailroute.course.geometry import leg_endpoints, target_of
 from sailroute.course.model import Course
 from sailroute.planning.route import route_course
+from sailroute.progress import Progress
 from sailroute.routing.api import route_leg
 from sailroute.routing.geometry import chain_leg, start_centre
 from sailroute.routing.laylines import LaylineKind, vmg_angles
@@ -56,10 +57,12 @@ def route_remaining(
     leg: int,
     xy: XY,
     t: float,
+    progress: Progress | None = None,
 ) -> list[LegResult]:
     """Route legs ``leg`` .. last from the boat at ``xy`` [m] at epoch ``t`` [s]
     (:func:`~sailroute.planning.route.route_course` from a boat under way: inside the
-    course's boundary and round its obstacles, as ``plan`` routes).
+    course's boundary and round its obstacles, as ``plan`` routes; ``progress`` gets its
+    calls).
 
     Returns
     -------
@@ -68,7 +71,13 @@ def route_remaining(
         ended, and marks are rounded on their sides.
     """
     return route_course(
-        course, wind, boat, settings, from_leg=leg, under_way=((float(xy[0]), float(xy[1])), t)
+        course,
+        wind,
+        boat,
+        settings,
+        from_leg=leg,
+        under_way=((float(xy[0]), float(xy[1])), t),
+        progress=progress,
     )
 
 
@@ -114,6 +123,7 @@ def side_that_pays(
     wind: WindField,
     boat: BoatModel,
     settings: RoutingSettings,
+    progress: Callable[[float], None] | None = None,
 ) -> SidePays:
     """The side of the rhumb line the best route of a leg takes, and what it gains.
 
@@ -130,6 +140,8 @@ def side_that_pays(
         The leg's target.
     wind, boat, settings
         As for the route.
+    progress : callable, optional
+        The routers' progress callback (it may stop them by raising).
 
     Returns
     -------
@@ -152,9 +164,16 @@ def side_that_pays(
         wind,
         boat,
         settings,
+        progress=progress,
     )
     rest = route_leg(
-        Start(via.end_xy, None, name="mirror"), target, via.t_end, wind, boat, settings
+        Start(via.end_xy, None, name="mirror"),
+        target,
+        via.t_end,
+        wind,
+        boat,
+        settings,
+        progress=progress,
     )
     # the router resolves times to about its time step: a mirror route found a little
     # faster than the best one means that both sides are worth the same
