@@ -55,7 +55,8 @@ header div{font-size:1em} header b{font-size:1.7em;display:block;font-variant-nu
 #measured{background:#f39c12;color:#123} #waiting{background:#2c3e50;color:#fff}
 main{display:grid;grid-template-columns:minmax(0,1fr) 340px;gap:.8em;padding:.8em}
 @media (max-width:1100px){main{grid-template-columns:minmax(0,1fr)}}
-#map{width:100%;height:auto;background:#dbe9f4;border-radius:.4em;display:block;touch-action:none}
+#map{width:100%;height:calc(100vh - 11em);min-height:400px;background:#dbe9f4;
+ border-radius:.4em;display:block;touch-action:none}
 #map.tapping{outline:4px solid #f39c12;cursor:crosshair}
 .panel{background:#fff;border-radius:.4em;padding:.6em .8em;margin-bottom:.8em}
 .panel h2{font-size:1em;margin:.1em 0 .4em}
@@ -78,7 +79,7 @@ button,select,input{font-size:1em;padding:.35em .6em;margin:.15em}
 <div class="banner" id="waiting"></div>
 <main>
  <div>
-  <svg id="map" viewBox="0 0 1000 700" preserveAspectRatio="xMidYMid meet"></svg>
+  <svg id="map"></svg>
   <div id="legend">
    <span><svg width="26" height="10"><line x1="0" y1="5" x2="26" y2="5" stroke="#1565c0"
     stroke-width="3"/></svg>route</span>
@@ -122,7 +123,7 @@ const mmss = s => s == null || !isFinite(s) ? "-" : (s < 0 ? "-" : "") + Math.fl
   / 60) + ":" + String(Math.round(Math.abs(s) % 60)).padStart(2, "0");
 const KN = 1.9438445;
 const NS = "http://www.w3.org/2000/svg";
-const W = 1000, H = 700;
+let W = 1000, H = 700;
 let view = null, tapping = false, last = null;
 function el(p, tag, attrs, text) { const e = document.createElementNS(NS, tag);
   for (const k in attrs) e.setAttribute(k, attrs[k]); if (text != null) e.textContent = text;
@@ -137,7 +138,7 @@ function fit(s) {
   let x0 = 1e18, x1 = -1e18, y0 = 1e18, y1 = -1e18;
   pts.forEach(p => { const x = p[1] * k * m, y = p[0] * m; x0 = Math.min(x0, x);
     x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y); });
-  const pad = 70, sc = Math.min((W - 2 * pad) / Math.max(x1 - x0, 50),
+  const pad = 110, sc = Math.min((W - 2 * pad) / Math.max(x1 - x0, 50),
     (H - 2 * pad) / Math.max(y1 - y0, 50));
   const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2;
   return {k: k, m: m, sc: sc, X: p => W / 2 + (p[1] * k * m - cx) * sc,
@@ -194,6 +195,8 @@ function scalebar(g, v) {
 }
 function draw(s) {
   const m = $("map"); m.innerHTML = ""; if (!s.marks.length) return;
+  W = Math.max(m.clientWidth, 300); H = Math.max(m.clientHeight, 300);
+  m.setAttribute("viewBox", "0 0 " + W + " " + H);
   const v = fit(s); view = v; const X = v.X, Y = v.Y;
   const g = el(m, "g", {});
   (s.lines || []).forEach(l => el(g, "line", {x1: X([l[1], l[2]]), y1: Y([l[1], l[2]]),
@@ -225,12 +228,16 @@ function draw(s) {
   el(n, "path", {d: "M40 18 L52 58 L40 50 L28 58 Z", fill: "#123"});
   el(n, "text", {x: 40, y: 76, "text-anchor": "middle", "font-size": 17, "font-weight": 700},
     "N");
-  if (s.wind) { const w = el(m, "g", {}); const c = [W - 60, 60];
-    el(w, "circle", {cx: c[0], cy: c[1], r: 34, fill: "#fff", opacity: 0.8});
-    arrow(w, c[0] - 26 * Math.sin(s.wind.twd_deg * Math.PI / 180), c[1] + 26 *
-      Math.cos(s.wind.twd_deg * Math.PI / 180), s.wind.twd_deg + 180, 52,
+  if (s.wind) { const w = el(m, "g", {}), c = [W - 70, 60], b = s.wind.twd_deg * Math.PI
+      / 180, sn = Math.sin(b), cs = Math.cos(b);
+    el(w, "circle", {cx: c[0], cy: c[1], r: 36, fill: "#fff", opacity: 0.85});
+    // from the side the wind comes from, blowing across the circle, head downwind
+    arrow(w, c[0] + 28 * sn, c[1] - 28 * cs, s.wind.twd_deg + 180, 48,
       {stroke: "#123", "stroke-width": 3});
-    el(w, "text", {x: c[0], y: c[1] + 52, "text-anchor": "middle", "font-size": 14},
+    const hx = c[0] - 20 * sn, hy = c[1] + 20 * cs;  // the head: base across the shaft
+    el(w, "path", {d: `M${hx - 7 * cs} ${hy - 7 * sn} L${hx + 7 * cs} ${hy + 7 * sn}
+      L${hx - 13 * sn} ${hy + 13 * cs} Z`, fill: "#123"});
+    el(w, "text", {x: c[0], y: c[1] + 54, "text-anchor": "middle", "font-size": 14},
       "wind from " + s.wind.twd_deg.toFixed(0) + "°"); }
   scalebar(el(m, "g", {}), v);
 }
@@ -259,7 +266,7 @@ function trend(s) {
     / 5) * 5, sp = w.map(q => q[1] * KN), smax = Math.ceil(Math.max(...sp, 2) + 1);
   const L = 46, R = 300, T = 20, B = 200;
   const X = t => L + (t - t0) / Math.max(t1 - t0, 1) * (R - L);
-  axis(g, L, B, R, B, -(t1 - t0) / 60, 0, 4, v => v.toFixed(0), "b", "minutes ago");
+  axis(g, L, B, R, B, -(t1 - t0) / 60, 0, 4, v => Math.abs(v).toFixed(0), "b", "minutes ago");
   axis(g, L, B, L, T, lo, hi, 4, v => ((v % 360 + 360) % 360).toFixed(0) + "°", "l",
     "TWD from (°)");
   axis(g, R, B, R, T, 0, smax, 4, v => v.toFixed(1), "r", "TWS (kn)");

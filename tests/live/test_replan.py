@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import time
+from dataclasses import replace
 
 import numpy as np
 import pynmea2
@@ -20,6 +22,11 @@ from sailroute.planning.route import route_course
 from sailroute.units import wind_speed_direction
 from sailroute.wind.uniform import UniformWind
 from tests.live.feed import trieste
+
+
+def load_trieste_file():
+    """The Trieste course with the file's own routing settings."""
+    return trieste(coarse=False)
 
 
 def test_live_wind_is_measured_now_and_the_forecast_ahead() -> None:
@@ -144,3 +151,38 @@ def test_a_far_position_or_a_wind_above_the_polar_is_said_not_routed() -> None:
     assert far is not None and "km from the course area" in far
     strong = input_problem(course, boat, mark, top + 1.0)
     assert strong is not None and "above the polar's highest wind speed" in strong
+
+
+def test_an_urgent_request_stops_the_older_one_and_routes_coarse() -> None:
+    """A route under way stops at its next step once a newer urgent request is made; the
+    urgent one routes with twice the time and heading steps (the Trieste file: 5 s and
+    2°), and its leg times stay within 3 % of the course's settings."""
+    import threading
+
+    from sailroute.live.planner import PlanCore, PlanRequest, Superseded, ThreadPlanner
+
+    course = load_trieste_file()
+    boat, winds = build_specs(course, ["mean"])
+    core = PlanCore(course, winds["mean"], boat, course.routing)
+    assert core.coarse is not None
+    assert (core.coarse.isochrone.dt_s, core.coarse.isochrone.heading_step_deg) == (10.0, 4.0)
+    planner = ThreadPlanner(core)
+    sx, sy = course.lines["start"].midpoint
+    req = PlanRequest(1, "interval", course.start_epoch, sx, sy, 0, 2.5, 65.0, 600.0)
+    out: list[object] = []
+
+    def run() -> None:
+        try:
+            out.append(planner.route(req))
+        except Superseded as exc:
+            out.append(exc)
+
+    th = threading.Thread(target=run)
+    th.start()
+    time.sleep(0.05)
+    planner.supersede(2)
+    th.join(30)
+    assert len(out) == 1 and isinstance(out[0], Superseded)
+    fine, _ = core.route(replace(req, number=3))
+    coarse, _ = core.route(replace(req, number=3, coarse=True))
+    np.testing.assert_allclose(coarse.leg_times_s, fine.leg_times_s, rtol=0.03)
