@@ -3,7 +3,7 @@
 :class:`LegTracker` is :func:`sailroute.analysis.segment.segment_track` made incremental:
 each new fix of the boat makes one straight move from the previous fix, tested against
 the crossing geometry of the leg being sailed, built by the same public functions
-(:func:`~sailroute.analysis.segment.start_geometry`,
+(:func:`~sailroute.analysis.segment.start_search_geometry`,
 :func:`~sailroute.analysis.segment.detection_geometry`,
 :func:`~sailroute.routing.geometry.segment_crossing`).  A mark is rounded when the move
 crosses the mark's rounding ray forwards, a gate or a line when it crosses it from the
@@ -14,8 +14,8 @@ advances the leg when ``analyze`` of its track would end the leg, not when someo
 within some metres of a mark.
 
 The start: before the gun nothing advances; the first move after the gun that crosses
-the start line (or its extension, :data:`~sailroute.analysis.segment.START_EXTENSION_M`
-beyond each end) from the pre-start side starts the race, and a boat already on the
+the start line (or its extension, as ``analyze`` searches it) from the pre-start side
+starts the race, and a boat already on the
 course side at the gun (over early, or a tracker that began after the start) is
 started from where it is.  ``analyze`` also times a boat over early that came back
 from its restart; here the restart only moves the start point, which tilts the first
@@ -27,7 +27,6 @@ The coach can set the leg by hand (:meth:`LegTracker.set_leg`, from the page or
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,31 +34,15 @@ import numpy as np
 from sailroute.analysis.segment import (
     DETECT_M,
     LINE_MARGIN_M,
-    START_EXTENSION_M,
     Crossing,
     detection_geometry,
-    start_geometry,
+    start_search_geometry,
 )
 from sailroute.course.geometry import leg_endpoints
 from sailroute.course.model import Course
 from sailroute.routing.geometry import TargetGeometry, segment_crossing, start_centre
 
 XY = tuple[float, float]
-
-
-def _extended(geom: TargetGeometry, margin_m: float) -> TargetGeometry:
-    """``geom`` lengthened by ``margin_m`` at both ends (what ``analyze`` searches for the
-    start)."""
-    ex, ey = geom.b[0] - geom.a[0], geom.b[1] - geom.a[1]
-    n = math.hypot(ex, ey)
-    ux, uy = ex / n, ey / n
-    return TargetGeometry(
-        (geom.a[0] - margin_m * ux, geom.a[1] - margin_m * uy),
-        (geom.b[0] + margin_m * ux, geom.b[1] + margin_m * uy),
-        geom.normal,
-        geom.kind,
-        geom.name,
-    )
 
 
 @dataclass(frozen=True)
@@ -106,7 +89,7 @@ class LegTracker:
     ) -> None:
         self.course = course
         self.detect_m, self.line_margin_m = detect_m, line_margin_m
-        self._start_line = _extended(start_geometry(course, detect_m), START_EXTENSION_M)
+        self._start_line = start_search_geometry(course, detect_m)
         self._prev: tuple[float, float, float] | None = None
         self.leg = 0
         self.started = False

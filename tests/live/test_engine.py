@@ -44,6 +44,46 @@ def _engine(tmp_path: Path, scenario: str = "mean", **kw) -> LiveEngine:
     return eng
 
 
+def _sk_delta(row: Row, sog: str = "1.0", context: str = "vessels.self") -> str:
+    """A Signal K delta of ``row``'s position and SOG (``sog`` as written in the JSON)."""
+    ts = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(row.t))
+    return (
+        '{"context":"' + context + '","updates":[{"timestamp":"' + ts + '","values":['
+        '{"path":"navigation.position","value":{"latitude":' + repr(row.lat) + ","
+        '"longitude":' + repr(row.lon) + '}},{"path":"navigation.speedOverGround",'
+        '"value":' + sog + "}]}]}"
+    )
+
+
+def _run_signalk(
+    tmp_path: Path, messages: list[str], want: int, host: str = "127.0.0.1"
+) -> LiveEngine:
+    """Serve ``messages`` on a WebSocket at ``host`` and run an engine on it until it has
+    ``want`` readings (10 s at most)."""
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    sock = socket.socket(family)
+    sock.bind((host, 0))
+    sock.listen()
+
+    def handler(ws: ServerConnection) -> None:
+        for m in messages:
+            ws.send(m)
+        time.sleep(1.0)
+
+    with serve(handler, sock=sock) as server:
+        port = server.socket.getsockname()[1]
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        where = f"[{host}]" if ":" in host else host
+        eng = _engine(tmp_path, source=parse_source(f"signalk://{where}:{port}"))
+        eng.start()
+        end = time.monotonic() + 10
+        while time.monotonic() < end and eng.n_readings < want:
+            time.sleep(0.05)
+        eng.close()
+        server.shutdown()
+    return eng
+
+
 def _records(path: Path) -> list[dict]:
     return [json.loads(line) for line in path.read_text().splitlines()]
 
@@ -171,36 +211,14 @@ def test_a_message_that_raises_is_counted_and_the_source_goes_on(tmp_path: Path)
 def test_deep_and_huge_signalk_messages_do_not_end_the_stream(tmp_path: Path) -> None:
     """A 100 000-deep message and a 401-digit number through a Signal K WebSocket: counted
     or left out, and the deltas after them arrive."""
-    course = trieste()
-    rows = approach(course, 10)
-
-    def delta(row: Row, value: str) -> str:
-        ts = time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(row.t))
-        return (
-            '{"context":"vessels.self","updates":[{"timestamp":"' + ts + '","values":['
-            '{"path":"navigation.position","value":{"latitude":' + repr(row.lat) + ","
-            '"longitude":' + repr(row.lon) + '}},{"path":"navigation.speedOverGround",'
-            '"value":' + value + "}]}]}"
-        )
-
-    def handler(ws: ServerConnection) -> None:
-        ws.send('{"self":"vessels.self"}')
-        ws.send('{"updates":' + "[" * 100_000 + "]" * 100_000 + "}")
-        ws.send(delta(rows[0], "9" * 401))
-        for r in rows[1:]:
-            ws.send(delta(r, "1.0"))
-        time.sleep(1.0)
-
-    with serve(handler, "127.0.0.1", 0) as server:
-        port = server.socket.getsockname()[1]
-        threading.Thread(target=server.serve_forever, daemon=True).start()
-        eng = _engine(tmp_path, source=SignalKSource(f"ws://127.0.0.1:{port}/signalk/v1/stream"))
-        eng.start()
-        end = time.monotonic() + 10
-        while time.monotonic() < end and eng.n_readings < len(rows):
-            time.sleep(0.05)
-        eng.close()
-        server.shutdown()
+    rows = approach(trieste(), 10)
+    messages = [
+        '{"self":"vessels.self"}',
+        '{"updates":' + "[" * 100_000 + "]" * 100_000 + "}",
+        _sk_delta(rows[0], "9" * 401),
+        *(_sk_delta(r) for r in rows[1:]),
+    ]
+    _run_signalk(tmp_path, messages, len(rows))
     recs = _records(tmp_path / "live.jsonl")
     fixes = [r for r in recs if r["kind"] == "input" and "lat" in r]
     assert len(fixes) == len(rows) and "sog_ms" not in fixes[0] and fixes[1]["sog_ms"] == 1.0
@@ -221,44 +239,8 @@ def test_ipv6_signalk_server_connects(tmp_path: Path) -> None:
             s.bind(("::1", 0))
     except OSError:
         pytest.skip("no IPv6 loopback on this machine")
-    course = trieste()
-    rows = approach(course, 5)
-    ts = [time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime(r.t)) for r in rows]
-
-    def handler(ws: ServerConnection) -> None:
-        for r, t in zip(rows, ts, strict=True):
-            ws.send(
-                json.dumps(
-                    {
-                        "updates": [
-                            {
-                                "timestamp": t,
-                                "values": [
-                                    {
-                                        "path": "navigation.position",
-                                        "value": {"latitude": r.lat, "longitude": r.lon},
-                                    }
-                                ],
-                            }
-                        ]
-                    }
-                )
-            )
-        time.sleep(1.0)
-
-    sock = socket.socket(socket.AF_INET6)
-    sock.bind(("::1", 0))
-    sock.listen()
-    with serve(handler, sock=sock) as server:
-        port = server.socket.getsockname()[1]
-        threading.Thread(target=server.serve_forever, daemon=True).start()
-        eng = _engine(tmp_path, source=parse_source(f"signalk://[::1]:{port}"))
-        eng.start()
-        end = time.monotonic() + 10
-        while time.monotonic() < end and eng.n_readings < len(rows):
-            time.sleep(0.05)
-        eng.close()
-        server.shutdown()
+    rows = approach(trieste(), 5)
+    eng = _run_signalk(tmp_path, [_sk_delta(r) for r in rows], len(rows), host="::1")
     assert eng.n_readings == len(rows)
 
 

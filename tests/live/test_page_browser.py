@@ -11,8 +11,6 @@ from __future__ import annotations
 import html
 import itertools
 import re
-import subprocess
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +20,7 @@ from sailroute.course.load import build_specs
 from sailroute.live.engine import LiveEngine, LiveSettings
 from sailroute.live.sources import NmeaFileSource
 from tests.live.feed import ais_sentence, approach, lines_of, sailed_track, trieste
-from tests.report.test_report_browser import CHROMIUM, FLAGS, REQUIRED
+from tests.report.test_report_browser import CHROMIUM, REQUIRED, chromium
 
 pytestmark = [
     pytest.mark.browser,
@@ -34,28 +32,9 @@ pytestmark = [
 ]
 
 MMSI = 247000777
-# the report test's flags, but this page is served from 127.0.0.1: every other host still
-# resolves to nothing
-LOCAL_FLAGS = [
-    "--host-resolver-rules=MAP * ~NOTFOUND , EXCLUDE 127.0.0.1" if f.startswith("--host-") else f
-    for f in FLAGS
-]
-
-
-def chromium(url: str, *args: str) -> subprocess.CompletedProcess[str]:
-    """Headless Chromium on ``url`` with a fresh profile; its console must stay silent."""
-    assert CHROMIUM is not None, "SAILROUTE_REQUIRE_BROWSER=1 but no Chromium found"
-    with tempfile.TemporaryDirectory(prefix="sailroute-chromium-") as profile:
-        proc = subprocess.run(
-            [CHROMIUM, *LOCAL_FLAGS, f"--user-data-dir={profile}", *args, url],
-            capture_output=True,
-            text=True,
-            timeout=90,
-        )
-    assert proc.returncode == 0, proc.stderr[-2000:]
-    console = [ln for ln in proc.stderr.splitlines() if "CONSOLE" in ln or "Uncaught" in ln]
-    assert console == [], "\n".join(console)
-    return proc
+# this page is served from 127.0.0.1: every other host still resolves to nothing (the last
+# --host-resolver-rules given wins over the report test's)
+LOCAL = "--host-resolver-rules=MAP * ~NOTFOUND , EXCLUDE 127.0.0.1"
 
 
 def build_engine(tmp_path: Path) -> LiveEngine:
@@ -124,9 +103,9 @@ def test_live_page_on_a_tablet_and_a_screen(tmp_path: Path, width: int, height: 
     try:
         url = eng.page.url
         size = f"--window-size={width},{height}"
-        dom = chromium(url, "--dump-dom", size).stdout
+        dom = chromium(url, LOCAL, "--dump-dom", size).stdout
         shot = tmp_path / f"live-{width}x{height}.png"
-        chromium(url, f"--screenshot={shot}", size)
+        chromium(url, LOCAL, f"--screenshot={shot}", size)
     finally:
         eng.close()
     print(f"screenshot: {shot}")
