@@ -339,10 +339,13 @@ function header(s) {
   $("side").textContent = p && p.side ? (p.side.side === "none" ? "neither" : p.side.side
     + " by " + p.side.gain_s.toFixed(0) + " s") : "-";
   $("plan").textContent = p ? "#" + p.number + " " + p.reason + " (" + mmss(age) + " ago)" : "-";
-  const c = s.counts;
+  const c = s.counts, kinds = ["bounds", "far", "jump", "time"].filter(k => c["gate_" + k])
+    .map(k => c["gate_" + k] + " " + k);
   $("info").textContent = "source " + s.source + " | messages " + c.used + " used, " + c.bad
-    + " broken, " + c.held_out + " held out" + (s.notes.length ? " | " + s.notes.join("; ")
-    : "");
+    + " broken (" + (c.bad_checksum || 0) + " bad checksum, " + (c.no_checksum || 0)
+    + " without, " + (c.malformed || 0) + " malformed), " + c.held_out + " readings held out"
+    + (kinds.length ? " (" + kinds.join(", ") + ")" : "") + (c.error ? ", " + c.error
+    + " raised" : "") + (s.notes.length ? " | " + s.notes.join("; ") : "");
 }
 async function poll() {
   try {

@@ -124,6 +124,7 @@ def test_live_page_on_a_tablet_and_a_screen(tmp_path: Path, width: int, height: 
         "TWS (kn)</text>",
         "minutes ago</text>",
         "wind from ",
+        "0 readings held out",
     ):
         assert text in dom, text
     assert re.search(r'id="scale-label"[^>]*>\d+ m</text>', dom)
