@@ -95,12 +95,9 @@ class Reading:
     timed: bool = False
     vessel: str = ""
 
-    def as_dict(self) -> dict[str, float | str]:
-        """The quantities given (for the JSON-lines log), rounded to what they resolve;
-        ``vessel`` only for another vessel's reading."""
-        out: dict[str, float | str] = {"t": round(self.t, 3)}
-        if self.vessel:
-            out["vessel"] = self.vessel
+    def as_dict(self) -> dict[str, float]:
+        """The quantities given (for the JSON-lines log), rounded to what they resolve."""
+        out: dict[str, float] = {"t": round(self.t, 3)}
         for name in ("lat", "lon"):
             v = getattr(self, name)
             if v is not None:

@@ -326,7 +326,6 @@ class LiveEngine:
         self.published: deque[tuple[int, float, float | None]] = deque(maxlen=1000)
         self.notes: list[str] = []
         self.log = JsonLog(log)
-        self.token = token
         self._threads: list[threading.Thread] = []
         self._plan_threads: set[threading.Thread] = set()
         self.source_ended = threading.Event()
@@ -435,7 +434,7 @@ class LiveEngine:
             r = replace(r, t=clock)
         why = self._gate.check(r)
         if why:
-            records.append({"kind": "reject", "why": why, **r.as_dict()})
+            records.append({"kind": "reject", "why": why, **_whose(r), **r.as_dict()})
             if isinstance(feed.decoder, NmeaDecoder) and self._gate.clock is not None:
                 feed.decoder.set_clock(self._gate.clock)  # not dated by the refused time
             return False
@@ -500,7 +499,7 @@ class LiveEngine:
         self.vessels.update(r.vessel, fix)
         if r.vessel != self.sailor.key:
             return False
-        records.append({"kind": "boat", **r.as_dict()})
+        records.append({"kind": "boat", **_whose(r), **r.as_dict()})
         return self._sailor_fix(fix, records)
 
     def _sailor_fix(self, fix: Fix, records: list[dict[str, Any]]) -> bool:
@@ -962,6 +961,7 @@ class LiveEngine:
         the log."""
         self.done.set()
         self._wake.set()
+        self.planner.supersede(2**62)  # the re-plans under way stop at their next step
         for th in self._threads:
             th.join(timeout=30.0)
         with self._lock:
@@ -989,6 +989,11 @@ class LiveEngine:
 
 
 _HELD = ("bounds", "far", "jump", "time")
+
+
+def _whose(r: Reading) -> dict[str, str]:
+    """``{"vessel": key}`` for another vessel's reading, else nothing (the log's records)."""
+    return {"vessel": r.vessel} if r.vessel else {}
 
 
 def _finite(v: float, digits: int) -> float | None:
