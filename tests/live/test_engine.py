@@ -20,7 +20,16 @@ from sailroute.live.convert import Row
 from sailroute.live.engine import LiveEngine, LiveSettings
 from sailroute.live.nmeaout import ROUTE_ID, sentence
 from sailroute.live.sources import MAX_LINE, NmeaFileSource, SignalKSource, parse_source
-from tests.live.feed import TRIESTE, FeedServer, approach, lines_of, trieste, write_feed
+from tests.live.feed import (
+    TRIESTE,
+    FeedServer,
+    ais_sentence,
+    approach,
+    lines_of,
+    sailed_track,
+    trieste,
+    write_feed,
+)
 
 
 def _engine(tmp_path: Path, scenario: str = "mean", **kw) -> LiveEngine:
@@ -440,8 +449,6 @@ def test_the_sailors_boat_from_ais_is_routed_not_the_coach_boat(tmp_path: Path) 
     course = eng.course
     coach = approach(course, 40, speed_ms=0.0, start_back_m=300.0)
     boat = approach(course, 40, speed_ms=2.0)
-    from tests.live.feed import ais_sentence
-
     for k, (c, b) in enumerate(zip(coach, boat, strict=True)):
         for line in lines_of([c]):
             eng.feed(line)
@@ -464,3 +471,34 @@ def test_the_sailors_boat_from_ais_is_routed_not_the_coach_boat(tmp_path: Path) 
     assert len(boats) == 4 and boats[0]["vessel"] == "urn:mrn:imo:mmsi:211000001"
     want = [boat[k].lat for k in (0, 10, 20, 30)]
     assert np.allclose([r["lat"] for r in boats], want, atol=2e-6)  # 1/10 000 minute
+
+
+def test_a_rounding_of_the_sailors_boat_re_plans_at_once(tmp_path: Path) -> None:
+    """The sailor's boat (AIS) goes round mark 1: the leg advances and the next re-plan
+    is due at once (``rounding``), on leg 2, without waiting for the interval."""
+    eng = _engine(tmp_path, sailor="247000001", settings=LiveSettings(side=False, every_s=1e6))
+    course = eng.course
+    boat, winds = build_specs(course, ["mean"])
+    polar = boat.routing_polar()
+    assert polar is not None
+    t, x, y = sailed_track(course, winds["mean"], polar, step_s=2.0)
+    lat, lon = course.frame.to_latlon(x, y)
+    coach = approach(course, int(t[-1] - t[0]), speed_ms=0.0, t0=float(t[0]))
+    reasons = []
+    k = 0
+    for row in coach:
+        for line in lines_of([row]):
+            eng.feed(line)
+        while k < t.size and t[k] <= row.t:
+            eng.feed(ais_sentence(247000001, lat[k], lon[k], None, None, None, int(t[k]) % 60))
+            k += 1
+            with eng._lock:
+                due = eng._due()
+            if due is not None:
+                reasons.append((due[0], due[1].leg))
+                with eng._lock:
+                    eng._in_flight -= 1  # not computed here: the trigger is what is tested
+        if eng.legs.leg == 2:
+            break
+    assert reasons[0] == ("first", 0) and reasons[1:] == [("rounding", 1), ("rounding", 2)]
+    eng.close()
