@@ -1,18 +1,21 @@
-"""Benchmark: ``sailroute live`` latency from a wind change to the new route, and memory
-over a one-hour replay.
+"""Benchmark: ``sailroute live`` from a wind step to a route in the new wind, in race time,
+and memory over a one-hour replay.
 
-    python benchmarks/bench_live.py [--shifts 5] [--hour-speed 60] [--tracemalloc] [--smoke]
+    python benchmarks/bench_live.py [--step 20] [--steps 5] [--speeds 1,4]
+                                    [--hour-speed 60] [--tracemalloc] [--smoke]
 
-1. Latency.  A TCP feed sends one second of instrument sentences (RMC, HDT, VHW, MWD)
-   every wall second, as a 1 Hz instrument network does, for a boat on leg 2 of the
-   Trieste course (``courses/trieste-coach-wl.yaml``, scenario ``mean``): the remainder is
-   three legs (1 -> 4, 4 -> 1, 1 -> finish).  Once a re-plan is on the page, the feed's
-   true wind turns by 15°; the time from the first sentence carrying the new direction
-   to (a) the page's ``/state.json`` showing a re-plan in the new wind (polled every 5 ms)
-   and (b) the NMEA port's ``RTE`` of that re-plan is measured, ``--shifts`` times.  The
-   measured wind is the last second's reading here (``window_s`` 0.5 s), so the time is
-   the pipeline's (decode, trigger, route, publish); with the default 60-s window a 15°
-   step crosses the 5° threshold after 20 s of data, on top of it.
+1. Step latency, from the command as a coach runs it: the Trieste course
+   (``courses/trieste-coach-wl.yaml`` with its own routing settings and default scenario,
+   ``measured``), the sailor's boat an AIS target beating towards mark 1, the coach
+   boat's instruments 200 m off giving the wind at 1 Hz, replayed from a file at each
+   of ``--speeds``; re-plans in the worker processes, every 10 s of data, with the side
+   that pays (the defaults of ``sailroute live``).  After 120 s of 4.8 kn from 65°, the
+   true wind steps by ``--step`` degrees every 40 s of data (65 -> 85 -> 65 ...), clean,
+   ``--steps`` times.  The latency of a step is the data time at which a route computed
+   in the new wind (its measured TWD within 2° of it) is published, minus the data time
+   of the first reading of the new wind: race time, whatever the replay speed.  The
+   re-plans' routing time (wall and CPU of the worker) and the process's CPU time are
+   printed with it.
 2. Memory.  A one-hour feed (the boat circling the course, the wind oscillating ±10°) is
    replayed from a file at ``--hour-speed`` times real time with a re-plan every 60 s of
    data; the process's resident memory is sampled every 0.5 s (with ``--tracemalloc`` also
@@ -20,24 +23,22 @@ over a one-hour replay.
    quarter and the end is printed, with the replay's wall time against the feed's.
 
 Prints the load average before and after (the machine is shared: the numbers are only
-comparable at similar load).  ``--smoke``: 2 shifts and a 10-minute replay (CI).
+comparable at similar load).  ``--smoke``: 2 steps at speed 4, a 10-minute replay (CI).
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
 import os
-import socket
 import sys
 import tempfile
-import threading
 import time
 import tracemalloc
-import urllib.request
 from pathlib import Path
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -47,6 +48,7 @@ from sailroute.course.load import load_course  # noqa: E402
 from sailroute.course.model import Course  # noqa: E402
 from sailroute.live.convert import Row, nmea_lines  # noqa: E402
 from sailroute.live.engine import LiveSettings  # noqa: E402
+from sailroute.nmea import checksum  # noqa: E402
 
 COURSE = ROOT / "courses" / "trieste-coach-wl.yaml"
 KN = 1852.0 / 3600.0
@@ -61,118 +63,112 @@ def _rss_mb() -> float:
         return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
 
 
-class LiveFeed:
-    """1 Hz sentences to one TCP client: a boat drifting slowly towards the gate, the wind
-    from ``self.twd``; ``changed_at`` is the wall time the first new direction went out."""
-
-    def __init__(self, course: Course) -> None:
-        self.course = course
-        self.twd = 65.0
-        self.changed_at: float | None = None
-        self._sent_twd = 65.0
-        self._sock = socket.create_server(("127.0.0.1", 0))
-        self.port = self._sock.getsockname()[1]
-        self._quit = threading.Event()
-        threading.Thread(target=self._serve, daemon=True).start()
-
-    def _serve(self) -> None:
-        conn, _ = self._sock.accept()
-        m1 = self.course.marks["1"].xy
-        gate = self.course.gates["4"].midpoint
-        t = self.course.start_epoch + 600.0
-        s = 0
-        while not self._quit.is_set():
-            f = min(s / 1200.0, 0.5)  # 1 -> gate at ~0.4 m/s
-            lat, lon = self.course.frame.to_latlon(
-                m1[0] + (gate[0] - m1[0]) * f - 30.0, m1[1] + (gate[1] - m1[1]) * f
-            )
-            twd = self.twd
-            row = Row(t + s, float(lat), float(lon), 0.8, 245.0, 245.0, 0.8, None, None, 5.0, twd)
-            data = "".join(line + "\r\n" for line in nmea_lines(row)).encode()
-            if twd != self._sent_twd and self.changed_at is None:
-                self.changed_at = time.monotonic()
-            self._sent_twd = twd
-            try:
-                conn.sendall(data)
-            except OSError:
-                return
-            s += 1
-            self._quit.wait(1.0)
-
-    def close(self) -> None:
-        self._quit.set()
-        self._sock.close()
+MMSI = 247000321
 
 
-def latency(course: Course, shifts: int) -> None:
-    feed = LiveFeed(course)
-    engine = start_live(
-        course,
-        source=f"nmea+tcp://127.0.0.1:{feed.port}",
-        scenario="mean",
-        every_s=10_000,
-        port=0,
-        nmea_port=0,
-        leg=2,
-        settings=LiveSettings(window_s=0.5, side=False),
+def step_feed(course: Course, path: Path, step_deg: float, steps: int) -> list[tuple[float, float]]:
+    """Write the step replay; ``(data time of the first new reading, new TWD)`` per step."""
+    frame = course.frame
+    mx, my = course.marks["1"].xy
+    (ax, ay), (bx, by) = course.lines["start"].a.xy, course.lines["start"].b.xy
+    sx, sy = (ax + bx) / 2.0, (ay + by) / 2.0
+    d = math.hypot(mx - sx, my - sy)
+    ux, uy = (mx - sx) / d, (my - sy) / d
+    cog = math.degrees(math.atan2(ux, uy)) % 360.0
+    t0 = course.start_epoch + 300.0
+    settle, period = 120, 40
+    n = settle + steps * period
+    changes, lines = [], []
+    for s in range(n):
+        k = (s - settle) // period + 1 if s >= settle else 0
+        twd = 65.0 + (step_deg if k % 2 else 0.0)
+        if s >= settle and (s - settle) % period == 0:
+            changes.append((t0 + s, twd))
+        # the sailor beats up the leg at 1 m/s (VMG); the coach boat idles 200 m to its side
+        bxy = (sx + ux * (40.0 + s), sy + uy * (40.0 + s))
+        cxy = (bxy[0] + 200.0 * uy, bxy[1] - 200.0 * ux)
+        cla, clo = frame.to_latlon(*cxy)
+        row = Row(t0 + s, float(cla), float(clo), 0.2, 90.0, None, None, None, None, 4.8, twd)
+        lines += [line + "\r\n" for line in nmea_lines(row)]
+        bla, blo = frame.to_latlon(*bxy)
+        lines.append(ais(MMSI, float(bla), float(blo), 1.0 / KN, cog, s % 60))
+    path.write_text("".join(lines), encoding="ascii")
+    return changes
+
+
+def ais(mmsi: int, lat: float, lon: float, sog_kn: float, cog: float, second: int) -> str:
+    """An AIS class B position report (message 18) as ``!AIVDM`` with its line end."""
+    bits = "".join(
+        [
+            f"{18:06b}",
+            "00",
+            f"{mmsi:030b}",
+            "0" * 8,
+            f"{round(sog_kn * 10):010b}",
+            "1",
+            f"{round(lon * 600_000) & (2**28 - 1):028b}",
+            f"{round(lat * 600_000) & (2**27 - 1):027b}",
+            f"{round(cog * 10) % 3600:012b}",
+            f"{511:09b}",
+            f"{second:06b}",
+            "0" * 29,
+        ]
     )
-    assert engine.page is not None and engine.nmea is not None
-    url = f"http://127.0.0.1:{engine.page.port}/state.json"
-    plotter = socket.create_connection(("127.0.0.1", engine.nmea.port))
-    plotter.settimeout(0.005)
-    buf = b""
+    v = [int(bits[i : i + 6], 2) for i in range(0, 168, 6)]
+    body = "AIVDM,1,1,,B," + "".join(chr(x + 48 if x < 40 else x + 56) for x in v) + ",0"
+    return f"!{body}*{checksum(body)}\r\n"
 
-    def state() -> dict:
-        with urllib.request.urlopen(url) as r:
-            return json.load(r)
 
-    try:
-        while not (s := state())["plan"]:
-            time.sleep(0.05)
-        page_ms, nmea_ms, route_ms, cpu_ms = [], [], [], []
-        for k in range(shifts):
-            time.sleep(1.5)
-            before = s["plan"]["number"]
-            new = 80.0 if k % 2 == 0 else 65.0
-            feed.changed_at = None
-            feed.twd = new
-            got_page = got_nmea = None
-            end = time.monotonic() + 60
-            while (got_page is None or got_nmea is None) and time.monotonic() < end:
-                if got_page is None:
-                    s = state()
-                    p = s["plan"]
-                    if p["number"] > before and abs(p["wind_twd_deg"] - new) < 1.0:
-                        got_page = time.monotonic()
-                        route_ms.append(1000 * p["compute_s"])
-                        cpu_ms.append(1000 * p["compute_cpu_s"])
-                with contextlib.suppress(TimeoutError):
-                    buf += plotter.recv(65536)
-                if got_nmea is None and f",live{before + 1},".encode() in buf:
-                    got_nmea = time.monotonic()
-                time.sleep(0.005)
-            assert feed.changed_at is not None and got_page and got_nmea, "no re-plan in 60 s"
-            page_ms.append(1000 * (got_page - feed.changed_at))
-            nmea_ms.append(1000 * (got_nmea - feed.changed_at))
-            buf = b""
-        legs = len(s["plan"]["leg_labels"])
-    finally:
-        engine.close()
-        feed.close()
-        plotter.close()
-    print(f"wind change -> route, {legs}-leg remainder, {shifts} shifts of 15°, 1 Hz feed:")
+def step_latency(course: Course, step_deg: float, steps: int, speed: float) -> None:
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "step.nmea"
+        changes = step_feed(course, path, step_deg, steps)
+        log = Path(d) / "live.jsonl"
+        c0, w0 = os.times(), time.monotonic()
+        engine = start_live(
+            course, source=str(path), boat=str(MMSI), speed=speed, port=0, nmea_port=0, log=log
+        )
+        try:
+            engine.wait()
+        finally:
+            engine.close()
+        c1, wall = os.times(), time.monotonic() - w0
+        plans = {
+            r["number"]: r
+            for r in (json.loads(x) for x in log.read_text().splitlines())
+            if r["kind"] == "plan"
+        }
+    shown = [(n, clock) for n, _, clock in engine.published if clock is not None]
+    lat = []
+    for t_step, twd in changes:
+        hit = next(
+            (
+                clock - t_step
+                for n, clock in shown
+                if clock >= t_step and abs((plans[n]["wind_twd_deg"] - twd + 180) % 360 - 180) < 2
+            ),
+            math.nan,
+        )
+        lat.append(hit)
+    reasons: dict[str, int] = {}
+    for p in plans.values():
+        reasons[p["reason"]] = reasons.get(p["reason"], 0) + 1
+    route = [p["compute_s"] for p in plans.values() if p["reason"] == "shift"]
+    cpu = [p["compute_cpu_s"] for p in plans.values() if p["reason"] == "shift"]
+    ok = [v for v in lat if math.isfinite(v)]
+    print(f"speed {speed:g}x, {len(changes)} steps of {step_deg:g}°:")
     print(
-        f"  page (/state.json) median {sorted(page_ms)[len(page_ms) // 2]:.0f} ms, "
-        f"max {max(page_ms):.0f} ms"
+        f"  step -> route in the new wind (race time): median {float(np.median(ok)):.1f} s, "
+        f"max {max(lat):.1f} s, each {[round(v, 1) for v in lat]}"
     )
     print(
-        f"  NMEA port (RTE)    median {sorted(nmea_ms)[len(nmea_ms) // 2]:.0f} ms, "
-        f"max {max(nmea_ms):.0f} ms"
+        f"  re-plans {len(plans)} {dict(sorted(reasons.items()))}; shift re-plans' routing "
+        f"median {1000 * float(np.median(route)):.0f} ms wall / "
+        f"{1000 * float(np.median(cpu)):.0f} ms CPU, max {1000 * max(route):.0f} ms wall"
     )
-    print(
-        f"  of which routing   median {sorted(route_ms)[len(route_ms) // 2]:.0f} ms wall, "
-        f"{sorted(cpu_ms)[len(cpu_ms) // 2]:.0f} ms CPU (the rest: waiting for a core)"
-    )
+    cpu_s = (c1.user - c0.user) + (c1.system - c0.system)
+    kids = (c1.children_user - c0.children_user) + (c1.children_system - c0.children_system)
+    print(f"  run {wall:.1f} s wall; CPU {cpu_s:.1f} s this process, {kids:.1f} s the workers")
 
 
 def memory(course: Course, seconds: int, speed: float, trace: bool) -> None:
@@ -212,6 +208,7 @@ def memory(course: Course, seconds: int, speed: float, trace: bool) -> None:
             nmea_port=0,
             log=Path(d) / "live.jsonl",
             leg=1,
+            boat="self",
             settings=LiveSettings(side=False),
         )
         rss, traced = [], []
@@ -241,18 +238,24 @@ def memory(course: Course, seconds: int, speed: float, trace: bool) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--shifts", type=int, default=5)
+    ap.add_argument("--step", type=float, default=20.0, help="wind step [°]")
+    ap.add_argument("--steps", type=int, default=5)
+    ap.add_argument("--speeds", default="1,4", help="replay speeds, comma-separated")
     ap.add_argument("--hour-speed", type=float, default=60.0)
+    ap.add_argument("--no-memory", action="store_true", help="only the step latency")
     ap.add_argument("--tracemalloc", action="store_true", help="also trace Python's heap")
-    ap.add_argument("--smoke", action="store_true", help="2 shifts, a 10-min replay (CI)")
+    ap.add_argument("--smoke", action="store_true", help="2 steps at 4x, a 10-min replay (CI)")
     args = ap.parse_args()
     course = load_course(COURSE)
     seconds = 3600
+    speeds = [float(v) for v in args.speeds.split(",")]
     if args.smoke:
-        args.shifts, seconds, args.hour_speed = 2, 600, 120.0
+        args.steps, speeds, seconds, args.hour_speed = 2, [4.0], 600, 120.0
     print(f"load average before: {_load()} ({os.cpu_count()} CPUs)")
-    latency(course, args.shifts)
-    memory(course, seconds, args.hour_speed, args.tracemalloc)
+    for speed in speeds:
+        step_latency(course, args.step, args.steps, speed)
+    if not args.no_memory:
+        memory(course, seconds, args.hour_speed, args.tracemalloc)
     print(f"load average after: {_load()}")
 
 

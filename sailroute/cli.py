@@ -1311,10 +1311,44 @@ def live_command(
     speed: Annotated[
         float, typer.Option("--speed", metavar="X", help="Replay speed of a recorded file.")
     ] = 1.0,
-    port: Annotated[int, typer.Option("--port", help="Port of the page on 127.0.0.1.")] = 8080,
+    boat: Annotated[
+        str | None,
+        typer.Option(
+            "--boat",
+            metavar="BOAT",
+            help="The sailor's boat: self (the instruments' own position), an AIS MMSI or a "
+            "Signal K vessel id (default: chosen on the page).",
+        ),
+    ] = None,
+    boat_source: Annotated[
+        str | None,
+        typer.Option(
+            "--boat-source",
+            metavar="SOURCE",
+            help="A second feed whose own position is the sailor's boat (as --source).",
+        ),
+    ] = None,
+    port: Annotated[int, typer.Option("--port", help="Port of the page.")] = 8080,
     nmea_port: Annotated[
-        int, typer.Option("--nmea-port", help="TCP port of the NMEA 0183 output on 127.0.0.1.")
+        int,
+        typer.Option("--nmea-port", help="TCP port of the NMEA 0183 output (busy: the next free)."),
     ] = 10110,
+    host: Annotated[
+        str | None,
+        typer.Option(
+            "--host",
+            metavar="ADDRESS",
+            help="Serve the page and NMEA out on this address, not 127.0.0.1 (the page then "
+            "needs the token in its address).",
+        ),
+    ] = None,
+    no_checksum: Annotated[
+        bool,
+        typer.Option(
+            "--accept-no-checksum",
+            help="Read NMEA 0183 sentences without a checksum (a talker that sends none).",
+        ),
+    ] = False,
     log: Annotated[
         str | None,
         typer.Option("--log", metavar="FILE", help="JSON-lines log of inputs and re-plans."),
@@ -1330,8 +1364,10 @@ def live_command(
     leg: Annotated[int, typer.Option("--leg", help="Leg being sailed now (1-based).")] = 1,
     router: RouterOpt = None,
 ) -> None:
-    """Re-plan the rest of the course from live instruments; page, NMEA out and a log."""
+    """Re-plan the rest of the course for the sailor's boat from live instruments; page,
+    NMEA out and a log."""
     from sailroute.commands.live import run_live_command
+    from sailroute.live.engine import LiveSettings
 
     def run() -> Any:
         return run_live_command(
@@ -1347,6 +1383,10 @@ def live_command(
             router=router,
             leg=leg,
             announce=typer.echo,
+            settings=LiveSettings(require_checksum=not no_checksum),
+            boat=boat,
+            boat_source=boat_source,
+            host=host,
         )
 
     _finish(run_guarded(run, debug=_debug(ctx)), False)

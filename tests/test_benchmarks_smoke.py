@@ -79,7 +79,9 @@ CASES = [
         marks=SLOW,
     ),
     pytest.param(
-        "bench_live.py", r"^wind change -> route, 3-leg remainder, 2 shifts of 15°", marks=SLOW
+        "bench_live.py",
+        r"^  step -> route in the new wind \(race time\): median [\d.]+ s, max [\d.]+ s",
+        marks=SLOW,
     ),
     pytest.param(
         "bench_peers.py", r"^- expansion and arrival test \(`_expand`\): [\d.]+ %$", marks=SLOW

@@ -450,6 +450,12 @@ def start_geometry(course: Course, detect_m: float = DETECT_M) -> TargetGeometry
     return TargetGeometry(g.a, g.b, (-g.normal[0], -g.normal[1]), "line", start.name)
 
 
+def start_search_geometry(course: Course, detect_m: float = DETECT_M) -> TargetGeometry:
+    """The start line as :func:`find_start` searches it after the gun: the
+    :func:`start_geometry` extended by :data:`START_EXTENSION_M` beyond each end."""
+    return _extended(start_geometry(course, detect_m), START_EXTENSION_M)
+
+
 def leg_target(course: Course, i: int) -> Target:
     """Target of leg ``i`` with the next leg's target centre as its rounding exit."""
     target = target_of(course, i)

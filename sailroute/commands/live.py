@@ -4,22 +4,60 @@ instruments, and turn instrument logs into NMEA 0183 replay files."""
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Callable
+import dataclasses
+import signal
+import threading
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 from sailroute.commands.result import CommandResult
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
 from sailroute.errors import InputError
+from sailroute.live.boat import vessel_key
 from sailroute.live.convert import convert_log
 from sailroute.live.engine import LiveEngine, LiveSettings
 from sailroute.live.planner import ProcessPlanner
-from sailroute.live.sources import parse_source
+from sailroute.live.sources import NmeaFileSource, Source, parse_source
+from sailroute.live.web import loopback
+from sailroute.outdir import check_out_file
 from sailroute.planning.route import default_scenario, settings_for
 from sailroute.tabular import parse_offset
 from sailroute.timeutil import iso, parse_time, to_epoch
 
 __all__ = ["live_report", "run_live_command", "run_live_convert_command", "start_live"]
+
+
+def _paths(value: Any) -> Iterator[Path]:
+    """Every :class:`~pathlib.Path` in a (nested) spec: dataclasses, mappings, sequences."""
+    if isinstance(value, Path):
+        yield value
+    elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+        for f in dataclasses.fields(value):
+            yield from _paths(getattr(value, f.name))
+    elif isinstance(value, dict):
+        for v in value.values():
+            yield from _paths(v)
+    elif isinstance(value, list | tuple):
+        for v in value:
+            yield from _paths(v)
+
+
+def course_inputs(course: Course) -> list[Path]:
+    """The files a course reads: the course file, its polar, its wind and current files."""
+    out = [course.source] if course.source is not None else []
+    polar = course.boat_spec.get("polar")
+    if isinstance(polar, str):
+        out.append(course.base_dir / polar)
+    for spec in course.scenarios.values():
+        out.extend(_paths(spec.wind))
+        out.extend(_paths(spec.current))
+    return out
+
+
+def _file_of(src: Source | None) -> list[Path]:
+    return [src.path] if isinstance(src, NmeaFileSource) else []
 
 
 def start_live(
@@ -36,6 +74,9 @@ def start_live(
     leg: int = 1,
     settings: LiveSettings | None = None,
     worker: bool = True,
+    boat: str | None = None,
+    boat_source: str | None = None,
+    host: str | None = None,
 ) -> LiveEngine:
     """Load the course and its forecast, open the ports and start the live threads.
 
@@ -46,7 +87,7 @@ def start_live(
     ------
     InputError
         A bad course, scenario, source, leg number, interval, a port out of 0..65535 or
-        in use.
+        in use, a log that is one of the inputs.
     """
     for option, value in (("--port", port), ("--nmea-port", nmea_port)):
         if value is not None and not 0 <= value <= 65535:
@@ -65,24 +106,20 @@ def start_live(
     if not 1 <= leg <= loaded.n_legs:
         raise InputError(f"--leg {leg}: the course has legs 1..{loaded.n_legs}")
     src = parse_source(source, speed)
+    second = None if boat_source is None else parse_source(boat_source, speed)
+    if boat_source is not None and boat is None:
+        boat = "boat-source"
+    if log is not None:
+        inputs = [*course_inputs(loaded), *_file_of(src), *_file_of(second)]
+        check_out_file(log, inputs, option="--log")
     routing = settings_for(loaded, router)
-    boat, winds = build_specs(loaded, [name])
-    base = settings or LiveSettings()
-    live = LiveSettings(
-        every_s,
-        base.shift_deg,
-        base.change_ms,
-        base.fade_s,
-        base.window_s,
-        base.stale_s,
-        base.reach_m,
-        base.side,
-    )
+    model, winds = build_specs(loaded, [name])
+    live = dataclasses.replace(settings or LiveSettings(), every_s=every_s)
     planner = ProcessPlanner(loaded, name, router) if worker else None
     return LiveEngine(
         loaded,
         winds[name],
-        boat,
+        model,
         routing,
         src,
         live,
@@ -91,18 +128,27 @@ def start_live(
         log=None if log is None else Path(log),
         leg=leg - 1,
         planner=planner,
+        sailor=None if boat is None else vessel_key(boat),
+        boat_source=second,
+        host=host or "127.0.0.1",
     ).start()
 
 
 def live_report(engine: LiveEngine) -> str:
-    """The terminal summary of a live run: inputs, re-plans, the last plan."""
+    """The terminal summary of a live run: inputs, what was held out, re-plans, the last
+    plan."""
     st = engine.state()
     c = st["counts"]
+    held = ", ".join(f"{c.get('gate_' + k, 0)} {k}" for k in ("bounds", "far", "jump", "time"))
     lines = [
         f"source {engine.source.label}: {engine.n_readings} readings, "
         f"{c['used']} messages used, {c.get('bad_checksum', 0)} with a bad checksum, "
-        f"{c.get('malformed', 0)} malformed, {engine.n_drops} connection drops",
-        f"re-plans: {engine.n_plans}",
+        f"{c.get('no_checksum', 0)} without one, {c.get('malformed', 0)} malformed, "
+        f"{c.get('too_long', 0)} too long, {engine.n_drops} connection drops",
+        f"readings held out: {c['held_out']} ({held})",
+        f"re-plans: {engine.n_plans}; the sailor's boat ({engine.sailor.key or 'none chosen'}) "
+        f"on leg {min(engine.legs.leg + 1, engine.course.n_legs)} of {engine.course.n_legs}"
+        + (" (finished)" if engine.legs.finished else ""),
     ]
     p = engine.plan
     if p is not None:
@@ -112,6 +158,8 @@ def live_report(engine: LiveEngine) -> str:
             f"{p.time_to_finish_s:.0f} s, wind {p.wind_tws_ms * 1.9438:.1f} kn "
             f"from {p.wind_twd_deg:.0f}°"
         )
+        if p.wind_note:
+            lines.append(f"  {p.wind_note}")
         if p.side is not None:
             lines.append(
                 f"side that pays: {p.side.side}"
@@ -119,7 +167,44 @@ def live_report(engine: LiveEngine) -> str:
             )
     if engine.error:
         lines.append(f"last routing problem: {engine.error}")
+    if engine.waiting:
+        lines.append(f"not routed: {engine.waiting}")
+    if engine.n_errors:
+        lines.append(f"messages that raised (skipped, in the log): {engine.n_errors}")
     return "\n".join(lines)
+
+
+class _Ended(KeyboardInterrupt):
+    """SIGTERM or SIGHUP: end as Ctrl-C ends."""
+
+
+class _Signals:
+    """While open, SIGTERM and SIGHUP raise :class:`_Ended` in the main thread, once;
+    after :meth:`closing` (and after the first), they are ignored, so that nothing
+    interrupts the close.  Outside the main thread it does nothing."""
+
+    def __init__(self) -> None:
+        self._old: dict[int, Any] = {}
+        self._raise = True
+
+    def __enter__(self) -> _Signals:
+        if threading.current_thread() is threading.main_thread():
+            for sg in (signal.SIGTERM, signal.SIGHUP):
+                self._old[sg] = signal.signal(sg, self._handler)
+        return self
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        if self._raise:
+            self._raise = False
+            raise _Ended(signal.Signals(signum).name)
+
+    def closing(self) -> None:
+        """From now on, ignore them."""
+        self._raise = False
+
+    def __exit__(self, *exc: object) -> None:
+        for sg, h in self._old.items():
+            signal.signal(sg, h)
 
 
 def run_live_command(
@@ -138,19 +223,24 @@ def run_live_command(
     announce: Callable[[str], None] | None = None,
     settings: LiveSettings | None = None,
     worker: bool = True,
+    boat: str | None = None,
+    boat_source: str | None = None,
+    host: str | None = None,
 ) -> CommandResult:
     """Everything ``sailroute live`` does, minus printing.
 
-    Runs until ``duration_s`` of wall time, the end of a replayed file, or Ctrl-C; every
-    way ends cleanly (threads joined, ports closed, log flushed).
+    Runs until ``duration_s`` of wall time, the end of a replayed file, Ctrl-C, SIGTERM
+    or SIGHUP; every way ends cleanly (threads joined, workers ended, ports closed, the
+    log's ``end`` line written).
 
     Parameters
     ----------
     course : Course, str or Path
         The course being raced.
     source : str
-        ``signalk://HOST:PORT``, ``nmea+tcp://HOST:PORT``, ``nmea+udp://:PORT`` or a
-        recorded ``.nmea`` file (:func:`sailroute.live.sources.parse_source`).
+        The coach boat's instruments: ``signalk://HOST:PORT``, ``nmea+tcp://HOST:PORT``,
+        ``nmea+udp://:PORT`` or a recorded ``.nmea`` file
+        (:func:`sailroute.live.sources.parse_source`).
     scenario : str, optional
         The forecast scenario (default: the course's first).
     every_s : float
@@ -158,25 +248,35 @@ def run_live_command(
     speed : float
         Replay speed of a recorded file (1 = real time).
     port, nmea_port : int or None
-        The page's HTTP port and the NMEA-out TCP port on 127.0.0.1 (0: any free port;
-        None: not served).
+        The page's HTTP port and the NMEA-out TCP port (0: any free port; None: not
+        served); a busy NMEA port is replaced by the next free one.
     log : str or Path, optional
-        The JSON-lines log.
+        The JSON-lines log (never one of the inputs).
     duration_s : float, optional
         Wall time to run [s].
     router : str, optional
         Overrides the course's router.
     leg : int
-        The leg being sailed at the start (1-based; later legs follow as marks are
-        reached).
+        The leg being sailed at the start (1-based; later legs follow as the sailor's
+        boat rounds).
     announce : callable, optional
-        Receives the page URL and the NMEA port once they are open.
+        Receives the page's address and the NMEA port once they are open.
     settings : LiveSettings, optional
-        Re-plan rules (wind thresholds, fade time); ``every_s`` replaces its interval.
+        Re-plan rules (wind thresholds, fade time, checksums); ``every_s`` replaces its
+        interval.
     worker : bool
-        Compute the re-plans in a worker process (default), so that routing never slows
-        the input reader (:mod:`sailroute.live.planner`); False: in a thread of this
+        Compute the re-plans in worker processes (default), so that routing never slows
+        the input reader (:mod:`sailroute.live.planner`); False: in threads of this
         process (no start-up time, for tests and short runs).
+    boat : str, optional
+        The sailor's boat: ``self``, an MMSI, a Signal K vessel id
+        (:mod:`sailroute.live.boat`); None: chosen on the page (or the boat of
+        ``boat_source``).
+    boat_source : str, optional
+        The sailor's boat's own feed (any ``source`` form).
+    host : str, optional
+        Serve the page and the NMEA port on this address instead of 127.0.0.1; every
+        request to the page then needs the token in its address.
 
     Returns
     -------
@@ -197,17 +297,27 @@ def run_live_command(
         leg=leg,
         settings=settings,
         worker=worker,
+        boat=boat,
+        boat_source=boat_source,
+        host=host,
     )
-    try:
-        if announce is not None:
-            if engine.page is not None:
-                announce(f"page: http://127.0.0.1:{engine.page.port}/")
-            if engine.nmea is not None:
-                announce(f"NMEA 0183 out (RMB, APB, WPL, RTE): tcp://127.0.0.1:{engine.nmea.port}")
-        with contextlib.suppress(KeyboardInterrupt):
-            engine.wait(duration_s)
-    finally:
-        engine.close()
+    with _Signals() as signals:
+        try:
+            with contextlib.suppress(KeyboardInterrupt):
+                if announce is not None:
+                    for note in engine.notes:
+                        announce(note)
+                    if engine.page is not None:
+                        announce(f"page: {engine.page.url}")
+                    if engine.nmea is not None:
+                        where = host if host and not loopback(host) else "127.0.0.1"
+                        announce(
+                            f"NMEA 0183 out (RMB, APB, WPL, RTE): tcp://{where}:{engine.nmea.port}"
+                        )
+                engine.wait(duration_s)
+        finally:
+            signals.closing()
+            engine.close()
     files = {"log": Path(log)} if log is not None else {}
     return CommandResult(live_report(engine), files, engine.plan, main=())
 

@@ -2,18 +2,25 @@
 
 Both decoders turn their input into :class:`Reading` objects: one per sentence or
 Signal K value, with the data time and only the quantities that input carries, in SI
-units (m s⁻¹, degrees true).  Bad input never raises: a sentence with a wrong
-checksum, a malformed sentence (a position off the globe among them) and a delta that
-is not JSON are counted in :class:`Counts` and skipped, so that one noisy instrument
-does not take the feed down; a Signal K value that is not a finite number, or a
-position off the globe, is left out of its reading.
+units (m s⁻¹, degrees true), and the vessel it is about (``""``: the own instruments;
+another boat: its Signal K context without ``vessels.``, or ``urn:mrn:imo:mmsi:<MMSI>``
+for an AIS report, the same key).  Bad input never raises: a sentence with a wrong or
+missing checksum (a talker without checksums is read only with ``require_checksum``
+off), a malformed sentence (a position off the globe, a date past the calendar among
+them) and a delta that is not JSON are counted in :class:`Counts` and skipped, so that
+one noisy instrument does not take the feed down; a Signal K value that is not a finite
+number, or a position off the globe, is left out of its reading.  What the numbers say
+(a speed of 5e29 m s⁻¹, a date in another year) is checked afterwards, against the
+feed's own history, by :mod:`sailroute.live.gates`.
 
 NMEA 0183 sentences read (with pynmea2): ``RMC`` (time, date, position, SOG, COG),
 ``GGA``/``GLL`` (position), ``VTG`` (COG, SOG), ``HDT``/``HDG`` (heading, true;
 ``HDG`` with its variation), ``VHW`` (heading and speed through the water), ``MWV``
 (wind angle and speed; ``R``: apparent, ``T``: true, both from the bow), ``MWD``
-(true wind direction and speed).  A sentence without a time of its own takes the
-time of the last ``RMC``/``GGA``/``GLL``/``ZDA`` (instruments send them every second).
+(true wind direction and speed), and AIS ``!AIVDM``/``!AIVDO`` position reports of other
+boats (:mod:`sailroute.live.ais`).  A sentence without a time of its own takes the time
+of the last ``RMC``/``GGA``/``GLL``/``ZDA`` (instruments send them every second); an AIS
+report the time of the second of the minute it gives (:func:`~sailroute.live.ais.report_time`).
 
 Signal K paths read: ``navigation.position``, ``navigation.courseOverGroundTrue``,
 ``navigation.speedOverGround``, ``navigation.headingTrue``,
@@ -22,7 +29,8 @@ Signal K paths read: ``navigation.position``, ``navigation.courseOverGroundTrue`
 ``angleTrueGround`` (with the heading), ``environment.wind.angleApparent``,
 ``environment.wind.speedApparent`` (Signal K is in SI units and radians already).  An
 angle and its speed are used together when they come in one update (as a server that
-reads NMEA 0183 sends them).
+reads NMEA 0183 sends them).  Deltas of other vessels (AIS targets, trackers) are read
+with their context as the vessel.
 """
 
 from __future__ import annotations
@@ -36,6 +44,7 @@ from typing import Any
 
 import pynmea2
 
+from sailroute.live.ais import AisError, is_ais, parse_ais, report_time
 from sailroute.units import wrap180, wrap360
 
 KN: float = 1852.0 / 3600.0
@@ -66,6 +75,9 @@ class Reading:
         Apparent wind speed [m s⁻¹] and angle from the bow [°, + starboard].
     timed : bool
         The input carried its own time (``RMC``, ``GGA``, a Signal K timestamp).
+    vessel : str
+        Whose reading it is: ``""`` for the own instruments, else the other vessel's key
+        (module docstring).
     """
 
     t: float
@@ -81,6 +93,7 @@ class Reading:
     aws_ms: float | None = None
     awa_deg: float | None = None
     timed: bool = False
+    vessel: str = ""
 
     def as_dict(self) -> dict[str, float]:
         """The quantities given (for the JSON-lines log), rounded to what they resolve."""
@@ -113,18 +126,24 @@ class Counts:
     Attributes
     ----------
     by_kind : Counter
-        ``"RMC"``, ``"MWV"``, ... for sentences used; ``"bad_checksum"``,
-        ``"malformed"``, ``"untimed"`` (no clock yet), ``"ignored"`` (a sentence type not
-        read, or flagged void by the instrument), ``"empty"`` (a wind sentence without
-        values).
+        ``"RMC"``, ``"MWV"``, ``"AIS"``, ... for sentences used; ``"bad_checksum"``,
+        ``"no_checksum"``, ``"malformed"``, ``"untimed"`` (no clock yet), ``"ignored"`` (a
+        sentence type not read, or flagged void by the instrument), ``"empty"`` (a wind
+        sentence without values).
     """
 
     by_kind: Counter[str] = field(default_factory=Counter)
 
     @property
     def bad(self) -> int:
-        """Sentences or deltas skipped as broken (bad checksum or malformed)."""
-        return self.by_kind["bad_checksum"] + self.by_kind["malformed"]
+        """Sentences or deltas skipped as broken (bad or missing checksum, malformed)."""
+        return sum(self.by_kind[k] for k in BROKEN)
+
+
+BROKEN: tuple[str, ...] = ("bad_checksum", "no_checksum", "malformed")
+"""The :class:`Counts` kinds of input skipped as broken."""
+NOT_USED: tuple[str, ...] = (*BROKEN, "untimed", "ignored", "empty")
+"""The :class:`Counts` kinds of input not used (the others count what was used)."""
 
 
 def _f(value: Any) -> float | None:
@@ -166,17 +185,32 @@ def _epoch(d: date, tm: time) -> float:
 class NmeaDecoder:
     """Decode NMEA 0183 sentences, one line at a time, keeping the data clock.
 
+    Parameters
+    ----------
+    require_checksum : bool
+        Refuse a sentence without ``*hh`` (counted ``no_checksum``).  Off only for a
+        talker known to send none: without a checksum a bit flipped on the wire gives a
+        wrong number that nothing can tell from a right one.
+
     Attributes
     ----------
     counts : Counts
         Sentences used and skipped.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, require_checksum: bool = True) -> None:
         self.counts = Counts()
+        self.require_checksum = require_checksum
         self._date: date | None = None
         self._t: float | None = None
         self._variation: float = 0.0
+
+    def set_clock(self, t: float) -> None:
+        """Take ``t`` [epoch s] as the data clock and its date (the caller refused the
+        time the last sentence set: a sentence from another clock must not date the next
+        ones)."""
+        self._t = t
+        self._date = datetime.fromtimestamp(t, UTC).date()
 
     @property
     def clock(self) -> float | None:
@@ -207,23 +241,57 @@ class NmeaDecoder:
         text = line.strip()
         if not text:
             return None
+        if is_ais(text):
+            return self._ais(text)
+        if text[0] != "$":
+            self.counts.by_kind["malformed"] += 1
+            return None
+        if self.require_checksum and "*" not in text:
+            self.counts.by_kind["no_checksum"] += 1
+            return None
         try:
             msg = pynmea2.parse(text)
         except pynmea2.ChecksumError:
             self.counts.by_kind["bad_checksum"] += 1
             return None
-        except (pynmea2.ParseError, ValueError, TypeError, AttributeError):
+        except (pynmea2.ParseError, ValueError, TypeError, AttributeError, OverflowError):
             self.counts.by_kind["malformed"] += 1
             return None
         try:
             reading = self._reading(msg)
-        except (ValueError, TypeError, AttributeError, IndexError):
+        except (ValueError, TypeError, AttributeError, IndexError, OverflowError):
+            # OverflowError: a year or a number past what a date or float holds
             self.counts.by_kind["malformed"] += 1
             return None
         if reading is None:
             return None
         self.counts.by_kind[msg.sentence_type] += 1
         return reading
+
+    def _ais(self, text: str) -> Reading | None:
+        """An AIS position report of another vessel, at the time of its second."""
+        try:
+            pos = parse_ais(text, require_checksum=self.require_checksum)
+        except AisError as exc:
+            kind = {"bad checksum": "bad_checksum", "no checksum": "no_checksum"}
+            self.counts.by_kind[kind.get(str(exc), "malformed")] += 1
+            return None
+        if pos is None:
+            self.counts.by_kind["ignored"] += 1
+            return None
+        if self._t is None:
+            self.counts.by_kind["untimed"] += 1
+            return None
+        self.counts.by_kind["AIS"] += 1
+        return Reading(
+            report_time(self._t, pos.second),
+            lat=pos.lat,
+            lon=pos.lon,
+            sog_ms=pos.sog_ms,
+            cog_deg=pos.cog_deg,
+            hdg_deg=pos.hdg_deg,
+            vessel=pos.vessel,
+        )
 
     def _reading(self, msg: Any) -> Reading | None:
         kind = msg.sentence_type
@@ -281,11 +349,14 @@ class NmeaDecoder:
         return Reading(t, lat=lat, lon=lon, timed=True)
 
     def _zda(self, msg: Any) -> Reading | None:
-        """The date and time only."""
-        if msg.datestamp is not None and msg.timestamp is not None:
-            self._date = msg.datestamp
-            self._t = _epoch(msg.datestamp, msg.timestamp)
-        return None
+        """The date and time only: a reading with a time and nothing else (the clock's
+        gate checks it like a fix's time)."""
+        if msg.datestamp is None or msg.timestamp is None:
+            self.counts.by_kind["empty"] += 1
+            return None
+        self._date = msg.datestamp
+        self._t = _epoch(msg.datestamp, msg.timestamp)
+        return Reading(self._t, timed=True)
 
     @staticmethod
     def _vtg(msg: Any, t: float) -> Reading | None:
@@ -397,25 +468,29 @@ def _sk_time(text: Any) -> float | None:
         return None
     try:
         dt = datetime.fromisoformat(text.replace("Z", "+00:00"))
-    except ValueError:
+        return (dt if dt.tzinfo else dt.replace(tzinfo=UTC)).timestamp()
+    except (ValueError, OverflowError):
         return None
-    return (dt if dt.tzinfo else dt.replace(tzinfo=UTC)).timestamp()
 
 
 class SignalKDecoder:
-    """Decode Signal K delta messages (JSON text) of the own vessel.
+    """Decode Signal K delta messages (JSON text).
 
     A delta is ``{"context": ..., "updates": [{"timestamp": ..., "values": [{"path": ...,
-    "value": ...}]}]}``; the server's hello message and other vessels' deltas (AIS) are
-    ignored.  Values at one update's timestamp become one :class:`Reading`.
+    "value": ...}]}]}``; values at one update's timestamp become one :class:`Reading`,
+    ``timed`` when it holds a position (a server stamps the values it got no time for
+    with its own clock, which need not be the GPS's).  The
+    server's hello message names the own vessel (``self``); a delta of that context, of
+    ``vessels.self`` or without a context is the own instruments', a delta of another
+    ``vessels.<id>`` context another vessel's (``vessel`` ``<id>``: an AIS target, a
+    tracker); other contexts (aids to navigation, aircraft) are ignored.
 
     Attributes
     ----------
     counts : Counts
         ``"delta"`` for deltas used, ``"malformed"`` for text that is not a delta.
     self_context : str or None
-        The own vessel's context (from the hello message ``self``); deltas of other
-        contexts are skipped.  None until the hello arrives: then every context counts.
+        The own vessel's context (from the hello message); None until it arrives.
     """
 
     def __init__(self) -> None:
@@ -436,18 +511,25 @@ class SignalKDecoder:
             if isinstance(msg.get("self"), str):  # the hello message
                 self.self_context = msg["self"]
             return []
-        ctx = msg.get("context")
-        if self.self_context is not None and ctx not in (None, self.self_context, "vessels.self"):
+        vessel = self._vessel(msg.get("context"))
+        if vessel is None:
             self.counts.by_kind["ignored"] += 1
             return []
         updates = msg["updates"]
         if not isinstance(updates, list):
             self.counts.by_kind["malformed"] += 1
             return []
-        out = [r for r in (self._update(up) for up in updates) if r is not None]
-        return out
+        return [r for r in (self._update(up, vessel) for up in updates) if r is not None]
 
-    def _update(self, up: Any) -> Reading | None:
+    def _vessel(self, ctx: Any) -> str | None:
+        """``""`` for the own vessel, the id of another one, None for another context."""
+        if ctx is None or ctx == "vessels.self" or ctx == self.self_context:
+            return ""
+        if isinstance(ctx, str) and ctx.startswith("vessels.") and len(ctx) > 8:
+            return ctx.removeprefix("vessels.")[:200]
+        return None
+
+    def _update(self, up: Any, vessel: str) -> Reading | None:
         """One update of a delta: its values at its time, or None when none is usable."""
         if not isinstance(up, dict) or not isinstance(up.get("values"), list):
             self.counts.by_kind["malformed"] += 1
@@ -463,4 +545,6 @@ class SignalKDecoder:
         if not fields:
             return None
         self.counts.by_kind["delta"] += 1
-        return Reading(t, timed=True, **fields)
+        # a server stamps what it did not get a time for (a heading, the wind) with its own
+        # clock: only a position's time is the data clock (the engine places the rest at it)
+        return Reading(t, timed="lat" in fields, vessel=vessel, **fields)

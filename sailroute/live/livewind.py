@@ -1,7 +1,6 @@
 """The wind a live re-plan routes in: the measured wind now, fading to the forecast ahead.
 
-:class:`RollingWind` keeps the boat's true-wind readings of the last minutes and gives
-their vector mean (the "measured wind now") and a thinned history for the wind trend.
+The measured wind now comes from :class:`sailroute.live.windest.WindEstimator`.
 :class:`LiveWind` is a :class:`~sailroute.wind.base.WindField`: the course scenario's
 wind (the forecast) corrected by the measured wind, the correction fading with the time
 ahead::
@@ -19,7 +18,6 @@ and keeps the forecast's spatial pattern and its trend.
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -34,8 +32,6 @@ from sailroute.wind.rotation import earth_to_local, rotate_clockwise
 
 DEFAULT_FADE_S: float = 600.0
 """Default e-folding time of the measured wind's weight ahead [s] (:class:`LiveWind`)."""
-DEFAULT_WINDOW_S: float = 60.0
-"""Default averaging window of the measured wind [s] (:class:`RollingWind`)."""
 MIN_SPEED_MS: float = 0.2
 """Floor of the forecast speed in the speed ratio [m s⁻¹] (no division by a calm)."""
 
@@ -59,74 +55,6 @@ def apparent_to_true(
     """
     tws, twd = true_wind(aws_ms, awa_deg, sog_ms, cog_deg, heading_deg=hdg_deg)
     return float(tws), float(twd)
-
-
-class RollingWind:
-    """True-wind readings of the last ``window_s`` and a 10-s history for the trend.
-
-    Not thread-safe: the owner holds its lock around every call.
-
-    Parameters
-    ----------
-    window_s : float
-        Averaging window of :meth:`mean` [s].
-    history_s : float
-        How far back :meth:`trend` goes [s] (bounded memory: one point per 10 s).
-    """
-
-    def __init__(self, window_s: float = DEFAULT_WINDOW_S, history_s: float = 1800.0) -> None:
-        self.window_s = window_s
-        self._recent: deque[tuple[float, float, float]] = deque()
-        self._trend: deque[tuple[float, float, float]] = deque(maxlen=int(history_s // 10) + 1)
-
-    def add(self, t: float, tws_ms: float, twd_deg: float) -> None:
-        """Add one reading at data time ``t`` [epoch s] (earlier readings are kept in order)."""
-        u, v = wind_components(tws_ms, twd_deg)
-        self._recent.append((t, float(u), float(v)))
-        while self._recent and self._recent[0][0] < t - self.window_s:
-            self._recent.popleft()
-        bucket = t // 10 * 10
-        if not self._trend or self._trend[-1][0] < bucket:
-            m = self.mean()
-            if m is not None:
-                self._trend.append((bucket, m[0], m[1]))
-
-    def mean(self) -> tuple[float, float] | None:
-        """Vector mean of the window: ``(tws [m s⁻¹], twd [° from])``, None when empty."""
-        if not self._recent:
-            return None
-        a = np.asarray(self._recent)
-        s, d = wind_speed_direction(a[:, 1].mean(), a[:, 2].mean())
-        return float(s), float(d)
-
-    @property
-    def last_t(self) -> float | None:
-        """Data time of the newest reading [epoch s]."""
-        return self._recent[-1][0] if self._recent else None
-
-    def trend(self) -> list[tuple[float, float, float]]:
-        """``(t, tws [m s⁻¹], twd [°])`` of the window mean every 10 s, oldest first."""
-        return list(self._trend)
-
-
-def wind_changed(
-    old: tuple[float, float] | None,
-    new: tuple[float, float],
-    dir_deg: float = 5.0,
-    speed_ms: float = 0.5144,
-) -> bool:
-    """True when ``new`` differs from ``old`` by at least ``dir_deg`` or ``speed_ms``.
-
-    Parameters
-    ----------
-    old, new : (float, float)
-        ``(tws [m s⁻¹], twd [°])``; ``old`` None (no plan yet) counts as a change.
-    dir_deg, speed_ms : float
-        Thresholds (default 5° and 1 kn).
-    """
-    if old is None:
-        return True
-    return bool(abs(float(wrap180(new[1] - old[1]))) >= dir_deg or abs(new[0] - old[0]) >= speed_ms)
 
 
 @dataclass(frozen=True, eq=False)

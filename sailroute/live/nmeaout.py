@@ -1,14 +1,18 @@
 """NMEA 0183 out to a chart plotter: the route as ``WPL``/``RTE``, steering as ``RMB``/``APB``.
 
 After each re-plan :func:`route_sentences` gives one ``WPL`` per turning point ahead
-(tacks, gybes, marks) and the ``RTE`` sentences listing them (route id ``live<number>``,
-so a plotter and a test can tell re-plans apart); every position update
-:func:`steer_sentences` gives ``RMB`` and ``APB`` to the next turning point.
-:class:`NmeaServer` sends them to every TCP client connected to its port.
+(tacks, gybes, marks) and the ``RTE`` sentences listing them, always under the route id
+:data:`ROUTE_ID`: a plotter updates that one route in place, and its route list does not
+fill up with one route per re-plan.  Waypoint identifiers are ASCII letters, digits and
+``-`` (a mark named ``Bóia`` is ``BIA``), so any mark name goes out.  Every position
+update of the sailor's boat :func:`steer_sentences` gives ``RMB`` and ``APB`` to the
+next turning point.  :class:`NmeaServer` sends them to every TCP client connected to
+its port; it only sends, and reads nothing from its clients.
 """
 
 from __future__ import annotations
 
+import errno
 import math
 import socket
 import threading
@@ -20,6 +24,10 @@ from sailroute.units import wrap180
 NM: float = 1852.0
 """One nautical mile [m]."""
 _TALKER = "SR"  # a "proprietary-looking" talker would confuse plotters; SR = sailroute
+ROUTE_ID: str = "sailroute"
+"""The route id of every ``RTE`` sent: one route, updated in place."""
+PORT_TRIES: int = 20
+"""A busy NMEA port is replaced by the next free one of this many (:func:`open_nmea_server`)."""
 
 
 def sentence(body: str) -> str:
@@ -28,18 +36,16 @@ def sentence(body: str) -> str:
 
 
 def _name(name: str) -> str:
-    """A waypoint id a plotter accepts: letters, digits, ``-``, at most 8 characters."""
-    out = "".join(c for c in name.upper() if c.isalnum() or c == "-")
+    """A waypoint id a plotter accepts: ASCII letters, digits, ``-``, at most 8 characters."""
+    out = "".join(c for c in name.upper() if (c.isascii() and c.isalnum()) or c == "-")
     return out[:8] or "WPT"
 
 
-def route_sentences(number: int, waypoints: Sequence[tuple[str, float, float]]) -> list[str]:
-    """``WPL`` per waypoint and the ``RTE`` sentences of the route ``live<number>``.
+def route_sentences(waypoints: Sequence[tuple[str, float, float]]) -> list[str]:
+    """``WPL`` per waypoint and the ``RTE`` sentences of the route :data:`ROUTE_ID`.
 
     Parameters
     ----------
-    number : int
-        Re-plan number (the route id).
     waypoints : sequence of (str, float, float)
         ``(name, lat [°], lon [°])`` in sailing order.
     """
@@ -49,7 +55,7 @@ def route_sentences(number: int, waypoints: Sequence[tuple[str, float, float]]) 
         out.append(
             sentence(f"{_TALKER}WPL,{','.join(lat_field(la))},{','.join(lon_field(lo))},{wid}")
         )
-    out += [sentence(body) for body in rte_bodies(_TALKER, f"live{number}", ids)]
+    out += [sentence(body) for body in rte_bodies(_TALKER, ROUTE_ID, ids)]
     return out
 
 
@@ -105,6 +111,36 @@ def steer_sentences(
     return [sentence(rmb), sentence(apb)]
 
 
+def open_nmea_server(port: int, host: str = "127.0.0.1") -> tuple[NmeaServer, str]:
+    """An :class:`NmeaServer` on ``port``, or, when that port is busy, on the next free one
+    of :data:`PORT_TRIES` (a Signal K server on the same laptop serves NMEA on 10110).
+
+    Returns
+    -------
+    server : NmeaServer
+    note : str
+        Empty, or what was busy and which port was taken instead.
+
+    Raises
+    ------
+    OSError
+        No free port among them (or another error than a busy port).
+    """
+    err: OSError | None = None
+    for p in range(port, min(port + PORT_TRIES, 65536)) if port else [0]:
+        try:
+            server = NmeaServer(p, host)
+        except OSError as exc:
+            if exc.errno not in (errno.EADDRINUSE, errno.EACCES):
+                raise
+            err = exc
+            continue
+        note = "" if p == port else f"NMEA port {port} is busy: using {server.port}"
+        return server, note
+    assert err is not None
+    raise err
+
+
 class NmeaServer:
     """Send NMEA sentences to every client of a TCP port on 127.0.0.1 (or ``host``).
 
@@ -117,7 +153,8 @@ class NmeaServer:
     """
 
     def __init__(self, port: int, host: str = "127.0.0.1") -> None:
-        self._sock = socket.create_server((host, port), reuse_port=False)
+        family = socket.AF_INET6 if ":" in host else socket.AF_INET
+        self._sock = socket.create_server((host, port), family=family, reuse_port=False)
         self._sock.settimeout(0.5)
         self.port: int = self._sock.getsockname()[1]
         self._clients: list[socket.socket] = []
@@ -146,7 +183,7 @@ class NmeaServer:
 
     def send(self, sentences: Sequence[str]) -> None:
         """Send to every client; a client that does not take them is dropped."""
-        data = "".join(sentences).encode("ascii")
+        data = "".join(sentences).encode("ascii", "replace")
         with self._lock:
             keep = []
             for c in self._clients:

@@ -4,79 +4,42 @@
   from the boat's position and time, each next one chained as
   :func:`sailroute.planning.route.route_course` chains them
   (:func:`~sailroute.routing.geometry.chain_leg`);
-* :func:`current_leg` — which leg the boat is on (advanced when it comes within reach of
-  the leg's mark, gate or line);
 * :func:`side_that_pays` — the side of the rhumb line the route of the current leg
   favours, and by how much: the time of the best route through the mirror point on the
   other side, minus the best route's time;
-* :func:`laylines` — the two laylines into the next mark at the polar's best VMG angle;
+* :func:`laylines` — the two laylines into the next mark at the best VMG angle in the
+  measured wind, and the boat's distance and time to each;
 * :func:`summarise` -> :class:`LivePlan` — the numbers the page and the plotter show.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from sailroute.boat.model import BoatModel
-from sailroute.boat.polar import Polar
-from sailroute.course.geometry import target_of
+from sailroute.course.geometry import leg_endpoints, target_of
 from sailroute.course.model import Course
 from sailroute.planning.route import route_course
+from sailroute.progress import Progress
 from sailroute.routing.api import route_leg
-from sailroute.routing.geometry import chain_leg
+from sailroute.routing.geometry import chain_leg, start_centre
+from sailroute.routing.laylines import LaylineKind, vmg_angles
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import LegResult, Start, Target
-from sailroute.units import bearing_deg, wind_speed_direction, wrap360
+from sailroute.units import bearing_deg, heading_unit, wrap180, wrap360
 from sailroute.wind.base import WindField
 
 DEFAULT_REACH_M: float = 25.0
-"""A leg counts as sailed once the boat is this close to its mark, gate or line [m]."""
+"""A turning point of the route counts as reached once the boat is this close [m] (the
+plotter's steering then goes on to the next one)."""
 MIN_SIDE_M: float = 20.0
 """A route that leaves the rhumb line by less than this favours no side [m]."""
 
 XY = tuple[float, float]
-
-
-def _to_segment(p: XY, a: XY, b: XY | None) -> float:
-    """Distance from ``p`` to the point ``a`` or the segment ``a``-``b`` [m]."""
-    px, py = p
-    if b is None:
-        return math.hypot(px - a[0], py - a[1])
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    dd = dx * dx + dy * dy
-    f = 0.0 if dd == 0 else min(max(((px - a[0]) * dx + (py - a[1]) * dy) / dd, 0.0), 1.0)
-    return math.hypot(px - a[0] - f * dx, py - a[1] - f * dy)
-
-
-def current_leg(course: Course, leg: int, xy: XY, reach_m: float = DEFAULT_REACH_M) -> int:
-    """The leg being sailed: ``leg``, or a later one once its target is within reach.
-
-    Parameters
-    ----------
-    course : Course
-        The course.
-    leg : int
-        The leg the boat was on (0-based).
-    xy : (float, float)
-        The boat's position [m].
-    reach_m : float
-        Distance at which a mark, gate or line counts as reached [m].
-
-    Returns
-    -------
-    int
-        ``course.n_legs`` once the finish is reached.
-    """
-    while leg < course.n_legs:
-        tg = target_of(course, leg)
-        if _to_segment(xy, tg.a, tg.b) > reach_m:
-            break
-        leg += 1
-    return leg
 
 
 def leg_target(course: Course, leg: int) -> Target:
@@ -94,10 +57,12 @@ def route_remaining(
     leg: int,
     xy: XY,
     t: float,
+    progress: Progress | None = None,
 ) -> list[LegResult]:
     """Route legs ``leg`` .. last from the boat at ``xy`` [m] at epoch ``t`` [s]
     (:func:`~sailroute.planning.route.route_course` from a boat under way: inside the
-    course's boundary and round its obstacles, as ``plan`` routes).
+    course's boundary and round its obstacles, as ``plan`` routes; ``progress`` gets its
+    calls).
 
     Returns
     -------
@@ -106,7 +71,13 @@ def route_remaining(
         ended, and marks are rounded on their sides.
     """
     return route_course(
-        course, wind, boat, settings, from_leg=leg, under_way=((float(xy[0]), float(xy[1])), t)
+        course,
+        wind,
+        boat,
+        settings,
+        from_leg=leg,
+        under_way=((float(xy[0]), float(xy[1])), t),
+        progress=progress,
     )
 
 
@@ -152,6 +123,7 @@ def side_that_pays(
     wind: WindField,
     boat: BoatModel,
     settings: RoutingSettings,
+    progress: Callable[[float], None] | None = None,
 ) -> SidePays:
     """The side of the rhumb line the best route of a leg takes, and what it gains.
 
@@ -168,6 +140,8 @@ def side_that_pays(
         The leg's target.
     wind, boat, settings
         As for the route.
+    progress : callable, optional
+        The routers' progress callback (it may stop them by raising).
 
     Returns
     -------
@@ -190,9 +164,16 @@ def side_that_pays(
         wind,
         boat,
         settings,
+        progress=progress,
     )
     rest = route_leg(
-        Start(via.end_xy, None, name="mirror"), target, via.t_end, wind, boat, settings
+        Start(via.end_xy, None, name="mirror"),
+        target,
+        via.t_end,
+        wind,
+        boat,
+        settings,
+        progress=progress,
     )
     # the router resolves times to about its time step: a mirror route found a little
     # faster than the best one means that both sides are worth the same
@@ -202,7 +183,7 @@ def side_that_pays(
 
 @dataclass(frozen=True)
 class Layline:
-    """One layline into a mark.
+    """One layline into a mark, and how far the boat is from it.
 
     Attributes
     ----------
@@ -210,39 +191,80 @@ class Layline:
         The tack sailed along it.
     bearing_deg : float
         Course sailed along it towards the mark [° true].
+    distance_m : float
+        Distance the boat sails on the other tack, at the best VMG angle, to reach it
+        [m]; below 0: the boat is beyond it (it has overstood); NaN: no boat position.
+    time_s : float
+        That distance at the polar's speed [s].
     """
 
     tack: str
     bearing_deg: float
+    distance_m: float = math.nan
+    time_s: float = math.nan
 
 
-def laylines(boat: BoatModel, tws_ms: float, twd_deg: float, upwind: bool) -> tuple[Layline, ...]:
-    """The two laylines into a mark at the polar's best VMG angle (none for other boats).
+def laylines(
+    boat: BoatModel,
+    tws_ms: float,
+    twd_deg: float,
+    upwind: bool,
+    mark_xy: XY | None = None,
+    boat_xy: XY | None = None,
+    grid_north_deg: float = 0.0,
+) -> tuple[Layline, ...]:
+    """The two laylines into a mark at the best VMG angle in a uniform wind, and the
+    boat's distance and time to each.
+
+    The best-VMG angle is :func:`sailroute.routing.laylines.vmg_angles`'s (in a uniform
+    wind its traced laylines are these straight lines).  A boat on port reaches the
+    starboard layline: its distance is along the port course from the boat to that
+    line, and the other way round.
 
     Parameters
     ----------
     boat : BoatModel
-        A :class:`~sailroute.boat.polar.Polar` gives its VMG angles; other models give
-        no laylines.
+        Gives the VMG angles and the speed at them.
     tws_ms, twd_deg : float
-        The wind at the mark [m s⁻¹, ° from].
+        The wind [m s⁻¹, ° from].
     upwind : bool
         A windward mark (beat angles) or a leeward one (run angles).
+    mark_xy, boat_xy : (float, float), optional
+        The mark and the boat [m, course frame]; without both, no distances.
+    grid_north_deg : float
+        Angle from the frame's +y to true north [°]
+        (:meth:`~sailroute.geo.LocalFrame.grid_north_deg`).
 
     Returns
     -------
     tuple of Layline
-        Starboard first; empty for a boat without a polar.
+        Starboard first.
     """
-    if not isinstance(boat, Polar):
-        return ()
-    up, down = boat.vmg_angles_deg(tws_ms)
-    twa = up if upwind else down
+    kind: LaylineKind = "tack" if upwind else "gybe"
+    twa = float(vmg_angles(boat, np.array([tws_ms]), kind)[0])
+    speed = float(np.asarray(boat.steady_speed(np.array([tws_ms]), np.array([twa])))[0])
     # on starboard the wind comes over the right side: course = twd - twa
-    return (
-        Layline("starboard", float(wrap360(twd_deg - twa))),
-        Layline("port", float(wrap360(twd_deg + twa))),
-    )
+    course = {"starboard": float(wrap360(twd_deg - twa)), "port": float(wrap360(twd_deg + twa))}
+    out = []
+    for tack, other in (("starboard", "port"), ("port", "starboard")):
+        dist = math.nan
+        if mark_xy is not None and boat_xy is not None:
+            # boat + a u_other = mark - s u_tack  ->  a u_other + s u_tack = mark - boat
+            ux, uy = heading_unit(course[other] + grid_north_deg)
+            vx, vy = heading_unit(course[tack] + grid_north_deg)
+            rx, ry = mark_xy[0] - boat_xy[0], mark_xy[1] - boat_xy[1]
+            det = float(ux * vy - uy * vx)
+            if abs(det) > 1e-9:
+                dist = float(rx * vy - ry * vx) / det
+        out.append(
+            Layline(
+                tack,
+                course[tack],
+                dist,
+                dist / speed if speed > 0 and math.isfinite(dist) else math.nan,
+            )
+        )
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -282,6 +304,9 @@ class LivePlan:
     compute_cpu_s : float
         CPU time of the thread that routed [s] (wall minus CPU: time spent waiting for
         a core).
+    wind_note : str
+        Empty when routed in the scenario's wind blended with the measured one; else why
+        it was routed in the measured wind only (:mod:`sailroute.live.planner`).
     """
 
     number: int
@@ -302,6 +327,7 @@ class LivePlan:
     reason: str
     compute_s: float
     compute_cpu_s: float = 0.0
+    wind_note: str = ""
 
     def as_dict(self) -> dict[str, object]:
         """JSON-ready form (for the page, the log)."""
@@ -334,7 +360,30 @@ class LivePlan:
             "reason": self.reason,
             "compute_s": round(self.compute_s, 3),
             "compute_cpu_s": round(self.compute_cpu_s, 3),
+            "wind_note": self.wind_note,
         }
+
+
+def upwind_or_downwind_laylines(
+    course: Course,
+    leg: int,
+    boat: BoatModel,
+    wind: tuple[float, float],
+    boat_xy: XY | None,
+    grid_north_deg: float = 0.0,
+) -> tuple[Layline, ...]:
+    """The laylines into the mark of ``leg`` in the uniform wind ``(tws, twd)``, with the
+    boat's distances: none for a gate, a line, or a leg that is a reach (its bearing more
+    than 60° from dead up- or downwind)."""
+    tg = target_of(course, leg)
+    if tg.kind != "mark":
+        return ()
+    fx, fy = boat_xy if boat_xy is not None else start_centre(leg_endpoints(course, leg)[0])
+    brg = float(bearing_deg(tg.a[0] - fx, tg.a[1] - fy))
+    off = abs(float(wrap180(brg - wind[1])))
+    if 60.0 <= off <= 120.0:  # a reach
+        return ()
+    return laylines(boat, wind[0], wind[1], off < 60.0, tg.a, boat_xy, grid_north_deg)
 
 
 def summarise(
@@ -344,7 +393,6 @@ def summarise(
     number: int,
     t: float,
     leg: int,
-    wind: WindField,
     boat: BoatModel,
     measured: tuple[float, float],
     reason: str,
@@ -367,16 +415,10 @@ def summarise(
         tg = target_of(course, leg + i)
         la, lo = frame.to_latlon(*tg.centre)
         points.append((tg.name or f"M{leg + i + 1}", float(la), float(lo)))
-    lls: tuple[Layline, ...] = ()
-    first = results[0]
-    tg0 = target_of(course, leg)
-    if tg0.kind == "mark":
-        u, v = wind.sample(first.t_end, *tg0.a)
-        tws, twd = wind_speed_direction(u, v)
-        brg = float(bearing_deg(tg0.a[0] - first.start_xy[0], tg0.a[1] - first.start_xy[1]))
-        off = abs((brg - float(twd) + 180.0) % 360.0 - 180.0)
-        if off < 60.0 or off > 120.0:  # a beat or a run, not a reach
-            lls = laylines(boat, float(tws), float(twd), upwind=off < 60.0)
+    start = results[0].start_xy
+    lls = upwind_or_downwind_laylines(
+        course, leg, boat, measured, start, float(frame.grid_north_deg(*frame.to_latlon(*start)))
+    )
     etas = tuple(float(r.t_end) for r in results)
     return LivePlan(
         number=number,

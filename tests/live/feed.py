@@ -7,13 +7,20 @@ import socket
 import threading
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+import numpy as np
+from numpy.typing import NDArray
+
+from sailroute.boat.polar import Polar
 from sailroute.course.load import load_course
 from sailroute.course.model import Course
 from sailroute.live.convert import Row, nmea_lines
+from sailroute.nmea import checksum
 from sailroute.routing.settings import routing_settings
+from sailroute.wind.base import WindField
+from tests import fleetgen
 from tests.conftest import COURSES
 
 TRIESTE = COURSES / "trieste-coach-wl.yaml"
@@ -77,6 +84,98 @@ def approach(
             )
         )
     return rows
+
+
+def _field(value: int, n: int) -> str:
+    return format(value & ((1 << n) - 1), f"0{n}b")
+
+
+def ais_sentence(
+    mmsi: int,
+    lat: float,
+    lon: float,
+    sog_kn: float | None = None,
+    cog_deg: float | None = None,
+    hdg_deg: float | None = None,
+    second: int | None = None,
+) -> str:
+    """An AIS class B position report (message 18) as ``!AIVDM``, encoded by ITU-R M.1371
+    (the inverse of :func:`sailroute.live.ais.parse_ais`, written separately for tests)."""
+    bits = "".join(
+        [
+            _field(18, 6),
+            _field(0, 2),
+            _field(mmsi, 30),
+            _field(0, 8),
+            _field(1023 if sog_kn is None else round(sog_kn * 10), 10),
+            "1",
+            _field(round(lon * 600_000), 28),
+            _field(round(lat * 600_000), 27),
+            _field(3600 if cog_deg is None else round(cog_deg * 10) % 3600, 12),
+            _field(511 if hdg_deg is None else round(hdg_deg) % 360, 9),
+            _field(60 if second is None else second, 6),
+            "0" * 29,
+        ]
+    )
+    payload = "".join(
+        chr(v + 48 if v < 40 else v + 56)
+        for v in (int(bits[i : i + 6], 2) for i in range(0, 168, 6))
+    )
+    body = f"AIVDM,1,1,,B,{payload},0"
+    return f"!{body}*{checksum(body)}"
+
+
+@dataclass(frozen=True)
+class _OneSkill:
+    """A wind as :func:`tests.fleetgen.route_plans` takes it: every boat of skill 1."""
+
+    wind: WindField
+
+    def dilated(self, gun: float, skill: float) -> WindField:
+        return self.wind
+
+
+def sailed_track(
+    course: Course,
+    wind: WindField,
+    polar: Polar,
+    *,
+    step_s: float = 1.0,
+    lead_s: float = 90.0,
+    tail_s: float = 60.0,
+) -> tuple[NDArray, NDArray, NDArray]:
+    """A boat sailing ``course`` in ``wind`` as the fleet generator sails its boats
+    (:func:`tests.fleetgen.route_plans`: routed leg by leg, 6 m off the marks, with drawn
+    roundings), starting 40 % along the start line 5.4 s after the gun (so that no fix
+    lies on the line), with ``lead_s`` of approach from below the line and ``tail_s`` on
+    past the finish, sampled every ``step_s``.
+
+    Returns
+    -------
+    t, x, y : ndarray
+        Times [epoch s] and positions [m, course frame].
+    """
+    line = course.lines["start"]
+    (ax, ay), (bx, by) = line.a.xy, line.b.xy
+    sx, sy = ax + 0.4 * (bx - ax), ay + 0.4 * (by - ay)
+    gun = course.start_epoch
+    plan = fleetgen._Plan("sailor", gun, gun + 5.4, (sx, sy), 1.0, 0, None)
+    routed = fleetgen.route_plans(course, [plan], polar, _OneSkill(wind))["sailor"]  # type: ignore[arg-type]
+    t, x, y = (np.array(v) for v in zip(*routed.knots(), strict=True))
+    nx, ny = by - ay, -(bx - ax)
+    n = math.hypot(nx, ny)
+    nx, ny = nx / n, ny / n
+    mx, my = course.marks["1"].xy
+    if (mx - sx) * nx + (my - sy) * ny < 0:  # the normal towards the course side
+        nx, ny = -nx, -ny
+    v = fleetgen.LOITER_MS
+    hx, hy = x[-1] - x[-2], y[-1] - y[-2]
+    h = math.hypot(hx, hy)
+    t = np.concatenate([[t[0] - lead_s], t, [t[-1] + tail_s]])
+    x = np.concatenate([[x[0] - nx * v * lead_s], x, [x[-1] + hx / h * v * tail_s]])
+    y = np.concatenate([[y[0] - ny * v * lead_s], y, [y[-1] + hy / h * v * tail_s]])
+    ts = np.arange(math.ceil(t[0]), t[-1], step_s)
+    return ts, np.interp(ts, t, x), np.interp(ts, t, y)
 
 
 def lines_of(rows: Sequence[Row]) -> list[str]:

@@ -16,10 +16,11 @@ TALLINN = TESTS_DATA / "live" / "tallinn-2023-09-27.nmea"
 
 
 def test_live_replays_a_file_to_its_end(tmp_path: Path) -> None:
-    """A recorded file at high speed: the page and NMEA ports are announced, the run ends at
-    the file's end with a summary, the log is written (Tallinn is far from Trieste: every
-    re-plan is refused with a message that the position is outside the course area, and
-    the run goes on)."""
+    """A recorded file at high speed: the page (with its token) and NMEA ports are
+    announced, the run ends at the file's end with a summary, the log is written.  The
+    Tallinn boat is 1700 km from the Trieste marks: every fix is held out as far from the
+    course area, counted in the summary and logged with the reason, and nothing is
+    routed from there."""
     log = tmp_path / "live.jsonl"
     res = CliRunner().invoke(
         app,
@@ -28,6 +29,8 @@ def test_live_replays_a_file_to_its_end(tmp_path: Path) -> None:
             COURSE,
             "--source",
             str(TALLINN),
+            "--boat",
+            "self",
             "--scenario",
             "measured",
             "--speed",
@@ -41,17 +44,16 @@ def test_live_replays_a_file_to_its_end(tmp_path: Path) -> None:
         ],
     )
     assert res.exit_code == 0, res.output
-    assert "page: http://127.0.0.1:" in res.output and "NMEA 0183 out" in res.output
-    assert "0 with a bad checksum, 0 malformed" in res.output
+    assert "page: http://127.0.0.1:" in res.output and "/?token=" in res.output
+    assert "NMEA 0183 out" in res.output
+    assert "0 with a bad checksum, 0 without one, 0 malformed" in res.output
+    assert "readings held out: 253 (0 bounds, 253 far, 0 jump, 0 time)" in res.output
+    assert "re-plans: 0" in res.output
     records = [json.loads(line) for line in log.read_text().splitlines()]
-    fixes = [r for r in records if r["kind"] == "input" and "lat" in r]
-    assert len(fixes) == 253
-    winds = [r for r in records if r["kind"] == "input" and "twd_deg" in r]
-    assert len(winds) == 253  # every apparent-wind sentence converted to true wind
-    errors = [r for r in records if r["kind"] == "error"]
-    # the Tallinn boat is 1700 km from the Trieste marks: said, not routed
-    assert errors and "km from the course area" in errors[0]["message"]
-    assert records[-1]["kind"] == "end"
+    far = [r for r in records if r["kind"] == "reject"]
+    assert len(far) == 253 and {r["why"] for r in far} == {"far"}
+    assert not [r for r in records if r["kind"] in ("plan", "input") and "lat" in r]
+    assert records[-1]["kind"] == "end" and records[-1]["counts"]["gate_far"] == 253
 
 
 def test_live_bad_source_is_exit_2(tmp_path: Path) -> None:
@@ -90,6 +92,10 @@ def test_help_lists_the_options() -> None:
     assert res.exit_code == 0
     for text in (
         "--source SOURCE",
+        "--boat BOAT",
+        "--boat-source SOURCE",
+        "--host ADDRESS",
+        "--accept-no-checksum",
         "--every S",
         "--speed X",
         "--nmea-port",

@@ -9,8 +9,10 @@ another ``signalk-server`` executable).
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
+import math
 import os
 import shutil
 import socket
@@ -43,19 +45,17 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
-@pytest.fixture
-def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
-    """A signalk-server on a free port replaying a boat closing on mark 1 (120 s at 10x)."""
+@contextlib.contextmanager
+def signalk_server(tmp_path: Path, feed: Path, rows_per_s: float, n_rows: int) -> Iterator[int]:
+    """A signalk-server on a free port of 127.0.0.1 replaying ``feed`` at ``rows_per_s``
+    rows (seconds of data) per second; yields its port, stops it by its PID."""
     exe = _server_bin()
     if exe is None:
         pytest.skip(
             f"signalk-server is not installed (npm install --prefix {CACHE} "
             f"signalk-server@{SIGNALK_VERSION}, as .ci/run does)"
         )
-    course = trieste()
-    rows = approach(course, 120, speed_ms=2.0)
-    feed = write_feed(tmp_path / "replay.nmea", rows)
-    per_s = len(feed.read_bytes()) / len(rows)
+    per_s = len(feed.read_bytes()) / n_rows
     conf = tmp_path / "signalk"
     conf.mkdir()
     (conf / "settings.json").write_text(
@@ -77,7 +77,7 @@ def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
                                         "dataType": "NMEA0183",
                                         "filename": str(feed),
                                         "keepRunning": False,
-                                        "throttleRate": int(per_s * 10),
+                                        "throttleRate": int(per_s * rows_per_s),
                                     },
                                 },
                             }
@@ -111,7 +111,7 @@ def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
                         + (tmp_path / "server.log").read_text()[-2000:]
                     )
                 time.sleep(0.3)
-        yield port, rows
+        yield port
     finally:
         proc.terminate()
         try:
@@ -119,6 +119,15 @@ def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait(5)
+
+
+@pytest.fixture
+def signalk(tmp_path: Path) -> Iterator[tuple[int, list]]:
+    """A signalk-server replaying a boat closing on mark 1 (120 s at 10x)."""
+    rows = approach(trieste(), 120, speed_ms=2.0)
+    feed = write_feed(tmp_path / "replay.nmea", rows)
+    with signalk_server(tmp_path, feed, 10.0, len(rows)) as port:
+        yield port, rows
 
 
 @pytest.mark.slow
@@ -132,6 +141,7 @@ def test_live_from_a_real_signalk_server(signalk: tuple[int, list], tmp_path: Pa
     log = tmp_path / "live.jsonl"
     engine = start_live(
         trieste(),
+        boat="self",
         source=f"signalk://127.0.0.1:{port}",
         scenario="mean",
         every_s=15,
@@ -166,3 +176,64 @@ def test_live_from_a_real_signalk_server(signalk: tuple[int, list], tmp_path: Pa
     assert len(plans) >= 3
     to_mark = [p["time_to_mark_s"] for p in plans]
     assert all(b < a for a, b in itertools.pairwise(to_mark)), to_mark
+
+
+@pytest.mark.slow
+def test_an_ais_target_through_a_real_signalk_server(tmp_path: Path) -> None:
+    """The server turns the recording's ``!AIVDM`` reports of the sailor's boat into
+    ``vessels.urn:mrn:imo:mmsi:<MMSI>`` deltas; ``live --boat <MMSI>`` routes that boat,
+    not the coach boat (whose own position stays 300 m off).  The server stamps AIS
+    deltas with its own clock, so the recording is dated now and played at 2x."""
+    from sailroute.commands.live import start_live
+    from sailroute.live.convert import nmea_lines
+    from tests.live.feed import ais_sentence
+
+    course = trieste()
+    now = float(int(time.time()))
+    coach = approach(course, 50, speed_ms=0.0, start_back_m=300.0, t0=now)
+    boat = approach(course, 50, speed_ms=2.0, t0=now)
+    lines = []
+    for c, b in zip(coach, boat, strict=True):
+        lines += list(nmea_lines(c))
+        sec = int(b.t) % 60
+        lines.append(ais_sentence(247000123, b.lat, b.lon, b.sog_kn, b.cog_deg, None, sec))
+    feed = tmp_path / "replay.nmea"
+    feed.write_text("\r\n".join(lines) + "\r\n", encoding="ascii")
+    log = tmp_path / "live.jsonl"
+    with signalk_server(tmp_path, feed, 2.0, len(coach)) as port:
+        engine = start_live(
+            course,
+            source=f"signalk://127.0.0.1:{port}",
+            scenario="mean",
+            boat="247000123",
+            every_s=5,
+            port=None,
+            nmea_port=None,
+            log=log,
+            leg=1,
+            worker=False,
+            settings=LiveSettings(side=False),
+        )
+        try:
+            end = time.monotonic() + 45
+            while time.monotonic() < end and engine.n_plans < 2:
+                time.sleep(0.2)
+        finally:
+            engine.close()
+    records = [json.loads(line) for line in log.read_text().splitlines()]
+    boats = [r for r in records if r["kind"] == "boat"]
+    assert len(boats) >= 5 and {r["vessel"] for r in boats} == {"urn:mrn:imo:mmsi:247000123"}
+    by_lat = sorted(b.lat for b in boat)
+    for r in boats:  # each is one of the reports, to AIS resolution
+        k = min(range(len(by_lat)), key=lambda i: abs(by_lat[i] - r["lat"]))
+        assert abs(by_lat[k] - r["lat"]) < 2e-6
+    plans = [r for r in records if r["kind"] == "plan"]
+    assert len(plans) >= 2
+    frame = course.frame
+    cx, cy = frame.to_xy(coach[0].lat, coach[0].lon)
+    for p in plans:  # from the sailor's boat (dead-reckoned), not from the coach boat
+        px, py = frame.to_xy(*p["route"][0])
+        b = min(boat, key=lambda r: abs(r.t - p["t"]))
+        bx, by = frame.to_xy(b.lat, b.lon)
+        assert math.hypot(float(px - bx), float(py - by)) < 10.0
+        assert math.hypot(float(px - cx), float(py - cy)) > 140.0

@@ -73,6 +73,7 @@ def test_signalk_stream_reconnects(tmp_path: Path) -> None:
         log = tmp_path / "live.jsonl"
         engine = start_live(
             course,
+            boat="self",
             source=f"signalk://127.0.0.1:{port}",
             scenario="mean",
             port=None,
