@@ -399,7 +399,7 @@ def write_fleet(
         from sailroute.report.fleet import fleet_page, fleet_report
         from sailroute.report.page_render import PLOTLY_FILE, write_report
 
-        page = fleet_page(analyses, rows, all_notes, wind)
+        page = fleet_page(analyses, rows, all_notes, wind, fleet=fleet)
         files["html"] = write_report(out / "report.html", fleet_report(page))
         files["plotly_js"] = out / PLOTLY_FILE
     return files

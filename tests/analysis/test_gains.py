@@ -1,6 +1,6 @@
 """Gains on the fleet (:mod:`sailroute.analysis.gains`) on generated fleets with a known answer.
 
-A small clean fleet (6 boats, 14 minutes) checks the bookkeeping: the parts add up to each
+A small fleet (6 boats, 14 minutes, one that never starts) checks the bookkeeping: the parts add up to each
 leg's gain, the start and the legs to the elapsed-time gain at the finish, the top three are
 the leg's fastest, and the outputs carry the same numbers.  The slow test sails five
 40-boat messy fleets (``tests/fleetgen.py``, seeds 1-5) and checks that each injected cause
@@ -44,7 +44,7 @@ def _analyse(f: Fleet, folder: Path) -> CommandResult:
 
 @pytest.fixture(scope="module")
 def small(tmp_path_factory: pytest.TempPathFactory) -> tuple[Fleet, CommandResult]:
-    f = messy_fleet(seed=3, n_boats=6, minutes=14, faults=FaultPlan.clean())
+    f = messy_fleet(seed=3, n_boats=6, minutes=14, faults=FaultPlan.clean(non_starters=1))
     return f, _analyse(f, tmp_path_factory.mktemp("gains"))
 
 
@@ -83,7 +83,8 @@ def test_the_top_three_are_the_legs_fastest(small: tuple[Fleet, CommandResult]) 
     tab = fleet.table
     top3 = fleet.gains.top3
     for i, top in enumerate(fleet.gains.top):
-        fastest = [tab.boats[k] for k in np.argsort(tab.time_s[:, i])[:3]]
+        times = np.where(tab.ranked, tab.time_s[:, i], np.inf)
+        fastest = [tab.boats[k] for k in np.argsort(times)[:3]]
         assert list(top) == fastest
         best = tab.boats.index(top[0])
         assert top3.total_s[best, i] > 0  # faster than the mean of the three
@@ -161,3 +162,26 @@ def test_each_injected_cause_shows_in_its_part(tmp_path: Path) -> None:
         # nobody pinches or foots here: the height part stays small
         assert np.nanpercentile(np.abs(sm["height"][ok]), 90) < 15.0
     assert np.median(rel_errors) < 0.15
+
+
+def test_the_page_reads_the_fleets_analysis(small: tuple[Fleet, CommandResult]) -> None:
+    from sailroute.report.fleet import fleet_page, fleet_report
+
+    f, res = small
+    fleet = _fleet(res)
+    assert fleet.gains is not None
+    page = fleet_page(fleet.analyses, fleet.rows(), fleet.all_notes(), fleet=fleet)
+    # the status, the leader and the tracks not debriefed are the fleet's
+    for boat in page.boats:
+        assert boat.ranked == fleet.entry(boat.name).status.ranked
+    assert page.boats[page.lead()].name == fleet.leader()
+    assert [n for n, _ in page.others] == [f.with_status("non_starter")[0].name]
+    tables = {t.name: t for t in fleet_report(page).tables}
+    gains = tables["gains"]
+    assert gains.headers[2:4] == ("total s", "start s")
+    # a row's total is its start plus its parts, and the leg tables name the top three
+    for row in gains.rows:
+        total, *rest = (float(v) for v in row[2:])
+        assert total == pytest.approx(sum(rest), abs=0.35)
+    assert ", ".join(fleet.gains.top[0]) in tables["gains-1"].caption
+    assert tables["not-debriefed"].rows[0][0] == page.others[0][0]
