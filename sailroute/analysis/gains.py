@@ -10,7 +10,9 @@ leg end): ``T_k`` its leg time [s], ``D_k`` its progress along the leg's axis (t
 of the leg's start — line or mark — to the centre of its target) [m], ``C_k`` what its
 manoeuvres cost (:func:`~sailroute.analysis.loss.manoeuvre_cost`: each window's time minus
 its progress at the straight-line rate) and ``n_k`` their number.  A reference ``R`` (the
-fleet's ranked boats for ``"median"``, the leg's three fastest for ``"top3"``) gives
+boats that sailed the leg for ``"median"``, the leg's three fastest for ``"top3"``: a boat
+without a place in the results, over early or whose data end on the last leg, sailed its
+known legs like the others) gives
 ``T_R``, ``D_R``, ``n_R``, ``c_R`` (median, or mean for the top three, over its boats; ``c``
 the cost per manoeuvre of the boats that manoeuvred) and ``C_R = n_R c_R``.
 
@@ -31,7 +33,7 @@ axis's bearing, so that progress per second is ``SOG cos(ω − θ)``).  The fle
 TWA is ``f(θ) = g(|θ|) · polar(TWS, |θ|)``: the polar scaled, per 5° of TWA, by the
 fleet's median ``SOG / polar`` there (bins sailed by too few boats take the leg's median
 ratio), so that a change of TWS along the leg is the polar's.  The fleet's angle ``θ_σ``
-on each tack ``σ`` is the median over the ranked boats of their median ``|θ|`` on it.
+on each tack ``σ`` is the median over the boats of their median ``|θ|`` on it.
 
 * ``P1 = ⟨f(θ) cos(ω − θ)⟩``: the boat's angles and wind at the fleet's speed;
 * ``P2 = ⟨f(σ θ_σ) cos(ω − σ θ_σ)⟩``: the fleet's angle on the boat's tack, in the wind
@@ -226,7 +228,8 @@ def fleet_gains(
         A polar's speed ``(tws [m s⁻¹], |TWA| [°]) -> [m s⁻¹]`` (the shape of the fleet's
         speed curve).
     ranked : sequence of bool, optional
-        Per boat: it is part of the reference (default all).
+        Per boat: it is part of the references and of the fleet's speed curve (default
+        all: every boat whose leg time is known).
 
     Returns
     -------

@@ -237,7 +237,7 @@ def _fleet(
     """The result of a fleet: its gains (with a ``polar``: :mod:`sailroute.analysis.gains`),
     every debriefed boat's files, the fleet's, the tables."""
     if polar is not None:
-        fleet = replace(fleet, gains=fleet_gains(fleet.course, fleet, polar.speed, fleet.ranked))
+        fleet = replace(fleet, gains=fleet_gains(fleet.course, fleet, polar.speed))
     rows = fleet.rows()
     # the page draws the fleet-wide wind: the first boat's first candidate not its own log
     first = fleet.analyses[0].track.name
