@@ -5,9 +5,9 @@ add up to each leg's gain, the start and the legs to the elapsed-time gain at th
 top three are the leg's fastest, and the outputs and the page carry the same numbers.  The
 slow test sails five 40-boat messy fleets (``tests/fleetgen.py``, seeds 1-5) and checks that
 each injected cause shows in its part.  Measured there (inferred wind, GPS error, 1-3 s
-fixes): the parts add up to 1e-13 s; the rest ("other") is 0.7 s per leg in the median, 2.7
+fixes): the parts add up to 1e-13 s; the rest ("other") is 0.7 s per leg in the median, 2.6
 s at the 95th percentile; the speed part follows the boats' skill (Spearman 0.97-1.00),
-within 12 % in the median of the time its skill predicts (35 % at the 90th percentile); the
+within 14 % in the median of the time its skill predicts (39 % at the 90th percentile); the
 manoeuvres part ranks the boats by their tack cost (Spearman 0.56-0.85) more than by their
 finish (-0.15-0.46); the measured cost per tack is 5.0-5.8 s for the 4.2 s class and
 7.7-8.6 s for the 7.3 s class.  No boat pinches or foots, yet the height part reaches 20-30 s
