@@ -18,6 +18,7 @@ from typing import Any, overload
 import numpy as np
 from numpy.typing import NDArray
 
+from sailroute.analysis.gains import FleetGains
 from sailroute.analysis.result import TrackAnalysis
 from sailroute.analysis.triage import BoatEntry, Triage
 from sailroute.course.model import Course
@@ -223,12 +224,16 @@ class FleetAnalysis(Sequence[TrackAnalysis]):
         The debriefed boats, in the order given.
     notes : tuple of str
         The run's notes besides triage's (the wind, the reference).
+    gains : FleetGains or None
+        Each boat's gains on the fleet (:func:`sailroute.analysis.gains.fleet_gains`; None:
+        not measured, a boat model without a polar).
     """
 
     course: Course
     triage: Triage
     analyses: tuple[TrackAnalysis, ...]
     notes: tuple[str, ...] = ()
+    gains: FleetGains | None = None
 
     def __len__(self) -> int:
         return len(self.analyses)

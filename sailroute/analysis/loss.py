@@ -143,19 +143,49 @@ def split_loss(
     """
     t = np.asarray(t, float)
     dt = np.diff(t)
-    inman = manoeuvre_mask(t, man_t)
-    # an interval belongs to a window when both its ends do
-    win = inman[:-1] & inman[1:]
-    dprog = np.diff(progress_m)
-    straight_t = float(np.sum(dt[~win]))
-    rate = float(np.sum(dprog[~win]) / straight_t) if straight_t > 0 else 0.0
-    ok_rate = rate > 0.05 and bool(win.any())
-    sailed_man = float(np.sum(window_costs(dt, dprog, win, rate))) if ok_rate else 0.0
+    sailed_man, win = manoeuvre_cost(t, progress_m, man_t)
     lm = sailed_man - optimal_penalty_s
     r_mid = 0.5 * (ratio[:-1] + ratio[1:])
     ok = ~win & np.isfinite(r_mid)
     lv = float(np.sum(dt[ok] * (1.0 - np.clip(r_mid[ok], 0.0, RATIO_MAX))))
     return LossSplit(float(loss_s), float(lm), lv, float(loss_s) - float(lm) - lv)
+
+
+def manoeuvre_cost(
+    t: NDArray, progress_m: NDArray, man_t: NDArray
+) -> tuple[float, NDArray[np.bool_]]:
+    """Time the sailed manoeuvres of one leg cost [s], and which intervals they cover.
+
+    The windows of ``man_t`` (:func:`manoeuvre_mask`; an interval belongs to a window when
+    both its ends do), each costing ``W − P / v̄`` (:func:`window_costs`) with ``v̄`` the
+    progress rate outside them; 0 when that rate is not positive or there is no window.
+
+    Parameters
+    ----------
+    t : ndarray
+        Times of the leg's points [epoch s].
+    progress_m : ndarray
+        Progress along the leg axis at those points [m].
+    man_t : ndarray
+        Times of the manoeuvres [epoch s].
+
+    Returns
+    -------
+    cost : float
+        [s], at least 0.
+    win : ndarray of bool
+        Per interval (``len(t) − 1``): inside a window.
+    """
+    t = np.asarray(t, float)
+    dt = np.diff(t)
+    inman = manoeuvre_mask(t, man_t)
+    win = inman[:-1] & inman[1:]
+    dprog = np.diff(np.asarray(progress_m, float))
+    straight_t = float(np.sum(dt[~win]))
+    rate = float(np.sum(dprog[~win]) / straight_t) if straight_t > 0 else 0.0
+    if rate <= 0.05 or not win.any():
+        return 0.0, win
+    return float(np.sum(window_costs(dt, dprog, win, rate))), win
 
 
 def window_costs(dt: NDArray, dprog: NDArray, win: NDArray, rate: float) -> NDArray[np.float64]:

@@ -21,9 +21,11 @@ from sailroute.analysis.debrief import (
     parse_boat_leg_times,
 )
 from sailroute.analysis.fleet import FleetAnalysis
+from sailroute.analysis.gains import fleet_gains
 from sailroute.analysis.result import TrackAnalysis
 from sailroute.analysis.segment import DETECT_M, StartClock
 from sailroute.analysis.triage import BoatEntry, Triage, class_notes, triage_fleet
+from sailroute.boat.polar import Polar
 from sailroute.commands.result import CommandResult
 from sailroute.course.load import build_specs, load_course
 from sailroute.course.model import Course
@@ -34,6 +36,7 @@ from sailroute.progress import Progress
 from sailroute.report.analysis import (
     analysis_table,
     fleet_table,
+    gains_table,
     results_table,
     write_analysis,
     write_fleet,
@@ -205,7 +208,7 @@ def run_analyze_command(
     if one:
         return _one_boat(out, analyses[0], tri, notes, plots)
     fleet = FleetAnalysis(course, tri, tuple(analyses), tuple(notes))
-    return _fleet(out, fleet, sources, plots, pages)
+    return _fleet(out, fleet, sources, plots, pages, polar)
 
 
 def _one_boat(
@@ -229,8 +232,12 @@ def _fleet(
     sources: Mapping[str, Sequence[Any]],
     plots: bool,
     pages: str,
+    polar: Polar | None,
 ) -> CommandResult:
-    """The result of a fleet: every debriefed boat's files, the fleet's, the tables."""
+    """The result of a fleet: its gains (with a ``polar``: :mod:`sailroute.analysis.gains`),
+    every debriefed boat's files, the fleet's, the tables."""
+    if polar is not None:
+        fleet = replace(fleet, gains=fleet_gains(fleet.course, fleet, polar.speed))
     rows = fleet.rows()
     # the page draws the fleet-wide wind: the first boat's first candidate not its own log
     first = fleet.analyses[0].track.name
@@ -261,6 +268,8 @@ def _fleet(
     n = len(fleet)
     parts = [analysis_table(a, legend=k == n - 1) for k, a in enumerate(fleet)] if few else []
     parts.append(results_table(fleet))
+    if fleet.gains is not None:
+        parts.append(gains_table(fleet, per_leg=few))
     if few:
         parts.append(fleet_table(rows))
     else:

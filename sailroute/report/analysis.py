@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from sailroute._version import __version__
+from sailroute.analysis.gains import PARTS, REFERENCES, FleetGains, GainTable
 from sailroute.analysis.windsource import ABOVE_POLAR_PCT
 from sailroute.report.files import _num, _point
 from sailroute.textin import CleanCsvWriter
@@ -362,11 +363,16 @@ def write_fleet(
         "loss_s",
         "note",
     )
+    gains = gain_columns(fleet.gains if fleet is not None else None)
     with cp.open("w", newline="", encoding="utf-8") as fh:
         w = CleanCsvWriter(fh)
-        w.writerow(cols)
+        w.writerow((*cols, *GAIN_COLUMNS))
         for r in rows:
-            w.writerow([_fmt(r[c]) if r[c] is not None else "" for c in cols])
+            g = gains.get((r["boat"], r["leg"] - 1), {})
+            w.writerow(
+                [_fmt(r[c]) if r[c] is not None else "" for c in cols]
+                + [_fmt(g[c]) if c in g else "" for c in GAIN_COLUMNS]
+            )
     jp = out / "fleet.json"
     all_notes = [*(fleet.triage.notes() if fleet is not None else ()), *notes]
     doc: dict[str, Any] = {
@@ -393,10 +399,79 @@ def write_fleet(
         from sailroute.report.fleet import fleet_page, fleet_report
         from sailroute.report.page_render import PLOTLY_FILE, write_report
 
-        page = fleet_page(analyses, rows, all_notes, wind)
+        page = fleet_page(analyses, rows, all_notes, wind, fleet=fleet)
         files["html"] = write_report(out / "report.html", fleet_report(page))
         files["plotly_js"] = out / PLOTLY_FILE
     return files
+
+
+GAIN_COLUMNS = (
+    "gain_s",
+    *(f"gain_{p}_s" for p in PARTS),
+    "gain_top3_s",
+)
+"""``fleet.csv``'s gain columns: the leg's gain on the fleet's median, its parts, and the
+gain on the leg's top three (:mod:`sailroute.analysis.gains`)."""
+
+
+def gain_columns(gains: FleetGains | None) -> dict[tuple[str, int], dict[str, float]]:
+    """Per (boat, 0-based leg) of known time, the values of :data:`GAIN_COLUMNS` [s]."""
+    if gains is None:
+        return {}
+    med, top = gains.median, gains.top3
+    out = {}
+    for k, boat in enumerate(med.boats):
+        for i in range(len(med.labels)):
+            if not math.isfinite(med.total_s[k, i]):
+                continue
+            out[(boat, i)] = {
+                "gain_s": float(med.total_s[k, i]),
+                **{f"gain_{p}_s": float(med.parts_s[k, i, j]) for j, p in enumerate(PARTS)},
+                "gain_top3_s": float(top.total_s[k, i]),
+            }
+    return out
+
+
+def gains_to_dict(gains: FleetGains, legs: Sequence[int]) -> dict[str, Any]:
+    """``fleet.json``'s ``gains``: per reference and boat, the start part, each leg's gain
+    and parts, and their sums over ``legs`` (0-based; the legs every ranked boat has)."""
+
+    def table(t: GainTable) -> dict[str, Any]:
+        summed = t.summed(legs)
+        return {
+            "reference_start_s": _num(t.reference_start_s, 2),
+            "reference_leg_time_s": [_num(float(v), 2) for v in t.reference_time_s],
+            "boats": {
+                b: {
+                    "start_s": _num(float(t.start_s[k]), 2),
+                    "legs": [
+                        {
+                            "leg": i + 1,
+                            "total_s": _num(float(t.total_s[k, i]), 2),
+                            **{
+                                f"{p}_s": _num(float(t.parts_s[k, i, j]), 2)
+                                for j, p in enumerate(PARTS)
+                            },
+                        }
+                        for i in range(len(t.labels))
+                    ],
+                    "summed": {f"{p}_s": _num(float(v[k]), 2) for p, v in summed.items()},
+                }
+                for k, b in enumerate(t.boats)
+            },
+        }
+
+    return {
+        "parts": list(PARTS),
+        "summed_over_legs": [i + 1 for i in legs],
+        "top": [list(t) for t in gains.top],
+        "fleet_angle_deg": [
+            {"port": _num(float(a), 1), "starboard": _num(float(b), 1)}
+            for a, b in gains.fleet_angle_deg
+        ],
+        "wind_sources": [list(w) for w in gains.wind_sources],
+        **{ref: table(gains.table(ref)) for ref in REFERENCES},
+    }
 
 
 def fleet_to_dict(fleet: FleetAnalysis) -> dict[str, Any]:
@@ -436,6 +511,7 @@ def fleet_to_dict(fleet: FleetAnalysis) -> dict[str, Any]:
             for r in fleet.results()
         ],
         "common_legs": [i + 1 for i in tab.common_legs()],
+        "gains": None if fleet.gains is None else gains_to_dict(fleet.gains, tab.common_legs()),
         "leader": fleet.leader(),
         "fleet_start": {
             "gun_time": iso(st.gun_t),
@@ -565,6 +641,43 @@ def results_table(fleet: FleetAnalysis) -> str:
             f"{cpos:>9}  {'; '.join(r.status)}"
         )
     return "\n".join(out)
+
+
+def gains_table(fleet: FleetAnalysis, per_leg: bool = False) -> str:
+    """The fleet's gains on its median, one row per debriefed boat in the order of the
+    results: the total over the start and the legs every ranked boat has, and its parts;
+    ``per_leg`` adds a row per leg under each boat."""
+    g = fleet.gains
+    if g is None:
+        return ""
+    t = g.median
+    legs = fleet.table.common_legs()
+    summed = t.summed(legs)
+    names = ("total", "start", *PARTS)
+    out = [
+        f"gains on the fleet's median over the start and legs {_leg_span(legs)} [s] "
+        "(+ faster; total = start + speed + height + side + manoeuvres + other)",
+        f"  {'boat':<24}" + "".join(f"{n[:10]:>11}" for n in names),
+    ]
+    by = {b: k for k, b in enumerate(t.boats)}
+    for r in fleet.results():
+        k = by.get(r.boat)
+        if k is None:
+            continue
+        out.append(f"  {r.boat:<24}" + "".join(_gain(summed[n][k]) for n in names))
+        if per_leg:
+            for i in range(len(t.labels)):
+                cells = [t.total_s[k, i], math.nan, *t.parts_s[k, i]]
+                out.append(f"    leg {i + 1:<18}" + "".join(_gain(v) for v in cells))
+    out.append(
+        "top three per leg: "
+        + "; ".join(f"leg {i + 1} {', '.join(top) or '-'}" for i, top in enumerate(g.top))
+    )
+    return "\n".join(out)
+
+
+def _gain(v: float) -> str:
+    return f"{v:>+11.1f}" if math.isfinite(v) else f"{'':>11}"
 
 
 def _leg_span(legs: Sequence[int]) -> str:

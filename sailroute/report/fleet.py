@@ -14,8 +14,10 @@ only that structure.  The page (``sailroute analyze`` with several tracks) holds
 * the results: boats that finished by their finish time, then the others by how far
   their known times go (unknown stays unknown, never a guess); sailed and lost times
   summed over the legs every boat's time is known for;
-* the leg times (a row per boat, a column per leg), the start, and each leg's details
-  (folded), every column sortable by a click on its header;
+* the leg times (a row per boat, a column per leg), the start, each boat's gains on the
+  fleet (:mod:`sailroute.analysis.gains`: a column per part, each leg folded with its top
+  three named) and each leg's details (folded), every column sortable by a click on its
+  header;
 * the notes: the fleet's once, and a finding shared by several boats once with the boats
   named, folded (:func:`fold_notes`).
 
@@ -66,6 +68,8 @@ from sailroute.units import KNOT
 from sailroute.wind.base import WindField
 
 if TYPE_CHECKING:  # pragma: no cover
+    from sailroute.analysis.fleet import FleetAnalysis
+    from sailroute.analysis.gains import FleetGains
     from sailroute.analysis.result import TrackAnalysis
 
 __all__ = [
@@ -218,6 +222,14 @@ class FleetPage:
         The reference route drawn dashed (the optimal legs from the leader's leg starts).
     wind : (str, WindField) or None
         The wind drawn: its name and field.
+    leader : str or None
+        The leader's name as the fleet's analysis decides it (None: :func:`leader`).
+    others : tuple of (str, str)
+        The tracks that were not debriefed and why (name, status).
+    gains : FleetGains or None
+        The boats' gains on the fleet (boats named as in :attr:`boats`).
+    gain_legs : tuple of int
+        The legs the gains are summed over (0-based; every ranked boat's time known).
     """
 
     course: Course
@@ -229,6 +241,15 @@ class FleetPage:
     judged: tuple[str, ...] = ()
     optimal: Route | None = None
     wind: tuple[str, WindField] | None = None
+    leader: str | None = None
+    others: tuple[tuple[str, str], ...] = ()
+    gains: FleetGains | None = None
+    gain_legs: tuple[int, ...] = ()
+
+    def lead(self) -> int:
+        """Index of the leader among :attr:`boats` (:attr:`leader`, else :func:`leader`)."""
+        names = [b.name for b in self.boats]
+        return names.index(self.leader) if self.leader in names else leader(self.boats)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -391,6 +412,7 @@ def fleet_page(
     wind: tuple[str, WindField] | None = None,
     *,
     budget: int = FLEET_POINTS,
+    fleet: FleetAnalysis | None = None,
 ) -> FleetPage:
     """The fleet's page from its analyses: the one place that reads the analysis model.
 
@@ -408,6 +430,10 @@ def fleet_page(
         The wind drawn; default the first boat's first leg's.
     budget : int
         Points of all the tracks together (:func:`boat_points`).
+    fleet : FleetAnalysis, optional
+        The fleet's analysis: it decides each boat's status (a boat without a place in the
+        results carries what triage found), the leader, the tracks not debriefed and the
+        gains.
     """
     course = analyses[0].course
     by = {(r["leg"], r["boat"]): r for r in rows}
@@ -416,6 +442,7 @@ def fleet_page(
     boats = []
     for a in analyses:
         st = a.segmentation.start
+        entry = fleet.entry(a.track.name).status if fleet is not None else None
         boats.append(
             FleetBoat(
                 name=a.track.name,
@@ -435,9 +462,14 @@ def fleet_page(
                     *([above] if (above := above_polar_legs(a)) else []),
                     *own.get(a.track.name, ()),
                 ),
+                status=""
+                if entry is None or entry.ranked
+                else "; ".join(c.value for c in entry.classes),
             )
         )
-    lead = leader(boats)
+    names = [a.track.name for a in analyses]
+    told = fleet.leader() if fleet is not None else None
+    lead = names.index(told) if told in names else leader(boats)
     opt = replace(
         optimal_route(analyses[lead]),
         name=f"optimal from {analyses[lead].track.name}'s leg starts",
@@ -452,6 +484,16 @@ def fleet_page(
         judged=tuple(_judged_notes(analyses, name_legs=False)),
         optimal=opt,
         wind=wind if wind is not None else (_wind_name(analyses[0]), analyses[0].wind),
+        leader=told,
+        others=()
+        if fleet is None
+        else tuple(
+            (e.name, "; ".join(c.value for c in e.status.classes) or "not debriefed")
+            for e in fleet.entries
+            if e.name not in names
+        ),
+        gains=fleet.gains if fleet is not None else None,
+        gain_legs=fleet.table.common_legs() if fleet is not None else (),
     )
 
 
@@ -673,6 +715,82 @@ def _leg_table(page: FleetPage, j: int, order: Sequence[int], places: Mapping[in
     )
 
 
+GAIN_HEADERS = ("total s", "start s", "speed s", "height s", "side s", "manoeuvres s", "other s")
+"""The gains table's columns after place and boat."""
+
+
+def _gain_cells(values: Sequence[float]) -> list[Cell]:
+    return [(_signed(v), _key(v)) for v in values]
+
+
+def _gains_tables(page: FleetPage, order: Sequence[int], places: Mapping[int, int]) -> list[Table]:
+    """The gains on the fleet's median: summed over the legs every ranked boat has, then
+    one folded table per leg naming its top three."""
+    g = page.gains
+    if g is None:
+        return []
+    t = g.median
+    by = {b: k for k, b in enumerate(t.boats)}
+    rows = [k for k in order if page.boats[k].name in by]
+    summed = t.summed(page.gain_legs)
+    names = ("total", "start", "speed", "height", "side", "manoeuvres", "other")
+
+    def total(b: FleetBoat) -> list[Cell]:
+        k = by[b.name]
+        return _gain_cells([float(summed[n][k]) for n in names])
+
+    n_legs = len(page.course.legs)
+    out = [
+        _boat_table(
+            "Gains on the fleet's median [s, + faster] over the start and "
+            f"{_legs_text(page.gain_legs, n_legs)}: total = start + speed (SOG against the "
+            "fleet's at the same TWA) + height (the angle sailed against the fleet's) + side "
+            "(the wind it had against the leg's axis) + manoeuvres (count × cost against the "
+            "fleet's median) + other (distance)",
+            GAIN_HEADERS,
+            page,
+            rows,
+            places,
+            total,
+            name="gains",
+        )
+    ]
+    for j in range(len(t.labels)):
+
+        def leg(b: FleetBoat, j: int = j) -> list[Cell]:
+            k = by[b.name]
+            return _gain_cells([float(t.total_s[k, j]), math.nan, *map(float, t.parts_s[k, j])])
+
+        top = ", ".join(g.top[j]) or "-"
+        out.append(
+            _boat_table(
+                f"Gains on leg {j + 1}: {t.labels[j].replace('->', '→')} (top three: {top})",
+                GAIN_HEADERS,
+                page,
+                rows,
+                places,
+                leg,
+                collapsed=True,
+                name=f"gains-{j + 1}",
+            )
+        )
+    return out
+
+
+def _others_table(page: FleetPage) -> list[Table]:
+    """The tracks that were not debriefed, with what triage found."""
+    if not page.others:
+        return []
+    return [
+        Table(
+            "Not debriefed (no track to draw, no place)",
+            ("boat", "status"),
+            tuple((name, status) for name, status in page.others),
+            name="not-debriefed",
+        )
+    ]
+
+
 def _polar_key(text: str) -> float | None:
     m = _NUMBER.match(text)
     return float(m.group(0)) if m else None
@@ -705,11 +823,13 @@ def fleet_report(page: FleetPage) -> Report:
         _results_table(page, order, places, colours),
         _leg_times_table(page, order, places),
         _start_table(page, order, places),
+        *_gains_tables(page, order, places),
         *(_leg_table(page, j, order, places) for j in range(len(course.legs))),
     ]
     tables = [replace(t, boats=tuple(position[k] for k in t.boats)) for t in tables]
+    tables += _others_table(page)
     ranked = [b for b in page.boats if b.ranked]
-    lead = page.boats[leader(page.boats)].name if page.boats else ""
+    lead = page.boats[page.lead()].name if page.boats else ""
     first = (
         f"; first {page.boats[finishers[0]].name} in "
         f"{format_duration(page.boats[finishers[0]].finish_s)}"
