@@ -500,6 +500,9 @@ def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:
     """
     from matplotlib.figure import Figure
 
+    from sailroute.report.chart import chart_for, draw_chart
+    from sailroute.report.mapdraw import finish_map
+
     with_map = bool(plans)
     fig = Figure(figsize=(15.0 if with_map else 9.0, 6.5), layout="constrained")
     axes: list[Any] = list(fig.subplots(1, 2 if with_map else 1, squeeze=False)[0])
@@ -544,9 +547,12 @@ def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:
         course = plans[0].course
         draw_area(mx, course.area)
         draw_course(mx, course)
+        xs_of, ys_of = [], []
         for i, p in enumerate(plans):
             xs = np.concatenate([r.track.x for r in p.results])
             ys = np.concatenate([r.track.y for r in p.results])
+            xs_of.append(xs)
+            ys_of.append(ys)
             mx.plot(
                 xs,
                 ys,
@@ -556,7 +562,21 @@ def plot_comparison(cmp: Comparison, plans: Sequence[Plan] = ()) -> Figure:
                 gid=f"route:{p.scenario}",
                 label=p.scenario,
             )
-        _map_frame(mx, _extent(course, [r for p in plans for r in p.results]))
-        mx.legend(fontsize=8)
+        extent = _extent(course, [r for p in plans for r in p.results])
+        draw_chart(mx, chart_for(course, [], extent), extent)
+        _map_frame(mx, extent)
+        mx.legend(fontsize=8, loc="upper left")
         mx.set_title("routes", fontsize=10)
+        # names, scale bar and north arrow are placed on the final layout: run the
+        # constrained layout once, then keep it
+        engine = fig.get_layout_engine()
+        if engine is not None:
+            engine.execute(fig)
+        fig.set_layout_engine("none")
+        finish_map(
+            fig,
+            mx,
+            routes=[np.column_stack([xs_of[i], ys_of[i]]) for i in range(len(plans))],
+            **course_labels(course),
+        )
     return fig

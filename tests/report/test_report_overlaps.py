@@ -155,13 +155,14 @@ def test_no_label_overlaps_on_the_shipped_pages(pages, tmp_path):
     assert len(found) == 2 * len(pages) >= 2 * (len(COURSES) + 4)
 
 
-def _png_boxes(fig):
-    """items, fixed, routes of a route.png figure, from its artists' extents [px]."""
+def _png_boxes(fig, ax_index: int = 0):
+    """items, fixed, routes of a map figure (route.png, or the map of comparison.png at
+    ``ax_index``), from its artists' extents [px]."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     FigureCanvasAgg(fig).draw()
     r = fig.canvas.get_renderer()
-    ax = fig.axes[0]
+    ax = fig.axes[ax_index]
     k = fig.dpi / 72.0
     items, fixed, routes = [], [], []
     for a in fig.findobj():
@@ -182,6 +183,9 @@ def _png_boxes(fig):
             for s in a.get_segments():
                 q = a.get_transform().transform(s)
                 routes.append((*q[0], *q[1]))
+        elif gid.startswith("route:"):  # comparison.png: a scenario's route, one line
+            q = a.get_transform().transform(np.column_stack(a.get_data()))
+            routes.extend((*q[i], *q[i + 1]) for i in range(len(q) - 1))
     furniture = [
         a.get_window_extent(r) for a in fig.findobj() if a.get_gid() in ("scale-bar", "north-arrow")
     ]
@@ -198,6 +202,24 @@ def _png_boxes(fig):
     e = ax.get_legend().get_window_extent(r)
     items.append(("legend", e.x0, e.y0, e.x1, e.y1, False))
     return items, fixed, routes
+
+
+@pytest.mark.parametrize("course", COURSES, ids=lambda p: p.stem)
+def test_no_label_overlaps_on_comparison_png(course):
+    """comparison.png's map: the routes of the course's first two scenarios (its only one
+    where it has one), the marks named, a scale bar and a north arrow."""
+    from sailroute.course.load import load_course
+    from sailroute.planning.result import compare
+    from sailroute.planning.route import plan_course
+    from sailroute.report.plots import plot_comparison
+
+    c = load_course(course)
+    runs = [plan_course(c, s) for s in list(c.scenarios)[:2]]
+    fig = plot_comparison(compare([r.plan for r in runs]), [r.plan for r in runs])
+    items, fixed, routes = _png_boxes(fig, ax_index=1)
+    names = [n for n, *_ in items if n.startswith("mark-name:")]
+    assert len(names) == len(c.marks) and fixed and routes
+    assert overlaps(items, fixed, routes) == []
 
 
 @pytest.mark.parametrize("course", COURSES, ids=lambda p: p.stem)

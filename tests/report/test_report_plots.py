@@ -69,6 +69,13 @@ def test_plot_comparison(plan, with_map):
     routes = by_gid(fig, "route:")
     assert len(routes) == (2 if with_map else 0)
     assert len(fig.axes) == (2 if with_map else 1)
+    # the map as route.png draws it: the marks named, a scale bar and a north arrow
+    names = sorted(a.get_text() for a in by_gid(fig, "mark-name:"))
+    assert names == (sorted(plan.course.marks) if with_map else [])
+    assert bool(by_gid(fig, "scale-bar")) == bool(by_gid(fig, "north-arrow")) == with_map
+    if with_map:
+        (text,) = [a for a in by_gid(fig, "scale-bar") if hasattr(a, "get_text")]
+        assert text.get_text().endswith(" m")
 
 
 # --- route.png conventions --------------------------------------------------------------------
