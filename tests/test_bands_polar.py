@@ -129,11 +129,15 @@ def test_the_polar_source_sits_beside_the_wind_and_can_be_switched_off(tmp_path:
     assert spec_for(off)[0].sources() == ("tws",)
 
 
-def test_pace_scatter_is_the_sd_of_the_legs_log_factors_about_the_level() -> None:
-    # legs whose own factors are 0.9 x e^{+-0.05}: sd 0.05 x sqrt(4/3) over 4 legs (ddof 1)
-    sailed = np.array([100.0, 100.0, 200.0, 200.0])
-    f = 0.9 * np.exp(np.array([0.05, -0.05, 0.05, -0.05]))
+def test_pace_scatter_is_the_robust_sd_of_the_legs_log_factors() -> None:
+    # legs whose own factors are 0.9 x e^{0.1, -0.1, 0, 0, 0}, and one leg three times
+    # too long (a start sailed in the leg): the absolute deviations 0.1, 0.1, 0, 0, 0 and
+    # 1.1 have the median 0.05; the long leg does not widen it
+    sailed = np.array([100.0, 100.0, 200.0, 200.0, 100.0, 100.0])
+    f = 0.9 * np.exp(np.array([0.1, -0.1, 0.0, 0.0, 0.0, 0.0]))
     route = f * sailed
-    sd = pace_scatter(route, np.zeros(4), sailed, np.array([0, 0, 2, 2]), np.array([0.9, 1.0, 0.9]))
-    assert sd == pytest.approx(0.05 * np.sqrt(4 / 3), rel=1e-9)
+    sailed[-1] *= 3.0
+    band = np.array([0, 0, 2, 2, 0, 0])
+    sd = pace_scatter(route, np.zeros(6), sailed, band, np.array([0.9, 1.0, 0.9]))
+    assert sd == pytest.approx(1.4826 * 0.05, rel=1e-9)
     assert pace_scatter(route[:2], np.zeros(2), sailed[:2], np.zeros(2, int), np.ones(3)) is None

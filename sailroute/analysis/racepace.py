@@ -37,6 +37,8 @@ from sailroute.boat.learn import LearnedPolar
 from sailroute.course.model import Course
 from sailroute.units import circular_mean_deg
 
+MAD_TO_SD = 1.4826
+"""Median absolute deviation to standard deviation, for a normal scatter [-]."""
 MIN_LEG_S = 10.0
 """Legs sailed faster than this after the penalties are left out [s]."""
 
@@ -88,8 +90,10 @@ def pace_factors(
 def pace_scatter(
     route_s: NDArray, penalty_s: NDArray, sailed_s: NDArray, band: NDArray, pace: NDArray
 ) -> float | None:
-    """Standard deviation of ``log`` of the legs' own factors about the level's pace of
-    their point of sail [-] (None: fewer than 3 legs).
+    """The scatter of ``log`` of the legs' own factors about the level's pace of their
+    point of sail [-]: ``1.4826 MAD`` (the standard deviation of a normal scatter, robust
+    to the few legs a start, a penalty or a data gap makes several times too long; None:
+    fewer than 3 legs).
 
     One leg's factor is ``(T_route - P) / (T_sailed - P)`` (:func:`pace_factors` on one
     leg); the scatter holds what moves one boat's leg off the race pace: the boat, the
@@ -101,7 +105,7 @@ def pace_scatter(
     if ok.sum() < 3:
         return None
     r = np.log(a[ok] / b[ok]) - np.log(np.asarray(pace, dtype=float)[band[ok]])
-    return float(np.std(r, ddof=1))
+    return float(MAD_TO_SD * np.median(np.abs(r - np.median(r))))
 
 
 def level_pace(factors: NDArray, q: float) -> tuple[float, float, float] | None:
@@ -190,6 +194,7 @@ def race_pace(
 
 
 __all__ = [
+    "MAD_TO_SD",
     "MIN_LEG_S",
     "level_pace",
     "pace_factors",
