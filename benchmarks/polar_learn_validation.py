@@ -12,11 +12,12 @@ its own wind with the learned median level: ``pace: steady`` (the table as learn
 steady sailing) and ``pace: race`` (scaled per point of sail by the fleet's pace over
 whole legs in the learning races, ``docs/polar-fit.md``).  The plan's leg times are
 compared with the times the boats sailed (their mean over the boats), leg by leg and in
-total.  Band coverage: ``--members`` polars drawn from the learned level's uncertainty
-(:func:`sailroute.boat.learn.draw_polars`, each scaled by the race pace) are routed in
-the same wind; an observed leg (each boat's) is covered when it lies within the members'
-P10-P90 of that leg.  The wind itself is held fixed: only the polar's uncertainty is in
-these bands.
+total.  Band coverage: the bands of ``plan --ensemble`` with ``--members`` members
+(:func:`sailroute.bands.route.band_summary`; the course's boat the learned median level at
+its race pace) from the polar's uncertainty alone (each member draws the table), the
+wind's alone (SailGP: the spread of the legs' measured mean wind about the race's;
+Snipe: the default 1 kn, 5 deg) and both; an observed leg (each boat's) is covered when
+it lies within the members' P10-P90 of that leg.
 
 * **SailGP Auckland 2025** (F50, 3 boats x races 25011905-08, measured wind; read in
   place from ``../shared/data/real/races/sailgp-auckland-2025``, licence none stated,
