@@ -21,12 +21,12 @@ from sailroute.boat.learnfile import read_learned, write_learned
 from sailroute.commands.bands import run_bands_command
 from sailroute.course.load import load_course
 from sailroute.report.bands import bands_table
+from tests.test_bands import reach_course
 
 MODE_SD = 0.04  # the one bootstrap mode: the whole table together [log speed]
 PACE_SD = 0.03  # the legs' scatter about the race pace [log speed]
 TWA = np.arange(30.0, 181.0, 15.0)
 TWS = np.array([3.0, 5.0, 7.0])
-FAST = {"router": "isochrone", "dt_s": 10.0, "heading_step_deg": 4.0}
 
 
 def learned(pace: tuple[float, float, float] = (0.9, 0.8, 0.95)) -> LearnedPolar:
@@ -46,20 +46,12 @@ def learned(pace: tuple[float, float, float] = (0.9, 0.8, 0.95)) -> LearnedPolar
 
 
 def reach(tmp_path: Path, boat: dict, uncertainty: dict) -> Path:
-    """One 800 m beam reach east, wind from the north at 10 kn, the boat a learned polar."""
+    """The 800 m beam reach of ``tests/test_bands.py`` (10 kn from the north), its boat a
+    learned polar."""
     write_learned(learned(), tmp_path / "fleet.json")
-    data = {
-        "name": "reach",
-        "start_time": "2024-05-01T10:00:00Z",
-        "origin": {"lat": 45.0, "lon": 13.0},
-        "marks": {"a": {"x": 0.0, "y": 0.0}, "b": {"x": 800.0, "y": 0.0}},
-        "legs": [{"from": "a", "to": "b", "rounding": "port"}],
-        "routing": FAST,
-        "boat": {"polar": "fleet.json", **boat},
-        "scenarios": {"north": {"type": "uniform", "tws_kn": 10, "twd_deg": 0}},
-        "uncertainty": uncertainty,
-    }
-    p = tmp_path / "reach.yaml"
+    p = reach_course(tmp_path, uncertainty)
+    data = yaml.safe_load(p.read_text())
+    data["boat"] = {"polar": "fleet.json", **boat}
     p.write_text(yaml.safe_dump(data, sort_keys=False))
     return p
 
