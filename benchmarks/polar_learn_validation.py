@@ -12,11 +12,12 @@ its own wind with the learned median level: ``pace: steady`` (the table as learn
 steady sailing) and ``pace: race`` (scaled per point of sail by the fleet's pace over
 whole legs in the learning races, ``docs/polar-fit.md``).  The plan's leg times are
 compared with the times the boats sailed (their mean over the boats), leg by leg and in
-total.  Band coverage: ``--members`` polars drawn from the learned level's uncertainty
-(:func:`sailroute.boat.learn.draw_polars`, each scaled by the race pace) are routed in
-the same wind; an observed leg (each boat's) is covered when it lies within the members'
-P10-P90 of that leg.  The wind itself is held fixed: only the polar's uncertainty is in
-these bands.
+total.  Band coverage: the bands of ``plan --ensemble`` with ``--members`` members
+(:func:`sailroute.bands.route.band_summary`; the course's boat the learned median level at
+its race pace) from the polar's uncertainty alone (each member draws the table), the
+wind's alone (SailGP: the spread of the legs' measured mean wind about the race's;
+Snipe: the default 1 kn, 5 deg) and both; an observed leg (each boat's) is covered when
+it lies within the members' P10-P90 of that leg.
 
 * **SailGP Auckland 2025** (F50, 3 boats x races 25011905-08, measured wind; read in
   place from ``../shared/data/real/races/sailgp-auckland-2025``, licence none stated,
@@ -45,6 +46,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -56,18 +58,17 @@ sys.path.insert(0, str(ROOT))
 
 from race_polar_validation import SNIPE, _s  # noqa: E402
 
-from sailroute.boat.efficiency import scale_polar  # noqa: E402
-from sailroute.boat.learn import draw_polars  # noqa: E402
-from sailroute.boat.learnfile import read_learned  # noqa: E402
+from sailroute.bands.route import band_summary, spec_for  # noqa: E402
 from sailroute.commands.course_import import run_course_import_command  # noqa: E402
 from sailroute.commands.polar_fit import run_fit_command  # noqa: E402
 from sailroute.course.load import load_course  # noqa: E402
 from sailroute.course.model import Course  # noqa: E402
-from sailroute.planning.route import plan_course, route_course, settings_for  # noqa: E402
+from sailroute.course.specs import build_specs  # noqa: E402
+from sailroute.course.uncertainty import uncertainty_from_mapping  # noqa: E402
+from sailroute.planning.route import plan_course, settings_for  # noqa: E402
 from sailroute.timeutil import parse_time, to_epoch  # noqa: E402
 from sailroute.track import read_track  # noqa: E402
 from sailroute.units import KNOT, circular_mean_deg  # noqa: E402
-from sailroute.wind.uniform import UniformWind  # noqa: E402
 
 SHARED = ROOT.parent / "shared" / "data" / "real" / "races"
 SAILGP = SHARED / "sailgp-auckland-2025"
@@ -76,6 +77,9 @@ F50 = ROOT.parent / "shared" / "data" / "real" / "polars" / "sailgp-f50"
 BOATS = ("NZL", "AUS", "GBR")
 XMLS = {"05": "25011905_03-13-55", "06": "25011906_03-35-13", "07": "25011907_03-56-34"}
 LEGS = slice(1, 6)  # legs 2-6 of a SailGP race
+SNIPE_SPREAD = {"tws_kn": 1.0, "twd_deg": 5.0}
+"""A sailors' wind estimate without a measurement: sailroute's default spread (1 kn, 5 deg
+at 1 sigma, ``DEFAULT_UNCERTAINTY``; its 6-min shifts left out, as for SailGP)."""
 
 
 def leg_counter(boat: str, race: str) -> list[float]:
@@ -138,21 +142,65 @@ def logged_wind(gun: float, end: float) -> tuple[float, float]:
     return float(np.nanmean(s)) / KNOT, float(circular_mean_deg(d[np.isfinite(d)]))
 
 
+BAND_KINDS = ("polar", "wind", "wind + polar")
+"""The bands compared: the learned polar's uncertainty alone (the wind fixed), the
+wind's alone (the polar fixed), both."""
+
+
 def band(
-    course: Course, learned_json: Path, tws_kn: float, twd_deg: float, members: int, seed: int
-) -> np.ndarray | None:
-    """Per leg, the P10 and P90 of the members' leg times [s] (None without members)."""
+    course: Course, uncertainty: dict[str, float], members: int, seed: int
+) -> dict[str, Any] | None:
+    """Per kind of band (:data:`BAND_KINDS`) the P10 and P90 of the members' leg times [s],
+    shape (legs, 2), and the one-at-a-time widths of the race [s] of ``wind + polar``
+    (None without members).  The bands are ``sailroute plan --ensemble``'s
+    (:func:`sailroute.bands.route.band_summary`): the course's boat is the learned polar,
+    so the members draw it (``uncertainty: {polar: true}``, the default)."""
     if members <= 0:
         return None
-    lp = read_learned(learned_json)
-    pace = lp.level("median").race_pace
-    wind = UniformWind(tws_kn * KNOT, twd_deg)
+    out: dict[str, Any] = {}
     settings = settings_for(course)
-    times = []
-    for p in draw_polars(lp, "median", members, np.random.default_rng(seed)):
-        boat = p if pace is None else scale_polar(p, *pace, key="race pace")
-        times.append([r.time_s for r in route_course(course, wind, boat, settings)])
-    return np.percentile(np.asarray(times), [10.0, 90.0], axis=0).T
+    boat, winds = build_specs(course, ["race"])
+    for kind in BAND_KINDS:
+        raw: dict[str, Any] = {"members": members, "seed": seed, "polar": "polar" in kind}
+        if "wind" in kind:
+            if not uncertainty:
+                continue
+            raw.update(uncertainty)
+        spec, _ = spec_for(replace(course, uncertainty=uncertainty_from_mapping(raw)))
+        b = band_summary(
+            course, "race", spec, wind=winds["race"], boat=boat, settings=settings,
+            oat=kind == "wind + polar",
+        )  # fmt: skip
+        out[kind] = b.bands()[:-1][:, [0, 2]]
+        if kind == "wind + polar":
+            out["widths"] = {k: float(v[-1]) for k, v in b.oat_widths().items()}
+    return out
+
+
+def wind_spread(bounds: dict[str, list[float]], tws_kn: float, twd_deg: float) -> dict[str, float]:
+    """The spread of the legs' measured mean wind about the race's mean: the RMS deviation
+    of the legs' mean TWS [kn] and of their mean TWD [deg] (legs 2-6 of each boat, the three
+    logs' wind in each boat's leg), as ``uncertainty`` keys (1 sigma)."""
+    tracks = [read_track(SAILGP / "Boat_logs" / f"data_{b}.csv", time_zone="UTC") for b in BOATS]
+    tws, twd = [], []
+    for ch in bounds.values():
+        for a, z in zip(
+            ch[LEGS.start : LEGS.stop], ch[LEGS.start + 1 : LEGS.stop + 1], strict=True
+        ):
+            s = np.concatenate([t.channels["tws_ms"][(t.t_s >= a) & (t.t_s <= z)] for t in tracks])
+            d = np.concatenate([t.channels["twd_deg"][(t.t_s >= a) & (t.t_s <= z)] for t in tracks])
+            tws.append(float(np.nanmean(s)) / KNOT)
+            twd.append(float(circular_mean_deg(d[np.isfinite(d)])))
+    dev = (np.asarray(twd) - twd_deg + 180.0) % 360.0 - 180.0
+    return {
+        "tws_kn": round(float(np.sqrt(np.mean((np.asarray(tws) - tws_kn) ** 2))), 3),
+        "twd_deg": round(float(np.sqrt(np.mean(dev**2))), 2),
+    }
+
+
+def race_boat(learned: Path) -> str:
+    """The learned median level at its race pace, as a course's ``boat``."""
+    return f"{{polar: {learned}, level: median, pace: race}}"
 
 
 def plan_legs(course: Course) -> list[float]:
@@ -164,7 +212,7 @@ def row(
     obs: dict[str, list[float]],
     legs: slice,
     plans: dict[str, list[float]],
-    bands: np.ndarray | None,
+    bands: dict[str, Any] | None,
 ) -> dict[str, Any]:
     """The numbers of one held-out race."""
     o = np.asarray(list(obs.values()), dtype=float)
@@ -173,10 +221,13 @@ def row(
     for k, t in plans.items():
         tt = np.asarray(t, dtype=float)[legs]
         out[k] = (float(tt.sum()), float(tt.sum() / mean.sum() - 1.0), tt / mean - 1.0)
-    if bands is not None:
-        b = bands[legs]
-        inside = (o >= b[:, 0]) & (o <= b[:, 1])
-        out["cover"] = (int(inside.sum()), int(inside.size))
+    for kind in BAND_KINDS:
+        if bands is not None and kind in bands:
+            b = bands[kind][legs]
+            inside = (o >= b[:, 0]) & (o <= b[:, 1])
+            out[f"cover {kind}"] = (int(inside.sum()), int(inside.size))
+    if bands is not None and "widths" in bands:
+        out["widths"] = bands["widths"]
     return out
 
 
@@ -188,11 +239,12 @@ def sailgp(tmp: Path, members: int, boot: int) -> list[dict[str, Any]]:
     logs = [SAILGP / "Boat_logs" / f"data_{b}.csv" for b in BOATS]
     rows = []
     for held in courses:
-        obs = {}
+        obs, bounds = {}, {}
         for b in BOATS:
             ch = leg_counter(b, held)
             if len(ch) >= 7:
                 obs[b] = list(np.diff(ch)[LEGS])
+                bounds[b] = ch
         c0 = load_course(courses[held])
         ends = [leg_counter(b, held) for b in BOATS]
         end = max(e[6] for e in ends if len(e) >= 7)
@@ -215,9 +267,16 @@ def sailgp(tmp: Path, members: int, boot: int) -> list[dict[str, Any]]:
         ):
             c = with_boat_and_wind(courses[held], tmp / f"held-{held}.yaml", spec, tws, twd)
             plans[tag] = plan_legs(c)
-        bands = band(c, learned, tws, twd, members, 1)
+        spread = wind_spread(bounds, tws, twd)
+        c = with_boat_and_wind(
+            courses[held], tmp / f"held-{held}.yaml", race_boat(learned), tws, twd
+        )
+        bands = band(c, spread, members, 1)
         r = row(f"SailGP 250119{held} (learned on the other 3)", obs, LEGS, plans, bands)
-        r["wind"] = f"{tws:.1f} kn {twd:.0f} deg"
+        r["wind"] = (
+            f"{tws:.1f} kn {twd:.0f} deg (legs' sd {spread['tws_kn']:.1f} kn, "
+            f"{spread['twd_deg']:.0f} deg)"
+        )
         rows.append(r)
     return rows
 
@@ -271,7 +330,8 @@ def snipe(tmp: Path, members: int, boot: int, both: bool = True) -> list[dict[st
         ):
             c = with_boat_and_wind(src, tmp / f"snipe-held-{held}.yaml", spec, tws, 110.0)
             plans[tag] = plan_legs(c)
-        bands = band(c, learned, tws, 110.0, members, 1)
+        c = with_boat_and_wind(src, tmp / f"snipe-held-{held}.yaml", race_boat(learned), tws, 110.0)
+        bands = band(c, SNIPE_SPREAD, members, 1)
         r = row(f"Snipe {held} (learned on {learn})", obs, slice(1, 4), plans, bands)
         r["wind"] = f"{tws:.0f} kn 110 deg (sailors' estimate)"
         rows.append(r)
@@ -282,18 +342,25 @@ def print_table(rows: Sequence[dict[str, Any]]) -> None:
     print(
         "| held-out race | wind | observed (mean of boats) | "
         + " | ".join(f"{k}: plan (error)" for k in ("steady", "race"))
-        + " | reference polar | per-leg error, race pace | inside members' P10-P90 |"
+        + " | reference polar | per-leg error, race pace | inside P10-P90: "
+        + " / ".join(BAND_KINDS)
+        + " | race band width by source |"
     )
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
+    keep = ("steady", "race", "widths", *(f"cover {k}" for k in BAND_KINDS))
     for r in rows:
-        ref = next(k for k in r if isinstance(r[k], tuple) and k not in ("steady", "race", "cover"))
-        cov = f"{r['cover'][0]}/{r['cover'][1]}" if "cover" in r else "-"
+        ref = next(k for k in r if isinstance(r[k], tuple) and k not in keep)
+        cov = " / ".join(
+            f"{r[f'cover {k}'][0]}/{r[f'cover {k}'][1]}" if f"cover {k}" in r else "-"
+            for k in BAND_KINDS
+        )
+        widths = ", ".join(f"{k} {v:.0f} s" for k, v in r.get("widths", {}).items())
         print(
             f"| {r['name']} | {r['wind']} | {r['observed_s']:.0f} s ({r['boats']} boats) | "
             + " | ".join(f"{r[k][0]:.0f} s ({r[k][1]:+.1%})" for k in ("steady", "race"))
             + f" | {ref}: {r[ref][0]:.0f} s ({r[ref][1]:+.1%}) | "
             + ", ".join(f"{e:+.0%}" for e in r["race"][2])
-            + f" | {cov} |"
+            + f" | {cov} | {widths or '-'} |"
         )
 
 
@@ -316,12 +383,13 @@ def main() -> None:
             rows += snipe(tmp, args.members, args.bootstrap, both=not args.smoke)
         if rows:
             print_table(rows)
-        cov = [r["cover"] for r in rows if "cover" in r]
-        if cov:
-            print(
-                f"legs inside P10-P90 (the learned polar's uncertainty, race pace, wind "
-                f"fixed): {sum(c[0] for c in cov)} of {sum(c[1] for c in cov)}"
-            )
+        for kind in BAND_KINDS:
+            cov = [r[f"cover {kind}"] for r in rows if f"cover {kind}" in r]
+            if cov:
+                print(
+                    f"legs inside P10-P90, {kind} uncertainty (learned median level, race "
+                    f"pace): {sum(c[0] for c in cov)} of {sum(c[1] for c in cov)}"
+                )
     print("49erFX Worlds 2019 F13: left out (no marks; needs `sailroute course infer`)")
     load = Path("/proc/loadavg").read_text(encoding="utf-8").strip()
     print(f"run time {time.perf_counter() - t0:.0f} s; load {load} (a shared 2-core machine)")

@@ -1031,12 +1031,13 @@ def analyze_command(
         ),
     ] = "auto",
     reference: Annotated[
-        Literal["course", "fleet"],
+        Literal["course", "fleet", "learned"],
         typer.Option(
             "--reference",
             case_sensitive=False,
-            help="Polar the boats are judged against: the course's, or it scaled "
-            "to what the fleet sails (fleet).",
+            help="Polar the boats are judged against: the course's, it scaled "
+            "to what the fleet sails (fleet), or the polar learned from the fleet's "
+            "tracks (learned, as `polar fit`).",
         ),
     ] = "course",
     pages: Annotated[

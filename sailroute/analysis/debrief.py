@@ -68,8 +68,9 @@ if TYPE_CHECKING:  # pragma: no cover
 BRIDGE_S = 1e9
 """Hole limit of the measured winds the routers sample [s]: no hole (see
 :attr:`sailroute.analysis.windsource.WindSource.route_field`)."""
-REFERENCES = ("course", "fleet")
-"""Values of ``analyze --reference``: the course's polar, or it scaled to the fleet."""
+REFERENCES = ("course", "fleet", "learned")
+"""Values of ``analyze --reference``: the course's polar, it scaled to the fleet, or the
+polar learned from the fleet (:mod:`sailroute.analysis.fleetlearn`)."""
 SMOOTH_S = 3.0
 """Window of the velocity smoothing used for COG, TWA and the manoeuvre detection [s]."""
 

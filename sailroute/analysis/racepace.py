@@ -37,6 +37,8 @@ from sailroute.boat.learn import LearnedPolar
 from sailroute.course.model import Course
 from sailroute.units import circular_mean_deg
 
+MAD_TO_SD = 1.4826
+"""Median absolute deviation to standard deviation, for a normal scatter [-]."""
 MIN_LEG_S = 10.0
 """Legs sailed faster than this after the penalties are left out [s]."""
 
@@ -85,6 +87,27 @@ def pace_factors(
         return np.where(den > 0, num / den, np.nan)
 
 
+def pace_scatter(
+    route_s: NDArray, penalty_s: NDArray, sailed_s: NDArray, band: NDArray, pace: NDArray
+) -> float | None:
+    """The scatter of ``log`` of the legs' own factors about the level's pace of their
+    point of sail [-]: ``1.4826 MAD`` (the standard deviation of a normal scatter, robust
+    to the few legs a start, a penalty or a data gap makes several times too long; None:
+    fewer than 3 legs).
+
+    One leg's factor is ``(T_route - P) / (T_sailed - P)`` (:func:`pace_factors` on one
+    leg); the scatter holds what moves one boat's leg off the race pace: the boat, the
+    shifts and tactics of that leg, the race.
+    """
+    a = np.maximum(route_s - penalty_s, 0.0)
+    b = sailed_s - penalty_s
+    ok = (b >= MIN_LEG_S) & np.isfinite(a) & np.isfinite(b) & (a > 0)
+    if ok.sum() < 3:
+        return None
+    r = np.log(a[ok] / b[ok]) - np.log(np.asarray(pace, dtype=float)[band[ok]])
+    return float(MAD_TO_SD * np.median(np.abs(r - np.median(r))))
+
+
 def level_pace(factors: NDArray, q: float) -> tuple[float, float, float] | None:
     """The ``q``-th percentile [%] of the boats' factors per point of sail; a band
     without any boat takes the mean of the others (None: no band has one)."""
@@ -117,7 +140,8 @@ def race_pace(
     Returns
     -------
     learned : LearnedPolar
-        With each level's race pace set (unchanged when no leg was timed).
+        With each level's race pace and the legs' scatter about it (:func:`pace_scatter`)
+        set (unchanged when no leg was timed).
     notes : tuple of str
         One line per race routed (the paces are the levels' own,
         :attr:`sailroute.boat.learn.LevelTable.race_pace`).
@@ -153,15 +177,28 @@ def race_pace(
             "sailed legs"
         )
     pace: dict[str, tuple[float, float, float]] = {}
+    scatter: dict[str, float] = {}
     for name, t in learned.levels.items():
         if not rows[name]:
             continue
         a = np.asarray(rows[name], dtype=float)
-        f = pace_factors(a[:, 0], a[:, 1], a[:, 2], a[:, 3].astype(int), a[:, 4].astype(int))
+        band_of = a[:, 3].astype(int)
+        f = pace_factors(a[:, 0], a[:, 1], a[:, 2], band_of, a[:, 4].astype(int))
         p = level_pace(f, t.percentile)
         if p is not None:
             pace[name] = p
-    return learned.with_race_pace(pace), tuple(notes)
+            sd = pace_scatter(a[:, 0], a[:, 1], a[:, 2], band_of, np.asarray(p))
+            if sd is not None:
+                scatter[name] = sd
+    return learned.with_race_pace(pace, scatter), tuple(notes)
 
 
-__all__ = ["MIN_LEG_S", "level_pace", "pace_factors", "race_mean_wind", "race_pace"]
+__all__ = [
+    "MAD_TO_SD",
+    "MIN_LEG_S",
+    "level_pace",
+    "pace_factors",
+    "pace_scatter",
+    "race_mean_wind",
+    "race_pace",
+]

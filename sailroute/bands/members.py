@@ -14,11 +14,16 @@ Conover 1979), so even a small ``n`` spans the tails.  A stratum value ``u`` bec
   ``z · rate``; ``ou``, the starting shift ``z · sigma`` of an Ornstein-Uhlenbeck
   path (:class:`sailroute.strategy.shiftmodel.OUShift`, stepped every 10 s with its exact
   transition, the innovations from the seeded generator);
+* ``polar`` (the course's boat is a learned polar, :class:`~sailroute.boat.learn.PolarDraw`):
+  the first bootstrap mode's coefficient ``z``; the other modes, each cell's rest and
+  the pace factor (the legs' scatter about the race pace) standard normal from the
+  seeded generator: a whole table, correlated along its rows and across them;
 * ``boat.<parameter>``: ``low + u (high - low)``.
 
 :func:`one_at_a_time` gives, per source, members at that source's quantiles 0.1, 0.5 and 0.9
 with every other source at its nominal value (no change), for the breakdown of which
-source widens the band most.  Members are data; :func:`member_wind` and
+source widens the band most; the ``polar`` member at quantile ``q`` has every cell of the
+table at its own quantile ``q``.  Members are data; :func:`member_wind` and
 :func:`member_boat` build what a router needs.
 """
 
@@ -35,6 +40,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.special import ndtri
 
+from sailroute.boat.learn import PolarDraw
 from sailroute.course.uncertainty import ShiftSpec, UncertaintySpec
 from sailroute.errors import InputError
 from sailroute.wind.base import WindField
@@ -92,6 +98,8 @@ class Member:
     boat : tuple of (str, float)
         Race-polar parameters (:class:`~sailroute.boat.kinetics.Kinetics` fields)
         changed from the course's boat; empty: the course's boat.
+    polar : PolarDraw or None
+        The draw of the course's learned polar; None: its table as learned.
     """
 
     name: str
@@ -101,6 +109,7 @@ class Member:
     shift_t_s: tuple[float, ...] = ()
     shift_deg: tuple[float, ...] = ()
     boat: tuple[tuple[str, float], ...] = ()
+    polar: PolarDraw | None = None
 
 
 NOMINAL: Final = Member("nominal")
@@ -192,9 +201,25 @@ def _apply(
         assert spec.shifts is not None
         t, s = _shift_series(spec.shifts, u, duration_s, rng)
         return dataclasses.replace(member, shift_t_s=t, shift_deg=s)
+    if source == "polar":
+        assert spec.polar is not None
+        return dataclasses.replace(member, polar=_polar_draw(spec, z, rng))
     name = source.removeprefix("boat.")
     lo, hi = next((lo, hi) for p, lo, hi in spec.boat if p == name)
     return dataclasses.replace(member, boat=(*member.boat, (name, lo + u * (hi - lo))))
+
+
+@lru_cache(maxsize=8)
+def _level_table(file: Path, level: str) -> Any:
+    from sailroute.boat.learnfile import read_learned
+
+    return read_learned(file).level(level)
+
+
+def _polar_draw(spec: UncertaintySpec, z: float, rng: np.random.Generator) -> PolarDraw:
+    """A main member's draw of the learned polar, its first mode at ``z``."""
+    assert spec.polar is not None
+    return PolarDraw.random(_level_table(spec.polar.file, spec.polar.level), rng, first=z)
 
 
 def check_ensemble_size(spec: UncertaintySpec, n: int, duration_s: float, n_legs: int) -> None:
@@ -285,9 +310,11 @@ def one_at_a_time(
         members = []
         for i, q in enumerate(quantiles):
             rng = np.random.default_rng([spec.seed, i])
-            members.append(
-                _apply(Member(f"{source}@{q:g}"), source, float(q), spec, duration_s, rng)
-            )
+            m = Member(f"{source}@{q:g}")
+            if source == "polar":  # every cell at its own quantile q
+                members.append(dataclasses.replace(m, polar=PolarDraw(quantile_z=float(ndtri(q)))))
+                continue
+            members.append(_apply(m, source, float(q), spec, duration_s, rng))
         out[source] = tuple(members)
     return out
 
@@ -304,7 +331,9 @@ def member_wind(base: WindField, member: Member, t0: float) -> WindField:
     t0 : float
         Race start [epoch s]; the member's shift times count from it.
     """
-    if member == dataclasses.replace(NOMINAL, name=member.name, boat=member.boat):
+    if member == dataclasses.replace(
+        NOMINAL, name=member.name, boat=member.boat, polar=member.polar
+    ):
         return base
     return PerturbedWind(
         base,
@@ -347,7 +376,8 @@ def member_boat(
     base_dir: Path,
     where: str,
 ) -> Any:
-    """The member's boat: the course's boat, or its race polar with parameters changed.
+    """The member's boat: the course's boat, its race polar with parameters changed, or
+    a draw of its learned polar.
 
     Parameters
     ----------
@@ -368,6 +398,8 @@ def member_boat(
         The member changes race-polar parameters but the course's boat is not a race
         polar (a polar file, a steady VPP).
     """
+    if member.polar is not None:
+        return _built(_freeze(dict(boat_spec)), str(base_dir), member.polar)
     if not member.boat:
         return base_boat
     form = _race_form(boat_spec, where)
@@ -391,10 +423,13 @@ def _thaw(value: Any) -> Any:
     return value
 
 
-@lru_cache(maxsize=32)
-def _built(frozen: Any, base_dir: str) -> Any:
-    """A race polar built once (members, and courses, that share boat parameters share it;
-    the spec was checked by the course already, so problems cannot arise here)."""
+@lru_cache(maxsize=256)
+def _built(frozen: Any, base_dir: str, draw: PolarDraw | None = None) -> Any:
+    """A race polar, or a draw of a learned polar, built once (members, and courses, that
+    share boat parameters share it; the spec was checked by the course already, so
+    problems cannot arise here)."""
     from sailroute.boat.build import boat_from_spec
 
-    return boat_from_spec(_thaw(frozen), base_dir=Path(base_dir), where="uncertainty.boat")
+    return boat_from_spec(
+        _thaw(frozen), base_dir=Path(base_dir), where="uncertainty.boat", draw=draw
+    )

@@ -34,7 +34,7 @@ from sailroute.bands.sides import honest_sides
 from sailroute.bands.summary import BandSummary, member_track
 from sailroute.course.load import build_current
 from sailroute.course.model import Course
-from sailroute.course.uncertainty import DEFAULT_UNCERTAINTY, UncertaintySpec
+from sailroute.course.uncertainty import DEFAULT_UNCERTAINTY, PolarSpread, UncertaintySpec
 from sailroute.planning.route import route_course, route_course_batch
 from sailroute.progress import Progress
 from sailroute.routing.batch import batchable
@@ -43,7 +43,14 @@ from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import LegResult
 from sailroute.wind.base import WindField
 
-__all__ = ["RouteMembers", "band_summary", "route_members", "route_together", "spec_for"]
+__all__ = [
+    "RouteMembers",
+    "band_summary",
+    "polar_spread",
+    "route_members",
+    "route_together",
+    "spec_for",
+]
 
 
 RouteMembers = Callable[..., list[list[LegResult]]]
@@ -52,13 +59,14 @@ leg results of each member, in order."""
 
 
 def spec_for(course: Course, n: int | None = None) -> tuple[UncertaintySpec, tuple[str, ...]]:
-    """The course's uncertainty (or the defaults), with ``n`` members if given, shifts fitted.
+    """The course's uncertainty (or the defaults), with ``n`` members if given, shifts
+    fitted, and the course's learned polar as a source (:func:`polar_spread`).
 
     Returns
     -------
     spec : UncertaintySpec
     notes : tuple of str
-        Says when the defaults were used.
+        Says when the defaults were used, and when the members draw the polar.
     """
     notes: tuple[str, ...] = ()
     spec = course.uncertainty
@@ -70,7 +78,38 @@ def spec_for(course: Course, n: int | None = None) -> tuple[UncertaintySpec, tup
         )
     if n is not None:
         spec = spec.with_members(n)
+    spread = polar_spread(course) if spec.draw_polar else None
+    if spread is not None:
+        spec = dataclasses.replace(spec, polar=spread)
+        notes += (
+            f"the boat is a polar learned from a fleet ({spread.file.name}, level "
+            f"{spread.level}): each member draws its table from the bootstrap's "
+            f"uncertainty (median cell sd {100 * spread.sd_log:.1f} %) and the legs' "
+            f"scatter about the race pace ({100 * spread.pace_sd_log:.1f} %); "
+            "`uncertainty: {polar: false}` keeps it fixed",
+        )
     return resolve_shifts(spec), notes
+
+
+def polar_spread(course: Course) -> PolarSpread | None:
+    """The course's boat as a band source, when it is a polar learned by ``sailroute polar
+    fit`` (None otherwise)."""
+    from sailroute.boat.build import learned_boat
+    from sailroute.boat.learnfile import read_learned
+
+    found = learned_boat(course.boat_spec, course.base_dir)
+    if found is None:
+        return None
+    lp = read_learned(found[0])
+    t = lp.level(found[1])
+    learned = t.sd_log[lp.status == "learned"]
+    return PolarSpread(
+        file=found[0],
+        level=found[1],
+        modes=int(t.modes.shape[0]),
+        sd_log=float(np.median(learned)) if learned.size else 0.0,
+        pace_sd_log=float(t.pace_sd_log or 0.0),
+    )
 
 
 def route_members(

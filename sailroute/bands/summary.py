@@ -165,6 +165,15 @@ class BandSummary:
                 "twd_sd_deg": u.twd_deg,
                 "shifts": shifts,
                 "boat": {name: [lo, hi] for name, lo, hi in u.boat},
+                "polar": None
+                if u.polar is None
+                else {
+                    "file": str(u.polar.file),
+                    "level": u.polar.level,
+                    "modes": u.polar.modes,
+                    "median_cell_sd_log": u.polar.sd_log,
+                    "pace_sd_log": u.polar.pace_sd_log,
+                },
                 "members": len(self.members),
                 "seed": u.seed,
                 "side_margin_s": u.side_margin_s,

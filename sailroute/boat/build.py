@@ -28,7 +28,7 @@ from collections.abc import Callable, Mapping
 from functools import cache, lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Final
+from typing import TYPE_CHECKING, Any, Final
 
 import numpy as np
 
@@ -39,6 +39,9 @@ from sailroute.boat.polar import INTERPOLATIONS, Polar
 from sailroute.checks import Checker, Problems, join_path, quoted, show, split_where, suggest
 from sailroute.errors import InputError
 from sailroute.units import KNOT, SPEED_UNITS
+
+if TYPE_CHECKING:
+    from sailroute.boat.learn import PolarDraw
 
 BUILTIN_TWS_KN: Final = tuple(float(v) for v in range(1, 29))
 """TWS columns of the shipped polars [kn]: 1-28 kn (0.5-14.4 m s⁻¹), the wind
@@ -154,6 +157,7 @@ def boat_from_spec(
     where: str,
     key: str = "boat",
     lines: Mapping[str, int] | None = None,
+    draw: PolarDraw | None = None,
 ) -> Polar:
     """Build the boat's polar from a course file's ``boat`` mapping.
 
@@ -176,6 +180,10 @@ def boat_from_spec(
         1-based line of each key path of the file (the course's line map): every
         problem (form keys, ``efficiency``, ``kinetics``, ``vpp`` parameters) is
         reported at its own key's line.
+    draw : PolarDraw, optional
+        A learned polar's level table is this draw of it (before its pace and the
+        ``efficiency``; a band's member, :mod:`sailroute.bands.members`); ignored for
+        other boats.
 
     Returns
     -------
@@ -212,6 +220,8 @@ def boat_from_spec(
         factors = check_efficiency(c.child("efficiency"), spec["efficiency"])
     build = {"builtin": _check_builtin, "polar": _check_polar, "vpp": _check_vpp}
     make = build[form](c, spec, Path(base_dir)) if form is not None else None
+    if form == "polar" and draw is not None and make is not None:
+        make = _learned_draw(c, spec, Path(base_dir), draw) or make
     probs.raise_if_any()
     assert make is not None
     polar = make(interpolation)
@@ -336,6 +346,35 @@ def _check_learned(c: Checker, spec: Mapping[str, Any], file: Path) -> _Make | N
     if pace not in PACES:
         return None
     return lambda interpolation: learned.polar(level, interpolation, pace)
+
+
+def learned_boat(spec: Mapping[str, Any], base_dir: Path) -> tuple[Path, str] | None:
+    """The learned polar file and level of a course's ``boat`` (a checked spec), or None
+    when the boat is not a polar learned by ``sailroute polar fit``."""
+    path = spec.get("polar") if isinstance(spec, Mapping) else None
+    if not isinstance(path, str):
+        return None
+    file = Path(path) if Path(path).is_absolute() else Path(base_dir) / path
+    from sailroute.boat.learnfile import is_learned, read_learned
+
+    if not is_learned(file):
+        return None
+    level = spec.get("level")
+    return file, read_learned(file).level(level if isinstance(level, str) else None).name
+
+
+def _learned_draw(
+    c: Checker, spec: Mapping[str, Any], base_dir: Path, draw: PolarDraw
+) -> _Make | None:
+    """A learned polar's level table drawn (``draw``), then at its pace; None: not learned."""
+    found = learned_boat(spec, base_dir)
+    if found is None:
+        return None
+    from sailroute.boat.learnfile import read_learned
+
+    learned = read_learned(found[0]).drawn(found[1], draw)
+    pace = spec.get("pace", "steady")
+    return lambda interpolation: learned.polar(found[1], interpolation, pace)
 
 
 def boat_label(spec: Mapping[str, Any]) -> str:

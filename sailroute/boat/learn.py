@@ -128,6 +128,10 @@ class LevelTable:
     race_pace : (float, float, float) or None
         The fleet's pace over whole legs at this level against this table, upwind, reach
         and downwind (:mod:`sailroute.analysis.racepace`; None: learned without courses).
+    pace_sd_log : float or None
+        Standard deviation of ``log`` of a boat's pace over one leg about ``race_pace``
+        in the races learned from [-] (boats, shifts and races together:
+        :func:`sailroute.analysis.racepace.race_pace`; None: learned without courses).
     """
 
     name: str
@@ -141,6 +145,66 @@ class LevelTable:
     vmg_up_ms: NDArray[np.float64]
     vmg_down_ms: NDArray[np.float64]
     race_pace: tuple[float, float, float] | None = None
+    pace_sd_log: float | None = None
+
+
+@dataclass(frozen=True)
+class PolarDraw:
+    """One version of a learned level's table, drawn from its uncertainty.
+
+    A drawn table is ``speed exp(offset)`` with ``offset`` (:meth:`log_offset`) either
+    ``sum_k modes_z[k] modes[k] + resid_sd_log cells_z + pace_z pace_sd_log`` (a random
+    draw: the bootstrap's correlated modes, each cell's own rest, and a common pace
+    factor for the legs' scatter about the race pace) or, with ``quantile_z`` set, every
+    cell at the same quantile of its own spread, ``quantile_z sqrt(sd_log² +
+    pace_sd_log²)`` (the table at its P10, P50, P90).
+
+    Attributes
+    ----------
+    modes_z : tuple of float
+        Coefficients of the level's modes (missing ones 0).
+    cells_z : tuple of float
+        Per cell (row-major), the standard normal of its rest (empty: 0).
+    pace_z : float
+        Standard normal of the pace factor.
+    quantile_z : float or None
+        Every cell at this many of its standard deviations instead.
+    """
+
+    modes_z: tuple[float, ...] = ()
+    cells_z: tuple[float, ...] = ()
+    pace_z: float = 0.0
+    quantile_z: float | None = None
+
+    def log_offset(self, t: LevelTable) -> NDArray[np.float64]:
+        """The draw's ``log speed`` change of each cell of ``t``, shape ``t.speed_ms.shape``."""
+        pace_sd = float(t.pace_sd_log or 0.0)
+        if self.quantile_z is not None:
+            return np.asarray(self.quantile_z * np.hypot(t.sd_log, pace_sd), dtype=float)
+        k = min(len(self.modes_z), t.modes.shape[0])
+        out = np.tensordot(np.asarray(self.modes_z[:k], dtype=float), t.modes[:k], axes=1)
+        out = np.zeros(t.speed_ms.shape) + out
+        if self.cells_z:
+            e = np.asarray(self.cells_z, dtype=float)
+            if e.size != t.speed_ms.size:
+                raise InputError(
+                    f"a polar draw of {e.size} cells for a table of {t.speed_ms.size}; "
+                    "draw it for this table (PolarDraw.random)"
+                )
+            out = out + t.resid_sd_log * e.reshape(t.speed_ms.shape)
+        return np.asarray(out + self.pace_z * pace_sd, dtype=float)
+
+    @staticmethod
+    def random(t: LevelTable, rng: np.random.Generator, first: float | None = None) -> PolarDraw:
+        """A random draw for table ``t``; ``first``, if given, is the first mode's
+        coefficient (a stratum of a Latin hypercube), the rest from ``rng``."""
+        z = np.atleast_1d(rng.standard_normal(t.modes.shape[0]))
+        if first is not None and z.size:
+            z[0] = first
+        e = rng.standard_normal(t.speed_ms.size)
+        return PolarDraw(
+            tuple(np.ravel(z).tolist()), tuple(np.ravel(e).tolist()), float(rng.standard_normal())
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -247,10 +311,27 @@ class LearnedPolar:
             f"{self.name} ({t.name}, race pace)"
         )
 
-    def with_race_pace(self, pace: Mapping[str, tuple[float, float, float]]) -> LearnedPolar:
-        """The same polar with each named level's race pace set."""
-        levels = {k: replace(t, race_pace=pace.get(k, t.race_pace)) for k, t in self.levels.items()}
+    def with_race_pace(
+        self,
+        pace: Mapping[str, tuple[float, float, float]],
+        sd_log: Mapping[str, float] | None = None,
+    ) -> LearnedPolar:
+        """The same polar with each named level's race pace (and its legs' scatter) set."""
+        sd = dict(sd_log or {})
+        levels = {
+            k: replace(t, race_pace=pace.get(k, t.race_pace), pace_sd_log=sd.get(k, t.pace_sd_log))
+            for k, t in self.levels.items()
+        }
         return replace(self, levels=MappingProxyType(levels))
+
+    def drawn(self, level: str | None, draw: PolarDraw) -> LearnedPolar:
+        """The same polar with the table of ``level`` replaced by a draw of it
+        (:class:`PolarDraw`; cells without speed stay 0)."""
+        t = self.level(level)
+        speed = np.where(t.speed_ms > 0, t.speed_ms * np.exp(draw.log_offset(t)), 0.0)
+        return replace(
+            self, levels=MappingProxyType({**self.levels, t.name: replace(t, speed_ms=speed)})
+        )
 
 
 @dataclass(frozen=True, eq=False)
@@ -1192,6 +1273,8 @@ def draw_polars(
     Each member is ``speed exp(sum_k z_k modes[k] + resid_sd_log e)`` with ``z`` and
     ``e`` standard normal: the bootstrap's leading modes carry the correlation of the
     cells (along a row, across the table), the residual keeps each cell's own spread.
+    The bootstrap's uncertainty alone: the legs' scatter about the race pace
+    (``pace_sd_log``) is left out (a band's members add it: :class:`PolarDraw`).
 
     Parameters
     ----------
@@ -1210,19 +1293,13 @@ def draw_polars(
     if int(n) != n or n < 1:
         raise InputError(f"draw_polars: n must be a whole number >= 1; got {n}")
     t = learned.level(level)
-    base = np.log(np.maximum(t.speed_ms, 1e-12))
     out = []
     for k in range(int(n)):
         z = rng.standard_normal(t.modes.shape[0])
-        e = rng.standard_normal(t.speed_ms.shape)
-        logv = base + np.tensordot(z, t.modes, axes=1) + t.resid_sd_log * e
+        e = rng.standard_normal(t.speed_ms.size)
+        d = PolarDraw(tuple(np.ravel(z).tolist()), tuple(np.ravel(e).tolist()))
         out.append(
-            Polar.from_arrays(
-                learned.twa_deg,
-                learned.tws_ms,
-                np.where(t.speed_ms > 0, np.exp(logv), 0.0),
-                name=f"{learned.name} ({t.name}) #{k + 1}",
-            )
+            learned.drawn(t.name, d).polar(t.name).with_name(f"{learned.name} ({t.name}) #{k + 1}")
         )
     return tuple(out)
 

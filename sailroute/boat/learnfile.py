@@ -69,6 +69,7 @@ def learned_to_dict(learned: LearnedPolar, unit: str) -> dict[str, Any]:
             "race_pace": None
             if t.race_pace is None
             else {b: round(float(v), 5) for b, v in zip(BAND_NAMES, t.race_pace, strict=True)},
+            "pace_sd_log": None if t.pace_sd_log is None else round(float(t.pace_sd_log), 5),
         }
     return {
         "default_level": DEFAULT_LEVEL if DEFAULT_LEVEL in learned.levels else next(iter(levels)),
@@ -183,6 +184,13 @@ def read_learned(path: str | Path, interpolation: str = "pchip") -> LearnedPolar
                 ) from None
             if not all(0.0 < v < 3.0 for v in (up, reach, down)):
                 raise InputError(f"{p}: {where}.race_pace: factors must lie in (0, 3)")
+        sd_pace = lv.get("pace_sd_log")
+        if sd_pace is not None and (
+            not isinstance(sd_pace, int | float) or not 0.0 <= float(sd_pace) < 1.0
+        ):
+            raise InputError(
+                f"{p}: {where}.pace_sd_log: expected a number in [0, 1) or null; got {sd_pace!r}"
+            )
         speed = arr(lv, "speed", where, f)
         if not np.all(np.isfinite(speed)) or np.any(speed < 0):
             raise InputError(f"{p}: {where}.speed: boat speeds must be finite and >= 0")
@@ -202,6 +210,7 @@ def read_learned(path: str | Path, interpolation: str = "pchip") -> LearnedPolar
                 [np.nan if v is None else float(v) * f for v in lv.get("vmg_down", [None] * n)]
             ),
             race_pace=pace_t,
+            pace_sd_log=None if sd_pace is None else float(sd_pace),
         )
     cells = blk.get("cells", {})
     status = np.asarray(cells.get("status", [["learned"] * n] * m), dtype=np.str_)

@@ -8,7 +8,7 @@ are :mod:`sailroute.report.analysis`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -21,6 +21,7 @@ from sailroute.analysis.debrief import (
     parse_boat_leg_times,
 )
 from sailroute.analysis.fleet import FleetAnalysis
+from sailroute.analysis.fleetlearn import beaten_note, learned_reference
 from sailroute.analysis.gains import fleet_gains
 from sailroute.analysis.result import TrackAnalysis
 from sailroute.analysis.segment import DETECT_M, StartClock
@@ -95,12 +96,16 @@ def run_analyze_command(
     fails only when no boat can be debriefed.
 
     ``wind`` chooses the wind each leg is judged in (:func:`analysis_winds`);
-    ``reference="fleet"`` judges every boat against the course's polar scaled to what
-    the fleet sails (:func:`sailroute.analysis.fleetpolar.fleet_polar`): the boats are
-    analysed twice.  ``gun`` (an ISO time with offset, or epoch seconds) replaces the
-    course's gun (``restart_time``, else ``start_time``): the restart after a general
-    recall.  ``data`` of the result is the :class:`~sailroute.analysis.fleet.FleetAnalysis`
-    (a sequence of the boats' analyses) for a fleet, a one-analysis tuple for one track.
+    ``reference="fleet"`` judges every boat against the course's polar scaled to what the
+    fleet sails (:func:`sailroute.analysis.fleetpolar.fleet_polar`), ``reference="learned"``
+    against the polar learned from the analysed fleet itself
+    (:func:`sailroute.analysis.fleetlearn.learned_reference`): the boats are analysed twice.
+    Judged against the course's polar, a fleet that beats it by more than 10 % on most legs
+    gets a first line saying so (:func:`~sailroute.analysis.fleetlearn.beaten_note`).
+    ``gun`` (an ISO time with offset, or epoch seconds) replaces the course's gun
+    (``restart_time``, else ``start_time``): the restart after a general recall. ``data`` of
+    the result is the :class:`~sailroute.analysis.fleet.FleetAnalysis` (a sequence of the
+    boats' analyses) for a fleet, a one-analysis tuple for one track.
     """
     course = course if isinstance(course, Course) else load_course(course)
     if not tracks:
@@ -159,9 +164,9 @@ def run_analyze_command(
     settings_for(course, router)
     boat, winds = build_specs(course, [name])
     polar = boat.routing_polar()
-    if reference == "fleet" and polar is None:
+    if reference != "course" and polar is None:
         raise InputError(
-            "--reference fleet scales a polar; the course's boat has none (a "
+            f"--reference {reference} scales a polar; the course's boat has none (a "
             "dynamic boat model): use --reference course"
         )
     boat_tracks = [e.track for e in debriefed if e.track is not None]
@@ -201,14 +206,40 @@ def run_analyze_command(
         return out_a
 
     analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())
-    if reference == "fleet":
-        fp = fleet_reference(analyses, polar)
-        notes.append(fp.describe())
-        analyses = analyse_all(fp.polar, fp.describe())
+    analyses, beaten = _rejudge(reference, analyses, analyse_all, notes, boat, polar, course, name)
     if one:
-        return _one_boat(out, analyses[0], tri, notes, plots)
-    fleet = FleetAnalysis(course, tri, tuple(analyses), tuple(notes))
-    return _fleet(out, fleet, sources, plots, pages, polar)
+        res = _one_boat(out, analyses[0], tri, notes, plots)
+    else:
+        fleet = FleetAnalysis(course, tri, tuple(analyses), tuple(notes))
+        res = _fleet(out, fleet, sources, plots, pages, polar)
+    return res if beaten is None else replace(res, report=f"note: {beaten}\n\n{res.report}")
+
+
+def _rejudge(
+    reference: str,
+    analyses: list[TrackAnalysis],
+    analyse_all: Callable[[Any, str], list[TrackAnalysis]],
+    notes: list[str],
+    boat: Any,
+    polar: Any,
+    course: Course,
+    scenario: str,
+) -> tuple[list[TrackAnalysis], str | None]:
+    """The analyses against ``reference`` (``analyses`` are against the course's boat), the
+    reference's line added to ``notes``; and the line saying the course's polar is beaten
+    on most legs (:func:`~sailroute.analysis.fleetlearn.beaten_note`, put first in
+    ``notes``; None: not beaten, or another reference asked for)."""
+    if reference == "course":
+        beaten = beaten_note(analyses, getattr(boat, "name", ""))
+        if beaten is not None:
+            notes.insert(0, beaten)
+        return analyses, beaten
+    if reference == "fleet":
+        ref: Any = fleet_reference(analyses, polar)
+    else:
+        ref = learned_reference(course, [a.track for a in analyses], scenario, polar)
+    notes.append(ref.describe())
+    return analyse_all(ref.polar, ref.describe()), None
 
 
 def _one_boat(

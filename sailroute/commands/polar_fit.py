@@ -16,11 +16,12 @@ from typing import Final
 
 import numpy as np
 
-from sailroute.analysis.learnsamples import FleetSamples, fleet_samples
+from sailroute.analysis.fleetlearn import learn_fleet
+from sailroute.analysis.learnsamples import FleetSamples
 from sailroute.boat.boatfile import slug
-from sailroute.boat.fit_samples import DEFAULT_TWS_STEP, PolarErrors, auto_tws_bins, compare_polars
-from sailroute.boat.learn import N_BOOT, LearnFit, learn_polar, parse_levels
-from sailroute.boat.learn_blocks import Blocks, SteadyRules, steady_blocks
+from sailroute.boat.fit_samples import DEFAULT_TWS_STEP, PolarErrors, compare_polars
+from sailroute.boat.learn import N_BOOT, LearnFit, parse_levels
+from sailroute.boat.learn_blocks import SteadyRules
 from sailroute.commands.result import CommandResult
 from sailroute.commands.vpp import UNITS, parse_speed_list, twa_grid
 from sailroute.errors import InputError
@@ -217,46 +218,37 @@ def run_fit_command(
             + "); give each race's course a name of its own"
         )
     tracks = read_fleet(log_list, columns, speed_unit, time_zone)
-    samples = fleet_samples(tracks, loaded, scenario)
-    blocks = steady_blocks(samples.series, rules)
-    step = DEFAULT_TWS_STEP[unit] * speed_factor(unit)
-    tws_n = (
-        np.asarray(parse_speed_list(tws_bins, unit, option="--tws-bins"))
-        if tws_bins is not None
-        else auto_tws_bins(blocks.tws_ms, step)
-        if blocks.size
-        else np.array([step])  # learn_polar says there is no steady sailing
-    )
     first = Path(log_list[0]).stem
     stem = slug(name) if name else slug(first) + ("-fit" if len(log_list) == 1 else "-fleet")
-    fit = learn_polar(
-        blocks,
-        tws_bins_ms=tws_n,
-        twa_bins_deg=twa_grid(twa_step_deg),
+    fit, samples, notes_t = learn_fleet(
+        tracks,
+        loaded,
+        scenario,
+        twa_bins_deg=np.asarray(twa_grid(twa_step_deg)),
+        tws_bins_ms=(
+            np.asarray(parse_speed_list(tws_bins, unit, option="--tws-bins"))
+            if tws_bins is not None
+            else None
+        ),
+        tws_step_ms=DEFAULT_TWS_STEP[unit] * speed_factor(unit),
         levels=lv,
         percentile=percentile,
         min_boats=min_boats,
         min_blocks=min_blocks,
         n_boot=bootstrap,
         seed=seed,
+        rules=rules,
         name=stem,
+        shape=shape_polar,
         options=FIT_OPTIONS,
         provenance={
             "logs": [str(p) for p in log_list],
             "courses": [str(c) for c in courses],
             "scenario": scenario,
-            "wind_source_seconds": _source_seconds(blocks),
             "shape": None if shape_polar is None else f"{shape} ({shape_polar.name})",
         },
-        shape=shape_polar,
     )
-    notes = list(samples.notes)
-    if loaded and samples.legs:
-        from sailroute.analysis.racepace import race_pace
-
-        learned, pace_notes = race_pace(fit.learned, loaded, samples)
-        fit = LearnFit(learned, fit.blocks, fit.cell, fit.factors)
-        notes += pace_notes
+    notes = list(notes_t)
     errors = {}
     if ref is not None:
         for lname in fit.learned.levels:
@@ -274,11 +266,3 @@ def run_fit_command(
         main=("json",),
         labels=POLAR_FILE_LABELS,
     )
-
-
-def _source_seconds(blocks: Blocks) -> dict[str, float]:
-    """Seconds of steady blocks judged in each wind source."""
-    return {
-        n: round(float(blocks.dur_s[blocks.source == k].sum()), 1)
-        for k, n in enumerate(blocks.sources)
-    }

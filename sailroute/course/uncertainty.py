@@ -9,6 +9,7 @@ and boat; this module reads and checks the section that says how far they spread
       twd_deg: 10          # 1 standard deviation of the mean direction [°]
       shifts: {model: oscillating, amplitude_deg: 8, period_min: 6}
       boat: {sea_age_h: [2, 4], pump_efficiency: [0.5, 0.87]}   # uniform over [lo, hi]
+      polar: true          # a learned polar's own uncertainty (the default; false: off)
       members: 50
       seed: 1
 
@@ -32,6 +33,7 @@ __all__ = [
     "DEFAULT_UNCERTAINTY",
     "SHIFT_MODELS",
     "UNCERTAINTY_KEYS",
+    "PolarSpread",
     "ShiftSpec",
     "UncertaintySpec",
     "check_uncertainty",
@@ -45,6 +47,7 @@ UNCERTAINTY_KEYS: Final = (
     "twd_deg",
     "shifts",
     "boat",
+    "polar",
     "members",
     "seed",
     "side_margin_s",
@@ -112,6 +115,31 @@ class ShiftSpec:
 
 
 @dataclass(frozen=True)
+class PolarSpread:
+    """A learned polar whose uncertainty the members draw (the course's boat).
+
+    Attributes
+    ----------
+    file : Path
+        The learned polar's JSON (``sailroute polar fit``).
+    level : str
+        The level the course sails.
+    modes : int
+        The level's bootstrap modes.
+    sd_log : float
+        Median over the learned cells of the bootstrap's ``sd log speed`` [-].
+    pace_sd_log : float
+        The legs' scatter about the race pace [-] (0: learned without courses).
+    """
+
+    file: Path
+    level: str
+    modes: int = 0
+    sd_log: float = 0.0
+    pace_sd_log: float = 0.0
+
+
+@dataclass(frozen=True)
 class UncertaintySpec:
     """What is uncertain about a scenario, in SI units.
 
@@ -128,6 +156,12 @@ class UncertaintySpec:
         Time-varying shift; None: none.
     boat : tuple of (str, float, float)
         Race-polar parameter, low and high end of its uniform range.
+    draw_polar : bool
+        Draw a learned polar's uncertainty when the course's boat is one (the
+        section's ``polar``, default true).
+    polar : PolarSpread or None
+        The learned polar drawn (set from the course's boat by
+        :func:`sailroute.bands.route.spec_for`); None: the boat is fixed.
     members : int
         Members of the main ensemble (>= 3).
     seed : int
@@ -144,6 +178,8 @@ class UncertaintySpec:
     twd_deg: float = 0.0
     shifts: ShiftSpec | None = None
     boat: tuple[tuple[str, float, float], ...] = ()
+    draw_polar: bool = True
+    polar: PolarSpread | None = None
     members: int = 20
     seed: int = 1
     side_margin_s: float = 2.0
@@ -152,7 +188,8 @@ class UncertaintySpec:
 
     def sources(self) -> tuple[str, ...]:
         """Names of the uncertain sources, in a fixed order: ``tws``, ``twd``,
-        ``shifts``, then ``boat.<parameter>`` for each boat parameter."""
+        ``shifts``, ``polar`` (a learned polar), then ``boat.<parameter>`` for each boat
+        parameter."""
         out = []
         if self.tws_add_ms > 0 or self.tws_rel > 0:
             out.append("tws")
@@ -160,6 +197,8 @@ class UncertaintySpec:
             out.append("twd")
         if self.shifts is not None:
             out.append("shifts")
+        if self.polar is not None:
+            out.append("polar")
         out += [f"boat.{name}" for name, _, _ in self.boat]
         return tuple(out)
 
@@ -265,7 +304,7 @@ def check_uncertainty(c: Checker, raw: Any, base_dir: Path | None = None) -> Unc
     UncertaintySpec or None
         None after a problem.
     """
-    if not c.is_mapping(raw, "a mapping with tws_kn, twd_deg, shifts, boat, members, seed"):
+    if not c.is_mapping(raw, "a mapping with tws_kn, twd_deg, shifts, boat, polar, members, seed"):
         return None
     n0 = len(c.p)
     c.keys(raw, UNCERTAINTY_KEYS)
@@ -286,6 +325,7 @@ def check_uncertainty(c: Checker, raw: Any, base_dir: Path | None = None) -> Unc
         else None
     )
     boat = _boat(c.child("boat"), raw["boat"]) if raw.get("boat") is not None else ()
+    draw_polar = c.boolean(raw, "polar", True)
     members = c.integer(raw, "members", DEFAULT_UNCERTAINTY.members, lo=3)
     seed = c.integer(raw, "seed", DEFAULT_UNCERTAINTY.seed, lo=0)
     m_s = c.number(raw, "side_margin_s", DEFAULT_UNCERTAINTY.side_margin_s, lo=0.0)
@@ -298,6 +338,7 @@ def check_uncertainty(c: Checker, raw: Any, base_dir: Path | None = None) -> Unc
         twd_deg=twd or 0.0,
         shifts=shifts,
         boat=boat,
+        draw_polar=bool(draw_polar),
         members=members,
         seed=seed,
         side_margin_s=m_s,

@@ -51,6 +51,11 @@ def _describe(b: BandSummary) -> str:
             parts.append(f"OU shifts sd {sh.sigma_deg:.3g}°, {sh.timescale_s:.0f} s{src}")
         else:
             parts.append(f"persistent shift sd {60 * sh.rate_deg_per_s:.3g}°/min")
+    if u.polar is not None:
+        parts.append(
+            f"polar {u.polar.file.name} ({u.polar.level}) sd {100 * u.polar.sd_log:.2g} % "
+            f"per cell, pace {100 * u.polar.pace_sd_log:.2g} %"
+        )
     parts += [f"{name} {lo:g}..{hi:g}" for name, lo, hi in u.boat]
     return ", ".join(parts) + " (speeds and directions 1 sigma, boat ranges uniform)"
 

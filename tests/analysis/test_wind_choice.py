@@ -208,7 +208,7 @@ def test_asking_for_a_wind_the_data_do_not_hold_is_a_clear_error(tmp_path: Path)
             SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "o", wind="measured", plots=False
         )
     assert not (tmp_path / "o").exists()
-    with pytest.raises(InputError, match="--reference: expected one of course, fleet"):
+    with pytest.raises(InputError, match="--reference: expected one of course, fleet, learned"):
         run_analyze_command(
             SNIPE_COURSE, [SNIPE_TRACK], out_dir=tmp_path / "p", reference="peers", plots=False
         )
