@@ -151,7 +151,7 @@ def test_positions_and_speeds_off_the_scale_are_not_logged_as_readings(tmp_path:
 
 def test_one_fix_from_another_clock_does_not_freeze_the_position(tmp_path: Path) -> None:
     """One RMC dated 2030 made every later (2018) fix "another clock" for the rest of the
-    session; now it is held out and the later fixes move the boat."""
+    run; now it is held out and the later fixes move the boat."""
     eng = _engine(tmp_path)
     rows = approach(eng.course, 30, speed_ms=2.0)
     for k, r in enumerate(rows):
