@@ -196,7 +196,7 @@ def test_out_that_is_a_file_fails_before_any_work(tmp_path, monkeypatch, args):
         (sailroute.course.load, "load_course"),
         (sailroute.commands.vpp, "vpp_polar"),
         (sailroute.commands.strategy, "run_strategy"),
-        (sailroute.commands.polar_fit, "learn_polar"),
+        (sailroute.commands.polar_fit, "learn_fleet"),
         (sailroute.commands.analyze, "analyze_track"),
     ]:
         monkeypatch.setattr(mod, name, work)
