@@ -7,7 +7,7 @@ Measured on seeds 1-5 (lags 5, 10, 7.5, 6 with a general recall, 9 s): every fau
 classified; 18 of the 20 boats over at the gun called (back or not), none wrongly (the two
 missed were 0.4 s / 0.8 m and 4.0 s / 8.3 m over at the gun, 0.5 and 2.7 sd); the lag
 found within 0.3-1.0 s; leg ends within half a fix of the truth without GPS error (100 %
-of 560), and with the generator's error 91 % within one fix and 99 % within 3 s.  That is
+of 552), and with the generator's error 91 % within one fix and 99 % within 3 s.  That is
 the GPS error's limit, measured as the recorded fixes crossing the truth's own line
 without any estimator: at 1-s fixes 76 % of the leg ends within a fix (75 % from the error
 alone; windward marks 72 %, gate roundings 70 %, the finish 89 %), at 2 s 94 % (94 %), at
