@@ -996,7 +996,7 @@ def gate_rounding(
     found = [c for c in found if c.known]
     if found:
         return found[0]
-    return _close_pass(mark.xy, target.rounding, t, x, y, passed.t, end)
+    return _close_pass(mark.xy, target.rounding, t, x, y, passed.t, end, geom, gap_s)
 
 
 def _settled(
@@ -1065,11 +1065,20 @@ def _close_pass(
     y: NDArray,
     t_from: float,
     t_before: float,
+    geom: TargetGeometry | None = None,
+    gap_s: float = math.inf,
 ) -> Crossing | None:
     """The first pass within :data:`MARK_TOLERANCE_M` of ``mark`` after ``t_from`` (before
     ``t_before``) that turns :data:`CLOSE_PASS_TURN_DEG` in the rounding's sense, or
     reverses (:data:`REVERSAL_DEG`) in a sense the track cannot tell
-    (:func:`turn_sense`), at its closest approach."""
+    (:func:`turn_sense`).
+
+    It is timed where the pass crosses the mark's rounding ray ``geom`` forwards (the
+    crossing nearest its closest approach, while the boat is within the tolerance of the
+    mark, a fix either side): a crossing :func:`_settled` did not count (the boat leaves
+    alongside the ray, or wanders back over it on GPS noise) still says when the boat went
+    round.  Only a pass that never crosses the ray is timed at its closest fix, which is
+    flat in time at a rounding and as noisy as the fixes."""
     idx = np.flatnonzero((t > t_from) & (t < t_before))
     if idx.size == 0 or rounding is None:
         return None
@@ -1081,6 +1090,11 @@ def _close_pass(
         turn, decided = turn_sense(t, x, y, float(t[k]) - 20.0, float(t[k]) + 20.0)
         sense = -turn if rounding == "port" else turn
         if sense >= CLOSE_PASS_TURN_DEG or (not decided and abs(turn) >= REVERSAL_DEG):
+            lo, hi = float(t[max(idx[a] - 1, 0)]), float(t[min(idx[b - 1] + 1, t.size - 1)])
+            over = [] if geom is None else _crossings(t, x, y, geom, lo, gap_s, hi)
+            over = [c for c in over if c.known]
+            if over:
+                return min(over, key=lambda c: abs(c.t - float(t[k])))
             return Crossing(float(t[k]), float(x[k]), float(y[k]))
     return None
 
@@ -1101,7 +1115,7 @@ def _mark_crossings(
     :data:`GATE_ROUNDING_S` or more before the first of them (or when there is none)."""
     found = _settled(_crossings(t, x, y, geom, t_from, gap_s, t_before), geom, t, x, y)
     first = next((c.t_lo for c in found), math.inf)
-    close = _close_pass(mark, rounding, t, x, y, t_from, min(first, t_before))
+    close = _close_pass(mark, rounding, t, x, y, t_from, min(first, t_before), geom, gap_s)
     if close is not None and close.t + GATE_ROUNDING_S < first:
         return [close, *found]
     return found

@@ -6,9 +6,15 @@ precision and recall, and leg ends are found within a fix of the truth.
 Measured on seeds 1-5 (lags 5, 10, 7.5, 6 with a general recall, 9 s): every fault
 classified; 18 of the 20 boats over at the gun called (back or not), none wrongly (the two
 missed were 0.4 s / 0.8 m and 4.0 s / 8.3 m over at the gun, 0.5 and 2.7 sd); the lag
-found within 0.3-1.0 s; leg ends within one fix of the truth: 100 % of 560 without GPS
-error, 91 % with the generator's 1.7 m (its correlated part moves a crossing by about a
-second at 1.5-2 m/s) and 99 % within 3 s.
+found within 0.3-1.0 s; leg ends within half a fix of the truth without GPS error (100 %
+of 552), and with the generator's error 91 % within one fix and 99 % within 3 s.  That is
+the GPS error's limit, measured as the recorded fixes crossing the truth's own line
+without any estimator: at 1-s fixes 76 % of the leg ends within a fix (75 % from the error
+alone; windward marks 72 %, gate roundings 70 %, the finish 89 %), at 2 s 94 % (94 %), at
+3 s 99 % (98 %); the detected time is the error's within 0.3 s for 98.6 %.  The error
+across the line, 1.6 m (the 1.5 m correlated over 60 s, which no smoothing of one track
+removes, and the 0.7 m white averaged between two fixes), over the speed across it
+(1.8-2.3 m/s) is a normal error of sd 0.7-0.9 s: a second is about one sd.
 """
 
 from __future__ import annotations
@@ -20,8 +26,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from sailroute.analysis.segment import detection_geometry
 from sailroute.analysis.triage import BoatClass, triage_fleet
-from tests.fleetgen import FaultPlan, Fleet, messy_fleet
+from sailroute.track.kinematics import track_xy
+from tests.fleetgen import BoatTruth, FaultPlan, Fleet, messy_fleet
 
 pytestmark = pytest.mark.slow
 
@@ -92,9 +100,44 @@ def test_every_injected_fault_is_classified_and_ocs_called(fleets: list[Fleet]) 
     assert tp / (tp + fp) >= 0.95 and tp / (tp + fn) >= 0.90, (tp, fp, fn)
 
 
-def _errors(f: Fleet) -> list[tuple[float, float]]:
-    """(|detected − true| [s], fix interval [s]) of every leg end of the clean boats (at a
-    gate, the rounding of the mark chosen)."""
+def _truth_normal(f: Fleet, b: BoatTruth, i: int) -> tuple[float, float]:
+    """Unit normal [-] of the line whose crossing ends leg ``i`` in the truth: at a gate,
+    the gate's line through the mark rounded (the truth's rounding is straight below it,
+    moving along the gate away from the other mark); else the target's own crossing
+    geometry from where the routed leg began (a mark's rounding ray, a line)."""
+    spec = f.course.legs[i]
+    if b.gate_marks[i]:
+        gate = f.course.gates[spec.to_name]
+        m, o = (gate.a, gate.b) if gate.a.name == b.gate_marks[i] else (gate.b, gate.a)
+        n = math.hypot(m.x - o.x, m.y - o.y)
+        return (m.x - o.x) / n, (m.y - o.y) / n
+    tr = b.legs[i].track
+    return detection_geometry(f.course, i, (float(tr.x[0]), float(tr.y[0]))).normal
+
+
+def _gps_limit(f: Fleet, b: BoatTruth, i: int, t_true: float) -> float:
+    """The error [s] GPS error alone gives leg ``i``'s end: when the recorded fixes
+    (the true path plus the injected error) cross the truth's own line through the true
+    position at ``t_true`` [epoch s, the track's clock], interpolated between fixes, the
+    crossing nearest ``t_true`` within 20 s (inf: none)."""
+    nx, ny = _truth_normal(f, b, i)
+    tt = t_true + f.clock_lag_s
+    px, py = np.interp(tt, b.path_t, b.path_x), np.interp(tt, b.path_t, b.path_y)
+    track = f.track(b.name)
+    x, y = track_xy(track, f.course.frame)
+    t = track.t_s
+    side = (x - px) * nx + (y - py) * ny
+    k = np.flatnonzero((np.abs(t[:-1] - t_true) < 20.0) & (side[:-1] < 0.0) & (side[1:] >= 0.0))
+    if k.size == 0:
+        return math.inf
+    tc = t[k] - side[k] / (side[k + 1] - side[k]) * (t[k + 1] - t[k])
+    return float(tc[np.argmin(np.abs(tc - t_true))] - t_true)
+
+
+def _errors(f: Fleet, limit: bool = False) -> list[tuple[float, float, float, float]]:
+    """(|detected − true| [s], fix interval [s], |GPS limit| [s], |detected − true − GPS
+    limit| [s]) of every leg end of the clean boats (at a gate, the rounding of the mark
+    chosen); the GPS limit (:func:`_gps_limit`) only with ``limit`` (else NaN)."""
     tri = _triage(f)
     out = []
     by = {e.name: e for e in tri.entries}
@@ -103,19 +146,29 @@ def _errors(f: Fleet) -> list[tuple[float, float]]:
         if seg is None:  # the first of a duplicate pair (the copy came first)
             continue
         for i, c in enumerate(seg.ends):
-            truth = b.gate_round_t[i] if b.gate_marks[i] else b.leg_end_t[i]
-            err = abs(c.t - (truth - f.clock_lag_s)) if c.known else math.inf
-            out.append((err, b.sample_s))
+            truth = (b.gate_round_t[i] if b.gate_marks[i] else b.leg_end_t[i]) - f.clock_lag_s
+            err = c.t - truth if c.known else math.inf
+            gps = _gps_limit(f, b, i, truth) if limit else math.nan
+            out.append((abs(err), b.sample_s, abs(gps), abs(err - gps)))
     return out
 
 
 def test_leg_ends_within_a_fix_of_the_truth(fleets: list[Fleet]) -> None:
-    exact = [e for f in fleets for e in _errors(f.resampled(noise=False))]
-    within = np.mean([err <= dt for err, dt in exact])
-    assert within >= 0.95, within
-    noisy = [e for f in fleets for e in _errors(f)]
-    assert np.mean([err <= dt for err, dt in noisy]) >= 0.85
-    assert np.mean([err <= 3.0 for err, _ in noisy]) >= 0.95
+    """Without GPS error every leg end lies within half a fix interval of the truth; with
+    it, at each fix interval, as many lie within a fix of it as the GPS error alone allows
+    (the recorded fixes crossing the truth's own line), and the detected time is the one
+    the error gives to within 0.3 s."""
+    exact = np.array([e for f in fleets for e in _errors(f.resampled(noise=False))])
+    assert np.all(exact[:, 0] <= 0.5 * exact[:, 1]), np.max(exact[:, 0] / exact[:, 1])
+    noisy = np.array([e for f in fleets for e in _errors(f, limit=True)])
+    err, dt, gps, added = noisy.T
+    for step in (1.0, 2.0, 3.0):
+        m = dt == step
+        got, limit = np.mean(err[m] <= step), np.mean(gps[m] <= step)
+        assert got >= limit - 0.02, (step, got, limit)
+    assert np.mean(added <= 0.3) >= 0.97
+    assert np.mean(err <= dt) >= 0.88
+    assert np.mean(err <= 3.0) >= 0.98
 
 
 def test_a_whole_run_is_not_stopped_by_one_boat(fleets: list[Fleet], tmp_path: Path) -> None:

@@ -5,6 +5,7 @@ route round the windward-leeward course of ``test_analyze.py``."""
 from __future__ import annotations
 
 import json
+import math
 import re
 from pathlib import Path
 
@@ -474,3 +475,31 @@ def test_gun_option_checks_the_day(fleet, tmp_path: Path) -> None:
     )
     assert res.exit_code == 2
     assert "--gun 2024-05-02T12:00:00Z: expected the gun of this race, within 6 h" in res.output
+
+
+MARK_COURSE = (
+    GATE_COURSE.replace("  G1: {x: -50, y: 500}\n  G2: {x: 50, y: 500}\n", "  M: {x: 0, y: 500}\n")
+    .replace("gates:\n  G: [G1, G2]\n", "")
+    .replace("  - {to: G}\n", "  - {to: M, rounding: port}\n")
+)
+"""Start line at y = 0, then round M (0, 500) to port and back to the line."""
+
+
+def test_a_close_pass_is_timed_where_it_crosses_the_rounding_ray(tmp_path: Path) -> None:
+    # north 8 m east of M, over the top (the ray points north from the mark, crossed
+    # westwards) at 21° to the ray, then back south 2.5 m beside the ray's line: the
+    # crossing is too shallow and never gets 4 m beyond the ray to be settled, but the
+    # pass turns 180° round the mark
+    p = tmp_path / "mark.yaml"
+    p.write_text(MARK_COURSE, encoding="utf-8")
+    course = load_course(p)
+    pts = [(8, -100), (8, 495), (3, 503), (-2, 490), (-2.5, 440), (-2.5, -30)]
+    t, x, y = _polyline(course, pts, speed=2.0)
+    end = segment_track(course, t, x, y).ends[0]
+    # where the path crosses the ray (x = 0, leaning 0.5° towards the start at x = 8, the
+    # fixes cutting the corner at (3, 503)): 3/5 of the way from (3, 503) to (−2, 490),
+    # not at the fix closest to the mark (1.7 m east of the ray)
+    assert end.x == pytest.approx(0.0, abs=0.1)
+    assert end.y == pytest.approx(503.0 - 0.6 * 13.0, abs=0.3)
+    s = 595.0 + math.hypot(5.0, 8.0) + 0.6 * math.hypot(5.0, 13.0)
+    assert end.t == pytest.approx(course.start_epoch - 20.0 + s / 2.0, abs=0.1)
