@@ -4,6 +4,7 @@ Usage::
 
     .venv/bin/python benchmarks/polar_learn_validation.py [--members 20] [--bootstrap 100]
     .venv/bin/python benchmarks/polar_learn_validation.py --only sailgp --members 0
+    .venv/bin/python benchmarks/polar_learn_validation.py --only 49erfx
     .venv/bin/python benchmarks/polar_learn_validation.py --smoke  # Snipe P01 -> P02, no bands
 
 For each held-out race the polar is learned (``run_fit_command``, the same code as the
@@ -16,7 +17,7 @@ total.  Band coverage: the bands of ``plan --ensemble`` with ``--members`` membe
 (:func:`sailroute.bands.route.band_summary`; the course's boat the learned median level at
 its race pace) from the polar's uncertainty alone (each member draws the table), the
 wind's alone (SailGP: the spread of the legs' measured mean wind about the race's;
-Snipe: the default 1 kn, 5 deg) and both; an observed leg (each boat's) is covered when
+Snipe and 49erFX: the default 1 kn, 5 deg) and both; an observed leg (each boat's) is covered when
 it lies within the members' P10-P90 of that leg.
 
 * **SailGP Auckland 2025** (F50, 3 boats x races 25011905-08, measured wind; read in
@@ -34,8 +35,20 @@ it lies within the members' P10-P90 of that leg.
   ``benchmarks/race_polar_validation.py``.  The polar of one race holds one TWS column,
   so it is learned with ``--shape builtin:ilca7 --tws-bins 4,6,8,10`` (the ILCA's shape
   scaled to the Snipe per point of sail) to plan the other race's wind.
-* **49erFX Worlds 2019 F13** (25 boats, no marks): left out until ``sailroute course
-  infer`` can give its course.
+* **49erFX Worlds 2019 F13** (25 boats at 1 Hz, GPS only, no marks; read in place from
+  ``../shared/data/real/races/49erfx-worlds-2019-f13``, licence none stated, nothing
+  copied): the course from all 25 tracks (``sailroute course infer``: start, windward
+  mark, leeward gate, a second windward mark, finish; the gun inferred, the direction
+  the mean of the wind inferred from the tracks), each boat's legs from its roundings
+  there (a leg a boat's log does not time is left out of the mean).  The fleet is split
+  in finishing order into places 1, 3, 5, ... and 2, 4, 6, ... (:func:`alternate`: each
+  half spans the fleet); the polar is learned on one half (its wind: the direction
+  inferred from that half's tracks) and planned against the other's mean legs, and the
+  other way round.  The tracks carry no wind and the data give no speed, so both the
+  learning and the plan use a nominal 12 kn (:data:`FX_TWS_KN`): the learned table sits
+  in that column and the plan reads it there, so the leg times do not depend on it (the
+  same at 10 and 14 kn); the TWS spread of the bands reads the one column's taper below
+  it (speeds falling to 0 at TWS 0) and its clamp above.
 """
 
 from __future__ import annotations
@@ -60,6 +73,7 @@ from race_polar_validation import SNIPE, _s  # noqa: E402
 
 from sailroute.bands.route import band_summary, spec_for  # noqa: E402
 from sailroute.commands.course_import import run_course_import_command  # noqa: E402
+from sailroute.commands.course_infer import run_course_infer_command  # noqa: E402
 from sailroute.commands.polar_fit import run_fit_command  # noqa: E402
 from sailroute.course.load import load_course  # noqa: E402
 from sailroute.course.model import Course  # noqa: E402
@@ -73,13 +87,20 @@ from sailroute.units import KNOT, circular_mean_deg  # noqa: E402
 SHARED = ROOT.parent / "shared" / "data" / "real" / "races"
 SAILGP = SHARED / "sailgp-auckland-2025"
 SNIPE_DIR = SHARED / "snipe-valencia-2025"
+FX_DIR = SHARED / "49erfx-worlds-2019-f13"
+FX_COLUMNS = {"lat": "Latitude [Deg N]", "lon": "Longitude [Deg E]", "time": "TimeStamp"}
+FX_TWS_KN = 12.0
+"""The 49erFX race's nominal wind speed [kn]: the tracks carry no wind and its README gives
+none.  The polar is learned in it and the race planned in it, so the plan does not depend
+on it (the same leg times to the second at 10, 12 and 14 kn)."""
 F50 = ROOT.parent / "shared" / "data" / "real" / "polars" / "sailgp-f50"
 BOATS = ("NZL", "AUS", "GBR")
 XMLS = {"05": "25011905_03-13-55", "06": "25011906_03-35-13", "07": "25011907_03-56-34"}
 LEGS = slice(1, 6)  # legs 2-6 of a SailGP race
-SNIPE_SPREAD = {"tws_kn": 1.0, "twd_deg": 5.0}
-"""A sailors' wind estimate without a measurement: sailroute's default spread (1 kn, 5 deg
-at 1 sigma, ``DEFAULT_UNCERTAINTY``; its 6-min shifts left out, as for SailGP)."""
+DEFAULT_SPREAD = {"tws_kn": 1.0, "twd_deg": 5.0}
+"""A wind without a measurement (a sailors' estimate, a direction from the tracks):
+sailroute's default spread (1 kn, 5 deg at 1 sigma, ``DEFAULT_UNCERTAINTY``; its 6-min
+shifts left out, as for SailGP)."""
 
 
 def leg_counter(boat: str, race: str) -> list[float]:
@@ -216,7 +237,7 @@ def row(
 ) -> dict[str, Any]:
     """The numbers of one held-out race."""
     o = np.asarray(list(obs.values()), dtype=float)
-    mean = o.mean(axis=0)
+    mean = np.nanmean(o, axis=0)  # a leg a boat's log does not time is left out
     out: dict[str, Any] = {"name": name, "observed_s": float(mean.sum()), "boats": len(obs)}
     for k, t in plans.items():
         tt = np.asarray(t, dtype=float)[legs]
@@ -225,7 +246,7 @@ def row(
         if bands is not None and kind in bands:
             b = bands[kind][legs]
             inside = (o >= b[:, 0]) & (o <= b[:, 1])
-            out[f"cover {kind}"] = (int(inside.sum()), int(inside.size))
+            out[f"cover {kind}"] = (int(inside.sum()), int(np.isfinite(o).sum()))
     if bands is not None and "widths" in bands:
         out["widths"] = bands["widths"]
     return out
@@ -331,9 +352,58 @@ def snipe(tmp: Path, members: int, boot: int, both: bool = True) -> list[dict[st
             c = with_boat_and_wind(src, tmp / f"snipe-held-{held}.yaml", spec, tws, 110.0)
             plans[tag] = plan_legs(c)
         c = with_boat_and_wind(src, tmp / f"snipe-held-{held}.yaml", race_boat(learned), tws, 110.0)
-        bands = band(c, SNIPE_SPREAD, members, 1)
+        bands = band(c, DEFAULT_SPREAD, members, 1)
         r = row(f"Snipe {held} (learned on {learn})", obs, slice(1, 4), plans, bands)
         r["wind"] = f"{tws:.0f} kn 110 deg (sailors' estimate)"
+        rows.append(r)
+    return rows
+
+
+def alternate(order: Sequence[int]) -> tuple[list[int], list[int]]:
+    """Two halves of a fleet in finishing order: places 1, 3, 5, ... and 2, 4, 6, ..., so
+    that each spans the fleet from its winner to its last."""
+    return list(order[0::2]), list(order[1::2])
+
+
+def fx(tmp: Path, members: int, boot: int) -> list[dict[str, Any]]:
+    """The 49erFX race: its course inferred from all the tracks, the polar learned on one
+    half of the fleet (:func:`alternate`) and the race planned against the other's legs."""
+    if not FX_DIR.is_dir():
+        print(f"49erFX: {FX_DIR} not present: left out")
+        return []
+    paths = {p.stem: p for p in sorted(FX_DIR.glob("*.csv"))}
+    course = tmp / "fx.yaml"
+    ic = run_course_infer_command(
+        list(paths.values()), out=course, wind_tws_kn=FX_TWS_KN, columns=FX_COLUMNS,
+        speed_unit="kn", time_zone="UTC", name="49erFX Worlds 2019 F13",
+    ).data  # fmt: skip
+    marks = np.asarray(ic.leg_roundings, dtype=float)  # legs x boats [epoch s]
+    legs = np.diff(np.vstack([np.full(marks.shape[1], ic.gun.t), marks]), axis=0).T
+    finished = [k for k in np.argsort(marks[-1]) if np.isfinite(marks[-1][k])]
+    halves = alternate(finished)
+    tag = ("odd places", "even places")
+    cols = ",".join(f"{k}={v}" for k, v in FX_COLUMNS.items())
+    rows = []
+    for learn, held in ((0, 1), (1, 0)):
+        out = tmp / f"fx-{learn}"
+        run_fit_command(
+            [paths[ic.boats[k]] for k in halves[learn]], courses=[course], columns=cols,
+            speed_unit="kn", time_zone="UTC", bootstrap=boot, out_dir=out, name="49erfx-fleet",
+        )  # fmt: skip
+        learned = out / "49erfx-fleet.json"
+        plans = {}
+        for pace in ("steady", "race"):
+            spec = f"{{polar: {learned}, level: median, pace: {pace}}}"
+            c = with_boat_and_wind(course, tmp / "fx-held.yaml", spec, FX_TWS_KN, ic.twd_deg)
+            plans[pace] = plan_legs(c)
+        c = with_boat_and_wind(
+            course, tmp / "fx-held.yaml", race_boat(learned), FX_TWS_KN, ic.twd_deg
+        )
+        bands = band(c, DEFAULT_SPREAD, members, 1)
+        obs = {ic.boats[k]: list(legs[k]) for k in halves[held]}
+        name = f"49erFX F13, {tag[held]} (learned on the {tag[learn]})"
+        r = row(name, obs, slice(0, legs.shape[1]), plans, bands)
+        r["wind"] = f"{FX_TWS_KN:.0f} kn (nominal) {ic.twd_deg:.0f} deg (inferred from the tracks)"
         rows.append(r)
     return rows
 
@@ -349,7 +419,7 @@ def print_table(rows: Sequence[dict[str, Any]]) -> None:
     print("|---|---|---|---|---|---|---|---|---|")
     keep = ("steady", "race", "widths", *(f"cover {k}" for k in BAND_KINDS))
     for r in rows:
-        ref = next(k for k in r if isinstance(r[k], tuple) and k not in keep)
+        ref = next((k for k in r if isinstance(r[k], tuple) and k not in keep), None)
         cov = " / ".join(
             f"{r[f'cover {k}'][0]}/{r[f'cover {k}'][1]}" if f"cover {k}" in r else "-"
             for k in BAND_KINDS
@@ -358,7 +428,7 @@ def print_table(rows: Sequence[dict[str, Any]]) -> None:
         print(
             f"| {r['name']} | {r['wind']} | {r['observed_s']:.0f} s ({r['boats']} boats) | "
             + " | ".join(f"{r[k][0]:.0f} s ({r[k][1]:+.1%})" for k in ("steady", "race"))
-            + f" | {ref}: {r[ref][0]:.0f} s ({r[ref][1]:+.1%}) | "
+            + (f" | {ref}: {r[ref][0]:.0f} s ({r[ref][1]:+.1%}) | " if ref else " | - | ")
             + ", ".join(f"{e:+.0%}" for e in r["race"][2])
             + f" | {cov} | {widths or '-'} |"
         )
@@ -368,7 +438,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--members", type=int, default=20, help="members of the bands (0: none)")
     ap.add_argument("--bootstrap", type=int, default=100, help="bootstrap replicates")
-    ap.add_argument("--only", default="", help="sailgp or snipe")
+    ap.add_argument("--only", default="", help="sailgp, snipe or 49erfx")
     ap.add_argument("--smoke", action="store_true", help="Snipe P01 -> P02, no members")
     args = ap.parse_args()
     if args.smoke:
@@ -381,6 +451,8 @@ def main() -> None:
             rows += sailgp(tmp, args.members, args.bootstrap)
         if args.only in ("", "snipe"):
             rows += snipe(tmp, args.members, args.bootstrap, both=not args.smoke)
+        if args.only in ("", "49erfx"):
+            rows += fx(tmp, args.members, args.bootstrap)
         if rows:
             print_table(rows)
         for kind in BAND_KINDS:
@@ -390,7 +462,6 @@ def main() -> None:
                     f"legs inside P10-P90, {kind} uncertainty (learned median level, race "
                     f"pace): {sum(c[0] for c in cov)} of {sum(c[1] for c in cov)}"
                 )
-    print("49erFX Worlds 2019 F13: left out (no marks; needs `sailroute course infer`)")
     load = Path("/proc/loadavg").read_text(encoding="utf-8").strip()
     print(f"run time {time.perf_counter() - t0:.0f} s; load {load} (a shared 2-core machine)")
 

@@ -207,11 +207,12 @@ def run_analyze_command(
 
     analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())
     analyses, beaten = _rejudge(reference, analyses, analyse_all, notes, boat, polar, course, name)
+    banner = () if beaten is None else (beaten,)
     if one:
-        res = _one_boat(out, analyses[0], tri, notes, plots)
+        res = _one_boat(out, analyses[0], tri, notes, plots, banner)
     else:
         fleet = FleetAnalysis(course, tri, tuple(analyses), tuple(notes))
-        res = _fleet(out, fleet, sources, plots, pages, polar)
+        res = _fleet(out, fleet, sources, plots, pages, polar, banner)
     return res if beaten is None else replace(res, report=f"note: {beaten}\n\n{res.report}")
 
 
@@ -243,11 +244,17 @@ def _rejudge(
 
 
 def _one_boat(
-    out: Path, a: TrackAnalysis, tri: Triage, notes: list[str], plots: bool
+    out: Path,
+    a: TrackAnalysis,
+    tri: Triage,
+    notes: list[str],
+    plots: bool,
+    banner: Sequence[str] = (),
 ) -> CommandResult:
-    """The result of one track: its files, its table and the run's notes."""
+    """The result of one track: its files, its table and the run's notes (``banner`` at
+    the top of its page)."""
     all_notes = [*tri.notes(), *notes]
-    files = write_output_set(out, lambda d: write_analysis(d, a, plots=plots))
+    files = write_output_set(out, lambda d: write_analysis(d, a, plots=plots, banner=banner))
     return CommandResult(
         "\n\n".join([analysis_table(a), _notes_text(all_notes)]),
         files,
@@ -264,9 +271,11 @@ def _fleet(
     plots: bool,
     pages: str,
     polar: Polar | None,
+    banner: Sequence[str] = (),
 ) -> CommandResult:
     """The result of a fleet: its gains (with a ``polar``: :mod:`sailroute.analysis.gains`),
-    every debriefed boat's files, the fleet's, the tables."""
+    every debriefed boat's files, the fleet's, the tables (``banner`` at the top of the
+    fleet's page and of each boat's)."""
     if polar is not None:
         fleet = replace(fleet, gains=fleet_gains(fleet.course, fleet, polar.speed))
     rows = fleet.rows()
@@ -280,7 +289,8 @@ def _fleet(
         boat_pages = plots and pages == "boat"
         for a in fleet.analyses:
             s = a.track.name
-            for kind, p in write_analysis(d / s, a, plots=boat_pages, scripts=d).items():
+            boat_files = write_analysis(d / s, a, plots=boat_pages, scripts=d, banner=banner)
+            for kind, p in boat_files.items():
                 files[f"{s}/{kind}"] = p
         files.update(
             write_fleet(
@@ -291,6 +301,7 @@ def _fleet(
                 notes=fleet.notes,
                 wind=fleet_wind_layer,
                 fleet=fleet,
+                banner=banner,
             )
         )
         return files

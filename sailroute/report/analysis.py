@@ -228,9 +228,11 @@ def write_analysis(
     *,
     plots: bool = True,
     scripts: str | Path | None = None,
+    banner: Sequence[str] = (),
 ) -> dict[str, Path]:
     """Write ``analysis.json``, ``analysis.csv``, ``points.csv`` and (with ``plots``)
-    ``legs.png``, ``loss.png`` and ``report.html`` into ``out_dir`` (created).
+    ``legs.png``, ``loss.png`` and ``report.html`` into ``out_dir`` (created); ``banner``:
+    lines at the top of the page (:func:`sailroute.report.html.analysis_report`).
 
     The page loads plotly.js from the folder ``scripts``
     (:func:`sailroute.report.page_render.write_report`); default ``out_dir``, and then the
@@ -326,7 +328,9 @@ def write_analysis(
         from sailroute.report.html import analysis_report
         from sailroute.report.page_render import PLOTLY_FILE, write_report
 
-        files["html"] = write_report(out / "report.html", analysis_report(a), scripts=scripts)
+        files["html"] = write_report(
+            out / "report.html", analysis_report(a, banner), scripts=scripts
+        )
         if scripts is None:
             files["plotly_js"] = out / PLOTLY_FILE
     return files
@@ -341,6 +345,7 @@ def write_fleet(
     notes: Sequence[str] = (),
     wind: tuple[str, WindField] | None = None,
     fleet: FleetAnalysis | None = None,
+    banner: Sequence[str] = (),
 ) -> dict[str, Path]:
     """Write ``fleet.csv`` (one row per leg and boat), ``fleet.json`` and (with ``plots``)
     the fleet's ``report.html`` (:mod:`sailroute.report.fleet`) with the plotly.js bundle
@@ -349,7 +354,8 @@ def write_fleet(
     ``notes`` (the run's findings on the wind and the reference) go into ``fleet.json``
     and the page; ``wind`` is the fleet-wide wind drawn on the page (name, field).
     ``fleet`` (the triaged fleet) adds every track's status (debriefed or not), the
-    results, the fleet's start and triage's notes."""
+    results, the fleet's start and triage's notes.  ``banner``: lines at the top of the
+    page instead of among its notes (:attr:`sailroute.report.fleet.FleetPage.banner`)."""
     out = Path(out_dir)
     cp = out / "fleet.csv"
     cols = (
@@ -399,7 +405,7 @@ def write_fleet(
         from sailroute.report.fleet import fleet_page, fleet_report
         from sailroute.report.page_render import PLOTLY_FILE, write_report
 
-        page = fleet_page(analyses, rows, all_notes, wind, fleet=fleet)
+        page = fleet_page(analyses, rows, all_notes, wind, fleet=fleet, banner=banner)
         files["html"] = write_report(out / "report.html", fleet_report(page))
         files["plotly_js"] = out / PLOTLY_FILE
     return files

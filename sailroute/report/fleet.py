@@ -230,6 +230,9 @@ class FleetPage:
         The boats' gains on the fleet (boats named as in :attr:`boats`).
     gain_legs : tuple of int
         The legs the gains are summed over (0-based; every ranked boat's time known).
+    banner : tuple of str
+        Shown at the top of the page, above the summary and the tables (the course's
+        polar beaten on most legs); not among :attr:`notes`.
     """
 
     course: Course
@@ -245,6 +248,7 @@ class FleetPage:
     others: tuple[tuple[str, str], ...] = ()
     gains: FleetGains | None = None
     gain_legs: tuple[int, ...] = ()
+    banner: tuple[str, ...] = ()
 
     def lead(self) -> int:
         """Index of the leader among :attr:`boats` (:attr:`leader`, else :func:`leader`)."""
@@ -413,6 +417,7 @@ def fleet_page(
     *,
     budget: int = FLEET_POINTS,
     fleet: FleetAnalysis | None = None,
+    banner: Sequence[str] = (),
 ) -> FleetPage:
     """The fleet's page from its analyses: the one place that reads the analysis model.
 
@@ -434,11 +439,16 @@ def fleet_page(
         The fleet's analysis: it decides each boat's status (a boat without a place in the
         results carries what triage found), the leader, the tracks not debriefed and the
         gains.
+    banner : sequence of str
+        Lines for the top of the page (:attr:`FleetPage.banner`); one of them among
+        ``notes`` is shown there only.
     """
     course = analyses[0].course
     by = {(r["leg"], r["boat"]): r for r in rows}
     share = boat_points(len(analyses), budget)
-    fleet_notes, own = _boat_notes(notes, [a.track.name for a in analyses])
+    fleet_notes, own = _boat_notes(
+        [n for n in notes if n not in banner], [a.track.name for a in analyses]
+    )
     boats = []
     for a in analyses:
         st = a.segmentation.start
@@ -494,6 +504,7 @@ def fleet_page(
         ),
         gains=fleet.gains if fleet is not None else None,
         gain_legs=fleet.table.common_legs() if fleet is not None else (),
+        banner=tuple(banner),
     )
 
 
@@ -803,7 +814,7 @@ def fleet_report(page: FleetPage) -> Report:
     (:func:`rank_colours`), then the optimal legs; tables: the results, the leg times,
     the start and each leg's details (folded), all sortable and a row picks its boat;
     notes: how to read the page, what the boats are judged against, the fleet's notes,
-    then each boat's findings folded (:func:`fold_notes`).
+    then each boat's findings folded (:func:`fold_notes`); the banner above the summary.
     """
     course, off = page.course, page.course.utc_offset_s
     order = results_order(page.boats)
@@ -875,4 +886,5 @@ def fleet_report(page: FleetPage) -> Report:
         folded=folded,
         pick=True,
         chart=page_chart(course, [page.wind[1]] if page.wind else [], routes),
+        banner=page.banner,
     )

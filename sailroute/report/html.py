@@ -298,9 +298,10 @@ def comparison_report(
     )
 
 
-def analysis_report(a: TrackAnalysis) -> Report:
+def analysis_report(a: TrackAnalysis, banner: Sequence[str] = ()) -> Report:
     """The page of ``sailroute analyze``: the sailed track, the optimal legs from the
-    boat's own leg starts (dashed) and the leg table with the time lost."""
+    boat's own leg starts (dashed) and the leg table with the time lost; ``banner`` at
+    the top (the course's polar beaten on most legs: :attr:`Report.banner`)."""
     course, off = a.course, a.course.utc_offset_s
     sailed, optimal = routes_from_analysis(a)
     colours = tuple(LEG_COLOURS[k % len(LEG_COLOURS)] for k in range(len(a.legs)))
@@ -421,6 +422,7 @@ def analysis_report(a: TrackAnalysis) -> Report:
             _wind_note(layers),
         ),
         chart=page_chart(course, [a.wind], [sailed, optimal]),
+        banner=tuple(banner),
     )
 
 

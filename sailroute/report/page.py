@@ -275,6 +275,9 @@ class Report:
     title : str
     summary : tuple of str
         Lines under the title.
+    banner : tuple of str
+        Lines above the summary, set apart: what changes how the whole page reads (the
+        course's polar beaten on most legs: the losses are its error).
     course : Course
         Marks, lines and gates; ``utc_offset_s`` for the times.
     routes : tuple of Route
@@ -318,6 +321,7 @@ class Report:
     folded: tuple[NoteGroup, ...] = ()
     pick: bool = False
     chart: Chart | None = None
+    banner: tuple[str, ...] = ()
 
 
 def clock(t: float, utc_offset_s: float = 0.0) -> str:

@@ -51,6 +51,8 @@ body { font-family: Helvetica, Arial, sans-serif; margin: 16px 24px; color: #222
 h1 { font-size: 20px; margin: 0 0 6px 0; }
 h2 { font-size: 16px; margin: 18px 0 6px 0; }
 p.summary { margin: 2px 0; }
+p.banner { margin: 4px 0 8px 0; padding: 6px 10px; background: #fff4d6;
+           border-left: 4px solid #d99a00; }
 #sailroute-map { width: 100%; }
 #sailroute-wrap { position: relative; }
 #sailroute-furniture { position: absolute; pointer-events: none;
@@ -547,7 +549,12 @@ def render_html(report: Report, plotly_src: str = PLOTLY_FILE) -> str:
     fig = figure(report)
     notes = "\n".join(f'<p class="note">{_h(n)}</p>' for n in report.notes)
     folded = "\n".join(_folded_html(g) for g in report.folded)
-    summary = "\n".join(f'<p class="summary">{_h(s)}</p>' for s in report.summary)
+    summary = "\n".join(
+        [
+            *(f'<p class="banner" role="note">{_h(b)}</p>' for b in report.banner),
+            *(f'<p class="summary">{_h(s)}</p>' for s in report.summary),
+        ]
+    )
     tables = "\n".join(_table_html(t) for t in report.tables)
     src = html.escape(quote(plotly_src, safe="/._-~"))
     js = _JS % {

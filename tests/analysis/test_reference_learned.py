@@ -77,11 +77,19 @@ def test_a_fleet_faster_than_the_course_polar_is_told_and_judged_by_its_own(
     fast_fleet: tuple[Path, list[Path]], tmp_path: Path
 ) -> None:
     course, tracks = fast_fleet
-    res = run_analyze_command(course, tracks, out_dir=tmp_path / "course", plots=False)
+    res = run_analyze_command(course, tracks, out_dir=tmp_path / "course")
     first = res.report.splitlines()[0]
     assert first.startswith("note: the course polar (ILCA 7) is beaten by more than 10 %")
     doc = json.loads((tmp_path / "course" / "fleet.json").read_text())
     assert any(n.startswith("the course polar (ILCA 7) is beaten") for n in doc["notes"])
+    # the fleet's page and one boat's: the line heads the page, above its tables, once
+    one = run_analyze_command(course, tracks[:1], out_dir=tmp_path / "one")
+    assert one.report.startswith("note: the course polar (ILCA 7) is beaten")
+    for page in (tmp_path / "course" / "report.html", tmp_path / "one" / "report.html"):
+        body = page.read_text(encoding="utf-8").split("<h1>", 1)[1]
+        assert body.split("<p", 1)[1].startswith(' class="banner" role="note">the course polar')
+        assert body.index('class="banner"') < body.index("<table")
+        assert body.count("is beaten by more than 10 %") == 1
     # against the course's polar the fleet "gains" about a tenth of every leg
     assert np.median(_relative_losses(res)) < -0.1
     learned = run_analyze_command(

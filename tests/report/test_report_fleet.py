@@ -12,6 +12,7 @@ place and total is known before the page is built.
 from __future__ import annotations
 
 import dataclasses
+import html
 import math
 from pathlib import Path
 
@@ -364,6 +365,26 @@ def test_findings_are_folded_and_the_fleets_notes_kept(fleet60) -> None:
     assert page.count("late start: 0.0 s after the gun") == 1
 
 
+BEATEN = (
+    "the course polar (ILCA 7) is beaten by more than 10 % on 7 of 8 legs (each judged in the "
+    "wind its boat had): it is not this fleet's boat, and the losses below are its error"
+)
+
+
+def test_a_beaten_course_polar_heads_the_page(fleet60) -> None:
+    """The line that disowns every loss on the page is the first thing under the title,
+    set apart, above the summary, the map and the tables, and said once."""
+    report = fleet_report(dataclasses.replace(fleet60, banner=(BEATEN,)))
+    assert report.banner == (BEATEN,) and BEATEN not in report.notes
+    page = render_html(report)
+    body = page[page.index("<h1>") :]
+    first_p = body[body.index("<p") : body.index("</p>")]
+    assert first_p == f'<p class="banner" role="note">{html.escape(BEATEN)}'
+    assert body.index('class="banner"') < body.index('class="summary"') < body.index("<table")
+    assert page.count("is beaten by more than 10 %") == 1
+    assert 'class="banner"' not in render_html(fleet_report(fleet60))
+
+
 def test_a_page_of_60_boats_of_45_min_at_1_hz_stays_small(fleet60) -> None:
     page = render_html(fleet_report(fleet60))
     assert len(page.encode()) < 6_000_000  # 2700 fixes per boat would make ~20 MB
@@ -493,6 +514,9 @@ def test_the_page_is_built_from_the_analyses_in_one_place(tmp_path_factory) -> N
         "the start line lay elsewhere",
     ]
     page = fleet_page(analyses, rows, notes)
+    # the run's notes with the beaten-polar line first: it goes to the banner, only there
+    told = fleet_page(analyses, rows, [BEATEN, *notes], banner=[BEATEN])
+    assert told.banner == (BEATEN,) and told.notes == page.notes
     by = {b.name: b for b in page.boats}
     assert [b.name for b in page.boats] == ["fast", "slow", "short"]  # as given
     assert page.notes == ("the start line lay elsewhere",)  # the fleet's own
