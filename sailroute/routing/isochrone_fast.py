@@ -22,8 +22,10 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import os
 import threading
 import time
+from pathlib import Path
 from types import ModuleType
 from typing import Any, Final, NamedTuple
 
@@ -39,7 +41,7 @@ from sailroute.routing.isochrone_inputs import (
     _segment_params,
     _step_length,
 )
-from sailroute.routing.isochrone_polar import PointPolars, _DeviceTables
+from sailroute.routing.isochrone_polar import PointPolars, _DeviceTables, support_rows
 from sailroute.routing.isochrone_records import (
     _CHUNK_ELEMENTS,
     Groups,
@@ -73,11 +75,30 @@ path)."""
 
 JIT_AFTER_S: Final = 1.5
 """With ``routing.engine = "auto"``, the compiled kernels take over once this process
-has spent this long [s of CPU] in NumPy steps, or for a front that holds several
-members (:mod:`sailroute.routing.batch`).  Numba's start-up in a fresh process, importing
-it and its first compiled call, costs about 0.7 s of CPU: it pays for a batch, a
-comparison or a day of live re-plans, not for one plan of a course (about 1 s of NumPy
-steps)."""
+has spent this long [s of CPU] in NumPy steps, for a front that holds several members
+(:mod:`sailroute.routing.batch`), or where numba's cache holds them already
+(:func:`kernels_cached`).  Numba's start-up in a fresh process, importing it and its
+first compiled call, costs about 0.35 s of CPU (:mod:`sailroute.jit`), less than the
+NumPy steps of one plan of a course (about 0.8 s); compiling the kernels, about 15 s,
+pays for a batch, a comparison or a day of live re-plans, not for one plan."""
+
+
+STEP_KERNELS: Final = (
+    "sample_points",
+    "wind_states",
+    "support_headings",
+    "aim_directions",
+    "step_inputs",
+    "dense_speeds",
+    "candidates",
+    "sector_winners",
+    "survivors",
+)
+"""The kernels of :mod:`~sailroute.routing.isochrone_jit` that a step calls."""
+
+_PYCACHE: Final = Path(__file__).parent / "__pycache__"
+"""Where numba caches the kernels, unless ``NUMBA_CACHE_DIR`` says otherwise or the
+folder is read-only (then numba's user-wide cache directory)."""
 
 
 class _Usage:
@@ -85,6 +106,7 @@ class _Usage:
 
     numpy_s = 0.0  # CPU time spent in NumPy steps [s]
     kernels: ModuleType | None = None  # isochrone_jit, once imported
+    cached: bool | None = None  # kernels_cached(), once asked
 
 
 def kernels() -> ModuleType:
@@ -96,10 +118,36 @@ def kernels() -> ModuleType:
     return _Usage.kernels
 
 
+def kernels_cached() -> bool:
+    """Whether numba's cache holds the compiled step kernels (:data:`STEP_KERNELS`) for
+    the current source of :mod:`~sailroute.routing.isochrone_jit`: a run has compiled
+    them, so loading them costs numba's start-up only, not a compilation (about 15 s).
+
+    A look at the cache folder comes first; numba is imported only where it holds the
+    kernels (or where the folder is elsewhere).  Asked once per process.
+    """
+    if _Usage.cached is None:
+        _Usage.cached = _step_kernels_in_cache()
+    return _Usage.cached
+
+
+def _step_kernels_in_cache() -> bool:
+    in_tree = "NUMBA_CACHE_DIR" not in os.environ and os.access(_PYCACHE, os.W_OK)
+    if in_tree and not any(_PYCACHE.glob("isochrone_jit.candidates-*.nbi")):
+        return False  # nothing compiled yet: no need to import numba to know it
+    from sailroute.routing import isochrone_jit
+
+    return all(
+        bool(getattr(isochrone_jit, name)._cache._cache_file._load_index()) for name in STEP_KERNELS
+    )
+
+
 def compiled(settings: RoutingSettings, xp: Any, *, members: int = 1) -> bool:
     """Whether a step takes the compiled path: ``routing.engine`` "numba", or "auto" with
-    numba installed once the work pays for its start-up (:data:`JIT_AFTER_S`: a front of
-    several ``members``, or enough NumPy steps already); NumPy arrays only.
+    numba installed once the work pays for its start-up: a front of several
+    ``members``, enough NumPy steps already (:data:`JIT_AFTER_S`), or kernels that a
+    run has compiled before (:func:`kernels_cached`: loading them costs less than the
+    NumPy steps of one plan save); NumPy arrays only.
 
     Raises
     ------
@@ -120,6 +168,7 @@ def compiled(settings: RoutingSettings, xp: Any, *, members: int = 1) -> bool:
         or members > 1
         or _Usage.kernels is not None
         or _Usage.numpy_s >= JIT_AFTER_S
+        or kernels_cached()
     )
 
 
@@ -273,6 +322,7 @@ def prepare(
 
     beta = np.degrees(np.arctan2(sup_y, sup_x))  # the support's bearing, per side
     best, sig, rad = np.empty((2, n)), np.empty((2, n)), np.empty((2, n))
+    support_rows(dev, move_row)
     kernels().support_headings(
         move_row, move[3], beta, dev.sup_ms, dev.sup_deg, man[0], best, sig, rad
     )

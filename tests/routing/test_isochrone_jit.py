@@ -179,10 +179,31 @@ def test_the_engine_setting_is_checked_and_numba_can_be_missing(monkeypatch):
 def test_auto_compiles_for_members_and_after_enough_numpy_steps(monkeypatch):
     monkeypatch.setattr(isochrone_fast._Usage, "kernels", None)
     monkeypatch.setattr(isochrone_fast._Usage, "numpy_s", 0.0)
+    monkeypatch.setattr(isochrone_fast._Usage, "cached", False)
     auto = with_engine(SET, "auto")
-    assert not isochrone_fast.compiled(auto, np)  # one plan: NumPy (numba's start-up)
+    assert not isochrone_fast.compiled(auto, np)  # one plan, nothing compiled: NumPy
     assert isochrone_fast.compiled(auto, np, members=2)  # a batch pays for it
     assert not isochrone_fast.compiled(with_engine(SET, "numpy"), np, members=2)
     monkeypatch.setattr(isochrone_fast._Usage, "numpy_s", isochrone_fast.JIT_AFTER_S)
     assert isochrone_fast.compiled(auto, np)
     assert not isochrone_fast.compiled(auto, object())  # another array module
+    monkeypatch.setattr(isochrone_fast._Usage, "numpy_s", 0.0)
+    monkeypatch.setattr(isochrone_fast._Usage, "cached", True)
+    assert isochrone_fast.compiled(auto, np)  # compiled before: loading them pays
+
+
+def test_kernels_count_as_cached_only_when_every_step_kernel_is_in_numbas_index(
+    monkeypatch, tmp_path
+):
+    from sailroute.routing import isochrone_jit
+
+    both(LINE, MARK, UniformWind(4.4, 0.0), SET)  # compiles the step kernels, or loads them
+    assert isochrone_fast._step_kernels_in_cache()
+    stale = getattr(isochrone_jit, isochrone_fast.STEP_KERNELS[-1])._cache._cache_file
+    monkeypatch.setattr(stale, "_load_index", dict)  # numba's answer for a stale index
+    assert not isochrone_fast._step_kernels_in_cache()
+    monkeypatch.undo()
+    assert isochrone_fast._step_kernels_in_cache()
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setattr(isochrone_fast, "_PYCACHE", tmp_path)  # nothing compiled there
+    assert not isochrone_fast._step_kernels_in_cache()
