@@ -20,6 +20,7 @@ compiled, :func:`pack`).
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
 import math
 import os
@@ -98,7 +99,7 @@ STEP_KERNELS: Final = (
 
 _PYCACHE: Final = Path(__file__).parent / "__pycache__"
 """Where numba caches the kernels, unless ``NUMBA_CACHE_DIR`` says otherwise or the
-folder is read-only (then numba's user-wide cache directory)."""
+folder is read-only (:func:`_cache_folder`)."""
 
 
 class _Usage:
@@ -131,9 +132,20 @@ def kernels_cached() -> bool:
     return _Usage.cached
 
 
+def _cache_folder() -> Path | None:
+    """The folder where numba caches the kernels, by its own rule (``NUMBA_CACHE_DIR``:
+    a subfolder named after the source folder and its SHA-1; else ``__pycache__``); None
+    where the source tree is read-only (numba's user-wide cache directory)."""
+    src = os.path.abspath(_PYCACHE.parent)
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    if env:
+        return Path(env) / f"{os.path.basename(src)}_{hashlib.sha1(src.encode()).hexdigest()}"
+    return _PYCACHE if os.access(_PYCACHE if _PYCACHE.exists() else src, os.W_OK) else None
+
+
 def _step_kernels_in_cache() -> bool:
-    in_tree = "NUMBA_CACHE_DIR" not in os.environ and os.access(_PYCACHE, os.W_OK)
-    if in_tree and not any(_PYCACHE.glob("isochrone_jit.candidates-*.nbi")):
+    folder = _cache_folder()
+    if folder is not None and not any(folder.glob("isochrone_jit.candidates-*.nbi")):
         return False  # nothing compiled yet: no need to import numba to know it
     from sailroute.routing import isochrone_jit
 

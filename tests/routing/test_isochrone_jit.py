@@ -206,4 +206,10 @@ def test_kernels_count_as_cached_only_when_every_step_kernel_is_in_numbas_index(
     assert isochrone_fast._step_kernels_in_cache()
     monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
     monkeypatch.setattr(isochrone_fast, "_PYCACHE", tmp_path)  # nothing compiled there
+    assert isochrone_fast._cache_folder() == tmp_path
+    assert not isochrone_fast._step_kernels_in_cache()
+    monkeypatch.undo()
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # numba's own rule for the folder
+    sub = numba.core.caching._CacheLocator.get_suitable_cache_subpath(isochrone_jit.__file__)
+    assert isochrone_fast._cache_folder() == tmp_path / sub
     assert not isochrone_fast._step_kernels_in_cache()
