@@ -125,7 +125,8 @@ def kernels_cached() -> bool:
     them, so loading them costs numba's start-up only, not a compilation (about 15 s).
 
     A look at the cache folder comes first; numba is imported only where it holds the
-    kernels (or where the folder is elsewhere).  Asked once per process.
+    kernels (or where the folder is elsewhere).  False where numba itself would load
+    from source (no ``.pyc``: :func:`_numba_bytecode`).  Asked once per process.
     """
     if _Usage.cached is None:
         _Usage.cached = _step_kernels_in_cache()
@@ -143,7 +144,23 @@ def _cache_folder() -> Path | None:
     return _PYCACHE if os.access(_PYCACHE if _PYCACHE.exists() else src, os.W_OK) else None
 
 
+def _numba_bytecode() -> bool:
+    """Whether numba's modules load from their compiled bytecode (``.pyc``, under
+    ``PYTHONPYCACHEPREFIX`` where it is set): from source its import and first call
+    cost about 2 s of CPU more."""
+    spec = importlib.util.find_spec("numba")  # does not import it
+    if spec is None or spec.origin is None:
+        return False
+    root = Path(spec.origin).parent
+    return all(
+        Path(importlib.util.cache_from_source(str(py))).is_file()
+        for py in (root / "__init__.py", root / "np" / "arraymath.py")
+    )
+
+
 def _step_kernels_in_cache() -> bool:
+    if not _numba_bytecode():
+        return False
     folder = _cache_folder()
     if folder is not None and not any(folder.glob("isochrone_jit.candidates-*.nbi")):
         return False  # nothing compiled yet: no need to import numba to know it

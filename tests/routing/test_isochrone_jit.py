@@ -14,6 +14,7 @@ polar, a full heading fan, a front capped at a few points, and members routed to
 from __future__ import annotations
 
 import dataclasses
+import sys
 
 import numpy as np
 import pytest
@@ -198,18 +199,24 @@ def test_kernels_count_as_cached_only_when_every_step_kernel_is_in_numbas_index(
     from sailroute.routing import isochrone_jit
 
     both(LINE, MARK, UniformWind(4.4, 0.0), SET)  # compiles the step kernels, or loads them
-    assert isochrone_fast._step_kernels_in_cache()
-    stale = getattr(isochrone_jit, isochrone_fast.STEP_KERNELS[-1])._cache._cache_file
-    monkeypatch.setattr(stale, "_load_index", dict)  # numba's answer for a stale index
-    assert not isochrone_fast._step_kernels_in_cache()
-    monkeypatch.undo()
-    assert isochrone_fast._step_kernels_in_cache()
-    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
-    monkeypatch.setattr(isochrone_fast, "_PYCACHE", tmp_path)  # nothing compiled there
-    assert isochrone_fast._cache_folder() == tmp_path
-    assert not isochrone_fast._step_kernels_in_cache()
-    monkeypatch.undo()
-    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # numba's own rule for the folder
-    sub = numba.core.caching._CacheLocator.get_suitable_cache_subpath(isochrone_jit.__file__)
-    assert isochrone_fast._cache_folder() == tmp_path / sub
-    assert not isochrone_fast._step_kernels_in_cache()
+    with monkeypatch.context() as m:
+        m.setattr(isochrone_fast, "_numba_bytecode", lambda: True)
+        assert isochrone_fast._step_kernels_in_cache()
+        stale = getattr(isochrone_jit, isochrone_fast.STEP_KERNELS[-1])._cache._cache_file
+        m.setattr(stale, "_load_index", dict)  # numba's answer for a stale index
+        assert not isochrone_fast._step_kernels_in_cache()
+    with monkeypatch.context() as m:
+        m.setattr(isochrone_fast, "_numba_bytecode", lambda: True)
+        m.delenv("NUMBA_CACHE_DIR", raising=False)
+        m.setattr(isochrone_fast, "_PYCACHE", tmp_path)  # nothing compiled there
+        assert isochrone_fast._cache_folder() == tmp_path
+        assert not isochrone_fast._step_kernels_in_cache()
+    with monkeypatch.context() as m:
+        m.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # numba's own rule for the folder
+        sub = numba.core.caching._CacheLocator.get_suitable_cache_subpath(isochrone_jit.__file__)
+        assert isochrone_fast._cache_folder() == tmp_path / sub
+        assert not isochrone_fast._step_kernels_in_cache()
+    with monkeypatch.context() as m:
+        m.setattr(sys, "pycache_prefix", str(tmp_path))  # no .pyc of numba: from source
+        assert not isochrone_fast._numba_bytecode()
+        assert not isochrone_fast._step_kernels_in_cache()
