@@ -166,9 +166,13 @@ def _step_kernels_in_cache() -> bool:
         return False  # nothing compiled yet: no need to import numba to know it
     from sailroute.routing import isochrone_jit
 
-    return all(
-        bool(getattr(isochrone_jit, name)._cache._cache_file._load_index()) for name in STEP_KERNELS
-    )
+    try:  # numba's cache index (private: another numba version may lack it)
+        return all(
+            bool(getattr(isochrone_jit, name)._cache._cache_file._load_index())
+            for name in STEP_KERNELS
+        )
+    except (AttributeError, OSError, EOFError, ValueError):
+        return False
 
 
 def compiled(settings: RoutingSettings, xp: Any, *, members: int = 1) -> bool:
