@@ -44,7 +44,23 @@ try:  # optional extra
 except ImportError:  # pragma: no cover - exercised where numba is not installed
     AVAILABLE = False
 
-__all__ = ["AVAILABLE", "inline", "jit"]
+__all__ = ["AVAILABLE", "inline", "jit", "load_registries"]
+
+
+def load_registries() -> None:
+    """Load numba's typing and lowering registries now, as its first compiled call
+    would (about 0.15 s of CPU): a caller can then pause the garbage collector over the
+    whole start-up (:func:`sailroute.routing.isochrone_fast.kernels`).  Without numba,
+    or with a numba whose internals differ, nothing happens here and the first call
+    loads them."""
+    if not AVAILABLE:
+        return
+    try:
+        from numba.core.registry import cpu_target
+
+        cpu_target.target_context.refresh()
+    except (ImportError, AttributeError):  # pragma: no cover - another numba's layout
+        pass
 
 
 def jit(fn: Any) -> Any:

@@ -20,6 +20,7 @@ compiled, :func:`pack`).
 
 from __future__ import annotations
 
+import gc
 import hashlib
 import importlib.util
 import math
@@ -111,10 +112,21 @@ class _Usage:
 
 
 def kernels() -> ModuleType:
-    """The compiled kernels, :mod:`sailroute.routing.isochrone_jit` (imports numba)."""
+    """The compiled kernels, :mod:`sailroute.routing.isochrone_jit` (imports numba and
+    loads its registries, :func:`sailroute.jit.load_registries`, with the cyclic garbage
+    collector paused: its full passes over numba's new objects cost about 0.05 s of CPU
+    and find nothing)."""
     if _Usage.kernels is None:
-        from sailroute.routing import isochrone_jit
+        collecting = gc.isenabled()
+        gc.disable()  # numba's start-up makes objects that all live on: no cycles to find
+        try:
+            from sailroute.jit import load_registries
+            from sailroute.routing import isochrone_jit
 
+            load_registries()
+        finally:
+            if collecting:
+                gc.enable()
         _Usage.kernels = isochrone_jit
     return _Usage.kernels
 

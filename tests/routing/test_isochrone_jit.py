@@ -220,3 +220,27 @@ def test_kernels_count_as_cached_only_when_every_step_kernel_is_in_numbas_index(
         m.setattr(sys, "pycache_prefix", str(tmp_path))  # no .pyc of numba: from source
         assert not isochrone_fast._numba_bytecode()
         assert not isochrone_fast._step_kernels_in_cache()
+
+
+def test_numba_starts_with_the_collector_paused_and_leaves_it_as_it_was(monkeypatch):
+    import gc
+
+    import sailroute.jit
+    from sailroute.routing import isochrone_jit
+
+    real, seen = sailroute.jit.load_registries, []
+
+    def load() -> None:
+        seen.append(gc.isenabled())
+        real()
+
+    monkeypatch.setattr(sailroute.jit, "load_registries", load)
+    for enabled in (True, False):
+        monkeypatch.setattr(isochrone_fast._Usage, "kernels", None)
+        (gc.enable if enabled else gc.disable)()
+        try:
+            assert isochrone_fast.kernels() is isochrone_jit
+            assert gc.isenabled() is enabled
+        finally:
+            gc.enable()
+    assert seen == [False, False]
