@@ -78,6 +78,7 @@ CASES = [
         r"6 legs \(boat 1, boat 2\) \| \d/6 = \d+ % \| \d+ s \(",
         marks=SLOW,
     ),
+    pytest.param("bench_plan.py", r"^same leg times to 1e-06 s: yes$", marks=SLOW),
     pytest.param(
         "bench_live.py",
         r"^  step -> route in the new wind \(race time\): median [\d.]+ s, max [\d.]+ s",

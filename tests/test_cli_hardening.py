@@ -449,6 +449,25 @@ def test_ctrl_c_outside_the_work_is_reported_too(tmp_path, monkeypatch):
     assert res.exit_code == 130 and res.output == "interrupted\n"
 
 
+def test_the_process_ends_with_its_objects_frozen_out_of_the_last_collections(monkeypatch):
+    """``main`` freezes the heap as it returns (the interpreter's shutdown then does not
+    traverse numba's registries), whatever way the command ends."""
+    import gc
+    import sys
+
+    from sailroute.__main__ import main
+
+    monkeypatch.setattr(sys, "argv", ["sailroute", "--help"])
+    gc.unfreeze()
+    assert gc.get_freeze_count() == 0
+    try:
+        with pytest.raises(SystemExit) as ended:
+            main()
+        assert ended.value.code == 0 and gc.get_freeze_count() > 1000
+    finally:
+        gc.unfreeze()
+
+
 PROGRESS_LINE = re.compile(r"leg \d+/\d+ .+: (routing\.\.\.|.+ \(computed in .+ s\))")
 
 

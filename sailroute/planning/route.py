@@ -30,7 +30,6 @@ from sailroute.parallel import SERIAL, check_scheduler, map_tasks
 from sailroute.planning.result import Comparison, Plan, compare, make_plan
 from sailroute.progress import Progress
 from sailroute.routing.api import check_current_router, get_router, route_leg
-from sailroute.routing.batch import batchable, route_leg_batch
 from sailroute.routing.geometry import chain_leg
 from sailroute.routing.obstacles import RaceArea, land_filled, obstacles_for
 from sailroute.routing.settings import RoutingSettings
@@ -310,6 +309,8 @@ def route_course_batch(
     list of list of LegResult
         Per member, its legs in order.
     """
+    from sailroute.routing.batch import route_leg_batch  # not loaded by a single plan
+
     results: list[list[LegResult]] = [[] for _ in winds]
     if progress is not None:
         progress.start_count(len(winds), "member", together=True)
@@ -494,6 +495,8 @@ def route_scenarios(
     boat, winds = build_specs(course, names)
     _warn(progress, check_boat_and_winds(course, boat, winds))
     open_water = course.area == RaceArea()  # the batch routes without a race area
+    from sailroute.routing.batch import batchable  # not loaded by a single plan
+
     if (
         where == SERIAL
         and batch

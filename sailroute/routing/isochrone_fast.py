@@ -20,10 +20,14 @@ compiled, :func:`pack`).
 
 from __future__ import annotations
 
+import gc
+import hashlib
 import importlib.util
 import math
+import os
 import threading
 import time
+from pathlib import Path
 from types import ModuleType
 from typing import Any, Final, NamedTuple
 
@@ -39,7 +43,7 @@ from sailroute.routing.isochrone_inputs import (
     _segment_params,
     _step_length,
 )
-from sailroute.routing.isochrone_polar import PointPolars, _DeviceTables
+from sailroute.routing.isochrone_polar import PointPolars, _DeviceTables, support_rows
 from sailroute.routing.isochrone_records import (
     _CHUNK_ELEMENTS,
     Groups,
@@ -73,11 +77,30 @@ path)."""
 
 JIT_AFTER_S: Final = 1.5
 """With ``routing.engine = "auto"``, the compiled kernels take over once this process
-has spent this long [s of CPU] in NumPy steps, or for a front that holds several
-members (:mod:`sailroute.routing.batch`).  Numba's start-up in a fresh process, importing
-it and its first compiled call, costs about 0.7 s of CPU: it pays for a batch, a
-comparison or a day of live re-plans, not for one plan of a course (about 1 s of NumPy
-steps)."""
+has spent this long [s of CPU] in NumPy steps, for a front that holds several members
+(:mod:`sailroute.routing.batch`), or where numba's cache holds them already
+(:func:`kernels_cached`).  Numba's start-up in a fresh process, importing it and its
+first compiled call, costs about 0.35 s of CPU (:mod:`sailroute.jit`), less than the
+NumPy steps of one plan of a course (about 0.8 s); compiling the kernels, about 15 s,
+pays for a batch, a comparison or a day of live re-plans, not for one plan."""
+
+
+STEP_KERNELS: Final = (
+    "sample_points",
+    "wind_states",
+    "support_headings",
+    "aim_directions",
+    "step_inputs",
+    "dense_speeds",
+    "candidates",
+    "sector_winners",
+    "survivors",
+)
+"""The kernels of :mod:`~sailroute.routing.isochrone_jit` that a step calls."""
+
+_PYCACHE: Final = Path(__file__).parent / "__pycache__"
+"""Where numba caches the kernels, unless ``NUMBA_CACHE_DIR`` says otherwise or the
+folder is read-only (:func:`_cache_folder`)."""
 
 
 class _Usage:
@@ -85,21 +108,91 @@ class _Usage:
 
     numpy_s = 0.0  # CPU time spent in NumPy steps [s]
     kernels: ModuleType | None = None  # isochrone_jit, once imported
+    cached: bool | None = None  # kernels_cached(), once asked
 
 
 def kernels() -> ModuleType:
-    """The compiled kernels, :mod:`sailroute.routing.isochrone_jit` (imports numba)."""
+    """The compiled kernels, :mod:`sailroute.routing.isochrone_jit` (imports numba and
+    loads its registries, :func:`sailroute.jit.load_registries`, with the cyclic garbage
+    collector paused: its full passes over numba's new objects cost about 0.05 s of CPU
+    and find nothing)."""
     if _Usage.kernels is None:
-        from sailroute.routing import isochrone_jit
+        collecting = gc.isenabled()
+        gc.disable()  # numba's start-up makes objects that all live on: no cycles to find
+        try:
+            from sailroute.jit import load_registries
+            from sailroute.routing import isochrone_jit
 
+            load_registries()
+        finally:
+            if collecting:
+                gc.enable()
         _Usage.kernels = isochrone_jit
     return _Usage.kernels
 
 
+def kernels_cached() -> bool:
+    """Whether numba's cache holds the compiled step kernels (:data:`STEP_KERNELS`) for
+    the current source of :mod:`~sailroute.routing.isochrone_jit`: a run has compiled
+    them, so loading them costs numba's start-up only, not a compilation (about 15 s).
+
+    A look at the cache folder comes first; numba is imported only where it holds the
+    kernels (or where the folder is elsewhere).  False where numba itself would load
+    from source (no ``.pyc``: :func:`_numba_bytecode`).  Asked once per process.
+    """
+    if _Usage.cached is None:
+        _Usage.cached = _step_kernels_in_cache()
+    return _Usage.cached
+
+
+def _cache_folder() -> Path | None:
+    """The folder where numba caches the kernels, by its own rule (``NUMBA_CACHE_DIR``:
+    a subfolder named after the source folder and its SHA-1; else ``__pycache__``); None
+    where the source tree is read-only (numba's user-wide cache directory)."""
+    src = os.path.abspath(_PYCACHE.parent)
+    env = os.environ.get("NUMBA_CACHE_DIR")
+    if env:
+        return Path(env) / f"{os.path.basename(src)}_{hashlib.sha1(src.encode()).hexdigest()}"
+    return _PYCACHE if os.access(_PYCACHE if _PYCACHE.exists() else src, os.W_OK) else None
+
+
+def _numba_bytecode() -> bool:
+    """Whether numba's modules load from their compiled bytecode (``.pyc``, under
+    ``PYTHONPYCACHEPREFIX`` where it is set): from source its import and first call
+    cost about 2 s of CPU more."""
+    spec = importlib.util.find_spec("numba")  # does not import it
+    if spec is None or spec.origin is None:
+        return False
+    root = Path(spec.origin).parent
+    return all(
+        Path(importlib.util.cache_from_source(str(py))).is_file()
+        for py in (root / "__init__.py", root / "np" / "arraymath.py")
+    )
+
+
+def _step_kernels_in_cache() -> bool:
+    if not _numba_bytecode():
+        return False
+    folder = _cache_folder()
+    if folder is not None and not any(folder.glob("isochrone_jit.candidates-*.nbi")):
+        return False  # nothing compiled yet: no need to import numba to know it
+    from sailroute.routing import isochrone_jit
+
+    try:  # numba's cache index (private: another numba version may lack it)
+        return all(
+            bool(getattr(isochrone_jit, name)._cache._cache_file._load_index())
+            for name in STEP_KERNELS
+        )
+    except (AttributeError, OSError, EOFError, ValueError):
+        return False
+
+
 def compiled(settings: RoutingSettings, xp: Any, *, members: int = 1) -> bool:
     """Whether a step takes the compiled path: ``routing.engine`` "numba", or "auto" with
-    numba installed once the work pays for its start-up (:data:`JIT_AFTER_S`: a front of
-    several ``members``, or enough NumPy steps already); NumPy arrays only.
+    numba installed once the work pays for its start-up: a front of several
+    ``members``, enough NumPy steps already (:data:`JIT_AFTER_S`), or kernels that a
+    run has compiled before (:func:`kernels_cached`: loading them costs less than the
+    NumPy steps of one plan save); NumPy arrays only.
 
     Raises
     ------
@@ -120,6 +213,7 @@ def compiled(settings: RoutingSettings, xp: Any, *, members: int = 1) -> bool:
         or members > 1
         or _Usage.kernels is not None
         or _Usage.numpy_s >= JIT_AFTER_S
+        or kernels_cached()
     )
 
 
@@ -273,6 +367,7 @@ def prepare(
 
     beta = np.degrees(np.arctan2(sup_y, sup_x))  # the support's bearing, per side
     best, sig, rad = np.empty((2, n)), np.empty((2, n)), np.empty((2, n))
+    support_rows(dev, move_row)
     kernels().support_headings(
         move_row, move[3], beta, dev.sup_ms, dev.sup_deg, man[0], best, sig, rad
     )

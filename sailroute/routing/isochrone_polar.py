@@ -64,7 +64,11 @@ class PolarTables:
     sup_ms, sup_deg : ndarray, shape (n_w, n_b)
         Support of the polar: the largest speed component ``S(a) cos(a - beta)`` over
         the headings of that side [m s⁻¹], and the |TWA| ``a`` giving it [°] (grid
-        maximum refined by a parabola, or a VMG angle).
+        maximum refined by a parabola, or a VMG angle).  Filled in blocks of
+        :data:`SUPPORT_BLOCK` rows when first needed (:meth:`fill_support`; NaN before):
+        a course in one wind reads a few rows of several hundred.
+    sup_ready : ndarray of bool, shape (ceil(n_w / SUPPORT_BLOCK),)
+        Which blocks of rows of ``sup_ms`` and ``sup_deg`` are filled.
     """
 
     twa_deg: NDArray[np.float64]
@@ -80,7 +84,35 @@ class PolarTables:
     sup_beta_deg: NDArray[np.float64]
     sup_ms: NDArray[np.float64]
     sup_deg: NDArray[np.float64]
+    sup_ready: NDArray[np.bool_]
 
+    def fill_support(self, lo: int = 0, hi: int | None = None) -> PolarTables:
+        """Fill the support rows ``lo`` to ``hi`` (both included; default: all) where
+        they are still empty; returns ``self``.  Every block is computed as the whole
+        table would be (:func:`_support_table`), so the numbers do not depend on the
+        order in which rows are asked for."""
+        last = self.tws_ms.shape[0] - 1 if hi is None else min(hi, self.tws_ms.shape[0] - 1)
+        b0, b1 = max(lo, 0) // SUPPORT_BLOCK, last // SUPPORT_BLOCK + 1
+        if self.sup_ready[b0:b1].all():
+            return self
+        for b in range(b0, b1):
+            if not self.sup_ready[b]:
+                r0, r1 = b * SUPPORT_BLOCK, min((b + 1) * SUPPORT_BLOCK, self.tws_ms.shape[0])
+                self.sup_ms[r0:r1], self.sup_deg[r0:r1] = _support_table(
+                    self.twa_deg,
+                    self.speed_ms[r0:r1],
+                    self.up_deg[r0:r1],
+                    self.down_deg[r0:r1],
+                    self.up_vmg_ms[r0:r1],
+                    self.down_vmg_ms[r0:r1],
+                    self.sup_beta_deg,
+                )
+                self.sup_ready[b] = True
+        return self
+
+
+SUPPORT_BLOCK = 64
+"""Rows of :attr:`PolarTables.sup_ms` filled at a time [-]."""
 
 _TABLE_CACHE: weakref.WeakKeyDictionary[Any, dict[int, PolarTables]] = weakref.WeakKeyDictionary()
 
@@ -137,9 +169,22 @@ def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
     )
     vu, vd = np.maximum(vu, 0.0), np.maximum(vd, 0.0)
     beta = np.linspace(-180.0, 180.0, 361)
-    sup_ms, sup_deg = _support_table(a, speed, up, down, vu, vd, beta)
+    empty = np.full((nodes.shape[0], beta.shape[0]), np.nan)
     tables = PolarTables(
-        a, np.cos(rad), np.sin(rad), nodes, speed, up, down, vu, vd, vmax, beta, sup_ms, sup_deg
+        a,
+        np.cos(rad),
+        np.sin(rad),
+        nodes,
+        speed,
+        up,
+        down,
+        vu,
+        vd,
+        vmax,
+        beta,
+        empty,
+        empty.copy(),
+        np.zeros(-(-nodes.shape[0] // SUPPORT_BLOCK), dtype=np.bool_),
     )
     per_polar[n_a] = tables
     return tables
@@ -154,8 +199,9 @@ def _support_table(
     vd: NDArray,
     beta: NDArray,
 ) -> tuple[NDArray, NDArray]:
-    """Largest speed component towards ``beta`` and its |TWA|, per TWS node (see
-    :class:`PolarTables`); grid maxima refined by a parabola through their neighbours."""
+    """Largest speed component towards ``beta`` and its |TWA|, per TWS node of
+    ``speed``'s rows (see :class:`PolarTables`); grid maxima refined by a parabola
+    through their neighbours."""
     n_w, n_a = speed.shape
     cb, sb = np.cos(np.radians(beta)), np.sin(np.radians(beta))
     ca, sa = np.cos(np.radians(a)), np.sin(np.radians(a))
@@ -225,6 +271,16 @@ class _DeviceTables:
     # each polar's TWS nodes and their number, shape (P,); None: one polar
     node_start: Any = None
     node_count: Any = None
+    # the PolarTables whose sup_ms and sup_deg these are, filled on demand
+    # (support_rows); None: filled in full
+    lazy: PolarTables | None = None
+
+
+def support_rows(dev: _DeviceTables, node: Any) -> None:
+    """Fill the support rows ``node`` and ``node + 1`` of ``dev`` where still empty
+    (:meth:`PolarTables.fill_support`), before a lookup there."""
+    if dev.lazy is not None and node.shape[0]:
+        dev.lazy.fill_support(int(node.min()), int(node.max()) + 1)
 
 
 def stacked_tables(tabs: Sequence[PolarTables]) -> _DeviceTables:
@@ -234,7 +290,7 @@ def stacked_tables(tabs: Sequence[PolarTables]) -> _DeviceTables:
     first = tabs[0]
 
     def rows(name: str) -> NDArray:
-        return np.concatenate([getattr(t, name) for t in tabs], axis=0)
+        return np.concatenate([getattr(t.fill_support(), name) for t in tabs], axis=0)
 
     counts = np.array([t.tws_ms.shape[0] for t in tabs], dtype=np.int64)
     return _DeviceTables(
@@ -302,6 +358,10 @@ class PointPolars:
 
 
 def _device_tables(tab: PolarTables, xp: ModuleType) -> _DeviceTables:
+    """``tab`` in ``xp``: NumPy shares its arrays (the support rows filled on demand,
+    :func:`support_rows`), another module gets copies of the full tables."""
+    if xp is not np:
+        tab.fill_support()
     return _DeviceTables(
         xp.asarray(tab.twa_deg),
         xp.asarray(tab.cos_a),
@@ -315,6 +375,7 @@ def _device_tables(tab: PolarTables, xp: ModuleType) -> _DeviceTables:
         xp.asarray(tab.vmax_ms),
         xp.asarray(tab.sup_ms),
         xp.asarray(tab.sup_deg),
+        lazy=tab if xp is np else None,
     )
 
 
@@ -328,6 +389,7 @@ def _support(
     """Polar support towards ``beta_deg`` (from the upwind direction, towards the side)
     at the table rows ``node, weight``: the best speed component [m s⁻¹] and its |TWA|
     [°], interpolated bilinearly in (TWS, beta) from :attr:`PolarTables.sup_ms`."""
+    support_rows(dev, node)
     pos = (beta_deg + 180.0) * (dev.sup_ms.shape[1] - 1) / 360.0
     col = clip(xp.floor(pos).astype(xp.int64), 0, dev.sup_ms.shape[1] - 2, xp=xp)
     frac = clip(pos - col, 0.0, 1.0, xp=xp)

@@ -130,9 +130,10 @@ class IsochroneSettings:
     engine : {"auto", "numpy", "numba"}
         Kernels of a step: ``"numba"`` compiled (``sailroute/routing/isochrone_jit.py``,
         the extra ``fast``), ``"numpy"`` NumPy calls, ``"auto"`` compiled where numba is
-        installed and the work pays for its start-up (an ensemble, or a process that has
-        routed a while: :func:`~sailroute.routing.isochrone_fast.compiled`).  The routes
-        are the same bit for bit.
+        installed and the work pays for its start-up (an ensemble, a process that has
+        routed a while, or kernels already in numba's cache:
+        :func:`~sailroute.routing.isochrone_fast.compiled`).  The routes are the same
+        bit for bit.
     """
 
     FLAT: ClassVar[Mapping[str, str]] = {

@@ -606,6 +606,22 @@ def test_polar_tables_are_cached_and_consistent():
     assert np.interp(TWS, a.tws_ms, a.up_deg) == pytest.approx(A_UP, abs=0.05)
 
 
+def test_support_rows_are_filled_on_demand_as_the_whole_table_would_be():
+    from sailroute.routing.isochrone_polar import SUPPORT_BLOCK, _support_table
+
+    a = polar_tables(laser_like_polar(), 3.0)  # a new polar object: new tables
+    assert not a.sup_ready.any() and np.isnan(a.sup_ms).all()
+    a.fill_support(2 * SUPPORT_BLOCK + 5, 2 * SUPPORT_BLOCK + 6)  # one block only
+    filled = np.isfinite(a.sup_ms).all(axis=1)
+    assert filled[2 * SUPPORT_BLOCK : 3 * SUPPORT_BLOCK].all() and filled.sum() == SUPPORT_BLOCK
+    full = _support_table(
+        a.twa_deg, a.speed_ms, a.up_deg, a.down_deg, a.up_vmg_ms, a.down_vmg_ms, a.sup_beta_deg
+    )
+    assert a.fill_support() is a and a.sup_ready.all()
+    np.testing.assert_array_equal(a.sup_ms, full[0])
+    np.testing.assert_array_equal(a.sup_deg, full[1])
+
+
 # --- errors --------------------------------------------------------------------------
 
 

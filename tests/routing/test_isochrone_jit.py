@@ -14,6 +14,7 @@ polar, a full heading fan, a front capped at a few points, and members routed to
 from __future__ import annotations
 
 import dataclasses
+import sys
 
 import numpy as np
 import pytest
@@ -179,10 +180,67 @@ def test_the_engine_setting_is_checked_and_numba_can_be_missing(monkeypatch):
 def test_auto_compiles_for_members_and_after_enough_numpy_steps(monkeypatch):
     monkeypatch.setattr(isochrone_fast._Usage, "kernels", None)
     monkeypatch.setattr(isochrone_fast._Usage, "numpy_s", 0.0)
+    monkeypatch.setattr(isochrone_fast._Usage, "cached", False)
     auto = with_engine(SET, "auto")
-    assert not isochrone_fast.compiled(auto, np)  # one plan: NumPy (numba's start-up)
+    assert not isochrone_fast.compiled(auto, np)  # one plan, nothing compiled: NumPy
     assert isochrone_fast.compiled(auto, np, members=2)  # a batch pays for it
     assert not isochrone_fast.compiled(with_engine(SET, "numpy"), np, members=2)
     monkeypatch.setattr(isochrone_fast._Usage, "numpy_s", isochrone_fast.JIT_AFTER_S)
     assert isochrone_fast.compiled(auto, np)
     assert not isochrone_fast.compiled(auto, object())  # another array module
+    monkeypatch.setattr(isochrone_fast._Usage, "numpy_s", 0.0)
+    monkeypatch.setattr(isochrone_fast._Usage, "cached", True)
+    assert isochrone_fast.compiled(auto, np)  # compiled before: loading them pays
+
+
+def test_kernels_count_as_cached_only_when_every_step_kernel_is_in_numbas_index(
+    monkeypatch, tmp_path
+):
+    from sailroute.routing import isochrone_jit
+
+    both(LINE, MARK, UniformWind(4.4, 0.0), SET)  # compiles the step kernels, or loads them
+    with monkeypatch.context() as m:
+        m.setattr(isochrone_fast, "_numba_bytecode", lambda: True)
+        assert isochrone_fast._step_kernels_in_cache()
+        stale = getattr(isochrone_jit, isochrone_fast.STEP_KERNELS[-1])._cache._cache_file
+        m.setattr(stale, "_load_index", dict)  # numba's answer for a stale index
+        assert not isochrone_fast._step_kernels_in_cache()
+    with monkeypatch.context() as m:
+        m.setattr(isochrone_fast, "_numba_bytecode", lambda: True)
+        m.delenv("NUMBA_CACHE_DIR", raising=False)
+        m.setattr(isochrone_fast, "_PYCACHE", tmp_path)  # nothing compiled there
+        assert isochrone_fast._cache_folder() == tmp_path
+        assert not isochrone_fast._step_kernels_in_cache()
+    with monkeypatch.context() as m:
+        m.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # numba's own rule for the folder
+        sub = numba.core.caching._CacheLocator.get_suitable_cache_subpath(isochrone_jit.__file__)
+        assert isochrone_fast._cache_folder() == tmp_path / sub
+        assert not isochrone_fast._step_kernels_in_cache()
+    with monkeypatch.context() as m:
+        m.setattr(sys, "pycache_prefix", str(tmp_path))  # no .pyc of numba: from source
+        assert not isochrone_fast._numba_bytecode()
+        assert not isochrone_fast._step_kernels_in_cache()
+
+
+def test_numba_starts_with_the_collector_paused_and_leaves_it_as_it_was(monkeypatch):
+    import gc
+
+    import sailroute.jit
+    from sailroute.routing import isochrone_jit
+
+    real, seen = sailroute.jit.load_registries, []
+
+    def load() -> None:
+        seen.append(gc.isenabled())
+        real()
+
+    monkeypatch.setattr(sailroute.jit, "load_registries", load)
+    for enabled in (True, False):
+        monkeypatch.setattr(isochrone_fast._Usage, "kernels", None)
+        (gc.enable if enabled else gc.disable)()
+        try:
+            assert isochrone_fast.kernels() is isochrone_jit
+            assert gc.isenabled() is enabled
+        finally:
+            gc.enable()
+    assert seen == [False, False]
