@@ -67,9 +67,10 @@ Pinching, footing, banking
 ``sailing`` gives a boat of the draw a :class:`Sailing` (recorded in
 :attr:`BoatTruth.upwind_twa_offset_deg` and :attr:`BoatTruth.bank`).  A boat that
 pinches or foots is routed with its own polar (:func:`offset_polar`), whose best upwind
-VMG lies ``upwind_twa_offset_deg`` off the class polar's, at the class polar's speed there.  A boat that banks on a side is routed up the first beat in two pieces, to its
-side's waypoint (:func:`bank_waypoint`) on the tack to that side and from there to the
-mark, joined into one leg; the router otherwise knows the wind and would go where it pays.
+VMG lies ``upwind_twa_offset_deg`` off the class polar's, at the class polar's speed there.
+A boat that banks on a side is routed up the first beat in two pieces, to its side's
+waypoint (:func:`bank_waypoint`) on the tack to that side and from there to the mark,
+joined into one leg; the router otherwise knows the wind and would go where it pays.
 ``wind_fields`` sets :class:`FleetWind` fields after the draw (a wind without oscillation,
 a persistent shift over the first beat).  Neither draws anything: every other boat, and
 the whole fleet without them, comes out as it did, bit for bit.
