@@ -138,7 +138,7 @@ from sailroute.course.model import Course
 from sailroute.course.templates import CourseLayout, windward_leeward
 from sailroute.geo import LocalFrame
 from sailroute.routing.batch import route_leg_batch
-from sailroute.routing.geometry import chain_leg, target_geometry
+from sailroute.routing.geometry import chain_leg, start_centre, target_geometry
 from sailroute.routing.settings import IsochroneSettings, RoutingSettings
 from sailroute.routing.types import (
     LegResult,
@@ -453,11 +453,7 @@ def bank_waypoint(course: Course, polar: Polar, wind: FleetWind, bank: Bank) -> 
     up the course, on the close-hauled course from the start line's centre in the mean
     wind (``wind.twd_deg ∓ α*``), a point the router passes."""
     start, target = leg_endpoints(course, 0)
-    c = (
-        start.a
-        if start.b is None
-        else ((start.a[0] + start.b[0]) / 2, (start.a[1] + start.b[1]) / 2)
-    )
+    c = start_centre(start)
     alpha = float(polar.vmg_upwind(wind.tws_ms)[0])
     ax, ay = _unit(wind.axis_deg)
     up = (target.centre[0] - c[0]) * ax + (target.centre[1] - c[1]) * ay
@@ -670,11 +666,7 @@ class Fleet:
         :func:`~sailroute.course.geometry.wind_mode` tells them.
         """
         start, target = leg_endpoints(self.course, leg)
-        a = (
-            start.a
-            if start.b is None
-            else ((start.a[0] + start.b[0]) / 2, (start.a[1] + start.b[1]) / 2)
-        )
+        a = start_centre(start)
         if t is None:
             mids = [
                 0.5 * (b.legs[leg].t_start + b.legs[leg].t_end)
