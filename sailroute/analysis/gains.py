@@ -101,8 +101,8 @@ REFERENCES: Final = ("median", "top3")
 BIN_DEG: Final = 5.0
 """Width of the TWA bins of the fleet's speed curve [°]."""
 BIN_MIN_SAMPLES: Final = 10
-"""A TWA bin needs this many points (and a third of the fleet's boats, at least 2) to
-have a ratio of its own."""
+"""A TWA bin needs this many points (and a third of the fleet's boats, at least 2, with
+their median angle on a tack in it) to have a ratio of its own."""
 TOP: Final = 3
 """Boats in the leg's top group."""
 
