@@ -62,6 +62,19 @@ fix interval of the truth and over 95 % within two (seeds 0-2); without the erro
 Fixes, error and SOG/COG come from their own random stream (``[seed, 1]``), so a fleet
 recorded again with another lag or without error keeps every other draw.
 
+Pinching, footing, banking
+--------------------------
+``sailing`` gives a boat of the draw a :class:`Sailing` (recorded in
+:attr:`BoatTruth.upwind_twa_offset_deg` and :attr:`BoatTruth.bank`).  A boat that
+pinches or foots is routed with its own polar (:func:`offset_polar`), whose best upwind
+VMG lies ``upwind_twa_offset_deg`` off the class polar's, at the class polar's speed there.
+A boat that banks on a side is routed up the first beat in two pieces, to its side's
+waypoint (:func:`bank_waypoint`) on the tack to that side and from there to the mark,
+joined into one leg; the router otherwise knows the wind and would go where it pays.
+``wind_fields`` sets :class:`FleetWind` fields after the draw (a wind without oscillation,
+a persistent shift over the first beat).  Neither draws anything: every other boat, and
+the whole fleet without them, comes out as it did, bit for bit.
+
 Faults (each on its own boats, recorded in :attr:`BoatTruth.faults`)
 -------------------------------------------------------------------
 ``non_starter``
@@ -111,7 +124,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Final
+from typing import Any, Final, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -125,9 +138,17 @@ from sailroute.course.model import Course
 from sailroute.course.templates import CourseLayout, windward_leeward
 from sailroute.geo import LocalFrame
 from sailroute.routing.batch import route_leg_batch
-from sailroute.routing.geometry import chain_leg, target_geometry
+from sailroute.routing.geometry import chain_leg, start_centre, target_geometry
 from sailroute.routing.settings import IsochroneSettings, RoutingSettings
-from sailroute.routing.types import LegResult, Manoeuvre, Side, Start, Target
+from sailroute.routing.types import (
+    LegResult,
+    Manoeuvre,
+    RouteTrack,
+    Side,
+    Start,
+    Target,
+    side_name,
+)
 from sailroute.timeutil import iso, parse_time, to_epoch
 from sailroute.track.model import Track
 from sailroute.units import KNOT, bearing_deg, heading_unit, wrap180
@@ -368,6 +389,79 @@ class Fault:
             object.__setattr__(self, "params", MappingProxyType(dict(self.params)))
 
 
+# ------------------------------------------------------------------------------ how a boat sails
+
+Bank = Literal["left", "right"]
+"""A side of the course, looking upwind."""
+BANK_TACK: Final[Mapping[Bank, Side]] = MappingProxyType({"left": "starboard", "right": "port"})
+"""The tack that sails to each side."""
+PEAK_SLOPE: Final = 0.004
+"""How fast the VMG of a pinching or footing boat's polar falls off either side of its
+angle [per °] (:func:`offset_polar`): enough for the router to hold the angle, too little to
+touch the reaching angles."""
+BANK_HEIGHT: Final = 0.45
+"""How far up the first beat a banking boat's waypoint lies [-] (:func:`bank_waypoint`)."""
+
+
+@dataclass(frozen=True)
+class Sailing:
+    """How one boat sails besides its skill and manoeuvre class (the defaults: as routed).
+
+    Attributes
+    ----------
+    upwind_twa_offset_deg : float
+        It sails its beats this many degrees of TWA off the polar's best VMG angle, at the
+        polar's speed for that angle (:func:`offset_polar`): − pinches, + foots [°].  At
+        its other angles below 90° it is slower than the class polar (its VMG capped below
+        its own best): sent elsewhere than up the wind (a banking boat to its waypoint,
+        a boat reaching in to a mark from beyond the layline) it loses speed as well.
+    bank : {"left", "right"} or None
+        It sails its first beat close-hauled from its start to a waypoint on that side
+        (:func:`bank_waypoint`; on starboard to the left, on port to the right) before the
+        router takes it on to the windward mark; None: the router's choice all the way.
+    """
+
+    upwind_twa_offset_deg: float = 0.0
+    bank: Bank | None = None
+
+
+def offset_polar(polar: Polar, offset_deg: float, slope: float = PEAK_SLOPE) -> Polar:
+    """The polar of a boat that pinches (``offset_deg`` < 0) or foots (> 0) upwind.
+
+    At each TWS column its best upwind VMG lies at ``θ_t = α* + offset_deg`` (``α*`` the
+    class polar's best VMG angle) with the class polar's speed there; elsewhere below 90°
+    its VMG is the class polar's, capped at ``VMG(θ_t) (1 − slope |θ − θ_t|)``, so that
+    the router sails ``θ_t``.  Tabulated every 0.5° of TWA on the class polar's TWS columns
+    (the same interpolation): on a column ``θ_t`` holds to 0.5°; between two columns the peak
+    is the interpolation's (3° off at 4.5 m s⁻¹ for the ILCA 7, whose best angle moves
+    from 42° to 38.5° between its 8 and 9 kn columns).
+    """
+    twa = np.linspace(0.0, 180.0, 361)
+    tws = polar.tws_ms
+    alpha = np.asarray(polar.vmg_upwind(tws)[0], float) + offset_deg
+    spd = polar.speed(tws[None, :], twa[:, None])
+    v_t = polar.speed(tws, alpha) * np.cos(np.radians(alpha))
+    up = twa < 90.0
+    cos = np.cos(np.radians(twa[up]))[:, None]
+    cap = v_t[None, :] * np.clip(1.0 - slope * np.abs(twa[up, None] - alpha[None, :]), 0.0, 1.0)
+    spd[up] = np.minimum(spd[up], cap / cos)
+    return Polar.from_arrays(twa, tws, spd, f"{polar.name} {offset_deg:+g}°", polar.interpolation)
+
+
+def bank_waypoint(course: Course, polar: Polar, wind: FleetWind, bank: Bank) -> Target:
+    """The waypoint of a boat banking on ``bank``: :data:`BANK_HEIGHT` of the first beat
+    up the course, on the close-hauled course from the start line's centre in the mean
+    wind (``wind.twd_deg ∓ α*``), a point the router passes."""
+    start, target = leg_endpoints(course, 0)
+    c = start_centre(start)
+    alpha = float(polar.vmg_upwind(wind.tws_ms)[0])
+    ax, ay = _unit(wind.axis_deg)
+    up = (target.centre[0] - c[0]) * ax + (target.centre[1] - c[1]) * ay
+    d = BANK_HEIGHT * up / math.cos(math.radians(alpha))
+    ux, uy = _unit(wind.twd_deg - alpha if bank == "left" else wind.twd_deg + alpha)
+    return Target("mark", (c[0] + d * ux, c[1] + d * uy), name=f"bank {bank}")
+
+
 # ------------------------------------------------------------------------------ truth
 
 
@@ -427,6 +521,10 @@ class BoatTruth:
     path_t, path_x, path_y : ndarray
         The true path [epoch s, m, m] (pre-start, legs, after the finish), linear between
         points; the track's fixes are taken on it.
+    upwind_twa_offset_deg : float
+        Its beats sailed this far off the best VMG angle [°] (:class:`Sailing`; − pinches).
+    bank : {"left", "right"} or None
+        The side it banked on up the first beat (:class:`Sailing`).
     """
 
     name: str
@@ -454,6 +552,8 @@ class BoatTruth:
     path_t: NDArray[np.float64]
     path_x: NDArray[np.float64]
     path_y: NDArray[np.float64]
+    upwind_twa_offset_deg: float = 0.0
+    bank: Bank | None = None
 
     @property
     def kinds(self) -> tuple[str, ...]:
@@ -566,11 +666,7 @@ class Fleet:
         :func:`~sailroute.course.geometry.wind_mode` tells them.
         """
         start, target = leg_endpoints(self.course, leg)
-        a = (
-            start.a
-            if start.b is None
-            else ((start.a[0] + start.b[0]) / 2, (start.a[1] + start.b[1]) / 2)
-        )
+        a = start_centre(start)
         if t is None:
             mids = [
                 0.5 * (b.legs[leg].t_start + b.legs[leg].t_end)
@@ -614,6 +710,7 @@ class Fleet:
                 "faults": [
                     {"kind": f.kind, **{k: val(v) for k, v in f.params.items()}} for f in b.faults
                 ],
+                **_styled(b),
             }
             for b in self.boats
         }
@@ -669,6 +766,17 @@ class Fleet:
         writer = {"gpx": write_gpx, "csv": write_csv}[fmt]
         paths = [writer(d / f"{tr.name}.{fmt}", tr) for tr in self.tracks]
         return course, paths
+
+
+def _styled(b: BoatTruth) -> dict[str, Any]:
+    """A boat's :class:`Sailing` in the truth's JSON: only what differs from the default
+    (a fleet without styles keeps its JSON)."""
+    out: dict[str, Any] = {}
+    if b.upwind_twa_offset_deg:
+        out["upwind_twa_offset_deg"] = b.upwind_twa_offset_deg
+    if b.bank is not None:
+        out["bank"] = b.bank
+    return out
 
 
 # ------------------------------------------------------------------------------ writers
@@ -841,6 +949,8 @@ class _Plan:
     tack: int
     side: Side | None
     overrides: Mapping[int, Target] = field(default_factory=lambda: MappingProxyType({}))
+    twa_offset: float = 0.0
+    bank: Bank | None = None
 
     def tau(self, t: float) -> float:
         """Dilated time of true time ``t``."""
@@ -1012,10 +1122,72 @@ class Routed:
         return out
 
 
-def _group_key(p: _Plan, i: int) -> tuple[int, Side | None, str]:
-    """Boats routed in one front share the penalties, on the first leg the first tack, and
-    the target (a boat with its own target is routed alone)."""
-    return (p.tack, p.side if i == 0 else None, p.key if i in p.overrides else "")
+GroupKey = tuple[int, Side | None, str, float, Bank | None]
+"""What the boats routed in one front share (:func:`_group_key`)."""
+
+
+def _group_key(p: _Plan, i: int) -> GroupKey:
+    """Boats routed in one front share the penalties, on the first leg the first tack and
+    the side they bank on, the target (a boat with its own target is routed alone) and the
+    polar (its upwind TWA offset)."""
+    return (
+        p.tack,
+        p.side if i == 0 else None,
+        p.key if i in p.overrides else "",
+        p.twa_offset,
+        p.bank if i == 0 else None,
+    )
+
+
+def _joined(a: LegResult, b: LegResult) -> LegResult:
+    """Two routed pieces of one leg as one leg (``b`` starts where ``a`` ends)."""
+    ta, tb = a.track, b.track
+    skip = 1 if tb.t[0] <= ta.t[-1] + 1e-9 else 0
+
+    def cat(name: str) -> Any:
+        u, v = getattr(ta, name), getattr(tb, name)
+        return None if u is None or v is None else np.concatenate([u, v[skip:]])
+
+    track = RouteTrack(**{f.name: cat(f.name) for f in dataclasses.fields(RouteTrack)})
+    return dataclasses.replace(
+        b,
+        t_start=a.t_start,
+        start_xy=a.start_xy,
+        distance_m=a.distance_m + b.distance_m,
+        n_tacks=a.n_tacks + b.n_tacks,
+        n_gybes=a.n_gybes + b.n_gybes,
+        manoeuvres=a.manoeuvres + b.manoeuvres,
+        track=track,
+    )
+
+
+def _banked(
+    starts: Sequence[Start],
+    way: Target,
+    target: Target,
+    t0s: Sequence[float],
+    winds: Sequence[DilatedWind],
+    polar: Polar,
+    settings: RoutingSettings,
+) -> list[LegResult]:
+    """A first leg routed to the waypoint ``way`` and from there to ``target``, joined
+    (:func:`_joined`); the second piece starts on the tack the first ended on, so a tack at
+    the waypoint costs its penalty."""
+    first = route_leg_batch(starts, way, t0s, winds, polar, settings)
+    out: dict[int, LegResult] = {}
+    ends = [int(leg.track.side[-1]) for leg in first]
+    for sd in sorted(set(ends)):
+        idx = [k for k, e in enumerate(ends) if e == sd]
+        res = route_leg_batch(
+            [Start(first[k].end_xy, None, "start") for k in idx],
+            target,
+            [first[k].t_end for k in idx],
+            [winds[k] for k in idx],
+            polar,
+            dataclasses.replace(settings, initial_side=side_name(sd)),
+        )
+        out.update({k: _joined(first[k], leg) for k, leg in zip(idx, res, strict=True)})
+    return [out[k] for k in range(len(first))]
 
 
 def route_plans(
@@ -1034,13 +1206,15 @@ def route_plans(
     done: dict[str, list[LegResult]] = {p.key: [] for p in plans}  # dilated time
     turns: dict[str, list[Rounding]] = {p.key: [] for p in plans}  # dilated time
     winds = {p.key: wind.dilated(p.gun, p.skill) for p in plans}
+    polars = {p.twa_offset: offset_polar(polar, p.twa_offset) for p in plans if p.twa_offset}
+    polars[0.0] = polar
     for i in range(n):
         following = target_of(course, i + 1) if i + 1 < n else None
         ends = leg_endpoints(course, i)
-        groups: dict[tuple[int, Side | None, str], list[_Plan]] = {}
+        groups: dict[GroupKey, list[_Plan]] = {}
         for p in plans:
             groups.setdefault(_group_key(p, i), []).append(p)
-        for (tack, side, own), members in groups.items():
+        for (tack, side, own, offset, bank), members in groups.items():
             target = (
                 members[0].overrides[i]
                 if own
@@ -1063,9 +1237,12 @@ def route_plans(
                 gybe_penalty_s=TACK_CLASSES[tack][1],
                 initial_side=side,
             )
-            res = route_leg_batch(
-                starts, target, t0s, [winds[p.key] for p in members], polar, settings
-            )
+            felt = [winds[p.key] for p in members]
+            if bank is None:
+                res = route_leg_batch(starts, target, t0s, felt, polars[offset], settings)
+            else:
+                way = bank_waypoint(course, polar, wind, bank)
+                res = _banked(starts, way, target, t0s, felt, polars[offset], settings)
             for p, leg in zip(members, res, strict=True):
                 done[p.key].append(leg)
                 if i + 1 < n:
@@ -1245,6 +1422,8 @@ class _Boat:
     side: Side | None
     frac: float
     sample_s: float
+    twa_offset: float = 0.0
+    bank: Bank | None = None
 
 
 @dataclass(frozen=True)
@@ -1378,7 +1557,17 @@ def _draw_start(race: _Race, b: _Boat, rng: np.random.Generator, key: str, gun: 
         t0 = head[-1][0] + 10.0 + _dist(q, race.line.point(a)) / LOITER_MS + approach
     else:
         t0 = gun + 0.5 + min(abs(float(rng.normal(0.0, 2.5))), 8.0)
-    plan = _Plan(key, gun, t0, race.line.point(a), b.skill, b.tack, b.side)
+    plan = _Plan(
+        key,
+        gun,
+        t0,
+        race.line.point(a),
+        b.skill,
+        b.tack,
+        b.side,
+        twa_offset=b.twa_offset,
+        bank=b.bank,
+    )
     return _Drawn(b, plan, tuple(head), approach, ocs_s, returned)
 
 
@@ -1705,6 +1894,8 @@ def _truth(d: _Drawn, s: _Sailed, race: _Race, name: str, n_legs: int) -> BoatTr
         path_t=kt,
         path_x=kx,
         path_y=ky,
+        upwind_twa_offset_deg=b.twa_offset,
+        bank=b.bank,
     )
 
 
@@ -1724,6 +1915,8 @@ def messy_fleet(
     gun: float = GUN,
     centre: tuple[float, float] = CENTRE,
     router: RoutingSettings = ROUTER,
+    sailing: Mapping[int, Sailing] | None = None,
+    wind_fields: Mapping[str, float] | None = None,
 ) -> Fleet:
     """Sail a fleet and record it (module docstring).
 
@@ -1759,6 +1952,13 @@ def messy_fleet(
         Course centre ``(lat, lon)`` [°].
     router : RoutingSettings
         Router settings (the penalties and first tack are set per group).
+    sailing : mapping of int to Sailing, optional
+        How boat ``k`` of the draw sails (0: the best boat; the others in the order drawn,
+        faults included); a banking boat starts on the tack to its side.  Nothing else is
+        drawn differently.
+    wind_fields : mapping of str to float, optional
+        :class:`FleetWind` fields set after the wind is drawn (``{"osc_amp_deg": 0.0,
+        "shift_deg": 12.0, "shift_start_s": 60.0}``); the other draws stay as they are.
     """
     plan = FaultPlan() if faults is None else faults
     rng = np.random.default_rng(seed)
@@ -1776,6 +1976,8 @@ def messy_fleet(
         tws_phase=float(rng.uniform(0.0, 2.0 * math.pi)),
         pressure_left=pressure_left,
     )
+    if wind_fields:
+        wind = dataclasses.replace(wind, **wind_fields)
     lay = layout(twd, _leg_length(polar, wind.tws_ms, minutes, laps), laps)
     marks = lay.marks
     data = course_mapping(
@@ -1785,6 +1987,13 @@ def messy_fleet(
     first_gun = gun - plan.recall_s if plan.general_recall else None
     race = _Race(course, _line_of(marks), wind, polar, plan, gun, first_gun, marks)
     boats = _draw_boats(rng, n_boats, plan, sample_s)
+    for k, how in (sailing or {}).items():
+        boats[k] = dataclasses.replace(
+            boats[k],
+            twa_offset=float(how.upwind_twa_offset_deg),
+            bank=how.bank,
+            side=boats[k].side if how.bank is None else BANK_TACK[how.bank],
+        )
     drawn = [_draw_start(race, b, rng, b.name, gun) for b in boats]
     gun2 = gun + 60.0 * math.ceil(1.3 * minutes + 15.0)
     second = {

@@ -31,9 +31,15 @@ measured on the points outside the manoeuvre windows (time means over them, ``θ
 signed TWA from COG in the wind the leg was judged in, ``ω`` the wind's direction minus the
 axis's bearing, so that progress per second is ``SOG cos(ω − θ)``).  The fleet's speed at a
 TWA is ``f(θ) = g(|θ|) · polar(TWS, |θ|)``: the polar scaled, per 5° of TWA, by the
-fleet's median ``SOG / polar`` there (bins sailed by too few boats take the leg's median
-ratio), so that a change of TWS along the leg is the polar's.  The fleet's angle ``θ_σ``
-on each tack ``σ`` is the median over the boats of their median ``|θ|`` on it.
+median ``SOG / polar`` of the boats whose median ``|θ|`` on a tack lies in that bin (their
+points on that tack; bins held by fewer than a third of the boats take the leg's median
+ratio), so that a change of TWS along the leg is the polar's.  ``f`` is read at a boat's
+median angle on each tack, so it is measured there: binned point by point instead, the
+points whose angle noise puts them at 32° while their boats sail 42° (at the speed of 42°)
+would set the fleet's speed at 32°, and a boat that pinches to 32° at the polar's speed
+would show a speed loss and a height gain (docs/analysis.md, "Gains on the fleet").  The
+fleet's angle ``θ_σ`` on each tack ``σ`` is the median over the boats of their median
+``|θ|`` on it.
 
 * ``P1 = ⟨f(θ) cos(ω − θ)⟩``: the boat's angles and wind at the fleet's speed;
 * ``P2 = ⟨f(σ θ_σ) cos(ω − σ θ_σ)⟩``: the fleet's angle on the boat's tack, in the wind
@@ -95,8 +101,8 @@ REFERENCES: Final = ("median", "top3")
 BIN_DEG: Final = 5.0
 """Width of the TWA bins of the fleet's speed curve [°]."""
 BIN_MIN_SAMPLES: Final = 10
-"""A TWA bin needs this many points (and a third of the fleet's boats, at least 2) to
-have a ratio of its own."""
+"""A TWA bin needs this many points (and a third of the fleet's boats, at least 2, with
+their median angle on a tack in it) to have a ratio of its own."""
 TOP: Final = 3
 """Boats in the leg's top group."""
 
@@ -305,32 +311,36 @@ def _leg_measures(
         else ~manoeuvre_mask(p["t"], np.array([m.t for m in a.legs[i].manoeuvres]))
         for a, p in zip(analyses, pts, strict=True)
     ]
-    # the fleet's speed curve: median SOG / polar per TWA bin, over the ranked boats
+    # the fleet's speed curve: median SOG / polar per TWA bin, over the ranked boats, each
+    # boat's points on a tack in the bin of its median angle on that tack (where f is read)
     nbins = math.ceil(180.0 / BIN_DEG)
     ratios: list[list[NDArray]] = [[] for _ in range(nbins)]
+    owners: list[set[int]] = [set() for _ in range(nbins)]
     boat_angle: list[list[float]] = [[], []]
     for k, (p, s) in enumerate(zip(pts, straight, strict=True)):
         if p is None or s is None or not rank[k]:
             continue
         ok = s & np.isfinite(p["polar_ms"]) & (p["polar_ms"] > POLAR_MIN_MS)
         ab = np.abs(p["twa_deg"])
-        b = np.minimum((ab / BIN_DEG).astype(int), nbins - 1)
-        for j in np.unique(b[ok]):
-            sel = ok & (b == j)
-            ratios[int(j)].append(p["sog_ms"][sel] / p["polar_ms"][sel])
         for side, sign in enumerate((-1.0, 1.0)):
             on = s & (np.sign(p["twa_deg"]) == sign)
-            if on.sum() >= 3:
-                boat_angle[side].append(float(np.median(ab[on])))
+            if on.sum() < 3:
+                continue
+            boat_angle[side].append(float(np.median(ab[on])))
+            sel = on & ok
+            if sel.any():
+                j = min(int(boat_angle[side][-1] / BIN_DEG), nbins - 1)
+                ratios[j].append(p["sog_ms"][sel] / p["polar_ms"][sel])
+                owners[j].add(k)
     n_ref = max(2, math.ceil(int(rank.sum()) / 3))
     everything = [r for rs in ratios for r in rs]
     g0 = float(np.median(np.concatenate(everything))) if everything else 1.0
     g = np.array(
         [
             float(np.median(np.concatenate(rs)))
-            if len(rs) >= n_ref and sum(r.size for r in rs) >= BIN_MIN_SAMPLES
+            if len(who) >= n_ref and sum(r.size for r in rs) >= BIN_MIN_SAMPLES
             else g0
-            for rs in ratios
+            for rs, who in zip(ratios, owners, strict=True)
         ]
     )
     ang = np.array([float(np.median(v)) if v else math.nan for v in boat_angle])

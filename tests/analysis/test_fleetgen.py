@@ -40,7 +40,10 @@ from tests.fleetgen import (
     FaultPlan,
     Fleet,
     FleetWind,
+    Sailing,
+    bank_waypoint,
     messy_fleet,
+    offset_polar,
     shared_fleet,
 )
 
@@ -627,3 +630,69 @@ def test_a_gybing_class_runs_at_its_best_downwind_angle(tmp_path) -> None:
     course, _ = f.write(tmp_path)
     assert load_course(course).boat_spec == {"polar": polar.name}
     assert (tmp_path / polar.name).read_bytes() == polar.read_bytes()
+
+
+# --- how a boat sails: pinching, footing, banking -----------------------------------------
+
+
+@pytest.mark.parametrize("offset", [-10.0, -4.0, 6.0, 10.0])
+def test_an_offset_polar_peaks_off_the_best_angle_at_the_polars_speed(offset: float) -> None:
+    p = messy_fleet(0, n_boats=2, minutes=10, faults=CLEAN).polar
+    q = offset_polar(p, offset)
+    tws = p.tws_ms[[3, 6, 9, 12]]  # on its columns (between them: the interpolation's peak)
+    best = p.vmg_upwind(tws)[0]
+    a, _ = q.vmg_upwind(tws)
+    assert np.allclose(a, best + offset, atol=0.5)
+    assert np.allclose(q.speed(tws, a), p.speed(tws, a), rtol=0.01)
+    # the reaches and the runs are the class polar's
+    for twa in (75.0, 110.0, 150.0, 175.0):
+        assert np.allclose(q.speed(tws, twa), p.speed(tws, twa), rtol=1e-3)
+
+
+@pytest.fixture(scope="module")
+def styled() -> Fleet:
+    """Four boats in a wind without oscillation: one pinches 10°, two bank."""
+    sailing = {1: Sailing(-10.0), 2: Sailing(bank="left"), 3: Sailing(bank="right")}
+    wind = {"osc_amp_deg": 0.0, "tws_amp": 0.0}
+    return messy_fleet(3, n_boats=4, minutes=14, faults=CLEAN, sailing=sailing, wind_fields=wind)
+
+
+def test_a_styled_boat_sails_as_told(styled: Fleet) -> None:
+    by = {b.upwind_twa_offset_deg: b for b in styled.boats if b.bank is None}
+    assert set(by) == {0.0, -10.0}
+    best = float(styled.polar.vmg_upwind(styled.wind.tws_ms)[0])
+    for off, b in by.items():  # its beats at the best angle plus its offset
+        twa = np.abs(np.concatenate([b.legs[i].track.twa_deg for i in (0, 2)]))
+        assert float(np.median(twa[twa < 90.0])) == pytest.approx(best + off, abs=1.0)
+    for b in styled.boats:
+        if b.bank is None:
+            continue
+        # it starts on the tack to its side and passes its waypoint up the first beat
+        way = bank_waypoint(styled.course, styled.polar, styled.wind, b.bank).a
+        tr = b.legs[0].track
+        assert b.first_side == ("starboard" if b.bank == "left" else "port")
+        assert float(np.min(np.hypot(tr.x - way[0], tr.y - way[1]))) < 25.0
+        # the tack sailed out to it: one board from the line
+        k = int(np.argmin(np.hypot(tr.x - way[0], tr.y - way[1])))
+        assert len(set(tr.side[1:k].tolist())) == 1
+    doc = styled.truth_json()["boats"]
+    assert {k for b in doc.values() for k in b} >= {"upwind_twa_offset_deg", "bank"}
+
+
+def test_a_fleet_without_styles_keeps_its_truth(clean: Fleet) -> None:
+    # the styles draw nothing: every other boat and the JSON stay as they were
+    assert all(b.upwind_twa_offset_deg == 0.0 and b.bank is None for b in clean.boats)
+    doc = clean.truth_json()["boats"]
+    assert not {k for b in doc.values() for k in b} & {"upwind_twa_offset_deg", "bank"}
+    styled = messy_fleet(
+        1, n_boats=10, minutes=25, faults=CLEAN, clock_lag_s=0.0, sailing={4: Sailing(-6.0)}
+    )
+    same = [b.name for b in clean.boats if b.name != styled.boats[0].name]
+    for name in [b.name for b in clean.boats]:
+        a, c = clean.truth(name), styled.truth(name)
+        assert (a.skill, a.tack_cost_s, a.start_fraction) == (
+            c.skill,
+            c.tack_cost_s,
+            c.start_fraction,
+        )
+    assert same
