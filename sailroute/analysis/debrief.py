@@ -14,6 +14,7 @@ adds reading, file output and the terminal table.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -33,6 +34,7 @@ from sailroute.analysis.loss import (
     time_mean,
 )
 from sailroute.analysis.manoeuvres import find_sailed_manoeuvres
+from sailroute.analysis.optimal import OptimalLeg, leg_start, route_one, route_together
 from sailroute.analysis.result import LegAnalysis, PointTable, TrackAnalysis
 from sailroute.analysis.segment import (
     DETECT_M,
@@ -50,11 +52,9 @@ from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.planning.route import default_scenario, settings_for
 from sailroute.progress import Progress
-from sailroute.routing.api import route_leg
-from sailroute.routing.geometry import target_barrier
-from sailroute.routing.obstacles import Obstacles, constraint_label, land_filled, obstacles_for
+from sailroute.routing.obstacles import Obstacles, constraint_label, obstacles_for
 from sailroute.routing.settings import RoutingSettings
-from sailroute.routing.types import LegResult, Start
+from sailroute.routing.types import LegResult
 from sailroute.track.kinematics import track_xy, velocity
 from sailroute.track.model import Track
 from sailroute.track.read import read_track
@@ -183,6 +183,140 @@ def analyze_track(
     RoutingError
         An optimal leg cannot be routed.
     """
+    prep = prepare_debrief(
+        course,
+        track,
+        scenario,
+        leg_times=leg_times,
+        router=router,
+        detect_m=detect_m,
+        built=built,
+        winds=winds,
+        missing=missing,
+        gate_end=gate_end,
+        wind=wind,
+        segmentation=segmentation,
+        clock=clock,
+    )
+    routed = [
+        None
+        if leg is None
+        else route_one(course, leg, prep.sources, prep.boat, prep.settings, progress)
+        for leg in prep.optimal
+    ]
+    return finish_debrief(prep, routed)
+
+
+def analyze_fleet(
+    prepared: Sequence[PreparedDebrief], progress: Progress | None = None
+) -> list[TrackAnalysis]:
+    """The debriefs of a fleet's prepared tracks (:func:`prepare_debrief`, one boat and
+    course): each leg's optimal routes of all boats routed as one front
+    (:func:`sailroute.analysis.optimal.route_together`), then each boat completed.
+
+    ``progress`` counts the boats: the legs routed together (share of the leg done, boats
+    arrived, the time left of the routing), then ``boat k of N done`` lines while the
+    boats are completed (about ten, with the time left).
+    """
+    if not prepared:
+        return []
+    first = prepared[0]
+    n = len(prepared)
+    if progress is not None:
+        progress.set_prefix("")
+        progress.start_count(n, "boat", together=True)
+    routed = route_together(
+        first.course,
+        [p.optimal for p in prepared],
+        [p.sources for p in prepared],
+        first.boat,
+        first.settings,
+        progress,
+    )
+    if progress is not None:
+        progress.start_count(n, "boat")
+    every = -(-n // 10)  # about ten lines
+    out = []
+    for k, (p, r) in enumerate(zip(prepared, routed, strict=True)):
+        out.append(finish_debrief(p, r))
+        if progress is not None and ((k + 1) % every == 0 or k + 1 == n):
+            progress.item_done(k + 1, p.track.name)
+    return out
+
+
+@dataclass(frozen=True)
+class PreparedDebrief:
+    """A track made ready for its debrief: all but the optimal legs
+    (:func:`prepare_debrief`; :func:`finish_debrief` completes it).
+
+    Attributes
+    ----------
+    course, track, scenario
+        The course, the track, the wind scenario's name.
+    settings, boat, design
+        The routing settings, the boat and the scenario's wind.
+    sources : tuple of WindSource
+        The candidate winds, best first.
+    t, x, y : arrays
+        The track's fixes [epoch s] in the course frame [m].
+    seg : Segmentation
+        Its start and leg ends.
+    svx, svy : arrays
+        The smoothed velocity [m/s].
+    chosen : tuple of int
+        Per leg, the source it is judged in.
+    manoeuvres : tuple of SailedManoeuvre
+        The tacks and gybes over the race.
+    optimal : tuple of OptimalLeg or None
+        Per leg, the optimal route to compute (None: the leg's start is unknown).
+    area_notes : tuple of str
+        Per leg, the note of a start inside the race area's clearances (or "").
+    """
+
+    course: Course
+    track: Track
+    scenario: str
+    settings: RoutingSettings
+    boat: Any
+    design: WindField
+    sources: tuple[WindSource, ...]
+    t: NDArray
+    x: NDArray
+    y: NDArray
+    seg: Segmentation
+    svx: NDArray
+    svy: NDArray
+    chosen: tuple[int, ...]
+    manoeuvres: tuple[Any, ...]
+    optimal: tuple[OptimalLeg | None, ...]
+    area_notes: tuple[str, ...]
+
+
+def prepare_debrief(
+    course: Course,
+    track: Track,
+    scenario: str | None = None,
+    *,
+    leg_times: Sequence[float | None] | None = None,
+    router: str | None = None,
+    detect_m: float = DETECT_M,
+    built: tuple[Any, WindField] | None = None,
+    winds: Sequence[WindSource] | None = None,
+    missing: str = "error",
+    gate_end: str = "line",
+    wind: str = "auto",
+    segmentation: Segmentation | None = None,
+    clock: StartClock | None = None,
+) -> PreparedDebrief:
+    """Everything :func:`analyze_track` does before routing the optimal legs (the same
+    parameters): the track projected and segmented, each leg's wind, the manoeuvres and
+    the optimal legs to route (:class:`~sailroute.analysis.optimal.OptimalLeg`).
+
+    Raises
+    ------
+    InputError, OutOfCoverageError
+        As :func:`analyze_track`.
+    """
     name = default_scenario(course) if scenario is None else scenario
     settings: RoutingSettings = settings_for(course, router)
     if built is None:
@@ -247,6 +381,54 @@ def analyze_track(
     mans, _ = find_sailed_manoeuvres(
         tr, twd_r, bearing_deg(svx[race], svy[race]), np.hypot(svx[race], svy[race])
     )
+    optimal: list[OptimalLeg | None] = []
+    area_notes: list[str] = []
+    for i, spec in enumerate(course.legs):
+        a, b = bounds[i], bounds[i + 1]
+        if not a.known:
+            optimal.append(None)
+            area_notes.append("")
+            continue
+        if b.known:  # routed in the leg's wind, then in the next covering its points
+            k, pts = chosen[i], _leg_points(t, x, y, a, b)
+        else:  # in the first wind from the leg's own on that covers its start
+            pts = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
+            found = first_covering(sources, *pts, skip=chosen[i] - 1)
+            k = len(sources) - 1 if found is None else found
+        leg_obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
+        start = leg_start(course, i, bounds, settings)
+        optimal.append(OptimalLeg(i, start, a.t, k, pts, leg_obstacles))
+        area_notes.append(area_note)
+    return PreparedDebrief(
+        course,
+        track,
+        name,
+        settings,
+        boat,
+        scen_wind,
+        tuple(sources),
+        t,
+        x,
+        y,
+        seg,
+        svx,
+        svy,
+        tuple(chosen),
+        tuple(mans),
+        tuple(optimal),
+        tuple(area_notes),
+    )
+
+
+def finish_debrief(
+    prep: PreparedDebrief, routed: Sequence[tuple[LegResult, WindSource] | None]
+) -> TrackAnalysis:
+    """The debrief of a prepared track (:func:`prepare_debrief`) given its optimal legs
+    (``routed``: per leg, the route and the wind it was routed in; None where
+    :attr:`PreparedDebrief.optimal` is None): the legs compared and the point table."""
+    course, t, x, y = prep.course, prep.t, prep.x, prep.y
+    svx, svy, sources, chosen = prep.svx, prep.svy, prep.sources, prep.chosen
+    bounds, boat, settings, mans = prep.seg.bounds, prep.boat, prep.settings, prep.manoeuvres
 
     legs: list[LegAnalysis] = []
     cols: dict[str, list[NDArray]] = {k: [] for k in _POINT_COLUMNS}
@@ -272,22 +454,18 @@ def analyze_track(
                 course,
                 i,
                 bounds,
-                sources,
-                chosen[i],
-                boat,
-                settings,
-                target,
+                sources[ask.k if (ask := prep.optimal[i]) is not None else chosen[i]],
+                routed[i],
                 centre,
-                progress,
-                obstacles=obstacles,
-                design=scen_wind,
+                prep.area_notes[i],
+                design=prep.design,
             )
             legs.append(leg)
             unknown = np.full(tl.size, np.nan)
             _add_points(cols, i, tl, xl, yl, sog, cog, tws, twd, twa, polar, unknown, unknown)
             continue
         src = sources[chosen[i]]
-        mode = source_leg_mode(course, i, src, scen_wind, a.t, (a.x, a.y), centre).mode
+        mode = source_leg_mode(course, i, src, prep.design, a.t, (a.x, a.y), centre).mode
         if mode == "upwind":
             vmg = sog * np.cos(np.radians(twa))
         elif mode == "downwind":
@@ -295,21 +473,11 @@ def analyze_track(
         else:
             ux, uy = centre[0] - xl, centre[1] - yl
             vmg = (vx * ux + vy * uy) / np.maximum(np.hypot(ux, uy), 1e-9)
-        # optimal route from the same point and time
-        leg_obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
-        opt, src = _optimal_leg(
-            course,
-            i,
-            bounds,
-            sources,
-            chosen[i],
-            (tl, xl, yl),
-            boat,
-            settings,
-            target,
-            progress,
-            obstacles=leg_obstacles,
-        )
+        # the optimal route from the same point and time
+        got = routed[i]
+        assert got is not None  # a known leg start: routed
+        opt, src = got
+        area_note = prep.area_notes[i]
         sailed = b.t - a.t
         loss = sailed - opt.time_s
         prog = axis_progress(xl, yl, (a.x, a.y), centre)
@@ -382,13 +550,13 @@ def analyze_track(
     )
     return TrackAnalysis(
         course,
-        track,
-        name,
+        prep.track,
+        prep.scenario,
         settings.router,
-        seg,
+        prep.seg,
         tuple(legs),
         points,
-        sources[chosen[0]].field if chosen else scen_wind,
+        sources[chosen[0]].field if chosen else prep.design,
     )
 
 
@@ -640,108 +808,28 @@ def _leg_area(
     )
 
 
-def _optimal_leg(
-    course: Course,
-    i: int,
-    bounds: Sequence[Crossing],
-    sources: Sequence[WindSource],
-    k: int,
-    points: tuple[NDArray, NDArray, NDArray],
-    boat: Any,
-    settings: RoutingSettings,
-    target: Any,
-    progress: Progress | None,
-    *,
-    obstacles: Obstacles | None = None,
-) -> tuple[LegResult, WindSource]:
-    """The optimal route of leg ``i`` from the boat's own leg start point and time.
-
-    Routed in ``sources[k]``, inside the race area's ``obstacles`` (the course's
-    boundary and obstacles, :func:`~sailroute.routing.obstacles.obstacles_for`); when
-    that wind ends before the optimal route does, in the next source that covers the
-    leg's sailed ``points``.
-    """
-    a = bounds[i]
-    barrier = None
-    if i > 0 and np.isfinite(bounds[i - 1].x):
-        prev_start = (bounds[i - 1].x, bounds[i - 1].y)
-        barrier = target_barrier(
-            leg_target(course, i - 1),
-            Start(prev_start, None, course.legs[i - 1].from_name),
-            settings.zone_m,
-        )
-    spec = course.legs[i]
-    start = Start((a.x, a.y), None, spec.from_name, barrier)
-    if progress is not None:
-        progress.start_leg(i, spec.label)
-    while True:
-        try:
-            opt = route_leg(
-                start,
-                target,
-                a.t,
-                land_filled(course.area, sources[k].for_routing),
-                boat,
-                settings,
-                progress=progress.update if progress is not None else None,
-                obstacles=obstacles,
-            )
-            if sources[k].route_field is not None:  # raises if the route crosses a hole
-                sources[k].field.sample(opt.track.t, opt.track.x, opt.track.y)
-            break
-        except OutOfCoverageError:
-            nxt = first_covering(sources, *points, skip=k)
-            if nxt is None:
-                raise
-            k = nxt
-    if progress is not None:
-        progress.end_leg(opt.time_s, f"{opt.n_tacks} tacks, {opt.n_gybes} gybes")
-    return opt, sources[k]
-
-
 def _unknown_leg(
     course: Course,
     i: int,
     bounds: Sequence[Crossing],
-    sources: Sequence[WindSource],
-    k: int,
-    boat: Any,
-    settings: RoutingSettings,
-    target: Any,
+    source: WindSource,
+    routed: tuple[LegResult, WindSource] | None,
     centre: tuple[float, float],
-    progress: Progress | None,
+    area_note: str,
     *,
-    obstacles: Obstacles | None = None,
     design: WindField | None = None,
 ) -> LegAnalysis:
     """A leg whose start or end time is unknown: no sailed time, loss or split; the
-    optimal route when the start is known."""
+    optimal route when the start is known (``routed``: the route and the wind it was
+    routed in; ``source``: the wind the leg is judged in, its mode from it)."""
     nan = float("nan")
     spec = course.legs[i]
     a, b = bounds[i], bounds[i + 1]
     opt = None
     mode = ""
-    area_note = ""
-    source = sources[k]
-    if a.known:
-        start_pt = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
-        found = first_covering(sources, *start_pt, skip=k - 1)
-        k = len(sources) - 1 if found is None else found
-        mode = source_leg_mode(course, i, sources[k], design, a.t, (a.x, a.y), centre).mode
-        obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
-        opt, source = _optimal_leg(
-            course,
-            i,
-            bounds,
-            sources,
-            k,
-            start_pt,
-            boat,
-            settings,
-            target,
-            progress,
-            obstacles=obstacles,
-        )
+    if routed is not None:
+        mode = source_leg_mode(course, i, source, design, a.t, (a.x, a.y), centre).mode
+        opt, source = routed
     note = (
         b.note
         if not b.known
@@ -885,13 +973,17 @@ def load_and_analyze(
 __all__ = [
     "LegAnalysis",
     "PointTable",
+    "PreparedDebrief",
     "TrackAnalysis",
     "analysis_winds",
+    "analyze_fleet",
     "analyze_track",
     "check_same_race",
+    "finish_debrief",
     "fleet_ranking",
     "fleet_reference",
     "load_and_analyze",
     "parse_boat_leg_times",
     "parse_leg_times",
+    "prepare_debrief",
 ]

@@ -16,9 +16,11 @@ from typing import Any
 from sailroute.analysis.debrief import (
     REFERENCES,
     analysis_winds,
+    analyze_fleet,
     analyze_track,
     fleet_reference,
     parse_boat_leg_times,
+    prepare_debrief,
 )
 from sailroute.analysis.fleet import FleetAnalysis
 from sailroute.analysis.result import TrackAnalysis
@@ -174,28 +176,38 @@ def run_analyze_command(
     )
 
     def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
-        out_a = []
-        for e in debriefed:
-            assert e.track is not None
-            if progress is not None:
-                progress.set_prefix(f"{e.name}: ")
+        if one:
+            assert debriefed[0].track is not None
             a = analyze_track(
                 course,
-                e.track,
+                debriefed[0].track,
                 name,
-                leg_times=times[e.name],
+                leg_times=times[debriefed[0].name],
                 router=router,
                 detect_m=detect_m,
                 built=(judged_by, winds[name]),
-                winds=sources[e.name],
+                winds=sources[debriefed[0].name],
                 progress=progress,
                 missing="error",
                 gate_end=gate_end,
-                segmentation=None if one else e.segmentation,
                 clock=StartClock.plain(tri.start.track_gun_t),
             )
-            out_a.append(replace(a, reference=label))
-        return out_a
+            return [replace(a, reference=label)]
+        prepared = []
+        for e in debriefed:
+            assert e.track is not None
+            prepared.append(
+                prepare_debrief(
+                    course,
+                    e.track,
+                    name,
+                    router=router,
+                    built=(judged_by, winds[name]),
+                    winds=sources[e.name],
+                    segmentation=e.segmentation,
+                )
+            )
+        return [replace(a, reference=label) for a in analyze_fleet(prepared, progress)]
 
     analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())
     if reference == "fleet":
