@@ -307,10 +307,13 @@ def prepare_debrief(
     wind: str = "auto",
     segmentation: Segmentation | None = None,
     clock: StartClock | None = None,
+    xy: tuple[NDArray, NDArray] | None = None,
 ) -> PreparedDebrief:
     """Everything :func:`analyze_track` does before routing the optimal legs (the same
     parameters): the track projected and segmented, each leg's wind, the manoeuvres and
     the optimal legs to route (:class:`~sailroute.analysis.optimal.OptimalLeg`).
+    ``xy``: the track's fixes already in the course frame [m] (a fleet's triage,
+    :attr:`~sailroute.analysis.triage.BoatEntry.xy`); default: projected here.
 
     Raises
     ------
@@ -332,7 +335,7 @@ def prepare_debrief(
     # the optimal legs keep inside the boundary and round the obstacles, as plan's do
     obstacles = obstacles_for(course.area, scen_wind)
     where = f"{track.source or track.name}"
-    x, y = track_xy(track, course.frame)
+    x, y = xy if xy is not None and xy[0].size == len(track) else track_xy(track, course.frame)
     t = track.t_s
     if segmentation is None:
         check_same_race(course, track, x, y)
@@ -622,6 +625,7 @@ def analysis_winds(
     *,
     gun_t: float | None = None,
     race_end_t: float | None = None,
+    xy: Sequence[tuple[NDArray, NDArray]] | None = None,
 ) -> tuple[dict[str, list[WindSource]], list[str]]:
     """The candidate winds each boat is judged in, best first, and what was found.
 
@@ -647,6 +651,9 @@ def analysis_winds(
     race_end_t : float, optional
         The race's end [epoch s] (a fleet's :attr:`~sailroute.analysis.triage.Triage.race_end_t`);
         default the last leg end found in any track.
+    xy : sequence of (x, y) arrays, optional
+        Each track's fixes already in the course frame [m], in the order of ``tracks``
+        (a fleet's triage projected them); default: projected here.
 
     Returns
     -------
@@ -705,9 +712,9 @@ def analysis_winds(
             notes.extend(fw.notes)
             t0, t1 = course.start_epoch, course.gun_epoch + course.time_limit_s
             parts = []
-            for tr in tracks:
+            for k, tr in enumerate(tracks):
                 m = (tr.t_s >= t0) & (tr.t_s <= t1)
-                x, y = track_xy(tr, frame)
+                x, y = track_xy(tr, frame) if xy is None else xy[k]
                 parts.append((tr.t_s[m], x[m], y[m]))
             t_all, x_all, y_all = (np.concatenate(c) for c in zip(*parts, strict=True))
             notes.append(
@@ -731,6 +738,7 @@ def analysis_winds(
                 t0=gun - 60.0,
                 t1=_race_end(course, tracks) if race_end_t is None else race_end_t,
                 marks=[m.xy for m in course.marks.values()],
+                xy=xy,
             )
         except InputError as exc:
             if choice == "inferred":

@@ -164,6 +164,8 @@ def run_analyze_command(
             "dynamic boat model): use --reference course"
         )
     boat_tracks = [e.track for e in debriefed if e.track is not None]
+    # the tracks as the fleet's triage projected them, where it did
+    projected = [e.xy for e in debriefed if e.track is not None and e.xy is not None]
     sources, notes = analysis_winds(
         course,
         boat_tracks,
@@ -173,6 +175,7 @@ def run_analyze_command(
         wind,
         gun_t=tri.start.track_gun_t,
         race_end_t=tri.race_end_t,
+        xy=projected if not one and len(projected) == len(boat_tracks) else None,
     )
 
     def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
@@ -205,6 +208,7 @@ def run_analyze_command(
                     built=(judged_by, winds[name]),
                     winds=sources[e.name],
                     segmentation=e.segmentation,
+                    xy=e.xy,
                 )
             )
         return [replace(a, reference=label) for a in analyze_fleet(prepared, progress)]

@@ -27,6 +27,7 @@ from sailroute.analysis.triage import triage_fleet
 from sailroute.course.load import build_specs
 from sailroute.planning.route import default_scenario
 from sailroute.progress import Progress
+from sailroute.track.kinematics import track_xy
 from tests.fleetgen import FaultPlan, messy_fleet
 
 REL = 2e-3
@@ -35,16 +36,23 @@ REL = 2e-3
 
 @pytest.fixture(scope="module")
 def prepared():
-    """Six boats of 12 min (GPS error, fixes every 1-2 s, no fault), prepared."""
+    """Six boats of 12 min (GPS error, fixes every 1-2 s, one log spanning two races),
+    prepared with the projections of the triage, which must be those of their tracks
+    (the log cut to the race)."""
     fleet = messy_fleet(
         3,
         n_boats=6,
         minutes=12,
-        faults=FaultPlan.clean(noise_white_m=0.7, noise_corr_m=1.5),
+        faults=FaultPlan.clean(noise_white_m=0.7, noise_corr_m=1.5, two_races=1),
         sample_s=(1, 2),
     )
     course = fleet.course
     tri = triage_fleet(course, [(tr.name, tr.name, tr) for tr in fleet.tracks])
+    assert any(e.cut is not None for e in tri.analysed)
+    for e in tri.analysed:
+        assert e.track is not None and e.xy is not None
+        for got, want in zip(e.xy, track_xy(e.track, course.frame), strict=True):
+            np.testing.assert_array_equal(got, want)
     name = default_scenario(course)
     boat, winds = build_specs(course, [name])
     tracks = [e.track for e in tri.analysed]
@@ -56,6 +64,7 @@ def prepared():
         boat,
         gun_t=tri.start.track_gun_t,
         race_end_t=tri.race_end_t,
+        xy=[e.xy for e in tri.analysed],
     )
     return [
         prepare_debrief(
@@ -65,6 +74,7 @@ def prepared():
             built=(boat, winds[name]),
             winds=sources[e.name],
             segmentation=e.segmentation,
+            xy=e.xy,
         )
         for e in tri.analysed
     ]
