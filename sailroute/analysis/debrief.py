@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from sailroute.analysis.fleet import fleet_ranking
 from sailroute.analysis.legmode import source_leg_mode
@@ -58,8 +58,16 @@ from sailroute.routing.types import LegResult
 from sailroute.track.kinematics import track_xy, velocity
 from sailroute.track.model import Track
 from sailroute.track.read import read_track
-from sailroute.units import KNOT, bearing_deg, signed_twa, wind_speed_direction
+from sailroute.units import (
+    KNOT,
+    bearing_deg,
+    signed_twa,
+    wind_components,
+    wind_speed_direction,
+)
 from sailroute.wind.base import WindField
+from sailroute.wind.combine import SpeedDirectionWind
+from sailroute.wind.uniform import UniformWind
 
 if TYPE_CHECKING:  # pragma: no cover
     from sailroute.analysis.fleetpolar import FleetPolar
@@ -723,7 +731,6 @@ def analysis_winds(
     inferred: WindSource | None = None
     if choice == "inferred" or (choice == "auto" and len(series) < len(tracks)):
         from sailroute.analysis.infer_wind import infer_wind, summary
-        from sailroute.wind.combine import SpeedDirectionWind
 
         gun = course.gun_epoch if gun_t is None else gun_t
         cx = float(np.mean([m.x for m in course.marks.values()]))
@@ -746,7 +753,7 @@ def analysis_winds(
             notes.append(f"wind not inferred from the tracks: {exc}")
         else:
             # held at its ends: an optimal route may run past the last tack of the fleet
-            field = SpeedDirectionWind(
+            field = speed_direction_wind(
                 wind, inf.field(frame, tws_ms=float(tws0[0]), clamp=True), "inferred wind"
             )
             sm = summary(inf)
@@ -762,6 +769,36 @@ def analysis_winds(
         avail = [s for s in (own.get(tr.name), fleet, inferred, scen) if s is not None]
         out[tr.name] = wind_order(choice, avail)
     return out, notes
+
+
+@dataclass(frozen=True, eq=False)
+class SteadySpeedWind(SpeedDirectionWind):
+    """A :class:`~sailroute.wind.combine.SpeedDirectionWind` whose ``speed_from`` is steady
+    and uniform: its speed ``speed_ms`` [m s⁻¹] computed once, not sampled at every point
+    (:func:`speed_direction_wind`)."""
+
+    speed_ms: float = 0.0
+
+    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
+        """Wind ``(u, v)`` [m s⁻¹]: the steady speed in the direction of
+        ``direction_from`` at the points, as the parent class computes them."""
+        du, dv = self.direction_from.sample(t, x, y)
+        _, direction = wind_speed_direction(du, dv)
+        return wind_components(self.speed_ms, direction)
+
+
+def speed_direction_wind(
+    speed_from: WindField, direction_from: WindField, name: str
+) -> SpeedDirectionWind:
+    """The speed of one wind with the direction of another: a
+    :class:`SteadySpeedWind` where ``speed_from`` is a steady
+    :class:`~sailroute.wind.uniform.UniformWind` (the same numbers, without sampling it at
+    every point a router asks), else a :class:`~sailroute.wind.combine.SpeedDirectionWind`."""
+    if isinstance(speed_from, UniformWind) and speed_from.times is None:
+        u, v = speed_from.sample(np.zeros(1), np.zeros(1), np.zeros(1))
+        speed, _ = wind_speed_direction(u, v)
+        return SteadySpeedWind(speed_from, direction_from, name, float(speed[0]))
+    return SpeedDirectionWind(speed_from, direction_from, name)
 
 
 def _race_end(course: Course, tracks: Sequence[Track]) -> float:
