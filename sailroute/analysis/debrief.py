@@ -13,6 +13,7 @@ adds reading, file output and the terminal table.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -76,6 +77,8 @@ if TYPE_CHECKING:  # pragma: no cover
 BRIDGE_S = 1e9
 """Hole limit of the measured winds the routers sample [s]: no hole (see
 :attr:`sailroute.analysis.windsource.WindSource.route_field`)."""
+DONE_LINE_S = 2.0
+"""Least time between two ``boat k of N done`` lines of a fleet's debrief [s]."""
 REFERENCES = ("course", "fleet")
 """Values of ``analyze --reference``: the course's polar, or it scaled to the fleet."""
 SMOOTH_S = 3.0
@@ -223,8 +226,8 @@ def analyze_fleet(
     (:func:`sailroute.analysis.optimal.route_together`), then each boat completed.
 
     ``progress`` counts the boats: the legs routed together (share of the leg done, boats
-    arrived, the time left of the routing), then ``boat k of N done`` lines while the
-    boats are completed (about ten, with the time left).
+    arrived, the time left of the routing), then ``boat k of N done`` while the boats are
+    completed (a line every :data:`DONE_LINE_S` and the last).
     """
     if not prepared:
         return []
@@ -243,12 +246,14 @@ def analyze_fleet(
     )
     if progress is not None:
         progress.start_count(n, "boat")
-    every = -(-n // 10)  # about ten lines
+    last = time.perf_counter()
     out = []
     for k, (p, r) in enumerate(zip(prepared, routed, strict=True)):
         out.append(finish_debrief(p, r))
-        if progress is not None and ((k + 1) % every == 0 or k + 1 == n):
+        now = time.perf_counter()
+        if progress is not None and (k + 1 == n or now - last >= DONE_LINE_S):
             progress.item_done(k + 1, p.track.name)
+            last = now
     return out
 
 
