@@ -141,6 +141,7 @@ def analyze_process(label: str, src: Path, folder: Path, out: Path) -> Run:
     proc = subprocess.Popen(
         [*cmd, "-o", str(out), "--quiet"],
         env=env,
+        cwd=out.parent,  # not this checkout: `-m` would find its package before PYTHONPATH's
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
     )
@@ -162,6 +163,25 @@ def analyze_process(label: str, src: Path, folder: Path, out: Path) -> Run:
     )
 
 
+def package_of(src: Path, cwd: Path) -> str:
+    """Where ``python -m sailroute`` finds the package with ``PYTHONPATH=src`` in ``cwd``
+    (and its commit when it is a git checkout)."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    code = "import sailroute, os; print(os.path.dirname(sailroute.__file__))"
+    where = subprocess.run(
+        [sys.executable, "-c", code], env=env, cwd=cwd, capture_output=True, text=True
+    ).stdout.strip()
+    rev = subprocess.run(
+        ["git", "-C", str(src), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+    ).stdout.strip()
+    dirty = subprocess.run(
+        ["git", "-C", str(src), "status", "--porcelain", "--untracked-files=no"],
+        capture_output=True,
+        text=True,
+    ).stdout.strip()
+    return f"{where} ({rev or 'not a git checkout'}{', with changes' if dirty else ''})"
+
+
 def generated(boats: int, minutes: float, base: Path | None, repeat: int) -> None:
     """The ``--generated`` benchmark (module docstring)."""
     sys.path.insert(0, str(ROOT / "benchmarks"))
@@ -176,6 +196,8 @@ def generated(boats: int, minutes: float, base: Path | None, repeat: int) -> Non
         plan = [("this", ROOT, "clean"), ("this", ROOT, "messy")]
         if base is not None:
             plan.insert(0, ("base", base, "clean"))
+        for who, src in dict.fromkeys((who, src) for who, src, _ in plan):
+            print(f"{who}: {package_of(src, d)}")
         runs: list[Run] = []
         for k in range(repeat):
             for who, src, kind in plan:

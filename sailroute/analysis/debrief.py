@@ -7,6 +7,10 @@ the track (``sailroute.track``) is projected into the course frame, split into l
 leg start point and time to the same target in the scenario's wind
 (:func:`sailroute.routing.api.route_leg`), then compared
 (:mod:`sailroute.analysis.loss`); the results are :mod:`sailroute.analysis.result`.
+A fleet is debriefed in three steps, so that its boats' optimal legs are routed together
+(:func:`analyze_fleet`, :mod:`sailroute.analysis.optimal`): each track prepared
+(:func:`prepare_debrief`), every leg routed for all boats, each boat finished
+(:func:`finish_debrief`).
 Nothing here prints or writes; :func:`sailroute.commands.analyze.run_analyze_command`
 adds reading, file output and the terminal table.
 """

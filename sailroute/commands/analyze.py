@@ -179,24 +179,25 @@ def run_analyze_command(
     )
 
     def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
-        if one:
-            assert debriefed[0].track is not None
+        if one:  # its own segmentation and errors, its legs routed one by one
+            e = debriefed[0]
+            assert e.track is not None
             a = analyze_track(
                 course,
-                debriefed[0].track,
+                e.track,
                 name,
-                leg_times=times[debriefed[0].name],
+                leg_times=times[e.name],
                 router=router,
                 detect_m=detect_m,
                 built=(judged_by, winds[name]),
-                winds=sources[debriefed[0].name],
+                winds=sources[e.name],
                 progress=progress,
                 missing="error",
                 gate_end=gate_end,
                 clock=StartClock.plain(tri.start.track_gun_t),
             )
             return [replace(a, reference=label)]
-        prepared = []
+        prepared = []  # a fleet: triaged and segmented, its legs routed together
         for e in debriefed:
             assert e.track is not None
             prepared.append(
