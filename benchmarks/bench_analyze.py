@@ -2,7 +2,7 @@
 
     python benchmarks/bench_analyze.py [--points 300000] [--repeat 1] [--smoke]
     python benchmarks/bench_analyze.py --generated [--boats 60] [--minutes 45]
-                                       [--base DIR] [--repeat 2] [--smoke]
+                                       [--base DIR] [--repeat 2] [--legs] [--smoke]
 
 Both cases use the shipped Snipe example (``courses/snipe-valencia-p01.yaml``, a 1 Hz
 Garmin track of 33 min, ``data/snipe-valencia-2025-06-21-ESP30782-P01.gpx``) and time
@@ -34,7 +34,9 @@ a non-starter cannot run the messy one).  The runs alternate (base clean, clean,
 ``os.wait4``), wall time, peak memory (its ``ru_maxrss``) and the bytes it wrote are
 printed, then the medians, the ratio of the clean runs' CPU times (base / this) and the
 task's targets (wall < 30 s, peak < 1 GB, output < 50 MB), with the load average before
-and after.  ``--smoke``: 14 boats of 6 min, one round.
+and after.  ``--legs``: then, in this process, the messy fleet's optimal legs routed one
+by one and together (``sailroute.analysis.optimal``), alternately, ``--repeat`` times.
+``--smoke``: 14 boats of 6 min, one round.
 """
 
 from __future__ import annotations
@@ -182,7 +184,76 @@ def package_of(src: Path, cwd: Path) -> str:
     return f"{where} ({rev or 'not a git checkout'}{', with changes' if dirty else ''})"
 
 
-def generated(boats: int, minutes: float, base: Path | None, repeat: int) -> None:
+def legs_one_by_one_and_together(folder: Path, repeat: int) -> None:
+    """The optimal legs of the fleet in ``folder``, in this process: routed one by one
+    (``route_one``) and together (``route_together``), alternately, CPU and wall."""
+    from sailroute.analysis.debrief import analysis_winds, prepare_debrief
+    from sailroute.analysis.optimal import route_one, route_together
+    from sailroute.analysis.triage import triage_fleet
+    from sailroute.course.load import build_specs
+    from sailroute.planning.route import default_scenario
+
+    course = load_course(folder / "course.yaml")
+    read = [(p.stem, str(p), read_track(p, name=p.stem)) for p in sorted(folder.glob("*.gpx"))]
+    tri = triage_fleet(course, read)
+    name = default_scenario(course)
+    boat, winds = build_specs(course, [name])
+    fleet = tri.analysed
+    sources, _ = analysis_winds(
+        course,
+        [e.track for e in fleet if e.track is not None],
+        name,
+        winds[name],
+        boat,
+        gun_t=tri.start.track_gun_t,
+        race_end_t=tri.race_end_t,
+        xy=[e.xy for e in fleet if e.xy is not None],
+    )
+    prepared = [
+        prepare_debrief(
+            course,
+            e.track,
+            name,
+            built=(boat, winds[name]),
+            winds=sources[e.name],
+            segmentation=e.segmentation,
+            xy=e.xy,
+        )
+        for e in fleet
+        if e.track is not None
+    ]
+    legs = sum(leg is not None for p in prepared for leg in p.optimal)
+    settings = prepared[0].settings
+
+    def one_by_one() -> None:
+        for p in prepared:
+            for leg in p.optimal:
+                if leg is not None:
+                    route_one(course, leg, p.sources, boat, settings)
+
+    def together() -> None:
+        route_together(
+            course, [p.optimal for p in prepared], [p.sources for p in prepared], boat, settings
+        )
+
+    together()  # the compiled step loaded and its kernels compiled, not timed
+    for _ in range(repeat):
+        times = []
+        for fn in (one_by_one, together):
+            c, w = time.process_time(), time.perf_counter()
+            fn()
+            times.append((time.process_time() - c, time.perf_counter() - w))
+        (c1, w1), (c2, w2) = times
+        print(
+            f"optimal legs of the messy fleet ({len(prepared)} boats, {legs} legs), in one "
+            f"process: one by one CPU {c1:.2f} s (wall {w1:.2f} s), together CPU {c2:.2f} s "
+            f"(wall {w2:.2f} s), ratio {c1 / c2:.2f} (load {os.getloadavg()[0]:.2f})"
+        )
+
+
+def generated(
+    boats: int, minutes: float, base: Path | None, repeat: int, legs: bool = False
+) -> None:
     """The ``--generated`` benchmark (module docstring)."""
     sys.path.insert(0, str(ROOT / "benchmarks"))
     from fleet_input import write_fleet
@@ -209,6 +280,8 @@ def generated(boats: int, minutes: float, base: Path | None, repeat: int) -> Non
                     f"{r.peak_mib:5.0f} MiB  wrote {r.written_mb:5.1f} MB  exit {r.code}  "
                     f"(load {os.getloadavg()[0]:.2f})"
                 )
+        if legs:
+            legs_one_by_one_and_together(cases["messy"], repeat)
     med = {}
     for who, _, kind in plan:
         mine = [r for r in runs if r.label == f"{who} {kind}"]
@@ -254,6 +327,9 @@ def main() -> None:
     ap.add_argument("--boats", type=int, default=60, help="boats of the generated fleet")
     ap.add_argument("--minutes", type=float, default=45.0, help="its race length [min]")
     ap.add_argument("--base", type=Path, default=None, help="checkout of the version before")
+    ap.add_argument(
+        "--legs", action="store_true", help="and the optimal legs one by one and together"
+    )
     args = ap.parse_args()
     print(
         f"load average before: {' '.join(f'{v:.2f}' for v in os.getloadavg())} "
@@ -262,7 +338,7 @@ def main() -> None:
     if args.generated:
         boats, minutes = (14, 6.0) if args.smoke else (args.boats, args.minutes)
         repeat = 1 if args.smoke else args.repeat or 2
-        generated(boats, minutes, args.base, repeat)
+        generated(boats, minutes, args.base, repeat, args.legs)
         print(f"load average after: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
         return
     n = 20_000 if args.smoke else args.points
