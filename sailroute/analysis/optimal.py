@@ -17,7 +17,7 @@ routed one by one, as alone.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -208,6 +208,16 @@ def route_together(
     return out
 
 
+def _boats_arrived(progress: Progress) -> Callable[[float, str], None]:
+    """The front's progress callback, its members called boats (``12 of 60 boats
+    arrived``)."""
+
+    def update(fraction: float, note: str = "") -> None:
+        progress.update(fraction, note.replace(" members arrived", " boats arrived"))
+
+    return update
+
+
 def _front(
     course: Course,
     i: int,
@@ -235,7 +245,7 @@ def _front(
             member_winds,
             boat,
             settings,
-            progress=progress.update if progress is not None else None,
+            progress=None if progress is None else _boats_arrived(progress),
         )
     except (OutOfCoverageError, RoutingError):
         return [None] * len(members)

@@ -128,7 +128,7 @@ def test_fleet_debrief_is_the_boats_debriefed_with_their_routes(prepared, togeth
     counts the boats (legs routed together, then boats done) with the time left."""
     first = prepared[0]
     stream = io.StringIO()
-    progress = Progress(first.course.n_legs, stream)
+    progress = Progress(first.course.n_legs, stream, live=True, min_interval_s=0.0)
     fleet = analyze_fleet(prepared, progress)
     assert [a.track.name for a in fleet] == [p.track.name for p in prepared]
     for a, p, r in zip(fleet, prepared, together, strict=True):
@@ -137,12 +137,14 @@ def test_fleet_debrief_is_the_boats_debriefed_with_their_routes(prepared, togeth
             [leg.loss_s for leg in own.legs], nan_ok=True
         )
         np.testing.assert_array_equal(a.points.loss_s, own.points.loss_s)
-    lines = stream.getvalue().splitlines()
+    text = stream.getvalue()
+    assert f" of {len(prepared)} boats arrived" in text  # the live line's note
+    lines = [part.strip() for part in text.replace("\r", "\n").splitlines() if part.strip()]
     n = len(prepared)
-    legs = [line for line in lines if line.startswith("leg ")]
-    assert len(legs) == 2 * first.course.n_legs  # "routing..." and the leg's line
-    assert f"median of {n} boats" in legs[1]
-    assert "s left)" in legs[1]  # the routing's time left
+    ends = [line for line in lines if "median of" in line]  # a line per leg routed
+    assert len(ends) == first.course.n_legs
+    assert f"median of {n} boats" in ends[0]
+    assert "s left)" in ends[0]  # the routing's time left
     done = [line for line in lines if line.startswith("boat ")]
     assert done[-1].startswith(f"boat {n} of {n} done ({prepared[-1].track.name}): ")
     assert done[-1].endswith(" elapsed")
