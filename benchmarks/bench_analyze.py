@@ -187,7 +187,7 @@ def package_of(src: Path, cwd: Path) -> str:
 def legs_one_by_one_and_together(folder: Path, repeat: int) -> None:
     """The optimal legs of the fleet in ``folder``, in this process: routed one by one
     (``route_one``) and together (``route_together``), alternately, CPU and wall."""
-    from sailroute.analysis.debrief import analysis_winds, prepare_debrief
+    from sailroute.analysis.debrief import analysis_winds, prepare_fleet
     from sailroute.analysis.optimal import route_one, route_together
     from sailroute.analysis.triage import triage_fleet
     from sailroute.course.load import build_specs
@@ -209,19 +209,7 @@ def legs_one_by_one_and_together(folder: Path, repeat: int) -> None:
         race_end_t=tri.race_end_t,
         xy=[e.xy for e in fleet if e.xy is not None],
     )
-    prepared = [
-        prepare_debrief(
-            course,
-            e.track,
-            name,
-            built=(boat, winds[name]),
-            winds=sources[e.name],
-            segmentation=e.segmentation,
-            xy=e.xy,
-        )
-        for e in fleet
-        if e.track is not None
-    ]
+    prepared = prepare_fleet(course, fleet, name, (boat, winds[name]), sources)
     legs = sum(leg is not None for p in prepared for leg in p.optimal)
     settings = prepared[0].settings
 

@@ -49,7 +49,7 @@ from sailroute.analysis.segment import (
     leg_target,
     segment_track,
 )
-from sailroute.analysis.triage import race_window_problem
+from sailroute.analysis.triage import BoatEntry, race_window_problem
 from sailroute.analysis.windsource import WindSource, first_covering
 from sailroute.course.geometry import feature_centre
 from sailroute.course.load import build_specs, load_course
@@ -438,6 +438,35 @@ def prepare_debrief(
         tuple(optimal),
         tuple(area_notes),
     )
+
+
+def prepare_fleet(
+    course: Course,
+    entries: Sequence[BoatEntry],
+    scenario: str,
+    built: tuple[Any, WindField],
+    sources: Mapping[str, Sequence[WindSource]],
+    *,
+    router: str | None = None,
+) -> list[PreparedDebrief]:
+    """:func:`prepare_debrief` for each track of a fleet's triage
+    (:func:`~sailroute.analysis.triage.triage_fleet`: ``entries``, those with a track),
+    with the segmentation and the projection the triage found, judged in ``sources``
+    (per boat name, :func:`analysis_winds`)."""
+    return [
+        prepare_debrief(
+            course,
+            e.track,
+            scenario,
+            router=router,
+            built=built,
+            winds=sources[e.name],
+            segmentation=e.segmentation,
+            xy=e.xy,
+        )
+        for e in entries
+        if e.track is not None
+    ]
 
 
 def finish_debrief(
@@ -1040,4 +1069,5 @@ __all__ = [
     "parse_boat_leg_times",
     "parse_leg_times",
     "prepare_debrief",
+    "prepare_fleet",
 ]

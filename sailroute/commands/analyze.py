@@ -20,7 +20,7 @@ from sailroute.analysis.debrief import (
     analyze_track,
     fleet_reference,
     parse_boat_leg_times,
-    prepare_debrief,
+    prepare_fleet,
 )
 from sailroute.analysis.fleet import FleetAnalysis
 from sailroute.analysis.result import TrackAnalysis
@@ -197,21 +197,10 @@ def run_analyze_command(
                 clock=StartClock.plain(tri.start.track_gun_t),
             )
             return [replace(a, reference=label)]
-        prepared = []  # a fleet: triaged and segmented, its legs routed together
-        for e in debriefed:
-            assert e.track is not None
-            prepared.append(
-                prepare_debrief(
-                    course,
-                    e.track,
-                    name,
-                    router=router,
-                    built=(judged_by, winds[name]),
-                    winds=sources[e.name],
-                    segmentation=e.segmentation,
-                    xy=e.xy,
-                )
-            )
+        # a fleet: triaged and segmented, its legs routed together
+        prepared = prepare_fleet(
+            course, debriefed, name, (judged_by, winds[name]), sources, router=router
+        )
         return [replace(a, reference=label) for a in analyze_fleet(prepared, progress)]
 
     analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())

@@ -20,7 +20,7 @@ from sailroute.analysis.debrief import (
     analysis_winds,
     analyze_fleet,
     finish_debrief,
-    prepare_debrief,
+    prepare_fleet,
 )
 from sailroute.analysis.optimal import route_one, route_together
 from sailroute.analysis.triage import triage_fleet
@@ -66,18 +66,7 @@ def prepared():
         race_end_t=tri.race_end_t,
         xy=[e.xy for e in tri.analysed],
     )
-    return [
-        prepare_debrief(
-            course,
-            e.track,
-            name,
-            built=(boat, winds[name]),
-            winds=sources[e.name],
-            segmentation=e.segmentation,
-            xy=e.xy,
-        )
-        for e in tri.analysed
-    ]
+    return prepare_fleet(course, tri.analysed, name, (boat, winds[name]), sources)
 
 
 @pytest.fixture(scope="module")
