@@ -7,18 +7,24 @@ the track (``sailroute.track``) is projected into the course frame, split into l
 leg start point and time to the same target in the scenario's wind
 (:func:`sailroute.routing.api.route_leg`), then compared
 (:mod:`sailroute.analysis.loss`); the results are :mod:`sailroute.analysis.result`.
+A fleet is debriefed in three steps, so that its boats' optimal legs are routed together
+(:func:`analyze_fleet`, :mod:`sailroute.analysis.optimal`): each track prepared
+(:func:`prepare_debrief`), every leg routed for all boats, each boat finished
+(:func:`finish_debrief`).
 Nothing here prints or writes; :func:`sailroute.commands.analyze.run_analyze_command`
 adds reading, file output and the terminal table.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from sailroute.analysis.fleet import fleet_ranking
 from sailroute.analysis.legmode import source_leg_mode
@@ -33,6 +39,7 @@ from sailroute.analysis.loss import (
     time_mean,
 )
 from sailroute.analysis.manoeuvres import find_sailed_manoeuvres
+from sailroute.analysis.optimal import OptimalLeg, leg_start, route_one, route_together
 from sailroute.analysis.result import LegAnalysis, PointTable, TrackAnalysis
 from sailroute.analysis.segment import (
     DETECT_M,
@@ -42,7 +49,7 @@ from sailroute.analysis.segment import (
     leg_target,
     segment_track,
 )
-from sailroute.analysis.triage import race_window_problem
+from sailroute.analysis.triage import BoatEntry, race_window_problem
 from sailroute.analysis.windsource import WindSource, first_covering
 from sailroute.course.geometry import feature_centre
 from sailroute.course.load import build_specs, load_course
@@ -50,16 +57,22 @@ from sailroute.course.model import Course
 from sailroute.errors import InputError, OutOfCoverageError
 from sailroute.planning.route import default_scenario, settings_for
 from sailroute.progress import Progress
-from sailroute.routing.api import route_leg
-from sailroute.routing.geometry import target_barrier
-from sailroute.routing.obstacles import Obstacles, constraint_label, land_filled, obstacles_for
+from sailroute.routing.obstacles import Obstacles, constraint_label, obstacles_for
 from sailroute.routing.settings import RoutingSettings
-from sailroute.routing.types import LegResult, Start
+from sailroute.routing.types import LegResult
 from sailroute.track.kinematics import track_xy, velocity
 from sailroute.track.model import Track
 from sailroute.track.read import read_track
-from sailroute.units import KNOT, bearing_deg, signed_twa, wind_speed_direction
+from sailroute.units import (
+    KNOT,
+    bearing_deg,
+    signed_twa,
+    wind_components,
+    wind_speed_direction,
+)
 from sailroute.wind.base import WindField
+from sailroute.wind.combine import SpeedDirectionWind
+from sailroute.wind.uniform import UniformWind
 
 if TYPE_CHECKING:  # pragma: no cover
     from sailroute.analysis.fleetpolar import FleetPolar
@@ -68,6 +81,8 @@ if TYPE_CHECKING:  # pragma: no cover
 BRIDGE_S = 1e9
 """Hole limit of the measured winds the routers sample [s]: no hole (see
 :attr:`sailroute.analysis.windsource.WindSource.route_field`)."""
+DONE_LINE_S = 2.0
+"""Least time between two ``boat k of N done`` lines of a fleet's debrief [s]."""
 REFERENCES = ("course", "fleet", "learned")
 """Values of ``analyze --reference``: the course's polar, it scaled to the fleet, or the
 polar learned from the fleet (:mod:`sailroute.analysis.fleetlearn`)."""
@@ -184,6 +199,145 @@ def analyze_track(
     RoutingError
         An optimal leg cannot be routed.
     """
+    prep = prepare_debrief(
+        course,
+        track,
+        scenario,
+        leg_times=leg_times,
+        router=router,
+        detect_m=detect_m,
+        built=built,
+        winds=winds,
+        missing=missing,
+        gate_end=gate_end,
+        wind=wind,
+        segmentation=segmentation,
+        clock=clock,
+    )
+    routed = [
+        None
+        if leg is None
+        else route_one(course, leg, prep.sources, prep.boat, prep.settings, progress)
+        for leg in prep.optimal
+    ]
+    return finish_debrief(prep, routed)
+
+
+def analyze_fleet(
+    prepared: Sequence[PreparedDebrief], progress: Progress | None = None
+) -> list[TrackAnalysis]:
+    """The debriefs of a fleet's prepared tracks (:func:`prepare_debrief`, one boat and
+    course): each leg's optimal routes of all boats routed as one front
+    (:func:`sailroute.analysis.optimal.route_together`), then each boat completed.
+
+    ``progress`` counts the boats: the legs routed together (share of the leg done, boats
+    arrived, the time left of the routing), then ``boat k of N done`` while the boats are
+    completed (a line every :data:`DONE_LINE_S` and the last).
+    """
+    if not prepared:
+        return []
+    first = prepared[0]
+    n = len(prepared)
+    if progress is not None:
+        progress.set_prefix("")
+        progress.start_count(n, "boat", together=True)
+    routed = route_together(
+        first.course,
+        [p.optimal for p in prepared],
+        [p.sources for p in prepared],
+        first.boat,
+        first.settings,
+        progress,
+    )
+    if progress is not None:
+        progress.start_count(n, "boat")
+    last = time.perf_counter()
+    out = []
+    for k, (p, r) in enumerate(zip(prepared, routed, strict=True)):
+        out.append(finish_debrief(p, r))
+        now = time.perf_counter()
+        if progress is not None and (k + 1 == n or now - last >= DONE_LINE_S):
+            progress.item_done(k + 1, p.track.name)
+            last = now
+    return out
+
+
+@dataclass(frozen=True)
+class PreparedDebrief:
+    """A track made ready for its debrief: all but the optimal legs
+    (:func:`prepare_debrief`; :func:`finish_debrief` completes it).
+
+    Attributes
+    ----------
+    course, track, scenario
+        The course, the track, the wind scenario's name.
+    settings, boat, design
+        The routing settings, the boat and the scenario's wind.
+    sources : tuple of WindSource
+        The candidate winds, best first.
+    t, x, y : arrays
+        The track's fixes [epoch s] in the course frame [m].
+    seg : Segmentation
+        Its start and leg ends.
+    svx, svy : arrays
+        The smoothed velocity [m/s].
+    chosen : tuple of int
+        Per leg, the source it is judged in.
+    manoeuvres : tuple of SailedManoeuvre
+        The tacks and gybes over the race.
+    optimal : tuple of OptimalLeg or None
+        Per leg, the optimal route to compute (None: the leg's start is unknown).
+    area_notes : tuple of str
+        Per leg, the note of a start inside the race area's clearances (or "").
+    """
+
+    course: Course
+    track: Track
+    scenario: str
+    settings: RoutingSettings
+    boat: Any
+    design: WindField
+    sources: tuple[WindSource, ...]
+    t: NDArray
+    x: NDArray
+    y: NDArray
+    seg: Segmentation
+    svx: NDArray
+    svy: NDArray
+    chosen: tuple[int, ...]
+    manoeuvres: tuple[Any, ...]
+    optimal: tuple[OptimalLeg | None, ...]
+    area_notes: tuple[str, ...]
+
+
+def prepare_debrief(
+    course: Course,
+    track: Track,
+    scenario: str | None = None,
+    *,
+    leg_times: Sequence[float | None] | None = None,
+    router: str | None = None,
+    detect_m: float = DETECT_M,
+    built: tuple[Any, WindField] | None = None,
+    winds: Sequence[WindSource] | None = None,
+    missing: str = "error",
+    gate_end: str = "line",
+    wind: str = "auto",
+    segmentation: Segmentation | None = None,
+    clock: StartClock | None = None,
+    xy: tuple[NDArray, NDArray] | None = None,
+) -> PreparedDebrief:
+    """Everything :func:`analyze_track` does before routing the optimal legs (the same
+    parameters): the track projected and segmented, each leg's wind, the manoeuvres and
+    the optimal legs to route (:class:`~sailroute.analysis.optimal.OptimalLeg`).
+    ``xy``: the track's fixes already in the course frame [m] (a fleet's triage,
+    :attr:`~sailroute.analysis.triage.BoatEntry.xy`); default: projected here.
+
+    Raises
+    ------
+    InputError, OutOfCoverageError
+        As :func:`analyze_track`.
+    """
     name = default_scenario(course) if scenario is None else scenario
     settings: RoutingSettings = settings_for(course, router)
     if built is None:
@@ -199,7 +353,7 @@ def analyze_track(
     # the optimal legs keep inside the boundary and round the obstacles, as plan's do
     obstacles = obstacles_for(course.area, scen_wind)
     where = f"{track.source or track.name}"
-    x, y = track_xy(track, course.frame)
+    x, y = xy if xy is not None and xy[0].size == len(track) else track_xy(track, course.frame)
     t = track.t_s
     if segmentation is None:
         check_same_race(course, track, x, y)
@@ -248,6 +402,83 @@ def analyze_track(
     mans, _ = find_sailed_manoeuvres(
         tr, twd_r, bearing_deg(svx[race], svy[race]), np.hypot(svx[race], svy[race])
     )
+    optimal: list[OptimalLeg | None] = []
+    area_notes: list[str] = []
+    for i, spec in enumerate(course.legs):
+        a, b = bounds[i], bounds[i + 1]
+        if not a.known:
+            optimal.append(None)
+            area_notes.append("")
+            continue
+        if b.known:  # routed in the leg's wind, then in the next covering its points
+            k, pts = chosen[i], _leg_points(t, x, y, a, b)
+        else:  # in the first wind from the leg's own on that covers its start
+            pts = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
+            found = first_covering(sources, *pts, skip=chosen[i] - 1)
+            k = len(sources) - 1 if found is None else found
+        leg_obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
+        start = leg_start(course, i, bounds, settings)
+        optimal.append(OptimalLeg(i, start, a.t, k, pts, leg_obstacles))
+        area_notes.append(area_note)
+    return PreparedDebrief(
+        course,
+        track,
+        name,
+        settings,
+        boat,
+        scen_wind,
+        tuple(sources),
+        t,
+        x,
+        y,
+        seg,
+        svx,
+        svy,
+        tuple(chosen),
+        tuple(mans),
+        tuple(optimal),
+        tuple(area_notes),
+    )
+
+
+def prepare_fleet(
+    course: Course,
+    entries: Sequence[BoatEntry],
+    scenario: str,
+    built: tuple[Any, WindField],
+    sources: Mapping[str, Sequence[WindSource]],
+    *,
+    router: str | None = None,
+) -> list[PreparedDebrief]:
+    """:func:`prepare_debrief` for each track of a fleet's triage
+    (:func:`~sailroute.analysis.triage.triage_fleet`: ``entries``, those with a track),
+    with the segmentation and the projection the triage found, judged in ``sources``
+    (per boat name, :func:`analysis_winds`)."""
+    return [
+        prepare_debrief(
+            course,
+            e.track,
+            scenario,
+            router=router,
+            built=built,
+            winds=sources[e.name],
+            segmentation=e.segmentation,
+            xy=e.xy,
+        )
+        for e in entries
+        if e.track is not None
+    ]
+
+
+def finish_debrief(
+    prep: PreparedDebrief, routed: Sequence[tuple[LegResult, WindSource] | None]
+) -> TrackAnalysis:
+    """The debrief of a prepared track (:func:`prepare_debrief`) given its optimal legs
+    (``routed``: per leg, the route and the wind it was routed in; None where
+    :attr:`PreparedDebrief.optimal` is None): the legs compared and the point table."""
+    course, t, x, y = prep.course, prep.t, prep.x, prep.y
+    svx, svy, sources, chosen = prep.svx, prep.svy, prep.sources, prep.chosen
+    bounds, boat, settings, mans = prep.seg.bounds, prep.boat, prep.settings, prep.manoeuvres
 
     legs: list[LegAnalysis] = []
     cols: dict[str, list[NDArray]] = {k: [] for k in _POINT_COLUMNS}
@@ -273,22 +504,18 @@ def analyze_track(
                 course,
                 i,
                 bounds,
-                sources,
-                chosen[i],
-                boat,
-                settings,
-                target,
+                sources[ask.k if (ask := prep.optimal[i]) is not None else chosen[i]],
+                routed[i],
                 centre,
-                progress,
-                obstacles=obstacles,
-                design=scen_wind,
+                prep.area_notes[i],
+                design=prep.design,
             )
             legs.append(leg)
             unknown = np.full(tl.size, np.nan)
             _add_points(cols, i, tl, xl, yl, sog, cog, tws, twd, twa, polar, unknown, unknown)
             continue
         src = sources[chosen[i]]
-        mode = source_leg_mode(course, i, src, scen_wind, a.t, (a.x, a.y), centre).mode
+        mode = source_leg_mode(course, i, src, prep.design, a.t, (a.x, a.y), centre).mode
         if mode == "upwind":
             vmg = sog * np.cos(np.radians(twa))
         elif mode == "downwind":
@@ -296,21 +523,11 @@ def analyze_track(
         else:
             ux, uy = centre[0] - xl, centre[1] - yl
             vmg = (vx * ux + vy * uy) / np.maximum(np.hypot(ux, uy), 1e-9)
-        # optimal route from the same point and time
-        leg_obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
-        opt, src = _optimal_leg(
-            course,
-            i,
-            bounds,
-            sources,
-            chosen[i],
-            (tl, xl, yl),
-            boat,
-            settings,
-            target,
-            progress,
-            obstacles=leg_obstacles,
-        )
+        # the optimal route from the same point and time
+        got = routed[i]
+        assert got is not None  # a known leg start: routed
+        opt, src = got
+        area_note = prep.area_notes[i]
         sailed = b.t - a.t
         loss = sailed - opt.time_s
         prog = axis_progress(xl, yl, (a.x, a.y), centre)
@@ -383,13 +600,13 @@ def analyze_track(
     )
     return TrackAnalysis(
         course,
-        track,
-        name,
+        prep.track,
+        prep.scenario,
         settings.router,
-        seg,
+        prep.seg,
         tuple(legs),
         points,
-        sources[chosen[0]].field if chosen else scen_wind,
+        sources[chosen[0]].field if chosen else prep.design,
     )
 
 
@@ -455,6 +672,7 @@ def analysis_winds(
     *,
     gun_t: float | None = None,
     race_end_t: float | None = None,
+    xy: Sequence[tuple[NDArray, NDArray]] | None = None,
 ) -> tuple[dict[str, list[WindSource]], list[str]]:
     """The candidate winds each boat is judged in, best first, and what was found.
 
@@ -480,6 +698,9 @@ def analysis_winds(
     race_end_t : float, optional
         The race's end [epoch s] (a fleet's :attr:`~sailroute.analysis.triage.Triage.race_end_t`);
         default the last leg end found in any track.
+    xy : sequence of (x, y) arrays, optional
+        Each track's fixes already in the course frame [m], in the order of ``tracks``
+        (a fleet's triage projected them); default: projected here.
 
     Returns
     -------
@@ -538,9 +759,9 @@ def analysis_winds(
             notes.extend(fw.notes)
             t0, t1 = course.start_epoch, course.gun_epoch + course.time_limit_s
             parts = []
-            for tr in tracks:
+            for k, tr in enumerate(tracks):
                 m = (tr.t_s >= t0) & (tr.t_s <= t1)
-                x, y = track_xy(tr, frame)
+                x, y = track_xy(tr, frame) if xy is None else xy[k]
                 parts.append((tr.t_s[m], x[m], y[m]))
             t_all, x_all, y_all = (np.concatenate(c) for c in zip(*parts, strict=True))
             notes.append(
@@ -549,7 +770,6 @@ def analysis_winds(
     inferred: WindSource | None = None
     if choice == "inferred" or (choice == "auto" and len(series) < len(tracks)):
         from sailroute.analysis.infer_wind import infer_wind, summary
-        from sailroute.wind.combine import SpeedDirectionWind
 
         gun = course.gun_epoch if gun_t is None else gun_t
         cx = float(np.mean([m.x for m in course.marks.values()]))
@@ -564,6 +784,7 @@ def analysis_winds(
                 t0=gun - 60.0,
                 t1=_race_end(course, tracks) if race_end_t is None else race_end_t,
                 marks=[m.xy for m in course.marks.values()],
+                xy=xy,
             )
         except InputError as exc:
             if choice == "inferred":
@@ -571,7 +792,7 @@ def analysis_winds(
             notes.append(f"wind not inferred from the tracks: {exc}")
         else:
             # held at its ends: an optimal route may run past the last tack of the fleet
-            field = SpeedDirectionWind(
+            field = speed_direction_wind(
                 wind, inf.field(frame, tws_ms=float(tws0[0]), clamp=True), "inferred wind"
             )
             sm = summary(inf)
@@ -587,6 +808,36 @@ def analysis_winds(
         avail = [s for s in (own.get(tr.name), fleet, inferred, scen) if s is not None]
         out[tr.name] = wind_order(choice, avail)
     return out, notes
+
+
+@dataclass(frozen=True, eq=False)
+class SteadySpeedWind(SpeedDirectionWind):
+    """A :class:`~sailroute.wind.combine.SpeedDirectionWind` whose ``speed_from`` is steady
+    and uniform: its speed ``speed_ms`` [m s⁻¹] computed once, not sampled at every point
+    (:func:`speed_direction_wind`)."""
+
+    speed_ms: float = 0.0
+
+    def sample(self, t: ArrayLike, x: ArrayLike, y: ArrayLike) -> tuple[NDArray, NDArray]:
+        """Wind ``(u, v)`` [m s⁻¹]: the steady speed in the direction of
+        ``direction_from`` at the points, as the parent class computes them."""
+        du, dv = self.direction_from.sample(t, x, y)
+        _, direction = wind_speed_direction(du, dv)
+        return wind_components(self.speed_ms, direction)
+
+
+def speed_direction_wind(
+    speed_from: WindField, direction_from: WindField, name: str
+) -> SpeedDirectionWind:
+    """The speed of one wind with the direction of another: a
+    :class:`SteadySpeedWind` where ``speed_from`` is a steady
+    :class:`~sailroute.wind.uniform.UniformWind` (the same numbers, without sampling it at
+    every point a router asks), else a :class:`~sailroute.wind.combine.SpeedDirectionWind`."""
+    if isinstance(speed_from, UniformWind) and speed_from.times is None:
+        u, v = speed_from.sample(np.zeros(1), np.zeros(1), np.zeros(1))
+        speed, _ = wind_speed_direction(u, v)
+        return SteadySpeedWind(speed_from, direction_from, name, float(speed[0]))
+    return SpeedDirectionWind(speed_from, direction_from, name)
 
 
 def _race_end(course: Course, tracks: Sequence[Track]) -> float:
@@ -641,108 +892,28 @@ def _leg_area(
     )
 
 
-def _optimal_leg(
-    course: Course,
-    i: int,
-    bounds: Sequence[Crossing],
-    sources: Sequence[WindSource],
-    k: int,
-    points: tuple[NDArray, NDArray, NDArray],
-    boat: Any,
-    settings: RoutingSettings,
-    target: Any,
-    progress: Progress | None,
-    *,
-    obstacles: Obstacles | None = None,
-) -> tuple[LegResult, WindSource]:
-    """The optimal route of leg ``i`` from the boat's own leg start point and time.
-
-    Routed in ``sources[k]``, inside the race area's ``obstacles`` (the course's
-    boundary and obstacles, :func:`~sailroute.routing.obstacles.obstacles_for`); when
-    that wind ends before the optimal route does, in the next source that covers the
-    leg's sailed ``points``.
-    """
-    a = bounds[i]
-    barrier = None
-    if i > 0 and np.isfinite(bounds[i - 1].x):
-        prev_start = (bounds[i - 1].x, bounds[i - 1].y)
-        barrier = target_barrier(
-            leg_target(course, i - 1),
-            Start(prev_start, None, course.legs[i - 1].from_name),
-            settings.zone_m,
-        )
-    spec = course.legs[i]
-    start = Start((a.x, a.y), None, spec.from_name, barrier)
-    if progress is not None:
-        progress.start_leg(i, spec.label)
-    while True:
-        try:
-            opt = route_leg(
-                start,
-                target,
-                a.t,
-                land_filled(course.area, sources[k].for_routing),
-                boat,
-                settings,
-                progress=progress.update if progress is not None else None,
-                obstacles=obstacles,
-            )
-            if sources[k].route_field is not None:  # raises if the route crosses a hole
-                sources[k].field.sample(opt.track.t, opt.track.x, opt.track.y)
-            break
-        except OutOfCoverageError:
-            nxt = first_covering(sources, *points, skip=k)
-            if nxt is None:
-                raise
-            k = nxt
-    if progress is not None:
-        progress.end_leg(opt.time_s, f"{opt.n_tacks} tacks, {opt.n_gybes} gybes")
-    return opt, sources[k]
-
-
 def _unknown_leg(
     course: Course,
     i: int,
     bounds: Sequence[Crossing],
-    sources: Sequence[WindSource],
-    k: int,
-    boat: Any,
-    settings: RoutingSettings,
-    target: Any,
+    source: WindSource,
+    routed: tuple[LegResult, WindSource] | None,
     centre: tuple[float, float],
-    progress: Progress | None,
+    area_note: str,
     *,
-    obstacles: Obstacles | None = None,
     design: WindField | None = None,
 ) -> LegAnalysis:
     """A leg whose start or end time is unknown: no sailed time, loss or split; the
-    optimal route when the start is known."""
+    optimal route when the start is known (``routed``: the route and the wind it was
+    routed in; ``source``: the wind the leg is judged in, its mode from it)."""
     nan = float("nan")
     spec = course.legs[i]
     a, b = bounds[i], bounds[i + 1]
     opt = None
     mode = ""
-    area_note = ""
-    source = sources[k]
-    if a.known:
-        start_pt = (np.array([a.t]), np.array([a.x]), np.array([a.y]))
-        found = first_covering(sources, *start_pt, skip=k - 1)
-        k = len(sources) - 1 if found is None else found
-        mode = source_leg_mode(course, i, sources[k], design, a.t, (a.x, a.y), centre).mode
-        obstacles, area_note = _leg_area(obstacles, (a.x, a.y), spec.label)
-        opt, source = _optimal_leg(
-            course,
-            i,
-            bounds,
-            sources,
-            k,
-            start_pt,
-            boat,
-            settings,
-            target,
-            progress,
-            obstacles=obstacles,
-        )
+    if routed is not None:
+        mode = source_leg_mode(course, i, source, design, a.t, (a.x, a.y), centre).mode
+        opt, source = routed
     note = (
         b.note
         if not b.known
@@ -886,13 +1057,18 @@ def load_and_analyze(
 __all__ = [
     "LegAnalysis",
     "PointTable",
+    "PreparedDebrief",
     "TrackAnalysis",
     "analysis_winds",
+    "analyze_fleet",
     "analyze_track",
     "check_same_race",
+    "finish_debrief",
     "fleet_ranking",
     "fleet_reference",
     "load_and_analyze",
     "parse_boat_leg_times",
     "parse_leg_times",
+    "prepare_debrief",
+    "prepare_fleet",
 ]

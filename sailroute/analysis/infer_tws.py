@@ -160,12 +160,20 @@ def invert_polar(boat: BoatModel, twa_deg: NDArray, sog_ms: NDArray) -> NDArray[
     ang = np.arange(0.0, 181.0)
     table = np.asarray(boat.steady_speed(grid[None, :], ang[:, None]), float)
     table = np.maximum.accumulate(table, axis=1)  # the rising part of each column
-    row = table[np.clip(np.rint(np.abs(twa_deg)).astype(int), 0, 180)]
-    c = (row < sog_ms[:, None]).sum(1)
+    a = np.clip(np.rint(np.abs(twa_deg)).astype(int), 0, 180)
+    sog_ms = np.asarray(sog_ms, float)
+    # per point, the speeds of its angle's row below its SOG: the row rises, so they
+    # are the first c (one search per angle, not a row of the table per point)
+    c = np.zeros(a.size, dtype=np.intp)
+    order = np.argsort(a, kind="stable")
+    angles, first = np.unique(a[order], return_index=True)
+    for k, lo, hi in zip(angles, first, [*first[1:], a.size], strict=True):
+        idx = order[lo:hi]
+        c[idx] = np.searchsorted(table[k], sog_ms[idx], side="left")
     ok = (c > 0) & (c < grid.size)
     ci = np.clip(c, 1, grid.size - 1)
-    s0 = row[np.arange(c.size), ci - 1]
-    s1 = row[np.arange(c.size), ci]
+    s0 = table[a, ci - 1]
+    s1 = table[a, ci]
     with np.errstate(invalid="ignore", divide="ignore"):
         f = np.where(s1 > s0, (sog_ms - s0) / (s1 - s0), 0.0)
     return np.where(ok, grid[ci - 1] + f * (grid[ci] - grid[ci - 1]), np.nan)

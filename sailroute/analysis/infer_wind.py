@@ -639,6 +639,7 @@ def infer_wind(
     min_speed_ms: float = MIN_SPEED_MS,
     tws: TwsSource | None = None,
     marks: Sequence[tuple[float, float]] = (),
+    xy: Sequence[tuple[NDArray, NDArray]] | None = None,
 ) -> InferredWind:
     """Estimate TWD(t) with its uncertainty, and TWS(t) from a chosen source, from boats'
     GPS tracks.
@@ -676,6 +677,9 @@ def infer_wind(
         a rounding, not a tack or a gybe (a rounding from a reach to a broad reach turns
         the stern through the wind as a gybe does, with courses that are not symmetric
         about it).
+    xy : sequence of (x, y) arrays, optional
+        Each track's fixes already in ``frame`` [m], in the order of ``tracks`` (a
+        caller that projected them; default: projected here).
 
     Returns
     -------
@@ -712,7 +716,8 @@ def infer_wind(
             f"more than {MAX_SPAN_S / 3600:.0f} h (tracks of different days?); infer one race "
             "at a time: give t0 and t1, or the tracks of one race"
         )
-    xy = [track_xy(tr, frame) for tr in trs]
+    if xy is None or len(xy) != len(trs):
+        xy = [track_xy(tr, frame) for tr in trs]
     keep, far_notes = _same_place(trs, xy, t0, t1)
     trs, xy = [trs[i] for i in keep], [xy[i] for i in keep]
     names = [tr.name or f"track {i + 1}" for i, tr in enumerate(trs)]

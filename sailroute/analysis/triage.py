@@ -195,6 +195,8 @@ class BoatEntry:
         Its start and leg ends (None: not segmented, see ``status``).
     cut : tuple of float or None
         ``(first, last)`` time kept [epoch s] when the log was cut at a long gap.
+    xy : (x, y) arrays or None
+        ``track``'s fixes in the course frame [m] (projected once for the fleet).
     """
 
     name: str
@@ -203,6 +205,7 @@ class BoatEntry:
     status: BoatStatus = field(default_factory=BoatStatus)
     segmentation: Segmentation | None = None
     cut: tuple[float, float] | None = None
+    xy: tuple[NDArray, NDArray] | None = field(default=None, repr=False)
 
     @property
     def analysed(self) -> bool:
@@ -630,7 +633,15 @@ def triage_fleet(
     ends = [c.t for s in segs.values() for c in s.bounds[1:] if c.known]
     race_end = min(window[1], max(ends) + 60.0) if ends else window[1]
     entries = tuple(
-        BoatEntry(n, fleet.source[n], fleet.kept.get(n), fleet.status[n], segs.get(n), cut.get(n))
+        BoatEntry(
+            n,
+            fleet.source[n],
+            fleet.kept.get(n),
+            fleet.status[n],
+            segs.get(n),
+            cut.get(n),
+            fleet.xy[n][1:] if n in fleet.xy and n in fleet.kept else None,
+        )
         for n, _, _ in tracks
     )
     return Triage(entries, start, recall, race_end, allow, moved)

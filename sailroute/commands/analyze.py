@@ -16,9 +16,11 @@ from typing import Any
 from sailroute.analysis.debrief import (
     REFERENCES,
     analysis_winds,
+    analyze_fleet,
     analyze_track,
     fleet_reference,
     parse_boat_leg_times,
+    prepare_fleet,
 )
 from sailroute.analysis.fleet import FleetAnalysis
 from sailroute.analysis.fleetlearn import beaten_note, learned_reference
@@ -170,6 +172,8 @@ def run_analyze_command(
             "dynamic boat model): use --reference course"
         )
     boat_tracks = [e.track for e in debriefed if e.track is not None]
+    # the tracks as the fleet's triage projected them, where it did
+    projected = [e.xy for e in debriefed if e.track is not None and e.xy is not None]
     sources, notes = analysis_winds(
         course,
         boat_tracks,
@@ -179,14 +183,13 @@ def run_analyze_command(
         wind,
         gun_t=tri.start.track_gun_t,
         race_end_t=tri.race_end_t,
+        xy=projected if not one and len(projected) == len(boat_tracks) else None,
     )
 
     def analyse_all(judged_by: Any, label: str) -> list[TrackAnalysis]:
-        out_a = []
-        for e in debriefed:
+        if one:  # its own segmentation and errors, its legs routed one by one
+            e = debriefed[0]
             assert e.track is not None
-            if progress is not None:
-                progress.set_prefix(f"{e.name}: ")
             a = analyze_track(
                 course,
                 e.track,
@@ -199,11 +202,14 @@ def run_analyze_command(
                 progress=progress,
                 missing="error",
                 gate_end=gate_end,
-                segmentation=None if one else e.segmentation,
                 clock=StartClock.plain(tri.start.track_gun_t),
             )
-            out_a.append(replace(a, reference=label))
-        return out_a
+            return [replace(a, reference=label)]
+        # a fleet: triaged and segmented, its legs routed together
+        prepared = prepare_fleet(
+            course, debriefed, name, (judged_by, winds[name]), sources, router=router
+        )
+        return [replace(a, reference=label) for a in analyze_fleet(prepared, progress)]
 
     analyses = analyse_all(boat, f"course polar {getattr(boat, 'name', '')}".strip())
     analyses, beaten = _rejudge(reference, analyses, analyse_all, notes, boat, polar, course, name)
