@@ -139,6 +139,59 @@ def test_levels_are_the_percentiles_of_the_boats_speeds() -> None:
     assert lp.boats.max() == 5 and lp.blocks.max() == 40
 
 
+def test_winds_spread_over_a_narrow_range_keep_the_polars_slope_in_tws() -> None:
+    # six boats (0.95-1.0 of the polar) sail a beat and a run in winds spread uniformly over
+    # 17-23.5 kn (the 2 kn columns 18, 20, 22 kn), with 2 deg of wind-angle and 2 % of speed
+    # scatter; the known polar rises 5 % per m/s of wind.  The median level's beat and run
+    # keep that rise: each cell within 2 sd of the known answer, and the rise from 18 to
+    # 22 kn (10.7 %) within 2 sd of both cells (a table held flat across the columns
+    # would miss it by 10 %)
+    def speed(tws, twa):
+        return 6.0 * POLAR.speed(5.0, twa) * (1.0 + 0.05 * (np.asarray(tws) - 10.0))
+
+    rng = np.random.default_rng(0)
+    skills = np.linspace(0.95, 1.0, 6)
+    n = 120
+    tws = rng.uniform(8.75, 12.1, (skills.size, n))
+    twa = np.where(rng.random((skills.size, n)) < 0.5, 45.0, 150.0)
+    twa = twa + rng.normal(0.0, 2.0, twa.shape)
+    v = skills[:, None] * speed(tws, twa) * (1.0 + 0.02 * rng.standard_normal(twa.shape))
+    k = tws.size
+    blocks = Blocks(
+        boat=np.repeat(np.arange(skills.size), n),
+        race=np.zeros(k, dtype=np.int64),
+        source=np.zeros(k, dtype=np.int64),
+        t_s=np.arange(k, dtype=float) * 20.0,
+        dur_s=np.full(k, 20.0),
+        tws_ms=tws.ravel(),
+        twd_deg=np.zeros(k),
+        twa_deg=(twa * np.where(np.arange(n) % 2 == 0, 1.0, -1.0)).ravel(),
+        speed_ms=v.ravel(),
+        boats=tuple(f"b{i}" for i in range(skills.size)),
+        races=("race",),
+        sources=("measured",),
+        dropped={},
+        n_samples=k * 20,
+    )
+    lp = learn_polar(
+        blocks, tws_bins_ms=np.array([18.0, 20.0, 22.0]) * KNOT,
+        twa_bins_deg=np.arange(0.0, 181.0, 10.0), n_boot=60,
+    ).learned  # fmt: skip
+    t = lp.levels["median"]
+    q = float(np.percentile(skills, 50.0))
+    rows = [int(np.argmin(np.abs(lp.twa_deg - a))) for a in (45.0, 150.0)]
+    for i in rows:
+        assert list(lp.status[i]) == ["learned"] * 3
+        want = q * speed(lp.tws_ms, lp.twa_deg[i])
+        assert np.all(np.abs(np.log(t.speed_ms[i] / want)) <= 2.0 * t.sd_log[i])
+        assert np.all(np.diff(t.speed_ms[i]) > 0)
+        rise = np.log(t.speed_ms[i, -1] / t.speed_ms[i, 0])
+        known = np.log(want[-1] / want[0])
+        assert known > 0.1
+        assert abs(rise - known) <= 2.0 * np.hypot(t.sd_log[i, 0], t.sd_log[i, -1])
+        assert 2.0 * np.hypot(t.sd_log[i, 0], t.sd_log[i, -1]) < 0.5 * known
+
+
 def test_a_fleet_of_one_boat_gives_every_level_its_own_speed() -> None:
     lp = learn(make_blocks({"solo": 0.93}, GRID))
     i, j = cell(lp, 6.0, 90.0)
