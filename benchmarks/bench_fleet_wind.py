@@ -189,16 +189,9 @@ def xml_course(race: int) -> tuple[float, list[tuple[float, float]], float]:
 
 def leg_changes(boat: str, race: int) -> list[float]:
     """Times [epoch s] at which a boat's leg counter steps up in a race."""
-    out, prev = [], None
-    with (LOGS / f"data_{boat}.csv").open() as f:
-        for row in csv.DictReader(f):
-            if not row["TRK_RACE_NUM_unk"].startswith(str(race)):
-                continue
-            leg = float(row["TRK_LEG_NUM_unk"])
-            if prev is not None and leg > prev:
-                out.append(datetime.fromisoformat(row["DATETIME"]).replace(tzinfo=UTC).timestamp())
-            prev = leg
-    return out
+    from tests.analysis.windfleet import leg_counter_changes
+
+    return leg_counter_changes(LOGS / f"data_{boat}.csv", str(race))
 
 
 def _smooth_deg(d: np.ndarray, n: int = 31) -> np.ndarray:

@@ -54,7 +54,6 @@ it lies within the members' P10-P90 of that leg.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 import tempfile
 import time
@@ -80,9 +79,9 @@ from sailroute.course.model import Course  # noqa: E402
 from sailroute.course.specs import build_specs  # noqa: E402
 from sailroute.course.uncertainty import uncertainty_from_mapping  # noqa: E402
 from sailroute.planning.route import plan_course, settings_for  # noqa: E402
-from sailroute.timeutil import parse_time, to_epoch  # noqa: E402
 from sailroute.track import read_track  # noqa: E402
 from sailroute.units import KNOT, circular_mean_deg  # noqa: E402
+from tests.analysis.windfleet import leg_counter_changes  # noqa: E402
 
 SHARED = ROOT.parent / "shared" / "data" / "real" / "races"
 SAILGP = SHARED / "sailgp-auckland-2025"
@@ -105,16 +104,7 @@ shifts left out, as for SailGP)."""
 
 def leg_counter(boat: str, race: str) -> list[float]:
     """Times [epoch s] the log's TRK_LEG_NUM of race ``2501190<race>`` steps up."""
-    out, prev = [], None
-    with open(SAILGP / "Boat_logs" / f"data_{boat}.csv", newline="") as fh:
-        for row in csv.DictReader(fh):
-            if not row["TRK_RACE_NUM_unk"].startswith("250119" + race):
-                continue
-            leg = float(row["TRK_LEG_NUM_unk"])
-            if prev is not None and leg > prev:
-                out.append(to_epoch(parse_time(row["DATETIME"].replace(" ", "T") + "Z", "t")))
-            prev = leg
-    return out
+    return leg_counter_changes(SAILGP / "Boat_logs" / f"data_{boat}.csv", "250119" + race)
 
 
 def with_boat_and_wind(src: Path, dest: Path, boat: str, tws_kn: float, twd_deg: float) -> Course:

@@ -40,6 +40,7 @@ from sailroute.timeutil import parse_time, to_epoch
 from sailroute.track import read_track
 from sailroute.track.kinematics import track_xy
 from sailroute.units import KNOT, circular_mean_deg
+from tests.analysis import windfleet
 from tests.conftest import SHARED_REAL, requires_shared
 
 RACE = SHARED_REAL / "races" / "sailgp-auckland-2025"
@@ -102,17 +103,7 @@ def course_from_xml(xml: Path, tws_kn: float, twd_deg: float, out: Path) -> Path
 def leg_counter_changes(boat: str) -> list[float]:
     """Times [epoch s] at which the log's TRK_LEG_NUM of race 25011905 steps up (0 -> 1 is
     the start, then each leg change)."""
-    out = []
-    prev = None
-    with open(RACE / "Boat_logs" / f"data_{boat}.csv", newline="") as fh:
-        for row in csv.DictReader(fh):
-            if not row["TRK_RACE_NUM_unk"].startswith(RACE_ID):
-                continue
-            leg = float(row["TRK_LEG_NUM_unk"])
-            if prev is not None and leg > prev:
-                out.append(to_epoch(parse_time(row["DATETIME"].replace(" ", "T") + "Z", "t")))
-            prev = leg
-    return out
+    return windfleet.leg_counter_changes(RACE / "Boat_logs" / f"data_{boat}.csv", RACE_ID)
 
 
 @pytest.fixture(scope="module")

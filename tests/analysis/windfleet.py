@@ -15,6 +15,7 @@ mode from the course geometry in the true wind at the leg start (``course.geomet
 
 from __future__ import annotations
 
+import csv
 import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -255,3 +256,20 @@ def race_xml(path: Path, frame: LocalFrame) -> tuple[float, list[tuple[float, fl
     wg = np.mean([marks["WG1"], marks["WG2"]], axis=0)
     axis = float(bearing_deg(wg[0] - lg[0], wg[1] - lg[1]))
     return to_epoch(parse_time(start.get("Start", ""))), list(marks.values()), axis
+
+
+def leg_counter_changes(log: Path, race: str) -> list[float]:
+    """Times [epoch s] at which a SailGP boat log's leg counter (``TRK_LEG_NUM``) steps up
+    in the race whose number starts with ``race`` (0 -> 1 is the start, then each leg
+    change)."""
+    out: list[float] = []
+    prev = None
+    with open(log, newline="") as fh:
+        for row in csv.DictReader(fh):
+            if not row["TRK_RACE_NUM_unk"].startswith(race):
+                continue
+            leg = float(row["TRK_LEG_NUM_unk"])
+            if prev is not None and leg > prev:
+                out.append(to_epoch(parse_time(row["DATETIME"].replace(" ", "T") + "Z", "t")))
+            prev = leg
+    return out
