@@ -929,6 +929,7 @@ def polar_fit_command(
             "fleet did not sail, scaled to it per point of sail.",
         ),
     ] = None,
+    quiet: QuietOpt = False,
     json_out: JsonOpt = False,
 ) -> None:
     """Learn a polar from a fleet's steady sailing: levels, uncertainty, verdict; writes
@@ -937,28 +938,30 @@ def polar_fit_command(
 
     def run() -> Any:
         _check_out(out)
-        return run_fit_command(
-            logs,
-            courses=course or (),
-            scenario=scenario,
-            columns=columns,
-            speed_unit=speed_unit,
-            time_zone=time_zone,
-            levels=levels,
-            percentile=percentile,
-            min_boats=min_boats,
-            min_blocks=min_blocks,
-            bootstrap=bootstrap,
-            seed=seed,
-            tws_bins=tws_bins,
-            twa_step_deg=twa_step,
-            out_dir=out,
-            unit=unit,
-            reference=reference,
-            reference_unit=reference_unit,
-            shape=shape,
-            name=name,
-        )
+        with _progress(0, quiet) as progress:
+            return run_fit_command(
+                logs,
+                courses=course or (),
+                scenario=scenario,
+                columns=columns,
+                speed_unit=speed_unit,
+                time_zone=time_zone,
+                levels=levels,
+                percentile=percentile,
+                min_boats=min_boats,
+                min_blocks=min_blocks,
+                bootstrap=bootstrap,
+                seed=seed,
+                tws_bins=tws_bins,
+                twa_step_deg=twa_step,
+                out_dir=out,
+                unit=unit,
+                reference=reference,
+                reference_unit=reference_unit,
+                shape=shape,
+                name=name,
+                progress=progress,
+            )
 
     _finish(run_guarded(run, debug=_debug(ctx)), json_out)
 

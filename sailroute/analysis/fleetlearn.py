@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Final
+from typing import TYPE_CHECKING, Any, Final
 
 import numpy as np
 from numpy.typing import NDArray
@@ -30,6 +30,9 @@ from sailroute.boat.learn_blocks import SteadyRules, steady_blocks
 from sailroute.boat.polar import Polar
 from sailroute.course.model import Course
 from sailroute.track.model import Track
+
+if TYPE_CHECKING:
+    from sailroute.progress import Progress
 
 __all__ = [
     "BEATEN_PCT",
@@ -69,6 +72,7 @@ def learn_fleet(
     shape: Polar | None = None,
     options: Mapping[str, str] | None = None,
     provenance: Mapping[str, Any] | None = None,
+    progress: Progress | None = None,
 ) -> tuple[LearnFit, FleetSamples, tuple[str, ...]]:
     """Learn a polar from a fleet's tracks (module docstring).
 
@@ -91,6 +95,10 @@ def learn_fleet(
         What counts as steady sailing.
     provenance : mapping, optional
         Kept in the learned polar.
+    progress : Progress, optional
+        Counts the boats while their samples are taken
+        (:func:`~sailroute.analysis.learnsamples.fleet_samples`), then says what is
+        learned from (steady blocks, boats, bootstrap replicates); None: silent.
 
     Returns
     -------
@@ -107,8 +115,13 @@ def learn_fleet(
         :func:`~sailroute.boat.learn.learn_polar` (no steady sailing, mixed classes, a
         fleet too small for any cell).
     """
-    samples = fleet_samples(tracks, courses, scenario)
+    samples = fleet_samples(tracks, courses, scenario, progress=progress)
     blocks = steady_blocks(samples.series, rules)
+    if progress is not None:
+        progress.note(
+            f"learning the polar from {blocks.size} steady blocks of {len(blocks.boats)} "
+            f"boat(s) ({n_boot} bootstrap replicates)"
+        )
     tws_n = (
         np.asarray(tws_bins_ms, dtype=float)
         if tws_bins_ms is not None

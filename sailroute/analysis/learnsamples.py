@@ -15,12 +15,20 @@ recorded.  Every sample is taken in the wind ``sailroute analyze`` would judge i
 
 Positions are projected into the course's frame (a frame at the log's mean position
 without a course); the wind direction is in the same frame.
+
+A :class:`~sailroute.progress.Progress` given as ``progress`` counts the boats, a line per
+boat (``boat 3 of 12 done (NZL): 0.4 s elapsed, about 2.1 s left``; with several courses
+``race 2 of 3, boat 3 of 12 done ...``, each race counted from its own start).  When a
+boat has no instruments, the fleet's wind (its direction inferred from all the tracks) is
+built before the boats are counted, with a line saying so, so that the time left counts
+the boats only.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -33,6 +41,9 @@ from sailroute.geo import LocalFrame
 from sailroute.track.kinematics import track_xy
 from sailroute.track.model import Track
 from sailroute.units import wind_speed_direction
+
+if TYPE_CHECKING:
+    from sailroute.progress import Progress
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,8 +90,9 @@ def no_wind_message(track: Track, exc: Exception) -> str:
     )
 
 
-def samples_from_logs(tracks: Sequence[Track]) -> FleetSamples:
-    """Each log in its own measured wind, over the whole log (no course).
+def samples_from_logs(tracks: Sequence[Track], *, progress: Progress | None = None) -> FleetSamples:
+    """Each log in its own measured wind, over the whole log (no course); ``progress``
+    counts the boats (module docstring).
 
     Raises
     ------
@@ -91,7 +103,9 @@ def samples_from_logs(tracks: Sequence[Track]) -> FleetSamples:
 
     out = []
     notes: list[str] = []
-    for tr in tracks:
+    if progress is not None:
+        progress.start_count(len(tracks), "boat")
+    for k, tr in enumerate(tracks):
         try:
             sensor = sensor_from_track(tr)
         except InputError as exc:
@@ -120,6 +134,8 @@ def samples_from_logs(tracks: Sequence[Track]) -> FleetSamples:
                 (label,),
             )
         )
+        if progress is not None:
+            progress.item_done(k + 1, tr.name)
     return FleetSamples(tuple(out), tuple(notes))
 
 
@@ -151,7 +167,12 @@ def _own_winds(tracks: Sequence[Track], course: Course) -> dict[str, WindSource]
 
 
 def samples_in_race(
-    course: Course, tracks: Sequence[Track], scenario: str | None = None
+    course: Course,
+    tracks: Sequence[Track],
+    scenario: str | None = None,
+    *,
+    progress: Progress | None = None,
+    race: str = "",
 ) -> FleetSamples:
     """Each track's part of one race, leg by leg in the wind ``analyze`` would take.
 
@@ -164,6 +185,11 @@ def samples_in_race(
     scenario : str, optional
         The course's scenario (default its first): the wind of last resort, and the speed
         of an inferred direction.
+    progress : Progress, optional
+        Counts the boats sailing the race (module docstring); None: silent.
+    race : str
+        The race's place in the run (``"race 2 of 3"``), put before the lines' ``boat k
+        of N``.
 
     Raises
     ------
@@ -171,8 +197,6 @@ def samples_in_race(
         An unknown scenario, or bad boat/wind specs of the course.
     """
     from sailroute.analysis.debrief import analysis_winds
-    from sailroute.analysis.segment import segment_track
-    from sailroute.analysis.windsource import covers, first_covering
     from sailroute.course.load import build_specs
     from sailroute.planning.route import default_scenario
 
@@ -191,72 +215,114 @@ def samples_in_race(
         if tr not in racing
     ]
     own = _own_winds(racing, course)
-    full: list[dict[str, list[WindSource]]] = []
+    built: list[tuple[dict[str, list[WindSource]], list[str]]] = []
+    used: list[bool] = []
+
+    def fleet_winds() -> tuple[dict[str, list[WindSource]], list[str]]:
+        if not built:
+            built.append(analysis_winds(course, racing, name, winds[name], boat))
+        return built[0]
 
     def candidates(tr: Track) -> list[WindSource]:
-        # analyze's order; the fleet's and the inferred wind are built only when a leg
-        # is not covered by the boat's own instruments (the first of that order)
-        if not full:
-            sources, found = analysis_winds(course, racing, name, winds[name], boat)
-            full.append(sources)
+        # analyze's order; the fleet's and the inferred wind are built before the boats
+        # when one has no instruments, else when a leg is not covered by a boat's own (the
+        # first of that order); their findings join the notes where they are first used
+        sources, found = fleet_winds()
+        if not used:
+            used.append(True)
             notes.extend(found)
-        return full[0][tr.name]
+        return sources[tr.name]
 
+    where = f"{race}, " if race else ""
+    if len(own) < len(racing):  # a pass over all the tracks: not in any boat's time
+        if progress is not None:
+            progress.note(
+                f"{where}{course.name}: inferring the wind direction from the {len(racing)} "
+                f"tracks ({len(racing) - len(own)} without instruments)"
+            )
+        fleet_winds()
+    if progress is not None:
+        progress.start_count(len(racing), f"{where}boat")
     out = []
     legs = []
-    for tr in racing:
-        x, y = track_xy(tr, course.frame)
-        t = np.asarray(tr.t_s, float)
-        try:
-            seg = segment_track(course, t, x, y, where=tr.name, missing="unknown")
-        except InputError as exc:
-            notes.append(f"{tr.name}: not found sailing {course.name} ({exc}): left out")
-            continue
-        labels: list[str] = []
-        parts: list[tuple[NDArray, WindSource]] = []
-        b = seg.bounds
-        legs.append(
-            RaceLegs(course.name, tr.name, np.array([c.t if c.known else np.nan for c in b]))
-        )
-        for i in range(len(b) - 1):
-            if not (b[i].known and b[i + 1].known):
-                continue
-            m = np.flatnonzero((t > b[i].t) & (t < b[i + 1].t))
-            if m.size < 2:
-                continue
-            mine = own.get(tr.name)
-            if mine is not None and covers(mine.field, t[m], x[m], y[m]):
-                src: WindSource | None = mine
-            else:
-                srcs = candidates(tr)
-                k = first_covering(srcs, t[m], x[m], y[m])
-                src = None if k is None else srcs[k]
-            if src is None:
-                notes.append(f"{tr.name}: {course.name} leg {i + 1}: no wind covers it: left out")
-                continue
-            if src.label not in labels:
-                labels.append(src.label)
-            parts.append((m, src))
-        if not parts:
-            notes.append(f"{tr.name}: no leg of {course.name} with both ends found: left out")
-            continue
-        idx = np.concatenate([m for m, _ in parts])
-        which = np.concatenate(
-            [np.full(m.size, labels.index(w.label), dtype=np.int64) for m, w in parts]
-        )
-        sampled = [_sample(w.field, t[m], x[m], y[m]) for m, w in parts]
-        tws = np.concatenate([a for a, _ in sampled])
-        twd = np.concatenate([d for _, d in sampled])
-        out.append(
-            BoatSeries(tr.name, course.name, t[idx], x[idx], y[idx], tws, twd, which, tuple(labels))
-        )
+    for k, tr in enumerate(racing):
+        got = _race_series(course, tr, own.get(tr.name), candidates, notes)
+        if got is not None:
+            legs.append(got[0])
+            if got[1] is not None:
+                out.append(got[1])
+        if progress is not None:
+            progress.item_done(k + 1, tr.name)
     return FleetSamples(tuple(out), tuple(notes), tuple(legs))
 
 
+def _race_series(
+    course: Course,
+    tr: Track,
+    mine: WindSource | None,
+    candidates: Callable[[Track], list[WindSource]],
+    notes: list[str],
+) -> tuple[RaceLegs, BoatSeries | None] | None:
+    """One track's legs and samples in one race (:func:`samples_in_race`): each leg in its
+    own wind ``mine`` where that covers it, else the first of ``candidates(tr)`` that does.
+    None: not found sailing the race; no series: no leg with both ends and wind.  What is
+    left out is added to ``notes``."""
+    from sailroute.analysis.segment import segment_track
+    from sailroute.analysis.windsource import covers, first_covering
+
+    x, y = track_xy(tr, course.frame)
+    t = np.asarray(tr.t_s, float)
+    try:
+        seg = segment_track(course, t, x, y, where=tr.name, missing="unknown")
+    except InputError as exc:
+        notes.append(f"{tr.name}: not found sailing {course.name} ({exc}): left out")
+        return None
+    labels: list[str] = []
+    parts: list[tuple[NDArray, WindSource]] = []
+    b = seg.bounds
+    legs = RaceLegs(course.name, tr.name, np.array([c.t if c.known else np.nan for c in b]))
+    for i in range(len(b) - 1):
+        if not (b[i].known and b[i + 1].known):
+            continue
+        m = np.flatnonzero((t > b[i].t) & (t < b[i + 1].t))
+        if m.size < 2:
+            continue
+        if mine is not None and covers(mine.field, t[m], x[m], y[m]):
+            src: WindSource | None = mine
+        else:
+            srcs = candidates(tr)
+            k = first_covering(srcs, t[m], x[m], y[m])
+            src = None if k is None else srcs[k]
+        if src is None:
+            notes.append(f"{tr.name}: {course.name} leg {i + 1}: no wind covers it: left out")
+            continue
+        if src.label not in labels:
+            labels.append(src.label)
+        parts.append((m, src))
+    if not parts:
+        notes.append(f"{tr.name}: no leg of {course.name} with both ends found: left out")
+        return legs, None
+    idx = np.concatenate([m for m, _ in parts])
+    which = np.concatenate(
+        [np.full(m.size, labels.index(w.label), dtype=np.int64) for m, w in parts]
+    )
+    sampled = [_sample(w.field, t[m], x[m], y[m]) for m, w in parts]
+    tws = np.concatenate([a for a, _ in sampled])
+    twd = np.concatenate([d for _, d in sampled])
+    return legs, BoatSeries(
+        tr.name, course.name, t[idx], x[idx], y[idx], tws, twd, which, tuple(labels)
+    )
+
+
 def fleet_samples(
-    tracks: Sequence[Track], courses: Sequence[Course] = (), scenario: str | None = None
+    tracks: Sequence[Track],
+    courses: Sequence[Course] = (),
+    scenario: str | None = None,
+    *,
+    progress: Progress | None = None,
 ) -> FleetSamples:
-    """The fleet's samples: per race with courses, else each log in its own wind.
+    """The fleet's samples: per race with courses, else each log in its own wind;
+    ``progress`` counts the boats (of each race: ``race 2 of 3, boat 3 of 12``).
 
     Raises
     ------
@@ -264,12 +330,13 @@ def fleet_samples(
         Without courses, a track without wind; with courses, no track sailing any of them.
     """
     if not courses:
-        return samples_from_logs(tracks)
+        return samples_from_logs(tracks, progress=progress)
     series: list[BoatSeries] = []
     notes: list[str] = []
     legs: list[RaceLegs] = []
-    for c in courses:
-        fs = samples_in_race(c, tracks, scenario)
+    for r, c in enumerate(courses):
+        race = f"race {r + 1} of {len(courses)}" if len(courses) > 1 else ""
+        fs = samples_in_race(c, tracks, scenario, progress=progress, race=race)
         series += fs.series
         notes += fs.notes
         legs += fs.legs

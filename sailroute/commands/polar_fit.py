@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Final
+from typing import TYPE_CHECKING, Final
 
 import numpy as np
 
@@ -30,6 +30,9 @@ from sailroute.report.files import POLAR_FILE_LABELS
 from sailroute.report.polar import learned_report, write_learned_outputs
 from sailroute.track.model import Track
 from sailroute.units import speed_factor
+
+if TYPE_CHECKING:
+    from sailroute.progress import Progress
 
 
 @dataclass(frozen=True)
@@ -142,6 +145,7 @@ def run_fit_command(
     rules: SteadyRules | None = None,
     name: str | None = None,
     shape: str | None = None,
+    progress: Progress | None = None,
 ) -> CommandResult:
     """Everything ``sailroute polar fit`` does, minus printing.
 
@@ -190,6 +194,10 @@ def run_fit_command(
         ``builtin:NAME`` or a polar file whose shape fills the cells the fleet did not
         sail (every requested row and column kept), scaled per point of sail to the
         learned cells.
+    progress : Progress, optional
+        Counts the boats while their samples are taken (``boat 3 of 12 done (NZL): ...``,
+        :func:`~sailroute.analysis.fleetlearn.learn_fleet`); None: silent.  The results and
+        the files are the same with or without it.
     """
     from sailroute.boat.io import read_polar
     from sailroute.course.load import load_course
@@ -247,6 +255,7 @@ def run_fit_command(
             "scenario": scenario,
             "shape": None if shape_polar is None else f"{shape} ({shape_polar.name})",
         },
+        progress=progress,
     )
     notes = list(notes_t)
     errors = {}

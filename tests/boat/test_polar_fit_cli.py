@@ -1,18 +1,22 @@
 """``sailroute polar fit LOG...``: a fleet's logs in, a learned polar's files out; bad input
-gives one line each and writes nothing."""
+gives one line each and writes nothing; the boats are counted on stderr (``-q``: not), the
+output the same either way."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
 import pytest
+from click.testing import Result
 from typer.testing import CliRunner
 
 from sailroute.boat.build import boat_from_spec, builtin_polar
 from sailroute.cli import app
 from sailroute.units import KNOT
+from tests.fleetgen import FaultPlan, messy_fleet
 
 runner = CliRunner()
 POLAR = builtin_polar("ilca7-steady")
@@ -111,7 +115,8 @@ def test_bad_input_is_one_line_and_writes_nothing(
         for k, (n, s, w) in enumerate(logs)
     ]
     out = tmp_path / "out"
-    res = runner.invoke(app, ["polar", "fit", *map(str, paths), *extra, "--out", str(out)])
+    # -q: the error alone (without it the boats counted before the error come first)
+    res = runner.invoke(app, ["polar", "fit", *map(str, paths), *extra, "-q", "--out", str(out)])
     assert res.exit_code == 2, res.output
     assert message in res.output and len(res.output.strip().splitlines()) == 1, res.output
     assert not out.exists()
@@ -142,3 +147,98 @@ def test_plan_sails_the_learned_polar_and_says_which(tmp_path: Path, fleet: list
     best = POLAR.vmg_upwind(10.0 * KNOT)[1]
     beat = doc["legs"][1] if doc["legs"][1]["mode"] == "upwind" else doc["legs"][0]
     assert beat["mode"] == "upwind" and beat["time_s"] > 600.0 / best
+
+
+# --- progress on stderr: the boats counted, nothing else changed --------------------------
+
+
+@pytest.fixture(scope="module")
+def races(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[Path], list[Path], list[str]]:
+    """Four boats' GPS tracks (no wind) of a generated race (``tests/fleetgen.py``) and its
+    course twice, under two names: two races of the same four boats."""
+    d = tmp_path_factory.mktemp("races")
+    fl = messy_fleet(0, n_boats=4, minutes=12, faults=FaultPlan.clean(), sample_s=(1, 1))
+    course, tracks = fl.write(d, "gpx")
+    again = d / "again.yaml"
+    text = re.sub(r"^name:.*$", "name: the race again", course.read_text(), count=1, flags=re.M)
+    again.write_text(text, encoding="utf-8")
+    return tracks, [course, again], [t.name for t in fl.tracks]
+
+
+RUNS = {"shown": [], "quiet": ["-q"]}
+
+
+@pytest.fixture(scope="module")
+def shown_and_quiet(
+    tmp_path_factory: pytest.TempPathFactory, races: tuple[list[Path], list[Path], list[str]]
+) -> tuple[Path, dict[str, Result]]:
+    """``polar fit`` of the two races, with its progress and with ``-q``."""
+    d = tmp_path_factory.mktemp("runs")
+    tracks, courses, _ = races
+    args = ["polar", "fit", *map(str, tracks), "--bootstrap", "20"]
+    args += [a for c in courses for a in ("--course", str(c))]
+    res = {tag: runner.invoke(app, [*args, *q, "-o", str(d / tag)]) for tag, q in RUNS.items()}
+    for r in res.values():
+        assert r.exit_code == 0, r.output
+    return d, res
+
+
+def test_each_race_counts_its_boats_on_stderr(
+    shown_and_quiet: tuple[Path, dict[str, Result]],
+    races: tuple[list[Path], list[Path], list[str]],
+) -> None:
+    d, res = shown_and_quiet
+    lines = res["shown"].stderr.splitlines()
+    names = races[2]
+    for k, race in enumerate(("messy fleet (seed 0)", "the race again")):
+        where = f"race {k + 1} of 2"
+        counted = [ln for ln in lines if ln.startswith(f"{where}, boat ")]
+        # a line per boat, each named once in the order given, up to 4 of 4
+        got = [re.match(rf"{where}, boat (\d) of 4 done \((\w+)\): ", ln) for ln in counted]
+        assert [m.groups() if m else ln for m, ln in zip(got, counted, strict=True)] == [
+            (str(i + 1), n) for i, n in enumerate(names)
+        ]
+        assert all(", about " in ln and ln.endswith(" left") for ln in counted[:-1])
+        assert counted[-1].endswith(" elapsed")  # the last: nothing left
+        # no boat has instruments: the fleet's wind is inferred first, not counted as a boat
+        note = f"{where}, {race}: inferring the wind direction from the 4 tracks (4 without "
+        note += "instruments)"
+        assert lines.index(note) == lines.index(counted[0]) - 1
+    # then what the polar is learned from: the blocks the written polar says it has
+    doc = json.loads((d / "shown" / "bel2686-fleet.json").read_text())
+    blocks = doc["learned"]["provenance"]["blocks"]
+    assert (
+        lines[-1]
+        == f"learning the polar from {blocks} steady blocks of 4 boat(s) (20 bootstrap replicates)"
+    )
+    assert len(lines) == 2 * (1 + 4) + 1
+    assert " of 4 done" not in res["shown"].stdout
+
+
+def test_quiet_shows_no_progress(shown_and_quiet: tuple[Path, dict[str, Result]]) -> None:
+    _, res = shown_and_quiet
+    assert res["quiet"].stderr == "" and res["shown"].stderr != ""
+
+
+def test_the_progress_changes_no_output(shown_and_quiet: tuple[Path, dict[str, Result]]) -> None:
+    d, res = shown_and_quiet
+    files = {tag: sorted(p.relative_to(d / tag) for p in (d / tag).rglob("*")) for tag in RUNS}
+    assert files["shown"] == files["quiet"] and len(files["shown"]) == 5  # 4 + the manifest
+    for rel in files["shown"]:
+        assert (d / "shown" / rel).read_bytes() == (d / "quiet" / rel).read_bytes(), rel
+    assert res["shown"].stdout.replace(str(d / "shown"), "OUT") == res["quiet"].stdout.replace(
+        str(d / "quiet"), "OUT"
+    )
+
+
+def test_logs_without_a_course_count_the_boats_too(tmp_path: Path, fleet: list[Path]) -> None:
+    res = runner.invoke(
+        app, ["polar", "fit", *map(str, fleet), "--out", str(tmp_path / "o"), "--bootstrap", "0"]
+    )
+    assert res.exit_code == 0, res.output
+    lines = res.stderr.splitlines()
+    # each log in its own wind: no wind to infer, the three boats, then the learning
+    assert [ln.split(":")[0] for ln in lines[:3]] == [
+        f"boat {k + 1} of 3 done (boat{k})" for k in range(3)
+    ]
+    assert lines[3].startswith("learning the polar from ") and len(lines) == 4
