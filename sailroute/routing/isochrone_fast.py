@@ -109,24 +109,22 @@ class _Usage:
 
 def kernels() -> Any:
     """The compiled kernels: the ahead-of-time module of
-    :mod:`~sailroute.routing.isochrone_aot` where one is built for the current source
-    (no numba to import), else :mod:`sailroute.routing.isochrone_jit` where numba's cache
-    holds them, else the ahead-of-time module built now (about 12 s of CPU, once), or,
-    where it cannot be built (no C compiler or no Python headers), the kernels compiled
-    just in time (:func:`_just_in_time`)."""
+    :mod:`~sailroute.routing.isochrone_aot` for the current source (no numba to import),
+    built now where there is none (about 12 s of CPU, once per install or change of the
+    kernels), or, where it cannot be built (no C compiler or no Python headers, or the
+    build failed), the kernels numba compiles just in time (:func:`_just_in_time`)."""
     if _Usage.kernels is None:
         _Usage.kernels = _ahead_of_time() or _just_in_time()
     return _Usage.kernels
 
 
 def _ahead_of_time() -> isochrone_aot.Kernels | None:
-    """The ahead-of-time kernels, loaded or built (:func:`kernels`); None where there
-    are none and building them is not the way (numba's cache holds its own, or a build
-    is impossible or failed)."""
+    """The ahead-of-time kernels, loaded or built (:func:`kernels`); None where there is
+    no module and none can be built."""
     folder = _cache_folder()
     module = isochrone_aot.load(folder)
     if module is None and folder is not None and not _Usage.build_failed:
-        if _jit_kernels_in_cache() or not isochrone_aot.can_build():
+        if not isochrone_aot.can_build():
             return None
         try:
             isochrone_aot.build(folder, _just_in_time())
