@@ -197,3 +197,41 @@ def test_a_new_process_routes_through_the_module_without_importing_numba(aot_mod
     c = load_course(course)
     numpy_run = plan_course(dataclasses.replace(c, routing=with_engine(c.routing, "numpy")))
     assert times == [leg.time_s for leg in numpy_run.plan.legs]
+
+
+def test_the_cpu_is_read_from_the_first_processor_of_cpuinfo(tmp_path):
+    info = tmp_path / "cpuinfo"
+    info.write_text(
+        "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD EPYC\n"
+        "cpu MHz\t\t: 2596.1\nflags\t\t: fpu sse2  avx2\n\n"
+        "processor\t: 1\nvendor_id\t: AuthenticAMD\nflags\t\t: fpu sse2 avx2 avx512f\n"
+    )
+    assert isochrone_aot.host_cpu(info) == (
+        "vendor_id : AuthenticAMD\nmodel name : AMD EPYC\nflags : fpu sse2 avx2"
+    )  # the clock speed, which varies, is left out
+    assert isochrone_aot.host_cpu(tmp_path / "none") == ""
+
+
+def test_another_cpu_gets_another_module(monkeypatch):
+    monkeypatch.setattr(isochrone_aot, "host_cpu", lambda: "flags : sse2 avx2")
+    avx2 = isochrone_aot.module_name()
+    monkeypatch.setattr(isochrone_aot, "host_cpu", lambda: "flags : sse2")
+    assert isochrone_aot.module_name() != avx2
+
+
+def test_the_module_is_compiled_for_this_cpus_features_or_a_generic_one():
+    from numba.core import codegen
+
+    class CC:
+        target_cpu = ""
+
+    plain = codegen.AOTCPUCodegen._customize_tm_features
+    cc = CC()
+    with isochrone_aot._for_this_cpu(cc, known=False):
+        assert cc.target_cpu == "generic"
+        assert codegen.AOTCPUCodegen._customize_tm_features is plain
+    with isochrone_aot._for_this_cpu(cc, known=True):
+        assert cc.target_cpu == "host"
+        gen = codegen.AOTCPUCodegen.__new__(codegen.AOTCPUCodegen)
+        assert gen._customize_tm_features() == gen._get_host_cpu_features() != ""
+    assert codegen.AOTCPUCodegen._customize_tm_features is plain
