@@ -11,8 +11,10 @@ The wind and current are sampled as on the NumPy path, in one call per step; the
 looked up once per step (a PCHIP polar inside the kernels, from its dense table).
 
 :func:`compiled` says whether a step takes this path (``routing.engine``, NumPy arrays,
-numba installed, and for ``auto`` whether the work pays for numba's start-up); numba is
-imported only then (:func:`kernels`).  The NumPy functions do what this path leaves to
+numba installed, and for ``auto`` whether the work pays for the kernels' start-up); the
+kernels are loaded only then (:func:`kernels`): the module compiled ahead of time
+(:mod:`~sailroute.routing.isochrone_aot`, no numba imported) where it is built, else
+numba's.  The NumPy functions do what this path leaves to
 them: the candidates of a step in a race area (:class:`~sailroute.routing.obstacles.
 Obstacles`) and the inputs of a step in a surface current (its candidates are still
 compiled, :func:`pack`).
@@ -35,6 +37,7 @@ import numpy as np
 
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.routing import isochrone_aot
 from sailroute.routing.geometry import barrier_segment, segment_frame
 from sailroute.routing.isochrone_inputs import (
     _barrier_ray,
@@ -79,23 +82,14 @@ JIT_AFTER_S: Final = 1.5
 """With ``routing.engine = "auto"``, the compiled kernels take over once this process
 has spent this long [s of CPU] in NumPy steps, for a front that holds several members
 (:mod:`sailroute.routing.batch`), or where numba's cache holds them already
-(:func:`kernels_cached`).  Numba's start-up in a fresh process, importing it and its
-first compiled call, costs about 0.35 s of CPU (:mod:`sailroute.jit`), less than the
-NumPy steps of one plan of a course (about 0.8 s); compiling the kernels, about 15 s,
-pays for a batch, a comparison or a day of live re-plans, not for one plan."""
+(:func:`kernels_cached`).  Loading them costs a few milliseconds from the ahead-of-time
+module (:mod:`~sailroute.routing.isochrone_aot`) and about 0.35 s of CPU from numba's
+cache (numba's start-up, :mod:`sailroute.jit`), less than the NumPy steps of one plan of
+a course (about 0.8 s); compiling them, about 12-15 s, pays for a batch, a comparison or
+a day of live re-plans, not for one plan."""
 
 
-STEP_KERNELS: Final = (
-    "sample_points",
-    "wind_states",
-    "support_headings",
-    "aim_directions",
-    "step_inputs",
-    "dense_speeds",
-    "candidates",
-    "sector_winners",
-    "survivors",
-)
+STEP_KERNELS: Final = tuple(isochrone_aot.SIGNATURES)
 """The kernels of :mod:`~sailroute.routing.isochrone_jit` that a step calls."""
 
 _PYCACHE: Final = Path(__file__).parent / "__pycache__"
@@ -107,16 +101,46 @@ class _Usage:
     """What this process has done so far (:func:`compiled`)."""
 
     numpy_s = 0.0  # CPU time spent in NumPy steps [s]
-    kernels: ModuleType | None = None  # isochrone_jit, once imported
+    kernels: Any = None  # the kernels in use (kernels()), once chosen
+    jit: ModuleType | None = None  # isochrone_jit, once imported
     cached: bool | None = None  # kernels_cached(), once asked
+    build_failed = False  # an ahead-of-time build failed in this process
 
 
-def kernels() -> ModuleType:
-    """The compiled kernels, :mod:`sailroute.routing.isochrone_jit` (imports numba and
-    loads its registries, :func:`sailroute.jit.load_registries`, with the cyclic garbage
-    collector paused: its full passes over numba's new objects cost about 0.05 s of CPU
-    and find nothing)."""
+def kernels() -> Any:
+    """The compiled kernels: the ahead-of-time module of
+    :mod:`~sailroute.routing.isochrone_aot` for the current source (no numba to import),
+    built now where there is none (about 12 s of CPU, once per install or change of the
+    kernels), or, where it cannot be built (no C compiler or no Python headers, or the
+    build failed), the kernels numba compiles just in time (:func:`_just_in_time`)."""
     if _Usage.kernels is None:
+        _Usage.kernels = _ahead_of_time() or _just_in_time()
+    return _Usage.kernels
+
+
+def _ahead_of_time() -> isochrone_aot.Kernels | None:
+    """The ahead-of-time kernels, loaded or built (:func:`kernels`); None where there is
+    no module and none can be built."""
+    folder = _cache_folder()
+    module = isochrone_aot.load(folder)
+    if module is None and folder is not None and not _Usage.build_failed:
+        if not isochrone_aot.can_build():
+            return None
+        try:
+            isochrone_aot.build(folder, _just_in_time())
+        except Exception:  # any compiler failure: the JIT kernels serve
+            _Usage.build_failed = True
+            return None
+        module = isochrone_aot.load(folder)
+    return None if module is None else isochrone_aot.Kernels(module, _just_in_time)
+
+
+def _just_in_time() -> ModuleType:
+    """:mod:`sailroute.routing.isochrone_jit`, numba's just-in-time kernels (imports
+    numba and loads its registries, :func:`sailroute.jit.load_registries`, with the
+    cyclic garbage collector paused: its full passes over numba's new objects cost about
+    0.05 s of CPU and find nothing)."""
+    if _Usage.jit is None:
         collecting = gc.isenabled()
         gc.disable()  # numba's start-up makes objects that all live on: no cycles to find
         try:
@@ -127,18 +151,20 @@ def kernels() -> ModuleType:
         finally:
             if collecting:
                 gc.enable()
-        _Usage.kernels = isochrone_jit
-    return _Usage.kernels
+        _Usage.jit = isochrone_jit
+    return _Usage.jit
 
 
 def kernels_cached() -> bool:
-    """Whether numba's cache holds the compiled step kernels (:data:`STEP_KERNELS`) for
-    the current source of :mod:`~sailroute.routing.isochrone_jit`: a run has compiled
-    them, so loading them costs numba's start-up only, not a compilation (about 15 s).
+    """Whether the compiled step kernels (:data:`STEP_KERNELS`) load without compiling,
+    from the ahead-of-time module built for the current source
+    (:mod:`~sailroute.routing.isochrone_aot`: a few milliseconds) or from numba's cache
+    (about 0.35 s: numba's start-up), rather than being compiled (about 12-15 s).
 
     A look at the cache folder comes first; numba is imported only where it holds the
-    kernels (or where the folder is elsewhere).  False where numba itself would load
-    from source (no ``.pyc``: :func:`_numba_bytecode`).  Asked once per process.
+    just-in-time kernels (or where the folder is elsewhere).  Those count only where
+    numba itself loads from its bytecode (no ``.pyc``: :func:`_numba_bytecode`).  Asked
+    once per process.
     """
     if _Usage.cached is None:
         _Usage.cached = _step_kernels_in_cache()
@@ -171,8 +197,14 @@ def _numba_bytecode() -> bool:
 
 
 def _step_kernels_in_cache() -> bool:
-    if not _numba_bytecode():
-        return False
+    folder = _cache_folder()
+    if folder is not None and isochrone_aot.module_path(folder).is_file():
+        return True
+    return _numba_bytecode() and _jit_kernels_in_cache()
+
+
+def _jit_kernels_in_cache() -> bool:
+    """Whether numba's cache holds every step kernel compiled just in time."""
     folder = _cache_folder()
     if folder is not None and not any(folder.glob("isochrone_jit.candidates-*.nbi")):
         return False  # nothing compiled yet: no need to import numba to know it

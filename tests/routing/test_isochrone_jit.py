@@ -1,4 +1,5 @@
-"""The compiled isochrone step (routing.engine = "numba") against the NumPy one.
+"""The compiled isochrone step (routing.engine = "numba") against the NumPy one, through
+numba's just-in-time kernels and through the module compiled ahead of time.
 
 The kernels of sailroute/routing/isochrone_jit.py do the NumPy step's arithmetic in its
 order, and the trigonometric functions stay NumPy's, so every route must come out the
@@ -105,11 +106,13 @@ PENALTIES = routing_settings(tack_penalty_s=6.0, gybe_penalty_s=4.0, dt_s=5.0)
     ],
     ids=["beat", "penalties", "run-gate", "reach-line", "box", "clamped", "full-fan", "capped"],
 )
+@pytest.mark.usefixtures("compiled_kernels")
 def test_the_compiled_step_routes_every_leg_as_numpy_does(start, target, wind, settings):
     res = both(start, target, wind, settings)
     assert res.time_s > 0 and np.isfinite(res.time_s)
 
 
+@pytest.mark.usefixtures("compiled_kernels")
 def test_a_leg_after_a_rounding_keeps_the_mark_on_its_side_the_same_way():
     # leg 2 of a course: it starts where leg 1 ended, behind the barrier of mark 1
     wind = UniformWind(4.4, 0.0)
@@ -120,6 +123,7 @@ def test_a_leg_after_a_rounding_keeps_the_mark_on_its_side_the_same_way():
     both(start, target, wind, PENALTIES)
 
 
+@pytest.mark.usefixtures("compiled_kernels")
 def test_a_current_and_a_linear_polar_go_the_same_way():
     current = UniformCurrent(0.5, 120.0)
     both(LINE, MARK, UniformWind(4.4, 20.0), PENALTIES, current=current)
@@ -128,6 +132,7 @@ def test_a_current_and_a_linear_polar_go_the_same_way():
     both(LINE, MARK, UniformWind(4.4, 0.0), SET, polar=linear)
 
 
+@pytest.mark.usefixtures("compiled_kernels")
 def test_a_race_area_goes_round_the_same_way():
     # the candidates' race-area test stays NumPy's; the rest of the step is compiled
     island = AreaPolygon("island", (-40.0, 120.0, 120.0, -40.0), (300.0, 300.0, 420.0, 420.0))
@@ -136,6 +141,7 @@ def test_a_race_area_goes_round_the_same_way():
     assert res.distance_m > 700.0
 
 
+@pytest.mark.usefixtures("compiled_kernels")
 def test_members_routed_together_are_the_same_on_both_paths():
     # winds, start times and boats of their own; the compiled batch against the NumPy
     # batch, and each member against its own route (the first leg: bit for bit)
@@ -198,13 +204,14 @@ def test_kernels_count_as_cached_only_when_every_step_kernel_is_in_numbas_index(
 ):
     from sailroute.routing import isochrone_jit
 
+    monkeypatch.setattr(isochrone_fast._Usage, "kernels", isochrone_fast._just_in_time())
     both(LINE, MARK, UniformWind(4.4, 0.0), SET)  # compiles the step kernels, or loads them
     with monkeypatch.context() as m:
         m.setattr(isochrone_fast, "_numba_bytecode", lambda: True)
-        assert isochrone_fast._step_kernels_in_cache()
+        assert isochrone_fast._jit_kernels_in_cache()
         stale = getattr(isochrone_jit, isochrone_fast.STEP_KERNELS[-1])._cache._cache_file
         m.setattr(stale, "_load_index", dict)  # numba's answer for a stale index
-        assert not isochrone_fast._step_kernels_in_cache()
+        assert not isochrone_fast._jit_kernels_in_cache()
     with monkeypatch.context() as m:
         m.setattr(isochrone_fast, "_numba_bytecode", lambda: True)
         m.delenv("NUMBA_CACHE_DIR", raising=False)
@@ -218,6 +225,7 @@ def test_kernels_count_as_cached_only_when_every_step_kernel_is_in_numbas_index(
         assert not isochrone_fast._step_kernels_in_cache()
     with monkeypatch.context() as m:
         m.setattr(sys, "pycache_prefix", str(tmp_path))  # no .pyc of numba: from source
+        m.setattr(isochrone_fast, "_PYCACHE", tmp_path)  # and no module compiled ahead
         assert not isochrone_fast._numba_bytecode()
         assert not isochrone_fast._step_kernels_in_cache()
 
@@ -236,10 +244,10 @@ def test_numba_starts_with_the_collector_paused_and_leaves_it_as_it_was(monkeypa
 
     monkeypatch.setattr(sailroute.jit, "load_registries", load)
     for enabled in (True, False):
-        monkeypatch.setattr(isochrone_fast._Usage, "kernels", None)
+        monkeypatch.setattr(isochrone_fast._Usage, "jit", None)
         (gc.enable if enabled else gc.disable)()
         try:
-            assert isochrone_fast.kernels() is isochrone_jit
+            assert isochrone_fast._just_in_time() is isochrone_jit
             assert gc.isenabled() is enabled
         finally:
             gc.enable()
