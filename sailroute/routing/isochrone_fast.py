@@ -97,6 +97,10 @@ _PYCACHE: Final = Path(__file__).parent / "__pycache__"
 folder is read-only (:func:`_cache_folder`)."""
 
 
+_LOADING = threading.Lock()
+"""Held while the kernels are loaded or built (:func:`kernels`)."""
+
+
 class _Usage:
     """What this process has done so far (:func:`compiled`)."""
 
@@ -114,7 +118,9 @@ def kernels() -> Any:
     kernels), or, where it cannot be built (no C compiler or no Python headers, or the
     build failed), the kernels numba compiles just in time (:func:`_just_in_time`)."""
     if _Usage.kernels is None:
-        _Usage.kernels = _ahead_of_time() or _just_in_time()
+        with _LOADING:  # threads routing at once build or load them once
+            if _Usage.kernels is None:
+                _Usage.kernels = _ahead_of_time() or _just_in_time()
     return _Usage.kernels
 
 

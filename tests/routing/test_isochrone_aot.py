@@ -75,7 +75,7 @@ def test_the_signatures_are_the_ones_numbas_dispatchers_compile_for_the_driver(m
     ],
 )
 def test_a_call_fits_only_the_types_it_was_compiled_for(types, args, fits):
-    assert isochrone_aot._fits(args, isochrone_aot._parse(types)) is fits
+    assert isochrone_aot.check(types)(*args) is fits
 
 
 def test_a_call_that_does_not_fit_goes_to_the_just_in_time_kernels():
