@@ -53,23 +53,34 @@ def load() -> str:
     return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
+def child_cpu(
+    cmd: list[str], src: Path, env: dict[str, str], cwd: Path
+) -> tuple[float, float, bytes]:
+    """Run ``cmd`` in a fresh process with ``sailroute`` imported from ``src``: CPU [s] of
+    the child (user + system, ``os.wait4``), wall [s] and its standard output; exits with
+    the command and its standard error where it fails."""
+    full = dict(env, PYTHONPATH=str(src))
+    t0 = time.perf_counter()
+    with tempfile.TemporaryFile() as out_f, tempfile.TemporaryFile() as err_f:
+        proc = subprocess.Popen(cmd, cwd=cwd, env=full, stdout=out_f, stderr=err_f)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out_f.seek(0)
+        err_f.seek(0)
+        stdout, err = out_f.read(), err_f.read().decode(errors="replace")
+    if proc.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)} (from {src}) failed ({proc.returncode}):\n{err}")
+    return usage.ru_utime + usage.ru_stime, wall, stdout
+
+
 def run_once(src: Path, env: dict[str, str], out: Path) -> tuple[float, float, list[float]]:
     """One fresh ``plan`` from ``src``: CPU [s] of the child, wall [s], leg times [s]."""
     cmd = [sys.executable, "-m", "sailroute", "plan", str(COURSE), "--no-plots", "-q"]
     cmd += ["-o", str(out)]
-    full = dict(env, PYTHONPATH=str(src))
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(
-        cmd, cwd=out.parent, env=full, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
-    )
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    err = proc.stderr.read().decode() if proc.stderr is not None else ""
-    if proc.returncode != 0:
-        raise SystemExit(f"{' '.join(cmd)} (from {src}) failed ({proc.returncode}):\n{err}")
+    cpu, wall, _ = child_cpu(cmd, src, env, out.parent)
     legs = json.loads((out / "plan.json").read_text())["legs"]
-    return usage.ru_utime + usage.ru_stime, wall, [float(leg["time_s"]) for leg in legs]
+    return cpu, wall, [float(leg["time_s"]) for leg in legs]
 
 
 def exact_leg_times(src: Path, env: dict[str, str]) -> list[float]:
@@ -91,9 +102,9 @@ def exact_leg_times(src: Path, env: dict[str, str]) -> list[float]:
     return [float(x) for x in out.stdout.strip().strip("[]").split(",")]
 
 
-def prime_kernels(env: dict[str, str]) -> str:
-    """Route the course once on ``engine: numba`` here (compiles the step kernels into
-    numba's cache, or loads them); whether ``auto`` now finds them cached."""
+def prime_kernels(env: dict[str, str], src: Path = ROOT) -> str:
+    """Route the course once on ``engine: numba`` from ``src`` (compiles the step kernels
+    into numba's cache, or loads them); whether ``auto`` now finds them cached."""
     code = (
         "import dataclasses, sys\n"
         "from sailroute.course.load import load_course\n"
@@ -107,7 +118,7 @@ def prime_kernels(env: dict[str, str]) -> str:
     )
     out = subprocess.run(
         [sys.executable, "-c", code],
-        env=dict(env, PYTHONPATH=str(ROOT)),
+        env=dict(env, PYTHONPATH=str(src)),
         capture_output=True,
         text=True,
         check=True,

@@ -1,0 +1,167 @@
+"""The command line's start-up in fresh processes, against a baseline checkout, alternately
+in one run.
+
+Usage::
+
+    git worktree add --detach /tmp/startup_base <commit>
+    .venv/bin/python benchmarks/bench_startup.py --baseline /tmp/startup_base [--runs 7]
+    .venv/bin/python benchmarks/bench_startup.py --smoke   # this tree against itself, 1 pair
+
+Three commands, each in a new process, this tree (A) and the baseline (B, the same
+interpreter with ``PYTHONPATH=<baseline>``) in turn, A B A B ... after a warm-up pair:
+
+* ``python -m sailroute --help``: the interpreter, ``sailroute.cli`` and typer;
+* ``python -c "import sailroute.commands.plan"``: what the ``plan`` command imports before
+  it reads the course;
+* ``python -m sailroute plan courses/hyeres-r1.yaml --no-plots -q -o out``: the whole
+  command, routing included.
+
+The CPU time is the child's user + system time (``os.wait4``, the helper of
+``benchmarks/bench_plan.py``), wall time beside it; the two bytecode set-ups of
+``bench_plan.py`` (as run here, where ``PYTHONDONTWRITEBYTECODE=1`` compiles sailroute's
+modules at every start, and a primed ``PYTHONPYCACHEPREFIX``).  Numba's cache of the
+compiled step is primed on each side first (``--smoke``: left as it is), so that both route
+alike.  Every ``plan`` writes into ``out`` of its own directory: its files and its
+standard output must be the same bytes as the baseline's (the script exits 1 otherwise).
+The table gives medians, and B - A and B / A as the medians of the pairs' differences and
+ratios; the load average is printed before and after.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import tempfile
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_plan import COURSE, ROOT, child_cpu, load, prime_kernels
+
+PLAN = ("-m", "sailroute", "plan", str(COURSE), "--no-plots", "-q", "-o", "out")
+COMMANDS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("sailroute --help", ("-m", "sailroute", "--help")),
+    ('python -c "import sailroute.commands.plan"', ("-c", "import sailroute.commands.plan")),
+    ("sailroute plan hyeres-r1.yaml --no-plots -q", PLAN),
+)
+
+
+def outputs(cwd: Path, stdout: bytes) -> dict[str, bytes]:
+    """A ``plan``'s standard output and the files it wrote into ``cwd/out``, by name."""
+    files = {p.name: p.read_bytes() for p in sorted((cwd / "out").iterdir())}
+    return {"standard output": stdout, **files}
+
+
+def differing(a: dict[str, bytes], b: dict[str, bytes]) -> list[str]:
+    """Names of the outputs that are not the same bytes on both sides (or on one only)."""
+    return sorted(k for k in a.keys() | b.keys() if a.get(k) != b.get(k))
+
+
+def bench(
+    args: tuple[str, ...],
+    env_a: dict[str, str],
+    env_b: dict[str, str],
+    base: Path,
+    runs: int,
+    tmp: Path,
+    *,
+    warm_up: bool,
+) -> dict[str, Any]:
+    """``runs`` pairs A B of one command (after a warm-up pair): medians, the pairs'
+    differences and ratios, and the outputs of the last pair that differ."""
+    cmd = [sys.executable, *args]
+    cwd_a, cwd_b = tmp / "a", tmp / "b"
+    cwd_a.mkdir(parents=True, exist_ok=True)
+    cwd_b.mkdir(parents=True, exist_ok=True)
+    if warm_up:  # (and the bytecode cache's priming)
+        child_cpu(cmd, ROOT, env_a, cwd_a)
+        child_cpu(cmd, base, env_b, cwd_b)
+    cpu_a, cpu_b, wall_a, wall_b, diffs, ratios = [], [], [], [], [], []
+    differ: list[str] = []
+    for _ in range(runs):
+        ca, wa, out_a = child_cpu(cmd, ROOT, env_a, cwd_a)
+        cb, wb, out_b = child_cpu(cmd, base, env_b, cwd_b)
+        if args is PLAN:
+            differ = differing(outputs(cwd_a, out_a), outputs(cwd_b, out_b)) or differ
+        elif out_a != out_b:
+            differ = ["standard output"]
+        cpu_a.append(ca)
+        cpu_b.append(cb)
+        wall_a.append(wa)
+        wall_b.append(wb)
+        diffs.append(cb - ca)
+        ratios.append(cb / ca)
+    return {
+        "cpu_a": statistics.median(cpu_a),
+        "cpu_b": statistics.median(cpu_b),
+        "wall_a": statistics.median(wall_a),
+        "wall_b": statistics.median(wall_b),
+        "diff": statistics.median(diffs),
+        "ratio": statistics.median(ratios),
+        "spread": (min(ratios), max(ratios)),
+        "differ": differ,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--baseline", type=Path, help="checkout of the baseline (--smoke: this tree)")
+    ap.add_argument("--runs", type=int, default=7, help="pairs per command and set-up (default 7)")
+    ap.add_argument(
+        "--smoke", action="store_true", help="1 pair, the set-up as run here, no warm-up"
+    )
+    args = ap.parse_args(argv)
+    if args.baseline is None and not args.smoke:
+        ap.error("--baseline is required (a checkout of the commit to compare with)")
+    base = ROOT if args.baseline is None else args.baseline.resolve()
+    if not (base / "sailroute" / "__main__.py").is_file():
+        raise SystemExit(f"--baseline {base}: not a sailroute checkout (no sailroute/__main__.py)")
+    runs = 1 if args.smoke else args.runs
+    print("# bench_startup: the command line's start-up, fresh processes")
+    print(f"A: {ROOT}   B: {base}   python {sys.version.split()[0]}, {os.cpu_count()} cores")
+    print(f"load average at the start: {load()}")
+    env = dict(os.environ)
+    print(f"PYTHONDONTWRITEBYTECODE={env.get('PYTHONDONTWRITEBYTECODE', '')!r}")
+    rows = []
+    with tempfile.TemporaryDirectory() as tmpdir:
+        tmp = Path(tmpdir)
+        setups = [("as run here", env, env)]
+        if args.smoke:
+            print("numba's cache as it is (--smoke)")
+        else:
+            warm_a = dict(env, PYTHONPYCACHEPREFIX=str(tmp / "pyc-a"))
+            warm_b = dict(env, PYTHONPYCACHEPREFIX=str(tmp / "pyc-b"))
+            for e in (warm_a, warm_b):
+                e.pop("PYTHONDONTWRITEBYTECODE", None)  # the warm-up run writes the cache
+            setups.append(("primed cache", warm_a, warm_b))
+            found = [prime_kernels(e, src) for e, src in ((env, ROOT), (env, base))]
+            found += [prime_kernels(warm_a, ROOT), prime_kernels(warm_b, base)]
+            print(f"numba's cache primed; auto finds the kernels, A and B: {found[:2]}")
+        for setup, ea, eb in setups:
+            for name, cmd in COMMANDS:
+                row = bench(cmd, ea, eb, base, runs, tmp / setup, warm_up=not args.smoke)
+                rows.append({"command": name, "setup": setup, **row})
+    print(f"load average at the end: {load()}")
+    print()
+    print("| command | set-up | A: CPU (wall) | B: CPU (wall) | B - A CPU | B / A CPU (range) |")
+    print("|---|---|---:|---:|---:|---:|")
+    for r in rows:
+        lo, hi = r["spread"]
+        print(
+            f"| `{r['command']}` | {r['setup']} | {r['cpu_a']:.3f} s ({r['wall_a']:.3f} s) | "
+            f"{r['cpu_b']:.3f} s ({r['wall_b']:.3f} s) | {r['diff'] * 1e3:+.0f} ms | "
+            f"**{r['ratio']:.2f}x** ({lo:.2f}-{hi:.2f}) |"
+        )
+    differ = sorted({f"{r['command']}: {k}" for r in rows for k in r["differ"]})
+    print()
+    if differ:
+        print("FAIL: not the same bytes as the baseline: " + "; ".join(differ))
+        return 1
+    print("outputs (plan's files, every command's standard output) the same bytes as B: yes")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
