@@ -41,11 +41,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_plan import COURSE, ROOT, child_cpu, load, prime_kernels
 
 PLAN = ("-m", "sailroute", "plan", str(COURSE), "--no-plots", "-q", "-o", "out")
-COMMANDS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("sailroute --help", ("-m", "sailroute", "--help")),
-    ('python -c "import sailroute.commands.plan"', ("-c", "import sailroute.commands.plan")),
-    ("sailroute plan hyeres-r1.yaml --no-plots -q", PLAN),
-)
+COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
+    "help": ("sailroute --help", ("-m", "sailroute", "--help")),
+    "import": (
+        'python -c "import sailroute.commands.plan"',
+        ("-c", "import sailroute.commands.plan"),
+    ),
+    "plan": ("sailroute plan hyeres-r1.yaml --no-plots -q", PLAN),
+}
 
 
 def outputs(cwd: Path, stdout: bytes) -> dict[str, bytes]:
@@ -110,6 +113,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--baseline", type=Path, help="checkout of the baseline (--smoke: this tree)")
     ap.add_argument("--runs", type=int, default=7, help="pairs per command and set-up (default 7)")
     ap.add_argument(
+        "--only", nargs="+", choices=COMMANDS, default=list(COMMANDS), help="commands to time"
+    )
+    ap.add_argument(
         "--smoke", action="store_true", help="1 pair, the set-up as run here, no warm-up"
     )
     args = ap.parse_args(argv)
@@ -136,11 +142,12 @@ def main(argv: list[str] | None = None) -> int:
             for e in (warm_a, warm_b):
                 e.pop("PYTHONDONTWRITEBYTECODE", None)  # the warm-up run writes the cache
             setups.append(("primed cache", warm_a, warm_b))
+        if not args.smoke and "plan" in args.only:
             found = [prime_kernels(e, src) for e, src in ((env, ROOT), (env, base))]
             found += [prime_kernels(warm_a, ROOT), prime_kernels(warm_b, base)]
             print(f"numba's cache primed; auto finds the kernels, A and B: {found[:2]}")
         for setup, ea, eb in setups:
-            for name, cmd in COMMANDS:
+            for name, cmd in (COMMANDS[k] for k in args.only):
                 row = bench(cmd, ea, eb, base, runs, tmp / setup, warm_up=not args.smoke)
                 rows.append({"command": name, "setup": setup, **row})
     print(f"load average at the end: {load()}")

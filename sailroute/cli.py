@@ -27,6 +27,7 @@ from typer._click.exceptions import BadParameter
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 from sailroute._version import __version__
+from sailroute.cli_values import use_plain_coercion
 from sailroute.errors import SailrouteError
 
 if TYPE_CHECKING:
@@ -88,6 +89,7 @@ class _Command(TyperCommand):
         return _tidy(super().get_params(ctx))
 
     def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        use_plain_coercion(self.get_params(ctx))  # typer's values without importing pydantic
         try:
             return super().parse_args(ctx, args)
         except BadParameter as exc:  # typer 0.29 prefixes pydantic's "Value error, "
@@ -112,6 +114,10 @@ class _Group(TyperGroup):
 
     def get_params(self, ctx: Any) -> list[Any]:
         return _tidy(super().get_params(ctx))
+
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        use_plain_coercion(self.get_params(ctx))
+        return super().parse_args(ctx, args)
 
     def make_context(self, *args: Any, **kwargs: Any) -> Any:
         try:
