@@ -119,6 +119,7 @@ def prime_kernels(env: dict[str, str], src: Path = ROOT) -> str:
     out = subprocess.run(
         [sys.executable, "-c", code],
         env=dict(env, PYTHONPATH=str(src)),
+        cwd=src.parent,  # not a folder holding a sailroute (``-c`` puts it first on the path)
         capture_output=True,
         text=True,
         check=True,
