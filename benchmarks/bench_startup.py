@@ -13,6 +13,8 @@ interpreter with ``PYTHONPATH=<baseline>``) in turn, A B A B ... after a warm-up
 * ``python -m sailroute --help``: the interpreter, ``sailroute.cli`` and typer;
 * ``python -c "import sailroute.commands.plan"``: what the ``plan`` command imports before
   it reads the course;
+* ``python -c "load_course('courses/hyeres-r1.yaml')"``: the course loaded, its scenarios
+  checked, its marks projected (``--only load``; not by default);
 * ``sailroute plan courses/hyeres-r1.yaml --no-plots -q -o out``: the whole command,
   routing included, as the console script runs it (``sailroute.__main__.main``), with
   the CPU time spent in ``plan_course`` (the routing and the plan's numbers) taken by the
@@ -71,6 +73,10 @@ COMMANDS: dict[str, tuple[str, tuple[str, ...]]] = {
     "import": (
         'python -c "import sailroute.commands.plan"',
         ("-c", "import sailroute.commands.plan"),
+    ),
+    "load": (
+        "python -c \"load_course('hyeres-r1.yaml')\"",
+        ("-c", f"from sailroute.course.load import load_course; load_course({str(COURSE)!r})"),
     ),
     "plan": ("sailroute plan hyeres-r1.yaml --no-plots -q", PLAN),
 }
@@ -151,7 +157,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--baseline", type=Path, help="checkout of the baseline (--smoke: this tree)")
     ap.add_argument("--runs", type=int, default=7, help="pairs per command and set-up (default 7)")
     ap.add_argument(
-        "--only", nargs="+", choices=COMMANDS, default=list(COMMANDS), help="commands to time"
+        "--only",
+        nargs="+",
+        choices=COMMANDS,
+        default=["help", "import", "plan"],
+        help="commands to time (default: help import plan)",
     )
     ap.add_argument(
         "--smoke", action="store_true", help="1 pair, the set-up as run here, no warm-up"
