@@ -3,12 +3,13 @@
 A course without a race area and a scenario of uniform wind loads, builds its wind and
 routes with neither shapely, the wind readers (WRF, CF NetCDF, stations, NDBC,
 blended), ``numpy.ma`` (on the NumPy step) nor pydantic; ``sailroute.wind`` still names
-every source.
+every source; the command shortens the idle spin of OpenBLAS's threads.
 """
 
 from __future__ import annotations
 
 import importlib
+import os
 import subprocess
 import sys
 
@@ -61,3 +62,22 @@ def test_the_wind_package_lists_its_names_once() -> None:
     assert sorted(sailroute.wind.__all__) == sorted(sailroute.wind._EXPORTS)
     with pytest.raises(AttributeError, match=r"'sailroute\.wind' has no attribute 'open_wfr'"):
         _ = sailroute.wind.open_wfr
+
+
+@pytest.mark.parametrize(("given", "used"), [(None, "22"), ("28", "28")])
+def test_the_command_shortens_openblas_idle_spin_unless_told(given: str | None, used: str) -> None:
+    # before NumPy loads (OpenBLAS reads it then); a value in the environment is kept
+    code = (
+        "import os, sys\n"
+        "from sailroute.__main__ import main\n"
+        "sys.argv = ['sailroute', '--version']\n"
+        "try:\n    main()\nexcept SystemExit:\n    pass\n"
+        "print(os.environ['OPENBLAS_THREAD_TIMEOUT'], 'numpy' in sys.modules)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_THREAD_TIMEOUT"}
+    if given is not None:
+        env["OPENBLAS_THREAD_TIMEOUT"] = given
+    res = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env, check=True
+    )
+    assert res.stdout.split()[-2:] == [used, "False"], res.stdout + res.stderr
