@@ -1,9 +1,9 @@
 """What a plan's start-up imports: the readers and libraries of its own course only.
 
 A course without a race area and a scenario of uniform wind loads, builds its wind and
-routes with neither shapely, the wind readers (WRF, CF NetCDF, stations, NDBC,
-blended), ``numpy.ma`` (on the NumPy step) nor pydantic; ``sailroute.wind`` still names
-every source; the command shortens the idle spin of OpenBLAS's threads.
+routes with neither shapely, the gridded wind, the readers (WRF, CF NetCDF, stations,
+NDBC, blended), ``numpy.ma`` (on the NumPy step) nor pydantic; ``sailroute.wind`` still
+names every source; the command shortens the idle spin of OpenBLAS's threads.
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ NOT_FOR_A_UNIFORM_PLAN = (
     "pydantic",
     "shapely",
     "numpy.ma",
+    "sailroute.wind.grid",
     "sailroute.wind.wrf",
     "sailroute.wind.cf",
     "sailroute.wind.stations",

@@ -38,8 +38,6 @@ from typing import Any, Final
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from sailroute.wind.grid import GridWind
-
 __all__ = [
     "BOUNDARY_NAME",
     "AreaPolygon",
@@ -842,7 +840,11 @@ def land_filled(area: RaceArea, wind: Any) -> Any:
     more from a NaN node, so its interpolated wind is unchanged.  Any other wind (or
     course) is returned as it is.
     """
-    if not (area.wind_land_is_obstacle and isinstance(wind, GridWind)):
+    if not area.wind_land_is_obstacle:
+        return wind
+    from sailroute.wind.grid import GridWind  # (a gridded wind: the only one with land)
+
+    if not isinstance(wind, GridWind):
         return wind
     u, v = np.asarray(wind.u, dtype=float), np.asarray(wind.v, dtype=float)
     nan = np.isnan(u) | np.isnan(v)
@@ -876,9 +878,12 @@ def obstacles_for(area: RaceArea, wind: object = None) -> Obstacles | None:
         None when the course constrains nothing.
     """
     extra = []
-    if area.wind_land_is_obstacle and isinstance(wind, GridWind):
-        nan = np.isnan(np.asarray(wind.u, dtype=float)).any(axis=0)
-        land = land_obstacle(wind.x, wind.y, nan)
-        if land is not None:
-            extra.append(land)
+    if area.wind_land_is_obstacle:
+        from sailroute.wind.grid import GridWind
+
+        if isinstance(wind, GridWind):
+            nan = np.isnan(np.asarray(wind.u, dtype=float)).any(axis=0)
+            land = land_obstacle(wind.x, wind.y, nan)
+            if land is not None:
+                extra.append(land)
     return Obstacles.build(area, extra)
