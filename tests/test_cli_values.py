@@ -165,27 +165,29 @@ def test_values_typer_reads_differently_are_left_to_it() -> None:
 
 
 @pytest.mark.parametrize(
-    "args",
+    ("args", "message"),
     [
-        ["plan", "c.yaml", "--router", "nope"],
-        ["plan", "c.yaml", "--router", "GRIDDP", "--ensemble", "abc", "-o", "x"],
-        ["plan", "c.yaml", "--ensemble", "2.5"],
-        ["plan", "c.yaml", "--backend", ""],
-        ["vpp", "--crew-mass", "abc"],
-        ["vpp", "--twa-step", " 4 ", "--crew-mass", "nan", "--unit", "KN", "--kinetics", "x"],
-        ["strategy", "--shift", "OU", "--tws-kn", "1e3", "--seed", "1e3"],
-        ["strategy", "--shift", "OU", "--tws-kn", "-0", "--start-tack", "PORT", "--runs", ""],
+        (["plan", "c.yaml", "--router", "nope"], "'--router' / '-r': 'nope' is not one of"),
+        (["plan", "c.yaml", "-r", "GRIDDP", "--ensemble", "abc"], "'--ensemble': Input should"),
+        (["plan", "c.yaml", "--ensemble", "2.5"], "be a valid integer, unable to parse string"),
+        (["plan", "c.yaml", "--backend", ""], "'--backend': '' is not one of 'numpy', 'cupy'"),
+        (["plan", "c.yaml", "-s", "~/x", "--ensemble", "0012"], "c.yaml"),
+        (["vpp", "--crew-mass", "abc"], "'--crew-mass': Input should be a valid number"),
+        (["vpp", "--twa-step", " 4 ", "--unit", "KN", "--kinetics", "x"], "'x' is not one of"),
+        (["strategy", "--shift", "OU", "--tws-kn", "1e3", "--seed", "1e3"], "'--seed': Input"),
+        (["strategy", "--tws-kn", "-0", "--start-tack", "PORT", "--runs", ""], "'--runs': Input"),
     ],
 )
 def test_a_command_line_reads_the_same_with_typer_own_conversion(
-    args: list[str], monkeypatch: pytest.MonkeyPatch
+    args: list[str], message: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # (each ends before any work: a course that is not there, or a refused value)
+    # each ends before any work: a refused value, or a course that is not there (exit 2)
     runner = CliRunner()
     ours = runner.invoke(app, args)
     monkeypatch.setattr(cli_values, "_CHECKED", False)
     theirs = runner.invoke(app, args)
     assert (ours.exit_code, ours.output) == (theirs.exit_code, theirs.output)
+    assert ours.exit_code == 2 and message in ours.output, ours.output
 
 
 def test_a_plan_command_line_does_not_import_pydantic() -> None:
