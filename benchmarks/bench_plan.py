@@ -168,26 +168,48 @@ def bench(
     }
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def primed(env: dict[str, str], cache: Path) -> dict[str, str]:
+    """``env`` with a bytecode cache of its own in ``cache`` (``PYTHONPYCACHEPREFIX``),
+    which the first run (the warm-up) writes: as after a normal install."""
+    out = dict(env, PYTHONPYCACHEPREFIX=str(cache))
+    out.pop("PYTHONDONTWRITEBYTECODE", None)
+    return out
+
+
+def baseline_parser(doc: str) -> argparse.ArgumentParser:
+    """The options of a benchmark of this tree against a baseline checkout: ``--baseline``,
+    ``--runs`` (pairs) and ``--smoke`` (1 pair against itself)."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--baseline", type=Path, help="checkout of the baseline (--smoke: this tree)")
     ap.add_argument("--runs", type=int, default=7, help="pairs per set-up (default 7)")
     ap.add_argument(
-        "--cold-kernels", action="store_true", help="A without numba's cache (auto: NumPy)"
-    )
-    ap.add_argument(
         "--smoke", action="store_true", help="1 pair, the set-up as run here, no warm-up"
     )
-    args = ap.parse_args(argv)
+    return ap
+
+
+def start(ap: argparse.ArgumentParser, args: argparse.Namespace, title: str) -> tuple[Path, int]:
+    """The baseline checkout (``--smoke``: this tree) and the pairs to run; prints the
+    title, both trees and the load average."""
     if args.baseline is None and not args.smoke:
         ap.error("--baseline is required (a checkout of the commit to compare with)")
     base = ROOT if args.baseline is None else args.baseline.resolve()
     if not (base / "sailroute" / "__main__.py").is_file():
         raise SystemExit(f"--baseline {base}: not a sailroute checkout (no sailroute/__main__.py)")
-    runs = 1 if args.smoke else args.runs
-    print(f"# bench_plan: {COURSE.relative_to(ROOT)}, plan --no-plots, fresh processes")
+    print(title)
     print(f"A: {ROOT}   B: {base}   python {sys.version.split()[0]}, {os.cpu_count()} cores")
     print(f"load average at the start: {load()}")
+    return base, 1 if args.smoke else args.runs
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = baseline_parser(__doc__)
+    ap.add_argument(
+        "--cold-kernels", action="store_true", help="A without numba's cache (auto: NumPy)"
+    )
+    args = ap.parse_args(argv)
+    title = f"# bench_plan: {COURSE.relative_to(ROOT)}, plan --no-plots, fresh processes"
+    base, runs = start(ap, args, title)
     rows = []
     with tempfile.TemporaryDirectory() as tmpdir:
         tmp = Path(tmpdir)
@@ -203,10 +225,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"PYTHONDONTWRITEBYTECODE={env.get('PYTHONDONTWRITEBYTECODE', '')!r}")
         setups = [("as run here", env_a, env)]
         if not args.smoke:
-            warm_a = dict(env_a, PYTHONPYCACHEPREFIX=str(tmp / "pyc-a"))
-            warm_b = dict(env, PYTHONPYCACHEPREFIX=str(tmp / "pyc-b"))
-            for e in (warm_a, warm_b):
-                e.pop("PYTHONDONTWRITEBYTECODE", None)  # the warm-up run writes the cache
+            warm_a, warm_b = primed(env_a, tmp / "pyc-a"), primed(env, tmp / "pyc-b")
             if not args.cold_kernels:  # numba's own .pyc into the prefix too
                 prime_kernels(warm_a)
             setups.append(("primed cache", warm_a, warm_b))

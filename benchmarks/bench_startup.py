@@ -35,7 +35,6 @@ ratios; the load average is printed before and after.
 
 from __future__ import annotations
 
-import argparse
 import os
 import statistics
 import sys
@@ -44,7 +43,16 @@ from pathlib import Path
 from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_plan import COURSE, ROOT, child_cpu, load, prime_kernels
+from bench_plan import (
+    COURSE,
+    ROOT,
+    baseline_parser,
+    child_cpu,
+    load,
+    prime_kernels,
+    primed,
+    start,
+)
 
 PLAN_CODE = f"""\
 import sys, time
@@ -159,9 +167,7 @@ def bench(
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--baseline", type=Path, help="checkout of the baseline (--smoke: this tree)")
-    ap.add_argument("--runs", type=int, default=7, help="pairs per command and set-up (default 7)")
+    ap = baseline_parser(__doc__)
     ap.add_argument(
         "--only",
         nargs="+",
@@ -169,19 +175,8 @@ def main(argv: list[str] | None = None) -> int:
         default=["help", "import", "plan"],
         help="commands to time (default: help import plan)",
     )
-    ap.add_argument(
-        "--smoke", action="store_true", help="1 pair, the set-up as run here, no warm-up"
-    )
     args = ap.parse_args(argv)
-    if args.baseline is None and not args.smoke:
-        ap.error("--baseline is required (a checkout of the commit to compare with)")
-    base = ROOT if args.baseline is None else args.baseline.resolve()
-    if not (base / "sailroute" / "__main__.py").is_file():
-        raise SystemExit(f"--baseline {base}: not a sailroute checkout (no sailroute/__main__.py)")
-    runs = 1 if args.smoke else args.runs
-    print("# bench_startup: the command line's start-up, fresh processes")
-    print(f"A: {ROOT}   B: {base}   python {sys.version.split()[0]}, {os.cpu_count()} cores")
-    print(f"load average at the start: {load()}")
+    base, runs = start(ap, args, "# bench_startup: the command line's start-up, fresh processes")
     env = dict(os.environ)
     print(f"PYTHONDONTWRITEBYTECODE={env.get('PYTHONDONTWRITEBYTECODE', '')!r}")
     rows: list[dict[str, Any]] = []
@@ -192,10 +187,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.smoke:
             print("numba's cache as it is (--smoke)")
         else:
-            warm_a = dict(env, PYTHONPYCACHEPREFIX=str(tmp / "pyc-a"))
-            warm_b = dict(env, PYTHONPYCACHEPREFIX=str(tmp / "pyc-b"))
-            for e in (warm_a, warm_b):
-                e.pop("PYTHONDONTWRITEBYTECODE", None)  # the warm-up run writes the cache
+            warm_a, warm_b = primed(env, tmp / "pyc-a"), primed(env, tmp / "pyc-b")
             setups.append(("primed cache", warm_a, warm_b))
         if not args.smoke and "plan" in args.only:
             found = [prime_kernels(e, src) for e, src in ((env, ROOT), (env, base))]

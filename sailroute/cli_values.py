@@ -85,20 +85,18 @@ def _str(value: Any, ctx: Any) -> Any:
     return value if type(value) is str else DEFER
 
 
-def _int(value: Any, ctx: Any) -> Any:
-    if type(value) is int:
-        return value
-    if type(value) is str and _INT.fullmatch(value):
-        return int(value)
-    return DEFER
+def _number(kind: type[int] | type[float], plain: re.Pattern[str]) -> Converter:
+    """A number of ``kind`` as is, or text that matches ``plain`` (a decimal that Python
+    and pydantic read alike) as ``kind(text)``."""
 
+    def convert(value: Any, ctx: Any) -> Any:
+        if type(value) is kind:
+            return value
+        if type(value) is str and plain.fullmatch(value):
+            return kind(value)
+        return DEFER
 
-def _float(value: Any, ctx: Any) -> Any:
-    if type(value) is float:
-        return value
-    if type(value) is str and _FLOAT.fullmatch(value):
-        return float(value)
-    return DEFER
+    return convert
 
 
 def _bool(value: Any, ctx: Any) -> Any:
@@ -134,7 +132,12 @@ def _listed(item: Converter) -> Converter:
     return convert
 
 
-_LEAVES: Final[dict[Any, Converter]] = {str: _str, int: _int, float: _float, bool: _bool}
+_LEAVES: Final[dict[Any, Converter]] = {
+    str: _str,
+    int: _number(int, _INT),
+    float: _number(float, _FLOAT),
+    bool: _bool,
+}
 
 
 def converter(annotation: Any, info: Any) -> Converter | None:

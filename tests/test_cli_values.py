@@ -6,8 +6,6 @@ from __future__ import annotations
 
 import random
 import struct
-import subprocess
-import sys
 from collections.abc import Iterator
 from typing import Any
 
@@ -22,7 +20,7 @@ from typer.testing import CliRunner
 
 from sailroute import cli_values
 from sailroute.cli import app
-from tests.conftest import ROOT
+from tests.conftest import python_c
 
 TABLE = (
     # numbers
@@ -199,9 +197,7 @@ def test_a_plan_command_line_does_not_import_pydantic() -> None:
         "try:\n    main()\nexcept SystemExit as e:\n    print(e.code)\n"
         "print('pydantic' in sys.modules)\n"
     )
-    res = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
-    )
+    res = python_c(code)
     assert res.stdout.split() == ["2", "False"], res.stdout + res.stderr
     assert "no-such-course.yaml" in res.stderr
 
@@ -225,9 +221,7 @@ def test_another_typer_keeps_its_own_conversion(tamper: str) -> None:
         "ctx = cmd.make_context('plan', ['c.yaml', '--router', 'GRIDDP'])\n"
         "print(cli_values._CHECKED, ctx.params['router'], 'pydantic' in sys.modules)\n"
     )
-    res = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
-    )
+    res = python_c(code)
     assert res.stdout.split() == ["False", "griddp", "True"], res.stdout + res.stderr
 
 

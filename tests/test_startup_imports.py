@@ -10,13 +10,11 @@ from __future__ import annotations
 
 import importlib
 import os
-import subprocess
-import sys
 
 import pytest
 
 import sailroute.wind
-from tests.conftest import ROOT
+from tests.conftest import python_c
 
 NOT_FOR_A_UNIFORM_PLAN = (
     "pydantic",
@@ -43,9 +41,7 @@ def test_a_uniform_plan_of_hyeres_imports_no_reader_shapely_or_pydantic(tmp_path
         f"print([m for m in {NOT_FOR_A_UNIFORM_PLAN!r} if m in sys.modules])\n"
         "print('numba' in sys.modules)\n"
     )
-    res = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True
-    )
+    res = python_c(code)
     *_, imported, compiled = res.stdout.splitlines()
     # numba's dispatch imports numpy.ma itself (typeof checks for masked arrays)
     allowed = "['numpy.ma']" if compiled == "True" else "[]"
@@ -78,7 +74,5 @@ def test_the_command_shortens_openblas_idle_spin_unless_told(given: str | None, 
     env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_THREAD_TIMEOUT"}
     if given is not None:
         env["OPENBLAS_THREAD_TIMEOUT"] = given
-    res = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env, check=True
-    )
+    res = python_c(code, env)
     assert res.stdout.split()[-2:] == [used, "False"], res.stdout + res.stderr
