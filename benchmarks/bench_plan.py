@@ -53,23 +53,34 @@ def load() -> str:
     return " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
+def child_cpu(
+    cmd: list[str], src: Path, env: dict[str, str], cwd: Path
+) -> tuple[float, float, bytes]:
+    """Run ``cmd`` in a fresh process with ``sailroute`` imported from ``src``: CPU [s] of
+    the child (user + system, ``os.wait4``), wall [s] and its standard output; exits with
+    the command and its standard error where it fails."""
+    full = dict(env, PYTHONPATH=str(src))
+    t0 = time.perf_counter()
+    with tempfile.TemporaryFile() as out_f, tempfile.TemporaryFile() as err_f:
+        proc = subprocess.Popen(cmd, cwd=cwd, env=full, stdout=out_f, stderr=err_f)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out_f.seek(0)
+        err_f.seek(0)
+        stdout, err = out_f.read(), err_f.read().decode(errors="replace")
+    if proc.returncode != 0:
+        raise SystemExit(f"{' '.join(cmd)} (from {src}) failed ({proc.returncode}):\n{err}")
+    return usage.ru_utime + usage.ru_stime, wall, stdout
+
+
 def run_once(src: Path, env: dict[str, str], out: Path) -> tuple[float, float, list[float]]:
     """One fresh ``plan`` from ``src``: CPU [s] of the child, wall [s], leg times [s]."""
     cmd = [sys.executable, "-m", "sailroute", "plan", str(COURSE), "--no-plots", "-q"]
     cmd += ["-o", str(out)]
-    full = dict(env, PYTHONPATH=str(src))
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(
-        cmd, cwd=out.parent, env=full, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
-    )
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    err = proc.stderr.read().decode() if proc.stderr is not None else ""
-    if proc.returncode != 0:
-        raise SystemExit(f"{' '.join(cmd)} (from {src}) failed ({proc.returncode}):\n{err}")
+    cpu, wall, _ = child_cpu(cmd, src, env, out.parent)
     legs = json.loads((out / "plan.json").read_text())["legs"]
-    return usage.ru_utime + usage.ru_stime, wall, [float(leg["time_s"]) for leg in legs]
+    return cpu, wall, [float(leg["time_s"]) for leg in legs]
 
 
 def exact_leg_times(src: Path, env: dict[str, str]) -> list[float]:
@@ -91,9 +102,9 @@ def exact_leg_times(src: Path, env: dict[str, str]) -> list[float]:
     return [float(x) for x in out.stdout.strip().strip("[]").split(",")]
 
 
-def prime_kernels(env: dict[str, str]) -> str:
-    """Route the course once on ``engine: numba`` here (compiles the step kernels into
-    numba's cache, or loads them); whether ``auto`` now finds them cached."""
+def prime_kernels(env: dict[str, str], src: Path = ROOT) -> str:
+    """Route the course once on ``engine: numba`` from ``src`` (compiles the step kernels
+    into numba's cache, or loads them); whether ``auto`` now finds them cached."""
     code = (
         "import dataclasses, sys\n"
         "from sailroute.course.load import load_course\n"
@@ -107,7 +118,8 @@ def prime_kernels(env: dict[str, str]) -> str:
     )
     out = subprocess.run(
         [sys.executable, "-c", code],
-        env=dict(env, PYTHONPATH=str(ROOT)),
+        env=dict(env, PYTHONPATH=str(src)),
+        cwd=src.parent,  # not a folder holding a sailroute (``-c`` puts it first on the path)
         capture_output=True,
         text=True,
         check=True,
@@ -156,26 +168,48 @@ def bench(
     }
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def primed(env: dict[str, str], cache: Path) -> dict[str, str]:
+    """``env`` with a bytecode cache of its own in ``cache`` (``PYTHONPYCACHEPREFIX``),
+    which the first run (the warm-up) writes: as after a normal install."""
+    out = dict(env, PYTHONPYCACHEPREFIX=str(cache))
+    out.pop("PYTHONDONTWRITEBYTECODE", None)
+    return out
+
+
+def baseline_parser(doc: str) -> argparse.ArgumentParser:
+    """The options of a benchmark of this tree against a baseline checkout: ``--baseline``,
+    ``--runs`` (pairs) and ``--smoke`` (1 pair against itself)."""
+    ap = argparse.ArgumentParser(description=doc.split("\n\n")[0])
     ap.add_argument("--baseline", type=Path, help="checkout of the baseline (--smoke: this tree)")
     ap.add_argument("--runs", type=int, default=7, help="pairs per set-up (default 7)")
     ap.add_argument(
-        "--cold-kernels", action="store_true", help="A without numba's cache (auto: NumPy)"
-    )
-    ap.add_argument(
         "--smoke", action="store_true", help="1 pair, the set-up as run here, no warm-up"
     )
-    args = ap.parse_args(argv)
+    return ap
+
+
+def start(ap: argparse.ArgumentParser, args: argparse.Namespace, title: str) -> tuple[Path, int]:
+    """The baseline checkout (``--smoke``: this tree) and the pairs to run; prints the
+    title, both trees and the load average."""
     if args.baseline is None and not args.smoke:
         ap.error("--baseline is required (a checkout of the commit to compare with)")
     base = ROOT if args.baseline is None else args.baseline.resolve()
     if not (base / "sailroute" / "__main__.py").is_file():
         raise SystemExit(f"--baseline {base}: not a sailroute checkout (no sailroute/__main__.py)")
-    runs = 1 if args.smoke else args.runs
-    print(f"# bench_plan: {COURSE.relative_to(ROOT)}, plan --no-plots, fresh processes")
+    print(title)
     print(f"A: {ROOT}   B: {base}   python {sys.version.split()[0]}, {os.cpu_count()} cores")
     print(f"load average at the start: {load()}")
+    return base, 1 if args.smoke else args.runs
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = baseline_parser(__doc__)
+    ap.add_argument(
+        "--cold-kernels", action="store_true", help="A without numba's cache (auto: NumPy)"
+    )
+    args = ap.parse_args(argv)
+    title = f"# bench_plan: {COURSE.relative_to(ROOT)}, plan --no-plots, fresh processes"
+    base, runs = start(ap, args, title)
     rows = []
     with tempfile.TemporaryDirectory() as tmpdir:
         tmp = Path(tmpdir)
@@ -191,10 +225,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"PYTHONDONTWRITEBYTECODE={env.get('PYTHONDONTWRITEBYTECODE', '')!r}")
         setups = [("as run here", env_a, env)]
         if not args.smoke:
-            warm_a = dict(env_a, PYTHONPYCACHEPREFIX=str(tmp / "pyc-a"))
-            warm_b = dict(env, PYTHONPYCACHEPREFIX=str(tmp / "pyc-b"))
-            for e in (warm_a, warm_b):
-                e.pop("PYTHONDONTWRITEBYTECODE", None)  # the warm-up run writes the cache
+            warm_a, warm_b = primed(env_a, tmp / "pyc-a"), primed(env, tmp / "pyc-b")
             if not args.cold_kernels:  # numba's own .pyc into the prefix too
                 prime_kernels(warm_a)
             setups.append(("primed cache", warm_a, warm_b))

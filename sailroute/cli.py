@@ -14,7 +14,9 @@ else.  Start-up is kept short (``sailroute --help`` < 150 ms): everything heavy 
 imported inside the commands.
 """
 
-from __future__ import annotations
+# No ``from __future__ import annotations`` here: typer reads every command's signature
+# twice as it builds the command line (``sailroute --help`` as much as ``plan``), and it
+# evaluated each string annotation with ``eval`` both times, about 25 ms of every start.
 
 import sys
 from collections.abc import Callable, Iterator
@@ -27,6 +29,7 @@ from typer._click.exceptions import BadParameter
 from typer.core import TyperArgument, TyperCommand, TyperGroup, TyperOption
 
 from sailroute._version import __version__
+from sailroute.cli_values import use_plain_coercion
 from sailroute.errors import SailrouteError
 
 if TYPE_CHECKING:
@@ -88,6 +91,7 @@ class _Command(TyperCommand):
         return _tidy(super().get_params(ctx))
 
     def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        use_plain_coercion(self.get_params(ctx))  # typer's values without importing pydantic
         try:
             return super().parse_args(ctx, args)
         except BadParameter as exc:  # typer 0.29 prefixes pydantic's "Value error, "
@@ -112,6 +116,10 @@ class _Group(TyperGroup):
 
     def get_params(self, ctx: Any) -> list[Any]:
         return _tidy(super().get_params(ctx))
+
+    def parse_args(self, ctx: Any, args: list[str]) -> list[str]:
+        use_plain_coercion(self.get_params(ctx))
+        return super().parse_args(ctx, args)
 
     def make_context(self, *args: Any, **kwargs: Any) -> Any:
         try:
@@ -239,7 +247,7 @@ def _terminal_tables(json_out: bool) -> Iterator[None]:
         yield
 
 
-def _finish(res: CommandResult, json_out: bool) -> None:
+def _finish(res: "CommandResult", json_out: bool) -> None:
     """Print the report and the files written, or (``--json``) the main JSON file only."""
     if json_out:
         path = res.main_json()

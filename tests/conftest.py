@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TypeVar
 
@@ -21,6 +24,14 @@ def requires_shared(test: F) -> F:
     """Mark a test ``shared`` (reads ../shared/data/real) and skip it when that is absent."""
     skip = pytest.mark.skipif(not SHARED_REAL.is_dir(), reason="../shared/data/real not present")
     return pytest.mark.shared(skip(test))
+
+
+def python_c(code: str, env: Mapping[str, str] | None = None) -> subprocess.CompletedProcess[str]:
+    """``python -c code`` in a fresh process from the repository root (exit 0 checked):
+    for what a process imports or sets as it starts."""
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, env=env, check=True
+    )
 
 
 def pytest_report_header(config: pytest.Config) -> list[str]:

@@ -48,7 +48,7 @@ LAYERS: tuple[tuple[str, ...], ...] = (
     ("live",),
     ("report",),
     ("commands",),
-    ("api", "cli", "__main__", "__init__"),
+    ("api", "cli", "cli_values", "__main__", "__init__"),
 )
 RANK = {name: k for k, names in enumerate(LAYERS) for name in names}
 

@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import shapely
 
 from sailroute.checks import Checker, join_path, show
 from sailroute.geo import LocalFrame
@@ -256,6 +255,8 @@ def _marks_clear(
     marks: Mapping[str, tuple[float, float]],
 ) -> None:
     """A problem for each mark inside a grown obstacle or outside the shrunk boundary."""
+    import shapely
+
     if not marks:
         return
     names = list(marks)

@@ -17,7 +17,6 @@ import math
 from typing import Any
 
 import numpy as np
-import shapely
 from numpy.typing import NDArray
 
 from sailroute.geo import LocalFrame
@@ -59,6 +58,8 @@ def kept_ring(
     """The closed line the routes keep to [m]: the obstacle grown or (``boundary``) the
     boundary shrunk by its clearance (the outer ring of the largest part); None without a
     clearance."""
+    import shapely
+
     if p.clearance_m <= 0:
         return None
     grow = -p.clearance_m if boundary else p.clearance_m

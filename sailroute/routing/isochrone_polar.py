@@ -27,7 +27,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sailroute.boat.polar import Polar
-from sailroute.numerics import clip
+from sailroute.numerics import clip, sorted_distinct
 from sailroute.routing.isochrone_records import _StepInputs
 
 # --------------------------------------------------------------------------------------
@@ -147,7 +147,7 @@ def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
     a = np.linspace(180.0 / n_a, 180.0, n_a)
     own = np.asarray(polar.tws_ms, dtype=float).ravel()
     top = float(own.max()) if own.size and own.max() > 0 else 30.0
-    nodes = np.sort(
+    nodes = sorted_distinct(
         np.concatenate(
             [
                 np.linspace(0.0, top, math.ceil(top / TABLE_TWS_STEP_MS) + 1),
@@ -155,9 +155,6 @@ def polar_tables(polar: Polar, heading_step_deg: float) -> PolarTables:
             ]
         )
     )
-    # distinct values (np.unique's result without NaNs; np.unique imports numpy.ma, 22 ms
-    # of a plan's start-up)
-    nodes = nodes[np.concatenate([[True], nodes[1:] != nodes[:-1]])]
     speed = np.asarray(polar.speed(nodes[:, None], a[None, :]), dtype=float)
     up, vu = _vmg_angles(polar, nodes, True)
     down, vd = _vmg_angles(polar, nodes, False)

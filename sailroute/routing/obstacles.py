@@ -21,7 +21,9 @@ vectorised predicates that every router uses:
   groups) and a box per group inside its blocked water (a move from free water that
   ends there is blocked without the edge test).
 
-Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C).
+Polygons are shapely 2 geometries (validity, buffering, point-in-polygon in C),
+imported by the functions that use them: a course without a race area routes, and
+starts, without shapely.
 """
 
 from __future__ import annotations
@@ -34,11 +36,7 @@ from dataclasses import dataclass, field
 from typing import Any, Final
 
 import numpy as np
-import shapely
 from numpy.typing import ArrayLike, NDArray
-
-from sailroute.routing.rings import ring_problem
-from sailroute.wind.grid import GridWind
 
 __all__ = [
     "BOUNDARY_NAME",
@@ -92,6 +90,8 @@ class AreaPolygon:
 
     def polygon(self) -> Any:
         """The ring as a shapely Polygon (no clearance)."""
+        import shapely
+
         return shapely.polygons(np.column_stack([self.x, self.y]))
 
 
@@ -126,6 +126,10 @@ def polygon_problem(
     self-intersection (shapely's ``explain_validity``), a boundary that a clearance
     leaves empty; the ring checks and wording of :func:`sailroute.routing.rings.ring_problem`
     come first."""
+    import shapely
+
+    from sailroute.routing.rings import ring_problem
+
     ring = ring_problem(np.column_stack([x, y]))
     if ring is not None:
         return ring
@@ -147,6 +151,8 @@ def polygon_problem(
 
 def _rings(geom: Any) -> list[NDArray[np.float64]]:
     """Vertex arrays (closed) of every ring of a (multi)polygon."""
+    import shapely
+
     out = []
     for part in shapely.get_parts(geom):
         for ring in shapely.get_rings(part):
@@ -230,6 +236,10 @@ class Obstacles:
             More obstacles, already in the course frame (e.g. land cells of a wind
             grid, :func:`land_obstacle`), without clearance.
         """
+        if area.boundary is None and not area.obstacles and not extra:
+            return None
+        import shapely
+
         names: list[str] = []
         grown: list[Any] = []
         owners: list[int] = []
@@ -349,6 +359,8 @@ class Obstacles:
     ) -> NDArray[np.bool_]:
         """:meth:`segments_free` through ``shapely.intersects`` on linestrings (the same
         answer up to touching; slower per segment, see ``benchmarks/bench_obstacles.py``)."""
+        import shapely
+
         a = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (x0, y0, x1, y1)))
         shape = a[0].shape
         coords = np.stack(
@@ -471,6 +483,8 @@ class Obstacles:
 
     def _free_xy(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.bool_]:
         """:meth:`points_free` of float arrays of one shape."""
+        import shapely
+
         if self.inside is not None:
             ok = np.asarray(shapely.contains_xy(self.inside, x, y), dtype=bool)
         else:
@@ -618,6 +632,8 @@ class Obstacles:
         straight line: 0 when it is free, infinite when it leaves the boundary; else, for
         the worst obstacle crossing it, the two-piece path past its nearer side (its
         farthest vertex on that side from the line, at the obstacle's middle along it)."""
+        import shapely
+
         if bool(self.segments_free(a[0], a[1], b[0], b[1])):
             return 0.0
         line = shapely.LineString([a, b])
@@ -643,6 +659,8 @@ class Obstacles:
         """The name of what separates the points ``a`` and ``b`` [m] (the constraint
         nearest to ``a`` round its part of free water), or None when one part of free
         water holds both (or either is not in free water: the routers report that)."""
+        import shapely
+
         if not bool(np.all(self.points_free([a[0], b[0]], [a[1], b[1]]))):
             return None
         water = self.inside
@@ -662,6 +680,8 @@ class Obstacles:
 
     def _enclosing(self, part: Any) -> str:
         """The name of an obstacle whose edge bounds ``part`` (the boundary if none)."""
+        import shapely
+
         e = self.edges
         lines = shapely.linestrings(np.stack([e[:, :2], e[:, 2:]], axis=1))
         touching = self.owner[shapely.distance(shapely.boundary(part), lines) < 1e-6]
@@ -704,6 +724,8 @@ def _inner_box(grown: Any) -> tuple[float, float, float, float]:
     """A box inside the core of one grown obstacle (:data:`CORE_M` inside it): its
     bounding box shrunk towards a point inside it until the core holds it; NaN if no
     shrink of 1/64 or more fits."""
+    import shapely
+
     core = shapely.buffer(grown, -CORE_M, quad_segs=QUAD_SEGS)
     if core.is_empty:
         return (math.nan,) * 4
@@ -795,6 +817,8 @@ def land_obstacle(
         round it: every point whose interpolation touches the node (axis-aligned boxes,
         so a rotated grid is covered with a margin of its rotation).
     """
+    import shapely
+
     xa, ya = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     jj, ii = np.nonzero(np.asarray(nan, dtype=bool))
     if jj.size == 0:
@@ -816,7 +840,11 @@ def land_filled(area: RaceArea, wind: Any) -> Any:
     more from a NaN node, so its interpolated wind is unchanged.  Any other wind (or
     course) is returned as it is.
     """
-    if not (area.wind_land_is_obstacle and isinstance(wind, GridWind)):
+    if not area.wind_land_is_obstacle:
+        return wind
+    from sailroute.wind.grid import GridWind  # (a gridded wind: the only one with land)
+
+    if not isinstance(wind, GridWind):
         return wind
     u, v = np.asarray(wind.u, dtype=float), np.asarray(wind.v, dtype=float)
     nan = np.isnan(u) | np.isnan(v)
@@ -850,9 +878,12 @@ def obstacles_for(area: RaceArea, wind: object = None) -> Obstacles | None:
         None when the course constrains nothing.
     """
     extra = []
-    if area.wind_land_is_obstacle and isinstance(wind, GridWind):
-        nan = np.isnan(np.asarray(wind.u, dtype=float)).any(axis=0)
-        land = land_obstacle(wind.x, wind.y, nan)
-        if land is not None:
-            extra.append(land)
+    if area.wind_land_is_obstacle:
+        from sailroute.wind.grid import GridWind
+
+        if isinstance(wind, GridWind):
+            nan = np.isnan(np.asarray(wind.u, dtype=float)).any(axis=0)
+            land = land_obstacle(wind.x, wind.y, nan)
+            if land is not None:
+                extra.append(land)
     return Obstacles.build(area, extra)

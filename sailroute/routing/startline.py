@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from sailroute.boat.model import BoatModel
 from sailroute.errors import InputError, OutOfCoverageError
+from sailroute.numerics import sorted_distinct
 from sailroute.routing.types import Side
 from sailroute.timeutil import iso
 from sailroute.units import bearing_deg, heading_unit, signed_twa, wind_speed_direction, wrap180
@@ -219,7 +220,7 @@ def start_line_numbers(
     vmg = float(boat.steady_speed(tws, twa_up)) * float(np.cos(np.radians(twa_up)))
     gain_s = gain_m / vmg if vmg > 0 else (0.0 if gain_m == 0 else float("inf"))
     t0 = max(t_gun - window_s, float(wind.coverage.t0))
-    times = np.unique(np.append(np.arange(t_gun, t0 - 1e-9, -step_s), t0))
+    times = sorted_distinct(np.append(np.arange(t_gun, t0 - 1e-9, -step_s), t0))
     try:
         _, twds = _wind_at(wind, times, mid)
     except OutOfCoverageError:  # a field that covers the gun but not the minutes before

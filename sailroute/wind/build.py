@@ -32,7 +32,6 @@ from sailroute.wind.specs import (
     parse_current_spec,
     parse_wind_spec,
 )
-from sailroute.wind.stations import StationData
 
 __all__ = [
     "CURRENT_TYPES",
@@ -247,6 +246,10 @@ def wind_notes(field: WindField) -> list[str]:
         if info.get("height_m") is not None:
             text += f", wind at {info['height_m']:g} m"
         return [text]
+    if data is None:
+        return []
+    from sailroute.wind.stationread import StationData  # (a reader: only for a field with data)
+
     if isinstance(data, StationData):
         text = f"{name}: {data.n_raw} rows read"
         if data.n_missing:

@@ -27,7 +27,6 @@ from sailroute.wind.spec_base import (
     _wrapped,
 )
 from sailroute.wind.uniform import UniformWind
-from sailroute.wind.wrf import open_wrf
 
 _UNIFORM_KEYS = ("type", "tws_kn", "tws_ms", "twd_deg", "table", "interpolation", "clamp")
 
@@ -251,6 +250,8 @@ def _s_to_minutes(v: float | None) -> float | None:
 
 
 def _build_wrf(spec: WrfWindSpec, ctx: BuildContext) -> WindField:
+    from sailroute.wind.wrf import open_wrf
+
     return _wrapped(
         spec.where,
         lambda: open_wrf(
@@ -462,6 +463,7 @@ def _parse_grib(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> GribWi
 
 def _open_netcdf(spec: NetcdfWindSpec, ctx: BuildContext) -> WindField:
     from sailroute.wind.cf import is_wrfout, open_netcdf
+    from sailroute.wind.wrf import open_wrf
 
     opts = spec.options()
     if is_wrfout(spec.path):

@@ -12,12 +12,12 @@ import functools
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from sailroute.checks import Checker, resolve_path, show
 from sailroute.errors import InputError
+from sailroute.tabular import CANONICAL_COLUMNS, DEFAULT_MISSING, TIME_PARTS, parse_offset
 from sailroute.wind.base import WindField
-from sailroute.wind.blended import BlendedWind
 from sailroute.wind.height import DEFAULT_EXPONENT, DEFAULT_ROUGHNESS_M
 from sailroute.wind.measured import (
     DEFAULT_MAX_GAP_S,
@@ -25,22 +25,15 @@ from sailroute.wind.measured import (
     DEFAULT_RESAMPLE_S,
     DEFAULT_SMOOTH_S,
     FLEET_METHODS,
-    fleet_wind,
-    sensor_from_track,
 )
-from sailroute.wind.ndbc import is_ndbc_text, read_ndbc
 from sailroute.wind.spec_base import BuildContext, Pairs, _dict, _pairs, _speed_unit, _wrapped
 from sailroute.wind.spec_gridded import WrfWindSpec, _build_wrf, _pair, _parse_wrf
-from sailroute.wind.stations import (
-    CANONICAL_COLUMNS,
-    DEFAULT_MISSING,
-    TIME_PARTS,
-    StationData,
-    StationWind,
-    parse_offset,
-    read_stations,
-    resample_stations,
-)
+
+if TYPE_CHECKING:
+    from sailroute.wind.stationread import StationData
+
+# The readers (stations, NDBC, blended, the boats' logs) are imported by the builders
+# that use them: the parsers run for every scenario of a course that loads.
 
 MEASURED_MARGIN_S = 600.0
 """Records within this of the race window [s] are used by ``type: measured``."""
@@ -260,6 +253,8 @@ def _parse_stations(
 
 def _read_station_data(spec: StationReadSpec) -> StationData:
     """The records of a station file, its :class:`InputError` prefixed with ``spec.where``."""
+    from sailroute.wind.ndbc import is_ndbc_text
+    from sailroute.wind.stationread import read_stations
 
     def read() -> StationData:
         if spec.format == "ndbc" or (spec.format == "auto" and is_ndbc_text(spec.path)):
@@ -283,6 +278,9 @@ def _read_station_data(spec: StationReadSpec) -> StationData:
 
 def _read_ndbc_checked(spec: StationReadSpec) -> StationData:
     """NDBC realtime text: only position, station, height and resample_s apply."""
+    from sailroute.wind.ndbc import read_ndbc
+    from sailroute.wind.stationread import resample_stations
+
     if spec.position is None:
         raise InputError(
             f"{spec.path.name} is NDBC text, which does not carry the buoy's position; "
@@ -305,6 +303,8 @@ def _read_ndbc_checked(spec: StationReadSpec) -> StationData:
 
 
 def _build_stations(spec: StationsWindSpec, ctx: BuildContext) -> WindField:
+    from sailroute.wind.stations import StationWind
+
     data = _read_station_data(spec.read)
     return _wrapped(
         spec.where,
@@ -427,6 +427,8 @@ def _parse_blended(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> Ble
 
 
 def _build_blended(spec: BlendedWindSpec, ctx: BuildContext) -> WindField:
+    from sailroute.wind.blended import BlendedWind
+
     base = _build_wrf(spec.wrf, ctx)
     data = _read_station_data(spec.stations)
     opts: dict[str, Any] = {
@@ -540,6 +542,7 @@ def _parse_measured(spec: Mapping[str, Any], chk: Checker, base_dir: Path) -> Me
 
 def _build_measured(spec: MeasuredWindSpec, ctx: BuildContext) -> WindField:
     from sailroute.track.read import read_track  # track reads through wind.stations: late
+    from sailroute.wind.measured import fleet_wind, sensor_from_track
 
     def sensor(p: Path) -> Any:
         return sensor_from_track(

@@ -158,3 +158,18 @@ def test_rk4_error_drops_sixteenfold_when_the_step_halves() -> None:
 def test_wrap180_maps_to_the_documented_half_open_range() -> None:
     got = wrap180([180.0, -180.0, 540.0, -190.0, 190.0, 0.0, -0.0, 359.5])
     np.testing.assert_array_equal(got, [180.0, 180.0, 180.0, 170.0, -170.0, 0.0, 0.0, -0.5])
+
+
+def test_sorted_distinct_is_numpys_unique_without_nan() -> None:
+    from sailroute.numerics import sorted_distinct
+
+    rng = np.random.default_rng(3)
+    for x in (
+        rng.integers(-5, 5, size=40),
+        rng.integers(0, 4, size=(3, 7)).astype(float) / 3.0,
+        np.append(np.arange(1524564600.0, 1524564000.0 - 1e-9, -10.0), 1524564000.0),
+        np.array([2.5]),
+        np.array([], dtype=float),
+    ):
+        got, want = sorted_distinct(x), np.unique(x)
+        assert got.dtype == want.dtype and np.array_equal(got, want)

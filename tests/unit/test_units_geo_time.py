@@ -9,7 +9,7 @@ import pytest
 from pyproj import Geod
 
 from sailroute.errors import InputError
-from sailroute.geo import LocalFrame
+from sailroute.geo import LocalFrame, wrap_lon
 from sailroute.timeutil import iso, iso_datetime, parse_time, to_epoch
 from sailroute.units import (
     KNOT,
@@ -85,6 +85,46 @@ def test_local_frame_matches_geodesic_over_5km() -> None:
     lat2, lon2 = frame.to_latlon(x, y)
     np.testing.assert_allclose(lat2, lat, atol=1e-10)
     np.testing.assert_allclose(lon2, lon, atol=1e-10)
+
+
+_ORIGINS = [
+    (43.064507, 6.229547),
+    (45.642375, 13.701999999999998),  # a mean of marks: 17 digits, which PROJ rounds
+    (89.9, 0.0),
+    (-90.0, 12.0),
+    (0.0, 359.9),
+    (41.2, 288.67),
+    (60.1, -179.99),
+    (1e-07, -1e-09),
+] + [
+    (float(a), float(b))
+    for a, b in np.random.default_rng(9).uniform((-90.0, -180.0), (90.0, 360.0), (12, 2))
+]
+
+
+@pytest.mark.parametrize(("lat0", "lon0"), _ORIGINS)
+def test_local_frame_is_what_pyproj_computes_from_epsg_4326_to_the_bit(
+    lat0: float, lon0: float
+) -> None:
+    # the frame's source CRS is a PROJ string (no look-up in PROJ's database at every
+    # start): plans, GPX and KML keep the same bytes as with EPSG:4326
+    from pyproj import Transformer
+
+    proj = f"+proj=aeqd +lat_0={lat0!r} +lon_0={lon0!r} +datum=WGS84 +units=m +no_defs"
+    fwd = Transformer.from_crs("EPSG:4326", proj, always_xy=True)
+    inv = Transformer.from_crs(proj, "EPSG:4326", always_xy=True)
+    rng = np.random.default_rng(5)
+    lat = np.clip(lat0 + rng.uniform(-2.0, 2.0, 2000), -90.0, 90.0)
+    lon = lon0 + rng.uniform(-3.0, 3.0, 2000)
+    x, y = rng.uniform(-6e4, 6e4, 2000), rng.uniform(-6e4, 6e4, 2000)
+    frame = LocalFrame(lat0, lon0)
+    want_x, want_y = fwd.transform(lon, lat)
+    want_lon, want_lat = inv.transform(x, y)
+    got_x, got_y = frame.to_xy(lat, lon)
+    got_lat, got_lon = frame.to_latlon(x, y)
+    assert np.array_equal(got_x, want_x) and np.array_equal(got_y, want_y)
+    assert np.array_equal(got_lat, want_lat)
+    assert np.array_equal(got_lon, np.asarray(wrap_lon(want_lon)))
 
 
 def test_parse_time_requires_offset() -> None:
