@@ -80,6 +80,11 @@ CASES = [
     ),
     pytest.param("bench_plan.py", r"^same leg times to 1e-06 s: yes$", marks=SLOW),
     pytest.param(
+        "bench_band_cost.py",
+        r"^the bands cost \*\*\d+\.\d single plans\*\* in CPU \(pairs ",
+        marks=SLOW,
+    ),
+    pytest.param(
         "bench_startup.py",
         r"^outputs \(plan's files, every command's standard output\) the same bytes as B: yes$",
         marks=SLOW,
