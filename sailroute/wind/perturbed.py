@@ -205,10 +205,8 @@ def sample_perturbed(
     v = np.array(np.broadcast_to(v, t.shape), dtype=float)
     scale, add = p.scale[which], p.add[which]
     factor = scale
-    adds = np.flatnonzero(add != 0.0)
-    if adds.shape[0]:
-        factor = scale.copy()
-        factor[adds] = _speed_factor(u[adds], v[adds], scale[adds], add[adds])
+    if p.add.any():  # each point's own factor: the same numbers, computed for all points
+        factor = np.where(add != 0.0, _speed_factor(u, v, scale, add), scale)
     turns = p.turns[which]
     if turns.any():
         # a constant turn's cosine and sine once per member; a shift series' per point
