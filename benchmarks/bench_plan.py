@@ -20,12 +20,13 @@ bytecode set-ups, as in docs/performance.md ("CLI start-up and the main job"):
 * ``primed cache``: a ``.pyc`` cache for everything in a temporary ``PYTHONPYCACHEPREFIX``
   (primed by one run of each side), as after a normal install.
 
-Numba's cache of the compiled step (``routing.engine: auto`` loads it where it holds the
-kernels, :func:`sailroute.routing.isochrone_fast.kernels_cached`) is primed first by a
-run on ``engine: numba``; ``--cold-kernels`` gives A an empty ``NUMBA_CACHE_DIR`` instead,
-so that ``auto`` routes on NumPy.  Every run's leg times are read back from its
-``plan.json`` (to the ms) and, unrounded, from one more plan of each side in-process: they
-must equal the baseline's to 1e-6 s (the script exits 1 otherwise).
+The compiled step's kernels (``routing.engine: auto`` loads them where they are built,
+:func:`sailroute.routing.isochrone_fast.kernels_cached`: the module compiled ahead of
+time, or numba's cache) are primed first by a run on ``engine: numba``, which builds
+them where they are not; ``--cold-kernels`` gives A an empty ``NUMBA_CACHE_DIR`` instead
+(the folder of both), so that ``auto`` routes on NumPy.  Every run's leg times are read
+back from its ``plan.json`` (to the ms) and, unrounded, from one more plan of each side
+in-process: they must equal the baseline's to 1e-6 s (the script exits 1 otherwise).
 The table gives medians, and the ratio B/A as the median of the pairs' ratios; the load
 average is printed before and after.
 """
@@ -205,7 +206,7 @@ def start(ap: argparse.ArgumentParser, args: argparse.Namespace, title: str) -> 
 def main(argv: list[str] | None = None) -> int:
     ap = baseline_parser(__doc__)
     ap.add_argument(
-        "--cold-kernels", action="store_true", help="A without numba's cache (auto: NumPy)"
+        "--cold-kernels", action="store_true", help="A without built kernels (auto: NumPy)"
     )
     args = ap.parse_args(argv)
     title = f"# bench_plan: {COURSE.relative_to(ROOT)}, plan --no-plots, fresh processes"
@@ -216,12 +217,12 @@ def main(argv: list[str] | None = None) -> int:
         env = dict(os.environ)
         env_a = dict(env)
         if args.smoke:
-            print("numba's cache for A as it is (--smoke)")
+            print("the kernels for A as they are (--smoke)")
         elif args.cold_kernels:
             env_a["NUMBA_CACHE_DIR"] = str(tmp / "numba-empty")
-            print("numba's cache for A: empty (auto routes a single plan on NumPy)")
+            print("the kernels for A: none built (auto routes a single plan on NumPy)")
         else:
-            print(f"numba's cache for A primed; auto finds the kernels: {prime_kernels(env)}")
+            print(f"the kernels for A primed; auto finds them: {prime_kernels(env)}")
         print(f"PYTHONDONTWRITEBYTECODE={env.get('PYTHONDONTWRITEBYTECODE', '')!r}")
         setups = [("as run here", env_a, env)]
         if not args.smoke:
