@@ -22,7 +22,7 @@ interpreter with ``PYTHONPATH=<baseline>``) in turn, A B A B ... after a warm-up
   about (the interpreter, the imports, the parsing of the command line, loading the
   course, writing the files), without the noise of the routing.
 
-The CPU time is the child's user + system time (``os.wait4``, the helper of
+The CPU time is the child's user + system time (``os.wait4``, ``child_cpu`` of
 ``benchmarks/bench_plan.py``), wall time beside it; the two bytecode set-ups of
 ``bench_plan.py`` (as run here, where ``PYTHONDONTWRITEBYTECODE=1`` compiles sailroute's
 modules at every start, and a primed ``PYTHONPYCACHEPREFIX``).  Numba's cache of the
