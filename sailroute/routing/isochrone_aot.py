@@ -318,8 +318,8 @@ def build(folder: Path, kernels: ModuleType) -> Path:
         Whatever the AOT compiler or the C compiler raise (no compiler, no headers): the
         caller falls back to the just-in-time kernels.
     """
-    name = module_name()
     target = module_path(folder)
+    name = target.name.split(".")[0]  # module_name(), hashed once
     folder.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=folder, prefix=".aot-") as tmp, _quiet():
         pycc: Any = importlib.import_module("numba.pycc")  # pending deprecation: _quiet
