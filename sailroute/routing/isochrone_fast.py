@@ -81,7 +81,7 @@ path)."""
 JIT_AFTER_S: Final = 1.5
 """With ``routing.engine = "auto"``, the compiled kernels take over once this process
 has spent this long [s of CPU] in NumPy steps, for a front that holds several members
-(:mod:`sailroute.routing.batch`), or where numba's cache holds them already
+(:mod:`sailroute.routing.batch`), or where they are built already
 (:func:`kernels_cached`).  Loading them costs a few milliseconds from the ahead-of-time
 module (:mod:`~sailroute.routing.isochrone_aot`) and about 0.35 s of CPU from numba's
 cache (numba's start-up, :mod:`sailroute.jit`), less than the NumPy steps of one plan of
