@@ -42,6 +42,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--runs", type=int, default=3, help="timed pairs (default 3)")
     ap.add_argument("--smoke", action="store_true", help="3 members, 1 pair, no warm-up")
     args = ap.parse_args(argv)
+    if args.runs < 1 or args.members < 3:
+        ap.error("--runs must be at least 1 and --members at least 3 (a band's smallest)")
     members, runs = (3, 1) if args.smoke else (args.members, args.runs)
     print(
         f"# bench_band_cost: {COURSE.relative_to(ROOT)}, plan --ensemble {members} "
