@@ -14,9 +14,10 @@ The winds of the members are sampled in one call per step where they are version
 one wind (:func:`~sailroute.wind.perturbed.sample_perturbed`: the members of a leg-time
 band), and the polars looked up in one call per step.
 
-A member leaves the common front when its next step would be shorter than ``dt_s``
-(near the target) or one of its points can reach the target within the step; it
-finishes its leg alone, from its own front, with the isochrone driver.  Every step a
+Each member steps its own length in the common front: ``dt_s``, shortened near the
+target from its own time to go as the single-member router shortens it.  A member
+leaves the common front when one of its points can reach the target within its step;
+it finishes its leg alone, from its own front, with the isochrone driver.  Every step a
 member takes is therefore the step the single-member router takes, with the same
 numbers:
 
@@ -348,41 +349,56 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
     sizes = [a.shape[0] for a in x0]
     root = _root_layer(np.concatenate(t0), np.concatenate(x0), np.concatenate(y0), s, np)
     history = [_Front(root, tuple(members), _groups(members, sizes))]
-    dt = float(s.isochrone.dt_s)
     while history[-1].members:
         front = history[-1]
-        # a member whose step shortens near the target finishes alone
-        short = [m for m in front.members if _step_length(s, m.tau_hint) != dt]
-        if short:
-            _finish_alone(short, history, leg, results)
-            continue
         ctx = front.members[0].ctx
         jit = fast.compiled(s, np, members=len(front.members))
         winds = _MemberWinds(front, leg.current)
         polar = _front_polar(front, leg)
+        dt = _step_lengths(front, s)
         prepared = (
-            fast.prepare(front.layer, winds, polar, leg.dev, ctx, s, math.inf, front.groups)
+            fast.prepare(front.layer, winds, polar, leg.dev, ctx, s, math.inf, front.groups, dt)
             if jit
             else None
         )
         if prepared is None:
             prepared = _prepare(
-                front.layer, winds, polar, leg.dev, ctx, s, math.inf, np, front.groups
+                front.layer, winds, polar, leg.dev, ctx, s, math.inf, np, front.groups, dt
             )
         pre, tau_min, dist_min = prepared
         near = np.logical_or.reduceat(pre.near_target, front.groups.starts)
-        if near.any():  # the arrival is tested member by member
-            _finish_alone(
-                [m for m, k in zip(front.members, near, strict=True) if k], history, leg, results
-            )
-            continue
+        if near.any():  # tested for the arrival alone, below; the others step on
+            pre = pre._replace(near_target=np.zeros_like(pre.near_target))
         out = _common_step(pre, front, ctx, leg, jit)
         if isinstance(out, list):  # members without a survivor: their own error
             _finish_alone(out, history, leg, results)
             continue
+        if near.any():  # they finish alone from the front before this step
+            _finish_alone(
+                [m for m, k in zip(front.members, near, strict=True) if k], history, leg, results
+            )
+            stay = history[-1].members
+            if not stay:
+                continue
+            renumber = np.full(front.layer.x.shape[0], -1, dtype=np.int64)
+            renumber[_rows(front, stay)] = np.arange(history[-1].layer.x.shape[0])
+            out = _keep(out, stay, renumber)
+            front = history[-1]
+            tau_min, dist_min = tau_min[~near], dist_min[~near]
         history.append(out)
         _after_step(front, out, tau_min, dist_min, leg)
         _report(members, results, leg)
+
+
+def _step_lengths(front: _Front, s: RoutingSettings) -> float | Any:
+    """The step length of the front's points [s]: ``dt_s``, or where a member's step
+    shortens near the target (:func:`~sailroute.routing.isochrone_inputs._step_length`
+    of its time to go), each point its member's."""
+    own = [_step_length(s, m.tau_hint) for m in front.members]
+    full = float(s.isochrone.dt_s)
+    if all(d == full for d in own):
+        return full
+    return np.asarray(own)[front.groups.member]
 
 
 def _report(members: list[_Member], results: dict[int, LegResult], leg: _Leg) -> None:
@@ -490,23 +506,34 @@ def _finish_alone(
             tau_hint=m.tau_hint,
         )
         results[m.index] = _result(m, layers, arrival, leg)
-    front = history[-1]
-    stay = tuple(m for m in front.members if m not in leaving)
-    rows = (
-        np.concatenate([np.arange(*front.block(m)) for m in stay])
-        if stay
-        else np.zeros(0, dtype=np.int64)
-    )
+    history[-1] = _keep(history[-1], tuple(m for m in history[-1].members if m not in leaving))
+
+
+def _rows(front: _Front, members: Sequence[_Member]) -> Any:
+    """The points of ``members`` in ``front``, block after block."""
+    if not members:
+        return np.zeros(0, dtype=np.int64)
+    return np.concatenate([np.arange(*front.block(m)) for m in members])
+
+
+def _keep(front: _Front, stay: tuple[_Member, ...], renumber: Any = None) -> _Front:
+    """``front`` with the points of the members ``stay`` only (in their order there);
+    ``renumber``: the new number of each point of the front before (whose members
+    left too), for the parents."""
+    rows = _rows(front, stay)
     sizes = [front.block(m)[1] - front.block(m)[0] for m in stay]
     layer = _Layer(
         **{f.name: getattr(front.layer, f.name)[rows] for f in dataclasses.fields(_Layer)}
     )
-    history[-1] = _Front(
+    if renumber is not None:
+        layer = dataclasses.replace(layer, parent=renumber[layer.parent])
+    return _Front(
         layer,
         stay,
         _groups(stay, sizes)
         if stay
         else Groups(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)),
+        None if front.moved is None else front.moved[rows],
     )
 
 

@@ -45,7 +45,7 @@ _FRONT: Final = "(f8:1 f8:1 f8:2 i8:1 f8:2 b1:2 f8:1 f8:1 f8:3 f8:2 f8:3)"
 """The tuple ``front`` (:data:`~sailroute.routing.isochrone_jit.FRONT`)."""
 
 SIGNATURES: Final[dict[str, tuple[str, str]]] = {
-    "sample_points": ("none", "f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8 f8 f8:1 f8:1 f8:1 "
+    "sample_points": ("none", "f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8 f8:1 f8:1 f8:1 "
                       "f8:2 f8:2 f8:2 f8:2"),
     "wind_states": ("b1", "f8:2 f8:2 f8:1 f8:1 i8:2 f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8:1 f8:2 "
                     "i8:1 f8:2 i8:1 f8:2 b1:2 f8:2 f8:1 f8:2"),
@@ -53,13 +53,13 @@ SIGNATURES: Final[dict[str, tuple[str, str]]] = {
     "aim_directions": ("none", "f8:1 f8:1 f8:2 f8:2 f8:2 f8:2 f8:2 f8:2 f8:2 f8:1 f8:1 f8:3 "
                        "f8:3 f8:3"),
     "step_inputs": ("b1", "f8:1 f8:1 f8:1 f8:2 i8:1 f8:2 i8:1 f8:2 b1:2 f8:3 f8:3 f8:3 f8:3 "
-                    "f8:2 f8:2 f8:2 f8:2 f8:1 f8:2 f8:1 f8 f8:1 f8:2 f8:1 f8:1 f8:1 f8:1 "
+                    "f8:2 f8:2 f8:2 f8:2 f8:1 f8:2 f8:1 f8:1 f8:1 f8:2 f8:1 f8:1 f8:1 f8:1 "
                     "i8:1 i8 f8:3 f8:3 f8:1 b1:1 b1:2 f8:2"),
     "dense_speeds": ("none", "f8:2 f8:2 i8:1 f8:1 f8:2 f8:2"),
-    "candidates": ("i8", f"i8 i8 i8 i8 i8 f8 f8 {_FRONT} f8:2 i8:2 f8:2 f8:2 f8:2 b1:2 f8:1 "
+    "candidates": ("i8", f"i8 i8 i8 i8 i8 f8:1 f8 {_FRONT} f8:2 i8:2 f8:2 f8:2 f8:2 b1:2 f8:1 "
                    "f8:1 f8:1 f8:1 f8:1 b1:1 f8:1 f8:1 f4:1 f4:1 i8:2 f8:1"),
     "sector_winners": ("none", "i8 i8:2 f8:1 f4:1 f4 f4 f8:1 i8:1"),
-    "survivors": ("none", f"i8:1 i8:1 i8:1 i8 i8 f8 {_FRONT} f8:2 f8:2 f8:2 f8:2 b1:1"),
+    "survivors": ("none", f"i8:1 i8:1 i8:1 i8 i8 f8:1 {_FRONT} f8:2 f8:2 f8:2 f8:2 b1:1"),
 }  # fmt: skip
 """Return and argument types of each step kernel, as the driver
 (:mod:`~sailroute.routing.isochrone_fast`) calls it: ``f8``, ``f4``, ``i8`` a float64,

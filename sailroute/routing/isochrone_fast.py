@@ -328,6 +328,7 @@ def prepare(
     s: RoutingSettings,
     tau_hint: float,
     groups: Groups | None = None,
+    dt: Any = None,
 ) -> tuple[_StepInputs, Any, Any] | None:
     """:func:`~sailroute.routing.isochrone_inputs._prepare`, compiled; None in a current
     (the NumPy function prepares those steps)."""
@@ -335,7 +336,8 @@ def prepare(
         return None
     x, y = f.x, f.y
     n = int(x.shape[0])
-    dt = _step_length(s, tau_hint)
+    dt = _step_length(s, tau_hint) if dt is None else dt
+    dts = _per_point(dt)
     geo = _geometry(ctx, dev)
     hr = np.radians(f.heading)
     way, pt, px, py = (np.empty((5, n)) for _ in range(4))
@@ -348,7 +350,7 @@ def prepare(
         f.bsp,
         f.tau_est,
         np.asarray(f.t, dtype=float).reshape(-1),
-        dt,
+        dts,
         float(s.max_leg_time_s),
         geo.aim,
         geo.frame,
@@ -468,7 +470,7 @@ def prepare(
         dev.vmax_ms,
         dev.speed_ms,
         np.array([ctx.tack_s, ctx.gybe_s, geo.inv_step, geo.inv_rad_step]),
-        dt,
+        dts,
         geo.target,
         geo.rays,
         geo.ray_clear,
@@ -513,6 +515,13 @@ def prepare(
     if groups is None:
         return pre, float(least[0, 0]), float(least[1, 0])
     return pre, least[0], least[1]
+
+
+def _per_point(dt: float | Any) -> Any:
+    """The step length ``dt`` [s] as the kernels take it: one value, or one per point."""
+    if isinstance(dt, float):
+        return np.array([dt])
+    return np.ascontiguousarray(dt, dtype=np.float64)
 
 
 def _speeds(polar: Polar | PointPolars, tws: Any, twa: Any, out: Any) -> None:
@@ -705,7 +714,7 @@ def candidates(pre: _StepInputs, dev: _DeviceTables, ctx: _Context) -> tuple[Any
             chunk,
             pre.first,
             pre.stop,
-            pre.dt,
+            _per_point(pre.dt),
             t_step,
             front,
             current,
@@ -755,7 +764,7 @@ def survivors(
         column,
         pre.first,
         pre.n_grid,
-        pre.dt,
+        _per_point(pre.dt),
         p.front(pre),
         np.stack([dev.twa_deg, dev.cos_a, dev.sin_a]),
         dev.speed_ms,
@@ -763,7 +772,7 @@ def survivors(
         out,
         moved,
     )
-    t_new = pre.t + pre.dt if isinstance(pre.t, float) else pre.t[row] + pre.dt
+    t_new = pre.t + pre.dt if isinstance(pre.t, float) else pre.t[row] + pre.dt_of(row)
     layer = _Layer(
         t=t_new,
         x=out[0],

@@ -83,7 +83,7 @@ def _direction(dx: Any, dy: Any, xp: ModuleType) -> tuple[Any, Any, Any]:
 
 def _sample_step(
     f: _Layer,
-    dt: float,
+    dt: float | Any,
     aim_x: Any,
     aim_y: Any,
     dist: Any,
@@ -384,11 +384,14 @@ def _prepare(
     tau_hint: float,
     xp: ModuleType,
     groups: Groups | None = None,
+    dt: float | Any = None,
 ) -> tuple[_StepInputs, Any, Any]:
     """Step length, wind, VMG angles, direct bearing and time to go of the front points.
 
     * The step is ``dt_s``, shortened to ``max(min_dt_s, tau / 3)`` once the estimated
-      time to go ``tau`` (from the previous step, ``tau_hint``) is below three steps.
+      time to go ``tau`` (from the previous step, ``tau_hint``) is below three steps;
+      ``dt`` [s], where given, is the step instead (members routed together: one per
+      point, each member's own).
     * Each move uses one wind sample, taken at mid-step time at the point's predicted
       mid-step position (half a step along its previous move): second order in time and,
       for a boat holding its course, in space.
@@ -402,7 +405,7 @@ def _prepare(
     distance to the aim points [m] (with ``groups``: per member, arrays of shape (M,)).
     """
     x, y = f.x, f.y
-    dt = _step_length(s, tau_hint)
+    dt = _step_length(s, tau_hint) if dt is None else dt
     aim_x, aim_y = aim_points(x, y, ctx.geom, xp=xp)  # direct bearing to the aim point
     ex, ey, dist = _direction(aim_x - x, aim_y - y, xp)
     u, v, cur = _sample_step(f, dt, aim_x, aim_y, dist, wind, ctx, s, xp)

@@ -125,7 +125,7 @@ def sample_points(
     bsp: Any,
     tau_est: Any,
     t: Any,
-    dt: float,
+    dt: Any,
     max_leg_s: float,
     aim: Any,
     frame: Any,
@@ -139,16 +139,17 @@ def sample_points(
 
     ``aim = (ax, ay, ux, uy, m, length)`` of the target segment
     (:func:`~sailroute.routing.geometry.segment_frame`); ``frame = (cx, cy, fx, fy)``;
-    ``cover = (t0, t1, xmin, xmax, ymin, ymax)``; ``t`` the front's time, one value or one
-    per point.  Writes ``out`` (5, n): aim point x, y, unit direction x, y, distance;
+    ``cover = (t0, t1, xmin, xmax, ymin, ymax)``; ``t`` the front's time and ``dt`` the
+    step length [s], each one value or one per point.  Writes ``out`` (5, n): aim point x,
+    y, unit direction x, y, distance;
     ``pt, px, py`` (5, n): the clipped sample times and world positions (row 0 mid-step,
     rows 1-4 along the way).
     """
     ax, ay, ux, uy, m, length = aim[0], aim[1], aim[2], aim[3], aim[4], aim[5]
     cx, cy, fx, fy = frame[0], frame[1], frame[2], frame[3]
-    half_dt = 0.5 * dt
     n = x.shape[0]
     for i in range(n):
+        dt_i = dt[i] if dt.shape[0] > 1 else dt[0]
         xi, yi = x[i], y[i]
         r = _clip((xi - ax) * ux + (yi - ay) * uy, m, length - m)
         aim_x = ax + r * ux
@@ -162,8 +163,8 @@ def sample_points(
         out[2, i] = dx * inv_d if there else 0.0
         out[3, i] = dy * inv_d if there else 1.0
         out[4, i] = dist
-        t_mid = (t[i] if t.shape[0] > 1 else t[0]) + 0.5 * dt
-        half = 0.0 if debt[i] > 0 else half_dt * bsp[i]
+        t_mid = (t[i] if t.shape[0] > 1 else t[0]) + 0.5 * dt_i
+        half = 0.0 if debt[i] > 0 else (0.5 * dt_i) * bsp[i]
         # no time to go yet: at isochrone_inputs._ROOT_SPEED_MS = 2 m/s
         horizon = dist * 0.5 if tau_est[i] != tau_est[i] else _mn(tau_est[i], max_leg_s)
         for k in range(5):
@@ -438,7 +439,7 @@ def step_inputs(
     vmax: Any,
     speed_ms: Any,
     consts: Any,
-    dt: float,
+    dt: Any,
     target: Any,
     rays: Any,
     ray_clear: Any,
@@ -464,7 +465,8 @@ def step_inputs(
     their clearances ``ray_clear`` (``first_clear`` per point for ray 0 when it has
     any points); ``box = (xmin, xmax, ymin, ymax)`` or empty.  Writes ``exact`` (4, n,
     4: |TWA|, speed, cosine and sine of the columns VMG up, VMG down and direct per
-    side), ``ttg`` (3, 2, n: time to go and its gradient per side), ``reach`` (n,),
+    side), ``ttg`` (3, 2, n: time to go and its gradient per side), ``reach`` (n,: in the
+    step ``dt`` [s], one value or one per point),
     ``near`` (n,) and ``near_rays`` (k, n); ``least`` (2, n_groups): each member's
     least time to go and least distance to its aim points.  Returns whether every
     move stays in the box.
@@ -552,7 +554,7 @@ def step_inputs(
         top_ex = bsp[i, 0]
         for k in range(1, 4):
             top_ex = _mx(top_ex, bsp[i, k])
-        reach_i = _mx(top, top_ex) * dt * 1.0001
+        reach_i = _mx(top, top_ex) * (dt[i] if dt.shape[0] > 1 else dt[0]) * 1.0001
         reach[i] = reach_i
         near[i] = _segment_distance(x[i], y[i], target) <= reach_i + 1e-6
         for b in range(rays.shape[0]):
@@ -931,7 +933,7 @@ def candidates(
     chunk: int,
     first: int,
     stop: int,
-    dt: float,
+    dt: Any,
     t_step: float,
     front: Any,
     current: Any,
@@ -961,7 +963,8 @@ def candidates(
     infinite where forbidden) and its end point seen from the pruning's origin in
     float32 (``qx32, qy32``); per row and block one row of ``segments``: its first
     candidate, their number, the first one's id (``isochrone_kernel._KEEP``) and the
-    side index plus the member's first key.  ``front``: the step's arrays (:data:`FRONT`;
+    side index plus the member's first key.  ``dt``: the step length [s], one value or
+    one per row.  ``front``: the step's arrays (:data:`FRONT`;
     ``exact`` (4, n, 4) and ``ttg`` (3, 2, n: time to go, gradient x, y; block ``_KEEP``,
     ``_SWITCH``) as :func:`step_inputs` writes them); ``tables = (twa, cos, sin)`` (3,
     n_a) of the grid; ``current`` (2, n)
@@ -995,6 +998,7 @@ def candidates(
         for block in range(2):
             j0 = 0 if (block == 0 or any_free) else n_grid
             for r in range(c0, c1):
+                dt_r = dt[r] if dt.shape[0] > 1 else dt[0]
                 side = man[0, r]
                 sigma = side if block == 0 else -side
                 pending = any_pending and flags[1, r]
@@ -1009,16 +1013,16 @@ def candidates(
                         speed_ms[node, first + j0 : stop], speed_ms[node + 1, first + j0 : stop],
                         twa[j0:], cos_a[j0:], sin_a[j0:], ttg[0, block, r], ttg[1, block, r],
                         ttg[2, block, r], man[2, r], man[3, r], debt[r], charged[r], free_owes,
-                        dt, sc[: n_grid - j0], qx[: n_grid - j0], qy[: n_grid - j0],
+                        dt_r, sc[: n_grid - j0], qx[: n_grid - j0], qy[: n_grid - j0],
                     )  # fmt: skip
                 _exact_moves(
-                    mode, r, block, sigma, free_owes, dt, x, y, move, man, debt, charged, ttg,
+                    mode, r, block, sigma, free_owes, dt_r, x, y, move, man, debt, charged, ttg,
                     exact, sc, qx, qy,
                 )  # fmt: skip
                 if current.shape[0] > 0:  # drift with the water for the whole step
                     for j in range(m):
-                        qx[j] = qx[j] + dt * current[0, r]
-                        qy[j] = qy[j] + dt * current[1, r]
+                        qx[j] = qx[j] + dt_r * current[0, r]
+                        qy[j] = qy[j] + dt_r * current[1, r]
                 _forbid(
                     r, block, first, j0, n_grid, pending, x, y, man, direct_sin, fans, bars,
                     near_bars, bar_clear, first_clear, box, frame, sc, qx, qy,
@@ -1028,7 +1032,7 @@ def candidates(
                         return -1
                 if near.shape[0] > 0 and near[r]:
                     _arrival_row(
-                        r, block, j0, n_grid, first, mode, free_owes, dt, x, y, move, move_row,
+                        r, block, j0, n_grid, first, mode, free_owes, dt_r, x, y, move, move_row,
                         man, debt, charged, exact, tables, speed_ms, current, cross, sc, qx, qy,
                         in_chunk,
                     )  # fmt: skip
@@ -1081,7 +1085,7 @@ def survivors(
     column: Any,
     first: int,
     n_grid: int,
-    dt: float,
+    dt: Any,
     front: Any,
     tables: Any,
     speed_ms: Any,
@@ -1093,10 +1097,12 @@ def survivors(
     (``isochrone_kernel._winner_columns`` and ``_survivors``) of the step's arrays
     ``front`` (:data:`FRONT`): writes ``out`` (11, m: x, y, side, debt, |TWA|, |TWA| before
     a pending manoeuvre or NaN, its penalty so far, boat speed, delay, velocity x and y)
-    and ``moved`` (m,)."""
+    and ``moved`` (m,); ``dt``: the step length [s], one value or one per row of the
+    front."""
     x, y, move, move_row, man, flags, debt, charged, exact, _, _ = front
     for i in range(row.shape[0]):
         r, c = row[i], column[i]
+        dt_r = dt[r] if dt.shape[0] > 1 else dt[0]
         switch = block[i] == 1
         if c < n_grid:
             cc = c + first
@@ -1122,14 +1128,14 @@ def survivors(
             owed = _owed(_SWITCHED, pen, 0.0, 0.0, not free)
         else:
             owed = _owed(_PENDING, pen, debt[r], charged[r], True) if pending else 0.0
-        delay = _mn(owed, dt)
-        mv = dt - delay
+        delay = _mn(owed, dt_r)
+        mv = dt_r - delay
         in_manoeuvre = (not free if switch else pending) and not (mv > 0)
         px = x[r] + mv * vx
         py = y[r] + mv * vy
         if current.shape[0] > 0:
-            px = px + dt * current[0, r]
-            py = py + dt * current[1, r]
+            px = px + dt_r * current[0, r]
+            py = py + dt_r * current[1, r]
         out[0, i] = px
         out[1, i] = py
         out[2, i] = sigma

@@ -264,7 +264,7 @@ def _survivors(
 ) -> tuple[_Layer, Any]:
     """The new front from the winning ``(row, block, column)`` triples (shape (m,)) and
     their scores (estimated time to go [s]); also which of them moved (bool, (m,))."""
-    dt = pre.dt
+    dt = pre.dt_of(row)
     twa, bsp, sx, sy = _winner_columns(pre, row, block, column, dev, xp)
     m = pre.manoeuvre
     side = m.side[row]
@@ -384,8 +384,9 @@ def _switch_timing(c: _StepInputs, switch: _Block, any_free: bool, xp: ModuleTyp
     owed = _penalty(switch.twa_deg, m.penalty_up_s[:, None], m.penalty_down_s[:, None], xp)
     if any_free:
         owed[m.free] = 0.0
-    delay = xp.minimum(owed, c.dt)
-    return _Timing(delay, c.dt - delay, owed - delay)
+    dt = c.dt_rows
+    delay = xp.minimum(owed, dt)
+    return _Timing(delay, dt - delay, owed - delay)
 
 
 def _keep_timing(c: _StepInputs, keep: _Block, sub: Any, xp: ModuleType) -> _Timing:
@@ -402,15 +403,17 @@ def _keep_timing(c: _StepInputs, keep: _Block, sub: Any, xp: ModuleType) -> _Tim
         pos = xp.flatnonzero(m.pending[sub])
         price = _penalty(keep.twa_deg[pr], m.penalty_up_s[pr, None], m.penalty_down_s[pr, None], xp)
         owed[pos] = xp.maximum(m.debt_s[pr, None] + price - m.charged_s[pr, None], 0.0)
-    delay = xp.minimum(owed, c.dt)
-    return _Timing(delay, c.dt - delay, owed - delay)
+    dt = c.dt if isinstance(c.dt, float) else c.dt[sub, None]
+    delay = xp.minimum(owed, dt)
+    return _Timing(delay, dt - delay, owed - delay)
 
 
 def _drifted(c: _StepInputs, qx: Any, qy: Any) -> tuple[Any, Any]:
     """End points moved by the current over the whole step, stopped or not."""
     if c.current_x is None:
         return qx, qy
-    return qx + c.dt * c.current_x[:, None], qy + c.dt * c.current_y[:, None]
+    dt = c.dt_rows
+    return qx + dt * c.current_x[:, None], qy + dt * c.current_y[:, None]
 
 
 def _keep_ends(
@@ -418,8 +421,8 @@ def _keep_ends(
 ) -> tuple[Any, Any]:
     """End points [m] of the moves of block ``_KEEP``: a whole step, except for the
     pending rows (``pending``, with their ``pending_timing``), which may still owe time."""
-    qx = c.x[:, None] + c.dt * keep.vx
-    qy = c.y[:, None] + c.dt * keep.vy
+    qx = c.x[:, None] + c.dt_rows * keep.vx
+    qy = c.y[:, None] + c.dt_rows * keep.vy
     if pending_timing is not None:
         qx[pending] = c.x[pending, None] + pending_timing.move * keep.vx[pending]
         qy[pending] = c.y[pending, None] + pending_timing.move * keep.vy[pending]
@@ -569,7 +572,7 @@ def _arrival(
 def _keep_scores(c: _StepInputs, keep: _Block, pending: Any, pending_timing: _Timing | None) -> Any:
     """Estimated time to go after the moves of block ``_KEEP`` [s], ``τ - dt G·v`` (the
     pending rows: ``τ + debt - move G·v``)."""
-    score = c.keep.tau_s[:, None] - c.dt * keep.rate
+    score = c.keep.tau_s[:, None] - c.dt_rows * keep.rate
     if pending_timing is not None:
         score[pending] = (
             c.keep.tau_s[pending, None]

@@ -336,8 +336,9 @@ class _StepInputs(NamedTuple):
     ----------
     t : float or array
         Start of the step [epoch s] (per point for members routed together).
-    dt : float
-        Step length [s].
+    dt : float or array
+        Step length [s]: one value, or one per point (members routed together, each
+        member's own, :mod:`sailroute.routing.batch`).
     first, stop : int
         The grid columns ``first:stop`` of the polar tables that are tried (the fan).
     x, y : array
@@ -382,7 +383,7 @@ class _StepInputs(NamedTuple):
     """
 
     t: Any
-    dt: float
+    dt: float | Any
     first: int
     stop: int
     x: Any
@@ -421,6 +422,16 @@ class _StepInputs(NamedTuple):
         """Candidates per point and block: the grid columns and three exact ones."""
         return self.stop - self.first + 3
 
+    @property
+    def dt_rows(self) -> float | Any:
+        """The step length as a column, one row per point (shape (n, 1)), to go with
+        arrays of one row per point and one column per candidate; a float as it is."""
+        return self.dt if isinstance(self.dt, float) else self.dt[:, None]
+
+    def dt_of(self, rows: Any) -> float | Any:
+        """The step length of the points ``rows`` (an index array); a float as it is."""
+        return self.dt if isinstance(self.dt, float) else self.dt[rows]
+
     def rows(self, r0: int, r1: int, xp: ModuleType) -> _StepInputs:
         """The points ``r0:r1`` only (views)."""
         if r0 == 0 and r1 == self.n:
@@ -429,7 +440,7 @@ class _StepInputs(NamedTuple):
         still = self.current_x is None
         return _StepInputs(
             t=self.t,
-            dt=self.dt,
+            dt=self.dt if isinstance(self.dt, float) else self.dt[sl],
             first=self.first,
             stop=self.stop,
             x=self.x[sl],
