@@ -299,14 +299,15 @@ class _MemberWinds:
     (:func:`~sailroute.routing.isochrone_inputs._sample_step`), clipped to the
     coverage the members share; each member's columns go to its own wind: with one
     ``sample`` call of their base for the members whose winds are versions of one wind
-    (:func:`~sailroute.wind.perturbed.sample_perturbed`), else member by member; in a
-    current, less the current (one call), as :class:`~sailroute.wind.current.
-    RelativeWind` gives it.
+    (:func:`~sailroute.wind.perturbed.sample_perturbed`; on the compiled path its
+    arithmetic in one compiled pass, ``jit``), else member by member; in a current, less
+    the current (one call), as :class:`~sailroute.wind.current.RelativeWind` gives it.
     """
 
-    def __init__(self, front: _Front, current: CurrentField | None) -> None:
+    def __init__(self, front: _Front, current: CurrentField | None, jit: bool) -> None:
         self._front = front
         self._current = current
+        self._compiled = fast.kernels().perturbed_winds if jit else None
         self.coverage = front.members[0].wind.coverage
         self.clamp = front.members[0].wind.clamp
         bases: dict[int, list[int]] = {}  # members by the wind their winds perturb
@@ -324,12 +325,14 @@ class _MemberWinds:
         for ks in self._bases:
             winds = [f.members[k].true_wind for k in ks]
             if len(ks) == len(f.members):  # one base: no gathering
-                u, v = sample_perturbed(winds, position, t, x, y)
+                u, v = sample_perturbed(winds, position, t, x, y, compiled=self._compiled)
                 continue
             local = np.full(len(f.members), -1, dtype=np.int64)
             local[ks] = np.arange(len(ks))
             idx = np.flatnonzero(local[position] >= 0)
-            u[idx], v[idx] = sample_perturbed(winds, local[position[idx]], t[idx], x[idx], y[idx])
+            u[idx], v[idx] = sample_perturbed(
+                winds, local[position[idx]], t[idx], x[idx], y[idx], compiled=self._compiled
+            )
         if self._current is None:
             return u, v
         cu, cv = self._current.sample(t, x, y)
@@ -353,7 +356,7 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
         front = history[-1]
         ctx = front.members[0].ctx
         jit = fast.compiled(s, np, members=len(front.members))
-        winds = _MemberWinds(front, leg.current)
+        winds = _MemberWinds(front, leg.current, jit)
         polar = _front_polar(front, leg)
         dt = _step_lengths(front, s)
         prepared = (

@@ -60,6 +60,8 @@ SIGNATURES: Final[dict[str, tuple[str, str]]] = {
                    "f8:1 f8:1 f8:1 f8:1 b1:1 f8:1 f8:1 f4:1 f4:1 i8:2 f8:1"),
     "sector_winners": ("none", "i8 i8:2 f8:1 f4:1 f4 f4 f8:1 i8:1"),
     "survivors": ("none", f"i8:1 i8:1 i8:1 i8 i8 f8:1 {_FRONT} f8:2 f8:2 f8:2 f8:2 b1:1"),
+    "perturbed_winds": ("none", "f8:1 f8:1 f8:1 i8:1 f8:1 f8:1 b1:1 f8:1 f8:1 b1:1 f8:1 f8:1 "
+                        "f8:1 f8:1"),
 }  # fmt: skip
 """Return and argument types of each step kernel, as the driver
 (:mod:`~sailroute.routing.isochrone_fast`) calls it: ``f8``, ``f4``, ``i8`` a float64,

@@ -1148,3 +1148,48 @@ def survivors(
         out[9, i] = vx
         out[10, i] = vy
         moved[i] = mv > 0 and bsp > 0
+
+
+# --------------------------------------------------------------------------------------
+# the members' winds
+
+
+@_jit
+def perturbed_winds(
+    u: Any,
+    v: Any,
+    speed: Any,
+    which: Any,
+    scale: Any,
+    add: Any,
+    turns: Any,
+    cos: Any,
+    sin: Any,
+    series: Any,
+    cos_p: Any,
+    sin_p: Any,
+    out_u: Any,
+    out_v: Any,
+) -> None:
+    """The arithmetic of :func:`~sailroute.wind.perturbed.sample_perturbed` point by
+    point, the same operations in the same order: the base wind ``u, v`` (n,) of the
+    point's member ``which`` (n,), its speed ``speed = hypot(u, v)`` (NumPy's; empty
+    where no member adds speed), per member the speed ``scale`` and ``add`` [m s⁻¹],
+    whether it ``turns`` and the cosine and sine of its constant turn; members with a
+    shift series (``series``) take the point's own ``cos_p, sin_p`` (n,).  Writes the
+    members' winds into ``out_u, out_v``."""
+    for i in range(u.shape[0]):
+        w = which[i]
+        ui, vi = u[i], v[i]
+        f = scale[w]
+        if add[w] != 0.0:
+            s = speed[i]
+            new = f * s + add[w]
+            if not (new >= 0.0 or new != new):  # np.maximum(new, 0.0)
+                new = 0.0
+            f = new / s if s > 0.0 else 0.0
+        if turns[w]:
+            c, sn = (cos_p[i], sin_p[i]) if series[w] else (cos[w], sin[w])
+            ui, vi = ui * c + vi * sn, vi * c - ui * sn
+        out_u[i] = f * ui
+        out_v[i] = f * vi

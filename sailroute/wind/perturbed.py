@@ -10,7 +10,7 @@ angles veer the wind (clockwise, the direction it comes from increases).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
@@ -189,6 +189,8 @@ def sample_perturbed(
     t: NDArray[np.float64],
     x: NDArray[np.float64],
     y: NDArray[np.float64],
+    *,
+    compiled: Callable[..., None] | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Wind ``(u, v)`` [m s⁻¹] at the points ``(t[i], x[i], y[i])`` (1-D) of the winds
     ``winds[which[i]]``, which all perturb one base field (or are it), with one
@@ -196,13 +198,17 @@ def sample_perturbed(
     gives there, bit for bit (the same operations, point by point).
 
     Used by the ensemble router (:mod:`sailroute.routing.batch`), whose members' winds
-    are versions of one scenario's wind.
+    are versions of one scenario's wind.  ``compiled``: a compiled function that does
+    the arithmetic after the base's sample in one pass, with the same numbers
+    (:func:`sailroute.routing.isochrone_jit.perturbed_winds` and its arguments).
     """
     base = winds[0].base if isinstance(winds[0], PerturbedWind) else winds[0]
     p = _member_params(winds)
     u, v = base.sample(t, x, y)
     u = np.array(np.broadcast_to(u, t.shape), dtype=float)
     v = np.array(np.broadcast_to(v, t.shape), dtype=float)
+    if compiled is not None:
+        return _compiled(compiled, p, which, t, u, v)
     scale, add = p.scale[which], p.add[which]
     factor = scale
     if p.add.any():  # each point's own factor: the same numbers, computed for all points
@@ -221,3 +227,43 @@ def sample_perturbed(
             idx = np.flatnonzero(turns)
             u[idx], v[idx] = rotate_by(u[idx], v[idx], cos[idx], sin[idx])
     return factor * u, factor * v
+
+
+def _compiled(
+    compiled: Callable[..., None],
+    p: _MemberParams,
+    which: NDArray[np.int64],
+    t: NDArray[np.float64],
+    u: NDArray[np.float64],
+    v: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`sample_perturbed`'s arithmetic by ``compiled``: the speeds and the shift
+    series' turns (trigonometry) by NumPy, as there, the rest point by point."""
+    speed = np.hypot(u, v) if p.add.any() else np.zeros(0)
+    series = np.zeros(len(p.winds), dtype=np.bool_)
+    cos_p = sin_p = np.zeros(0)
+    if p.series:
+        series[list(p.series)] = True
+        cos_p, sin_p = np.empty_like(u), np.empty_like(u)
+        for k in p.series:
+            mine = np.flatnonzero(which == k)
+            b = np.radians(p.winds[k].turn_deg(t[mine]))
+            cos_p[mine], sin_p[mine] = np.cos(b), np.sin(b)
+    out_u, out_v = np.empty_like(u), np.empty_like(v)
+    compiled(
+        u,
+        v,
+        speed,
+        np.ascontiguousarray(which, dtype=np.int64),
+        p.scale,
+        p.add,
+        p.turns,
+        p.cos,
+        p.sin,
+        series,
+        cos_p,
+        sin_p,
+        out_u,
+        out_v,
+    )
+    return out_u, out_v

@@ -252,3 +252,36 @@ def test_numba_starts_with_the_collector_paused_and_leaves_it_as_it_was(monkeypa
         finally:
             gc.enable()
     assert seen == [False, False]
+
+
+@pytest.mark.usefixtures("compiled_kernels")
+@pytest.mark.parametrize(
+    "wind",
+    [UniformWind(0.0, 0.0), gridded_wind(clamp=True)],
+    ids=["calm", "gridded"],
+)
+def test_members_winds_in_one_compiled_pass_are_numpys_bit_for_bit(wind):
+    # sample_perturbed's arithmetic compiled: scaled, added to (down to a calm),
+    # turned by a constant offset and by a shift series; the base itself as a member
+    from sailroute.wind.perturbed import PerturbedWind, sample_perturbed
+
+    times = T0 + np.arange(0.0, 3600.0, 10.0)
+    winds = [
+        wind,
+        PerturbedWind(wind, speed_scale=1.1),
+        PerturbedWind(wind, speed_add_ms=-0.7, direction_offset_deg=-5.0),
+        PerturbedWind(wind, shift_times=times, shift_deg=6.0 * np.sin(times / 300.0)),
+        PerturbedWind(wind, speed_scale=0.9, speed_add_ms=-9.0),
+        PerturbedWind(wind, speed_add_ms=0.3, direction_offset_deg=12.5),
+    ]
+    rng = np.random.default_rng(5)
+    which = rng.integers(0, len(winds), 2000)
+    t = T0 + rng.uniform(0.0, 3600.0, 2000)
+    x, y = rng.uniform(-900.0, 900.0, (2, 2000))
+    kernel = isochrone_fast.kernels().perturbed_winds
+    for members in (winds, winds[:3], winds[1:2]):  # with and without a series, one member
+        w = which % len(members)
+        got = sample_perturbed(members, w, t, x, y, compiled=kernel)
+        want = sample_perturbed(members, w, t, x, y)
+        np.testing.assert_array_equal(got[0], want[0])
+        np.testing.assert_array_equal(got[1], want[1])
