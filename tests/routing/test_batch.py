@@ -52,6 +52,30 @@ def test_a_batch_gives_each_member_its_own_route_bit_for_bit(target):
         same_result(route_isochrone(LINE, target, t0, w, POLAR, SET), got)
 
 
+def test_members_shorten_their_steps_together_and_finish_alone_within_reach(monkeypatch):
+    # near the target each member's steps shorten (dt_s down to min_dt_s) inside the
+    # common front; it leaves only once a point can reach the target within its step,
+    # so it sails at most two steps alone (the shortening alone takes about eight)
+    from sailroute.routing import batch as batch_module
+
+    alone = []
+    route_on = batch_module._route_on
+
+    def counted(layers, *args, **kwargs):
+        before = len(layers)
+        arrival = route_on(layers, *args, **kwargs)
+        alone.append(len(layers) - before + 1)  # the steps appended and the arrival's
+        return arrival
+
+    monkeypatch.setattr(batch_module, "_route_on", counted)
+    winds = [UniformWind(4.4, 0.0), UniformWind(3.0, 20.0), UniformWind(6.0, 80.0)]
+    mark = Target("mark", (40.0, 700.0), rounding="port", name="1")
+    batch = route_leg_batch(LINE, mark, [T0, T0 + 50.0, T0], winds, POLAR, SET)
+    assert len(alone) == len(winds) and max(alone) <= 2
+    for t0, w, got in zip((T0, T0 + 50.0, T0), winds, batch, strict=True):
+        same_result(route_isochrone(LINE, mark, t0, w, POLAR, SET), got)
+
+
 def test_members_in_a_stronger_wind_finish_in_the_closed_form_order():
     # a reach north to a wide line, the wind from the east (no manoeuvre): the leg time
     # is L / max_a S(tws, a) sin(a), the best speed towards the line (0.01° scan), so the
