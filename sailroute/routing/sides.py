@@ -54,25 +54,51 @@ class _Extremes:
         self.active[k] = False
 
 
+class _Groups:
+    """The paths grouped once: by the wind their winds perturb (each group's different
+    winds, ``members``, and each path's index among them, ``which``) and by boat."""
+
+    def __init__(self, winds: Sequence[WindField], boats: Sequence[BoatModel]) -> None:
+        bases: dict[int, dict[int, int]] = {}  # base -> its winds' indices, in order of use
+        self.members: list[list[WindField]] = []
+        group, which = [], []
+        for w in winds:
+            base = id(w.base if isinstance(w, PerturbedWind) else w)
+            if base not in bases:
+                bases[base] = {}
+                self.members.append([])
+            own = bases[base]
+            if id(w) not in own:
+                own[id(w)] = len(own)
+                self.members[list(bases).index(base)].append(w)
+            group.append(list(bases).index(base))
+            which.append(own[id(w)])
+        self.wind_group = np.array(group, dtype=np.int64)
+        self.which = np.array(which, dtype=np.int64)
+        index: dict[int, int] = {}
+        self.boats: list[BoatModel] = []
+        for b in boats:
+            if id(b) not in index:
+                index[id(b)] = len(self.boats)
+                self.boats.append(b)
+        self.boat = np.array([index[id(b)] for b in boats], dtype=np.int64)
+
+
 def _sample(
-    winds: Sequence[WindField], act: NDArray, state: _Extremes
+    winds: Sequence[WindField], act: NDArray, state: _Extremes, groups: _Groups
 ) -> tuple[NDArray, NDArray, NDArray]:
     """The wind ``(u, v)`` at the active paths ``act`` (one call per wind the others
     perturb, :func:`~sailroute.wind.perturbed.sample_perturbed`), and which of them
     could be sampled (a path that leaves the wind data gives no time)."""
     u, v = np.full(act.shape[0], np.nan), np.full(act.shape[0], np.nan)
     ok = np.ones(act.shape[0], dtype=bool)
-    groups: dict[int, list[int]] = {}
-    for i, k in enumerate(act):
-        w = winds[k]
-        groups.setdefault(id(w.base if isinstance(w, PerturbedWind) else w), []).append(i)
     t, x, y = state.t[act], state.x[act], state.y[act]
-    for rows in groups.values():
-        idx = np.asarray(rows, dtype=np.int64)
-        own = [winds[k] for k in act[idx]]
-        order = {id(w): j for j, w in enumerate(dict.fromkeys(own))}
-        members = list(dict.fromkeys(own))
-        which = np.array([order[id(w)] for w in own], dtype=np.int64)
+    group = groups.wind_group[act]
+    for j, members in enumerate(groups.members):
+        idx = np.flatnonzero(group == j)
+        if idx.shape[0] == 0:
+            continue
+        which = groups.which[act[idx]]
         try:
             u[idx], v[idx] = sample_perturbed(members, which, t[idx], x[idx], y[idx])
         except SailrouteError:  # one by one: only the paths out of the data stop
@@ -118,15 +144,14 @@ class _VmgAngles:
         return angles[:, 0], angles[:, 1]
 
 
-def _speeds(boats: Sequence[BoatModel], act: NDArray, tws: NDArray, twa: NDArray) -> NDArray:
+def _speeds(groups: _Groups, act: NDArray, tws: NDArray, twa: NDArray) -> NDArray:
     """Steady speeds of the active paths' boats, one call per boat."""
     out = np.empty(act.shape[0])
-    groups: dict[int, list[int]] = {}
-    for i, k in enumerate(act.tolist()):
-        groups.setdefault(id(boats[k]), []).append(i)
-    for rows in groups.values():
-        idx = np.asarray(rows, dtype=np.int64)
-        out[idx] = boats[act[idx[0]]].steady_speed(tws[idx], twa[idx])
+    boat = groups.boat[act]
+    for j, b in enumerate(groups.boats):
+        idx = np.flatnonzero(boat == j)
+        if idx.shape[0]:
+            out[idx] = b.steady_speed(tws[idx], twa[idx])
     return out
 
 
@@ -160,15 +185,16 @@ def extreme_times(
     )
     limit = np.broadcast_to(np.asarray(max_time_s, dtype=float), st.t.shape)
     vmg = _VmgAngles()
+    groups = _Groups(winds, boats)
     while st.active.any():
         st.finish(np.flatnonzero(st.active & (st.t - st.t0 >= limit)), math.inf)
         act = np.flatnonzero(st.active)
         if act.shape[0] == 0:
             break
-        u, v, ok = _sample(winds, act, st)
+        u, v, ok = _sample(winds, act, st, groups)
         st.finish(act[~ok], math.inf)
         act, u, v = act[ok], u[ok], v[ok]
-        _extreme_step(st, act, u, v, vmg, boats, tack_penalty_s, gybe_penalty_s, dt_s)
+        _extreme_step(st, act, u, v, vmg, boats, groups, tack_penalty_s, gybe_penalty_s, dt_s)
     return st.time
 
 
@@ -179,6 +205,7 @@ def _extreme_step(
     v: NDArray,
     vmg: _VmgAngles,
     boats: Sequence[BoatModel],
+    groups: _Groups,
     tack_penalty_s: float,
     gybe_penalty_s: float,
     dt_s: float,
@@ -208,7 +235,7 @@ def _extreme_step(
     turned = (st.tack[act] != 0) & (side != st.tack[act])
     t = st.t[act] + np.where(turned, np.where(upwind, tack_penalty_s, gybe_penalty_s), 0.0)
     st.tack[act] = side
-    speed = _speeds(boats, act, tws, np.abs(twa))
+    speed = _speeds(groups, act, tws, np.abs(twa))
     step = speed * dt_s
     stop = ~(speed > 0)
     arrive = ~stop & (heading == bearing) & (dist <= step) & ~there
