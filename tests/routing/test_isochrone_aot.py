@@ -17,9 +17,11 @@ import numpy as np
 import pytest
 
 from sailroute.routing import isochrone_aot, isochrone_fast
+from sailroute.routing.batch import route_leg_batch
 from sailroute.routing.isochrone import route_isochrone
 from sailroute.routing.settings import RoutingSettings
 from sailroute.routing.types import Start, Target
+from sailroute.wind.perturbed import PerturbedWind
 from sailroute.wind.uniform import UniformWind
 from tests.routing.polars import laser_like_polar
 from tests.routing.winds import T0
@@ -38,12 +40,16 @@ def with_engine(settings: RoutingSettings, engine: str) -> RoutingSettings:
 
 
 def test_the_signatures_are_the_ones_numbas_dispatchers_compile_for_the_driver(monkeypatch):
-    # a leg through the just-in-time kernels: the types numba's dispatchers see from
-    # the driver are the types the module is compiled for (read-only or not aside)
+    # a leg and members in perturbed winds through the just-in-time kernels: the types
+    # numba's dispatchers see from the drivers are the types the module is compiled for
+    # (read-only or not aside)
     jit = isochrone_fast._just_in_time()
     monkeypatch.setattr(isochrone_fast._Usage, "kernels", jit)
     settings = with_engine(RoutingSettings(), "numba")
-    route_isochrone(LINE, MARK, T0, UniformWind(4.4, 0.0), laser_like_polar(), settings)
+    wind = UniformWind(4.4, 0.0)
+    route_isochrone(LINE, MARK, T0, wind, laser_like_polar(), settings)
+    members = [PerturbedWind(wind, speed_add_ms=0.3), PerturbedWind(wind, direction_offset_deg=4.0)]
+    route_leg_batch(LINE, MARK, [T0, T0], members, laser_like_polar(), settings)
     for name in isochrone_fast.STEP_KERNELS:
         want = isochrone_aot.signature(name)
         seen = [
