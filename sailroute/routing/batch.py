@@ -63,14 +63,16 @@ from sailroute.routing.geometry import (
     target_geometry,
 )
 from sailroute.routing.isochrone import (
-    _backtrack,
+    _arrival_move,
     _check_start_time,
     _check_target_covered,
     _context,
+    _moves_back,
     _root_layer,
     _route_on,
     _routing_polar,
     _timeout_error,
+    _track,
     check_leg_work,
 )
 from sailroute.routing.isochrone_inputs import _prepare, _step_length
@@ -495,7 +497,7 @@ def _finish_alone(
     out of the common front (``history[-1]``)."""
     for m in leaving:
         _report(list(history[0].members), results, leg)
-        layers = _own_layers(m, history)
+        layers = [_own_front(m, history[-1])]
         arrival = _route_on(
             layers,
             m.wind,
@@ -507,8 +509,9 @@ def _finish_alone(
             polar=leg.polars[m.polar],
             calm_since=m.calm_since,
             tau_hint=m.tau_hint,
+            check_work=len(history) == 1,  # else checked after the first common step
         )
-        results[m.index] = _result(m, layers, arrival, leg)
+        results[m.index] = _result(m, history, layers, arrival, leg)
     history[-1] = _keep(history[-1], tuple(m for m in history[-1].members if m not in leaving))
 
 
@@ -540,38 +543,38 @@ def _keep(front: _Front, stay: tuple[_Member, ...], renumber: Any = None) -> _Fr
     )
 
 
-def _own_layers(m: _Member, history: list[_Front]) -> list[_Layer]:
-    """The fronts of member ``m`` alone, as the single-member router keeps them (its
-    points, parents counted within its own previous front, a float time)."""
-    out: list[_Layer] = []
-    prev_lo = 0
-    for front in history:
-        lo, hi = front.block(m)
-        lay = front.layer
-        parent = lay.parent[lo:hi] - prev_lo if out else lay.parent[lo:hi]
-        out.append(
-            _Layer(
-                t=float(lay.t[lo]),
-                x=lay.x[lo:hi],
-                y=lay.y[lo:hi],
-                side=lay.side[lo:hi],
-                debt=lay.debt[lo:hi],
-                abs_twa=lay.abs_twa[lo:hi],
-                pend_old=lay.pend_old[lo:hi],
-                pend_pen=lay.pend_pen[lo:hi],
-                parent=parent,
-                heading=lay.heading[lo:hi],
-                bsp=lay.bsp[lo:hi],
-                delay=lay.delay[lo:hi],
-                tau_est=lay.tau_est[lo:hi],
-            )
-        )
-        prev_lo = lo
-    return out
+def _own_front(m: _Member, front: _Front) -> _Layer:
+    """The points of member ``m`` in ``front``, with a float time, as the single-member
+    router keeps its fronts (``parent`` still indexes the common front before)."""
+    lo, hi = front.block(m)
+    own = {f.name: getattr(front.layer, f.name)[lo:hi] for f in dataclasses.fields(_Layer)}
+    return _Layer(**{**own, "t": float(front.layer.t[lo])})
 
 
-def _result(m: _Member, layers: list[_Layer], arrival: _Arrival, leg: _Leg) -> LegResult:
-    """The member's :class:`LegResult`, as the single-member router assembles it."""
+def _result(
+    m: _Member, history: list[_Front], layers: list[_Layer], arrival: _Arrival, leg: _Leg
+) -> LegResult:
+    """The member's :class:`LegResult`, as the single-member router assembles it:
+    the moves of ``layers`` (its own fronts from its last one in the common ``history``
+    to ``arrival``), then those of the common fronts, which are followed by their
+    rows (``history[k].layer.parent`` indexes the rows of ``history[k - 1]``)."""
+    moves = [_arrival_move(arrival, layers[-1])]
+    idx = _moves_back(layers, [lay.t for lay in layers], arrival.parent, moves)
+    starts = [front.block(m)[0] for front in history]
+    common = [front.layer for front in history]
+    times = [float(lay.t[lo]) for lay, lo in zip(common, starts, strict=True)]
+    row = _moves_back(common, times, starts[-1] + idx, moves)
+    moves.reverse()
     polar = leg.polars[m.polar]
-    track = _backtrack(layers, arrival, leg.frame, m.wind, polar, m.world_start, leg.current)
+    track = _track(
+        moves,
+        row - starts[0],
+        int(common[0].side[row]),
+        arrival,
+        leg.frame,
+        m.wind,
+        polar,
+        m.world_start,
+        leg.current,
+    )
     return make_leg_result(track, "isochrone", leg.barrier)

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from types import ModuleType
 from typing import Any, Final
 
@@ -248,13 +248,16 @@ def _route_on(
     progress: Callable[[float], None] | None = None,
     calm_since: float | None = None,
     tau_hint: float = np.inf,
+    check_work: bool = True,
 ) -> _Arrival:
     """Step the front ``layers[-1]`` until it arrives; the new fronts are appended to
     ``layers``.
 
     ``calm_since`` (time since which no point moved, or None) and ``tau_hint`` (the
     front's estimated time to go [s]) carry on a route begun elsewhere (the members of
-    :func:`~sailroute.routing.batch.route_leg_batch` finish their legs here).
+    :func:`~sailroute.routing.batch.route_leg_batch` finish their legs here);
+    ``check_work`` False: the leg's work was checked there (:func:`check_leg_work`,
+    else called after the first step where ``layers`` holds one front).
 
     Raises
     ------
@@ -278,7 +281,7 @@ def _route_on(
         elif calm_since is None:
             calm_since = layers[-1].t
         tau_hint = tau_min - (layer.t - layers[-1].t)
-        if len(layers) == 1:  # after the first step: the time to go is known
+        if check_work and len(layers) == 1:  # after the first step: the time to go is known
             check_leg_work(ctx.label, settings, ctx, n_angles, tau_hint)
         layers.append(layer)
         elapsed = layer.t - t0
@@ -454,6 +457,11 @@ from the start."""
 # backtracking
 
 
+_Move = tuple[float, float, float, float, float, float, float, int]
+"""One move of a route: start and end time [epoch s], source point x, y (leg frame) [m],
+heading (leg frame) [°], boat speed [m s⁻¹], time stopped at its start [s], side."""
+
+
 def _backtrack(
     layers: list[_Layer],
     arr: _Arrival,
@@ -463,24 +471,38 @@ def _backtrack(
     world_start: tuple[NDArray, NDArray],
     current: CurrentField | None = None,
 ) -> RouteTrack:
-    """Polyline of the chosen route: step starts, penalty stops, exact arrival (world frame).
+    """Polyline of the chosen route through ``layers`` (the fronts from the start to
+    the one ``arr`` left from): :func:`_moves_back` and :func:`_track`."""
+    moves = [_arrival_move(arr, layers[-1])]
+    root = _moves_back(layers, [lay.t for lay in layers], arr.parent, moves)
+    moves.reverse()
+    return _track(
+        moves, root, int(layers[0].side[root]), arr, frame, wind, polar, world_start, current
+    )
 
-    The vertices at the start point get its world coordinates ``world_start[k][root]``
-    exactly (not through the leg frame and back), so a leg starts bit-for-bit where
-    the previous one ended.  In a ``current`` the headings and speeds are through the
-    water and the track gets SOG/COG (velocity through the water plus the current).
-    """
-    # moves, newest first: (t_start, t_end, index in its source layer, heading, bsp, delay, side)
-    moves = [(arr.t_start, arr.t, arr.parent, arr.heading, arr.bsp, arr.delay, arr.side)]
-    idx = arr.parent
+
+def _arrival_move(arr: _Arrival, last: _Layer) -> _Move:
+    """The move of ``arr`` from the point ``arr.parent`` of the front ``last``."""
+    x, y = float(last.x[arr.parent]), float(last.y[arr.parent])
+    return (arr.t_start, arr.t, x, y, arr.heading, arr.bsp, arr.delay, arr.side)
+
+
+def _moves_back(
+    layers: Sequence[_Layer], times: Sequence[float], idx: int, moves: list[_Move]
+) -> int:
+    """Append to ``moves`` the moves into point ``idx`` of ``layers[-1]``, newest first,
+    back to ``layers[0]`` (``layers[k].parent`` indexes ``layers[k - 1]``; ``times[k]``:
+    the time of ``layers[k]`` [epoch s]), and return the index in ``layers[0]`` they
+    start from."""
     for k in range(len(layers) - 1, 0, -1):
-        lay = layers[k]
+        lay, src = layers[k], layers[k - 1]
         pidx = int(lay.parent[idx])
         moves.append(
             (
-                layers[k - 1].t,
-                lay.t,
-                pidx,
+                times[k - 1],
+                times[k],
+                float(src.x[pidx]),
+                float(src.y[pidx]),
                 float(lay.heading[idx]),
                 float(lay.bsp[idx]),
                 float(lay.delay[idx]),
@@ -488,19 +510,37 @@ def _backtrack(
             )
         )
         idx = pidx
-    moves.reverse()
-    root_side = int(layers[0].side[idx])
+    return idx
 
+
+def _track(
+    moves: Sequence[_Move],
+    root: int,
+    root_side: int,
+    arr: _Arrival,
+    frame: _LegFrame,
+    wind: WindField,
+    polar: Polar,
+    world_start: tuple[NDArray, NDArray],
+    current: CurrentField | None = None,
+) -> RouteTrack:
+    """Polyline of the route sailing ``moves`` (oldest first, the last one ``arr``'s)
+    from start point ``root`` (on side ``root_side``): step starts, penalty stops,
+    exact arrival (world frame).
+
+    The vertices at the start point get its world coordinates ``world_start[k][root]``
+    exactly (not through the leg frame and back), so a leg starts bit-for-bit where
+    the previous one ended.  In a ``current`` the headings and speeds are through the
+    water and the track gets SOG/COG (velocity through the water plus the current).
+    """
     # a stopped boat (penalty) shows the heading it will sail next
-    hd_next = [m[3] for m in moves]
+    hd_next = [m[4] for m in moves]
     for i in range(len(moves) - 2, -1, -1):
-        if moves[i][5] >= moves[i][1] - moves[i][0]:  # stopped for the whole step
+        if moves[i][6] >= moves[i][1] - moves[i][0]:  # stopped for the whole step
             hd_next[i] = hd_next[i + 1]
 
     rows: list[tuple[float, float, float, float, float, int]] = []
-    for m, (ts, te, pidx, _, b, dl, sd) in enumerate(moves):
-        src = layers[m]
-        px, py = float(src.x[pidx]), float(src.y[pidx])
+    for m, (ts, te, px, py, _, b, dl, sd) in enumerate(moves):
         hd = hd_next[m]
         if m == 0 and root_side != 0 and sd != root_side:
             # forced start side, turned at once: show the old side with the mirrored heading
@@ -508,13 +548,13 @@ def _backtrack(
         rows.append((ts, px, py, hd, 0.0 if dl > 0 else b, sd))
         if dl > 0 and ts + dl < te:
             rows.append((ts + dl, px, py, hd, b, sd))
-    rows.append((arr.t, arr.x, arr.y, moves[-1][3], moves[-1][4], moves[-1][6]))
+    rows.append((arr.t, arr.x, arr.y, moves[-1][4], moves[-1][5], moves[-1][7]))
 
     a = np.array(rows)
     wx, wy = frame.to_world(a[:, 1], a[:, 2])
-    at_start = (a[:, 1] == float(layers[0].x[idx])) & (a[:, 2] == float(layers[0].y[idx]))
-    wx[at_start] = float(world_start[0][idx])
-    wy[at_start] = float(world_start[1][idx])
+    at_start = (a[:, 1] == moves[0][2]) & (a[:, 2] == moves[0][3])
+    wx[at_start] = float(world_start[0][root])
+    wy[at_start] = float(world_start[1][root])
     heading = np.mod(a[:, 3] + frame.offset_deg, 360.0)
     if np.isnan(heading[0]):
         u, v = wind.sample(a[0, 0], wx[0], wy[0])
