@@ -15,11 +15,12 @@ one wind (:func:`~sailroute.wind.perturbed.sample_perturbed`: the members of a l
 band), and the polars looked up in one call per step.
 
 Each member steps its own length in the common front: ``dt_s``, shortened near the
-target from its own time to go as the single-member router shortens it.  A member
-leaves the common front when one of its points can reach the target within its step;
-it finishes its leg alone, from its own front, with the isochrone driver.  Every step a
-member takes is therefore the step the single-member router takes, with the same
-numbers:
+target from its own time to go as the single-member router shortens it.  Where one of a
+member's points can reach the target within its step, its own points are tested for the
+crossing as the single-member router tests them; a member that arrives leaves the front
+with its route.  A member left without a survivor finishes its leg alone, from its own
+front, with the isochrone driver (and its error).  Every step a member takes is
+therefore the step the single-member router takes, with the same numbers:
 
 * when every member starts from the same :class:`~sailroute.routing.types.Start` (the
   first leg of a course; an ensemble of winds or of start times), each gets the
@@ -372,27 +373,48 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
             )
         pre, tau_min, dist_min = prepared
         near = np.logical_or.reduceat(pre.near_target, front.groups.starts)
-        if near.any():  # tested for the arrival alone, below; the others step on
+        arrivals: dict[int, _Arrival] = {}
+        if near.any():  # the arrival member by member; the common step has none
+            for k in np.flatnonzero(near).tolist():
+                arrival = _arrival(pre, front, front.members[k], leg, jit)
+                if arrival is not None:
+                    arrivals[k] = arrival
             pre = pre._replace(near_target=np.zeros_like(pre.near_target))
         out = _common_step(pre, front, ctx, leg, jit)
         if isinstance(out, list):  # members without a survivor: their own error
             _finish_alone(out, history, leg, results)
             continue
-        if near.any():  # they finish alone from the front before this step
-            _finish_alone(
-                [m for m, k in zip(front.members, near, strict=True) if k], history, leg, results
-            )
-            stay = history[-1].members
+        if arrivals:  # they leave: their routes end in this step
+            for k, arrival in arrivals.items():
+                m = front.members[k]
+                results[m.index] = _result(m, history, [_own_front(m, front)], arrival, leg)
+            left = np.zeros(len(front.members), dtype=bool)
+            left[list(arrivals)] = True
+            stay = tuple(m for m, gone in zip(front.members, left, strict=True) if not gone)
+            history[-1] = _keep(front, stay)
             if not stay:
                 continue
             renumber = np.full(front.layer.x.shape[0], -1, dtype=np.int64)
             renumber[_rows(front, stay)] = np.arange(history[-1].layer.x.shape[0])
             out = _keep(out, stay, renumber)
             front = history[-1]
-            tau_min, dist_min = tau_min[~near], dist_min[~near]
+            tau_min, dist_min = tau_min[~left], dist_min[~left]
         history.append(out)
         _after_step(front, out, tau_min, dist_min, leg)
         _report(members, results, leg)
+
+
+def _arrival(pre: Any, front: _Front, m: _Member, leg: _Leg, jit: bool) -> _Arrival | None:
+    """Whether member ``m``, one of whose points can reach the target within its step,
+    arrives in this step: its candidates tested for the crossing as the single-member
+    router tests them (its points ``pre`` prepared with the others, its own time and
+    step length), the arrival or None."""
+    lo, hi = front.block(m)
+    own = pre.rows(lo, hi, np)
+    dt = own.dt if isinstance(own.dt, float) else float(own.dt[0])
+    own = own._replace(t=float(front.layer.t[lo]), dt=dt)
+    arrival, _, _ = _candidates(own, leg.dev, m.ctx, np, jit)
+    return arrival
 
 
 def _step_lengths(front: _Front, s: RoutingSettings) -> float | Any:
