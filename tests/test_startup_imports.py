@@ -76,3 +76,21 @@ def test_the_command_shortens_openblas_idle_spin_unless_told(given: str | None, 
         env["OPENBLAS_THREAD_TIMEOUT"] = given
     res = python_c(code, env)
     assert res.stdout.split()[-2:] == [used, "False"], res.stdout + res.stderr
+
+
+def test_bands_without_plots_import_no_page_writer_or_learned_polar(tmp_path) -> None:
+    # the page writer (and shapely behind its charts) only where plots are written; the
+    # learned polar's modules only where the course's boat is a learned polar
+    code = (
+        "import sys\n"
+        "from sailroute.cli import main\n"
+        "sys.argv = ['sailroute', 'plan', 'courses/hyeres-r1.yaml', '--ensemble', '3',"
+        f" '--no-plots', '-q', '-o', {str(tmp_path)!r}]\n"
+        "try:\n    main()\nexcept SystemExit as e:\n    assert not e.code, e.code\n"
+        "names = ('sailroute.report.page_render', 'shapely', 'sailroute.boat.learn',"
+        " 'sailroute.boat.learnfile')\n"
+        "print([m for m in names if m in sys.modules])\n"
+    )
+    res = python_c(code)
+    assert res.stdout.splitlines()[-1] == "[]", res.stdout + res.stderr
+    assert (tmp_path / "bands.json").is_file()

@@ -35,16 +35,18 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from statistics import NormalDist
-from typing import Any, Final
+from typing import TYPE_CHECKING, Any, Final
 
 import numpy as np
 from numpy.typing import NDArray
 
-from sailroute.boat.learn import PolarDraw
 from sailroute.course.uncertainty import ShiftSpec, UncertaintySpec
 from sailroute.errors import InputError
 from sailroute.wind.base import WindField
 from sailroute.wind.perturbed import PerturbedWind
+
+if TYPE_CHECKING:  # the learned polar's module only where a band draws it
+    from sailroute.boat.learn import PolarDraw
 
 _NORMAL: Final = NormalDist()
 """The standard normal distribution: a stratum's quantile ``u`` as ``z`` (its inverse CDF,
@@ -223,6 +225,8 @@ def _level_table(file: Path, level: str) -> Any:
 
 def _polar_draw(spec: UncertaintySpec, z: float, rng: np.random.Generator) -> PolarDraw:
     """A main member's draw of the learned polar, its first mode at ``z``."""
+    from sailroute.boat.learn import PolarDraw
+
     assert spec.polar is not None
     return PolarDraw.random(_level_table(spec.polar.file, spec.polar.level), rng, first=z)
 
@@ -317,6 +321,8 @@ def one_at_a_time(
             rng = np.random.default_rng([spec.seed, i])
             m = Member(f"{source}@{q:g}")
             if source == "polar":  # every cell at its own quantile q
+                from sailroute.boat.learn import PolarDraw
+
                 draw = PolarDraw(quantile_z=_NORMAL.inv_cdf(float(q)))
                 members.append(dataclasses.replace(m, polar=draw))
                 continue

@@ -95,11 +95,12 @@ def polar_spread(course: Course) -> PolarSpread | None:
     """The course's boat as a band source, when it is a polar learned by ``sailroute polar
     fit`` (None otherwise)."""
     from sailroute.boat.build import learned_boat
-    from sailroute.boat.learnfile import read_learned
 
     found = learned_boat(course.boat_spec, course.base_dir)
     if found is None:
         return None
+    from sailroute.boat.learnfile import read_learned
+
     lp = read_learned(found[0])
     t = lp.level(found[1])
     learned = t.sd_log[lp.status == "learned"]

@@ -67,7 +67,6 @@ def run_bands_command(
         ``bands_png``; ``data``: the tuple of :class:`BandSummary`.
     """
     from sailroute.report.bands import bands_page, bands_table, write_bands
-    from sailroute.report.page_render import PLOTLY_FILE, write_report
 
     router, backend, progress = options.router, options.backend, options.progress
     scheduler = options.scheduler
@@ -118,6 +117,8 @@ def run_bands_command(
     def write(d: Path) -> dict[str, Path]:
         files = write_bands(d, summaries, course_name=course.name, plot=plots)
         if plots:
+            from sailroute.report.page_render import PLOTLY_FILE, write_report
+
             files["html"] = write_report(
                 d / "report.html",
                 bands_page(course, summaries, winds, router=settings.router, boat=boat),
