@@ -1066,16 +1066,30 @@ def sector_winners(
     """Keep the best candidate per key of the first ``n_seg`` segments of
     :func:`candidates` (``isochrone_kernel._sector_winners``): key = ``floor(phi scale +
     off)`` (float32, as NumPy) times 2 plus the segment's side index; the first in
-    order wins a tie."""
+    order wins a tie.  A segment's keys come in runs (its candidates in heading order):
+    a run's best is kept in registers and written once."""
     for g in range(n_seg):
         k0, m, wid0, sidx = segments[g, 0], segments[g, 1], segments[g, 2], segments[g, 3]
+        run = -1  # the key of the current run, its best score and candidate
+        run_best = np.inf
+        run_who = np.int64(0)
         for j in range(m):
             sc = score[k0 + j]
             if sc < np.inf:
                 key = np.int64(phi[k0 + j] * scale + off) * 2 + sidx
-                if sc < best[key]:
-                    best[key] = sc
-                    who[key] = wid0 + j
+                if key != run:
+                    if run >= 0:
+                        best[run] = run_best
+                        who[run] = run_who
+                    run = key
+                    run_best = best[key]
+                    run_who = who[key]
+                if sc < run_best:
+                    run_best = sc
+                    run_who = wid0 + j
+        if run >= 0:
+            best[run] = run_best
+            who[run] = run_who
 
 
 @_jit
