@@ -729,10 +729,13 @@ def _forbid(
     if block == 1 and pending:
         sc[:] = np.inf
     if fans.shape[0] > 0:  # members: only the grid columns of each one's own fan
-        for j in range(n_grid - j0):
-            col = first + j0 + j
-            if col < fans[1, r] or col >= fans[2, r]:
-                sc[j] = np.inf
+        n_own = n_grid - j0
+        lo = min(max(fans[1, r] - first - j0, 0), n_own)
+        hi = min(max(fans[2, r] - first - j0, lo), n_own)
+        for j in range(lo):
+            sc[j] = np.inf
+        for j in range(hi, n_own):
+            sc[j] = np.inf
     for bi in range(bars.shape[0]):
         if near_bars[bi, r]:
             own = bi == 0 and first_clear.shape[0] > 0
@@ -1027,19 +1030,21 @@ def candidates(
                     r, block, first, j0, n_grid, pending, x, y, man, direct_sin, fans, bars,
                     near_bars, bar_clear, first_clear, box, frame, sc, qx, qy,
                 )  # fmt: skip
+                nan = False
+                ox, oy = qx32[k : k + m], qy32[k : k + m]
+                o0, o1 = origin[0], origin[1]
                 for j in range(m):
-                    if sc[j] != sc[j]:
-                        return -1
+                    nan |= sc[j] != sc[j]
+                    ox[j] = np.float32(qx[j] - o0)
+                    oy[j] = np.float32(qy[j] - o1)
+                if nan:
+                    return -1
                 if near.shape[0] > 0 and near[r]:
                     _arrival_row(
                         r, block, j0, n_grid, first, mode, free_owes, dt_r, x, y, move, move_row,
                         man, debt, charged, exact, tables, speed_ms, current, cross, sc, qx, qy,
                         in_chunk,
                     )  # fmt: skip
-                ox, oy = qx32[k : k + m], qy32[k : k + m]
-                for j in range(m):
-                    ox[j] = np.float32(qx[j] - origin[0])
-                    oy[j] = np.float32(qy[j] - origin[1])
                 sidx = (1 if side < 0 else 0) if block == 0 else (0 if side < 0 else 1)
                 segments[n_seg, 0] = k
                 segments[n_seg, 1] = m
