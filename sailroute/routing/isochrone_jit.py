@@ -67,6 +67,13 @@ def _mx(a: Any, b: Any) -> Any:
 
 
 @_jit
+def _each(a: Any, i: int) -> Any:
+    """Point ``i``'s value of ``a``, which holds one value for all points or one per
+    point (a front's time, a step's length)."""
+    return a[i] if a.shape[0] > 1 else a[0]
+
+
+@_jit
 def _clip(x: Any, lo: Any, hi: Any) -> Any:
     """``sailroute.numerics.clip``: ``minimum(maximum(x, lo), hi)``."""
     return _mn(_mx(x, lo), hi)
@@ -149,7 +156,7 @@ def sample_points(
     cx, cy, fx, fy = frame[0], frame[1], frame[2], frame[3]
     n = x.shape[0]
     for i in range(n):
-        dt_i = dt[i] if dt.shape[0] > 1 else dt[0]
+        dt_i = _each(dt, i)
         xi, yi = x[i], y[i]
         r = _clip((xi - ax) * ux + (yi - ay) * uy, m, length - m)
         aim_x = ax + r * ux
@@ -163,7 +170,7 @@ def sample_points(
         out[2, i] = dx * inv_d if there else 0.0
         out[3, i] = dy * inv_d if there else 1.0
         out[4, i] = dist
-        t_mid = (t[i] if t.shape[0] > 1 else t[0]) + 0.5 * dt_i
+        t_mid = _each(t, i) + 0.5 * dt_i
         half = 0.0 if debt[i] > 0 else (0.5 * dt_i) * bsp[i]
         # no time to go yet: at isochrone_inputs._ROOT_SPEED_MS = 2 m/s
         horizon = dist * 0.5 if tau_est[i] != tau_est[i] else _mn(tau_est[i], max_leg_s)
@@ -554,7 +561,7 @@ def step_inputs(
         top_ex = bsp[i, 0]
         for k in range(1, 4):
             top_ex = _mx(top_ex, bsp[i, k])
-        reach_i = _mx(top, top_ex) * (dt[i] if dt.shape[0] > 1 else dt[0]) * 1.0001
+        reach_i = _mx(top, top_ex) * _each(dt, i) * 1.0001
         reach[i] = reach_i
         near[i] = _segment_distance(x[i], y[i], target) <= reach_i + 1e-6
         for b in range(rays.shape[0]):
@@ -1001,7 +1008,7 @@ def candidates(
         for block in range(2):
             j0 = 0 if (block == 0 or any_free) else n_grid
             for r in range(c0, c1):
-                dt_r = dt[r] if dt.shape[0] > 1 else dt[0]
+                dt_r = _each(dt, r)
                 side = man[0, r]
                 sigma = side if block == 0 else -side
                 pending = any_pending and flags[1, r]
@@ -1121,7 +1128,7 @@ def survivors(
     x, y, move, move_row, man, flags, debt, charged, exact, _, _ = front
     for i in range(row.shape[0]):
         r, c = row[i], column[i]
-        dt_r = dt[r] if dt.shape[0] > 1 else dt[0]
+        dt_r = _each(dt, r)
         switch = block[i] == 1
         if c < n_grid:
             cc = c + first
