@@ -217,16 +217,29 @@ def sample_perturbed(
     if turns.any():
         # a constant turn's cosine and sine once per member; a shift series' per point
         cos, sin = p.cos[which], p.sin[which]
-        for k in p.series:
-            mine = np.flatnonzero(which == k)
-            b = np.radians(p.winds[k].turn_deg(t[mine]))
-            cos[mine], sin[mine] = np.cos(b), np.sin(b)
+        _series_turns(p, which, t, cos, sin)
         if turns.all():
             u, v = rotate_by(u, v, cos, sin)
         else:
             idx = np.flatnonzero(turns)
             u[idx], v[idx] = rotate_by(u[idx], v[idx], cos[idx], sin[idx])
     return factor * u, factor * v
+
+
+def _series_turns(
+    p: _MemberParams,
+    which: NDArray[np.int64],
+    t: NDArray[np.float64],
+    cos: NDArray[np.float64],
+    sin: NDArray[np.float64],
+) -> None:
+    """Write the cosine and sine of each shift-series member's turn at its points' times
+    ``t`` [epoch s] into ``cos`` and ``sin`` (one per point; the others left as they
+    are)."""
+    for k in p.series:
+        mine = np.flatnonzero(which == k)
+        b = np.radians(p.winds[k].turn_deg(t[mine]))
+        cos[mine], sin[mine] = np.cos(b), np.sin(b)
 
 
 def _compiled(
@@ -245,10 +258,7 @@ def _compiled(
     if p.series:
         series[list(p.series)] = True
         cos_p, sin_p = np.empty_like(u), np.empty_like(u)
-        for k in p.series:
-            mine = np.flatnonzero(which == k)
-            b = np.radians(p.winds[k].turn_deg(t[mine]))
-            cos_p[mine], sin_p[mine] = np.cos(b), np.sin(b)
+        _series_turns(p, which, t, cos_p, sin_p)
     out_u, out_v = np.empty_like(u), np.empty_like(v)
     compiled(
         u,
