@@ -8,6 +8,8 @@ any NumPy-compatible array module (``xp``: NumPy or CuPy) where their callers ne
   step, the polar look-up).
 * :func:`sorted_distinct`: ``np.unique`` without ``numpy.ma`` (the start line's sample
   times, the polar tables' wind-speed nodes).
+* :func:`distinct_objects`: the distinct objects of a sequence by identity and each
+  item's index among them (the members of an ensemble grouped by polar, wind or boat).
 * :func:`golden_max`, :func:`golden_steps`: vectorised golden-section search (one
   maximiser per item, fixed number of steps) for the VMG optima of a polar, the
   VPP's sail controls and the deadline solver's steering refinement.
@@ -32,12 +34,14 @@ one home of the angle conventions.  Why these are ours and not SciPy's solvers:
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from types import ModuleType
-from typing import Any, Final
+from typing import Any, Final, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+T = TypeVar("T")
 
 INV_PHI: Final = (math.sqrt(5.0) - 1.0) / 2.0
 """``1/φ = (√5 − 1)/2 ≈ 0.618``: the bracket shrinks by this factor per golden-section step."""
@@ -65,6 +69,20 @@ def sorted_distinct(x: ArrayLike) -> NDArray:
     """
     a = np.sort(np.asarray(x).ravel())
     return a[np.concatenate([[True], a[1:] != a[:-1]])] if a.size else a
+
+
+def distinct_objects(items: Sequence[T]) -> tuple[list[T], NDArray[np.int64]]:
+    """The distinct objects of ``items`` by identity, in order of first use, and the
+    index of each item among them (an int64 array, one per item)."""
+    index: dict[int, int] = {}
+    distinct: list[T] = []
+    codes = np.empty(len(items), dtype=np.int64)
+    for k, item in enumerate(items):
+        j = index.setdefault(id(item), len(distinct))
+        if j == len(distinct):
+            distinct.append(item)
+        codes[k] = j
+    return distinct, codes
 
 
 # --------------------------------------------------------------------------------------

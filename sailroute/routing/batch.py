@@ -53,6 +53,7 @@ import numpy as np
 from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.errors import InputError
+from sailroute.numerics import distinct_objects
 from sailroute.routing import isochrone_fast as fast
 from sailroute.routing.geometry import (
     barrier_clearance,
@@ -178,13 +179,9 @@ def route_leg_batch(
             f"times, {len(winds)} winds, {len(starts)} starts and {len(boats)} boats"
         )
     check_settings(settings, label)
-    polars: dict[int, Polar] = {}  # the different polars, in order of first use
-    which = []
-    for b in boats:
-        p = _routing_polar(b, label)
-        polars.setdefault(id(p), p)
-        which.append(list(polars).index(id(p)))
-    tabs = [polar_tables(p, settings.isochrone.heading_step_deg) for p in polars.values()]
+    # the different polars, in order of first use, and each member's
+    polars, which = distinct_objects([_routing_polar(b, label) for b in boats])
+    tabs = [polar_tables(p, settings.isochrone.heading_step_deg) for p in polars]
     geom = target_geometry(target, starts[0], settings.zone_m)
     frame = _LegFrame.for_leg(geom.centre, start_centre(starts[0]))
     barriers = leg_barriers(starts[0], target)
@@ -207,7 +204,7 @@ def route_leg_batch(
                 starts[k],
                 felt,
                 wind,
-                which[k],
+                int(which[k]),
                 ctx,
                 start_points(starts[k], settings.start_line_spacing_m),
                 None if clearances is None else clearances[k],
@@ -216,7 +213,7 @@ def route_leg_batch(
     leg = _Leg(
         target,
         settings,
-        tuple(polars.values()),
+        tuple(polars),
         frame,
         _device_tables(tabs[0], np) if len(tabs) == 1 else stacked_tables(tabs),
         tuple(_device_tables(t, np) for t in tabs),

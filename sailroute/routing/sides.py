@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike, NDArray
 from sailroute.boat.model import BoatModel
 from sailroute.boat.polar import Polar
 from sailroute.errors import SailrouteError
+from sailroute.numerics import distinct_objects
 from sailroute.units import wind_speed_direction, wrap180
 from sailroute.wind.base import WindField
 from sailroute.wind.perturbed import PerturbedWind, sample_perturbed
@@ -59,29 +60,15 @@ class _Groups:
     winds, ``members``, and each path's index among them, ``which``) and by boat."""
 
     def __init__(self, winds: Sequence[WindField], boats: Sequence[BoatModel]) -> None:
-        bases: dict[int, dict[int, int]] = {}  # base -> its winds' indices, in order of use
+        bases = [w.base if isinstance(w, PerturbedWind) else w for w in winds]
+        distinct_bases, self.wind_group = distinct_objects(bases)
         self.members: list[list[WindField]] = []
-        group, which = [], []
-        for w in winds:
-            base = id(w.base if isinstance(w, PerturbedWind) else w)
-            if base not in bases:
-                bases[base] = {}
-                self.members.append([])
-            own = bases[base]
-            if id(w) not in own:
-                own[id(w)] = len(own)
-                self.members[list(bases).index(base)].append(w)
-            group.append(list(bases).index(base))
-            which.append(own[id(w)])
-        self.wind_group = np.array(group, dtype=np.int64)
-        self.which = np.array(which, dtype=np.int64)
-        index: dict[int, int] = {}
-        self.boats: list[BoatModel] = []
-        for b in boats:
-            if id(b) not in index:
-                index[id(b)] = len(self.boats)
-                self.boats.append(b)
-        self.boat = np.array([index[id(b)] for b in boats], dtype=np.int64)
+        self.which = np.empty(len(winds), dtype=np.int64)
+        for g in range(len(distinct_bases)):
+            paths = np.flatnonzero(self.wind_group == g)
+            members, self.which[paths] = distinct_objects([winds[k] for k in paths.tolist()])
+            self.members.append(members)
+        self.boats, self.boat = distinct_objects(boats)
 
 
 def _sample(

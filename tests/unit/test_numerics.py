@@ -13,6 +13,7 @@ from scipy.interpolate import PchipInterpolator
 
 from sailroute.numerics import (
     INV_PHI,
+    distinct_objects,
     golden_max,
     golden_steps,
     hermite,
@@ -173,3 +174,12 @@ def test_sorted_distinct_is_numpys_unique_without_nan() -> None:
     ):
         got, want = sorted_distinct(x), np.unique(x)
         assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
+def test_distinct_objects_are_kept_by_identity_in_order_of_first_use():
+    a, b = [1.0], [1.0]  # equal, not the same object
+    distinct, codes = distinct_objects([b, a, b, b, a])
+    assert distinct[0] is b and distinct[1] is a and len(distinct) == 2
+    assert codes.dtype == np.int64 and codes.tolist() == [0, 1, 0, 0, 1]
+    empty, none = distinct_objects([])
+    assert empty == [] and none.shape == (0,)
