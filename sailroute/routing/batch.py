@@ -391,9 +391,7 @@ def _route_front(members: list[_Member], leg: _Leg, results: dict[int, LegResult
             history[-1] = _keep(front, stay)
             if not stay:
                 continue
-            renumber = np.full(front.layer.x.shape[0], -1, dtype=np.int64)
-            renumber[_rows(front, stay)] = np.arange(history[-1].layer.x.shape[0])
-            out = _keep(out, stay, renumber)
+            out = _keep(out, stay, parents_in=front)
             front = history[-1]
             tau_min, dist_min = tau_min[~left], dist_min[~left]
         history.append(out)
@@ -541,16 +539,19 @@ def _rows(front: _Front, members: Sequence[_Member]) -> Any:
     return np.concatenate([np.arange(*front.block(m)) for m in members])
 
 
-def _keep(front: _Front, stay: tuple[_Member, ...], renumber: Any = None) -> _Front:
+def _keep(front: _Front, stay: tuple[_Member, ...], parents_in: _Front | None = None) -> _Front:
     """``front`` with the points of the members ``stay`` only (in their order there);
-    ``renumber``: the new number of each point of the front before (whose members
-    left too), for the parents."""
+    ``parents_in``: the front before, which keeps the same members too, its rows
+    renumbered in the parents."""
     rows = _rows(front, stay)
     sizes = [front.block(m)[1] - front.block(m)[0] for m in stay]
     layer = _Layer(
         **{f.name: getattr(front.layer, f.name)[rows] for f in dataclasses.fields(_Layer)}
     )
-    if renumber is not None:
+    if parents_in is not None:
+        kept = _rows(parents_in, stay)
+        renumber = np.full(parents_in.layer.x.shape[0], -1, dtype=np.int64)
+        renumber[kept] = np.arange(kept.shape[0])
         layer = dataclasses.replace(layer, parent=renumber[layer.parent])
     return _Front(
         layer,
